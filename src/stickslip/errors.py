@@ -1,0 +1,27 @@
+"""Typed exceptions of the public API.
+
+Every error a user can provoke with bad input is a :class:`StickslipError`;
+the command line turns it into a one-line message and exit status 2.
+"""
+
+from __future__ import annotations
+
+
+class StickslipError(Exception):
+    """Base class of every error raised on purpose by stickslip."""
+
+
+class ParameterError(StickslipError, ValueError):
+    """A parameter (or a parameter file) is unknown, malformed or out of range."""
+
+
+class UnitError(ParameterError):
+    """A value carries a unit of the wrong dimension, or an unknown unit."""
+
+
+class DataError(StickslipError, ValueError):
+    """A data file (CSV of measurements or traces) cannot be used."""
+
+
+class ModelError(StickslipError, ArithmeticError):
+    """The model has no finite answer for these inputs (e.g. a divergent integral)."""

@@ -1,0 +1,292 @@
+r"""Steady sliding: the bond population at constant velocity (Eqs 6-8).
+
+At steady sliding velocity V the age distribution of bonds obeys Eq 6,
+
+    dn/dt_a = -(u0/tau) exp( lambda/kT * M t_a V / (1 - (t_a V/dl_m)^2) - (t_a/tau_a) e^{-V/V_a} ) n,
+
+with the birth condition of Eq 7, n(0) = [N0 - N]/tau, and the stress of Eq 8.
+With the dimensionless age x = t_a V / dl_m in [0, 1) and
+
+    T = u0 dl_m / (V tau),   a = lambda M dl_m / kT,   alpha = dl_m/(V tau_a) e^{-V/V_a},
+
+the log-hazard is L(x) = ln T + a x/(1-x^2) - alpha x, the survival is
+S(x) = exp(-H(x)) with H(x) = int_0^x e^L, and (docs/steady-state.md)
+
+    N/N0  = i / (tau V/dl_m + i),           i = int_0^1 S dx,
+    sigma = M N0 dl_m j / (tau V/dl_m + i),  j = int_0^1 x S/(1-x^2) dx.
+
+L is convex in x, so the hazard e^L is largest at the ends of any interval;
+this lets the quadrature choose panels from explicit bounds (see
+:func:`_march`) and follow the survival wherever it falls off: at x ~ 1/T,
+at x ~ 1e-6 for very long chains, on a plateau left by aging, or at the FENE
+cliff close to x = 1.  dsigma/dV comes from differentiating under the
+integral (the same panels), not from finite differences.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from ..errors import ModelError, ParameterError
+from ..numerics.quadrature import panel_rule
+from ..parameters import BOLTZMANN, Parameters
+
+if TYPE_CHECKING:  # pragma: no cover
+    import pandas as pd
+    from matplotlib.axes import Axes
+
+#: Quadrature settings: nodes per panel, and the largest change of the
+#: log-hazard (LOG_HAZARD_STEP) and of the cumulative hazard (HAZARD_STEP)
+#: allowed across one panel; panels near x = 1 shrink geometrically (END_RATIO).
+ORDER = 14
+LOG_HAZARD_STEP = 5.0
+HAZARD_STEP = 5.0
+END_RATIO = 0.5
+WIDEST_PANEL = 0.5
+#: The survival is cut where the cumulative hazard exceeds this (exp(-40) ~ 4e-18).
+HAZARD_CUTOFF = 40.0
+#: A stretch whose hazard integral is below this is crossed in one panel.
+NEGLIGIBLE_HAZARD = 1e-13
+#: With no FENE term (a = 0) the march stops this close to x = 1.
+SMALLEST_GAP = 1e-30
+MAX_PANELS = 5000
+BISECTIONS = 8
+_LOG_CAP = 700.0  # exp(700) ~ 1e304: keeps e^L finite where S is long zero
+
+
+@dataclass(frozen=True)
+class SteadyState:
+    """Steady friction curve sigma(V) (Eqs 6-8); arrays have the shape of ``velocity``."""
+
+    velocity: np.ndarray
+    stress: np.ndarray
+    bonded_fraction: np.ndarray
+    stress_slope: np.ndarray
+    aging: bool
+    parameters: Parameters = field(repr=False)
+    ages: tuple[np.ndarray, ...] | None = field(default=None, repr=False)
+    densities: tuple[np.ndarray, ...] | None = field(default=None, repr=False)
+
+    def age_distribution(self, index: int = 0) -> tuple[np.ndarray, np.ndarray]:
+        """(t_a in s, n(t_a) in 1/(m^2 s)) at velocity number ``index`` (needs ``distribution=True``)."""
+        if self.ages is None or self.densities is None:
+            raise ValueError("age distribution not computed: call steady_state(..., distribution=True)")
+        return self.ages[index], self.densities[index]
+
+    def to_frame(self) -> pd.DataFrame:
+        """One row per velocity, SI units."""
+        import pandas as pd
+
+        return pd.DataFrame(
+            {
+                "velocity": np.ravel(self.velocity),
+                "stress": np.ravel(self.stress),
+                "bonded_fraction": np.ravel(self.bonded_fraction),
+                "stress_slope": np.ravel(self.stress_slope),
+            }
+        )
+
+    def plot(self, ax: Axes | None = None, **kwargs: Any) -> Axes:
+        """sigma against log V; returns the Axes (never shows the figure)."""
+        from ..plotting import plot_steady
+
+        return plot_steady(self, ax=ax, **kwargs)
+
+
+@dataclass(frozen=True)
+class _Scales:
+    """Dimensionless groups of Eq 6 at each velocity (see module docstring)."""
+
+    log_t: np.ndarray  # ln T
+    a: float
+    alpha: np.ndarray
+    beta: np.ndarray  # -d(alpha)/d(ln V) / ... : alpha (1 + V/V_a)
+    birth: np.ndarray  # tau V / dl_m = u0/T
+
+
+def _scales(params: Parameters, velocity: np.ndarray, aging: bool) -> _Scales:
+    b, g = params.bonds, params.aging
+    max_age = b.max_extension / velocity
+    log_t = np.log(b.breakage_weight) + np.log(max_age) - np.log(b.bond_time)
+    a = b.activation_length * b.chain_stiffness * b.max_extension / (BOLTZMANN * b.temperature)
+    if aging:
+        alpha = (max_age / g.aging_time) * np.exp(-velocity / g.aging_velocity)
+        beta = alpha * (1.0 + velocity / g.aging_velocity)
+    else:
+        alpha = np.zeros_like(velocity)
+        beta = np.zeros_like(velocity)
+    return _Scales(log_t=log_t, a=float(a), alpha=alpha, beta=beta, birth=b.bond_time * velocity / b.max_extension)
+
+
+def _log_hazard(x: np.ndarray, y: np.ndarray, log_t: np.ndarray, a: float, alpha: np.ndarray) -> np.ndarray:
+    # y = 1 - x is carried separately so that the FENE term keeps full precision near x = 1
+    return log_t + a * x / (y * (1.0 + x)) - alpha * x
+
+
+def _log_hazard_slope(x: np.ndarray, y: np.ndarray, a: float, alpha: np.ndarray) -> np.ndarray:
+    return a * (1.0 + x * x) / (y * (1.0 + x)) ** 2 - alpha
+
+
+def _hazard(x: np.ndarray, y: np.ndarray, log_t: np.ndarray, a: float, alpha: np.ndarray) -> np.ndarray:
+    return np.exp(np.minimum(_log_hazard(x, y, log_t, a, alpha), _LOG_CAP))
+
+
+def _panel_width(x: np.ndarray, y: np.ndarray, s: _Scales) -> np.ndarray:
+    """Width of the next panel at left end x (y = 1 - x), from explicit bounds.
+
+    A panel [x, x+w] is good when it is resolved (|L'| w <= LOG_HAZARD_STEP and
+    e^L w <= HAZARD_STEP) or negligible (e^L w <= NEGLIGIBLE_HAZARD).  L is
+    convex, so |L'| and e^L are largest at an end of the panel and testing both
+    ends decides; both tests only get harder as w grows, so the widest good w
+    is found by geometric bisection between a width known to be good and the
+    widest allowed panel (WIDEST_PANEL, and END_RATIO * y towards x = 1).
+    """
+    widest = np.minimum(WIDEST_PANEL, END_RATIO * y)
+    h_left = _hazard(x, y, s.log_t, s.a, s.alpha)
+    slope_left = np.abs(_log_hazard_slope(x, y, s.a, s.alpha))
+
+    def good(w: np.ndarray) -> np.ndarray:
+        h_right = _hazard(x + w, y - w, s.log_t, s.a, s.alpha)
+        slope_right = np.abs(_log_hazard_slope(x + w, y - w, s.a, s.alpha))
+        h_max = np.maximum(h_left, h_right) * w
+        resolved = (np.maximum(slope_left, slope_right) * w <= LOG_HAZARD_STEP) & (h_max <= HAZARD_STEP)
+        return resolved | (h_max <= NEGLIGIBLE_HAZARD)
+
+    ok = good(widest)
+    if np.all(ok):
+        return widest
+    # a width that is good for sure: capped by the left end, then once by the right end
+    low = np.minimum(widest, LOG_HAZARD_STEP / np.maximum(slope_left, 1e-300))
+    low = np.minimum(low, HAZARD_STEP / np.maximum(h_left, 1e-300))
+    slope_right = np.abs(_log_hazard_slope(x + low, y - low, s.a, s.alpha))
+    h_right = _hazard(x + low, y - low, s.log_t, s.a, s.alpha)
+    low = np.minimum(low, LOG_HAZARD_STEP / np.maximum(slope_right, 1e-300))
+    low = np.minimum(low, HAZARD_STEP / np.maximum(h_right, 1e-300))
+    low = np.where(ok, widest, low)
+    top = widest.copy()
+    for _ in range(BISECTIONS):
+        mid = np.sqrt(low * top)
+        better = good(mid) & ~ok
+        low = np.where(better, mid, low)
+        top = np.where(better | ok, top, mid)
+    return low
+
+
+@dataclass
+class _Integrals:
+    i: np.ndarray
+    j: np.ndarray
+    di: np.ndarray  # d i / d ln V
+    dj: np.ndarray  # d j / d ln V
+    nodes: list[list[np.ndarray]] | None  # per velocity: panels of (x, S)
+
+
+def _march(s: _Scales, keep_nodes: bool = False) -> _Integrals:
+    """Integrate i, j and their ln V derivatives panel by panel from x = 0.
+
+    All velocities advance together; each finishes when its cumulative hazard
+    passes HAZARD_CUTOFF (the survival is then below 4e-18) or x reaches 1.
+    """
+    rule = panel_rule(ORDER)
+    t_half = 0.5 * (rule.nodes + 1.0)  # node positions in [0, 1] of a panel
+    integrate = rule.cumulative.T  # (K, K+1): right-multiply row vectors of samples
+    weights = rule.weights
+    n = s.log_t.size
+    x_left, y_left = np.zeros(n), np.ones(n)
+    hazard, moment = np.zeros(n), np.zeros(n)  # H and G = int x e^L
+    out = _Integrals(np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n), [[] for _ in range(n)] if keep_nodes else None)
+    active = np.arange(n)
+    for _ in range(MAX_PANELS):
+        if active.size == 0:
+            return out
+        sub = _Scales(s.log_t[active], s.a, s.alpha[active], s.beta[active], s.birth[active])
+        xl, yl = x_left[active], y_left[active]
+        w = _panel_width(xl, yl, sub)
+        x = xl[:, None] + w[:, None] * t_half
+        y = yl[:, None] - w[:, None] * t_half
+        h = _hazard(x, y, sub.log_t[:, None], s.a, sub.alpha[:, None])
+        half = 0.5 * w
+        cum_h = (h @ integrate) * half[:, None]
+        cum_g = ((x * h) @ integrate) * half[:, None]
+        big_h = hazard[active][:, None] + cum_h[:, :-1]
+        big_g = moment[active][:, None] + cum_g[:, :-1]
+        survival = np.exp(-big_h)
+        stretch = x / (y * (1.0 + x))  # x/(1-x^2)
+        d_hazard = sub.beta[:, None] * big_g - big_h  # d H / d ln V
+        out.i[active] += half * (survival @ weights)
+        out.j[active] += half * ((survival * stretch) @ weights)
+        out.di[active] -= half * ((survival * d_hazard) @ weights)
+        out.dj[active] -= half * ((survival * stretch * d_hazard) @ weights)
+        if out.nodes is not None:
+            for row, k in enumerate(active):
+                out.nodes[k].append(np.stack([x[row], survival[row]]))
+        hazard[active] += cum_h[:, -1]
+        moment[active] += cum_g[:, -1]
+        x_left[active] = xl + w
+        y_left[active] = yl - w
+        done = (hazard[active] >= HAZARD_CUTOFF) | (y_left[active] <= SMALLEST_GAP)
+        active = active[~done]
+    raise ModelError("steady-state quadrature did not converge: more than %d panels needed" % MAX_PANELS)
+
+
+def _check_velocity(velocity: Any) -> np.ndarray:
+    try:
+        v = np.asarray(velocity, dtype=float)
+    except (TypeError, ValueError):
+        raise ParameterError(f"velocity: expected numbers in m/s, got {velocity!r}") from None
+    bad = ~np.isfinite(v) | (v <= 0)
+    if np.any(bad):
+        raise ParameterError(f"velocity: expected positive finite values in m/s, got {v[bad].ravel()[0]!r}")
+    return v
+
+
+def steady_state(
+    params: Parameters, velocity: Any, aging: bool = True, distribution: bool = False
+) -> SteadyState:
+    """The steady friction stress, bonded fraction and dsigma/dV at each sliding velocity (Eqs 6-8).
+
+    ``velocity`` is in m/s (scalar or array); ``aging=False`` drops the aging
+    term of Eq 6 (the paper's no-aging curve).  With ``distribution=True`` the
+    age distribution n(t_a) of Eqs 6-7 is kept at the quadrature nodes.
+
+    Raises :class:`ModelError` when the stress is infinite: with a zero
+    activation length bonds survive to full extension, where the FENE force
+    of Eq 3 diverges, and the integral of Eq 8 diverges logarithmically.
+    """
+    v = _check_velocity(velocity)
+    if params.bonds.activation_length == 0.0:
+        raise ModelError(
+            "bonds.activation_length = 0: bonds survive to full extension, where the FENE force (Eq 3) is"
+            " infinite, so the stress integral (Eq 8) diverges; use a positive activation length"
+        )
+    flat = np.ravel(v)
+    s = _scales(params, flat, aging)
+    got = _march(s, keep_nodes=distribution)
+    denom = s.birth + got.i
+    b = params.bonds
+    scale = b.chain_stiffness * b.site_density * b.max_extension
+    stress = scale * got.j / denom
+    fraction = got.i / denom
+    # d(sigma)/d(ln V), with d(birth)/d(ln V) = birth
+    dstress = scale * (got.dj * denom - got.j * (s.birth + got.di)) / denom**2
+    slope = dstress / flat
+    ages = densities = None
+    if got.nodes is not None:
+        max_age = b.max_extension / flat
+        newborn = b.site_density / (max_age * denom)  # n(0) = N0/(tau + I), Eq 7
+        ages = tuple(np.concatenate([p[0] for p in panels]) * max_age[k] for k, panels in enumerate(got.nodes))
+        densities = tuple(np.concatenate([p[1] for p in panels]) * newborn[k] for k, panels in enumerate(got.nodes))
+    shape = v.shape
+    return SteadyState(
+        velocity=v,
+        stress=stress.reshape(shape),
+        bonded_fraction=fraction.reshape(shape),
+        stress_slope=slope.reshape(shape),
+        aging=aging,
+        parameters=params,
+        ages=ages,
+        densities=densities,
+    )

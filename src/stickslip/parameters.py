@@ -1,0 +1,321 @@
+"""Model parameters: frozen, validated dataclasses, TOML files and built-in sets.
+
+Every value is stored in SI base units.  Files and overrides carry units as
+strings (``bond_time = "224 us"``); :mod:`stickslip.units` converts them.
+Unknown keys are errors, never ignored.
+
+The canonical keys, ``section.key``, and the symbols of Juvekar & Singh:
+
+========================  =======  ===============================================
+key                       symbol   meaning
+========================  =======  ===============================================
+bonds.site_density        N0       occupiable bonding sites per unit area (Eq 1, 7)
+bonds.bond_time           tau      thermal make-break time constant (Eq 1)
+bonds.breakage_weight     u0       exp(-W0/kT), breakage weight of a new bond
+bonds.chain_stiffness     M        chain stiffness (FENE, Eq 3)
+bonds.activation_length   lambda   activation length of the Eyring factor
+bonds.temperature         T        absolute temperature
+bonds.max_extension       dl_m     maximum chain extension (FENE, Eq 3)
+aging.aging_time          tau_a    aging time constant of Eq 1 / Eq 6
+aging.aging_velocity      V_a      characteristic aging velocity (Eq 1 / Eq 6)
+stick.attached_chains     Nc0      attached chains per area at the stick (Eq 15)
+stick.break_rate          uc/tau   chain breakage rate at the stick (Eq 15)
+stick.aging_time          tau_a    aging time constant of Eq 15
+block.shear_modulus       G_d      shear modulus of the block (Eq 5)
+block.height              h        height of the block (Eq 5)
+block.top_length          B        trapezoid length on the puller side (Eq 17)
+block.base_length         l        trapezoid length on the contact side (Eq 17)
+========================  =======  ===============================================
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import sys
+from collections.abc import Mapping
+from dataclasses import dataclass, field, fields
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+from .errors import ParameterError
+from .units import format_si, to_si
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover - exercised on Python 3.10 only
+    import tomli as tomllib
+
+BOLTZMANN = 1.380649e-23  # J/K, exact in the 2019 SI
+
+
+def _spec(dimension: str, symbol: str, doc: str, zero_allowed: bool = False) -> Any:
+    return field(metadata={"dimension": dimension, "symbol": symbol, "doc": doc, "zero_allowed": zero_allowed})
+
+
+class _Validated:
+    """Mixin: every field must be a finite float, positive (or >= 0 where allowed)."""
+
+    _section = ""
+
+    def __post_init__(self) -> None:
+        for f in fields(self):  # type: ignore[arg-type]
+            key = f"{self._section}.{f.name}"
+            raw = getattr(self, f.name)
+            if isinstance(raw, bool) or not isinstance(raw, (int, float)):
+                raise ParameterError(f"{key}: expected a number in SI units, got {raw!r}")
+            value = float(raw)
+            if math.isnan(value) or math.isinf(value):
+                raise ParameterError(f"{key}: expected a finite number, got {value}")
+            if f.metadata["zero_allowed"]:
+                if value < 0:
+                    raise ParameterError(f"{key}: expected a value >= 0, got {value:g}")
+            elif value <= 0:
+                raise ParameterError(f"{key}: expected a positive value, got {value:g}")
+            object.__setattr__(self, f.name, value)
+
+
+@dataclass(frozen=True)
+class BondParameters(_Validated):
+    """Bond population of the slip phase (Eqs 1-8)."""
+
+    _section = "bonds"
+    site_density: float = _spec("per_area", "N0", "occupiable bonding sites per unit area")
+    bond_time: float = _spec("time", "tau", "thermal make-break time constant")
+    breakage_weight: float = _spec("dimensionless", "u0", "breakage weight exp(-W0/kT) of a new bond")
+    chain_stiffness: float = _spec("stiffness", "M", "chain stiffness (FENE)")
+    activation_length: float = _spec("length", "lambda", "activation length (Eyring factor)", zero_allowed=True)
+    temperature: float = _spec("temperature", "T", "absolute temperature")
+    max_extension: float = _spec("length", "dl_m", "maximum chain extension (FENE)")
+
+    @property
+    def force_sensitivity(self) -> float:
+        """lambda/kT in 1/N: the Eyring exponent per unit chain force."""
+        return self.activation_length / (BOLTZMANN * self.temperature)
+
+    @property
+    def stretch_sensitivity(self) -> float:
+        """lambda*M/kT in 1/m (the paper's 'lambda M/kT')."""
+        return self.force_sensitivity * self.chain_stiffness
+
+
+@dataclass(frozen=True)
+class AgingParameters(_Validated):
+    """Velocity-dependent aging of bonds (the aging term of Eqs 1 and 6)."""
+
+    _section = "aging"
+    aging_time: float = _spec("time", "tau_a", "aging time constant")
+    aging_velocity: float = _spec("velocity", "V_a", "characteristic aging velocity")
+
+
+@dataclass(frozen=True)
+class StickParameters(_Validated):
+    """Attached-chain population of the stick phase (Eqs 13-15)."""
+
+    _section = "stick"
+    attached_chains: float = _spec("per_area", "Nc0", "attached chains per unit area when the block sticks")
+    break_rate: float = _spec("rate", "uc/tau", "chain breakage rate at the stick")
+    aging_time: float = _spec("time", "tau_a", "aging time constant of the stick phase")
+
+
+@dataclass(frozen=True)
+class BlockParameters(_Validated):
+    """The elastic block and its trapezoid geometry (Eqs 5, 11, 17)."""
+
+    _section = "block"
+    shear_modulus: float = _spec("stress", "G_d", "shear modulus of the block")
+    height: float = _spec("length", "h", "height of the block")
+    top_length: float = _spec("length", "B", "length on the puller side")
+    base_length: float = _spec("length", "l", "length on the contact side")
+
+    @property
+    def stiffness(self) -> float:
+        """G_d/h in Pa/m (Eq 5)."""
+        return self.shear_modulus / self.height
+
+    @property
+    def geometric_factor(self) -> float:
+        """ln(B/l)/(B/l - 1) of Eq 17; exactly 1 for a rectangular block."""
+        d = self.top_length / self.base_length - 1.0
+        if abs(d) < 1e-6:  # series of log1p(d)/d, error O(d^3)
+            return 1.0 - d / 2.0 + d * d / 3.0
+        return math.log1p(d) / d
+
+    @property
+    def effective_stiffness(self) -> float:
+        """K = (G_d/h) * geometric factor, Pa/m: d(sigma)/dt = K (V0 - V) (Eq 17)."""
+        return self.stiffness * self.geometric_factor
+
+
+SECTIONS: dict[str, type] = {
+    "bonds": BondParameters,
+    "aging": AgingParameters,
+    "stick": StickParameters,
+    "block": BlockParameters,
+}
+_META_KEYS = ("name", "description", "reference")
+
+
+def parameter_keys() -> list[str]:
+    """All canonical keys, ``section.key``."""
+    return [f"{s}.{f.name}" for s, cls in SECTIONS.items() for f in fields(cls)]
+
+
+def key_dimension(key: str) -> str:
+    """The dimension (see :data:`stickslip.units.DIMENSIONS`) of a canonical key."""
+    section, _, name = key.partition(".")
+    cls = SECTIONS.get(section)
+    if cls is None or name not in {f.name for f in fields(cls)}:
+        raise ParameterError(f"unknown parameter key {key!r}; expected one of: {', '.join(parameter_keys())}")
+    return next(f.metadata["dimension"] for f in fields(cls) if f.name == name)
+
+
+@dataclass(frozen=True)
+class Parameters:
+    """A complete, validated parameter set (SI units throughout)."""
+
+    bonds: BondParameters
+    aging: AgingParameters
+    stick: StickParameters
+    block: BlockParameters
+    name: str = "custom"
+    description: str = ""
+    reference: str = ""
+
+    def as_dict(self) -> dict[str, float]:
+        """Flat mapping ``section.key -> SI float``."""
+        return {
+            f"{s}.{f.name}": getattr(getattr(self, s), f.name) for s, cls in SECTIONS.items() for f in fields(cls)
+        }
+
+    def with_overrides(self, overrides: Mapping[str, Any] | None) -> Parameters:
+        """A new set with ``section.key`` values replaced (numbers in SI, or strings with units)."""
+        if not overrides:
+            return self
+        values: dict[str, Any] = self.as_dict()
+        for key, raw in overrides.items():
+            dimension = key_dimension(key)
+            values[key] = to_si(raw, dimension, key)
+        return _build(values, name=self.name, description=self.description, reference=self.reference)
+
+    def rows(self) -> list[tuple[str, str, str, str]]:
+        """(key, symbol, value with unit, meaning) for display."""
+        out = []
+        for s, cls in SECTIONS.items():
+            for f in fields(cls):
+                value = getattr(getattr(self, s), f.name)
+                out.append((f"{s}.{f.name}", f.metadata["symbol"], format_si(value, f.metadata["dimension"]), f.metadata["doc"]))
+        return out
+
+    def to_toml(self) -> str:
+        """An editable TOML file; values carry their units, and a reload gives the same set."""
+        lines = [f"name = {_toml_str(self.name)}"]
+        if self.description:
+            lines.append(f"description = {_toml_str(self.description)}")
+        if self.reference:
+            lines.append(f"reference = {_toml_str(self.reference)}")
+        for s, cls in SECTIONS.items():
+            lines += ["", f"[{s}]"]
+            for f in fields(cls):
+                value = getattr(getattr(self, s), f.name)
+                text = format_si(value, f.metadata["dimension"]) if f.metadata["dimension"] != "dimensionless" else None
+                # repr() keeps every digit, so export -> load is exact
+                shown = f'"{value!r} {text.split(" ", 1)[1]}"' if text else repr(value)
+                lines.append(f"{f.name} = {shown}  # {f.metadata['symbol']}: {f.metadata['doc']}")
+        return "\n".join(lines) + "\n"
+
+
+def _toml_str(text: str) -> str:
+    return '"' + text.replace("\\", "\\\\").replace('"', '\\"') + '"'
+
+
+def _build(values: Mapping[str, float], **meta: str) -> Parameters:
+    sections = {}
+    for s, cls in SECTIONS.items():
+        sections[s] = cls(**{f.name: values[f"{s}.{f.name}"] for f in fields(cls)})
+    return Parameters(**sections, **meta)
+
+
+def parameters_from_mapping(data: Mapping[str, Any], source: str = "parameters") -> Parameters:
+    """Build a set from a nested mapping as read from TOML (values with units)."""
+    meta: dict[str, str] = {}
+    values: dict[str, float] = {}
+    for top, content in data.items():
+        if top in _META_KEYS:
+            if not isinstance(content, str):
+                raise ParameterError(f"{source}: {top} must be a string, got {content!r}")
+            meta[top] = content
+            continue
+        if top not in SECTIONS:
+            raise ParameterError(
+                f"{source}: unknown section or key {top!r}; expected sections {', '.join(SECTIONS)}"
+                f" (and optional {', '.join(_META_KEYS)})"
+            )
+        if not isinstance(content, Mapping):
+            raise ParameterError(f"{source}: [{top}] must be a table of key = value")
+        for name, raw in content.items():
+            key = f"{top}.{name}"
+            values[key] = to_si(raw, key_dimension(key), f"{source}: {key}")
+    missing = [k for k in parameter_keys() if k not in values]
+    if missing:
+        raise ParameterError(f"{source}: missing parameter(s) {', '.join(missing)}")
+    return _build(values, **meta)
+
+
+def available_parameter_sets() -> list[str]:
+    """Names of the built-in parameter sets."""
+    folder = resources.files("stickslip") / "parameter_sets"
+    return sorted(p.name[: -len(".toml")] for p in folder.iterdir() if p.name.endswith(".toml"))
+
+
+def read_parameter_file(path: str | Path) -> Parameters:
+    """Read a TOML parameter file."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise ParameterError(f"parameter file {str(path)!r} not found") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ParameterError(f"parameter file {str(path)!r} cannot be read: {exc}") from None
+    return _parse_toml(text, str(path))
+
+
+def _parse_toml(text: str, source: str) -> Parameters:
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ParameterError(f"{source}: malformed TOML: {exc}") from None
+    return parameters_from_mapping(data, source)
+
+
+def load_parameters(name_or_path: str | Path | Parameters = "gelatin-glass", overrides: Mapping[str, Any] | None = None) -> Parameters:
+    """A built-in set by name (``"gelatin-glass"``) or a TOML file by path, with optional overrides.
+
+    >>> p = load_parameters("gelatin-glass", overrides={"bonds.max_extension": "1 m"})
+    >>> p.bonds.max_extension
+    1.0
+    """
+    if isinstance(name_or_path, Parameters):
+        return name_or_path.with_overrides(overrides)
+    text = str(name_or_path)
+    if text in available_parameter_sets():
+        resource = resources.files("stickslip") / "parameter_sets" / f"{text}.toml"
+        params = _parse_toml(resource.read_text(encoding="utf-8"), text)
+    elif Path(text).is_file() or text.endswith(".toml") or "/" in text:
+        params = read_parameter_file(text)
+    else:
+        raise ParameterError(
+            f"unknown parameter set {text!r}: expected a built-in name ({', '.join(available_parameter_sets())}) or a TOML file"
+        )
+    return params.with_overrides(overrides)
+
+
+def replace(params: Parameters, **sections: Any) -> Parameters:
+    """``dataclasses.replace`` for nested sections, e.g. ``replace(p, bonds={"bond_time": 1e-3})``."""
+    changes = {}
+    for s, values in sections.items():
+        if s not in SECTIONS:
+            raise ParameterError(f"unknown section {s!r}")
+        changes[s] = dataclasses.replace(getattr(params, s), **values)
+    return dataclasses.replace(params, **changes)
