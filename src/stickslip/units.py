@@ -29,6 +29,7 @@ DIMENSIONS: dict[str, tuple[str, str]] = {
     "stress_per_length": ("[mass] / [length] ** 2 / [time] ** 2", "Pa/m"),
     "force": ("[mass] * [length] / [time] ** 2", "N"),
     "area": ("[length] ** 2", "m^2"),
+    "stress_per_velocity": ("[mass] / [length] ** 2 / [time]", "Pa s/m"),
 }
 
 _NUMBER_THEN_UNIT = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(.*?)\s*$")
@@ -40,7 +41,6 @@ def registry() -> Any:
     import pint
 
     ureg = pint.UnitRegistry(autoconvert_offset_to_baseunit=True)
-    ureg.define("micron = micrometer")
     return ureg
 
 
@@ -96,6 +96,7 @@ def _base_unit(dimension: str) -> str:
         "stress_per_length": "Pa/m",
         "force": "N",
         "area": "m**2",
+        "stress_per_velocity": "Pa*s/m",
     }[dimension]
 
 
@@ -110,7 +111,9 @@ def _parse(text: str, name: str, dimension: str) -> Any:
     try:
         if match:
             number, unit = float(match.group(1)), match.group(2)
-            return ureg.Quantity(number, unit or "dimensionless")
+            if not unit:  # a bare number is SI, whatever the dimension
+                return ureg.Quantity(number, _base_unit(dimension) if dimension != "dimensionless" else "")
+            return ureg.Quantity(number, unit)
         return ureg.Quantity(ureg.parse_expression(text))
     except (pint.UndefinedUnitError, pint.errors.DefinitionSyntaxError) as exc:
         raise UnitError(f"{name}: unknown unit in {text!r} ({exc})") from None

@@ -1,9 +1,220 @@
-"""Subcommands (placeholder until implemented)."""
+"""``stickslip analyze``: per-cycle characteristics of a measured stick-slip record (Table 1).
+
+Output in SI base units for machines (``--json``, ``-o cycles.csv`` with the
+units in the header brackets) and in Table 1's units for people (the table).
+"""
 
 from __future__ import annotations
 
+import io
+import math
+from pathlib import Path
+from typing import Any
+
 import click
+
+from .common import emit_json, params_options, positive, save_figure, write_text
+from .params_cmd import load_cli_parameters, print_rich, si_text
+
+#: Columns of ``-o cycles.csv``: (field, SI unit).
+CSV_COLUMNS = (
+    ("cycle", ""),
+    ("complete", ""),
+    ("start_time", "s"),
+    ("peak_time", "s"),
+    ("end_time", "s"),
+    ("critical_stress", "Pa"),
+    ("stick_slope", "Pa/s"),
+    ("stick_slope_stderr", "Pa/s"),
+    ("stiffness", "Pa/m"),
+    ("stiffness_stderr", "Pa/m"),
+    ("peak_stress", "Pa"),
+    ("stick_time", "s"),
+    ("jump_velocity", "m/s"),
+    ("slip_time", "s"),
+    ("period", "s"),
+    ("stress_drop", "Pa"),
+)
+
+#: Rows of the printed table: (field, heading, factor from SI, digits).
+TABLE_ROWS = (
+    ("critical_stress", "σc [Pa]", 1.0, 4),
+    ("stick_slope", "dσ/dt stick [Pa/s]", 1.0, 4),
+    ("stiffness", "Gd/h [kPa/m]", 1e-3, 4),
+    ("peak_stress", "σs [Pa]", 1.0, 4),
+    ("stick_time", "ts [s]", 1.0, 4),
+    ("jump_velocity", "Vs [µm/s]", 1e6, 4),
+    ("slip_time", "slip time [s]", 1.0, 4),
+    ("period", "period [s]", 1.0, 4),
+)
+
+
+@click.command("analyze")
+@click.argument("trace", type=click.Path(dir_okay=False, path_type=Path))
+@click.option(
+    "--v0", "v0_text", required=True, metavar="V", help='Pulling velocity, e.g. "50 um/s" (bare number: m/s).'
+)
+@click.option(
+    "--contact-area",
+    "area_text",
+    default=None,
+    metavar="A",
+    help='Contact area, e.g. "15 cm^2", to turn a force column into stress (bare number: m^2).',
+)
+@params_options
+@click.option("--json", "as_json", is_flag=True, help="Print the analysis as JSON (SI units).")
+@click.option(
+    "-o",
+    "--output",
+    type=click.Path(dir_okay=False, path_type=Path),
+    help="Write the per-cycle table as CSV (SI units in the header brackets).",
+)
+@click.option(
+    "--plot",
+    "plot_path",
+    type=click.Path(dir_okay=False, path_type=Path),
+    help="Save a figure of the record with the detected phases (and the model with --compare).",
+)
+@click.option(
+    "--compare", is_flag=True, help="Simulate the model at V0, align it at the first whole cycle, report the misfit."
+)
+def analyze_command(
+    trace: Path,
+    v0_text: str,
+    area_text: str | None,
+    params_name: str,
+    overrides: tuple[str, ...],
+    as_json: bool,
+    output: Path | None,
+    plot_path: Path | None,
+    compare: bool,
+) -> None:
+    """Analyse a measured stress record: regime, and per cycle sigma_c, slope, Gd/h, sigma_s, ts, Vs.
+
+    TRACE is a CSV file with columns ``time`` and ``stress`` (or ``force``
+    with --contact-area), units in header brackets (``time [s],stress [kPa]``;
+    bare names are SI).  Empty stress cells are gaps.
+    """
+    from ..analysis import analyze_trace, compare_with_model, read_trace
+
+    v0 = positive(si_text(v0_text, "--v0"), "velocity", "--v0")
+    area = None if area_text is None else positive(si_text(area_text, "--contact-area"), "area", "--contact-area")
+    params = load_cli_parameters(params_name, overrides)
+    record = read_trace(trace, contact_area=area)
+    analysis = analyze_trace(record, None, v0, params)
+    comparison = compare_with_model(analysis, params) if compare else None
+    if output is not None:
+        write_text(output, cycles_csv(analysis))
+    if as_json:
+        data = analysis.as_dict()
+        if comparison is not None:
+            data["comparison"] = comparison.as_dict()
+        emit_json(data)
+    else:
+        print_rich(*_report(analysis, comparison))
+    if plot_path is not None:
+        _save_plot(analysis, comparison, plot_path)
+
+
+def cycles_csv(analysis: Any) -> str:
+    """The cycles as CSV, SI units in the header brackets; empty cells where a value is not in the record."""
+    out = io.StringIO()
+    out.write(",".join(f"{name} [{unit}]" if unit else name for name, unit in CSV_COLUMNS) + "\n")
+    for cycle in analysis.cycles:
+        data = cycle.as_dict()
+        data["cycle"] = cycle.index
+        data["complete"] = int(cycle.complete)
+        out.write(",".join(_cell(data[name]) for name, _ in CSV_COLUMNS) + "\n")
+    return out.getvalue()
+
+
+def _cell(value: Any) -> str:
+    if value is None:
+        return ""
+    if isinstance(value, float):
+        return repr(value) if math.isfinite(value) else ""
+    return str(value)
+
+
+def _report(analysis: Any, comparison: Any) -> list[Any]:
+    from rich.markup import escape
+    from rich.table import Table
+
+    v0 = analysis.pulling_velocity
+    head = (
+        f"{analysis.source}: {analysis.message}\n"
+        f"V0 = {v0 * 1e6:.6g} µm/s, noise {analysis.noise:.3g} Pa,"
+        f" drops above {analysis.threshold:.3g} Pa count as slips"
+    )
+    parts: list[Any] = [escape(head)]
+    if analysis.cycles:
+        table = Table(title="Per cycle (Table 1 rows)", title_justify="left")
+        table.add_column("")
+        for cycle in analysis.cycles:
+            table.add_column(f"cycle {cycle.index}" + ("" if cycle.complete else "*"), justify="right")
+        table.add_column("mean ± sd", justify="right")
+        for name, heading, factor, digits in TABLE_ROWS:
+            cells = [_number(getattr(c, name), factor, digits) for c in analysis.cycles]
+            stats = analysis.summary[name]
+            spread = "" if stats["std"] is None else f" ± {stats['std'] * factor:.2g}"
+            table.add_row(
+                escape(heading), *cells, "" if stats["mean"] is None else f"{stats['mean'] * factor:.{digits}g}{spread}"
+            )
+        parts.append(table)
+        if any(not c.complete for c in analysis.cycles):
+            notes = [f"cycle {c.index}: {c.message}" for c in analysis.cycles if c.message]
+            parts.append(escape("* cut by the record's ends.  " + "; ".join(notes)))
+    if "mean_stress" in analysis.summary:
+        s = analysis.summary
+        spread = "" if s["stress_std"] is None else f" ± {s['stress_std']:.3g} Pa (sd of {s['steady_samples']} samples)"
+        parts.append(
+            escape(f"steady sliding from t = {s['steady_from']:.6g} s: mean stress {s['mean_stress']:.6g} Pa{spread}")
+        )
+    if comparison is not None:
+        parts.append(escape(_comparison_text(comparison)))
+    return parts
+
+
+def _comparison_text(comparison: Any) -> str:
+    lines = [f"model ({comparison.model_regime}): {comparison.message}"]
+    if comparison.rms_misfit is not None:
+        lines.append(f"RMS misfit {comparison.rms_misfit:.4g} Pa over {comparison.points} samples")
+    for row in comparison.cycles:
+        diff = row["difference"]
+        shown = [
+            f"{label} {_signed(diff[name], factor)}{unit}"
+            for name, label, factor, unit in (
+                ("critical_stress", "Δσc", 1.0, " Pa"),
+                ("peak_stress", "Δσs", 1.0, " Pa"),
+                ("stick_time", "Δts", 1.0, " s"),
+                ("slip_time", "Δslip", 1.0, " s"),
+            )
+            if diff[name] is not None
+        ]
+        lines.append(f"record cycle {row['record_cycle']} - model cycle {row['model_cycle']}: " + ", ".join(shown))
+    return "\n".join(lines)
+
+
+def _number(value: float | None, factor: float, digits: int) -> str:
+    return "--" if value is None else f"{value * factor:.{digits}g}"
+
+
+def _signed(value: float, factor: float) -> str:
+    return f"{value * factor:+.4g}"
+
+
+def _save_plot(analysis: Any, comparison: Any, path: Path) -> None:
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(9, 4.5))
+    ax = fig.add_subplot()
+    if comparison is None:
+        analysis.plot(ax=ax)
+    else:
+        comparison.plot(ax=ax)
+    save_figure(fig, path)
 
 
 def register(cli: click.Group) -> None:
-    """Add this module's commands to the stickslip group."""
+    """Add ``stickslip analyze`` to the group."""
+    cli.add_command(analyze_command)

@@ -1,9 +1,238 @@
-"""Subcommands (placeholder until implemented)."""
+"""``stickslip simulate`` and ``stickslip stick``: stick-slip cycles (Eqs 10-17) and the stick phase (Eq 15).
+
+Machines get SI base units (``--json``, the ``-o`` CSV with units in its
+header); people get um/s, Pa and s.
+"""
 
 from __future__ import annotations
 
+import io
+from pathlib import Path
+from typing import Any
+
 import click
+import numpy as np
+
+from .common import emit_json, params_options, positive, save_figure, write_text
+from .params_cmd import load_cli_parameters, print_rich, si_text
+
+#: Rows of the Nc/Nc0 table printed by ``stick`` (the whole curve is in --json and -o).
+STICK_TABLE_ROWS = 11
+
+
+def _velocity(text: str) -> float:
+    return positive(si_text(text, "--v0"), "velocity", "--v0", allow_zero=True)
+
+
+def _stress(text: str | None) -> float | None:
+    if text is None:
+        return None
+    return positive(si_text(text, "--start-stress"), "stress", "--start-stress", allow_zero=True)
+
+
+def _csv(columns: dict[str, Any], units: dict[str, str]) -> str:
+    """CSV with units in the header brackets (``time [s],...``), numbers in SI with every digit."""
+    out = io.StringIO()
+    names = list(columns)
+    out.write(",".join(f"{n} [{units[n]}]" if units.get(n) else n for n in names) + "\n")
+    for row in zip(*(columns[n] for n in names), strict=True):
+        out.write(",".join(v if isinstance(v, str) else repr(float(v)) for v in row) + "\n")
+    return out.getvalue()
+
+
+def _fmt(value: float | None, scale: float = 1.0, digits: int = 5) -> str:
+    return "—" if value is None else f"{value * scale:.{digits}g}"
+
+
+# --------------------------------------------------------------------------- simulate
+@click.command("simulate")
+@click.option(
+    "--v0", "v0_text", required=True, metavar="V", help='Pulling velocity, e.g. "50 um/s" (>= 0; bare number: m/s).'
+)
+@click.option("--duration", "duration_text", required=True, metavar="T", help='Length of the run, e.g. "120 s".')
+@click.option(
+    "--start-stress",
+    "start_text",
+    default=None,
+    metavar="S",
+    help="Stress at which the block starts stuck [default: σc].",
+)
+@click.option(
+    "--jump-curve",
+    type=click.Choice(["aging", "no-aging"]),
+    default="aging",
+    show_default=True,
+    help="Steady curve the stick-to-slip jump lands on (aging keeps the stress continuous; see docs/errata.md).",
+)
+@click.option(
+    "-o", "--output", type=click.Path(dir_okay=False, path_type=Path), help="Write the trace as CSV (SI units)."
+)
+@click.option("--plot", "plot_path", type=click.Path(dir_okay=False, path_type=Path), help="Save σ(t) (Fig 5) here.")
+@click.option("--json", "as_json", is_flag=True, help="Print the summary as JSON (SI units).")
+@params_options
+def simulate_command(
+    v0_text: str,
+    duration_text: str,
+    start_text: str | None,
+    jump_curve: str,
+    output: Path | None,
+    plot_path: Path | None,
+    as_json: bool,
+    params_name: str,
+    overrides: tuple[str, ...],
+) -> None:
+    """Simulate stick-slip: stick -> jump -> slip -> jump -> ... for a pulling velocity and duration.
+
+    The block starts stuck at σc (or --start-stress) with fresh chains.  The
+    regime is "stick-slip", "steady" (V0 >= Vc: the slip settles at V0),
+    "stuck" (a stick never ends) or "undetermined" (the model has no answer).
+    """
+    from ..model.cycle import COLUMN_UNITS, CYCLE_COLUMNS, simulate
+
+    v0 = _velocity(v0_text)
+    duration = positive(si_text(duration_text, "--duration"), "time", "--duration")
+    start = _stress(start_text)
+    params = load_cli_parameters(params_name, overrides)
+    sim = simulate(params, v0, duration, start_stress=start, jump_curve=jump_curve)
+    if output is not None:
+        write_text(output, _csv({n: getattr(sim, n) for n in CYCLE_COLUMNS}, COLUMN_UNITS))
+    if plot_path is not None:
+        from ..cycle_plots import plot_simulation
+
+        ax = plot_simulation(sim)
+        ax.legend(loc="upper right", frameon=False, fontsize=8)
+        ax.set_title(f"V0 = {v0 * 1e6:.4g} µm/s, {params.name}: {sim.regime}", fontsize=11)
+        save_figure(ax.figure, plot_path)
+    if as_json:
+        emit_json(sim.summary())
+        return
+    print_rich(*_simulation_report(sim, params.name))
+
+
+def _simulation_report(sim: Any, name: str) -> list[Any]:
+    from rich.table import Table
+
+    head = [
+        f"Stick-slip simulation, {name}: V0 = {sim.pulling_velocity * 1e6:.6g} µm/s for {sim.duration:.6g} s,"
+        f" starting stuck at {sim.start_stress:.6g} Pa (jump onto the {sim.jump_curve} curve)",
+        f"  Vc = {sim.critical_velocity * 1e6:.6g} µm/s, σc = {sim.critical_stress:.6g} Pa,"
+        f" K = {sim.stiffness / 1e3:.6g} kPa/m (Eq 17)",
+        f"  regime: {sim.regime}",
+        f"  {sim.message}",
+        f"  at t = {sim.time[-1]:.6g} s: σ = {sim.final_stress:.6g} Pa, V = {sim.final_velocity * 1e6:.6g} µm/s"
+        + ("" if sim.time[-1] >= sim.duration else " (the model stops here)"),
+    ]
+    out: list[Any] = ["\n".join(head)]
+    if sim.cycles:
+        table = Table(title="Cycles", title_justify="left")
+        for heading in ("#", "start (s)", "σ start (Pa)", "σs (Pa)", "ts (s)", "Vs (µm/s)", "slip (s)", "period (s)"):
+            table.add_column(heading, justify="right")
+        for c in sim.cycles:
+            table.add_row(
+                str(c.index + 1),
+                _fmt(c.start_time, digits=6),
+                _fmt(c.start_stress),
+                _fmt(c.peak_stress),
+                _fmt(c.stick_time),
+                _fmt(c.jump_velocity, 1e6),
+                _fmt(c.slip_time),
+                _fmt(c.period),
+            )
+        out.append(table)
+    else:
+        out.append("  no stick phase ended in a slip within the run")
+    return out
+
+
+# --------------------------------------------------------------------------- stick
+@click.command("stick")
+@click.option(
+    "--v0", "v0_text", required=True, metavar="V", help='Pulling velocity, e.g. "50 um/s"; 0 holds a constant load.'
+)
+@click.option(
+    "--start-stress", "start_text", default=None, metavar="S", help="Stress at the instant of sticking [default: σc]."
+)
+@click.option("--no-aging", is_flag=True, help="Drop the aging term of Eq 15 (tau_a -> infinity).")
+@click.option(
+    "--until",
+    "until_text",
+    default=None,
+    metavar="T",
+    help="When the block stays stuck, follow Nc/Nc0 up to this time [default: 10 aging times of Eq 15].",
+)
+@click.option("--json", "as_json", is_flag=True, help="Print the result and the Nc/Nc0 curve as JSON (SI units).")
+@click.option("-o", "--output", type=click.Path(dir_okay=False, path_type=Path), help="Write the Nc/Nc0 curve as CSV.")
+@click.option(
+    "--plot", "plot_path", type=click.Path(dir_okay=False, path_type=Path), help="Save Nc/Nc0(t) (Fig 6) here."
+)
+@params_options
+def stick_command(
+    v0_text: str,
+    start_text: str | None,
+    no_aging: bool,
+    until_text: str | None,
+    as_json: bool,
+    output: Path | None,
+    plot_path: Path | None,
+    params_name: str,
+    overrides: tuple[str, ...],
+) -> None:
+    """The stick phase (Eqs 11-16): stick time ts, peak stress σs, and Nc/Nc0 against time.
+
+    Says so when the block stays stuck for ever (aging wins over loading)
+    instead of inventing a stick time.
+    """
+    from ..model.stick import stick_phase
+
+    v0 = _velocity(v0_text)
+    start = _stress(start_text)
+    params = load_cli_parameters(params_name, overrides)
+    if until_text is None:
+        until = 10.0 * params.stick.aging_time
+    else:
+        until = positive(si_text(until_text, "--until"), "time", "--until")
+    stick = stick_phase(params, v0, start_stress=start, aging=not no_aging, horizon=until)
+    columns = {"time": stick.time, "stress": stick.stress, "chain_fraction": stick.chain_fraction}
+    if output is not None:
+        write_text(output, _csv(columns, {"time": "s", "stress": "Pa"}))
+    if plot_path is not None:
+        from ..cycle_plots import plot_stick
+
+        ax = plot_stick(stick)
+        ax.legend(loc="lower left", frameon=False, fontsize=8)
+        ax.set_title(f"Attached chains, {params.name}: {stick.status}", fontsize=11)
+        save_figure(ax.figure, plot_path)
+    if as_json:
+        emit_json({**stick.as_dict(), "curve": columns})
+        return
+    print_rich(*_stick_report(stick, params.name))
+
+
+def _stick_report(stick: Any, name: str) -> list[Any]:
+    from rich.table import Table
+
+    if stick.status == "slipped":
+        verdict = f"  the block slips after ts = {stick.stick_time:.6g} s at σs = {stick.peak_stress:.6g} Pa"
+    elif stick.stuck:
+        verdict = "  THE BLOCK STAYS STUCK: it never slips (no stick time)"
+    else:
+        verdict = "  UNDETERMINED: no slip found, and no proof that the block stays stuck"
+    head = [
+        f"Stick phase (Eq 15), {name}: V0 = {stick.pulling_velocity * 1e6:.6g} µm/s, from {stick.start_stress:.6g} Pa,"
+        f" {'with' if stick.aging else 'without'} aging",
+        verdict,
+        f"  {stick.message}",
+    ]
+    table = Table(title="Nc/Nc0 against time", title_justify="left")
+    for heading in ("t (s)", "σ (Pa)", "Nc/Nc0"):
+        table.add_column(heading, justify="right")
+    picks = np.unique(np.linspace(0, stick.time.size - 1, STICK_TABLE_ROWS).round().astype(int))
+    for k in picks:
+        table.add_row(f"{stick.time[k]:.5g}", f"{stick.stress[k]:.5g}", f"{stick.chain_fraction[k]:.5f}")
+    return ["\n".join(head), table]
 
 
 def register(cli: click.Group) -> None:
-    """Add this module's commands to the stickslip group."""
+    """Add ``stickslip simulate`` and ``stickslip stick`` to the group."""
+    cli.add_command(simulate_command)
+    cli.add_command(stick_command)

@@ -1,9 +1,277 @@
-"""Subcommands (placeholder until implemented)."""
+"""``stickslip fit steady`` and ``stickslip fit stick``: the model's parameters from measurements (Section 3).
+
+Without ``--json`` the Markdown report is printed; ``-o`` writes the fitted
+parameter set as TOML (usable by every other command with ``--params``).
+"""
 
 from __future__ import annotations
 
+import dataclasses
+from pathlib import Path
+from typing import Any
+
 import click
+
+from ..fitting.results import human
+from ..parameters import Parameters, key_dimension
+from .common import emit_json, params_options, positive, save_figure, write_text
+from .params_cmd import load_cli_parameters, si_text
+
+SPLIT_DEFAULT = "800 um/s"
+
+
+def _fix_values(items: tuple[str, ...]) -> dict[str, Any]:
+    out: dict[str, Any] = {}
+    for item in items:
+        key, sep, value = item.partition("=")
+        key = key.strip()
+        if not sep or not key or not value.strip():
+            raise click.BadParameter(
+                f"{item!r}: expected KEY=VALUE, e.g. bonds.max_extension='1 um'", param_hint="--fix"
+            )
+        key_dimension(key)  # unknown keys: ParameterError naming the valid ones
+        if key in out:
+            raise click.BadParameter(f"{key} given twice", param_hint="--fix")
+        out[key] = si_text(value.strip(), key)
+    return out
+
+
+def _fitted_set(params: Parameters, name: str, description: str) -> Parameters:
+    reference = f"start values: {params.reference}" if params.reference else ""
+    return dataclasses.replace(params, name=name, description=description, reference=reference)
+
+
+def _toml_with_header(params: Parameters, header: list[str]) -> str:
+    return "\n".join(f"# {line}" for line in header) + "\n" + params.to_toml()
+
+
+def _figure_to(path: Path, make: Any) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    save_figure(make(), path)
+
+
+@click.group("fit")
+def fit_group() -> None:
+    """Fit the model to measurements: steady friction curves and stick times."""
+
+
+@fit_group.command("steady")
+@click.argument("data", type=click.Path(dir_okay=False, path_type=Path))
+@click.option(
+    "--method",
+    type=click.Choice(["two-step", "joint"]),
+    default="two-step",
+    show_default=True,
+    help="two-step: the paper's (no aging above --split, then aging below it); joint: everything at once.",
+)
+@click.option(
+    "--split", default=SPLIT_DEFAULT, show_default=True, metavar="V", help="Split velocity of the two-step fit."
+)
+@click.option(
+    "--fix", "fix_items", multiple=True, metavar="KEY=VALUE", help="Hold a parameter at a value (repeatable)."
+)
+@click.option("--free", "free_keys", multiple=True, metavar="KEY", help="Also fit this parameter (repeatable).")
+@click.option(
+    "--intervals",
+    type=click.Choice(["auto", "delta", "profile", "bootstrap"]),
+    default="auto",
+    show_default=True,
+    help="Intervals of Vc and σc; auto: delta for two-step, profile likelihood for joint (docs/fitting.md).",
+)
+@click.option("--samples", type=click.IntRange(min=20), default=200, show_default=True, help="Bootstrap refits.")
+@click.option("--level", type=click.FloatRange(0.5, 0.999), default=0.95, show_default=True, help="Confidence level.")
+@click.option("--seed", type=int, default=None, help="Random seed (bootstrap, Bayesian sampler).")
+@click.option(
+    "-o", "--output", type=click.Path(dir_okay=False, path_type=Path), help="Write the fitted parameters (TOML)."
+)
+@click.option(
+    "--report", "report_path", type=click.Path(dir_okay=False, path_type=Path), help="Write the report (Markdown)."
+)
+@click.option(
+    "--plot", "plot_path", type=click.Path(dir_okay=False, path_type=Path), help="Save the fit and residuals (PNG)."
+)
+@click.option("--json", "as_json", is_flag=True, help="Print the results as JSON (SI units).")
+@click.option("--bayes", is_flag=True, help="Also sample the posterior with emcee (needs stickslip[bayes]).")
+@click.option("--walkers", type=click.IntRange(min=4), default=32, show_default=True, help="emcee walkers.")
+@click.option("--steps", type=click.IntRange(min=10), default=2000, show_default=True, help="emcee steps per walker.")
+@click.option(
+    "--corner",
+    "corner_path",
+    type=click.Path(dir_okay=False, path_type=Path),
+    help="Save a corner plot (with --bayes).",
+)
+@params_options
+def steady_command(
+    data: Path,
+    method: str,
+    split: str,
+    fix_items: tuple[str, ...],
+    free_keys: tuple[str, ...],
+    intervals: str,
+    samples: int,
+    level: float,
+    seed: int | None,
+    output: Path | None,
+    report_path: Path | None,
+    plot_path: Path | None,
+    as_json: bool,
+    bayes: bool,
+    walkers: int,
+    steps: int,
+    corner_path: Path | None,
+    params_name: str,
+    overrides: tuple[str, ...],
+) -> None:
+    """Fit the steady friction curve (Eqs 6-8) to DATA: a CSV of velocity, stress and optional stress_err.
+
+    Units go in the header (velocity [um/s]); bare names are SI.  Start values and
+    everything not fitted come from --params/--set (default gelatin-glass).
+    """
+    from ..fitting.steady_fit import fit_steady
+
+    if corner_path is not None and not bayes:
+        raise click.UsageError("--corner needs --bayes")
+    posterior_module = _bayes_module() if bayes else None
+    params = load_cli_parameters(params_name, overrides)
+    split_value = positive(si_text(split, "--split"), "velocity", "--split")
+    fit = fit_steady(
+        data,
+        params=params,
+        method=method,
+        split=split_value,
+        fix=_fix_values(fix_items),
+        free=list(free_keys),
+        intervals=None if intervals == "auto" else intervals,
+        level=level,
+        bootstrap_samples=samples,
+        seed=seed,
+    )
+    posterior = None
+    if posterior_module is not None:
+        posterior = posterior_module.sample_posterior(fit, walkers=walkers, steps=steps, seed=seed)
+    if output is not None:
+        fitted = _fitted_set(
+            fit.parameters,
+            f"fit of {data.name}",
+            f"stickslip fit steady --method {method} of {data}, start values from {params.name}",
+        )
+        vc, sc = fit.critical_velocity, fit.critical_stress
+        header = [f"Fitted by stickslip fit steady ({method}) to {data}; fitted keys: {', '.join(fit.free_keys)}."]
+        if vc.value is not None and sc.value is not None:
+            header.append(f"Vc = {human(vc.value, 'velocity')}, sigma_c = {human(sc.value, 'stress')} (Eq 9).")
+        write_text(output, _toml_with_header(fitted, header))
+    report = fit.report() if posterior is None else fit.report() + "\n" + posterior.report()
+    if report_path is not None:
+        write_text(report_path, report)
+    if plot_path is not None:
+        from ..fitting.plots import steady_fit_figure
+
+        band = posterior.stress_band() if posterior is not None else None
+        _figure_to(plot_path, lambda: steady_fit_figure(fit, band=band))
+    if corner_path is not None and posterior is not None:
+        from ..fitting.plots import corner_figure
+
+        _figure_to(corner_path, lambda: corner_figure(posterior))
+    if as_json:
+        result = fit.as_dict()
+        if posterior is not None:
+            result["posterior"] = posterior.as_dict()
+        emit_json(result)
+    else:
+        click.echo(report)
+
+
+def _bayes_module() -> Any:
+    try:
+        import corner  # noqa: F401
+        import emcee  # noqa: F401
+    except ImportError:
+        raise click.ClickException("the Bayesian fit needs emcee and corner: pip install stickslip[bayes]") from None
+    from ..fitting import bayes
+
+    return bayes
+
+
+@fit_group.command("stick")
+@click.argument("table", type=click.Path(dir_okay=False, path_type=Path))
+@click.option("--fix", "fix_items", multiple=True, metavar="KEY=VALUE", help="Hold a stick parameter at a value.")
+@click.option("--free", "free_keys", multiple=True, metavar="KEY", help="Prefer to fit this stick parameter.")
+@click.option("--exclude-row", "exclude_rows", multiple=True, type=int, metavar="N", help="Leave out file row N.")
+@click.option("--include-steady", is_flag=True, help="Keep rows whose pulling velocity is above Vc.")
+@click.option("--level", type=click.FloatRange(0.5, 0.999), default=0.95, show_default=True, help="Confidence level.")
+@click.option(
+    "-o", "--output", type=click.Path(dir_okay=False, path_type=Path), help="Write the fitted parameters (TOML)."
+)
+@click.option(
+    "--report", "report_path", type=click.Path(dir_okay=False, path_type=Path), help="Write the report (Markdown)."
+)
+@click.option(
+    "--plot", "plot_path", type=click.Path(dir_okay=False, path_type=Path), help="Save stick times, data and fit (PNG)."
+)
+@click.option("--json", "as_json", is_flag=True, help="Print the results as JSON (SI units).")
+@params_options
+def stick_command(
+    table: Path,
+    fix_items: tuple[str, ...],
+    free_keys: tuple[str, ...],
+    exclude_rows: tuple[int, ...],
+    include_steady: bool,
+    level: float,
+    output: Path | None,
+    report_path: Path | None,
+    plot_path: Path | None,
+    as_json: bool,
+    params_name: str,
+    overrides: tuple[str, ...],
+) -> None:
+    """Fit Nc0, uc/τ and the stick aging time (Eq 15) to measured stick times in TABLE.
+
+    Columns: pulling_velocity, stick_time, optional peak_stress, start_stress (and the
+    other columns of the paper's Table 1).  Bond parameters, block and start values
+    come from --params/--set: use the file written by 'stickslip fit steady -o'.
+    """
+    from ..fitting.stick_fit import fit_stick
+
+    params = load_cli_parameters(params_name, overrides)
+    fit = fit_stick(
+        table,
+        params=params,
+        fix=_fix_values(fix_items),
+        free=list(free_keys),
+        exclude_rows=list(exclude_rows),
+        include_steady=include_steady,
+        level=level,
+    )
+    if output is not None:
+        fitted = _fitted_set(
+            fit.parameters, f"stick fit of {table.name}", f"stickslip fit stick of {table}, from {params.name}"
+        )
+        write_text(
+            output,
+            _toml_with_header(
+                fitted, [f"Fitted by stickslip fit stick to {table}; fitted keys: {', '.join(fit.free_keys)}."]
+            ),
+        )
+    report = fit.report()
+    if report_path is not None:
+        write_text(report_path, report)
+    if plot_path is not None:
+        from ..fitting.plots import new_axes, plot_stick_fit
+
+        def make() -> Any:
+            fig, (ax,) = new_axes()
+            plot_stick_fit(fit, ax)
+            return fig
+
+        _figure_to(plot_path, make)
+    if as_json:
+        emit_json(fit.as_dict())
+    else:
+        click.echo(report)
 
 
 def register(cli: click.Group) -> None:
-    """Add this module's commands to the stickslip group."""
+    """Add ``stickslip fit steady|stick`` to the group."""
+    cli.add_command(fit_group)

@@ -1,9 +1,239 @@
-"""Subcommands (placeholder until implemented)."""
+"""``stickslip params``: list, show and export parameter sets.
+
+``params show [NAME|FILE]`` prints every key with its symbol, value (in a
+readable unit) and meaning, then the derived quantities the paper uses
+(lambda/kT, lambda*M/kT, G_d/h, the Eq 17 geometric factor and K).
+``params export [NAME|FILE] [-o FILE]`` writes an editable TOML file whose
+reload gives exactly the same set.  Both take ``--params`` and ``--set``.
+"""
 
 from __future__ import annotations
 
+import dataclasses
+import io
+import math
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
 import click
+
+from ..errors import ParameterError
+from ..parameters import BOLTZMANN, SECTIONS, Parameters, available_parameter_sets, key_dimension, load_parameters
+from ..units import DIMENSIONS
+from .common import params_options, resolve_params, stdout_is_terminal, write_text
+
+#: Width of tables written to files or pipes (a terminal uses its own width).
+PLAIN_WIDTH = 140
+
+_PREFIXES = ((1e6, "M"), (1e3, "k"), (1.0, ""), (1e-3, "m"), (1e-6, "µ"), (1e-9, "n"), (1e-12, "p"))
+#: Dimensions shown with an SI prefix on their leading unit, and that unit split as (leading, rest).
+_PREFIXED = {
+    "time": ("s", ""),
+    "length": ("m", ""),
+    "velocity": ("m", "/s"),
+    "stress": ("Pa", ""),
+    "stress_rate": ("Pa", "/s"),
+    "stress_per_length": ("Pa", "/m"),
+    "stiffness": ("N", "/m"),
+    "force": ("N", ""),
+}
+
+
+def human(value: float, dimension: str, digits: int = 6) -> str:
+    """``value`` (SI) in a readable unit: ``human(2.24e-4, "time") == "224 µs"``."""
+    if not math.isfinite(value):
+        return f"{value} {DIMENSIONS[dimension][1]}".strip()
+    if dimension == "temperature":
+        return f"{value:.{digits}g} K ({value - 273.15:.{digits}g} °C)"
+    if dimension == "length" and 1e-11 <= abs(value) < 1e-9:  # molecular lengths read best in angstrom
+        return f"{value * 1e10:.{digits}g} Å"
+    if dimension in _PREFIXED and value != 0:
+        lead, rest = _PREFIXED[dimension]
+        factor, prefix = next(((f, p) for f, p in _PREFIXES if abs(value) >= f * (1 - 1e-12)), _PREFIXES[-1])
+        return f"{value / factor:.{digits}g} {prefix}{lead}{rest}"
+    unit = DIMENSIONS[dimension][1].replace("^2", "²")
+    return f"{value:.{digits}g} {unit}".strip()
+
+
+def si_text(text: str, name: str) -> str | float:
+    """A bare number is SI: return it as a float (finite), else the text for :func:`~stickslip.units.to_si`.
+
+    Works around ``units.to_si`` reading the *string* ``"0.001"`` as
+    dimensionless (and so rejecting it for a time) although a bare number
+    in SI is allowed on the command line.
+    """
+    try:
+        value = float(text)
+    except (TypeError, ValueError):
+        return text
+    if not math.isfinite(value):
+        raise ParameterError(f"{name}: expected a finite number, got {text!r}")
+    return value
+
+
+def load_cli_parameters(params_name: str, overrides: Sequence[str]) -> Parameters:
+    """The set named by ``--params`` with ``--set`` overrides (bare numbers in SI)."""
+    fixed = []
+    for item in overrides:
+        key, sep, value = item.partition("=")
+        if sep and key.strip():
+            dimension = key_dimension(key.strip())
+            number = si_text(value.strip(), key.strip())
+            if isinstance(number, float):
+                unit = DIMENSIONS[dimension][1]
+                value = f"{number!r} {unit}".strip()
+        fixed.append(f"{key}={value}" if sep else item)
+    return resolve_params(params_name, fixed)
+
+
+def _chosen_set(ctx: click.Context, name: str | None, params_name: str) -> str:
+    """NAME argument or --params, not both."""
+    if name is None:
+        return params_name
+    source = ctx.get_parameter_source("params_name")
+    if source is not None and source.name == "COMMANDLINE" and params_name != name:
+        raise click.UsageError(f"give the parameter set once: either NAME ({name!r}) or --params ({params_name!r})")
+    return name
+
+
+def _with_override_note(params: Parameters, overrides: Sequence[str]) -> Parameters:
+    if not overrides:
+        return params
+    note = "with --set " + ", ".join(overrides)
+    description = f"{params.description} ({note})" if params.description else note
+    return dataclasses.replace(params, description=description)
+
+
+def print_rich(*renderables: Any, output: Path | None = None) -> None:
+    """Print rich renderables: in colour on a terminal, as plain text to a pipe or ``output`` file."""
+    from rich.console import Console
+
+    if output is None and stdout_is_terminal():
+        console = Console(highlight=False)
+        for item in renderables:
+            console.print(item)
+        return
+    buffer = io.StringIO()
+    console = Console(file=buffer, width=PLAIN_WIDTH, color_system=None, highlight=False, force_terminal=False)
+    for item in renderables:
+        console.print(item)
+    text = "\n".join(line.rstrip() for line in buffer.getvalue().splitlines()) + "\n"
+    if output is None:
+        click.echo(text, nl=False)
+    else:
+        write_text(output, text)
+
+
+def parameter_table(params: Parameters, changed: Sequence[str] = ()) -> Any:
+    """A rich table: key, symbol, value with unit, meaning (keys in ``changed`` are flagged)."""
+    from rich.table import Table
+
+    title = f"Parameter set {params.name}" + (f"\n{params.description}" if params.description else "")
+    table = Table(title=title, title_justify="left")
+    for column in ("key", "symbol", "value", "meaning"):
+        table.add_column(column, overflow="fold")
+    for s, cls in SECTIONS.items():
+        for f in dataclasses.fields(cls):
+            key = f"{s}.{f.name}"
+            value = human(getattr(getattr(params, s), f.name), f.metadata["dimension"])
+            flag = " (set)" if key in changed else ""
+            table.add_row(key + flag, f.metadata["symbol"], value, f.metadata["doc"])
+    return table
+
+
+def derived_rows(params: Parameters) -> list[tuple[str, str, str, str]]:
+    """(quantity, symbol, value, meaning) of the derived quantities used by the model."""
+    b, k = params.bonds, params.block
+    kt = BOLTZMANN * b.temperature
+    return [
+        ("thermal energy", "kT", f"{kt:.6g} J", "Boltzmann constant times T"),
+        ("force sensitivity", "λ/kT", f"{b.force_sensitivity:.6g} 1/N", "Eyring exponent per unit chain force (Eq 15)"),
+        (
+            "stretch sensitivity",
+            "λM/kT",
+            f"{b.stretch_sensitivity:.6g} 1/m = {b.stretch_sensitivity * 1e-6:.6g} 1/µm",
+            "Eyring exponent per unit chain extension (Eq 6); the paper's '2.47e12 m^-2'",
+        ),
+        ("block stiffness", "G_d/h", human(k.stiffness, "stress_per_length"), "shear modulus over height (Eq 5)"),
+        ("geometric factor", "ln(B/l)/(B/l-1)", f"{k.geometric_factor:.6g}", "trapezoid correction (Eq 17)"),
+        (
+            "effective stiffness",
+            "K",
+            human(k.effective_stiffness, "stress_per_length"),
+            "G_d/h times the factor (Eq 17)",
+        ),
+    ]
+
+
+def derived_table(params: Parameters) -> Any:
+    from rich.table import Table
+
+    table = Table(title="Derived quantities", title_justify="left")
+    for column in ("quantity", "symbol", "value", "meaning"):
+        table.add_column(column, overflow="fold")
+    for row in derived_rows(params):
+        table.add_row(*row)
+    return table
+
+
+def _changed_keys(overrides: Sequence[str]) -> list[str]:
+    return [item.partition("=")[0].strip() for item in overrides]
+
+
+@click.group("params")
+def params_group() -> None:
+    """List, show and export parameter sets (values carry units)."""
+
+
+@params_group.command("list")
+def list_command() -> None:
+    """The built-in parameter sets."""
+    from rich.table import Table
+
+    table = Table(title="Built-in parameter sets", title_justify="left")
+    table.add_column("name")
+    table.add_column("description", overflow="fold")
+    for name in available_parameter_sets():
+        table.add_row(name, load_parameters(name).description)
+    print_rich(table)
+
+
+@params_group.command("show")
+@click.argument("name", required=False, metavar="[NAME|FILE]")
+@params_options
+@click.pass_context
+def show_command(ctx: click.Context, name: str | None, params_name: str, overrides: tuple[str, ...]) -> None:
+    """Print a parameter set with units, and the derived quantities.
+
+    NAME is a built-in set (see `stickslip params list`) or a TOML file;
+    it defaults to --params.
+    """
+    params = load_cli_parameters(_chosen_set(ctx, name, params_name), overrides)
+    params = _with_override_note(params, overrides)
+    print_rich(parameter_table(params, _changed_keys(overrides)), derived_table(params))
+
+
+@params_group.command("export")
+@click.argument("name", required=False, metavar="[NAME|FILE]")
+@params_options
+@click.option("-o", "--output", type=click.Path(dir_okay=False, path_type=Path), help="Write here instead of stdout.")
+@click.pass_context
+def export_command(
+    ctx: click.Context, name: str | None, params_name: str, overrides: tuple[str, ...], output: Path | None
+) -> None:
+    """Write a parameter set as an editable TOML file (values with units).
+
+    Loading the file back (`--params FILE`) gives exactly the same values.
+    """
+    params = load_cli_parameters(_chosen_set(ctx, name, params_name), overrides)
+    text = _with_override_note(params, overrides).to_toml()
+    if output is None:
+        click.echo(text, nl=False)
+    else:
+        write_text(output, text)
 
 
 def register(cli: click.Group) -> None:
-    """Add this module's commands to the stickslip group."""
+    """Add ``stickslip params ...`` to the group."""
+    cli.add_command(params_group)

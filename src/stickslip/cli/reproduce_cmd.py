@@ -1,9 +1,62 @@
-"""Subcommands (placeholder until implemented)."""
+"""``stickslip reproduce``: the paper's figures and numbers, recomputed, in one offline report."""
 
 from __future__ import annotations
+
+import sys
+from pathlib import Path
 
 import click
 
 
 def register(cli: click.Group) -> None:
-    """Add this module's commands to the stickslip group."""
+    """Add ``reproduce`` to the stickslip group."""
+    cli.add_command(reproduce)
+
+
+@click.command()
+@click.option(
+    "-o",
+    "--output",
+    type=click.Path(file_okay=False, path_type=Path),
+    default=Path("stickslip-report"),
+    show_default=True,
+    help="Folder for report.html, results.json, the figures (PNG, SVG) and the curves (CSV).",
+)
+@click.option("--quiet", is_flag=True, help="Print nothing.")
+def reproduce(output: Path, quiet: bool) -> None:
+    """Recompute the paper's figures and every number it states; write an offline HTML report.
+
+    The report (report.html, one self-contained file) puts each number the
+    paper prints beside the value computed here, with the relative difference
+    and a link to the erratum wherever they differ by more than 2 %.
+    """
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from ..report import build_report
+
+    if quiet:
+        build_report(output)
+        return
+    if sys.stderr.isatty():
+        report = _build_with_progress(output)
+    else:
+        report = build_report(output)
+    click.echo(f"report: {report.html} ({len(report.files)} files, {report.elapsed:.1f} s)")
+
+
+def _build_with_progress(output: Path):
+    from rich.console import Console
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+
+    from ..report import build_report
+
+    console = Console(stderr=True)
+    columns = (TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn())
+    with Progress(*columns, console=console, transient=True) as progress:
+        task = progress.add_task("Starting", total=None)
+
+        def show(description: str, done: int, total: int) -> None:
+            progress.update(task, description=description, completed=done, total=total)
+
+        return build_report(output, progress=show)

@@ -1,9 +1,204 @@
-"""Subcommands (placeholder until implemented)."""
+"""``stickslip curve`` and ``stickslip critical``: the steady friction curve (Eqs 6-8) and its minimum (Eq 9).
+
+Output in SI base units for machines (csv, json) and in um/s and Pa for
+people (the rich table and the ``critical`` summary).
+"""
 
 from __future__ import annotations
 
+import io
+from pathlib import Path
+from typing import Any
+
 import click
+import numpy as np
+
+from ..errors import ParameterError
+from .common import emit_json, params_options, positive, save_figure, write_text
+from .params_cmd import human, load_cli_parameters, print_rich, si_text
+
+DEFAULT_VMIN = "10 um/s"
+DEFAULT_VMAX = "10 mm/s"
+DEFAULT_POINTS = 50
+#: Columns of csv/json output, with the SI unit written in the csv header.
+COLUMNS = (
+    ("velocity", "m/s"),
+    ("stress", "Pa"),
+    ("bonded_fraction", ""),
+    ("stress_slope", "Pa s/m"),
+)
+
+
+def _velocity(text: str, name: str) -> float:
+    """A positive, finite velocity from an option value (unit optional; a bare number is m/s)."""
+    return positive(si_text(text, name), "velocity", name)
+
+
+def _velocities(
+    velocity: tuple[str, ...], vmin: str | None, vmax: str | None, points: int | None
+) -> tuple[np.ndarray, float, float]:
+    """The velocities to evaluate, and the range (m/s) to plot."""
+    if velocity:
+        used = [flag for flag, value in (("--vmin", vmin), ("--vmax", vmax), ("--points", points)) if value is not None]
+        if used:
+            raise click.UsageError(f"--velocity cannot be combined with {', '.join(used)}: give a list or a range")
+        values = np.array([_velocity(text, "--velocity") for text in velocity])
+        lo = min(_velocity(DEFAULT_VMIN, "--vmin"), float(values.min()) / 1.5)
+        hi = max(_velocity(DEFAULT_VMAX, "--vmax"), float(values.max()) * 1.5)
+        return values, lo, hi
+    low_text = vmin if vmin is not None else DEFAULT_VMIN
+    high_text = vmax if vmax is not None else DEFAULT_VMAX
+    lo, hi = _velocity(low_text, "--vmin"), _velocity(high_text, "--vmax")
+    if lo >= hi:
+        raise ParameterError(f"--vmin {low_text!r} ({lo:g} m/s) must be below --vmax {high_text!r} ({hi:g} m/s)")
+    count = DEFAULT_POINTS if points is None else points
+    return np.geomspace(lo, hi, count), lo, hi
+
+
+def curve_csv(columns: dict[str, np.ndarray]) -> str:
+    """CSV in SI with units in the header brackets (readable by :func:`stickslip.tables.read_table`)."""
+    out = io.StringIO()
+    out.write(",".join(f"{name} [{unit}]" if unit else name for name, unit in COLUMNS) + "\n")
+    for row in zip(*(columns[name] for name, _ in COLUMNS), strict=True):
+        out.write(",".join(repr(float(x)) for x in row) + "\n")
+    return out.getvalue()
+
+
+def curve_table(columns: dict[str, np.ndarray], title: str) -> Any:
+    """A rich table in um/s and Pa, with the branch (sign of dsigma/dV) of each row."""
+    from rich.table import Table
+
+    table = Table(title=title, title_justify="left")
+    for heading in ("V [µm/s]", "σ [Pa]", "N/N0", "dσ/dV [Pa s/mm]", "branch"):
+        table.add_column(heading, justify="right" if heading != "branch" else "left")
+    for v, s, n, d in zip(*(columns[name] for name, _ in COLUMNS), strict=True):
+        branch = "weakening" if d < 0 else "strengthening" if d > 0 else "extremum"
+        table.add_row(f"{v * 1e6:.6g}", f"{s:.6g}", f"{n:.4g}", f"{d * 1e-3:.5g}", branch)
+    return table
+
+
+@click.command("curve")
+@click.option("--vmin", default=None, metavar="V", help=f"Lowest velocity of the range [default: {DEFAULT_VMIN}].")
+@click.option("--vmax", default=None, metavar="V", help=f"Highest velocity of the range [default: {DEFAULT_VMAX}].")
+@click.option(
+    "--points",
+    type=click.IntRange(min=2),
+    default=None,
+    help=f"Number of log-spaced velocities [default: {DEFAULT_POINTS}].",
+)
+@click.option(
+    "--velocity",
+    multiple=True,
+    metavar="V",
+    help='A velocity to evaluate, e.g. "350 um/s" (repeatable; replaces the range).',
+)
+@click.option("--no-aging", is_flag=True, help="Drop the aging term of Eq 6 (the paper's no-aging curve).")
+@click.option(
+    "--format", "fmt", type=click.Choice(["table", "csv", "json"]), default="table", show_default=True, help="Output."
+)
+@click.option("-o", "--output", type=click.Path(dir_okay=False, path_type=Path), help="Write the output here.")
+@click.option(
+    "--plot",
+    "plot_path",
+    type=click.Path(dir_okay=False, path_type=Path),
+    help="Also save the figure of Fig 1/Fig 4 (sigma against log V, with and without aging).",
+)
+@params_options
+def curve_command(
+    vmin: str | None,
+    vmax: str | None,
+    points: int | None,
+    velocity: tuple[str, ...],
+    no_aging: bool,
+    fmt: str,
+    output: Path | None,
+    plot_path: Path | None,
+    params_name: str,
+    overrides: tuple[str, ...],
+) -> None:
+    """The steady friction curve sigma(V) of Eqs 6-8.
+
+    Velocities accept units ("350 um/s", "1 mm/s"); a bare number is m/s.
+    csv and json are in SI base units; the table uses um/s and Pa.
+    """
+    from ..model.steady import steady_state
+
+    values, lo, hi = _velocities(velocity, vmin, vmax, points)
+    params = load_cli_parameters(params_name, overrides)
+    result = steady_state(params, values, aging=not no_aging)
+    columns = {name: np.ravel(getattr(result, name)) for name, _ in COLUMNS}
+    if fmt == "json":
+        emit_json(columns, output)
+    elif fmt == "csv":
+        text = curve_csv(columns)
+        if output is None:
+            click.echo(text, nl=False)
+        else:
+            write_text(output, text)
+    else:
+        title = f"Steady friction curve, {params.name}, {'without' if no_aging else 'with'} aging"
+        print_rich(curve_table(columns, title), output=output)
+    if plot_path is not None:
+        _save_curve_plot(params, values, columns["stress"], lo, hi, bool(velocity), no_aging, plot_path)
+
+
+def _save_curve_plot(
+    params: Any,
+    values: np.ndarray,
+    stress: np.ndarray,
+    lo: float,
+    hi: float,
+    mark: bool,
+    no_aging: bool,
+    path: Path,
+) -> None:
+    from ..plotting import UM_PER_S, figure_steady_curve
+
+    fig = figure_steady_curve(params, vmin=lo, vmax=hi)
+    if mark:  # the requested velocities, on the curve they were computed with
+        ax = fig.axes[0]
+        label = "requested (without aging)" if no_aging else "requested (with aging)"
+        ax.plot(values * UM_PER_S, stress, "s", markersize=6, color="#e67e22", label=label, zorder=8)
+        ax.legend(loc="lower right", frameon=False)
+    save_figure(fig, path)
+
+
+@click.command("critical")
+@click.option("--json", "as_json", is_flag=True, help="Print JSON in SI units.")
+@params_options
+def critical_command(as_json: bool, params_name: str, overrides: tuple[str, ...]) -> None:
+    """Vc and sigma_c (Eq 9): the minimum of the aging curve.
+
+    Also prints the maximum (turnover) of the no-aging curve.  When the
+    curve has no minimum the message says why, and the exit status is 0.
+    """
+    from ..model.critical import critical_point
+
+    params = load_cli_parameters(params_name, overrides)
+    point = critical_point(params)
+    if as_json:
+        emit_json(point.as_dict())
+        return
+    lines = [f"Critical point (Eq 9), parameter set {params.name}:"]
+    if point.exists:
+        lines += [
+            f"  Vc  = {point.velocity * 1e6:.6g} µm/s   (critical velocity: minimum of the aging curve)",
+            f"  σc  = {point.stress:.6g} Pa   (critical stress)",
+        ]
+    else:
+        lines.append(f"  none: {point.message}")
+    lines.append("No-aging curve turnover (its maximum; jump velocities lie below it):")
+    if point.turnover_velocity is not None:
+        lines += [
+            f"  V   = {human(point.turnover_velocity, 'velocity')}",
+            f"  σ   = {point.turnover_stress:.6g} Pa",
+        ]
+    else:
+        lines.append(f"  none: {point.turnover_message}")
+    click.echo("\n".join(lines))
 
 
 def register(cli: click.Group) -> None:
-    """Add this module's commands to the stickslip group."""
+    """Add ``stickslip curve`` and ``stickslip critical`` to the group."""
+    cli.add_command(curve_command)
+    cli.add_command(critical_command)

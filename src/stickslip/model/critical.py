@@ -80,6 +80,28 @@ def find_extrema(
     return tuple(found)
 
 
+def _no_minimum_message(params: Parameters, extrema: tuple[Extremum, ...]) -> str:
+    """Say in words why there is no Vc, from the slope of the curve at the ends of the range."""
+    lo, hi = SEARCH_RANGE
+    span = f"between {lo:g} and {hi:g} m/s"
+    if not extrema:
+        slope = float(steady_state(params, np.sqrt(lo * hi)).stress_slope)
+        if slope > 0:
+            return (
+                f"the steady friction curve with aging rises monotonically {span}: no velocity-weakening branch,"
+                " so no critical velocity (steady sliding is stable at every pulling velocity in that range)"
+            )
+        return (
+            f"the steady friction curve with aging falls monotonically {span}: it is velocity-weakening throughout"
+            " and has no minimum, so no critical velocity separates stick-slip from steady sliding in that range"
+        )
+    return (
+        f"the steady friction curve with aging has no minimum {span} (only a maximum at"
+        f" {extrema[0].velocity:.6g} m/s): the weakening branch lies above it, and there is no critical velocity"
+        " in the sense of Eq 9"
+    )
+
+
 def critical_point(params: Parameters) -> CriticalPoint:
     """Vc and sigma_c (Eq 9): the lowest-velocity minimum of the aging curve.
 
@@ -94,11 +116,7 @@ def critical_point(params: Parameters) -> CriticalPoint:
         message = f"minimum of the aging curve at Vc = {v:.6g} m/s, sigma_c = {s:.6g} Pa"
     else:
         v = s = None
-        message = (
-            "the steady friction curve with aging has no minimum between "
-            f"{SEARCH_RANGE[0]:g} and {SEARCH_RANGE[1]:g} m/s: no velocity-weakening branch, so no "
-            "critical velocity (sliding is steady at every pulling velocity in that range)"
-        )
+        message = _no_minimum_message(params, extrema)
     maxima = [e for e in find_extrema(params, aging=False) if e.kind == "maximum"]
     if maxima:
         tv, ts = maxima[0].velocity, maxima[0].stress

@@ -25,6 +25,7 @@ integral (the same panels), not from finite differences.
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
@@ -38,22 +39,42 @@ if TYPE_CHECKING:  # pragma: no cover
     import pandas as pd
     from matplotlib.axes import Axes
 
-#: Quadrature settings: nodes per panel, and the largest change of the
-#: log-hazard (LOG_HAZARD_STEP) and of the cumulative hazard (HAZARD_STEP)
-#: allowed across one panel; panels near x = 1 shrink geometrically (END_RATIO).
-ORDER = 14
-LOG_HAZARD_STEP = 5.0
-HAZARD_STEP = 5.0
-END_RATIO = 0.5
-WIDEST_PANEL = 0.5
-#: The survival is cut where the cumulative hazard exceeds this (exp(-40) ~ 4e-18).
-HAZARD_CUTOFF = 40.0
-#: A stretch whose hazard integral is below this is crossed in one panel.
-NEGLIGIBLE_HAZARD = 1e-13
+@dataclass(frozen=True)
+class QuadratureSettings:
+    """Panel rule of the steady-state quadrature (defaults give ~1e-10 relative error).
+
+    order: Gauss-Legendre nodes per panel.  log_hazard_step / hazard_step: the
+    largest change of the log-hazard L and of the cumulative hazard H allowed
+    across one panel.  end_ratio: panels near x = 1 span at most this fraction
+    of the remaining gap 1 - x.  Coarser settings exist for convergence studies.
+    """
+
+    order: int = 16
+    log_hazard_step: float = 16.0
+    hazard_step: float = 16.0
+    end_ratio: float = 0.7
+    widest_panel: float = 0.5
+    #: the survival is cut where H exceeds this (exp(-36) ~ 2e-16)
+    hazard_cutoff: float = 36.0
+    #: a stretch whose hazard integral is below this is crossed in one panel
+    negligible_hazard: float = 1e-13
+
+    def refined(self, factor: float) -> QuadratureSettings:
+        """Panels ``factor`` times narrower (same order): for convergence tests."""
+        return dataclasses.replace(
+            self,
+            log_hazard_step=self.log_hazard_step / factor,
+            hazard_step=self.hazard_step / factor,
+            end_ratio=self.end_ratio / factor,
+            widest_panel=self.widest_panel / factor,
+        )
+
+
+DEFAULT_QUADRATURE = QuadratureSettings()
 #: With no FENE term (a = 0) the march stops this close to x = 1.
 SMALLEST_GAP = 1e-30
-MAX_PANELS = 5000
-BISECTIONS = 8
+MAX_PANELS = 20000
+BISECTIONS = 6
 _LOG_CAP = 700.0  # exp(700) ~ 1e304: keeps e^L finite where S is long zero
 
 
@@ -134,17 +155,17 @@ def _hazard(x: np.ndarray, y: np.ndarray, log_t: np.ndarray, a: float, alpha: np
     return np.exp(np.minimum(_log_hazard(x, y, log_t, a, alpha), _LOG_CAP))
 
 
-def _panel_width(x: np.ndarray, y: np.ndarray, s: _Scales) -> np.ndarray:
+def _panel_width(x: np.ndarray, y: np.ndarray, s: _Scales, q: QuadratureSettings) -> np.ndarray:
     """Width of the next panel at left end x (y = 1 - x), from explicit bounds.
 
-    A panel [x, x+w] is good when it is resolved (|L'| w <= LOG_HAZARD_STEP and
-    e^L w <= HAZARD_STEP) or negligible (e^L w <= NEGLIGIBLE_HAZARD).  L is
+    A panel [x, x+w] is good when it is resolved (|L'| w <= q.log_hazard_step and
+    e^L w <= q.hazard_step) or negligible (e^L w <= q.negligible_hazard).  L is
     convex, so |L'| and e^L are largest at an end of the panel and testing both
     ends decides; both tests only get harder as w grows, so the widest good w
     is found by geometric bisection between a width known to be good and the
     widest allowed panel (WIDEST_PANEL, and END_RATIO * y towards x = 1).
     """
-    widest = np.minimum(WIDEST_PANEL, END_RATIO * y)
+    widest = np.minimum(q.widest_panel, q.end_ratio * y)
     h_left = _hazard(x, y, s.log_t, s.a, s.alpha)
     slope_left = np.abs(_log_hazard_slope(x, y, s.a, s.alpha))
 
@@ -152,19 +173,19 @@ def _panel_width(x: np.ndarray, y: np.ndarray, s: _Scales) -> np.ndarray:
         h_right = _hazard(x + w, y - w, s.log_t, s.a, s.alpha)
         slope_right = np.abs(_log_hazard_slope(x + w, y - w, s.a, s.alpha))
         h_max = np.maximum(h_left, h_right) * w
-        resolved = (np.maximum(slope_left, slope_right) * w <= LOG_HAZARD_STEP) & (h_max <= HAZARD_STEP)
-        return resolved | (h_max <= NEGLIGIBLE_HAZARD)
+        resolved = (np.maximum(slope_left, slope_right) * w <= q.log_hazard_step) & (h_max <= q.hazard_step)
+        return resolved | (h_max <= q.negligible_hazard)
 
     ok = good(widest)
     if np.all(ok):
         return widest
     # a width that is good for sure: capped by the left end, then once by the right end
-    low = np.minimum(widest, LOG_HAZARD_STEP / np.maximum(slope_left, 1e-300))
-    low = np.minimum(low, HAZARD_STEP / np.maximum(h_left, 1e-300))
+    low = np.minimum(widest, q.log_hazard_step / np.maximum(slope_left, 1e-300))
+    low = np.minimum(low, q.hazard_step / np.maximum(h_left, 1e-300))
     slope_right = np.abs(_log_hazard_slope(x + low, y - low, s.a, s.alpha))
     h_right = _hazard(x + low, y - low, s.log_t, s.a, s.alpha)
-    low = np.minimum(low, LOG_HAZARD_STEP / np.maximum(slope_right, 1e-300))
-    low = np.minimum(low, HAZARD_STEP / np.maximum(h_right, 1e-300))
+    low = np.minimum(low, q.log_hazard_step / np.maximum(slope_right, 1e-300))
+    low = np.minimum(low, q.hazard_step / np.maximum(h_right, 1e-300))
     low = np.where(ok, widest, low)
     top = widest.copy()
     for _ in range(BISECTIONS):
@@ -184,13 +205,13 @@ class _Integrals:
     nodes: list[list[np.ndarray]] | None  # per velocity: panels of (x, S)
 
 
-def _march(s: _Scales, keep_nodes: bool = False) -> _Integrals:
+def _march(s: _Scales, q: QuadratureSettings, keep_nodes: bool = False) -> _Integrals:
     """Integrate i, j and their ln V derivatives panel by panel from x = 0.
 
     All velocities advance together; each finishes when its cumulative hazard
-    passes HAZARD_CUTOFF (the survival is then below 4e-18) or x reaches 1.
+    passes ``hazard_cutoff`` (the survival is then below 2e-16) or x reaches 1.
     """
-    rule = panel_rule(ORDER)
+    rule = panel_rule(q.order)
     t_half = 0.5 * (rule.nodes + 1.0)  # node positions in [0, 1] of a panel
     integrate = rule.cumulative.T  # (K, K+1): right-multiply row vectors of samples
     weights = rule.weights
@@ -204,7 +225,7 @@ def _march(s: _Scales, keep_nodes: bool = False) -> _Integrals:
             return out
         sub = _Scales(s.log_t[active], s.a, s.alpha[active], s.beta[active], s.birth[active])
         xl, yl = x_left[active], y_left[active]
-        w = _panel_width(xl, yl, sub)
+        w = _panel_width(xl, yl, sub, q)
         x = xl[:, None] + w[:, None] * t_half
         y = yl[:, None] - w[:, None] * t_half
         h = _hazard(x, y, sub.log_t[:, None], s.a, sub.alpha[:, None])
@@ -227,7 +248,7 @@ def _march(s: _Scales, keep_nodes: bool = False) -> _Integrals:
         moment[active] += cum_g[:, -1]
         x_left[active] = xl + w
         y_left[active] = yl - w
-        done = (hazard[active] >= HAZARD_CUTOFF) | (y_left[active] <= SMALLEST_GAP)
+        done = (hazard[active] >= q.hazard_cutoff) | (y_left[active] <= SMALLEST_GAP)
         active = active[~done]
     raise ModelError("steady-state quadrature did not converge: more than %d panels needed" % MAX_PANELS)
 
@@ -244,13 +265,18 @@ def _check_velocity(velocity: Any) -> np.ndarray:
 
 
 def steady_state(
-    params: Parameters, velocity: Any, aging: bool = True, distribution: bool = False
+    params: Parameters,
+    velocity: Any,
+    aging: bool = True,
+    distribution: bool = False,
+    quadrature: QuadratureSettings = DEFAULT_QUADRATURE,
 ) -> SteadyState:
     """The steady friction stress, bonded fraction and dsigma/dV at each sliding velocity (Eqs 6-8).
 
     ``velocity`` is in m/s (scalar or array); ``aging=False`` drops the aging
     term of Eq 6 (the paper's no-aging curve).  With ``distribution=True`` the
     age distribution n(t_a) of Eqs 6-7 is kept at the quadrature nodes.
+    ``quadrature`` sets the panel rule (see :class:`QuadratureSettings`).
 
     Raises :class:`ModelError` when the stress is infinite: with a zero
     activation length bonds survive to full extension, where the FENE force
@@ -264,7 +290,7 @@ def steady_state(
         )
     flat = np.ravel(v)
     s = _scales(params, flat, aging)
-    got = _march(s, keep_nodes=distribution)
+    got = _march(s, quadrature, keep_nodes=distribution)
     denom = s.birth + got.i
     b = params.bonds
     scale = b.chain_stiffness * b.site_density * b.max_extension

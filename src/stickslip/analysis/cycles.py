@@ -1,0 +1,517 @@
+"""Per-cycle characteristics of a measured stick-slip record (the rows of Table 1).
+
+For each stick phase found by :mod:`.detect` the stress is fitted by a
+straight line (Eq 12: the block is stuck, dsigma/dt = K V0 with
+K = (G_d/h) ln(B/l)/(B/l - 1), Eq 17), and both ends of the line are located
+by hinge fits against the adjacent slip branches (:mod:`.fits`).  Then
+
+* ``critical_stress`` sigma_c = the line at the start corner (where the stick began),
+* ``peak_stress`` sigma_s     = the line at the end corner (Eq 16),
+* ``stick_time`` t_s          = end corner - start corner,
+* ``stick_slope`` and its standard error from the regression (corners excluded
+  by a small margin),
+* ``stiffness`` G_d/h         = slope / (V0 * geometric factor)  (Eq 17),
+* ``jump_velocity`` V_s       = where the steady curve carries sigma_s (Eq 8,
+  :func:`stickslip.model.jump.jump_velocity`),
+* ``slip_time``               = next start corner - end corner,
+* ``period``                  = next start corner - start corner.
+
+A cycle is one stick phase and the slip that follows; quantities that the
+record does not contain (a stick cut by its start, a slip cut by its end) are
+None and the cycle is ``complete=False``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass, field
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from ..errors import DataError, ParameterError
+from ..parameters import Parameters, load_parameters
+from .detect import MEDIAN_WIDTH, Coarse, coarse_segments, rise_start
+from .fits import QUADRATIC, Corner, Line, fit_corner, fit_line
+from .traces import Trace, check_trace
+
+if TYPE_CHECKING:  # pragma: no cover
+    import pandas as pd
+    from matplotlib.axes import Axes
+
+#: Slip-side window at the end corner: at most this fraction of the stress drop ...
+BRANCH_FRACTION = 0.25
+#: ... and at most this fraction of the slip's duration.
+BRANCH_TIME_FRACTION = 0.25
+#: A sample this many noise levels off the stick line belongs to a slip.
+DEVIATION_SIGMAS = 5.0
+#: Slip-side window at the start corner (fractions of the drop and of the slip time) and its shape.
+START_FRACTION = 0.35
+START_TIME_FRACTION = 0.35
+START_POWERS: tuple[float, ...] | None = QUADRATIC
+#: Fraction of the stick phase used on the stick side of a hinge fit.
+STICK_WINDOW = 0.3
+#: Margin excluded at each real corner from the stick-line regression (fraction of the phase).
+LINE_MARGIN = 0.05
+#: R^2 above which a record without slips is one linear stick rise ("stuck").
+STUCK_R2 = 0.9
+
+#: The per-cycle quantities summarised by mean and standard deviation, with their SI units.
+CYCLE_QUANTITIES = {
+    "critical_stress": "Pa",
+    "stick_slope": "Pa/s",
+    "stiffness": "Pa/m",
+    "peak_stress": "Pa",
+    "stick_time": "s",
+    "jump_velocity": "m/s",
+    "slip_time": "s",
+    "period": "s",
+    "stress_drop": "Pa",
+}
+
+
+#: CycleResult fields kept for plotting, not reported.
+_PRIVATE_FIELDS = ("line", "stick_from", "stick_to")
+
+
+@dataclass(frozen=True)
+class CycleResult:
+    """One stick phase and the slip after it (SI units; None where the record does not show it)."""
+
+    index: int
+    complete: bool
+    start_time: float | None
+    peak_time: float | None
+    end_time: float | None
+    critical_stress: float | None
+    stick_slope: float | None
+    stick_slope_stderr: float | None
+    stiffness: float | None
+    stiffness_stderr: float | None
+    peak_stress: float | None
+    stick_time: float | None
+    jump_velocity: float | None
+    slip_time: float | None
+    period: float | None
+    stress_drop: float | None
+    stick_points: int
+    stick_rms: float | None
+    message: str = ""
+    line: Line | None = field(default=None, repr=False, compare=False)
+    stick_from: float = field(default=math.nan, repr=False, compare=False)
+    stick_to: float = field(default=math.nan, repr=False, compare=False)
+
+    def as_dict(self) -> dict[str, Any]:
+        data = asdict(self)
+        for key in _PRIVATE_FIELDS:
+            data.pop(key)
+        return data
+
+
+@dataclass(frozen=True)
+class TraceAnalysis:
+    """Result of :func:`analyze_trace`: the regime, the cycles and their summary."""
+
+    time: np.ndarray
+    stress: np.ndarray
+    pulling_velocity: float
+    regime: str  # "stick-slip" | "steady" | "stuck"
+    message: str
+    cycles: tuple[CycleResult, ...]
+    summary: dict[str, Any]
+    noise: float
+    threshold: float
+    steady_from: float | None
+    parameters: Parameters = field(repr=False)
+    source: str = "trace"
+
+    def as_dict(self) -> dict[str, Any]:
+        """JSON-ready dictionary (SI units)."""
+        return {
+            "source": self.source,
+            "regime": self.regime,
+            "message": self.message,
+            "pulling_velocity": self.pulling_velocity,
+            "noise": self.noise,
+            "drop_threshold": self.threshold,
+            "cycles": [c.as_dict() for c in self.cycles],
+            "summary": self.summary,
+        }
+
+    def to_frame(self) -> pd.DataFrame:
+        """One row per cycle."""
+        import pandas as pd
+
+        columns = [name for name in CycleResult.__dataclass_fields__ if name not in _PRIVATE_FIELDS]
+        return pd.DataFrame([c.as_dict() for c in self.cycles], columns=columns)
+
+    def plot(self, ax: Axes | None = None, **kwargs: Any) -> Axes:
+        from .plots import plot_analysis
+
+        return plot_analysis(self, ax=ax, **kwargs)
+
+
+@dataclass
+class _Stick:
+    """Working record of one stick phase while it is being fitted."""
+
+    start_guess: float | None
+    end_guess: float | None
+    prev_peak: tuple[float, float] | None  # coarse (time, level) of the peak before
+    start_level: float | None
+    end_level: float | None
+    next_level: float | None  # coarse level the slip after the peak falls to
+    next_time: float | None = None  # coarse time where it gets there
+    line: Line | None = None
+    start: Corner | None = None
+    end: Corner | None = None
+
+
+def analyze_trace(
+    time: Any,
+    stress: Any,
+    pulling_velocity: float,
+    params: Parameters | None = None,
+    source: str = "trace",
+) -> TraceAnalysis:
+    """Detect stick phases, slips and cycles in a stress record and measure Table 1's quantities.
+
+    ``time`` (s) and ``stress`` (Pa, NaN for gaps) are arrays; times strictly
+    increasing.  ``time`` may instead be a :class:`~.traces.Trace` from
+    :func:`~.traces.read_trace`, with ``stress=None``.  ``pulling_velocity`` V0 (m/s) turns the stick slope into a
+    stiffness with the geometric factor of ``params.block`` (Eq 17);
+    ``params`` (default gelatin-glass) also gives the steady curve on which
+    the jump velocity is read.
+    """
+    if isinstance(time, Trace):
+        if stress is not None:
+            raise DataError("analyze_trace: give either a Trace (and stress=None) or time and stress arrays")
+        trace = time
+    else:
+        trace = check_trace(time, stress, source=source)
+    v0 = _check_velocity(pulling_velocity)
+    params = load_parameters("gelatin-glass") if params is None else params
+    valid = trace.valid
+    t, x = trace.time[valid], trace.stress[valid]
+    coarse = coarse_segments(t, x)
+    if np.median(x) < -coarse.threshold:
+        raise DataError(
+            f"{trace.source}: the stress is negative over most of the record (median {np.median(x):.4g} Pa);"
+            " friction stress is taken positive: flip the sign of the column"
+        )
+    sticks = _stick_phases(t, x, coarse)
+    for stick in sticks:
+        _fit_stick(t, x, coarse, stick)
+    sticks = [s for s in sticks if s.line is not None]
+    regime, steady_from = _regime(t, x, coarse, sticks)
+    cycles = _cycles(sticks, v0, params, steady_from is not None)
+    summary = _summary(t, x, cycles, regime, steady_from, v0)
+    message = _message(regime, cycles, coarse, summary)
+    return TraceAnalysis(
+        time=trace.time,
+        stress=trace.stress,
+        pulling_velocity=v0,
+        regime=regime,
+        message=message,
+        cycles=tuple(cycles),
+        summary=summary,
+        noise=coarse.noise,
+        threshold=coarse.threshold,
+        steady_from=steady_from,
+        parameters=params,
+        source=trace.source,
+    )
+
+
+def _check_velocity(value: Any) -> float:
+    try:
+        v0 = float(value)
+    except (TypeError, ValueError):
+        raise ParameterError(f"pulling_velocity: expected a velocity in m/s, got {value!r}") from None
+    if not math.isfinite(v0) or v0 <= 0:
+        raise ParameterError(f"pulling_velocity: expected a positive finite velocity in m/s, got {value!r}")
+    return v0
+
+
+def _stick_phases(t: np.ndarray, x: np.ndarray, coarse: Coarse) -> list[_Stick]:
+    sticks = []
+    for k, peak in enumerate(coarse.peaks):
+        prev = (float(coarse.peaks[k - 1]), float(coarse.peak_levels[k - 1])) if k else None
+        next_time = None
+        if k + 1 < coarse.peaks.size:
+            next_level, next_time = float(coarse.trough_levels[k + 1]), float(coarse.troughs[k + 1])
+        elif coarse.final_trough is not None:
+            next_level, next_time = coarse.final_level, coarse.final_trough
+        else:
+            after = coarse.grid_time >= peak
+            next_level = float(np.min(coarse.grid_stress[after]))
+        sticks.append(
+            _Stick(
+                float(coarse.troughs[k]),
+                float(peak),
+                prev,
+                float(coarse.trough_levels[k]),
+                float(coarse.peak_levels[k]),
+                next_level,
+                next_time,
+            )
+        )
+    if coarse.final_trough is not None:
+        prev = (float(coarse.peaks[-1]), float(coarse.peak_levels[-1]))
+        sticks.append(_Stick(coarse.final_trough, None, prev, coarse.final_level, None, None))
+    if not coarse.peaks.size:
+        q = rise_start(coarse.grid_stress, coarse.threshold)
+        sticks.append(_Stick(float(coarse.grid_time[q]), None, None, float(coarse.grid_stress[q]), None, None))
+    return sticks
+
+
+def _fit_stick(t: np.ndarray, x: np.ndarray, coarse: Coarse, stick: _Stick) -> None:
+    """Stick line and corners: line on the coarse interior -> corners -> line between the corners -> corners."""
+    step = float(np.median(np.diff(t)))
+    lo = stick.start_guess if stick.start_guess is not None else float(t[0])
+    hi = stick.end_guess if stick.end_guess is not None else float(t[-1])
+    margin = min(max(3 * MEDIAN_WIDTH * step, 0.1 * (hi - lo)), 0.25 * (hi - lo))
+    inner_lo = lo + margin if lo > t[0] else lo
+    inner_hi = hi - margin if stick.end_guess is not None else hi
+    line = _line_between(t, x, inner_lo, inner_hi) or _line_between(t, x, lo, hi)
+    if line is None:
+        return
+    stick.line = line
+    stick.start = _start_corner(t, x, coarse, stick, step)
+    stick.end = _end_corner(t, x, coarse, stick, step)
+    began = stick.start is not None and stick.start.significant
+    a = stick.start.time if began else (float(t[0]) if stick.prev_peak is None else inner_lo)
+    b = stick.end.time if stick.end is not None else inner_hi
+    span = b - a
+    lo_cut = a + max(2 * step, LINE_MARGIN * span) if began else a
+    hi_cut = b - max(2 * step, LINE_MARGIN * span) if stick.end is not None else b
+    refit = _line_between(t, x, lo_cut, hi_cut) if hi_cut > lo_cut else None
+    if refit is not None:
+        stick.line = refit
+        stick.start = _start_corner(t, x, coarse, stick, step)
+        stick.end = _end_corner(t, x, coarse, stick, step)
+
+
+def _line_between(t: np.ndarray, x: np.ndarray, lo: float, hi: float) -> Line | None:
+    inside = (t >= lo) & (t <= hi)
+    return fit_line(t[inside], x[inside])
+
+
+def _stick_span(t: np.ndarray, stick: _Stick) -> float:
+    lo = stick.start.time if stick.start is not None else stick.start_guess
+    hi = stick.end.time if stick.end is not None else stick.end_guess
+    lo = float(t[0]) if lo is None else lo
+    hi = float(t[-1]) if hi is None else hi
+    return max(hi - lo, 0.0)
+
+
+def _start_corner(t: np.ndarray, x: np.ndarray, coarse: Coarse, stick: _Stick, step: float) -> Corner | None:
+    """Where the stick began: hinge between the end of the previous slip and the stick line."""
+    guess, line = stick.start_guess, stick.line
+    if guess is None or line is None:
+        return None
+    span = _stick_span(t, stick)
+    reach = max(5 * step, 0.1 * span)
+    top, level = stick.prev_peak if stick.prev_peak is not None else (float(t[0]), None)
+    hi = guess + reach if stick.end_guess is None else min(guess + reach, 0.5 * (guess + stick.end_guess))
+    near = np.nonzero((t >= top) & (t <= hi))[0]
+    # the last sample clearly above the stick line is the last one of the slip
+    off = near[x[near] - line(t[near]) > _deviation(coarse)]
+    if off.size == 0:
+        return None
+    last = int(off[-1])
+    branch_lo = t[last] - START_TIME_FRACTION * (t[last] - top)
+    if level is not None:
+        branch_lo = max(
+            branch_lo,
+            _crossing_before(coarse, t[last], stick.start_level + START_FRACTION * (level - stick.start_level)),
+        )
+    branch_lo = min(max(branch_lo, top), float(t[max(last - 1, 0)]))
+    search = (float(t[last]), float(t[last]) + reach)
+    inside = (t >= branch_lo) & (t <= search[1] + max(STICK_WINDOW * span, reach))
+    return fit_corner(t[inside], x[inside], line, False, search, coarse.noise, START_POWERS)
+
+
+def _end_corner(t: np.ndarray, x: np.ndarray, coarse: Coarse, stick: _Stick, step: float) -> Corner | None:
+    """Where the stick ended: hinge between the stick line and the start of the slip."""
+    guess, line = stick.end_guess, stick.line
+    if guess is None or line is None:
+        return None
+    span = _stick_span(t, stick)
+    reach = max(5 * step, 0.1 * span)
+    bottom = stick.next_time if stick.next_time is not None else float(t[-1])
+    lo = guess - reach if stick.start_guess is None else max(guess - reach, 0.5 * (guess + stick.start_guess))
+    near = np.nonzero((t >= lo) & (t <= bottom))[0]
+    # the first sample clearly below the stick line is the first one of the slip
+    off = near[line(t[near]) - x[near] > _deviation(coarse)]
+    if off.size == 0:
+        return None
+    first = int(off[0])
+    branch_hi = t[first] + BRANCH_TIME_FRACTION * (bottom - t[first])
+    branch_hi = min(
+        branch_hi,
+        _crossing_after(coarse, t[first], stick.end_level - BRANCH_FRACTION * (stick.end_level - stick.next_level)),
+    )
+    branch_hi = max(min(branch_hi, bottom), float(t[min(first + 1, t.size - 1)]))
+    search = (float(t[first]) - reach, float(t[first]))
+    inside = (t >= search[0] - max(STICK_WINDOW * span, reach)) & (t <= branch_hi)
+    return fit_corner(t[inside], x[inside], line, True, search, coarse.noise)
+
+
+def _deviation(coarse: Coarse) -> float:
+    """A departure from the stick line larger than noise: DEVIATION_SIGMAS noise levels."""
+    return max(DEVIATION_SIGMAS * coarse.noise, 1e-9 * float(np.max(np.abs(coarse.grid_stress))))
+
+
+def _crossing_after(coarse: Coarse, start: float, level: float) -> float:
+    """First grid time after ``start`` where the smoothed record falls below ``level``."""
+    g, y = coarse.grid_time, coarse.grid_stress
+    after = np.nonzero((g > start) & (y < level))[0]
+    return float(g[after[0]]) if after.size else float(g[-1])
+
+
+def _crossing_before(coarse: Coarse, end: float, level: float) -> float:
+    """Last grid time before ``end`` where the smoothed record is above ``level``."""
+    g, y = coarse.grid_time, coarse.grid_stress
+    before = np.nonzero((g < end) & (y > level))[0]
+    return float(g[before[-1]]) if before.size else float(g[0])
+
+
+def _regime(t: np.ndarray, x: np.ndarray, coarse: Coarse, sticks: list[_Stick]) -> tuple[str, float | None]:
+    if coarse.peaks.size:
+        if coarse.steady_from is not None:
+            return "steady", coarse.steady_from
+        return "stick-slip", None
+    whole = fit_line(t, x)
+    spread = float(np.sum((x - np.mean(x)) ** 2))
+    if whole is not None and spread > 0:
+        r2 = 1.0 - whole.rms**2 * whole.count / spread
+        rise = whole.slope * float(t[-1] - t[0])
+        if rise > coarse.threshold and r2 > STUCK_R2:
+            return "stuck", None
+    sticks.clear()
+    return "steady", float(t[0]) if coarse.steady_from is None else coarse.steady_from
+
+
+def _cycles(sticks: list[_Stick], v0: float, params: Parameters, ends_steady: bool) -> list[CycleResult]:
+    factor = params.block.geometric_factor
+    cycles = []
+    for k, stick in enumerate(sticks):
+        line = stick.line
+        start = stick.start if stick.start is not None and stick.start.significant else None
+        end = stick.end
+        following = sticks[k + 1] if k + 1 < len(sticks) else None
+        nxt = following.start if following is not None and following.start is not None else None
+        if nxt is not None and not nxt.significant:
+            nxt = None
+        if end is None:
+            nxt = None
+        peak = end.stress if end is not None else None
+        jump, jump_message = _jump(params, peak)
+        notes = [jump_message] if jump_message else []
+        if start is None:
+            notes.append("stick began before the record")
+        if end is None:
+            notes.append("record ends before the slip")
+        elif nxt is None:
+            notes.append(
+                "slip ends in steady sliding" if ends_steady and following is None else "record ends during the slip"
+            )
+        cycles.append(
+            CycleResult(
+                index=k + 1,
+                complete=start is not None and end is not None and nxt is not None,
+                start_time=start.time if start else None,
+                peak_time=end.time if end else None,
+                end_time=nxt.time if nxt else None,
+                critical_stress=start.stress if start else None,
+                stick_slope=line.slope,
+                stick_slope_stderr=line.slope_stderr,
+                stiffness=line.slope / (v0 * factor),
+                stiffness_stderr=line.slope_stderr / (v0 * factor),
+                peak_stress=peak,
+                stick_time=end.time - start.time if start and end else None,
+                jump_velocity=jump,
+                slip_time=nxt.time - end.time if nxt and end else None,
+                period=nxt.time - start.time if nxt and start else None,
+                stress_drop=end.stress - nxt.stress if nxt and end else None,
+                stick_points=line.count,
+                stick_rms=line.rms,
+                message="; ".join(notes),
+                line=line,
+                stick_from=start.time if start else line.t_min,
+                stick_to=end.time if end else line.t_max,
+            )
+        )
+    return cycles
+
+
+def _jump(params: Parameters, peak: float | None) -> tuple[float | None, str]:
+    if peak is None:
+        return None, ""
+    try:
+        from ..model.jump import jump_velocity
+    except ImportError:
+        return None, "jump velocity not computed: the jump solver (stickslip.model.jump) is not available"
+    if peak <= 0:
+        return None, f"no jump velocity: peak stress {peak:.4g} Pa is not positive"
+    result = jump_velocity(params, peak)
+    return (result.velocity, "" if result.velocity is not None else f"no jump velocity: {result.message}")
+
+
+def _stats(values: list[float]) -> dict[str, Any]:
+    n = len(values)
+    if n == 0:
+        return {"mean": None, "std": None, "n": 0}
+    array = np.asarray(values, dtype=float)
+    return {"mean": float(np.mean(array)), "std": float(np.std(array, ddof=1)) if n > 1 else None, "n": n}
+
+
+def _summary(
+    t: np.ndarray, x: np.ndarray, cycles: list[CycleResult], regime: str, steady_from: float | None, v0: float
+) -> dict[str, Any]:
+    summary: dict[str, Any] = {
+        "regime": regime,
+        "pulling_velocity": v0,
+        "n_cycles": len(cycles),
+        "n_complete": sum(c.complete for c in cycles),
+    }
+    for name in CYCLE_QUANTITIES:
+        summary[name] = _stats([getattr(c, name) for c in cycles if getattr(c, name) is not None])
+    if steady_from is not None:
+        inside = t >= steady_from
+        tail = x[inside]
+        trend = fit_line(t[inside], tail)
+        summary.update(
+            mean_stress=float(np.mean(tail)),
+            stress_std=float(np.std(tail, ddof=1)) if tail.size > 1 else None,
+            stress_sem=float(np.std(tail, ddof=1) / np.sqrt(tail.size)) if tail.size > 1 else None,
+            stress_slope=None if trend is None else trend.slope,
+            steady_from=float(steady_from),
+            steady_to=float(t[-1]),
+            steady_samples=int(tail.size),
+        )
+    return summary
+
+
+def _message(regime: str, cycles: list[CycleResult], coarse: Coarse, summary: dict[str, Any]) -> str:
+    complete = sum(c.complete for c in cycles)
+    if regime == "stick-slip":
+        text = f"stick-slip: {len(cycles)} cycle(s), {complete} complete"
+        if not any(c.start_time is not None and c.peak_time is not None for c in cycles):
+            text += " (no whole stick phase: too short a record to tell stick-slip from a transient)"
+        return text
+    if regime == "stuck":
+        return "stuck: the stress rises along one stick line and never drops; no slip in the record"
+    mean = summary["mean_stress"]
+    if cycles:
+        return (
+            f"steady sliding at {mean:.6g} Pa after {len(cycles)} stick-slip transient(s); no stick after the last slip"
+        )
+    drop = f"no stress drop larger than {coarse.threshold:.3g} Pa (10 noise levels)" if coarse.noise > 0 else "no drop"
+    text = f"steady sliding at {mean:.6g} Pa: {drop}"
+    if summary["steady_from"] > float(coarse.grid_time[0]):
+        text += f"; settled from t = {summary['steady_from']:.6g} s"
+    elif coarse.steady_from is None:
+        text += f"; the stress has not settled (it changes by {summary['stress_slope']:.3g} Pa/s)"
+    return text

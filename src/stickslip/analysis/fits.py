@@ -1,0 +1,248 @@
+"""Least-squares pieces of the trace analysis: the stick line and the corners.
+
+The stick phase of the model is a straight line (Eq 12, with the slope of
+Eq 17), and both ends of it are corners: the slope jumps from K (V0 - Vc) to
+K V0 where the block sticks and from K V0 to K (V0 - Vs) where it slips.  A
+corner is located by a *hinge fit*: the stick line (fixed, from the fit over
+the whole stick phase) on one side of the corner time tc, and a low-order
+polynomial joined continuously to it at tc on the other side,
+
+    sigma(t) = L(t)                                  on the stick side,
+    sigma(t) = L(tc) + c (t - tc) + d (t - tc)^2     on the slip side,
+
+with tc chosen to minimise the sum of squared residuals (for fixed tc the
+problem is linear in c, d).  The corner's stress is L(tc): the peak and the
+trough are read off the fitted line, never from a single noisy sample.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import minimize_scalar
+
+#: A corner is real when the hinge lowers the sum of squares by this many noise variances.
+CORNER_CHI2 = 30.0
+#: The slip branch is shortened (by this factor per step) down to this many samples ...
+MIN_BRANCH_SAMPLES = 6
+BRANCH_SHRINK = 0.6
+#: Branch shapes, as powers of |t - tc|: a straight line and a parabola.
+STRAIGHT = (1.0,)
+QUADRATIC = (1.0, 2.0)
+#: ... and may then be a quadratic if it has at least this many.
+QUADRATIC_MIN_SAMPLES = 6
+#: A branch is curved when a quadratic fits it better by this many noise variances.
+CURVATURE_CHI2 = 4.0
+
+
+@dataclass(frozen=True)
+class Line:
+    """sigma = intercept + slope (t - t_ref), from ordinary least squares."""
+
+    t_ref: float
+    intercept: float
+    slope: float
+    slope_stderr: float
+    rms: float
+    count: int
+    t_min: float  # time span of the fitted samples
+    t_max: float
+
+    def __call__(self, t: np.ndarray | float) -> np.ndarray | float:
+        return self.intercept + self.slope * (np.asarray(t) - self.t_ref)
+
+
+@dataclass(frozen=True)
+class Corner:
+    """A fitted corner of the stick line: time, stress on the line, the slip branch's slope there."""
+
+    time: float
+    stress: float
+    branch_slope: float
+    sse_gain: float
+    significant: bool
+
+
+def fit_line(t: np.ndarray, x: np.ndarray) -> Line | None:
+    """Straight-line least squares with the slope's standard error; None for fewer than 3 points."""
+    n = t.size
+    if n < 3:
+        return None
+    t_ref = float(np.mean(t))
+    u = t - t_ref
+    sxx = float(np.dot(u, u))
+    if sxx <= 0:
+        return None
+    slope = float(np.dot(u, x - np.mean(x)) / sxx)
+    intercept = float(np.mean(x))
+    residual = x - (intercept + slope * u)
+    sse = float(np.dot(residual, residual))
+    variance = sse / (n - 2)
+    slope_stderr = float(np.sqrt(variance / sxx))
+    return Line(t_ref, intercept, slope, slope_stderr, float(np.sqrt(sse / n)), n, float(t[0]), float(t[-1]))
+
+
+def fit_corner(
+    t: np.ndarray,
+    x: np.ndarray,
+    line: Line,
+    branch_after: bool,
+    search: tuple[float, float],
+    noise: float,
+    powers: tuple[float, ...] | None = None,
+) -> Corner | None:
+    """Hinge fit of a corner of ``line`` inside the samples ``t, x`` (one window around the corner).
+
+    ``branch_after`` is True at the end of a stick (the slip branch follows
+    the corner) and False at its start (the slip branch precedes it).  The
+    corner time is searched in ``search``.  The slip branch is
+    ``sum_k c_k |t - tc|**powers[k]`` on the whole window when ``powers`` is
+    given.  Otherwise it is a straight line when its samples allow (a
+    quadratic does not fit them significantly better); if not, the branch
+    window is shortened towards the corner, down to :data:`MIN_BRANCH_SAMPLES`,
+    where a quadratic is allowed.  None when the window holds no sample on
+    the slip side.
+    """
+    lo, hi = search
+    if hi <= lo or t.size < 3:
+        return None
+    sign = 1.0 if branch_after else -1.0
+    edge = hi if branch_after else lo
+    if not np.any(sign * (t - edge) > 0):
+        return None
+    on_line = x - line(t)
+    floor = max(noise, 1e-12 * max(1.0, float(np.max(np.abs(x)))))
+    if powers is not None:
+        tc, total, branch_slope, _, _ = _hinge(t, x, on_line, line, sign, search, powers)
+        gain = float(np.dot(on_line, on_line)) - total
+        return Corner(tc, float(line(tc)), branch_slope, gain, bool(gain > CORNER_CHI2 * floor**2))
+    first = _hinge(t, x, on_line, line, sign, search, STRAIGHT)
+    gain = float(np.dot(on_line, on_line)) - first[1]
+    significant = gain > CORNER_CHI2 * floor**2
+    # samples beyond the search interval are slip for sure; rank them by distance from it
+    distance = sign * (t - edge)
+    beyond = np.sort(distance[distance > 0])
+    reach = float(beyond[-1])
+    while True:
+        limit = reach if beyond.size <= MIN_BRANCH_SAMPLES else max(reach, float(beyond[MIN_BRANCH_SAMPLES - 1]))
+        keep = distance <= limit
+        tc, _, branch_slope, _, count = _hinge(t[keep], x[keep], on_line[keep], line, sign, search, STRAIGHT)
+        if _adequate(t[keep], x[keep], line, tc, sign, floor):
+            break
+        if limit <= float(beyond[min(MIN_BRANCH_SAMPLES, beyond.size) - 1]):
+            if count >= QUADRATIC_MIN_SAMPLES:
+                tc, _, branch_slope, _, count = _hinge(t[keep], x[keep], on_line[keep], line, sign, search, QUADRATIC)
+            break
+        reach *= BRANCH_SHRINK
+    return Corner(tc, float(line(tc)), branch_slope, gain, bool(significant))
+
+
+def _adequate(t: np.ndarray, x: np.ndarray, line: Line, tc: float, sign: float, noise: float) -> bool:
+    """Is a straight branch enough (a quadratic lowers its sum of squares by < CURVATURE_CHI2 noise variances)?"""
+    branch = sign * (t - tc) > 0
+    if np.count_nonzero(branch) < 3:
+        return True
+    _, straight = _branch_fit(t[branch], x[branch], line, tc, sign, STRAIGHT)
+    _, curved = _branch_fit(t[branch], x[branch], line, tc, sign, QUADRATIC)
+    return straight - curved <= CURVATURE_CHI2 * noise**2
+
+
+def _hinge(
+    t: np.ndarray,
+    x: np.ndarray,
+    on_line: np.ndarray,
+    line: Line,
+    sign: float,
+    search: tuple[float, float],
+    powers: tuple[float, ...],
+) -> tuple[float, float, float, float, int]:
+    """Best corner time, total SSE, branch slope at the corner, branch SSE and branch sample count."""
+    lo, hi = search
+    scale = max(float(t[-1] - t[0]), 1e-300)
+
+    def profile(tcs: np.ndarray) -> np.ndarray:
+        return _sse_profile(t, x, on_line, line, np.atleast_1d(tcs), sign, powers, scale)
+
+    inside = t[(t > lo) & (t < hi)]
+    candidates = np.unique(np.concatenate([[lo, hi], inside, 0.5 * (inside[1:] + inside[:-1])]))
+    values = profile(candidates)
+    best = int(np.argmin(values))
+    left = candidates[max(best - 1, 0)]
+    right = candidates[min(best + 1, candidates.size - 1)]
+    tc, value = float(candidates[best]), float(values[best])
+    if right > left:
+        refined = minimize_scalar(
+            lambda c: float(profile(np.array([c]))[0]),
+            bounds=(left, right),
+            method="bounded",
+            options={"xatol": 1e-3 * (right - left)},
+        )
+        if refined.fun < value:
+            tc, value = float(refined.x), float(refined.fun)
+    branch = sign * (t - tc) > 0
+    slope, branch_sse = _branch_fit(t[branch], x[branch], line, tc, sign, powers)
+    return tc, value, slope, branch_sse, int(np.count_nonzero(branch))
+
+
+def _sse_profile(
+    t: np.ndarray,
+    x: np.ndarray,
+    on_line: np.ndarray,
+    line: Line,
+    tcs: np.ndarray,
+    sign: float,
+    powers: tuple[float, ...],
+    scale: float,
+) -> np.ndarray:
+    """Hinge sum of squares for each corner time in ``tcs`` (vectorised over the candidates)."""
+    distance = sign * (t[None, :] - tcs[:, None]) / scale
+    branch = distance > 0
+    y = np.where(branch, x[None, :] - np.asarray(line(tcs))[:, None], 0.0)
+    stick_sse = (~branch).astype(float) @ (on_line * on_line)
+    reach = np.where(branch, distance, 0.0)
+    basis = [reach**p for p in powers]
+    n = len(powers)
+    gram = np.empty((tcs.size, n, n))
+    moment = np.empty((tcs.size, n))
+    for a in range(n):
+        moment[:, a] = np.sum(basis[a] * y, axis=1)
+        for b in range(a, n):
+            gram[:, a, b] = gram[:, b, a] = np.sum(basis[a] * basis[b], axis=1)
+    coef = _falling_fit(gram, moment, sign)
+    branch_sse = np.sum(y * y, axis=1) - np.sum(coef * moment, axis=1)
+    return stick_sse + np.maximum(branch_sse, 0.0)
+
+
+def _falling_fit(gram: np.ndarray, moment: np.ndarray, sign: float) -> np.ndarray:
+    """Least-squares coefficients (batched normal equations) with the branch falling at the corner.
+
+    During a slip V > V0, so the stress falls (Eq 17): the branch's slope at
+    the corner, sign * coef[0] in time, must be <= 0.  Without this bound a
+    parabola can bend up to meet the stick line tangentially and slide the
+    corner into the stick.  With one bound the constrained optimum is either
+    the free one or the one with coef[0] = 0.
+    """
+    coef = np.einsum("nij,nj->ni", np.linalg.pinv(gram, hermitian=True), moment)
+    rising = sign * coef[:, 0] > 0
+    if np.any(rising):
+        fixed = np.zeros((int(np.count_nonzero(rising)), gram.shape[1]))
+        if gram.shape[1] > 1:
+            sub = np.linalg.pinv(gram[rising][:, 1:, 1:], hermitian=True)
+            fixed[:, 1:] = np.einsum("nij,nj->ni", sub, moment[rising][:, 1:])
+        coef[rising] = fixed
+    return coef
+
+
+def _branch_fit(
+    t: np.ndarray, x: np.ndarray, line: Line, tc: float, sign: float, powers: tuple[float, ...]
+) -> tuple[float, float]:
+    """Slope at the corner and sum of squares of the (falling) branch joined to the line at tc."""
+    if t.size == 0:
+        return float(line.slope), 0.0
+    reach = sign * (t - tc)
+    basis = np.column_stack([reach**p for p in powers])
+    y = x - line(tc)
+    coef = _falling_fit((basis.T @ basis)[None], (basis.T @ y)[None], sign)[0]
+    r = y - basis @ coef
+    return float(sign * coef[0]), float(np.dot(r, r))

@@ -1,0 +1,137 @@
+"""Measured stress-time records: reading a CSV trace and checking it.
+
+A trace file has a ``time`` column and either ``stress`` or ``force`` (the
+latter divided by a contact area), units in header brackets as everywhere in
+stickslip (``time [s],stress [Pa]``; bare names are SI).  Empty or NaN stress
+cells are gaps and are kept as NaN; times must be present, finite and strictly
+increasing.  Every problem is a typed error naming the file and row.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..errors import DataError, ParameterError
+from ..tables import read_table
+
+#: Fewest usable (finite-stress) samples a trace must have.
+MIN_SAMPLES = 20
+
+TRACE_DIMENSIONS = {"time": "time", "stress": "stress", "force": "force"}
+
+
+@dataclass(frozen=True)
+class Trace:
+    """A stress record: ``time`` (s) and ``stress`` (Pa, NaN in gaps), with the file rows."""
+
+    time: np.ndarray
+    stress: np.ndarray
+    rows: np.ndarray
+    source: str
+
+    @property
+    def valid(self) -> np.ndarray:
+        """Boolean mask of the samples with a finite stress."""
+        return np.isfinite(self.stress)
+
+    @property
+    def duration(self) -> float:
+        return float(self.time[-1] - self.time[0])
+
+    def to_frame(self) -> Any:
+        import pandas as pd
+
+        return pd.DataFrame({"time": self.time, "stress": self.stress})
+
+
+def read_trace(path: str | Path, contact_area: float | None = None) -> Trace:
+    """Read a trace CSV: ``time`` and ``stress``, or ``time`` and ``force`` with ``contact_area`` (m^2).
+
+    Raises :class:`DataError` for a missing column, a bad cell, unsorted or
+    repeated times, or too few usable samples; :class:`ParameterError` for a
+    missing, superfluous or non-positive contact area.
+    """
+    table = read_table(path, TRACE_DIMENSIONS, required=["time"], allow_missing=["stress", "force"])
+    has_stress, has_force = "stress" in table, "force" in table
+    if has_stress and has_force:
+        raise DataError(f"{table.source}: give either a 'stress' or a 'force' column, not both")
+    if not (has_stress or has_force):
+        raise DataError(f"{table.source}: missing column 'stress' (or 'force' with a contact area)")
+    if has_force:
+        if contact_area is None:
+            raise ParameterError(f"{table.source}: the trace has a 'force' column; give the contact area to convert it")
+        area = _positive_area(contact_area)
+        stress = table["force"] / area
+    else:
+        if contact_area is not None:
+            raise ParameterError(
+                f"{table.source}: a contact area was given but the trace has a 'stress' column; it needs none"
+            )
+        stress = table["stress"]
+    return check_trace(table["time"], stress, source=table.source, rows=table.rows)
+
+
+def check_trace(
+    time: Any,
+    stress: Any,
+    source: str = "trace",
+    rows: Sequence[int] | np.ndarray | None = None,
+) -> Trace:
+    """Validate a record given as arrays and return it as a :class:`Trace`.
+
+    ``rows`` (file row numbers) are used in messages; without them samples are
+    named by their 0-based index.
+    """
+    t = _as_vector(time, "time", source)
+    s = _as_vector(stress, "stress", source)
+    if t.size != s.size:
+        raise DataError(f"{source}: time has {t.size} values but stress has {s.size}")
+    labels = np.arange(t.size) if rows is None else np.asarray(rows, dtype=int)
+    where = "row" if rows is not None else "sample"
+    bad = np.nonzero(~np.isfinite(t))[0]
+    if bad.size:
+        raise DataError(f"{source}: {where} {labels[bad[0]]}: time is missing or not finite")
+    bad = np.nonzero(np.isinf(s))[0]
+    if bad.size:
+        raise DataError(f"{source}: {where} {labels[bad[0]]}: stress is infinite")
+    steps = np.diff(t)
+    bad = np.nonzero(steps <= 0)[0]
+    if bad.size:
+        k = bad[0] + 1
+        what = "repeats" if steps[bad[0]] == 0 else "goes back from"
+        raise DataError(
+            f"{source}: {where} {labels[k]}: time {t[k]:g} s {what} the previous time {t[k - 1]:g} s;"
+            " times must be strictly increasing (sort the record and remove duplicates)"
+        )
+    usable = int(np.count_nonzero(np.isfinite(s)))
+    if usable < MIN_SAMPLES:
+        raise DataError(
+            f"{source}: record too short: {usable} samples with a stress value, need at least {MIN_SAMPLES}"
+        )
+    return Trace(time=t, stress=s, rows=np.asarray(labels), source=source)
+
+
+def _as_vector(values: Any, name: str, source: str) -> np.ndarray:
+    try:
+        array = np.asarray(values, dtype=float)
+    except (TypeError, ValueError):
+        raise DataError(f"{source}: {name}: expected numbers") from None
+    if array.ndim != 1:
+        raise DataError(f"{source}: {name}: expected a one-dimensional array, got shape {array.shape}")
+    return array
+
+
+def _positive_area(value: Any) -> float:
+    try:
+        area = float(value)
+    except (TypeError, ValueError):
+        raise ParameterError(f"contact_area: expected an area in m^2, got {value!r}") from None
+    if not math.isfinite(area) or area <= 0:
+        raise ParameterError(f"contact_area: expected a positive area, got {value!r}")
+    return area

@@ -1,0 +1,309 @@
+r"""Bayesian steady fit: posterior samples with emcee (optional extra ``stickslip[bayes]``).
+
+The sampled parameters are the ln-values of the keys the least-squares fit
+determined (:class:`~stickslip.fitting.steady_fit.SteadyFit.free_keys`); keys
+it fixed stay fixed, for the reasons it gave.  Stated priors:
+
+* each sampled ln-parameter is uniform on [ln x0 - ln 1e4, ln x0 + ln 1e4]
+  around its start value x0 (log-uniform, the fit's search box);
+* with stated ``stress_err`` the likelihood is Gaussian with those errors;
+  without, each point has an error s * stress with an unknown relative noise
+  s under the Jeffreys prior 1/s, integrated out analytically:
+  p(data | theta) ~ chi2(theta)^(-n/2).
+
+Vc and sigma_c (Eq 9) are computed for a random subset of the posterior
+samples (local solver around the best-fit Vc), which gives their posteriors;
+the credible band of sigma(V) comes from the same kind of subset.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from ..errors import ParameterError, StickslipError
+from ..model.steady import steady_state
+from ..parameters import Parameters, key_dimension
+from . import identify
+from .batch import stress_many
+from .critical_uncertainty import critical_many
+from .problem import SEARCH_BOX, Space
+from .results import Estimate
+
+if TYPE_CHECKING:  # pragma: no cover
+    import pandas as pd
+    from matplotlib.axes import Axes
+
+    from .data import SteadyData
+    from .steady_fit import SteadyFit
+
+#: Posterior samples used for Vc, sigma_c and the credible band.
+CRITICAL_DRAWS = 200
+BAND_DRAWS = 200
+
+
+class BayesUnavailable(StickslipError):
+    """emcee (or corner) is not installed."""
+
+
+def _emcee() -> Any:
+    try:
+        import emcee
+    except ImportError:
+        raise BayesUnavailable("the Bayesian fit needs emcee: pip install stickslip[bayes]") from None
+    return emcee
+
+
+@dataclass(frozen=True)
+class SteadyPosterior:
+    """Posterior samples of a steady fit (ln-values of ``keys``) and what follows from them."""
+
+    fit: SteadyFit
+    keys: tuple[str, ...]
+    chain: np.ndarray  # (samples, keys), ln of SI values
+    log_prob: np.ndarray
+    walkers: int
+    steps: int
+    burn: int
+    thin: int
+    acceptance: float
+    autocorrelation: np.ndarray
+    priors: tuple[str, ...]
+    noise: str
+    estimates: tuple[Estimate, ...]
+    critical_velocity: Estimate
+    critical_stress: Estimate
+    critical_samples: np.ndarray = field(repr=False)  # (draws, 2): Vc, sigma_c
+    messages: tuple[str, ...] = ()
+
+    @property
+    def data(self) -> SteadyData:
+        return self.fit.data
+
+    def parameters(self, index: int) -> Parameters:
+        """The parameter set of posterior sample ``index``."""
+        return Space(self.fit.parameters, self.keys).params(self.chain[index])
+
+    def stress_band(
+        self, velocity: np.ndarray | None = None, level: float = 0.95, draws: int = BAND_DRAWS, seed: int = 0
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(velocity, lower, upper): the central ``level`` credible band of sigma(V)."""
+        if velocity is None:
+            lo = float(self.data.velocity.min()) / 2.0
+            if self.fit.critical_velocity.value is not None:
+                lo = min(lo, self.fit.critical_velocity.value / 2.0)
+            velocity = np.geomspace(lo, float(self.data.velocity.max()) * 1.3, 60)
+        rng = np.random.default_rng(seed)
+        picks = rng.choice(self.chain.shape[0], size=min(draws, self.chain.shape[0]), replace=False)
+        curves = np.array([steady_state(self.parameters(int(k)), velocity).stress for k in picks])
+        tail = (1.0 - level) / 2.0
+        low, high = np.quantile(curves, [tail, 1.0 - tail], axis=0)
+        return velocity, low, high
+
+    def corner_samples(self) -> tuple[np.ndarray, list[str]]:
+        """log10 of the sampled parameters (SI) and of Vc, sigma_c on the subset where they were computed."""
+        rng = np.random.default_rng(1)
+        n = self.critical_samples.shape[0]
+        rows = rng.choice(self.chain.shape[0], size=n, replace=False) if n < self.chain.shape[0] else np.arange(n)
+        params = self.chain[rows] / math.log(10.0)
+        both = np.column_stack([params, np.log10(self.critical_samples)])
+        labels = [f"log10 {identify.SYMBOLS.get(k, k)}" for k in self.keys] + ["log10 Vc", "log10 σc"]
+        return both, labels
+
+    def to_frame(self) -> pd.DataFrame:
+        """The posterior samples as SI values, one column per key, and their log-probability."""
+        import pandas as pd
+
+        frame = pd.DataFrame(np.exp(self.chain), columns=list(self.keys))
+        frame["log_prob"] = self.log_prob
+        return frame
+
+    def as_dict(self) -> dict[str, Any]:
+        return {
+            "parameters": {e.key: e.as_dict() for e in self.estimates},
+            "critical_velocity": self.critical_velocity.as_dict(),
+            "critical_stress": self.critical_stress.as_dict(),
+            "priors": list(self.priors),
+            "noise": self.noise,
+            "walkers": self.walkers,
+            "steps": self.steps,
+            "burn": self.burn,
+            "thin": self.thin,
+            "samples": int(self.chain.shape[0]),
+            "acceptance_fraction": self.acceptance,
+            "autocorrelation_time": self.autocorrelation.tolist(),
+            "messages": list(self.messages),
+        }
+
+    def report(self) -> str:
+        from .report import posterior_report
+
+        return posterior_report(self)
+
+    def plot(self, ax: Axes | None = None) -> Axes:
+        """The fit with the 95 % credible band of sigma(V)."""
+        from .plots import plot_steady_fit
+
+        return plot_steady_fit(self.fit, ax=ax, band=self.stress_band())
+
+
+class _LogPosterior:
+    """Vectorised over walkers: rows of ln-parameters -> log posterior (uniform prior in the box)."""
+
+    def __init__(self, fit: SteadyFit, keys: tuple[str, ...]) -> None:
+        self.space = Space(fit.parameters, keys)
+        centre = Space(fit.start, keys).vector()
+        self.lower, self.upper = centre - SEARCH_BOX, centre + SEARCH_BOX
+        data = fit.data
+        self.velocity = data.velocity
+        self.stress = data.stress
+        self.stated = data.stress_err is not None
+        self.error = data.stress_err if data.stress_err is not None else data.stress
+
+    def __call__(self, thetas: np.ndarray) -> np.ndarray:
+        out = np.full(thetas.shape[0], -np.inf)
+        inside = np.all((thetas >= self.lower) & (thetas <= self.upper), axis=1)
+        rows = np.nonzero(inside)[0]
+        if rows.size == 0:
+            return out
+        sets = []
+        for k in rows:
+            try:
+                sets.append(self.space.params(thetas[k]))
+            except ParameterError:  # exp overflow cannot happen inside the box, but be safe
+                sets.append(None)
+        good = [k for k, p in zip(rows, sets, strict=True) if p is not None]
+        stress = stress_many([p for p in sets if p is not None], self.velocity)
+        chi = np.sum(((stress - self.stress) / self.error) ** 2, axis=1)
+        finite = np.isfinite(chi)
+        good_rows = np.asarray(good)[finite]
+        chi = chi[finite]
+        out[good_rows] = -0.5 * chi if self.stated else -0.5 * self.velocity.size * np.log(chi)
+        return out
+
+
+def sample_posterior(
+    fit: SteadyFit,
+    walkers: int = 32,
+    steps: int = 2000,
+    burn: int | None = None,
+    thin: int | None = None,
+    seed: int | None = None,
+    critical_draws: int = CRITICAL_DRAWS,
+    progress: bool = False,
+) -> SteadyPosterior:
+    """Sample the posterior of the fit's free parameters with emcee (module docstring for the priors)."""
+    emcee = _emcee()
+    keys = tuple(fit.free_keys)
+    if not keys:
+        raise ParameterError("nothing to sample: the fit has no free parameters")
+    if walkers < 2 * len(keys):
+        raise ParameterError(f"walkers: need at least {2 * len(keys)} for {len(keys)} parameters, got {walkers}")
+    if steps < 10:
+        raise ParameterError(f"steps: expected at least 10, got {steps}")
+    burn = steps // 4 if burn is None else burn
+    if not 0 <= burn < steps:
+        raise ParameterError(f"burn: expected 0 <= burn < steps ({steps}), got {burn}")
+    rng = np.random.default_rng(seed)
+    log_post = _LogPosterior(fit, keys)
+    centre = Space(fit.parameters, keys).vector()
+    sd = np.sqrt(np.clip(np.diag(fit.covariance), 1e-8, 1.0))
+    start = centre + 0.05 * sd * rng.standard_normal((walkers, len(keys)))
+    sampler = emcee.EnsembleSampler(walkers, len(keys), log_post, vectorize=True)
+    sampler.random_state = np.random.RandomState(int(rng.integers(2**31))).get_state()
+    sampler.run_mcmc(start, steps, progress=progress)
+    tau = np.asarray(sampler.get_autocorr_time(tol=0, discard=burn), dtype=float)
+    messages = []
+    if np.any(steps - burn < 50 * tau):
+        messages.append(
+            f"the chain is shorter than 50 autocorrelation times (τ up to {np.nanmax(tau):.3g} steps after {burn}"
+            " burn-in steps): the posterior summaries are rough; run more --steps"
+        )
+    thin = max(1, int(np.nanmin(tau) / 2)) if thin is None else thin
+    chain = sampler.get_chain(discard=burn, thin=thin, flat=True)
+    log_prob = sampler.get_log_prob(discard=burn, thin=thin, flat=True)
+    estimates = _parameter_summaries(fit, keys, chain)
+    vc, sc, critical = _critical_summaries(fit, keys, chain, critical_draws, rng, messages)
+    priors = tuple(
+        f"{k}: uniform in ln on [{math.exp(lo):.4g}, {math.exp(hi):.4g}] (SI; a factor 1e4 either side of"
+        " the start value)"
+        for k, lo, hi in zip(keys, log_post.lower, log_post.upper, strict=True)
+    )
+    if fit.data.stress_err is not None:
+        noise = "Gaussian with the stated stress_err"
+    else:
+        noise = "Gaussian, relative error s·σ with unknown s (Jeffreys prior 1/s, integrated out)"
+    held = [e.key for e in fit.estimates if e.fixed]
+    priors += (f"held fixed as in the least-squares fit: {', '.join(held)}",)
+    return SteadyPosterior(
+        fit=fit,
+        keys=keys,
+        chain=chain,
+        log_prob=log_prob,
+        walkers=walkers,
+        steps=steps,
+        burn=burn,
+        thin=thin,
+        acceptance=float(np.mean(sampler.acceptance_fraction)),
+        autocorrelation=tau,
+        priors=priors,
+        noise=noise,
+        estimates=estimates,
+        critical_velocity=vc,
+        critical_stress=sc,
+        critical_samples=critical,
+        messages=tuple(messages),
+    )
+
+
+def _summary(key: str, symbol: str, dimension: str, values: np.ndarray, note: str = "") -> Estimate:
+    lo, median, hi = np.quantile(values, [0.025, 0.5, 0.975])
+    return Estimate(
+        key, symbol, dimension, float(median), float(np.std(values, ddof=1)), (float(lo), float(hi)), "posterior", note
+    )
+
+
+def _parameter_summaries(fit: SteadyFit, keys: tuple[str, ...], chain: np.ndarray) -> tuple[Estimate, ...]:
+    return tuple(
+        _summary(k, identify.SYMBOLS.get(k, k), key_dimension(k), np.exp(chain[:, i]), "log-uniform prior")
+        for i, k in enumerate(keys)
+    )
+
+
+def _critical_summaries(
+    fit: SteadyFit,
+    keys: tuple[str, ...],
+    chain: np.ndarray,
+    draws: int,
+    rng: np.random.Generator,
+    messages: list[str],
+) -> tuple[Estimate, Estimate, np.ndarray]:
+    guess = fit.critical_velocity.value
+    space = Space(fit.parameters, keys)
+    found = np.zeros((0, 2))
+    if guess is not None:
+        picks = rng.choice(chain.shape[0], size=min(draws, chain.shape[0]), replace=False)
+        located = critical_many([space.params(chain[k]) for k in picks], guess)
+        found = located[np.all(np.isfinite(located), axis=1)]
+    missing = min(draws, chain.shape[0]) - len(found)
+    if guess is None or len(found) < 10:
+        note = "too few posterior samples have a minimum of σ(V)"
+        messages.append(note)
+        empty = np.zeros((0, 2))
+        return (
+            Estimate("critical_velocity", "Vc", "velocity", None, status="undetermined", note=note),
+            Estimate("critical_stress", "σc", "stress", None, status="undetermined", note=note),
+            empty,
+        )
+    values = found
+    note = f"posterior of {len(found)} random samples"
+    if missing:
+        note += f" ({missing} without a minimum left out)"
+    return (
+        _summary("critical_velocity", "Vc", "velocity", values[:, 0], note),
+        _summary("critical_stress", "σc", "stress", values[:, 1], note),
+        values,
+    )

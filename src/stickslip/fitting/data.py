@@ -1,0 +1,240 @@
+"""Measurement files for fitting: steady friction curves and stick-phase tables.
+
+Both are CSV files with a header row; units go in brackets after the column
+name (``velocity [um/s]``), a bare name means SI, and lines starting with
+``#`` are comments.  Every problem is a :class:`~stickslip.errors.DataError`
+naming the file, the row (the header is row 1) and the column.
+
+Steady data (``stickslip fit steady``): ``velocity``, ``stress`` and an
+optional ``stress_err`` (one standard deviation).  Stick data (``stickslip fit
+stick``): ``pulling_velocity``, ``stick_time`` and optional ``peak_stress``,
+``start_stress``; the other columns of the paper's Table 1 (``cycle``,
+``stick_slope``, ``stiffness``, ``jump_velocity``) are recognised and kept but
+not used by the fit.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from ..errors import DataError
+from ..tables import Table, read_table
+
+if TYPE_CHECKING:  # pragma: no cover
+    import pandas as pd
+    from matplotlib.axes import Axes
+
+#: Fewest points a steady curve may have: the paper's two-step fit needs at
+#: least one more point than free parameters in each velocity range.
+MIN_STEADY_POINTS = 4
+#: Fewest rows of a stick table.
+MIN_STICK_ROWS = 2
+#: Velocities closer than this (relative) count as duplicates.
+DUPLICATE_TOLERANCE = 1e-9
+
+STEADY_COLUMNS = {"velocity": "velocity", "stress": "stress", "stress_err": "stress"}
+STICK_COLUMNS = {
+    "pulling_velocity": "velocity",
+    "stick_time": "time",
+    "peak_stress": "stress",
+    "start_stress": "stress",
+    "cycle": "dimensionless",
+    "stick_slope": "stress_rate",
+    "stiffness": "stress_per_length",
+    "jump_velocity": "velocity",
+}
+#: Stick-table columns that may have empty cells (``--`` in the paper's Table 1 becomes an empty cell).
+STICK_OPTIONAL_CELLS = ("peak_stress", "start_stress", "cycle", "stick_slope", "stiffness", "jump_velocity")
+
+
+@dataclass(frozen=True)
+class SteadyData:
+    """A measured steady friction curve, SI units, in file order."""
+
+    velocity: np.ndarray
+    stress: np.ndarray
+    stress_err: np.ndarray | None
+    rows: np.ndarray
+    source: str = "data"
+
+    def __len__(self) -> int:
+        return int(self.velocity.size)
+
+    @classmethod
+    def from_arrays(cls, velocity: Any, stress: Any, stress_err: Any = None, source: str = "data") -> SteadyData:
+        """Validated data from arrays in SI units (rows are numbered from 1)."""
+        columns = {"velocity": _as_column(velocity, "velocity", source), "stress": _as_column(stress, "stress", source)}
+        if stress_err is not None:
+            columns["stress_err"] = _as_column(stress_err, "stress_err", source)
+        sizes = {name: col.size for name, col in columns.items()}
+        if len(set(sizes.values())) != 1:
+            raise DataError(f"{source}: columns have different lengths {sizes}")
+        rows = np.arange(1, columns["velocity"].size + 1)
+        return _validated_steady(Table(source, columns, rows))
+
+    def subset(self, mask: np.ndarray) -> SteadyData:
+        err = None if self.stress_err is None else self.stress_err[mask]
+        return SteadyData(self.velocity[mask], self.stress[mask], err, self.rows[mask], self.source)
+
+    def to_frame(self) -> pd.DataFrame:
+        import pandas as pd
+
+        frame = {"row": self.rows, "velocity": self.velocity, "stress": self.stress}
+        if self.stress_err is not None:
+            frame["stress_err"] = self.stress_err
+        return pd.DataFrame(frame)
+
+    def plot(self, ax: Axes | None = None, **kwargs: Any) -> Axes:
+        """Stress against log velocity (um/s), with error bars where given."""
+        from .plots import plot_steady_data
+
+        return plot_steady_data(self, ax=ax, **kwargs)
+
+
+@dataclass(frozen=True)
+class StickData:
+    """Measured stick phases: one row per cycle (NaN where a cell was empty)."""
+
+    pulling_velocity: np.ndarray
+    stick_time: np.ndarray
+    peak_stress: np.ndarray | None
+    start_stress: np.ndarray | None
+    rows: np.ndarray
+    extra: dict[str, np.ndarray]
+    source: str = "table"
+
+    def __len__(self) -> int:
+        return int(self.pulling_velocity.size)
+
+    @classmethod
+    def from_arrays(
+        cls,
+        pulling_velocity: Any,
+        stick_time: Any,
+        peak_stress: Any = None,
+        start_stress: Any = None,
+        source: str = "table",
+    ) -> StickData:
+        """Validated stick data from arrays in SI units (NaN allowed in peak_stress/start_stress)."""
+        columns = {
+            "pulling_velocity": _as_column(pulling_velocity, "pulling_velocity", source),
+            "stick_time": _as_column(stick_time, "stick_time", source),
+        }
+        for name, values in (("peak_stress", peak_stress), ("start_stress", start_stress)):
+            if values is not None:
+                columns[name] = _as_column(values, name, source, allow_nan=True)
+        sizes = {name: col.size for name, col in columns.items()}
+        if len(set(sizes.values())) != 1:
+            raise DataError(f"{source}: columns have different lengths {sizes}")
+        return _validated_stick(Table(source, columns, np.arange(1, columns["stick_time"].size + 1)))
+
+    def subset(self, mask: np.ndarray) -> StickData:
+        def pick(a: np.ndarray | None) -> np.ndarray | None:
+            return None if a is None else a[mask]
+
+        return StickData(
+            self.pulling_velocity[mask],
+            self.stick_time[mask],
+            pick(self.peak_stress),
+            pick(self.start_stress),
+            self.rows[mask],
+            {k: v[mask] for k, v in self.extra.items()},
+            self.source,
+        )
+
+    def to_frame(self) -> pd.DataFrame:
+        import pandas as pd
+
+        frame: dict[str, np.ndarray] = {"row": self.rows, "pulling_velocity": self.pulling_velocity}
+        frame["stick_time"] = self.stick_time
+        if self.peak_stress is not None:
+            frame["peak_stress"] = self.peak_stress
+        if self.start_stress is not None:
+            frame["start_stress"] = self.start_stress
+        frame.update(self.extra)
+        return pd.DataFrame(frame)
+
+
+def read_steady_data(path: str | Path) -> SteadyData:
+    """Read and validate a steady friction curve (columns velocity, stress, optional stress_err)."""
+    table = read_table(path, STEADY_COLUMNS, required=["velocity", "stress"])
+    return _validated_steady(table)
+
+
+def read_stick_data(path: str | Path) -> StickData:
+    """Read and validate a stick table (pulling_velocity, stick_time, optional peak_stress, start_stress)."""
+    table = read_table(
+        path, STICK_COLUMNS, required=["pulling_velocity", "stick_time"], allow_missing=STICK_OPTIONAL_CELLS
+    )
+    return _validated_stick(table)
+
+
+def _as_column(values: Any, name: str, source: str, allow_nan: bool = False) -> np.ndarray:
+    try:
+        column = np.asarray(values, dtype=float).ravel()
+    except (TypeError, ValueError):
+        raise DataError(f"{source}: column {name!r}: expected numbers, got {values!r}") from None
+    bad = np.isinf(column) | (np.isnan(column) if not allow_nan else np.zeros(column.shape, bool))
+    if np.any(bad):
+        k = int(np.nonzero(bad)[0][0])
+        raise DataError(f"{source}: row {k + 1}, column {name!r}: missing, NaN or infinite value")
+    return column
+
+
+def _require_positive(table: Table, names: Sequence[str]) -> None:
+    """DataError at the first row (in file order) where a named column is <= 0 (NaN cells are skipped)."""
+    for k in range(len(table)):
+        for name in names:
+            if name in table and table[name][k] <= 0:
+                raise DataError(
+                    f"{table.source}: row {table.rows[k]}, column {name!r}: expected a positive value,"
+                    f" got {table[name][k]:g}"
+                )
+
+
+def _validated_steady(table: Table) -> SteadyData:
+    n = len(table)
+    if n < MIN_STEADY_POINTS:
+        raise DataError(
+            f"{table.source}: {n} data row(s), expected at least {MIN_STEADY_POINTS} to fit a friction curve"
+        )
+    _require_positive(table, ["velocity", "stress", "stress_err"])
+    v = table["velocity"]
+    order = np.argsort(v, kind="stable")
+    close = np.nonzero(np.diff(v[order]) <= DUPLICATE_TOLERANCE * v[order][1:])[0]
+    if close.size:
+        first, second = sorted((int(order[close[0]]), int(order[close[0] + 1])))
+        raise DataError(
+            f"{table.source}: row {table.rows[second]}, column 'velocity': duplicates the velocity of row"
+            f" {table.rows[first]} ({v[first]:g} m/s); average repeated measurements into one row with a stress_err"
+        )
+    err = table["stress_err"] if "stress_err" in table else None
+    return SteadyData(v, table["stress"], err, table.rows, table.source)
+
+
+def _validated_stick(table: Table) -> StickData:
+    n = len(table)
+    if n < MIN_STICK_ROWS:
+        raise DataError(f"{table.source}: {n} data row(s), expected at least {MIN_STICK_ROWS} stick phases")
+    _require_positive(
+        table,
+        ["pulling_velocity", "stick_time", "peak_stress", "start_stress", "stick_slope", "stiffness", "jump_velocity"],
+    )
+    peak = table["peak_stress"] if "peak_stress" in table else None
+    start = table["start_stress"] if "start_stress" in table else None
+    if peak is not None and start is not None:
+        both = np.isfinite(peak) & np.isfinite(start)
+        bad = np.nonzero(both & (peak <= start))[0]
+        if bad.size:
+            k = int(bad[0])
+            raise DataError(
+                f"{table.source}: row {table.rows[k]}, column 'peak_stress': {peak[k]:g} Pa is not above the"
+                f" start_stress {start[k]:g} Pa of the same row"
+            )
+    extra = {name: table[name] for name in ("cycle", "stick_slope", "stiffness", "jump_velocity") if name in table}
+    return StickData(table["pulling_velocity"], table["stick_time"], peak, start, table.rows, extra, table.source)

@@ -1,0 +1,125 @@
+"""Figures of the fits (matplotlib, no pyplot: safe in any backend; never shows anything)."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+if TYPE_CHECKING:  # pragma: no cover
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
+
+    from .bayes import SteadyPosterior
+    from .data import SteadyData
+    from .steady_fit import SteadyFit
+    from .stick_fit import StickFit
+
+UM = 1e6  # m/s -> um/s on the axes
+
+
+def new_axes(rows: int = 1, height: float = 4.0) -> tuple[Figure, list[Axes]]:
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(6.4, height * rows), constrained_layout=True)
+    if rows == 1:
+        return fig, [fig.add_subplot(1, 1, 1)]
+    axes = fig.subplots(rows, 1, sharex=True, gridspec_kw={"height_ratios": [3] + [1] * (rows - 1)})
+    return fig, list(axes)
+
+
+def _axes(ax: Axes | None) -> Axes:
+    return new_axes()[1][0] if ax is None else ax
+
+
+def plot_steady_data(data: SteadyData, ax: Axes | None = None, **kwargs: Any) -> Axes:
+    ax = _axes(ax)
+    style = {"fmt": "o", "color": "k", "ms": 4, "capsize": 2, "label": "data"} | kwargs
+    err = None if data.stress_err is None else data.stress_err
+    ax.errorbar(data.velocity * UM, data.stress, yerr=err, **style)
+    ax.set_xscale("log")
+    ax.set_xlabel("sliding velocity V (µm/s)")
+    ax.set_ylabel("friction stress σ (Pa)")
+    return ax
+
+
+def _curve_range(fit: SteadyFit) -> np.ndarray:
+    lo = float(fit.data.velocity.min()) / 2.0
+    if fit.critical_velocity.value is not None:
+        lo = min(lo, fit.critical_velocity.value / 2.0)
+    return np.geomspace(lo, float(fit.data.velocity.max()) * 1.3, 120)
+
+
+def plot_steady_fit(fit: SteadyFit, ax: Axes | None = None, band: tuple[np.ndarray, ...] | None = None) -> Axes:
+    """Data, fitted curve (with aging; without aging dashed) and Vc with its interval."""
+    ax = plot_steady_data(fit.data, _axes(ax))
+    v = _curve_range(fit)
+    ax.plot(v * UM, fit.curve(v), color="C0", label=f"fit ({fit.method})")
+    ax.plot(v * UM, fit.curve(v, aging=False), color="C0", ls="--", lw=1, label="fit without aging")
+    if band is not None:
+        bv, lo, hi = band
+        ax.fill_between(bv * UM, lo, hi, color="C0", alpha=0.25, lw=0, label="95 % credible band")
+    vc, sc = fit.critical_velocity, fit.critical_stress
+    if vc.value is not None and sc.value is not None:
+        xerr = None
+        if vc.interval is not None and None not in vc.interval:
+            xerr = [[(vc.value - vc.interval[0]) * UM], [(vc.interval[1] - vc.value) * UM]]  # type: ignore[operator]
+        yerr = None
+        if sc.interval is not None and None not in sc.interval:
+            yerr = [[sc.value - sc.interval[0]], [sc.interval[1] - sc.value]]  # type: ignore[operator]
+        ax.errorbar([vc.value * UM], [sc.value], xerr=xerr, yerr=yerr, fmt="s", color="C3", capsize=3, label="Vc, σc")
+    if fit.split is not None:
+        ax.axvline(fit.split * UM, color="0.6", ls=":", lw=1, label="split (two-step)")
+    top = float(np.max(fit.data.stress)) * 1.4
+    ax.set_ylim(0, top)
+    ax.legend(fontsize="small")
+    return ax
+
+
+def plot_residuals(fit: SteadyFit, ax: Axes | None = None) -> Axes:
+    ax = _axes(ax)
+    ax.axhline(0.0, color="0.5", lw=1)
+    ax.plot(fit.data.velocity * UM, fit.residuals, "o", color="k", ms=4)
+    ax.set_xscale("log")
+    ax.set_xlabel("sliding velocity V (µm/s)")
+    ax.set_ylabel("(data − fit)/error")
+    return ax
+
+
+def steady_fit_figure(fit: SteadyFit, band: tuple[np.ndarray, ...] | None = None) -> Figure:
+    """Two panels: the fit and its normalised residuals."""
+    fig, (top, bottom) = new_axes(rows=2, height=2.4)
+    plot_steady_fit(fit, top, band=band)
+    top.set_xlabel("")
+    plot_residuals(fit, bottom)
+    return fig
+
+
+def plot_stick_fit(fit: StickFit, ax: Axes | None = None) -> Axes:
+    """Measured and fitted stick times against pulling velocity."""
+    ax = _axes(ax)
+    data = fit.data
+    used = fit.used
+    ax.plot(data.pulling_velocity[used] * UM, data.stick_time[used], "o", color="k", ms=5, label="data (fitted)")
+    if np.any(~used):
+        ax.plot(
+            data.pulling_velocity[~used] * UM, data.stick_time[~used], "x", color="0.5", ms=6, label="data (left out)"
+        )
+    ax.plot(data.pulling_velocity[used] * UM, fit.model_stick_time[used], "s", mfc="none", color="C0", label="model")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("pulling velocity V0 (µm/s)")
+    ax.set_ylabel("stick time ts (s)")
+    ax.legend(fontsize="small")
+    return ax
+
+
+def corner_figure(posterior: SteadyPosterior) -> Figure:
+    """Corner plot of the posterior (the ``corner`` package), in log10 of the SI values, with Vc and sigma_c."""
+    import corner
+    from matplotlib.figure import Figure
+
+    samples, labels = posterior.corner_samples()
+    fig = Figure(figsize=(1.6 * len(labels) + 1, 1.6 * len(labels) + 1))
+    corner.corner(samples, labels=labels, fig=fig, quantiles=[0.025, 0.5, 0.975], show_titles=True, title_fmt=".3g")
+    return fig

@@ -1,0 +1,201 @@
+"""Markdown reports of the fits (also the plain-text output of ``stickslip fit``)."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from .results import Estimate, display_unit, human
+
+if TYPE_CHECKING:  # pragma: no cover
+    from .bayes import SteadyPosterior
+    from .steady_fit import SteadyFit
+    from .stick_fit import StickFit
+
+
+def _table(header: Sequence[str], rows: Sequence[Sequence[str]]) -> list[str]:
+    lines = ["| " + " | ".join(header) + " |", "|" + "|".join("---" for _ in header) + "|"]
+    lines += ["| " + " | ".join(r) + " |" for r in rows]
+    return lines
+
+
+def _g(x: float | None, digits: int = 4) -> str:
+    if x is None or not np.isfinite(x):
+        return "—"
+    return f"{x:.{digits}g}"
+
+
+def _interval(e: Estimate, size: float = 1.0) -> str:
+    if e.interval is None:
+        return "—"
+    lo, hi = e.interval
+    return f"[{'unbounded' if lo is None else _g(lo / size)}, {'unbounded' if hi is None else _g(hi / size)}]"
+
+
+def _scaled(x: float | None, size: float, digits: int) -> str:
+    return "—" if x is None else _g(x / size, digits)
+
+
+def estimate_rows(estimates: Sequence[Estimate], with_key: bool = True) -> list[list[str]]:
+    rows = []
+    for e in estimates:
+        unit, size = display_unit(e.value, e.dimension)
+        status = "fixed: " + e.note if e.fixed else (e.note or e.status)
+        first = [f"`{e.key}`", e.symbol] if with_key else [e.symbol]
+        rows.append([*first, _scaled(e.value, size, 6), _scaled(e.stderr, size, 3), _interval(e, size), unit, status])
+    return rows
+
+
+def _messages(messages: Sequence[str]) -> list[str]:
+    if not messages:
+        return []
+    return ["## Notes", "", *[f"- {m}" for m in messages], ""]
+
+
+def _correlation(keys: Sequence[str], matrix: np.ndarray) -> list[str]:
+    if not keys:
+        return []
+    header = ["", *[f"`{k.split('.')[1]}`" for k in keys]]
+    rows = [[f"`{k.split('.')[1]}`", *[_g(x, 3) for x in row]] for k, row in zip(keys, matrix, strict=True)]
+    return ["## Correlation of the fitted ln-parameters", "", *_table(header, rows), ""]
+
+
+def steady_report(fit: SteadyFit) -> str:
+    level = f"{100 * fit.level:g} %"
+    data = fit.data
+    lines = [
+        "# Steady friction fit",
+        "",
+        f"- data: `{data.source}`, {len(data)} points, {human(float(data.velocity.min()), 'velocity')} to"
+        f" {human(float(data.velocity.max()), 'velocity')}",
+        f"- method: {fit.method}" + (f" (split at {human(fit.split, 'velocity')})" if fit.split else ""),
+        f"- noise: {fit.noise}",
+        f"- χ² = {_g(fit.chi_square)}, degrees of freedom {fit.dof}, reduced χ² = {_g(fit.reduced_chi_square)}",
+        f"- intervals: {level}; parameters symmetric in ln (Wald); Vc and σc by {fit.interval_method}",
+        "",
+        "## Critical point (Eq 9)",
+        "",
+        *_table(
+            ["quantity", "value", "std. error", f"{level} interval", "unit", "method"],
+            estimate_rows((fit.critical_velocity, fit.critical_stress), with_key=False),
+        ),
+        "",
+        *_messages(fit.messages),
+        "## Parameters",
+        "",
+        *_table(
+            ["key", "symbol", "value", "std. error", f"{level} interval", "unit", "status"],
+            estimate_rows(fit.estimates),
+        ),
+        "",
+        "## Identifiable combinations",
+        "",
+        "σ(V) depends on the parameters only through these (docs/fitting.md).",
+        "",
+        *_table(
+            ["combination", "value", "std. error", f"{level} interval", "unit", "status"],
+            estimate_rows(fit.combinations, with_key=False),
+        ),
+        "",
+        *_correlation(fit.free_keys, fit.correlation),
+        "## Fit steps",
+        "",
+        *_table(
+            ["step", "fitted", "points", "χ²", "evaluations", "status"],
+            [
+                [
+                    s.name,
+                    ", ".join(f"`{k}`" for k in s.keys) or "—",
+                    str(s.points),
+                    _g(s.chi_square),
+                    str(s.nfev),
+                    s.message,
+                ]
+                for s in fit.stages
+            ],
+        ),
+        "",
+        "## Residuals",
+        "",
+        *_table(
+            ["row", "V (µm/s)", "σ (Pa)", "fit (Pa)", "(data − fit)/error"],
+            [
+                [str(r), _g(v * 1e6, 5), _g(s, 5), _g(m, 5), f"{z:+.2f}"]
+                for r, v, s, m, z in zip(
+                    data.rows, data.velocity, data.stress, fit.model_stress, fit.residuals, strict=True
+                )
+            ],
+        ),
+        "",
+    ]
+    return "\n".join(lines)
+
+
+def stick_report(fit: StickFit) -> str:
+    level = f"{100 * fit.level:g} %"
+    data = fit.data
+    rows = []
+    for k in range(len(data)):
+        used = bool(fit.used[k])
+        rows.append(
+            [
+                str(data.rows[k]),
+                _g(data.pulling_velocity[k] * 1e6, 4),
+                _g(fit.start_stress[k], 4),
+                _g(data.stick_time[k], 4),
+                _g(fit.model_stick_time[k], 4) if used else "—",
+                _g(data.peak_stress[k], 4) if data.peak_stress is not None else "—",
+                _g(fit.model_peak_stress[k], 4) if used else "—",
+                "fitted" if used else "left out: " + fit.excluded.get(int(data.rows[k]), ""),
+            ]
+        )
+    lines = [
+        "# Stick-phase fit (Eqs 13-16)",
+        "",
+        f"- data: `{data.source}`, {int(fit.used.sum())} of {len(data)} rows fitted",
+        f"- noise: {fit.noise}",
+        f"- χ² = {_g(fit.chi_square)}, degrees of freedom {fit.dof}, reduced χ² = {_g(fit.reduced_chi_square)}",
+        f"- intervals: {level}, symmetric in ln (Wald)",
+        "",
+        *_messages(fit.messages),
+        "## Parameters",
+        "",
+        *_table(
+            ["key", "symbol", "value", "std. error", f"{level} interval", "unit", "status"],
+            estimate_rows(fit.estimates),
+        ),
+        "",
+        *_correlation(fit.free_keys, fit.correlation),
+        "## Rows",
+        "",
+        *_table(["row", "V0 (µm/s)", "start σ (Pa)", "ts (s)", "fit ts (s)", "σs (Pa)", "fit σs (Pa)", "use"], rows),
+        "",
+    ]
+    return "\n".join(lines)
+
+
+def posterior_report(post: SteadyPosterior) -> str:
+    lines = [
+        "# Bayesian steady fit (emcee)",
+        "",
+        f"- data: `{post.data.source}`, {len(post.data)} points; noise: {post.noise}",
+        f"- sampler: {post.walkers} walkers × {post.steps} steps, first {post.burn} discarded, thinned by {post.thin};"
+        f" {post.chain.shape[0]} samples; mean acceptance {post.acceptance:.2f}",
+        f"- autocorrelation time (steps): {', '.join(_g(t, 3) for t in post.autocorrelation)}",
+        "",
+        "## Priors",
+        "",
+        *[f"- {p}" for p in post.priors],
+        "",
+        *_messages(post.messages),
+        "## Posterior (median and central 95 % credible interval)",
+        "",
+        *_table(
+            ["quantity", "median", "std. dev.", "95 % credible interval", "unit", "prior / note"],
+            estimate_rows((*post.estimates, post.critical_velocity, post.critical_stress), with_key=False),
+        ),
+        "",
+    ]
+    return "\n".join(lines)

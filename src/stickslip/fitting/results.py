@@ -1,0 +1,96 @@
+"""Small result records shared by the fits: an estimate with its uncertainty."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from ..units import format_si
+
+#: Display units by dimension: (name, size in SI), smallest first; the largest not exceeding the value is used.
+_DISPLAY = {
+    "velocity": (("nm/s", 1e-9), ("µm/s", 1e-6), ("mm/s", 1e-3), ("m/s", 1.0)),
+    "time": (("ns", 1e-9), ("µs", 1e-6), ("ms", 1e-3), ("s", 1.0)),
+    "length": (("pm", 1e-12), ("nm", 1e-9), ("µm", 1e-6), ("mm", 1e-3), ("m", 1.0)),
+    "stress": (("Pa", 1.0), ("kPa", 1e3), ("MPa", 1e6)),
+}
+
+
+def display_unit(value: float | None, dimension: str) -> tuple[str, float]:
+    """(unit name, size in SI) for showing ``value`` to people."""
+    choices = _DISPLAY.get(dimension)
+    if choices is None:
+        text = format_si(1.0, dimension)
+        return (text.split(" ", 1)[1] if " " in text else "", 1.0)
+    if value is None or value == 0 or not np.isfinite(value):
+        return choices[0]
+    chosen = choices[0]
+    for name, size in choices:
+        if abs(value) >= size:
+            chosen = (name, size)
+    return chosen
+
+
+def human(value: float, dimension: str, digits: int = 6) -> str:
+    """``value`` (SI) in a unit for people, e.g. ``human(1.24097e-4, "velocity") == "124.097 µm/s"``."""
+    unit, size = display_unit(value, dimension)
+    return f"{value / size:.{digits}g} {unit}".strip()
+
+
+@dataclass(frozen=True)
+class Estimate:
+    """A fitted, fixed or derived quantity (SI units).
+
+    ``stderr`` and ``interval`` are None for fixed values, and for derived
+    values the data do not determine; ``note`` says why in words.
+    """
+
+    key: str
+    symbol: str
+    dimension: str
+    value: float | None
+    stderr: float | None = None
+    interval: tuple[float | None, float | None] | None = None
+    status: str = "fitted"  # "fitted", "fixed", "derived", "undetermined"
+    note: str = ""
+
+    @property
+    def fixed(self) -> bool:
+        return self.status == "fixed"
+
+    def as_dict(self) -> dict[str, Any]:
+        """``{value, stderr, interval}``, or ``{value, fixed: true, reason}`` for a fixed value."""
+        if self.fixed:
+            return {"value": self.value, "fixed": True, "reason": self.note}
+        out: dict[str, Any] = {
+            "value": self.value,
+            "stderr": self.stderr,
+            "interval": None if self.interval is None else list(self.interval),
+        }
+        if self.status != "fitted":
+            out["status"] = self.status
+        if self.note:
+            out["note"] = self.note
+        return out
+
+    def text(self) -> str:
+        """One line for reports: value ± stderr [interval] with units."""
+        if self.value is None:
+            return "—"
+        unit_value = format_si(self.value, self.dimension)
+        if self.fixed:
+            return f"{unit_value} (fixed)"
+        parts = [unit_value]
+        if self.stderr is not None and math.isfinite(self.stderr):
+            parts.append(f"± {self.stderr:.3g}")
+        if self.interval is not None:
+            lo, hi = self.interval
+            parts.append(f"[{_num(lo)}, {_num(hi)}]")
+        return " ".join(parts)
+
+
+def _num(x: float | None) -> str:
+    return "unbounded" if x is None else f"{x:.4g}"

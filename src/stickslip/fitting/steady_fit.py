@@ -1,0 +1,778 @@
+"""Fit the steady friction curve (Eqs 6-8) to measured stress against velocity (paper, Section 3).
+
+Methods:
+
+* ``two-step`` (the paper's): above the split velocity (800 um/s) the aging
+  term is dropped and N0, tau and the force sensitivity are fitted (u0 = 1
+  and dl_m fixed); then below it tau_a and V_a are fitted with those held.
+  The covariance of step 2 includes the propagated uncertainty of step 1.
+* ``joint``: every free parameter at once on all points with aging, started
+  from the two-step result.
+
+What the data cannot determine is fixed, with a message, rather than fitted
+(:mod:`stickslip.fitting.identify`): exact degeneracies of sigma(V) before the
+fit, and directions with a standard deviation above a factor e after it.
+Vc and sigma_c (Eq 9) come with intervals by propagation (``delta``), by the
+profile likelihood (``profile``) or by a parametric bootstrap (``bootstrap``).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+from scipy import stats
+
+from ..errors import DataError, ParameterError
+from ..model.critical import critical_point
+from ..model.steady import steady_state
+from ..parameters import Parameters, key_dimension, load_parameters
+from ..units import to_si
+from . import identify
+from .critical_uncertainty import Profile, critical_gradient, local_critical
+from .data import SteadyData, read_steady_data
+from .problem import Block, Space, jacobian, minimize, residuals
+from .results import Estimate, human
+
+if TYPE_CHECKING:  # pragma: no cover
+    import pandas as pd
+    from matplotlib.axes import Axes
+
+METHODS = ("two-step", "joint")
+INTERVAL_METHODS = ("delta", "profile", "bootstrap")
+DEFAULT_SPLIT = 800e-6
+#: Above the split the two-step fit neglects aging; warn when that changes sigma by more than this many errors.
+AGING_NEGLECT_WARNING = 0.5
+#: Give up the fix-and-refit loop after this many rounds (never reached: each round fixes one key).
+MAX_ROUNDS = 10
+
+
+@dataclass(frozen=True)
+class Stage:
+    """One least-squares step of a method."""
+
+    name: str
+    keys: tuple[str, ...]
+    points: int
+    chi_square: float
+    nfev: int
+    success: bool
+    message: str
+
+
+@dataclass(frozen=True)
+class SteadyFit:
+    """Result of :func:`fit_steady`; every number in SI units."""
+
+    data: SteadyData
+    parameters: Parameters
+    start: Parameters
+    method: str
+    split: float | None
+    estimates: tuple[Estimate, ...]
+    combinations: tuple[Estimate, ...]
+    free_keys: tuple[str, ...]
+    covariance: np.ndarray  # of ln(parameter) for free_keys
+    correlation: np.ndarray
+    chi_square: float
+    dof: int
+    noise: str
+    noise_scale: float
+    model_stress: np.ndarray
+    residuals: np.ndarray  # (data - model)/error
+    critical_velocity: Estimate
+    critical_stress: Estimate
+    interval_method: str
+    level: float
+    stages: tuple[Stage, ...]
+    messages: tuple[str, ...]
+    samples: dict[str, np.ndarray] | None = field(default=None, repr=False)
+
+    @property
+    def reduced_chi_square(self) -> float:
+        return self.chi_square / self.dof if self.dof > 0 else float("nan")
+
+    def estimate(self, key: str) -> Estimate:
+        for e in (*self.estimates, *self.combinations):
+            if e.key == key:
+                return e
+        raise KeyError(key)
+
+    def curve(self, velocity: Any, aging: bool = True) -> np.ndarray:
+        """The fitted sigma(V) at ``velocity`` (m/s)."""
+        return steady_state(self.parameters, velocity, aging=aging).stress
+
+    def to_frame(self) -> pd.DataFrame:
+        """One row per data point: data, fitted stress, normalised residual."""
+        frame = self.data.to_frame()
+        frame["model_stress"] = self.model_stress
+        frame["residual"] = self.residuals
+        return frame
+
+    def as_dict(self) -> dict[str, Any]:
+        """The JSON summary (SI units)."""
+        return {
+            "method": self.method,
+            "split_velocity": self.split,
+            "parameters": {e.key: e.as_dict() for e in self.estimates},
+            "combinations": {e.key: e.as_dict() | {"symbol": e.symbol} for e in self.combinations},
+            "critical_velocity": self.critical_velocity.as_dict(),
+            "critical_stress": self.critical_stress.as_dict(),
+            "interval_method": self.interval_method,
+            "confidence_level": self.level,
+            "chi_square": self.chi_square,
+            "dof": self.dof,
+            "reduced_chi_square": self.reduced_chi_square,
+            "noise": self.noise,
+            "correlation": {
+                "keys": list(self.free_keys),
+                "matrix": self.correlation.tolist(),
+            },
+            "residuals": self.residuals.tolist(),
+            "messages": list(self.messages),
+        }
+
+    def report(self) -> str:
+        """A Markdown report of the fit."""
+        from .report import steady_report
+
+        return steady_report(self)
+
+    def plot(self, ax: Axes | None = None, **kwargs: Any) -> Axes:
+        """Data, fitted curve (extended below the data to show the minimum) and Vc; returns the Axes."""
+        from .plots import plot_steady_fit
+
+        return plot_steady_fit(self, ax=ax, **kwargs)
+
+
+# --------------------------------------------------------------------------- setup
+
+
+def _resolve_fix(params: Parameters, fix: Mapping[str, Any] | None) -> tuple[Parameters, dict[str, float]]:
+    values: dict[str, float] = {}
+    for key, raw in (fix or {}).items():
+        _check_steady_key(key, "--fix")
+        values[key] = to_si(raw, key_dimension(key), key)
+    if values:
+        params = params.with_overrides(values)
+    return params, values
+
+
+def _check_steady_key(key: str, option: str) -> None:
+    key_dimension(key)  # unknown keys raise ParameterError with the list of keys
+    if key not in identify.STEADY_KEYS:
+        raise ParameterError(
+            f"{option} {key}: the steady friction curve does not depend on it; steady-fit keys are"
+            f" {', '.join(identify.STEADY_KEYS)}"
+        )
+
+
+def _requested(free: Sequence[str] | None, fixed: Mapping[str, float]) -> tuple[list[str], list[str]]:
+    explicit: list[str] = []
+    for key in free or ():
+        _check_steady_key(key, "--free")
+        if key in fixed:
+            raise ParameterError(f"{key} is given both to --fix and to --free")
+        if key not in explicit:
+            explicit.append(key)
+    defaults = [k for k in identify.DEFAULT_FREE if k not in fixed and k not in explicit]
+    return explicit, explicit + defaults
+
+
+def _blocks(data: SteadyData, split: float | None) -> tuple[np.ndarray, Block, Block | None, Block | None]:
+    error = data.stress_err if data.stress_err is not None else data.stress
+    everything = Block(data.velocity, data.stress, error, aging=True)
+    if split is None:
+        return error, everything, None, None
+    high = data.velocity >= split
+    hi_block = Block(data.velocity[high], data.stress[high], error[high], aging=False)
+    lo_block = Block(data.velocity[~high], data.stress[~high], error[~high], aging=True)
+    return error, everything, hi_block, lo_block
+
+
+def _scaled_start(params: Parameters, block: Block, free: Sequence[str]) -> Parameters:
+    """Rescale N0 so that the start curve matches the data's level (sigma is proportional to N0)."""
+    if "bonds.site_density" not in free:
+        return params
+    model = steady_state(params, block.velocity, aging=block.aging).stress
+    w = 1.0 / block.error**2
+    factor = float(np.sum(w * model * block.stress) / np.sum(w * model * model))
+    return params.with_overrides({"bonds.site_density": params.bonds.site_density * factor})
+
+
+# --------------------------------------------------------------------------- fitting
+
+
+@dataclass
+class _Progress:
+    params: Parameters
+    start: Parameters
+    explicit: tuple[str, ...]
+    noise_known: bool
+    messages: list[str]
+    undetermined: list[str]
+    stages: list[Stage]
+
+
+def _fit_block(
+    progress: _Progress, keys: Sequence[str], block: Block, name: str, precheck: bool = False
+) -> tuple[list[str], np.ndarray]:
+    """Fit ``keys`` on ``block``; fix and refit while a direction is undetermined.
+
+    With ``precheck`` (a start already close to the minimum) undetermined
+    directions are first looked for at the start, which saves the optimiser
+    a walk along them.
+    """
+    keys = list(keys)
+    if len(keys) >= len(block):
+        raise DataError(
+            f"{name}: {len(block)} data point(s) for {len(keys)} free parameter(s) ({', '.join(keys)});"
+            " need more points than parameters (lower --split, --fix some parameters or use --method joint)"
+        )
+    while precheck and keys:
+        space = Space(progress.params, tuple(keys))
+        r = residuals(space, space.vector(), block)
+        scale = 1.0 if progress.noise_known else math.sqrt(float(r @ r) / (len(block) - len(keys)))
+        bad = identify.undetermined(keys, jacobian(space, space.vector(), block), scale)
+        if not bad:
+            break
+        _fix_undetermined(progress, keys, bad[0], name)
+    for _ in range(MAX_ROUNDS):
+        space = Space(progress.params, tuple(keys))
+        theta0 = space.vector()
+        centre = Space(progress.start, tuple(keys)).vector()
+        got = minimize(space, theta0, block, centre)
+        progress.params = space.params(got.theta)
+        dof = len(block) - len(keys)
+        scale = 1.0 if progress.noise_known else math.sqrt(got.chi_square / dof)
+        if not keys:
+            progress.stages.append(Stage(name, (), len(block), got.chi_square, got.nfev, got.success, got.message))
+            return keys, got.theta
+        jac = jacobian(Space(progress.params, tuple(keys)), got.theta, block)
+        bad = identify.undetermined(keys, jac, scale)
+        if not bad:
+            for key in got.at_edge:
+                progress.messages.append(
+                    f"warning: {key} ended at the edge of the search box (a factor 1e4 from its start value);"
+                    " the fit may be wrong: start from closer values (--params/--set) or fix it"
+                )
+            progress.stages.append(
+                Stage(name, tuple(keys), len(block), got.chi_square, got.nfev, got.success, got.message)
+            )
+            return keys, got.theta
+        _fix_undetermined(progress, keys, bad[0], name)
+    raise RuntimeError("fix-and-refit loop did not terminate")  # pragma: no cover
+
+
+def _fix_undetermined(progress: _Progress, keys: list[str], direction: identify.Direction, name: str) -> None:
+    """Fix the key that pins ``direction`` at its input value (removing it from ``keys``), with a message."""
+    key = identify.choose_key_to_fix(keys, direction, progress.explicit)
+    start_value = progress.start.as_dict()[key]
+    progress.params = progress.params.with_overrides({key: start_value})
+    keys.remove(key)
+    progress.undetermined.append(key)
+    progress.messages.append(
+        f"{key} ({identify.SYMBOLS[key]}) is not determined by these data in {name}: the direction"
+        f" {direction.describe()} of the fitted ln-parameters is unconstrained, so {key} is fixed at its input"
+        f" value {human(start_value, key_dimension(key))} and the results are conditional on it"
+    )
+
+
+def _two_step(progress: _Progress, requested: Sequence[str], hi: Block, lo: Block, split: float) -> list[Block]:
+    step1 = identify.select_identifiable([k for k in requested if k in identify.NO_AGING_KEYS], aging=False)
+    step2 = [k for k in requested if k in identify.AGING_KEYS]
+    progress.messages.extend(step1.messages)
+    v_split = human(split, "velocity")
+    if len(hi) == 0 or len(lo) == 0:
+        side = "at or above" if len(hi) == 0 else "below"
+        raise DataError(
+            f"two-step fit: no data point {side} the split velocity {v_split}; set --split inside the data range"
+            " or use --method joint"
+        )
+    progress.params = _scaled_start(progress.params, hi, step1.free)
+    _fit_block(progress, step1.free, hi, f"step 1 (V >= {v_split}, no aging)")
+    _fit_block(progress, step2, lo, f"step 2 (V < {v_split}, with aging)")
+    return [hi, lo]
+
+
+def _free_after(progress: _Progress, requested: Sequence[str]) -> list[str]:
+    return [k for k in requested if k not in progress.undetermined]
+
+
+def _covariance_two_step(
+    params: Parameters, keys1: Sequence[str], keys2: Sequence[str], hi: Block, lo: Block, scale2: float
+) -> np.ndarray:
+    """Covariance of the two-step estimator: step-1 uncertainty propagated through step 2 (docs/fitting.md)."""
+    p1, p2 = len(keys1), len(keys2)
+    space1 = Space(params, tuple(keys1))
+    j11 = jacobian(space1, space1.vector(), hi)
+    c1 = scale2 * _inverse(j11.T @ j11)
+    if p2 == 0:
+        return c1
+    space2 = Space(params, tuple(keys2))
+    j22 = jacobian(space2, space2.vector(), lo)
+    h22 = _inverse(j22.T @ j22)
+    if p1 == 0:
+        return scale2 * h22
+    j21 = jacobian(space1, space1.vector(), lo)
+    gain = h22 @ j22.T @ j21  # d theta2 / d theta1 = -gain
+    c22 = gain @ c1 @ gain.T + scale2 * h22
+    c12 = -c1 @ gain.T
+    return np.block([[c1, c12], [c12.T, c22]])
+
+
+def _inverse(matrix: np.ndarray) -> np.ndarray:
+    """Inverse of a symmetric positive semi-definite matrix; infinite variance along null directions."""
+    values, vectors = np.linalg.eigh(matrix)
+    if values.size == 0:
+        return matrix
+    if values.min() <= values.max() * 1e-14:
+        return np.full_like(matrix, np.inf)
+    return (vectors / values) @ vectors.T
+
+
+def _quantile(level: float, dof: int, noise_known: bool) -> float:
+    tail = 0.5 + level / 2.0
+    return float(stats.norm.ppf(tail) if noise_known else stats.t.ppf(tail, max(dof, 1)))
+
+
+def _log_interval(value: float, sd_log: float, q: float) -> tuple[float, float]:
+    return value * math.exp(-q * sd_log), value * math.exp(q * sd_log)
+
+
+def fit_steady(
+    data: SteadyData | str | Path,
+    params: Parameters | str | None = None,
+    method: str = "two-step",
+    split: float = DEFAULT_SPLIT,
+    fix: Mapping[str, Any] | None = None,
+    free: Sequence[str] | None = None,
+    intervals: str | None = None,
+    level: float = 0.95,
+    bootstrap_samples: int = 200,
+    seed: int | None = None,
+) -> SteadyFit:
+    """Fit Eqs 6-8 to a steady friction curve; see the module docstring for the methods.
+
+    ``params`` gives the start values and every value not fitted (default
+    gelatin-glass); ``fix`` maps keys to values (SI numbers or strings with
+    units) held fixed; ``free`` adds keys to fit (e.g. ``bonds.breakage_weight``).
+    ``intervals`` chooses how the intervals of Vc and sigma_c are computed;
+    None picks the method whose coverage was checked for each fit method
+    (docs/fitting.md): ``delta`` for two-step, ``profile`` for joint.
+    """
+    if not isinstance(data, SteadyData):
+        data = read_steady_data(data)
+    if method not in METHODS:
+        raise ParameterError(f"method: expected one of {', '.join(METHODS)}, got {method!r}")
+    if intervals is None:
+        intervals = "delta" if method == "two-step" else "profile"
+    if intervals not in INTERVAL_METHODS:
+        raise ParameterError(f"intervals: expected one of {', '.join(INTERVAL_METHODS)}, got {intervals!r}")
+    if intervals == "profile" and method != "joint":
+        raise ParameterError(
+            "intervals: the profile likelihood needs --method joint (the two-step estimate does not minimise"
+            " one chi-square); use delta or bootstrap with two-step"
+        )
+    if not 0.0 < level < 1.0:
+        raise ParameterError(f"level: expected a confidence level between 0 and 1, got {level!r}")
+    if not (math.isfinite(split) and split > 0):
+        raise ParameterError(f"split: expected a positive velocity in m/s, got {split!r}")
+    if intervals == "bootstrap" and bootstrap_samples < 20:
+        raise ParameterError(f"bootstrap samples: expected at least 20, got {bootstrap_samples}")
+    base = params if isinstance(params, Parameters) else load_parameters(params or "gelatin-glass")
+    base, fixed = _resolve_fix(base, fix)
+    explicit, requested = _requested(free, fixed)
+    error, everything, hi, lo = _blocks(data, split)
+    noise_known = data.stress_err is not None
+    progress = _Progress(base, base, tuple(explicit), noise_known, [], [], [])
+    progress.messages.append(_structure_note(requested, fixed))
+    assert hi is not None and lo is not None
+    _two_step(progress, requested, hi, lo, split)
+    step_keys = _free_after(progress, requested)
+    if method == "joint":
+        # the two-step result is only the start: what the joint fit cannot determine is decided afresh
+        progress.messages = progress.messages[:1]
+        progress.stages = [dataclasses.replace(s, name=f"start, {s.name}") for s in progress.stages]
+        progress.undetermined = []
+        selection = identify.select_identifiable(requested, aging=True)
+        progress.messages.extend(selection.messages)
+        keys, _ = _fit_block(progress, selection.free, everything, "the joint fit", precheck=True)
+    else:
+        keys = [k for k in step_keys if k in identify.NO_AGING_KEYS] + [
+            k for k in step_keys if k in identify.AGING_KEYS
+        ]
+        keys = [k for k in keys if _stage_has(progress.stages, k)]
+    fitted = progress.params
+    full_r = residuals(Space(fitted, ()), np.zeros(0), everything)
+    chi_square = float(full_r @ full_r)
+    if method == "joint":
+        dof = len(data) - len(keys)
+        scale2 = 1.0 if noise_known else chi_square / dof
+        space = Space(fitted, tuple(keys))
+        jac = jacobian(space, space.vector(), everything)
+        covariance = scale2 * _inverse(jac.T @ jac) if keys else np.zeros((0, 0))
+    else:
+        keys1 = [k for k in keys if k in identify.NO_AGING_KEYS]
+        keys2 = [k for k in keys if k in identify.AGING_KEYS]
+        stage_chi = sum(s.chi_square for s in progress.stages)
+        dof = len(data) - len(keys)
+        scale2 = 1.0 if noise_known else stage_chi / dof
+        covariance = _covariance_two_step(fitted, keys1, keys2, hi, lo, scale2)
+        _warn_aging_neglected(progress, fitted, hi, math.sqrt(scale2))
+    if dof <= 0:
+        raise DataError(f"{data.source}: {len(data)} points for {len(keys)} free parameters; need more points")
+    noise_scale = math.sqrt(scale2)
+    q = _quantile(level, dof, noise_known)
+    sd = np.sqrt(np.clip(np.diag(covariance), 0.0, np.inf)) if keys else np.zeros(0)
+    correlation = covariance / np.outer(sd, sd) if keys else np.zeros((0, 0))
+    estimates = _parameter_estimates(fitted, base, keys, sd, q, fixed, progress)
+    combos = _combination_estimates(fitted, keys, covariance, q, method)
+    model = steady_state(fitted, data.velocity).stress
+    noise = (
+        "stated stress_err (chi-square not rescaled)"
+        if noise_known
+        else f"relative, estimated from the scatter: {100 * noise_scale:.3g} % of the stress"
+    )
+    vc, sc, samples = _critical_estimates(
+        fitted, keys, covariance, q, intervals, level, dof, noise_known, everything, data, method, split,
+        fix, free, base, bootstrap_samples, seed, scale2, progress,
+    )  # fmt: skip
+    _note_extrapolation(progress, vc, data)
+    return SteadyFit(
+        data=data,
+        parameters=fitted,
+        start=base,
+        method=method,
+        split=split if method == "two-step" else None,
+        estimates=estimates,
+        combinations=combos,
+        free_keys=tuple(keys),
+        covariance=covariance,
+        correlation=correlation,
+        chi_square=chi_square,
+        dof=dof,
+        noise=noise,
+        noise_scale=noise_scale,
+        model_stress=model,
+        residuals=(data.stress - model) / error,
+        critical_velocity=vc,
+        critical_stress=sc,
+        interval_method=intervals,
+        level=level,
+        stages=tuple(progress.stages),
+        messages=tuple(progress.messages),
+        samples=samples,
+    )
+
+
+def _stage_has(stages: Sequence[Stage], key: str) -> bool:
+    return any(key in s.keys for s in stages)
+
+
+def _structure_note(requested: Sequence[str], fixed: Mapping[str, float]) -> str:
+    held = [k for k in identify.STEADY_KEYS if k not in requested]
+    combos = ", ".join(identify.combination_names())
+    note = f"σ(V) depends on the bond and aging parameters only through {combos} (docs/fitting.md)."
+    if "bonds.max_extension" not in requested:
+        note += (
+            " Δl_m and τ are not separately identifiable from steady data (Δl_m, τ, τa -> s times with"
+            " λM/kT, M·N0 -> 1/s times leaves σ(V) unchanged): Δl_m is fixed at its input value."
+        )
+    user = [k for k in held if k in fixed]
+    if user:
+        note += f" Fixed by request: {', '.join(user)}."
+    rest = [k for k in held if k not in fixed]
+    if rest:
+        note += f" Held at input values: {', '.join(rest)}."
+    return note
+
+
+def _warn_aging_neglected(progress: _Progress, params: Parameters, hi: Block, noise_scale: float) -> None:
+    with_aging = steady_state(params, hi.velocity, aging=True).stress
+    without = steady_state(params, hi.velocity, aging=False).stress
+    shift = np.abs(with_aging - without) / (hi.error * noise_scale)
+    k = int(np.argmax(shift))
+    if shift[k] > AGING_NEGLECT_WARNING:
+        progress.messages.append(
+            f"warning: step 1 neglects aging above the split, but with the fitted parameters aging changes σ by"
+            f" {shift[k]:.2g} standard errors at {human(hi.velocity[k], 'velocity')}: the two-step estimates are"
+            " biased by the approximation; --method joint fits all points with aging"
+        )
+
+
+def _parameter_estimates(
+    fitted: Parameters,
+    base: Parameters,
+    keys: Sequence[str],
+    sd: np.ndarray,
+    q: float,
+    fixed: Mapping[str, float],
+    progress: _Progress,
+) -> tuple[Estimate, ...]:
+    values = fitted.as_dict()
+    out = []
+    for key in identify.STEADY_KEYS:
+        symbol, dimension, value = identify.SYMBOLS[key], key_dimension(key), values[key]
+        if key in keys:
+            s = float(sd[keys.index(key)])
+            out.append(Estimate(key, symbol, dimension, value, value * s, _log_interval(value, s, q)))
+            continue
+        if key in fixed:
+            reason = "fixed by request"
+        elif key in progress.undetermined:
+            reason = "not determined by the data; fixed at its input value"
+        elif key == "bonds.breakage_weight":
+            reason = "u0 = 1 a priori (W0 = 0, paper Section 3)"
+        elif key == "bonds.max_extension":
+            reason = "exact scale degeneracy with τ, τa, λM/kT and M·N0; fixed at its input value"
+        else:
+            reason = "σ(V) depends on it only through products with fitted parameters; fixed at its input value"
+        out.append(Estimate(key, symbol, dimension, value, status="fixed", note=reason))
+    return tuple(out)
+
+
+def _combination_estimates(
+    fitted: Parameters, keys: Sequence[str], covariance: np.ndarray, q: float, method: str
+) -> tuple[Estimate, ...]:
+    matrix = identify.exponent_matrix(keys) if keys else np.zeros((len(identify.COMBINATIONS), 0))
+    cov = matrix @ covariance @ matrix.T if keys else np.zeros((len(identify.COMBINATIONS),) * 2)
+    out = []
+    for k, combo in enumerate(identify.COMBINATIONS):
+        value = combo.value(fitted)
+        if not matrix[k].any():
+            out.append(Estimate(combo.name, combo.symbol, combo.dimension, value, status="fixed", note="not fitted"))
+            continue
+        s = math.sqrt(max(cov[k, k], 0.0))
+        out.append(Estimate(combo.name, combo.symbol, combo.dimension, value, value * s, _log_interval(value, s, q)))
+    return tuple(out)
+
+
+def _note_extrapolation(progress: _Progress, vc: Estimate, data: SteadyData) -> None:
+    if vc.value is None:
+        return
+    lo, hi = float(data.velocity.min()), float(data.velocity.max())
+    if not lo <= vc.value <= hi:
+        progress.messages.append(
+            f"Vc = {human(vc.value, 'velocity')} lies outside the measured range"
+            f" {human(lo, 'velocity')} to {human(hi, 'velocity')}: it is an extrapolation of the fitted curve"
+        )
+
+
+def _critical_estimates(
+    fitted: Parameters,
+    keys: Sequence[str],
+    covariance: np.ndarray,
+    q: float,
+    intervals: str,
+    level: float,
+    dof: int,
+    noise_known: bool,
+    everything: Block,
+    data: SteadyData,
+    method: str,
+    split: float,
+    fix: Mapping[str, Any] | None,
+    free: Sequence[str] | None,
+    base: Parameters,
+    bootstrap_samples: int,
+    seed: int | None,
+    scale2: float,
+    progress: _Progress,
+) -> tuple[Estimate, Estimate, dict[str, np.ndarray] | None]:
+    point = critical_point(fitted)
+    if not point.exists:
+        message = f"the fitted curve has no minimum: {point.message}"
+        progress.messages.append(message)
+        return (
+            Estimate("critical_velocity", "Vc", "velocity", None, status="undetermined", note=message),
+            Estimate("critical_stress", "σc", "stress", None, status="undetermined", note=message),
+            None,
+        )
+    vc, sc = float(point.velocity), float(point.stress)
+    space = Space(fitted, tuple(keys))
+    theta = space.vector()
+    if intervals == "delta" or not keys:
+        grad_v, grad_s = critical_gradient(space, theta, vc) if keys else (np.zeros(0), np.zeros(0))
+        sd_v = math.sqrt(max(float(grad_v @ covariance @ grad_v), 0.0)) if keys else 0.0
+        sd_s = math.sqrt(max(float(grad_s @ covariance @ grad_s), 0.0)) if keys else 0.0
+        note = "first-order propagation (delta method) of the parameter covariance, interval symmetric in ln"
+        return (
+            Estimate("critical_velocity", "Vc", "velocity", vc, vc * sd_v, _log_interval(vc, sd_v, q), "derived", note),
+            Estimate("critical_stress", "σc", "stress", sc, sc * sd_s, _log_interval(sc, sd_s, q), "derived", note),
+            None,
+        )
+    if intervals == "profile":
+        return (
+            *_profile_estimates(fitted, keys, covariance, vc, sc, level, dof, noise_known, everything, progress),
+            None,
+        )
+    return _bootstrap_estimates(
+        fitted, vc, sc, data, method, split, fix, free, base, bootstrap_samples, seed, scale2, level, progress
+    )
+
+
+def _profile_estimates(
+    fitted: Parameters,
+    keys: Sequence[str],
+    covariance: np.ndarray,
+    vc: float,
+    sc: float,
+    level: float,
+    dof: int,
+    noise_known: bool,
+    everything: Block,
+    progress: _Progress,
+) -> tuple[Estimate, Estimate]:
+    """Profile-likelihood intervals of the joint fit over its free keys (fixed keys stay fixed)."""
+    space = Space(fitted, tuple(keys))
+    centre = Space(progress.start, tuple(keys)).vector()
+    best = minimize(space, space.vector(), everything, centre)
+    theta = best.theta
+    located = local_critical(space.params(theta), vc)
+    if located is not None:
+        vc, sc = located
+    profile = Profile(space, everything, centre)
+    profile_dof = max(len(everything) - len(keys), 1)
+    if noise_known:
+        threshold, scale = float(stats.chi2.ppf(level, 1)), 1.0
+    else:
+        threshold, scale = float(stats.f.ppf(level, 1, profile_dof)), best.chi_square / profile_dof
+    grad_v, grad_s = critical_gradient(space, theta, vc)
+    cov = _inverse_or_none(space, theta, everything, scale)
+    guess_v = math.sqrt(max(float(grad_v @ cov @ grad_v), 1e-6)) if cov is not None else 0.1
+    guess_s = math.sqrt(max(float(grad_s @ cov @ grad_s), 1e-6)) if cov is not None else 0.05
+    ends_v = [
+        profile.end(
+            profile.chi_square_at_velocity, math.log(vc), theta, best.chi_square, threshold, scale, guess_v, side
+        )
+        for side in (-1, 1)
+    ]
+    start_s = np.append(theta, math.log(vc))
+    ends_s = [
+        profile.end(
+            profile.chi_square_at_stress, math.log(sc), start_s, best.chi_square, threshold, scale, guess_s, side
+        )
+        for side in (-1, 1)
+    ]
+    note = "profile likelihood"
+    if progress.undetermined:
+        note += f", conditional on {', '.join(progress.undetermined)}"
+    out = []
+    q = _quantile(level, profile_dof, noise_known)
+    for name, symbol, dim, value, ends, sd in (
+        ("critical_velocity", "Vc", "velocity", vc, ends_v, guess_v),
+        ("critical_stress", "σc", "stress", sc, ends_s, guess_s),
+    ):
+        interval = tuple(None if e.value is None else math.exp(e.value) for e in ends)
+        lo, hi = interval
+        extra = ""
+        if (lo is not None and lo >= value) or (hi is not None and hi <= value) or not all(e.converged for e in ends):
+            interval = _log_interval(value, sd, q)
+            extra = "; the profile search failed, so the delta-method interval is given instead"
+            progress.messages.append(f"warning: profile-likelihood interval of {symbol} failed; delta method used")
+        else:
+            unbounded = [where for where, e in zip(("below", "above"), ends, strict=True) if e.value is None]
+            if unbounded:
+                extra = f"; the data do not bound {symbol} from {' or '.join(unbounded)} within a factor 100"
+        known = [x for x in interval if x is not None]
+        stderr = (max(known) - min(known)) / (2 * q) if len(known) == 2 else None
+        out.append(Estimate(name, symbol, dim, value, stderr, interval, "derived", note + extra))  # type: ignore[arg-type]
+    return out[0], out[1]
+
+
+def _inverse_or_none(space: Space, theta: np.ndarray, block: Block, scale: float) -> np.ndarray | None:
+    jac = jacobian(space, theta, block)
+    cov = _inverse(jac.T @ jac)
+    return None if not np.all(np.isfinite(cov)) else scale * cov
+
+
+def _bootstrap_estimates(
+    fitted: Parameters,
+    vc: float,
+    sc: float,
+    data: SteadyData,
+    method: str,
+    split: float,
+    fix: Mapping[str, Any] | None,
+    free: Sequence[str] | None,
+    base: Parameters,
+    samples: int,
+    seed: int | None,
+    scale2: float,
+    level: float,
+    progress: _Progress,
+) -> tuple[Estimate, Estimate, dict[str, np.ndarray]]:
+    """Parametric bootstrap: refit curves simulated from the fit with its noise; percentile intervals."""
+    rng = np.random.default_rng(seed)
+    model = steady_state(fitted, data.velocity).stress
+    sigma = (data.stress_err if data.stress_err is not None else model) * math.sqrt(scale2)
+    held = dict(fix or {})
+    for key in progress.undetermined:
+        held[key] = base.as_dict()[key]
+    found_v, found_s, failed = [], [], 0
+    for _ in range(samples):
+        fake = model + sigma * rng.standard_normal(model.size)
+        if np.any(fake <= 0):
+            failed += 1
+            continue
+        err = data.stress_err if data.stress_err is not None else None
+        synthetic = SteadyData(data.velocity, fake, err, data.rows, data.source)
+        try:
+            refit = _point_fit(synthetic, fitted, method, split, held, free)
+        except (DataError, ParameterError):
+            failed += 1
+            continue
+        located = local_critical(refit, vc)
+        if located is None:
+            failed += 1
+            continue
+        found_v.append(located[0])
+        found_s.append(located[1])
+    tail = (1 - level) / 2
+    note = f"parametric bootstrap, {len(found_v)} refits, percentile interval"
+    if failed:
+        note += f" ({failed} simulated data sets gave no fit or no minimum and were left out)"
+    out = []
+    for name, symbol, dim, value, sample in (
+        ("critical_velocity", "Vc", "velocity", vc, np.array(found_v)),
+        ("critical_stress", "σc", "stress", sc, np.array(found_s)),
+    ):
+        if sample.size < 10:
+            out.append(Estimate(name, symbol, dim, value, None, None, "derived", note + ": too few to use"))
+            continue
+        lo, hi = np.quantile(sample, [tail, 1 - tail])
+        out.append(
+            Estimate(name, symbol, dim, value, float(np.std(sample, ddof=1)), (float(lo), float(hi)), "derived", note)
+        )
+    return out[0], out[1], {"critical_velocity": np.array(found_v), "critical_stress": np.array(found_s)}
+
+
+def _point_fit(
+    data: SteadyData,
+    start: Parameters,
+    method: str,
+    split: float,
+    fix: Mapping[str, Any],
+    free: Sequence[str] | None,
+) -> Parameters:
+    """Best-fit parameters only (no covariance, no identifiability loop): the bootstrap's refit."""
+    params, fixed = _resolve_fix(start, fix)
+    _, requested = _requested([k for k in free or () if k not in fixed], fixed)
+    _, everything, hi, lo = _blocks(data, split)
+    assert hi is not None and lo is not None
+    step1 = identify.select_identifiable([k for k in requested if k in identify.NO_AGING_KEYS], aging=False).free
+    step2 = [k for k in requested if k in identify.AGING_KEYS]
+    for keys, block in ((step1, hi), (step2, lo)):
+        space = Space(params, tuple(keys))
+        params = space.params(minimize(space, space.vector(), block).theta)
+    if method == "joint":
+        keys = identify.select_identifiable([*step1, *step2], aging=True).free
+        space = Space(params, tuple(keys))
+        params = space.params(minimize(space, space.vector(), everything).theta)
+    return params

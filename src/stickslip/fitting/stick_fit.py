@@ -1,0 +1,506 @@
+r"""Fit the stick-phase parameters (Eq 15) to measured stick times, like the paper's Table 1.
+
+Each row is one stick phase: the stress starts at ``start_stress`` (sigma_c;
+the model's critical stress where the cell is empty) and rises at the
+measured loading rate ``stick_slope`` when the table has it, else at
+K V0 with the block stiffness K of Eq 17.  The model's stick time t_s and
+peak stress sigma_s (Eq 16) come from
+:func:`stickslip.model.stick.stick_phase`.
+
+Fitted: ``stick.attached_chains`` (Nc0), ``stick.break_rate`` (uc/tau) and
+``stick.aging_time`` (tau_a of Eq 15), as ln-values.  In Eq 15 Nc0 appears
+only as (lambda/kT)/Nc0, so Nc0 is determined relative to the force
+sensitivity lambda/kT of the bonds, which is held.  With stick times at
+only two pulling velocities (Table 1) the three parameters are not all
+determined: the fit finds the undetermined direction from its covariance
+and fixes a parameter, with a message, as the steady fit does.
+
+Residuals are ln(model/measured) of t_s, and of sigma_s where given and the
+loading rate is not measured (with a measured rate sigma_s = sigma_c +
+rate * t_s repeats t_s and is only compared), with one relative noise level
+estimated from the scatter.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import lmfit
+import numpy as np
+from scipy import stats
+
+from ..errors import DataError, ModelError, ParameterError
+from ..model.critical import critical_point
+from ..model.stick import stick_phase
+from ..parameters import Parameters, key_dimension, load_parameters, replace
+from ..units import to_si
+from . import identify
+from .data import StickData, read_stick_data
+from .problem import JACOBIAN_STEP, SEARCH_BOX, lmfit_covariance_ignored, lmfit_name
+from .results import Estimate, human
+
+if TYPE_CHECKING:  # pragma: no cover
+    import pandas as pd
+    from matplotlib.axes import Axes
+
+STICK_KEYS = ("stick.attached_chains", "stick.break_rate", "stick.aging_time")
+#: Fixed first when the data leave a direction undetermined.
+STICK_FIX_PREFERENCE = ("stick.aging_time", "stick.break_rate", "stick.attached_chains")
+#: ln-residual given to a row whose block never slips in the model (a factor e^5 off).
+STUCK_RESIDUAL = 5.0
+#: Evaluations per (free parameter + 1) allowed in the first pass of the fit.
+FIRST_PASS_EVALUATIONS = 12
+#: Factors of Nc0 tried for the start (:func:`_scanned_start`).
+SCAN_FACTORS = (0.25, 0.4, 0.63, 0.8, 1.0, 1.25, 1.6, 2.5, 4.0)
+
+
+@dataclass(frozen=True)
+class StickFit:
+    """Result of :func:`fit_stick` (SI units)."""
+
+    data: StickData
+    parameters: Parameters
+    start: Parameters
+    estimates: tuple[Estimate, ...]
+    free_keys: tuple[str, ...]
+    covariance: np.ndarray
+    correlation: np.ndarray
+    used: np.ndarray  # bool per row
+    excluded: dict[int, str]  # file row -> reason
+    start_stress: np.ndarray
+    loading_rate: np.ndarray
+    model_stick_time: np.ndarray
+    model_peak_stress: np.ndarray
+    fitted_peak_stress: bool
+    chi_square: float
+    dof: int
+    noise: str
+    noise_scale: float
+    level: float
+    messages: tuple[str, ...]
+
+    @property
+    def reduced_chi_square(self) -> float:
+        return self.chi_square / self.dof if self.dof > 0 else float("nan")
+
+    def to_frame(self) -> pd.DataFrame:
+        frame = self.data.to_frame()
+        frame["used"] = self.used
+        frame["start_stress_used"] = self.start_stress
+        frame["loading_rate"] = self.loading_rate
+        frame["model_stick_time"] = self.model_stick_time
+        frame["model_peak_stress"] = self.model_peak_stress
+        return frame
+
+    def as_dict(self) -> dict[str, Any]:
+        return {
+            "parameters": {e.key: e.as_dict() for e in self.estimates},
+            "chi_square": self.chi_square,
+            "dof": self.dof,
+            "reduced_chi_square": self.reduced_chi_square,
+            "noise": self.noise,
+            "confidence_level": self.level,
+            "correlation": {"keys": list(self.free_keys), "matrix": self.correlation.tolist()},
+            "rows": [
+                {
+                    "row": int(r),
+                    "used": bool(u),
+                    "pulling_velocity": float(v),
+                    "stick_time": float(t),
+                    "model_stick_time": float(m) if u else None,
+                    "model_peak_stress": float(s) if u else None,
+                    "excluded": self.excluded.get(int(r)),
+                }
+                for r, u, v, t, m, s in zip(
+                    self.data.rows,
+                    self.used,
+                    self.data.pulling_velocity,
+                    self.data.stick_time,
+                    self.model_stick_time,
+                    self.model_peak_stress,
+                    strict=True,
+                )
+            ],
+            "messages": list(self.messages),
+        }
+
+    def report(self) -> str:
+        from .report import stick_report
+
+        return stick_report(self)
+
+    def plot(self, ax: Axes | None = None) -> Axes:
+        from .plots import plot_stick_fit
+
+        return plot_stick_fit(self, ax=ax)
+
+
+@dataclass(frozen=True)
+class _Rows:
+    velocity: np.ndarray
+    start: np.ndarray
+    rate: np.ndarray  # d sigma/dt in the stick phase, Pa/s
+    stick_time: np.ndarray
+    peak: np.ndarray | None  # only when fitted
+
+
+def _params_for_rate(params: Parameters, velocity: float, rate: float) -> Parameters:
+    """Parameters whose Eq 17 loading rate K V0 equals the measured ``rate`` (by the shear modulus)."""
+    block = params.block
+    modulus = rate / (velocity * block.geometric_factor) * block.height
+    return replace(params, block={"shear_modulus": modulus})
+
+
+def _model(params: Parameters, rows: _Rows) -> tuple[np.ndarray, np.ndarray, list[str]]:
+    times, peaks, problems = [], [], []
+    for v, s0, rate in zip(rows.velocity, rows.start, rows.rate, strict=True):
+        phase = stick_phase(_params_for_rate(params, float(v), float(rate)), float(v), start_stress=float(s0))
+        if phase.stick_time is None:
+            times.append(math.nan)
+            peaks.append(math.nan)
+            problems.append(phase.message)
+        else:
+            times.append(phase.stick_time)
+            peaks.append(float(phase.peak_stress))  # type: ignore[arg-type]
+    return np.array(times), np.array(peaks), problems
+
+
+def _residuals(params: Parameters, rows: _Rows) -> np.ndarray:
+    try:
+        times, peaks, _ = _model(params, rows)
+    except (ModelError, ParameterError):
+        size = rows.stick_time.size + (0 if rows.peak is None else rows.peak.size)
+        return np.full(size, STUCK_RESIDUAL)
+    r = np.log(times / rows.stick_time)
+    if rows.peak is not None:
+        r = np.append(r, np.log(peaks / rows.peak))
+    return np.where(np.isfinite(r), r, STUCK_RESIDUAL)
+
+
+def _with(params: Parameters, keys: Sequence[str], theta: Sequence[float]) -> Parameters:
+    values = {k.split(".")[1]: math.exp(float(t)) for k, t in zip(keys, theta, strict=True)}
+    return replace(params, stick=values) if values else params
+
+
+def _jacobian(params: Parameters, keys: Sequence[str], theta: np.ndarray, rows: _Rows) -> np.ndarray:
+    cols = []
+    for k in range(len(keys)):
+        step = np.zeros_like(theta)
+        step[k] = JACOBIAN_STEP
+        up = _residuals(_with(params, keys, theta + step), rows)
+        down = _residuals(_with(params, keys, theta - step), rows)
+        cols.append((up - down) / (2 * JACOBIAN_STEP))
+    return np.array(cols).T
+
+
+def _minimize(
+    params: Parameters, keys: Sequence[str], centre: np.ndarray, rows: _Rows, max_nfev: int | None = None
+) -> tuple[Parameters, float, bool]:
+    theta0 = np.array([math.log(params.as_dict()[k]) for k in keys])
+    pars = lmfit.Parameters()
+    for key, t, c in zip(keys, theta0, centre, strict=True):
+        pars.add(
+            lmfit_name(key),
+            value=float(np.clip(t, c - SEARCH_BOX, c + SEARCH_BOX)),
+            min=c - SEARCH_BOX,
+            max=c + SEARCH_BOX,
+        )
+    names = [lmfit_name(k) for k in keys]
+
+    def objective(p: lmfit.Parameters) -> np.ndarray:
+        return _residuals(_with(params, keys, [p[n].value for n in names]), rows)
+
+    # stick times are known to a few per cent: tolerances of 1e-6 are ample and save ODE solves
+    with lmfit_covariance_ignored():
+        result = lmfit.minimize(
+            objective,
+            pars,
+            method="least_squares",
+            calc_covar=False,
+            ftol=1e-6,
+            xtol=1e-6,
+            gtol=1e-6,
+            max_nfev=max_nfev,
+        )
+    fitted = _with(params, keys, [result.params[n].value for n in names])
+    r = _residuals(fitted, rows)
+    return fitted, float(r @ r), bool(result.success)
+
+
+def _select_rows(
+    data: StickData, params: Parameters, exclude: Sequence[int], include_steady: bool
+) -> tuple[np.ndarray, dict[int, str], float | None, list[str]]:
+    messages: list[str] = []
+    known_rows = {int(r) for r in data.rows}
+    for row in exclude:
+        if int(row) not in known_rows:
+            raise DataError(f"{data.source}: --exclude-row {row}: no such data row (rows are {sorted(known_rows)})")
+    point = critical_point(params)
+    vc = point.velocity if point.exists else None
+    used = np.ones(len(data), dtype=bool)
+    excluded: dict[int, str] = {}
+    for k, row in enumerate(data.rows):
+        row = int(row)
+        if row in exclude:
+            used[k], excluded[row] = False, "excluded by request"
+        elif vc is not None and not include_steady and data.pulling_velocity[k] >= vc:
+            used[k] = False
+            excluded[row] = f"V0 above Vc = {human(vc, 'velocity')}: steady sliding, a start from rest"
+    steady_rows = [r for r, why in excluded.items() if why.startswith("V0 above")]
+    if steady_rows:
+        messages.append(
+            f"{'rows' if len(steady_rows) > 1 else 'row'} {', '.join(map(str, steady_rows))} left out: pulling"
+            " velocity above the critical velocity"
+            f" {human(vc, 'velocity')} of the bond parameters, where sliding is steady and the one stick is a"
+            " start from rest, not a stick at σc (use --include-steady to keep them)"
+        )
+    return used, excluded, (point.stress if point.exists else None), messages
+
+
+def fit_stick(
+    table: StickData | str | Path,
+    params: Parameters | str | None = None,
+    fix: Mapping[str, Any] | None = None,
+    free: Sequence[str] | None = None,
+    exclude_rows: Sequence[int] = (),
+    include_steady: bool = False,
+    level: float = 0.95,
+) -> StickFit:
+    """Fit Nc0, uc/tau and the stick aging time (Eq 15) to measured stick times (module docstring).
+
+    ``params`` supplies the bond parameters (lambda/kT, and sigma_c where a
+    row has no start stress), the block and the start values; ``fix`` holds
+    stick keys at given values; ``free`` lists keys the user insists on
+    fitting (they are fixed only if nothing else pins an undetermined direction).
+    """
+    data = table if isinstance(table, StickData) else read_stick_data(table)
+    if not 0.0 < level < 1.0:
+        raise ParameterError(f"level: expected a confidence level between 0 and 1, got {level!r}")
+    base = params if isinstance(params, Parameters) else load_parameters(params or "gelatin-glass")
+    fixed: dict[str, float] = {}
+    for key, raw in (fix or {}).items():
+        _check_stick_key(key, "--fix")
+        fixed[key] = to_si(raw, key_dimension(key), key)
+    base = base.with_overrides(fixed) if fixed else base
+    for key in free or ():
+        _check_stick_key(key, "--free")
+        if key in fixed:
+            raise ParameterError(f"{key} is given both to --fix and to --free")
+    keys = [k for k in STICK_KEYS if k not in fixed]
+    used, excluded, sigma_c, messages = _select_rows(data, base, exclude_rows, include_steady)
+    rows, fitted_peak = _rows(data, used, base, sigma_c, messages)
+    n_obs = rows.stick_time.size + (0 if rows.peak is None else rows.peak.size)
+    if rows.stick_time.size < 2:
+        raise DataError(f"{data.source}: {rows.stick_time.size} usable row(s); need at least 2 stick phases to fit")
+    undetermined: list[str] = []
+    centre_all = {k: math.log(base.as_dict()[k]) for k in STICK_KEYS}
+    current = base
+    protected = list(free or ())
+    while len(keys) >= n_obs:
+        key = identify.choose_key_to_fix(
+            keys, identify.Direction(math.inf, {k: 1.0 for k in keys}), protected, STICK_FIX_PREFERENCE
+        )
+        _fix(keys, undetermined, messages, key, base, "more parameters than observations")
+    current = _scanned_start(current, keys, rows)
+    for _ in range(len(keys) + 1):
+        if not keys:
+            break
+        centre = np.array([centre_all[k] for k in keys])
+        # a short first pass: the determined directions converge quickly, an undetermined one would
+        # be followed for hundreds of ODE solves before the optimiser gives up on it
+        current, _, converged = _minimize(
+            current, keys, centre, rows, max_nfev=FIRST_PASS_EVALUATIONS * (len(keys) + 1)
+        )
+        bad = _undetermined(current, keys, rows, n_obs)
+        if not bad:
+            if not converged:
+                current, _, _ = _minimize(current, keys, centre, rows)
+                bad = _undetermined(current, keys, rows, n_obs)
+            if not bad:
+                break
+        key = identify.choose_key_to_fix(keys, bad[0], protected, STICK_FIX_PREFERENCE)
+        current = current.with_overrides({key: base.as_dict()[key]})
+        _fix(keys, undetermined, messages, key, base, f"the direction {bad[0].describe()} is unconstrained")
+    dof = n_obs - len(keys)
+    r = _residuals(current, rows)
+    chi = float(r @ r)
+    scale2 = chi / dof if dof > 0 else float("nan")
+    theta = np.array([math.log(current.as_dict()[k]) for k in keys])
+    jac = _jacobian(current, keys, theta, rows) if keys else np.zeros((n_obs, 0))
+    covariance = scale2 * np.linalg.pinv(jac.T @ jac) if keys else np.zeros((0, 0))
+    sd = np.sqrt(np.clip(np.diag(covariance), 0, np.inf))
+    correlation = covariance / np.outer(sd, sd) if keys else np.zeros((0, 0))
+    q = float(stats.t.ppf(0.5 + level / 2, max(dof, 1)))
+    estimates = []
+    for key in STICK_KEYS:
+        value = current.as_dict()[key]
+        dim = key_dimension(key)
+        if key in keys:
+            s = float(sd[keys.index(key)])
+            estimates.append(
+                Estimate(
+                    key,
+                    identify.SYMBOLS[key],
+                    dim,
+                    value,
+                    value * s,
+                    (value * math.exp(-q * s), value * math.exp(q * s)),
+                )
+            )
+        else:
+            reason = "fixed by request" if key in fixed else "not determined by the data; fixed at its input value"
+            estimates.append(Estimate(key, identify.SYMBOLS[key], dim, value, status="fixed", note=reason))
+    full = _Rows(data.pulling_velocity, _start_column(data, sigma_c), _rate_column(data, base), data.stick_time, None)
+    times, peaks, problems = _model(
+        current, _Rows(*(a[used] for a in (full.velocity, full.start, full.rate, full.stick_time)), None)
+    )
+    model_t = np.full(len(data), np.nan)
+    model_s = np.full(len(data), np.nan)
+    model_t[used], model_s[used] = times, peaks
+    messages.extend(f"model: {p}" for p in problems)
+    messages.extend(_outliers(data, used, model_t))
+    if dof <= 0:
+        messages.append("no degrees of freedom left: the noise cannot be estimated and the errors are undefined")
+    noise = f"relative (ln), estimated from the scatter: {100 * math.sqrt(scale2):.3g} %" if dof > 0 else "undefined"
+    return StickFit(
+        data=data,
+        parameters=current,
+        start=base,
+        estimates=tuple(estimates),
+        free_keys=tuple(keys),
+        covariance=covariance,
+        correlation=correlation,
+        used=used,
+        excluded=excluded,
+        start_stress=full.start,
+        loading_rate=full.rate,
+        model_stick_time=model_t,
+        model_peak_stress=model_s,
+        fitted_peak_stress=fitted_peak,
+        chi_square=chi,
+        dof=dof,
+        noise=noise,
+        noise_scale=math.sqrt(scale2) if dof > 0 else float("nan"),
+        level=level,
+        messages=tuple(messages),
+    )
+
+
+def _outliers(data: StickData, used: np.ndarray, model_t: np.ndarray) -> list[str]:
+    """Rows whose stick time is off by more than 4 robust standard deviations of the others."""
+    r = np.log(model_t[used] / data.stick_time[used])
+    if r.size < 4 or not np.all(np.isfinite(r)):
+        return []
+    spread = 1.4826 * float(np.median(np.abs(r - np.median(r))))
+    out = []
+    for row, value in zip(data.rows[used], r, strict=True):
+        if spread > 0 and abs(value - np.median(r)) > 4 * spread:
+            out.append(
+                f"row {row}: the model's stick time is off by a factor {math.exp(-value):.3g}, far outside the scatter"
+                f" of the other rows ({100 * spread:.2g} %): an outlier? (--exclude-row {row} leaves it out)"
+            )
+    return out
+
+
+def _scanned_start(params: Parameters, keys: Sequence[str], rows: _Rows) -> Parameters:
+    """The start with the best Nc0 of a coarse scan (factors 1/4 to 4).
+
+    The stick time depends most strongly on Nc0 (the load per chain), and a
+    start where some block never slips gives the optimiser no gradient.
+    """
+    if "stick.attached_chains" not in keys:
+        return params
+    best, best_cost = params, math.inf
+    for factor in SCAN_FACTORS:
+        trial = params.with_overrides({"stick.attached_chains": params.stick.attached_chains * factor})
+        r = _residuals(trial, rows)
+        cost = float(r @ r)
+        if cost < best_cost:
+            best, best_cost = trial, cost
+    return best
+
+
+def _undetermined(params: Parameters, keys: Sequence[str], rows: _Rows, n_obs: int) -> list[identify.Direction]:
+    if not keys:
+        return []
+    theta = np.array([math.log(params.as_dict()[k]) for k in keys])
+    r = _residuals(params, rows)
+    scale = math.sqrt(float(r @ r) / (n_obs - len(keys)))
+    return identify.undetermined(keys, _jacobian(params, keys, theta, rows), max(scale, 1e-3))
+
+
+def _fix(keys: list[str], undetermined: list[str], messages: list[str], key: str, base: Parameters, why: str) -> None:
+    keys.remove(key)
+    undetermined.append(key)
+    value = base.as_dict()[key]
+    messages.append(
+        f"{key} ({identify.SYMBOLS[key]}) is not determined by these stick times ({why}): fixed at its input value"
+        f" {human(value, key_dimension(key))}; the other estimates are conditional on it"
+    )
+
+
+def _check_stick_key(key: str, option: str) -> None:
+    key_dimension(key)
+    if key not in STICK_KEYS:
+        raise ParameterError(
+            f"{option} {key}: not a stick-phase fit parameter; expected one of {', '.join(STICK_KEYS)}"
+        )
+
+
+def _start_column(data: StickData, sigma_c: float | None) -> np.ndarray:
+    start = data.start_stress if data.start_stress is not None else np.full(len(data), np.nan)
+    missing = ~np.isfinite(start)
+    if np.any(missing):
+        if sigma_c is None:
+            raise DataError(
+                f"{data.source}: row {data.rows[np.nonzero(missing)[0][0]]}, column 'start_stress' is empty and the"
+                " bond parameters have no critical stress to start from; give the start stress"
+            )
+        start = np.where(missing, sigma_c, start)
+    return start
+
+
+def _rate_column(data: StickData, params: Parameters) -> np.ndarray:
+    model_rate = params.block.effective_stiffness * data.pulling_velocity
+    measured = data.extra.get("stick_slope")
+    if measured is None:
+        return model_rate
+    return np.where(np.isfinite(measured), measured, model_rate)
+
+
+def _rows(
+    data: StickData, used: np.ndarray, params: Parameters, sigma_c: float | None, messages: list[str]
+) -> tuple[_Rows, bool]:
+    start = _start_column(data, sigma_c)
+    if data.start_stress is None or np.any(~np.isfinite(data.start_stress[used])):
+        messages.append(
+            f"rows without start_stress start at the critical stress σc = {human(sigma_c or 0.0, 'stress')} of the"
+            " bond parameters"
+        )
+    rate = _rate_column(data, params)
+    measured = "stick_slope" in data.extra
+    if measured:
+        messages.append("loading rate of each stick phase from its measured stick_slope (instead of K·V0 of Eq 17)")
+    peak = None
+    fitted_peak = False
+    if data.peak_stress is not None and not measured:
+        have = np.isfinite(data.peak_stress)
+        if np.any(have & used):
+            if not np.all(have[used]):
+                raise DataError(
+                    f"{data.source}: column 'peak_stress' is empty in some fitted rows; give it in every row or in none"
+                )
+            peak = data.peak_stress[used]
+            fitted_peak = True
+            messages.append("peak stresses fitted together with stick times (one relative noise level)")
+    elif data.peak_stress is not None:
+        messages.append(
+            "peak stresses compared, not fitted: with the measured loading rate σs = σc + rate·ts repeats"
+            " the stick time"
+        )
+    rows = _Rows(data.pulling_velocity[used], start[used], rate[used], data.stick_time[used], peak)
+    return rows, fitted_peak

@@ -1,0 +1,393 @@
+r"""Whole stick-slip cycles: stick (Eqs 11-17) -> jump (Eqs 8, 16) -> slip (Eq 10) -> jump back -> ...
+
+The block starts stuck at sigma_c (or a given stress) with a fresh population
+of attached chains.  The puller loads it linearly (Eq 12, with the Eq 17
+stiffness K) until the chains collapse at t_s (Eq 15), at the stress sigma_s
+(Eq 16).  The velocity jumps to Vs on the steady curve (stress continuous),
+then relaxes along the aging curve by Eq 10:
+
+* V0 < Vc: down to Vc in finite time, where the block jumps back to rest at
+  sigma_c and the next stick begins with fresh chains;
+* V0 >= Vc: to V0, after which the block slides steadily at sigma(V0).
+
+Every stick after the first starts at sigma_c with Nc = Nc0, so every cycle
+after the first is the same cycle: each distinct phase is solved once and
+repeated with a time and displacement offset.  That is the physics of the
+model (the state at each re-stick is the same), not an approximation.
+
+Bookkeeping of the trace (positions measured from the slider's initial
+position): ``block_shear = sigma/K``, ``puller_displacement = sigma_0/K + V0 t``
+and ``slider_displacement = int V dt``, so that puller = slider + shear at
+all times.  With ``jump_curve="no-aging"`` the slip starts on the aging
+curve at the no-aging Vs, where the stress differs from sigma_s (for
+gelatin-glass it is ~18 Pa higher); the stress then jumps at the jump and
+the slider is displaced by (sigma_s - sigma(Vs))/K in no time, which keeps
+the bookkeeping exact and shows why the aging curve is the default.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from ..errors import ParameterError
+from ..parameters import Parameters
+from .jump import Jump, check_curve, jump_velocity, require_critical_point
+from .slip import SlipPhase, slip_phase
+from .stick import StickPhase, _number, check_stress, check_velocity, stick_phase
+
+if TYPE_CHECKING:  # pragma: no cover
+    import pandas as pd
+    from matplotlib.axes import Axes
+
+#: Trace columns, in order (SI units: s, Pa, m/s, m, m, m, Nc/Nc0, phase name).
+CYCLE_COLUMNS = (
+    "time",
+    "stress",
+    "velocity",
+    "slider_displacement",
+    "puller_displacement",
+    "block_shear",
+    "chain_fraction",
+    "phase",
+)
+COLUMN_UNITS = {
+    "time": "s",
+    "stress": "Pa",
+    "velocity": "m/s",
+    "slider_displacement": "m",
+    "puller_displacement": "m",
+    "block_shear": "m",
+    "chain_fraction": "",
+    "phase": "",
+}
+REGIMES = ("stick-slip", "steady", "stuck", "undetermined")
+#: Long runs are thinned so that the trace stays below about this many rows (phase ends are always kept).
+MAX_ROWS = 1_000_000
+#: Runs of more cycles than this are refused (the trace would be mostly thinning).
+MAX_CYCLES = 100_000
+
+
+@dataclass(frozen=True)
+class Cycle:
+    """One stick phase that ended in a slip, and the slip that followed."""
+
+    index: int
+    start_time: float
+    start_stress: float  # sigma where the stick began (sigma_c after the first)
+    peak_stress: float  # sigma_s (Eq 16)
+    stick_time: float  # t_s
+    jump_velocity: float  # Vs
+    slip_time: float | None = None  # None until the next stick began
+    period: float | None = None
+
+    def as_dict(self) -> dict[str, Any]:
+        return {
+            "start_time": self.start_time,
+            "start_stress": self.start_stress,
+            "peak_stress": self.peak_stress,
+            "stick_time": self.stick_time,
+            "jump_velocity": self.jump_velocity,
+            "slip_time": self.slip_time,
+            "period": self.period,
+        }
+
+
+@dataclass(frozen=True)
+class Simulation:
+    """A simulated trace (SI units) and its cycles; see :func:`simulate`."""
+
+    time: np.ndarray
+    stress: np.ndarray
+    velocity: np.ndarray
+    slider_displacement: np.ndarray
+    puller_displacement: np.ndarray
+    block_shear: np.ndarray
+    chain_fraction: np.ndarray
+    phase: np.ndarray
+    regime: str
+    cycles: tuple[Cycle, ...]
+    final_stress: float  # at the end of the trace: ``duration``, or where the model stops ("undetermined")
+    final_velocity: float
+    message: str
+    pulling_velocity: float
+    duration: float
+    start_stress: float
+    jump_curve: str
+    critical_velocity: float
+    critical_stress: float
+    stiffness: float
+    stick_phases: tuple[StickPhase, ...] = field(default=(), repr=False)
+    slip_phases: tuple[SlipPhase, ...] = field(default=(), repr=False)
+    jumps: tuple[Jump, ...] = field(default=(), repr=False)
+    parameters: Parameters | None = field(default=None, repr=False, compare=False)
+
+    def summary(self) -> dict[str, Any]:
+        """The JSON summary, SI units."""
+        return {
+            "regime": self.regime,
+            "message": self.message,
+            "final_stress": self.final_stress,
+            "final_velocity": self.final_velocity,
+            "end_time": float(self.time[-1]),
+            "pulling_velocity": self.pulling_velocity,
+            "duration": self.duration,
+            "start_stress": self.start_stress,
+            "jump_curve": self.jump_curve,
+            "critical_velocity": self.critical_velocity,
+            "critical_stress": self.critical_stress,
+            "effective_stiffness": self.stiffness,
+            "cycles": [c.as_dict() for c in self.cycles],
+        }
+
+    def to_frame(self) -> pd.DataFrame:
+        """The trace, one row per sample, columns :data:`CYCLE_COLUMNS` (SI units)."""
+        import pandas as pd
+
+        return pd.DataFrame({name: getattr(self, name) for name in CYCLE_COLUMNS})
+
+    def plot(self, ax: Axes | None = None, **kwargs: Any) -> Axes:
+        """sigma(t) over the cycles (Fig 5a-c); returns the Axes."""
+        from ..cycle_plots import plot_simulation
+
+        return plot_simulation(self, ax=ax, **kwargs)
+
+
+@dataclass
+class _Trace:
+    """Rows of the trace, appended phase by phase; each phase thinned by ``stride`` (its ends always kept)."""
+
+    sigma0: float
+    stiffness: float
+    v0: float
+    end: float
+    stride: int = 1
+    parts: list[tuple[np.ndarray, ...]] = field(default_factory=list)
+    names: list[str] = field(default_factory=list)
+
+    def add(
+        self, t: np.ndarray, stress: np.ndarray, velocity: np.ndarray, slider: np.ndarray, n: np.ndarray, phase: str
+    ) -> None:
+        if self.stride > 1 and t.size > 2:
+            keep = np.unique(np.r_[np.arange(0, t.size, self.stride), t.size - 1])
+            t, stress, velocity, slider, n = t[keep], stress[keep], velocity[keep], slider[keep], n[keep]
+        self.parts.append((t, stress, velocity, slider, n))
+        self.names.append(phase)
+
+    def build(self) -> dict[str, np.ndarray]:
+        t, stress, velocity, slider, n = (np.concatenate(column) for column in zip(*self.parts, strict=True))
+        phase = np.repeat(np.array(self.names), [part[0].size for part in self.parts])
+        return {
+            "time": t,
+            "stress": stress,
+            "velocity": velocity,
+            "slider_displacement": slider,
+            "puller_displacement": self.sigma0 / self.stiffness + self.v0 * t,
+            "block_shear": stress / self.stiffness,
+            "chain_fraction": n,
+            "phase": phase,
+        }
+
+
+def _add_stick(trace: _Trace, stick: StickPhase, t0: float, slider: float) -> None:
+    t = stick.time
+    if t0 + t[-1] > trace.end:  # cut at the end of the run, with the exact state there
+        cut = trace.end - t0
+        inside = t < cut
+        t = np.r_[t[inside], cut]
+        n = np.r_[stick.chain_fraction[inside], stick.chain_fraction_at(cut)]
+    else:
+        n = stick.chain_fraction
+    trace.add(t0 + t, stick.stress_at(t), np.zeros(t.size), np.full(t.size, slider), n, "stick")
+
+
+def _add_slip(trace: _Trace, slip: SlipPhase, t0: float, slider: float) -> None:
+    t, v, s, x = slip.time, slip.velocity, slip.stress, slip.slider_displacement
+    if t0 + slip.duration > trace.end:
+        cut = trace.end - t0
+        inside = t < cut
+        v_cut, s_cut, x_cut = slip.at(cut)
+        t, v, s, x = np.r_[t[inside], cut], np.r_[v[inside], v_cut], np.r_[s[inside], s_cut], np.r_[x[inside], x_cut]
+    trace.add(t0 + t, s, v, slider + x, np.zeros(t.size), "slip")
+
+
+def _add_steady(trace: _Trace, t0: float, stress: float, slider: float) -> None:
+    t = np.linspace(t0, trace.end, 50) if trace.end > t0 else np.array([t0])
+    trace.add(
+        t, np.full(t.size, stress), np.full(t.size, trace.v0), slider + trace.v0 * (t - t0), np.zeros(t.size), "steady"
+    )
+
+
+@dataclass(frozen=True)
+class _Cycle:
+    """A stick from a given stress and what follows it; ``problem`` says why the chain of phases stops."""
+
+    stick: StickPhase
+    jump: Jump | None
+    slip: SlipPhase | None
+    problem: str | None  # None, or the regime ("stuck"/"undetermined") with ``message``
+    message: str = ""
+
+
+@dataclass
+class _Phases:
+    """Each distinct phase solved once (keyed by the stress the stick starts at)."""
+
+    params: Parameters
+    v0: float
+    curve: str
+    horizon: float
+    cycles: dict[float, _Cycle] = field(default_factory=dict)
+
+    def cycle(self, sigma: float) -> _Cycle:
+        if sigma not in self.cycles:
+            self.cycles[sigma] = self._solve(sigma)
+        return self.cycles[sigma]
+
+    def _solve(self, sigma: float) -> _Cycle:
+        stick = stick_phase(self.params, self.v0, sigma, horizon=self.horizon)
+        if stick.status != "slipped":
+            return _Cycle(stick, None, None, "stuck" if stick.stuck else "undetermined", stick.message)
+        assert stick.peak_stress is not None
+        jump = jump_velocity(self.params, stick.peak_stress, self.curve)
+        if not jump.reachable or jump.velocity is None:
+            message = f"the chains collapse at sigma_s = {stick.peak_stress:.6g} Pa, but {jump.message}"
+            return _Cycle(stick, jump, None, "undetermined", message)
+        slip = slip_phase(self.params, self.v0, jump.velocity)
+        if slip.ends == "stick" and slip.duration == 0.0:
+            message = (
+                f"degenerate cycle: the chains collapse after {stick.stick_time:.6g} s at sigma_s ="
+                f" {stick.peak_stress:.6g} Pa, no more than sigma_c, so the jump lands at Vc where the slip ends at"
+                " once and the block sticks again without moving (creep by infinitesimal slips, outside the model)"
+            )
+            return _Cycle(stick, jump, slip, "undetermined", message)
+        return _Cycle(stick, jump, slip, None)
+
+    def all(self, kind: str) -> tuple[Any, ...]:
+        return tuple(getattr(c, kind) for c in self.cycles.values() if getattr(c, kind) is not None)
+
+
+def simulate(
+    params: Parameters,
+    pulling_velocity: float,
+    duration: float,
+    start_stress: float | None = None,
+    jump_curve: str = "aging",
+) -> Simulation:
+    """Simulate the block pulled at ``pulling_velocity`` (m/s, >= 0) for ``duration`` seconds.
+
+    Starts stuck at ``start_stress`` (Pa; default sigma_c) with fresh chains
+    and chains stick -> jump -> slip -> jump -> ...  ``jump_curve`` is the
+    steady curve on which the jump lands (``"aging"``, default, keeps the
+    stress continuous; ``"no-aging"`` is the paper's Section 3 reading).
+
+    ``regime`` describes where the run is heading, whatever ``duration``:
+    ``"stick-slip"`` (cycles repeat), ``"steady"`` (the slip settles at V0 >=
+    Vc), ``"stuck"`` (a stick never ends) or ``"undetermined"`` (the model has
+    no answer: the jump stress is off the branch, a stick can neither be
+    shown to end nor to last for ever, or the cycle degenerates); ``message``
+    says which and why.  Runs longer than MAX_CYCLES periods are refused.
+    """
+    v0 = check_velocity(pulling_velocity)
+    end = _number(duration, "duration", "s")
+    if end <= 0:
+        raise ParameterError(f"duration: expected a positive time in s, got {end!r}")
+    check_curve(jump_curve)
+    cp = require_critical_point(params)
+    assert cp.velocity is not None and cp.stress is not None
+    sigma_c = float(cp.stress)
+    sigma0 = sigma_c if start_stress is None else check_stress(start_stress)
+    stiffness = params.block.effective_stiffness
+    phases = _Phases(params, v0, jump_curve, end)
+    regime, message, period = _outlook(phases, sigma0, sigma_c)
+    trace = _Trace(sigma0, stiffness, v0, end)
+    if period is not None:
+        repeat = phases.cycle(sigma_c)
+        assert repeat.slip is not None
+        count = end / period
+        if count > MAX_CYCLES:
+            raise ParameterError(
+                f"duration: {end:.6g} s holds {count:.3g} cycles of {period:.6g} s; at most {MAX_CYCLES:g} are"
+                " traced, so give a shorter duration"
+            )
+        rows = count * (repeat.stick.time.size + repeat.slip.time.size)
+        trace.stride = max(1, math.ceil(rows / MAX_ROWS))
+    cycles: list[Cycle] = []
+    t, slider, sigma = 0.0, 0.0, sigma0
+    while True:  # one stick (and the slip after it) per pass; t advances by a period > 0
+        cycle = phases.cycle(sigma)
+        stick, jump, slip = cycle.stick, cycle.jump, cycle.slip
+        _add_stick(trace, stick, t, slider)
+        if slip is None or jump is None or jump.velocity is None:
+            break  # stuck, or no answer; _outlook has the words
+        assert stick.stick_time is not None and stick.peak_stress is not None
+        if t + stick.stick_time > end:
+            break
+        cycles.append(Cycle(len(cycles), t, sigma, stick.peak_stress, stick.stick_time, jump.velocity))
+        t += stick.stick_time
+        slider += (stick.peak_stress - slip.start_stress) / stiffness  # 0 unless the jump left the aging curve
+        _add_slip(trace, slip, t, slider)
+        if slip.ends == "steady":
+            if t + slip.duration < end:
+                _add_steady(trace, t + slip.duration, slip.end_stress, slider + slip.slider_displacement[-1])
+            break
+        if cycle.problem is not None or t + slip.duration > end:
+            break
+        slider += slip.slider_displacement[-1]
+        t += slip.duration
+        cycles[-1] = dataclasses.replace(cycles[-1], slip_time=slip.duration, period=stick.stick_time + slip.duration)
+        sigma = sigma_c
+    if regime == "stick-slip":
+        message += f"; {sum(c.period is not None for c in cycles)} whole cycle(s) in {end:.6g} s"
+    elif regime == "stuck" and cycles:
+        message += f" (after {len(cycles)} slip(s))"
+    columns = trace.build()
+    return Simulation(
+        **columns,
+        regime=regime,
+        cycles=tuple(cycles),
+        final_stress=float(columns["stress"][-1]),
+        final_velocity=float(columns["velocity"][-1]),
+        message=message,
+        pulling_velocity=v0,
+        duration=end,
+        start_stress=sigma0,
+        jump_curve=jump_curve,
+        critical_velocity=float(cp.velocity),
+        critical_stress=sigma_c,
+        stiffness=stiffness,
+        stick_phases=phases.all("stick"),
+        slip_phases=phases.all("slip"),
+        jumps=phases.all("jump"),
+        parameters=params,
+    )
+
+
+def _outlook(phases: _Phases, sigma0: float, sigma_c: float) -> tuple[str, str, float | None]:
+    """(regime, message, period of the repeating cycle or None): where the run is heading, whatever its length."""
+    first = phases.cycle(sigma0)
+    if first.problem is not None:
+        return first.problem, first.message, None
+    assert first.slip is not None
+    if first.slip.ends == "steady":
+        return "steady", first.slip.message, None
+    repeat = phases.cycle(sigma_c)
+    if repeat.problem is not None:
+        return repeat.problem, repeat.message, None
+    assert repeat.slip is not None and repeat.jump is not None and repeat.jump.velocity is not None
+    stick = repeat.stick
+    assert stick.stick_time is not None and stick.peak_stress is not None
+    if repeat.slip.ends == "steady":
+        return "steady", repeat.slip.message, None
+    period = stick.stick_time + repeat.slip.duration
+    return (
+        "stick-slip",
+        f"stick-slip with period {period:.6g} s (stick {stick.stick_time:.6g} s, slip {repeat.slip.duration:.6g} s):"
+        f" sigma_c = {sigma_c:.6g} Pa -> sigma_s = {stick.peak_stress:.6g} Pa,"
+        f" jump to Vs = {repeat.jump.velocity * 1e6:.6g} um/s",
+        period,
+    )

@@ -1,0 +1,284 @@
+r"""The jump from stick to slip: the velocity Vs at which the steady curve carries sigma_s (Eqs 8, 16).
+
+When the attached chains collapse (Eq 15) at the stress sigma_s of Eq 16,
+the block slips and its velocity jumps, in no time on the scale of the
+loading, to the velocity Vs at which steady sliding carries that stress.
+The block's shear cannot change instantly, so the stress is continuous
+through the jump: Vs is the root of
+
+    sigma(Vs) = sigma_s,      Vc < Vs < V_max,
+
+on the velocity-strengthening right branch of the steady curve (Eqs 6-8),
+between the critical velocity Vc of Eq 9 and the curve's maximum.  By
+default the curve is the aging curve, the one the slip phase then follows
+(Eq 10); the paper's Section 3 uses the no-aging form of Eq 8 instead
+(``curve="no-aging"``, see docs/errata.md).  When sigma_s lies outside the
+stresses of that branch the jump is unreachable and the result says so.
+
+Numerics: the branch is interpolated once per parameter set by a Chebyshev
+series in ln V, converged to 1e-12 of the largest coefficient (one or two
+vectorised calls of :func:`stickslip.model.steady.steady_state`); Brent's
+method finds the root of the series.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+from functools import lru_cache
+
+import numpy as np
+import scipy.fft
+from numpy.polynomial import chebyshev as cheb
+from scipy.optimize import brentq
+
+from ..errors import ModelError, ParameterError
+from ..parameters import Parameters
+from .critical import CriticalPoint, critical_point
+from .steady import steady_state
+
+CURVES = ("aging", "no-aging")
+
+#: Chebyshev series: relative size of the trailing coefficients accepted as converged.
+CHEBYSHEV_TOLERANCE = 1e-12
+CHEBYSHEV_START = 32
+CHEBYSHEV_MAX = 1024
+
+
+# --------------------------------------------------------------------------- Chebyshev tools
+def chebyshev_points(n: int) -> np.ndarray:
+    """The n+1 Chebyshev points of the second kind, cos(pi j/n), from +1 down to -1."""
+    return np.cos(np.pi * np.arange(n + 1) / n)
+
+
+def chebyshev_coefficients(values: np.ndarray) -> np.ndarray:
+    """Chebyshev coefficients of the interpolant through values at :func:`chebyshev_points` (last axis)."""
+    n = values.shape[-1] - 1
+    c = scipy.fft.dct(values, type=1, axis=-1) / n
+    c[..., 0] /= 2.0
+    c[..., -1] /= 2.0
+    return c
+
+
+def _converged(coefficients: np.ndarray, tol: float, floor: np.ndarray | float) -> bool:
+    tail = max(2, coefficients.shape[-1] // 8)
+    scale = np.max(np.abs(coefficients), axis=-1)
+    return bool(np.all(np.max(np.abs(coefficients[..., -tail:]), axis=-1) <= tol * scale + floor + 1e-300))
+
+
+def adaptive_chebyshev(
+    sample: Callable[[np.ndarray], np.ndarray],
+    lo: float,
+    hi: float,
+    tol: float = CHEBYSHEV_TOLERANCE,
+    start: int = CHEBYSHEV_START,
+    largest: int = CHEBYSHEV_MAX,
+    floor: np.ndarray | float = 0.0,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Chebyshev interpolation on [lo, hi] of the rows of ``sample(x) -> (m, len(x))``, doubling until converged.
+
+    Converged when the trailing coefficients of every row are below ``tol``
+    times its largest one plus ``floor`` (per row: the absolute noise of the
+    samples, below which coefficients mean nothing).  Returns (x nodes,
+    values (m, n+1), coefficients (m, n+1)).  The grids are nested, so
+    doubling samples only the new points.
+    """
+    n = start
+    u = chebyshev_points(n)
+    x = 0.5 * (lo + hi) + 0.5 * (hi - lo) * u
+    values = np.atleast_2d(sample(x))
+    while True:
+        coefficients = chebyshev_coefficients(values)
+        if _converged(coefficients, tol, floor):
+            return x, values, coefficients
+        if 2 * n > largest:
+            raise ModelError(
+                f"Chebyshev interpolation on [{lo:.6g}, {hi:.6g}] did not converge with {largest + 1} points"
+            )
+        n *= 2
+        u = chebyshev_points(n)
+        x = 0.5 * (lo + hi) + 0.5 * (hi - lo) * u
+        new = np.empty((values.shape[0], n + 1))
+        new[:, ::2] = values
+        new[:, 1::2] = np.atleast_2d(sample(x[1::2]))
+        values = new
+
+
+def to_unit(x: np.ndarray | float, lo: float, hi: float) -> np.ndarray:
+    """Map [lo, hi] onto the Chebyshev interval [-1, 1]."""
+    return (2.0 * np.asarray(x, dtype=float) - lo - hi) / (hi - lo)
+
+
+# --------------------------------------------------------------------------- the steady curve, cached
+@lru_cache(maxsize=32)
+def cached_critical_point(params: Parameters) -> CriticalPoint:
+    """:func:`critical_point` once per parameter set (parameters are frozen, so they are a safe key)."""
+    return critical_point(params)
+
+
+def require_critical_point(params: Parameters) -> CriticalPoint:
+    """The critical point, or a ModelError saying why stick-slip is undefined without it."""
+    cp = cached_critical_point(params)
+    if not cp.exists:
+        raise ModelError(f"no stick-slip cycle: {cp.message}")
+    return cp
+
+
+def branch_maximum(params: Parameters, curve: str) -> tuple[float, float]:
+    """(velocity, stress) where the right branch of ``curve`` ends: the curve's maximum above Vc."""
+    cp = require_critical_point(params)
+    assert cp.velocity is not None
+    if curve == "aging":
+        maxima = [e for e in cp.extrema if e.kind == "maximum" and e.velocity > cp.velocity]
+        if maxima:
+            return maxima[0].velocity, maxima[0].stress
+    if cp.turnover_velocity is not None and cp.turnover_stress is not None:
+        return cp.turnover_velocity, cp.turnover_stress
+    v_top = 1e2  # the end of the critical-point search: the branch rises all the way
+    return v_top, float(steady_state(params, v_top, aging=curve == "aging").stress)
+
+
+#: The aging branch's series reaches this far below Vc, so that the slip phase can subtract a pole at
+#: any V0 in [BELOW_VC * Vc, Vc) (see :mod:`stickslip.model.slip`).
+BELOW_VC = 0.5
+
+
+@dataclass(frozen=True)
+class BranchInterpolant:
+    """sigma(V) and g = V dsigma/dV on the right branch of a steady curve, as Chebyshev series in ln V.
+
+    The series span [ln(BELOW_VC Vc), ln V_max] for the aging curve and
+    [ln Vc, ln V_max] for the no-aging curve; ``log_vc`` marks Vc.
+    """
+
+    curve_name: str
+    log_lo: float
+    log_hi: float
+    log_vc: float
+    stress_series: np.ndarray
+    g_series: np.ndarray
+
+    def _u(self, velocity: np.ndarray | float) -> np.ndarray:
+        return to_unit(np.log(velocity), self.log_lo, self.log_hi)
+
+    def stress(self, velocity: np.ndarray | float) -> np.ndarray:
+        return cheb.chebval(self._u(velocity), self.stress_series)
+
+    def slope(self, velocity: np.ndarray | float) -> np.ndarray:
+        """dsigma/dV."""
+        return cheb.chebval(self._u(velocity), self.g_series) / np.asarray(velocity, dtype=float)
+
+    def __call__(self, velocity: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(sigma, dsigma/dV): the curve in the form the slip phase takes."""
+        return self.stress(velocity), self.slope(velocity)
+
+    @property
+    def noise(self) -> tuple[float, float]:
+        """Absolute accuracy of the series of sigma and of g (the convergence level they were built to)."""
+        return (
+            CHEBYSHEV_TOLERANCE * float(np.max(np.abs(self.stress_series))),
+            CHEBYSHEV_TOLERANCE * float(np.max(np.abs(self.g_series))),
+        )
+
+    def covers(self, velocity: float) -> bool:
+        x = math.log(velocity)
+        return self.log_lo - 1e-12 <= x <= self.log_hi + 1e-12
+
+
+@lru_cache(maxsize=32)
+def branch_interpolant(params: Parameters, curve: str) -> BranchInterpolant:
+    """The branch series of ``curve``, computed once per parameter set (cached)."""
+    cp = require_critical_point(params)
+    assert cp.velocity is not None
+    v_max, _ = branch_maximum(params, curve)
+    aging = curve == "aging"
+    lo = math.log(cp.velocity * (BELOW_VC if aging else 1.0))
+    hi = math.log(v_max)
+
+    def sample(x: np.ndarray) -> np.ndarray:
+        v = np.exp(x)
+        state = steady_state(params, v, aging=aging)
+        return np.array([state.stress, state.stress_slope * v])
+
+    _, _, c = adaptive_chebyshev(sample, lo, hi, start=64)
+    return BranchInterpolant(curve, lo, hi, math.log(cp.velocity), c[0], c[1])
+
+
+# --------------------------------------------------------------------------- the jump
+@dataclass(frozen=True)
+class Jump:
+    """The jump velocity Vs where the steady ``curve`` carries ``stress`` (None when unreachable)."""
+
+    stress: float
+    velocity: float | None
+    reachable: bool
+    curve: str
+    message: str
+    lowest_stress: float  # the branch's stress at Vc
+    highest_stress: float  # the branch's maximum
+
+    def as_dict(self) -> dict[str, object]:
+        return {
+            "stress": self.stress,
+            "jump_velocity": self.velocity,
+            "reachable": self.reachable,
+            "curve": self.curve,
+            "message": self.message,
+        }
+
+
+def check_curve(curve: str) -> str:
+    if curve not in CURVES:
+        raise ParameterError(f"jump curve: expected one of {', '.join(CURVES)}, got {curve!r}")
+    return curve
+
+
+def jump_velocity(params: Parameters, stress: float, curve: str = "aging") -> Jump:
+    """Vs with sigma(Vs) = ``stress`` (Pa) on the right branch of the steady ``curve`` (Eq 8).
+
+    ``curve`` is ``"aging"`` (default: the curve the slip then follows, so the
+    stress is continuous) or ``"no-aging"`` (Eq 8 as written in Section 3).
+    """
+    check_curve(curve)
+    if isinstance(stress, bool) or not isinstance(stress, (int, float, np.floating)) or not math.isfinite(stress):
+        raise ParameterError(f"stress: expected a finite number in Pa, got {stress!r}")
+    stress = float(stress)
+    cp = require_critical_point(params)
+    assert cp.velocity is not None
+    v_max, s_max = branch_maximum(params, curve)
+    s_low = cp.stress if curve == "aging" else float(steady_state(params, cp.velocity, aging=False).stress)
+    assert s_low is not None
+    if not s_low <= stress <= s_max:
+        where = "below" if stress < s_low else "above"
+        return Jump(
+            stress,
+            None,
+            False,
+            curve,
+            f"sigma = {stress:.6g} Pa is {where} the stresses {s_low:.6g}-{s_max:.6g} Pa of the {curve} curve's"
+            f" right branch (Vc = {cp.velocity:.6g} m/s to its maximum at {v_max:.6g} m/s): no jump velocity",
+            s_low,
+            s_max,
+        )
+    branch = branch_interpolant(params, curve)
+
+    def excess(x: float) -> float:
+        return float(branch.stress(math.exp(x))) - stress
+
+    if excess(branch.log_vc) >= 0.0:  # at sigma_c itself (to the series' accuracy)
+        log_v = branch.log_vc
+    elif excess(branch.log_hi) <= 0.0:
+        log_v = branch.log_hi
+    else:
+        log_v = brentq(excess, branch.log_vc, branch.log_hi, xtol=1e-14, rtol=4 * np.finfo(float).eps)
+    velocity = math.exp(log_v)
+    return Jump(
+        stress,
+        velocity,
+        True,
+        curve,
+        f"the {curve} curve carries {stress:.6g} Pa at Vs = {velocity:.6g} m/s",
+        s_low,
+        s_max,
+    )

@@ -1,0 +1,360 @@
+r"""The stick phase: linear loading of the stuck block and the collapse of the attached chains (Eqs 11-17).
+
+While the block is stuck its base does not move, so the stress rises
+linearly (Eqs 11-12, with the trapezoid factor of Eq 17):
+
+    sigma(t) = sigma_0 + K V0 t,      K = (G_d/h) ln(B/l)/(B/l - 1),
+
+and the attached chains, which share the load equally (Eq 14), break at the
+aged rate of Eq 15:
+
+    dNc/dt = -(uc/tau) exp( (lambda/kT) sigma(t)/Nc - t/tau_a ) Nc,   Nc(0) = Nc0.
+
+With n = Nc/Nc0, s(t) = (lambda/kT) sigma(t)/Nc0 and r = uc/tau this is
+dn/dt = -r n exp(s(t)/n - t/tau_a).  The collapse n -> 0 happens in finite
+time t_s (the stick time); the stress there is sigma_s of Eq 16.
+
+Numerics (docs/stick-phase.md).  The equation is explosive, not stiff:
+a time-stepper loses precision as n -> 0, while time as a function of n is
+regular there (dt/dn = -exp(-s/n + t/tau_a)/(r n) -> 0 with all its
+derivatives).  When aging wins, n levels off and t(n) is singular instead.
+Both are regular in the arc-length-like variable theta with
+
+    dt'/dtheta = 1/(1 + w),   dn/dtheta = -w/(1 + w),   w = r T n exp(s/n - t/tau_a),
+
+(t' = t/T, T a time scale): theta follows time while the chains hold and
+follows n while they collapse.  w is handled through its logarithm, so
+nothing overflows.  Whether the block stays stuck for ever is decided at
+checkpoints by an explicit bound on the remaining breakage
+(:func:`never_slips`); when neither the collapse nor the proof comes before a
+generous horizon the answer is "undetermined", never an invented number.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+from scipy.optimize import brentq
+
+from ..errors import ParameterError
+from ..numerics.events import integrate_in_chunks
+from ..parameters import Parameters
+from .jump import require_critical_point
+
+if TYPE_CHECKING:  # pragma: no cover
+    import pandas as pd
+    from matplotlib.axes import Axes
+
+#: Tolerances of the theta integration (time and n are both O(1) there).
+RTOL = 1e-11
+ATOL = 1e-13
+#: With aging, give up (status "undetermined") after this many aging times without slip or proof.
+HORIZON_AGING_TIMES = 1e4
+#: Without aging the collapse always comes; this only guards against absurd parameters.
+HORIZON_SCALED_TIME = 1e15
+#: Below this n the chains are gone for the integrator (exp(-s/n) underflowed long before).
+N_GONE = 1e-200
+#: -ln of the shortest time scale used (1e-300 s), see _Rates.time_scale.
+SHORTEST_LOG_TIME = 690.0
+#: Samples of the output curve.
+SAMPLES = 400
+#: Candidate floors, as fractions of the way from K V0 tau_a b/Nc0 to n, tried by the stuck proof.
+FLOOR_FRACTIONS = (0.5, 0.8, 0.9, 0.95, 0.99)
+
+
+@dataclass(frozen=True)
+class StickPhase:
+    """One stick phase (Eqs 11-16).  Arrays in SI units; time from the instant of sticking."""
+
+    time: np.ndarray
+    stress: np.ndarray
+    chain_fraction: np.ndarray
+    stuck: bool
+    stick_time: float | None
+    peak_stress: float | None
+    start_stress: float
+    pulling_velocity: float
+    status: str  # "slipped", "stuck" or "undetermined"
+    message: str
+    aging: bool
+    stiffness: float  # the effective K of Eq 17, Pa/m
+    chain_floor: float | None = None  # a proven lower bound of Nc/Nc0 for all time, when stuck
+    parameters: Parameters | None = field(default=None, repr=False, compare=False)
+    _dense: Any = field(default=None, repr=False, compare=False)
+
+    @property
+    def end_time(self) -> float:
+        """The last time computed (t_s when the block slipped)."""
+        return float(self.time[-1])
+
+    def stress_at(self, t: np.ndarray | float) -> np.ndarray:
+        """sigma(t) of Eq 12 (with the Eq 17 stiffness)."""
+        return self.start_stress + self.stiffness * self.pulling_velocity * np.asarray(t, dtype=float)
+
+    def chain_fraction_at(self, t: float) -> float:
+        """Nc/Nc0 at time ``t`` (0 after the collapse; the dense solution in between)."""
+        t = float(t)
+        if self.stick_time is not None and t >= self.stick_time:
+            return 0.0
+        if t <= 0.0:
+            return 1.0
+        if self._dense is None or t >= self.end_time:
+            return float(np.interp(t, self.time, self.chain_fraction))
+        dense, scale = self._dense
+        theta = brentq(lambda s: float(dense(s)[0]) * scale - t, dense.start, dense.end, xtol=1e-14, rtol=1e-14)
+        return float(min(max(dense(theta)[1], 0.0), 1.0))
+
+    def as_dict(self) -> dict[str, object]:
+        return {
+            "status": self.status,
+            "stuck": self.stuck,
+            "stick_time": self.stick_time,
+            "peak_stress": self.peak_stress,
+            "start_stress": self.start_stress,
+            "pulling_velocity": self.pulling_velocity,
+            "aging": self.aging,
+            "chain_floor": self.chain_floor,
+            "message": self.message,
+        }
+
+    def to_frame(self) -> pd.DataFrame:
+        """time [s], stress [Pa], chain_fraction (Nc/Nc0)."""
+        import pandas as pd
+
+        return pd.DataFrame({"time": self.time, "stress": self.stress, "chain_fraction": self.chain_fraction})
+
+    def plot(self, ax: Axes | None = None, **kwargs: Any) -> Axes:
+        """Nc/Nc0 against time (Figs 3, 6); returns the Axes."""
+        from ..cycle_plots import plot_stick
+
+        return plot_stick(self, ax=ax, **kwargs)
+
+
+def check_velocity(value: Any, name: str = "pulling_velocity") -> float:
+    """A pulling velocity in m/s: finite and >= 0."""
+    v = _number(value, name, "m/s")
+    if v < 0:
+        raise ParameterError(f"{name}: expected a velocity >= 0 in m/s, got {v!r}")
+    return v
+
+
+def check_stress(value: Any, name: str = "start_stress") -> float:
+    s = _number(value, name, "Pa")
+    if s < 0:
+        raise ParameterError(f"{name}: expected a stress >= 0 in Pa, got {s!r}")
+    return s
+
+
+def _number(value: Any, name: str, unit: str) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
+        raise ParameterError(f"{name}: expected a number in {unit}, got {value!r}")
+    v = float(value)
+    if not math.isfinite(v):
+        raise ParameterError(f"{name}: expected a finite number in {unit}, got {v!r}")
+    return v
+
+
+@dataclass(frozen=True)
+class _Rates:
+    """Eq 15 in the variables of the module docstring: dn/dt = -r n exp((s0 + k t)/n - t/tau_a)."""
+
+    r: float  # uc/tau, 1/s
+    s0: float  # (lambda/kT) sigma_0/Nc0
+    k: float  # (lambda/kT) K V0/Nc0, 1/s
+    inv_aging: float  # 1/tau_a (0 without aging), 1/s
+
+    def log_rate(self, t: float, n: float) -> float:
+        """ln of the breakage rate per chain, ln(r) + s(t)/n - t/tau_a."""
+        return math.log(self.r) + (self.s0 + self.k * t) / n - t * self.inv_aging
+
+    def time_scale(self) -> float:
+        """T: the time in which the fresh load would break the chains, or the loading and aging times.
+
+        Kept above 1e-300 s: a load that breaks the chains faster collapses them at t ~ 0 anyway.
+        """
+        fresh = math.log(self.r) + self.s0
+        other = self.k + self.inv_aging
+        total = np.logaddexp(fresh, math.log(other)) if other > 0 else fresh
+        return float(math.exp(-min(float(total), SHORTEST_LOG_TIME)))
+
+
+def never_slips(rates: _Rates, t: float, n: float) -> float | None:
+    """A proven floor of n for all times after ``t`` (so the block never slips), or None.
+
+    For t' > t, while n >= n_low, the breakage rate per chain is at most
+    r exp(c t' + d) with c = k/n_low - 1/tau_a and d = s0/n_low.  If c < 0 the
+    remaining breakage is at most R = r exp(c t + d)/|c|, so n stays above
+    n e^{-R}; if that is >= n_low, n can never reach n_low (the first time it
+    did would contradict the bound).  docs/stick-phase.md has the details.
+    """
+    if rates.inv_aging == 0.0 or n <= 0.0:
+        return None
+    balance = rates.k / rates.inv_aging  # n must stay above k tau_a for aging to win
+    if n <= balance:
+        return None
+    for fraction in FLOOR_FRACTIONS:
+        floor = balance + fraction * (n - balance)
+        if floor <= 0.0:
+            continue
+        c = rates.k / floor - rates.inv_aging
+        log_r = math.log(rates.r) + c * t + rates.s0 / floor - math.log(-c)
+        if log_r < math.log(math.log(n / floor)):
+            return floor
+    return None
+
+
+def _no_load_phase(
+    params: Parameters, rates: _Rates, v0: float, stress: float, aging: bool, horizon: float
+) -> StickPhase:
+    # Nothing pulls: n decays as exp(-r tau_a (1 - e^{-t/tau_a})) (or e^{-r t}) and the block never slips.
+    t = np.linspace(0.0, max(horizon, 1.0 / rates.r if rates.r > 0 else 1.0), SAMPLES)
+    if aging:
+        n = np.exp(-rates.r / rates.inv_aging * -np.expm1(-t * rates.inv_aging))
+    else:
+        n = np.exp(-rates.r * t)
+    return StickPhase(
+        time=t,
+        stress=np.zeros_like(t),
+        chain_fraction=n,
+        stuck=True,
+        stick_time=None,
+        peak_stress=None,
+        start_stress=stress,
+        pulling_velocity=v0,
+        status="stuck",
+        message="no load (zero start stress and zero pulling velocity): the block never slips",
+        aging=aging,
+        stiffness=params.block.effective_stiffness,
+        parameters=params,
+    )
+
+
+def stick_phase(
+    params: Parameters,
+    pulling_velocity: float,
+    start_stress: float | None = None,
+    aging: bool = True,
+    horizon: float | None = None,
+) -> StickPhase:
+    """Solve the stick phase (Eqs 11-16) from the instant of sticking.
+
+    ``pulling_velocity`` (m/s) may be 0: a constant load ``start_stress`` is
+    held (a creep-rupture lifetime).  ``start_stress=None`` means sigma_c of
+    the critical point (Eq 9).  ``aging=False`` drops the aging term of
+    Eq 15 (tau_a -> infinity).  When the block stays stuck the chain
+    fraction is followed at least up to ``horizon`` seconds (if given).
+
+    The result's ``status`` is ``"slipped"`` (with ``stick_time`` = t_s and
+    ``peak_stress`` = sigma_s of Eq 16), ``"stuck"`` (proven: the block never
+    slips) or ``"undetermined"`` (neither within 10^4 aging times).
+    """
+    v0 = check_velocity(pulling_velocity)
+    if start_stress is None:
+        cp = require_critical_point(params)
+        assert cp.stress is not None
+        sigma0 = float(cp.stress)
+    else:
+        sigma0 = check_stress(start_stress)
+    if horizon is not None:
+        horizon = _number(horizon, "horizon", "s")
+    stiffness = params.block.effective_stiffness
+    b = params.bonds.force_sensitivity
+    nc0 = params.stick.attached_chains
+    rates = _Rates(
+        r=params.stick.break_rate,
+        s0=b * sigma0 / nc0,
+        k=b * stiffness * v0 / nc0,
+        inv_aging=1.0 / params.stick.aging_time if aging else 0.0,
+    )
+    if rates.s0 == 0.0 and rates.k == 0.0:
+        return _no_load_phase(params, rates, v0, sigma0, aging, horizon or 0.0)
+    scale = rates.time_scale()
+    log_rt = math.log(rates.r) + math.log(scale)
+
+    def field_(_theta: float, y: np.ndarray) -> list[float]:
+        tp, n = y[0], y[1]
+        if n <= N_GONE:  # the collapse, continued smoothly through n = 0
+            return [0.0, -1.0]
+        t = tp * scale
+        log_w = log_rt + math.log(n) + (rates.s0 + rates.k * t) / n - t * rates.inv_aging
+        # 1/(1 + w) without overflow
+        if log_w > 0.0:
+            e = math.exp(-log_w)
+            hold = e / (1.0 + e)
+        else:
+            hold = 1.0 / (1.0 + math.exp(log_w))
+        return [hold, hold - 1.0]
+
+    def collapse(_theta: float, y: np.ndarray) -> float:
+        return float(y[1])
+
+    floor: list[float] = []
+
+    def decide(_theta: float, y: np.ndarray) -> bool:
+        found = never_slips(rates, float(y[0]) * scale, float(y[1]))
+        if found is not None:
+            floor.append(found)
+        return found is not None
+
+    if aging:
+        t_end = HORIZON_AGING_TIMES * params.stick.aging_time
+        # checkpoints in theta; theta = t' + (1 - n) exactly, so theta >= t'
+        count = max(1, math.ceil(math.log2(max(t_end / params.stick.aging_time, 2.0))) + 1)
+        checkpoints = [params.stick.aging_time * 2.0**j / scale + 1.0 for j in range(count)]
+    else:
+        checkpoints = [HORIZON_SCALED_TIME]
+    result = integrate_in_chunks(field_, [0.0, 1.0], collapse, checkpoints, decide, rtol=RTOL, atol=ATOL)
+    dense = result.solution
+    if result.reason == "decided" and horizon is not None and horizon > float(result.y_end[0]) * scale:
+        # the block is stuck: follow the (slow, t-like) decay on to the requested horizon
+        theta_h = result.s_end + (horizon / scale - float(result.y_end[0])) * 1.001 + 1.0
+        integrate_in_chunks(
+            field_, result.y_end, collapse, [theta_h], lambda *_: False, rtol=RTOL, atol=ATOL,
+            start=result.s_end, chained=dense,
+        )  # fmt: skip
+    theta = np.linspace(dense.start, dense.end, SAMPLES)
+    tp, n = dense(theta)
+    time = np.maximum.accumulate(tp * scale)
+    n = np.clip(n, 0.0, 1.0)
+    if result.reason == "event":
+        ts = float(result.y_end[0]) * scale
+        time = np.minimum(np.maximum.accumulate(time), ts)  # dense output may overshoot ts by rounding
+        time[-1], n[-1] = ts, 0.0
+        sigma_s = sigma0 + stiffness * v0 * ts
+        status, stuck = "slipped", False
+        message = (
+            f"the attached chains collapse at ts = {ts:.6g} s, sigma_s = {sigma_s:.6g} Pa (Eqs 15-16): the block slips"
+        )
+        stick_time, peak = ts, sigma_s
+    elif result.reason == "decided":
+        status, stuck, stick_time, peak = "stuck", True, None, None
+        message = (
+            f"the block stays stuck: aging wins and Nc/Nc0 provably stays above {floor[0]:.4g} for all time"
+            f" (Eq 15; checked at t = {float(result.y_end[0]) * scale:.4g} s)"
+        )
+    else:
+        status, stuck, stick_time, peak = "undetermined", False, None, None
+        message = (
+            f"undetermined: no slip up to t = {time[-1]:.4g} s, and no proof that the block stays stuck"
+            f" (Nc/Nc0 = {n[-1]:.4g} there)"
+        )
+    return StickPhase(
+        time=time,
+        stress=sigma0 + stiffness * v0 * time,
+        chain_fraction=n,
+        stuck=stuck,
+        stick_time=stick_time,
+        peak_stress=peak,
+        start_stress=sigma0,
+        pulling_velocity=v0,
+        status=status,
+        message=message,
+        aging=aging,
+        stiffness=stiffness,
+        chain_floor=floor[0] if floor else None,
+        parameters=params,
+        _dense=(dense, scale),
+    )

@@ -1,0 +1,212 @@
+"""``stickslip reproduce``: compute everything once, draw the figures, write the report.
+
+The run is a list of named steps so that a caller can show progress
+(:data:`ProgressCallback`); nothing here prints.
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from datetime import datetime, timezone
+from pathlib import Path
+from typing import Any
+
+from ..errors import DataError
+from ..parameters import Parameters, load_parameters
+from .comparisons import TOLERANCE, Comparison, compare
+from .computations import ModelRun, computed_values, run_steps
+from .errata import Errata, load_errata
+from .figures import Curve, save_figure_files
+from .html import RenderedFigure, render_report
+from .paper import resolve_errata
+from .report_figures import FIGURE_BUILDERS
+
+#: Called before each step with (description, steps done, total steps), and once more at the end.
+ProgressCallback = Callable[[str, int, int], None]
+
+PAPER = "V. A. Juvekar and A. K. Singh, Analysis of Stick-Slip Motion as a Jump Phenomenon"
+
+
+@dataclass(frozen=True)
+class Report:
+    """What :func:`build_report` wrote."""
+
+    folder: Path
+    html: Path
+    results: Path
+    figures: tuple[Path, ...]
+    curves: tuple[Path, ...]
+    comparisons: tuple[Comparison, ...]
+    elapsed: float
+
+    @property
+    def files(self) -> tuple[Path, ...]:
+        return (self.html, self.results, *self.figures, *self.curves)
+
+
+def _prepare_folder(folder: Path) -> Path:
+    folder = Path(folder)
+    if folder.exists() and not folder.is_dir():
+        raise DataError(f"output folder {str(folder)!r} exists and is not a folder")
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise DataError(f"output folder {str(folder)!r} cannot be created: {exc.strerror or exc}") from None
+    return folder
+
+
+def build_report(
+    folder: str | Path = "stickslip-report",
+    progress: ProgressCallback | None = None,
+    params: Parameters | None = None,
+) -> Report:
+    """Reproduce the paper's figures and numbers into ``folder``; returns what was written.
+
+    ``folder`` gets ``report.html`` (self-contained), ``results.json``, one
+    PNG and one SVG per figure and one CSV per plotted curve.  ``params``
+    defaults to the built-in ``gelatin-glass`` set, the paper's.
+    """
+    started = time.perf_counter()
+    folder = _prepare_folder(Path(folder))
+    params = params if params is not None else load_parameters("gelatin-glass")
+    notify = progress or (lambda description, done, total: None)
+
+    model_steps = run_steps()
+    total = len(model_steps) + len(FIGURE_BUILDERS) + 2
+    done = 0
+
+    def step(description: str) -> None:
+        nonlocal done
+        notify(description, done, total)
+        done += 1
+
+    errata = load_errata()
+    run = ModelRun(params)
+    for description, action in model_steps:
+        step(description)
+        action(run)
+
+    rendered: list[RenderedFigure] = []
+    figure_paths: list[Path] = []
+    curve_paths: list[Path] = []
+    for description, builder in FIGURE_BUILDERS:
+        step(description)
+        figure = builder(run)
+        png, paths = _write(lambda f=figure: save_figure_files(f, folder))
+        figure_paths += paths
+        curves = tuple(figure.curves())
+        for curve in curves:
+            curve_paths.append(_write_text(folder / f"{curve.name}.csv", curve.to_csv()))
+        rendered.append(RenderedFigure(figure, png, curves))
+        figure.figure.clear()
+
+    step("Comparing every number the paper states")
+    links = resolve_errata({e.id: e.title for e in errata.entries})
+    comparisons = compare(computed_values(run), links)
+
+    step("Writing report.html and results.json")
+    names = [p.name for p in (*figure_paths, *curve_paths)]
+    built = datetime.now(timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
+    results_path = folder / "results.json"
+    html_path = folder / "report.html"
+    elapsed = time.perf_counter() - started
+    results = _results(run, comparisons, rendered, errata, built, elapsed)
+    _write_text(results_path, json.dumps(results, indent=2, ensure_ascii=False) + "\n")
+    html = render_report(
+        version=_version(),
+        params=params,
+        built=built,
+        elapsed=elapsed,
+        figures=rendered,
+        comparisons=comparisons,
+        errata=errata,
+        files=["results.json", *names],
+        analyses=run.trace_analyses,
+    )
+    _write_text(html_path, html)
+    notify("Done", total, total)
+    return Report(
+        folder=folder,
+        html=html_path,
+        results=results_path,
+        figures=tuple(figure_paths),
+        curves=tuple(curve_paths),
+        comparisons=tuple(comparisons),
+        elapsed=time.perf_counter() - started,
+    )
+
+
+def _results(
+    run: ModelRun,
+    comparisons: list[Comparison],
+    figures: list[RenderedFigure],
+    errata: Errata,
+    built: str,
+    elapsed: float,
+) -> dict[str, Any]:
+    from ..cli.common import json_safe
+
+    flagged = [c for c in comparisons if c.flagged]
+    return json_safe(
+        {
+            "paper": PAPER,
+            "stickslip_version": _version(),
+            "built": built,
+            "elapsed_seconds": elapsed,
+            "parameter_set": run.params.name,
+            "parameters": run.params.as_dict(),
+            "tolerance": TOLERANCE,
+            "summary": {
+                "compared": len(comparisons),
+                "within_tolerance": len(comparisons) - len(flagged),
+                "beyond_tolerance": len(flagged),
+                "beyond_tolerance_with_errata": sum(c.errata is not None for c in flagged),
+            },
+            "comparisons": [c.as_dict() for c in comparisons],
+            "model": run.summary(),
+            "errata": [{"id": e.id, "title": e.title} for e in errata.entries],
+            "figures": [
+                {
+                    "id": f.figure.id,
+                    "number": f.figure.number,
+                    "title": f.figure.title,
+                    "png": f"{f.figure.id}.png",
+                    "svg": f"{f.figure.id}.svg",
+                    "curves": [_curve_entry(c) for c in f.curves],
+                }
+                for f in figures
+            ],
+        }
+    )
+
+
+def _curve_entry(curve: Curve) -> dict[str, Any]:
+    return {
+        "csv": f"{curve.name}.csv",
+        "panel": curve.panel,
+        "label": curve.label,
+        "x": curve.x_name,
+        "y": curve.y_name,
+        "points": int(curve.x.size),
+    }
+
+
+def _version() -> str:
+    from .. import __version__
+
+    return __version__
+
+
+def _write(action: Callable[[], Any]) -> Any:
+    try:
+        return action()
+    except OSError as exc:
+        raise DataError(f"cannot write the report: {exc.strerror or exc} ({getattr(exc, 'filename', '')})") from None
+
+
+def _write_text(path: Path, text: str) -> Path:
+    _write(lambda: path.write_text(text, encoding="utf-8"))
+    return path

@@ -1,0 +1,122 @@
+"""The errata (docs/errata.md), rendered into the report so that its links work offline.
+
+Entries are level-2 headings ``## E<n> title``; each becomes an element with
+``id="e<n>"`` so that the comparison table can link ``#e<n>``.  The text is
+package data (``stickslip/report/errata.md``, a copy of ``docs/errata.md``)
+so that an installed wheel renders it; in a source checkout without the copy
+``docs/errata.md`` is read instead.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+from html import escape
+from importlib import resources
+from pathlib import Path
+
+from ..errors import DataError
+
+_ENTRY = re.compile(r"^(E\d+)\b[\s.:—–-]*(.*)$")
+#: The one piece of raw HTML the errata may use: an empty anchor, ``<a id="e1"></a>``.
+_ANCHOR = re.compile(r'^\s*<a\s+(?:id|name)="([A-Za-z][\w.-]*)"\s*>\s*</a>\s*$')
+
+
+@dataclass(frozen=True)
+class ErrataEntry:
+    id: str  # "E3"
+    title: str
+
+    @property
+    def anchor(self) -> str:
+        return self.id.lower()
+
+
+@dataclass(frozen=True)
+class Errata:
+    source: str
+    entries: tuple[ErrataEntry, ...]
+    html: str
+
+    def get(self, entry_id: str) -> ErrataEntry | None:
+        return next((e for e in self.entries if e.id == entry_id), None)
+
+
+def errata_text() -> tuple[str, str]:
+    """(markdown text, where it came from).  Raises DataError when no copy can be found."""
+    packaged = resources.files("stickslip") / "report" / "errata.md"
+    if packaged.is_file():
+        return packaged.read_text(encoding="utf-8"), "stickslip/report/errata.md"
+    checkout = Path(__file__).resolve().parents[3] / "docs" / "errata.md"
+    if checkout.is_file():
+        return checkout.read_text(encoding="utf-8"), "docs/errata.md"
+    raise DataError("errata not found: expected package data stickslip/report/errata.md (a copy of docs/errata.md)")
+
+
+def render_errata(text: str, source: str = "errata.md") -> Errata:
+    """Markdown to HTML with entry anchors, made safe for an offline page.
+
+    markdown-it renders the Markdown; images are dropped (they would be
+    fetched), raw HTML is shown as text, except empty anchors
+    ``<a id="..."></a>``, which are kept unless the heading that follows
+    already carries that id.
+    """
+    from markdown_it import MarkdownIt
+
+    md = MarkdownIt("commonmark", {"html": True}).enable("table").disable("image")
+    tokens = md.parse(text)
+    entries: list[ErrataEntry] = []
+    for k, token in enumerate(tokens):
+        if token.type != "heading_open" or token.tag != "h2":
+            continue
+        inline = tokens[k + 1]
+        match = _ENTRY.match(inline.content.strip())
+        if match:
+            entry = ErrataEntry(match.group(1), match.group(2).strip())
+            if any(e.id == entry.id for e in entries):
+                raise DataError(f"{source}: errata entry {entry.id} appears twice")
+            entries.append(entry)
+            token.attrSet("id", entry.anchor)
+    heading_ids = {e.anchor for e in entries}
+    for token in tokens:
+        # headings move one level down: the errata sit inside a section of the report
+        if token.type in ("heading_open", "heading_close"):
+            token.tag = f"h{min(int(token.tag[1]) + 1, 6)}"
+        elif token.type == "html_block":
+            _neutralise(token, heading_ids)
+        elif token.type == "inline" and token.children:
+            _neutralise_inline(token.children, heading_ids)
+    html = md.renderer.render(tokens, md.options, {}).replace("<p></p>\n", "")
+    return Errata(source, tuple(entries), html)
+
+
+def _neutralise(token: object, heading_ids: set[str]) -> None:
+    """Raw HTML in the errata: keep an empty anchor (unless a heading has its id), show anything else as text."""
+    content = token.content  # type: ignore[attr-defined]
+    anchor = _ANCHOR.match(content)
+    if anchor:
+        name = anchor.group(1)
+        token.content = "" if name in heading_ids else f'<a id="{name}"></a>\n'  # type: ignore[attr-defined]
+    else:
+        token.content = escape(content)  # type: ignore[attr-defined]
+
+
+def _neutralise_inline(children: list, heading_ids: set[str]) -> None:
+    """Inline raw HTML: an anchor arrives as two tokens, ``<a id="x">`` and ``</a>``."""
+    k = 0
+    while k < len(children):
+        child = children[k]
+        if child.type == "html_inline":
+            after = children[k + 1] if k + 1 < len(children) else None
+            if after is not None and after.type == "html_inline" and after.content.strip() == "</a>":
+                child.content += after.content
+                after.content = ""
+                after.type = "text"
+            _neutralise(child, heading_ids)
+            child.content = child.content.rstrip("\n")
+        k += 1
+
+
+def load_errata() -> Errata:
+    text, source = errata_text()
+    return render_errata(text, source)

@@ -1,0 +1,445 @@
+"""Every number Juvekar & Singh state, as printed, with where they state it.
+
+Values are SI floats converted from the printed value *as printed*: where the
+paper's unit is wrong (lambda M/kT in m^-2, G_d/h in Pa/m) the printed unit is
+kept in ``paper_unit`` and the row links the erratum that explains it.
+Nothing here is computed; :mod:`stickslip.report.comparisons` puts the
+model's value beside each of these.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+
+#: Sliding velocities of the stick-slip experiments (Figs 5a-c), m/s.
+PULLING_VELOCITIES = (50e-6, 100e-6, 350e-6)
+
+#: The range of the steady-sliding data of Baumberger et al. (Fig 4), m/s.
+DATA_RANGE = (140e-6, 2000e-6)
+#: Split between the two steps of the steady fit (Section 3), m/s.
+FIT_SPLIT = 800e-6
+
+
+@dataclass(frozen=True)
+class PaperNumber:
+    """One number the paper states.
+
+    ``kind`` is "model" for a number the paper computes from its model (the
+    model here should reproduce it), "parameter" for a fitted or chosen
+    parameter, "input" for a measured property of the experiment the model
+    takes as given, and "measured" for an experimental value the model is
+    compared with (Table 1).
+    """
+
+    key: str
+    quantity: str
+    group: str
+    kind: str
+    paper: float
+    unit: str  # SI unit of the model value
+    display: str  # unit the report shows (see stickslip.report.formatting.DISPLAY_UNITS)
+    printed: str  # as printed in the paper
+    source: str
+    paper_unit: str | None = None  # SI unit of the paper value when it differs from ``unit`` (a wrong printed unit)
+    note: str = ""  # context a reader needs beside the number
+
+
+def _n(key, quantity, group, kind, paper, unit, display, printed, source, paper_unit=None, note="") -> PaperNumber:
+    return PaperNumber(key, quantity, group, kind, paper, unit, display, printed, source, paper_unit, note)
+
+
+STEADY = "Steady sliding (Figs 1 and 4, Eq 9)"
+FIT = "Fitted slip-phase parameters (Section 3, Fig 4)"
+BLOCK = "Block stiffness and geometry (Eqs 5, 17)"
+STICK = "Stick phase (Eqs 15-16, Fig 6)"
+SLIP = "Jump and slip phase (Eqs 8, 10, Fig 5d)"
+
+TEXT_NUMBERS: tuple[PaperNumber, ...] = (
+    _n("critical_velocity", "Critical velocity Vc", STEADY, "model", 125e-6, "m/s", "um/s", "125 µm.s⁻¹", "Section 3"),
+    _n("critical_stress", "Critical stress σc", STEADY, "model", 259.0, "Pa", "Pa", "259 Pa", "Section 3"),
+    _n(
+        "critical_stress_cycles",
+        "σc where sticking begins, all cycles (259 ± 5 Pa)",
+        STEADY,
+        "measured",
+        259.0,
+        "Pa",
+        "Pa",
+        "259 ± 5 Pa",
+        "Section 3, from Table 1",
+    ),
+    _n(
+        "steady_stress_350",
+        "Steady stress at V0 = 350 µm/s",
+        STEADY,
+        "measured",
+        400.0,
+        "Pa",
+        "Pa",
+        "0.4 kPa",
+        "Section 3 (Fig 5c)",
+    ),
+    _n("site_density", "Site density N0", FIT, "parameter", 1.22e14, "1/m^2", "1/m^2", "1.22 × 10¹⁴ m⁻²", "Section 3"),
+    _n("bond_time", "Make-break time τ", FIT, "parameter", 224e-6, "s", "us", "224 µs", "Section 3"),
+    _n(
+        "stretch_sensitivity",
+        "λM/kT",
+        FIT,
+        "parameter",
+        2.47e12,
+        "1/m",
+        "1/m",
+        "2.47 × 10¹² m⁻²",
+        "Section 3",
+        paper_unit="1/m^2",
+    ),
+    _n("max_extension", "Maximum chain extension Δlm", FIT, "parameter", 1.074e-6, "m", "um", "1.074 µm", "Section 3"),
+    _n("breakage_weight", "Breakage weight u0 (fixed)", FIT, "parameter", 1.0, "", "", "unity", "Section 3"),
+    _n("aging_time", "Aging time τa", FIT, "parameter", 899e-6, "s", "us", "899 µs", "Section 3"),
+    _n("aging_velocity", "Aging velocity Va", FIT, "parameter", 360e-6, "m/s", "um/s", "360 µm.s⁻¹", "Section 3"),
+    _n("shear_modulus", "Shear modulus Gd", BLOCK, "input", 4e3, "Pa", "kPa", "4 kPa", "Section 3"),
+    _n("height", "Block height h", BLOCK, "input", 10e-3, "m", "mm", "10 mm", "Section 3"),
+    _n(
+        "stiffness_printed",
+        "Stiffness Gd/h, as printed in Section 3",
+        BLOCK,
+        "model",
+        400.0,
+        "Pa/m",
+        "kPa/m",
+        "400 Pa.m⁻¹",
+        "Section 3",
+    ),
+    _n(
+        "stiffness",
+        "Stiffness Gd/h, as printed in the Table 1 discussion",
+        BLOCK,
+        "model",
+        400e3,
+        "Pa/m",
+        "kPa/m",
+        "400 kPa.m⁻¹",
+        "Section 3, after Table 1",
+    ),
+    _n("top_length", "Trapezoid length on the puller side B", BLOCK, "input", 50e-3, "m", "mm", "50 mm", "Eq 17"),
+    _n("base_length", "Trapezoid length on the glass l", BLOCK, "input", 30e-3, "m", "mm", "30 mm", "Eq 17"),
+    _n("geometric_factor", "Geometric factor ln(B/l)/(B/l − 1)", BLOCK, "model", 0.766, "", "", "0.766", "Eq 17"),
+    _n(
+        "attached_chains",
+        "Attached chains Nc0",
+        STICK,
+        "parameter",
+        2.07e12,
+        "1/m^2",
+        "1/m^2",
+        "2.07 × 10¹²",
+        "Section 3",
+    ),
+    _n(
+        "break_rate",
+        "Chain breakage rate uc/τ",
+        STICK,
+        "parameter",
+        1.4e-4,
+        "1/s",
+        "1/s",
+        "1.4 × 10⁻⁴ s⁻¹",
+        "Section 3",
+    ),
+    _n("stick_aging_time", "Stick aging time τa (Eq 15)", STICK, "parameter", 10.0, "s", "s", "10 s", "Section 3"),
+    _n(
+        "stick_time_50",
+        "Stick time ts, V0 = 50 µm/s (paper's simulation)",
+        STICK,
+        "model",
+        18.3,
+        "s",
+        "s",
+        "18.3 s",
+        "Section 3, Fig 6",
+    ),
+    _n(
+        "stick_time_100",
+        "Stick time ts, V0 = 100 µm/s (paper's simulation)",
+        STICK,
+        "model",
+        9.3,
+        "s",
+        "s",
+        "9.3 s (printed “for V0 = 50 µm.s⁻¹”)",
+        "Section 3, Fig 6",
+    ),
+    _n(
+        "stick_time_measured_50",
+        "Stick time ts, V0 = 50 µm/s (measured, Fig 6 discussion)",
+        STICK,
+        "measured",
+        18.1,
+        "s",
+        "s",
+        "18.1 s",
+        "Section 3, Fig 6",
+    ),
+    _n(
+        "stick_time_measured_100",
+        "Stick time ts, V0 = 100 µm/s (measured, Fig 6 discussion)",
+        STICK,
+        "measured",
+        8.8,
+        "s",
+        "s",
+        "8.8 s",
+        "Section 3, Fig 6",
+    ),
+    _n(
+        "stick_time_table_50",
+        "Stick time ts, V0 = 50 µm/s (measured, Table 1 discussion)",
+        STICK,
+        "measured",
+        18.9,
+        "s",
+        "s",
+        "18.9 s",
+        "Section 3, after Table 1",
+    ),
+    _n(
+        "stick_time_table_100",
+        "Stick time ts, V0 = 100 µm/s (measured, Table 1 discussion)",
+        STICK,
+        "measured",
+        8.6,
+        "s",
+        "s",
+        "8.6 s",
+        "Section 3, after Table 1",
+    ),
+    _n(
+        "slip_stress_50",
+        "Slip stress σs, V0 = 50 µm/s (Eq 16)",
+        STICK,
+        "measured",
+        554.0,
+        "Pa",
+        "Pa",
+        "554 Pa",
+        "Table 1, cycle 1",
+    ),
+    _n(
+        "slip_stress_100",
+        "Slip stress σs, V0 = 100 µm/s (Eq 16)",
+        STICK,
+        "measured",
+        549.0,
+        "Pa",
+        "Pa",
+        "549 Pa",
+        "Table 1, cycles 2 and 4",
+    ),
+    _n(
+        "jump_velocity_50",
+        "Jump velocity Vs for σs = 554 Pa, V0 = 50 µm/s (Eq 8)",
+        SLIP,
+        "model",
+        702e-6,
+        "m/s",
+        "um/s",
+        "702 µm.s⁻¹",
+        "Table 1, cycle 1",
+    ),
+    _n(
+        "jump_velocity_100",
+        "Jump velocity Vs for σs = 549 Pa, V0 = 100 µm/s (Eq 8)",
+        SLIP,
+        "model",
+        702e-6,
+        "m/s",
+        "um/s",
+        "702 µm.s⁻¹",
+        "Table 1, cycles 2 and 4",
+    ),
+    _n(
+        "slip_asymptote_50",
+        "Slip-phase asymptote, V0 = 50 µm/s",
+        SLIP,
+        "model",
+        125e-6,
+        "m/s",
+        "um/s",
+        "125 µm.s⁻¹",
+        "Section 3, Fig 5d",
+    ),
+    _n(
+        "slip_asymptote_100",
+        "Slip-phase asymptote, V0 = 100 µm/s",
+        SLIP,
+        "model",
+        125e-6,
+        "m/s",
+        "um/s",
+        "125 µm.s⁻¹",
+        "Section 3, Fig 5d",
+    ),
+    _n(
+        "slip_asymptote_350",
+        "Slip-phase asymptote, V0 = 350 µm/s",
+        SLIP,
+        "model",
+        350e-6,
+        "m/s",
+        "um/s",
+        "350 µm.s⁻¹",
+        "Section 3, Fig 5d",
+    ),
+)
+
+TABLE1 = "Table 1: stick-slip cycles of Baumberger et al. (measured)"
+
+#: Table 1 columns: (pulling velocity in m/s, cycle number).
+TABLE1_COLUMNS: tuple[tuple[float, int], ...] = (
+    (50e-6, 1),
+    (50e-6, 2),
+    (50e-6, 3),
+    (100e-6, 1),
+    (100e-6, 2),
+    (100e-6, 3),
+    (100e-6, 4),
+    (350e-6, 1),
+)
+
+#: Context for Table 1 columns that the model is not meant to reproduce cycle by cycle.
+TABLE1_NOTES = {
+    (100e-6, 1): "first cycle: the paper attributes its higher σs to extra aging before shearing began",
+    (350e-6, 1): "above Vc: one start-up stick from rest, then steady sliding (the model's stick starts at σc)",
+}
+
+#: Table 1 rows: key, label, SI unit, display unit, values as printed (None for "--"), SI value of one printed unit.
+TABLE1_ROWS: tuple[tuple[str, str, str, str, tuple[str | None, ...], float], ...] = (
+    ("critical_stress", "σc", "Pa", "Pa", ("255", "262", "264", "261", "261", "261", "254", None), 1.0),
+    (
+        "stick_slope",
+        "dσ/dt in the stick phase",
+        "Pa/s",
+        "Pa/s",
+        ("16.5", "16.3", "16.8", "35.0", "33.5", "34.0", "34.0", "116"),
+        1.0,
+    ),
+    (
+        "stiffness",
+        "Gd/h from the stick slope",
+        "Pa/m",
+        "kPa/m",
+        ("431", "424", "437", "457", "437", "444", "444", "457"),
+        1e3,
+    ),
+    ("slip_stress", "σs", "Pa", "Pa", ("554", "556", "552", "658", "549", "542", "549", "800"), 1.0),
+    ("stick_time", "ts", "s", "s", ("18.3", "18.3", "17.8", "18.2", "8.82", "8.61", "8.83", "7.51"), 1.0),
+    ("jump_velocity", "Vs", "m/s", "um/s", ("702", "702", "720", "1026", "702", "702", "702", "760"), 1e-6),
+)
+
+
+def _table1_numbers() -> tuple[PaperNumber, ...]:
+    out = []
+    for key, label, unit, display, values, scale in TABLE1_ROWS:
+        for (velocity, cycle), value in zip(TABLE1_COLUMNS, values, strict=True):
+            if value is None:
+                continue
+            v_um = round(velocity * 1e6)
+            out.append(
+                PaperNumber(
+                    key=f"table1_{key}_{v_um}_{cycle}",
+                    quantity=f"{label}, V0 = {v_um} µm/s, cycle {cycle}",
+                    group=TABLE1,
+                    kind="measured",
+                    paper=float(value) * scale,
+                    unit=unit,
+                    display=display,
+                    printed=value,
+                    source="Table 1",
+                    note=TABLE1_NOTES.get((velocity, cycle), ""),
+                )
+            )
+    return tuple(out)
+
+
+TABLE1_NUMBERS = _table1_numbers()
+
+#: Every number the paper states, in report order.
+PAPER_NUMBERS: tuple[PaperNumber, ...] = TEXT_NUMBERS + TABLE1_NUMBERS
+
+
+def _topics_for(number: PaperNumber) -> tuple[str, ...]:
+    key = number.key
+    if key in TEXT_ERRATA:
+        return TEXT_ERRATA[key]
+    if not key.startswith("table1_"):
+        return ()
+    row, v_um, cycle = key[len("table1_") :].rsplit("_", 2)
+    column = (int(v_um), int(cycle))
+    return TABLE1_ERRATA.get((row, column), TABLE1_ERRATA.get((row, None), ()))
+
+
+# Errata are named by what their titles say, not by number, so that renumbering docs/errata.md (merging in
+# new entries) keeps every link right.  Each pattern is a regular expression searched in the entry titles
+# ("## E<n> title"); the first pattern that matches an entry gives the link.  tests/test_report.py checks
+# that every pattern used matches exactly one entry.
+CRITICAL = r"^Vc = 125 µm/s and σc = 259"
+STICK_TIMES = (r"simulated stick times 18\.3 s and 9\.3 s", r"t_s = 9\.3 s for V0 = 50")
+TABLE1_STICK_TIMES = (r"^Table 1 stick times",)
+JUMP = (r"curve gives the jump velocity",)
+COLUMN_350 = (r"^Table 1, 350 µm/s column",)
+
+TEXT_ERRATA: dict[str, tuple[str, ...]] = {
+    "critical_velocity": (CRITICAL,),
+    "critical_stress": (CRITICAL,),
+    "critical_stress_cycles": (CRITICAL,),
+    "steady_stress_350": (r"350 µm/s, not 150 µm/s",),
+    "stretch_sensitivity": (r"^λM/kT = 2\.47.*wrong dimension",),
+    "aging_time": (r"^Notation: τ_A, V_A",),
+    "aging_velocity": (r"V_a ≪ 800 µm/s",),
+    "stiffness_printed": (r"400 Pa\.m⁻¹",),
+    "stiffness": (r"400 Pa\.m⁻¹",),
+    "geometric_factor": (r"Substitution of these lengths",),
+    "stick_aging_time": (r"^Notation: τ_A, V_A",),
+    "stick_time_50": STICK_TIMES,
+    "stick_time_100": STICK_TIMES,
+    "stick_time_measured_50": STICK_TIMES,
+    "stick_time_measured_100": STICK_TIMES,
+    "stick_time_table_50": TABLE1_STICK_TIMES,
+    "stick_time_table_100": TABLE1_STICK_TIMES,
+    "jump_velocity_50": JUMP,
+    "jump_velocity_100": JUMP,
+    "slip_asymptote_50": (r"asymptotic value 125", CRITICAL),
+    "slip_asymptote_100": (r"asymptotic value 125", CRITICAL),
+    "slip_asymptote_350": (r"asymptotic value 125",),
+}
+
+#: (Table 1 row, (V0 in um/s, cycle) or None for the whole row) -> topics, as in TEXT_ERRATA.
+TABLE1_ERRATA: dict[tuple[str, tuple[int, int] | None], tuple[str, ...]] = {
+    ("critical_stress", None): (CRITICAL,),
+    ("stick_slope", None): (r"^Table 1's G_d/h row",),
+    ("stiffness", None): (r"^Table 1's G_d/h row",),
+    ("slip_stress", (100, 1)): (r"^Table 1 σs",),
+    ("slip_stress", (100, 3)): (r"^Table 1 σs",),
+    ("slip_stress", (350, 1)): COLUMN_350,
+    ("stick_time", None): STICK_TIMES,
+    ("stick_time", (100, 1)): TABLE1_STICK_TIMES,
+    ("stick_time", (350, 1)): TABLE1_STICK_TIMES,
+    ("jump_velocity", None): JUMP,
+    ("jump_velocity", (350, 1)): COLUMN_350,
+}
+
+#: Paper key -> the topics of the errata that bear on it, best first.
+ERRATA_TOPICS: dict[str, tuple[str, ...]] = {n.key: t for n in PAPER_NUMBERS if (t := _topics_for(n))}
+
+
+def resolve_errata(titles: dict[str, str]) -> dict[str, str]:
+    """Paper key -> erratum id, given the errata's ``{id: title}``; keys whose topics match no entry are left out."""
+    found: dict[str, str] = {}
+    for key, topics in ERRATA_TOPICS.items():
+        for topic in topics:
+            match = next((entry for entry, title in titles.items() if re.search(topic, title)), None)
+            if match is not None:
+                found[key] = match
+                break
+    return found

@@ -1,0 +1,214 @@
+"""Command line: ``stickslip analyze`` (Table 1 rows from a measured record).
+
+Records are written in the tests: a sawtooth with known corners (stick slope
+K V0, K = G_d/h ln(B/l)/(B/l - 1) = 306.5 kPa/m) in mixed units, and a
+record sampled from the simulator for ``--compare``.  Bad input goes through
+``main()`` to check exit status 2 and a one-line message.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from stickslip.cli.main import main
+from stickslip.tables import read_table
+
+GD_H = 400e3
+K = GD_H * math.log(5 / 3) / (2 / 3)
+V0 = 50e-6
+LOWS = (258.0, 256.0, 260.0, 257.0)
+HIGHS = (552.0, 549.0, 556.0)
+SLIP = 1.5  # s, a straight fall
+
+
+def sawtooth(t: np.ndarray) -> tuple[np.ndarray, list[float], list[float]]:
+    """Sticks at K V0 from LOWS[j] to HIGHS[j], straight falls of SLIP s; (stress, start times, peak times)."""
+    slope = K * V0
+    out = np.full(t.shape, np.nan)
+    starts, peaks, start = [], [], 0.0
+    for j, high in enumerate(HIGHS):
+        peak = start + (high - LOWS[j]) / slope
+        starts.append(start)
+        peaks.append(peak)
+        stick = (t >= start) & (t <= peak)
+        out[stick] = LOWS[j] + slope * (t[stick] - start)
+        fall = (t > peak) & (t < peak + SLIP)
+        out[fall] = high + (LOWS[j + 1] - high) * (t[fall] - peak) / SLIP
+        start = peak + SLIP
+    starts.append(start)
+    rest = t >= start
+    out[rest] = LOWS[-1] + slope * (t[rest] - start)
+    before = t < 0
+    out[before] = LOWS[0] + slope * t[before]
+    return out, starts, peaks
+
+
+@pytest.fixture(scope="module")
+def record(tmp_path_factory):
+    """A noisy sawtooth in ms and kPa, starting mid-stick, with a gap; and its truth."""
+    rng = np.random.default_rng(7)
+    t = np.arange(-6.0, 66.0, 0.02) + rng.uniform(-0.005, 0.005, 3600)
+    stress, starts, peaks = sawtooth(t)
+    stress = stress + 2.9 * rng.standard_normal(t.size)
+    folder = tmp_path_factory.mktemp("analyze")
+    path = folder / "trace.csv"
+    lines = ["# a comment line", "time [ms],stress [kPa]"]
+    for k, (a, b) in enumerate(zip(t, stress, strict=True)):
+        lines.append(f"{a * 1e3:.4f}," + ("" if 900 <= k < 905 else f"{b * 1e-3:.7f}"))
+    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    force = folder / "force.csv"  # the same record as a force on 20 cm^2, in mN
+    force.write_text(
+        "time [s],force [mN]\n" + "".join(f"{a:.17g},{b * 20e-4 * 1e3:.17g}\n" for a, b in zip(t, stress, strict=True)),
+        encoding="utf-8",
+    )
+    return {"path": path, "force": force, "starts": starts, "peaks": peaks, "folder": folder}
+
+
+def run_main(capsys, *args: str) -> tuple[int, str, str]:
+    with pytest.raises(SystemExit) as exit_info:
+        main(list(args))
+    out, err = capsys.readouterr()
+    return int(exit_info.value.code), out, err
+
+
+def test_table_output(capsys, record):
+    code, out, err = run_main(capsys, "analyze", str(record["path"]), "--v0", "50 um/s")
+    assert code == 0, err
+    assert "stick-slip: 4 cycle(s), 2 complete" in out
+    for heading in ("σc [Pa]", "dσ/dt stick [Pa/s]", "Gd/h [kPa/m]", "σs [Pa]", "ts [s]", "Vs [µm/s]"):
+        assert heading in out
+    row = next(line for line in out.splitlines() if "Gd/h [kPa/m]" in line)
+    values = [float(v) for v in row.replace("│", " ").split()[3:-3]]
+    assert values == pytest.approx([GD_H / 1e3] * len(values), rel=0.01)
+
+
+def test_json_output_in_si(capsys, record):
+    code, out, _ = run_main(capsys, "analyze", str(record["path"]), "--v0", "5e-5", "--json")
+    assert code == 0
+    data = json.loads(out)
+    assert data["regime"] == "stick-slip" and data["pulling_velocity"] == pytest.approx(V0)
+    complete = [c for c in data["cycles"] if c["complete"]]
+    assert [c["index"] for c in complete] == [2, 3]
+    for cycle in complete:
+        j = cycle["index"] - 1
+        assert cycle["critical_stress"] == pytest.approx(LOWS[j], abs=2.9)
+        assert cycle["peak_stress"] == pytest.approx(HIGHS[j], abs=2.9)
+        assert cycle["stick_time"] == pytest.approx(record["peaks"][j] - record["starts"][j], rel=0.02)
+        assert cycle["stiffness"] == pytest.approx(GD_H, rel=0.02)
+        assert cycle["slip_time"] == pytest.approx(SLIP, abs=0.1)
+        assert 5e-4 < cycle["jump_velocity"] < 8e-4  # m/s: SI
+    assert data["cycles"][0]["critical_stress"] is None  # cut by the start of the record
+    assert data["summary"]["stiffness"]["n"] == 4
+    assert data["summary"]["stiffness"]["mean"] == pytest.approx(GD_H, rel=0.01)
+
+
+def test_cycles_csv_reads_back_with_units(capsys, record, tmp_path):
+    target = tmp_path / "cycles.csv"
+    code, _, _ = run_main(capsys, "analyze", str(record["path"]), "--v0", "50 um/s", "-o", str(target))
+    assert code == 0
+    header = target.read_text(encoding="utf-8").splitlines()[0]
+    assert "critical_stress [Pa]" in header and "stiffness [Pa/m]" in header and "jump_velocity [m/s]" in header
+    dimensions = {"s": "time", "Pa": "stress", "Pa/s": "stress_rate", "Pa/m": "stress_per_length", "m/s": "velocity"}
+    columns = {}
+    for cell in header.split(","):
+        name, _, unit = cell.partition(" [")
+        columns[name] = dimensions[unit.rstrip("]")] if unit else "dimensionless"
+    names = list(columns)
+    table = read_table(target, columns, required=names, allow_missing=names)  # units of the right dimension
+    assert list(table["complete"]) == [0, 1, 1, 0]
+    assert np.isnan(table["critical_stress"][0])
+    assert table["peak_stress"][1] == pytest.approx(HIGHS[1], abs=2.9)
+
+
+def test_force_with_contact_area_gives_the_same_stress(capsys, record):
+    _, by_stress, _ = run_main(capsys, "analyze", str(record["path"]), "--v0", "50 um/s", "--json")
+    code, by_force, err = run_main(
+        capsys, "analyze", str(record["force"]), "--v0", "50 um/s", "--contact-area", "20 cm^2", "--json"
+    )
+    assert code == 0, err
+    a, b = json.loads(by_stress), json.loads(by_force)
+    for x, y in zip(a["cycles"], b["cycles"], strict=True):
+        if x["peak_stress"] is not None:
+            assert y["peak_stress"] == pytest.approx(x["peak_stress"], abs=0.05)
+
+
+def test_plot_and_compare(capsys, tmp_path, record):
+    from stickslip.model.cycle import simulate
+    from stickslip.parameters import load_parameters
+
+    sim = simulate(load_parameters("gelatin-glass"), V0, 90.0)
+    rng = np.random.default_rng(8)
+    t = np.arange(5.0, 85.0, 0.05)
+    stress = np.interp(t, sim.time, sim.stress) + 3.0 * rng.standard_normal(t.size)
+    path = tmp_path / "sim.csv"
+    path.write_text("time,stress\n" + "".join(f"{a:.17g},{b:.17g}\n" for a, b in zip(t, stress, strict=True)))
+    picture = tmp_path / "analysis.png"
+    code, out, err = run_main(
+        capsys, "analyze", str(path), "--v0", "50 um/s", "--compare", "--json", "--plot", str(picture)
+    )
+    assert code == 0, err
+    comparison = json.loads(out)["comparison"]
+    assert comparison["model_regime"] == "stick-slip"
+    assert comparison["rms_misfit"] == pytest.approx(3.0, rel=0.15)
+    assert comparison["cycles"][0]["difference"]["peak_stress"] == pytest.approx(0.0, abs=3.0)
+    assert picture.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    code, out, _ = run_main(capsys, "analyze", str(path), "--v0", "50 um/s", "--compare")
+    assert code == 0 and "RMS misfit" in out and "record cycle 2 - model cycle 1" in out
+
+
+def test_steady_record(capsys, tmp_path):
+    rng = np.random.default_rng(9)
+    t = np.arange(0.0, 60.0, 0.05)
+    path = tmp_path / "steady.csv"
+    stress = 391.5 + 3.0 * rng.standard_normal(t.size)
+    path.write_text("time,stress [Pa]\n" + "".join(f"{a:.17g},{b:.17g}\n" for a, b in zip(t, stress, strict=True)))
+    code, out, _ = run_main(capsys, "analyze", str(path), "--v0", "350 um/s", "--json")
+    assert code == 0
+    data = json.loads(out)
+    assert data["regime"] == "steady" and data["cycles"] == []
+    assert data["summary"]["mean_stress"] == pytest.approx(391.5, abs=0.5)
+    assert data["summary"]["stress_std"] == pytest.approx(3.0, rel=0.1)
+    code, out, _ = run_main(capsys, "analyze", str(path), "--v0", "350 um/s")
+    assert "steady sliding" in out and "mean stress" in out
+
+
+@pytest.mark.parametrize(
+    ("content", "args", "match"),
+    [
+        (None, [], "file not found"),
+        ("time,stress\n" + "".join(f"{k},1\n" for k in (0, 2, 1, 3) * 8), [], "row 4: time 1 s goes back"),
+        ("time,stress\n" + "".join(f"{k},1\n" for k in range(5)), [], "too short"),
+        ("time,value\n1,2\n", [], "unknown column 'value'"),
+        ("time\n" + "".join(f"{k}\n" for k in range(30)), [], "missing column 'stress'"),
+        ("time,force\n" + "".join(f"{k},1\n" for k in range(30)), [], "contact area"),
+        ("time,stress\n1,abc\n", [], "row 2, column 'stress': 'abc' is not a number"),
+    ],
+)
+def test_bad_files_exit_2(capsys, tmp_path, content, args, match):
+    path = tmp_path / "bad.csv"
+    if content is not None:
+        path.write_text(content, encoding="utf-8")
+    code, out, err = run_main(capsys, "analyze", str(path), "--v0", "50 um/s", *args)
+    assert code == 2 and out == ""
+    assert err.startswith("stickslip: error: ") and match in err and err.count("\n") == 1
+
+
+@pytest.mark.parametrize(
+    ("args", "match"),
+    [
+        (["--v0", "50 Pa"], "--v0"),
+        (["--v0", "-5 um/s"], "--v0"),
+        (["--v0", "0"], "--v0"),
+        ([], "--v0"),
+        (["--v0", "50 um/s", "--contact-area", "3 s"], "--contact-area"),
+        (["--v0", "50 um/s", "--set", "block.height=-1 mm"], "block.height"),
+    ],
+)
+def test_bad_options_exit_2(capsys, record, args, match):
+    code, _, err = run_main(capsys, "analyze", str(record["path"]), *args)
+    assert code == 2
+    assert err.startswith("stickslip: error: ") and match in err and err.count("\n") == 1

@@ -1,0 +1,136 @@
+"""``stickslip fit steady|stick`` end to end, in process (main() with argv)."""
+
+from __future__ import annotations
+
+import json
+import sys
+
+import numpy as np
+import pytest
+from scipy import stats
+
+from stickslip.cli.main import main
+from stickslip.fitting import datasets, read_steady_data
+from stickslip.parameters import load_parameters
+
+SYNTHETIC = str(datasets.synthetic_steady_path())
+
+
+def run(capsys, *argv: str) -> tuple[int, str, str]:
+    with pytest.raises(SystemExit) as info:
+        main(list(argv))
+    out, err = capsys.readouterr()
+    return int(info.value.code), out, err
+
+
+def test_fit_steady_json_and_files(tmp_path, capsys):
+    toml, report, png = tmp_path / "fitted.toml", tmp_path / "fit.md", tmp_path / "fit.png"
+    code, out, err = run(
+        capsys, "fit", "steady", SYNTHETIC, "--json", "-o", str(toml), "--report", str(report), "--plot", str(png)
+    )
+    assert code == 0, err
+    result = json.loads(out)
+    for name in ("critical_velocity", "critical_stress"):
+        assert set(result[name]) >= {"value", "stderr", "interval"}
+    assert result["parameters"]["bonds.max_extension"]["fixed"] is True
+    assert set(result["parameters"]["bonds.site_density"]) >= {"value", "stderr", "interval"}
+    assert 0.5 < result["reduced_chi_square"] < 2.0
+    assert "## Critical point" in report.read_text()
+    assert png.read_bytes()[:4] == b"\x89PNG"
+    # the fitted file works in another command and reproduces the data's curve
+    code, out, err = run(capsys, "critical", "--params", str(toml))
+    assert code == 0, err
+    vc = result["critical_velocity"]["value"] * 1e6
+    assert f"{vc:.6g}" in out
+    data = read_steady_data(SYNTHETIC)
+    argv = ["curve", "--params", str(toml), "--format", "json"]
+    for v in data.velocity:
+        argv += ["--velocity", repr(float(v))]
+    code, out, err = run(capsys, *argv)
+    assert code == 0, err
+    stress = np.array(json.loads(out)["stress"])
+    z = (data.stress - stress) / data.stress_err
+    assert stats.chi2.sf(float(z @ z), 20) > 0.01
+
+
+def test_fit_steady_prints_the_report_with_units(capsys):
+    code, out, err = run(
+        capsys, "fit", "steady", SYNTHETIC, "--fix", "bonds.bond_time=224 us", "--free", "bonds.breakage_weight"
+    )
+    assert code == 0, err
+    assert "# Steady friction fit" in out and "µm/s" in out
+    assert "fixed by request" in out
+
+
+@pytest.mark.parametrize(
+    ("content", "expected"),
+    [
+        ("velocity [um/s],stress [Pa]\n100,250\n200,300\n200,310\n400,400\n", "row 4, column 'velocity': duplicates"),
+        ("velocity [um/s],stress [Pa]\n100,250\n200,-3\n300,310\n400,400\n", "row 3, column 'stress'"),
+        ("velocity [um/s],friction [Pa]\n100,250\n", "unknown column 'friction'"),
+        ("velocity [zorks],stress [Pa]\n100,250\n", "unknown unit"),
+    ],
+)
+def test_bad_files_exit_2_with_one_line(tmp_path, capsys, content, expected):
+    path = tmp_path / "bad.csv"
+    path.write_text(content)
+    code, out, err = run(capsys, "fit", "steady", str(path))
+    assert code == 2 and out == ""
+    assert err.startswith("stickslip: error: ") and err.count("\n") == 1
+    assert expected in err and "Traceback" not in err
+
+
+@pytest.mark.parametrize(
+    ("argv", "expected"),
+    [
+        (["--fix", "bonds.bond_time"], "expected KEY=VALUE"),
+        (["--fix", "bonds.colour=3"], "unknown parameter key"),
+        (["--free", "block.height"], "does not depend on it"),
+        (["--split", "800"], "no data point at or above the split"),  # a bare number is SI: 800 m/s
+        (["--split", "800 Pa"], "--split"),
+        (["--corner", "c.png"], "--corner needs --bayes"),
+    ],
+)
+def test_bad_options_exit_2(capsys, argv, expected):
+    code, _, err = run(capsys, "fit", "steady", SYNTHETIC, *argv)
+    assert code == 2 and expected in err and err.count("\n") == 1
+
+
+def test_bayes_option(tmp_path, capsys):
+    corner_png = tmp_path / "corner.png"
+    code, out, err = run(
+        capsys, "fit", "steady", SYNTHETIC, "--bayes", "--walkers", "10", "--steps", "20", "--seed", "3",
+        "--corner", str(corner_png), "--json",
+    )  # fmt: skip
+    assert code == 0, err
+    posterior = json.loads(out)["posterior"]
+    assert posterior["walkers"] == 10 and posterior["steps"] == 20
+    assert any("uniform in ln" in p for p in posterior["priors"])
+    assert posterior["critical_velocity"]["value"] > 0
+    assert corner_png.read_bytes()[:4] == b"\x89PNG"
+
+
+def test_bayes_without_emcee(monkeypatch, capsys):
+    monkeypatch.setitem(sys.modules, "emcee", None)
+    code, _, err = run(capsys, "fit", "steady", SYNTHETIC, "--bayes")
+    assert code == 2 and "pip install stickslip[bayes]" in err and err.count("\n") == 1
+
+
+def test_fit_stick(tmp_path, capsys):
+    table = tmp_path / "stick.csv"
+    table.write_text(
+        "pulling_velocity [um/s],stick_time [s],start_stress [Pa]\n"
+        "50,18.3,255\n50,18.3,262\n100,8.82,261\n100,8.61,261\n"
+    )
+    toml = tmp_path / "stick.toml"
+    code, out, err = run(
+        capsys, "fit", "stick", str(table), "--json", "-o", str(toml), "--fix", "stick.break_rate=1.4e-4 1/s"
+    )
+    assert code == 0, err
+    result = json.loads(out)
+    assert result["parameters"]["stick.break_rate"]["fixed"] is True
+    assert set(result["parameters"]["stick.attached_chains"]) >= {"value", "stderr", "interval"}
+    fitted = load_parameters(str(toml))
+    assert fitted.stick.attached_chains == pytest.approx(result["parameters"]["stick.attached_chains"]["value"])
+    code, out, err = run(capsys, "fit", "stick", str(table), "--exclude-row", "7")
+    assert code == 2 and "no such data row" in err

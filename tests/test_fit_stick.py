@@ -1,0 +1,79 @@
+"""Stick-phase fit (Eq 15): recovery of known parameters, what Table 1 can and cannot determine, bad input."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from stickslip.errors import DataError, ParameterError
+from stickslip.fitting import StickData, datasets
+from stickslip.fitting.stick_fit import fit_stick
+from stickslip.model.critical import critical_point
+from stickslip.model.stick import stick_phase
+from stickslip.parameters import load_parameters
+
+TRUE = load_parameters("gelatin-glass")
+SIGMA_C = critical_point(TRUE).stress
+VELOCITIES = np.array([30e-6, 60e-6, 100e-6])
+
+
+@pytest.fixture(scope="module")
+def synthetic_table() -> StickData:
+    phases = [stick_phase(TRUE, v, start_stress=SIGMA_C) for v in VELOCITIES]
+    times = np.array([p.stick_time for p in phases])
+    peaks = np.array([p.peak_stress for p in phases])
+    return StickData.from_arrays(VELOCITIES, times, peaks, np.full(3, SIGMA_C))
+
+
+def test_recovery_from_exact_stick_times_at_three_velocities(synthetic_table):
+    """Three pulling velocities determine Nc0, uc/tau and tau_a; from a start off by factors 1.2-2 the fit
+    returns the generating values (stick times from the model itself, so to the ODE tolerance)."""
+    start = TRUE.with_overrides(
+        {"stick.attached_chains": 2.07e12 * 1.2, "stick.break_rate": 2.8e-4, "stick.aging_time": 5.0}
+    )
+    fit = fit_stick(synthetic_table, params=start)
+    assert fit.free_keys == ("stick.attached_chains", "stick.break_rate", "stick.aging_time")
+    for key, value in (("stick.attached_chains", 2.07e12), ("stick.break_rate", 1.4e-4), ("stick.aging_time", 10.0)):
+        assert fit.parameters.as_dict()[key] == pytest.approx(value, rel=1e-5)
+    assert fit.fitted_peak_stress  # no measured loading rate: peak stresses are data too
+    assert np.allclose(fit.model_stick_time, synthetic_table.stick_time, rtol=1e-6)
+
+
+def test_table1_two_velocities_cannot_determine_three_parameters():
+    """Table 1 has stick-slip cycles at only 50 and 100 um/s: one direction is undetermined, a parameter is
+    fixed with a message, and the rest reproduce the measured stick times (the paper: 18.3 s, 9.3 s)."""
+    fit = fit_stick(datasets.table1_path(), exclude_rows=[10, 11, 14])
+    assert len(fit.free_keys) == 2
+    assert any("is not determined by these stick times" in m for m in fit.messages)
+    assert any("row 15 left out" in m for m in fit.messages)  # 350 um/s: above Vc
+    assert any("measured stick_slope" in m for m in fit.messages)
+    used = fit.used
+    assert list(fit.data.rows[used]) == [8, 9, 12, 13]
+    assert np.allclose(fit.model_stick_time[used], fit.data.stick_time[used], rtol=0.05)
+    nc0 = fit.parameters.stick.attached_chains
+    assert 1.5e12 < nc0 < 3e12  # the paper's Nc0 = 2.07e12 m^-2
+    assert fit.reduced_chi_square < 0.01  # ln-residuals of a few per cent
+    text = fit.report()
+    assert "## Rows" in text and "left out" in text
+    out = fit.as_dict()
+    assert {r["row"] for r in out["rows"] if r["used"]} == {8, 9, 12, 13}
+
+
+def test_outlier_row_is_flagged():
+    fit = fit_stick(datasets.table1_path(), fix={"stick.aging_time": "10 s", "stick.break_rate": "1.4e-4 1/s"})
+    assert any(m.startswith("row 11:") and "outlier" in m for m in fit.messages)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "error", "match"),
+    [
+        ({"fix": {"bonds.bond_time": 1e-4}}, ParameterError, "not a stick-phase fit parameter"),
+        ({"free": ["stick.nonsense"]}, ParameterError, "unknown parameter key"),
+        ({"exclude_rows": [99]}, DataError, "no such data row"),
+        ({"exclude_rows": [8, 9, 10, 11, 12, 13]}, DataError, "1 usable row"),
+        ({"level": 0.0}, ParameterError, "level"),
+    ],
+)
+def test_bad_requests(kwargs, error, match):
+    with pytest.raises(error, match=match):
+        fit_stick(datasets.table1_path(), **kwargs)

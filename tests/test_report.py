@@ -1,0 +1,411 @@
+"""stickslip reproduce: results.json against the library's own functions and the paper, and the files written.
+
+The report is built once per session (it is the slowest thing in the suite)
+through the real command line, ``stickslip reproduce -o DIR --quiet``, and
+shared with tests/test_report_browser.py through :func:`built_report`.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import subprocess
+import sys
+import time
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from stickslip import critical_point, load_parameters, steady_state
+from stickslip.errors import DataError
+from stickslip.report import build as build_module
+from stickslip.report.comparisons import TOLERANCE, Computed
+from stickslip.report.errata import load_errata, render_errata
+from stickslip.report.figures import ReportFigure, extract_curves
+from stickslip.report.formatting import format_number, format_percent, format_quantity
+from stickslip.report.paper import PAPER_NUMBERS
+
+_BUILT: dict[str, object] = {}
+
+
+def built_report(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The report folder, built once per session by ``stickslip reproduce -o DIR --quiet``."""
+    if "folder" not in _BUILT:
+        folder = tmp_path_factory.mktemp("reproduce") / "report"
+        started = time.perf_counter()
+        done = subprocess.run(
+            [sys.executable, "-m", "stickslip.cli.main", "reproduce", "-o", str(folder), "--quiet"],
+            capture_output=True,
+            text=True,
+            timeout=300,
+        )
+        _BUILT.update(folder=folder, process=done, seconds=time.perf_counter() - started)
+        assert done.returncode == 0, f"stickslip reproduce failed: {done.stderr}"
+    return _BUILT["folder"]  # type: ignore[return-value]
+
+
+@pytest.fixture(scope="module")
+def report(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    return built_report(tmp_path_factory)
+
+
+@pytest.fixture(scope="module")
+def results(report: Path) -> dict:
+    return json.loads((report / "results.json").read_text(encoding="utf-8"))
+
+
+@pytest.fixture(scope="module")
+def rows(results: dict) -> dict[str, dict]:
+    return {row["key"]: row for row in results["comparisons"]}
+
+
+@pytest.fixture(scope="module")
+def params():
+    return load_parameters("gelatin-glass")
+
+
+# ---------------------------------------------------------------- the command
+
+
+def test_quiet_prints_nothing(report: Path) -> None:
+    done = _BUILT["process"]
+    assert done.stdout == "" and done.stderr == ""  # type: ignore[attr-defined]
+
+
+def test_writes_report_results_figures_and_curves(report: Path, results: dict) -> None:
+    assert (report / "report.html").stat().st_size > 0
+    assert results["figures"], "no figures"
+    for figure in results["figures"]:
+        png = (report / figure["png"]).read_bytes()
+        assert png.startswith(b"\x89PNG\r\n\x1a\n") and len(png) > 1000
+        root = ET.fromstring((report / figure["svg"]).read_bytes())
+        assert root.tag.endswith("svg")
+        assert figure["curves"], f"{figure['id']}: no curve written as CSV"
+        for curve in figure["curves"]:
+            table = pd.read_csv(report / curve["csv"])
+            assert list(table.columns) == [curve["x"], curve["y"]]
+            assert len(table) == curve["points"] >= 1
+            assert np.isfinite(table.to_numpy()).any()
+    written = {p.name for p in report.iterdir()}
+    listed = {"report.html", "results.json"}
+    for figure in results["figures"]:
+        listed |= {figure["png"], figure["svg"], *(c["csv"] for c in figure["curves"])}
+    assert written == listed
+
+
+def test_html_is_self_contained(report: Path) -> None:
+    html = (report / "report.html").read_text(encoding="utf-8")
+    assert "<script" not in html.lower()
+    assert "@import" not in html and "url(http" not in html
+    for attribute in ("src=", "href="):
+        for chunk in html.split(attribute)[1:]:
+            target = chunk[1:].split(chunk[0], 1)[0]
+            assert not target.startswith(("http:", "https:", "//")) or attribute == "href=", target
+            if attribute == "src=":
+                assert target.startswith("data:image/png;base64,"), target[:60]
+
+
+def test_not_a_folder_is_a_one_line_error(tmp_path: Path) -> None:
+    target = tmp_path / "taken"
+    target.write_text("x")
+    done = subprocess.run(
+        [sys.executable, "-m", "stickslip.cli.main", "reproduce", "-o", str(target)],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert done.returncode == 2
+    assert done.stderr.count("\n") == 1 and done.stderr.startswith("stickslip: error:")
+    assert str(target) in done.stderr
+
+
+def test_summary_line_when_not_a_terminal(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
+    from click.testing import CliRunner
+
+    from stickslip.cli.main import cli
+
+    calls = []
+
+    def fake_build(folder, progress=None):
+        calls.append((folder, progress))
+        return build_module.Report(
+            Path(folder), Path(folder) / "report.html", Path(folder) / "results.json", (), (), (), 1.0
+        )
+
+    monkeypatch.setattr("stickslip.report.build_report", fake_build)
+    result = CliRunner().invoke(cli, ["reproduce", "-o", str(tmp_path / "r")])
+    assert result.exit_code == 0
+    assert result.output.strip() == f"report: {tmp_path / 'r' / 'report.html'} (2 files, 1.0 s)"
+    assert calls == [(tmp_path / "r", None)]
+    quiet = CliRunner().invoke(cli, ["reproduce", "-o", str(tmp_path / "q"), "--quiet"])
+    assert quiet.exit_code == 0 and quiet.output == ""
+
+
+def test_progress_display_on_a_terminal(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
+    from stickslip.cli import reproduce_cmd
+
+    seen = []
+
+    def fake_build(folder, progress=None):
+        for k in range(3):
+            progress(f"step {k}", k, 3)
+            seen.append(k)
+        progress("Done", 3, 3)
+        return build_module.Report(
+            Path(folder), Path(folder) / "report.html", Path(folder) / "results.json", (), (), (), 1.0
+        )
+
+    monkeypatch.setattr("stickslip.report.build_report", fake_build)
+    report = reproduce_cmd._build_with_progress(tmp_path)
+    assert seen == [0, 1, 2] and report.html.name == "report.html"
+
+
+def test_progress_callback_counts_every_step(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
+    """build_report's callback: done goes 0, 1, ..., total, one call per step, with a description."""
+    from matplotlib.figure import Figure
+
+    def tiny_figure(run):
+        fig = Figure()
+        fig.add_subplot().plot([1.0, 2.0], [3.0, 4.0], label="line")
+        return ReportFigure("tiny", "Fig 0", "tiny", "caption", fig)
+
+    monkeypatch.setattr(build_module, "run_steps", lambda: [("one", lambda run: None), ("two", lambda run: None)])
+    monkeypatch.setattr(build_module, "FIGURE_BUILDERS", [("tiny figure", tiny_figure)])
+    monkeypatch.setattr(build_module, "load_errata", lambda: render_errata("## E1 an erratum\n"))
+    monkeypatch.setattr(
+        build_module, "computed_values", lambda run: {n.key: Computed(n.paper, "x") for n in PAPER_NUMBERS}
+    )
+    calls = []
+    report = build_module.build_report(tmp_path / "r", progress=lambda d, done, total: calls.append((d, done, total)))
+    assert [c[1] for c in calls] == list(range(len(calls)))
+    assert {c[2] for c in calls} == {len(calls) - 1} == {5}
+    assert all(c[0] for c in calls)
+    assert (tmp_path / "r" / "tiny_line.csv").read_text() == "x,y\n1.0,3.0\n2.0,4.0\n"
+    assert report.html.exists()
+
+
+# ---------------------------------------------------------------- the comparison table
+
+
+def test_comparisons_have_the_promised_fields(results: dict) -> None:
+    comparisons = results["comparisons"]
+    assert [row["key"] for row in comparisons] == [n.key for n in PAPER_NUMBERS]
+    for row in comparisons:
+        assert {"quantity", "paper", "computed", "relative_difference"} <= set(row)
+        assert isinstance(row["computed"], float), row
+        expected = (row["computed"] - row["paper"]) / abs(row["paper"])
+        assert row["relative_difference"] == pytest.approx(expected, rel=1e-12, abs=1e-15)
+
+
+def test_every_difference_beyond_two_percent_names_an_existing_erratum(results: dict) -> None:
+    known = {entry["id"] for entry in results["errata"]}
+    assert known == {e.id for e in load_errata().entries}
+    for row in results["comparisons"]:
+        if abs(row["relative_difference"]) > TOLERANCE:
+            assert row.get("errata") in known, f"{row['key']}: differs by {row['relative_difference']:+.1%}, no erratum"
+        if "errata" in row:
+            assert row["errata"] in known
+
+
+def test_every_linked_number_finds_exactly_its_erratum() -> None:
+    """Each number with errata topics (stickslip.report.paper.ERRATA_TOPICS) resolves against the shipped errata,
+    and a topic that matches, matches one entry only."""
+    import re
+
+    from stickslip.report.paper import ERRATA_TOPICS, resolve_errata
+
+    titles = {e.id: e.title for e in load_errata().entries}
+    for topic in {t for topics in ERRATA_TOPICS.values() for t in topics}:
+        hits = [entry for entry, title in titles.items() if re.search(topic, title)]
+        assert len(hits) <= 1, f"errata topic {topic!r} matches {hits}"
+    unresolved = sorted(set(ERRATA_TOPICS) - set(resolve_errata(titles)))
+    assert not unresolved, f"no erratum in docs/errata.md has the topic of: {unresolved}"
+
+
+def test_errata_are_found_by_title_not_by_number() -> None:
+    from stickslip.report.paper import resolve_errata
+
+    titles = {"E1": "Vc = 125 µm/s and σc = 259 ± 5 Pa against the computed critical point", "E7": "Notation: τ_A, V_A"}
+    links = resolve_errata(titles)
+    assert links["critical_velocity"] == links["table1_critical_stress_50_1"] == "E1"
+    assert links["aging_time"] == links["stick_aging_time"] == "E7"
+    assert links["slip_asymptote_50"] == "E1"  # falls back to the critical point when no entry on the asymptote
+    assert "stretch_sensitivity" not in links
+    renumbered = resolve_errata({"E30": titles["E1"], "E2": "The asymptotic value 125 µm/s is reached"})
+    assert renumbered["critical_velocity"] == "E30" and renumbered["slip_asymptote_50"] == "E2"
+
+
+def test_packaged_errata_is_a_copy_of_the_docs() -> None:
+    """The report embeds stickslip/report/errata.md; in a checkout it must be docs/errata.md, unchanged."""
+    from importlib import resources
+
+    packaged = resources.files("stickslip") / "report" / "errata.md"
+    docs = Path(__file__).resolve().parents[1] / "docs" / "errata.md"
+    if packaged.is_file() and docs.is_file():
+        assert packaged.read_text(encoding="utf-8") == docs.read_text(encoding="utf-8")
+    else:
+        assert packaged.is_file() or docs.is_file(), "no errata to embed in the report"
+
+
+def test_steady_numbers_match_the_library(rows: dict, params) -> None:
+    c = critical_point(params)
+    assert rows["critical_velocity"]["computed"] == c.velocity
+    assert rows["critical_stress"]["computed"] == c.stress
+    assert rows["steady_stress_350"]["computed"] == float(steady_state(params, 350e-6).stress)
+    assert rows["geometric_factor"]["computed"] == params.block.geometric_factor
+    assert rows["stiffness"]["computed"] == params.block.stiffness
+    assert rows["stretch_sensitivity"]["computed"] == params.bonds.stretch_sensitivity
+
+
+def test_steady_numbers_match_the_paper(rows: dict) -> None:
+    """Numbers printed in the paper (Section 3): the independent check of the model behind the table."""
+    assert rows["critical_velocity"]["computed"] == pytest.approx(125e-6, rel=0.01)
+    assert rows["critical_stress"]["computed"] == pytest.approx(259.0, rel=0.01)
+    assert rows["geometric_factor"]["computed"] == pytest.approx(0.766, abs=5e-4)
+    assert rows["stiffness"]["computed"] == pytest.approx(400e3, rel=1e-12)
+    # the paper's "0.4 kPa" is read off a plot: one significant figure
+    assert rows["steady_stress_350"]["computed"] == pytest.approx(400.0, abs=50.0)
+
+
+def test_stick_jump_and_slip_numbers_match_the_library(rows: dict, params) -> None:
+    from stickslip.model.cycle import simulate
+    from stickslip.model.jump import jump_velocity
+    from stickslip.model.stick import stick_phase
+
+    for v0, velocity in ((50, 50e-6), (100, 100e-6)):
+        stick = stick_phase(params, velocity)
+        for key in (f"stick_time_{v0}", f"stick_time_measured_{v0}", f"stick_time_table_{v0}"):
+            assert rows[key]["computed"] == stick.stick_time
+        assert rows[f"slip_stress_{v0}"]["computed"] == stick.peak_stress
+        for cycle in (1, 2, 3):
+            assert rows[f"table1_stick_time_{v0}_{cycle}"]["computed"] == stick.stick_time
+            assert rows[f"table1_slip_stress_{v0}_{cycle}"]["computed"] == stick.peak_stress
+    assert rows["jump_velocity_50"]["computed"] == jump_velocity(params, 554.0).velocity
+    assert rows["jump_velocity_100"]["computed"] == jump_velocity(params, 549.0).velocity
+    for key, stress in (("50_3", 552.0), ("100_1", 658.0), ("350_1", 800.0)):
+        assert rows[f"table1_jump_velocity_{key}"]["computed"] == jump_velocity(params, stress).velocity
+    for v0, velocity, duration in ((50, 50e-6, 30.0), (350, 350e-6, 45.0)):
+        slip = simulate(params, velocity, duration).slip_phases[0]
+        assert rows[f"slip_asymptote_{v0}"]["computed"] == slip.end_velocity
+
+
+def test_stick_jump_and_slip_numbers_match_the_paper(rows: dict) -> None:
+    """Where the paper's number is a model result it agrees within the paper's rounding (errata E10, E15)."""
+    assert rows["jump_velocity_50"]["computed"] == pytest.approx(702e-6, rel=0.01)
+    assert rows["slip_stress_50"]["computed"] == pytest.approx(554.0, rel=0.01)
+    assert rows["slip_stress_100"]["computed"] == pytest.approx(549.0, rel=0.02)
+    assert rows["slip_asymptote_50"]["computed"] == pytest.approx(125e-6, rel=0.01)
+    assert rows["slip_asymptote_100"]["computed"] == pytest.approx(125e-6, rel=0.01)
+    assert rows["slip_asymptote_350"]["computed"] == pytest.approx(350e-6, rel=1e-6)
+    # the paper's simulated stick times are 5 % below Eq 15 as printed (E10); ts ~ 1/V0 holds for both
+    assert rows["stick_time_50"]["computed"] == pytest.approx(18.3, rel=0.06)
+    assert rows["stick_time_100"]["computed"] == pytest.approx(9.3, rel=0.06)
+
+
+def test_figures_are_the_papers(results: dict) -> None:
+    assert [f["number"] for f in results["figures"]] == ["Figs 1 and 4", "Fig 2", "Figs 3 and 6", "Fig 5a-c", "Fig 5d"]
+    panels = {c["panel"] for f in results["figures"] if f["number"] == "Fig 5a-c" for c in f["curves"]}
+    assert panels == {"a", "b", "c"}
+
+
+def test_stick_segments_of_fig5_rise_at_the_block_stiffness(report: Path, params) -> None:
+    """Eq 12 with the Eq 17 factor: while stuck, dσ/dt = (Gd/h) ln(B/l)/(B/l - 1) V0, here 15.32 Pa/s at 50 µm/s."""
+    for panel, v0 in (("a", 50e-6), ("b", 100e-6)):
+        table = pd.read_csv(report / f"fig5a-c_cycles_{panel}_stick.csv").dropna()
+        t, sigma = table.iloc[:, 0].to_numpy(), table.iloc[:, 1].to_numpy()
+        first = t < t[0] + 5.0  # inside the first stick
+        slope = np.polyfit(t[first], sigma[first], 1)[0]
+        assert slope == pytest.approx(4000.0 / 0.010 * math.log(5 / 3) / (5 / 3 - 1) * v0, rel=1e-9)
+
+
+def test_chain_fraction_csv_falls_from_one_to_zero_at_the_stick_time(report: Path, rows: dict) -> None:
+    table = pd.read_csv(report / "fig3-6_chain_fraction_v0-50-um-s.csv")
+    t, n = table.iloc[:, 0].to_numpy(), table.iloc[:, 1].to_numpy()
+    assert n[0] == 1.0 and np.all(np.diff(n) <= 0) and n[-1] < 1e-3
+    assert t[-1] == pytest.approx(rows["stick_time_50"]["computed"], rel=1e-9)
+
+
+def test_steady_curve_csv_is_the_model(report: Path, params) -> None:
+    """The CSV of the plotted aging curve holds sigma(V) of the library at its own velocities."""
+    table = pd.read_csv(report / "fig1-4_steady_curve_with-aging.csv")
+    velocity = table.iloc[:, 0].to_numpy() * 1e-6
+    assert table.columns[0] == "sliding velocity V [µm/s]"
+    expected = steady_state(params, velocity).stress
+    assert np.allclose(table.iloc[:, 1].to_numpy(), expected, rtol=1e-12)
+
+
+# ---------------------------------------------------------------- building blocks
+
+
+def test_curves_are_read_from_what_is_drawn() -> None:
+    from matplotlib.figure import Figure
+
+    fig = Figure()
+    top, bottom = fig.subplots(2, sharex=True)
+    top.plot([1, 2, 3], [4, 5, 6], label="model")
+    top.plot([2], [5], "o")
+    top.axvline(2.5)  # a reference line, not a curve
+    top.axvspan(1, 2)
+    top.set_ylabel("$\\sigma$ (Pa)")
+    bottom.scatter([1, 2], [7, 8], label="data")
+    bottom.errorbar([1, 2], [3, 4], yerr=[0.1, 0.2], fmt="s", label="measured")
+    bottom.set_xlabel("time t (s)")
+    curves = extract_curves(fig, "f")
+    assert [(c.name, c.label) for c in curves] == [
+        ("f_a_model", "model"),
+        ("f_a_point-2", ""),
+        ("f_b_measured", "measured"),
+        ("f_b_data", "data"),
+    ]
+    assert curves[0].x_name == "time t [s]" and curves[0].y_name == "σ [Pa]"
+    assert curves[0].to_csv() == "time t [s],σ [Pa]\n1.0,4.0\n2.0,5.0\n3.0,6.0\n"
+    assert list(curves[3].y) == [7.0, 8.0]
+
+
+def test_errata_rendering_anchors_entries_and_stays_offline() -> None:
+    text = (
+        "# Errata\n\nIntro.\n\n## E1 First\n\nText ![img](http://example.com/x.png) <script>x</script>\n\n"
+        "## E12: Second one\n\n| a | b |\n|---|---|\n| 1 | 2 |\n\n## Notes\n"
+    )
+    errata = render_errata(text)
+    assert [(e.id, e.title) for e in errata.entries] == [("E1", "First"), ("E12", "Second one")]
+    assert '<h3 id="e1">' in errata.html and '<h3 id="e12">' in errata.html and "<h3>Notes</h3>" in errata.html
+    assert "<img" not in errata.html and "<script" not in errata.html and "<table>" in errata.html
+    with pytest.raises(DataError, match="E1 appears twice"):
+        render_errata("## E1 a\n\n## E1 b\n")
+
+
+@pytest.mark.parametrize(
+    ("value", "display", "text"),
+    [
+        (124.0970327e-6, "um/s", "124.1 µm/s"),
+        (257.35938, "Pa", "257.4 Pa"),
+        (1.22e14, "1/m^2", "1.220 × 10¹⁴ m⁻²"),
+        (2.4707387e6, "1/m", "2.471 × 10⁶ m⁻¹"),
+        (9.99996e5, "", "1.000 × 10⁶"),
+        (1.4e-4, "1/s", "1.400 × 10⁻⁴ s⁻¹"),
+        (0.766238, "", "0.7662"),
+        (None, "Pa", "—"),
+    ],
+)
+def test_numbers_are_formatted_for_people(value: float | None, display: str, text: str) -> None:
+    assert format_quantity(value, display) == text
+
+
+def test_percentages() -> None:
+    assert format_percent(-0.0072237) == "-0.72 %"
+    assert format_percent(0.1234) == "+12.3 %"
+    assert format_percent(999.0) == "+9.99e4 %"
+    assert format_percent(None) == "—"
+    assert format_number(math.nan) == "—"
+
+
+def test_paper_numbers_have_unique_keys_and_display_units() -> None:
+    from stickslip.report.formatting import DISPLAY_UNITS
+
+    keys = [n.key for n in PAPER_NUMBERS]
+    assert len(keys) == len(set(keys))
+    assert all(n.display in DISPLAY_UNITS and n.paper != 0 for n in PAPER_NUMBERS)
