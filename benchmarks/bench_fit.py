@@ -154,7 +154,7 @@ def coverage(seeds: int) -> None:
             fit = fit_steady(synthetic(24, seed=10_000 + seed), method=method, intervals=intervals)
             lo, hi = fit.critical_velocity.interval
             slo, shi = fit.critical_stress.interval
-            hits += [(lo is None or lo < vc_true) and (hi is None or vc_true < hi)]
+            hits[0] += (lo is None or lo < vc_true) and (hi is None or vc_true < hi)
             hits[1] += (slo is None or slo < sc_true) and (shi is None or sc_true < shi)
         per_fit = (time.perf_counter() - start) / seeds
         rate = hits / seeds

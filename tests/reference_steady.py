@@ -76,12 +76,28 @@ def reference_point(params, velocity: float, aging: bool = True) -> tuple[float,
 
     # L rising already at x = 0 (when the FENE term beats aging) is caught by the event at once
     first = min(1e-3, 1e-3 / math.exp(log_t))  # inside the initial decay on x ~ 1/T
-    sol = solve_ivp(rhs_x, (0.0, 0.5), [0.0, 0.0, 0.0], method="DOP853", rtol=RTOL, atol=1e-300,
-                    events=(done, rising_x), first_step=first)
+    sol = solve_ivp(
+        rhs_x,
+        (0.0, 0.5),
+        [0.0, 0.0, 0.0],
+        method="DOP853",
+        rtol=RTOL,
+        atol=1e-300,
+        events=(done, rising_x),
+        first_step=first,
+    )
     position_is_x = True
     if sol.status == 0:
-        sol = solve_ivp(rhs_y, (0.5, 0.0), sol.y[:, -1], method="DOP853", rtol=RTOL, atol=1e-300,
-                        events=(done, rising_y), first_step=1e-6)
+        sol = solve_ivp(
+            rhs_y,
+            (0.5, 0.0),
+            sol.y[:, -1],
+            method="DOP853",
+            rtol=RTOL,
+            atol=1e-300,
+            events=(done, rising_y),
+            first_step=1e-6,
+        )
         position_is_x = False
     if sol.status != 1:
         raise RuntimeError(f"reference integration did not reach H = {H_END}: {sol.message}")

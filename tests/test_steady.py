@@ -13,8 +13,8 @@ import mpmath
 import numpy as np
 import pytest
 from scipy.interpolate import CubicSpline
-from reference_steady import reference_point
 
+from reference_steady import reference_point
 from stickslip import ModelError, ParameterError, critical_point, load_parameters, steady_state
 from stickslip.model.steady import QuadratureSettings
 from stickslip.parameters import BOLTZMANN
@@ -45,7 +45,7 @@ def test_critical_point_is_a_minimum_of_the_curve():
     c = critical_point(GEL)
     around = steady_state(GEL, c.velocity * np.array([0.98, 1.0, 1.02])).stress
     assert around[1] < around[0] and around[1] < around[2]
-    assert float(steady_state(GEL, c.velocity).stress) == pytest.approx(c.stress, rel=1e-12)
+    assert float(steady_state(GEL, c.velocity).stress) == pytest.approx(c.stress, rel=1e-8)
 
 
 def test_stress_at_350_um_per_s():
@@ -271,8 +271,8 @@ def test_default_quadrature_is_converged():
     for aging in (True, False):
         default = steady_state(GEL, v, aging=aging)
         fine = steady_state(GEL, v, aging=aging, quadrature=QuadratureSettings(order=24).refined(3))
-        assert rel(default.stress, fine.stress) < 1e-9
-        assert rel(default.bonded_fraction, fine.bonded_fraction) < 1e-9
+        assert rel(default.stress, fine.stress) < 1e-8  # 100x inside the 1e-6
+        assert rel(default.bonded_fraction, fine.bonded_fraction) < 1e-8
 
 
 # --- the result object and bad input -------------------------------------------------------

@@ -185,9 +185,7 @@ class Parameters:
 
     def as_dict(self) -> dict[str, float]:
         """Flat mapping ``section.key -> SI float``."""
-        return {
-            f"{s}.{f.name}": getattr(getattr(self, s), f.name) for s, cls in SECTIONS.items() for f in fields(cls)
-        }
+        return {f"{s}.{f.name}": getattr(getattr(self, s), f.name) for s, cls in SECTIONS.items() for f in fields(cls)}
 
     def with_overrides(self, overrides: Mapping[str, Any] | None) -> Parameters:
         """A new set with ``section.key`` values replaced (numbers in SI, or strings with units)."""
@@ -205,7 +203,14 @@ class Parameters:
         for s, cls in SECTIONS.items():
             for f in fields(cls):
                 value = getattr(getattr(self, s), f.name)
-                out.append((f"{s}.{f.name}", f.metadata["symbol"], format_si(value, f.metadata["dimension"]), f.metadata["doc"]))
+                out.append(
+                    (
+                        f"{s}.{f.name}",
+                        f.metadata["symbol"],
+                        format_si(value, f.metadata["dimension"]),
+                        f.metadata["doc"],
+                    )
+                )
         return out
 
     def to_toml(self) -> str:
@@ -289,7 +294,9 @@ def _parse_toml(text: str, source: str) -> Parameters:
     return parameters_from_mapping(data, source)
 
 
-def load_parameters(name_or_path: str | Path | Parameters = "gelatin-glass", overrides: Mapping[str, Any] | None = None) -> Parameters:
+def load_parameters(
+    name_or_path: str | Path | Parameters = "gelatin-glass", overrides: Mapping[str, Any] | None = None
+) -> Parameters:
     """A built-in set by name (``"gelatin-glass"``) or a TOML file by path, with optional overrides.
 
     >>> p = load_parameters("gelatin-glass", overrides={"bonds.max_extension": "1 m"})
@@ -306,7 +313,8 @@ def load_parameters(name_or_path: str | Path | Parameters = "gelatin-glass", ove
         params = read_parameter_file(text)
     else:
         raise ParameterError(
-            f"unknown parameter set {text!r}: expected a built-in name ({', '.join(available_parameter_sets())}) or a TOML file"
+            f"unknown parameter set {text!r}: expected a built-in name"
+            f" ({', '.join(available_parameter_sets())}) or a TOML file"
         )
     return params.with_overrides(overrides)
 

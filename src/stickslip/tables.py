@@ -71,12 +71,13 @@ def read_table(
     for position, cell in enumerate(header, start=1):
         match = _HEADER.match(cell)
         if not match:
-            raise DataError(f"{source}: row {header_row}, column {position}: cannot read header {cell!r}; expected name or 'name [unit]'")
+            raise DataError(
+                f"{source}: row {header_row}, column {position}: cannot read header {cell!r};"
+                " expected name or 'name [unit]'"
+            )
         name, unit = match.group(1), match.group(2)
         if name not in dimensions:
-            raise DataError(
-                f"{source}: unknown column {name!r}; expected {', '.join(dimensions)}"
-            )
+            raise DataError(f"{source}: unknown column {name!r}; expected {', '.join(dimensions)}")
         if name in names:
             raise DataError(f"{source}: column {name!r} appears twice")
         dimension = dimensions[name]
@@ -94,7 +95,7 @@ def read_table(
     for row_number, row in numbered[1:]:
         if len(row) != len(names):
             raise DataError(f"{source}: row {row_number}: expected {len(names)} values, got {len(row)}")
-        for name, factor, cell in zip(names, factors, row):
+        for name, factor, cell in zip(names, factors, row, strict=True):
             text = cell.strip()
             try:
                 value = float(text) if text else math.nan
@@ -115,4 +116,6 @@ def require_positive(table: Table, name: str) -> None:
     bad = np.nonzero(column <= 0)[0]
     if bad.size:
         k = bad[0]
-        raise DataError(f"{table.source}: row {table.rows[k]}, column {name!r}: expected a positive value, got {column[k]:g}")
+        raise DataError(
+            f"{table.source}: row {table.rows[k]}, column {name!r}: expected a positive value, got {column[k]:g}"
+        )

@@ -283,7 +283,7 @@ def _fix_undetermined(progress: _Progress, keys: list[str], direction: identify.
     )
 
 
-def _two_step(progress: _Progress, requested: Sequence[str], hi: Block, lo: Block, split: float) -> list[Block]:
+def _two_step(progress: _Progress, requested: Sequence[str], hi: Block, lo: Block, split: float) -> None:
     step1 = identify.select_identifiable([k for k in requested if k in identify.NO_AGING_KEYS], aging=False)
     step2 = [k for k in requested if k in identify.AGING_KEYS]
     progress.messages.extend(step1.messages)
@@ -297,7 +297,18 @@ def _two_step(progress: _Progress, requested: Sequence[str], hi: Block, lo: Bloc
     progress.params = _scaled_start(progress.params, hi, step1.free)
     _fit_block(progress, step1.free, hi, f"step 1 (V >= {v_split}, no aging)")
     _fit_block(progress, step2, lo, f"step 2 (V < {v_split}, with aging)")
-    return [hi, lo]
+
+
+def _joint_start(
+    progress: _Progress, requested: Sequence[str], hi: Block, lo: Block, everything: Block, split: float
+) -> None:
+    """Start values for the joint fit: the two-step result when both velocity ranges can carry their step."""
+    n1 = len(identify.select_identifiable([k for k in requested if k in identify.NO_AGING_KEYS], aging=False).free)
+    n2 = len([k for k in requested if k in identify.AGING_KEYS])
+    if len(hi) > n1 and len(lo) > n2:
+        _two_step(progress, requested, hi, lo, split)
+    else:
+        progress.params = _scaled_start(progress.params, everything, requested)
 
 
 def _free_after(progress: _Progress, requested: Sequence[str]) -> list[str]:
@@ -393,9 +404,8 @@ def fit_steady(
     progress = _Progress(base, base, tuple(explicit), noise_known, [], [], [])
     progress.messages.append(_structure_note(requested, fixed))
     assert hi is not None and lo is not None
-    _two_step(progress, requested, hi, lo, split)
-    step_keys = _free_after(progress, requested)
     if method == "joint":
+        _joint_start(progress, requested, hi, lo, everything, split)
         # the two-step result is only the start: what the joint fit cannot determine is decided afresh
         progress.messages = progress.messages[:1]
         progress.stages = [dataclasses.replace(s, name=f"start, {s.name}") for s in progress.stages]
@@ -404,6 +414,8 @@ def fit_steady(
         progress.messages.extend(selection.messages)
         keys, _ = _fit_block(progress, selection.free, everything, "the joint fit", precheck=True)
     else:
+        _two_step(progress, requested, hi, lo, split)
+        step_keys = _free_after(progress, requested)
         keys = [k for k in step_keys if k in identify.NO_AGING_KEYS] + [
             k for k in step_keys if k in identify.AGING_KEYS
         ]

@@ -19,7 +19,7 @@ import numpy as np
 from scipy.optimize import brentq
 
 from ..parameters import Parameters
-from .steady import steady_state
+from .steady import ACCURATE_QUADRATURE, steady_state
 
 #: Velocity range searched for extrema, m/s, and the grid density per decade.
 SEARCH_RANGE = (1e-9, 1e2)
@@ -65,7 +65,7 @@ def find_extrema(
     lo, hi = search_range
     n = int(np.ceil(np.log10(hi / lo) * POINTS_PER_DECADE)) + 1
     grid = np.geomspace(lo, hi, n)
-    slope = steady_state(params, grid, aging=aging).stress_slope
+    slope = steady_state(params, grid, aging=aging, quadrature=ACCURATE_QUADRATURE).stress_slope
     sign = np.sign(slope)
     found = []
     for k in np.nonzero(sign[:-1] * sign[1:] < 0)[0]:
@@ -75,7 +75,7 @@ def find_extrema(
 
         log_v = brentq(g, np.log(grid[k]), np.log(grid[k + 1]), xtol=1e-13, rtol=1e-13)
         v = float(np.exp(log_v))
-        stress = float(steady_state(params, v, aging=aging).stress)
+        stress = float(steady_state(params, v, aging=aging, quadrature=ACCURATE_QUADRATURE).stress)
         found.append(Extremum(v, stress, "minimum" if slope[k] < 0 else "maximum"))
     return tuple(found)
 

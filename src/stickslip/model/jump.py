@@ -36,7 +36,7 @@ from scipy.optimize import brentq
 from ..errors import ModelError, ParameterError
 from ..parameters import Parameters
 from .critical import CriticalPoint, critical_point
-from .steady import steady_state
+from .steady import ACCURATE_QUADRATURE, steady_state
 
 CURVES = ("aging", "no-aging")
 
@@ -136,7 +136,7 @@ def branch_maximum(params: Parameters, curve: str) -> tuple[float, float]:
     if cp.turnover_velocity is not None and cp.turnover_stress is not None:
         return cp.turnover_velocity, cp.turnover_stress
     v_top = 1e2  # the end of the critical-point search: the branch rises all the way
-    return v_top, float(steady_state(params, v_top, aging=curve == "aging").stress)
+    return v_top, float(steady_state(params, v_top, aging=curve == "aging", quadrature=ACCURATE_QUADRATURE).stress)
 
 
 #: The aging branch's series reaches this far below Vc, so that the slip phase can subtract a pole at
@@ -198,7 +198,7 @@ def branch_interpolant(params: Parameters, curve: str) -> BranchInterpolant:
 
     def sample(x: np.ndarray) -> np.ndarray:
         v = np.exp(x)
-        state = steady_state(params, v, aging=aging)
+        state = steady_state(params, v, aging=aging, quadrature=ACCURATE_QUADRATURE)
         return np.array([state.stress, state.stress_slope * v])
 
     _, _, c = adaptive_chebyshev(sample, lo, hi, start=64)
@@ -247,7 +247,11 @@ def jump_velocity(params: Parameters, stress: float, curve: str = "aging") -> Ju
     cp = require_critical_point(params)
     assert cp.velocity is not None
     v_max, s_max = branch_maximum(params, curve)
-    s_low = cp.stress if curve == "aging" else float(steady_state(params, cp.velocity, aging=False).stress)
+    s_low = (
+        cp.stress
+        if curve == "aging"
+        else float(steady_state(params, cp.velocity, aging=False, quadrature=ACCURATE_QUADRATURE).stress)
+    )
     assert s_low is not None
     if not s_low <= stress <= s_max:
         where = "below" if stress < s_low else "above"

@@ -53,7 +53,7 @@ from .jump import (
     require_critical_point,
     to_unit,
 )
-from .steady import steady_state
+from .steady import ACCURATE_QUADRATURE, steady_state
 from .stick import check_velocity
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -290,7 +290,7 @@ def steady_curve(params: Parameters) -> Curve:
     """
 
     def curve(v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        state = steady_state(params, v, aging=True)
+        state = steady_state(params, v, aging=True, quadrature=ACCURATE_QUADRATURE)
         return state.stress, state.stress_slope
 
     return curve

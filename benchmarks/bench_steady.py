@@ -1,0 +1,89 @@
+"""Benchmark: the steady friction curve sigma(V) (Eqs 6-8), issue 2.
+
+Times stickslip.steady_state on 1000 log-spaced velocities from 10 um/s to
+10 mm/s (gelatin-glass, with aging) on one core, beside a plain implementation
+that calls scipy.integrate.quad per velocity (the survival S(t_a) needs the
+cumulative hazard, itself a quad: a nested quad).  The plain one is timed on
+a subset of velocities spread over the same range and scaled to 1000.
+
+    python benchmarks/bench_steady.py
+"""
+
+from __future__ import annotations
+
+import os
+
+for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ[_var] = "1"  # one core, as the issue asks
+
+import math  # noqa: E402
+import platform  # noqa: E402
+import statistics  # noqa: E402
+import time  # noqa: E402
+import warnings  # noqa: E402
+
+import numpy as np  # noqa: E402
+from scipy.integrate import quad  # noqa: E402
+
+from stickslip import load_parameters, steady_state  # noqa: E402
+
+VELOCITIES = np.geomspace(10e-6, 10e-3, 1000)
+PLAIN_SUBSET = 12
+
+
+def plain_quad_stress(params, velocity: float) -> float:
+    """Eqs 6-8 the straightforward way: nested adaptive quadrature, one velocity at a time."""
+    b, g = params.bonds, params.aging
+    t_max = b.max_extension / velocity
+    aging = math.exp(-velocity / g.aging_velocity) / g.aging_time
+
+    def hazard(t):
+        x = t / t_max
+        exponent = b.force_sensitivity * b.chain_stiffness * t * velocity / (1 - x * x) - t * aging
+        return b.breakage_weight / b.bond_time * math.exp(min(exponent, 700.0))
+
+    def survival(t):
+        return math.exp(-quad(hazard, 0.0, t, limit=200)[0])
+
+    end = t_max * (1 - 1e-12)
+    bonded = quad(survival, 0.0, end, limit=200)[0]
+    moment = quad(lambda t: t * survival(t) / (1 - (t / t_max) ** 2), 0.0, end, limit=200)[0]
+    return b.chain_stiffness * velocity * b.site_density * moment / (b.bond_time + bonded)
+
+
+def main() -> None:
+    params = load_parameters("gelatin-glass")
+    steady_state(params, VELOCITIES)  # warm-up (imports, caches)
+    runs = []
+    for _ in range(30):
+        start = time.perf_counter()
+        fast = steady_state(params, VELOCITIES)
+        runs.append(time.perf_counter() - start)
+    best, median = min(runs), statistics.median(runs)
+
+    subset = VELOCITIES[np.linspace(0, VELOCITIES.size - 1, PLAIN_SUBSET).astype(int)]
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        start = time.perf_counter()
+        plain = np.array([plain_quad_stress(params, float(v)) for v in subset])
+        plain_per_velocity = (time.perf_counter() - start) / subset.size
+    plain_total = plain_per_velocity * VELOCITIES.size
+    agreement = np.max(np.abs(steady_state(params, subset).stress / plain - 1))
+
+    print(f"machine: {platform.machine()}, {os.cpu_count()} cores, Python {platform.python_version()}, one thread")
+    print("sigma(V), gelatin-glass with aging, 1000 log-spaced velocities, 10 um/s - 10 mm/s")
+    print(f"  stickslip.steady_state   best {best * 1e3:8.2f} ms   median {median * 1e3:8.2f} ms   (30 runs)")
+    print(
+        f"  plain nested scipy quad  {plain_total:8.2f} s    ({plain_per_velocity * 1e3:.0f} ms per velocity,"
+        f" timed on {subset.size} velocities)"
+    )
+    print(f"  speed-up (plain / best)  {plain_total / best:8.0f}x")
+    print(
+        f"  max relative difference of the two on the subset: {agreement:.1e}"
+        f" (the plain quad raised {len(caught)} IntegrationWarnings near the FENE end)"
+    )
+    print(f"  Vc on this grid ~ {VELOCITIES[np.argmin(fast.stress)] * 1e6:.1f} um/s (the curve's minimum)")
+
+
+if __name__ == "__main__":
+    main()

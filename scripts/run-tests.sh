@@ -1,0 +1,25 @@
+#!/usr/bin/env bash
+# The README's test command: from a fresh machine to a finished test run.
+# Installs Debian's chromium + chromium-driver (the report is checked in a real
+# browser), makes a fresh virtual environment, installs stickslip with its test
+# extras from this checkout, lints, and runs pytest (arguments go to pytest).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+if ! command -v chromium >/dev/null 2>&1 || ! command -v chromedriver >/dev/null 2>&1; then
+  sudo=""
+  if [ "$(id -u)" -ne 0 ]; then sudo="sudo"; fi
+  $sudo apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq chromium chromium-driver
+fi
+
+venv="${STICKSLIP_VENV:-.venv}"
+python3 -m venv "$venv"
+"$venv/bin/python" -m pip install -q --upgrade pip
+"$venv/bin/python" -m pip install -q ".[test]"
+
+"$venv/bin/ruff" check src tests benchmarks scripts
+"$venv/bin/ruff" format --check src tests benchmarks scripts
+
+# run from the tests' view of an installed package (not the source tree)
+"$venv/bin/python" -m pytest "$@"
