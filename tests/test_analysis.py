@@ -22,7 +22,6 @@ import pytest
 from stickslip.analysis import analyze_trace, check_trace, compare_with_model, read_trace
 from stickslip.analysis.detect import noise_level
 from stickslip.errors import DataError, ParameterError
-from stickslip.parameters import load_parameters
 
 matplotlib.use("Agg")
 
@@ -32,11 +31,6 @@ K = GD_H * FACTOR
 VC = 124.097e-6  # critical velocity of gelatin-glass (docs/steady-state.md)
 VS = 700e-6  # a typical jump velocity: only sets the slip's shape here
 SIGMA_350 = 391.535  # steady stress at 350 um/s (docs/steady-state.md)
-
-
-@pytest.fixture(scope="module")
-def params():
-    return load_parameters("gelatin-glass")
 
 
 # --------------------------------------------------------------------------- synthetic records

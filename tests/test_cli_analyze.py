@@ -14,7 +14,7 @@ import math
 import numpy as np
 import pytest
 
-from stickslip.cli.main import main
+from cli_helpers import run_main
 from stickslip.tables import read_table
 
 GD_H = 400e3
@@ -66,13 +66,6 @@ def record(tmp_path_factory):
         encoding="utf-8",
     )
     return {"path": path, "force": force, "starts": starts, "peaks": peaks, "folder": folder}
-
-
-def run_main(capsys, *args: str) -> tuple[int, str, str]:
-    with pytest.raises(SystemExit) as exit_info:
-        main(list(args))
-    out, err = capsys.readouterr()
-    return int(exit_info.value.code), out, err
 
 
 def test_table_output(capsys, record):

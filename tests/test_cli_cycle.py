@@ -12,28 +12,9 @@ import json
 
 import numpy as np
 import pytest
-from click.testing import CliRunner
 
-from stickslip.cli.main import cli, main
+from cli_helpers import run, run_main
 from stickslip.model.cycle import CYCLE_COLUMNS
-
-
-@pytest.fixture(scope="module")
-def runner() -> CliRunner:
-    return CliRunner()
-
-
-def run(runner: CliRunner, *args: str) -> str:
-    result = runner.invoke(cli, list(args), catch_exceptions=False)
-    assert result.exit_code == 0, result.output
-    return result.output
-
-
-def run_main(capsys: pytest.CaptureFixture[str], *args: str) -> tuple[int, str, str]:
-    with pytest.raises(SystemExit) as exit_info:
-        main(list(args))
-    out, err = capsys.readouterr()
-    return int(exit_info.value.code), out, err
 
 
 def test_simulate_json_at_50_um_per_s(runner):

@@ -18,9 +18,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 import tomllib
-from click.testing import CliRunner
 
-from stickslip.cli.main import cli, main
+from cli_helpers import run, run_main
+from stickslip.cli.main import cli
 from stickslip.model.steady import steady_state
 from stickslip.parameters import load_parameters
 from stickslip.tables import read_table
@@ -29,25 +29,6 @@ from stickslip.units import DIMENSIONS
 VC_ISSUE = 124.1e-6  # m/s
 SIGMA_C_ISSUE = 257.4  # Pa
 SIGMA_350_ISSUE = 391.5  # Pa
-
-
-@pytest.fixture(scope="module")
-def runner() -> CliRunner:
-    return CliRunner()
-
-
-def run(runner: CliRunner, *args: str) -> str:
-    result = runner.invoke(cli, list(args), catch_exceptions=False)
-    assert result.exit_code == 0, result.output
-    return result.output
-
-
-def run_main(capsys: pytest.CaptureFixture[str], *args: str) -> tuple[int, str, str]:
-    """``main()`` in-process: (exit status, stdout, stderr)."""
-    with pytest.raises(SystemExit) as exit_info:
-        main(list(args))
-    out, err = capsys.readouterr()
-    return int(exit_info.value.code), out, err
 
 
 # --- critical ---------------------------------------------------------------------------------

@@ -13,22 +13,11 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from stickslip.errors import ParameterError
-from stickslip.model.critical import critical_point
 from stickslip.model.cycle import CYCLE_COLUMNS, simulate
 from stickslip.model.slip import slip_phase
 from stickslip.model.steady import steady_state
 from stickslip.model.stick import stick_phase
 from stickslip.parameters import load_parameters
-
-
-@pytest.fixture(scope="module")
-def params():
-    return load_parameters()
-
-
-@pytest.fixture(scope="module")
-def critical(params):
-    return critical_point(params)
 
 
 @pytest.fixture(scope="module")

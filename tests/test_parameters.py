@@ -68,11 +68,6 @@ PAPER_SI = {
 }
 
 
-@pytest.fixture(scope="module")
-def params() -> Parameters:
-    return load_parameters("gelatin-glass")
-
-
 def _set(params: Parameters, key: str, value: object) -> Parameters:
     section, name = key.split(".")
     return replace(params, **{section: {name: value}})

@@ -19,24 +19,12 @@ import numpy as np
 import pytest
 
 from stickslip.errors import ModelError, ParameterError
-from stickslip.model.critical import critical_point
 from stickslip.model.jump import branch_interpolant, jump_velocity
 from stickslip.model.slip import SETTLE_TOLERANCE, slip_phase, slip_trajectory, steady_curve
 from stickslip.model.steady import steady_state
-from stickslip.parameters import load_parameters
 
 VC, SC, A, K = 124e-6, 257.0, 180.0, 3.0e5  # the analytic test curve and stiffness
 MP_DIGITS = 30
-
-
-@pytest.fixture(scope="module")
-def params():
-    return load_parameters()
-
-
-@pytest.fixture(scope="module")
-def critical(params):
-    return critical_point(params)
 
 
 def log_square_curve(v):

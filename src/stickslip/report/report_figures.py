@@ -78,7 +78,7 @@ def chain_fraction_figure(run: ModelRun) -> ReportFigure:
         f"τa = {stick.aging_time:g} s), starting at σc. As in the paper, it falls slowly while the load is "
         "shared by many chains, then collapses: each chain that lets go loads the others more (Eq 14). "
         f"The collapse gives the stick time ts = {ts50:.2f} s at 50 µm/s and {ts100:.2f} s at 100 µm/s; the "
-        "paper's simulation gives 18.3 s and 9.3 s (orange triangles; see the table and errata E10, E5)."
+        "paper's simulation gives 18.3 s and 9.3 s (orange triangles; see the table and errata E18, E5)."
     )
     return ReportFigure("fig3-6_chain_fraction", "Figs 3 and 6", "Attached chains in the stick phase", caption, fig)
 

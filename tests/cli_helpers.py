@@ -1,0 +1,23 @@
+"""Running the command line in-process, for the CLI tests."""
+
+from __future__ import annotations
+
+import pytest
+from click.testing import CliRunner
+
+from stickslip.cli.main import cli, main
+
+
+def run(runner: CliRunner, *args: str) -> str:
+    """A command that must succeed: its standard output."""
+    result = runner.invoke(cli, list(args), catch_exceptions=False)
+    assert result.exit_code == 0, result.output
+    return result.output
+
+
+def run_main(capsys: pytest.CaptureFixture[str], *args: str) -> tuple[int, str, str]:
+    """``main()`` in-process, as the console script runs it: (exit status, stdout, stderr)."""
+    with pytest.raises(SystemExit) as exit_info:
+        main(list(args))
+    out, err = capsys.readouterr()
+    return int(exit_info.value.code), out, err
