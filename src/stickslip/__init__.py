@@ -1,14 +1,38 @@
 """stickslip: the bond-population-balance model of soft-solid friction and stick-slip.
 
 Implements Juvekar & Singh, "Analysis of Stick-Slip Motion as a Jump Phenomenon":
-the steady friction curve sigma(V) (Eqs 6-9), the stick phase (Eqs 11-16), the
-jump, the slip phase (Eq 10) and whole cycles (Eq 17).
+the steady friction curve sigma(V) (Eqs 6-8), the critical point (Eq 9), the
+stick phase (Eqs 11-16), the jump, the slip phase (Eq 10) and whole cycles
+(Eq 17); fitting to measurements and the analysis of measured traces.
+
+The model is importable at once; fitting and trace analysis (which pull in
+lmfit and more of scipy) are loaded on first use of their names.
 """
+
+from __future__ import annotations
+
+from importlib import import_module
+from typing import Any
 
 from .errors import DataError, ModelError, ParameterError, StickslipError, UnitError
 from .model.critical import CriticalPoint, critical_point
-from .model.steady import SteadyState, steady_state
+from .model.cycle import Simulation, simulate
+from .model.jump import jump_velocity
+from .model.slip import SlipPhase, slip_phase
+from .model.steady import SteadyState, steady_state, steady_stress_many
+from .model.stick import StickPhase, stick_phase
 from .parameters import Parameters, available_parameter_sets, load_parameters
+
+_LAZY = {
+    "fit_steady": "stickslip.fitting",
+    "fit_stick": "stickslip.fitting",
+    "read_steady_data": "stickslip.fitting",
+    "read_stick_data": "stickslip.fitting",
+    "sample_posterior": "stickslip.fitting",
+    "analyze_trace": "stickslip.analysis",
+    "read_trace": "stickslip.analysis",
+    "compare_with_model": "stickslip.analysis",
+}
 
 __all__ = [
     "CriticalPoint",
@@ -16,12 +40,29 @@ __all__ = [
     "ModelError",
     "ParameterError",
     "Parameters",
+    "Simulation",
+    "SlipPhase",
     "SteadyState",
+    "StickPhase",
     "StickslipError",
     "UnitError",
     "available_parameter_sets",
     "critical_point",
+    "jump_velocity",
     "load_parameters",
+    "simulate",
+    "slip_phase",
     "steady_state",
+    "steady_stress_many",
+    "stick_phase",
+    *_LAZY,
 ]
 __version__ = "0.1.0"
+
+
+def __getattr__(name: str) -> Any:
+    if name in _LAZY:
+        value = getattr(import_module(_LAZY[name]), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module 'stickslip' has no attribute {name!r}")

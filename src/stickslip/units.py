@@ -64,6 +64,10 @@ def to_si(value: Any, dimension: str, name: str = "value") -> float:
         return float(value)
     ureg = registry()
     if isinstance(value, str):
+        try:  # a bare number (also "nan", "inf") is SI; range checks are the caller's
+            return float(value)
+        except ValueError:
+            pass
         quantity = _parse(value, name, dimension)
     elif isinstance(value, ureg.Quantity):
         quantity = value

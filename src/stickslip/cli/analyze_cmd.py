@@ -13,8 +13,8 @@ from typing import Any
 
 import click
 
-from .common import emit_json, params_options, positive, save_figure, write_text
-from .params_cmd import load_cli_parameters, print_rich, si_text
+from .common import emit_json, params_options, positive, resolve_params, save_figure, write_text
+from .params_cmd import print_rich
 
 #: Columns of ``-o cycles.csv``: (field, SI unit).
 CSV_COLUMNS = (
@@ -97,9 +97,9 @@ def analyze_command(
     """
     from ..analysis import analyze_trace, compare_with_model, read_trace
 
-    v0 = positive(si_text(v0_text, "--v0"), "velocity", "--v0")
-    area = None if area_text is None else positive(si_text(area_text, "--contact-area"), "area", "--contact-area")
-    params = load_cli_parameters(params_name, overrides)
+    v0 = positive(v0_text, "velocity", "--v0")
+    area = None if area_text is None else positive(area_text, "area", "--contact-area")
+    params = resolve_params(params_name, overrides)
     record = read_trace(trace, contact_area=area)
     analysis = analyze_trace(record, None, v0, params)
     comparison = compare_with_model(analysis, params) if compare else None

@@ -13,21 +13,21 @@ from typing import Any
 import click
 import numpy as np
 
-from .common import emit_json, params_options, positive, save_figure, write_text
-from .params_cmd import load_cli_parameters, print_rich, si_text
+from .common import emit_json, params_options, positive, resolve_params, save_figure, write_text
+from .params_cmd import print_rich
 
 #: Rows of the Nc/Nc0 table printed by ``stick`` (the whole curve is in --json and -o).
 STICK_TABLE_ROWS = 11
 
 
 def _velocity(text: str) -> float:
-    return positive(si_text(text, "--v0"), "velocity", "--v0", allow_zero=True)
+    return positive(text, "velocity", "--v0", allow_zero=True)
 
 
 def _stress(text: str | None) -> float | None:
     if text is None:
         return None
-    return positive(si_text(text, "--start-stress"), "stress", "--start-stress", allow_zero=True)
+    return positive(text, "stress", "--start-stress", allow_zero=True)
 
 
 def _csv(columns: dict[str, Any], units: dict[str, str]) -> str:
@@ -90,9 +90,9 @@ def simulate_command(
     from ..model.cycle import COLUMN_UNITS, CYCLE_COLUMNS, simulate
 
     v0 = _velocity(v0_text)
-    duration = positive(si_text(duration_text, "--duration"), "time", "--duration")
+    duration = positive(duration_text, "time", "--duration")
     start = _stress(start_text)
-    params = load_cli_parameters(params_name, overrides)
+    params = resolve_params(params_name, overrides)
     sim = simulate(params, v0, duration, start_stress=start, jump_curve=jump_curve)
     if output is not None:
         write_text(output, _csv({n: getattr(sim, n) for n in CYCLE_COLUMNS}, COLUMN_UNITS))
@@ -186,11 +186,11 @@ def stick_command(
 
     v0 = _velocity(v0_text)
     start = _stress(start_text)
-    params = load_cli_parameters(params_name, overrides)
+    params = resolve_params(params_name, overrides)
     if until_text is None:
         until = 10.0 * params.stick.aging_time
     else:
-        until = positive(si_text(until_text, "--until"), "time", "--until")
+        until = positive(until_text, "time", "--until")
     stick = stick_phase(params, v0, start_stress=start, aging=not no_aging, horizon=until)
     columns = {"time": stick.time, "stress": stick.stress, "chain_fraction": stick.chain_fraction}
     if output is not None:

@@ -14,8 +14,7 @@ import click
 
 from ..fitting.results import human
 from ..parameters import Parameters, key_dimension
-from .common import emit_json, params_options, positive, save_figure, write_text
-from .params_cmd import load_cli_parameters, si_text
+from .common import emit_json, params_options, positive, resolve_params, save_figure, write_text
 
 SPLIT_DEFAULT = "800 um/s"
 
@@ -32,7 +31,7 @@ def _fix_values(items: tuple[str, ...]) -> dict[str, Any]:
         key_dimension(key)  # unknown keys: ParameterError naming the valid ones
         if key in out:
             raise click.BadParameter(f"{key} given twice", param_hint="--fix")
-        out[key] = si_text(value.strip(), key)
+        out[key] = value.strip()
     return out
 
 
@@ -134,8 +133,8 @@ def steady_command(
     if corner_path is not None and not bayes:
         raise click.UsageError("--corner needs --bayes")
     posterior_module = _bayes_module() if bayes else None
-    params = load_cli_parameters(params_name, overrides)
-    split_value = positive(si_text(split, "--split"), "velocity", "--split")
+    params = resolve_params(params_name, overrides)
+    split_value = positive(split, "velocity", "--split")
     fit = fit_steady(
         data,
         params=params,
@@ -234,7 +233,7 @@ def stick_command(
     """
     from ..fitting.stick_fit import fit_stick
 
-    params = load_cli_parameters(params_name, overrides)
+    params = resolve_params(params_name, overrides)
     fit = fit_stick(
         table,
         params=params,

@@ -18,8 +18,7 @@ from typing import Any
 
 import click
 
-from ..errors import ParameterError
-from ..parameters import BOLTZMANN, SECTIONS, Parameters, available_parameter_sets, key_dimension, load_parameters
+from ..parameters import BOLTZMANN, SECTIONS, Parameters, available_parameter_sets, load_parameters
 from ..units import DIMENSIONS
 from .common import params_options, resolve_params, stdout_is_terminal, write_text
 
@@ -54,37 +53,6 @@ def human(value: float, dimension: str, digits: int = 6) -> str:
         return f"{value / factor:.{digits}g} {prefix}{lead}{rest}"
     unit = DIMENSIONS[dimension][1].replace("^2", "²")
     return f"{value:.{digits}g} {unit}".strip()
-
-
-def si_text(text: str, name: str) -> str | float:
-    """A bare number is SI: return it as a float (finite), else the text for :func:`~stickslip.units.to_si`.
-
-    Works around ``units.to_si`` reading the *string* ``"0.001"`` as
-    dimensionless (and so rejecting it for a time) although a bare number
-    in SI is allowed on the command line.
-    """
-    try:
-        value = float(text)
-    except (TypeError, ValueError):
-        return text
-    if not math.isfinite(value):
-        raise ParameterError(f"{name}: expected a finite number, got {text!r}")
-    return value
-
-
-def load_cli_parameters(params_name: str, overrides: Sequence[str]) -> Parameters:
-    """The set named by ``--params`` with ``--set`` overrides (bare numbers in SI)."""
-    fixed = []
-    for item in overrides:
-        key, sep, value = item.partition("=")
-        if sep and key.strip():
-            dimension = key_dimension(key.strip())
-            number = si_text(value.strip(), key.strip())
-            if isinstance(number, float):
-                unit = DIMENSIONS[dimension][1]
-                value = f"{number!r} {unit}".strip()
-        fixed.append(f"{key}={value}" if sep else item)
-    return resolve_params(params_name, fixed)
 
 
 def _chosen_set(ctx: click.Context, name: str | None, params_name: str) -> str:
@@ -209,7 +177,7 @@ def show_command(ctx: click.Context, name: str | None, params_name: str, overrid
     NAME is a built-in set (see `stickslip params list`) or a TOML file;
     it defaults to --params.
     """
-    params = load_cli_parameters(_chosen_set(ctx, name, params_name), overrides)
+    params = resolve_params(_chosen_set(ctx, name, params_name), overrides)
     params = _with_override_note(params, overrides)
     print_rich(parameter_table(params, _changed_keys(overrides)), derived_table(params))
 
@@ -226,7 +194,7 @@ def export_command(
 
     Loading the file back (`--params FILE`) gives exactly the same values.
     """
-    params = load_cli_parameters(_chosen_set(ctx, name, params_name), overrides)
+    params = resolve_params(_chosen_set(ctx, name, params_name), overrides)
     text = _with_override_note(params, overrides).to_toml()
     if output is None:
         click.echo(text, nl=False)

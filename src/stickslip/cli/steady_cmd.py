@@ -14,8 +14,8 @@ import click
 import numpy as np
 
 from ..errors import ParameterError
-from .common import emit_json, params_options, positive, save_figure, write_text
-from .params_cmd import human, load_cli_parameters, print_rich, si_text
+from .common import emit_json, params_options, positive, resolve_params, save_figure, write_text
+from .params_cmd import human, print_rich
 
 DEFAULT_VMIN = "10 um/s"
 DEFAULT_VMAX = "10 mm/s"
@@ -31,7 +31,7 @@ COLUMNS = (
 
 def _velocity(text: str, name: str) -> float:
     """A positive, finite velocity from an option value (unit optional; a bare number is m/s)."""
-    return positive(si_text(text, name), "velocity", name)
+    return positive(text, "velocity", name)
 
 
 def _velocities(
@@ -124,7 +124,7 @@ def curve_command(
     from ..model.steady import steady_state
 
     values, lo, hi = _velocities(velocity, vmin, vmax, points)
-    params = load_cli_parameters(params_name, overrides)
+    params = resolve_params(params_name, overrides)
     result = steady_state(params, values, aging=not no_aging)
     columns = {name: np.ravel(getattr(result, name)) for name, _ in COLUMNS}
     if fmt == "json":
@@ -174,7 +174,7 @@ def critical_command(as_json: bool, params_name: str, overrides: tuple[str, ...]
     """
     from ..model.critical import critical_point
 
-    params = load_cli_parameters(params_name, overrides)
+    params = resolve_params(params_name, overrides)
     point = critical_point(params)
     if as_json:
         emit_json(point.as_dict())

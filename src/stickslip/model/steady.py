@@ -26,6 +26,7 @@ integral (the same panels), not from finite differences.
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
@@ -126,7 +127,7 @@ class _Scales:
     """Dimensionless groups of Eq 6 at each velocity (see module docstring)."""
 
     log_t: np.ndarray  # ln T
-    a: float
+    a: np.ndarray  # FENE strength lambda M dl_m/kT (per point: batches may mix parameter sets)
     alpha: np.ndarray
     beta: np.ndarray  # -d(alpha)/d(ln V) / ... : alpha (1 + V/V_a)
     birth: np.ndarray  # tau V / dl_m = u0/T
@@ -143,20 +144,9 @@ def _scales(params: Parameters, velocity: np.ndarray, aging: bool) -> _Scales:
     else:
         alpha = np.zeros_like(velocity)
         beta = np.zeros_like(velocity)
-    return _Scales(log_t=log_t, a=float(a), alpha=alpha, beta=beta, birth=b.bond_time * velocity / b.max_extension)
-
-
-def _log_hazard(x: np.ndarray, y: np.ndarray, log_t: np.ndarray, a: float, alpha: np.ndarray) -> np.ndarray:
-    # y = 1 - x is carried separately so that the FENE term keeps full precision near x = 1
-    return log_t + a * x / (y * (1.0 + x)) - alpha * x
-
-
-def _log_hazard_slope(x: np.ndarray, y: np.ndarray, a: float, alpha: np.ndarray) -> np.ndarray:
-    return a * (1.0 + x * x) / (y * (1.0 + x)) ** 2 - alpha
-
-
-def _hazard(x: np.ndarray, y: np.ndarray, log_t: np.ndarray, a: float, alpha: np.ndarray) -> np.ndarray:
-    return np.exp(np.minimum(_log_hazard(x, y, log_t, a, alpha), _LOG_CAP))
+    return _Scales(
+        log_t=log_t, a=np.full_like(velocity, a), alpha=alpha, beta=beta, birth=b.bond_time * velocity / b.max_extension
+    )
 
 
 def _log_hazard_and_slope(x: np.ndarray, y: np.ndarray, s: _Scales) -> tuple[np.ndarray, np.ndarray]:
@@ -232,13 +222,13 @@ def _march(s: _Scales, q: QuadratureSettings, keep_nodes: bool = False) -> _Inte
     for _ in range(MAX_PANELS):
         if active.size == 0:
             return out
-        sub = _Scales(s.log_t[active], s.a, s.alpha[active], s.beta[active], s.birth[active])
+        sub = _Scales(s.log_t[active], s.a[active], s.alpha[active], s.beta[active], s.birth[active])
         xl, yl = x_left[active], y_left[active]
         w = _panel_width(xl, yl, sub, q)
         x = xl[:, None] + w[:, None] * t_half
         y = yl[:, None] - w[:, None] * t_half
         stretch = x / (y * (1.0 + x))  # x/(1-x^2), the FENE factor
-        log_h = sub.log_t[:, None] + s.a * stretch - sub.alpha[:, None] * x
+        log_h = sub.log_t[:, None] + sub.a[:, None] * stretch - sub.alpha[:, None] * x
         h = np.exp(np.minimum(log_h, _LOG_CAP))
         half = 0.5 * w
         # one product gives H and G = int x e^L at the nodes and over the whole panel
@@ -276,6 +266,19 @@ def _check_velocity(velocity: Any) -> np.ndarray:
     return v
 
 
+def _require_finite_stress(params: Parameters, which: str = "") -> None:
+    if params.bonds.activation_length == 0.0:
+        raise ModelError(
+            f"{which}bonds.activation_length = 0: bonds survive to full extension, where the FENE force (Eq 3) is"
+            " infinite, so the stress integral (Eq 8) diverges; use a positive activation length"
+        )
+
+
+def _stress_scale(params: Parameters) -> float:
+    b = params.bonds
+    return b.chain_stiffness * b.site_density * b.max_extension
+
+
 def steady_state(
     params: Parameters,
     velocity: Any,
@@ -295,17 +298,12 @@ def steady_state(
     of Eq 3 diverges, and the integral of Eq 8 diverges logarithmically.
     """
     v = _check_velocity(velocity)
-    if params.bonds.activation_length == 0.0:
-        raise ModelError(
-            "bonds.activation_length = 0: bonds survive to full extension, where the FENE force (Eq 3) is"
-            " infinite, so the stress integral (Eq 8) diverges; use a positive activation length"
-        )
+    _require_finite_stress(params)
     flat = np.ravel(v)
     s = _scales(params, flat, aging)
     got = _march(s, quadrature, keep_nodes=distribution)
     denom = s.birth + got.i
-    b = params.bonds
-    scale = b.chain_stiffness * b.site_density * b.max_extension
+    scale = _stress_scale(params)
     stress = scale * got.j / denom
     fraction = got.i / denom
     # d(sigma)/d(ln V), with d(birth)/d(ln V) = birth
@@ -313,6 +311,7 @@ def steady_state(
     slope = dstress / flat
     ages = densities = None
     if got.nodes is not None:
+        b = params.bonds
         max_age = b.max_extension / flat
         newborn = b.site_density / (max_age * denom)  # n(0) = N0/(tau + I), Eq 7
         ages = tuple(np.concatenate([p[0] for p in panels]) * max_age[k] for k, panels in enumerate(got.nodes))
@@ -328,3 +327,27 @@ def steady_state(
         ages=ages,
         densities=densities,
     )
+
+
+def steady_stress_many(
+    params_list: Sequence[Parameters],
+    velocity: Any,
+    aging: bool = True,
+    quadrature: QuadratureSettings = DEFAULT_QUADRATURE,
+) -> np.ndarray:
+    """sigma(V) (Eqs 6-8) for many parameter sets at once: shape (len(params_list), len(velocity)).
+
+    One quadrature march serves every (set, velocity) pair, so the per-call
+    cost is paid once: this is what fitting Jacobians and MCMC walkers need.
+    Same accuracy as :func:`steady_state`.
+    """
+    v = np.ravel(_check_velocity(velocity))
+    if len(params_list) == 0:
+        return np.empty((0, v.size))
+    for k, p in enumerate(params_list):
+        _require_finite_stress(p, f"parameter set {k}: ")
+    parts = [_scales(p, v, aging) for p in params_list]
+    joined = _Scales(*(np.concatenate([getattr(part, f.name) for part in parts]) for f in dataclasses.fields(_Scales)))
+    got = _march(joined, quadrature)
+    scale = np.repeat([_stress_scale(p) for p in params_list], v.size)
+    return (scale * got.j / (joined.birth + got.i)).reshape(len(params_list), v.size)
