@@ -166,22 +166,26 @@ def _panel_width(x: np.ndarray, y: np.ndarray, s: _Scales, q: QuadratureSettings
     widest allowed panel (q.widest_panel, and q.end_ratio * y towards x = 1).
     The hazard tests are done on logarithms: no exponential can overflow.
     """
-    log_resolved, log_negligible = np.log(q.hazard_step), np.log(q.negligible_hazard)
     widest = np.minimum(q.widest_panel, q.end_ratio * y)
     l_left, slope_left = _log_hazard_and_slope(x, y, s)
+    # the left end only caps w: below cap_resolved it is resolved there, below cap_negligible negligible
+    cap_negligible = q.negligible_hazard * np.exp(-np.maximum(l_left, -_LOG_CAP))
+    cap_resolved = np.minimum(
+        q.hazard_step * np.exp(-np.maximum(l_left, -_LOG_CAP)), q.log_hazard_step / np.maximum(slope_left, 1e-300)
+    )
+    log_resolved, log_negligible = np.log(q.hazard_step), np.log(q.negligible_hazard)
 
     def good(w: np.ndarray) -> np.ndarray:
         l_right, slope_right = _log_hazard_and_slope(x + w, y - w, s)
-        log_integral = np.maximum(l_left, l_right) + np.log(w)
-        resolved = (np.maximum(slope_left, slope_right) * w <= q.log_hazard_step) & (log_integral <= log_resolved)
-        return resolved | (log_integral <= log_negligible)
+        log_integral = l_right + np.log(w)
+        resolved = (w <= cap_resolved) & (slope_right * w <= q.log_hazard_step) & (log_integral <= log_resolved)
+        return resolved | ((w <= cap_negligible) & (log_integral <= log_negligible))
 
     ok = good(widest)
     if ok.all():
         return widest
-    # a width that is good for sure: capped by the left end, then once by the right end (see docstring)
-    low = np.minimum(widest, q.log_hazard_step / np.maximum(slope_left, 1e-300))
-    low = np.minimum(low, np.exp(np.minimum(log_resolved - l_left, 0.0)))
+    # a width that is good for sure: the left cap, then once capped by the right end (see docstring)
+    low = np.minimum(widest, cap_resolved)
     l_right, slope_right = _log_hazard_and_slope(x + low, y - low, s)
     low = np.minimum(low, q.log_hazard_step / np.maximum(slope_right, 1e-300))
     low = np.minimum(low, np.exp(np.minimum(log_resolved - l_right, 0.0)))
@@ -207,51 +211,56 @@ class _Integrals:
 def _march(s: _Scales, q: QuadratureSettings, keep_nodes: bool = False) -> _Integrals:
     """Integrate i, j and their ln V derivatives panel by panel from x = 0.
 
-    All velocities advance together; each finishes when its cumulative hazard
+    All points advance together; each finishes when its cumulative hazard
     passes ``hazard_cutoff`` (the survival is then below 2e-16) or x reaches 1.
+    The working arrays hold only the points still marching: finished ones are
+    written out and dropped, so a step costs what the remaining points cost.
     """
     rule = panel_rule(q.order)
     t_half = 0.5 * (rule.nodes + 1.0)  # node positions in [0, 1] of a panel
     integrate = rule.cumulative.T  # (K, K+1): right-multiply row vectors of samples
     weights = rule.weights
     n = s.log_t.size
+    out = _Integrals(np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n), [[] for _ in range(n)] if keep_nodes else None)
+    index = np.arange(n)  # original position of each marching point
+    sub = s
     x_left, y_left = np.zeros(n), np.ones(n)
     hazard, moment = np.zeros(n), np.zeros(n)  # H and G = int x e^L
-    out = _Integrals(np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n), [[] for _ in range(n)] if keep_nodes else None)
-    active = np.arange(n)
+    sums = np.zeros((4, n))  # i, j, -di, -dj
     for _ in range(MAX_PANELS):
-        if active.size == 0:
-            return out
-        sub = _Scales(s.log_t[active], s.a[active], s.alpha[active], s.beta[active], s.birth[active])
-        xl, yl = x_left[active], y_left[active]
-        w = _panel_width(xl, yl, sub, q)
-        x = xl[:, None] + w[:, None] * t_half
-        y = yl[:, None] - w[:, None] * t_half
+        w = _panel_width(x_left, y_left, sub, q)
+        x = x_left[:, None] + w[:, None] * t_half
+        y = y_left[:, None] - w[:, None] * t_half
         stretch = x / (y * (1.0 + x))  # x/(1-x^2), the FENE factor
         log_h = sub.log_t[:, None] + sub.a[:, None] * stretch - sub.alpha[:, None] * x
         h = np.exp(np.minimum(log_h, _LOG_CAP))
         half = 0.5 * w
         # one product gives H and G = int x e^L at the nodes and over the whole panel
         cumulative = (np.stack((h, x * h)) @ integrate) * half[:, None]
-        big_h = hazard[active][:, None] + cumulative[0, :, :-1]
-        big_g = moment[active][:, None] + cumulative[1, :, :-1]
+        big_h = hazard[:, None] + cumulative[0, :, :-1]
+        big_g = moment[:, None] + cumulative[1, :, :-1]
         survival = np.exp(-big_h)
         d_hazard = sub.beta[:, None] * big_g - big_h  # d H / d ln V
         weighted = survival * stretch
-        sums = (np.stack((survival, weighted, survival * d_hazard, weighted * d_hazard)) @ weights) * half
-        out.i[active] += sums[0]
-        out.j[active] += sums[1]
-        out.di[active] -= sums[2]
-        out.dj[active] -= sums[3]
+        sums += (np.stack((survival, weighted, survival * d_hazard, weighted * d_hazard)) @ weights) * half
         if out.nodes is not None:
-            for row, k in enumerate(active):
+            for row, k in enumerate(index):
                 out.nodes[k].append(np.stack([x[row], survival[row]]))
-        hazard[active] += cumulative[0, :, -1]
-        moment[active] += cumulative[1, :, -1]
-        x_left[active] = xl + w
-        y_left[active] = yl - w
-        done = (hazard[active] >= q.hazard_cutoff) | (y_left[active] <= SMALLEST_GAP)
-        active = active[~done]
+        hazard += cumulative[0, :, -1]
+        moment += cumulative[1, :, -1]
+        x_left += w
+        y_left -= w
+        done = (hazard >= q.hazard_cutoff) | (y_left <= SMALLEST_GAP)
+        if done.any():
+            finished = index[done]
+            out.i[finished], out.j[finished] = sums[0, done], sums[1, done]
+            out.di[finished], out.dj[finished] = -sums[2, done], -sums[3, done]
+            if done.all():
+                return out
+            keep = ~done
+            index, x_left, y_left, hazard, moment = index[keep], x_left[keep], y_left[keep], hazard[keep], moment[keep]
+            sums = sums[:, keep]
+            sub = _Scales(*(getattr(sub, f.name)[keep] for f in dataclasses.fields(_Scales)))
     raise ModelError(f"steady-state quadrature did not converge: more than {MAX_PANELS} panels needed")
 
 
