@@ -308,3 +308,23 @@ def test_age_distribution_obeys_eqs_6_and_7():
 def test_bad_velocity_is_a_parameter_error(bad):
     with pytest.raises(ParameterError, match="velocity"):
         steady_state(GEL, bad)
+
+
+def test_cliff_sharper_than_double_precision_is_a_step():
+    """Far outside the physical box (from a runaway naive fit): FENE and aging terms ~1e51 cancel at the cliff.
+
+    The cliff sits at 1 - x ~ a/(2 alpha) ~ 1e-51 and is narrower than one ulp there, so the survival is a
+    step; with T/alpha ~ 1e-45 its plateau is 1, and Eqs 6-7 give N/N0 = 1/(1 + u0/T) (to ~1e-40).
+    """
+    p = GEL.with_overrides(
+        {
+            "bonds.bond_time": 3.0088761528934844e41,
+            "bonds.activation_length": 8.542011288442298e-56,
+            "bonds.max_extension": 1.4257884827815274e39,
+        }
+    )
+    v = np.array([1e-9, 1e-7, 1e-5])
+    got = steady_state(p, v)
+    t_big = p.bonds.breakage_weight * p.bonds.max_extension / (v * p.bonds.bond_time)
+    assert np.allclose(got.bonded_fraction, 1 / (1 + p.bonds.breakage_weight / t_big), rtol=1e-12, atol=0)
+    assert np.all(np.isfinite(got.stress)) and np.all(got.stress > 0)

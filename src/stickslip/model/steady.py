@@ -248,9 +248,13 @@ def _march(s: _Scales, q: QuadratureSettings, keep_nodes: bool = False) -> _Inte
                 out.nodes[k].append(np.stack([x[row], survival[row]]))
         hazard += cumulative[0, :, -1]
         moment += cumulative[1, :, -1]
+        # a panel narrower than one ulp of x (left half) or of 1 - x (right half, where 1 - x carries
+        # the precision) means the survival falls to zero within
+        # that ulp (FENE and aging terms ~1e50 cancelling): a step, exact to the precision of x
+        stalled = np.where(x_left < 0.5, x_left + w == x_left, y_left - w == y_left)
         x_left += w
         y_left -= w
-        done = (hazard >= q.hazard_cutoff) | (y_left <= SMALLEST_GAP)
+        done = (hazard >= q.hazard_cutoff) | (y_left <= SMALLEST_GAP) | stalled
         if done.any():
             finished = index[done]
             out.i[finished], out.j[finished] = sums[0, done], sums[1, done]
