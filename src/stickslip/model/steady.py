@@ -275,7 +275,7 @@ def _check_velocity(velocity: Any) -> np.ndarray:
         raise ParameterError(f"velocity: expected numbers in m/s, got {velocity!r}") from None
     bad = ~np.isfinite(v) | (v <= 0)
     if np.any(bad):
-        raise ParameterError(f"velocity: expected positive finite values in m/s, got {v[bad].ravel()[0]!r}")
+        raise ParameterError(f"velocity: expected positive finite values in m/s, got {float(v[bad].ravel()[0])!r}")
     return v
 
 
