@@ -28,17 +28,9 @@ from stickslip.model.critical import critical_point
 from stickslip.model.cycle import simulate
 from stickslip.model.steady import steady_state
 from stickslip.parameters import load_parameters
+from timing import best_of
 
 V0 = 50e-6
-
-
-def best_of(func, repeat: int) -> tuple[float, object]:
-    best, out = math.inf, None
-    for _ in range(repeat):
-        start = time.perf_counter()
-        out = func()
-        best = min(best, time.perf_counter() - start)
-    return best, out
 
 
 def reference_cycle(params, sigma_c: float, v_c: float) -> tuple[float, float, float]:

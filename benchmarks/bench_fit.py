@@ -32,6 +32,7 @@ from stickslip.fitting.bayes import sample_posterior
 from stickslip.model.critical import critical_point
 from stickslip.model.steady import steady_state
 from stickslip.parameters import load_parameters, replace
+from timing import best_of
 
 TRUE = load_parameters("gelatin-glass")
 NAIVE_KEYS = (
@@ -49,15 +50,6 @@ def synthetic(points: int, seed: int, relative: float = 0.02) -> SteadyData:
     true = steady_state(TRUE, v).stress
     rng = np.random.default_rng(seed)
     return SteadyData.from_arrays(v, true * (1 + relative * rng.standard_normal(points)), relative * true)
-
-
-def best_of(func, repeat: int) -> tuple[float, object]:
-    best, out = math.inf, None
-    for _ in range(repeat):
-        start = time.perf_counter()
-        out = func()
-        best = min(best, time.perf_counter() - start)
-    return best, out
 
 
 def _sections(theta: np.ndarray) -> dict[str, dict[str, float]]:

@@ -1,0 +1,18 @@
+"""Timing helper shared by the benchmark scripts (run them as ``python benchmarks/<name>.py``)."""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable
+from typing import Any
+
+
+def best_of(func: Callable[[], Any], repeat: int) -> tuple[float, Any]:
+    """(fastest wall time in s over ``repeat`` calls, the last result)."""
+    best, out = math.inf, None
+    for _ in range(repeat):
+        start = time.perf_counter()
+        out = func()
+        best = min(best, time.perf_counter() - start)
+    return best, out
