@@ -200,3 +200,15 @@ def _mark_critical(ax: Axes, vc: float, sc: float, grid: np.ndarray, stress: np.
         ax.text(x / 2.0, 0.82, "velocity weakening\n(dσ/dV < 0)  ←", ha="right", **style)
     if np.count_nonzero(grid > vc) >= 2:
         ax.text(x * 1.5, 0.82, "→  velocity strengthening\n    (dσ/dV > 0)", ha="left", **style)
+
+
+def protocol_plot(protocol: Any, ax: Axes | None = None) -> Axes:
+    """The load-point velocity of a :class:`~stickslip.protocols.Protocol` against time (a staircase)."""
+    ax = new_axes(ax)
+    b = protocol.boundaries
+    v = np.append(protocol.velocities, protocol.velocities[-1]) * UM_PER_S
+    ax.step(b, v, where="post", color=AGING_COLOR)
+    ax.set_xlabel("time (s)")
+    ax.set_ylabel("load-point velocity (µm/s)")
+    ax.set_title(protocol.describe(), fontsize="small")
+    return apply_style(ax)

@@ -1,0 +1,258 @@
+"""Loading protocols as data: what the load point (puller) does, and when.
+
+A :class:`Protocol` is a sequence of :class:`Segment` s, each a constant
+load-point velocity held for a duration.  Every experiment friction researchers
+run on a rig is one of these: constant pulling, velocity steps, slide-hold-slide,
+arbitrary piecewise-constant histories, or a CSV of (time, velocity) change points.
+
+The protocol knows nothing of any model.  The quasi-static bond model, the
+time-dependent bond model and rate-and-state friction all read the same object:
+``protocol.pieces()`` for the intervals to integrate (a solver stops exactly at
+each change, never steps across one), ``velocity_at(t)`` and ``displacement_at(t)``
+for the load point's history.  Everything is SI (m/s, s).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .errors import DataError, ParameterError
+
+__all__ = [
+    "Protocol",
+    "Segment",
+    "constant",
+    "parse_segment",
+    "read_protocol",
+    "segments",
+    "slide_hold_slide",
+    "velocity_steps",
+]
+
+
+@dataclass(frozen=True)
+class Segment:
+    """The load point moves at ``velocity`` (m/s, >= 0) for ``duration`` (s, > 0)."""
+
+    velocity: float
+    duration: float
+
+    def __post_init__(self) -> None:
+        for name, value in (("velocity", self.velocity), ("duration", self.duration)):
+            if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
+                raise ParameterError(f"segment {name}: expected a number in SI units, got {value!r}")
+            if not math.isfinite(float(value)):
+                raise ParameterError(f"segment {name}: expected a finite number, got {value!r}")
+        if self.velocity < 0:
+            raise ParameterError(f"segment velocity: expected a value >= 0 m/s, got {self.velocity:g}")
+        if self.duration <= 0:
+            raise ParameterError(f"segment duration: expected a positive time, got {self.duration:g} s")
+        object.__setattr__(self, "velocity", float(self.velocity))
+        object.__setattr__(self, "duration", float(self.duration))
+
+
+@dataclass(frozen=True)
+class Protocol:
+    """A piecewise-constant load-point velocity history starting at t = 0."""
+
+    segments: tuple[Segment, ...]
+    name: str = "segments"
+
+    def __post_init__(self) -> None:
+        items = tuple(self.segments)
+        if not items:
+            raise ParameterError("protocol: expected at least one segment (velocity and duration)")
+        for item in items:
+            if not isinstance(item, Segment):
+                raise ParameterError(f"protocol: expected Segment items, got {type(item).__name__}")
+        object.__setattr__(self, "segments", items)
+
+    @property
+    def duration(self) -> float:
+        """Total length of the protocol (s)."""
+        return float(self.boundaries[-1])
+
+    @property
+    def boundaries(self) -> np.ndarray:
+        """Segment start times and the end time: ``[0, t1, ..., T]`` (length n + 1)."""
+        return np.concatenate([[0.0], np.cumsum([s.duration for s in self.segments])])
+
+    @property
+    def velocities(self) -> np.ndarray:
+        return np.array([s.velocity for s in self.segments])
+
+    @property
+    def change_times(self) -> np.ndarray:
+        """Interior times where the velocity changes (solvers must stop exactly there)."""
+        b = self.boundaries[1:-1]
+        v = self.velocities
+        return b[v[1:] != v[:-1]]
+
+    @property
+    def initial_velocity(self) -> float:
+        return self.segments[0].velocity
+
+    def pieces(self) -> Iterator[tuple[float, float, float]]:
+        """``(t_start, t_end, velocity)`` for each segment, in order."""
+        b = self.boundaries
+        for i, s in enumerate(self.segments):
+            yield float(b[i]), float(b[i + 1]), s.velocity
+
+    def velocity_at(self, t: Any) -> np.ndarray:
+        """Load-point velocity at times ``t`` (right-continuous; the last segment's beyond the end)."""
+        t = np.asarray(t, dtype=float)
+        index = np.clip(np.searchsorted(self.boundaries, t, side="right") - 1, 0, len(self.segments) - 1)
+        return self.velocities[index]
+
+    def displacement_at(self, t: Any) -> np.ndarray:
+        """Load-point displacement since t = 0 (m): the exact integral of the velocity."""
+        t = np.asarray(t, dtype=float)
+        b = self.boundaries
+        v = self.velocities
+        start_disp = np.concatenate([[0.0], np.cumsum(v * np.diff(b))])
+        index = np.clip(np.searchsorted(b, t, side="right") - 1, 0, len(v) - 1)
+        return start_disp[index] + v[index] * (t - b[index])
+
+    def to_frame(self) -> Any:
+        import pandas as pd
+
+        b = self.boundaries
+        return pd.DataFrame({"start": b[:-1], "end": b[1:], "velocity": self.velocities})
+
+    def describe(self) -> str:
+        """One line a person can read: ``100 um/s for 10 s, then 1000 um/s for 20 s``."""
+        parts = [f"{s.velocity * 1e6:g} um/s for {s.duration:g} s" for s in self.segments]
+        return ", then ".join(parts)
+
+    def plot(self, ax: Any = None) -> Any:
+        from .plotting import protocol_plot
+
+        return protocol_plot(self, ax=ax)
+
+
+def constant(velocity: float, duration: float) -> Protocol:
+    """Pulling at one velocity for ``duration``."""
+    return Protocol((Segment(velocity, duration),), name="constant")
+
+
+def segments(items: Sequence[tuple[float, float] | Segment]) -> Protocol:
+    """Piecewise-constant velocities from ``[(velocity, duration), ...]``."""
+    return Protocol(tuple(_as_segment(item) for item in items), name="segments")
+
+
+def velocity_steps(velocities: Sequence[float], durations: Sequence[float] | float) -> Protocol:
+    """Velocity steps: ``velocities[i]`` held for ``durations[i]`` (or one duration for all)."""
+    if isinstance(durations, (int, float)):
+        durations = [float(durations)] * len(velocities)
+    if len(durations) != len(velocities):
+        raise ParameterError(
+            f"velocity_steps: {len(velocities)} velocities but {len(durations)} durations; expected one duration each"
+        )
+    return Protocol(tuple(Segment(v, d) for v, d in zip(velocities, durations, strict=True)), name="velocity steps")
+
+
+def slide_hold_slide(
+    slide_velocity: float,
+    slide_time: float,
+    hold_time: float,
+    reslide_time: float | None = None,
+    hold_velocity: float = 0.0,
+) -> Protocol:
+    """Slide at ``slide_velocity``, hold (load point still, or at ``hold_velocity``), slide again."""
+    reslide = slide_time if reslide_time is None else reslide_time
+    return Protocol(
+        (Segment(slide_velocity, slide_time), Segment(hold_velocity, hold_time), Segment(slide_velocity, reslide)),
+        name="slide-hold-slide",
+    )
+
+
+def parse_segment(text: str, name: str = "--segment") -> Segment:
+    """``"100 um/s:10 s"`` (velocity, colon, duration; units optional, bare numbers SI) to a Segment."""
+    from .units import to_si
+
+    velocity_text, sep, duration_text = str(text).rpartition(":")
+    if not sep or not velocity_text.strip() or not duration_text.strip():
+        raise ParameterError(f"{name} {text!r}: expected VELOCITY:DURATION, e.g. '100 um/s:10 s'")
+    velocity = to_si(velocity_text.strip(), "velocity", f"{name} velocity")
+    duration = to_si(duration_text.strip(), "time", f"{name} duration")
+    try:
+        return Segment(velocity, duration)
+    except ParameterError as exc:
+        raise ParameterError(f"{name} {text!r}: {exc}") from None
+
+
+def read_protocol(path: str | Path) -> Protocol:
+    """A protocol from a CSV file.
+
+    Two layouts, told apart by the header (SI units, comma or tab separated):
+
+    * ``velocity,duration``: one segment per row;
+    * ``time,velocity``: change points.  ``velocity`` holds from that row's
+      ``time`` until the next row's; the last row marks the end of the protocol
+      (its velocity is not used).  Times must increase strictly; the first
+      row's time is taken as the start.
+    """
+    import pandas as pd
+
+    path = Path(path)
+    if not path.is_file():
+        raise DataError(f"{path}: protocol file not found (expected a CSV with columns time,velocity)")
+    try:
+        frame = pd.read_csv(path, sep=None, engine="python", comment="#", nrows=1_000_000)
+    except (ValueError, OSError, UnicodeDecodeError, pd.errors.ParserError) as exc:
+        raise DataError(f"{path}: cannot read as CSV ({str(exc).splitlines()[0]})") from None
+    columns = {str(c).strip().lower(): c for c in frame.columns}
+    if {"velocity", "duration"} <= set(columns):
+        pairs = _numeric_rows(frame, path, [columns["velocity"], columns["duration"]])
+        try:
+            return Protocol(tuple(_checked_segment(v, d, path, i) for i, (v, d) in enumerate(pairs)), name=path.name)
+        except ParameterError as exc:
+            raise DataError(str(exc)) from None
+    if {"time", "velocity"} <= set(columns):
+        rows = _numeric_rows(frame, path, [columns["time"], columns["velocity"]])
+        if len(rows) < 2:
+            raise DataError(f"{path}: expected at least two rows (a start and an end time), got {len(rows)}")
+        items = []
+        for i in range(len(rows) - 1):
+            (t0, v), (t1, _) = rows[i], rows[i + 1]
+            if not t1 > t0:
+                raise DataError(f"{path}: row {i + 3}: time {t1:g} s does not increase (previous {t0:g} s)")
+            items.append(_checked_segment(v, t1 - t0, path, i))
+        return Protocol(tuple(items), name=path.name)
+    found = ", ".join(str(c) for c in frame.columns) or "none"
+    raise DataError(f"{path}: expected columns time,velocity or velocity,duration (SI units); found {found}")
+
+
+def _numeric_rows(frame: Any, path: Path, cols: list[Any]) -> list[tuple[float, float]]:
+    import pandas as pd
+
+    data = frame[cols].apply(pd.to_numeric, errors="coerce").to_numpy(dtype=float)
+    bad = ~np.isfinite(data).all(axis=1)
+    if bad.any():
+        row = int(np.argmax(bad))
+        raw = frame.iloc[row][cols].tolist()
+        raise DataError(f"{path}: row {row + 2}: expected two finite numbers in SI units, got {raw}")
+    return [(float(a), float(b)) for a, b in data]
+
+
+def _checked_segment(velocity: float, duration: float, path: Path, index: int) -> Segment:
+    try:
+        return Segment(velocity, duration)
+    except ParameterError as exc:
+        raise DataError(f"{path}: row {index + 2}: {exc}") from None
+
+
+def _as_segment(item: tuple[float, float] | Segment) -> Segment:
+    if isinstance(item, Segment):
+        return item
+    try:
+        velocity, duration = item
+    except (TypeError, ValueError):
+        raise ParameterError(f"protocol: expected (velocity, duration) pairs, got {item!r}") from None
+    return Segment(velocity, duration)
