@@ -40,6 +40,8 @@ def reference_point(params, velocity: float, aging: bool = True) -> tuple[float,
         return log_t + a * x / (y * (1.0 + x)) - alpha * x
 
     def rates(x, y, hazard):
+        if y <= 0.0:  # past the FENE end (trial stages only): no survivors, no hazard to add
+            return 0.0, 0.0, 0.0
         survival = math.exp(min(-hazard, 300.0))  # trial stages of rejected steps may overshoot
         return math.exp(min(log_hazard(x, y), 300.0)), survival, survival * x / (y * (1.0 + x))
 
@@ -68,6 +70,8 @@ def reference_point(params, velocity: float, aging: bool = True) -> tuple[float,
         def rhs_h(h, state):
             p = state[0]
             x, y = (p, 1.0 - p) if position_is_x else (1.0 - p, p)
+            if y <= 0.0:  # a trial stage stepped past the FENE end, where e^-L and its products vanish
+                return [0.0, 0.0, 0.0]
             dpos = math.exp(min(-log_hazard(x, y), 300.0))
             survival = math.exp(-h)
             return [sign * dpos, survival * dpos, survival * x / (y * (1.0 + x)) * dpos]
