@@ -192,6 +192,7 @@ def stick_command(
     else:
         until = positive(until_text, "time", "--until")
     stick = stick_phase(params, v0, start_stress=start, aging=not no_aging, horizon=until)
+    jump = _jump_after(params, stick)
     columns = {"time": stick.time, "stress": stick.stress, "chain_fraction": stick.chain_fraction}
     if output is not None:
         write_text(output, _csv(columns, {"time": "s", "stress": "Pa"}))
@@ -203,15 +204,37 @@ def stick_command(
         ax.set_title(f"Attached chains, {params.name}: {stick.status}", fontsize=11)
         save_figure(ax.figure, plot_path)
     if as_json:
-        emit_json({**stick.as_dict(), "curve": columns})
+        extra = {"jump_velocity": jump.velocity, "jump_message": jump.message} if jump is not None else {}
+        emit_json({**stick.as_dict(), **extra, "curve": columns})
         return
-    print_rich(*_stick_report(stick, params.name))
+    print_rich(*_stick_report(stick, params.name, jump))
 
 
-def _stick_report(stick: Any, name: str) -> list[Any]:
+def _jump_after(params: Any, stick: Any) -> Any:
+    """The jump that would follow the collapse (Eq 8), as ``simulate`` takes it; None when the block did not slip."""
+    from ..errors import ModelError
+    from ..model.jump import jump_velocity
+
+    if stick.status != "slipped":
+        return None
+    try:
+        return jump_velocity(params, stick.peak_stress)
+    except ModelError:  # no critical point: the stick alone still has its answer
+        return None
+
+
+def _stick_report(stick: Any, name: str, jump: Any = None) -> list[Any]:
     from rich.table import Table
 
-    if stick.status == "slipped":
+    detail = stick.message
+    if stick.status == "slipped" and jump is not None and not jump.reachable:
+        # the same verdict as simulate's "undetermined": no velocity on the steady curve carries sigma_s
+        verdict = (
+            f"  UNDETERMINED after the stick: the chains collapse at ts = {stick.stick_time:.6g} s, σs ="
+            f" {stick.peak_stress:.6g} Pa, but no jump velocity exists ({jump.message})"
+        )
+        detail = "the model has no answer past this stick (simulate: regime undetermined)"
+    elif stick.status == "slipped":
         verdict = f"  the block slips after ts = {stick.stick_time:.6g} s at σs = {stick.peak_stress:.6g} Pa"
     elif stick.stuck:
         verdict = "  THE BLOCK STAYS STUCK: it never slips (no stick time)"
@@ -221,7 +244,7 @@ def _stick_report(stick: Any, name: str) -> list[Any]:
         f"Stick phase (Eq 15), {name}: V0 = {stick.pulling_velocity * 1e6:.6g} µm/s, from {stick.start_stress:.6g} Pa,"
         f" {'with' if stick.aging else 'without'} aging",
         verdict,
-        f"  {stick.message}",
+        f"  {detail}",
     ]
     table = Table(title="Nc/Nc0 against time", title_justify="left")
     for heading in ("t (s)", "σ (Pa)", "Nc/Nc0"):

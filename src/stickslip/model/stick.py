@@ -28,6 +28,12 @@ nothing overflows.  Whether the block stays stuck for ever is decided at
 checkpoints by an explicit bound on the remaining breakage
 (:func:`never_slips`); when neither the collapse nor the proof comes before a
 generous horizon the answer is "undetermined", never an invented number.
+
+Below a threshold pulling velocity (:func:`stuck_threshold`, 19.14 µm/s for
+``gelatin-glass`` from sigma_c) Eq 15 keeps the block stuck for ever: its
+aging term -t/tau_a grows without bound and outgrows the load.  That is a
+limitation of Eq 15, not a prediction: Baumberger et al. saw stick-slip of
+the same gel down to 10 µm/s (docs/stick-phase.md §5).
 """
 
 from __future__ import annotations
@@ -61,6 +67,13 @@ N_GONE = 1e-200
 SHORTEST_LOG_TIME = 690.0
 #: Samples of the output curve.
 SAMPLES = 400
+#: Said whenever Eq 15 keeps a pulled block stuck for ever (docs/stick-phase.md §5).
+STUCK_LIMITATION = (
+    "this is a limitation of Eq 15, whose aging term -t/tau_a grows without bound, not a prediction:"
+    " Baumberger et al. saw stick-slip of the same gel down to 10 um/s"
+)
+#: Relative width to which :func:`stuck_threshold` brackets the threshold velocity.
+THRESHOLD_RTOL = 1e-4
 #: Candidate floors, as fractions of the way from K V0 tau_a b/Nc0 to n, tried by the stuck proof.
 FLOOR_FRACTIONS = (0.5, 0.8, 0.9, 0.95, 0.99)
 
@@ -335,6 +348,8 @@ def stick_phase(
             f"the block stays stuck: aging wins and Nc/Nc0 provably stays above {floor[0]:.4g} for all time"
             f" (Eq 15; checked at t = {float(result.y_end[0]) * scale:.4g} s)"
         )
+        if v0 > 0.0:
+            message += f"; {STUCK_LIMITATION}"
     else:
         status, stuck, stick_time, peak = "undetermined", False, None, None
         message = (
@@ -357,4 +372,92 @@ def stick_phase(
         chain_floor=floor[0] if floor else None,
         parameters=params,
         _dense=(dense, scale),
+    )
+
+
+@dataclass(frozen=True)
+class StuckThreshold:
+    """The pulling velocity below which Eq 15 keeps the block stuck for ever (docs/stick-phase.md §5).
+
+    ``velocity`` is the midpoint of the bracket ``(lower, upper)``: at
+    ``lower`` the block provably never slips, at ``upper`` it slips.
+    ``ceiling`` = Nc0 kT/(lambda K tau_a) is the closed-form bound above
+    which no block stays stuck.  ``velocity`` is 0 when the block slips at
+    every V0 (no aging, or a start stress that breaks the chains unpulled),
+    and None when the bracket could not be decided (``message`` says why).
+    """
+
+    velocity: float | None
+    lower: float
+    upper: float
+    ceiling: float
+    start_stress: float
+    aging: bool
+    message: str
+
+    def as_dict(self) -> dict[str, object]:
+        return {
+            "velocity": self.velocity,
+            "lower": self.lower,
+            "upper": self.upper,
+            "ceiling": self.ceiling,
+            "start_stress": self.start_stress,
+            "aging": self.aging,
+            "message": self.message,
+        }
+
+
+def stuck_ceiling(params: Parameters) -> float:
+    """Nc0 kT/(lambda K tau_a), m/s: at and above it k tau_a >= 1 >= n, so every stick ends in a slip."""
+    return params.stick.attached_chains / (
+        params.bonds.force_sensitivity * params.block.effective_stiffness * params.stick.aging_time
+    )
+
+
+def stuck_threshold(
+    params: Parameters, start_stress: float | None = None, aging: bool = True, rtol: float = THRESHOLD_RTOL
+) -> StuckThreshold:
+    """The threshold V* of Eq 15: below it the block never slips, above it every stick ends (§5 of the note).
+
+    The stick phase is monotone in V0 (a faster puller breaks more chains at
+    every instant), and it ends in a slip exactly when Nc/Nc0 falls below
+    k tau_a = (lambda/kT) K V0 tau_a/Nc0, so V* is unique and lies below
+    :func:`stuck_ceiling`; it is bracketed by bisection on the proven outcome
+    of :func:`stick_phase`.  ``start_stress=None`` means sigma_c.
+    """
+    if start_stress is None:
+        cp = require_critical_point(params)
+        assert cp.stress is not None
+        sigma0 = float(cp.stress)
+    else:
+        sigma0 = check_stress(start_stress)
+    ceiling = stuck_ceiling(params)
+
+    def result(velocity: float | None, lower: float, upper: float, message: str) -> StuckThreshold:
+        return StuckThreshold(velocity, lower, upper, ceiling, sigma0, aging, message)
+
+    if not aging:
+        return result(0.0, 0.0, 0.0, "without the aging term of Eq 15 every stick ends in a slip")
+    unpulled = stick_phase(params, 0.0, sigma0)
+    if unpulled.status == "slipped":
+        return result(0.0, 0.0, 0.0, f"held at {sigma0:.6g} Pa the chains collapse even unpulled: {unpulled.message}")
+    if unpulled.status != "stuck":
+        return result(None, 0.0, ceiling, f"undecided at V0 = 0: {unpulled.message}")
+    lower, upper = 0.0, ceiling
+    while upper - lower > rtol * upper:
+        middle = 0.5 * (lower + upper)
+        status = stick_phase(params, middle, sigma0).status
+        if status == "undetermined":
+            return result(None, lower, upper, f"undecided at V0 = {middle:.6g} m/s (neither slip nor proof)")
+        if status == "stuck":
+            lower = middle
+        else:
+            upper = middle
+    velocity = 0.5 * (lower + upper)
+    return result(
+        velocity,
+        lower,
+        upper,
+        f"from {sigma0:.6g} Pa the block never slips below V0 = {velocity * 1e6:.5g} um/s (Eq 15 with"
+        f" tau_a = {params.stick.aging_time:g} s; every V0 above {ceiling * 1e6:.5g} um/s slips); {STUCK_LIMITATION}",
     )
