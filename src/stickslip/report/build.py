@@ -16,7 +16,7 @@ from typing import Any
 
 from ..errors import DataError
 from ..parameters import Parameters, load_parameters
-from .comparisons import TOLERANCE, Comparison, compare
+from .comparisons import TOLERANCE, Comparison, compare, count_classes
 from .computations import ModelRun, computed_values, run_steps
 from .errata import Errata, load_errata
 from .figures import Curve, save_figure_files
@@ -125,6 +125,9 @@ def build_report(
         errata=errata,
         files=["results.json", *names],
         analyses=run.trace_analyses,
+        thresholds=run.thresholds,
+        jump_floor=run.jump_floor,
+        curve_maximum=run.critical.turnover_stress if run.critical is not None else None,
     )
     _write_text(html_path, html)
     notify("Done", total, total)
@@ -161,9 +164,9 @@ def _results(
             "tolerance": TOLERANCE,
             "summary": {
                 "compared": len(comparisons),
-                "within_tolerance": len(comparisons) - len(flagged),
-                "beyond_tolerance": len(flagged),
-                "beyond_tolerance_with_errata": sum(c.errata is not None for c in flagged),
+                "by_class": count_classes(comparisons),
+                "flagged": len(flagged),
+                "flagged_with_errata": sum(c.errata is not None for c in flagged),
             },
             "comparisons": [c.as_dict() for c in comparisons],
             "model": run.summary(),

@@ -1,8 +1,20 @@
-"""The comparison table: each number the paper states beside the value computed here.
+"""The comparison table: each number the paper states beside the value computed here, and what the difference is.
 
-relative_difference = (computed - paper) / |paper|.  Where it exceeds
-:data:`TOLERANCE` the row names the erratum (docs/errata.md) that explains
-the difference.
+relative_difference = (computed - paper) / |paper| (None where the paper's
+unit has another dimension: "units differ").  Every row is put in one class
+(:data:`CLASSES`), decided in this order:
+
+1. **input**: the computed value is the paper's own input handed back (a
+   parameter, or arithmetic on the paper's numbers such as 0.766 or
+   slope/(0.766 V0)) and matches it.  An echo that does not match is a
+   **paper error**: the paper's unit or arithmetic is wrong.
+2. **agrees**: |relative difference| <= :data:`TOLERANCE`.
+3. **scatter**: a measurement whose computed value lies inside the band the
+   paper states ("259 ± 5 Pa", "0.4 kPa") or shows (the cycles at the same
+   V0 that it calls the same, widened by the tolerance).
+4. otherwise the row's declared explanation: **paper error** (an erratum
+   in errata.md says what is wrong in the paper) or **model limitation**
+   (the model cannot have it; the erratum says why).
 """
 
 from __future__ import annotations
@@ -11,18 +23,58 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
-from .paper import PAPER_NUMBERS, PaperNumber
+from .paper import PAPER_NUMBERS, TOLERANCE, PaperNumber
 
-#: Relative difference above which a row must be explained by an erratum.
-TOLERANCE = 0.02
+__all__ = ["CLASSES", "TOLERANCE", "Comparison", "Computed", "classify", "compare", "count_classes"]
+
+#: Class -> how the report names it, in the order the headline counts them.
+CLASSES = {
+    "input": "input (echo)",
+    "agrees": f"agrees (≤ {100 * TOLERANCE:g} %)",
+    "scatter": "within the paper's scatter",
+    "erratum": "paper error (erratum)",
+    "limitation": "model limitation",
+}
 
 
 @dataclass(frozen=True)
 class Computed:
-    """The model's counterpart of one paper number, and how it was obtained."""
+    """The model's counterpart of one paper number, and how it was obtained.
+
+    ``echo`` marks a value that is the paper's own input handed back (not a
+    prediction).  ``alternative`` is a second value shown beside it, e.g. the
+    model with the nominal stiffness where ``value`` uses the stiffness
+    measured in that Table 1 column; it is shown, not classified.
+    """
 
     value: float | None
     how: str
+    echo: bool = False
+    alternative: float | None = None
+    alternative_label: str = ""
+
+
+def classify(number: PaperNumber, computed: float | None, echo: bool) -> str:
+    """The class of one row (see the module docstring)."""
+    difference = relative_difference(number, computed)
+    close = difference is not None and abs(difference) <= TOLERANCE
+    if echo:
+        return "input" if close else "erratum"
+    if number.units_differ:
+        return "erratum"
+    if close:
+        return "agrees"
+    if computed is not None and number.scatter is not None:
+        low, high = number.scatter
+        if low <= computed <= high:
+            return "scatter"
+    return number.explanation
+
+
+def relative_difference(number: PaperNumber, computed: float | None) -> float | None:
+    if computed is None or number.units_differ:
+        return None
+    return (computed - number.paper) / abs(number.paper)
 
 
 @dataclass(frozen=True)
@@ -31,18 +83,26 @@ class Comparison:
     computed: float | None
     how: str
     errata: str | None
+    echo: bool = False
+    alternative: float | None = None
+    alternative_label: str = ""
 
     @property
     def relative_difference(self) -> float | None:
-        if self.computed is None:
-            return None
-        return (self.computed - self.number.paper) / abs(self.number.paper)
+        return relative_difference(self.number, self.computed)
+
+    @property
+    def alternative_difference(self) -> float | None:
+        return relative_difference(self.number, self.alternative)
+
+    @property
+    def classification(self) -> str:
+        return classify(self.number, self.computed, self.echo)
 
     @property
     def flagged(self) -> bool:
-        """True when the computed value differs from the paper's by more than the tolerance."""
-        rd = self.relative_difference
-        return rd is None or abs(rd) > TOLERANCE
+        """True when the row is neither an echoed input nor an agreement within the tolerance."""
+        return self.classification not in ("input", "agrees")
 
     def as_dict(self) -> dict[str, Any]:
         n = self.number
@@ -58,8 +118,19 @@ class Comparison:
             "computed": self.computed,
             "unit": n.unit,
             "relative_difference": self.relative_difference,
+            "class": self.classification,
             "how": self.how,
         }
+        if n.units_differ:
+            out["difference"] = "units differ"
+        if n.scatter is not None:
+            out["scatter"] = list(n.scatter)
+        if self.alternative is not None:
+            out["alternative"] = {
+                "value": self.alternative,
+                "label": self.alternative_label,
+                "relative_difference": self.alternative_difference,
+            }
         if n.note:
             out["note"] = n.note
         if self.errata is not None:
@@ -75,6 +146,18 @@ def compare(computed: dict[str, Computed], errata: dict[str, str]) -> list[Compa
     rows = []
     for n in PAPER_NUMBERS:
         c = computed[n.key]
-        value = c.value if c.value is None or math.isfinite(c.value) else None
-        rows.append(Comparison(n, value, c.how, errata.get(n.key)))
+        value = _finite(c.value)
+        rows.append(Comparison(n, value, c.how, errata.get(n.key), c.echo, _finite(c.alternative), c.alternative_label))
     return rows
+
+
+def count_classes(rows: list[Comparison] | tuple[Comparison, ...]) -> dict[str, int]:
+    """Rows per class, every class present (0 when none)."""
+    counts = dict.fromkeys(CLASSES, 0)
+    for row in rows:
+        counts[row.classification] += 1
+    return counts
+
+
+def _finite(value: float | None) -> float | None:
+    return value if value is None or math.isfinite(value) else None

@@ -21,14 +21,24 @@ from ..model.cycle import Simulation, simulate
 from ..model.jump import Jump, jump_velocity
 from ..model.slip import SlipPhase, slip_phase
 from ..model.steady import steady_state
-from ..model.stick import StickPhase, stick_phase
+from ..model.stick import StickPhase, StuckThreshold, stick_phase, stuck_threshold
 from ..parameters import Parameters
 from .comparisons import Computed
-from .paper import PULLING_VELOCITIES, TABLE1_COLUMNS, TABLE1_ROWS, TEXT_NUMBERS
+from .paper import (
+    PULLING_VELOCITIES,
+    TABLE1_COLUMNS,
+    TABLE1_FROM_REST,
+    TABLE1_ROWS,
+    TABLE1_SET_APART,
+    TEXT_NUMBERS,
+    table1_value,
+)
 
 #: Simulated time at each pulling velocity (µm/s -> s): the cycles of Table 1 (3 at 50, 4 at 100 µm/s) and,
-#: at 350 µm/s, the first stick and the slip that settles into steady sliding (Fig 5c).
+#: at 350 µm/s, the start-up stick from rest and the slip that settles into steady sliding (Fig 5c).
 DURATIONS = {50: 75.0, 100: 65.0, 350: 45.0}
+#: Pulling velocities (µm/s) whose run starts from rest, as the experiment did (Table 1 gives no sigma_c there).
+FROM_REST = {350}
 
 #: The paper's sigma_s for which it reads V_s off the steady curve (Table 1 and the text rows).
 _TABLE1_SLIP_STRESSES = {
@@ -41,6 +51,19 @@ _TEXT_SLIP_STRESSES = {
     "jump_velocity_100": next(n.paper for n in TEXT_NUMBERS if n.key == "slip_stress_100"),
 }
 
+Column = tuple[int, int]  # (V0 in um/s, cycle)
+
+
+@dataclass(frozen=True)
+class ColumnStick:
+    """The stick of one Table 1 column, at the stiffness its slope implies and at the nominal one."""
+
+    velocity: float  # m/s
+    start_stress: float  # Pa: the model's sigma_c, or 0 for a stick from rest
+    stiffness: float  # Pa/m, effective (with the Eq 17 factor): the column's slope / V0
+    measured: StickPhase  # with ``stiffness``
+    nominal: StickPhase  # with the parameter set's K = 0.766 Gd/h
+
 
 @dataclass
 class ModelRun:
@@ -49,7 +72,11 @@ class ModelRun:
     params: Parameters
     critical: CriticalPoint | None = None
     steady_350: float | None = None
-    sticks: dict[int, StickPhase] = field(default_factory=dict)  # by pulling velocity in um/s, from sigma_c
+    sticks: dict[int, StickPhase] = field(default_factory=dict)  # by V0 in um/s: the first stick of each run
+    columns: dict[Column, ColumnStick] = field(default_factory=dict)  # Table 1 column by column
+    mean_sticks: dict[int, StickPhase] = field(default_factory=dict)  # at the mean measured stiffness of a V0
+    thresholds: dict[str, StuckThreshold] = field(default_factory=dict)  # V* of Eq 15 from sigma_c and from rest
+    jump_floor: float | None = None  # lowest V0 whose sigma_s (from sigma_c) the steady curve still carries
     jumps: dict[float, Jump] = field(default_factory=dict)  # by stress: V_s on the aging curve (Eq 8)
     simulations: dict[int, Simulation] = field(default_factory=dict)  # by pulling velocity in um/s
     table1_first_slip_100: SlipPhase | None = None  # slip from Table 1's sigma_s = 658 Pa at 100 um/s (Fig 5d)
@@ -62,10 +89,37 @@ class ModelRun:
             "critical_point": c.as_dict() if c is not None else None,
             "steady_stress_350": self.steady_350,
             "stick_phases": {f"{v} um/s": s.as_dict() for v, s in self.sticks.items()},
+            "table1_sticks": {
+                f"{v} um/s cycle {k}": {
+                    "start_stress": col.start_stress,
+                    "measured_stiffness": col.stiffness,
+                    "measured": col.measured.as_dict(),
+                    "nominal_stiffness": self.params.block.effective_stiffness,
+                    "nominal": col.nominal.as_dict(),
+                }
+                for (v, k), col in self.columns.items()
+            },
+            "stuck_threshold": {name: t.as_dict() for name, t in self.thresholds.items()},
+            "lowest_velocity_with_a_jump": self.jump_floor,
             "jump_velocities": [j.as_dict() for j in self.jumps.values()],
             "simulations": {f"{v} um/s": s.summary() for v, s in self.simulations.items()},
             "table1_of_model_traces": {f"{v} um/s": a.summary for v, a in self.trace_analyses.items()},
         }
+
+
+def measured_stiffness(velocity: float, cycles: list[int] | None = None) -> float:
+    """Effective stiffness K (Pa/m, Eq 17 factor included) from Table 1's stick slopes: slope / V0, averaged
+    over ``cycles`` (default: the cycles at ``velocity`` the paper does not set apart)."""
+    if cycles is None:
+        cycles = [c for v, c in TABLE1_COLUMNS if v == velocity and (v, c) not in TABLE1_SET_APART]
+    slopes = [table1_value("stick_slope", velocity, c) for c in cycles]
+    return sum(s for s in slopes if s is not None) / len(slopes) / velocity
+
+
+def with_stiffness(params: Parameters, stiffness: float) -> Parameters:
+    """``params`` with the effective stiffness K (Pa/m) set through Gd (h and the trapezoid kept)."""
+    block = params.block
+    return params.with_overrides({"block.shear_modulus": stiffness / block.geometric_factor * block.height})
 
 
 def _steady(run: ModelRun) -> None:
@@ -75,7 +129,43 @@ def _steady(run: ModelRun) -> None:
 
 def _sticks(run: ModelRun) -> None:
     for velocity in PULLING_VELOCITIES:
-        run.sticks[_um(velocity)] = stick_phase(run.params, velocity)
+        start = 0.0 if _um(velocity) in FROM_REST else None
+        run.sticks[_um(velocity)] = stick_phase(run.params, velocity, start)
+    assert run.critical is not None and run.critical.stress is not None
+    for velocity, cycle in TABLE1_COLUMNS:
+        start = 0.0 if (velocity, cycle) in TABLE1_FROM_REST else float(run.critical.stress)
+        stiffness = measured_stiffness(velocity, [cycle])
+        run.columns[(_um(velocity), cycle)] = ColumnStick(
+            velocity,
+            start,
+            stiffness,
+            stick_phase(with_stiffness(run.params, stiffness), velocity, start),
+            stick_phase(run.params, velocity, start),
+        )
+    for velocity in (50e-6, 100e-6):
+        run.mean_sticks[_um(velocity)] = stick_phase(with_stiffness(run.params, measured_stiffness(velocity)), velocity)
+    run.thresholds["from sigma_c"] = stuck_threshold(run.params)
+    run.thresholds["from rest"] = stuck_threshold(run.params, start_stress=0.0)
+    run.jump_floor = _jump_floor(run)
+
+
+def _jump_floor(run: ModelRun) -> float | None:
+    """The V0 at which sigma_s (from sigma_c) equals the steady curve's maximum: below it no jump velocity exists."""
+    from scipy.optimize import brentq
+
+    c, threshold = run.critical, run.thresholds["from sigma_c"]
+    if c is None or c.turnover_stress is None or threshold.velocity is None:
+        return None
+    top = float(c.turnover_stress)
+
+    def excess(velocity: float) -> float:
+        peak = stick_phase(run.params, velocity).peak_stress
+        return float("inf") if peak is None else peak - top
+
+    low, high = threshold.upper, PULLING_VELOCITIES[0]
+    if not (excess(low) > 0.0 > excess(high)):
+        return None
+    return float(brentq(excess, low, high, xtol=1e-11))
 
 
 def _jumps(run: ModelRun) -> None:
@@ -94,7 +184,8 @@ def _simulation(velocity: int) -> Callable[[ModelRun], None]:
     si = next(v for v in PULLING_VELOCITIES if _um(v) == velocity)
 
     def action(run: ModelRun) -> None:
-        run.simulations[velocity] = simulate(run.params, si, DURATIONS[velocity])
+        start = 0.0 if velocity in FROM_REST else None
+        run.simulations[velocity] = simulate(run.params, si, DURATIONS[velocity], start_stress=start)
 
     return action
 
@@ -115,7 +206,7 @@ def run_steps() -> list[Step]:
     """The named steps that fill a :class:`ModelRun`, in order."""
     return [
         ("Steady friction curve and critical point (Eqs 6-9)", _steady),
-        ("Stick phases at 50, 100 and 350 µm/s (Eqs 11-16)", _sticks),
+        ("Stick phases of every Table 1 column and the stuck threshold (Eqs 11-16)", _sticks),
         ("Jump velocities and slip phases (Eqs 8, 10)", _jumps),
         *((f"Stick-slip cycles at {v} µm/s (Eqs 10-17)", _simulation(v)) for v in DURATIONS),
         ("Table 1 measured on the model's traces (trace analysis)", _analyses),
@@ -130,6 +221,13 @@ def _jump(run: ModelRun, stress: float | None) -> float | None:
     return run.jumps[stress].velocity if stress is not None else None
 
 
+NOMINAL = "nominal K = 0.766 × 400 kPa/m"
+
+
+def _echo(value: float, how: str = "parameter set") -> Computed:
+    return Computed(value, how, echo=True)
+
+
 def computed_values(run: ModelRun) -> dict[str, Computed]:
     """Paper key -> the value computed here (SI) and how."""
     p = run.params
@@ -137,36 +235,46 @@ def computed_values(run: ModelRun) -> dict[str, Computed]:
     assert c is not None and run.steady_350 is not None
     vc = c.velocity if c.exists else None
     sc = c.stress if c.exists else None
-    stick = run.sticks
     out: dict[str, Computed] = {
         "critical_velocity": Computed(vc, "minimum of the steady curve with aging, dσ/dV = 0 (Eq 9)"),
         "critical_stress": Computed(sc, "σ at Vc on the steady curve with aging (Eqs 8-9)"),
         "critical_stress_cycles": Computed(sc, "the model's σc: every stick begins at the minimum of the curve"),
         "steady_stress_350": Computed(run.steady_350, "steady curve with aging at V = 350 µm/s (Eqs 6-8)"),
-        "site_density": Computed(p.bonds.site_density, "parameter set"),
-        "bond_time": Computed(p.bonds.bond_time, "parameter set"),
-        "stretch_sensitivity": Computed(p.bonds.stretch_sensitivity, "λM/kT from λ, M and T of the parameter set"),
-        "max_extension": Computed(p.bonds.max_extension, "parameter set"),
-        "breakage_weight": Computed(p.bonds.breakage_weight, "parameter set"),
-        "aging_time": Computed(p.aging.aging_time, "parameter set"),
-        "aging_velocity": Computed(p.aging.aging_velocity, "parameter set"),
-        "shear_modulus": Computed(p.block.shear_modulus, "parameter set"),
-        "height": Computed(p.block.height, "parameter set"),
-        "stiffness_printed": Computed(p.block.stiffness, "Gd / h"),
-        "stiffness": Computed(p.block.stiffness, "Gd / h"),
-        "top_length": Computed(p.block.top_length, "parameter set"),
-        "base_length": Computed(p.block.base_length, "parameter set"),
-        "geometric_factor": Computed(p.block.geometric_factor, "ln(B/l)/(B/l − 1) with B and l of the parameter set"),
-        "attached_chains": Computed(p.stick.attached_chains, "parameter set"),
-        "break_rate": Computed(p.stick.break_rate, "parameter set"),
-        "stick_aging_time": Computed(p.stick.aging_time, "parameter set"),
+        "site_density": _echo(p.bonds.site_density),
+        "bond_time": _echo(p.bonds.bond_time),
+        "stretch_sensitivity": _echo(p.bonds.stretch_sensitivity, "λM/kT from λ, M and T of the parameter set"),
+        "max_extension": _echo(p.bonds.max_extension),
+        "breakage_weight": _echo(p.bonds.breakage_weight),
+        "aging_time": _echo(p.aging.aging_time),
+        "aging_velocity": _echo(p.aging.aging_velocity),
+        "shear_modulus": _echo(p.block.shear_modulus),
+        "height": _echo(p.block.height),
+        "stiffness_printed": _echo(p.block.stiffness, "Gd / h"),
+        "stiffness": _echo(p.block.stiffness, "Gd / h"),
+        "stiffness_against_table1": Computed(
+            _mean_table1_stiffness(p), "mean over Table 1's eight columns of slope / (0.766 V0) (Eq 17 with V = 0)"
+        ),
+        "top_length": _echo(p.block.top_length),
+        "base_length": _echo(p.block.base_length),
+        "geometric_factor": _echo(p.block.geometric_factor, "ln(B/l)/(B/l − 1) with B and l of the parameter set"),
+        "attached_chains": _echo(p.stick.attached_chains),
+        "break_rate": _echo(p.stick.break_rate),
+        "stick_aging_time": _echo(p.stick.aging_time),
     }
-    how_ts = "Eq 15 from σc until Nc = 0, with K = (Gd/h) ln(B/l)/(B/l − 1) (Eqs 12, 17)"
     for v0 in (50, 100):
-        ts = stick[v0].stick_time
-        for prefix in ("stick_time", "stick_time_measured", "stick_time_table"):
-            out[f"{prefix}_{v0}"] = Computed(ts, how_ts)
-        out[f"slip_stress_{v0}"] = Computed(stick[v0].peak_stress, "σs = σc + K V0 ts (Eq 16)")
+        nominal, measured = run.sticks[v0], run.mean_sticks[v0]
+        k = measured.stiffness / 1e3
+        simulated = "Eq 15 from σc until Nc = 0 with the paper's parameters, K = 0.766 × 400 kPa/m (Eqs 12, 17)"
+        out[f"stick_time_{v0}"] = Computed(nominal.stick_time, simulated)
+        with_k = f"with K = {k:.1f} kPa/m, the mean of Table 1's slopes at {v0} µm/s"
+        how = f"Eq 15 from σc {with_k}"
+        for prefix in ("stick_time_measured", "stick_time_table"):
+            out[f"{prefix}_{v0}"] = Computed(measured.stick_time, how, alternative=nominal.stick_time,
+                                             alternative_label=NOMINAL)  # fmt: skip
+        out[f"slip_stress_{v0}"] = Computed(
+            measured.peak_stress, f"σs = σc + K V0 ts (Eq 16) {with_k}", alternative=nominal.peak_stress,
+            alternative_label=NOMINAL,
+        )  # fmt: skip
     for key, stress in _TEXT_SLIP_STRESSES.items():
         out[key] = Computed(_jump(run, stress), f"steady curve with aging carries {stress:g} Pa (Eq 8, right branch)")
     for v0 in (50, 100, 350):
@@ -184,19 +292,38 @@ def computed_values(run: ModelRun) -> dict[str, Computed]:
     return out
 
 
+def _mean_table1_stiffness(params: Parameters) -> float:
+    ks = [measured_stiffness(v, [c]) / params.block.geometric_factor for v, c in TABLE1_COLUMNS]
+    return sum(ks) / len(ks)
+
+
 def _table1_value(run: ModelRun, key: str, velocity: float, cycle: int, sc: float | None) -> Computed:
     p = run.params
-    stick = run.sticks[_um(velocity)]
+    column = run.columns[(_um(velocity), cycle)]
+    k = column.stiffness / 1e3
+    start = "from rest" if column.start_stress == 0.0 else "from σc"
     if key == "critical_stress":
         return Computed(sc, "the model's σc (Eq 9)")
     if key == "stick_slope":
-        return Computed(p.block.effective_stiffness * velocity, "K V0 = (Gd/h) ln(B/l)/(B/l − 1) V0 (Eqs 12, 17)")
+        return Computed(
+            column.stiffness * velocity, f"the column's own slope: K = slope / V0 = {k:.1f} kPa/m is taken from it",
+            echo=True, alternative=p.block.effective_stiffness * velocity, alternative_label=f"{NOMINAL}: K V0",
+        )  # fmt: skip
     if key == "stiffness":
-        return Computed(p.block.stiffness, "Gd / h of the parameter set")
+        return Computed(
+            column.stiffness / p.block.geometric_factor, "slope / (0.766 V0): the paper's arithmetic redone (Eq 17)",
+            echo=True, alternative=p.block.stiffness, alternative_label="nominal Gd/h = 4 kPa / 10 mm",
+        )  # fmt: skip
     if key == "slip_stress":
-        return Computed(stick.peak_stress, "σs = σc + K V0 ts (Eqs 15-16), stick from σc")
+        return Computed(
+            column.measured.peak_stress, f"σs = σ0 + K V0 ts (Eqs 15-16), {start}, K = {k:.1f} kPa/m from the slope",
+            alternative=column.nominal.peak_stress, alternative_label=NOMINAL,
+        )  # fmt: skip
     if key == "stick_time":
-        return Computed(stick.stick_time, "Eq 15 from σc until Nc = 0")
+        return Computed(
+            column.measured.stick_time, f"Eq 15 {start} until Nc = 0, K = {k:.1f} kPa/m from the slope",
+            alternative=column.nominal.stick_time, alternative_label=NOMINAL,
+        )  # fmt: skip
     if key == "jump_velocity":
         stress = _TABLE1_SLIP_STRESSES[(velocity, cycle)]
         return Computed(_jump(run, stress), f"steady curve with aging carries this cycle's σs = {stress:g} Pa (Eq 8)")

@@ -63,3 +63,41 @@ def format_percent(fraction: float | None) -> str:
     if abs(percent) >= 10:
         return f"{percent:+.1f} %"
     return f"{percent:+.2f} %"
+
+
+#: Parameter dimension -> the unit a person writes, with SI prefixes chosen per value (see format_parameter).
+_PREFIXED_UNITS = {
+    "time": "s",
+    "length": "m",
+    "velocity": "m/s",
+    "stress": "Pa",
+    "stiffness": "N/m",
+    "stress_per_length": "Pa/m",
+}
+_PREFIXES = ((1e3, "k"), (1.0, ""), (1e-3, "m"), (1e-6, "µ"), (1e-9, "n"))
+#: Units written with a power of ten rather than a prefix.
+_PLAIN_UNITS = {"rate": "s⁻¹", "per_area": "m⁻²", "temperature": "K", "dimensionless": "", "force": "N"}
+
+
+def format_parameter(value: float, dimension: str, digits: int = 6) -> str:
+    """A parameter (SI) as a person writes it: ``format_parameter(0.000224, "time") == "224 µs"``.
+
+    Prefixed units pick the prefix that puts the number in [1, 1000); trailing zeros are dropped.
+    """
+    if not math.isfinite(value):
+        return format_number(value)
+    if dimension in _PREFIXED_UNITS and value != 0:
+        unit = _PREFIXED_UNITS[dimension]
+        scale, prefix = next(((s, p) for s, p in _PREFIXES if abs(value) >= s * (1 - 1e-12)), _PREFIXES[-1])
+        return f"{_trim(format_number(value / scale, digits))} {prefix}{unit}"
+    written = _PLAIN_UNITS.get(dimension, "")
+    text = _trim(format_number(value, digits))
+    return f"{text} {written}" if written else text
+
+
+def _trim(text: str) -> str:
+    """``"224.0"`` -> ``"224"``, ``"1.220 × 10¹⁴"`` -> ``"1.22 × 10¹⁴"``."""
+    mantissa, sep, rest = text.partition(" × ")
+    if "." in mantissa:
+        mantissa = mantissa.rstrip("0").rstrip(".")
+    return mantissa + sep + rest

@@ -9,12 +9,13 @@ from importlib import resources
 from string import Template
 
 from ..analysis import TraceAnalysis
+from ..model.stick import StuckThreshold
 from ..parameters import Parameters
-from .comparisons import TOLERANCE, Comparison
+from .comparisons import CLASSES, TOLERANCE, Comparison, count_classes
 from .errata import Errata
 from .figures import Curve, ReportFigure, data_uri
-from .formatting import format_percent, format_quantity
-from .paper import TABLE1_COLUMNS, TABLE1_ROWS
+from .formatting import DISPLAY_UNITS, format_parameter, format_percent, format_quantity
+from .paper import TABLE1_COLUMNS, TABLE1_ROWS, PaperNumber
 
 KIND_LABELS = {
     "model": "model result",
@@ -50,10 +51,47 @@ def figure_section(item: RenderedFigure) -> str:
     )
 
 
+def paper_text(n: PaperNumber) -> str:
+    """The paper's number as printed, with its unit (Table 1 prints the unit in the row heading only)."""
+    if n.source != "Table 1":
+        return n.printed
+    unit = DISPLAY_UNITS[n.display][1]
+    return f"{n.printed} {unit}" if unit else n.printed
+
+
+def difference_text(row: Comparison) -> str:
+    return "units differ" if row.number.units_differ else format_percent(row.relative_difference)
+
+
+def class_badge(row: Comparison) -> str:
+    c = row.classification
+    return f'<span class="class class-{c}">{escape(CLASSES[c])}</span>'
+
+
+def _errata_link(row: Comparison, errata: Errata) -> str:
+    if row.errata is None:
+        return ""
+    entry = errata.get(row.errata)
+    title = f' title="{escape(entry.title)}"' if entry is not None else ""
+    anchor = entry.anchor if entry is not None else row.errata.lower()
+    return f'<a href="#{escape(anchor)}"{title}>{escape(row.errata)}</a>'
+
+
+def _alternative(row: Comparison, display: str, digits: int = 4) -> str:
+    if row.alternative is None:
+        return ""
+    value = format_quantity(row.alternative, display, digits)
+    return (
+        f'<br><span class="alt">{escape(row.alternative_label)}: {escape(value)}'
+        f" ({escape(format_percent(row.alternative_difference))})</span>"
+    )
+
+
 def comparison_table(rows: Sequence[Comparison], errata: Errata) -> str:
     head = (
         '<table class="comparisons">\n<thead><tr><th>Quantity</th><th>Kind</th><th>Paper</th><th>Source</th>'
-        "<th>Computed</th><th>Difference</th><th>Erratum</th><th>Computed from</th></tr></thead>\n<tbody>"
+        "<th>Computed</th><th>Difference</th><th>Class</th><th>Erratum</th><th>Computed from</th></tr></thead>\n"
+        "<tbody>"
     )
     out = [head]
     group = None
@@ -61,23 +99,19 @@ def comparison_table(rows: Sequence[Comparison], errata: Errata) -> str:
         n = row.number
         if n.group != group:
             group = n.group
-            out.append(f'<tr class="group"><th colspan="8">{escape(group)}</th></tr>')
+            out.append(f'<tr class="group"><th colspan="9">{escape(group)}</th></tr>')
         css = "flagged" if row.flagged else "agrees"
-        link = ""
-        if row.errata is not None:
-            entry = errata.get(row.errata)
-            title = f' title="{escape(entry.title)}"' if entry is not None else ""
-            anchor = entry.anchor if entry is not None else row.errata.lower()
-            link = f'<a href="#{escape(anchor)}"{title}>{escape(row.errata)}</a>'
         out.append(
-            f'<tr id="cmp-{escape(n.key)}" class="{css}" data-key="{escape(n.key)}">'
+            f'<tr id="cmp-{escape(n.key)}" class="{css}" data-key="{escape(n.key)}"'
+            f' data-class="{escape(row.classification)}">'
             f"<td>{escape(n.quantity)}{_note(n.note)}</td>"
             f'<td><span class="badge">{escape(KIND_LABELS[n.kind])}</span></td>'
-            f'<td class="printed">{escape(n.printed)}</td>'
+            f'<td class="printed">{escape(paper_text(n))}</td>'
             f"<td>{escape(n.source)}</td>"
-            f'<td class="num">{escape(format_quantity(row.computed, n.display))}</td>'
-            f'<td class="num diff">{escape(format_percent(row.relative_difference))}</td>'
-            f"<td>{link}</td>"
+            f'<td class="num">{escape(format_quantity(row.computed, n.display))}{_alternative(row, n.display)}</td>'
+            f'<td class="num diff">{escape(difference_text(row))}</td>'
+            f"<td>{class_badge(row)}</td>"
+            f"<td>{_errata_link(row, errata)}</td>"
             f'<td class="how">{escape(row.how)}</td></tr>'
         )
     out.append("</tbody>\n</table>")
@@ -85,10 +119,11 @@ def comparison_table(rows: Sequence[Comparison], errata: Errata) -> str:
 
 
 def table1_matrix(rows: Sequence[Comparison]) -> str:
-    """Table 1 laid out as in the paper, each cell the paper's value over the model's, with the difference."""
+    """Table 1 laid out as in the paper: each cell the paper's value, the model's (at the column's measured
+    stiffness) with the difference and its class, and the model at the nominal stiffness."""
     by_key = {r.number.key: r for r in rows}
     head = "".join(f"<th>{round(v * 1e6)} µm/s<br>cycle {c}</th>" for v, c in TABLE1_COLUMNS)
-    out = [f'<table class="table1">\n<thead><tr><th></th>{head}</tr></thead>\n<tbody>']
+    out = [f'<div class="wide"><table class="table1">\n<thead><tr><th></th>{head}</tr></thead>\n<tbody>']
     for key, label, _unit, display, _values, _scale in TABLE1_ROWS:
         cells = []
         for velocity, cycle in TABLE1_COLUMNS:
@@ -97,13 +132,19 @@ def table1_matrix(rows: Sequence[Comparison]) -> str:
                 cells.append('<td class="num">--</td>')
                 continue
             css = "flagged" if row.flagged else "agrees"
+            nominal = ""
+            if row.alternative is not None:
+                nominal = (
+                    f'<br><span class="alt">nominal: {escape(format_quantity(row.alternative, display, digits=3))}'
+                    f" ({escape(format_percent(row.alternative_difference))})</span>"
+                )
             cells.append(
-                f'<td class="num {css}"><a href="#cmp-{escape(row.number.key)}">{escape(row.number.printed)}</a><br>'
-                f"{escape(format_quantity(row.computed, display, digits=3))}<br>"
-                f'<span class="diff">{escape(format_percent(row.relative_difference))}</span></td>'
+                f'<td class="num {css}"><a href="#cmp-{escape(row.number.key)}">{escape(paper_text(row.number))}</a>'
+                f"<br>{escape(format_quantity(row.computed, display, digits=3))}<br>"
+                f'<span class="diff">{escape(difference_text(row))}</span><br>{class_badge(row)}{nominal}</td>'
             )
         out.append(f"<tr><th>{escape(label)}</th>{''.join(cells)}</tr>")
-    out.append("</tbody>\n</table>")
+    out.append("</tbody>\n</table></div>")
     return "\n".join(out)
 
 
@@ -117,7 +158,10 @@ def trace_table(analyses: Mapping[int, TraceAnalysis]) -> str:
     At 100 µm/s the paper's mean leaves out cycle 1, which the paper sets apart (extra aging).
     """
     head = "".join(f"<th>{escape(label)}</th>" for _key, label, *_ in TABLE1_ROWS)
-    out = [f'<table class="traces">\n<thead><tr><th>V0</th><th></th>{head}<th>cycles</th></tr></thead>\n<tbody>']
+    out = [
+        f'<div class="wide"><table class="traces">\n<thead><tr><th>V0</th><th></th>{head}<th>cycles</th></tr></thead>'
+        "\n<tbody>"
+    ]
     for velocity_um, analysis in analyses.items():
         velocity = velocity_um * 1e-6
         columns = [
@@ -141,7 +185,7 @@ def trace_table(analyses: Mapping[int, TraceAnalysis]) -> str:
             first = f'<th rowspan="2">{velocity_um} µm/s</th>' if k == 0 else ""
             tds = "".join(f'<td class="num">{escape(c)}</td>' for c in cells)
             out.append(f"<tr>{first}<td>{escape(what)}</td>{tds}<td>{escape(count)}</td></tr>")
-    out.append("</tbody>\n</table>")
+    out.append("</tbody>\n</table></div>")
     return "\n".join(out)
 
 
@@ -151,13 +195,27 @@ def _note(text: str) -> str:
 
 def parameter_table(params: Parameters) -> str:
     out = ["<table>\n<thead><tr><th>Key</th><th>Symbol</th><th>Value</th><th>Meaning</th></tr></thead>\n<tbody>"]
-    for key, symbol, value, meaning in params.rows():
+    for key, symbol, value, dimension, meaning in parameter_rows(params):
         out.append(
             f"<tr><td><code>{escape(key)}</code></td><td>{escape(symbol)}</td>"
-            f'<td class="num">{escape(value)}</td><td>{escape(meaning)}</td></tr>'
+            f'<td class="num">{escape(format_parameter(value, dimension))}</td><td>{escape(meaning)}</td></tr>'
         )
     out.append("</tbody>\n</table>")
     return "\n".join(out)
+
+
+def parameter_rows(params: Parameters) -> list[tuple[str, str, float, str, str]]:
+    """(key, symbol, SI value, dimension, meaning) of every parameter."""
+    from dataclasses import fields
+
+    from ..parameters import SECTIONS
+
+    return [
+        (f"{s}.{f.name}", f.metadata["symbol"], getattr(getattr(params, s), f.name), f.metadata["dimension"],
+         f.metadata["doc"])
+        for s, cls in SECTIONS.items()
+        for f in fields(cls)
+    ]  # fmt: skip
 
 
 def file_list(names: Sequence[str]) -> str:
@@ -166,19 +224,58 @@ def file_list(names: Sequence[str]) -> str:
 
 
 def summary_sentence(rows: Sequence[Comparison]) -> str:
-    total = len(rows)
-    within = sum(not r.flagged for r in rows)
-    flagged = [r for r in rows if r.flagged]
-    explained = sum(r.errata is not None for r in flagged)
+    """The headline: how many rows fall in each class."""
+    counts = count_classes(list(rows))
     text = (
-        f"{total} numbers stated in the paper are compared with this package's computation: "
-        f"{within} agree within {100 * TOLERANCE:g} %"
+        f"{len(rows)} numbers stated in the paper are compared with this package's computation: "
+        f"{counts['input']} are the paper's own inputs handed back (parameters and arithmetic on them, not counted "
+        f"as agreement); {counts['agrees']} agree within {100 * TOLERANCE:g} %; {counts['scatter']} lie within the "
+        f"scatter the paper states or shows; {counts['erratum']} differ because of an error in the paper (each links "
+        f"its erratum); {counts['limitation']} are limitations of the model (each explained)."
     )
-    if flagged:
-        text += f"; {len(flagged)} differ by more, {explained} of them explained by an erratum."
-    else:
-        text += "."
     return escape(text)
+
+
+def stiffness_paragraph(rows: Sequence[Comparison]) -> str:
+    """How the report keeps the one stiffness fact from being counted in every slope, Gd/h and stick time."""
+    below = [-100 * d for r in rows if r.number.key.startswith("table1_stick_slope_") and
+             (d := r.alternative_difference) is not None]  # fmt: skip
+    span = f"{min(below):.0f}–{max(below):.0f} %" if below else "about 10 %"
+    return (
+        "<p><strong>Stiffness.</strong> The nominal stiffness 0.766 × 400 kPa/m gives stick slopes "
+        f"{span} below Table 1's: one fact, counted once (the row “Gd/h = 400 kPa/m compares well”). So that it "
+        "is not counted again in every slope, Gd/h and stick time, Table 1's σs and ts are computed with the "
+        "stiffness each column's own slope implies (K = slope / V0), and the model with the nominal stiffness is "
+        "shown beside (“nominal”). The start-up sticks (100 µm/s cycle 1, where σs − slope × ts = 21 Pa, and the "
+        "350 µm/s column, above Vc) start from rest, as the experiment did; every other stick starts at the "
+        "model's σc.</p>"
+    )
+
+
+def threshold_paragraph(
+    thresholds: Mapping[str, StuckThreshold], jump_floor: float | None = None, curve_maximum: float | None = None
+) -> str:
+    """The stuck-for-ever threshold of Eq 15, stated as the model limitation it is."""
+    rest, sigma_c = thresholds.get("from rest"), thresholds.get("from sigma_c")
+    if sigma_c is None or sigma_c.velocity is None:
+        return ""
+    v_star = sigma_c.velocity * 1e6
+    extra = f" ({rest.velocity * 1e6:.1f} µm/s for a stick from rest)" if rest and rest.velocity else ""
+    gap = ""
+    if jump_floor is not None and curve_maximum is not None:
+        gap = (
+            f" Between {v_star:.1f} and {jump_floor * 1e6:.1f} µm/s the chains collapse at a σs above the steady "
+            f"curve's maximum ({curve_maximum:.0f} Pa): no jump velocity exists and the model has no answer."
+        )
+    return (
+        f'<p class="limitation"><strong>Model limitation: stuck for ever below {v_star:.2f} µm/s.</strong> With '
+        "τa = 10 s the aging term −t/τa of Eq 15 grows without bound, so below this pulling velocity the breakage "
+        f"rate of the attached chains decays faster than the load raises it and the block never slips{escape(extra)};"
+        f" no block stays stuck above Nc0 kT/(λ K τa) = {sigma_c.ceiling * 1e6:.2f} µm/s.{escape(gap)} "
+        "Baumberger et al. drove the same gel from 10 µm/s to 2 mm/s and saw stick-slip below Vc, so this is a "
+        "limitation of Eq 15 that conflicts with experiment, not a prediction (errata: “Where stick–slip "
+        "happens”; <code>stickslip.model.stick.stuck_threshold</code>).</p>"
+    )
 
 
 def render_report(
@@ -192,6 +289,9 @@ def render_report(
     errata: Errata,
     files: Sequence[str],
     analyses: Mapping[int, TraceAnalysis],
+    thresholds: Mapping[str, StuckThreshold] | None = None,
+    jump_floor: float | None = None,
+    curve_maximum: float | None = None,
 ) -> str:
     contents = [
         f'<li><a href="#{escape(f.figure.id)}">{escape(f.figure.number)}: {escape(f.figure.title)}</a></li>'
@@ -212,6 +312,8 @@ def render_report(
         built=escape(built),
         elapsed=f"{elapsed:.1f}",
         summary=summary_sentence(comparisons),
+        limitation=threshold_paragraph(thresholds or {}, jump_floor, curve_maximum),
+        stiffness=stiffness_paragraph(comparisons),
         contents="\n".join(contents),
         figures="\n".join(figure_section(f) for f in figures),
         tolerance=f"{100 * TOLERANCE:g} %",

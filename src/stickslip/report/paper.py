@@ -10,7 +10,7 @@ model's value beside each of these.
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 #: Sliding velocities of the stick-slip experiments (Figs 5a-c), m/s.
 PULLING_VELOCITIES = (50e-6, 100e-6, 350e-6)
@@ -41,12 +41,27 @@ class PaperNumber:
     display: str  # unit the report shows (see stickslip.report.formatting.DISPLAY_UNITS)
     printed: str  # as printed in the paper
     source: str
-    paper_unit: str | None = None  # SI unit of the paper value when it differs from ``unit`` (a wrong printed unit)
+    paper_unit: str | None = None  # SI unit of the paper value, set only where the printed unit is wrong
     note: str = ""  # context a reader needs beside the number
+    scatter: tuple[float, float] | None = None  # SI band the paper states (or shows) for this measurement
+    explanation: str = "erratum"  # the class of a difference beyond tolerance and scatter: "erratum" or "limitation"
+
+    @property
+    def units_differ(self) -> bool:
+        """The paper prints this number with a wrong unit (an erratum): no relative difference is meaningful."""
+        return self.paper_unit is not None
 
 
-def _n(key, quantity, group, kind, paper, unit, display, printed, source, paper_unit=None, note="") -> PaperNumber:
-    return PaperNumber(key, quantity, group, kind, paper, unit, display, printed, source, paper_unit, note)
+def _n(
+    key, quantity, group, kind, paper, unit, display, printed, source, paper_unit=None, note="", scatter=None
+) -> PaperNumber:
+    return PaperNumber(key, quantity, group, kind, paper, unit, display, printed, source, paper_unit, note, scatter)
+
+
+#: "259 ± 5 Pa": the band the paper states for sigma_c over all cycles (Section 3, Table 1).
+CRITICAL_STRESS_BAND = (254.0, 264.0)
+#: "0.4 kPa" read off the 350 um/s trace: one significant figure.
+STEADY_350_BAND = (350.0, 450.0)
 
 
 STEADY = "Steady sliding (Figs 1 and 4, Eq 9)"
@@ -68,6 +83,7 @@ TEXT_NUMBERS: tuple[PaperNumber, ...] = (
         "Pa",
         "259 ± 5 Pa",
         "Section 3, from Table 1",
+        scatter=CRITICAL_STRESS_BAND,
     ),
     _n(
         "steady_stress_350",
@@ -79,6 +95,7 @@ TEXT_NUMBERS: tuple[PaperNumber, ...] = (
         "Pa",
         "0.4 kPa",
         "Section 3 (Fig 5c)",
+        scatter=STEADY_350_BAND,
     ),
     _n("site_density", "Site density N0", FIT, "parameter", 1.22e14, "1/m^2", "1/m^2", "1.22 × 10¹⁴ m⁻²", "Section 3"),
     _n("bond_time", "Make-break time τ", FIT, "parameter", 224e-6, "s", "us", "224 µs", "Section 3"),
@@ -110,6 +127,7 @@ TEXT_NUMBERS: tuple[PaperNumber, ...] = (
         "kPa/m",
         "400 Pa.m⁻¹",
         "Section 3",
+        paper_unit="Pa/m",  # printed Pa/m where 4 kPa / 10 mm is 400 kPa/m (E2)
     ),
     _n(
         "stiffness",
@@ -121,6 +139,18 @@ TEXT_NUMBERS: tuple[PaperNumber, ...] = (
         "kPa/m",
         "400 kPa.m⁻¹",
         "Section 3, after Table 1",
+    ),
+    _n(
+        "stiffness_against_table1",
+        "Gd/h = 400 kPa/m, “compares well” with Table 1's Gd/h (their mean)",
+        BLOCK,
+        "input",
+        400e3,
+        "Pa/m",
+        "kPa/m",
+        "400 kPa.m⁻¹",
+        "Section 3, after Table 1",
+        note="the one place where the nominal stiffness is compared with the measured slopes (E14)",
     ),
     _n("top_length", "Trapezoid length on the puller side B", BLOCK, "input", 50e-3, "m", "mm", "50 mm", "Eq 17"),
     _n("base_length", "Trapezoid length on the glass l", BLOCK, "input", 30e-3, "m", "mm", "30 mm", "Eq 17"),
@@ -307,10 +337,18 @@ TABLE1_COLUMNS: tuple[tuple[float, int], ...] = (
     (350e-6, 1),
 )
 
+#: Columns whose stick started from rest (the start-up stick of a run): 100 um/s cycle 1 (sigma_s - slope t_s =
+#: 658 - 35 x 18.2 = 21 Pa) and the one 350 um/s cycle (above Vc, Table 1 gives no sigma_c).  The model starts
+#: these sticks at zero stress; every other stick starts at the model's sigma_c.
+TABLE1_FROM_REST = frozenset({(100e-6, 1), (350e-6, 1)})
+#: The column the paper sets apart (extra aging before shearing began); it is left out of the scatter bands.
+TABLE1_SET_APART = frozenset({(100e-6, 1)})
+
 #: Context for Table 1 columns that the model is not meant to reproduce cycle by cycle.
 TABLE1_NOTES = {
-    (100e-6, 1): "first cycle: the paper attributes its higher σs to extra aging before shearing began",
-    (350e-6, 1): "above Vc: one start-up stick from rest, then steady sliding (the model's stick starts at σc)",
+    (100e-6, 1): "first cycle, a stick from rest (σs − slope·ts = 21 Pa); the paper puts its higher σs down to"
+    " extra aging before shearing began, which the model does not have",
+    (350e-6, 1): "above Vc: one start-up stick from rest, then steady sliding; the column is inconsistent in itself",
 }
 
 #: Table 1 rows: key, label, SI unit, display unit, values as printed (None for "--"), SI value of one printed unit.
@@ -337,6 +375,47 @@ TABLE1_ROWS: tuple[tuple[str, str, str, str, tuple[str | None, ...], float], ...
     ("jump_velocity", "Vs", "m/s", "um/s", ("702", "702", "720", "1026", "702", "702", "702", "760"), 1e-6),
 )
 
+#: What each Table 1 row is: measured on the stress records, or computed by the paper (Gd/h from the slope by
+#: Eq 17, Vs read off its steady curve by Eq 8).
+TABLE1_KINDS = {
+    "critical_stress": "measured",
+    "stick_slope": "measured",
+    "stiffness": "model",
+    "slip_stress": "measured",
+    "stick_time": "measured",
+    "jump_velocity": "model",
+}
+
+#: Relative difference up to which a computed value agrees with the paper's; also the margin of the scatter bands.
+TOLERANCE = 0.02
+
+#: (Table 1 row, (V0 um/s, cycle)) -> the class of a difference beyond tolerance and scatter, where it is not a
+#: paper error: the start-up sticks lack the aging before shearing began (the paper's own explanation of 658 Pa).
+TABLE1_LIMITATIONS = {("slip_stress", (100, 1)), ("stick_time", (100, 1)), ("slip_stress", (350, 1))}
+
+
+def table1_value(key: str, velocity: float, cycle: int) -> float | None:
+    """A Table 1 entry in SI units, as printed (None for "--")."""
+    _key, _label, _unit, _display, values, scale = next(r for r in TABLE1_ROWS if r[0] == key)
+    value = values[TABLE1_COLUMNS.index((velocity, cycle))]
+    return None if value is None else float(value) * scale
+
+
+def scatter_band(key: str, velocity: float) -> tuple[float, float] | None:
+    """The measurements of ``key`` at ``velocity`` that the paper calls the same, from lowest to highest,
+    widened by the tolerance: a value inside is within the cycle-to-cycle scatter.  sigma_c has the paper's own
+    259 ± 5 Pa.  None when fewer than two cycles are alike."""
+    if key == "critical_stress":
+        return CRITICAL_STRESS_BAND
+    values = [
+        v
+        for column in TABLE1_COLUMNS
+        if column[0] == velocity and column not in TABLE1_SET_APART and (v := table1_value(key, *column)) is not None
+    ]
+    if len(values) < 2:
+        return None
+    return min(values) * (1.0 - TOLERANCE), max(values) * (1.0 + TOLERANCE)
+
 
 def _table1_numbers() -> tuple[PaperNumber, ...]:
     out = []
@@ -345,18 +424,24 @@ def _table1_numbers() -> tuple[PaperNumber, ...]:
             if value is None:
                 continue
             v_um = round(velocity * 1e6)
+            kind = TABLE1_KINDS[key]
+            scatter = None
+            if kind == "measured" and (velocity, cycle) not in TABLE1_SET_APART:
+                scatter = scatter_band(key, velocity)
             out.append(
                 PaperNumber(
                     key=f"table1_{key}_{v_um}_{cycle}",
                     quantity=f"{label}, V0 = {v_um} µm/s, cycle {cycle}",
                     group=TABLE1,
-                    kind="measured",
+                    kind=kind,
                     paper=float(value) * scale,
                     unit=unit,
                     display=display,
                     printed=value,
                     source="Table 1",
                     note=TABLE1_NOTES.get((velocity, cycle), ""),
+                    scatter=scatter,
+                    explanation="limitation" if (key, (v_um, cycle)) in TABLE1_LIMITATIONS else "erratum",
                 )
             )
     return tuple(out)
@@ -364,8 +449,20 @@ def _table1_numbers() -> tuple[PaperNumber, ...]:
 
 TABLE1_NUMBERS = _table1_numbers()
 
+#: Measurements quoted in the text -> the Table 1 cycles they summarise (18.9 s is left out: a misprint, E9).
+TEXT_SCATTER = {
+    "stick_time_measured_50": ("stick_time", 50e-6),
+    "stick_time_measured_100": ("stick_time", 100e-6),
+    "stick_time_table_100": ("stick_time", 100e-6),
+    "slip_stress_50": ("slip_stress", 50e-6),
+    "slip_stress_100": ("slip_stress", 100e-6),
+}
+
 #: Every number the paper states, in report order.
-PAPER_NUMBERS: tuple[PaperNumber, ...] = TEXT_NUMBERS + TABLE1_NUMBERS
+PAPER_NUMBERS: tuple[PaperNumber, ...] = (
+    tuple(replace(n, scatter=scatter_band(*TEXT_SCATTER[n.key])) if n.key in TEXT_SCATTER else n for n in TEXT_NUMBERS)
+    + TABLE1_NUMBERS
+)
 
 
 def _topics_for(number: PaperNumber) -> tuple[str, ...]:
@@ -399,6 +496,7 @@ TEXT_ERRATA: dict[str, tuple[str, ...]] = {
     "aging_velocity": (r"V_a ≪ 800 µm/s",),
     "stiffness_printed": (r"400 Pa\.m⁻¹",),
     "stiffness": (r"400 Pa\.m⁻¹",),
+    "stiffness_against_table1": (r"^Table 1's G_d/h row",),
     "geometric_factor": (r"Substitution of these lengths",),
     "stick_aging_time": (r"^Notation: τ_A, V_A",),
     "stick_time_50": STICK_TIMES,

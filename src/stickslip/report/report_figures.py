@@ -8,11 +8,15 @@ adds the paper's own numbers where they can be set beside the model.
 from __future__ import annotations
 
 from collections.abc import Callable
+from typing import TYPE_CHECKING
 
 from .computations import ModelRun
 from .figures import ReportFigure
 from .formatting import format_quantity
 from .paper import DATA_RANGE
+
+if TYPE_CHECKING:  # pragma: no cover
+    from matplotlib.figure import Figure
 
 UM = 1e6
 PAPER_COLOR = "#e67e22"
@@ -25,7 +29,11 @@ def steady_figure(run: ModelRun) -> ReportFigure:
     ax = fig.axes[0]
     lo, hi = DATA_RANGE
     ax.axvspan(lo * UM, hi * UM, color="#8aa6d6", alpha=0.15, zorder=0, label="range of the steady data (Fig 4)")
-    ax.plot([125.0], [259.0], "D", color=PAPER_COLOR, markersize=6, zorder=8, label="paper: Vc = 125 µm/s, σc = 259 Pa")
+    # an open diamond, drawn under the computed critical point, so that both stay visible (they nearly coincide)
+    ax.plot(
+        [125.0], [259.0], "D", markerfacecolor="none", markeredgecolor=PAPER_COLOR, markeredgewidth=1.6,
+        markersize=11, zorder=4, label="paper: Vc = 125 µm/s, σc = 259 Pa",
+    )  # fmt: skip
     ax.plot([350.0], [400.0], "s", color=PAPER_COLOR, markersize=6, zorder=8, label="measured: 0.4 kPa at 350 µm/s")
     ax.legend(loc="lower right", frameon=False, fontsize=8)
     c = run.critical
@@ -34,7 +42,8 @@ def steady_figure(run: ModelRun) -> ReportFigure:
         "Friction stress against sliding velocity at steady sliding (Eqs 6-8), with the aging term of Eq 6 "
         "(solid) and without it (dotted). The aging curve has its minimum at the critical point "
         f"Vc = {c.velocity * UM:.1f} µm/s, σc = {c.stress:.1f} Pa (Eq 9; the paper's 125 µm/s, 259 Pa are the "
-        "orange diamond); left of it the friction is velocity weakening and steady sliding is unstable, and "
+        "open orange diamond around the computed point); left of it the friction is velocity weakening and "
+        "steady sliding is unstable, and "
         "the curve rises steeply as the paper notes. Without aging there is no minimum, only the turnover "
         f"at {c.turnover_velocity * UM / 1e3:.2f} mm/s. The shaded band is the velocity range of the "
         "steady-sliding data of Baumberger et al. (140-2000 µm/s) that the parameters were fitted to; below "
@@ -88,18 +97,33 @@ def cycles_figure(run: ModelRun) -> ReportFigure:
 
     sims = [run.simulations[v] for v in (50, 100, 350)]
     fig = figure_cycles(sims, title="Stick-slip cycles (Fig 5a-c)")
+    _label_critical_stress_and_clear_peaks(fig, sims[0].critical_stress)
     s50, s100, s350 = sims
+    first = s350.cycles[0]
     caption = (
-        "Shear stress against time at V0 = 50, 100 and 350 µm/s (Eqs 10-17), starting from a stick at σc "
-        "(dashed line). Stick phases rise linearly (Eq 12) and end at σs (Eq 16); slip phases follow the "
-        f"steady curve down to σc. At 50 µm/s the period is {s50.cycles[0].period:.1f} s "
+        "Shear stress against time at V0 = 50, 100 and 350 µm/s (Eqs 10-17). At 50 and 100 µm/s the run starts "
+        "with a stick at σc (dashed line); stick phases rise linearly (Eq 12) and end at σs (Eq 16); slip phases "
+        f"follow the steady curve down to σc. At 50 µm/s the period is {s50.cycles[0].period:.1f} s "
         f"(stick {s50.cycles[0].stick_time:.1f} s); at 100 µm/s {s100.cycles[0].period:.1f} s "
-        f"(stick {s100.cycles[0].stick_time:.2f} s). At 350 µm/s, above Vc, one stick is followed by a slip "
+        f"(stick {s100.cycles[0].stick_time:.2f} s). At 350 µm/s, above Vc, the run starts from rest as the "
+        f"experiment did (Table 1 gives no σc there): one start-up stick of {first.stick_time:.2f} s to "
+        f"σs = {first.peak_stress:.1f} Pa, a jump to {first.jump_velocity * UM:.0f} µm/s, and a slip "
         f"that settles at the steady stress {s350.final_stress:.1f} Pa (the paper's 0.4 kPa). The measured "
         "traces of Baumberger et al. that the paper plots as points are not distributed with the package; "
         "their characteristics (Table 1) are compared with the model in the table below."
     )
     return ReportFigure("fig5a-c_cycles", "Fig 5a-c", "Stress during stick-slip at 50, 100 and 350 µm/s", caption, fig)
+
+
+def _label_critical_stress_and_clear_peaks(fig: Figure, critical_stress: float) -> None:
+    """Name the dashed σc line in the legend, and leave room above the peaks so the legend covers no data."""
+    for index, ax in enumerate(fig.axes):
+        for line in ax.get_lines():
+            if line.get_linestyle() == "--":
+                line.set_label(f"σc = {critical_stress:.1f} Pa" if index == 0 else "_σc")
+        low, high = ax.get_ylim()
+        ax.set_ylim(low, high + 0.25 * (high - low))
+    fig.axes[0].legend(loc="upper right", frameon=False, fontsize=8, ncols=4)
 
 
 def slip_velocity_figure(run: ModelRun) -> ReportFigure:
