@@ -22,7 +22,7 @@ from scipy.special import exp1
 
 import stickslip.model.stick as stick_module
 from stickslip.errors import ParameterError
-from stickslip.model.stick import never_slips, stick_phase
+from stickslip.model.stick import never_slips, stick_phase, stuck_threshold
 from stickslip.parameters import load_parameters
 
 
@@ -257,3 +257,70 @@ def test_overwhelming_load_collapses_at_once(params):
     stick = stick_phase(few, 50e-6, start_stress=1e4)
     assert stick.status == "slipped" and 0.0 <= stick.stick_time < 1e-250
     assert np.all(np.isfinite(stick.time)) and stick.peak_stress == pytest.approx(1e4, rel=1e-12)
+
+
+# --- the stuck-for-ever threshold V* (docs/stick-phase.md §5) -------------------------------------------
+
+
+def _time_domain_outcome(params, v0, sigma0, t_end):
+    """DOP853 on y = ln n in time, independent of the theta parametrisation: the time n drops below k tau_a
+    (None if it never does before t_end), and (t, n) at the end."""
+    b, nc0 = params.bonds.force_sensitivity, params.stick.attached_chains
+    r, tau_a = params.stick.break_rate, params.stick.aging_time
+    k = b * params.block.effective_stiffness * v0 / nc0
+
+    def rate(t, y):
+        return [-r * np.exp((b * sigma0 / nc0 + k * t) / np.exp(y[0]) - t / tau_a)]
+
+    def below(t, y):
+        return y[0] - math.log(k * tau_a)
+
+    below.terminal, below.direction = True, -1
+    sol = solve_ivp(rate, (0.0, t_end), [0.0], method="DOP853", rtol=1e-11, atol=1e-13, events=below)
+    crossed = float(sol.t_events[0][0]) if sol.t_events[0].size else None
+    return crossed, float(sol.t[-1]), math.exp(float(sol.y[0, -1])), k
+
+
+def test_stuck_threshold_brackets_the_time_domain_outcome(params, sigma_c):
+    """Just above V* the chains fall below k tau_a (then they must collapse, §5); just below they stay above it
+    and a bound on all the breakage still to come (the §4 argument, redone here) keeps them there for ever."""
+    threshold = stuck_threshold(params)
+    assert threshold.lower < threshold.velocity < threshold.upper
+    assert threshold.upper - threshold.lower <= 2e-4 * threshold.upper
+    crossed, *_ = _time_domain_outcome(params, 1.01 * threshold.velocity, sigma_c, 5000.0)
+    assert crossed is not None
+    crossed, t_end, n_end, k = _time_domain_outcome(params, 0.99 * threshold.velocity, sigma_c, 3000.0)
+    assert crossed is None
+    tau_a, r, s0 = params.stick.aging_time, params.stick.break_rate, params.bonds.force_sensitivity * sigma_c
+    s0 /= params.stick.attached_chains
+    floor = 0.5 * (n_end + k * tau_a)
+    c = k / floor - 1.0 / tau_a
+    assert c < 0.0
+    remaining = r * math.exp(c * t_end + s0 / floor) / -c
+    assert n_end * math.exp(-remaining) > floor
+
+
+def test_stuck_threshold_lies_below_the_closed_form_ceiling_and_scales_with_the_aging_time(params):
+    """V* < Nc0 kT/(lambda K tau_a) (at k tau_a >= 1 > n nothing can stay stuck); and with t/tau_a as the time,
+    V* K tau_a depends on r tau_a and s0 only, so doubling tau_a while halving r halves V*."""
+    threshold = stuck_threshold(params)
+    ceiling = params.stick.attached_chains / (
+        params.bonds.force_sensitivity * params.block.effective_stiffness * params.stick.aging_time
+    )
+    assert threshold.ceiling == pytest.approx(ceiling, rel=1e-12)
+    assert 0.5 * ceiling < threshold.velocity < ceiling
+    slower = params.with_overrides(
+        {"stick.aging_time": 2 * params.stick.aging_time, "stick.break_rate": params.stick.break_rate / 2}
+    )
+    assert stuck_threshold(slower).velocity == pytest.approx(threshold.velocity / 2, rel=3e-4)
+    assert "limitation of Eq 15" in threshold.message
+
+
+def test_stuck_threshold_without_aging_or_with_an_overwhelming_load_is_zero(params):
+    assert stuck_threshold(params, aging=False).velocity == 0.0
+    # held at 2 kPa the chains collapse unpulled (E1(s0) < r tau_a): every V0 slips
+    assert stuck_threshold(params, start_stress=2000.0).velocity == 0.0
+
+
+def test_stuck_message_names_the_limitation(params):
+    assert "limitation of Eq 15" in stick_phase(params, 10e-6).message

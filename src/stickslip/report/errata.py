@@ -1,10 +1,9 @@
-"""The errata (docs/errata.md), rendered into the report so that its links work offline.
+"""The errata (``stickslip/report/errata.md``), rendered into the report so that its links work offline.
 
 Entries are level-2 headings ``## E<n> title``; each becomes an element with
 ``id="e<n>"`` so that the comparison table can link ``#e<n>``.  The text is
-package data (``stickslip/report/errata.md``, a copy of ``docs/errata.md``)
-so that an installed wheel renders it; in a source checkout without the copy
-``docs/errata.md`` is read instead.
+package data, the one source of the errata (docs/errata.md only points to
+it), so that an installed wheel renders it.
 """
 
 from __future__ import annotations
@@ -13,7 +12,6 @@ import re
 from dataclasses import dataclass
 from html import escape
 from importlib import resources
-from pathlib import Path
 
 from ..errors import DataError
 
@@ -43,14 +41,11 @@ class Errata:
 
 
 def errata_text() -> tuple[str, str]:
-    """(markdown text, where it came from).  Raises DataError when no copy can be found."""
+    """(markdown text, where it came from).  Raises DataError when the package data is missing."""
     packaged = resources.files("stickslip") / "report" / "errata.md"
-    if packaged.is_file():
-        return packaged.read_text(encoding="utf-8"), "stickslip/report/errata.md"
-    checkout = Path(__file__).resolve().parents[3] / "docs" / "errata.md"
-    if checkout.is_file():
-        return checkout.read_text(encoding="utf-8"), "docs/errata.md"
-    raise DataError("errata not found: expected package data stickslip/report/errata.md (a copy of docs/errata.md)")
+    if not packaged.is_file():
+        raise DataError("errata not found: expected package data stickslip/report/errata.md (reinstall stickslip)")
+    return packaged.read_text(encoding="utf-8"), "stickslip/report/errata.md"
 
 
 def render_errata(text: str, source: str = "errata.md") -> Errata:
