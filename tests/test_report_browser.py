@@ -158,3 +158,17 @@ def test_page_loads_nothing_from_outside(page) -> None:
         " document.styleSheets.length]"
     )
     assert counts == [0, 0, 1]
+
+
+def test_page_fits_an_800_pixel_window(page) -> None:
+    """At 800 px the page itself never scrolls sideways; wide tables scroll inside their own box."""
+    driver, _ = page
+    driver.set_window_size(800, 900)
+    try:
+        widths = driver.execute_script(
+            "return [document.documentElement.scrollWidth, document.documentElement.clientWidth,"
+            " document.body.scrollWidth]"
+        )
+        assert widths[0] <= widths[1] and widths[2] <= widths[1], f"page overflows at 800 px: {widths}"
+    finally:
+        driver.set_window_size(1280, 1024)
