@@ -324,3 +324,17 @@ def test_stuck_threshold_without_aging_or_with_an_overwhelming_load_is_zero(para
 
 def test_stuck_message_names_the_limitation(params):
     assert "limitation of Eq 15" in stick_phase(params, 10e-6).message
+
+
+def test_stick_and_simulate_agree_where_sigma_s_is_above_the_curve(runner):
+    """At 20 um/s (between V* and 20.46 um/s) the chains collapse above the steady curve's maximum: no jump."""
+    from stickslip.cli.main import cli
+
+    stick = runner.invoke(cli, ["stick", "--v0", "20 um/s"])
+    simulate = runner.invoke(cli, ["simulate", "--v0", "20 um/s", "--duration", "200 s"])
+    assert stick.exit_code == 0 and simulate.exit_code == 0
+    assert "UNDETERMINED after the stick" in stick.output and "no jump velocity" in stick.output
+    assert "regime: undetermined" in simulate.output
+    assert "the block slips after" not in stick.output
+    slipping = runner.invoke(cli, ["stick", "--v0", "50 um/s"])
+    assert "the block slips after ts = 19.2881 s" in slipping.output
