@@ -338,3 +338,32 @@ def test_stick_and_simulate_agree_where_sigma_s_is_above_the_curve(runner):
     assert "the block slips after" not in stick.output
     slipping = runner.invoke(cli, ["stick", "--v0", "50 um/s"])
     assert "the block slips after ts = 19.2881 s" in slipping.output
+
+
+# --- the bounded-aging extension (docs/stick-phase.md §6) ------------------------------------------------
+
+
+def test_bounded_aging_at_constant_load_matches_its_closed_form(params, sigma_c):
+    """V0 = 0, aging exponent min(t/tau_a, A): t_s = A tau_a + e^A (E1(s0)/r - tau_a (1 - e^-A))."""
+    s0 = scaled_load(params, sigma_c)
+    r, tau_a = params.stick.break_rate, params.stick.aging_time
+    for cap in (0.5, 2.0):
+        expected = cap * tau_a + math.exp(cap) * (exp1(s0) / r - tau_a * -math.expm1(-cap))
+        held = stick_phase(params, 0.0, start_stress=sigma_c, aging_cap=cap)
+        assert held.status == "slipped" and held.stick_time == pytest.approx(expected, rel=1e-8)
+
+
+def test_bounded_aging_limits(params):
+    """A = 0 is Eq 15 without aging; a stick that ends before A tau_a does not feel the cap; at 10 um/s, where
+    Eq 15 as printed never slips, every cap ends the stick; out-of-range caps are refused."""
+    assert stick_phase(params, 10e-6, aging_cap=0.0).stick_time == pytest.approx(
+        stick_phase(params, 10e-6, aging=False).stick_time, rel=1e-9
+    )
+    plain = stick_phase(params, 50e-6)
+    assert plain.stick_time < 2.0 * params.stick.aging_time
+    assert stick_phase(params, 50e-6, aging_cap=2.0).stick_time == pytest.approx(plain.stick_time, rel=1e-9)
+    times = [stick_phase(params, 10e-6, aging_cap=cap).stick_time for cap in (2.0, 3.0, 5.0)]
+    assert all(t is not None for t in times) and times == sorted(times)  # more aging, longer stick
+    for bad in (-1.0, 1e3, math.nan):
+        with pytest.raises(ParameterError, match="aging_cap"):
+            stick_phase(params, 10e-6, aging_cap=bad)

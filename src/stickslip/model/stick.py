@@ -72,6 +72,8 @@ STUCK_LIMITATION = (
     "this is a limitation of Eq 15, whose aging term -t/tau_a grows without bound, not a prediction:"
     " Baumberger et al. saw stick-slip of the same gel down to 10 um/s"
 )
+#: Largest bound of the aging exponent accepted by the bounded-aging extension (e^-100: aging has long won).
+MAX_AGING_CAP = 100.0
 #: Relative width to which :func:`stuck_threshold` brackets the threshold velocity.
 THRESHOLD_RTOL = 1e-4
 #: Candidate floors, as fractions of the way from K V0 tau_a b/Nc0 to n, tried by the stuck proof.
@@ -178,10 +180,15 @@ class _Rates:
     s0: float  # (lambda/kT) sigma_0/Nc0
     k: float  # (lambda/kT) K V0/Nc0, 1/s
     inv_aging: float  # 1/tau_a (0 without aging), 1/s
+    aging_cap: float = math.inf  # bound of the aging exponent t/tau_a (the bounded-aging extension)
+
+    def aging(self, t: float) -> float:
+        """The aging exponent of Eq 15, t/tau_a, bounded by ``aging_cap``."""
+        return min(t * self.inv_aging, self.aging_cap)
 
     def log_rate(self, t: float, n: float) -> float:
         """ln of the breakage rate per chain, ln(r) + s(t)/n - t/tau_a."""
-        return math.log(self.r) + (self.s0 + self.k * t) / n - t * self.inv_aging
+        return math.log(self.r) + (self.s0 + self.k * t) / n - self.aging(t)
 
     def time_scale(self) -> float:
         """T: the time in which the fresh load would break the chains, or the loading and aging times.
@@ -203,8 +210,8 @@ def never_slips(rates: _Rates, t: float, n: float) -> float | None:
     n e^{-R}; if that is >= n_low, n can never reach n_low (the first time it
     did would contradict the bound).  docs/stick-phase.md has the details.
     """
-    if rates.inv_aging == 0.0 or n <= 0.0:
-        return None
+    if rates.inv_aging == 0.0 or n <= 0.0 or math.isfinite(rates.aging_cap):
+        return None  # without aging, or with bounded aging, the load always wins in the end
     balance = rates.k / rates.inv_aging  # n must stay above k tau_a for aging to win
     if n <= balance:
         return None
@@ -225,7 +232,9 @@ def _no_load_phase(
     # Nothing pulls: n decays as exp(-r tau_a (1 - e^{-t/tau_a})) (or e^{-r t}) and the block never slips.
     t = np.linspace(0.0, max(horizon, 1.0 / rates.r if rates.r > 0 else 1.0), SAMPLES)
     if aging:
-        n = np.exp(-rates.r / rates.inv_aging * -np.expm1(-t * rates.inv_aging))
+        capped = np.minimum(t * rates.inv_aging, rates.aging_cap)  # the aging exponent, bounded or not
+        aged = -np.expm1(-capped) / rates.inv_aging + (t - capped / rates.inv_aging) * np.exp(-capped)
+        n = np.exp(-rates.r * aged)
     else:
         n = np.exp(-rates.r * t)
     return StickPhase(
@@ -251,8 +260,15 @@ def stick_phase(
     start_stress: float | None = None,
     aging: bool = True,
     horizon: float | None = None,
+    aging_cap: float | None = None,
 ) -> StickPhase:
     """Solve the stick phase (Eqs 11-16) from the instant of sticking.
+
+    ``aging_cap`` switches on the **bounded-aging extension** (not in the
+    paper; off by default): the aging exponent t/tau_a of Eq 15 is replaced
+    by min(t/tau_a, aging_cap), a contact that stops strengthening after
+    aging_cap aging times.  Then the load always wins and every stick ends
+    (docs/stick-phase.md §6).
 
     ``pulling_velocity`` (m/s) may be 0: a constant load ``start_stress`` is
     held (a creep-rupture lifetime).  ``start_stress=None`` means sigma_c of
@@ -273,6 +289,11 @@ def stick_phase(
         sigma0 = check_stress(start_stress)
     if horizon is not None:
         horizon = _number(horizon, "horizon", "s")
+    cap = math.inf
+    if aging_cap is not None:
+        cap = _number(aging_cap, "aging_cap", "aging times")
+        if not 0 <= cap <= MAX_AGING_CAP:
+            raise ParameterError(f"aging_cap: expected a bound of t/tau_a from 0 to {MAX_AGING_CAP:g}, got {cap!r}")
     stiffness = params.block.effective_stiffness
     b = params.bonds.force_sensitivity
     nc0 = params.stick.attached_chains
@@ -281,6 +302,7 @@ def stick_phase(
         s0=b * sigma0 / nc0,
         k=b * stiffness * v0 / nc0,
         inv_aging=1.0 / params.stick.aging_time if aging else 0.0,
+        aging_cap=cap if aging else math.inf,
     )
     if rates.s0 == 0.0 and rates.k == 0.0:
         return _no_load_phase(params, rates, v0, sigma0, aging, horizon or 0.0)
@@ -292,7 +314,7 @@ def stick_phase(
         if n <= N_GONE:  # the collapse, continued smoothly through n = 0
             return [0.0, -1.0]
         t = tp * scale
-        log_w = log_rt + math.log(n) + (rates.s0 + rates.k * t) / n - t * rates.inv_aging
+        log_w = log_rt + math.log(n) + (rates.s0 + rates.k * t) / n - rates.aging(t)
         # 1/(1 + w) without overflow
         if log_w > 0.0:
             e = math.exp(-log_w)
@@ -312,7 +334,7 @@ def stick_phase(
             floor.append(found)
         return found is not None
 
-    if aging:
+    if aging and not math.isfinite(rates.aging_cap):
         t_end = HORIZON_AGING_TIMES * params.stick.aging_time
         # checkpoints in theta; theta = t' + (1 - n) exactly, so theta >= t'
         count = max(1, math.ceil(math.log2(max(t_end / params.stick.aging_time, 2.0))) + 1)
