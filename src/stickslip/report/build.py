@@ -15,6 +15,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import DataError
+from ..fileio import atomic_write_text
 from ..parameters import Parameters, load_parameters
 from .comparisons import TOLERANCE, Comparison, compare, count_classes
 from .computations import ModelRun, computed_values, run_steps
@@ -211,5 +212,5 @@ def _write(action: Callable[[], Any]) -> Any:
 
 
 def _write_text(path: Path, text: str) -> Path:
-    _write(lambda: path.write_text(text, encoding="utf-8"))
+    _write(lambda: atomic_write_text(path, text))
     return path
