@@ -221,7 +221,7 @@ def _jump(run: ModelRun, stress: float | None) -> float | None:
     return run.jumps[stress].velocity if stress is not None else None
 
 
-NOMINAL = "nominal K = 0.766 × 400 kPa/m"
+NOMINAL = "nominal K"  # = 0.766 × 400 kPa/m
 
 
 def _echo(value: float, how: str = "parameter set") -> Computed:
@@ -301,27 +301,28 @@ def _table1_value(run: ModelRun, key: str, velocity: float, cycle: int, sc: floa
     p = run.params
     column = run.columns[(_um(velocity), cycle)]
     k = column.stiffness / 1e3
+    own = f"K = slope/V0 = {k:.1f} kPa/m (Gd/h {k / p.block.geometric_factor:.1f})"
     start = "from rest" if column.start_stress == 0.0 else "from σc"
     if key == "critical_stress":
         return Computed(sc, "the model's σc (Eq 9)")
     if key == "stick_slope":
         return Computed(
-            column.stiffness * velocity, f"the column's own slope: K = slope / V0 = {k:.1f} kPa/m is taken from it",
-            echo=True, alternative=p.block.effective_stiffness * velocity, alternative_label=f"{NOMINAL}: K V0",
+            column.stiffness * velocity, f"the column's own slope: {own} is taken from it",
+            echo=True, alternative=p.block.effective_stiffness * velocity, alternative_label=NOMINAL,
         )  # fmt: skip
     if key == "stiffness":
         return Computed(
             column.stiffness / p.block.geometric_factor, "slope / (0.766 V0): the paper's arithmetic redone (Eq 17)",
-            echo=True, alternative=p.block.stiffness, alternative_label="nominal Gd/h = 4 kPa / 10 mm",
+            echo=True, alternative=p.block.stiffness, alternative_label="nominal Gd/h",
         )  # fmt: skip
     if key == "slip_stress":
         return Computed(
-            column.measured.peak_stress, f"σs = σ0 + K V0 ts (Eqs 15-16), {start}, K = {k:.1f} kPa/m from the slope",
+            column.measured.peak_stress, f"σs = σ0 + K V0 ts (Eqs 15-16), {start}, {own}",
             alternative=column.nominal.peak_stress, alternative_label=NOMINAL,
         )  # fmt: skip
     if key == "stick_time":
         return Computed(
-            column.measured.stick_time, f"Eq 15 {start} until Nc = 0, K = {k:.1f} kPa/m from the slope",
+            column.measured.stick_time, f"Eq 15 {start} until Nc = 0, {own}",
             alternative=column.nominal.stick_time, alternative_label=NOMINAL,
         )  # fmt: skip
     if key == "jump_velocity":

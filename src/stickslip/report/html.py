@@ -89,7 +89,8 @@ def _alternative(row: Comparison, display: str, digits: int = 4) -> str:
 
 def comparison_table(rows: Sequence[Comparison], errata: Errata) -> str:
     head = (
-        '<table class="comparisons">\n<thead><tr><th>Quantity</th><th>Kind</th><th>Paper</th><th>Source</th>'
+        '<div class="wide"><table class="comparisons">\n<thead><tr><th>Quantity</th><th>Kind</th><th>Paper</th>'
+        "<th>Source</th>"
         "<th>Computed</th><th>Difference</th><th>Class</th><th>Erratum</th><th>Computed from</th></tr></thead>\n"
         "<tbody>"
     )
@@ -114,7 +115,7 @@ def comparison_table(rows: Sequence[Comparison], errata: Errata) -> str:
             f"<td>{_errata_link(row, errata)}</td>"
             f'<td class="how">{escape(row.how)}</td></tr>'
         )
-    out.append("</tbody>\n</table>")
+    out.append("</tbody>\n</table></div>")
     return "\n".join(out)
 
 
