@@ -10,7 +10,8 @@ if ! command -v chromium >/dev/null 2>&1 || ! command -v chromedriver >/dev/null
   sudo=""
   if [ "$(id -u)" -ne 0 ]; then sudo="sudo"; fi
   $sudo apt-get update -qq
-  # without recommends: the browser and its driver only (about 26 packages, no perl or systemd upgrades)
+  # without recommends: the browser, its driver and their libraries (26 new packages on a Debian 12 machine
+  # that had Python and X libraries already; no perl or systemd upgrades)
   DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends chromium chromium-driver
 fi
 
