@@ -284,20 +284,20 @@ def test_unknown_section_in_file_is_named(params, tmp_path):
 
 
 def test_wrong_dimension_in_file_names_file_and_key(params, tmp_path):
-    text = params.to_toml().replace('bond_time = "0.000224 s"', 'bond_time = "224 m"')
+    text = params.to_toml().replace('bond_time = "224 us"', 'bond_time = "224 m"')
     path = _write(tmp_path, text)
     with pytest.raises(UnitError, match=r"p\.toml: bonds\.bond_time.*expected a time"):
         load_parameters(str(path))
 
 
 def test_negative_value_in_file_is_named(params, tmp_path):
-    path = _write(tmp_path, params.to_toml().replace('height = "0.01 m"', 'height = "-1 cm"'))
+    path = _write(tmp_path, params.to_toml().replace('height = "10 mm"', 'height = "-1 cm"'))
     with pytest.raises(ParameterError, match=r"block\.height: expected a positive value"):
         load_parameters(str(path))
 
 
 def test_boolean_value_in_file_is_rejected(params, tmp_path):
-    path = _write(tmp_path, params.to_toml().replace('height = "0.01 m"', "height = true"))
+    path = _write(tmp_path, params.to_toml().replace('height = "10 mm"', "height = true"))
     with pytest.raises(ParameterError, match=r"block\.height"):
         load_parameters(str(path))
 

@@ -12,9 +12,8 @@ from typing import Any
 
 import click
 
-from ..fitting.results import human
 from ..parameters import Parameters, key_dimension
-from .common import emit_json, params_options, positive, resolve_params, save_figure, write_text
+from .common import emit_json, params_options, positive, require_unit, resolve_params, save_figure, write_text
 
 SPLIT_DEFAULT = "800 um/s"
 
@@ -28,7 +27,7 @@ def _fix_values(items: tuple[str, ...]) -> dict[str, Any]:
             raise click.BadParameter(
                 f"{item!r}: expected KEY=VALUE, e.g. bonds.max_extension='1 um'", param_hint="--fix"
             )
-        key_dimension(key)  # unknown keys: ParameterError naming the valid ones
+        require_unit(value.strip(), key_dimension(key), f"--fix {key}=")  # unknown keys: ParameterError
         if key in out:
             raise click.BadParameter(f"{key} given twice", param_hint="--fix")
         out[key] = value.strip()
@@ -159,6 +158,8 @@ def steady_command(
         vc, sc = fit.critical_velocity, fit.critical_stress
         header = [f"Fitted by stickslip fit steady ({method}) to {data}; fitted keys: {', '.join(fit.free_keys)}."]
         if vc.value is not None and sc.value is not None:
+            from ..fitting.results import human  # not at module level: it imports lmfit (start-up time)
+
             header.append(f"Vc = {human(vc.value, 'velocity')}, sigma_c = {human(sc.value, 'stress')} (Eq 9).")
         write_text(output, _toml_with_header(fitted, header))
     report = fit.report() if posterior is None else fit.report() + "\n" + posterior.report()
