@@ -286,18 +286,23 @@ def read_parameter_file(path: str | Path) -> Parameters:
     shown = shorten(str(path), 240)
     try:
         info = path.stat()
-        if not stat.S_ISREG(info.st_mode):  # a FIFO would block for ever, /dev/zero never end
-            raise ParameterError(f"parameter file {shown} is not a regular file")
-        if info.st_size > MAX_PARAMETER_FILE_BYTES:
-            raise ParameterError(
-                f"parameter file {shown} is {info.st_size} bytes; a parameter file is at most"
-                f" {MAX_PARAMETER_FILE_BYTES} bytes"
-            )
+    except FileNotFoundError:
+        raise ParameterError(f"parameter file {shown} not found") from None
+    except (OSError, ValueError) as exc:  # ValueError: a NUL in the name
+        raise ParameterError(f"parameter file {shown} cannot be read: {shorten(str(exc))}") from None
+    if not stat.S_ISREG(info.st_mode):  # a FIFO would block for ever, /dev/zero never end
+        raise ParameterError(f"parameter file {shown} is not a regular file")
+    if info.st_size > MAX_PARAMETER_FILE_BYTES:
+        raise ParameterError(
+            f"parameter file {shown} is {info.st_size} bytes; a parameter file is at most"
+            f" {MAX_PARAMETER_FILE_BYTES} bytes"
+        )
+    try:
         with open(path, "rb") as handle:
             text = handle.read(MAX_PARAMETER_FILE_BYTES + 1).decode("utf-8")
     except FileNotFoundError:
         raise ParameterError(f"parameter file {shown} not found") from None
-    except (OSError, ValueError) as exc:  # ValueError: a NUL in the name, or not UTF-8
+    except (OSError, ValueError) as exc:  # ValueError: not UTF-8
         raise ParameterError(f"parameter file {shown} cannot be read: {shorten(str(exc))}") from None
     if len(text) > MAX_PARAMETER_FILE_BYTES:
         raise ParameterError(f"parameter file {shown} is longer than {MAX_PARAMETER_FILE_BYTES} bytes")

@@ -24,7 +24,7 @@ from typing import Any
 import click
 
 from ..errors import ParameterError, UnitError
-from ..fileio import atomic_path, atomic_write_text
+from ..fileio import atomic_path, atomic_write_text, refuse_input_as_output
 from ..parameters import Parameters, key_dimension, load_parameters
 from ..units import DIMENSIONS, bare_number, shorten, to_si
 
@@ -80,6 +80,19 @@ def resolve_params(params_name: str, overrides: Sequence[str]) -> Parameters:
         require_unit(value, key_dimension(key), f"--set {key}=")
         mapping[key] = value
     return load_parameters(params_name, overrides=mapping)
+
+
+def refuse_overwriting_inputs(
+    inputs: Sequence[Path | str | None], outputs: Sequence[tuple[str, Path | None]], params_name: str | None = None
+) -> None:
+    """Refuse (DataError, one line) any output that names an input: a data file, or the --params TOML file.
+
+    Call it before computing anything, so the user does not wait for a refusal.
+    """
+    files: list[str | Path | None] = list(inputs)
+    if params_name is not None:
+        files.append(params_name)  # a built-in set name is no file, and is skipped
+    refuse_input_as_output(files, list(outputs))
 
 
 def require_unit(text: str, dimension: str, prefix: str) -> None:

@@ -13,7 +13,17 @@ from typing import Any
 import click
 
 from ..parameters import Parameters, key_dimension
-from .common import emit_json, params_options, positive, require_unit, resolve_params, save_figure, write_text
+from .common import (
+    InputFile,
+    emit_json,
+    params_options,
+    positive,
+    refuse_overwriting_inputs,
+    require_unit,
+    resolve_params,
+    save_figure,
+    write_text,
+)
 
 SPLIT_DEFAULT = "800 um/s"
 
@@ -56,7 +66,7 @@ def fit_group() -> None:
 
 
 @fit_group.command("steady")
-@click.argument("data", type=click.Path(dir_okay=False, path_type=Path))
+@click.argument("data", type=InputFile())
 @click.option(
     "--method",
     type=click.Choice(["two-step", "joint"]),
@@ -127,6 +137,8 @@ def steady_command(
     Units go in the header (velocity [um/s]); bare names are SI.  Start values and
     everything not fitted come from --params/--set (default gelatin-glass).
     """
+    written = [("-o", output), ("--report", report_path), ("--plot", plot_path), ("--corner", corner_path)]
+    refuse_overwriting_inputs([data], written, params_name)
     from ..fitting.steady_fit import fit_steady
 
     if corner_path is not None and not bayes:
@@ -195,7 +207,7 @@ def _bayes_module() -> Any:
 
 
 @fit_group.command("stick")
-@click.argument("table", type=click.Path(dir_okay=False, path_type=Path))
+@click.argument("table", type=InputFile())
 @click.option("--fix", "fix_items", multiple=True, metavar="KEY=VALUE", help="Hold a stick parameter at a value.")
 @click.option("--free", "free_keys", multiple=True, metavar="KEY", help="Prefer to fit this stick parameter.")
 @click.option("--exclude-row", "exclude_rows", multiple=True, type=int, metavar="N", help="Leave out file row N.")
@@ -232,6 +244,7 @@ def stick_command(
     other columns of the paper's Table 1).  Bond parameters, block and start values
     come from --params/--set: use the file written by 'stickslip fit steady -o'.
     """
+    refuse_overwriting_inputs([table], [("-o", output), ("--report", report_path), ("--plot", plot_path)], params_name)
     from ..fitting.stick_fit import fit_stick
 
     params = resolve_params(params_name, overrides)

@@ -78,8 +78,11 @@ def _run(argv: list[str] | None) -> int:
     except BrokenPipeError:  # `stickslip curve --format csv | head`: the reader left
         _silence_stdout()
         return 1
-    except (OverflowError, FloatingPointError) as exc:
-        return _fail(f"a number left the floating-point range ({exc}); check that the values are physical")
+    except (OverflowError, FloatingPointError):
+        return _fail(
+            "a number left the floating-point range (about 1e-308 to 1e308) during the computation;"
+            " check that the input values are physical"
+        )
     except MemoryError:
         return _fail("out of memory: the input or the requested size is too large for this machine")
     except Exception as exc:  # a bug: still one line, but say it is ours

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import sys
-from pathlib import Path
 
 import click
 
@@ -17,19 +16,24 @@ def register(cli: click.Group) -> None:
 @click.option(
     "-o",
     "--output",
-    type=click.Path(file_okay=False, path_type=Path),
-    default=Path("stickslip-report"),
+    default="stickslip-report",
     show_default=True,
-    help="Folder for report.html, results.json, the figures (PNG, SVG) and the curves (CSV).",
+    help="Folder for report.html, results.json, the figures (PNG, SVG) and the curves (CSV):"
+    " a new or empty folder, or one holding an earlier report.",
 )
 @click.option("--quiet", is_flag=True, help="Print nothing.")
-def reproduce(output: Path, quiet: bool) -> None:
+def reproduce(output: str, quiet: bool) -> None:
     """Recompute the paper's figures and every number it states; write an offline HTML report.
 
     The report (report.html, one self-contained file) puts each number the
     paper prints beside the value computed here, with the relative difference
     and a link to the erratum wherever they differ by more than 2 %.
+    Every file is written atomically; a folder holding anything but an
+    earlier report is refused.
     """
+    from ..report.build import prepare_report_folder
+
+    prepare_report_folder(output)  # refuse a bad folder before the minute of computing
     import matplotlib
 
     matplotlib.use("Agg")
@@ -45,7 +49,7 @@ def reproduce(output: Path, quiet: bool) -> None:
     click.echo(f"report: {report.html} ({len(report.files)} files, {report.elapsed:.1f} s)")
 
 
-def _build_with_progress(output: Path):
+def _build_with_progress(output: str):
     from rich.console import Console
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 

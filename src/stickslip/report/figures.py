@@ -17,6 +17,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ..fileio import atomic_write_bytes
+
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.axes import Axes
     from matplotlib.figure import Figure
@@ -184,8 +186,8 @@ def save_figure_files(figure: ReportFigure, folder: Path) -> tuple[bytes, list[P
     """Write ``<id>.png`` and ``<id>.svg`` into ``folder``; returns the PNG bytes (for embedding) and the paths."""
     png = figure.png()
     png_path, svg_path = folder / f"{figure.id}.png", folder / f"{figure.id}.svg"
-    png_path.write_bytes(png)
-    svg_path.write_bytes(figure.svg())
+    atomic_write_bytes(png_path, png)
+    atomic_write_bytes(svg_path, figure.svg())
     return png, [png_path, svg_path]
 
 
