@@ -199,11 +199,11 @@ class InputFile(click.ParamType):
 
     def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> Path:
         path = Path(value)
-        shown = shorten(str(value))
+        shown = shorten(str(value), 240)
         try:
             info = path.stat()
         except FileNotFoundError:
-            self.fail(f"{shown}: no such file", param, ctx)
+            self.fail(f"{shown}: file not found", param, ctx)
         except (OSError, ValueError) as exc:
             self.fail(f"{shown}: cannot be read ({getattr(exc, 'strerror', None) or exc})", param, ctx)
         if stat.S_ISDIR(info.st_mode):

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import sys
+from pathlib import Path
 
 import click
 
@@ -33,23 +34,23 @@ def reproduce(output: str, quiet: bool) -> None:
     """
     from ..report.build import prepare_report_folder
 
-    prepare_report_folder(output)  # refuse a bad folder before the minute of computing
+    folder = prepare_report_folder(output)  # refuse a bad folder before computing anything
     import matplotlib
 
     matplotlib.use("Agg")
     from ..report import build_report
 
     if quiet:
-        build_report(output)
+        build_report(folder)
         return
     if sys.stderr.isatty():
-        report = _build_with_progress(output)
+        report = _build_with_progress(folder)
     else:
-        report = build_report(output)
+        report = build_report(folder)
     click.echo(f"report: {report.html} ({len(report.files)} files, {report.elapsed:.1f} s)")
 
 
-def _build_with_progress(output: str):
+def _build_with_progress(output: Path):
     from rich.console import Console
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
