@@ -307,3 +307,15 @@ def test_the_light_commands_import_no_heavy_library():
         )
         assert done.returncode == 0, done.stderr
         assert done.stdout.strip().splitlines()[-1] == "HEAVY []", (argv, done.stdout[-300:])
+
+
+def test_outputs_get_the_usual_file_mode_not_a_private_one(tmp_path):
+    umask = os.umask(0o022)
+    os.umask(umask)
+    common.write_text(tmp_path / "new.csv", "a\n")
+    assert (tmp_path / "new.csv").stat().st_mode & 0o777 == 0o666 & ~umask
+    kept = tmp_path / "kept.csv"
+    kept.write_text("old\n", encoding="utf-8")
+    kept.chmod(0o640)
+    common.write_text(kept, "new\n")
+    assert kept.stat().st_mode & 0o777 == 0o640 and kept.read_text(encoding="utf-8") == "new\n"
