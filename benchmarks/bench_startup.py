@@ -7,10 +7,12 @@ the script prints the best and the median wall time and the child's CPU time
 <= 0.4 s for ``stickslip --help``, ``stickslip critical`` and ``stickslip curve``
 with a few velocities.
 
-    python benchmarks/bench_startup.py [--repeat N]
+    python benchmarks/bench_startup.py [--repeat N] [--compare OTHER_SRC]
 
-Run from the repository root; the package is taken from ``src/`` (or from an
-installed stickslip when ``src/`` is absent).
+The package is taken from this checkout's ``src/``.  ``--compare`` times a
+second copy of the package (e.g. an older commit unpacked with
+``git archive COMMIT src | tar -x -C /tmp/old``, then ``--compare /tmp/old/src``)
+in the same run, command by command, so that both see the same machine load.
 """
 
 from __future__ import annotations
@@ -56,20 +58,23 @@ def run_once(command: list[str], env: dict[str, str]) -> tuple[float, float]:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=9, help="runs per command")
+    parser.add_argument("--compare", type=Path, default=None, help="another src/ folder to time beside this one")
     args = parser.parse_args()
-    env = dict(os.environ)
-    if (ROOT / "src" / "stickslip").is_dir():
-        env["PYTHONPATH"] = str(ROOT / "src") + os.pathsep + env.get("PYTHONPATH", "")
+    sources = {"": ROOT / "src"} if args.compare is None else {"this: ": ROOT / "src", "other: ": args.compare}
+    envs = {label: {**os.environ, "PYTHONPATH": str(src)} for label, src in sources.items()}
     machine = f"Python {platform.python_version()} on {platform.machine()}, {os.cpu_count()} cores"
     print(f"{machine}; {args.repeat} runs each, wall time and the child's CPU time (user + system)")
-    print(f"{'command':44s} {'best':>8s} {'median':>8s} {'cpu best':>9s} {'cpu med':>8s}")
+    print(f"{'command':50s} {'best':>8s} {'median':>8s} {'cpu best':>9s} {'cpu med':>8s}")
     for label, command in CASES:
-        run_once(command, env)  # warm the file cache and the bytecode
-        walls, cpus = zip(*(run_once(command, env) for _ in range(args.repeat)), strict=True)
-        print(
-            f"{label:44s} {min(walls):7.3f}s {statistics.median(walls):7.3f}s"
-            f" {min(cpus):8.3f}s {statistics.median(cpus):7.3f}s"
-        )
+        for source, env in envs.items():
+            if source and "reference" in label and source != next(iter(envs)):
+                continue  # the references do not depend on the package
+            run_once(command, env)  # warm the file cache and the bytecode
+            walls, cpus = zip(*(run_once(command, env) for _ in range(args.repeat)), strict=True)
+            print(
+                f"{source + label:50s} {min(walls):7.3f}s {statistics.median(walls):7.3f}s"
+                f" {min(cpus):8.3f}s {statistics.median(cpus):7.3f}s"
+            )
 
 
 if __name__ == "__main__":

@@ -412,7 +412,7 @@ def test_fast_unit_table_agrees_with_pint(unit):
     assert units_module._dimension_text(vector) == dimensionality
 
 
-@pytest.mark.parametrize("text", ["Pa s/m", "(m/s)^2", "degC", "ft/s", "kg m/s^2", "Å", "m^0.5"])
+@pytest.mark.parametrize("text", ["Pa s/m", "(m/s)^2", "degC", "°C", "%", "ft/s", "kg m/s^2", "Å", "m^0.5"])
 def test_units_outside_the_table_go_to_pint(text):
     assert units_module._fast_unit(text) is None
     assert units_module._readable_unit(text)

@@ -74,7 +74,7 @@ _NUMBER_THEN_UNIT = re.compile(rf"^({_NUMBER})\s*(.*)$", re.DOTALL)
 _EXPONENT = re.compile(r"(?:\^|\*\*)\s*[-+]?\d{1,2}(?:\.\d{1,3})?(?!\d)(?!\s*(?:\^|\*\*))")
 #: A leading "1" of "1/m^2" (also inside parentheses).
 _LEADING_ONE = re.compile(r"(?<![\w.])1(?=\s*/)")
-_UNIT_CHARACTERS = re.compile(r"^[^\W\d]*(?:[^\W\d]|[\s*/()])*$")
+_UNIT_CHARACTERS = re.compile(r"^(?:[^\W\d]|[\s*/()°%])*$")
 
 #: Units converted without pint: symbol -> (factor to SI, (mass, length, time, temperature) exponents).
 _UNITS: dict[str, tuple[float, tuple[int, int, int, int]]] = {
