@@ -80,7 +80,7 @@ def test_table_output(capsys, record):
 
 
 def test_json_output_in_si(capsys, record):
-    code, out, _ = run_main(capsys, "analyze", str(record["path"]), "--v0", "5e-5", "--json")
+    code, out, _ = run_main(capsys, "analyze", str(record["path"]), "--v0", "5e-5 m/s", "--json")
     assert code == 0
     data = json.loads(out)
     assert data["regime"] == "stick-slip" and data["pulling_velocity"] == pytest.approx(V0)

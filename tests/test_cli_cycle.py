@@ -31,8 +31,8 @@ def test_simulate_json_at_50_um_per_s(runner):
     assert summary["critical_stress"] == pytest.approx(257.4, abs=0.05)
 
 
-def test_simulate_json_at_100_um_per_s_with_a_bare_si_number(runner):
-    summary = json.loads(run(runner, "simulate", "--v0", "1e-4", "--duration", "30", "--json"))
+def test_simulate_json_at_100_um_per_s_in_si_units(runner):
+    summary = json.loads(run(runner, "simulate", "--v0", "1e-4 m/s", "--duration", "30 s", "--json"))
     assert summary["cycles"][0]["stick_time"] == pytest.approx(9.75, abs=0.01)
     assert summary["cycles"][0]["peak_stress"] == pytest.approx(556.0, abs=1.0)
 

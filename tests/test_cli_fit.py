@@ -45,7 +45,7 @@ def test_fit_steady_json_and_files(tmp_path, capsys):
     data = read_steady_data(SYNTHETIC)
     argv = ["curve", "--params", str(toml), "--format", "json"]
     for v in data.velocity:
-        argv += ["--velocity", repr(float(v))]
+        argv += ["--velocity", f"{float(v)!r} m/s"]
     code, out, err = run(capsys, *argv)
     assert code == 0, err
     stress = np.array(json.loads(out)["stress"])
@@ -86,7 +86,8 @@ def test_bad_files_exit_2_with_one_line(tmp_path, capsys, content, expected):
         (["--fix", "bonds.bond_time"], "expected KEY=VALUE"),
         (["--fix", "bonds.colour=3"], "unknown parameter key"),
         (["--free", "block.height"], "does not depend on it"),
-        (["--split", "800"], "no data point at or above the split"),  # a bare number is SI: 800 m/s
+        (["--split", "800"], '--split 800: a velocity needs a unit, e.g. --split "800 um/s"'),
+        (["--split", "800 m/s"], "no data point at or above the split"),
         (["--split", "800 Pa"], "--split"),
         (["--corner", "c.png"], "--corner needs --bayes"),
     ],

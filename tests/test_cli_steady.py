@@ -104,8 +104,8 @@ def test_curve_at_350_um_per_s(runner):
     assert data["stress"][0] == pytest.approx(SIGMA_350_ISSUE, rel=1e-3)
 
 
-def test_curve_bare_velocity_is_si_and_repeatable(runner):
-    data = json.loads(run(runner, "curve", "--velocity", "0.00035", "--velocity", "1 mm/s", "--format", "json"))
+def test_curve_velocity_in_si_units_and_repeatable(runner):
+    data = json.loads(run(runner, "curve", "--velocity", "0.00035 m/s", "--velocity", "1 mm/s", "--format", "json"))
     assert data["velocity"] == pytest.approx([350e-6, 1e-3], rel=1e-15)
     assert data["stress"][0] == pytest.approx(SIGMA_350_ISSUE, rel=1e-3)
 
@@ -199,7 +199,7 @@ def test_params_show_lists_every_key_with_units(runner):
 
 
 def test_params_show_with_set(runner):
-    out = run(runner, "params", "show", "--set", "bonds.bond_time=1 ms", "--set", "block.height=0.02")
+    out = run(runner, "params", "show", "--set", "bonds.bond_time=1 ms", "--set", "block.height=0.02 m")
     row = next(line for line in out.splitlines() if "bonds.bond_time (set)" in line)
     assert "1 ms" in row
     assert "bonds.site_density (set)" not in out
@@ -212,16 +212,16 @@ def test_params_list(runner):
 
 def test_params_export_round_trip_through_the_cli(runner, tmp_path):
     path = tmp_path / "mine.toml"
-    run(runner, "params", "export", "gelatin-glass", "-o", str(path), "--set", "aging.aging_velocity=0.0004")
+    run(runner, "params", "export", "gelatin-glass", "-o", str(path), "--set", "aging.aging_velocity=0.0004 m/s")
     loaded = load_parameters(str(path))
     assert loaded.aging.aging_velocity == 0.0004
     stdout_text = run(runner, "params", "export")
     assert load_parameters().as_dict() == load_parameters(_saved(tmp_path, stdout_text)).as_dict()
-    assert tomllib.loads(stdout_text)["bonds"]["bond_time"] == "0.000224 s"
+    assert tomllib.loads(stdout_text)["bonds"]["bond_time"] == "224 us"
     # the file works as --params, with the override still in it
     via_file = json.loads(run(runner, "curve", "--velocity", "350 um/s", "--format", "json", "--params", str(path)))
     via_set = json.loads(
-        run(runner, "curve", "--velocity", "350 um/s", "--format", "json", "--set", "aging.aging_velocity=0.0004")
+        run(runner, "curve", "--velocity", "350 um/s", "--format", "json", "--set", "aging.aging_velocity=0.0004 m/s")
     )
     assert via_file == via_set
     assert via_file["stress"][0] != pytest.approx(SIGMA_350_ISSUE, rel=1e-3)

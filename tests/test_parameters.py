@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import sys
+import time
 from pathlib import Path
 
 import mpmath
@@ -16,6 +18,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from stickslip import units as units_module
 from stickslip.errors import ParameterError, UnitError
 from stickslip.parameters import (
     SECTIONS,
@@ -26,7 +29,12 @@ from stickslip.parameters import (
     parameter_keys,
     replace,
 )
-from stickslip.units import DIMENSIONS
+from stickslip.units import DIMENSIONS, format_quantity, to_si
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover
+    import tomli as tomllib
 
 ALL_KEYS = [
     "bonds.site_density",
@@ -284,20 +292,20 @@ def test_unknown_section_in_file_is_named(params, tmp_path):
 
 
 def test_wrong_dimension_in_file_names_file_and_key(params, tmp_path):
-    text = params.to_toml().replace('bond_time = "0.000224 s"', 'bond_time = "224 m"')
+    text = params.to_toml().replace('bond_time = "224 us"', 'bond_time = "224 m"')
     path = _write(tmp_path, text)
     with pytest.raises(UnitError, match=r"p\.toml: bonds\.bond_time.*expected a time"):
         load_parameters(str(path))
 
 
 def test_negative_value_in_file_is_named(params, tmp_path):
-    path = _write(tmp_path, params.to_toml().replace('height = "0.01 m"', 'height = "-1 cm"'))
+    path = _write(tmp_path, params.to_toml().replace('height = "10 mm"', 'height = "-1 cm"'))
     with pytest.raises(ParameterError, match=r"block\.height: expected a positive value"):
         load_parameters(str(path))
 
 
 def test_boolean_value_in_file_is_rejected(params, tmp_path):
-    path = _write(tmp_path, params.to_toml().replace('height = "0.01 m"', "height = true"))
+    path = _write(tmp_path, params.to_toml().replace('height = "10 mm"', "height = true"))
     with pytest.raises(ParameterError, match=r"block\.height"):
         load_parameters(str(path))
 
@@ -376,3 +384,100 @@ def test_rows_show_units_for_every_key(params):
     assert by_key["bonds.bond_time"][1] == "tau"
     assert by_key["bonds.bond_time"][2].endswith(" s")
     assert by_key["aging.aging_velocity"][2].endswith(" m/s")
+
+
+# --- the unit boundary: the fast table, bounded parsing, written values -----------------------------
+
+TABLE_UNITS = [
+    *(p + u for p in units_module._PREFIXES for u in units_module._UNITS),
+    *units_module._UNITS,
+    *units_module._PLAIN_UNITS,
+]
+COMPOSITES = ["um/s", "mm/s", "1/m^2", "1/m**2", "N/m", "mN/m", "kPa/m", "Pa/s", "Pa*s/m", "cm^2", "s^-1", "m/s/s"]
+
+
+def _pint_si(magnitude: float, unit: str) -> tuple[float, str]:
+    """(SI magnitude, dimensionality) by pint alone: the reference for the fast table."""
+    ureg = units_module.registry()
+    quantity = ureg.Quantity(magnitude, ureg.parse_units(unit)).to_base_units()
+    return float(quantity.magnitude), str(quantity.dimensionality)
+
+
+@pytest.mark.parametrize("unit", TABLE_UNITS + COMPOSITES)
+def test_fast_unit_table_agrees_with_pint(unit):
+    factor, vector = units_module._fast_unit(unit)
+    for magnitude in (1.0, 360.0, 1.074, 2.5e-7):
+        value, dimensionality = _pint_si(magnitude, unit)
+        assert magnitude * factor == pytest.approx(value, rel=4e-16, abs=0)
+    assert units_module._dimension_text(vector) == dimensionality
+
+
+@pytest.mark.parametrize("text", ["Pa s/m", "(m/s)^2", "degC", "°C", "%", "ft/s", "kg m/s^2", "Å", "m^0.5"])
+def test_units_outside_the_table_go_to_pint(text):
+    assert units_module._fast_unit(text) is None
+    assert units_module._readable_unit(text)
+
+
+@pytest.mark.parametrize(
+    "text",
+    ["(10**10**10) s", "(10**400) s", "10**10**10 s", "1 s**100", "2 m^2^2", "3 * 10 s", "5 m / 2 s", "1e3 (10) s"],
+)
+def test_power_towers_and_numbers_inside_units_are_refused_before_pint(text):
+    started = time.perf_counter()
+    with pytest.raises(UnitError, match=r"bonds\.bond_time: cannot read"):
+        to_si(text, "time", "bonds.bond_time")
+    assert time.perf_counter() - started < 0.5
+
+
+def test_long_values_are_refused_at_once_and_echoed_short():
+    text = "1" * 100_000 + " s"
+    started = time.perf_counter()
+    with pytest.raises(UnitError, match="too long") as info:
+        to_si(text, "time", "bonds.bond_time")
+    assert time.perf_counter() - started < 0.5
+    assert len(str(info.value)) < 250
+    with pytest.raises(ParameterError) as info:
+        load_parameters().with_overrides({"bonds." + "x" * 100_000: "1 s"})
+    assert len(str(info.value)) < 1000
+
+
+def test_huge_numbers_become_inf_and_are_refused_by_validation(params):
+    assert to_si("1e400 s", "time") == math.inf
+    with pytest.raises(ParameterError, match="finite"):
+        params.with_overrides({"bonds.bond_time": "1e400 s"})
+    with pytest.raises(UnitError):
+        to_si(10**400, "time", "bonds.bond_time")
+
+
+def test_bare_numbers_are_si_in_the_python_api(params):
+    p = params.with_overrides({"bonds.bond_time": "2.24e-4", "aging.aging_velocity": 3.6e-4})
+    assert (p.bonds.bond_time, p.aging.aging_velocity) == (2.24e-4, 3.6e-4)
+
+
+def test_export_writes_what_a_person_would_write(params):
+    data = tomllib.loads(params.to_toml())
+    assert data["aging"]["aging_velocity"] == "360 um/s"
+    assert data["bonds"]["site_density"] == "1.22e14 1/m^2"
+    assert data["bonds"]["bond_time"] == "224 us"
+    assert data["bonds"]["chain_stiffness"] == "1e-4 N/m"
+    assert data["bonds"]["activation_length"] == "1 angstrom"
+    assert data["block"]["shear_modulus"] == "4 kPa"
+    assert data["bonds"]["breakage_weight"] == 1.0
+    noisy = replace(params, aging={"aging_velocity": 0.00035999999999999997}, bonds={"bond_time": 0.1 + 0.2})
+    data = tomllib.loads(noisy.to_toml())
+    assert data["aging"]["aging_velocity"] == "360 um/s"
+    assert data["bonds"]["bond_time"] == "300.00000000000006 ms"  # the float really is not 0.3 s
+
+
+@settings(max_examples=200, deadline=None)
+@given(
+    dimension=st.sampled_from([d for d in DIMENSIONS if d != "temperature"]),
+    value=st.floats(min_value=1e-300, max_value=1e300),
+    negative=st.booleans(),
+)
+def test_written_values_read_back_exactly(dimension, value, negative):
+    value = -value if negative else value
+    text = format_quantity(value, dimension)
+    assert to_si(text, dimension) == value
+    number = text.split()[0]
+    assert len(number) <= 24

@@ -86,7 +86,7 @@ def test_writes_report_results_figures_and_curves(report: Path, results: dict) -
             assert len(table) == curve["points"] >= 1
             assert np.isfinite(table.to_numpy()).any()
     written = {p.name for p in report.iterdir()}
-    listed = {"report.html", "results.json"}
+    listed = {"report.html", "results.json", build_module.MARKER}
     for figure in results["figures"]:
         listed |= {figure["png"], figure["svg"], *(c["csv"] for c in figure["curves"])}
     assert written == listed

@@ -5,25 +5,43 @@ the steady friction curve sigma(V) (Eqs 6-8), the critical point (Eq 9), the
 stick phase (Eqs 11-16), the jump, the slip phase (Eq 10) and whole cycles
 (Eq 17); fitting to measurements and the analysis of measured traces.
 
-The model is importable at once; fitting and trace analysis (which pull in
-lmfit and more of scipy) are loaded on first use of their names.
+Every public name is loaded on first use (PEP 562), so that ``import
+stickslip`` (and the command line, which imports it first) stays fast: the
+model pulls in scipy, fitting lmfit, trace analysis pandas.
 """
 
 from __future__ import annotations
 
 from importlib import import_module
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from .errors import DataError, ModelError, ParameterError, StickslipError, UnitError
-from .model.critical import CriticalPoint, critical_point
-from .model.cycle import Simulation, simulate
-from .model.jump import jump_velocity
-from .model.slip import SlipPhase, slip_phase
-from .model.steady import SteadyState, steady_state, steady_stress_many
-from .model.stick import StickPhase, stick_phase
-from .parameters import Parameters, available_parameter_sets, load_parameters
+
+if TYPE_CHECKING:
+    from .model.critical import CriticalPoint, critical_point
+    from .model.cycle import Simulation, simulate
+    from .model.jump import jump_velocity
+    from .model.slip import SlipPhase, slip_phase
+    from .model.steady import SteadyState, steady_state, steady_stress_many
+    from .model.stick import StickPhase, stick_phase
+    from .parameters import Parameters, available_parameter_sets, load_parameters
 
 _LAZY = {
+    "CriticalPoint": "stickslip.model.critical",
+    "critical_point": "stickslip.model.critical",
+    "Simulation": "stickslip.model.cycle",
+    "simulate": "stickslip.model.cycle",
+    "jump_velocity": "stickslip.model.jump",
+    "SlipPhase": "stickslip.model.slip",
+    "slip_phase": "stickslip.model.slip",
+    "SteadyState": "stickslip.model.steady",
+    "steady_state": "stickslip.model.steady",
+    "steady_stress_many": "stickslip.model.steady",
+    "StickPhase": "stickslip.model.stick",
+    "stick_phase": "stickslip.model.stick",
+    "Parameters": "stickslip.parameters",
+    "available_parameter_sets": "stickslip.parameters",
+    "load_parameters": "stickslip.parameters",
     "fit_steady": "stickslip.fitting",
     "fit_stick": "stickslip.fitting",
     "read_steady_data": "stickslip.fitting",

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import contextlib
 import os
+import stat
 import tempfile
 from collections.abc import Iterator
 from pathlib import Path
@@ -33,6 +34,7 @@ def atomic_path(path: str | Path, suffix: str | None = None) -> Iterator[Path]:
     )
     os.close(handle)
     temp = Path(temp_name)
+    _set_mode(temp, target)
     try:
         yield temp
         _fsync_file(temp)
@@ -86,6 +88,18 @@ def _same_file(a: Path, b: Path) -> bool:
         return os.path.samefile(a, b)
     except OSError:
         return a.resolve() == b.resolve()
+
+
+def _set_mode(temp: Path, target: Path) -> None:
+    """Give the new file the mode a plain ``open`` would (mkstemp makes it private, 0600), or the old file's."""
+    try:
+        mode = stat.S_IMODE(target.stat().st_mode)
+    except OSError:
+        umask = os.umask(0o022)
+        os.umask(umask)
+        mode = 0o666 & ~umask
+    with contextlib.suppress(OSError):
+        os.chmod(temp, mode)
 
 
 def _fsync_file(path: Path) -> None:

@@ -2,7 +2,9 @@
 
 Every value is stored in SI base units.  Files and overrides carry units as
 strings (``bond_time = "224 us"``); :mod:`stickslip.units` converts them.
-Unknown keys are errors, never ignored.
+A bare number (``bond_time = 0.000224`` in a TOML file, ``{"bonds.bond_time":
+2.24e-4}`` or ``"2.24e-4"`` in Python) is taken as SI; only the command line
+insists on a unit for a dimensional value.  Unknown keys are errors, never ignored.
 
 The canonical keys, ``section.key``, and the symbols of Juvekar & Singh:
 
@@ -32,6 +34,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import stat
 import sys
 from collections.abc import Mapping
 from dataclasses import dataclass, field, fields
@@ -40,7 +43,7 @@ from pathlib import Path
 from typing import Any
 
 from .errors import ParameterError
-from .units import format_si, to_si
+from .units import format_quantity, format_si, shorten, to_si
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -64,7 +67,7 @@ class _Validated:
             key = f"{self._section}.{f.name}"
             raw = getattr(self, f.name)
             if isinstance(raw, bool) or not isinstance(raw, (int, float)):
-                raise ParameterError(f"{key}: expected a number in SI units, got {raw!r}")
+                raise ParameterError(f"{key}: expected a number in SI units, got {shorten(raw)}")
             value = float(raw)
             if math.isnan(value) or math.isinf(value):
                 raise ParameterError(f"{key}: expected a finite number, got {value}")
@@ -167,7 +170,7 @@ def key_dimension(key: str) -> str:
     section, _, name = key.partition(".")
     cls = SECTIONS.get(section)
     if cls is None or name not in {f.name for f in fields(cls)}:
-        raise ParameterError(f"unknown parameter key {key!r}; expected one of: {', '.join(parameter_keys())}")
+        raise ParameterError(f"unknown parameter key {shorten(key)}; expected one of: {', '.join(parameter_keys())}")
     return next(f.metadata["dimension"] for f in fields(cls) if f.name == name)
 
 
@@ -214,7 +217,7 @@ class Parameters:
         return out
 
     def to_toml(self) -> str:
-        """An editable TOML file; values carry their units, and a reload gives the same set."""
+        """An editable TOML file; values as a person writes them (``"360 um/s"``), and a reload gives the same set."""
         lines = [f"name = {_toml_str(self.name)}"]
         if self.description:
             lines.append(f"description = {_toml_str(self.description)}")
@@ -223,10 +226,9 @@ class Parameters:
         for s, cls in SECTIONS.items():
             lines += ["", f"[{s}]"]
             for f in fields(cls):
-                value = getattr(getattr(self, s), f.name)
-                text = format_si(value, f.metadata["dimension"]) if f.metadata["dimension"] != "dimensionless" else None
-                # repr() keeps every digit, so export -> load is exact
-                shown = f'"{value!r} {text.split(" ", 1)[1]}"' if text else repr(value)
+                dimension = f.metadata["dimension"]
+                text = format_quantity(getattr(getattr(self, s), f.name), dimension)
+                shown = text if dimension == "dimensionless" else _toml_str(text)
                 lines.append(f"{f.name} = {shown}  # {f.metadata['symbol']}: {f.metadata['doc']}")
         return "\n".join(lines) + "\n"
 
@@ -249,12 +251,12 @@ def parameters_from_mapping(data: Mapping[str, Any], source: str = "parameters")
     for top, content in data.items():
         if top in _META_KEYS:
             if not isinstance(content, str):
-                raise ParameterError(f"{source}: {top} must be a string, got {content!r}")
+                raise ParameterError(f"{source}: {top} must be a string, got {shorten(content)}")
             meta[top] = content
             continue
         if top not in SECTIONS:
             raise ParameterError(
-                f"{source}: unknown section or key {top!r}; expected sections {', '.join(SECTIONS)}"
+                f"{source}: unknown section or key {shorten(top)}; expected sections {', '.join(SECTIONS)}"
                 f" (and optional {', '.join(_META_KEYS)})"
             )
         if not isinstance(content, Mapping):
@@ -274,15 +276,36 @@ def available_parameter_sets() -> list[str]:
     return sorted(p.name[: -len(".toml")] for p in folder.iterdir() if p.name.endswith(".toml"))
 
 
+#: Largest parameter file read (a complete one is about 2 kB).
+MAX_PARAMETER_FILE_BYTES = 1_000_000
+
+
 def read_parameter_file(path: str | Path) -> Parameters:
-    """Read a TOML parameter file."""
+    """Read a TOML parameter file (a regular file of at most :data:`MAX_PARAMETER_FILE_BYTES`)."""
     path = Path(path)
+    shown = shorten(str(path), 240)
     try:
-        text = path.read_text(encoding="utf-8")
+        info = path.stat()
     except FileNotFoundError:
-        raise ParameterError(f"parameter file {str(path)!r} not found") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ParameterError(f"parameter file {str(path)!r} cannot be read: {exc}") from None
+        raise ParameterError(f"parameter file {shown} not found") from None
+    except (OSError, ValueError) as exc:  # ValueError: a NUL in the name
+        raise ParameterError(f"parameter file {shown} cannot be read: {shorten(str(exc))}") from None
+    if not stat.S_ISREG(info.st_mode):  # a FIFO would block for ever, /dev/zero never end
+        raise ParameterError(f"parameter file {shown} is not a regular file")
+    if info.st_size > MAX_PARAMETER_FILE_BYTES:
+        raise ParameterError(
+            f"parameter file {shown} is {info.st_size} bytes; a parameter file is at most"
+            f" {MAX_PARAMETER_FILE_BYTES} bytes"
+        )
+    try:
+        with open(path, "rb") as handle:
+            text = handle.read(MAX_PARAMETER_FILE_BYTES + 1).decode("utf-8")
+    except FileNotFoundError:
+        raise ParameterError(f"parameter file {shown} not found") from None
+    except (OSError, ValueError) as exc:  # ValueError: not UTF-8
+        raise ParameterError(f"parameter file {shown} cannot be read: {shorten(str(exc))}") from None
+    if len(text) > MAX_PARAMETER_FILE_BYTES:
+        raise ParameterError(f"parameter file {shown} is longer than {MAX_PARAMETER_FILE_BYTES} bytes")
     return _parse_toml(text, str(path))
 
 
@@ -309,14 +332,21 @@ def load_parameters(
     if text in available_parameter_sets():
         resource = resources.files("stickslip") / "parameter_sets" / f"{text}.toml"
         params = _parse_toml(resource.read_text(encoding="utf-8"), text)
-    elif Path(text).is_file() or text.endswith(".toml") or "/" in text:
+    elif text.endswith(".toml") or "/" in text or _is_file(text):
         params = read_parameter_file(text)
     else:
         raise ParameterError(
-            f"unknown parameter set {text!r}: expected a built-in name"
+            f"unknown parameter set {shorten(text)}: expected a built-in name"
             f" ({', '.join(available_parameter_sets())}) or a TOML file"
         )
     return params.with_overrides(overrides)
+
+
+def _is_file(text: str) -> bool:
+    try:
+        return Path(text).is_file()
+    except (OSError, ValueError):  # a name too long for the system, or with a NUL byte
+        return False
 
 
 def replace(params: Parameters, **sections: Any) -> Parameters:
@@ -324,6 +354,6 @@ def replace(params: Parameters, **sections: Any) -> Parameters:
     changes = {}
     for s, values in sections.items():
         if s not in SECTIONS:
-            raise ParameterError(f"unknown section {s!r}")
+            raise ParameterError(f"unknown section {shorten(s)}")
         changes[s] = dataclasses.replace(getattr(params, s), **values)
     return dataclasses.replace(params, **changes)

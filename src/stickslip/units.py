@@ -1,7 +1,20 @@
 """The unit boundary: strings such as ``"224 us"`` become SI floats here, and only here.
 
-Inside the package every number is a float in SI base units.  pint does the
-parsing and the dimension check; this module adds the error messages.
+Inside the package every number is a float in SI base units.  A value string
+is a number followed by a unit expression (``"224 us"``, ``"1.22e14 1/m^2"``,
+``"20 degC"``); a bare number (``0.000224``, ``"0.000224"``) is already SI,
+in TOML files and in the Python API alike.  (The command line is stricter and
+refuses a bare non-zero number for a dimensional option: see
+:func:`bare_number` and :mod:`stickslip.cli.common`.)
+
+What is parsed is bounded before anything is evaluated: at most
+:data:`MAX_VALUE_LENGTH` characters, one leading number, and a unit
+expression whose only digits are small exponents (``m^2``, ``s**-1``), so no
+value string can make the program compute for long.  Common units
+(``um/s``, ``kPa``, ``1/m^2``, ...) are converted by a small table, which
+keeps pint (slow to import and to build) off the path of everyday commands;
+tests check every entry of the table against pint.  Anything else (``degC``,
+``ft``, ``angstrom**2``) goes to pint.
 """
 
 from __future__ import annotations
@@ -32,7 +45,56 @@ DIMENSIONS: dict[str, tuple[str, str]] = {
     "stress_per_velocity": ("[mass] / [length] ** 2 / [time]", "Pa s/m"),
 }
 
-_NUMBER_THEN_UNIT = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(.*?)\s*$")
+#: Exponents of (mass, length, time, temperature) of each dimension.
+_DIMENSION_VECTORS: dict[str, tuple[int, int, int, int]] = {
+    "dimensionless": (0, 0, 0, 0),
+    "time": (0, 0, 1, 0),
+    "length": (0, 1, 0, 0),
+    "velocity": (0, 1, -1, 0),
+    "rate": (0, 0, -1, 0),
+    "per_area": (0, -2, 0, 0),
+    "stiffness": (1, 0, -2, 0),
+    "temperature": (0, 0, 0, 1),
+    "stress": (1, -1, -2, 0),
+    "stress_rate": (1, -1, -3, 0),
+    "stress_per_length": (1, -2, -2, 0),
+    "force": (1, 1, -2, 0),
+    "area": (0, 2, 0, 0),
+    "stress_per_velocity": (1, -2, -1, 0),
+}
+
+#: Longest value string accepted (the longest sensible one is ~30 characters).
+MAX_VALUE_LENGTH = 200
+#: Longest piece of a user's value echoed in an error message.
+ECHO_LENGTH = 60
+
+_NUMBER = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
+_NUMBER_THEN_UNIT = re.compile(rf"^({_NUMBER})\s*(.*)$", re.DOTALL)
+#: An exponent pint may see: one or two digits, optionally a short fraction, not itself raised to a power.
+_EXPONENT = re.compile(r"(?:\^|\*\*)\s*[-+]?\d{1,2}(?:\.\d{1,3})?(?!\d)(?!\s*(?:\^|\*\*))")
+#: A leading "1" of "1/m^2" (also inside parentheses).
+_LEADING_ONE = re.compile(r"(?<![\w.])1(?=\s*/)")
+_UNIT_CHARACTERS = re.compile(r"^(?:[^\W\d]|[\s*/()°%])*$")
+
+#: Units converted without pint: symbol -> (factor to SI, (mass, length, time, temperature) exponents).
+_UNITS: dict[str, tuple[float, tuple[int, int, int, int]]] = {
+    "m": (1.0, (0, 1, 0, 0)),
+    "s": (1.0, (0, 0, 1, 0)),
+    "g": (1e-3, (1, 0, 0, 0)),
+    "N": (1.0, (1, 1, -2, 0)),
+    "Pa": (1.0, (1, -1, -2, 0)),
+    "J": (1.0, (1, 2, -2, 0)),
+    "Hz": (1.0, (0, 0, -1, 0)),
+    "K": (1.0, (0, 0, 0, 1)),
+}
+#: Units that take no prefix here.
+_PLAIN_UNITS: dict[str, tuple[float, tuple[int, int, int, int]]] = {
+    "angstrom": (1e-10, (0, 1, 0, 0)),
+    "min": (60.0, (0, 0, 1, 0)),
+    "h": (3600.0, (0, 0, 1, 0)),
+}
+_PREFIXES = {"G": 1e9, "M": 1e6, "k": 1e3, "c": 1e-2, "m": 1e-3, "u": 1e-6, "µ": 1e-6, "μ": 1e-6, "n": 1e-9, "p": 1e-12}
+_FAST_TOKEN = re.compile(r"\s*(?:(\*\*|\^)\s*([-+]?\d)|([*/])|([^\W\d]+)|(1)(?=\s*/)|(\S))")
 
 
 @lru_cache(maxsize=1)
@@ -44,46 +106,179 @@ def registry() -> Any:
     return ureg
 
 
+def shorten(value: Any, limit: int = ECHO_LENGTH) -> str:
+    """``repr(value)``, its middle cut out beyond ``limit`` characters, so that an error line stays short."""
+    text = repr(value)
+    if len(text) <= limit:
+        return text
+    head = (2 * limit) // 3
+    return f"{text[:head]}…{text[head - limit :]} ({len(text)} characters)"
+
+
 def _describe(dimension: str) -> str:
     unit = DIMENSIONS[dimension][1]
     return f"a {dimension.replace('_', ' ')}" + (f" (e.g. in {unit})" if unit else " number")
+
+
+def bare_number(text: str) -> float | None:
+    """The number if ``text`` is a number without a unit (``"50"``, ``" 1e-4 "``), else None."""
+    if len(text) > MAX_VALUE_LENGTH:
+        return None
+    try:
+        return float(text)
+    except ValueError:
+        return None
 
 
 def to_si(value: Any, dimension: str, name: str = "value") -> float:
     """Convert ``value`` to a float in SI base units of the given ``dimension``.
 
     ``value`` may be a number (taken as SI already), a string with a unit
-    (``"224 us"``, ``"20 degC"``, ``"350 um/s"``) or a pint quantity.
-    ``name`` is the key or option named in the error message.
+    (``"224 us"``, ``"20 degC"``, ``"350 um/s"``), a bare number as a string
+    (SI, like a number) or a pint quantity.  ``name`` is the key or option
+    named in the error message.
     """
     if dimension not in DIMENSIONS:
         raise KeyError(f"unknown dimension {dimension!r}")
     if isinstance(value, bool):
         raise UnitError(f"{name}: expected {_describe(dimension)}, got {value!r}")
     if isinstance(value, (int, float)):
-        return float(value)
-    ureg = registry()
-    if isinstance(value, str):
-        try:  # a bare number (also "nan", "inf") is SI; range checks are the caller's
+        try:
             return float(value)
-        except ValueError:
-            pass
-        quantity = _parse(value, name, dimension)
-    elif isinstance(value, ureg.Quantity):
-        quantity = value
-    else:
-        raise UnitError(f"{name}: expected {_describe(dimension)}, got {value!r}")
-    wanted = DIMENSIONS[dimension][0]
+        except OverflowError:  # a Python int beyond the float range
+            raise UnitError(f"{name}: {shorten(value)} is beyond the range of a float") from None
+    if isinstance(value, str):
+        return _string_to_si(value, dimension, name)
+    if hasattr(value, "dimensionality") and hasattr(value, "to"):
+        return _quantity_to_si(value, dimension, name, value)
+    raise UnitError(f"{name}: expected {_describe(dimension)}, got {shorten(value)}")
+
+
+def _string_to_si(text: str, dimension: str, name: str) -> float:
+    stripped = text.strip()
+    if not stripped:
+        raise UnitError(f"{name}: empty value, expected {_describe(dimension)}")
+    if len(stripped) > MAX_VALUE_LENGTH:
+        raise UnitError(
+            f"{name}: value of {len(stripped)} characters is too long (at most {MAX_VALUE_LENGTH}): {shorten(stripped)}"
+        )
+    number = bare_number(stripped)
+    if number is not None:  # a bare number (also "nan", "inf") is SI; range checks are the caller's
+        return number
+    match = _NUMBER_THEN_UNIT.match(stripped)
+    magnitude, unit = (float(match.group(1)), match.group(2).strip()) if match else (1.0, stripped)
+    if not _readable_unit(unit):
+        raise UnitError(
+            f"{name}: cannot read {shorten(stripped)} as {_describe(dimension)}:"
+            " expected a number and a unit, e.g. '350 um/s' (digits in a unit only as small exponents, m^2)"
+        )
+    fast = _fast_unit(unit)
+    if fast is not None:
+        if fast[1] != _DIMENSION_VECTORS[dimension]:
+            raise UnitError(
+                f"{name}: {shorten(stripped)} has dimension {_dimension_text(fast[1])}, expected {_describe(dimension)}"
+            )
+        return magnitude * fast[0]
+    return _quantity_to_si(_pint_quantity(magnitude, unit, stripped, name, dimension), dimension, name, stripped)
+
+
+def _readable_unit(unit: str) -> bool:
+    """Whether ``unit`` is a bounded unit expression: names, * / ( ), small exponents and a leading 1."""
+    rest = _LEADING_ONE.sub(" ", _EXPONENT.sub(" ", unit))
+    return bool(_UNIT_CHARACTERS.match(rest)) and "**" not in rest
+
+
+def _fast_unit(unit: str) -> tuple[float, tuple[int, ...]] | None:
+    """(factor, dimension exponents) of a product/quotient of table units, or None to ask pint.
+
+    Handles ``um/s``, ``1/m^2``, ``Pa*s/m``, ``N/m``, ``kPa`` and the like:
+    names joined by ``*`` and ``/`` (left to right), each with an optional
+    one-digit exponent.  Juxtaposition (``Pa s``) and parentheses go to pint.
+    """
+    factor, dims = 1.0, [0, 0, 0, 0]
+    sign, expect_term, position = 1, True, 0
+    while position < len(unit):
+        token = _FAST_TOKEN.match(unit, position)
+        if token is None:
+            return None
+        position = token.end()
+        operator, name, one, other = token.group(3, 4, 5, 6)
+        if other is not None:
+            return None
+        if operator is not None:
+            if expect_term:
+                return None
+            sign, expect_term = (-1 if operator == "/" else 1), True
+        elif name is not None or one is not None:
+            if not expect_term:
+                return None  # juxtaposition: pint's precedence rules, not ours
+            entry = (1.0, (0, 0, 0, 0)) if one is not None else _table_unit(name)
+            if entry is None:
+                return None
+            exponent = 1
+            after = _FAST_TOKEN.match(unit, position)
+            if after is not None and after.group(2) is not None:
+                exponent, position = int(after.group(2)), after.end()
+            factor = factor * entry[0] ** exponent if sign > 0 else factor / entry[0] ** exponent
+            dims = [d + sign * exponent * e for d, e in zip(dims, entry[1], strict=True)]
+            expect_term = False
+        else:  # an exponent with nothing to raise
+            return None
+    if expect_term:
+        return None
+    return factor, tuple(dims)
+
+
+def _dimension_text(vector: tuple[int, ...]) -> str:
+    """pint's way of writing a dimension: ``[length] / [time] ** 2``."""
+    names = ("[mass]", "[length]", "[time]", "[temperature]")
+    up = [n + (f" ** {e}" if e != 1 else "") for n, e in zip(names, vector, strict=True) if e > 0]
+    down = [n + (f" ** {-e}" if e != -1 else "") for n, e in zip(names, vector, strict=True) if e < 0]
+    if not up and not down:
+        return "dimensionless"
+    return " / ".join([" * ".join(up) or "1", *down])
+
+
+def _table_unit(name: str) -> tuple[float, tuple[int, int, int, int]] | None:
+    if name in _UNITS:
+        return _UNITS[name]
+    if name in _PLAIN_UNITS:
+        return _PLAIN_UNITS[name]
+    prefix, base = name[:1], name[1:]
+    if prefix in _PREFIXES and base in _UNITS:
+        return _PREFIXES[prefix] * _UNITS[base][0], _UNITS[base][1]
+    return None
+
+
+def _pint_quantity(magnitude: float, unit: str, text: str, name: str, dimension: str) -> Any:
     import pint
 
+    ureg = registry()
     try:
-        if wanted:
-            return float(quantity.to_base_units().to(ureg.parse_units(_base_unit(dimension))).magnitude)
-        return float(quantity.to("dimensionless").magnitude)
+        units = ureg.parse_units(unit) if unit else ureg.dimensionless
+        return ureg.Quantity(magnitude, units)
+    except pint.UndefinedUnitError as exc:
+        raise UnitError(f"{name}: unknown unit in {shorten(text)} ({shorten(str(exc))})") from None
+    except Exception:  # pint raises many things on garbage; all mean "not a quantity"
+        raise UnitError(f"{name}: cannot read {shorten(text)} as {_describe(dimension)}") from None
+
+
+def _quantity_to_si(quantity: Any, dimension: str, name: str, shown: Any) -> float:
+    import pint
+
+    ureg = registry()
+    if not isinstance(quantity, ureg.Quantity):
+        raise UnitError(f"{name}: a quantity from another pint registry; pass a string such as '350 um/s'")
+    try:
+        if dimension == "dimensionless":
+            return float(quantity.to("dimensionless").magnitude)
+        return float(quantity.to_base_units().to(ureg.parse_units(_base_unit(dimension))).magnitude)
     except pint.DimensionalityError:
         raise UnitError(
-            f"{name}: {value!r} has dimension {quantity.dimensionality}, expected {_describe(dimension)}"
+            f"{name}: {shorten(shown)} has dimension {quantity.dimensionality}, expected {_describe(dimension)}"
         ) from None
+    except (OverflowError, ZeroDivisionError, ValueError, TypeError):
+        raise UnitError(f"{name}: cannot read {shorten(shown)} as {_describe(dimension)}") from None
 
 
 def _base_unit(dimension: str) -> str:
@@ -104,30 +299,61 @@ def _base_unit(dimension: str) -> str:
     }[dimension]
 
 
-def _parse(text: str, name: str, dimension: str) -> Any:
-    import pint
-
-    ureg = registry()
-    text = text.strip()
-    if not text:
-        raise UnitError(f"{name}: empty value, expected {_describe(dimension)}")
-    match = _NUMBER_THEN_UNIT.match(text)
-    try:
-        if match:
-            number, unit = float(match.group(1)), match.group(2)
-            if not unit:  # a bare number is SI, whatever the dimension
-                return ureg.Quantity(number, _base_unit(dimension) if dimension != "dimensionless" else "")
-            return ureg.Quantity(number, unit)
-        return ureg.Quantity(ureg.parse_expression(text))
-    except (pint.UndefinedUnitError, pint.errors.DefinitionSyntaxError) as exc:
-        raise UnitError(f"{name}: unknown unit in {text!r} ({exc})") from None
-    except Exception:  # pint raises many things on garbage; all mean "not a quantity"
-        raise UnitError(f"{name}: cannot read {text!r} as {_describe(dimension)}") from None
-
-
 def format_si(value: float, dimension: str) -> str:
     """``value`` (SI) with its display unit, e.g. ``'0.000224 s'``."""
     unit = DIMENSIONS[dimension][1]
     if math.isinf(value):
         return "inf" + (f" {unit}" if unit else "")
     return f"{value:.6g}" + (f" {unit}" if unit else "")
+
+
+#: Units a person writes, per dimension: (factor to SI, unit), largest first; the first not above |value| is used.
+_WRITTEN_UNITS: dict[str, tuple[tuple[float, str], ...]] = {
+    "time": ((1.0, "s"), (1e-3, "ms"), (1e-6, "us"), (1e-9, "ns"), (1e-12, "ps")),
+    "length": ((1.0, "m"), (1e-3, "mm"), (1e-6, "um"), (1e-9, "nm"), (1e-10, "angstrom"), (1e-12, "pm")),
+    "velocity": ((1.0, "m/s"), (1e-3, "mm/s"), (1e-6, "um/s"), (1e-9, "nm/s")),
+    "stress": ((1e9, "GPa"), (1e6, "MPa"), (1e3, "kPa"), (1.0, "Pa"), (1e-3, "mPa")),
+    "force": ((1.0, "N"), (1e-3, "mN"), (1e-6, "uN"), (1e-9, "nN"), (1e-12, "pN")),
+}
+
+
+def format_quantity(value: float, dimension: str) -> str:
+    """``value`` (SI) as a person would write it: ``"360 um/s"``, ``"1.22e14 1/m^2"``, ``"1.0"``.
+
+    The unit is chosen for readability (SI prefixes for times, lengths,
+    velocities, stresses and forces) and the number has the fewest digits
+    that :func:`to_si` reads back as exactly ``value``.
+    """
+    if dimension == "dimensionless":
+        text = _shortest(value, "") or repr(value)
+        return text if any(c in text for c in ".en") else text + ".0"  # a TOML float, not an integer
+    si_unit = DIMENSIONS[dimension][1]
+    choices = _WRITTEN_UNITS.get(dimension, ((1.0, si_unit),))
+    unit = choices[0][1]
+    if value != 0 and math.isfinite(value):
+        unit = next((u for f, u in choices if abs(value) >= f * (1 - 1e-9)), choices[-1][1])
+    text = _shortest(value, unit)
+    return f"{text} {unit}" if text is not None else f"{value!r} {si_unit}"
+
+
+def _shortest(value: float, unit: str) -> str | None:
+    """The shortest number x such that ``"x unit"`` reads back as exactly ``value`` (None if there is none)."""
+    if not math.isfinite(value):
+        return None
+    fast = _fast_unit(unit) if unit else None
+    factor = fast[0] if fast is not None else 1.0  # units outside the table are SI units here
+    scaled = value / factor
+    candidates = [_plain(scaled, digits) for digits in range(1, 18)]
+    candidates += [repr(math.nextafter(scaled, math.copysign(math.inf, step))) for step in (1, -1)]
+    return next((text for text in candidates if float(text) * factor == value), None)
+
+
+def _plain(number: float, digits: int) -> str:
+    """``number`` to ``digits`` significant digits: ``360``, ``1.074``, ``1e-4``, ``1.22e14``."""
+    mantissa, exponent = f"{number:.{digits - 1}e}".split("e")
+    power = int(exponent)
+    if -3 <= power < 6:  # read as a plain decimal
+        text = f"{float(f'{mantissa}e{power}'):.{max(digits - 1 - power, 0)}f}"
+        return text.rstrip("0").rstrip(".") if "." in text else text
+    mantissa = mantissa.rstrip("0").rstrip(".") if "." in mantissa else mantissa
+    return f"{mantissa}e{power}"

@@ -13,7 +13,16 @@ from typing import Any
 
 import click
 
-from .common import emit_json, params_options, positive, resolve_params, save_figure, write_text
+from .common import (
+    InputFile,
+    emit_json,
+    params_options,
+    positive,
+    refuse_overwriting_inputs,
+    resolve_params,
+    save_figure,
+    write_text,
+)
 from .params_cmd import print_rich
 
 #: Columns of ``-o cycles.csv``: (field, SI unit).
@@ -50,7 +59,7 @@ TABLE_ROWS = (
 
 
 @click.command("analyze")
-@click.argument("trace", type=click.Path(dir_okay=False, path_type=Path))
+@click.argument("trace", type=InputFile())
 @click.option(
     "--v0", "v0_text", required=True, metavar="V", help='Pulling velocity, e.g. "50 um/s" (bare number: m/s).'
 )
@@ -95,6 +104,7 @@ def analyze_command(
     with --contact-area), units in header brackets (``time [s],stress [kPa]``;
     bare names are SI).  Empty stress cells are gaps.
     """
+    refuse_overwriting_inputs([trace], [("-o", output), ("--plot", plot_path)], params_name)
     from ..analysis import analyze_trace, compare_with_model, read_trace
 
     v0 = positive(v0_text, "velocity", "--v0")

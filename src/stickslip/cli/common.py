@@ -1,9 +1,21 @@
-"""Shared pieces of the command line: --params/--set, unit-aware options, output."""
+"""Shared pieces of the command line: --params/--set, unit-aware options, input files, output.
+
+On the command line a dimensional value needs its unit: ``--v0 "50 um/s"``,
+``--set bonds.bond_time="224 us"``.  A bare non-zero number (``--v0 50``) is
+refused with a line that shows how to write it, because nobody means 50 m/s;
+zero needs no unit, and dimensionless keys (``bonds.breakage_weight``) take
+bare numbers.  TOML files and the Python API keep reading bare numbers as SI.
+
+Every file a command writes goes through :mod:`stickslip.fileio` (atomic),
+and every input file is checked by :class:`InputFile` (a regular file of
+bounded size: a FIFO or /dev/zero is refused instead of read for ever).
+"""
 
 from __future__ import annotations
 
 import json
 import math
+import stat
 import sys
 from collections.abc import Callable, Sequence
 from pathlib import Path
@@ -11,9 +23,30 @@ from typing import Any
 
 import click
 
-from ..errors import ParameterError
-from ..parameters import Parameters, load_parameters
-from ..units import to_si
+from ..errors import ParameterError, UnitError
+from ..fileio import atomic_path, atomic_write_text, refuse_input_as_output
+from ..parameters import Parameters, key_dimension, load_parameters
+from ..units import DIMENSIONS, bare_number, shorten, to_si
+
+#: Largest data file (CSV) a command reads: a 10^7-sample record is about 0.4 GB.
+MAX_INPUT_BYTES = 2_000_000_000
+
+#: Unit shown in the example of the "needs a unit" message (beside SI).
+_EXAMPLE_UNITS = {
+    "time": "s",
+    "length": "um",
+    "velocity": "um/s",
+    "rate": "1/s",
+    "per_area": "1/m^2",
+    "stiffness": "N/m",
+    "temperature": "K",
+    "stress": "Pa",
+    "stress_rate": "Pa/s",
+    "stress_per_length": "kPa/m",
+    "force": "N",
+    "area": "cm^2",
+    "stress_per_velocity": "Pa s/m",
+}
 
 
 def params_options(func: Callable[..., Any]) -> Callable[..., Any]:
@@ -23,7 +56,7 @@ def params_options(func: Callable[..., Any]) -> Callable[..., Any]:
         "overrides",
         multiple=True,
         metavar="SECTION.KEY=VALUE",
-        help="Override one parameter (a value with a unit, or a bare number in SI); repeatable.",
+        help="Override one parameter, with its unit, e.g. bonds.bond_time='224 us'; repeatable.",
     )(func)
     func = click.option(
         "--params",
@@ -42,16 +75,55 @@ def resolve_params(params_name: str, overrides: Sequence[str]) -> Parameters:
     for item in overrides:
         key, sep, value = item.partition("=")
         if not sep or not key.strip():
-            raise ParameterError(f"--set {item!r}: expected SECTION.KEY=VALUE, e.g. bonds.bond_time='224 us'")
-        mapping[key.strip()] = value.strip()
+            raise ParameterError(f"--set {shorten(item)}: expected SECTION.KEY=VALUE, e.g. bonds.bond_time='224 us'")
+        key, value = key.strip(), value.strip()
+        require_unit(value, key_dimension(key), f"--set {key}=")
+        mapping[key] = value
     return load_parameters(params_name, overrides=mapping)
 
 
+def refuse_overwriting_inputs(
+    inputs: Sequence[Path | str | None], outputs: Sequence[tuple[str, Path | None]], params_name: str | None = None
+) -> None:
+    """Refuse (DataError, one line) any output that names an input: a data file, or the --params TOML file.
+
+    Call it before computing anything, so the user does not wait for a refusal.
+    """
+    files: list[str | Path | None] = list(inputs)
+    if params_name is not None:
+        files.append(params_name)  # a built-in set name is no file, and is skipped
+    refuse_input_as_output(files, list(outputs))
+
+
+def require_unit(text: str, dimension: str, prefix: str) -> None:
+    """Refuse a bare non-zero number for a dimensional value typed on the command line.
+
+    ``prefix`` is how the value was introduced (``"--v0 "``, ``"--set bonds.bond_time="``):
+    the message quotes it and shows the same option spelled with a unit.
+    """
+    number = bare_number(text)
+    if dimension == "dimensionless" or number is None or number == 0 or not math.isfinite(number):
+        return
+    typed = text.strip()
+    if len(typed) > 40:
+        typed = shorten(typed, 40)
+    unit = _EXAMPLE_UNITS.get(dimension, "")
+    si = DIMENSIONS[dimension][1]
+    hint = f'e.g. {prefix}"{typed} {unit}"' + (f' (or "{typed} {si}" if you mean SI)' if si != unit else "")
+    raise UnitError(f"{prefix}{typed}: a {dimension.replace('_', ' ')} needs a unit, {hint}")
+
+
 def quantity(text: str | float, dimension: str, name: str) -> float:
-    """An option value with an optional unit, as an SI float; must be finite."""
+    """An option value with its unit, as an SI float; must be finite.
+
+    A string that is a bare non-zero number is refused (see the module note);
+    a float passed by code (a default) is SI.
+    """
+    if isinstance(text, str):
+        require_unit(text, dimension, f"{name} ")
     value = to_si(text, dimension, name)
     if not math.isfinite(value):
-        raise ParameterError(f"{name}: expected a finite value, got {text!r}")
+        raise ParameterError(f"{name}: expected a finite value, got {shorten(text)}")
     return value
 
 
@@ -60,7 +132,7 @@ def positive(text: str | float, dimension: str, name: str, allow_zero: bool = Fa
     value = quantity(text, dimension, name)
     if value < 0 or (value == 0 and not allow_zero):
         expected = "a value >= 0" if allow_zero else "a positive value"
-        raise ParameterError(f"{name}: expected {expected}, got {text!r}")
+        raise ParameterError(f"{name}: expected {expected}, got {shorten(text)}")
     return value
 
 
@@ -94,18 +166,53 @@ def emit_json(obj: Any, output: Path | None = None) -> None:
 
 
 def write_text(path: Path, text: str) -> None:
+    """Write ``text`` atomically (the old file stays whole until the new one is complete)."""
     try:
-        Path(path).write_text(text, encoding="utf-8")
+        atomic_write_text(path, text)
     except OSError as exc:
-        raise click.FileError(str(path), hint=str(exc.strerror or exc)) from None
+        raise click.FileError(shorten(str(path)), hint=str(exc.strerror or exc)) from None
 
 
 def save_figure(fig: Any, path: Path) -> None:
-    """Save a matplotlib figure, turning I/O problems into a one-line error."""
+    """Save a matplotlib figure atomically, in the format its suffix names; I/O problems are one line."""
+    path = Path(path)
+    fmt = path.suffix[1:].lower() or "png"
     try:
-        fig.savefig(path, dpi=120, bbox_inches="tight")
+        with atomic_path(path, suffix=f".{fmt}") as temp:
+            fig.savefig(temp, format=fmt, dpi=120, bbox_inches="tight")
     except (OSError, ValueError) as exc:
-        raise click.FileError(str(path), hint=str(exc)) from None
+        hint = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
+        raise click.FileError(shorten(str(path)), hint=hint) from None
+
+
+class InputFile(click.ParamType):
+    """A file argument that must be a regular, readable file of at most :data:`MAX_INPUT_BYTES`.
+
+    Checked before reading, so a FIFO (which would block) or a device such as
+    /dev/zero (which never ends) is refused in one line.
+    """
+
+    name = "file"
+
+    def __init__(self, max_bytes: int = MAX_INPUT_BYTES) -> None:
+        self.max_bytes = max_bytes
+
+    def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> Path:
+        path = Path(value)
+        shown = shorten(str(value), 240)
+        try:
+            info = path.stat()
+        except FileNotFoundError:
+            self.fail(f"{shown}: file not found", param, ctx)
+        except (OSError, ValueError) as exc:
+            self.fail(f"{shown}: cannot be read ({getattr(exc, 'strerror', None) or exc})", param, ctx)
+        if stat.S_ISDIR(info.st_mode):
+            self.fail(f"{shown} is a folder, not a file", param, ctx)
+        if not stat.S_ISREG(info.st_mode):
+            self.fail(f"{shown} is not a regular file (save a pipe or device to a file first)", param, ctx)
+        if info.st_size > self.max_bytes:
+            self.fail(f"{shown} is {info.st_size} bytes; at most {self.max_bytes} bytes are read", param, ctx)
+        return path
 
 
 def echo_err(message: str) -> None:

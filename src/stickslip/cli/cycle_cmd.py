@@ -13,7 +13,15 @@ from typing import Any
 import click
 import numpy as np
 
-from .common import emit_json, params_options, positive, resolve_params, save_figure, write_text
+from .common import (
+    emit_json,
+    params_options,
+    positive,
+    refuse_overwriting_inputs,
+    resolve_params,
+    save_figure,
+    write_text,
+)
 from .params_cmd import print_rich
 
 #: Rows of the Nc/Nc0 table printed by ``stick`` (the whole curve is in --json and -o).
@@ -89,6 +97,7 @@ def simulate_command(
     """
     from ..model.cycle import COLUMN_UNITS, CYCLE_COLUMNS, simulate
 
+    refuse_overwriting_inputs([], [("-o", output), ("--plot", plot_path)], params_name)
     v0 = _velocity(v0_text)
     duration = positive(duration_text, "time", "--duration")
     start = _stress(start_text)
@@ -184,6 +193,7 @@ def stick_command(
     """
     from ..model.stick import stick_phase
 
+    refuse_overwriting_inputs([], [("-o", output), ("--plot", plot_path)], params_name)
     v0 = _velocity(v0_text)
     start = _stress(start_text)
     params = resolve_params(params_name, overrides)

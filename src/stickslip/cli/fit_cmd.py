@@ -12,9 +12,18 @@ from typing import Any
 
 import click
 
-from ..fitting.results import human
 from ..parameters import Parameters, key_dimension
-from .common import emit_json, params_options, positive, resolve_params, save_figure, write_text
+from .common import (
+    InputFile,
+    emit_json,
+    params_options,
+    positive,
+    refuse_overwriting_inputs,
+    require_unit,
+    resolve_params,
+    save_figure,
+    write_text,
+)
 
 SPLIT_DEFAULT = "800 um/s"
 
@@ -28,7 +37,7 @@ def _fix_values(items: tuple[str, ...]) -> dict[str, Any]:
             raise click.BadParameter(
                 f"{item!r}: expected KEY=VALUE, e.g. bonds.max_extension='1 um'", param_hint="--fix"
             )
-        key_dimension(key)  # unknown keys: ParameterError naming the valid ones
+        require_unit(value.strip(), key_dimension(key), f"--fix {key}=")  # unknown keys: ParameterError
         if key in out:
             raise click.BadParameter(f"{key} given twice", param_hint="--fix")
         out[key] = value.strip()
@@ -57,7 +66,7 @@ def fit_group() -> None:
 
 
 @fit_group.command("steady")
-@click.argument("data", type=click.Path(dir_okay=False, path_type=Path))
+@click.argument("data", type=InputFile())
 @click.option(
     "--method",
     type=click.Choice(["two-step", "joint"]),
@@ -128,6 +137,8 @@ def steady_command(
     Units go in the header (velocity [um/s]); bare names are SI.  Start values and
     everything not fitted come from --params/--set (default gelatin-glass).
     """
+    written = [("-o", output), ("--report", report_path), ("--plot", plot_path), ("--corner", corner_path)]
+    refuse_overwriting_inputs([data], written, params_name)
     from ..fitting.steady_fit import fit_steady
 
     if corner_path is not None and not bayes:
@@ -159,6 +170,8 @@ def steady_command(
         vc, sc = fit.critical_velocity, fit.critical_stress
         header = [f"Fitted by stickslip fit steady ({method}) to {data}; fitted keys: {', '.join(fit.free_keys)}."]
         if vc.value is not None and sc.value is not None:
+            from ..fitting.results import human  # not at module level: it imports lmfit (start-up time)
+
             header.append(f"Vc = {human(vc.value, 'velocity')}, sigma_c = {human(sc.value, 'stress')} (Eq 9).")
         write_text(output, _toml_with_header(fitted, header))
     report = fit.report() if posterior is None else fit.report() + "\n" + posterior.report()
@@ -194,7 +207,7 @@ def _bayes_module() -> Any:
 
 
 @fit_group.command("stick")
-@click.argument("table", type=click.Path(dir_okay=False, path_type=Path))
+@click.argument("table", type=InputFile())
 @click.option("--fix", "fix_items", multiple=True, metavar="KEY=VALUE", help="Hold a stick parameter at a value.")
 @click.option("--free", "free_keys", multiple=True, metavar="KEY", help="Prefer to fit this stick parameter.")
 @click.option("--exclude-row", "exclude_rows", multiple=True, type=int, metavar="N", help="Leave out file row N.")
@@ -231,6 +244,7 @@ def stick_command(
     other columns of the paper's Table 1).  Bond parameters, block and start values
     come from --params/--set: use the file written by 'stickslip fit steady -o'.
     """
+    refuse_overwriting_inputs([table], [("-o", output), ("--report", report_path), ("--plot", plot_path)], params_name)
     from ..fitting.stick_fit import fit_stick
 
     params = resolve_params(params_name, overrides)

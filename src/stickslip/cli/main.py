@@ -1,22 +1,38 @@
 """The ``stickslip`` command: a click group whose subcommands live one module per topic.
 
 Errors a user can cause end as one line on stderr and exit status 2; no
-traceback ever reaches the user.
+traceback and no raw numpy/scipy warning ever reaches the user (warnings are
+collected and summarised in one line).  ``stickslip`` alone prints the help.
+
+Start-up time matters (``stickslip critical`` should answer in well under
+half a second): the command modules import only click, numpy and the light
+parts of the package at module level; pint, pandas, matplotlib, scipy,
+lmfit and rich are imported inside the functions that use them.
 """
 
 from __future__ import annotations
 
+import os
 import sys
+import warnings
+from typing import Any
 
 import click
 
+from .. import __version__
 from ..errors import StickslipError
+
+#: Longest error line printed (a message quoting a huge value is cut).
+MAX_MESSAGE_LENGTH = 600
 
 
 @click.group(context_settings={"help_option_names": ["-h", "--help"]})
-@click.version_option(package_name="stickslip")
+@click.version_option(version=__version__, prog_name="stickslip")
 def cli() -> None:
-    """Friction and stick-slip of soft solids: the bond-population model of Juvekar & Singh."""
+    """Friction and stick-slip of soft solids: the bond-population model of Juvekar & Singh.
+
+    Values carry units: --v0 "50 um/s", --set bonds.bond_time="224 us".
+    """
 
 
 def _register() -> None:
@@ -29,28 +45,87 @@ def _register() -> None:
 _register()
 
 
-def main(argv: list[str] | None = None) -> None:
-    """Console entry point."""
+def _one_line(text: str) -> str:
+    text = " ".join(text.split())
+    if len(text) > MAX_MESSAGE_LENGTH:
+        text = text[: MAX_MESSAGE_LENGTH - 30] + f"… ({len(text)} characters)"
+    return text
+
+
+def _fail(message: str, status: int = 2) -> int:
+    click.echo(_one_line(f"stickslip: error: {message}"), err=True)
+    return status
+
+
+def _run(argv: list[str] | None) -> int:
+    """Run the command; the exit status, every error already reported in one line."""
     try:
         cli.main(args=argv, prog_name="stickslip", standalone_mode=False)
+    except click.exceptions.NoArgsIsHelpError as exc:  # `stickslip` or `stickslip fit` alone: the help
+        click.echo(exc.ctx.get_help())
+        return 0
     except click.exceptions.Abort:
         click.echo("stickslip: aborted", err=True)
-        sys.exit(130)
+        return 130
     except click.exceptions.Exit as exc:
-        sys.exit(exc.exit_code)
+        return int(exc.exit_code)
     except click.ClickException as exc:  # usage errors, bad option values, unwritable files
-        message = exc.format_message().replace("\n", " ")
-        click.echo(f"stickslip: error: {message}", err=True)
-        sys.exit(2)
+        return _fail(exc.format_message())
     except StickslipError as exc:
-        click.echo(f"stickslip: error: {exc}".replace("\n", " "), err=True)
-        sys.exit(2)
+        return _fail(str(exc))
     except KeyboardInterrupt:
-        sys.exit(130)
+        return 130
+    except BrokenPipeError:  # `stickslip curve --format csv | head`: the reader left
+        _silence_stdout()
+        return 1
+    except (OverflowError, FloatingPointError):
+        return _fail(
+            "a number left the floating-point range (about 1e-308 to 1e308) during the computation;"
+            " check that the input values are physical"
+        )
+    except MemoryError:
+        return _fail("out of memory: the input or the requested size is too large for this machine")
     except Exception as exc:  # a bug: still one line, but say it is ours
-        click.echo(f"stickslip: internal error ({type(exc).__name__}): {exc}".replace("\n", " "), err=True)
-        sys.exit(1)
-    sys.exit(0)
+        return _fail(f"internal error ({type(exc).__name__}): {exc}", status=1)
+    return 0
+
+
+def _silence_stdout() -> None:
+    """Point stdout at /dev/null so the interpreter's final flush does not fail again."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+    except (OSError, ValueError):  # stdout without a file descriptor (tests)
+        pass
+
+
+def main(argv: list[str] | None = None) -> None:
+    """Console entry point."""
+    caught: list[tuple[type[Warning], str]] = []
+
+    def collect(message: Any, category: type[Warning], *args: Any, **kwargs: Any) -> None:
+        caught.append((category, str(message)))
+
+    shown = warnings.showwarning
+    warnings.showwarning = collect  # numpy's "overflow encountered in exp" is not for the user's eyes
+    try:
+        status = _run(argv)
+    finally:
+        warnings.showwarning = shown
+    if status == 0 and caught:
+        click.echo(_one_line(f"stickslip: warning: {_warning_summary(caught)}"), err=True)
+    sys.exit(status)
+
+
+def _warning_summary(caught: list[tuple[type[Warning], str]]) -> str:
+    numeric = [text for category, text in caught if issubclass(category, RuntimeWarning)]
+    if numeric:
+        return (
+            f"the computation met floating-point trouble ({numeric[0]}"
+            + (f", and {len(numeric) - 1} more" if len(numeric) > 1 else "")
+            + "); check the numbers above"
+        )
+    return "; ".join(dict.fromkeys(text for _, text in caught))
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -20,7 +20,7 @@ import click
 
 from ..parameters import BOLTZMANN, SECTIONS, Parameters, available_parameter_sets, load_parameters
 from ..units import DIMENSIONS
-from .common import params_options, resolve_params, stdout_is_terminal, write_text
+from .common import params_options, refuse_overwriting_inputs, resolve_params, stdout_is_terminal, write_text
 
 #: Width of tables written to files or pipes (a terminal uses its own width).
 PLAIN_WIDTH = 140
@@ -194,8 +194,9 @@ def export_command(
 
     Loading the file back (`--params FILE`) gives exactly the same values.
     """
-    params = resolve_params(_chosen_set(ctx, name, params_name), overrides)
-    text = _with_override_note(params, overrides).to_toml()
+    chosen = _chosen_set(ctx, name, params_name)
+    refuse_overwriting_inputs([], [("-o", output)], chosen)
+    text = _with_override_note(resolve_params(chosen, overrides), overrides).to_toml()
     if output is None:
         click.echo(text, nl=False)
     else:

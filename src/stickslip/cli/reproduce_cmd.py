@@ -17,31 +17,36 @@ def register(cli: click.Group) -> None:
 @click.option(
     "-o",
     "--output",
-    type=click.Path(file_okay=False, path_type=Path),
-    default=Path("stickslip-report"),
+    default="stickslip-report",
     show_default=True,
-    help="Folder for report.html, results.json, the figures (PNG, SVG) and the curves (CSV).",
+    help="Folder for report.html, results.json, the figures (PNG, SVG) and the curves (CSV):"
+    " a new or empty folder, or one holding an earlier report.",
 )
 @click.option("--quiet", is_flag=True, help="Print nothing.")
-def reproduce(output: Path, quiet: bool) -> None:
+def reproduce(output: str, quiet: bool) -> None:
     """Recompute the paper's figures and every number it states; write an offline HTML report.
 
     The report (report.html, one self-contained file) puts each number the
     paper prints beside the value computed here, with the relative difference
     and a link to the erratum wherever they differ by more than 2 %.
+    Every file is written atomically; a folder holding anything but an
+    earlier report is refused.
     """
+    from ..report.build import prepare_report_folder
+
+    folder = prepare_report_folder(output)  # refuse a bad folder before computing anything
     import matplotlib
 
     matplotlib.use("Agg")
     from ..report import build_report
 
     if quiet:
-        build_report(output)
+        build_report(folder)
         return
     if sys.stderr.isatty():
-        report = _build_with_progress(output)
+        report = _build_with_progress(folder)
     else:
-        report = build_report(output)
+        report = build_report(folder)
     click.echo(f"report: {report.html} ({len(report.files)} files, {report.elapsed:.1f} s)")
 
 

@@ -14,7 +14,15 @@ import click
 import numpy as np
 
 from ..errors import ParameterError
-from .common import emit_json, params_options, positive, resolve_params, save_figure, write_text
+from .common import (
+    emit_json,
+    params_options,
+    positive,
+    refuse_overwriting_inputs,
+    resolve_params,
+    save_figure,
+    write_text,
+)
 from .params_cmd import human, print_rich
 
 DEFAULT_VMIN = "10 um/s"
@@ -123,6 +131,7 @@ def curve_command(
     """
     from ..model.steady import steady_state
 
+    refuse_overwriting_inputs([], [("-o", output), ("--plot", plot_path)], params_name)
     values, lo, hi = _velocities(velocity, vmin, vmax, points)
     params = resolve_params(params_name, overrides)
     result = steady_state(params, values, aging=not no_aging)

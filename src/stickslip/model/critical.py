@@ -16,8 +16,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import brentq
 
+from ..numerics.roots import brentq  # scipy.optimize would add 0.3 s to start-up
 from ..parameters import Parameters
 from .steady import ACCURATE_QUADRATURE, steady_state
 

@@ -7,6 +7,7 @@ The run is a list of named steps so that a caller can show progress
 from __future__ import annotations
 
 import json
+import stat
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -17,6 +18,7 @@ from typing import Any
 from ..errors import DataError
 from ..fileio import atomic_write_text
 from ..parameters import Parameters, load_parameters
+from ..units import shorten
 from .comparisons import TOLERANCE, Comparison, compare, count_classes
 from .computations import ModelRun, computed_values, run_steps
 from .errata import Errata, load_errata
@@ -48,15 +50,44 @@ class Report:
         return (self.html, self.results, *self.figures, *self.curves)
 
 
-def _prepare_folder(folder: Path) -> Path:
-    folder = Path(folder)
+#: Written first into every report folder, so that a later run recognises the folder as its own.
+MARKER = ".stickslip-report"
+
+
+def prepare_report_folder(where: str | Path) -> Path:
+    """The output folder: new, empty, or holding an earlier stickslip report; anything else is refused."""
+    if not str(where).strip():
+        raise DataError("output folder: empty path; name a folder, e.g. stickslip-report")
+    folder = Path(where)
+    shown = shorten(str(folder), 240)
     if folder.exists() and not folder.is_dir():
-        raise DataError(f"output folder {str(folder)!r} exists and is not a folder")
+        raise DataError(f"output folder {shown} exists and is not a folder")
     try:
+        if folder.is_dir() and any(folder.iterdir()) and not _holds_report(folder):
+            raise DataError(
+                f"output folder {shown} holds other files and no earlier stickslip report;"
+                " refusing to write into it (choose a new or empty folder)"
+            )
         folder.mkdir(parents=True, exist_ok=True)
+        atomic_write_text(folder / MARKER, "This folder holds a report written by stickslip reproduce.\n")
     except OSError as exc:
-        raise DataError(f"output folder {str(folder)!r} cannot be created: {exc.strerror or exc}") from None
+        raise DataError(f"output folder {shown} cannot be written: {exc.strerror or exc}") from None
     return folder
+
+
+def _holds_report(folder: Path) -> bool:
+    """Whether ``folder`` holds a report of ours: the marker, or (older reports) our results.json."""
+    if (folder / MARKER).is_file():
+        return True
+    results = folder / "results.json"
+    try:
+        info = results.stat()
+        if not stat.S_ISREG(info.st_mode) or info.st_size > 50_000_000:  # never block on a FIFO
+            return False
+        data = json.loads(results.read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return False
+    return isinstance(data, dict) and "stickslip_version" in data and data.get("paper") == PAPER
 
 
 def build_report(
@@ -68,10 +99,12 @@ def build_report(
 
     ``folder`` gets ``report.html`` (self-contained), ``results.json``, one
     PNG and one SVG per figure and one CSV per plotted curve.  ``params``
-    defaults to the built-in ``gelatin-glass`` set, the paper's.
+    defaults to the built-in ``gelatin-glass`` set, the paper's.  ``folder``
+    must be new, empty or hold an earlier report (a DataError otherwise), and
+    every file is written atomically.
     """
     started = time.perf_counter()
-    folder = _prepare_folder(Path(folder))
+    folder = prepare_report_folder(folder)
     params = params if params is not None else load_parameters("gelatin-glass")
     notify = progress or (lambda description, done, total: None)
 

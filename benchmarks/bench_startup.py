@@ -1,0 +1,81 @@
+"""Benchmark: how long a ``stickslip`` command takes to start and finish, issue 9 section 5.
+
+Each command runs as a fresh subprocess (as a user runs it), several times;
+the script prints the best and the median wall time and the child's CPU time
+(user + system), beside ``python -c pass`` (the interpreter alone) and
+``python -c "import numpy"`` as the plain references.  The target is
+<= 0.4 s for ``stickslip --help``, ``stickslip critical`` and ``stickslip curve``
+with a few velocities.
+
+    python benchmarks/bench_startup.py [--repeat N] [--compare OTHER_SRC]
+
+The package is taken from this checkout's ``src/``.  ``--compare`` times a
+second copy of the package (e.g. an older commit unpacked with
+``git archive COMMIT src | tar -x -C /tmp/old``, then ``--compare /tmp/old/src``)
+in the same run, command by command, so that both see the same machine load.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import platform
+import statistics
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+STICKSLIP = [sys.executable, "-m", "stickslip.cli.main"]
+CASES = (
+    ("python -c pass (reference)", [sys.executable, "-c", "pass"]),
+    ('python -c "import numpy" (reference)', [sys.executable, "-c", "import numpy"]),
+    ("stickslip --help", [*STICKSLIP, "--help"]),
+    ("stickslip critical", [*STICKSLIP, "critical"]),
+    ("stickslip critical --json", [*STICKSLIP, "critical", "--json"]),
+    (
+        "stickslip curve --velocity (3 velocities)",
+        [*STICKSLIP, "curve", "--velocity", "50 um/s", "--velocity", "350 um/s", "--velocity", "1 mm/s"],
+    ),
+    ("stickslip params show", [*STICKSLIP, "params", "show"]),
+)
+
+
+def run_once(command: list[str], env: dict[str, str]) -> tuple[float, float]:
+    """(wall time, child CPU time) of one run; the command must succeed."""
+    before = os.times()
+    start = time.perf_counter()
+    done = subprocess.run(command, env=env, capture_output=True, check=False)
+    wall = time.perf_counter() - start
+    after = os.times()
+    if done.returncode != 0:
+        raise SystemExit(f"{' '.join(command)} failed: {done.stderr.decode(errors='replace')}")
+    cpu = (after.children_user - before.children_user) + (after.children_system - before.children_system)
+    return wall, cpu
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--repeat", type=int, default=9, help="runs per command")
+    parser.add_argument("--compare", type=Path, default=None, help="another src/ folder to time beside this one")
+    args = parser.parse_args()
+    sources = {"": ROOT / "src"} if args.compare is None else {"this: ": ROOT / "src", "other: ": args.compare}
+    envs = {label: {**os.environ, "PYTHONPATH": str(src)} for label, src in sources.items()}
+    machine = f"Python {platform.python_version()} on {platform.machine()}, {os.cpu_count()} cores"
+    print(f"{machine}; {args.repeat} runs each, wall time and the child's CPU time (user + system)")
+    print(f"{'command':50s} {'best':>8s} {'median':>8s} {'cpu best':>9s} {'cpu med':>8s}")
+    for label, command in CASES:
+        for source, env in envs.items():
+            if source and "reference" in label and source != next(iter(envs)):
+                continue  # the references do not depend on the package
+            run_once(command, env)  # warm the file cache and the bytecode
+            walls, cpus = zip(*(run_once(command, env) for _ in range(args.repeat)), strict=True)
+            print(
+                f"{source + label:50s} {min(walls):7.3f}s {statistics.median(walls):7.3f}s"
+                f" {min(cpus):8.3f}s {statistics.median(cpus):7.3f}s"
+            )
+
+
+if __name__ == "__main__":
+    main()
