@@ -202,3 +202,14 @@ def test_sweep_plot_command_writes_an_image_and_refuses_unknown_keys(small_sweep
     assert status == 0 and image.read_bytes()[:4] == b"\x89PNG" and str(image) in out
     status, _, err = run_main(capsys, "sweep", "plot", str(folder), "--y", "bonds.bond_time")
     assert status == 2 and "not a varied key" in err and err.count("\n") == 1
+
+
+def test_progress_is_plain_lines_when_not_a_terminal_and_nothing_when_quiet(tmp_path, capsys):
+    args = ["sweep", "--vary", "pulling_velocity=1 mm/s,2 mm/s", "--workers", "0", "-o"]
+    status, out, err = run_main(capsys, *args, str(tmp_path / "a"))
+    assert status == 0 and out == ""
+    assert err.splitlines()[0] == "sweep: 2 points" and "2/2 points (100%)" in err
+    assert err.splitlines()[-1] == f"sweep: 2 points in {tmp_path / 'a'} (0 failed); regimes: steady 2"
+    status, out, err = run_main(capsys, *args, str(tmp_path / "a"))  # resumed: nothing left to do
+    assert status == 0 and "2 already done" in err
+    assert run_main(capsys, *args, str(tmp_path / "b"), "--quiet")[1:] == ("", "")

@@ -108,39 +108,27 @@ def sweep(
     vary: Sequence[str] | Mapping[str, Any],
     output: str | Path | None = None,
     *,
-    model: str = "quasi-static",
-    params: str | Parameters = "gelatin-glass",
-    overrides: Mapping[str, Any] | None = None,
-    pulling_velocity: float | str | None = None,
-    duration: float | str = DEFAULT_DURATION,
-    samples: int | None = None,
-    seed: int = 0,
-    jump_curve: str = "aging",
     workers: int | None = None,
     scheduler: str | None = None,
     overwrite: bool = False,
     quiet: bool = True,
+    **specification: Any,
 ) -> Any:
     """Run a sweep and return its rows as a pandas DataFrame (sorted by point; inputs and results in SI).
 
     >>> frame = sweep(["pulling_velocity=10 um/s..1 mm/s:5:log"], workers=0)  # doctest: +SKIP
+    >>> frame = sweep({"block.height": "5 mm..2 cm:4"}, pulling_velocity="50 um/s", samples=None)  # doctest: +SKIP
+
+    ``specification`` are the keywords of :func:`build_spec` (``model``, ``params``, ``overrides``,
+    ``pulling_velocity``, ``duration``, ``samples``, ``seed``, ``jump_curve``); ``workers``, ``scheduler``
+    and ``overwrite`` those of :func:`run_sweep`; ``quiet=False`` shows progress on standard error.
 
     With ``output`` the rows are also kept there as Parquet chunks, and a
     second call with the same arguments resumes (or just reads) them.  The
     returned frame holds every row in memory: for sweeps too large for that,
     give ``output`` and read the folder with pyarrow datasets instead.
     """
-    spec = build_spec(
-        vary,
-        model=model,
-        params=params,
-        overrides=overrides,
-        pulling_velocity=pulling_velocity,
-        duration=duration,
-        samples=samples,
-        seed=seed,
-        jump_curve=jump_curve,
-    )
+    spec = build_spec(vary, **specification)
     folder = Path(output) if output is not None else Path(tempfile.mkdtemp(prefix="stickslip-sweep-"))
     try:
         run_sweep(spec, folder, workers=workers, scheduler=scheduler, overwrite=overwrite, progress=reporter(quiet))
