@@ -213,3 +213,15 @@ def test_progress_is_plain_lines_when_not_a_terminal_and_nothing_when_quiet(tmp_
     status, out, err = run_main(capsys, *args, str(tmp_path / "a"))  # resumed: nothing left to do
     assert status == 0 and "2 already done" in err
     assert run_main(capsys, *args, str(tmp_path / "b"), "--quiet")[1:] == ("", "")
+
+
+@pytest.mark.parametrize("model", ["transient", "rsf"])
+def test_a_model_not_in_this_version_is_refused_in_one_line(model, tmp_path, capsys):
+    import importlib.util
+
+    if importlib.util.find_spec(f"stickslip.{model}") is not None:
+        pytest.skip(f"stickslip.{model} is present")
+    status, _, err = run_main(
+        capsys, "sweep", "--model", model, "--vary", "pulling_velocity=1 mm/s", "-o", str(tmp_path)
+    )
+    assert status == 2 and f"no stickslip.{model} module" in err and err.count("\n") == 1, err

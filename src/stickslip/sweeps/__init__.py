@@ -54,6 +54,7 @@ def build_spec(
     ``{key: "LO..HI:N" or [values]}``; ``samples`` makes it a Latin hypercube over ranges ``LO..HI[:log]``.
     """
     adapter = get_model(model)
+    adapter.check_available()
     dimensions = adapter.dimensions()
     axes = tuple(_axis(item, dimensions) for item in _vary_texts(vary))
     design = check_design(axes, samples)

@@ -145,6 +145,9 @@ class QuasiStatic(BondModel):
 
     name = "quasi-static"
 
+    def check_available(self) -> None:
+        return None
+
     def run(self, values: Mapping[str, float], settings: Mapping[str, Any]) -> dict[str, Any]:
         from ..model.cycle import simulate
 
@@ -200,6 +203,9 @@ class Transient(BondModel):
     """The time-dependent population balance (Eqs 1-5), ``stickslip.transient.run_transient``."""
 
     name = "transient"
+
+    def check_available(self) -> None:
+        _require("stickslip.transient", self.name)
 
     def run(self, values: Mapping[str, float], settings: Mapping[str, Any]) -> dict[str, Any]:
         transient = _require("stickslip.transient", self.name)
@@ -283,6 +289,9 @@ class RateAndState:
 
     def dimensions(self) -> dict[str, str]:
         return {k: d for k, (d, _) in self.KEYS.items()}
+
+    def check_available(self) -> None:
+        _require("stickslip.rsf", self.name)
 
     def fixed_values(self, params: str | Parameters, overrides: Mapping[str, Any]) -> tuple[dict[str, float], str]:
         from ..units import to_si
