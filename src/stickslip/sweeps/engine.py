@@ -83,13 +83,20 @@ def dask_client(workers: int | None = None, scheduler: str | None = None) -> Ite
     count = workers if workers is not None else (os.cpu_count() or 1)
     if count < 1:
         raise StickslipError(f"--workers: expected at least 1 worker process, got {count}")
-    cluster = LocalCluster(
-        n_workers=count,
-        threads_per_worker=1,  # the model is Python and numpy on small arrays: processes, not threads
-        processes=True,
-        dashboard_address=None,
-        silence_logs=logging.ERROR,
-    )
+    try:
+        cluster = LocalCluster(
+            n_workers=count,
+            threads_per_worker=1,  # the model is Python and numpy on small arrays: processes, not threads
+            processes=True,
+            dashboard_address=None,
+            scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},  # its status server on a free port, not 8787
+            silence_logs=logging.ERROR,
+        )
+    except RuntimeError as exc:  # typically a script without the __main__ guard that spawned processes need
+        raise StickslipError(
+            f"could not start {count} local dask worker processes ({exc}); a script that runs a sweep must call it"
+            " under `if __name__ == '__main__':`, or use workers=0 to run in this process"
+        ) from None
     with cluster, Client(cluster) as client:
         yield client
 
