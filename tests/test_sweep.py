@@ -225,3 +225,12 @@ def test_a_model_not_in_this_version_is_refused_in_one_line(model, tmp_path, cap
         capsys, "sweep", "--model", model, "--vary", "pulling_velocity=1 mm/s", "-o", str(tmp_path)
     )
     assert status == 2 and f"no stickslip.{model} module" in err and err.count("\n") == 1, err
+
+
+def test_a_sweep_of_another_stickslip_version_is_refused(tmp_path):
+    spec = build_spec(["pulling_velocity=1 mm/s"])
+    run_sweep(spec, tmp_path, workers=0)
+    manifest = json.loads((tmp_path / MANIFEST).read_text())
+    (tmp_path / MANIFEST).write_text(json.dumps({**manifest, "version": "0.0.1"}))
+    with pytest.raises(ParameterError, match=r"same specification but stickslip 0\.0\.1"):
+        run_sweep(spec, tmp_path, workers=0)

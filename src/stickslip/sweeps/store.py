@@ -100,13 +100,15 @@ def open_store(folder: str | Path, spec: SweepSpec, batch_size: int, overwrite: 
         )
     manifest = read_manifest(path) if (path / MANIFEST).exists() else None
     if manifest is not None and not overwrite:
-        if manifest["specification"] != json.loads(spec.to_json()) or manifest["version"] != __version__:
-            why = "another version of stickslip" if manifest["version"] != __version__ else "another specification"
-            raise ParameterError(
-                f"-o {folder}: holds a sweep with {why} ({_difference(manifest['specification'], spec)});"
-                " give another output folder, or --overwrite to replace it"
-            )
-        return SweepStore(path, spec, int(manifest["batch_size"]), __version__)
+        if manifest["specification"] != json.loads(spec.to_json()):
+            why = f"another specification ({_difference(manifest['specification'], spec)})"
+        elif manifest["version"] != __version__:
+            why = f"the same specification but stickslip {manifest['version']} (this is {__version__})"
+        else:
+            return SweepStore(path, spec, int(manifest["batch_size"]), __version__)
+        raise ParameterError(
+            f"-o {folder}: holds a sweep of {why}; give another output folder, or --overwrite to replace it"
+        )
     if manifest is None and any(_CHUNK.match(p.name) for p in path.iterdir()) and not overwrite:
         raise DataError(f"-o {folder}: holds Parquet chunks but no {MANIFEST}; give --overwrite to replace them")
     for old in path.iterdir():
@@ -154,7 +156,7 @@ def _difference(old: Mapping[str, Any], spec: SweepSpec) -> str:
             if key == "axes":
                 return f"varied {[a['key'] for a in old[key]]} with other values than now"
             return f"{key} {old.get(key)!r}, now {new.get(key)!r}"
-    return "same specification"
+    return "it differs"
 
 
 def _remove_temporaries(folder: Path) -> None:
