@@ -75,7 +75,9 @@ def run(spec, workers: int) -> dict[str, float]:
             wall = time.perf_counter() - started
             client_cpu = time.process_time() - cpu
             after = client.run(time.process_time)
+        size = sum(p.stat().st_size for p in (Path(folder) / "out").iterdir())
         return {
+            "bytes_per_row": size / spec.size,
             "start": started - began,
             "wall": wall,
             "client_cpu": client_cpu,
@@ -91,9 +93,9 @@ def main() -> None:
     spec = build_spec(grid(args.points))
     small = build_spec(grid(args.small))
     print(f"sweep of {spec.size} quasi-static points (100 s runs), batches of {default_batch_size(spec.size)}")
-    walls, cpu = plain_loop(spec, 2)
+    walls, cpu = plain_loop(spec, 5)
     print(
-        f"plain loop of simulate (2 rows of the grid, 3 passes): best {min(walls) * 1e3:.1f} ms,"
+        f"plain loop of simulate (5 rows of the grid, 3 passes): best {min(walls) * 1e3:.1f} ms,"
         f" median {statistics.median(walls) * 1e3:.1f} ms per point wall; {cpu * 1e3:.1f} ms CPU"
         f" -> {spec.size} points in one process: {min(walls) * spec.size:.0f} s wall"
     )
@@ -102,7 +104,8 @@ def main() -> None:
         f"sweep, 2 workers: {big['wall']:.1f} s wall ({big['wall'] / spec.size * 1e3:.2f} ms per point)"
         f" + {big['start']:.1f} s cluster start; workers' CPU {big['worker_cpu']:.1f} s"
         f" ({big['worker_cpu'] / spec.size * 1e3:.1f} ms per point), this process's CPU {big['client_cpu']:.1f} s;"
-        f" on 2 idle cores: about {big['worker_cpu'] / 2 + big['client_cpu'] / 2:.0f} s"
+        f" on 2 idle cores: about {big['worker_cpu'] / 2 + big['client_cpu'] / 2:.0f} s;"
+        f" output {big['bytes_per_row']:.0f} bytes per row"
     )
     one, two = run(small, 1), run(small, 2)
     print(

@@ -234,3 +234,15 @@ def test_a_sweep_of_another_stickslip_version_is_refused(tmp_path):
     (tmp_path / MANIFEST).write_text(json.dumps({**manifest, "version": "0.0.1"}))
     with pytest.raises(ParameterError, match=r"same specification but stickslip 0\.0\.1"):
         run_sweep(spec, tmp_path, workers=0)
+
+
+def test_the_steady_curve_is_solved_once_for_every_block_and_stick(params):
+    from stickslip.model import jump
+
+    stickslip.simulate(params, 50e-6, 30.0)
+    before = jump.cached_critical_point.cache_info().misses, jump.branch_interpolant.cache_info().misses
+    for height in (0.007, 0.013):
+        other = params.with_overrides({"block.height": height, "stick.aging_time": "12 s"})
+        assert stickslip.simulate(other, 50e-6, 30.0).critical_velocity == stickslip.critical_point(params).velocity
+    after = jump.cached_critical_point.cache_info().misses, jump.branch_interpolant.cache_info().misses
+    assert after == before
