@@ -63,6 +63,7 @@ def test_linear_range_and_explicit_list_convert_units_to_si():
         (["--vary", "block.height=1 cm..2 cm:3"], "give --v0 V"),
         (["--vary", "block.height=1 cm,2 cm", "--vary", "block.stiffness=1 kPa/m", "--v0", "1 mm/s"], "only one"),
         (["--vary", "pulling_velocity=5 um/s", "--duration", "-3 s"], "--duration"),
+        (["--vary", "pulling_velocity=5 um/s", "--v0", "5 um/s"], "give the pulling velocity once"),
     ],
 )
 def test_bad_sweep_options_fail_in_one_line(capsys, tmp_path, args, expected):

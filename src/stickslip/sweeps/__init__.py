@@ -59,6 +59,8 @@ def build_spec(
     axes = tuple(_axis(item, dimensions) for item in _vary_texts(vary))
     design = check_design(axes, samples)
     given = dict(overrides or {})
+    if pulling_velocity is not None and "pulling_velocity" in {a.key for a in axes}:
+        raise ParameterError("--v0 and --vary pulling_velocity: give the pulling velocity once")
     if pulling_velocity is not None:
         given["pulling_velocity"] = pulling_velocity
     fixed, label = adapter.fixed_values(params, given)

@@ -325,9 +325,7 @@ class RateAndState:
             "peak_friction": _float(getattr(result, "peak_friction", None)),
             "trough_friction": _float(getattr(result, "trough_friction", None)),
             "mean_friction": _float(getattr(result, "mean_friction", None)),
-            "cycles": int(
-                getattr(result, "cycles", 0) if not isinstance(result.cycles, (list, tuple)) else len(result.cycles)
-            ),
+            "cycles": _count(getattr(result, "cycles", 0)),
             "critical_stiffness": self.critical_stiffness(values),
             "message": result.message,
         }
@@ -341,6 +339,11 @@ class RateAndState:
         along, critical = kc.index.to_numpy(dtype=float), kc.to_numpy(dtype=float)
         curve = (critical, along) if x == "k" else (along, critical)
         return [Boundary(curve[0], curve[1], "k = kc = σ(b − a)/Dc")]
+
+
+def _count(cycles: Any) -> int:
+    """A number of cycles, given as a count or as the cycles themselves."""
+    return len(cycles) if isinstance(cycles, (list, tuple)) else int(cycles or 0)
 
 
 def _float(value: Any) -> float:
