@@ -27,6 +27,20 @@ REGIME_COLORS = {
 }
 #: Display units: velocities in µm/s, everything else in SI.
 DISPLAY = {"velocity": (1e6, "µm/s")}
+#: Units of the result columns in colour (SI, as stored).
+RESULT_UNITS = {
+    "period": "s",
+    "stick_time": "s",
+    "peak_stress": "Pa",
+    "mean_stress": "Pa",
+    "jump_velocity": "m/s",
+    "critical_velocity": "m/s",
+    "wall_time": "s",
+    "peak_friction": "",
+    "trough_friction": "",
+    "mean_friction": "",
+    "critical_stiffness": "Pa/m",
+}
 #: Values whose largest/smallest ratio is at least this get a log axis or a log colour scale.
 DECADES = 30.0
 
@@ -149,4 +163,5 @@ def _draw_numbers(ax: Axes, xs: np.ndarray, ys: np.ndarray, values: np.ndarray, 
         mappable = ax.pcolormesh(ex, ey, np.ma.masked_invalid(grid), cmap="viridis", norm=norm)
     else:
         mappable = ax.scatter(xs, ys, c=values, s=14, cmap="viridis", norm=norm, plotnonfinite=False)
-    ax.figure.colorbar(mappable, ax=ax, label=f"{name} (SI; blank: none)")
+    unit = RESULT_UNITS.get(name, "")
+    ax.figure.colorbar(mappable, ax=ax, label=f"{name} ({unit}); blank: none" if unit else f"{name}; blank: none")
