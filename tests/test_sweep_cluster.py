@@ -91,7 +91,7 @@ def test_sigkill_midway_then_resume_gives_exactly_the_uninterrupted_rows(cluster
     command = _sweep_command(folder, cluster.scheduler_address)
     env = {**os.environ, "PYTHONPATH": SRC + os.pathsep + os.environ.get("PYTHONPATH", "")}
     process = subprocess.Popen(command, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
-    deadline = time.monotonic() + 60
+    deadline = time.monotonic() + 120
     while _chunks(folder) < 2 and process.poll() is None and time.monotonic() < deadline:
         time.sleep(0.01)
     children = psutil.Process(process.pid).children(recursive=True) if process.poll() is None else []
