@@ -95,9 +95,12 @@ def run_sweep(
     """Run (or resume) ``spec`` into the folder ``output``; ``workers=0`` runs in this process, without dask."""
     store = open_store(output, spec, batch_size or default_batch_size(spec.size), overwrite=overwrite)
     shown = progress if progress is not None else Silent()
-    shown.start(spec.size, store.rows_done(store.finished()))
+    finished = store.finished()
+    shown.start(spec.size, store.rows_done(finished))
     try:
-        if workers == 0 and scheduler is None:
+        if len(finished) == store.batches:
+            pass  # all done already: no cluster to start
+        elif workers == 0 and scheduler is None:
             compute(store, None, shown.advance)
         else:
             with dask_client(workers, scheduler) as client:
