@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 import json
 import math
+import sys
 
 import numpy as np
 import pandas as pd
@@ -247,3 +249,65 @@ def test_the_steady_curve_is_solved_once_for_every_block_and_stick(params):
         assert stickslip.simulate(other, 50e-6, 30.0).critical_velocity == stickslip.critical_point(params).velocity
     after = jump.cached_critical_point.cache_info().misses, jump.branch_interpolant.cache_info().misses
     assert after == before
+
+
+# --------------------------------------------------------------------------- the adapters of models still to land
+def test_transient_adapter_follows_its_contract(monkeypatch, params):
+    """A stand-in ``stickslip.transient`` (the quasi-static cycle behind the contract's names) runs the adapter."""
+    import types
+
+    calls = []
+
+    def run_transient(p, protocol, control, start):
+        calls.append((control, start, protocol.initial_velocity, protocol.duration))
+        return stickslip.simulate(p, protocol.initial_velocity, protocol.duration)
+
+    fake = types.SimpleNamespace(run_transient=run_transient, critical_stiffness=lambda p, v: 2e5 * (v / 1e-4) ** 0.5)
+    monkeypatch.setitem(sys.modules, "stickslip.transient", fake)
+    vary = ["pulling_velocity=50 um/s,1 mm/s", "block.effective_stiffness=100 kPa/m,300 kPa/m"]
+    transient = stickslip.sweep(vary, model="transient", duration="60 s", workers=0)
+    quasi = stickslip.sweep(vary, duration="60 s", workers=0)
+    assert calls[0][:2] == ("block", "steady") and calls[0][2:] == pytest.approx((50e-6, 60.0)) and len(calls) == 4
+    pd.testing.assert_series_equal(transient["regime"], quasi["regime"])
+    np.testing.assert_allclose(transient["period"], quasi["period"], rtol=1e-12)  # the last whole cycle = the first
+    spec = build_spec(vary, model="transient", duration="60 s")
+    ax = plot_phase_diagram(transient, spec, x="pulling_velocity", y="block.effective_stiffness")
+    line = next(line for line in ax.get_lines() if line.get_label().startswith("K = Kc"))
+    v = line.get_xdata() / 1e6  # drawn in um/s
+    np.testing.assert_allclose(line.get_ydata(), 2e5 * (v / 1e-4) ** 0.5, rtol=1e-12)
+
+
+def test_rate_and_state_adapter_follows_its_contract(monkeypatch):
+    import types
+
+    @dataclasses.dataclass(frozen=True)
+    class RSFParameters:
+        a: float
+        b: float
+        dc: float
+        stiffness: float
+        eta: float
+        mu0: float
+        v_ref: float
+        normal_stress: float
+
+    def simulate(p, protocol):
+        unstable = p.stiffness < p.normal_stress * (p.b - p.a) / p.dc
+        return types.SimpleNamespace(
+            regime="stick-slip" if unstable else "steady",
+            period=1.0 if unstable else None,
+            peak_friction=0.62,
+            trough_friction=0.58,
+            cycles=[1, 2, 3] if unstable else [],
+            message="stand-in",
+        )
+
+    monkeypatch.setitem(
+        sys.modules, "stickslip.rsf", types.SimpleNamespace(RSFParameters=RSFParameters, simulate=simulate)
+    )
+    vary = ["k=100 MPa/m..1 GPa/m:3:log", "Dc=5 um,20 um"]
+    frame = stickslip.sweep(vary, model="rsf", overrides={"normal_stress": "10 MPa"}, duration="10 s", workers=0)
+    kc = 10e6 * (0.015 - 0.010) / frame["dc"]
+    np.testing.assert_allclose(frame["critical_stiffness"], kc, rtol=1e-12)
+    assert (frame["regime"] == np.where(frame["k"] < kc, "stick-slip", "steady")).all()
+    assert frame["cycles"].tolist() == [3 if k < c else 0 for k, c in zip(frame["k"], kc, strict=True)]
