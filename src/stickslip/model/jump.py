@@ -127,7 +127,7 @@ def steady_curve_key(params: Parameters) -> Parameters:
 
 @lru_cache(maxsize=32)
 def cached_critical_point(params: Parameters) -> CriticalPoint:
-    """:func:`critical_point` once per parameter set (parameters are frozen, so they are a safe key)."""
+    """:func:`critical_point` once per key (callers pass :func:`steady_curve_key`: once per steady curve)."""
     return critical_point(params)
 
 
