@@ -89,9 +89,16 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--points", type=int, default=10_000)
     parser.add_argument("--small", type=int, default=2_000, help="points of the 1-vs-2-worker comparison")
+    parser.add_argument("--speedup-only", action="store_true", help="only the 1-vs-2-worker comparison")
     args = parser.parse_args()
     spec = build_spec(grid(args.points))
     small = build_spec(grid(args.small))
+    if not args.speedup_only:
+        big_sweep(spec)
+    speedup(small)
+
+
+def big_sweep(spec) -> None:
     print(f"sweep of {spec.size} quasi-static points (100 s runs), batches of {default_batch_size(spec.size)}")
     walls, cpu = plain_loop(spec, 5)
     print(
@@ -107,6 +114,9 @@ def main() -> None:
         f" on 2 idle cores: about {big['worker_cpu'] / 2 + big['client_cpu'] / 2:.0f} s;"
         f" output {big['bytes_per_row']:.0f} bytes per row"
     )
+
+
+def speedup(small) -> None:
     one, two = run(small, 1), run(small, 2)
     print(
         f"{small.size} points: 1 worker {one['wall']:.1f} s, 2 workers {two['wall']:.1f} s wall:"
