@@ -411,7 +411,8 @@ def test_stick_jump_and_slip_numbers_match_the_paper(rows: dict) -> None:
 
 
 def test_figures_are_the_papers(results: dict) -> None:
-    assert [f["number"] for f in results["figures"]] == ["Figs 1 and 4", "Fig 2", "Figs 3 and 6", "Fig 5a-c", "Fig 5d"]
+    numbers = [f["number"] for f in results["figures"]]
+    assert numbers == ["Figs 1 and 4", "Fig 2", "Figs 3 and 6", "Fig 5a-c", "Fig 5d", "Phase diagram"]
     panels = {c["panel"] for f in results["figures"] if f["number"] == "Fig 5a-c" for c in f["curves"]}
     assert panels == {"a", "b", "c"}
 

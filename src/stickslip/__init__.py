@@ -50,6 +50,7 @@ _LAZY = {
     "analyze_trace": "stickslip.analysis",
     "read_trace": "stickslip.analysis",
     "compare_with_model": "stickslip.analysis",
+    "sweep": "stickslip.sweeps",
 }
 
 __all__ = [

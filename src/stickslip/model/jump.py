@@ -23,6 +23,7 @@ method finds the root of the series.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -34,7 +35,7 @@ from numpy.polynomial import chebyshev as cheb
 from scipy.optimize import brentq
 
 from ..errors import ModelError, ParameterError
-from ..parameters import Parameters
+from ..parameters import BlockParameters, Parameters, StickParameters
 from .critical import CriticalPoint, critical_point
 from .steady import ACCURATE_QUADRATURE, steady_state
 
@@ -111,15 +112,28 @@ def to_unit(x: np.ndarray | float, lo: float, hi: float) -> np.ndarray:
 
 
 # --------------------------------------------------------------------------- the steady curve, cached
+_ANY_STICK = StickParameters(1.0, 1.0, 1.0)
+_ANY_BLOCK = BlockParameters(1.0, 1.0, 1.0, 1.0)
+
+
+def steady_curve_key(params: Parameters) -> Parameters:
+    """``params`` with all but the bonds and aging sections replaced by fixed values: the cache key of the curve.
+
+    The steady curve (Eqs 6-8), its critical point and its branch depend on nothing else, so a sweep over the
+    block's stiffness or the stick parameters (or a renamed set) reuses them instead of solving them again.
+    """
+    return dataclasses.replace(params, stick=_ANY_STICK, block=_ANY_BLOCK, name="", description="", reference="")
+
+
 @lru_cache(maxsize=32)
 def cached_critical_point(params: Parameters) -> CriticalPoint:
-    """:func:`critical_point` once per parameter set (parameters are frozen, so they are a safe key)."""
+    """:func:`critical_point` once per key (callers pass :func:`steady_curve_key`: once per steady curve)."""
     return critical_point(params)
 
 
 def require_critical_point(params: Parameters) -> CriticalPoint:
     """The critical point, or a ModelError saying why stick-slip is undefined without it."""
-    cp = cached_critical_point(params)
+    cp = cached_critical_point(steady_curve_key(params))
     if not cp.exists:
         raise ModelError(f"no stick-slip cycle: {cp.message}")
     return cp
@@ -265,7 +279,7 @@ def jump_velocity(params: Parameters, stress: float, curve: str = "aging") -> Ju
             s_low,
             s_max,
         )
-    branch = branch_interpolant(params, curve)
+    branch = branch_interpolant(steady_curve_key(params), curve)
 
     def excess(x: float) -> float:
         return float(branch.stress(math.exp(x))) - stress

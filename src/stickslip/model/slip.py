@@ -51,6 +51,7 @@ from .jump import (
     branch_maximum,
     chebyshev_coefficients,
     require_critical_point,
+    steady_curve_key,
     to_unit,
 )
 from .steady import ACCURATE_QUADRATURE, steady_state
@@ -327,7 +328,7 @@ def slip_phase(params: Parameters, pulling_velocity: float, start_velocity: floa
         v_end = v0 * (1.0 + gap)
         if abs(vs - v0) <= SETTLE_TOLERANCE * v0:
             v_end, gap = vs, None
-    curve = branch_interpolant(params, "aging")  # spectrally accurate, and solved once per parameter set
+    curve = branch_interpolant(steady_curve_key(params), "aging")  # spectrally accurate, solved once per curve
     if abs(math.log(vs / v_end)) < 1e-14:
         sigma = float(curve(np.array([vs]))[0][0])
         return _empty_slip(v0, vs, sigma, stiffness, ends)

@@ -25,7 +25,10 @@ from .errata import Errata, load_errata
 from .figures import Curve, save_figure_files
 from .html import RenderedFigure, render_report
 from .paper import resolve_errata
-from .report_figures import FIGURE_BUILDERS
+from .report_figures import FIGURE_BUILDERS as PAPER_FIGURES
+from .sweep_section import SWEEP_FIGURES
+
+FIGURE_BUILDERS = [*PAPER_FIGURES, *SWEEP_FIGURES]
 
 #: Called before each step with (description, steps done, total steps), and once more at the end.
 ProgressCallback = Callable[[str, int, int], None]

@@ -1,0 +1,184 @@
+"""``stickslip sweep``: parameter sweeps on dask into a resumable Parquet folder, and their phase diagrams."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import click
+
+from ..errors import ParameterError
+from .common import echo_err, params_options
+
+MODEL_NAMES = ("quasi-static", "transient", "rsf")
+
+
+@click.group(
+    "sweep",
+    invoke_without_command=True,
+    subcommand_metavar="[plot OUT ...]",
+    context_settings={"help_option_names": ["-h", "--help"]},
+)
+@click.option(
+    "--vary",
+    "vary",
+    multiple=True,
+    metavar="KEY=SPEC",
+    help="A varied key: 'KEY=LO..HI:N[:log]' or 'KEY=V1,V2,...' (values with units); several make a grid."
+    " Keys: the parameter keys (stickslip params show), pulling_velocity, block.stiffness, block.effective_stiffness"
+    " (for --model rsf: a, b, dc, k, eta, ...).",
+)
+@click.option(
+    "--samples", type=int, default=None, help="Latin-hypercube sample of N points over ranges 'KEY=LO..HI[:log]'."
+)
+@click.option("--seed", type=int, default=0, show_default=True, help="Seed of the Latin-hypercube sample.")
+@click.option("--model", type=click.Choice(MODEL_NAMES), default="quasi-static", show_default=True)
+@click.option(
+    "--v0", "v0_text", default=None, metavar="V", help="Pulling velocity when it is not varied, e.g. '50 um/s'."
+)
+@click.option(
+    "--duration", "duration_text", default="100 s", show_default=True, metavar="T", help="Length of each run."
+)
+@click.option(
+    "--jump-curve", type=click.Choice(["aging", "no-aging"]), default="aging", show_default=True, help="As in simulate."
+)
+@click.option(
+    "-o", "--output", type=click.Path(file_okay=False, path_type=Path), default=None, help="Output folder OUT."
+)
+@click.option("--workers", type=int, default=None, help="Local worker processes [default: one per core]; 0: no dask.")
+@click.option("--scheduler", default=None, metavar="ADDRESS", help="Use a running cluster, e.g. tcp://HOST:8786.")
+@click.option("--batch-size", type=int, default=None, help="Points per task [default: up to 256, at least 64 tasks].")
+@click.option("--quiet", is_flag=True, help="No progress and no summary.")
+@click.option("--overwrite", is_flag=True, help="Replace a sweep of another specification in OUT.")
+@params_options
+@click.pass_context
+def sweep_command(ctx: click.Context, **options: Any) -> None:
+    """Run the model over a grid or a Latin hypercube of parameters, on dask, into the Parquet folder OUT.
+
+    Re-running the same command continues where it stopped (also after kill -9);
+    a different specification into the same OUT is refused unless --overwrite.
+    `pandas.read_parquet(OUT)` reads the rows: one per point, the varied keys and
+    the results in SI units, status 'ok' or 'error' with the message.  Then draw
+    the phase diagram with `stickslip sweep plot OUT --x KEY --y KEY --color regime`.
+    """
+    if ctx.invoked_subcommand is not None:
+        return
+    _run(**options)
+
+
+def _run(
+    vary: tuple[str, ...],
+    samples: int | None,
+    seed: int,
+    model: str,
+    v0_text: str | None,
+    duration_text: str,
+    jump_curve: str,
+    output: Path | None,
+    workers: int | None,
+    scheduler: str | None,
+    batch_size: int | None,
+    quiet: bool,
+    overwrite: bool,
+    params_name: str,
+    overrides: tuple[str, ...],
+) -> None:
+    from ..sweeps import build_spec, run_sweep
+    from ..sweeps.progress import reporter
+
+    if output is None:
+        raise ParameterError("-o OUT: give the output folder of the sweep")
+    if not vary:
+        raise ParameterError(
+            "--vary: give at least one varied key, e.g. --vary 'pulling_velocity=5 um/s..5 mm/s:20:log'"
+        )
+    if workers is not None and workers < 0:
+        raise ParameterError(f"--workers: expected 0 (no dask) or more worker processes, got {workers}")
+    if workers is not None and scheduler is not None:
+        raise ParameterError("--workers and --scheduler: give one (a running cluster has its own workers)")
+    if batch_size is not None and batch_size < 1:
+        raise ParameterError(f"--batch-size: expected a positive number of points, got {batch_size}")
+    spec = build_spec(
+        list(vary),
+        model=model,
+        params=params_name,
+        overrides=_set_values(overrides),
+        pulling_velocity=v0_text,
+        duration=duration_text,
+        samples=samples,
+        seed=seed,
+        jump_curve=jump_curve,
+    )
+    store = run_sweep(
+        spec,
+        output,
+        workers=workers,
+        scheduler=scheduler,
+        overwrite=overwrite,
+        progress=reporter(quiet),
+        batch_size=batch_size,
+    )
+    if not quiet:
+        echo_err(_summary(store.folder, spec.size))
+
+
+def _set_values(overrides: tuple[str, ...]) -> dict[str, str]:
+    values = {}
+    for item in overrides:
+        key, sep, value = item.partition("=")
+        if not sep or not key.strip():
+            raise ParameterError(f"--set {item!r}: expected KEY=VALUE, e.g. bonds.bond_time='224 us'")
+        values[key.strip()] = value.strip()
+    return values
+
+
+def _summary(folder: Path, total: int) -> str:
+    """One line: points, errors, regimes, counted chunk by chunk (never the whole table in memory)."""
+    from collections import Counter
+
+    import pyarrow.dataset as ds
+
+    regimes: Counter[str] = Counter()
+    errors = 0
+    for batch in ds.dataset(folder, format="parquet").to_batches(columns=["status", "regime"]):
+        frame = batch.to_pydict()
+        errors += sum(s != "ok" for s in frame["status"])
+        regimes.update(r for r, s in zip(frame["regime"], frame["status"], strict=True) if s == "ok")
+    shown = ", ".join(f"{name} {count}" for name, count in regimes.most_common())
+    return f"sweep: {total} points in {folder} ({errors} failed){'; regimes: ' + shown if shown else ''}"
+
+
+@sweep_command.command("plot")
+@click.argument("folder", type=click.Path(exists=True, file_okay=False, path_type=Path), metavar="OUT")
+@click.option("--x", "x", default="pulling_velocity", show_default=True, help="Key on the horizontal axis.")
+@click.option("--y", "y", required=True, help="Key on the vertical axis.")
+@click.option(
+    "--color", "color", default="regime", show_default=True, help="Column shown in colour (regime: discrete)."
+)
+@click.option(
+    "-o",
+    "--output",
+    type=click.Path(dir_okay=False, path_type=Path),
+    default=None,
+    help="Image [default: OUT-COLOR.png].",
+)
+def plot_command(folder: Path, x: str, y: str, color: str, output: Path | None) -> None:
+    """Draw the phase diagram of the sweep in OUT, with the model's analytic stability boundary."""
+    from ..fileio import atomic_path
+    from ..sweeps import load_sweep
+    from ..sweeps.plots import plot_phase_diagram
+
+    frame, spec = load_sweep(folder)
+    target = output if output is not None else folder.parent / f"{folder.name}-{color}.png"
+    ax = plot_phase_diagram(frame, spec, x=x, y=y, color=color)
+    try:
+        with atomic_path(target) as temp:
+            ax.figure.savefig(temp, format=target.suffix.lstrip(".") or "png", dpi=120, bbox_inches="tight")
+    except (OSError, ValueError) as exc:
+        raise click.FileError(str(target), hint=str(exc)) from None
+    click.echo(f"phase diagram: {target}")
+
+
+def register(cli: click.Group) -> None:
+    """Add ``stickslip sweep`` (and ``stickslip sweep plot``) to the group."""
+    cli.add_command(sweep_command)

@@ -1,0 +1,64 @@
+"""The report's phase diagram: regimes of the paper's parameters over V0 and the block's stiffness.
+
+A grid sweep (:mod:`stickslip.sweeps`, in this process: no cluster for ~140
+points) of V0 = 5 µm/s … 5 mm/s by G/h × 0.1 … × 10 of the paper's block,
+drawn with the quasi-static boundary V0 = Vc (Eq 9).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+from .computations import ModelRun
+from .figures import ReportFigure
+
+#: Grid of the report's phase diagram (velocities by stiffness factors); regimes do not depend on the run length.
+VELOCITIES = "5 um/s..5 mm/s:15:log"
+STIFFNESS_FACTORS = (0.1, 10.0, 9)
+DURATION = "20 s"
+
+
+def phase_diagram_figure(run: ModelRun) -> ReportFigure:
+    import tempfile
+
+    from ..sweeps import build_spec, load_sweep, run_sweep
+    from ..sweeps.plots import plot_phase_diagram
+
+    params = run.params
+    low, high, count = STIFFNESS_FACTORS
+    stiffness = params.block.stiffness
+    spec = build_spec(
+        [f"pulling_velocity={VELOCITIES}", f"block.stiffness={low * stiffness!r}..{high * stiffness!r}:{count}:log"],
+        params=params,
+        duration=DURATION,
+    )
+    with tempfile.TemporaryDirectory() as folder:
+        run_sweep(spec, f"{folder}/sweep", workers=0)
+        frame, _ = load_sweep(f"{folder}/sweep")
+    ax = plot_phase_diagram(frame, spec, x="pulling_velocity", y="block.stiffness", color="regime")
+    ax.axhline(stiffness, color="white", linewidth=1.0, linestyle=":")
+    ax.set_title("Regimes over pulling velocity and block stiffness (quasi-static model)", fontsize=11)
+    counts = frame["regime"].value_counts()
+    at_paper = frame[(frame["block.stiffness"] - stiffness).abs() <= 1e-9 * stiffness]
+    slipping = at_paper.loc[at_paper["regime"] == "stick-slip", "pulling_velocity"]
+    band = (
+        f"at the paper's block (dotted line, G/h = {stiffness / 1e3:.0f} kPa/m) stick-slip is found from"
+        f" {slipping.min() * 1e6:.3g} to {slipping.max() * 1e6:.3g} µm/s"
+        if len(slipping)
+        else "at the paper's block (dotted line) no grid point is in stick-slip"
+    )
+    caption = (
+        f"Regime of {len(frame)} runs of the quasi-static cycle (a {VELOCITIES.split(':')[1]} × {count} grid, log"
+        f" spaced: V0 = 5 µm/s to 5 mm/s, block stiffness G/h from {low:g} to {high:g} times the paper's, set through"
+        f" the block height): {', '.join(f'{n} {c}' for n, c in counts.items())}. The dashed line is V0 = Vc"
+        f" = {run.critical.velocity * 1e6 if run.critical and run.critical.velocity else float('nan'):.1f} µm/s"
+        " (Eq 9): above it the slip settles onto the steady curve; below it a stick that ends is followed by"
+        f" stick-slip, and at low V0 or a soft block the chains age faster than they are loaded and the block stays"
+        f" stuck. {band[0].upper() + band[1:]}. Made with `stickslip sweep` (docs/sweep.md)."
+    )
+    return ReportFigure("phase_diagram", "Phase diagram", "Stick-slip, steady sliding and sticking", caption, ax.figure)
+
+
+SWEEP_FIGURES: list[tuple[str, Callable[[ModelRun], ReportFigure]]] = [
+    ("Phase diagram: regimes over V0 and stiffness", phase_diagram_figure),
+]

@@ -1,0 +1,194 @@
+"""Parameter sweeps on dask.distributed: grids or Latin hypercubes, resumable Parquet output, phase diagrams.
+
+``stickslip.sweep(...)`` (this package's :func:`sweep`) runs one and returns
+a pandas DataFrame; ``stickslip sweep`` is the command line.  See docs/sweep.md.
+"""
+
+from __future__ import annotations
+
+import shutil
+import tempfile
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+from ..errors import ParameterError
+from ..parameters import Parameters
+from ..units import to_si
+from .engine import compute, dask_client, default_batch_size, read_results
+from .models import ALIASES, MODELS, get_model
+from .progress import Silent, reporter
+from .spec import Axis, SweepSpec, check_design, parse_vary
+from .store import SweepStore, open_store, read_manifest
+
+__all__ = [
+    "MODELS",
+    "Axis",
+    "SweepSpec",
+    "build_spec",
+    "load_sweep",
+    "parse_vary",
+    "read_manifest",
+    "run_sweep",
+    "sweep",
+]
+
+DEFAULT_DURATION = 100.0  # s: several cycles at the paper's stick-slip velocities
+
+
+def build_spec(
+    vary: Sequence[str] | Mapping[str, Any],
+    *,
+    model: str = "quasi-static",
+    params: str | Parameters = "gelatin-glass",
+    overrides: Mapping[str, Any] | None = None,
+    pulling_velocity: float | str | None = None,
+    duration: float | str = DEFAULT_DURATION,
+    samples: int | None = None,
+    seed: int = 0,
+    jump_curve: str = "aging",
+) -> SweepSpec:
+    """The specification of a sweep, validated: every key known, every value of the right unit and in range.
+
+    ``vary`` is a list of ``--vary`` texts (``"KEY=LO..HI:N[:log]"``, ``"KEY=V1,V2"``) or a mapping
+    ``{key: "LO..HI:N" or [values]}``; ``samples`` makes it a Latin hypercube over ranges ``LO..HI[:log]``.
+    """
+    adapter = get_model(model)
+    adapter.check_available()
+    dimensions = adapter.dimensions()
+    axes = tuple(_axis(item, dimensions) for item in _vary_texts(vary))
+    design = check_design(axes, samples)
+    given = dict(overrides or {})
+    if pulling_velocity is not None and "pulling_velocity" in {a.key for a in axes}:
+        raise ParameterError("--v0 and --vary pulling_velocity: give the pulling velocity once")
+    if pulling_velocity is not None:
+        given["pulling_velocity"] = pulling_velocity
+    fixed, label = adapter.fixed_values(params, given)
+    adapter.check_keys(tuple(a.key for a in axes), fixed)
+    settings: dict[str, Any] = {"duration": _duration(duration)}
+    if model != "rsf":
+        settings["jump_curve"] = jump_curve
+    spec = SweepSpec(
+        model=model,
+        fixed=fixed,
+        axes=axes,
+        design=design,
+        samples=samples or 0,
+        seed=int(seed),
+        settings=settings,
+        label=label,
+    )
+    _check_corners(adapter, spec)
+    return spec
+
+
+def run_sweep(
+    spec: SweepSpec,
+    output: str | Path,
+    *,
+    workers: int | None = None,
+    scheduler: str | None = None,
+    overwrite: bool = False,
+    progress: Silent | None = None,
+    batch_size: int | None = None,
+) -> SweepStore:
+    """Run (or resume) ``spec`` into the folder ``output``; ``workers=0`` runs in this process, without dask."""
+    store = open_store(output, spec, batch_size or default_batch_size(spec.size), overwrite=overwrite)
+    shown = progress if progress is not None else Silent()
+    finished = store.finished()
+    shown.start(spec.size, store.rows_done(finished))
+    try:
+        if len(finished) == store.batches:
+            pass  # all done already: no cluster to start
+        elif workers == 0 and scheduler is None:
+            compute(store, None, shown.advance)
+        else:
+            with dask_client(workers, scheduler) as client:
+                compute(store, client, shown.advance)
+    finally:
+        shown.close()
+    return store
+
+
+def sweep(
+    vary: Sequence[str] | Mapping[str, Any],
+    output: str | Path | None = None,
+    *,
+    workers: int | None = None,
+    scheduler: str | None = None,
+    overwrite: bool = False,
+    quiet: bool = True,
+    **specification: Any,
+) -> Any:
+    """Run a sweep and return its rows as a pandas DataFrame (sorted by point; inputs and results in SI).
+
+    >>> frame = sweep(["pulling_velocity=10 um/s..1 mm/s:5:log"], workers=0)  # doctest: +SKIP
+    >>> frame = sweep({"block.height": "5 mm..2 cm:4"}, pulling_velocity="50 um/s", samples=None)  # doctest: +SKIP
+
+    ``specification`` are the keywords of :func:`build_spec` (``model``, ``params``, ``overrides``,
+    ``pulling_velocity``, ``duration``, ``samples``, ``seed``, ``jump_curve``); ``workers``, ``scheduler``
+    and ``overwrite`` those of :func:`run_sweep`; ``quiet=False`` shows progress on standard error.
+
+    With ``output`` the rows are also kept there as Parquet chunks, and a
+    second call with the same arguments resumes (or just reads) them.  The
+    returned frame holds every row in memory: for sweeps too large for that,
+    give ``output`` and read the folder with pyarrow datasets instead.
+    """
+    spec = build_spec(vary, **specification)
+    folder = Path(output) if output is not None else Path(tempfile.mkdtemp(prefix="stickslip-sweep-"))
+    try:
+        run_sweep(spec, folder, workers=workers, scheduler=scheduler, overwrite=overwrite, progress=reporter(quiet))
+        return read_results(folder)
+    finally:
+        if output is None:
+            shutil.rmtree(folder, ignore_errors=True)
+
+
+def load_sweep(folder: str | Path) -> tuple[Any, SweepSpec]:
+    """(the rows written so far as a DataFrame, the specification) of a sweep output folder."""
+    manifest = read_manifest(folder)
+    return read_results(folder), SweepSpec.from_dict(manifest["specification"])
+
+
+def _vary_texts(vary: Sequence[str] | Mapping[str, Any]) -> list[str]:
+    if isinstance(vary, str):
+        return [vary]
+    if isinstance(vary, Mapping):
+        texts = []
+        for key, body in vary.items():
+            if isinstance(body, str):
+                texts.append(f"{key}={body}")
+            else:
+                texts.append(f"{key}=" + ",".join(repr(float(v)) if not isinstance(v, str) else v for v in body))
+        return texts
+    return list(vary)
+
+
+def _axis(text: str, dimensions: Mapping[str, str]) -> Axis:
+    key, sep, body = text.partition("=")
+    if sep and key.strip() in ALIASES:
+        text = f"{ALIASES[key.strip()]}={body}"
+    return parse_vary(text, dimensions)
+
+
+def _duration(value: float | str) -> float:
+    seconds = to_si(value, "time", "--duration")
+    if not seconds > 0 or seconds == float("inf"):
+        raise ParameterError(f"--duration: expected a positive finite time, got {value!r}")
+    return seconds
+
+
+def _check_corners(adapter: Any, spec: SweepSpec) -> None:
+    """Build the model's inputs at each axis's ends, so a value out of range is refused before any work."""
+    if not hasattr(adapter, "parameters"):
+        return
+    ends = {a.key: (min(a.values), max(a.values)) if a.values else (a.low, a.high) for a in spec.axes}
+    first = {**spec.fixed, **{key: pair[0] for key, pair in ends.items()}}
+    if "pulling_velocity" not in first:
+        raise ParameterError("pulling_velocity: give --v0 V, or vary it with --vary 'pulling_velocity=LO..HI:N'")
+    for key, pair in ends.items():
+        for end in pair:
+            try:
+                adapter.parameters({**first, key: end})
+            except ParameterError as exc:
+                raise ParameterError(f"--vary {key}: the value {end:g} (SI) is refused: {exc}") from None

@@ -1,0 +1,384 @@
+"""The models a sweep can run, behind one small interface (the model registry).
+
+Each adapter says which keys it accepts (with their dimensions), builds the
+fixed values of a sweep, runs one point into a row of plain numbers, and
+draws its analytic stability boundary.  The quasi-static cycle is the
+package's :func:`stickslip.simulate`; the time-dependent bond model and
+rate-and-state are imported lazily from ``stickslip.transient`` and
+``stickslip.rsf`` so that a version without them still sweeps the rest, and
+says so in one line when asked for them.  The names those modules are
+called by are kept here, in one place.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from functools import lru_cache
+from importlib import import_module
+from typing import Any
+
+import numpy as np
+
+from ..errors import ParameterError, StickslipError
+from ..parameters import Parameters, key_dimension, load_parameters, parameter_keys, parameters_from_mapping
+
+#: Keys that set the block's stiffness directly (through its height): G_d/h, and K = (G_d/h) ln(B/l)/(B/l - 1).
+STIFFNESS_KEYS = {"block.stiffness": "stress_per_length", "block.effective_stiffness": "stress_per_length"}
+#: Columns every cycle model reports (SI), beside the inputs, status, message and wall time.
+CYCLE_RESULTS = {
+    "regime": "str",
+    "period": "float",
+    "stick_time": "float",
+    "peak_stress": "float",
+    "jump_velocity": "float",
+    "mean_stress": "float",
+    "cycles": "int",
+}
+NAN = float("nan")
+
+
+@dataclass(frozen=True)
+class Boundary:
+    """An analytic stability boundary in the plane of two swept keys (SI), with its legend label."""
+
+    x: np.ndarray
+    y: np.ndarray
+    label: str
+
+
+def _require(module: str, model: str) -> Any:
+    try:
+        return import_module(module)
+    except ModuleNotFoundError as exc:
+        if exc.name is not None and module.startswith(exc.name):
+            raise ParameterError(
+                f"--model {model}: this version of stickslip has no {module} module; use --model quasi-static"
+            ) from None
+        raise
+
+
+# --------------------------------------------------------------------------- the bond model (both forms)
+class BondModel:
+    """Shared by the quasi-static and the time-dependent bond model: parameter keys, stiffness keys."""
+
+    name = ""
+    results: Mapping[str, str] = {**CYCLE_RESULTS, "critical_velocity": "float"}
+
+    def dimensions(self) -> dict[str, str]:
+        return {
+            "pulling_velocity": "velocity",
+            **{k: key_dimension(k) for k in parameter_keys()},
+            **STIFFNESS_KEYS,
+        }
+
+    def fixed_values(self, params: str | Parameters, overrides: Mapping[str, Any]) -> tuple[dict[str, float], str]:
+        """(SI values of every key not varied, the parameter set's name) from ``--params`` and ``--set``."""
+        from ..units import to_si
+
+        extra = {k: v for k, v in overrides.items() if k in ("pulling_velocity", *STIFFNESS_KEYS)}
+        base = load_parameters(params, {k: v for k, v in overrides.items() if k not in extra})
+        fixed = base.as_dict()
+        for key, raw in extra.items():
+            fixed[key] = to_si(raw, self.dimensions()[key], key)
+        return fixed, base.name
+
+    def parameters(self, values: Mapping[str, float]) -> tuple[Parameters, float]:
+        """(the parameter set, the pulling velocity) of one point."""
+        params = _parameter_set(tuple(values[k] for k in parameter_keys()))
+        block = params.block
+        if "block.stiffness" in values:
+            params = params.with_overrides({"block.height": block.shear_modulus / _positive(values, "block.stiffness")})
+        if "block.effective_stiffness" in values:
+            height = block.shear_modulus * block.geometric_factor / _positive(values, "block.effective_stiffness")
+            params = params.with_overrides({"block.height": height})
+        if "pulling_velocity" not in values:
+            raise ParameterError("pulling_velocity: give --v0 V or --vary 'pulling_velocity=...'")
+        velocity = values["pulling_velocity"]
+        if not velocity >= 0:
+            raise ParameterError(f"pulling_velocity: expected a value >= 0 m/s, got {velocity:g}")
+        return params, velocity
+
+    def check_keys(self, varied: tuple[str, ...], fixed: Mapping[str, float]) -> None:
+        """Refuse two keys that set the same thing (the height and a stiffness)."""
+        setting = [k for k in ("block.height", *STIFFNESS_KEYS) if k in varied or (k in STIFFNESS_KEYS and k in fixed)]
+        if len(setting) > 1:
+            raise ParameterError(f"{' and '.join(setting)} both set the block's height; vary or set only one of them")
+
+    def stiffness_of(self, key: str, params: Parameters, k_effective: np.ndarray) -> np.ndarray:
+        """The value of stiffness-like ``key`` at which the effective stiffness is ``k_effective``."""
+        factor = params.block.geometric_factor
+        if key == "block.effective_stiffness":
+            return k_effective
+        if key == "block.stiffness":
+            return k_effective / factor
+        return params.block.shear_modulus * factor / k_effective  # block.height
+
+
+@lru_cache(maxsize=64)
+def _parameter_set(values: tuple[float, ...]) -> Parameters:
+    """Parameters from the SI values of :func:`parameter_keys`, in that order (validated)."""
+    nested: dict[str, dict[str, float]] = {}
+    for key, value in zip(parameter_keys(), values, strict=True):
+        section, _, name = key.partition(".")
+        nested.setdefault(section, {})[name] = value
+    return parameters_from_mapping({"name": "sweep point", **nested}, "sweep point")
+
+
+def _positive(values: Mapping[str, float], key: str) -> float:
+    value = values[key]
+    if not value > 0:
+        raise ParameterError(f"{key}: expected a positive value, got {value:g}")
+    return value
+
+
+def _mean(time: np.ndarray, stress: np.ndarray) -> float:
+    """Time average by the trapezoidal rule (NaN for a single instant)."""
+    span = float(time[-1] - time[0]) if time.size else 0.0
+    if span <= 0:
+        return float(stress[-1]) if stress.size else NAN
+    return float(np.sum(np.diff(time) * (stress[1:] + stress[:-1])) / (2.0 * span))
+
+
+class QuasiStatic(BondModel):
+    """The quasi-static stick -> jump -> slip cycle, :func:`stickslip.simulate`."""
+
+    name = "quasi-static"
+
+    def check_available(self) -> None:
+        return None
+
+    def run(self, values: Mapping[str, float], settings: Mapping[str, Any]) -> dict[str, Any]:
+        from ..model.cycle import simulate
+
+        params, velocity = self.parameters(values)
+        sim = simulate(params, velocity, settings["duration"], jump_curve=settings.get("jump_curve", "aging"))
+        row: dict[str, Any] = {
+            "regime": sim.regime,
+            "period": NAN,
+            "stick_time": NAN,
+            "peak_stress": NAN,
+            "jump_velocity": NAN,
+            "mean_stress": _mean(sim.time, sim.stress),
+            "cycles": sum(c.period is not None for c in sim.cycles),
+            "critical_velocity": sim.critical_velocity,
+            "message": sim.message,
+        }
+        # the first stick starts at sigma_c, so the first phases are those of the repeating cycle
+        if sim.slip_phases and sim.jumps and sim.jumps[0].velocity is not None:
+            stick, slip = sim.stick_phases[0], sim.slip_phases[0]
+            row.update(stick_time=stick.stick_time, peak_stress=stick.peak_stress, jump_velocity=sim.jumps[0].velocity)
+            if sim.regime == "stick-slip":
+                row["period"] = stick.stick_time + slip.duration
+                row["mean_stress"] = _cycle_mean(stick, slip, sim.stiffness, velocity)
+            elif sim.regime == "steady":
+                row["mean_stress"] = slip.end_stress
+        return row
+
+    def boundaries(self, spec: Any, frame: Any, x: str, y: str) -> list[Boundary]:
+        """V0 = Vc: the critical velocity against the other axis (from the rows' own Vc)."""
+        if "pulling_velocity" not in (x, y) or "critical_velocity" not in frame:
+            return []
+        other = y if x == "pulling_velocity" else x
+        if other in frame:
+            vc = frame.groupby(other)["critical_velocity"].median().dropna()
+            along, critical = vc.index.to_numpy(dtype=float), vc.to_numpy(dtype=float)
+        else:
+            critical = np.full(2, float(frame["critical_velocity"].median()))
+            along = np.array([np.nan, np.nan])
+        curve = (critical, along) if x == "pulling_velocity" else (along, critical)
+        return [Boundary(curve[0], curve[1], "V0 = Vc (Eq 9)")]
+
+
+def _cycle_mean(stick: Any, slip: Any, stiffness: float, velocity: float) -> float:
+    """Mean stress over the repeating cycle: the stick's is linear in time (Eq 12), the slip's by trapezoids."""
+    ts = stick.stick_time
+    stick_integral = stick.start_stress * ts + 0.5 * stiffness * velocity * ts * ts
+    t, s = slip.time, slip.stress
+    slip_integral = float(np.sum(np.diff(t) * (s[1:] + s[:-1])) / 2.0) if t.size > 1 else 0.0
+    return (stick_integral + slip_integral) / (ts + slip.duration)
+
+
+class Transient(BondModel):
+    """The time-dependent population balance (Eqs 1-5), ``stickslip.transient.run_transient``."""
+
+    name = "transient"
+
+    def check_available(self) -> None:
+        _require("stickslip.transient", self.name)
+
+    def run(self, values: Mapping[str, float], settings: Mapping[str, Any]) -> dict[str, Any]:
+        transient = _require("stickslip.transient", self.name)
+        from ..protocols import constant
+
+        params, velocity = self.parameters(values)
+        protocol = constant(velocity, settings["duration"])
+        result = transient.run_transient(params, protocol, control="block", start=settings.get("start", "steady"))
+        whole = [c for c in result.cycles if getattr(c, "period", None) is not None]
+        time, stress = np.asarray(result.time, dtype=float), np.asarray(result.stress, dtype=float)
+        row: dict[str, Any] = {
+            "regime": result.regime,
+            "period": NAN,
+            "stick_time": NAN,
+            "peak_stress": NAN,
+            "jump_velocity": NAN,
+            "mean_stress": _mean(time, stress),
+            "cycles": len(whole),
+            "critical_velocity": NAN,
+            "message": result.message,
+        }
+        if whole:  # the last whole cycle: the run has settled onto its cycle by then, if ever
+            last = whole[-1]
+            row.update(
+                period=last.period,
+                stick_time=last.stick_time,
+                peak_stress=last.peak_stress,
+                jump_velocity=last.jump_velocity,
+            )
+            inside = (time >= whole[0].start_time) & (time <= last.start_time + last.period)
+            if np.count_nonzero(inside) > 1:
+                row["mean_stress"] = _mean(time[inside], stress[inside])
+        return row
+
+    def boundaries(self, spec: Any, frame: Any, x: str, y: str) -> list[Boundary]:
+        """Kc(V0) of the linear stability of steady sliding, in the plane (V0, a stiffness key)."""
+        stiffness_axes = ("block.height", *STIFFNESS_KEYS)
+        if "pulling_velocity" not in (x, y) or not ({x, y} & set(stiffness_axes)):
+            return []
+        try:
+            transient = _require("stickslip.transient", self.name)
+        except ParameterError:
+            return []
+        other = y if x == "pulling_velocity" else x
+        params, _ = self.parameters({**spec.fixed, "pulling_velocity": 0.0})
+        lo, hi = float(frame["pulling_velocity"].min()), float(frame["pulling_velocity"].max())
+        velocity = np.geomspace(max(lo, 1e-12), max(hi, 2e-12), 80)
+        kc = np.array([transient.critical_stiffness(params, v) for v in velocity], dtype=float)
+        good = np.isfinite(kc) & (kc > 0)
+        along = self.stiffness_of(other, params, kc[good])
+        curve = (velocity[good], along) if x == "pulling_velocity" else (along, velocity[good])
+        return [Boundary(curve[0], curve[1], "K = Kc(V0), linear stability")]
+
+
+# --------------------------------------------------------------------------- rate-and-state
+class RateAndState:
+    """Rate-and-state friction on a spring-slider, ``stickslip.rsf`` (names to match that module at merge)."""
+
+    name = "rsf"
+    results: Mapping[str, str] = {
+        "regime": "str",
+        "period": "float",
+        "peak_friction": "float",
+        "trough_friction": "float",
+        "mean_friction": "float",
+        "cycles": "int",
+        "critical_stiffness": "float",
+    }
+    #: key -> (dimension, default in SI); k is the spring stiffness per area, eta the radiation damping.
+    KEYS: Mapping[str, tuple[str, float]] = {
+        "pulling_velocity": ("velocity", 1e-6),
+        "a": ("dimensionless", 0.010),
+        "b": ("dimensionless", 0.015),
+        "dc": ("length", 10e-6),
+        "k": ("stress_per_length", 1e9),
+        "eta": ("stress_per_velocity", 0.0),
+        "mu0": ("dimensionless", 0.6),
+        "v_ref": ("velocity", 1e-6),
+        "normal_stress": ("stress", 1e6),
+    }
+
+    def dimensions(self) -> dict[str, str]:
+        return {k: d for k, (d, _) in self.KEYS.items()}
+
+    def check_available(self) -> None:
+        _require("stickslip.rsf", self.name)
+
+    def fixed_values(self, params: str | Parameters, overrides: Mapping[str, Any]) -> tuple[dict[str, float], str]:
+        from ..units import to_si
+
+        fixed = {k: default for k, (_, default) in self.KEYS.items()}
+        for key, raw in overrides.items():
+            if key not in self.KEYS:
+                raise ParameterError(
+                    f"--set {key}: unknown rate-and-state key; expected one of: {', '.join(self.KEYS)}"
+                )
+            fixed[key] = to_si(raw, self.KEYS[key][0], key)
+        return fixed, "rate-and-state"
+
+    def check_keys(self, varied: tuple[str, ...], fixed: Mapping[str, float]) -> None:
+        return None
+
+    def critical_stiffness(self, values: Mapping[str, float]) -> float:
+        """kc = sigma (b - a) / Dc (Ruina; Rice & Ruina 1983)."""
+        return values["normal_stress"] * (values["b"] - values["a"]) / values["dc"]
+
+    def run(self, values: Mapping[str, float], settings: Mapping[str, Any]) -> dict[str, Any]:
+        rsf = _require("stickslip.rsf", self.name)
+        from ..protocols import constant
+
+        names = {k: values[k] for k in self.KEYS if k != "pulling_velocity"}
+        params = rsf.RSFParameters(**{("stiffness" if k == "k" else k): v for k, v in names.items()})
+        result = rsf.simulate(params, constant(values["pulling_velocity"], settings["duration"]))
+        return {
+            "regime": result.regime,
+            "period": _float(getattr(result, "period", None)),
+            "peak_friction": _float(getattr(result, "peak_friction", None)),
+            "trough_friction": _float(getattr(result, "trough_friction", None)),
+            "mean_friction": _float(getattr(result, "mean_friction", None)),
+            "cycles": _count(getattr(result, "cycles", 0)),
+            "critical_stiffness": self.critical_stiffness(values),
+            "message": result.message,
+        }
+
+    def boundaries(self, spec: Any, frame: Any, x: str, y: str) -> list[Boundary]:
+        """k = kc = sigma (b - a)/Dc: against the other axis when the stiffness k is on one."""
+        if "k" not in (x, y) or "critical_stiffness" not in frame:
+            return []
+        other = y if x == "k" else x
+        kc = frame.groupby(other)["critical_stiffness"].median().dropna()
+        along, critical = kc.index.to_numpy(dtype=float), kc.to_numpy(dtype=float)
+        curve = (critical, along) if x == "k" else (along, critical)
+        return [Boundary(curve[0], curve[1], "k = kc = σ(b − a)/Dc")]
+
+
+def _count(cycles: Any) -> int:
+    """A number of cycles, given as a count or as the cycles themselves."""
+    return len(cycles) if isinstance(cycles, (list, tuple)) else int(cycles or 0)
+
+
+def _float(value: Any) -> float:
+    return NAN if value is None else float(value)
+
+
+MODELS: dict[str, Any] = {m.name: m for m in (QuasiStatic(), Transient(), RateAndState())}
+#: Other spellings accepted for keys (the issue's symbols).
+ALIASES = {"Dc": "dc", "η": "eta", "V0": "pulling_velocity"}
+
+
+def get_model(name: str) -> Any:
+    """The adapter of ``--model NAME``."""
+    try:
+        return MODELS[name]
+    except KeyError:
+        raise ParameterError(f"--model {name!r}: expected one of {', '.join(MODELS)}") from None
+
+
+def result_columns(model: Any) -> dict[str, str]:
+    """Columns after the inputs: the model's results, then status, message and wall time."""
+    return {**model.results, "status": "str", "message": "str", "wall_time": "float"}
+
+
+def run_point(model: Any, values: Mapping[str, float], settings: Mapping[str, Any]) -> dict[str, Any]:
+    """One point as a row; a failure is a row with status "error" and the one-line reason, never an exception."""
+    import time
+
+    start = time.perf_counter()
+    try:
+        row = model.run(values, settings)
+        row["status"] = "ok"
+    except Exception as exc:  # any failure of one point is that point's result; the sweep goes on
+        row = {name: (None if kind == "str" else 0 if kind == "int" else NAN) for name, kind in model.results.items()}
+        kind = "" if isinstance(exc, StickslipError) else f"{type(exc).__name__}: "
+        row.update(status="error", message=(kind + str(exc)).replace("\n", " "))
+    row["wall_time"] = time.perf_counter() - start
+    return row
