@@ -1,0 +1,66 @@
+"""Figures of rate-and-state runs and fits (matplotlib Figure API, never pyplot)."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from ..plotting import apply_style, new_axes
+
+if TYPE_CHECKING:  # pragma: no cover
+    from matplotlib.axes import Axes
+
+    from .fit import RSFFit
+    from .results import RSFRun
+
+
+def plot_run(run: RSFRun, ax: Axes | None = None, x: str = "time", **kwargs: Any) -> Axes:
+    """Friction against time (or ``x="displacement"``: load-point displacement in um)."""
+    ax = new_axes(ax)
+    xs = run.time if x == "time" else run.load_point_displacement * 1e6
+    kwargs.setdefault("color", "#1f4e9c")
+    kwargs.setdefault("lw", 1.2)
+    ax.plot(xs, run.friction, **kwargs)
+    ax.set_xlabel("time (s)" if x == "time" else "load-point displacement (µm)")
+    ax.set_ylabel("friction μ")
+    if run.status != "ok":
+        ax.set_title(run.status, color="#c0392b", fontsize=9)
+    return apply_style(ax)
+
+
+def phase_plot(run: RSFRun, ax: Axes | None = None, **kwargs: Any) -> Axes:
+    """ln(V/V0) against friction with the steady-state line (slope a - b) and constant-state lines (slope a)."""
+    ax = new_axes(ax)
+    p = run.params
+    lnv = np.log(run.slider_velocity / p.v_ref)
+    kwargs.setdefault("color", "k")
+    kwargs.setdefault("lw", 1.5)
+    ax.plot(lnv, run.friction, **kwargs)
+    xlim = np.array(ax.get_xlim())
+    ylim = ax.get_ylim()
+    ax.plot(xlim, p.mu0 + (p.a - p.b) * xlim, color="#c0392b", ls="--", lw=1, label="steady state (slope a − b)")
+    # constant-state lines: mu = mu_state + a ln(V/V0), through the start and through the end state
+    levels = sorted({float(run.friction[0] - p.a * lnv[0]), float(run.friction[-1] - p.a * lnv[-1])})
+    for i, level in enumerate(levels):
+        label = "constant state (slope a)" if i == 0 else None
+        ax.plot(xlim, level + p.a * xlim, color="#7f8c8d", ls=":", lw=1, label=label)
+    ax.set_xlim(*xlim)
+    ax.set_ylim(*ylim)
+    ax.set_xlabel("ln(V/V₀)")
+    ax.set_ylabel("friction μ")
+    ax.legend(fontsize=8, frameon=False)
+    return apply_style(ax)
+
+
+def plot_fit(fit: RSFFit, ax: Axes | None = None) -> Axes:
+    """Data, fitted curve and residuals against load-point displacement."""
+    ax = new_axes(ax)
+    record, model = fit.record, fit.model_friction
+    disp = record.displacement * 1e6
+    ax.plot(disp, record.friction, ".", ms=1.5, color="#999999", label="data")
+    ax.plot(disp, model, color="#c0392b", lw=1.4, label="fit")
+    ax.set_xlabel("load-point displacement (µm)")
+    ax.set_ylabel("friction μ")
+    ax.legend(fontsize=8, frameon=False)
+    return apply_style(ax)
