@@ -77,8 +77,9 @@ def test_regularized_form_is_classical_far_from_zero_velocity():
 
 
 def test_analytic_jacobian_matches_central_differences():
-    p = RSFParams(a=0.011, states=(StateVariable("slip", 0.01, DC), StateVariable("nagata", 0.004, 5 * DC, c=0.5),
-                                   StateVariable("prz", 0.002, 2 * DC)), v_ref=V0, stiffness=800.0, eta=3.0)  # fmt: skip
+    states = (StateVariable("slip", 0.01, DC), StateVariable("nagata", 0.004, 5 * DC, c=0.5),
+              StateVariable("prz", 0.002, 2 * DC))  # fmt: skip
+    p = RSFParams(a=0.011, states=states, v_ref=V0, stiffness=800.0, eta=3.0)
     s = System(p)
     y = np.array([0.7, -0.2, 0.4, -1.1])
     jac = s.jacobian(0.0, y, 2e-6)

@@ -7,6 +7,7 @@ scale-free, so they are passed here as SI numbers.  rsfmodel integrated with ode
 and published 8 decimals; we require agreement to 1e-7 (friction, state) and 1e-7 relative (velocity).
 """
 
+# ruff: noqa: RUF005  (the published arrays read best as head + values)
 from __future__ import annotations
 
 import numpy as np
