@@ -108,3 +108,21 @@ def stability_figure(params: Any, v_low: float, v_high: float) -> Any:
     ax.legend(fontsize=8, frameon=False)
     apply_style(ax)
     return fig
+
+
+def fit_figure(fit: RSFFit) -> Any:
+    """Data with the fit (top) and residuals (bottom) against load-point displacement."""
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(8, 6), layout="constrained")
+    ax1, ax2 = fig.subplots(2, 1, sharex=True, height_ratios=[3, 1])
+    plot_fit(fit, ax=ax1)
+    ax2.plot(fit.record.displacement * 1e6, fit.residuals, ".", ms=1.2, color="#777777")
+    ax2.axhline(0, color="#c0392b", lw=1)
+    ax2.set_xlabel("load-point displacement (µm)")
+    ax2.set_ylabel("residual")
+    apply_style(ax2)
+    p = fit.parameters
+    ax1.set_title(f"a = {p['a'].value:.4g}, b = {p['b'].value:.4g}, Dc = {p['dc'].value * 1e6:.4g} µm, "
+                  f"χ²ᵣ = {fit.reduced_chi_square:.3g}", fontsize=9)  # fmt: skip
+    return fig

@@ -124,7 +124,14 @@ def _default_message(regime: Regime) -> str:
 
 
 def assemble_run(
-    system: System, protocol: Protocol, t: np.ndarray, y: np.ndarray, status: str, message: str, v_start: float
+    system: System,
+    protocol: Protocol,
+    t: np.ndarray,
+    y: np.ndarray,
+    status: str,
+    message: str,
+    v_start: float,
+    detect: bool = True,
 ) -> RSFRun:
     """Turn the solver's (t, y) into the physical trace."""
     o = system.offset
@@ -142,6 +149,8 @@ def assemble_run(
         Regime("blow-up", math.nan, float(np.max(friction)), float(np.min(friction)), math.nan)
         if status != "ok"
         else detect_regime(t, friction, velocity, protocol)
+        if detect
+        else Regime("not analysed", math.nan, math.nan, math.nan, math.nan)
     )
     return RSFRun(
         time=t,

@@ -45,12 +45,14 @@ def simulate(
     times: Any = None,
     rtol: float = RTOL,
     atol: float = ATOL,
+    detect: bool = True,
 ) -> RSFRun:
     """Run ``protocol`` on the spring-slider, starting in steady sliding at ``start_velocity``.
 
     ``start_velocity`` defaults to the first segment's velocity; ``every``
     samples the trace every ``every`` seconds from t = 0; ``times`` (sorted,
-    within the protocol) samples it at given times instead.
+    within the protocol) samples it at given times instead.  ``detect=False``
+    skips the regime detection (for fits, which call this hundreds of times).
     """
     if not isinstance(params, RSFParams):
         raise ParameterError(f"params: expected RSFParams, got {type(params).__name__}")
@@ -91,7 +93,7 @@ def simulate(
         y = y_end
     t_all = np.concatenate(t_parts)
     y_all = np.concatenate(y_parts, axis=1)
-    return assemble_run(system, protocol, t_all, y_all, status, message, v_start)
+    return assemble_run(system, protocol, t_all, y_all, status, message, v_start, detect)
 
 
 def _grid(protocol: Protocol, every: float | None, times: Any) -> np.ndarray | None:

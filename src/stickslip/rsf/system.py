@@ -47,6 +47,10 @@ class System:
         self.size = self.n + 1 + self.offset
         self.one_minus_h = 1.0 - sum(b * h for b, h in zip(self.b, self.h, strict=True))  # classical form
         self.has_jacobian = not (self.inertial or self.regularized)
+        self._terms = [(law.rate, b, dc) for law, b, dc in zip(self.laws, self.b, self.dc, strict=True)]
+        self._coupled = any(h != 0.0 for h in self.h)
+        if self.has_jacobian and not self._coupled:
+            self.rhs = self._rhs_classical  # type: ignore[method-assign]  # the common case, without generality's cost
 
     # ------------------------------------------------------------------ friction
     def friction(self, x: float, psi: list[float] | np.ndarray) -> float:
@@ -57,7 +61,7 @@ class System:
 
     def friction_many(self, x: np.ndarray, psi: np.ndarray) -> np.ndarray:
         """Vectorised :meth:`friction`; ``psi`` has shape (n, len(x))."""
-        bpsi = np.tensordot(np.asarray(self.b), psi, axes=1)
+        bpsi = sum(b * row for b, row in zip(self.b, psi, strict=True))  # tensordot is slow for these shapes
         if not self.regularized:
             return self.mu0 + self.a * x + bpsi
         z = x + (self.mu0 + bpsi) / self.a
@@ -92,6 +96,20 @@ class System:
         xdot = (Q * self.k * (vlp - v) - G) / (A + Q * self.eta * v)
         mudot = (A * xdot + G) / Q
         return [xdot, *(gi + hi * mudot for gi, hi in zip(g, self.h, strict=True))]
+
+    def _rhs_classical(self, t: float, y: np.ndarray, vlp: float) -> list[float]:
+        """:meth:`rhs` for the classical form without mass or dmu/dt coupling (same equations, fewer steps)."""
+        x, *psi = y.tolist()
+        v0 = self.v0
+        out = [0.0]
+        G = 0.0
+        for (rate, b, dc), p in zip(self._terms, psi):  # noqa: B905  (lengths match by construction)
+            g = rate(x, p, v0, dc)[0]
+            out.append(g)
+            G += b * g
+        v = v0 * _exp(x)
+        out[0] = (self.k * (vlp - v) - G) / (self.a + self.eta * v)
+        return out
 
     def jacobian(self, t: float, y: np.ndarray, vlp: float) -> np.ndarray:
         """Analytic Jacobian of :meth:`rhs` (classical friction form without inertia)."""
