@@ -153,10 +153,10 @@ def _dense_piece(
 
 
 def _unstable_somewhere(params: RSFParams, protocol: Protocol) -> bool:
-    from .stability import critical_stiffness
+    from .stability import growth_rate
 
-    speeds = {v for v in protocol.velocities if v > 0}
-    return any(params.stiffness < critical_stiffness(params, v) for v in speeds)
+    speeds = {float(v) for v in protocol.velocities if v > 0}
+    return any(growth_rate(params, v) > 0 for v in speeds)
 
 
 def _adaptive_piece(

@@ -26,7 +26,7 @@ from ..errors import ParameterError
 from .params import RSFParams
 from .system import System
 
-__all__ = ["Stability", "critical_stiffness", "neutral_period", "stability"]
+__all__ = ["Stability", "critical_stiffness", "growth_rate", "neutral_period", "stability"]
 
 _CLASSICAL = {"aging", "slip", "prz"}
 
@@ -85,7 +85,7 @@ def stability(params: RSFParams, velocity: float) -> Stability:
     """Everything about the stability of steady sliding at ``velocity`` with the params' stiffness."""
     velocity = _positive_velocity(velocity)
     kc = critical_stiffness(params, velocity)
-    growth = float(np.max(_eigenvalues(params, velocity).real))
+    growth = growth_rate(params, velocity)
     stable = params.stiffness > kc
     sigma = params.normal_stress
     method = "closed form" if _closed_form_applies(params) else "eigenvalues of the linearised equations"
@@ -109,6 +109,11 @@ def stability(params: RSFParams, velocity: float) -> Stability:
         method=method,
         message=message,
     )
+
+
+def growth_rate(params: RSFParams, velocity: float) -> float:
+    """Largest real part (1/s) of the linearised equations' eigenvalues at steady sliding: > 0 means unstable."""
+    return float(np.max(_eigenvalues(params, _positive_velocity(velocity)).real))
 
 
 def _positive_velocity(velocity: float) -> float:
