@@ -120,3 +120,11 @@ def test_real_sepiolite_velocity_step_is_described():
     assert fit.protocol.velocities == pytest.approx([0.2e-6, 2e-6], rel=0.01)
     assert fit.rms < 3 * fit.noise * math.sqrt(10)  # residual rms ~ 1.1e-3 against noise 3.4e-4 (drifts remain)
     assert 0.5 < (fit.parameters["a"].value - fit.parameters["b"].value) * math.log(10) / 0.05 < 1.5
+
+
+def test_optional_emcee_posterior():
+    fit = fit_record(synthetic(11, rows=300), stiffness=3e3, protocol=STEP, mcmc_steps=40, seed=2)
+    post = fit.posterior
+    assert post is not None and {"a", "b", "dc", "mu0"} <= set(post)
+    lo, hi = post["a"]["interval"]
+    assert lo < post["a"]["median"] < hi and 0.004 < post["a"]["median"] < 0.012

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from stickslip import protocols
-from stickslip.errors import ParameterError
+from stickslip.errors import ModelError, ParameterError
 from stickslip.rsf import (
     RSFParams,
     StateLaw,
@@ -76,12 +76,13 @@ def test_regularized_form_is_classical_far_from_zero_velocity():
     assert abs(reg.steady_friction(1e-6) - 0.6) < 1e-15 + 1e-12
 
 
-def test_analytic_jacobian_matches_central_differences():
+@pytest.mark.parametrize("mass", [0.0, 50.0])
+def test_analytic_jacobian_matches_central_differences(mass):
     states = (StateVariable("slip", 0.01, DC), StateVariable("nagata", 0.004, 5 * DC, c=0.5),
               StateVariable("prz", 0.002, 2 * DC))  # fmt: skip
-    p = RSFParams(a=0.011, states=states, v_ref=V0, stiffness=800.0, eta=3.0)
+    p = RSFParams(a=0.011, states=states, v_ref=V0, stiffness=800.0, eta=3.0, mass=mass, normal_stress=1e6)
     s = System(p)
-    y = np.array([0.7, -0.2, 0.4, -1.1])
+    y = np.array([0.62, 0.7, -0.2, 0.4, -1.1] if mass else [0.7, -0.2, 0.4, -1.1])
     jac = s.jacobian(0.0, y, 2e-6)
     for j in range(y.size):
         h = 1e-6
@@ -192,3 +193,21 @@ def test_bad_parameters_name_the_key(kwargs, match):
 def test_unknown_key_in_parameter_file_is_an_error():
     with pytest.raises(ParameterError, match="unknown key 'bee'"):
         RSFParams.from_dict({"a": 0.01, "bee": 1})
+
+
+def test_small_mass_approaches_the_quasi_static_slider():
+    """m -> 0: the inertial equations (s, x, psi) converge to the quasi-static slider, at first order in m."""
+    step = protocols.velocity_steps([1e-6, 10e-6], [5.0, 60.0])
+    quasi = rsf_params(0.01, 0.012, DC, v_ref=V0, stiffness=2e3)
+    ref = simulate(quasi, step, every=0.5)
+    gaps = [np.max(np.abs(simulate(quasi.replace(mass=m, normal_stress=1e6), step, every=0.5).friction - ref.friction))
+            for m in (1e5, 1e4, 1e3)]  # fmt: skip
+    assert gaps[-1] < 1e-7
+    assert np.log10(gaps[0] / gaps[1]) == pytest.approx(1.0, abs=0.05)  # observed order 1 in m
+    assert np.log10(gaps[1] / gaps[2]) == pytest.approx(1.0, abs=0.05)
+
+
+def test_too_short_an_inertial_time_is_said_in_words():
+    heavy = rsf_params(0.01, 0.012, DC, v_ref=V0, stiffness=2e3, mass=1.0, normal_stress=1e6)
+    with pytest.raises(ModelError, match="inertial time"):
+        simulate(heavy, protocols.velocity_steps([1e-6, 10e-6], [5.0, 60.0]), every=0.5)

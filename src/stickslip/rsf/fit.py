@@ -160,12 +160,12 @@ def fit_record(
         fit_stiffness = stiffness is None
     start = _initial_guess(record, protocol, guess or {}, stiffness)
     if states == 2:  # a one-state fit first: the two-state search starts from its answer, with a slower second state
-        first = _least_squares(record, protocol, law, 1, start, fit_stiffness, trend)
+        first, _ = _least_squares(record, protocol, law, 1, start, fit_stiffness, trend)
         start = {**start, **first.params.valuesdict()}
         start["dc"], start["dc2"] = math.exp(start["log_dc"]), 10 * math.exp(start["log_dc"])
         start["b2"] = 0.2 * start["b"]
         start["stiffness"] = math.exp(start["log_k"]) if "log_k" in start else start["stiffness"]
-    result = _least_squares(record, protocol, law, states, start, fit_stiffness, trend)
+    result, residual = _least_squares(record, protocol, law, states, start, fit_stiffness, trend)
     base = _base(record, protocol, law, states, start)
     values = result.params.valuesdict()
     model = _model(record, protocol, base, values)
@@ -176,7 +176,7 @@ def fit_record(
     dof = max(len(record) - result.nvarys, 1)
     redchi = float(np.sum((resid / noise) ** 2) / dof)
     table, corr, warns = _report(result, values, fit_stiffness, start["stiffness"], trend)
-    posterior = _posterior(result.userfcn, result, mcmc_steps, seed) if mcmc_steps > 0 else None
+    posterior = _posterior(residual, result, mcmc_steps, seed) if mcmc_steps > 0 else None
     return RSFFit(
         params=_final_params(base, values), parameters=table, correlations=corr, reduced_chi_square=redchi,
         rms=float(np.sqrt(np.mean(resid**2))), noise=noise, trend=float(values.get("trend", 0.0)), record=record,
@@ -255,9 +255,10 @@ def _least_squares(
     try:
         # MINPACK's forward-difference step sqrt(epsfcn) = 1e-5 (relative) sits well above the solver's
         # tolerance, so the Jacobians are not solver noise
-        return lmfit.minimize(residual, pars, method="leastsq", epsfcn=1e-10, max_nfev=METHOD_MAX_NFEV)
+        result = lmfit.minimize(residual, pars, method="leastsq", epsfcn=1e-10, max_nfev=METHOD_MAX_NFEV)
     except (ValueError, ArithmeticError) as exc:
         raise ModelError(f"rate-and-state fit failed: {exc}") from None
+    return result, residual
 
 
 def _final_params(base: RSFParams, values: dict[str, float]) -> RSFParams:

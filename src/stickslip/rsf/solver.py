@@ -173,16 +173,27 @@ def _adaptive_piece(
     blow_up.terminal = True  # type: ignore[attr-defined]
     blow_up.direction = 1  # type: ignore[attr-defined]
     jac = system.jacobian if system.has_jacobian else None
-    sol = solve_ivp(
-        system.rhs, (t0, t1), y0, method="LSODA", args=(vlp,), jac=jac, rtol=rtol, atol=atol, events=blow_up,
-        dense_output=dense,
-    )  # fmt: skip
+    with warnings.catch_warnings():
+        # LSODA's own warning on a failure is replaced by the ModelError or blow-up report below
+        warnings.simplefilter("ignore", UserWarning)
+        sol = solve_ivp(
+            system.rhs, (t0, t1), y0, method="LSODA", args=(vlp,), jac=jac, rtol=rtol, atol=atol, events=blow_up,
+            dense_output=dense,
+        )  # fmt: skip
     blown = float(sol.t_events[0][0]) if sol.t_events[0].size else None
     if blown is None and sol.status != 0:
         t_fail = float(sol.t[-1])
         x_fail = float(sol.y[o, -1])
         if x_fail > 0.5 * x_cap:  # the solver gave up while the slip rate ran away: a blow-up
             blown = t_fail
+        elif system.inertial:
+            v = system.v0 * math.exp(min(x_fail, EXP_CAP))
+            tau = system.inertia * v / system.a
+            raise ModelError(
+                f"rate-and-state solver failed at t = {t_fail:.6g} s: the slider's inertial time m V/(sigma a) = "
+                f"{tau:.3g} s is too short beside the run ({t1 - t0:.3g} s); inertia this small does not matter, "
+                "drop the mass (the quasi-static slider is its limit; use eta for fast slip)"
+            )
         else:
             raise ModelError(f"rate-and-state solver failed at t = {t_fail:.6g} s ({sol.message})")
     if dense:

@@ -46,10 +46,10 @@ class System:
         self.offset = 1 if self.inertial else 0  # index of x in y
         self.size = self.n + 1 + self.offset
         self.one_minus_h = 1.0 - sum(b * h for b, h in zip(self.b, self.h, strict=True))  # classical form
-        self.has_jacobian = not (self.inertial or self.regularized)
+        self.has_jacobian = not self.regularized
         self._terms = [(law.rate, b, dc) for law, b, dc in zip(self.laws, self.b, self.dc, strict=True)]
         self._coupled = any(h != 0.0 for h in self.h)
-        if self.has_jacobian and not self._coupled:
+        if self.has_jacobian and not (self._coupled or self.inertial):
             self.rhs = self._rhs_classical  # type: ignore[method-assign]  # the common case, without generality's cost
 
     # ------------------------------------------------------------------ friction
@@ -112,7 +112,9 @@ class System:
         return out
 
     def jacobian(self, t: float, y: np.ndarray, vlp: float) -> np.ndarray:
-        """Analytic Jacobian of :meth:`rhs` (classical friction form without inertia)."""
+        """Analytic Jacobian of :meth:`rhs` (classical friction form)."""
+        if self.inertial:
+            return self._jacobian_inertial(y, vlp)
         x = float(y[0])
         psi = [float(p) for p in y[1:]]
         n, a, k, eta, Q = self.n, self.a, self.k, self.eta, self.one_minus_h
@@ -132,6 +134,33 @@ class System:
             for j in range(n):
                 dmu_dpj = (a * jac[0, j + 1] + self.b[j] * rates[j][2]) / Q
                 jac[i + 1, j + 1] = (rates[i][2] if i == j else 0.0) + self.h[i] * dmu_dpj
+        return jac
+
+    def _jacobian_inertial(self, y: np.ndarray, vlp: float) -> np.ndarray:
+        """Jacobian of the inertial equations in (s, x, psi): xdot = (s - mu - eta V)/(m' V), m' = m/sigma."""
+        s, x = float(y[0]), float(y[1])
+        psi = [float(p) for p in y[2:]]
+        n, a, Q = self.n, self.a, self.one_minus_h
+        v = self.v0 * _exp(x)
+        rates = [law.rate(x, p, self.v0, dc) for law, p, dc in zip(self.laws, psi, self.dc, strict=True)]
+        force = s - self.friction(x, psi) - self.eta * v
+        mv = self.inertia * v
+        jac = np.zeros((n + 2, n + 2))
+        jac[0, 1] = -self.k * v
+        dx = np.empty(n + 2)  # d xdot / d (s, x, psi)
+        dx[0] = 1.0 / mv
+        dx[1] = (-a - self.eta * v - force) / mv
+        dx[2:] = [-b / mv for b in self.b]
+        jac[1] = dx
+        # dmu/dt = (a xdot + sum b g) / Q
+        dmu = a * dx / Q
+        dmu[1] += sum(b * r[1] for b, r in zip(self.b, rates, strict=True)) / Q
+        for j in range(n):
+            dmu[2 + j] += self.b[j] * rates[j][2] / Q
+        for i in range(n):
+            jac[2 + i] = self.h[i] * dmu
+            jac[2 + i, 1] += rates[i][1]
+            jac[2 + i, 2 + i] += rates[i][2]
         return jac
 
     # ------------------------------------------------------------------ states
