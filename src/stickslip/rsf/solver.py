@@ -33,6 +33,16 @@ __all__ = ["BLOW_UP_FACTOR", "evolve_state", "simulate"]
 #: A run "blows up" when V exceeds this multiple of max(driving velocities, start velocity).
 BLOW_UP_FACTOR = 1e10
 RTOL = 1e-10
+#: Right-hand-side evaluations allowed per protocol segment before a run is declared stalled.
+MAX_CALLS = 1_000_000
+
+
+class _Stalled(Exception):
+    def __init__(self, time: float) -> None:
+        super().__init__(time)
+        self.time = float(time)
+
+
 ATOL = 1e-12
 
 
@@ -173,13 +183,28 @@ def _adaptive_piece(
     blow_up.terminal = True  # type: ignore[attr-defined]
     blow_up.direction = 1  # type: ignore[attr-defined]
     jac = system.jacobian if system.has_jacobian else None
-    with warnings.catch_warnings():
-        # LSODA's own warning on a failure is replaced by the ModelError or blow-up report below
-        warnings.simplefilter("ignore", UserWarning)
-        sol = solve_ivp(
-            system.rhs, (t0, t1), y0, method="LSODA", args=(vlp,), jac=jac, rtol=rtol, atol=atol, events=blow_up,
-            dense_output=dense,
-        )  # fmt: skip
+    calls = [0]
+
+    def rhs(t: float, y: np.ndarray, vlp: float) -> list[float]:
+        calls[0] += 1
+        if calls[0] > MAX_CALLS:
+            raise _Stalled(t)
+        return system.rhs(t, y, vlp)
+
+    try:
+        with warnings.catch_warnings():
+            # LSODA's own warning on a failure is replaced by the ModelError or blow-up report below
+            warnings.simplefilter("ignore", UserWarning)
+            sol = solve_ivp(
+                rhs, (t0, t1), y0, method="LSODA", args=(vlp,), jac=jac, rtol=rtol, atol=atol, events=blow_up,
+                dense_output=dense,
+            )  # fmt: skip
+    except _Stalled as stalled:
+        raise ModelError(
+            f"rate-and-state solver stalled at t = {stalled.time:.6g} s ({MAX_CALLS} evaluations in the segment "
+            f"{t0:g} ... {t1:g} s): the equations are too stiff here (e.g. the regularised form far below V0 "
+            "under a very stiff spring); loosen the spring or use the classical form"
+        ) from None
     blown = float(sol.t_events[0][0]) if sol.t_events[0].size else None
     if blown is None and sol.status != 0:
         t_fail = float(sol.t[-1])
