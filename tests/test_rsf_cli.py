@@ -76,3 +76,12 @@ def test_simulate_bad_input_is_one_line_exit_2(capsys, args, message):
     code, _, err = run_main(capsys, "rsf", "simulate", "--segment", "1 um/s:10 s", *args)
     assert code == 2
     assert err.startswith("stickslip: error:") and message in err and err.count("\n") == 1
+
+
+def test_simulate_reads_a_protocol_file(tmp_path, capsys):
+    protocol = tmp_path / "protocol.csv"
+    protocol.write_text("velocity,duration\n1e-6,10\n1e-5,30\n")
+    code, out, _ = run_main(capsys, "rsf", "simulate", *MODEL, "--protocol", str(protocol), "--every", "1 s", "--json")
+    code2, out2, _ = run_main(capsys, "rsf", "simulate", *MODEL, *STEP, "--every", "1 s", "--json")
+    assert code == code2 == 0
+    assert json.loads(out)["final_friction"] == pytest.approx(json.loads(out2)["final_friction"], abs=1e-13)

@@ -211,3 +211,12 @@ def test_too_short_an_inertial_time_is_said_in_words():
     heavy = rsf_params(0.01, 0.012, DC, v_ref=V0, stiffness=2e3, mass=1.0, normal_stress=1e6)
     with pytest.raises(ModelError, match="inertial time"):
         simulate(heavy, protocols.velocity_steps([1e-6, 10e-6], [5.0, 60.0]), every=0.5)
+
+
+def test_parameter_mapping_reads_units_and_stress_stiffness():
+    p = RSFParams.from_dict({"a": 0.01, "v_ref": "1 um/s", "normal_stress": "30 MPa", "stiffness": "30 MPa/mm",
+                             "eta": "3 MPa*s/m", "states": [{"law": "slip", "b": 0.012, "dc": "20 um"}]})  # fmt: skip
+    assert p.stiffness == pytest.approx(1e3, rel=1e-12) and p.eta == pytest.approx(0.1, rel=1e-12)
+    assert p.states[0].dc == pytest.approx(20e-6, rel=1e-12) and p.v_ref == pytest.approx(1e-6, rel=1e-12)
+    with pytest.raises(ParameterError, match="normal_stress"):
+        RSFParams.from_dict({"stiffness": "30 MPa/mm"})

@@ -154,11 +154,28 @@ class RSFParams:
         values: dict[str, Any] = {"states": tuple(states) or (StateVariable(),)}
         dims = {"v_ref": "velocity", "stiffness": "per_length", "eta": "slowness", "mass": "mass_per_area",
                 "normal_stress": "stress"}  # fmt: skip
-        for key in ("a", "mu0", "v_ref", "stiffness", "eta", "mass", "normal_stress", "regularized"):
+        for key in ("a", "mu0", "v_ref", "normal_stress", "mass", "regularized"):
             if key in mapping:
                 value = mapping[key]
                 values[key] = to_si(value, dims[key], f"{source}: {key}") if key in dims else value
+        sigma = values.get("normal_stress")
+        for key, stress_dim in (("stiffness", "stress_per_length"), ("eta", "stress_per_velocity")):
+            if key in mapping:
+                values[key] = _friction_units(mapping[key], dims[key], stress_dim, sigma, f"{source}: {key}")
         return cls(**values)
+
+
+def _friction_units(value: Any, dimension: str, stress_dimension: str, sigma: float | None, name: str) -> float:
+    """A value in friction units, or in stress units (Pa/m, Pa s/m) divided by the normal stress."""
+    from ..errors import UnitError
+
+    try:
+        return to_si(value, dimension, name)
+    except UnitError:
+        converted = to_si(value, stress_dimension, name)  # raises the one-line UnitError if neither fits
+        if sigma is None:
+            raise ParameterError(f"{name}: {value!r} is in stress units; give normal_stress to convert it") from None
+        return converted / sigma
 
 
 def _toml_value(value: Any) -> str:
