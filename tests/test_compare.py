@@ -64,3 +64,13 @@ def test_compare_command(tmp_path, capsys):
     assert "bond model" in summary["bond_model"]
     assert summary["stick_slip"]["bond"]["regime"] == "stick-slip"
     assert figure.stat().st_size > 0 and (tmp_path / "compare.params.json").is_file()
+
+
+def test_compare_with_rsf_overrides_shows_an_rsf_oscillation(capsys):
+    code, out, err = run_main(capsys, "compare", "--duration", "120 s", "--a", "0.3", "--b", "0.6", "--dc", "100 um",
+                              "--json")  # fmt: skip
+    assert code == 0, err
+    summary = json.loads(out)
+    rsf = summary["stick_slip"]["rsf_parameters"]
+    assert (rsf["a"], rsf["b"], rsf["dc"]) == pytest.approx((0.3, 0.6, 100e-6)) and "overridden" in rsf["note"]
+    assert summary["stick_slip"]["rsf"]["period"] is not None

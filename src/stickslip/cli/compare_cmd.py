@@ -30,6 +30,9 @@ from .rsf_cmd import save_figure, sidecar, write
 @click.option("--pull", default="50 um/s", show_default=True, help="Pulling velocity of the stick-slip pair.")
 @click.option("--duration", default="120 s", show_default=True, help="Duration of the stick-slip pair.")
 @click.option("--eta", default=None, help="RSF radiation damping (s/m) [a/(100 V0)].")
+@click.option("--a", "rsf_a", default=None, help="Override the RSF a standing for the bond model.")
+@click.option("--b", "rsf_b", default=None, help="Override the RSF b.")
+@click.option("--dc", "rsf_dc", default=None, help='Override the RSF Dc, e.g. "50 um".')
 @click.option("--json", "as_json", is_flag=True, help="Print the summary as JSON (SI units).")
 @click.option("-o", "--output", type=click.Path(dir_okay=False, path_type=Path), help="Save the figure here.")
 def compare_command(**options: Any) -> None:
@@ -48,7 +51,7 @@ def compare_command(**options: Any) -> None:
     eta = None if options["eta"] is None else positive(options["eta"], "slowness", "--eta", allow_zero=True)
     refuse_input_as_output([options["params_name"]], [("-o", options["output"])])
 
-    rsf = rsf_of_bond(params, v0, v1, step_time)
+    rsf = _override(rsf_of_bond(params, v0, v1, step_time), options)
     step = protocols.velocity_steps([v0, v1], [step_time, step_time])
     shs = protocols.slide_hold_slide(v0, step_time, hold)
     panels = {}
@@ -56,7 +59,7 @@ def compare_command(**options: Any) -> None:
         bond = bond_response(params, protocol, "velocity")
         run = simulate(rsf.params, protocol, every=protocol.duration / 800)
         panels[name] = (bond, run)
-    local = rsf_of_bond(params, pull / 1.05, pull * 1.05)
+    local = _override(rsf_of_bond(params, pull / 1.05, pull * 1.05), options)
     pair = stick_slip_pair(params, pull, duration, local, eta)
     summary = {
         "rsf_of_bond_model": rsf.as_dict(),
@@ -77,6 +80,26 @@ def compare_command(**options: Any) -> None:
     if options["output"] is not None:
         save_figure(_figure(panels, pair, rsf, local), options["output"])
         write(sidecar(options["output"]), json.dumps(json_safe(summary), indent=2) + "\n")
+
+
+def _override(rsf: Any, options: dict[str, Any]) -> Any:
+    """The RSF of the bond model with a, b, Dc replaced where the user gave them (said in its note)."""
+    import dataclasses
+
+    from ..rsf import StateVariable
+    from .common import quantity
+
+    given = {k: options[k] for k in ("rsf_a", "rsf_b", "rsf_dc") if options.get(k) is not None}
+    if not given:
+        return rsf
+    p = rsf.params
+    s = p.states[0]
+    a = quantity(given["rsf_a"], "dimensionless", "--a") if "rsf_a" in given else p.a
+    b = quantity(given["rsf_b"], "dimensionless", "--b") if "rsf_b" in given else s.b
+    dc = positive(given["rsf_dc"], "length", "--dc") if "rsf_dc" in given else s.dc
+    note = rsf.note + "; overridden on the command line: " + ", ".join(f"{k[4:]} = {v}" for k, v in given.items())
+    params = p.replace(a=a, states=(StateVariable(s.law, b, dc, s.c),))
+    return dataclasses.replace(rsf, params=params, a_minus_b=a - b, note=note)
 
 
 def _text(summary: dict[str, Any]) -> str:
@@ -122,6 +145,8 @@ def _figure(panels: dict[str, Any], pair: dict[str, Any], rsf: Any, local: Any) 
     apply_style(ax)
     p = rsf.params
     how = "fitted" if rsf.determined else "a, Dc assumed: quasi-static bond model"
+    if "overridden" in rsf.note:
+        how = "given on the command line"
     fig.suptitle(f"RSF of the bond model: a = {p.a:.3g}, b = {p.b:.3g}, Dc = {p.dc * 1e6:.3g} µm ({how})", fontsize=9)
     return fig
 
