@@ -43,6 +43,9 @@ DIMENSIONS: dict[str, tuple[str, str]] = {
     "force": ("[mass] * [length] / [time] ** 2", "N"),
     "area": ("[length] ** 2", "m^2"),
     "stress_per_velocity": ("[mass] / [length] ** 2 / [time]", "Pa s/m"),
+    "per_length": ("1 / [length]", "1/m"),
+    "slowness": ("[time] / [length]", "s/m"),
+    "mass_per_area": ("[mass] / [length] ** 2", "kg/m^2"),
 }
 
 #: Exponents of (mass, length, time, temperature) of each dimension.
@@ -296,6 +299,9 @@ def _base_unit(dimension: str) -> str:
         "force": "N",
         "area": "m**2",
         "stress_per_velocity": "Pa*s/m",
+        "per_length": "1/m",
+        "slowness": "s/m",
+        "mass_per_area": "kg/m**2",
     }[dimension]
 
 

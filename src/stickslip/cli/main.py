@@ -36,9 +36,20 @@ def cli() -> None:
 
 
 def _register() -> None:
-    from . import analyze_cmd, cycle_cmd, fit_cmd, params_cmd, reproduce_cmd, steady_cmd, sweep_cmd
+    from . import (
+        analyze_cmd,
+        compare_cmd,
+        cycle_cmd,
+        fit_cmd,
+        params_cmd,
+        reproduce_cmd,
+        rsf_cmd,
+        steady_cmd,
+        sweep_cmd,
+    )
 
-    for module in (params_cmd, steady_cmd, cycle_cmd, fit_cmd, analyze_cmd, reproduce_cmd, sweep_cmd):
+    commands = (params_cmd, steady_cmd, cycle_cmd, fit_cmd, analyze_cmd, reproduce_cmd, rsf_cmd, compare_cmd, sweep_cmd)
+    for module in commands:
         module.register(cli)
 
 

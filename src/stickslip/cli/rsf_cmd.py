@@ -1,0 +1,373 @@
+"""``stickslip rsf simulate | fit | stability``: rate-and-state friction on the command line.
+
+Values carry units (``--dc "10 um"``, ``--stiffness "1e-3 1/um"``, ``--v-ref "1 um/s"``);
+a stiffness in Pa/m or a damping in Pa s/m needs ``--normal-stress``.  Every trace
+and fit writes its parameters beside it (``NAME.params.json``) so it can be rerun
+with ``--params``.
+"""
+
+from __future__ import annotations
+
+import io
+import json
+import math
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import click
+
+from ..errors import ParameterError, UnitError
+from ..fileio import atomic_path, atomic_write_text, refuse_input_as_output
+from .common import json_safe, quantity
+
+LAW_NAMES = ("aging", "slip", "prz", "nagata")
+
+
+def model_options(func: Callable[..., Any]) -> Callable[..., Any]:
+    """The friction law and spring-slider options shared by simulate and stability."""
+    options = [
+        click.option("--params", "params_file", type=click.Path(dir_okay=False, path_type=Path), default=None,
+                     help="Start from parameters written by an earlier run or fit (.params.json or .toml)."),
+        click.option("--law", default=None, help="State evolution law: aging, slip, prz, nagata or a registered one."),
+        click.option("--a", "a", default=None, help="Direct effect a."),
+        click.option("--b", "b", default=None, help="State weight b (first state variable)."),
+        click.option("--dc", default=None, help='Critical slip distance, e.g. "10 um".'),
+        click.option("--b2", default=None, help="Weight of a second state variable."),
+        click.option("--dc2", default=None, help="Critical slip distance of the second state variable."),
+        click.option("--c", "nagata_c", default=None, help="Nagata's c (nagata law only)."),
+        click.option("--mu0", default=None, help="Reference friction mu0 [0.6]."),
+        click.option("--v-ref", default=None, help='Reference velocity V0, e.g. "1 um/s" [1 um/s].'),
+        click.option("--stiffness", default=None,
+                     help='Spring stiffness: friction per slip ("1e-3 1/um") or Pa/m with --normal-stress.'),
+        click.option("--eta", default=None, help='Radiation damping: "s/m" (friction per velocity) or Pa s/m.'),
+        click.option("--mass", default=None, help='Slider mass per area, e.g. "100 kg/m^2" (needs --normal-stress).'),
+        click.option("--normal-stress", default=None, help='Normal stress, e.g. "30 MPa".'),
+        click.option("--regularized", is_flag=True, default=None, help="Use the regularised (asinh) friction form."),
+    ]  # fmt: skip
+    for option in reversed(options):
+        func = option(func)
+    return func
+
+
+def build_params(options: dict[str, Any]) -> Any:
+    """RSFParams from the model options (on top of ``--params`` if given)."""
+    from ..rsf import RSFParams
+
+    base: dict[str, Any] = {}
+    if options.get("params_file") is not None:
+        base = load_params_mapping(options["params_file"])
+    states = [dict(s) for s in base.get("states", [{"law": "aging", "b": 0.01, "dc": 10e-6}])]
+    first = states[0]
+    if options.get("law"):
+        for s in states:
+            s["law"] = options["law"]
+    if options.get("b") is not None:
+        first["b"] = _number(options["b"], "--b")
+    if options.get("dc") is not None:
+        first["dc"] = _positive(options["dc"], "length", "--dc")
+    if options.get("nagata_c") is not None:
+        for s in states:
+            s["c"] = _number(options["nagata_c"], "--c")
+    if (options.get("b2") is None) != (options.get("dc2") is None):
+        raise ParameterError("--b2/--dc2: a second state variable needs both --b2 and --dc2")
+    if options.get("b2") is not None:
+        second = {"law": first.get("law", "aging"), "b": _number(options["b2"], "--b2"),
+                  "dc": _positive(options["dc2"], "length", "--dc2"), "c": first.get("c", 0.0)}  # fmt: skip
+        states = [first, second]
+    mapping: dict[str, Any] = {k: v for k, v in base.items() if k != "states"}
+    mapping["states"] = states
+    sigma = base.get("normal_stress")
+    if options.get("normal_stress") is not None:
+        sigma = mapping["normal_stress"] = _positive(options["normal_stress"], "stress", "--normal-stress")
+    if options.get("a") is not None:
+        mapping["a"] = _number(options["a"], "--a")
+    if options.get("mu0") is not None:
+        mapping["mu0"] = _number(options["mu0"], "--mu0")
+    if options.get("v_ref") is not None:
+        mapping["v_ref"] = _positive(options["v_ref"], "velocity", "--v-ref")
+    if options.get("stiffness") is not None:
+        mapping["stiffness"] = _per_sigma(options["stiffness"], "per_length", "stress_per_length", sigma, "--stiffness")
+    if options.get("eta") is not None:
+        mapping["eta"] = _per_sigma(options["eta"], "slowness", "stress_per_velocity", sigma, "--eta", allow_zero=True)
+    if options.get("mass") is not None:
+        mapping["mass"] = _positive(options["mass"], "mass_per_area", "--mass", allow_zero=True)
+    if options.get("regularized"):
+        mapping["regularized"] = True
+    return RSFParams.from_dict(mapping, source="options")
+
+
+def load_params_mapping(path: Path) -> dict[str, Any]:
+    """The parameter mapping of a ``.params.json`` (trace or fit) or a ``.toml`` file."""
+    from ..errors import DataError
+
+    path = Path(path)
+    if not path.is_file():
+        raise DataError(f"--params {path}: file not found")
+    text = path.read_text(encoding="utf-8")
+    try:
+        if path.suffix.lower() == ".toml":
+            try:
+                import tomllib
+            except ModuleNotFoundError:  # pragma: no cover - Python 3.10
+                import tomli as tomllib  # type: ignore[no-redef]
+            data = tomllib.loads(text)
+        else:
+            data = json.loads(text)
+    except ValueError as exc:
+        raise DataError(f"--params {path}: cannot read ({str(exc).splitlines()[0]})") from None
+    return dict(data.get("parameters", data))
+
+
+def _number(text: str, name: str) -> float:
+    return quantity(text, "dimensionless", name)
+
+
+def _positive(text: str, dimension: str, name: str, allow_zero: bool = False) -> float:
+    from .common import positive
+
+    return positive(text, dimension, name, allow_zero=allow_zero)
+
+
+def _per_sigma(
+    text: str, dimension: str, stress_dimension: str, sigma: float | None, name: str, allow_zero: bool = False
+) -> float:
+    """A value in friction units, or in stress units divided by the normal stress."""
+    try:
+        return _positive(text, dimension, name, allow_zero)
+    except UnitError:
+        try:
+            value = _positive(text, stress_dimension, name, allow_zero)
+        except UnitError:
+            raise UnitError(
+                f"{name}: {text!r} has the wrong dimension; expected {dimension.replace('_', ' ')} "
+                f"or {stress_dimension.replace('_', ' ')} with --normal-stress"
+            ) from None
+        if sigma is None:
+            raise ParameterError(f"{name} {text!r} is in stress units: give --normal-stress to convert it") from None
+        return value / sigma
+
+
+def build_protocol(segment: tuple[str, ...], protocol_file: Path | None, fallback: list[dict] | None = None) -> Any:
+    from .. import protocols
+
+    if segment and protocol_file is not None:
+        raise click.UsageError("--segment and --protocol: give one of them")
+    if protocol_file is not None:
+        return protocols.read_protocol(protocol_file)
+    if segment:
+        return protocols.Protocol(tuple(protocols.parse_segment(s) for s in segment))
+    if fallback:
+        return protocols.segments([(s["velocity"], s["duration"]) for s in fallback])
+    raise click.UsageError('expected at least one --segment "V:T" (e.g. "1 um/s:100 s") or --protocol FILE')
+
+
+def trace_csv(frame: Any) -> str:
+    buffer = io.StringIO()
+    frame.to_csv(buffer, index=False, float_format="%.12g")
+    return buffer.getvalue()
+
+
+def sidecar(path: Path) -> Path:
+    """Where the parameters of an output file go: ``NAME.params.json`` beside it."""
+    return path.with_name(path.stem + ".params.json")
+
+
+def save_figure(fig: Any, path: Path) -> None:
+    try:
+        with atomic_path(path) as temp:
+            fig.savefig(temp, dpi=120, bbox_inches="tight", format=path.suffix.lstrip(".") or "png")
+    except (OSError, ValueError) as exc:
+        raise click.FileError(str(path), hint=str(exc)) from None
+
+
+def write(path: Path, text: str) -> None:
+    try:
+        atomic_write_text(path, text)
+    except OSError as exc:
+        raise click.FileError(str(path), hint=str(exc.strerror or exc)) from None
+
+
+@click.group("rsf")
+def rsf_group() -> None:
+    """Rate-and-state friction: spring-slider runs, fits to lab records, stability."""
+
+
+@rsf_group.command("simulate")
+@model_options
+@click.option("--start-velocity", default=None, help="Steady sliding at this velocity at t = 0 [first segment's].")
+@click.option("--segment", multiple=True, metavar="V:T", help='Load-point velocity and duration, "1 um/s:100 s".')
+@click.option("--protocol", "protocol_file", type=click.Path(dir_okay=False, path_type=Path), default=None,
+              help="Protocol CSV (time,velocity or velocity,duration; SI).")  # fmt: skip
+@click.option("--every", default=None, help='Sample the trace every DT (e.g. "0.1 s"); default: the solver\'s steps.')
+@click.option("-o", "--output", type=click.Path(dir_okay=False, path_type=Path), help="Write the trace CSV here.")
+@click.option("--json", "as_json", is_flag=True, help="Print the summary as JSON.")
+@click.option("--plot", "plot_path", type=click.Path(dir_okay=False, path_type=Path), help="Save a figure.")
+def simulate_command(**options: Any) -> None:
+    """Run a loading protocol on the rate-and-state spring-slider.
+
+    The trace has columns time, friction, slider_velocity, state,
+    load_point_displacement, slider_displacement (SI).  With -o the
+    parameters go beside it in NAME.params.json.
+    """
+    from ..rsf import simulate
+
+    fallback = None
+    start = None
+    if options["params_file"] is not None and options["params_file"].suffix.lower() == ".json":
+        meta = json.loads(options["params_file"].read_text(encoding="utf-8"))
+        fallback, start = meta.get("protocol"), meta.get("start_velocity")
+    params = build_params(options)
+    protocol = build_protocol(options["segment"], options["protocol_file"], fallback)
+    if options["start_velocity"] is not None:
+        start = _positive(options["start_velocity"], "velocity", "--start-velocity")
+    every = None if options["every"] is None else _positive(options["every"], "time", "--every")
+    output, plot_path = options["output"], options["plot_path"]
+    refuse_input_as_output([options["protocol_file"], options["params_file"]], [("-o", output), ("--plot", plot_path)])
+    run = simulate(params, protocol, start_velocity=start, every=every)
+    if output is not None:
+        write(output, trace_csv(run.to_frame()))
+        write(sidecar(output), run.metadata_json())
+    summary = run.summary()
+    if options["as_json"]:
+        click.echo(json.dumps(json_safe(summary), indent=2))
+    elif output is None:
+        click.echo(trace_csv(run.to_frame()), nl=False)
+    else:
+        click.echo(_summary_text(summary), err=True)
+    if plot_path is not None:
+        from ..rsf.plots import run_figure
+
+        save_figure(run_figure(run), plot_path)
+
+
+def _summary_text(summary: dict[str, Any]) -> str:
+    period = summary.get("period")
+    lines = [f"regime: {summary['regime']}", f"final friction: {summary['final_friction']:.6g}"]
+    if period is not None:
+        lines.append(f"period: {period:.6g} s")
+    lines.append(summary["message"])
+    return "\n".join(lines)
+
+
+@rsf_group.command("stability")
+@model_options
+@click.option("--velocity", "velocities", multiple=True, required=True, help='Sliding velocity, e.g. "1 um/s".')
+@click.option("--json", "as_json", is_flag=True, help="Print JSON (SI units).")
+@click.option("--plot", "plot_path", type=click.Path(dir_okay=False, path_type=Path),
+              help="Save the critical stiffness against velocity.")  # fmt: skip
+def stability_command(**options: Any) -> None:
+    """Critical stiffness k_c and neutral period of steady sliding (docs/rsf.md)."""
+    from ..rsf import stability
+
+    params = build_params(options)
+    reports = [stability(params, _positive(v, "velocity", "--velocity")).as_dict() for v in options["velocities"]]
+    if options["as_json"]:
+        click.echo(json.dumps(json_safe(reports if len(reports) > 1 else reports[0]), indent=2))
+    else:
+        for r in reports:
+            period = r["neutral_period"]
+            click.echo(
+                f"V = {r['velocity']:.6g} m/s: k_c = {r['critical_stiffness']:.6g} 1/m"
+                + (f" ({r['critical_stiffness_pa']:.6g} Pa/m)" if r["critical_stiffness_pa"] is not None else "")
+                + (f", neutral period {period:.6g} s" if not math.isnan(period) else "")
+                + f"; {r['message']}"
+            )
+    if options["plot_path"] is not None:
+        from ..rsf.plots import stability_figure
+
+        speeds = [r["velocity"] for r in reports]
+        save_figure(stability_figure(params, min(speeds) / 100, max(speeds) * 100), options["plot_path"])
+
+
+@rsf_group.command("fit")
+@click.argument("record_file", metavar="FILE", type=click.Path(dir_okay=False, path_type=Path))
+@click.option(
+    "--columns",
+    default=None,
+    metavar="ROLE=HEADER,...",
+    help='Map headers: time="Time(s)",displacement="Displ(microns)",friction=Friction.',
+)
+@click.option("--displacement-unit", default="m", show_default=True, help="Unit of the displacement column.")
+@click.option("--time-unit", default="s", show_default=True, help="Unit of the time column.")
+@click.option("--law", default="aging", show_default=True, help="State evolution law.")
+@click.option("--states", type=click.IntRange(1, 2), default=1, show_default=True, help="State variables.")
+@click.option("--stiffness", default=None, help='Fixed spring stiffness ("1e-3 1/um", or Pa/m with --normal-stress).')
+@click.option("--normal-stress", default=None, help="Normal stress, to read a stiffness in Pa/m.")
+@click.option("--fit-stiffness", is_flag=True, help="Fit the stiffness (the default when --stiffness is not given).")
+@click.option("--trend", is_flag=True, help="Fit a linear slip-dependent trend as well.")
+@click.option(
+    "--segment",
+    multiple=True,
+    metavar="V:T",
+    help="Load-point history from the record's start (default: found from the displacement).",
+)
+@click.option("--mcmc", "mcmc_steps", type=click.IntRange(min=0), default=0, help="emcee steps for a posterior.")
+@click.option("--seed", type=int, default=None, help="Seed of the emcee walkers.")
+@click.option("--json", "as_json", is_flag=True, help="Print the report as JSON (SI units).")
+@click.option("-o", "--output", type=click.Path(dir_okay=False, path_type=Path), help="Write fitted parameters (TOML).")
+@click.option("--plot", "plot_path", type=click.Path(dir_okay=False, path_type=Path), help="Save data and fit.")
+def fit_command(**options: Any) -> None:
+    """Fit rate-and-state friction to a lab record (time, load-point displacement, friction).
+
+    The load point's velocity history is found from the displacement (or
+    given with --segment); the slider starts in steady sliding.  The report
+    gives values, standard errors and 95 % intervals, correlations, reduced
+    chi-square against the record's own noise, and warnings when parameters
+    cannot be told apart.
+    """
+    from .. import protocols
+    from ..rsf.data import parse_columns, read_record
+    from ..rsf.fit import fit_record
+
+    output, plot_path = options["output"], options["plot_path"]
+    refuse_input_as_output([options["record_file"]], [("-o", output), ("--plot", plot_path)])
+    record = read_record(options["record_file"], parse_columns(options["columns"]), options["displacement_unit"],
+                         options["time_unit"])  # fmt: skip
+    sigma = None
+    if options["normal_stress"] is not None:
+        sigma = _positive(options["normal_stress"], "stress", "--normal-stress")
+    stiffness = None
+    if options["stiffness"] is not None:
+        if options["fit_stiffness"]:
+            raise click.UsageError("--stiffness and --fit-stiffness: give one of them")
+        stiffness = _per_sigma(options["stiffness"], "per_length", "stress_per_length", sigma, "--stiffness")
+    protocol = None
+    if options["segment"]:
+        protocol = protocols.Protocol(tuple(protocols.parse_segment(s) for s in options["segment"]))
+    fit = fit_record(record, law=options["law"], states=options["states"], stiffness=stiffness,
+                     fit_stiffness=True if options["fit_stiffness"] else None, trend=options["trend"],
+                     protocol=protocol, mcmc_steps=options["mcmc_steps"], seed=options["seed"])  # fmt: skip
+    report = fit.summary()
+    if output is not None:
+        write(output, fit.to_toml())
+        write(sidecar(output), json.dumps(json_safe({"parameters": fit.params.to_dict(), "fit": report}), indent=2))
+    if options["as_json"]:
+        click.echo(json.dumps(json_safe(report), indent=2))
+    else:
+        click.echo(_fit_text(fit))
+    if plot_path is not None:
+        from ..rsf.plots import fit_figure
+
+        save_figure(fit_figure(fit), plot_path)
+
+
+def _fit_text(fit: Any) -> str:
+    lines = [f"rate-and-state fit of {fit.record.source} ({len(fit.record)} rows); load point: "
+             f"{fit.protocol.describe()}"]  # fmt: skip
+    for name, p in fit.parameters.items():
+        if p.fixed:
+            lines.append(f"  {name:10s} {p.value:.6g} (fixed)")
+        elif p.interval is None:
+            lines.append(f"  {name:10s} {p.value:.6g} (no standard error)")
+        else:
+            lines.append(
+                f"  {name:10s} {p.value:.6g} ± {p.stderr:.2g}   95 % [{p.interval[0]:.6g}, {p.interval[1]:.6g}]"
+            )
+    lines.append(f"  reduced chi-square {fit.reduced_chi_square:.4g} (noise {fit.noise:.3g}), rms {fit.rms:.4g}")
+    lines += [f"  warning: {w}" for w in fit.warnings]
+    return "\n".join(lines)
+
+
+def register(cli: click.Group) -> None:
+    cli.add_command(rsf_group)

@@ -1,0 +1,130 @@
+r"""State evolution laws of rate-and-state friction, all in one place.
+
+Every law is written for the *state term* ``psi = ln(V0 theta / Dc)`` (the
+friction is ``mu = mu0 + a ln(V/V0) + sum_i b_i psi_i``), with ``x = ln(V/V0)``:
+
+=========  ==========================================  ===========================================
+law        d theta/dt                                   d psi/dt
+=========  ==========================================  ===========================================
+aging      1 - V theta/Dc                               (V0/Dc) (e^-psi - e^x)
+slip       -(V theta/Dc) ln(V theta/Dc)                 -(V0/Dc) e^x (x + psi)
+prz        1 - (V theta/(2 Dc))^2                        (V0/(2 Dc)) (e^-psi - e^(2x + psi))
+nagata     1 - V theta/Dc - (c/b) theta dmu/dt           aging - (c/b) dmu/dt
+=========  ==========================================  ===========================================
+
+(PRZ uses theta = (2 Dc/V0) e^psi, so that theta_ss = 2 Dc/V as in Perrin, Rice
+and Zheng 1995 and in rsfmodel.)  In steady state psi = -x for every law.
+
+Adding a law touches one place: subclass :class:`StateLaw` (or write any object
+with the same attributes) and call :func:`register_law`; ``stickslip rsf
+simulate --law NAME`` and :func:`stickslip.rsf.simulate` then know it.  A law
+returns ``d psi/dt`` *without* the ``dmu/dt`` coupling and its two partial
+derivatives (used in the solver's analytic Jacobian); a law whose rate depends
+on ``dmu/dt`` linearly (as Nagata's) says so with :meth:`StateLaw.coupling`.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import ClassVar
+
+from ..errors import ParameterError
+
+#: exp() arguments are capped here, so a run that blows up is caught by the solver, not an OverflowError.
+EXP_CAP = 700.0
+
+
+def cexp(z: float) -> float:
+    """exp(z) with the argument capped at :data:`EXP_CAP` (for use inside laws)."""
+    return math.exp(z if z < EXP_CAP else EXP_CAP)
+
+
+__all__ = ["EXP_CAP", "LAWS", "Aging", "Nagata", "Prz", "Slip", "StateLaw", "cexp", "get_law", "register_law"]
+
+
+class StateLaw:
+    """Base class (and documentation) of a state evolution law.
+
+    ``theta_scale``: theta = theta_scale (Dc/V0) e^psi.  ``rate`` returns
+    ``(g, dg/dx, dg/dpsi)`` where ``g`` is d psi/dt without the dmu/dt term.
+    ``coupling(b, c)`` is the coefficient h of ``d psi/dt = g + h dmu/dt``.
+    """
+
+    name: ClassVar[str] = "law"
+    theta_scale: ClassVar[float] = 1.0
+    description: ClassVar[str] = ""
+
+    def rate(self, x: float, psi: float, v0: float, dc: float) -> tuple[float, float, float]:
+        raise NotImplementedError
+
+    def coupling(self, b: float, c: float) -> float:
+        return 0.0
+
+
+class Aging(StateLaw):
+    name = "aging"
+    description = "Dieterich (1979) aging law: d theta/dt = 1 - V theta/Dc"
+
+    def rate(self, x: float, psi: float, v0: float, dc: float) -> tuple[float, float, float]:
+        r = v0 / dc
+        ev, ep = cexp(x), cexp(-psi)
+        return r * (ep - ev), -r * ev, -r * ep
+
+
+class Slip(StateLaw):
+    name = "slip"
+    description = "Ruina (1983) slip law: d theta/dt = -(V theta/Dc) ln(V theta/Dc)"
+
+    def rate(self, x: float, psi: float, v0: float, dc: float) -> tuple[float, float, float]:
+        w = v0 * cexp(x) / dc
+        s = x + psi
+        return -w * s, -w * (s + 1.0), -w
+
+
+class Prz(StateLaw):
+    name = "prz"
+    theta_scale = 2.0
+    description = "Perrin, Rice & Zheng (1995): d theta/dt = 1 - (V theta/(2 Dc))^2"
+
+    def rate(self, x: float, psi: float, v0: float, dc: float) -> tuple[float, float, float]:
+        r = v0 / (2.0 * dc)
+        ep, eq = cexp(-psi), cexp(2.0 * x + psi)
+        return r * (ep - eq), -2.0 * r * eq, -r * (ep + eq)
+
+
+class Nagata(Aging):
+    name = "nagata"
+    description = "Nagata et al. (2012): d theta/dt = 1 - V theta/Dc - (c/b) theta dmu/dt"
+
+    def coupling(self, b: float, c: float) -> float:
+        return -c / b
+
+
+#: The registry: law name -> law object.
+LAWS: dict[str, StateLaw] = {}
+
+
+def register_law(law: StateLaw, name: str | None = None) -> StateLaw:
+    """Make ``law`` available under ``name`` (default ``law.name``); returns it."""
+    key = (name or law.name).strip().lower()
+    if not key:
+        raise ParameterError("register_law: expected a non-empty law name")
+    for attr in ("rate", "coupling", "theta_scale"):
+        if not hasattr(law, attr):
+            raise ParameterError(f"register_law {key!r}: the law has no {attr!r} (see stickslip.rsf.laws.StateLaw)")
+    LAWS[key] = law
+    return law
+
+
+def get_law(name: str | StateLaw) -> StateLaw:
+    """The law registered under ``name`` (a law object passes through)."""
+    if not isinstance(name, str):
+        return name
+    try:
+        return LAWS[name.strip().lower()]
+    except KeyError:
+        raise ParameterError(f"law {name!r}: unknown; expected one of {', '.join(sorted(LAWS))}") from None
+
+
+for _law in (Aging(), Slip(), Prz(), Nagata()):
+    register_law(_law)

@@ -1,0 +1,213 @@
+"""Parameters of rate-and-state friction and of the spring-slider: frozen, validated, SI inside.
+
+``stiffness`` is friction per slip (1/m): a machine stiffness K in Pa/m with a
+normal stress sigma is ``K / sigma``.  ``eta`` is radiation damping in friction
+per velocity (s/m: the shear impedance over sigma).  ``mass`` is the slider's
+mass per unit area (kg/m^2) and needs ``normal_stress``.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import asdict, dataclass, field, replace
+from typing import Any
+
+from ..errors import ParameterError
+from ..units import to_si
+from .laws import get_law
+
+__all__ = ["RSFParams", "StateVariable", "rsf_params"]
+
+
+def _finite(name: str, value: Any, minimum: float | None = None, strict: bool = True) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        try:
+            value = float(value)
+        except (TypeError, ValueError):
+            raise ParameterError(f"{name}: expected a number, got {value!r}") from None
+    value = float(value)
+    if not math.isfinite(value):
+        raise ParameterError(f"{name}: expected a finite number, got {value!r}")
+    if minimum is not None and (value < minimum or (strict and value == minimum)):
+        relation = ">" if strict else ">="
+        raise ParameterError(f"{name}: expected a value {relation} {minimum:g}, got {value:g}")
+    return value
+
+
+@dataclass(frozen=True)
+class StateVariable:
+    """One state variable: its evolution ``law``, direct weight ``b``, length ``dc`` (m); ``c`` for Nagata."""
+
+    law: str = "aging"
+    b: float = 0.01
+    dc: float = 10e-6
+    c: float = 0.0
+
+    def __post_init__(self) -> None:
+        law = get_law(self.law)
+        object.__setattr__(self, "law", self.law.strip().lower() if isinstance(self.law, str) else law.name)
+        object.__setattr__(self, "b", _finite("b", self.b))
+        object.__setattr__(self, "dc", _finite("dc", self.dc, 0.0))
+        object.__setattr__(self, "c", _finite("c", self.c, 0.0, strict=False))
+        if law.coupling(1.0, 1.0) != 0.0 and self.b == 0:
+            raise ParameterError(f"b: the {self.law} law divides by b; expected b != 0")
+
+
+@dataclass(frozen=True)
+class RSFParams:
+    """Rate-and-state friction on a spring-slider (SI units; friction is dimensionless)."""
+
+    a: float = 0.01
+    states: tuple[StateVariable, ...] = field(default_factory=lambda: (StateVariable(),))
+    mu0: float = 0.6
+    v_ref: float = 1e-6
+    stiffness: float = 1e3
+    eta: float = 0.0
+    mass: float = 0.0
+    normal_stress: float | None = None
+    regularized: bool = False
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "a", _finite("a", self.a, 0.0))
+        states = tuple(self.states)
+        if not states:
+            raise ParameterError("states: expected at least one state variable")
+        for item in states:
+            if not isinstance(item, StateVariable):
+                raise ParameterError(f"states: expected StateVariable items, got {type(item).__name__}")
+        object.__setattr__(self, "states", states)
+        object.__setattr__(self, "mu0", _finite("mu0", self.mu0))
+        object.__setattr__(self, "v_ref", _finite("v_ref", self.v_ref, 0.0))
+        object.__setattr__(self, "stiffness", _finite("stiffness", self.stiffness, 0.0))
+        object.__setattr__(self, "eta", _finite("eta", self.eta, 0.0, strict=False))
+        object.__setattr__(self, "mass", _finite("mass", self.mass, 0.0, strict=False))
+        if self.normal_stress is not None:
+            object.__setattr__(self, "normal_stress", _finite("normal_stress", self.normal_stress, 0.0))
+        if self.mass > 0 and self.normal_stress is None:
+            raise ParameterError("mass: a slider mass needs normal_stress (the inertia term is mass/normal stress)")
+        object.__setattr__(self, "regularized", bool(self.regularized))
+
+    @property
+    def b(self) -> float:
+        """Sum of the state weights (the steady rate dependence is a - b)."""
+        return sum(s.b for s in self.states)
+
+    @property
+    def dc(self) -> float:
+        return self.states[0].dc
+
+    def steady_friction(self, velocity: Any) -> Any:
+        """mu_ss(V) = mu0 + (a - b) ln(V/V0) (the regularised form differs only where V/V0 << e^(-mu/a))."""
+        import numpy as np
+
+        v = np.asarray(velocity, dtype=float)
+        if not self.regularized:
+            return self.mu0 + (self.a - self.b) * np.log(v / self.v_ref)
+        return self.a * np.arcsinh(0.5 * v / self.v_ref * np.exp((self.mu0 - self.b * np.log(v / self.v_ref)) / self.a))
+
+    def replace(self, **changes: Any) -> RSFParams:
+        return replace(self, **changes)
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain SI values (the TOML/JSON written beside every trace and fit)."""
+        out = {k: v for k, v in asdict(self).items() if k != "states"}
+        out["states"] = [asdict(s) for s in self.states]
+        if out["normal_stress"] is None:
+            del out["normal_stress"]
+        return out
+
+    def to_toml(self) -> str:
+        lines = ["# rate-and-state parameters (SI: m, s, m/s; stiffness in 1/m; eta in s/m; mass in kg/m^2)"]
+        for key, value in self.to_dict().items():
+            if key != "states":
+                lines.append(f"{key} = {_toml_value(value)}")
+        for state in self.states:
+            lines.append("")
+            lines.append("[[states]]")
+            for key, value in asdict(state).items():
+                lines.append(f"{key} = {_toml_value(value)}")
+        return "\n".join(lines) + "\n"
+
+    @classmethod
+    def from_dict(cls, mapping: Mapping[str, Any], source: str = "parameters") -> RSFParams:
+        """From plain values or strings with units (as written by :meth:`to_dict`); unknown keys are errors."""
+        known = {"a", "states", "mu0", "v_ref", "stiffness", "eta", "mass", "normal_stress", "regularized"}
+        unknown = sorted(set(mapping) - known)
+        if unknown:
+            raise ParameterError(f"{source}: unknown key {unknown[0]!r}; expected one of {', '.join(sorted(known))}")
+        states = []
+        for i, item in enumerate(mapping.get("states", [])):
+            if not isinstance(item, Mapping):
+                raise ParameterError(f"{source}: states[{i}]: expected a table with law, b, dc")
+            extra = sorted(set(item) - {"law", "b", "dc", "c"})
+            if extra:
+                raise ParameterError(f"{source}: states[{i}]: unknown key {extra[0]!r}; expected law, b, dc, c")
+            states.append(
+                StateVariable(
+                    law=item.get("law", "aging"),
+                    b=item.get("b", 0.01),
+                    dc=to_si(item.get("dc", 10e-6), "length", f"{source}: states[{i}].dc"),
+                    c=item.get("c", 0.0),
+                )
+            )
+        values: dict[str, Any] = {"states": tuple(states) or (StateVariable(),)}
+        dims = {"v_ref": "velocity", "stiffness": "per_length", "eta": "slowness", "mass": "mass_per_area",
+                "normal_stress": "stress"}  # fmt: skip
+        for key in ("a", "mu0", "v_ref", "normal_stress", "mass", "regularized"):
+            if key in mapping:
+                value = mapping[key]
+                values[key] = to_si(value, dims[key], f"{source}: {key}") if key in dims else value
+        sigma = values.get("normal_stress")
+        for key, stress_dim in (("stiffness", "stress_per_length"), ("eta", "stress_per_velocity")):
+            if key in mapping:
+                values[key] = _friction_units(mapping[key], dims[key], stress_dim, sigma, f"{source}: {key}")
+        return cls(**values)
+
+
+def _friction_units(value: Any, dimension: str, stress_dimension: str, sigma: float | None, name: str) -> float:
+    """A value in friction units, or in stress units (Pa/m, Pa s/m) divided by the normal stress."""
+    from ..errors import UnitError
+
+    try:
+        return to_si(value, dimension, name)
+    except UnitError:
+        converted = to_si(value, stress_dimension, name)  # raises the one-line UnitError if neither fits
+        if sigma is None:
+            raise ParameterError(f"{name}: {value!r} is in stress units; give normal_stress to convert it") from None
+        return converted / sigma
+
+
+def _toml_value(value: Any) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, str):
+        return '"' + value.replace("\\", "\\\\").replace('"', '\\"') + '"'
+    return repr(float(value))
+
+
+def rsf_params(
+    a: float,
+    b: float,
+    dc: float,
+    *,
+    law: str = "aging",
+    b2: float | None = None,
+    dc2: float | None = None,
+    law2: str | None = None,
+    c: float = 0.0,
+    mu0: float = 0.6,
+    v_ref: float = 1e-6,
+    stiffness: float = 1e3,
+    eta: float = 0.0,
+    mass: float = 0.0,
+    normal_stress: float | None = None,
+    regularized: bool = False,
+) -> RSFParams:
+    """Convenience constructor for one or two state variables (SI values)."""
+    states = [StateVariable(law, b, dc, c)]
+    if (b2 is None) != (dc2 is None):
+        raise ParameterError("b2/dc2: a second state variable needs both b2 and dc2")
+    if b2 is not None and dc2 is not None:
+        states.append(StateVariable(law2 or law, b2, dc2, c))
+    return RSFParams(a, tuple(states), mu0, v_ref, stiffness, eta, mass, normal_stress, regularized)

@@ -1,0 +1,128 @@
+"""Figures of rate-and-state runs and fits (matplotlib Figure API, never pyplot)."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from ..plotting import apply_style, new_axes
+
+if TYPE_CHECKING:  # pragma: no cover
+    from matplotlib.axes import Axes
+
+    from .fit import RSFFit
+    from .results import RSFRun
+
+
+def plot_run(run: RSFRun, ax: Axes | None = None, x: str = "time", **kwargs: Any) -> Axes:
+    """Friction against time (or ``x="displacement"``: load-point displacement in um)."""
+    ax = new_axes(ax)
+    xs = run.time if x == "time" else run.load_point_displacement * 1e6
+    kwargs.setdefault("color", "#1f4e9c")
+    kwargs.setdefault("lw", 1.2)
+    ax.plot(xs, run.friction, **kwargs)
+    ax.set_xlabel("time (s)" if x == "time" else "load-point displacement (µm)")
+    ax.set_ylabel("friction μ")
+    if run.status != "ok":
+        ax.set_title(run.status, color="#c0392b", fontsize=9)
+    return apply_style(ax)
+
+
+def phase_plot(run: RSFRun, ax: Axes | None = None, **kwargs: Any) -> Axes:
+    """ln(V/V0) against friction with the steady-state line (slope a - b) and constant-state lines (slope a)."""
+    ax = new_axes(ax)
+    p = run.params
+    lnv = np.log(run.slider_velocity / p.v_ref)
+    kwargs.setdefault("color", "k")
+    kwargs.setdefault("lw", 1.5)
+    ax.plot(lnv, run.friction, **kwargs)
+    xlim = np.array(ax.get_xlim())
+    ylim = ax.get_ylim()
+    ax.plot(xlim, p.mu0 + (p.a - p.b) * xlim, color="#c0392b", ls="--", lw=1, label="steady state (slope a − b)")
+    # constant-state lines: mu = mu_state + a ln(V/V0), through the start and through the end state
+    levels = sorted({float(run.friction[0] - p.a * lnv[0]), float(run.friction[-1] - p.a * lnv[-1])})
+    for i, level in enumerate(levels):
+        label = "constant state (slope a)" if i == 0 else None
+        ax.plot(xlim, level + p.a * xlim, color="#7f8c8d", ls=":", lw=1, label=label)
+    ax.set_xlim(*xlim)
+    ax.set_ylim(*ylim)
+    ax.set_xlabel("ln(V/V₀)")
+    ax.set_ylabel("friction μ")
+    ax.legend(fontsize=8, frameon=False)
+    return apply_style(ax)
+
+
+def plot_fit(fit: RSFFit, ax: Axes | None = None) -> Axes:
+    """Data, fitted curve and residuals against load-point displacement."""
+    ax = new_axes(ax)
+    record, model = fit.record, fit.model_friction
+    disp = record.displacement * 1e6
+    ax.plot(disp, record.friction, ".", ms=1.5, color="#999999", label="data")
+    ax.plot(disp, model, color="#c0392b", lw=1.4, label="fit")
+    ax.set_xlabel("load-point displacement (µm)")
+    ax.set_ylabel("friction μ")
+    ax.legend(fontsize=8, frameon=False)
+    return apply_style(ax)
+
+
+def run_figure(run: RSFRun) -> Any:
+    """Friction, slip rate and state against time, and the phase plane, in one Figure."""
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(10, 7), layout="constrained")
+    (ax1, ax2), (ax3, ax4) = fig.subplots(2, 2)
+    plot_run(run, ax=ax1)
+    ax2.semilogy(run.time, run.slider_velocity * 1e6, color="#1f4e9c", lw=1.2, label="slider")
+    ax2.semilogy(run.time, np.maximum(run.load_point_velocity, 1e-30) * 1e6, color="#999999", lw=1, ls="--",
+                 label="load point")  # fmt: skip
+    ax2.set_xlabel("time (s)")
+    ax2.set_ylabel("velocity (µm/s)")
+    ax2.legend(fontsize=8, frameon=False)
+    apply_style(ax2)
+    for i, row in enumerate(run.state):
+        ax3.semilogy(run.time, row, lw=1.2, label=f"θ{i + 1}")
+    ax3.set_xlabel("time (s)")
+    ax3.set_ylabel("state θ (s)")
+    ax3.legend(fontsize=8, frameon=False)
+    apply_style(ax3)
+    phase_plot(run, ax=ax4)
+    fig.suptitle(run.summary()["message"], fontsize=9)
+    return fig
+
+
+def stability_figure(params: Any, v_low: float, v_high: float) -> Any:
+    """Critical stiffness against sliding velocity, with the spring's stiffness as a line."""
+    from matplotlib.figure import Figure
+
+    from .stability import critical_stiffness
+
+    fig = Figure(figsize=(6.4, 4.4), layout="constrained")
+    ax = fig.add_subplot()
+    speeds = np.geomspace(v_low, v_high, 80)
+    kc = np.array([critical_stiffness(params, v) for v in speeds])
+    ax.loglog(speeds * 1e6, np.where(kc > 0, kc, np.nan), color="#1f4e9c", label="k_c (unstable below)")
+    ax.axhline(params.stiffness, color="#c0392b", ls="--", lw=1, label="spring k")
+    ax.set_xlabel("sliding velocity V (µm/s)")
+    ax.set_ylabel("stiffness (friction per m)")
+    ax.legend(fontsize=8, frameon=False)
+    apply_style(ax)
+    return fig
+
+
+def fit_figure(fit: RSFFit) -> Any:
+    """Data with the fit (top) and residuals (bottom) against load-point displacement."""
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(8, 6), layout="constrained")
+    ax1, ax2 = fig.subplots(2, 1, sharex=True, height_ratios=[3, 1])
+    plot_fit(fit, ax=ax1)
+    ax2.plot(fit.record.displacement * 1e6, fit.residuals, ".", ms=1.2, color="#777777")
+    ax2.axhline(0, color="#c0392b", lw=1)
+    ax2.set_xlabel("load-point displacement (µm)")
+    ax2.set_ylabel("residual")
+    apply_style(ax2)
+    p = fit.parameters
+    ax1.set_title(f"a = {p['a'].value:.4g}, b = {p['b'].value:.4g}, Dc = {p['dc'].value * 1e6:.4g} µm, "
+                  f"χ²ᵣ = {fit.reduced_chi_square:.3g}", fontsize=9)  # fmt: skip
+    return fig

@@ -1,0 +1,160 @@
+r"""Linear stability of steady sliding: critical stiffness and the period at the Hopf point.
+
+Perturbing steady sliding at V (L = Dc/V, M = m V/sigma, a' = a + eta V) for one
+state variable with the aging, slip or PRZ law (identical to first order) gives
+
+    M L lam^3 + (M + a' L) lam^2 + (k V L + a' - b) lam + k V = 0,
+
+whose Hopf point (docs/rsf.md) is
+
+    k_c = ((b - a')/Dc) (1 + m V^2/(sigma a' Dc)),   T = 2 pi (Dc/V) sqrt(a'/(b - a')),
+
+i.e. the familiar sigma (b - a)/Dc and 2 pi (Dc/V) sqrt(a/(b - a)) without damping
+and mass.  For several state variables or Nagata's law k_c is found numerically:
+the stiffness at which the largest real part of the Jacobian's eigenvalues at
+steady state crosses zero (bisection in log k).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import ParameterError
+from .params import RSFParams
+from .system import System
+
+__all__ = ["Stability", "critical_stiffness", "growth_rate", "neutral_period", "stability"]
+
+_CLASSICAL = {"aging", "slip", "prz"}
+
+
+@dataclass(frozen=True)
+class Stability:
+    """Stability of steady sliding at ``velocity`` (SI; stiffness in friction per metre, 1/m)."""
+
+    velocity: float
+    stiffness: float
+    critical_stiffness: float
+    critical_stiffness_pa: float | None
+    neutral_period: float
+    growth_rate: float
+    stable: bool
+    method: str
+    message: str
+
+    def as_dict(self) -> dict[str, object]:
+        return dict(self.__dict__)
+
+
+def _closed_form_applies(p: RSFParams) -> bool:
+    return len(p.states) == 1 and p.states[0].law in _CLASSICAL and not p.regularized
+
+
+def critical_stiffness(params: RSFParams, velocity: float) -> float:
+    """k_c (1/m) at steady sliding velocity ``velocity``; 0 if steady sliding is stable at any stiffness."""
+    velocity = _positive_velocity(velocity)
+    if _closed_form_applies(params):
+        s = params.states[0]
+        a_eff = params.a + params.eta * velocity
+        if s.b <= a_eff:
+            return 0.0
+        inertia = params.mass * velocity**2 / ((params.normal_stress or 1.0) * a_eff * s.dc) if params.mass else 0.0
+        return (s.b - a_eff) / s.dc * (1.0 + inertia)
+    return _numerical_critical(params, velocity)
+
+
+def neutral_period(params: RSFParams, velocity: float) -> float:
+    """Period (s) of the neutral oscillation at k = k_c; NaN if there is no Hopf point."""
+    velocity = _positive_velocity(velocity)
+    kc = critical_stiffness(params, velocity)
+    if kc <= 0:
+        return math.nan
+    if _closed_form_applies(params):
+        s = params.states[0]
+        a_eff = params.a + params.eta * velocity
+        return 2 * math.pi * (s.dc / velocity) * math.sqrt(a_eff / (s.b - a_eff))
+    eig = _eigenvalues(params.replace(stiffness=kc), velocity)
+    omega = float(np.max(np.abs(eig.imag)))
+    return 2 * math.pi / omega if omega > 0 else math.nan
+
+
+def stability(params: RSFParams, velocity: float) -> Stability:
+    """Everything about the stability of steady sliding at ``velocity`` with the params' stiffness."""
+    velocity = _positive_velocity(velocity)
+    kc = critical_stiffness(params, velocity)
+    growth = growth_rate(params, velocity)
+    stable = params.stiffness > kc
+    sigma = params.normal_stress
+    method = "closed form" if _closed_form_applies(params) else "eigenvalues of the linearised equations"
+    if kc == 0:
+        message = "steady sliding is stable at every stiffness (velocity strengthening: b <= a + eta V)"
+    elif stable:
+        message = f"stable: k = {params.stiffness:.4g} 1/m is above k_c = {kc:.4g} 1/m; perturbations decay"
+    else:
+        message = (
+            f"unstable: k = {params.stiffness:.4g} 1/m is below k_c = {kc:.4g} 1/m; oscillations grow "
+            "(stick-slip, or a blow-up without radiation damping)"
+        )
+    return Stability(
+        velocity=velocity,
+        stiffness=params.stiffness,
+        critical_stiffness=kc,
+        critical_stiffness_pa=None if sigma is None else kc * sigma,
+        neutral_period=neutral_period(params, velocity),
+        growth_rate=growth,
+        stable=bool(stable),
+        method=method,
+        message=message,
+    )
+
+
+def growth_rate(params: RSFParams, velocity: float) -> float:
+    """Largest real part (1/s) of the linearised equations' eigenvalues at steady sliding: > 0 means unstable."""
+    return float(np.max(_eigenvalues(params, _positive_velocity(velocity)).real))
+
+
+def _positive_velocity(velocity: float) -> float:
+    v = float(velocity)
+    if not (math.isfinite(v) and v > 0):
+        raise ParameterError(f"velocity: expected a positive sliding velocity, got {velocity!r}")
+    return v
+
+
+def _eigenvalues(params: RSFParams, velocity: float) -> np.ndarray:
+    system = System(params)
+    y = system.steady_y(velocity)
+    if system.has_jacobian:
+        jac = system.jacobian(0.0, y, velocity)
+    else:
+        jac = np.empty((y.size, y.size))
+        for j in range(y.size):
+            h = 1e-6 * max(1.0, abs(y[j]))
+            up, down = y.copy(), y.copy()
+            up[j] += h
+            down[j] -= h
+            jac[:, j] = (np.array(system.rhs(0.0, up, velocity)) - np.array(system.rhs(0.0, down, velocity))) / (2 * h)
+    return np.linalg.eigvals(jac)
+
+
+def _numerical_critical(params: RSFParams, velocity: float) -> float:
+    def growth(k: float) -> float:
+        return float(np.max(_eigenvalues(params.replace(stiffness=k), velocity).real))
+
+    scale = max(abs(params.b - params.a), params.a) / min(s.dc for s in params.states)
+    lo, hi = scale * 1e-9, scale * 1e9
+    if growth(lo) <= 0:
+        return 0.0
+    if growth(hi) > 0:
+        return math.inf
+    for _ in range(200):
+        mid = math.sqrt(lo * hi)
+        if growth(mid) > 0:
+            lo = mid
+        else:
+            hi = mid
+        if hi / lo - 1 < 1e-12:
+            break
+    return math.sqrt(lo * hi)

@@ -1,0 +1,190 @@
+r"""The spring-slider's equations in log variables: right-hand side and analytic Jacobian.
+
+The unknowns are ``x = ln(V/V0)`` and the state terms ``psi_i = ln(V0 theta_i/Dc_i)``
+(plus ``s``, the spring's pull in friction units, when the slider has mass).
+Without inertia the spring balances friction plus radiation damping,
+``k (V_lp - V) = dmu/dt + eta dV/dt``; with ``mu = mu0 + a x + sum b_i psi_i``
+and ``d psi_i/dt = g_i + h_i dmu/dt`` (h_i = 0 except for Nagata's law):
+
+    dx/dt = ((1 - H) k (V_lp - V) - G) / (A + (1 - H) eta V),
+    dmu/dt = (A dx/dt + G) / (1 - H),    G = sum B_i g_i,  H = sum B_i h_i,
+
+where A = dmu/dx and B_i = dmu/dpsi_i (a and b_i for the classical form;
+state-dependent for the regularised asinh form).  With a mass m per area and
+normal stress sigma, ``m dV/dt = sigma (s - mu - eta V)`` and ``ds/dt = k (V_lp - V)``.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .laws import EXP_CAP, get_law
+from .laws import cexp as _exp
+from .params import RSFParams
+
+
+class System:
+    """Numbers of one :class:`RSFParams`, ready for fast scalar evaluation."""
+
+    def __init__(self, params: RSFParams) -> None:
+        self.params = params
+        self.a = params.a
+        self.mu0 = params.mu0
+        self.v0 = params.v_ref
+        self.k = params.stiffness
+        self.eta = params.eta
+        self.inertial = params.mass > 0
+        self.inertia = params.mass / params.normal_stress if self.inertial and params.normal_stress else 0.0
+        self.regularized = params.regularized
+        self.laws = [get_law(s.law) for s in params.states]
+        self.b = [s.b for s in params.states]
+        self.dc = [s.dc for s in params.states]
+        self.h = [law.coupling(s.b, s.c) for law, s in zip(self.laws, params.states, strict=True)]
+        self.n = len(self.b)
+        self.offset = 1 if self.inertial else 0  # index of x in y
+        self.size = self.n + 1 + self.offset
+        self.one_minus_h = 1.0 - sum(b * h for b, h in zip(self.b, self.h, strict=True))  # classical form
+        self.has_jacobian = not self.regularized
+        self._terms = [(law.rate, b, dc) for law, b, dc in zip(self.laws, self.b, self.dc, strict=True)]
+        self._coupled = any(h != 0.0 for h in self.h)
+        if self.has_jacobian and not (self._coupled or self.inertial):
+            self.rhs = self._rhs_classical  # type: ignore[method-assign]  # the common case, without generality's cost
+
+    # ------------------------------------------------------------------ friction
+    def friction(self, x: float, psi: list[float] | np.ndarray) -> float:
+        if not self.regularized:
+            return self.mu0 + self.a * x + sum(b * p for b, p in zip(self.b, psi, strict=True))
+        z = x + (self.mu0 + sum(b * p for b, p in zip(self.b, psi, strict=True))) / self.a
+        return self.a * _asinh_half_exp(z)
+
+    def friction_many(self, x: np.ndarray, psi: np.ndarray) -> np.ndarray:
+        """Vectorised :meth:`friction`; ``psi`` has shape (n, len(x))."""
+        bpsi = sum(b * row for b, row in zip(self.b, psi, strict=True))  # tensordot is slow for these shapes
+        if not self.regularized:
+            return self.mu0 + self.a * x + bpsi
+        z = x + (self.mu0 + bpsi) / self.a
+        return self.a * np.where(z > 0, z + np.log(0.5 + 0.5 * np.sqrt(1 + 4 * np.exp(-2 * np.abs(z)))),
+                                 np.arcsinh(0.5 * np.exp(np.minimum(z, 0))))  # fmt: skip
+
+    def _slopes(self, x: float, psi: list[float]) -> tuple[float, float]:
+        """(A, factor) with A = dmu/dx and B_i = factor * b_i."""
+        if not self.regularized:
+            return self.a, 1.0
+        z = x + (self.mu0 + sum(b * p for b, p in zip(self.b, psi, strict=True))) / self.a
+        factor = 1.0 / math.sqrt(1.0 + 4.0 * _exp(-2.0 * z)) if z > 0 else _half_exp_ratio(z)
+        return self.a * factor, factor
+
+    # ------------------------------------------------------------------ equations
+    def rhs(self, t: float, y: np.ndarray, vlp: float) -> list[float]:
+        o = self.offset
+        x = float(y[o])
+        psi = [float(p) for p in y[o + 1 :]]
+        v = self.v0 * _exp(x)
+        g = []
+        for law, p, dc in zip(self.laws, psi, self.dc, strict=True):
+            g.append(law.rate(x, p, self.v0, dc)[0])
+        A, factor = self._slopes(x, psi)
+        G = factor * sum(b * gi for b, gi in zip(self.b, g, strict=True))
+        Q = 1.0 - factor * sum(b * h for b, h in zip(self.b, self.h, strict=True))
+        if self.inertial:
+            s = float(y[0])
+            xdot = (s - self.friction(x, psi) - self.eta * v) / (self.inertia * v)
+            mudot = (A * xdot + G) / Q
+            return [self.k * (vlp - v), xdot, *(gi + hi * mudot for gi, hi in zip(g, self.h, strict=True))]
+        xdot = (Q * self.k * (vlp - v) - G) / (A + Q * self.eta * v)
+        mudot = (A * xdot + G) / Q
+        return [xdot, *(gi + hi * mudot for gi, hi in zip(g, self.h, strict=True))]
+
+    def _rhs_classical(self, t: float, y: np.ndarray, vlp: float) -> list[float]:
+        """:meth:`rhs` for the classical form without mass or dmu/dt coupling (same equations, fewer steps)."""
+        x, *psi = y.tolist()
+        v0 = self.v0
+        out = [0.0]
+        G = 0.0
+        for (rate, b, dc), p in zip(self._terms, psi):  # noqa: B905  (lengths match by construction)
+            g = rate(x, p, v0, dc)[0]
+            out.append(g)
+            G += b * g
+        v = v0 * _exp(x)
+        out[0] = (self.k * (vlp - v) - G) / (self.a + self.eta * v)
+        return out
+
+    def jacobian(self, t: float, y: np.ndarray, vlp: float) -> np.ndarray:
+        """Analytic Jacobian of :meth:`rhs` (classical friction form)."""
+        if self.inertial:
+            return self._jacobian_inertial(y, vlp)
+        x = float(y[0])
+        psi = [float(p) for p in y[1:]]
+        n, a, k, eta, Q = self.n, self.a, self.k, self.eta, self.one_minus_h
+        v = self.v0 * _exp(x)
+        rates = [law.rate(x, p, self.v0, dc) for law, p, dc in zip(self.laws, psi, self.dc, strict=True)]
+        G = sum(b * r[0] for b, r in zip(self.b, rates, strict=True))
+        D = a + Q * eta * v
+        xdot = (Q * k * (vlp - v) - G) / D
+        jac = np.empty((n + 1, n + 1))
+        dxx = (-Q * k * v - sum(b * r[1] for b, r in zip(self.b, rates, strict=True)) - xdot * Q * eta * v) / D
+        jac[0, 0] = dxx
+        dmu_dx = (a * dxx + sum(b * r[1] for b, r in zip(self.b, rates, strict=True))) / Q
+        for j in range(n):
+            jac[0, j + 1] = -self.b[j] * rates[j][2] / D
+        for i in range(n):
+            jac[i + 1, 0] = rates[i][1] + self.h[i] * dmu_dx
+            for j in range(n):
+                dmu_dpj = (a * jac[0, j + 1] + self.b[j] * rates[j][2]) / Q
+                jac[i + 1, j + 1] = (rates[i][2] if i == j else 0.0) + self.h[i] * dmu_dpj
+        return jac
+
+    def _jacobian_inertial(self, y: np.ndarray, vlp: float) -> np.ndarray:
+        """Jacobian of the inertial equations in (s, x, psi): xdot = (s - mu - eta V)/(m' V), m' = m/sigma."""
+        s, x = float(y[0]), float(y[1])
+        psi = [float(p) for p in y[2:]]
+        n, a, Q = self.n, self.a, self.one_minus_h
+        v = self.v0 * _exp(x)
+        rates = [law.rate(x, p, self.v0, dc) for law, p, dc in zip(self.laws, psi, self.dc, strict=True)]
+        force = s - self.friction(x, psi) - self.eta * v
+        mv = self.inertia * v
+        jac = np.zeros((n + 2, n + 2))
+        jac[0, 1] = -self.k * v
+        dx = np.empty(n + 2)  # d xdot / d (s, x, psi)
+        dx[0] = 1.0 / mv
+        dx[1] = (-a - self.eta * v - force) / mv
+        dx[2:] = [-b / mv for b in self.b]
+        jac[1] = dx
+        # dmu/dt = (a xdot + sum b g) / Q
+        dmu = a * dx / Q
+        dmu[1] += sum(b * r[1] for b, r in zip(self.b, rates, strict=True)) / Q
+        for j in range(n):
+            dmu[2 + j] += self.b[j] * rates[j][2] / Q
+        for i in range(n):
+            jac[2 + i] = self.h[i] * dmu
+            jac[2 + i, 1] += rates[i][1]
+            jac[2 + i, 2 + i] += rates[i][2]
+        return jac
+
+    # ------------------------------------------------------------------ states
+    def steady_y(self, velocity: float) -> np.ndarray:
+        """The steady state at slider velocity ``velocity`` (> 0)."""
+        x = math.log(velocity / self.v0)
+        psi = [-x] * self.n
+        head = [self.friction(x, psi) + self.eta * velocity] if self.inertial else []
+        return np.array([*head, x, *psi])
+
+    def theta(self, psi: np.ndarray) -> np.ndarray:
+        """State variables theta_i (s) from the state terms psi_i; shape (n, ...)."""
+        scale = np.array([law.theta_scale * dc / self.v0 for law, dc in zip(self.laws, self.dc, strict=True)])
+        return scale.reshape((-1,) + (1,) * (np.ndim(psi) - 1)) * np.exp(np.minimum(psi, EXP_CAP))
+
+
+def _asinh_half_exp(z: float) -> float:
+    """asinh(e^z / 2) without overflow."""
+    if z > 0:
+        return z + math.log(0.5 + 0.5 * math.sqrt(1.0 + 4.0 * math.exp(-2.0 * z)))
+    return math.asinh(0.5 * math.exp(z))
+
+
+def _half_exp_ratio(z: float) -> float:
+    """w / sqrt(1 + w^2) with w = e^z/2, for z <= 0."""
+    w = 0.5 * math.exp(z)
+    return w / math.sqrt(1.0 + w * w)
