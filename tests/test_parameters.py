@@ -481,3 +481,12 @@ def test_written_values_read_back_exactly(dimension, value, negative):
     assert to_si(text, dimension) == value
     number = text.split()[0]
     assert len(number) <= 24
+
+
+@pytest.mark.parametrize("dimension", sorted(DIMENSIONS))
+def test_every_dimension_has_exponents_that_pint_agrees_with(dimension):
+    """The fast path's exponent table must cover every dimension a model declares, and match pint's."""
+    exponents = units_module._DIMENSION_VECTORS[dimension]
+    pint_dims = units_module.registry().parse_expression(DIMENSIONS[dimension][1] or "1").dimensionality
+    expected = tuple(int(pint_dims.get(k, 0)) for k in ("[mass]", "[length]", "[time]", "[temperature]"))
+    assert exponents == expected

@@ -64,6 +64,9 @@ _DIMENSION_VECTORS: dict[str, tuple[int, int, int, int]] = {
     "force": (1, 1, -2, 0),
     "area": (0, 2, 0, 0),
     "stress_per_velocity": (1, -2, -1, 0),
+    "per_length": (0, -1, 0, 0),
+    "slowness": (0, -1, 1, 0),
+    "mass_per_area": (1, -2, 0, 0),
 }
 
 #: Longest value string accepted (the longest sensible one is ~30 characters).
