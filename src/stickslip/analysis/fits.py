@@ -17,6 +17,7 @@ trough are read off the fitted line, never from a single noisy sample.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -160,11 +161,8 @@ def _hinge(
     """Best corner time, total SSE, branch slope at the corner, branch SSE and branch sample count."""
     lo, hi = search
     scale = max(float(t[-1] - t[0]), 1e-300)
-
-    def profile(tcs: np.ndarray) -> np.ndarray:
-        return _sse_profile(t, x, on_line, line, np.atleast_1d(tcs), sign, powers, scale)
-
-    inside = t[(t > lo) & (t < hi)]
+    profile = _HingeProfile(t, on_line, line.slope, sign, hi if sign > 0 else lo, powers, scale)
+    inside = t[np.searchsorted(t, lo, "right") : np.searchsorted(t, hi, "left")]
     candidates = np.unique(np.concatenate([[lo, hi], inside, 0.5 * (inside[1:] + inside[:-1])]))
     values = profile(candidates)
     best = int(np.argmin(values))
@@ -185,6 +183,87 @@ def _hinge(
     return tc, value, slope, branch_sse, int(np.count_nonzero(branch))
 
 
+class _HingeProfile:
+    """Hinge sum of squares as a function of the corner time, from running sums: O(window) once, O(1) per tc.
+
+    With v = sign (t - edge)/scale (``edge`` the search bound on the branch
+    side) and r = v - vc for a corner at tc (vc = sign (tc - edge)/scale <= 0),
+    the branch samples are those with r > 0, the first m samples in the order
+    of decreasing v.  On the branch y = x - L(tc) = o + g r with o = x - L(t)
+    and g = sign slope scale, so every sum the fit needs is a binomial
+    expansion of sums of v^j and o v^j over the first m samples.  These are
+    accumulated from the far end of the branch, so that for a candidate inside
+    the search interval the terms are all of one sign beyond the edge and no
+    larger than |vc| within it: the expansion does not cancel.  The stick side's
+    sum of o^2 is accumulated from the other end.  Same value as
+    :func:`_sse_profile` (which evaluates it sample by sample) to rounding.
+    """
+
+    def __init__(
+        self,
+        t: np.ndarray,
+        on_line: np.ndarray,
+        slope: float,
+        sign: float,
+        edge: float,
+        powers: tuple[float, ...],
+        scale: float,
+    ) -> None:
+        self.powers = tuple(int(p) for p in powers)
+        if any(p != q or p < 1 for p, q in zip(self.powers, powers, strict=True)):
+            raise ValueError(f"hinge powers must be positive integers, got {powers}")
+        order = slice(None, None, -1) if sign > 0 else slice(None)
+        self.t, self.sign, self.edge, self.scale = t, sign, edge, scale
+        self.g = sign * slope * scale
+        v = sign * (t[order] - edge) / scale
+        o = on_line[order]
+        top = 2 * max(self.powers) + 1
+        power = np.ones_like(v)
+        self.v_sums = np.zeros((top + 1, v.size + 1))
+        self.o_sums = np.zeros((max(self.powers) + 2, v.size + 1))
+        for j in range(top + 1):
+            np.cumsum(power, out=self.v_sums[j, 1:])
+            if j < self.o_sums.shape[0]:
+                np.cumsum(o * power, out=self.o_sums[j, 1:])
+            power = power * v
+        self.oo_branch = np.concatenate([[0.0], np.cumsum(o * o)])
+        self.oo_stick = np.concatenate([[0.0], np.cumsum((o * o)[::-1])])[::-1]
+
+    def __call__(self, tcs: np.ndarray) -> np.ndarray:
+        tcs = np.atleast_1d(np.asarray(tcs, dtype=float))
+        if self.sign > 0:  # branch: t > tc
+            m = self.t.size - np.searchsorted(self.t, tcs, "right")
+        else:  # branch: t < tc
+            m = np.searchsorted(self.t, tcs, "left")
+        shift = -self.sign * (tcs - self.edge) / self.scale  # -vc >= 0
+        r_sums = self._expand(self.v_sums, m, shift)  # r_sums[k] = sum over the branch of r^k
+        ro_sums = self._expand(self.o_sums, m, shift)  # ro_sums[k] = sum of o r^k
+        g = self.g
+        n = len(self.powers)
+        gram = np.empty((tcs.size, n, n))
+        moment = np.empty((tcs.size, n))
+        for a, pa in enumerate(self.powers):
+            moment[:, a] = ro_sums[pa] + g * r_sums[pa + 1]
+            for b in range(a, n):
+                gram[:, a, b] = gram[:, b, a] = r_sums[pa + self.powers[b]]
+        yy = self.oo_branch[m] + 2.0 * g * ro_sums[1] + g * g * r_sums[2]
+        coef = _falling_fit(gram, moment, self.sign)
+        branch_sse = yy - np.sum(coef * moment, axis=1)
+        empty = m == 0
+        branch_sse[empty] = 0.0
+        return self.oo_stick[m] + np.maximum(branch_sse, 0.0)
+
+    @staticmethod
+    def _expand(sums: np.ndarray, m: np.ndarray, shift: np.ndarray) -> np.ndarray:
+        """sum over the first m samples of (v + shift)^k o-weighted, for every k < len(sums)."""
+        raw = sums[:, m]  # raw[j] = sum of v^j (times o) over the branch
+        out = np.zeros_like(raw)
+        for k in range(sums.shape[0]):
+            for j in range(k + 1):
+                out[k] += math.comb(k, j) * raw[j] * shift ** (k - j)
+        return out
+
+
 def _sse_profile(
     t: np.ndarray,
     x: np.ndarray,
@@ -195,7 +274,10 @@ def _sse_profile(
     powers: tuple[float, ...],
     scale: float,
 ) -> np.ndarray:
-    """Hinge sum of squares for each corner time in ``tcs`` (vectorised over the candidates)."""
+    """Hinge sum of squares for each corner time in ``tcs``, sample by sample: O(candidates x window).
+
+    The plain reference for :class:`_HingeProfile` (tests and benchmarks/bench_scale.py).
+    """
     distance = sign * (t[None, :] - tcs[:, None]) / scale
     branch = distance > 0
     y = np.where(branch, x[None, :] - np.asarray(line(tcs))[:, None], 0.0)
