@@ -32,7 +32,7 @@ import numpy as np
 
 from ..errors import DataError, ParameterError
 from ..parameters import Parameters, load_parameters
-from .detect import MEDIAN_WIDTH, Coarse, coarse_segments, rise_start
+from .detect import MEDIAN_WIDTH, Coarse, coarse_segments, rise_start, sampling_step
 from .fits import QUADRATIC, Corner, Line, fit_corner, fit_line
 from .traces import Trace, check_trace
 
@@ -201,7 +201,7 @@ def analyze_trace(
             " friction stress is taken positive: flip the sign of the column"
         )
     sticks = _stick_phases(t, x, coarse)
-    step = float(np.median(np.diff(t)))
+    step = sampling_step(t)
     for stick in sticks:
         _fit_stick(t, x, coarse, stick, step)
     sticks = [s for s in sticks if s.line is not None]

@@ -71,17 +71,35 @@ def noise_level(time: np.ndarray, stress: np.ndarray) -> float:
     if t.size < 3:
         return 0.0
     left, right = t[1:-1] - t[:-2], t[2:] - t[1:-1]
+    # three samples at one instant define no line (a jump written as a run of rows): skip them
+    x_prev, x_mid, x_next = x[:-2], x[1:-1], x[2:]
+    spaced = (left + right) > 0
+    if not np.all(spaced):
+        left, right, x_prev, x_mid, x_next = (a[spaced] for a in (left, right, x_prev, x_mid, x_next))
+    if left.size == 0:
+        return 0.0
     w_prev = right / (left + right)
     w_next = 1.0 - w_prev
-    residual = x[1:-1] - (w_prev * x[:-2] + w_next * x[2:])
+    residual = x_mid - (w_prev * x_prev + w_next * x_next)
     # Var(residual) = sigma^2 (1 + w_prev^2 + w_next^2) for independent noise
     scaled = residual / np.sqrt(1.0 + w_prev**2 + w_next**2)
     return float(MAD_SCALE * np.median(np.abs(scaled - np.median(scaled))))
 
 
+def sampling_step(time: np.ndarray) -> float:
+    """Median interval between successive distinct times (repeated times at jumps do not count)."""
+    steps = np.diff(time)
+    steps = steps[steps > 0]
+    return float(np.median(steps)) if steps.size else 0.0
+
+
 def uniform_grid(time: np.ndarray, stress: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The finite samples interpolated on a uniform grid at the median sampling interval."""
-    step = float(np.median(np.diff(time)))
+    """The finite samples interpolated on a uniform grid at the median sampling interval.
+
+    At a repeated time (a jump) the grid takes the value before it on its left and the one after it on its
+    right (``np.interp`` never selects the zero-width interval).
+    """
+    step = sampling_step(time)
     span = float(time[-1] - time[0])
     count = int(min(MAX_GRID, max(2, round(span / step) + 1)))
     grid = np.linspace(time[0], time[-1], count)

@@ -3,27 +3,50 @@
 A trace file has a ``time`` column and either ``stress`` or ``force`` (the
 latter divided by a contact area), units in header brackets as everywhere in
 stickslip (``time [s],stress [Pa]``; bare names are SI).  Empty or NaN stress
-cells are gaps and are kept as NaN; times must be present, finite and strictly
-increasing.  Every problem is a typed error naming the file and row.
+cells are gaps and are kept as NaN; times must be present, finite and never go
+back.  Two rows at one instant with different stresses are a jump (a real
+discontinuity, as ``simulate`` writes at a slip) and both are kept; a row that
+repeats the time and stress of the one before is a duplicated row and refused,
+unless it differs in another column of a model trace (then it is read once).
+The other columns the package's own traces carry (:data:`MODEL_COLUMNS`) are
+ignored, with a note; any other column is an error.  Every problem is a typed
+error naming the file and row.
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from ..errors import DataError, ParameterError
-from ..tables import read_table
+from ..tables import read_table, read_text_cells
 
 #: Fewest usable (finite-stress) samples a trace must have.
 MIN_SAMPLES = 20
 
 TRACE_DIMENSIONS = {"time": "time", "stress": "stress", "force": "force"}
+#: Columns of the package's model traces that the analysis does not use: ``simulate -o``
+#: (stickslip.model.cycle.CYCLE_COLUMNS), the time-dependent bond model and rate-and-state traces.
+MODEL_COLUMNS = (
+    "velocity",
+    "slider_displacement",
+    "puller_displacement",
+    "block_shear",
+    "chain_fraction",
+    "phase",
+    "bonded_fraction",
+    "slider_velocity",
+    "slider_position",
+    "puller_position",
+    "friction",
+    "state",
+    "load_point_displacement",
+)
 
 
 @dataclass(frozen=True)
@@ -34,6 +57,7 @@ class Trace:
     stress: np.ndarray
     rows: np.ndarray
     source: str
+    notes: tuple[str, ...] = ()  # what the reader did that a user should know (ignored columns, merged rows)
 
     @property
     def valid(self) -> np.ndarray:
@@ -57,12 +81,20 @@ def read_trace(path: str | Path, contact_area: float | None = None) -> Trace:
     repeated times, or too few usable samples; :class:`ParameterError` for a
     missing, superfluous or non-positive contact area.
     """
-    table = read_table(path, TRACE_DIMENSIONS, required=["time"], allow_missing=["stress", "force"])
+    table = read_table(
+        path, TRACE_DIMENSIONS, required=["time"], allow_missing=["stress", "force"], ignore=MODEL_COLUMNS
+    )
     has_stress, has_force = "stress" in table, "force" in table
     if has_stress and has_force:
         raise DataError(f"{table.source}: give either a 'stress' or a 'force' column, not both")
     if not (has_stress or has_force):
-        raise DataError(f"{table.source}: missing column 'stress' (or 'force' with a contact area)")
+        hint = (
+            "; its 'friction' column is a friction coefficient, not a stress: multiply it by the normal stress"
+            " and name the column 'stress [Pa]'"
+            if "friction" in table.ignored
+            else ""
+        )
+        raise DataError(f"{table.source}: missing column 'stress' (or 'force' with a contact area){hint}")
     if has_force:
         if contact_area is None:
             raise ParameterError(f"{table.source}: the trace has a 'force' column; give the contact area to convert it")
@@ -74,7 +106,36 @@ def read_trace(path: str | Path, contact_area: float | None = None) -> Trace:
                 f"{table.source}: a contact area was given but the trace has a 'stress' column; it needs none"
             )
         stress = table["stress"]
-    return check_trace(table["time"], stress, source=table.source, rows=table.rows)
+    time, rows = table["time"], table.rows
+    notes = []
+    if table.ignored:
+        notes.append(f"ignored column(s) {', '.join(table.ignored)}: analyze reads time and stress only")
+    repeats = _repeated_samples(time, stress)
+    if repeats.size and table.ignored:
+        cells = read_text_cells(path, table.ignored)
+        same = np.ones(repeats.size, dtype=bool)
+        for column in cells.values():
+            same &= column[repeats] == column[repeats - 1]
+        merged = repeats[~same]  # differ in a column not read: one sample for the analysis
+        if merged.size:
+            keep = np.ones(time.size, dtype=bool)
+            keep[merged] = False
+            time, stress, rows = time[keep], stress[keep], rows[keep]
+            notes.append(
+                f"{merged.size} row(s) repeat the time and stress of the row before and differ only in the"
+                f" ignored columns (first: row {table.rows[merged[0]]}): read once"
+            )
+    trace = check_trace(time, stress, source=table.source, rows=rows)
+    return replace(trace, notes=tuple(notes))
+
+
+def _repeated_samples(time: np.ndarray, stress: np.ndarray) -> np.ndarray:
+    """Indices of samples that repeat the time and the stress (or the gap) of the sample before."""
+    same_time = time[1:] == time[:-1]
+    if not np.any(same_time):
+        return np.empty(0, dtype=int)
+    same_stress = (stress[1:] == stress[:-1]) | (np.isnan(stress[1:]) & np.isnan(stress[:-1]))
+    return np.flatnonzero(same_time & same_stress) + 1
 
 
 def check_trace(
@@ -100,14 +161,19 @@ def check_trace(
     bad = np.nonzero(np.isinf(s))[0]
     if bad.size:
         raise DataError(f"{source}: {where} {labels[bad[0]]}: stress is infinite")
-    steps = np.diff(t)
-    bad = np.nonzero(steps <= 0)[0]
-    if bad.size:
-        k = bad[0] + 1
-        what = "repeats" if steps[bad[0]] == 0 else "goes back from"
+    back = np.flatnonzero(t[1:] < t[:-1])
+    if back.size:
+        k = back[0] + 1
         raise DataError(
-            f"{source}: {where} {labels[k]}: time {t[k]:g} s {what} the previous time {t[k - 1]:g} s;"
-            " times must be strictly increasing (sort the record and remove duplicates)"
+            f"{source}: {where} {labels[k]}: time {t[k]:g} s goes back from the previous time {t[k - 1]:g} s;"
+            " times must never decrease (sort the record)"
+        )
+    repeats = _repeated_samples(t, s)
+    if repeats.size:
+        k = repeats[0]
+        raise DataError(
+            f"{source}: {where} {labels[k]}: time {t[k]:g} s repeats the previous time {t[k - 1]:g} s with the same"
+            " stress: a duplicated row (remove it; a repeated time with a different stress is read as a jump)"
         )
     usable = int(np.count_nonzero(np.isfinite(s)))
     if usable < MIN_SAMPLES:

@@ -13,7 +13,7 @@ from typing import Any
 
 import click
 
-from .common import emit_json, params_options, positive, resolve_params, save_figure, write_text
+from .common import echo_err, emit_json, params_options, positive, resolve_params, save_figure, write_text
 from .params_cmd import print_rich
 
 #: Columns of ``-o cycles.csv``: (field, SI unit).
@@ -101,6 +101,8 @@ def analyze_command(
     area = None if area_text is None else positive(area_text, "area", "--contact-area")
     params = resolve_params(params_name, overrides)
     record = read_trace(trace, contact_area=area)
+    for note in record.notes:
+        echo_err(f"note: {note}")
     analysis = analyze_trace(record, None, v0, params)
     comparison = compare_with_model(analysis, params) if compare else None
     if output is not None:
