@@ -32,7 +32,7 @@ import numpy as np
 
 from ..errors import DataError, ParameterError
 from ..parameters import Parameters, load_parameters
-from .detect import MEDIAN_WIDTH, Coarse, coarse_segments, rise_start, sampling_step
+from .detect import MEDIAN_WIDTH, Coarse, coarse_segments, rise_start
 from .fits import QUADRATIC, Corner, Line, fit_corner, fit_line
 from .traces import Trace, check_trace
 
@@ -193,7 +193,7 @@ def analyze_trace(
     v0 = _check_velocity(pulling_velocity)
     params = load_parameters("gelatin-glass") if params is None else params
     valid = trace.valid
-    t, x = trace.time[valid], trace.stress[valid]
+    t, x = (trace.time, trace.stress) if np.all(valid) else (trace.time[valid], trace.stress[valid])
     coarse = coarse_segments(t, x)
     if np.median(x) < -coarse.threshold:
         raise DataError(
@@ -201,7 +201,7 @@ def analyze_trace(
             " friction stress is taken positive: flip the sign of the column"
         )
     sticks = _stick_phases(t, x, coarse)
-    step = sampling_step(t)
+    step = coarse.step
     for stick in sticks:
         _fit_stick(t, x, coarse, stick, step)
     sticks = [s for s in sticks if s.line is not None]

@@ -123,7 +123,8 @@ def fit_corner(
     significant = gain > CORNER_CHI2 * floor**2
     # samples beyond the search interval are slip for sure; rank them by distance from it
     distance = sign * (t - edge)
-    beyond = np.sort(distance[distance > 0])
+    beyond = distance[distance > 0]  # t is sorted: ascending beyond the upper edge, descending below the lower
+    beyond = beyond if branch_after else beyond[::-1]
     reach = float(beyond[-1])
     while True:
         limit = reach if beyond.size <= MIN_BRANCH_SAMPLES else max(reach, float(beyond[MIN_BRANCH_SAMPLES - 1]))
@@ -161,7 +162,7 @@ def _hinge(
     """Best corner time, total SSE, branch slope at the corner, branch SSE and branch sample count."""
     lo, hi = search
     scale = max(float(t[-1] - t[0]), 1e-300)
-    profile = _HingeProfile(t, on_line, line.slope, sign, hi if sign > 0 else lo, powers, scale)
+    profile = _HingeProfile(t, on_line, line.slope, sign, search, powers, scale)
     inside = t[np.searchsorted(t, lo, "right") : np.searchsorted(t, hi, "left")]
     candidates = np.unique(np.concatenate([[lo, hi], inside, 0.5 * (inside[1:] + inside[:-1])]))
     values = profile(candidates)
@@ -192,10 +193,11 @@ class _HingeProfile:
     of decreasing v.  On the branch y = x - L(tc) = o + g r with o = x - L(t)
     and g = sign slope scale, so every sum the fit needs is a binomial
     expansion of sums of v^j and o v^j over the first m samples.  These are
-    accumulated from the far end of the branch, so that for a candidate inside
-    the search interval the terms are all of one sign beyond the edge and no
-    larger than |vc| within it: the expansion does not cancel.  The stick side's
-    sum of o^2 is accumulated from the other end.  Same value as
+    accumulated from the far end of the branch (up to the other search bound:
+    no branch reaches further), so that for a candidate inside the search
+    interval the terms are all of one sign beyond the edge and no larger than
+    |vc| within it: the expansion does not cancel.  The stick side's sum of
+    o^2 is accumulated from the other end.  Same value as
     :func:`_sse_profile` (which evaluates it sample by sample) to rounding.
     """
 
@@ -205,29 +207,33 @@ class _HingeProfile:
         on_line: np.ndarray,
         slope: float,
         sign: float,
-        edge: float,
+        search: tuple[float, float],
         powers: tuple[float, ...],
         scale: float,
     ) -> None:
         self.powers = tuple(int(p) for p in powers)
         if any(p != q or p < 1 for p, q in zip(self.powers, powers, strict=True)):
             raise ValueError(f"hinge powers must be positive integers, got {powers}")
+        lo, hi = search
+        edge = hi if sign > 0 else lo
         order = slice(None, None, -1) if sign > 0 else slice(None)
         self.t, self.sign, self.edge, self.scale = t, sign, edge, scale
         self.g = sign * slope * scale
-        v = sign * (t[order] - edge) / scale
-        o = on_line[order]
-        top = 2 * max(self.powers) + 1
+        o_all = on_line[order]
+        self.oo_rest = np.concatenate([[0.0], np.cumsum((o_all * o_all)[::-1])])  # [q]: last q samples in order
+        reach = t.size - np.searchsorted(t, lo, "right") if sign > 0 else np.searchsorted(t, hi, "left")
+        v = sign * (t[order][:reach] - edge) / scale
+        o = o_all[:reach]
+        top = 2 * max(self.powers)
         power = np.ones_like(v)
         self.v_sums = np.zeros((top + 1, v.size + 1))
-        self.o_sums = np.zeros((max(self.powers) + 2, v.size + 1))
+        self.o_sums = np.zeros((max(self.powers) + 1, v.size + 1))
         for j in range(top + 1):
             np.cumsum(power, out=self.v_sums[j, 1:])
             if j < self.o_sums.shape[0]:
                 np.cumsum(o * power, out=self.o_sums[j, 1:])
-            power = power * v
+            power *= v
         self.oo_branch = np.concatenate([[0.0], np.cumsum(o * o)])
-        self.oo_stick = np.concatenate([[0.0], np.cumsum((o * o)[::-1])])[::-1]
 
     def __call__(self, tcs: np.ndarray) -> np.ndarray:
         tcs = np.atleast_1d(np.asarray(tcs, dtype=float))
@@ -253,7 +259,7 @@ class _HingeProfile:
         branch_sse = yy - np.sum(coef * moment, axis=1)
         empty = m == 0
         branch_sse[empty] = 0.0
-        return self.oo_stick[m] + np.maximum(branch_sse, 0.0)
+        return self.oo_rest[self.t.size - m] + np.maximum(branch_sse, 0.0)
 
     @staticmethod
     def _shift_weights(shift: np.ndarray, size: int) -> np.ndarray:

@@ -180,6 +180,8 @@ def check_trace(
         raise DataError(
             f"{source}: record too short: {usable} samples with a stress value, need at least {MIN_SAMPLES}"
         )
+    if t[-1] == t[0]:
+        raise DataError(f"{source}: every sample is at time {t[0]:g} s; a record must span some time")
     return Trace(time=t, stress=s, rows=np.asarray(labels), source=source)
 
 
