@@ -36,6 +36,9 @@ CSV_COLUMNS = (
     ("stress_drop", "Pa"),
 )
 
+#: The printed table shows at most this many cycles (and the mean of all); -o and --json hold every one.
+TABLE_CYCLES = 8
+
 #: Rows of the printed table: (field, heading, factor from SI, digits).
 TABLE_ROWS = (
     ("critical_stress", "σc [Pa]", 1.0, 4),
@@ -150,19 +153,28 @@ def _report(analysis: Any, comparison: Any) -> list[Any]:
     )
     parts: list[Any] = [escape(head)]
     if analysis.cycles:
+        shown = analysis.cycles[:TABLE_CYCLES]
         table = Table(title="Per cycle (Table 1 rows)", title_justify="left")
         table.add_column("")
-        for cycle in analysis.cycles:
+        for cycle in shown:
             table.add_column(f"cycle {cycle.index}" + ("" if cycle.complete else "*"), justify="right")
-        table.add_column("mean ± sd", justify="right")
+        table.add_column(
+            f"mean ± sd ({len(analysis.cycles)} cycles)" if len(shown) < len(analysis.cycles) else "mean ± sd",
+            justify="right",
+        )
         for name, heading, factor, digits in TABLE_ROWS:
-            cells = [_number(getattr(c, name), factor, digits) for c in analysis.cycles]
+            cells = [_number(getattr(c, name), factor, digits) for c in shown]
             stats = analysis.summary[name]
             spread = "" if stats["std"] is None else f" ± {stats['std'] * factor:.2g}"
             table.add_row(
                 escape(heading), *cells, "" if stats["mean"] is None else f"{stats['mean'] * factor:.{digits}g}{spread}"
             )
         parts.append(table)
+        if len(shown) < len(analysis.cycles):
+            parts.append(
+                f"the table shows the first {len(shown)} of {len(analysis.cycles)} cycles;"
+                " -o cycles.csv or --json gives every one"
+            )
         if any(not c.complete for c in analysis.cycles):
             notes = [f"cycle {c.index}: {c.message}" for c in analysis.cycles if c.message]
             parts.append(escape("* cut by the record's ends.  " + "; ".join(notes)))
