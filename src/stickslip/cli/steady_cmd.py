@@ -140,7 +140,7 @@ def curve_table(columns: dict[str, np.ndarray], title: str) -> Any:
     "--points",
     type=click.IntRange(min=2, max=MAX_POINTS),
     default=None,
-    help=f"Number of log-spaced velocities [default: {DEFAULT_POINTS}].",
+    help=f"Number of log-spaced velocities [default: {DEFAULT_POINTS}; at most {MAX_POINTS:,}].",
 )
 @click.option(
     "--velocity",
@@ -175,7 +175,9 @@ def curve_command(
     """The steady friction curve sigma(V) of Eqs 6-8.
 
     Velocities accept units ("350 um/s", "1 mm/s"); a bare number is m/s.
-    csv and json are in SI base units; the table uses um/s and Pa.
+    csv and json are in SI base units; the table uses um/s and Pa.  csv is
+    computed and written in chunks (any --points); the table shows at most
+    100 rows, evenly spread; json holds at most 100,000 velocities.
     """
     values, lo, hi = _velocities(velocity, vmin, vmax, points)
     params = resolve_params(params_name, overrides)
