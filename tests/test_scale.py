@@ -144,3 +144,11 @@ def test_curve_table_and_json_are_bounded(capsys):
     assert code == 2 and out == "" and "--points" in err and "10000000" in err
     code, out, _ = run_main(capsys, "curve", "--points", "5", "--format", "json")
     assert code == 0 and len(json.loads(out)["velocity"]) == 5
+
+
+def test_values_near_overflow_are_refused_in_one_line(capsys, tmp_path):
+    path = tmp_path / "huge.csv"
+    path.write_text("time,stress\n" + "".join(f"{k},{1e300 * (1 + k % 10 / 100)}\n" for k in range(100)))
+    code, out, err = run_main(capsys, "analyze", str(path), "--v0", "50 um/s")
+    assert code == 2 and out == "" and err.count("\n") == 1
+    assert "row 2: stress 1e+300 Pa is beyond 1e+100 Pa in magnitude" in err

@@ -28,6 +28,8 @@ from ..tables import read_table, read_text_cells
 
 #: Fewest usable (finite-stress) samples a trace must have.
 MIN_SAMPLES = 20
+#: Largest |time| (s) and |stress| (Pa) accepted.
+MAX_MAGNITUDE = 1e100
 
 TRACE_DIMENSIONS = {"time": "time", "stress": "stress", "force": "force"}
 #: Columns of the package's model traces that the analysis does not use: ``simulate -o``
@@ -161,6 +163,14 @@ def check_trace(
     bad = np.nonzero(np.isinf(s))[0]
     if bad.size:
         raise DataError(f"{source}: {where} {labels[bad[0]]}: stress is infinite")
+    for name, values, unit in (("time", t, "s"), ("stress", s, "Pa")):
+        # the fits square sums of these: keep them far from overflow (no record comes near 1e100)
+        bad = np.flatnonzero(np.abs(values) > MAX_MAGNITUDE)
+        if bad.size:
+            raise DataError(
+                f"{source}: {where} {labels[bad[0]]}: {name} {values[bad[0]]:g} {unit} is beyond"
+                f" {MAX_MAGNITUDE:g} {unit} in magnitude; not a measured record"
+            )
     back = np.flatnonzero(t[1:] < t[:-1])
     if back.size:
         k = back[0] + 1
