@@ -23,7 +23,7 @@ DEFAULT_POINTS = 50
 #: Most velocities one ``curve`` run evaluates (csv streams them in chunks: about a minute and 1 GB of file).
 MAX_POINTS = 10_000_000
 #: Velocities evaluated and written at a time, so that memory does not grow with --points.
-CHUNK = 8192
+CHUNK = 2048
 #: Most rows the table prints (a terminal shows no more); beyond, it shows this many, evenly spread.
 TABLE_ROWS = 100
 #: Most velocities in --format json (one document in memory); csv has no such limit.
