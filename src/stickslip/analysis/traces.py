@@ -24,7 +24,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import DataError, ParameterError
-from ..tables import read_table, read_text_cells
+from ..tables import Table, read_table, read_text_cells
 
 #: Fewest usable (finite-stress) samples a trace must have.
 MIN_SAMPLES = 20
@@ -79,8 +79,9 @@ class Trace:
 def read_trace(path: str | Path, contact_area: float | None = None) -> Trace:
     """Read a trace CSV: ``time`` and ``stress``, or ``time`` and ``force`` with ``contact_area`` (m^2).
 
-    Raises :class:`DataError` for a missing column, a bad cell, unsorted or
-    repeated times, or too few usable samples; :class:`ParameterError` for a
+    Raises :class:`DataError` for a missing column, a bad cell, a time that
+    goes back, a duplicated row, or too few usable samples (two rows at one
+    time with different stresses are a jump and are kept); :class:`ParameterError` for a
     missing, superfluous or non-positive contact area.
     """
     table = read_table(
@@ -108,27 +109,41 @@ def read_trace(path: str | Path, contact_area: float | None = None) -> Trace:
                 f"{table.source}: a contact area was given but the trace has a 'stress' column; it needs none"
             )
         stress = table["stress"]
-    time, rows = table["time"], table.rows
     notes = []
     if table.ignored:
         notes.append(f"ignored column(s) {', '.join(table.ignored)}: analyze reads time and stress only")
-    repeats = _repeated_samples(time, stress)
-    if repeats.size and table.ignored:
-        cells = read_text_cells(path, table.ignored)
-        same = np.ones(repeats.size, dtype=bool)
-        for column in cells.values():
-            same &= column[repeats] == column[repeats - 1]
-        merged = repeats[~same]  # differ in a column not read: one sample for the analysis
-        if merged.size:
-            keep = np.ones(time.size, dtype=bool)
-            keep[merged] = False
-            time, stress, rows = time[keep], stress[keep], rows[keep]
-            notes.append(
-                f"{merged.size} row(s) repeat the time and stress of the row before and differ only in the"
-                f" ignored columns (first: row {table.rows[merged[0]]}): read once"
-            )
+    time, stress, rows, merged = _merge_model_repeats(path, table, stress)
+    if merged:
+        notes.append(merged)
     trace = check_trace(time, stress, source=table.source, rows=rows)
     return replace(trace, notes=tuple(notes))
+
+
+def _merge_model_repeats(
+    path: str | Path, table: Table, stress: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, str]:
+    """Rows that repeat the time and stress of the row before but differ in an ignored column, read once.
+
+    A model trace writes such rows where its state changes at one instant (the chain fraction running
+    out at the end of a stick); for the analysis they are one sample.  Returns (time, stress, rows, note).
+    """
+    time, rows = table["time"], table.rows
+    repeats = _repeated_samples(time, stress)
+    if repeats.size == 0 or not table.ignored:
+        return time, stress, rows, ""
+    same = np.ones(repeats.size, dtype=bool)
+    for column in read_text_cells(path, table.ignored).values():
+        same &= column[repeats] == column[repeats - 1]
+    merged = repeats[~same]
+    if merged.size == 0:
+        return time, stress, rows, ""
+    keep = np.ones(time.size, dtype=bool)
+    keep[merged] = False
+    note = (
+        f"{merged.size} row(s) repeat the time and stress of the row before and differ only in the"
+        f" ignored columns (first: row {rows[merged[0]]}): read once"
+    )
+    return time[keep], stress[keep], rows[keep], note
 
 
 def _repeated_samples(time: np.ndarray, stress: np.ndarray) -> np.ndarray:
