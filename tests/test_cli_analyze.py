@@ -10,11 +10,13 @@ from __future__ import annotations
 
 import json
 import math
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
 
 from cli_helpers import run_main
+from stickslip.cli.analyze_cmd import _comparison_text
 from stickslip.tables import read_table
 
 GD_H = 400e3
@@ -292,7 +294,7 @@ def test_duplicated_rows_and_long_tables(capsys, tmp_path):
     path.write_text("time,stress\n" + "".join(f"{k},{k % 7}\n" for k in range(40)) + "39,4\n")
     code, _, err = run_main(capsys, "analyze", str(path), "--v0", "50 um/s")
     assert code == 2 and "row 42: time 39 s repeats the previous time 39 s with the same stress" in err
-    t = np.arange(0.0, 240.0, 0.02)  # ~ 11 cycles of a 21 s sawtooth: the table shows 8 and says so
+    t = np.arange(0.0, 240.0, 0.05)  # ~ 11 cycles of a 21 s sawtooth: the table shows 8 and says so
     phase = np.mod(t, 21.0)
     stress = np.where(phase < 19.0, 257.0 + 15.3 * phase, 547.7 - 145.35 * (phase - 19.0))
     path.write_text("time,stress\n" + "".join(f"{a:.6f},{b:.6f}\n" for a, b in zip(t, stress, strict=True)))
@@ -300,3 +302,9 @@ def test_duplicated_rows_and_long_tables(capsys, tmp_path):
     assert code == 0, err
     assert "cycle 8" in out and "cycle 9" not in out
     assert "the table shows the first 8 of 12 cycles; -o cycles.csv or --json gives every one" in out
+    difference = dict.fromkeys(("critical_stress", "peak_stress", "stick_time", "slip_time"), 0.0)
+    rows = [{"record_cycle": k + 2, "model_cycle": k + 1, "difference": difference} for k in range(11)]
+    comparison = SimpleNamespace(model_regime="stick-slip", message="", rms_misfit=None, cycles=rows)
+    text = _comparison_text(comparison).splitlines()
+    assert sum(line.startswith("record cycle ") for line in text) == 8
+    assert text[-1] == "(first 8 of 11 compared cycles; --json gives every one)"

@@ -193,7 +193,7 @@ def _comparison_text(comparison: Any) -> str:
     lines = [f"model ({comparison.model_regime}): {comparison.message}"]
     if comparison.rms_misfit is not None:
         lines.append(f"RMS misfit {comparison.rms_misfit:.4g} Pa over {comparison.points} samples")
-    for row in comparison.cycles:
+    for row in comparison.cycles[:TABLE_CYCLES]:
         diff = row["difference"]
         shown = [
             f"{label} {_signed(diff[name], factor)}{unit}"
@@ -206,6 +206,8 @@ def _comparison_text(comparison: Any) -> str:
             if diff[name] is not None
         ]
         lines.append(f"record cycle {row['record_cycle']} - model cycle {row['model_cycle']}: " + ", ".join(shown))
+    if len(comparison.cycles) > TABLE_CYCLES:
+        lines.append(f"(first {TABLE_CYCLES} of {len(comparison.cycles)} compared cycles; --json gives every one)")
     return "\n".join(lines)
 
 
