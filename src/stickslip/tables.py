@@ -78,8 +78,12 @@ def read_table(
     return Table(source, columns, rows, ignored)
 
 
-def read_text_cells(path: str | Path, names: Sequence[str]) -> dict[str, np.ndarray]:
-    """Raw text of the named columns, one entry per data row as :func:`read_table` numbers them."""
+def read_text_cells(path: str | Path, names: Sequence[str], count: int | None = None) -> dict[str, np.ndarray]:
+    """Raw text of the named columns, one entry per data row as :func:`read_table` numbers them.
+
+    ``count``, the number of data rows :func:`read_table` found, guards the columnar path: a file it
+    reads differently (a row of empty cells, which the row reader skips) is read row by row.
+    """
     path = Path(path)
     rows = _content_rows(path, str(path))
     first = next(rows, None)
@@ -89,7 +93,7 @@ def read_text_cells(path: str | Path, names: Sequence[str]) -> dict[str, np.ndar
     header_row, header = first
     positions = [_header_position(header, n) for n in names]
     columnar = _text_columns(path, header_row, len(header), positions)
-    if columnar is not None:
+    if columnar is not None and (count is None or all(c.size == count for c in columnar)):
         return dict(zip(names, columnar, strict=True))
     cells: list[list[str]] = [[] for _ in names]
     for row_number, row in _content_rows(path, str(path)):

@@ -132,7 +132,7 @@ def _merge_model_repeats(
     if repeats.size == 0 or not table.ignored:
         return time, stress, rows, ""
     same = np.ones(repeats.size, dtype=bool)
-    for column in read_text_cells(path, table.ignored).values():
+    for column in read_text_cells(path, table.ignored, count=time.size).values():
         same &= column[repeats] == column[repeats - 1]
     merged = repeats[~same]
     if merged.size == 0:
