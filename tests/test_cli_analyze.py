@@ -10,11 +10,13 @@ from __future__ import annotations
 
 import json
 import math
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
 
 from cli_helpers import run_main
+from stickslip.cli.analyze_cmd import _comparison_text
 from stickslip.tables import read_table
 
 GD_H = 400e3
@@ -205,3 +207,104 @@ def test_bad_options_exit_2(capsys, record, args, match):
     code, _, err = run_main(capsys, "analyze", str(record["path"]), *args)
     assert code == 2
     assert err.startswith("stickslip: error: ") and match in err and err.count("\n") == 1
+
+
+# --------------------------------------------------------------------------- what other commands write
+def test_simulate_output_chains_into_analyze(capsys, tmp_path):
+    trace = tmp_path / "trace.csv"
+    code, out, err = run_main(capsys, "simulate", "--v0", "50 um/s", "--duration", "60 s", "-o", str(trace), "--json")
+    assert code == 0, err
+    model = json.loads(out)["cycles"][1]  # a whole cycle of the simulation: the truth here
+    code, out, err = run_main(capsys, "analyze", str(trace), "--v0", "50 um/s", "--json")
+    assert code == 0, err
+    notes = err.splitlines()
+    assert notes[0] == (
+        "note: ignored column(s) velocity, slider_displacement, puller_displacement, block_shear, chain_fraction,"
+        " phase: analyze reads time and stress only"
+    )
+    assert len(notes) == 2 and "repeat the time and stress of the row before" in notes[1]
+    data = json.loads(out)  # the notes went to stderr: stdout is still one JSON document
+    assert data["regime"] == "stick-slip"
+    cycle = next(c for c in data["cycles"] if c["complete"])
+    assert cycle["critical_stress"] == pytest.approx(model["start_stress"], rel=1e-4)
+    assert cycle["peak_stress"] == pytest.approx(model["peak_stress"], rel=1e-4)
+    assert cycle["stick_time"] == pytest.approx(model["stick_time"], rel=1e-3)
+    assert cycle["slip_time"] == pytest.approx(model["slip_time"], rel=1e-2)
+    assert cycle["jump_velocity"] == pytest.approx(model["jump_velocity"], rel=1e-3)
+    assert cycle["stiffness"] == pytest.approx(GD_H, rel=1e-4)
+
+
+def test_jumps_at_one_instant_are_kept(capsys, tmp_path):
+    # the no-aging jump raises the stress at the instant of the slip: two rows at one time, both kept
+    trace = tmp_path / "trace.csv"
+    args = ("simulate", "--v0", "50 um/s", "--duration", "50 s", "--jump-curve", "no-aging", "-o", str(trace), "--json")
+    code, out, err = run_main(capsys, *args)
+    assert code == 0, err
+    model = json.loads(out)["cycles"][1]
+    code, out, err = run_main(capsys, "analyze", str(trace), "--v0", "50 um/s", "--json")
+    assert code == 0, err
+    cycle = next(c for c in json.loads(out)["cycles"] if c["complete"])
+    assert cycle["critical_stress"] == pytest.approx(model["start_stress"], rel=1e-4)
+    # the hinge assumes a continuous corner; an upward step at the slip moves it by < 0.5 % (docs/analysis.md)
+    assert cycle["peak_stress"] == pytest.approx(model["peak_stress"], rel=5e-3)
+    assert cycle["stick_time"] == pytest.approx(model["stick_time"], rel=5e-3)
+
+
+def test_bond_model_transient_trace_is_read_as_is(capsys, tmp_path):
+    t = np.arange(-5.0, 60.0, 0.01)
+    stress, starts, peaks = sawtooth(t)
+    columns = {
+        "time": t,
+        "stress": stress,
+        "bonded_fraction": np.clip(stress / 600.0, 0, 1),
+        "slider_velocity": np.zeros_like(t),
+        "slider_position": np.zeros_like(t),
+        "puller_position": V0 * t,
+    }
+    path = tmp_path / "transient.csv"
+    rows = zip(*columns.values(), strict=True)
+    path.write_text(",".join(columns) + "\n" + "".join(",".join(f"{v:.17g}" for v in row) + "\n" for row in rows))
+    code, out, err = run_main(capsys, "analyze", str(path), "--v0", "50 um/s", "--json")
+    assert code == 0, err
+    assert err == (
+        "note: ignored column(s) bonded_fraction, slider_velocity, slider_position, puller_position:"
+        " analyze reads time and stress only\n"
+    )
+    cycles = json.loads(out)["cycles"]
+    assert [c["complete"] for c in cycles] == [False, True, False]  # cut by the record's start and end
+    assert [c["peak_stress"] for c in cycles] == [
+        pytest.approx(HIGHS[0], abs=0.5),
+        pytest.approx(HIGHS[1], abs=0.5),
+        None,
+    ]
+    assert cycles[1]["stick_time"] == pytest.approx(peaks[1] - starts[1], rel=0.01)
+
+
+def test_rate_and_state_trace_is_refused_with_a_hint(capsys, tmp_path):
+    path = tmp_path / "rsf.csv"
+    header = "time,friction,slider_velocity,state,load_point_displacement,slider_displacement\n"
+    path.write_text(header + "".join(f"{k},0.6,1e-6,1,0,0\n" for k in range(30)))
+    code, out, err = run_main(capsys, "analyze", str(path), "--v0", "50 um/s")
+    assert code == 2 and out == "" and err.count("\n") == 1
+    assert "missing column 'stress'" in err and "friction coefficient" in err
+
+
+def test_duplicated_rows_and_long_tables(capsys, tmp_path):
+    path = tmp_path / "dup.csv"
+    path.write_text("time,stress\n" + "".join(f"{k},{k % 7}\n" for k in range(40)) + "39,4\n")
+    code, _, err = run_main(capsys, "analyze", str(path), "--v0", "50 um/s")
+    assert code == 2 and "row 42: time 39 s repeats the previous time 39 s with the same stress" in err
+    t = np.arange(0.0, 240.0, 0.05)  # ~ 11 cycles of a 21 s sawtooth: the table shows 8 and says so
+    phase = np.mod(t, 21.0)
+    stress = np.where(phase < 19.0, 257.0 + 15.3 * phase, 547.7 - 145.35 * (phase - 19.0))
+    path.write_text("time,stress\n" + "".join(f"{a:.6f},{b:.6f}\n" for a, b in zip(t, stress, strict=True)))
+    code, out, err = run_main(capsys, "analyze", str(path), "--v0", "50 um/s")
+    assert code == 0, err
+    assert "cycle 8" in out and "cycle 9" not in out
+    assert "the table shows the first 8 of 12 cycles; -o cycles.csv or --json gives every one" in out
+    difference = dict.fromkeys(("critical_stress", "peak_stress", "stick_time", "slip_time"), 0.0)
+    rows = [{"record_cycle": k + 2, "model_cycle": k + 1, "difference": difference} for k in range(11)]
+    comparison = SimpleNamespace(model_regime="stick-slip", message="", rms_misfit=None, cycles=rows)
+    text = _comparison_text(comparison).splitlines()
+    assert sum(line.startswith("record cycle ") for line in text) == 8
+    assert text[-1] == "(first 8 of 11 compared cycles; --json gives every one)"

@@ -10,7 +10,7 @@ from __future__ import annotations
 import csv
 import math
 import re
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -29,6 +29,7 @@ class Table:
     source: str
     columns: dict[str, np.ndarray]
     rows: np.ndarray  # file row number of each data row (header is row 1)
+    ignored: tuple[str, ...] = ()  # known columns present in the file and not read
 
     def __getitem__(self, name: str) -> np.ndarray:
         return self.columns[name]
@@ -40,34 +41,122 @@ class Table:
         return int(self.rows.size)
 
 
+@dataclass(frozen=True)
+class _Header:
+    row: int  # file row of the header (1-based)
+    names: list[str]  # every column, in file order
+    factors: dict[str, float]  # SI factor of each column that is read
+
+
 def read_table(
     path: str | Path,
     dimensions: Mapping[str, str],
     required: Sequence[str],
     allow_missing: Sequence[str] = (),
+    ignore: Sequence[str] = (),
 ) -> Table:
     """Read a CSV file whose columns are named in ``dimensions`` (name -> dimension).
 
     Columns in ``required`` must be present; others in ``dimensions`` are
-    optional; any other column is an error.  Empty or NaN cells are errors
-    except in columns listed in ``allow_missing`` (kept as NaN).
+    optional; columns named in ``ignore`` are known but not read (listed in
+    ``Table.ignored``); any other column is an error.  Empty or NaN cells are
+    errors except in columns listed in ``allow_missing`` (kept as NaN).
+
+    Large files are parsed column-wise by pyarrow when it is installed; a file
+    it cannot take as it stands (comment lines among the data, a bad cell) is
+    read row by row, which names the first offending row and column.
     """
     path = Path(path)
     source = str(path)
+    header = _read_header(path, source, dimensions, required, ignore)
+    fast = _read_columnar(path, header, allow_missing)
+    if fast is not None:
+        columns, rows = fast
+    else:
+        columns, rows = _read_rows(path, source, header, allow_missing)
+    ignored = tuple(n for n in header.names if n not in header.factors)
+    return Table(source, columns, rows, ignored)
+
+
+def read_text_cells(path: str | Path, names: Sequence[str], count: int | None = None) -> dict[str, np.ndarray]:
+    """Raw text of the named columns, one entry per data row as :func:`read_table` numbers them.
+
+    ``count``, the number of data rows :func:`read_table` found, guards the columnar path: a file it
+    reads differently (a row of empty cells, which the row reader skips) is read row by row.
+    """
+    path = Path(path)
+    rows = _content_rows(path, str(path))
+    first = next(rows, None)
+    rows.close()
+    if first is None:
+        return {n: np.empty(0, dtype=object) for n in names}
+    header_row, header = first
+    positions = [_header_position(header, n) for n in names]
+    columnar = _text_columns(path, header_row, len(header), positions)
+    if columnar is not None and (count is None or all(c.size == count for c in columnar)):
+        return dict(zip(names, columnar, strict=True))
+    cells: list[list[str]] = [[] for _ in names]
+    for row_number, row in _content_rows(path, str(path)):
+        if row_number > header_row:
+            for values, k in zip(cells, positions, strict=True):
+                values.append(row[k].strip() if k < len(row) else "")
+    return {n: np.asarray(v, dtype=object) for n, v in zip(names, cells, strict=True)}
+
+
+def _text_columns(path: Path, header_row: int, width: int, positions: list[int]) -> list[np.ndarray] | None:
+    try:
+        import pyarrow as pa
+        import pyarrow.csv as pacsv
+    except ImportError:  # pragma: no cover - pyarrow is a dependency
+        return None
+    labels = [f"c{k}" for k in range(width)]
+    try:
+        table = pacsv.read_csv(
+            path,
+            read_options=pacsv.ReadOptions(skip_rows=header_row, column_names=labels),
+            convert_options=pacsv.ConvertOptions(
+                include_columns=[labels[k] for k in positions],
+                column_types={labels[k]: pa.string() for k in positions},
+                strings_can_be_null=False,
+            ),
+        )
+    except (pa.ArrowException, OSError, ValueError):
+        return None
+    return [np.char.strip(table.column(labels[k]).to_numpy(zero_copy_only=False).astype(str)) for k in positions]
+
+
+def _header_position(header: list[str], name: str) -> int:
+    for k, cell in enumerate(header):
+        match = _HEADER.match(cell)
+        if match and match.group(1) == name:
+            return k
+    raise KeyError(name)
+
+
+def _content_rows(path: Path, source: str) -> Iterator[tuple[int, list[str]]]:
+    """(file row, cells) of every row that is not blank and not a '#' comment, streamed."""
     try:
         with path.open(newline="", encoding="utf-8-sig") as handle:
-            lines = [row for row in csv.reader(handle)]
+            for k, row in enumerate(csv.reader(handle), start=1):
+                if row and any(c.strip() for c in row) and not row[0].lstrip().startswith("#"):
+                    yield k, row
     except FileNotFoundError:
         raise DataError(f"{source}: file not found") from None
     except (OSError, UnicodeDecodeError, csv.Error) as exc:
         raise DataError(f"{source}: cannot be read as CSV ({exc})") from None
-    # skip blank lines and '#' comments, remembering file row numbers
-    numbered = [(k + 1, row) for k, row in enumerate(lines) if row and any(c.strip() for c in row)]
-    numbered = [(k, row) for k, row in numbered if not row[0].lstrip().startswith("#")]
-    if not numbered:
+
+
+def _read_header(
+    path: Path, source: str, dimensions: Mapping[str, str], required: Sequence[str], ignore: Sequence[str]
+) -> _Header:
+    rows = _content_rows(path, source)
+    first = next(rows, None)
+    rows.close()
+    if first is None:
         raise DataError(f"{source}: empty file, expected a header row with columns {', '.join(required)}")
-    header_row, header = numbered[0]
-    names, factors = [], []
+    header_row, header = first
+    names: list[str] = []
+    factors: dict[str, float] = {}
     for position, cell in enumerate(header, start=1):
         match = _HEADER.match(cell)
         if not match:
@@ -76,26 +165,38 @@ def read_table(
                 " expected name or 'name [unit]'"
             )
         name, unit = match.group(1), match.group(2)
-        if name not in dimensions:
+        if name not in dimensions and name not in ignore:
             raise DataError(f"{source}: unknown column {name!r}; expected {', '.join(dimensions)}")
         if name in names:
             raise DataError(f"{source}: column {name!r} appears twice")
-        dimension = dimensions[name]
+        names.append(name)
+        if name not in dimensions:
+            continue
         try:
-            factor = to_si(f"1 {unit}", dimension, f"column {name!r}") if unit and unit.strip() else 1.0
+            factor = to_si(f"1 {unit}", dimensions[name], f"column {name!r}") if unit and unit.strip() else 1.0
         except UnitError as exc:
             raise DataError(f"{source}: {exc}") from None
-        names.append(name)
-        factors.append(factor)
-    missing = [c for c in required if c not in names]
+        factors[name] = factor
+    missing = [c for c in required if c not in factors]
     if missing:
         raise DataError(f"{source}: missing column(s) {', '.join(missing)}; found {', '.join(names)}")
-    values: dict[str, list[float]] = {n: [] for n in names}
+    return _Header(header_row, names, factors)
+
+
+def _read_rows(
+    path: Path, source: str, header: _Header, allow_missing: Sequence[str]
+) -> tuple[dict[str, np.ndarray], np.ndarray]:
+    """Row by row: slow, but names the first bad row and column exactly."""
+    used = [(k, n, header.factors[n]) for k, n in enumerate(header.names) if n in header.factors]
+    values: dict[str, list[float]] = {n: [] for _, n, _ in used}
     rows = []
-    for row_number, row in numbered[1:]:
-        if len(row) != len(names):
-            raise DataError(f"{source}: row {row_number}: expected {len(names)} values, got {len(row)}")
-        for name, factor, cell in zip(names, factors, row, strict=True):
+    for row_number, row in _content_rows(path, source):
+        if row_number <= header.row:
+            continue
+        if len(row) != len(header.names):
+            raise DataError(f"{source}: row {row_number}: expected {len(header.names)} values, got {len(row)}")
+        for position, name, factor in used:
+            cell = row[position]
             text = cell.strip()
             try:
                 value = float(text) if text else math.nan
@@ -107,7 +208,88 @@ def read_table(
                 raise DataError(f"{source}: row {row_number}, column {name!r}: infinite value")
             values[name].append(value * factor)
         rows.append(row_number)
-    return Table(source, {n: np.asarray(v, dtype=float) for n, v in values.items()}, np.asarray(rows, dtype=int))
+    return {n: np.asarray(v, dtype=float) for n, v in values.items()}, np.asarray(rows, dtype=int)
+
+
+def _read_columnar(
+    path: Path, header: _Header, allow_missing: Sequence[str]
+) -> tuple[dict[str, np.ndarray], np.ndarray] | None:
+    """The columns parsed by pyarrow, or None when the file needs the row-by-row reader (or for its message)."""
+    try:
+        import pyarrow as pa
+        import pyarrow.csv as pacsv
+    except ImportError:  # pragma: no cover - pyarrow is a dependency; the row reader still works without it
+        return None
+    used = list(header.factors)
+    try:
+        table = pacsv.read_csv(
+            path,
+            read_options=pacsv.ReadOptions(skip_rows=header.row, column_names=header.names),
+            parse_options=pacsv.ParseOptions(ignore_empty_lines=True),
+            convert_options=pacsv.ConvertOptions(
+                include_columns=used,
+                column_types={n: pa.float64() for n in used},
+                null_values=[""],
+                strings_can_be_null=False,
+            ),
+        )
+    except (pa.ArrowException, OSError, ValueError):
+        return None
+    columns = {}
+    for name in used:
+        column = table.column(name).to_numpy()
+        if (name not in allow_missing and np.isnan(column).any()) or np.isinf(column).any():
+            return None  # the row reader names the row
+        factor = header.factors[name]
+        columns[name] = column * factor if factor != 1.0 else np.array(column, dtype=float)
+    del table
+    rows = _data_rows(path, header.row, len(next(iter(columns.values()))) if columns else 0)
+    return None if rows is None else (columns, rows)
+
+
+#: Bytes read at a time when numbering the rows of a large file.
+_CHUNK = 1 << 24
+
+
+def _data_rows(path: Path, header_row: int, count: int) -> np.ndarray | None:
+    """File row numbers of the ``count`` data rows after the header (empty lines skipped), or None if they
+    cannot be matched line for line (e.g. a quoted cell spanning lines)."""
+    lines = 0
+    ends_open = False
+    with path.open("rb") as handle:
+        while chunk := handle.read(_CHUNK):
+            lines += chunk.count(b"\n")
+            ends_open = not chunk.endswith(b"\n")
+    lines += int(ends_open)
+    if lines - header_row == count:
+        return np.arange(header_row + 1, header_row + 1 + count)
+    numbers = _non_empty_lines(path)
+    numbers = numbers[numbers > header_row]
+    return numbers if numbers.size == count else None
+
+
+def _non_empty_lines(path: Path) -> np.ndarray:
+    """1-based numbers of the lines that hold more than a line ending."""
+    found: list[np.ndarray] = []
+    line = 0
+    carry = b""
+    with path.open("rb") as handle:
+        while True:
+            chunk = handle.read(_CHUNK)
+            data = carry + chunk
+            if not chunk:
+                if data.strip(b"\r"):
+                    found.append(np.array([line + 1]))
+                break
+            raw = np.frombuffer(data, dtype=np.uint8)
+            ends = np.flatnonzero(raw == 10)
+            starts = np.concatenate([[0], ends[:-1] + 1])
+            length = ends - starts
+            empty = (length == 0) | ((length == 1) & (raw[starts] == 13))
+            found.append(line + 1 + np.flatnonzero(~empty))
+            line += ends.size
+            carry = data[ends[-1] + 1 :] if ends.size else data
+    return np.concatenate(found) if found else np.empty(0, dtype=int)
 
 
 def require_positive(table: Table, name: str) -> None:

@@ -24,6 +24,7 @@ None and the cycle is ``complete=False``.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
 from typing import TYPE_CHECKING, Any
 
@@ -192,7 +193,7 @@ def analyze_trace(
     v0 = _check_velocity(pulling_velocity)
     params = load_parameters("gelatin-glass") if params is None else params
     valid = trace.valid
-    t, x = trace.time[valid], trace.stress[valid]
+    t, x = (trace.time, trace.stress) if np.all(valid) else (trace.time[valid], trace.stress[valid])
     coarse = coarse_segments(t, x)
     if np.median(x) < -coarse.threshold:
         raise DataError(
@@ -200,8 +201,9 @@ def analyze_trace(
             " friction stress is taken positive: flip the sign of the column"
         )
     sticks = _stick_phases(t, x, coarse)
+    step = coarse.step
     for stick in sticks:
-        _fit_stick(t, x, coarse, stick)
+        _fit_stick(t, x, coarse, stick, step)
     sticks = [s for s in sticks if s.line is not None]
     regime, steady_from = _regime(t, x, coarse, sticks)
     cycles = _cycles(sticks, v0, params, steady_from is not None)
@@ -265,9 +267,13 @@ def _stick_phases(t: np.ndarray, x: np.ndarray, coarse: Coarse) -> list[_Stick]:
     return sticks
 
 
-def _fit_stick(t: np.ndarray, x: np.ndarray, coarse: Coarse, stick: _Stick) -> None:
-    """Stick line and corners: line on the coarse interior -> corners -> line between the corners -> corners."""
-    step = float(np.median(np.diff(t)))
+def _fit_stick(t: np.ndarray, x: np.ndarray, coarse: Coarse, stick: _Stick, step: float) -> None:
+    """Stick line and corners: line on the coarse interior -> corners -> line between the corners -> corners.
+
+    Every step works on the samples near this stick phase only (``t`` is sorted: windows are
+    found by bisection), so that a record costs time in proportion to its length, not to
+    its length times its number of cycles.
+    """
     lo = stick.start_guess if stick.start_guess is not None else float(t[0])
     hi = stick.end_guess if stick.end_guess is not None else float(t[-1])
     margin = min(max(3 * MEDIAN_WIDTH * step, 0.1 * (hi - lo)), 0.25 * (hi - lo))
@@ -293,8 +299,18 @@ def _fit_stick(t: np.ndarray, x: np.ndarray, coarse: Coarse, stick: _Stick) -> N
 
 
 def _line_between(t: np.ndarray, x: np.ndarray, lo: float, hi: float) -> Line | None:
-    inside = (t >= lo) & (t <= hi)
+    inside = _between(t, lo, hi)
     return fit_line(t[inside], x[inside])
+
+
+def _between(t: np.ndarray, lo: float, hi: float) -> slice:
+    """The samples with lo <= t <= hi, as a slice of the sorted times."""
+    return slice(int(np.searchsorted(t, lo, "left")), int(np.searchsorted(t, hi, "right")))
+
+
+def _indices(t: np.ndarray, lo: float, hi: float) -> np.ndarray:
+    window = _between(t, lo, hi)
+    return np.arange(window.start, max(window.start, window.stop))
 
 
 def _stick_span(t: np.ndarray, stick: _Stick) -> float:
@@ -314,7 +330,7 @@ def _start_corner(t: np.ndarray, x: np.ndarray, coarse: Coarse, stick: _Stick, s
     reach = max(5 * step, 0.1 * span)
     top, level = stick.prev_peak if stick.prev_peak is not None else (float(t[0]), None)
     hi = guess + reach if stick.end_guess is None else min(guess + reach, 0.5 * (guess + stick.end_guess))
-    near = np.nonzero((t >= top) & (t <= hi))[0]
+    near = _indices(t, top, hi)
     # the last sample clearly above the stick line is the last one of the slip
     off = near[x[near] - line(t[near]) > _deviation(coarse)]
     if off.size == 0:
@@ -328,7 +344,7 @@ def _start_corner(t: np.ndarray, x: np.ndarray, coarse: Coarse, stick: _Stick, s
         )
     branch_lo = min(max(branch_lo, top), float(t[max(last - 1, 0)]))
     search = (float(t[last]), float(t[last]) + reach)
-    inside = (t >= branch_lo) & (t <= search[1] + max(STICK_WINDOW * span, reach))
+    inside = _between(t, branch_lo, search[1] + max(STICK_WINDOW * span, reach))
     return fit_corner(t[inside], x[inside], line, False, search, coarse.noise, START_POWERS)
 
 
@@ -341,7 +357,7 @@ def _end_corner(t: np.ndarray, x: np.ndarray, coarse: Coarse, stick: _Stick, ste
     reach = max(5 * step, 0.1 * span)
     bottom = stick.next_time if stick.next_time is not None else float(t[-1])
     lo = guess - reach if stick.start_guess is None else max(guess - reach, 0.5 * (guess + stick.start_guess))
-    near = np.nonzero((t >= lo) & (t <= bottom))[0]
+    near = _indices(t, lo, bottom)
     # the first sample clearly below the stick line is the first one of the slip
     off = near[line(t[near]) - x[near] > _deviation(coarse)]
     if off.size == 0:
@@ -354,7 +370,7 @@ def _end_corner(t: np.ndarray, x: np.ndarray, coarse: Coarse, stick: _Stick, ste
     )
     branch_hi = max(min(branch_hi, bottom), float(t[min(first + 1, t.size - 1)]))
     search = (float(t[first]) - reach, float(t[first]))
-    inside = (t >= search[0] - max(STICK_WINDOW * span, reach)) & (t <= branch_hi)
+    inside = _between(t, search[0] - max(STICK_WINDOW * span, reach), branch_hi)
     return fit_corner(t[inside], x[inside], line, True, search, coarse.noise)
 
 
@@ -366,15 +382,30 @@ def _deviation(coarse: Coarse) -> float:
 def _crossing_after(coarse: Coarse, start: float, level: float) -> float:
     """First grid time after ``start`` where the smoothed record falls below ``level``."""
     g, y = coarse.grid_time, coarse.grid_stress
-    after = np.nonzero((g > start) & (y < level))[0]
-    return float(g[after[0]]) if after.size else float(g[-1])
+    first = int(np.searchsorted(g, start, "right"))
+    after = _first_index(y[first:], lambda chunk: chunk < level)
+    return float(g[first + after]) if after is not None else float(g[-1])
 
 
 def _crossing_before(coarse: Coarse, end: float, level: float) -> float:
     """Last grid time before ``end`` where the smoothed record is above ``level``."""
     g, y = coarse.grid_time, coarse.grid_stress
-    before = np.nonzero((g < end) & (y > level))[0]
-    return float(g[before[-1]]) if before.size else float(g[0])
+    stop = int(np.searchsorted(g, end, "left"))
+    before = _first_index(y[:stop][::-1], lambda chunk: chunk > level)
+    return float(g[stop - 1 - before]) if before is not None else float(g[0])
+
+
+def _first_index(values: np.ndarray, test: Callable[[np.ndarray], np.ndarray]) -> int | None:
+    """Index of the first value passing ``test``, or None; scans in doubling chunks, so a crossing
+    near the start costs in proportion to its distance, not to the length of ``values``."""
+    start, size = 0, 256
+    while start < values.size:
+        passed = test(values[start : start + size])
+        k = int(np.argmax(passed))
+        if passed[k]:
+            return start + k
+        start, size = start + size, 2 * size
+    return None
 
 
 def _regime(t: np.ndarray, x: np.ndarray, coarse: Coarse, sticks: list[_Stick]) -> tuple[str, float | None]:
@@ -479,7 +510,7 @@ def _summary(
     for name in CYCLE_QUANTITIES:
         summary[name] = _stats([getattr(c, name) for c in cycles if getattr(c, name) is not None])
     if steady_from is not None:
-        inside = t >= steady_from
+        inside = _between(t, steady_from, math.inf)
         tail = x[inside]
         trend = fit_line(t[inside], tail)
         summary.update(

@@ -63,6 +63,7 @@ class Coarse:
     final_trough: float | None
     final_level: float | None
     steady_from: float | None
+    step: float = 0.0  # median interval between distinct sample times
 
 
 def noise_level(time: np.ndarray, stress: np.ndarray) -> float:
@@ -70,20 +71,46 @@ def noise_level(time: np.ndarray, stress: np.ndarray) -> float:
     t, x = time, stress
     if t.size < 3:
         return 0.0
-    left, right = t[1:-1] - t[:-2], t[2:] - t[1:-1]
-    w_prev = right / (left + right)
-    w_next = 1.0 - w_prev
-    residual = x[1:-1] - (w_prev * x[:-2] + w_next * x[2:])
+    # in place where possible: a 10^7-sample record makes each temporary 80 MB
+    left, w_prev = t[1:-1] - t[:-2], t[2:] - t[1:-1]
+    x_prev, x_mid, x_next = x[:-2], x[1:-1], x[2:]
+    span = left + w_prev
+    spaced = span > 0  # three samples at one instant (a jump written as a run of rows) define no line
+    if not np.all(spaced):
+        left, w_prev, span, x_prev, x_mid, x_next = (a[spaced] for a in (left, w_prev, span, x_prev, x_mid, x_next))
+    if span.size == 0:
+        return 0.0
+    w_prev /= span
+    w_next = np.subtract(1.0, w_prev, out=left)
+    residual = np.multiply(w_prev, x_prev)
+    residual += np.multiply(w_next, x_next, out=span)
+    np.subtract(x_mid, residual, out=residual)
     # Var(residual) = sigma^2 (1 + w_prev^2 + w_next^2) for independent noise
-    scaled = residual / np.sqrt(1.0 + w_prev**2 + w_next**2)
-    return float(MAD_SCALE * np.median(np.abs(scaled - np.median(scaled))))
+    norm = np.square(w_prev, out=w_prev)
+    norm += np.square(w_next, out=w_next)
+    norm += 1.0
+    residual /= np.sqrt(norm, out=norm)
+    centre = np.median(residual)
+    residual -= centre
+    return float(MAD_SCALE * np.median(np.abs(residual, out=residual), overwrite_input=True))
 
 
-def uniform_grid(time: np.ndarray, stress: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The finite samples interpolated on a uniform grid at the median sampling interval."""
-    step = float(np.median(np.diff(time)))
+def sampling_step(time: np.ndarray) -> float:
+    """Median interval between successive distinct times (repeated times at jumps do not count)."""
+    steps = np.diff(time)
+    steps = steps[steps > 0]
+    return float(np.median(steps, overwrite_input=True)) if steps.size else 0.0
+
+
+def uniform_grid(time: np.ndarray, stress: np.ndarray, step: float | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """The finite samples interpolated on a uniform grid at the median sampling interval.
+
+    At a repeated time (a jump) the grid takes the value before it on its left and the one after it on its
+    right (``np.interp`` never selects the zero-width interval).
+    """
+    step = sampling_step(time) if step is None else step
     span = float(time[-1] - time[0])
-    count = int(min(MAX_GRID, max(2, round(span / step) + 1)))
+    count = int(min(MAX_GRID, max(2, round(span / step) + 1))) if step > 0 else 2
     grid = np.linspace(time[0], time[-1], count)
     return grid, np.interp(grid, time, stress)
 
@@ -91,7 +118,8 @@ def uniform_grid(time: np.ndarray, stress: np.ndarray) -> tuple[np.ndarray, np.n
 def coarse_segments(time: np.ndarray, stress: np.ndarray) -> Coarse:
     """Find drop events, troughs and a steady tail in a record of finite samples."""
     noise = noise_level(time, stress)
-    grid, raw = uniform_grid(time, stress)
+    step = sampling_step(time)
+    grid, raw = uniform_grid(time, stress, step)
     smooth = median_filter(raw, size=min(MEDIAN_WIDTH, raw.size), mode="nearest")
     scale = float(np.max(np.abs(smooth))) if smooth.size else 0.0
     threshold = max(PROMINENCE_SIGMAS * noise, 1e-9 * scale, 1e-300)
@@ -124,6 +152,7 @@ def coarse_segments(time: np.ndarray, stress: np.ndarray) -> Coarse:
         final_trough=None if final_trough is None else float(grid[final_trough]),
         final_level=None if final_trough is None else float(smooth[final_trough]),
         steady_from=steady_from,
+        step=step,
     )
 
 

@@ -17,6 +17,7 @@ trough are read off the fitted line, never from a single noisy sample.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -71,13 +72,13 @@ def fit_line(t: np.ndarray, x: np.ndarray) -> Line | None:
         return None
     t_ref = float(np.mean(t))
     u = t - t_ref
-    sxx = float(np.dot(u, u))
+    sxx = _dot(u, u)
     if sxx <= 0:
         return None
-    slope = float(np.dot(u, x - np.mean(x)) / sxx)
+    slope = _dot(u, x - np.mean(x)) / sxx
     intercept = float(np.mean(x))
     residual = x - (intercept + slope * u)
-    sse = float(np.dot(residual, residual))
+    sse = _dot(residual, residual)
     variance = sse / (n - 2)
     slope_stderr = float(np.sqrt(variance / sxx))
     return Line(t_ref, intercept, slope, slope_stderr, float(np.sqrt(sse / n)), n, float(t[0]), float(t[-1]))
@@ -115,14 +116,15 @@ def fit_corner(
     floor = max(noise, 1e-12 * max(1.0, float(np.max(np.abs(x)))))
     if powers is not None:
         tc, total, branch_slope, _, _ = _hinge(t, x, on_line, line, sign, search, powers)
-        gain = float(np.dot(on_line, on_line)) - total
+        gain = _dot(on_line, on_line) - total
         return Corner(tc, float(line(tc)), branch_slope, gain, bool(gain > CORNER_CHI2 * floor**2))
     first = _hinge(t, x, on_line, line, sign, search, STRAIGHT)
-    gain = float(np.dot(on_line, on_line)) - first[1]
+    gain = _dot(on_line, on_line) - first[1]
     significant = gain > CORNER_CHI2 * floor**2
     # samples beyond the search interval are slip for sure; rank them by distance from it
     distance = sign * (t - edge)
-    beyond = np.sort(distance[distance > 0])
+    beyond = distance[distance > 0]  # t is sorted: ascending beyond the upper edge, descending below the lower
+    beyond = beyond if branch_after else beyond[::-1]
     reach = float(beyond[-1])
     while True:
         limit = reach if beyond.size <= MIN_BRANCH_SAMPLES else max(reach, float(beyond[MIN_BRANCH_SAMPLES - 1]))
@@ -160,11 +162,8 @@ def _hinge(
     """Best corner time, total SSE, branch slope at the corner, branch SSE and branch sample count."""
     lo, hi = search
     scale = max(float(t[-1] - t[0]), 1e-300)
-
-    def profile(tcs: np.ndarray) -> np.ndarray:
-        return _sse_profile(t, x, on_line, line, np.atleast_1d(tcs), sign, powers, scale)
-
-    inside = t[(t > lo) & (t < hi)]
+    profile = _HingeProfile(t, on_line, line.slope, sign, search, powers, scale)
+    inside = t[np.searchsorted(t, lo, "right") : np.searchsorted(t, hi, "left")]
     candidates = np.unique(np.concatenate([[lo, hi], inside, 0.5 * (inside[1:] + inside[:-1])]))
     values = profile(candidates)
     best = int(np.argmin(values))
@@ -185,6 +184,96 @@ def _hinge(
     return tc, value, slope, branch_sse, int(np.count_nonzero(branch))
 
 
+class _HingeProfile:
+    """Hinge sum of squares as a function of the corner time, from running sums: O(window) once, O(1) per tc.
+
+    With v = sign (t - edge)/scale (``edge`` the search bound on the branch
+    side) and r = v - vc for a corner at tc (vc = sign (tc - edge)/scale <= 0),
+    the branch samples are those with r > 0, the first m samples in the order
+    of decreasing v.  On the branch y = x - L(tc) = o + g r with o = x - L(t)
+    and g = sign slope scale, so every sum the fit needs is a binomial
+    expansion of sums of v^j and o v^j over the first m samples.  These are
+    accumulated from the far end of the branch (up to the other search bound:
+    no branch reaches further), so that for a candidate inside the search
+    interval the terms are all of one sign beyond the edge and no larger than
+    |vc| within it: the expansion does not cancel.  The stick side's sum of
+    o^2 is accumulated from the other end.  Same value as
+    :func:`_sse_profile` (which evaluates it sample by sample) to rounding.
+    """
+
+    def __init__(
+        self,
+        t: np.ndarray,
+        on_line: np.ndarray,
+        slope: float,
+        sign: float,
+        search: tuple[float, float],
+        powers: tuple[float, ...],
+        scale: float,
+    ) -> None:
+        self.powers = tuple(int(p) for p in powers)
+        if any(p != q or p < 1 for p, q in zip(self.powers, powers, strict=True)):
+            raise ValueError(f"hinge powers must be positive integers, got {powers}")
+        lo, hi = search
+        edge = hi if sign > 0 else lo
+        order = slice(None, None, -1) if sign > 0 else slice(None)
+        self.t, self.sign, self.edge, self.scale = t, sign, edge, scale
+        self.g = sign * slope * scale
+        o_all = on_line[order]
+        self.oo_rest = np.concatenate([[0.0], np.cumsum((o_all * o_all)[::-1])])  # [q]: last q samples in order
+        reach = t.size - np.searchsorted(t, lo, "right") if sign > 0 else np.searchsorted(t, hi, "left")
+        v = sign * (t[order][:reach] - edge) / scale
+        o = o_all[:reach]
+        top = 2 * max(self.powers)
+        power = np.ones_like(v)
+        self.v_sums = np.zeros((top + 1, v.size + 1))
+        self.o_sums = np.zeros((max(self.powers) + 1, v.size + 1))
+        for j in range(top + 1):
+            np.cumsum(power, out=self.v_sums[j, 1:])
+            if j < self.o_sums.shape[0]:
+                np.cumsum(o * power, out=self.o_sums[j, 1:])
+            power *= v
+        self.oo_branch = np.concatenate([[0.0], np.cumsum(o * o)])
+
+    def __call__(self, tcs: np.ndarray) -> np.ndarray:
+        tcs = np.atleast_1d(np.asarray(tcs, dtype=float))
+        if self.sign > 0:  # branch: t > tc
+            m = self.t.size - np.searchsorted(self.t, tcs, "right")
+        else:  # branch: t < tc
+            m = np.searchsorted(self.t, tcs, "left")
+        shift = -self.sign * (tcs - self.edge) / self.scale  # -vc >= 0
+        weights = self._shift_weights(shift, self.v_sums.shape[0])
+        r_sums = np.einsum("kjm,jm->km", weights, self.v_sums[:, m])  # r_sums[k] = sum over the branch of r^k
+        size = self.o_sums.shape[0]
+        ro_sums = np.einsum("kjm,jm->km", weights[:size, :size], self.o_sums[:, m])  # sum of o r^k
+        g = self.g
+        n = len(self.powers)
+        gram = np.empty((tcs.size, n, n))
+        moment = np.empty((tcs.size, n))
+        for a, pa in enumerate(self.powers):
+            moment[:, a] = ro_sums[pa] + g * r_sums[pa + 1]
+            for b in range(a, n):
+                gram[:, a, b] = gram[:, b, a] = r_sums[pa + self.powers[b]]
+        yy = self.oo_branch[m] + 2.0 * g * ro_sums[1] + g * g * r_sums[2]
+        coef = _falling_fit(gram, moment, self.sign)
+        branch_sse = yy - np.sum(coef * moment, axis=1)
+        empty = m == 0
+        branch_sse[empty] = 0.0
+        return self.oo_rest[self.t.size - m] + np.maximum(branch_sse, 0.0)
+
+    @staticmethod
+    def _shift_weights(shift: np.ndarray, size: int) -> np.ndarray:
+        """weights[k, j, :] = C(k, j) shift^(k - j): sum of (v + shift)^k = sum_j weights[k, j] * (sum of v^j)."""
+        powers = shift[None, :] ** _EXPONENTS[:size, None]
+        return _BINOMIAL[:size, :size, None] * powers[_LAG[:size, :size]]
+
+
+#: Binomial coefficients C(k, j) (zero for j > k), for the expansions of the hinge profile.
+_BINOMIAL = np.array([[math.comb(k, j) for j in range(8)] for k in range(8)], dtype=float)
+_EXPONENTS = np.arange(8)
+_LAG = np.maximum(np.subtract.outer(_EXPONENTS, _EXPONENTS), 0)  # k - j where it is used (j <= k)
+
+
 def _sse_profile(
     t: np.ndarray,
     x: np.ndarray,
@@ -195,7 +284,10 @@ def _sse_profile(
     powers: tuple[float, ...],
     scale: float,
 ) -> np.ndarray:
-    """Hinge sum of squares for each corner time in ``tcs`` (vectorised over the candidates)."""
+    """Hinge sum of squares for each corner time in ``tcs``, sample by sample: O(candidates x window).
+
+    The plain reference for :class:`_HingeProfile` (tests and benchmarks/bench_scale.py).
+    """
     distance = sign * (t[None, :] - tcs[:, None]) / scale
     branch = distance > 0
     y = np.where(branch, x[None, :] - np.asarray(line(tcs))[:, None], 0.0)
@@ -223,15 +315,34 @@ def _falling_fit(gram: np.ndarray, moment: np.ndarray, sign: float) -> np.ndarra
     corner into the stick.  With one bound the constrained optimum is either
     the free one or the one with coef[0] = 0.
     """
-    coef = np.einsum("nij,nj->ni", np.linalg.pinv(gram, hermitian=True), moment)
+    coef = _solve_small(gram, moment)
     rising = sign * coef[:, 0] > 0
     if np.any(rising):
         fixed = np.zeros((int(np.count_nonzero(rising)), gram.shape[1]))
         if gram.shape[1] > 1:
-            sub = np.linalg.pinv(gram[rising][:, 1:, 1:], hermitian=True)
-            fixed[:, 1:] = np.einsum("nij,nj->ni", sub, moment[rising][:, 1:])
+            fixed[:, 1:] = _solve_small(gram[rising][:, 1:, 1:], moment[rising][:, 1:])
         coef[rising] = fixed
     return coef
+
+
+def _solve_small(gram: np.ndarray, moment: np.ndarray) -> np.ndarray:
+    """Batched minimum-norm solutions of gram @ coef = moment: the pseudo-inverse, in closed form for the
+    1x1 and well-conditioned 2x2 systems of the hinge fits (numpy's pinv costs a millisecond per call)."""
+    n = gram.shape[1]
+    if n == 1:
+        g = gram[:, 0, 0]
+        positive = g > 0
+        return np.where(positive, moment[:, 0], 0.0)[:, None] / np.where(positive, g, 1.0)[:, None]
+    if n == 2:
+        a, b, d = gram[:, 0, 0], gram[:, 0, 1], gram[:, 1, 1]
+        det = a * d - b * b
+        good = det > 1e-10 * a * d
+        if np.all(good):
+            return (
+                np.stack([d * moment[:, 0] - b * moment[:, 1], a * moment[:, 1] - b * moment[:, 0]], axis=1)
+                / det[:, None]
+            )
+    return np.einsum("nij,nj->ni", np.linalg.pinv(gram, hermitian=True), moment)
 
 
 def _branch_fit(
@@ -241,8 +352,16 @@ def _branch_fit(
     if t.size == 0:
         return float(line.slope), 0.0
     reach = sign * (t - tc)
-    basis = np.column_stack([reach**p for p in powers])
+    basis = [reach**p for p in powers]
     y = x - line(tc)
-    coef = _falling_fit((basis.T @ basis)[None], (basis.T @ y)[None], sign)[0]
-    r = y - basis @ coef
-    return float(sign * coef[0]), float(np.dot(r, r))
+    gram = np.array([[_dot(a, b) for b in basis] for a in basis])
+    moment = np.array([_dot(a, y) for a in basis])
+    coef = _falling_fit(gram[None], moment[None], sign)[0]
+    r = y - sum(c * a for c, a in zip(coef, basis, strict=True))
+    return float(sign * coef[0]), _dot(r, r)
+
+
+def _dot(a: np.ndarray, b: np.ndarray) -> float:
+    """Sum of a * b.  Not np.dot: a threaded BLAS dot on a long vector costs milliseconds on a loaded machine
+    (measured 12 ms against 10 us for 17,000 samples), and the analysis takes thousands of them."""
+    return float(np.einsum("i,i->", a, b))

@@ -3,27 +3,52 @@
 A trace file has a ``time`` column and either ``stress`` or ``force`` (the
 latter divided by a contact area), units in header brackets as everywhere in
 stickslip (``time [s],stress [Pa]``; bare names are SI).  Empty or NaN stress
-cells are gaps and are kept as NaN; times must be present, finite and strictly
-increasing.  Every problem is a typed error naming the file and row.
+cells are gaps and are kept as NaN; times must be present, finite and never go
+back.  Two rows at one instant with different stresses are a jump (a real
+discontinuity, as ``simulate`` writes at a slip) and both are kept; a row that
+repeats the time and stress of the one before is a duplicated row and refused,
+unless it differs in another column of a model trace (then it is read once).
+The other columns the package's own traces carry (:data:`MODEL_COLUMNS`) are
+ignored, with a note; any other column is an error.  Every problem is a typed
+error naming the file and row.
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from ..errors import DataError, ParameterError
-from ..tables import read_table
+from ..tables import Table, read_table, read_text_cells
 
 #: Fewest usable (finite-stress) samples a trace must have.
 MIN_SAMPLES = 20
+#: Largest |time| (s) and |stress| (Pa) accepted.
+MAX_MAGNITUDE = 1e100
 
 TRACE_DIMENSIONS = {"time": "time", "stress": "stress", "force": "force"}
+#: Columns of the package's model traces that the analysis does not use: ``simulate -o``
+#: (stickslip.model.cycle.CYCLE_COLUMNS), the time-dependent bond model and rate-and-state traces.
+MODEL_COLUMNS = (
+    "velocity",
+    "slider_displacement",
+    "puller_displacement",
+    "block_shear",
+    "chain_fraction",
+    "phase",
+    "bonded_fraction",
+    "slider_velocity",
+    "slider_position",
+    "puller_position",
+    "friction",
+    "state",
+    "load_point_displacement",
+)
 
 
 @dataclass(frozen=True)
@@ -34,6 +59,7 @@ class Trace:
     stress: np.ndarray
     rows: np.ndarray
     source: str
+    notes: tuple[str, ...] = ()  # what the reader did that a user should know (ignored columns, merged rows)
 
     @property
     def valid(self) -> np.ndarray:
@@ -53,16 +79,25 @@ class Trace:
 def read_trace(path: str | Path, contact_area: float | None = None) -> Trace:
     """Read a trace CSV: ``time`` and ``stress``, or ``time`` and ``force`` with ``contact_area`` (m^2).
 
-    Raises :class:`DataError` for a missing column, a bad cell, unsorted or
-    repeated times, or too few usable samples; :class:`ParameterError` for a
+    Raises :class:`DataError` for a missing column, a bad cell, a time that
+    goes back, a duplicated row, or too few usable samples (two rows at one
+    time with different stresses are a jump and are kept); :class:`ParameterError` for a
     missing, superfluous or non-positive contact area.
     """
-    table = read_table(path, TRACE_DIMENSIONS, required=["time"], allow_missing=["stress", "force"])
+    table = read_table(
+        path, TRACE_DIMENSIONS, required=["time"], allow_missing=["stress", "force"], ignore=MODEL_COLUMNS
+    )
     has_stress, has_force = "stress" in table, "force" in table
     if has_stress and has_force:
         raise DataError(f"{table.source}: give either a 'stress' or a 'force' column, not both")
     if not (has_stress or has_force):
-        raise DataError(f"{table.source}: missing column 'stress' (or 'force' with a contact area)")
+        hint = (
+            "; its 'friction' column is a friction coefficient, not a stress: multiply it by the normal stress"
+            " and name the column 'stress [Pa]'"
+            if "friction" in table.ignored
+            else ""
+        )
+        raise DataError(f"{table.source}: missing column 'stress' (or 'force' with a contact area){hint}")
     if has_force:
         if contact_area is None:
             raise ParameterError(f"{table.source}: the trace has a 'force' column; give the contact area to convert it")
@@ -74,7 +109,50 @@ def read_trace(path: str | Path, contact_area: float | None = None) -> Trace:
                 f"{table.source}: a contact area was given but the trace has a 'stress' column; it needs none"
             )
         stress = table["stress"]
-    return check_trace(table["time"], stress, source=table.source, rows=table.rows)
+    notes = []
+    if table.ignored:
+        notes.append(f"ignored column(s) {', '.join(table.ignored)}: analyze reads time and stress only")
+    time, stress, rows, merged = _merge_model_repeats(path, table, stress)
+    if merged:
+        notes.append(merged)
+    trace = check_trace(time, stress, source=table.source, rows=rows)
+    return replace(trace, notes=tuple(notes))
+
+
+def _merge_model_repeats(
+    path: str | Path, table: Table, stress: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, str]:
+    """Rows that repeat the time and stress of the row before but differ in an ignored column, read once.
+
+    A model trace writes such rows where its state changes at one instant (the chain fraction running
+    out at the end of a stick); for the analysis they are one sample.  Returns (time, stress, rows, note).
+    """
+    time, rows = table["time"], table.rows
+    repeats = _repeated_samples(time, stress)
+    if repeats.size == 0 or not table.ignored:
+        return time, stress, rows, ""
+    same = np.ones(repeats.size, dtype=bool)
+    for column in read_text_cells(path, table.ignored, count=time.size).values():
+        same &= column[repeats] == column[repeats - 1]
+    merged = repeats[~same]
+    if merged.size == 0:
+        return time, stress, rows, ""
+    keep = np.ones(time.size, dtype=bool)
+    keep[merged] = False
+    note = (
+        f"{merged.size} row(s) repeat the time and stress of the row before and differ only in the"
+        f" ignored columns (first: row {rows[merged[0]]}): read once"
+    )
+    return time[keep], stress[keep], rows[keep], note
+
+
+def _repeated_samples(time: np.ndarray, stress: np.ndarray) -> np.ndarray:
+    """Indices of samples that repeat the time and the stress (or the gap) of the sample before."""
+    same_time = time[1:] == time[:-1]
+    if not np.any(same_time):
+        return np.empty(0, dtype=int)
+    same_stress = (stress[1:] == stress[:-1]) | (np.isnan(stress[1:]) & np.isnan(stress[:-1]))
+    return np.flatnonzero(same_time & same_stress) + 1
 
 
 def check_trace(
@@ -100,20 +178,35 @@ def check_trace(
     bad = np.nonzero(np.isinf(s))[0]
     if bad.size:
         raise DataError(f"{source}: {where} {labels[bad[0]]}: stress is infinite")
-    steps = np.diff(t)
-    bad = np.nonzero(steps <= 0)[0]
-    if bad.size:
-        k = bad[0] + 1
-        what = "repeats" if steps[bad[0]] == 0 else "goes back from"
+    for name, values, unit in (("time", t, "s"), ("stress", s, "Pa")):
+        # the fits square sums of these: keep them far from overflow (no record comes near 1e100)
+        bad = np.flatnonzero(np.abs(values) > MAX_MAGNITUDE)
+        if bad.size:
+            raise DataError(
+                f"{source}: {where} {labels[bad[0]]}: {name} {values[bad[0]]:g} {unit} is beyond"
+                f" {MAX_MAGNITUDE:g} {unit} in magnitude; not a measured record"
+            )
+    back = np.flatnonzero(t[1:] < t[:-1])
+    if back.size:
+        k = back[0] + 1
         raise DataError(
-            f"{source}: {where} {labels[k]}: time {t[k]:g} s {what} the previous time {t[k - 1]:g} s;"
-            " times must be strictly increasing (sort the record and remove duplicates)"
+            f"{source}: {where} {labels[k]}: time {t[k]:g} s goes back from the previous time {t[k - 1]:g} s;"
+            " times must never decrease (sort the record)"
+        )
+    repeats = _repeated_samples(t, s)
+    if repeats.size:
+        k = repeats[0]
+        raise DataError(
+            f"{source}: {where} {labels[k]}: time {t[k]:g} s repeats the previous time {t[k - 1]:g} s with the same"
+            " stress: a duplicated row (remove it; a repeated time with a different stress is read as a jump)"
         )
     usable = int(np.count_nonzero(np.isfinite(s)))
     if usable < MIN_SAMPLES:
         raise DataError(
             f"{source}: record too short: {usable} samples with a stress value, need at least {MIN_SAMPLES}"
         )
+    if t[-1] == t[0]:
+        raise DataError(f"{source}: every sample is at time {t[0]:g} s; a record must span some time")
     return Trace(time=t, stress=s, rows=np.asarray(labels), source=source)
 
 

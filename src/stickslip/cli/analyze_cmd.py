@@ -15,6 +15,7 @@ import click
 
 from .common import (
     InputFile,
+    echo_err,
     emit_json,
     params_options,
     positive,
@@ -44,6 +45,9 @@ CSV_COLUMNS = (
     ("period", "s"),
     ("stress_drop", "Pa"),
 )
+
+#: The printed table shows at most this many cycles (and the mean of all); -o and --json hold every one.
+TABLE_CYCLES = 8
 
 #: Rows of the printed table: (field, heading, factor from SI, digits).
 TABLE_ROWS = (
@@ -111,6 +115,8 @@ def analyze_command(
     area = None if area_text is None else positive(area_text, "area", "--contact-area")
     params = resolve_params(params_name, overrides)
     record = read_trace(trace, contact_area=area)
+    for note in record.notes:
+        echo_err(f"note: {note}")
     analysis = analyze_trace(record, None, v0, params)
     comparison = compare_with_model(analysis, params) if compare else None
     if output is not None:
@@ -158,19 +164,28 @@ def _report(analysis: Any, comparison: Any) -> list[Any]:
     )
     parts: list[Any] = [escape(head)]
     if analysis.cycles:
+        shown = analysis.cycles[:TABLE_CYCLES]
         table = Table(title="Per cycle (Table 1 rows)", title_justify="left")
         table.add_column("")
-        for cycle in analysis.cycles:
+        for cycle in shown:
             table.add_column(f"cycle {cycle.index}" + ("" if cycle.complete else "*"), justify="right")
-        table.add_column("mean ± sd", justify="right")
+        table.add_column(
+            f"mean ± sd ({len(analysis.cycles)} cycles)" if len(shown) < len(analysis.cycles) else "mean ± sd",
+            justify="right",
+        )
         for name, heading, factor, digits in TABLE_ROWS:
-            cells = [_number(getattr(c, name), factor, digits) for c in analysis.cycles]
+            cells = [_number(getattr(c, name), factor, digits) for c in shown]
             stats = analysis.summary[name]
             spread = "" if stats["std"] is None else f" ± {stats['std'] * factor:.2g}"
             table.add_row(
                 escape(heading), *cells, "" if stats["mean"] is None else f"{stats['mean'] * factor:.{digits}g}{spread}"
             )
         parts.append(table)
+        if len(shown) < len(analysis.cycles):
+            parts.append(
+                f"the table shows the first {len(shown)} of {len(analysis.cycles)} cycles;"
+                " -o cycles.csv or --json gives every one"
+            )
         if any(not c.complete for c in analysis.cycles):
             notes = [f"cycle {c.index}: {c.message}" for c in analysis.cycles if c.message]
             parts.append(escape("* cut by the record's ends.  " + "; ".join(notes)))
@@ -189,7 +204,7 @@ def _comparison_text(comparison: Any) -> str:
     lines = [f"model ({comparison.model_regime}): {comparison.message}"]
     if comparison.rms_misfit is not None:
         lines.append(f"RMS misfit {comparison.rms_misfit:.4g} Pa over {comparison.points} samples")
-    for row in comparison.cycles:
+    for row in comparison.cycles[:TABLE_CYCLES]:
         diff = row["difference"]
         shown = [
             f"{label} {_signed(diff[name], factor)}{unit}"
@@ -202,6 +217,8 @@ def _comparison_text(comparison: Any) -> str:
             if diff[name] is not None
         ]
         lines.append(f"record cycle {row['record_cycle']} - model cycle {row['model_cycle']}: " + ", ".join(shown))
+    if len(comparison.cycles) > TABLE_CYCLES:
+        lines.append(f"(first {TABLE_CYCLES} of {len(comparison.cycles)} compared cycles; --json gives every one)")
     return "\n".join(lines)
 
 

@@ -21,13 +21,20 @@ from .common import (
     refuse_overwriting_inputs,
     resolve_params,
     save_figure,
-    write_text,
 )
 from .params_cmd import human, print_rich
 
 DEFAULT_VMIN = "10 um/s"
 DEFAULT_VMAX = "10 mm/s"
 DEFAULT_POINTS = 50
+#: Most velocities one ``curve`` run evaluates (csv streams them in chunks: about a minute and 1 GB of file).
+MAX_POINTS = 10_000_000
+#: Velocities evaluated and written at a time, so that memory does not grow with --points.
+CHUNK = 2048
+#: Most rows the table prints (a terminal shows no more); beyond, it shows this many, evenly spread.
+TABLE_ROWS = 100
+#: Most velocities in --format json (one document in memory); csv has no such limit.
+JSON_POINTS = 100_000
 #: Columns of csv/json output, with the SI unit written in the csv header.
 COLUMNS = (
     ("velocity", "m/s"),
@@ -65,11 +72,59 @@ def _velocities(
 
 def curve_csv(columns: dict[str, np.ndarray]) -> str:
     """CSV in SI with units in the header brackets (readable by :func:`stickslip.tables.read_table`)."""
-    out = io.StringIO()
-    out.write(",".join(f"{name} [{unit}]" if unit else name for name, unit in COLUMNS) + "\n")
-    for row in zip(*(columns[name] for name, _ in COLUMNS), strict=True):
-        out.write(",".join(repr(float(x)) for x in row) + "\n")
+    return (_csv_header() + _csv_rows(columns)).decode("utf-8")
+
+
+def _csv_header() -> bytes:
+    return (",".join(f"{name} [{unit}]" if unit else name for name, unit in COLUMNS) + "\n").encode()
+
+
+def _csv_rows(columns: dict[str, np.ndarray]) -> bytes:
+    """Rows with every digit (shortest round-trip text, as repr): by pyarrow's writer, else row by row."""
+    try:
+        import pyarrow as pa
+        import pyarrow.csv as pacsv
+    except ImportError:  # pragma: no cover - pyarrow is a dependency
+        rows = zip(*(columns[name] for name, _ in COLUMNS), strict=True)
+        return "".join(",".join(repr(float(x)) for x in row) + "\n" for row in rows).encode()
+    out = io.BytesIO()
+    table = pa.table({name: np.asarray(columns[name], dtype=float) for name, _ in COLUMNS})
+    pacsv.write_csv(table, out, pacsv.WriteOptions(include_header=False))
     return out.getvalue()
+
+
+def _evaluate(params: Any, velocities: np.ndarray, aging: bool) -> dict[str, np.ndarray]:
+    from ..model.steady import steady_state
+
+    result = steady_state(params, velocities, aging=aging)
+    return {name: np.ravel(getattr(result, name)) for name, _ in COLUMNS}
+
+
+def _stream_csv(params: Any, velocities: np.ndarray, aging: bool, output: Path | None) -> None:
+    """Evaluate and write CHUNK velocities at a time: memory stays flat whatever --points is."""
+
+    def write_all(write: Any) -> None:
+        write(_csv_header())
+        for start in range(0, velocities.size, CHUNK):
+            write(_csv_rows(_evaluate(params, velocities[start : start + CHUNK], aging)))
+
+    if output is None:
+        write_all(lambda chunk: click.echo(chunk.decode("utf-8"), nl=False))
+        return
+    from ..fileio import atomic_open
+
+    try:
+        with atomic_open(output, "wb") as handle:
+            write_all(handle.write)
+    except OSError as exc:
+        raise click.FileError(str(output), hint=str(exc.strerror or exc)) from None
+
+
+def _table_picks(count: int) -> np.ndarray:
+    """Indices of the rows the table shows: all of them, or TABLE_ROWS evenly spread with both ends."""
+    if count <= TABLE_ROWS:
+        return np.arange(count)
+    return np.unique(np.linspace(0, count - 1, TABLE_ROWS).round().astype(int))
 
 
 def curve_table(columns: dict[str, np.ndarray], title: str) -> Any:
@@ -90,9 +145,9 @@ def curve_table(columns: dict[str, np.ndarray], title: str) -> Any:
 @click.option("--vmax", default=None, metavar="V", help=f"Highest velocity of the range [default: {DEFAULT_VMAX}].")
 @click.option(
     "--points",
-    type=click.IntRange(min=2),
+    type=click.IntRange(min=2, max=MAX_POINTS),
     default=None,
-    help=f"Number of log-spaced velocities [default: {DEFAULT_POINTS}].",
+    help=f"Number of log-spaced velocities [default: {DEFAULT_POINTS}; at most {MAX_POINTS:,}].",
 )
 @click.option(
     "--velocity",
@@ -127,34 +182,41 @@ def curve_command(
     """The steady friction curve sigma(V) of Eqs 6-8.
 
     Velocities accept units ("350 um/s", "1 mm/s"); a bare number is m/s.
-    csv and json are in SI base units; the table uses um/s and Pa.
+    csv and json are in SI base units; the table uses um/s and Pa.  csv is
+    computed and written in chunks (any --points); the table shows at most
+    100 rows, evenly spread; json holds at most 100,000 velocities.
     """
-    from ..model.steady import steady_state
-
     refuse_overwriting_inputs([], [("-o", output), ("--plot", plot_path)], params_name)
     values, lo, hi = _velocities(velocity, vmin, vmax, points)
     params = resolve_params(params_name, overrides)
-    result = steady_state(params, values, aging=not no_aging)
-    columns = {name: np.ravel(getattr(result, name)) for name, _ in COLUMNS}
+    aging = not no_aging
     if fmt == "json":
-        emit_json(columns, output)
+        if values.size > JSON_POINTS:
+            raise ParameterError(
+                f"--format json holds at most {JSON_POINTS} velocities, got {values.size};"
+                f" --format csv -o FILE streams up to {MAX_POINTS}"
+            )
+        emit_json(_evaluate(params, values, aging), output)
     elif fmt == "csv":
-        text = curve_csv(columns)
-        if output is None:
-            click.echo(text, nl=False)
-        else:
-            write_text(output, text)
+        _stream_csv(params, values, aging, output)
     else:
+        picks = _table_picks(values.size)
         title = f"Steady friction curve, {params.name}, {'without' if no_aging else 'with'} aging"
-        print_rich(curve_table(columns, title), output=output)
+        parts: list[Any] = [curve_table(_evaluate(params, values[picks], aging), title)]
+        if picks.size < values.size:
+            parts.append(
+                f"{picks.size} of {values.size} velocities shown, evenly spread; --format csv -o FILE writes every one"
+            )
+        print_rich(*parts, output=output)
     if plot_path is not None:
-        _save_curve_plot(params, values, columns["stress"], lo, hi, bool(velocity), no_aging, plot_path)
+        stress = _evaluate(params, values, aging)["stress"] if velocity else None  # marks only for --velocity
+        _save_curve_plot(params, values, stress, lo, hi, bool(velocity), no_aging, plot_path)
 
 
 def _save_curve_plot(
     params: Any,
     values: np.ndarray,
-    stress: np.ndarray,
+    stress: np.ndarray | None,
     lo: float,
     hi: float,
     mark: bool,
@@ -164,7 +226,7 @@ def _save_curve_plot(
     from ..plotting import UM_PER_S, figure_steady_curve
 
     fig = figure_steady_curve(params, vmin=lo, vmax=hi)
-    if mark:  # the requested velocities, on the curve they were computed with
+    if mark and stress is not None:  # the requested velocities, on the curve they were computed with
         ax = fig.axes[0]
         label = "requested (without aging)" if no_aging else "requested (with aging)"
         ax.plot(values * UM_PER_S, stress, "s", markersize=6, color="#e67e22", label=label, zorder=8)
