@@ -79,8 +79,12 @@ ACCURATE_QUADRATURE = QuadratureSettings(log_hazard_step=16.0, hazard_step=16.0)
 #: With no FENE term (a = 0) the march stops this close to x = 1.
 SMALLEST_GAP = 1e-30
 MAX_PANELS = 20000
-BISECTIONS = 6
+#: Panel widths are found to within this factor of the widest good width (about 11 bisections at most).
+WIDTH_RATIO = 1.5
+MAX_BISECTIONS = 40
+_LOG_WIDTH_RATIO = float(np.log(WIDTH_RATIO))
 _LOG_CAP = 700.0  # exp(700) ~ 1e304: keeps e^L finite where S is long zero
+_TINY = 1e-300
 
 
 @dataclass(frozen=True)
@@ -155,48 +159,68 @@ def _log_hazard_and_slope(x: np.ndarray, y: np.ndarray, s: _Scales) -> tuple[np.
     return s.log_t + s.a * x / d - s.alpha * x, np.abs(s.a * (1.0 + x * x) / (d * d) - s.alpha)
 
 
-def _panel_width(x: np.ndarray, y: np.ndarray, s: _Scales, q: QuadratureSettings) -> np.ndarray:
-    """Width of the next panel at left end x (y = 1 - x), from explicit bounds.
+def _panel_width(x: np.ndarray, y: np.ndarray, s: _Scales, q: QuadratureSettings) -> tuple[np.ndarray, np.ndarray]:
+    """(width of the next panel at left end x (y = 1 - x), lanes where the survival steps to 0 within one ulp).
 
     A panel [x, x+w] is good when it is resolved (|L'| w <= q.log_hazard_step and
     e^L w <= q.hazard_step) or negligible (e^L w <= q.negligible_hazard).  L is
     convex, so |L'| and e^L are largest at an end of the panel and testing both
-    ends decides; both tests only get harder as w grows, so the widest good w
-    is found by geometric bisection between a width known to be good and the
-    widest allowed panel (q.widest_panel, and q.end_ratio * y towards x = 1).
-    The hazard tests are done on logarithms: no exponential can overflow.
+    ends decides; both tests only get harder as w grows, so the good widths
+    form an interval (0, w*].  The width returned is good and within
+    WIDTH_RATIO of w* (or the widest allowed panel: q.widest_panel, and
+    q.end_ratio * y towards x = 1): bisection on ln w runs until the bracket
+    is that tight, however many orders of magnitude it spans (a deep aging dip
+    followed by the FENE cliff puts w* hundreds of e-folds below the widest
+    panel).  When not even one ulp of the position is good, the hazard explodes
+    within that ulp (FENE and aging terms ~1e50 cancelling): the survival is a
+    step there, exact to the precision of x, and the lane is flagged.
+    Everything is done on logarithms: no exponential can overflow.
     """
-    widest = np.minimum(q.widest_panel, q.end_ratio * y)
+    log_widest = np.log(np.minimum(q.widest_panel, q.end_ratio * y))
     l_left, slope_left = _log_hazard_and_slope(x, y, s)
-    # the left end only caps w: below cap_resolved it is resolved there, below cap_negligible negligible
-    cap_negligible = q.negligible_hazard * np.exp(-np.maximum(l_left, -_LOG_CAP))
-    cap_resolved = np.minimum(
-        q.hazard_step * np.exp(-np.maximum(l_left, -_LOG_CAP)), q.log_hazard_step / np.maximum(slope_left, 1e-300)
-    )
-    log_resolved, log_negligible = np.log(q.hazard_step), np.log(q.negligible_hazard)
+    log_slope_left = np.log(np.maximum(slope_left, _TINY))
+    log_step, log_resolved = np.log(q.log_hazard_step), np.log(q.hazard_step)
+    log_negligible = np.log(q.negligible_hazard)
+    # the left end's share of the tests: resolved needs ln w below cap_resolved, negligible below cap_negligible
+    cap_resolved = np.minimum(log_resolved - l_left, log_step - log_slope_left)
+    cap_negligible = log_negligible - l_left
 
-    def good(w: np.ndarray) -> np.ndarray:
-        l_right, slope_right = _log_hazard_and_slope(x + w, y - w, s)
-        log_integral = l_right + np.log(w)
-        resolved = (w <= cap_resolved) & (slope_right * w <= q.log_hazard_step) & (log_integral <= log_resolved)
-        return resolved | ((w <= cap_negligible) & (log_integral <= log_negligible))
+    def good(log_w: np.ndarray, k: np.ndarray | slice) -> np.ndarray:
+        w = np.exp(log_w)
+        l_right, slope_right = _log_hazard_and_slope(x[k] + w, y[k] - w, _take(s, k))
+        log_integral = l_right + log_w
+        log_slope_right = np.log(np.maximum(slope_right, _TINY))
+        resolved = (log_w <= cap_resolved[k]) & (log_slope_right + log_w <= log_step) & (log_integral <= log_resolved)
+        return resolved | ((log_w <= cap_negligible[k]) & (log_integral <= log_negligible))
 
-    ok = good(widest)
-    if ok.all():
-        return widest
-    # a width that is good for sure: the left cap, then once capped by the right end (see docstring)
-    low = np.minimum(widest, cap_resolved)
-    l_right, slope_right = _log_hazard_and_slope(x + low, y - low, s)
-    low = np.minimum(low, q.log_hazard_step / np.maximum(slope_right, 1e-300))
-    low = np.minimum(low, np.exp(np.minimum(log_resolved - l_right, 0.0)))
-    low = np.where(ok, widest, low)
-    top = widest
-    for _ in range(BISECTIONS):
-        mid = np.sqrt(low * top)
-        better = good(mid)
-        low = np.where(better, mid, low)
-        top = np.where(better, top, mid)
-    return low
+    log_w = log_widest.copy()
+    step = np.zeros(x.size, dtype=bool)
+    open_ = np.nonzero(~good(log_widest, slice(None)))[0]
+    if open_.size == 0:
+        return np.exp(log_w), step
+    # bracket [low, top]: top is not good; low is good once confirmed (the floor, one ulp, may not be)
+    top = log_widest[open_]
+    low = np.log(2.0 * np.spacing(np.where(x[open_] < 0.5, x[open_], y[open_])))
+    confirmed = np.zeros(open_.size, dtype=bool)
+    guess = np.clip(np.minimum(cap_resolved[open_], top), low, top)  # the left end's cap: often close to w*
+    for _ in range(MAX_BISECTIONS):
+        better = good(guess, open_)
+        low = np.where(better, guess, low)
+        top = np.where(better, top, guess)
+        confirmed |= better
+        if np.all(top - low <= _LOG_WIDTH_RATIO):
+            break
+        guess = 0.5 * (low + top)
+    unconfirmed = ~confirmed
+    if unconfirmed.any():
+        step[open_[unconfirmed]] = ~good(low[unconfirmed], open_[unconfirmed])
+    log_w[open_] = low
+    return np.exp(log_w), step
+
+
+def _take(s: _Scales, k: np.ndarray | slice) -> _Scales:
+    """The lanes ``k`` of ``s``."""
+    return _Scales(*(getattr(s, f.name)[k] for f in dataclasses.fields(_Scales)))
 
 
 @dataclass
@@ -228,7 +252,7 @@ def _march(s: _Scales, q: QuadratureSettings, keep_nodes: bool = False) -> _Inte
     hazard, moment = np.zeros(n), np.zeros(n)  # H and G = int x e^L
     sums = np.zeros((4, n))  # i, j, -di, -dj
     for _ in range(MAX_PANELS):
-        w = _panel_width(x_left, y_left, sub, q)
+        w, step = _panel_width(x_left, y_left, sub, q)
         x = x_left[:, None] + w[:, None] * t_half
         y = y_left[:, None] - w[:, None] * t_half
         stretch = x / (y * (1.0 + x))  # x/(1-x^2), the FENE factor
@@ -248,13 +272,10 @@ def _march(s: _Scales, q: QuadratureSettings, keep_nodes: bool = False) -> _Inte
                 out.nodes[k].append(np.stack([x[row], survival[row]]))
         hazard += cumulative[0, :, -1]
         moment += cumulative[1, :, -1]
-        # a panel narrower than one ulp of x (left half) or of 1 - x (right half, where 1 - x carries
-        # the precision) means the survival falls to zero within
-        # that ulp (FENE and aging terms ~1e50 cancelling): a step, exact to the precision of x
-        stalled = np.where(x_left < 0.5, x_left + w == x_left, y_left - w == y_left)
         x_left += w
         y_left -= w
-        done = (hazard >= q.hazard_cutoff) | (y_left <= SMALLEST_GAP) | stalled
+        # step: the survival falls to zero within one ulp of x (see _panel_width), exact to the precision of x
+        done = (hazard >= q.hazard_cutoff) | (y_left <= SMALLEST_GAP) | step
         if done.any():
             finished = index[done]
             out.i[finished], out.j[finished] = sums[0, done], sums[1, done]
@@ -264,7 +285,7 @@ def _march(s: _Scales, q: QuadratureSettings, keep_nodes: bool = False) -> _Inte
             keep = ~done
             index, x_left, y_left, hazard, moment = index[keep], x_left[keep], y_left[keep], hazard[keep], moment[keep]
             sums = sums[:, keep]
-            sub = _Scales(*(getattr(sub, f.name)[keep] for f in dataclasses.fields(_Scales)))
+            sub = _take(sub, keep)
     raise ModelError(f"steady-state quadrature did not converge: more than {MAX_PANELS} panels needed")
 
 
