@@ -56,8 +56,9 @@ class QuadratureSettings:
     hazard_step: float = 24.0
     end_ratio: float = 0.7
     widest_panel: float = 0.5
-    #: the survival is cut where H exceeds this (exp(-36) ~ 2e-16)
+    #: the survival is cut where H exceeds this (exp(-36) ~ 2e-16) and what it can still add is below tail_tolerance
     hazard_cutoff: float = 36.0
+    tail_tolerance: float = 1e-13
     #: a stretch whose hazard integral is below this is crossed in one panel
     negligible_hazard: float = 1e-13
 
@@ -275,7 +276,8 @@ def _march(s: _Scales, q: QuadratureSettings, keep_nodes: bool = False) -> _Inte
         x_left += w
         y_left -= w
         # step: the survival falls to zero within one ulp of x (see _panel_width), exact to the precision of x
-        done = (hazard >= q.hazard_cutoff) | (y_left <= SMALLEST_GAP) | step
+        cut = (hazard >= q.hazard_cutoff) & _tail_negligible(hazard, y_left, sums[0], sums[1], sub, q)
+        done = cut | (y_left <= SMALLEST_GAP) | step
         if done.any():
             finished = index[done]
             out.i[finished], out.j[finished] = sums[0, done], sums[1, done]
@@ -287,6 +289,30 @@ def _march(s: _Scales, q: QuadratureSettings, keep_nodes: bool = False) -> _Inte
             sums = sums[:, keep]
             sub = _take(sub, keep)
     raise ModelError(f"steady-state quadrature did not converge: more than {MAX_PANELS} panels needed")
+
+
+#: Beyond 1 - y_c (see _tail_negligible) the log-hazard is at least this.
+_CLIFF_LOG_HAZARD = 50.0
+
+
+def _tail_negligible(
+    hazard: np.ndarray, y: np.ndarray, i: np.ndarray, j: np.ndarray, s: _Scales, q: QuadratureSettings
+) -> np.ndarray:
+    """True where the survival S = e^-H left at x = 1 - y can add at most q.tail_tolerance to i and to j.
+
+    S never rises, so the rest of i is at most S y.  The rest of j is the
+    hard part: with aging H can level off (a plateau down to the FENE cliff)
+    while x S/(1 - x^2) grows towards x = 1, and when the survival fell
+    early (x ~ 1/T) j is tiny, so a plateau at S ~ 1e-17 can still carry
+    1e-3 of j.  Beyond 1 - y_c, y_c = a/(3(alpha + |ln T| + 50)), L >= 50
+    (there x/(1+x) >= 1/3) and the survival dies at once; before it,
+    int x/(1-x^2) <= ln(1/y_c)/2.  So the rest of j is at most
+    S (ln(1/y_c)/2 + 1).
+    """
+    y_c = np.minimum(y, np.maximum(s.a, _TINY) / (3.0 * (s.alpha + np.abs(s.log_t) + _CLIFF_LOG_HAZARD)))
+    room_i = np.log(np.maximum(q.tail_tolerance * i, _TINY)) - np.log(y)
+    room_j = np.log(np.maximum(q.tail_tolerance * j, _TINY)) - np.log(0.5 * np.log(1.0 / y_c) + 1.0)
+    return -hazard <= np.minimum(room_i, room_j)
 
 
 def _check_velocity(velocity: Any) -> np.ndarray:
