@@ -41,6 +41,8 @@ def reference_point(params, velocity: float, aging: bool = True) -> tuple[float,
     alpha = (t_max / g.aging_time) * math.exp(-velocity / g.aging_velocity) if aging else 0.0
 
     def log_hazard(x, y):
+        if y <= 0.0:  # events evaluated at the FENE end itself
+            return math.inf
         return log_t + a * x / (y * (1.0 + x)) - alpha * x
 
     def rates(x, y, hazard):
@@ -56,7 +58,7 @@ def reference_point(params, velocity: float, aging: bool = True) -> tuple[float,
         return [-r for r in rates(1.0 - y, y, state[0])]
 
     def rising(x, y):
-        return a * (1.0 + x * x) / (y * (1.0 + x)) ** 2 >= alpha
+        return y <= 0.0 or a * (1.0 + x * x) / (y * (1.0 + x)) ** 2 >= alpha
 
     def done_x(x, state):  # H = 60 counts only on the rising branch (see the module docstring)
         return state[0] - H_END if rising(x, 1.0 - x) else -1.0
@@ -271,7 +273,8 @@ def box_case(rng, base, corner: bool):
         if corner:
             kt = KB * base.bonds.temperature
             a = _log_uniform(rng, *CORNER_A)
-            values["bonds.activation_length"] = a * kt / (values["bonds.chain_stiffness"] * values["bonds.max_extension"])
+            stretch = values["bonds.chain_stiffness"] * values["bonds.max_extension"]
+            values["bonds.activation_length"] = a * kt / stretch
             alpha = a * rng.uniform(*CORNER_RATIO)
             decay = math.exp(-velocity / values["aging.aging_velocity"])
             values["aging.aging_time"] = values["bonds.max_extension"] / (velocity * alpha) * decay

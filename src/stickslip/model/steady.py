@@ -52,13 +52,13 @@ class QuadratureSettings:
     """
 
     order: int = 16
-    log_hazard_step: float = 24.0
-    hazard_step: float = 24.0
+    log_hazard_step: float = 16.0
+    hazard_step: float = 16.0
     end_ratio: float = 0.7
     widest_panel: float = 0.5
     #: the survival is cut where H exceeds this (exp(-36) ~ 2e-16) and what it can still add is below tail_tolerance
     hazard_cutoff: float = 36.0
-    tail_tolerance: float = 1e-13
+    tail_tolerance: float = 1e-11
     #: a stretch whose hazard integral is below this is crossed in one panel
     negligible_hazard: float = 1e-13
 
@@ -76,11 +76,11 @@ class QuadratureSettings:
 DEFAULT_QUADRATURE = QuadratureSettings()
 #: ~1e-12 relative: for curves sampled once and then interpolated or root-found
 #: (jump velocity, slip trajectory, critical point), where noise would limit convergence.
-ACCURATE_QUADRATURE = QuadratureSettings(log_hazard_step=16.0, hazard_step=16.0)
+ACCURATE_QUADRATURE = QuadratureSettings(log_hazard_step=10.0, hazard_step=10.0)
 #: With no FENE term (a = 0) the march stops this close to x = 1.
 SMALLEST_GAP = 1e-30
 MAX_PANELS = 20000
-#: Panel widths are found to within this factor of the widest good width (about 11 bisections at most).
+#: Panel widths are found to within this factor of the widest good width.
 WIDTH_RATIO = 1.5
 MAX_BISECTIONS = 40
 _LOG_WIDTH_RATIO = float(np.log(WIDTH_RATIO))
@@ -169,7 +169,8 @@ def _panel_width(x: np.ndarray, y: np.ndarray, s: _Scales, q: QuadratureSettings
     ends decides; both tests only get harder as w grows, so the good widths
     form an interval (0, w*].  The width returned is good and within
     WIDTH_RATIO of w* (or the widest allowed panel: q.widest_panel, and
-    q.end_ratio * y towards x = 1): bisection on ln w runs until the bracket
+    q.end_ratio * y towards x = 1): a galloping search and bisection on ln w
+    run until the bracket
     is that tight, however many orders of magnitude it spans (a deep aging dip
     followed by the FENE cliff puts w* hundreds of e-folds below the widest
     panel).  When not even one ulp of the position is good, the hazard explodes
@@ -186,42 +187,68 @@ def _panel_width(x: np.ndarray, y: np.ndarray, s: _Scales, q: QuadratureSettings
     cap_resolved = np.minimum(log_resolved - l_left, log_step - log_slope_left)
     cap_negligible = log_negligible - l_left
 
-    def good(log_w: np.ndarray, k: np.ndarray | slice) -> np.ndarray:
+    def good(log_w: np.ndarray, lanes: _Lanes) -> np.ndarray:
         w = np.exp(log_w)
-        l_right, slope_right = _log_hazard_and_slope(x[k] + w, y[k] - w, _take(s, k))
+        l_right, slope_right = _log_hazard_and_slope(lanes.x + w, lanes.y - w, lanes.s)
         log_integral = l_right + log_w
-        log_slope_right = np.log(np.maximum(slope_right, _TINY))
-        resolved = (log_w <= cap_resolved[k]) & (log_slope_right + log_w <= log_step) & (log_integral <= log_resolved)
-        return resolved | ((log_w <= cap_negligible[k]) & (log_integral <= log_negligible))
+        resolved = (log_w <= lanes.cap_resolved) & (slope_right * w <= q.log_hazard_step)
+        resolved &= log_integral <= log_resolved
+        return resolved | ((log_w <= lanes.cap_negligible) & (log_integral <= log_negligible))
 
     log_w = log_widest.copy()
     step = np.zeros(x.size, dtype=bool)
-    open_ = np.nonzero(~good(log_widest, slice(None)))[0]
+    open_ = np.nonzero(~good(log_widest, _Lanes(x, y, s, cap_resolved, cap_negligible)))[0]
     if open_.size == 0:
         return np.exp(log_w), step
-    # bracket [low, top]: top is not good; low is good once confirmed (the floor, one ulp, may not be)
+    lanes = _Lanes(x[open_], y[open_], _take(s, open_), cap_resolved[open_], cap_negligible[open_])
+    # bracket [low, top]: top is not good; low is good once confirmed (before that it is the floor, one ulp
+    # of the position).  Gallop from the left end's cap (usually within a few times w*) with steps in ln w
+    # that double, then bisect: a few tests per panel, and at most ~2 log2(745) however deep the dip.
     top = log_widest[open_]
-    low = np.log(2.0 * np.spacing(np.where(x[open_] < 0.5, x[open_], y[open_])))
+    low = np.log(2.0 * np.spacing(np.where(lanes.x < 0.5, lanes.x, lanes.y)))
+    guess = np.clip(lanes.cap_resolved, low, top)
     confirmed = np.zeros(open_.size, dtype=bool)
-    guess = np.clip(np.minimum(cap_resolved[open_], top), low, top)  # the left end's cap: often close to w*
+    reach = np.full(open_.size, np.log(4.0))
+    k = np.arange(open_.size)
+    active = lanes
     for _ in range(MAX_BISECTIONS):
-        better = good(guess, open_)
-        low = np.where(better, guess, low)
-        top = np.where(better, top, guess)
-        confirmed |= better
-        if np.all(top - low <= _LOG_WIDTH_RATIO):
-            break
-        guess = 0.5 * (low + top)
-    unconfirmed = ~confirmed
-    if unconfirmed.any():
-        step[open_[unconfirmed]] = ~good(low[unconfirmed], open_[unconfirmed])
+        better = good(guess, active)
+        low[k] = np.where(better, guess, low[k])
+        top[k] = np.where(better, top[k], guess)
+        confirmed[k] |= better
+        reach[k] *= 2.0
+        wide = top[k] - low[k] > _LOG_WIDTH_RATIO
+        if not wide.all():
+            k = k[wide]
+            if k.size == 0:
+                break
+            active = lanes.take(k)
+        half = 0.5 * (top[k] - low[k])
+        guess = np.where(confirmed[k], low[k] + np.minimum(reach[k], half), top[k] - np.minimum(reach[k], half))
+    unconfirmed = np.nonzero(~confirmed)[0]
+    if unconfirmed.size:  # the bracket closed on the floor: is even one ulp good?
+        step[open_[unconfirmed]] = ~good(low[unconfirmed], lanes.take(unconfirmed))
     log_w[open_] = low
     return np.exp(log_w), step
 
 
+@dataclass(frozen=True)
+class _Lanes:
+    """The lanes whose panel width is being searched: left ends and the left end's caps on ln w."""
+
+    x: np.ndarray
+    y: np.ndarray
+    s: _Scales
+    cap_resolved: np.ndarray
+    cap_negligible: np.ndarray
+
+    def take(self, k: np.ndarray) -> _Lanes:
+        return _Lanes(self.x[k], self.y[k], _take(self.s, k), self.cap_resolved[k], self.cap_negligible[k])
+
+
 def _take(s: _Scales, k: np.ndarray | slice) -> _Scales:
     """The lanes ``k`` of ``s``."""
-    return _Scales(*(getattr(s, f.name)[k] for f in dataclasses.fields(_Scales)))
+    return _Scales(s.log_t[k], s.a[k], s.alpha[k], s.beta[k], s.birth[k])
 
 
 @dataclass
@@ -252,6 +279,8 @@ def _march(s: _Scales, q: QuadratureSettings, keep_nodes: bool = False) -> _Inte
     x_left, y_left = np.zeros(n), np.ones(n)
     hazard, moment = np.zeros(n), np.zeros(n)  # H and G = int x e^L
     sums = np.zeros((4, n))  # i, j, -di, -dj
+    if n == 0:
+        return out
     for _ in range(MAX_PANELS):
         w, step = _panel_width(x_left, y_left, sub, q)
         x = x_left[:, None] + w[:, None] * t_half
@@ -276,8 +305,11 @@ def _march(s: _Scales, q: QuadratureSettings, keep_nodes: bool = False) -> _Inte
         x_left += w
         y_left -= w
         # step: the survival falls to zero within one ulp of x (see _panel_width), exact to the precision of x
-        cut = (hazard >= q.hazard_cutoff) & _tail_negligible(hazard, y_left, sums[0], sums[1], sub, q)
-        done = cut | (y_left <= SMALLEST_GAP) | step
+        done = (y_left <= SMALLEST_GAP) | step
+        past = np.nonzero(hazard >= q.hazard_cutoff)[0]
+        if past.size:
+            tail = _tail_negligible(hazard[past], y_left[past], sums[0, past], sums[1, past], _take(sub, past), q)
+            done[past] |= tail
         if done.any():
             finished = index[done]
             out.i[finished], out.j[finished] = sums[0, done], sums[1, done]
@@ -313,6 +345,13 @@ def _tail_negligible(
     room_i = np.log(np.maximum(q.tail_tolerance * i, _TINY)) - np.log(y)
     room_j = np.log(np.maximum(q.tail_tolerance * j, _TINY)) - np.log(0.5 * np.log(1.0 / y_c) + 1.0)
     return -hazard <= np.minimum(room_i, room_j)
+
+
+def _require_parameters(params: Any, name: str = "params") -> None:
+    if not isinstance(params, Parameters):
+        raise ParameterError(
+            f"{name}: expected a stickslip Parameters set (load_parameters(...)), got {type(params).__name__}"
+        )
 
 
 def _check_velocity(velocity: Any) -> np.ndarray:
@@ -357,6 +396,7 @@ def steady_state(
     activation length bonds survive to full extension, where the FENE force
     of Eq 3 diverges, and the integral of Eq 8 diverges logarithmically.
     """
+    _require_parameters(params)
     v = _check_velocity(velocity)
     _require_finite_stress(params)
     flat = np.ravel(v)
@@ -394,20 +434,32 @@ def steady_stress_many(
     velocity: Any,
     aging: bool = True,
     quadrature: QuadratureSettings = DEFAULT_QUADRATURE,
+    paired: bool = False,
 ) -> np.ndarray:
     """sigma(V) (Eqs 6-8) for many parameter sets at once: shape (len(params_list), len(velocity)).
 
     One quadrature march serves every (set, velocity) pair, so the per-call
     cost is paid once: this is what fitting Jacobians and MCMC walkers need.
-    Same accuracy as :func:`steady_state`.
+    With ``paired=True`` set k is evaluated only at velocity[k] (shape
+    (len(params_list),)).  Same accuracy as :func:`steady_state`.
     """
     v = np.ravel(_check_velocity(velocity))
-    if len(params_list) == 0:
-        return np.empty((0, v.size))
     for k, p in enumerate(params_list):
+        _require_parameters(p, f"parameter set {k}")
         _require_finite_stress(p, f"parameter set {k}: ")
-    parts = [_scales(p, v, aging) for p in params_list]
+    if paired and v.size != len(params_list):
+        raise ParameterError(
+            f"velocity: paired=True needs one velocity per parameter set, got {v.size} for {len(params_list)} sets"
+        )
+    if len(params_list) == 0:
+        return np.empty(0) if paired else np.empty((0, v.size))
+    if paired:
+        parts = [_scales(p, v[k : k + 1], aging) for k, p in enumerate(params_list)]
+        scale = np.array([_stress_scale(p) for p in params_list])
+    else:
+        parts = [_scales(p, v, aging) for p in params_list]
+        scale = np.repeat([_stress_scale(p) for p in params_list], v.size)
     joined = _Scales(*(np.concatenate([getattr(part, f.name) for part in parts]) for f in dataclasses.fields(_Scales)))
     got = _march(joined, quadrature)
-    scale = np.repeat([_stress_scale(p) for p in params_list], v.size)
-    return (scale * got.j / (joined.birth + got.i)).reshape(len(params_list), v.size)
+    stress = scale * got.j / (joined.birth + got.i)
+    return stress if paired else stress.reshape(len(params_list), v.size)
