@@ -83,6 +83,9 @@ MAX_PANELS = 20000
 #: Panel widths are found to within this factor of the widest good width.
 WIDTH_RATIO = 1.5
 MAX_BISECTIONS = 40
+#: A panel narrower than this many ulps of the position cannot be sampled (its nodes would round onto
+#: each other, and L changes by O(1) per ulp): when not even that is good, the survival steps to 0 there.
+STEP_ULPS = 64.0
 _LOG_WIDTH_RATIO = float(np.log(WIDTH_RATIO))
 _LOG_CAP = 700.0  # exp(700) ~ 1e304: keeps e^L finite where S is long zero
 _TINY = 1e-300
@@ -161,7 +164,7 @@ def _log_hazard_and_slope(x: np.ndarray, y: np.ndarray, s: _Scales) -> tuple[np.
 
 
 def _panel_width(x: np.ndarray, y: np.ndarray, s: _Scales, q: QuadratureSettings) -> tuple[np.ndarray, np.ndarray]:
-    """(width of the next panel at left end x (y = 1 - x), lanes where the survival steps to 0 within one ulp).
+    """(width of the next panel at left end x (y = 1 - x), lanes where the survival steps to 0 there).
 
     A panel [x, x+w] is good when it is resolved (|L'| w <= q.log_hazard_step and
     e^L w <= q.hazard_step) or negligible (e^L w <= q.negligible_hazard).  L is
@@ -173,9 +176,9 @@ def _panel_width(x: np.ndarray, y: np.ndarray, s: _Scales, q: QuadratureSettings
     run until the bracket
     is that tight, however many orders of magnitude it spans (a deep aging dip
     followed by the FENE cliff puts w* hundreds of e-folds below the widest
-    panel).  When not even one ulp of the position is good, the hazard explodes
-    within that ulp (FENE and aging terms ~1e50 cancelling): the survival is a
-    step there, exact to the precision of x, and the lane is flagged.
+    panel).  When not even STEP_ULPS ulps of the position are good, the hazard explodes
+    within them (FENE and aging terms ~1e50 cancelling): the survival is a
+    step there, exact to ~STEP_ULPS ulps of x, and the lane is flagged.
     Everything is done on logarithms: no exponential can overflow.
     """
     log_widest = np.log(np.minimum(q.widest_panel, q.end_ratio * y))
@@ -201,11 +204,11 @@ def _panel_width(x: np.ndarray, y: np.ndarray, s: _Scales, q: QuadratureSettings
     if open_.size == 0:
         return np.exp(log_w), step
     lanes = _Lanes(x[open_], y[open_], _take(s, open_), cap_resolved[open_], cap_negligible[open_])
-    # bracket [low, top]: top is not good; low is good once confirmed (before that it is the floor, one ulp
-    # of the position).  Gallop from the left end's cap (usually within a few times w*) with steps in ln w
+    # bracket [low, top]: top is not good; low is good once confirmed (before that it is the floor, STEP_ULPS
+    # ulps of the position).  Gallop from the left end's cap (usually within a few times w*) with steps in ln w
     # that double, then bisect: a few tests per panel, and at most ~2 log2(745) however deep the dip.
     top = log_widest[open_]
-    low = np.log(2.0 * np.spacing(np.where(lanes.x < 0.5, lanes.x, lanes.y)))
+    low = np.log(STEP_ULPS * np.spacing(np.where(lanes.x < 0.5, lanes.x, lanes.y)))
     guess = np.clip(lanes.cap_resolved, low, top)
     confirmed = np.zeros(open_.size, dtype=bool)
     reach = np.full(open_.size, np.log(4.0))
@@ -226,7 +229,7 @@ def _panel_width(x: np.ndarray, y: np.ndarray, s: _Scales, q: QuadratureSettings
         half = 0.5 * (top[k] - low[k])
         guess = np.where(confirmed[k], low[k] + np.minimum(reach[k], half), top[k] - np.minimum(reach[k], half))
     unconfirmed = np.nonzero(~confirmed)[0]
-    if unconfirmed.size:  # the bracket closed on the floor: is even one ulp good?
+    if unconfirmed.size:  # the bracket closed on the floor: is even that good?
         step[open_[unconfirmed]] = ~good(low[unconfirmed], lanes.take(unconfirmed))
     log_w[open_] = low
     return np.exp(log_w), step
@@ -283,6 +286,7 @@ def _march(s: _Scales, q: QuadratureSettings, keep_nodes: bool = False) -> _Inte
         return out
     for _ in range(MAX_PANELS):
         w, step = _panel_width(x_left, y_left, sub, q)
+        w[step] = 0.0  # the survival steps to 0 within a few ulps: nothing more to integrate
         x = x_left[:, None] + w[:, None] * t_half
         y = y_left[:, None] - w[:, None] * t_half
         stretch = x / (y * (1.0 + x))  # x/(1-x^2), the FENE factor
@@ -304,7 +308,7 @@ def _march(s: _Scales, q: QuadratureSettings, keep_nodes: bool = False) -> _Inte
         moment += cumulative[1, :, -1]
         x_left += w
         y_left -= w
-        # step: the survival falls to zero within one ulp of x (see _panel_width), exact to the precision of x
+        # step: the survival falls to zero within a few ulps of x (see _panel_width), exact to that precision
         done = (y_left <= SMALLEST_GAP) | step
         past = np.nonzero(hazard >= q.hazard_cutoff)[0]
         if past.size:
@@ -347,7 +351,8 @@ def _tail_negligible(
     return -hazard <= np.minimum(room_i, room_j)
 
 
-def _require_parameters(params: Any, name: str = "params") -> None:
+def require_parameters(params: Any, name: str = "params") -> None:
+    """ParameterError unless ``params`` is a :class:`Parameters` set (a str, None or dict is a one-line error)."""
     if not isinstance(params, Parameters):
         raise ParameterError(
             f"{name}: expected a stickslip Parameters set (load_parameters(...)), got {type(params).__name__}"
@@ -396,7 +401,7 @@ def steady_state(
     activation length bonds survive to full extension, where the FENE force
     of Eq 3 diverges, and the integral of Eq 8 diverges logarithmically.
     """
-    _require_parameters(params)
+    require_parameters(params)
     v = _check_velocity(velocity)
     _require_finite_stress(params)
     flat = np.ravel(v)
@@ -407,7 +412,7 @@ def steady_state(
     stress = scale * got.j / denom
     fraction = got.i / denom
     # d(sigma)/d(ln V), with d(birth)/d(ln V) = birth
-    dstress = scale * (got.dj * denom - got.j * (s.birth + got.di)) / denom**2
+    dstress = scale * (got.dj - (got.j / denom) * (s.birth + got.di)) / denom  # no denom**2: it can underflow
     slope = dstress / flat
     ages = densities = None
     if got.nodes is not None:
@@ -445,7 +450,7 @@ def steady_stress_many(
     """
     v = np.ravel(_check_velocity(velocity))
     for k, p in enumerate(params_list):
-        _require_parameters(p, f"parameter set {k}")
+        require_parameters(p, f"parameter set {k}")
         _require_finite_stress(p, f"parameter set {k}: ")
     if paired and v.size != len(params_list):
         raise ParameterError(
