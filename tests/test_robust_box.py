@@ -18,8 +18,12 @@ import numpy as np
 import pytest
 
 from reference_steady import box_cases, reference_many, reference_point
-from stickslip import load_parameters, steady_state
+from stickslip import ModelError, ParameterError, critical_point, load_parameters, steady_state
+from stickslip.model.cycle import simulate
+from stickslip.model.jump import jump_velocity
+from stickslip.model.slip import slip_phase
 from stickslip.model.steady import ACCURATE_QUADRATURE, steady_stress_many
+from stickslip.model.stick import stick_phase
 
 GEL = load_parameters("gelatin-glass")
 SPEC = 1e-6  # the issue's accuracy requirement (relative)
@@ -162,3 +166,134 @@ def test_random_box_every_output_one_call_each():
 def test_empty_velocity_gives_an_empty_curve():
     got = steady_state(GEL, [])
     assert got.stress.shape == (0,) and got.bonded_fraction.shape == (0,) and got.stress_slope.shape == (0,)
+
+
+# --- section 2: the critical point ----------------------------------------------------------------
+
+#: Issue 12's critical-point example: raised scipy's "f(a) and f(b) must have different signs" (and a
+#: similar set took 20 s).
+ISSUE_CRITICAL = {
+    "bonds.site_density": 7.97762e14,
+    "bonds.bond_time": 0.065163,
+    "bonds.breakage_weight": 7.2751,
+    "bonds.chain_stiffness": 9.54687e-6,
+    "bonds.activation_length": 2.69198e-8,
+    "bonds.max_extension": 0.453198,
+    "aging.aging_time": 2.6895e-9,
+    "aging.aging_velocity": 0.148506,
+}
+
+
+def _assert_verified(params, point):
+    """A reported Vc is a minimum of the converged curve; otherwise the message says why not."""
+    assert point.message and "\n" not in point.message
+    if point.exists:
+        around = steady_state(params, point.velocity * np.array([0.99, 1.0, 1.01]), quadrature=ACCURATE_QUADRATURE)
+        assert around.stress[1] < around.stress[0] and around.stress[1] < around.stress[2]
+        assert float(around.stress[1]) == pytest.approx(point.stress, rel=1e-9)
+    else:
+        assert point.velocity is None and point.stress is None
+    for extremum in point.extrema:
+        assert math.isfinite(extremum.velocity) and math.isfinite(extremum.stress)
+
+
+def test_critical_point_of_the_issue_example():
+    params = GEL.with_overrides(ISSUE_CRITICAL)
+    with time_limit(30):
+        point = critical_point(params)
+    _assert_verified(params, point)
+
+
+def test_critical_point_over_random_sets():
+    cases = box_cases(seed=31, count=12, base=GEL, corner_share=0.5)
+    with time_limit(60):
+        for params, _, _ in cases:
+            _assert_verified(params, critical_point(params))
+
+
+# --- section 2: simulate, and the Python API ---------------------------------------------------------
+
+#: Sets for which simulate used to stop with "Chebyshev interpolation ... did not converge with 1025 points".
+CHEBYSHEV_SETS = [
+    {
+        "bonds.site_density": 5.34437e14,
+        "bonds.bond_time": 1.26375e-07,
+        "bonds.breakage_weight": 0.477724,
+        "bonds.chain_stiffness": 0.0462111,
+        "bonds.activation_length": 3.9957e-10,
+        "bonds.max_extension": 0.00255957,
+        "aging.aging_time": 5.06376e-06,
+        "aging.aging_velocity": 0.0352653,
+    },
+    {  # the aging curve falls 1e6-fold within 0.5 % of V just below Vc
+        "bonds.site_density": 1.01341e15,
+        "bonds.bond_time": 8.53148e-06,
+        "bonds.breakage_weight": 0.046309,
+        "bonds.chain_stiffness": 0.000703749,
+        "bonds.activation_length": 3.29684e-09,
+        "bonds.max_extension": 0.111138,
+        "aging.aging_time": 1.87556e-07,
+        "aging.aging_velocity": 3.85395e-06,
+    },
+]
+
+
+@pytest.mark.parametrize("overrides", CHEBYSHEV_SETS, ids=["slope-noise", "cliff-below-vc"])
+def test_simulate_follows_sharp_branches(overrides):
+    params = GEL.with_overrides(overrides)
+    vc = critical_point(params).velocity
+    for v0 in (0.7 * vc, 2.0 * vc):
+        with time_limit(30):
+            run = simulate(params, v0, 1.0)
+        assert run.regime in ("stick-slip", "steady", "stuck", "undetermined") and run.message
+        assert np.all(np.isfinite(run.stress)) and np.all(np.isfinite(run.time))
+
+
+def test_a_zero_stick_time_is_not_a_cycle():
+    run = simulate(GEL, 1e-4, 10.0, start_stress=1e6)  # the chains collapse the moment the block sticks
+    assert run.regime == "undetermined" and "stick time 0" in run.message
+    assert all(cycle.stick_time > 0.0 for cycle in run.cycles)
+
+
+CALLS = {
+    "steady_state": lambda p: steady_state(p, 1e-4),
+    "steady_stress_many": lambda p: steady_stress_many([p], [1e-4]),
+    "critical_point": critical_point,
+    "stick_phase": lambda p: stick_phase(p, 1e-4, 100.0),
+    "jump_velocity": lambda p: jump_velocity(p, 500.0),
+    "slip_phase": lambda p: slip_phase(p, 1e-4, 3e-4),
+    "simulate": lambda p: simulate(p, 1e-4, 1.0),
+}
+
+
+@pytest.mark.parametrize("call", list(CALLS))
+@pytest.mark.parametrize("bad", ["gelatin-glass", None, {"bonds": {}}], ids=["str", "None", "dict"])
+def test_public_model_functions_refuse_what_is_not_parameters(call, bad):
+    with pytest.raises(ParameterError, match="expected a stickslip Parameters set") as caught:
+        CALLS[call](bad)
+    assert "\n" not in str(caught.value)
+
+
+# --- section 3: what used to hang -------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    "run",
+    [
+        lambda: stick_phase(GEL, 1e300),
+        lambda: simulate(GEL, 1e300, 10.0),
+        lambda: simulate(GEL.with_overrides({"block.shear_modulus": 1e300}), 1e-4, 10.0),
+        lambda: simulate(GEL.with_overrides({"block.height": 1e-300}), 1e-4, 10.0),
+    ],
+    ids=["stick-v0", "simulate-v0", "shear-modulus", "height"],
+)
+def test_huge_loads_end_quickly_with_one_line(run):
+    with time_limit(20), pytest.raises(ModelError, match="loaded at") as caught:
+        run()
+    assert "\n" not in str(caught.value)
+
+
+def test_fast_but_representable_loads_still_slip():
+    with time_limit(20):
+        stick = stick_phase(GEL, 1e250)
+    assert stick.status == "slipped" and 0.0 < stick.stick_time < 1e-240
