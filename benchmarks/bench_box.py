@@ -25,7 +25,6 @@ import numpy as np  # noqa: E402
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
 
 from reference_steady import box_cases, reference_many  # noqa: E402
-
 from stickslip import load_parameters  # noqa: E402
 from stickslip.model.steady import steady_stress_many  # noqa: E402
 
@@ -57,9 +56,10 @@ def main() -> None:
     print(f"  production (steady_stress_many, paired)  wall {prod_wall:6.2f} s  cpu {prod_cpu:6.2f} s")
     print(f"  independent reference (reference_many)   wall {ref_wall:6.2f} s  cpu {ref_cpu:6.2f} s")
     print(f"  non-finite results: {int(np.sum(~np.isfinite(got)))}")
-    print(f"  worst relative error in sigma: {error.max():.2e} (corner {error[corner].max():.2e},")
-    print(f"    rest {error[~corner].max():.2e}); above 1e-6: {int(np.sum(error > 1e-6))}, above 1e-8:")
-    print(f"    {int(np.sum(error > 1e-8))}; median {np.median(error):.1e}")
+    worst_corner, worst_rest = error[corner].max(), error[~corner].max()
+    print(f"  worst relative error in sigma: {error.max():.2e} (corner {worst_corner:.2e}, rest {worst_rest:.2e})")
+    above = f"above 1e-6: {int(np.sum(error > 1e-6))}, above 1e-8: {int(np.sum(error > 1e-8))}"
+    print(f"  {above}, median {np.median(error):.1e}")
     params, velocity, aging = cases[worst]
     print(f"  worst at V = {velocity:.6g} m/s, aging {aging}: {params.as_dict()}")
 
