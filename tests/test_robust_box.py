@@ -297,3 +297,11 @@ def test_fast_but_representable_loads_still_slip():
     with time_limit(20):
         stick = stick_phase(GEL, 1e250)
     assert stick.status == "slipped" and 0.0 < stick.stick_time < 1e-240
+
+
+def test_parameters_beyond_floating_point_are_one_line_errors_without_warnings():
+    """RuntimeWarnings are errors in this suite: an overflow would fail here before the ModelError."""
+    params = GEL.with_overrides({"bonds.max_extension": 1e300})
+    with pytest.raises(ModelError, match="FENE strength") as caught:
+        critical_point(params)
+    assert "\n" not in str(caught.value)

@@ -290,7 +290,7 @@ def jump_velocity(params: Parameters, stress: float, curve: str = "aging") -> Ju
     def excess(x: float) -> float:
         return float(branch.stress(math.exp(x))) - stress
 
-    if excess(branch.log_vc) >= 0.0:  # at sigma_c itself (to the series' accuracy)
+    if excess(branch.log_vc) >= -branch.noise[0]:  # at sigma_c itself (to the series' accuracy)
         log_v = branch.log_vc
     elif excess(branch.log_hi) <= 0.0:
         log_v = branch.log_hi

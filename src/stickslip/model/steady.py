@@ -26,6 +26,7 @@ integral (the same panels), not from finite differences.
 from __future__ import annotations
 
 import dataclasses
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
@@ -143,11 +144,12 @@ class _Scales:
 
 def _scales(params: Parameters, velocity: np.ndarray, aging: bool) -> _Scales:
     b, g = params.bonds, params.aging
-    max_age = b.max_extension / velocity
-    log_t = np.log(b.breakage_weight) + np.log(max_age) - np.log(b.bond_time)
+    log_age = math.log(b.max_extension) - np.log(velocity)  # ln(dl_m/V), in logs: dl_m/V may overflow
+    log_t = math.log(b.breakage_weight) + log_age - math.log(b.bond_time)
     a = b.activation_length * b.chain_stiffness * b.max_extension / (BOLTZMANN * b.temperature)
     if aging:
-        alpha = (max_age / g.aging_time) * np.exp(-velocity / g.aging_velocity)
+        # capped at e^700 (~1e304) so that it stays finite: _check_scales refuses anything above LARGEST_RATE
+        alpha = np.exp(np.minimum(log_age - math.log(g.aging_time) - velocity / g.aging_velocity, 700.0))
         beta = alpha * (1.0 + velocity / g.aging_velocity)
     else:
         alpha = np.zeros_like(velocity)
@@ -155,6 +157,25 @@ def _scales(params: Parameters, velocity: np.ndarray, aging: bool) -> _Scales:
     return _Scales(
         log_t=log_t, a=np.full_like(velocity, a), alpha=alpha, beta=beta, birth=b.bond_time * velocity / b.max_extension
     )
+
+
+#: FENE strength and aging rate beyond which the log-hazard's terms could overflow (the box needs < 1e17).
+LARGEST_RATE = 1e200
+
+
+def _check_scales(s: _Scales) -> None:
+    """A one-line ModelError where the dimensionless groups leave floating point (far outside any physical box)."""
+    groups = (("FENE strength a = lambda M dl_m/kT", s.a), ("aging rate dl_m/(V tau_a) e^(-V/V_a)", s.alpha))
+    for name, values in groups:
+        bad = ~(np.abs(values) <= LARGEST_RATE)
+        if np.any(bad):
+            raise ModelError(
+                f"the {name} is {float(values[bad][0]):.3g}, beyond {LARGEST_RATE:g}: these parameters are outside"
+                " what the steady model can integrate in floating point"
+            )
+    bad = ~(np.isfinite(s.log_t) & np.isfinite(s.birth))
+    if np.any(bad):
+        raise ModelError("the breakage rate u0 dl_m/(V tau) or tau V/dl_m is not finite for these parameters")
 
 
 def _log_hazard_and_slope(x: np.ndarray, y: np.ndarray, s: _Scales) -> tuple[np.ndarray, np.ndarray]:
@@ -406,6 +427,7 @@ def steady_state(
     _require_finite_stress(params)
     flat = np.ravel(v)
     s = _scales(params, flat, aging)
+    _check_scales(s)
     got = _march(s, quadrature, keep_nodes=distribution)
     denom = s.birth + got.i
     scale = _stress_scale(params)
@@ -465,6 +487,7 @@ def steady_stress_many(
         parts = [_scales(p, v, aging) for p in params_list]
         scale = np.repeat([_stress_scale(p) for p in params_list], v.size)
     joined = _Scales(*(np.concatenate([getattr(part, f.name) for part in parts]) for f in dataclasses.fields(_Scales)))
+    _check_scales(joined)
     got = _march(joined, quadrature)
     stress = scale * got.j / (joined.birth + got.i)
     return stress if paired else stress.reshape(len(params_list), v.size)
