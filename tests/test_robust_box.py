@@ -305,3 +305,11 @@ def test_parameters_beyond_floating_point_are_one_line_errors_without_warnings()
     with pytest.raises(ModelError, match="FENE strength") as caught:
         critical_point(params)
     assert "\n" not in str(caught.value)
+
+
+def test_paired_batches_need_one_velocity_per_set():
+    with pytest.raises(ParameterError, match="one velocity per parameter set"):
+        steady_stress_many([GEL, GEL], [1e-4], paired=True)
+    assert steady_stress_many([], [], paired=True).shape == (0,)
+    both = steady_stress_many([GEL, GEL], [1e-4, 1e-3], paired=True)
+    assert both == pytest.approx(steady_state(GEL, [1e-4, 1e-3]).stress, rel=1e-14)
