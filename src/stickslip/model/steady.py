@@ -194,12 +194,13 @@ def _panel_width(x: np.ndarray, y: np.ndarray, s: _Scales, q: QuadratureSettings
     form an interval (0, w*].  The width returned is good and within
     WIDTH_RATIO of w* (or the widest allowed panel: q.widest_panel, and
     q.end_ratio * y towards x = 1): a galloping search and bisection on ln w
-    run until the bracket
-    is that tight, however many orders of magnitude it spans (a deep aging dip
-    followed by the FENE cliff puts w* hundreds of e-folds below the widest
-    panel).  When not even STEP_ULPS ulps of the position are good, the hazard explodes
-    within them (FENE and aging terms ~1e50 cancelling): the survival is a
-    step there, exact to ~STEP_ULPS ulps of x, and the lane is flagged.
+    run until the bracket is that tight, however many orders of magnitude it
+    spans (a deep aging dip followed by the FENE cliff puts w* hundreds of
+    e-folds below the widest panel; a fixed number of bisections there used to
+    stop the march in mid-dip, issue 12).  When not even STEP_ULPS ulps of the
+    position are good, the hazard explodes within them (FENE and aging terms
+    ~1e50 cancelling): the survival is a step there, exact to ~STEP_ULPS ulps
+    of x, and the lane is flagged.
     Everything is done on logarithms: no exponential can overflow.
     """
     log_widest = np.log(np.minimum(q.widest_panel, q.end_ratio * y))
