@@ -8,18 +8,24 @@ that maximum.
 
 Method: dsigma/dV (computed analytically under the integral, see
 :mod:`stickslip.model.steady`) is sampled on a log grid of velocities; each
-sign change is refined by Brent's method on log V.
+sign change clear of the quadrature noise is refined by Brent's method on
+log V (the same function, so the bracket's signs always hold) and kept only
+when the stress there is verified to be below (above) both ends of its
+bracket: a minimum of the converged curve, not of its noise.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
+from itertools import pairwise
 
 import numpy as np
 
+from ..errors import ModelError
 from ..numerics.roots import brentq  # scipy.optimize would add 0.3 s to start-up
 from ..parameters import Parameters
-from .steady import ACCURATE_QUADRATURE, steady_state
+from .steady import ACCURATE_QUADRATURE, require_parameters, steady_state
 
 #: Velocity range searched for extrema, m/s, and the grid density per decade.
 SEARCH_RANGE = (1e-9, 1e2)
@@ -58,25 +64,76 @@ class CriticalPoint:
         }
 
 
+#: Relative accuracy of sigma and of V dsigma/dV with ACCURATE_QUADRATURE, with margin: slopes below this
+#: (times sigma) are noise, and a minimum must be deeper than this to count.
+NOISE = 1e-9
+#: At most this many sign changes are refined (more means the curve is noise, not extrema).
+MAX_EXTREMA = 8
+
+
+def _curve(params: Parameters, velocity: np.ndarray | float, aging: bool) -> tuple[np.ndarray, np.ndarray]:
+    """(sigma, V dsigma/dV) with the accurate quadrature: the same function on the grid and in the root search."""
+    state = steady_state(params, np.atleast_1d(velocity), aging=aging, quadrature=ACCURATE_QUADRATURE)
+    stress, log_slope = state.stress, state.stress_slope * state.velocity
+    if not (np.all(np.isfinite(stress)) and np.all(np.isfinite(log_slope))):
+        raise ModelError(
+            "the steady friction curve is not finite between"
+            f" {float(np.min(velocity)):.3g} and {float(np.max(velocity)):.3g} m/s for these parameters"
+        )
+    return stress, log_slope
+
+
+def _significant_signs(stress: np.ndarray, log_slope: np.ndarray) -> np.ndarray:
+    """+1/-1 where V dsigma/dV stands clear of the quadrature noise, 0 where the curve is flat to it."""
+    sign = np.sign(log_slope)
+    sign[np.abs(log_slope) <= NOISE * np.abs(stress)] = 0.0
+    return sign
+
+
+def _refine(params: Parameters, aging: bool, lo: float, hi: float) -> float:
+    """ln V of the zero of V dsigma/dV between ln V = lo and hi (Brent), or the better end if the signs disagree."""
+
+    def g(log_v: float) -> float:
+        return float(_curve(params, math.exp(log_v), aging)[1][0])
+
+    g_lo, g_hi = g(lo), g(hi)
+    if g_lo == 0.0:
+        return lo
+    if g_hi == 0.0:
+        return hi
+    if g_lo * g_hi > 0.0:  # cannot happen with the grid's own values; never let brentq raise
+        return lo if abs(g_lo) < abs(g_hi) else hi
+    return float(brentq(g, lo, hi, xtol=1e-12, rtol=1e-13, maxiter=200))
+
+
 def find_extrema(
     params: Parameters, aging: bool, search_range: tuple[float, float] = SEARCH_RANGE
 ) -> tuple[Extremum, ...]:
-    """Every local extremum of sigma(V) in ``search_range``, lowest velocity first."""
+    """Every local extremum of sigma(V) in ``search_range`` that the converged curve resolves, lowest first.
+
+    The slope is sampled on a log grid; each change of sign (ignoring slopes
+    within NOISE of zero) is refined by Brent's method on the same
+    function, and kept only if the stress there is below (minimum) or above
+    (maximum) both ends of its bracket by more than NOISE: a verified
+    extremum of the converged curve, not a flicker of quadrature noise.
+    """
+    require_parameters(params)
     lo, hi = search_range
     n = int(np.ceil(np.log10(hi / lo) * POINTS_PER_DECADE)) + 1
     grid = np.geomspace(lo, hi, n)
-    slope = steady_state(params, grid, aging=aging, quadrature=ACCURATE_QUADRATURE).stress_slope
-    sign = np.sign(slope)
+    stress, log_slope = _curve(params, grid, aging)
+    sign = _significant_signs(stress, log_slope)
+    clear = np.nonzero(sign)[0]
+    changes = [(a, b) for a, b in pairwise(clear) if sign[a] != sign[b]]
     found = []
-    for k in np.nonzero(sign[:-1] * sign[1:] < 0)[0]:
-
-        def g(log_v: float) -> float:
-            return float(steady_state(params, np.exp(log_v), aging=aging).stress_slope)
-
-        log_v = brentq(g, np.log(grid[k]), np.log(grid[k + 1]), xtol=1e-13, rtol=1e-13)
-        v = float(np.exp(log_v))
-        stress = float(steady_state(params, v, aging=aging, quadrature=ACCURATE_QUADRATURE).stress)
-        found.append(Extremum(v, stress, "minimum" if slope[k] < 0 else "maximum"))
+    for a, b in changes[:MAX_EXTREMA]:
+        log_v = _refine(params, aging, math.log(grid[a]), math.log(grid[b]))
+        v = math.exp(log_v)
+        s = float(_curve(params, v, aging)[0][0])
+        kind = "minimum" if sign[a] < 0 else "maximum"
+        depth = (min(stress[a], stress[b]) - s) if kind == "minimum" else (s - max(stress[a], stress[b]))
+        if depth > NOISE * abs(s):
+            found.append(Extremum(v, s, kind))
     return tuple(found)
 
 
@@ -109,7 +166,7 @@ def critical_point(params: Parameters) -> CriticalPoint:
     such extremum between 1 nm/s and 100 m/s the field is None and the
     message says so in words.
     """
-    extrema = find_extrema(params, aging=True)
+    extrema = find_extrema(params, aging=True)  # checks params
     minima = [e for e in extrema if e.kind == "minimum"]
     if minima:
         v, s = minima[0].velocity, minima[0].stress

@@ -38,6 +38,7 @@ from ..errors import ParameterError
 from ..parameters import Parameters
 from .jump import Jump, check_curve, jump_velocity, require_critical_point
 from .slip import SlipPhase, slip_phase
+from .steady import require_parameters
 from .stick import StickPhase, _number, check_stress, check_velocity, stick_phase
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -252,7 +253,13 @@ class _Phases:
         stick = stick_phase(self.params, self.v0, sigma, horizon=self.horizon)
         if stick.status != "slipped":
             return _Cycle(stick, None, None, "stuck" if stick.stuck else "undetermined", stick.message)
-        assert stick.peak_stress is not None
+        assert stick.peak_stress is not None and stick.stick_time is not None
+        if stick.stick_time <= 0.0:  # issue 12: was reported as a cycle
+            message = (
+                f"the attached chains collapse the moment the block sticks at {sigma:.6g} Pa (stick time 0): there"
+                " is no stick phase, so no stick-slip cycle; the quasi-static model has no answer here"
+            )
+            return _Cycle(stick, None, None, "undetermined", message)
         jump = jump_velocity(self.params, stick.peak_stress, self.curve)
         if not jump.reachable or jump.velocity is None:
             message = f"the chains collapse at sigma_s = {stick.peak_stress:.6g} Pa, but {jump.message}"
@@ -292,6 +299,7 @@ def simulate(
     shown to end nor to last for ever, or the cycle degenerates); ``message``
     says which and why.  Runs longer than MAX_CYCLES periods are refused.
     """
+    require_parameters(params)
     v0 = check_velocity(pulling_velocity)
     end = _number(duration, "duration", "s")
     if end <= 0:

@@ -37,14 +37,18 @@ from scipy.optimize import brentq
 from ..errors import ModelError, ParameterError
 from ..parameters import BlockParameters, Parameters, StickParameters
 from .critical import CriticalPoint, critical_point
-from .steady import ACCURATE_QUADRATURE, steady_state
+from .steady import ACCURATE_QUADRATURE, require_parameters, steady_state
 
 CURVES = ("aging", "no-aging")
 
 #: Chebyshev series: relative size of the trailing coefficients accepted as converged.
 CHEBYSHEV_TOLERANCE = 1e-12
+#: The same for V dsigma/dV: the quadrature's slope carries ~1e-10 relative noise (issue 12: asking 1e-12
+#: of it made ordinary sets fail with "did not converge").
+SLOPE_TOLERANCE = 1e-9
 CHEBYSHEV_START = 32
-CHEBYSHEV_MAX = 1024
+#: Branches with a sharp maximum (strong aging) need ~700 points; 4097 leaves room.
+CHEBYSHEV_MAX = 4096
 
 
 # --------------------------------------------------------------------------- Chebyshev tools
@@ -62,7 +66,7 @@ def chebyshev_coefficients(values: np.ndarray) -> np.ndarray:
     return c
 
 
-def _converged(coefficients: np.ndarray, tol: float, floor: np.ndarray | float) -> bool:
+def _converged(coefficients: np.ndarray, tol: np.ndarray | float, floor: np.ndarray | float) -> bool:
     tail = max(2, coefficients.shape[-1] // 8)
     scale = np.max(np.abs(coefficients), axis=-1)
     return bool(np.all(np.max(np.abs(coefficients[..., -tail:]), axis=-1) <= tol * scale + floor + 1e-300))
@@ -72,7 +76,7 @@ def adaptive_chebyshev(
     sample: Callable[[np.ndarray], np.ndarray],
     lo: float,
     hi: float,
-    tol: float = CHEBYSHEV_TOLERANCE,
+    tol: np.ndarray | float = CHEBYSHEV_TOLERANCE,
     start: int = CHEBYSHEV_START,
     largest: int = CHEBYSHEV_MAX,
     floor: np.ndarray | float = 0.0,
@@ -80,7 +84,7 @@ def adaptive_chebyshev(
     """Chebyshev interpolation on [lo, hi] of the rows of ``sample(x) -> (m, len(x))``, doubling until converged.
 
     Converged when the trailing coefficients of every row are below ``tol``
-    times its largest one plus ``floor`` (per row: the absolute noise of the
+    (per row, or one for all) times its largest one plus ``floor`` (per row: the absolute noise of the
     samples, below which coefficients mean nothing).  Returns (x nodes,
     values (m, n+1), coefficients (m, n+1)).  The grids are nested, so
     doubling samples only the new points.
@@ -95,7 +99,8 @@ def adaptive_chebyshev(
             return x, values, coefficients
         if 2 * n > largest:
             raise ModelError(
-                f"Chebyshev interpolation on [{lo:.6g}, {hi:.6g}] did not converge with {largest + 1} points"
+                f"the steady curve varies too sharply between ln V = {lo:.6g} and {hi:.6g} to be followed with"
+                f" {largest + 1} Chebyshev points"
             )
         n *= 2
         u = chebyshev_points(n)
@@ -133,6 +138,7 @@ def cached_critical_point(params: Parameters) -> CriticalPoint:
 
 def require_critical_point(params: Parameters) -> CriticalPoint:
     """The critical point, or a ModelError saying why stick-slip is undefined without it."""
+    require_parameters(params)  # before the cache: a dict is unhashable
     cp = cached_critical_point(steady_curve_key(params))
     if not cp.exists:
         raise ModelError(f"no stick-slip cycle: {cp.message}")
@@ -162,7 +168,8 @@ BELOW_VC = 0.5
 class BranchInterpolant:
     """sigma(V) and g = V dsigma/dV on the right branch of a steady curve, as Chebyshev series in ln V.
 
-    The series span [ln(BELOW_VC Vc), ln V_max] for the aging curve and
+    The series span [ln(BELOW_VC Vc), ln V_max] (or from nearer Vc, see
+    :func:`branch_interpolant`) for the aging curve and
     [ln Vc, ln V_max] for the no-aging curve; ``log_vc`` marks Vc.
     """
 
@@ -192,7 +199,7 @@ class BranchInterpolant:
         """Absolute accuracy of the series of sigma and of g (the convergence level they were built to)."""
         return (
             CHEBYSHEV_TOLERANCE * float(np.max(np.abs(self.stress_series))),
-            CHEBYSHEV_TOLERANCE * float(np.max(np.abs(self.g_series))),
+            SLOPE_TOLERANCE * float(np.max(np.abs(self.g_series))),
         )
 
     def covers(self, velocity: float) -> bool:
@@ -207,7 +214,6 @@ def branch_interpolant(params: Parameters, curve: str) -> BranchInterpolant:
     assert cp.velocity is not None
     v_max, _ = branch_maximum(params, curve)
     aging = curve == "aging"
-    lo = math.log(cp.velocity * (BELOW_VC if aging else 1.0))
     hi = math.log(v_max)
 
     def sample(x: np.ndarray) -> np.ndarray:
@@ -215,7 +221,21 @@ def branch_interpolant(params: Parameters, curve: str) -> BranchInterpolant:
         state = steady_state(params, v, aging=aging, quadrature=ACCURATE_QUADRATURE)
         return np.array([state.stress, state.stress_slope * v])
 
-    _, _, c = adaptive_chebyshev(sample, lo, hi, start=64)
+    # Below Vc the aging curve can fall off a near-vertical cliff (issue 12: sigma dropping 1e6-fold within
+    # 0.5 % of V): reach less far below Vc then (the slip phase checks how far the series reaches).
+    reaches = (BELOW_VC, 0.9, 0.99, 1.0) if aging else (1.0,)
+    for k, below in enumerate(reaches):
+        lo = math.log(cp.velocity * below)
+        try:
+            _, _, c = adaptive_chebyshev(sample, lo, hi, tol=np.array([CHEBYSHEV_TOLERANCE, SLOPE_TOLERANCE]), start=64)
+            break
+        except ModelError:
+            if k == len(reaches) - 1:
+                raise ModelError(
+                    f"the {curve} curve's right branch, from Vc = {cp.velocity:.6g} to {v_max:.6g} m/s, varies too"
+                    f" sharply to be followed with {CHEBYSHEV_MAX + 1} Chebyshev points, so the slip phase cannot be"
+                    " solved for these parameters"
+                ) from None
     return BranchInterpolant(curve, lo, hi, math.log(cp.velocity), c[0], c[1])
 
 
@@ -284,7 +304,7 @@ def jump_velocity(params: Parameters, stress: float, curve: str = "aging") -> Ju
     def excess(x: float) -> float:
         return float(branch.stress(math.exp(x))) - stress
 
-    if excess(branch.log_vc) >= 0.0:  # at sigma_c itself (to the series' accuracy)
+    if excess(branch.log_vc) >= -branch.noise[0]:  # at sigma_c itself (to the series' accuracy)
         log_v = branch.log_vc
     elif excess(branch.log_hi) <= 0.0:
         log_v = branch.log_hi

@@ -149,6 +149,7 @@ def slip_trajectory(
     end_velocity: float | None = None,
     end_gap: float | None = None,
     noise: tuple[float, float] = (0.0, 0.0),
+    lowest: float = 0.0,
 ) -> SlipTrajectory:
     """Eq 10 in the V-parametrisation for any smooth steady curve ``curve(v) -> (sigma, dsigma/dV)``.
 
@@ -158,8 +159,9 @@ def slip_trajectory(
     one sign between them.  ``noise`` is the absolute accuracy of the curve's
     (sigma, V dsigma/dV): Chebyshev coefficients below it are not asked to
     converge (this matters for a short slip next to Vc, where sigma' ~ 0).
-    Exposed separately so that it can be checked on curves with known
-    integrals.
+    ``lowest`` is the lowest velocity ``curve`` may be evaluated at (the pole
+    at V0 is subtracted only above it).  Exposed separately so that it can be
+    checked on curves with known integrals.
     """
     v0, k = pulling_velocity, stiffness
     end_offset = None
@@ -170,7 +172,7 @@ def slip_trajectory(
         raise ValueError("slip_trajectory: give end_velocity or end_gap")
     xs = math.log(start_velocity)
     xe = math.log(v0) + end_offset if end_offset is not None else math.log(end_velocity)
-    subtract = v0 > 0.0 and v0 >= FAR_POLE * min(start_velocity, end_velocity)
+    subtract = v0 > 0.0 and v0 >= max(FAR_POLE * min(start_velocity, end_velocity), lowest)
     if subtract:
         x0 = math.log(v0)
         lo, hi = min(xs, xe, x0), max(xs, xe, x0)
@@ -332,7 +334,9 @@ def slip_phase(params: Parameters, pulling_velocity: float, start_velocity: floa
     if abs(math.log(vs / v_end)) < 1e-14:
         sigma = float(curve(np.array([vs]))[0][0])
         return _empty_slip(v0, vs, sigma, stiffness, ends)
-    trajectory = slip_trajectory(curve, stiffness, v0, vs, v_end, end_gap=gap, noise=curve.noise)
+    trajectory = slip_trajectory(
+        curve, stiffness, v0, vs, v_end, end_gap=gap, noise=curve.noise, lowest=math.exp(curve.log_lo) * (1 + 1e-12)
+    )
     xs, xe = trajectory.log_start, trajectory.log_end
     x = _output_points(trajectory)
     time = trajectory.time(x)

@@ -26,6 +26,7 @@ integral (the same panels), not from finite differences.
 from __future__ import annotations
 
 import dataclasses
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
@@ -52,12 +53,13 @@ class QuadratureSettings:
     """
 
     order: int = 16
-    log_hazard_step: float = 24.0
-    hazard_step: float = 24.0
+    log_hazard_step: float = 16.0
+    hazard_step: float = 16.0
     end_ratio: float = 0.7
     widest_panel: float = 0.5
-    #: the survival is cut where H exceeds this (exp(-36) ~ 2e-16)
+    #: the survival is cut where H exceeds this (exp(-36) ~ 2e-16) and what it can still add is below tail_tolerance
     hazard_cutoff: float = 36.0
+    tail_tolerance: float = 1e-11
     #: a stretch whose hazard integral is below this is crossed in one panel
     negligible_hazard: float = 1e-13
 
@@ -75,12 +77,19 @@ class QuadratureSettings:
 DEFAULT_QUADRATURE = QuadratureSettings()
 #: ~1e-12 relative: for curves sampled once and then interpolated or root-found
 #: (jump velocity, slip trajectory, critical point), where noise would limit convergence.
-ACCURATE_QUADRATURE = QuadratureSettings(log_hazard_step=16.0, hazard_step=16.0)
+ACCURATE_QUADRATURE = QuadratureSettings(log_hazard_step=10.0, hazard_step=10.0)
 #: With no FENE term (a = 0) the march stops this close to x = 1.
 SMALLEST_GAP = 1e-30
 MAX_PANELS = 20000
-BISECTIONS = 6
+#: Panel widths are found to within this factor of the widest good width.
+WIDTH_RATIO = 1.5
+MAX_BISECTIONS = 40
+#: A panel narrower than this many ulps of the position cannot be sampled (its nodes would round onto
+#: each other, and L changes by O(1) per ulp): when not even that is good, the survival steps to 0 there.
+STEP_ULPS = 64.0
+_LOG_WIDTH_RATIO = float(np.log(WIDTH_RATIO))
 _LOG_CAP = 700.0  # exp(700) ~ 1e304: keeps e^L finite where S is long zero
+_TINY = 1e-300
 
 
 @dataclass(frozen=True)
@@ -135,11 +144,12 @@ class _Scales:
 
 def _scales(params: Parameters, velocity: np.ndarray, aging: bool) -> _Scales:
     b, g = params.bonds, params.aging
-    max_age = b.max_extension / velocity
-    log_t = np.log(b.breakage_weight) + np.log(max_age) - np.log(b.bond_time)
+    log_age = math.log(b.max_extension) - np.log(velocity)  # ln(dl_m/V), in logs: dl_m/V may overflow
+    log_t = math.log(b.breakage_weight) + log_age - math.log(b.bond_time)
     a = b.activation_length * b.chain_stiffness * b.max_extension / (BOLTZMANN * b.temperature)
     if aging:
-        alpha = (max_age / g.aging_time) * np.exp(-velocity / g.aging_velocity)
+        # capped at e^700 (~1e304) so that it stays finite: _check_scales refuses anything above LARGEST_RATE
+        alpha = np.exp(np.minimum(log_age - math.log(g.aging_time) - velocity / g.aging_velocity, 700.0))
         beta = alpha * (1.0 + velocity / g.aging_velocity)
     else:
         alpha = np.zeros_like(velocity)
@@ -149,54 +159,121 @@ def _scales(params: Parameters, velocity: np.ndarray, aging: bool) -> _Scales:
     )
 
 
+#: FENE strength and aging rate beyond which the log-hazard's terms could overflow (the box needs < 1e17).
+LARGEST_RATE = 1e200
+
+
+def _check_scales(s: _Scales) -> None:
+    """A one-line ModelError where the dimensionless groups leave floating point (far outside any physical box)."""
+    groups = (("FENE strength a = lambda M dl_m/kT", s.a), ("aging rate dl_m/(V tau_a) e^(-V/V_a)", s.alpha))
+    for name, values in groups:
+        bad = ~(np.abs(values) <= LARGEST_RATE)
+        if np.any(bad):
+            raise ModelError(
+                f"the {name} is {float(values[bad][0]):.3g}, beyond {LARGEST_RATE:g}: these parameters are outside"
+                " what the steady model can integrate in floating point"
+            )
+    bad = ~(np.isfinite(s.log_t) & np.isfinite(s.birth))
+    if np.any(bad):
+        raise ModelError("the breakage rate u0 dl_m/(V tau) or tau V/dl_m is not finite for these parameters")
+
+
 def _log_hazard_and_slope(x: np.ndarray, y: np.ndarray, s: _Scales) -> tuple[np.ndarray, np.ndarray]:
     """L and |L'| at x (y = 1 - x), sharing the FENE denominator."""
     d = y * (1.0 + x)
     return s.log_t + s.a * x / d - s.alpha * x, np.abs(s.a * (1.0 + x * x) / (d * d) - s.alpha)
 
 
-def _panel_width(x: np.ndarray, y: np.ndarray, s: _Scales, q: QuadratureSettings) -> np.ndarray:
-    """Width of the next panel at left end x (y = 1 - x), from explicit bounds.
+def _panel_width(x: np.ndarray, y: np.ndarray, s: _Scales, q: QuadratureSettings) -> tuple[np.ndarray, np.ndarray]:
+    """(width of the next panel at left end x (y = 1 - x), lanes where the survival steps to 0 there).
 
     A panel [x, x+w] is good when it is resolved (|L'| w <= q.log_hazard_step and
     e^L w <= q.hazard_step) or negligible (e^L w <= q.negligible_hazard).  L is
     convex, so |L'| and e^L are largest at an end of the panel and testing both
-    ends decides; both tests only get harder as w grows, so the widest good w
-    is found by geometric bisection between a width known to be good and the
-    widest allowed panel (q.widest_panel, and q.end_ratio * y towards x = 1).
-    The hazard tests are done on logarithms: no exponential can overflow.
+    ends decides; both tests only get harder as w grows, so the good widths
+    form an interval (0, w*].  The width returned is good and within
+    WIDTH_RATIO of w* (or the widest allowed panel: q.widest_panel, and
+    q.end_ratio * y towards x = 1): a galloping search and bisection on ln w
+    run until the bracket is that tight, however many orders of magnitude it
+    spans (a deep aging dip followed by the FENE cliff puts w* hundreds of
+    e-folds below the widest panel; a fixed number of bisections there used to
+    stop the march in mid-dip, issue 12).  When not even STEP_ULPS ulps of the
+    position are good, the hazard explodes within them (FENE and aging terms
+    ~1e50 cancelling): the survival is a step there, exact to ~STEP_ULPS ulps
+    of x, and the lane is flagged.
+    Everything is done on logarithms: no exponential can overflow.
     """
-    widest = np.minimum(q.widest_panel, q.end_ratio * y)
+    log_widest = np.log(np.minimum(q.widest_panel, q.end_ratio * y))
     l_left, slope_left = _log_hazard_and_slope(x, y, s)
-    # the left end only caps w: below cap_resolved it is resolved there, below cap_negligible negligible
-    cap_negligible = q.negligible_hazard * np.exp(-np.maximum(l_left, -_LOG_CAP))
-    cap_resolved = np.minimum(
-        q.hazard_step * np.exp(-np.maximum(l_left, -_LOG_CAP)), q.log_hazard_step / np.maximum(slope_left, 1e-300)
-    )
-    log_resolved, log_negligible = np.log(q.hazard_step), np.log(q.negligible_hazard)
+    log_slope_left = np.log(np.maximum(slope_left, _TINY))
+    log_step, log_resolved = np.log(q.log_hazard_step), np.log(q.hazard_step)
+    log_negligible = np.log(q.negligible_hazard)
+    # the left end's share of the tests: resolved needs ln w below cap_resolved, negligible below cap_negligible
+    cap_resolved = np.minimum(log_resolved - l_left, log_step - log_slope_left)
+    cap_negligible = log_negligible - l_left
 
-    def good(w: np.ndarray) -> np.ndarray:
-        l_right, slope_right = _log_hazard_and_slope(x + w, y - w, s)
-        log_integral = l_right + np.log(w)
-        resolved = (w <= cap_resolved) & (slope_right * w <= q.log_hazard_step) & (log_integral <= log_resolved)
-        return resolved | ((w <= cap_negligible) & (log_integral <= log_negligible))
+    def good(log_w: np.ndarray, lanes: _Lanes) -> np.ndarray:
+        w = np.exp(log_w)
+        l_right, slope_right = _log_hazard_and_slope(lanes.x + w, lanes.y - w, lanes.s)
+        log_integral = l_right + log_w
+        resolved = (log_w <= lanes.cap_resolved) & (slope_right * w <= q.log_hazard_step)
+        resolved &= log_integral <= log_resolved
+        return resolved | ((log_w <= lanes.cap_negligible) & (log_integral <= log_negligible))
 
-    ok = good(widest)
-    if ok.all():
-        return widest
-    # a width that is good for sure: the left cap, then once capped by the right end (see docstring)
-    low = np.minimum(widest, cap_resolved)
-    l_right, slope_right = _log_hazard_and_slope(x + low, y - low, s)
-    low = np.minimum(low, q.log_hazard_step / np.maximum(slope_right, 1e-300))
-    low = np.minimum(low, np.exp(np.minimum(log_resolved - l_right, 0.0)))
-    low = np.where(ok, widest, low)
-    top = widest
-    for _ in range(BISECTIONS):
-        mid = np.sqrt(low * top)
-        better = good(mid)
-        low = np.where(better, mid, low)
-        top = np.where(better, top, mid)
-    return low
+    log_w = log_widest.copy()
+    step = np.zeros(x.size, dtype=bool)
+    open_ = np.nonzero(~good(log_widest, _Lanes(x, y, s, cap_resolved, cap_negligible)))[0]
+    if open_.size == 0:
+        return np.exp(log_w), step
+    lanes = _Lanes(x[open_], y[open_], _take(s, open_), cap_resolved[open_], cap_negligible[open_])
+    # bracket [low, top]: top is not good; low is good once confirmed (before that it is the floor, STEP_ULPS
+    # ulps of the position).  Gallop from the left end's cap (usually within a few times w*) with steps in ln w
+    # that double, then bisect: a few tests per panel, and at most ~2 log2(745) however deep the dip.
+    top = log_widest[open_]
+    low = np.log(STEP_ULPS * np.spacing(np.where(lanes.x < 0.5, lanes.x, lanes.y)))
+    guess = np.clip(lanes.cap_resolved, low, top)
+    confirmed = np.zeros(open_.size, dtype=bool)
+    reach = np.full(open_.size, np.log(4.0))
+    k = np.arange(open_.size)
+    active = lanes
+    for _ in range(MAX_BISECTIONS):
+        better = good(guess, active)
+        low[k] = np.where(better, guess, low[k])
+        top[k] = np.where(better, top[k], guess)
+        confirmed[k] |= better
+        reach[k] *= 2.0
+        wide = top[k] - low[k] > _LOG_WIDTH_RATIO
+        if not wide.all():
+            k = k[wide]
+            if k.size == 0:
+                break
+            active = lanes.take(k)
+        half = 0.5 * (top[k] - low[k])
+        guess = np.where(confirmed[k], low[k] + np.minimum(reach[k], half), top[k] - np.minimum(reach[k], half))
+    unconfirmed = np.nonzero(~confirmed)[0]
+    if unconfirmed.size:  # the bracket closed on the floor: is even that good?
+        step[open_[unconfirmed]] = ~good(low[unconfirmed], lanes.take(unconfirmed))
+    log_w[open_] = low
+    return np.exp(log_w), step
+
+
+@dataclass(frozen=True)
+class _Lanes:
+    """The lanes whose panel width is being searched: left ends and the left end's caps on ln w."""
+
+    x: np.ndarray
+    y: np.ndarray
+    s: _Scales
+    cap_resolved: np.ndarray
+    cap_negligible: np.ndarray
+
+    def take(self, k: np.ndarray) -> _Lanes:
+        return _Lanes(self.x[k], self.y[k], _take(self.s, k), self.cap_resolved[k], self.cap_negligible[k])
+
+
+def _take(s: _Scales, k: np.ndarray | slice) -> _Scales:
+    """The lanes ``k`` of ``s``."""
+    return _Scales(s.log_t[k], s.a[k], s.alpha[k], s.beta[k], s.birth[k])
 
 
 @dataclass
@@ -227,8 +304,11 @@ def _march(s: _Scales, q: QuadratureSettings, keep_nodes: bool = False) -> _Inte
     x_left, y_left = np.zeros(n), np.ones(n)
     hazard, moment = np.zeros(n), np.zeros(n)  # H and G = int x e^L
     sums = np.zeros((4, n))  # i, j, -di, -dj
+    if n == 0:
+        return out
     for _ in range(MAX_PANELS):
-        w = _panel_width(x_left, y_left, sub, q)
+        w, step = _panel_width(x_left, y_left, sub, q)
+        w[step] = 0.0  # the survival steps to 0 within a few ulps: nothing more to integrate
         x = x_left[:, None] + w[:, None] * t_half
         y = y_left[:, None] - w[:, None] * t_half
         stretch = x / (y * (1.0 + x))  # x/(1-x^2), the FENE factor
@@ -248,13 +328,14 @@ def _march(s: _Scales, q: QuadratureSettings, keep_nodes: bool = False) -> _Inte
                 out.nodes[k].append(np.stack([x[row], survival[row]]))
         hazard += cumulative[0, :, -1]
         moment += cumulative[1, :, -1]
-        # a panel narrower than one ulp of x (left half) or of 1 - x (right half, where 1 - x carries
-        # the precision) means the survival falls to zero within
-        # that ulp (FENE and aging terms ~1e50 cancelling): a step, exact to the precision of x
-        stalled = np.where(x_left < 0.5, x_left + w == x_left, y_left - w == y_left)
         x_left += w
         y_left -= w
-        done = (hazard >= q.hazard_cutoff) | (y_left <= SMALLEST_GAP) | stalled
+        # step: the survival falls to zero within a few ulps of x (see _panel_width), exact to that precision
+        done = (y_left <= SMALLEST_GAP) | step
+        past = np.nonzero(hazard >= q.hazard_cutoff)[0]
+        if past.size:
+            tail = _tail_negligible(hazard[past], y_left[past], sums[0, past], sums[1, past], _take(sub, past), q)
+            done[past] |= tail
         if done.any():
             finished = index[done]
             out.i[finished], out.j[finished] = sums[0, done], sums[1, done]
@@ -264,8 +345,40 @@ def _march(s: _Scales, q: QuadratureSettings, keep_nodes: bool = False) -> _Inte
             keep = ~done
             index, x_left, y_left, hazard, moment = index[keep], x_left[keep], y_left[keep], hazard[keep], moment[keep]
             sums = sums[:, keep]
-            sub = _Scales(*(getattr(sub, f.name)[keep] for f in dataclasses.fields(_Scales)))
+            sub = _take(sub, keep)
     raise ModelError(f"steady-state quadrature did not converge: more than {MAX_PANELS} panels needed")
+
+
+#: Beyond 1 - y_c (see _tail_negligible) the log-hazard is at least this.
+_CLIFF_LOG_HAZARD = 50.0
+
+
+def _tail_negligible(
+    hazard: np.ndarray, y: np.ndarray, i: np.ndarray, j: np.ndarray, s: _Scales, q: QuadratureSettings
+) -> np.ndarray:
+    """True where the survival S = e^-H left at x = 1 - y can add at most q.tail_tolerance to i and to j.
+
+    S never rises, so the rest of i is at most S y.  The rest of j is the
+    hard part: with aging H can level off (a plateau down to the FENE cliff)
+    while x S/(1 - x^2) grows towards x = 1, and when the survival fell
+    early (x ~ 1/T) j is tiny, so a plateau at S ~ 1e-17 can still carry
+    1e-3 of j.  Beyond 1 - y_c, y_c = a/(3(alpha + |ln T| + 50)), L >= 50
+    (there x/(1+x) >= 1/3) and the survival dies at once; before it,
+    int x/(1-x^2) <= ln(1/y_c)/2.  So the rest of j is at most
+    S (ln(1/y_c)/2 + 1).
+    """
+    y_c = np.minimum(y, np.maximum(s.a, _TINY) / (3.0 * (s.alpha + np.abs(s.log_t) + _CLIFF_LOG_HAZARD)))
+    room_i = np.log(np.maximum(q.tail_tolerance * i, _TINY)) - np.log(y)
+    room_j = np.log(np.maximum(q.tail_tolerance * j, _TINY)) - np.log(0.5 * np.log(1.0 / y_c) + 1.0)
+    return -hazard <= np.minimum(room_i, room_j)
+
+
+def require_parameters(params: Any, name: str = "params") -> None:
+    """ParameterError unless ``params`` is a :class:`Parameters` set (a str, None or dict is a one-line error)."""
+    if not isinstance(params, Parameters):
+        raise ParameterError(
+            f"{name}: expected a stickslip Parameters set (load_parameters(...)), got {type(params).__name__}"
+        )
 
 
 def _check_velocity(velocity: Any) -> np.ndarray:
@@ -310,17 +423,19 @@ def steady_state(
     activation length bonds survive to full extension, where the FENE force
     of Eq 3 diverges, and the integral of Eq 8 diverges logarithmically.
     """
+    require_parameters(params)
     v = _check_velocity(velocity)
     _require_finite_stress(params)
     flat = np.ravel(v)
     s = _scales(params, flat, aging)
+    _check_scales(s)
     got = _march(s, quadrature, keep_nodes=distribution)
     denom = s.birth + got.i
     scale = _stress_scale(params)
     stress = scale * got.j / denom
     fraction = got.i / denom
     # d(sigma)/d(ln V), with d(birth)/d(ln V) = birth
-    dstress = scale * (got.dj * denom - got.j * (s.birth + got.di)) / denom**2
+    dstress = scale * (got.dj - (got.j / denom) * (s.birth + got.di)) / denom  # no denom**2: it can underflow
     slope = dstress / flat
     ages = densities = None
     if got.nodes is not None:
@@ -347,20 +462,33 @@ def steady_stress_many(
     velocity: Any,
     aging: bool = True,
     quadrature: QuadratureSettings = DEFAULT_QUADRATURE,
+    paired: bool = False,
 ) -> np.ndarray:
     """sigma(V) (Eqs 6-8) for many parameter sets at once: shape (len(params_list), len(velocity)).
 
     One quadrature march serves every (set, velocity) pair, so the per-call
     cost is paid once: this is what fitting Jacobians and MCMC walkers need.
-    Same accuracy as :func:`steady_state`.
+    With ``paired=True`` set k is evaluated only at velocity[k] (shape
+    (len(params_list),)).  Same accuracy as :func:`steady_state`.
     """
     v = np.ravel(_check_velocity(velocity))
-    if len(params_list) == 0:
-        return np.empty((0, v.size))
     for k, p in enumerate(params_list):
+        require_parameters(p, f"parameter set {k}")
         _require_finite_stress(p, f"parameter set {k}: ")
-    parts = [_scales(p, v, aging) for p in params_list]
+    if paired and v.size != len(params_list):
+        raise ParameterError(
+            f"velocity: paired=True needs one velocity per parameter set, got {v.size} for {len(params_list)} sets"
+        )
+    if len(params_list) == 0:
+        return np.empty(0) if paired else np.empty((0, v.size))
+    if paired:
+        parts = [_scales(p, v[k : k + 1], aging) for k, p in enumerate(params_list)]
+        scale = np.array([_stress_scale(p) for p in params_list])
+    else:
+        parts = [_scales(p, v, aging) for p in params_list]
+        scale = np.repeat([_stress_scale(p) for p in params_list], v.size)
     joined = _Scales(*(np.concatenate([getattr(part, f.name) for part in parts]) for f in dataclasses.fields(_Scales)))
+    _check_scales(joined)
     got = _march(joined, quadrature)
-    scale = np.repeat([_stress_scale(p) for p in params_list], v.size)
-    return (scale * got.j / (joined.birth + got.i)).reshape(len(params_list), v.size)
+    stress = scale * got.j / (joined.birth + got.i)
+    return stress if paired else stress.reshape(len(params_list), v.size)

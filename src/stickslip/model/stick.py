@@ -45,10 +45,11 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from scipy.optimize import brentq
 
-from ..errors import ParameterError
+from ..errors import ModelError, ParameterError
 from ..numerics.events import integrate_in_chunks
 from ..parameters import Parameters
 from .jump import require_critical_point
+from .steady import require_parameters
 
 if TYPE_CHECKING:  # pragma: no cover
     import pandas as pd
@@ -280,6 +281,7 @@ def stick_phase(
     ``peak_stress`` = sigma_s of Eq 16), ``"stuck"`` (proven: the block never
     slips) or ``"undetermined"`` (neither within 10^4 aging times).
     """
+    require_parameters(params)
     v0 = check_velocity(pulling_velocity)
     if start_stress is None:
         cp = require_critical_point(params)
@@ -304,6 +306,11 @@ def stick_phase(
         inv_aging=1.0 / params.stick.aging_time if aging else 0.0,
         aging_cap=cap if aging else math.inf,
     )
+    if not rates.k <= math.exp(SHORTEST_LOG_TIME):  # issue 12: such loads made the integration hang (or NaN)
+        raise ModelError(
+            f"the block is loaded at K V0 = {stiffness * v0:.3g} Pa/s: the chains would collapse within 1e-300 s"
+            " of sticking, below what the stick model resolves; use a smaller pulling velocity or block stiffness"
+        )
     if rates.s0 == 0.0 and rates.k == 0.0:
         return _no_load_phase(params, rates, v0, sigma0, aging, horizon or 0.0)
     scale = rates.time_scale()
