@@ -277,7 +277,7 @@ def test_transient_adapter_follows_its_contract(monkeypatch, params):
 
 
 # --------------------------------------------------------------------------- rate-and-state (stickslip.rsf)
-RSF_FIXED = {"a": "0.005", "b": "0.01", "dc": "10 um", "eta": "0.5 s/m"}
+RSF_FIXED = {"a": "0.005", "b": "0.01", "Dc": "10 um", "η": "0.5 s/m"}  # the aliases --vary takes
 RSF_VARY = ["k=250 1/m,350 1/m,750 1/m,1000 1/m", "pulling_velocity=10 um/s,20 um/s"]
 
 

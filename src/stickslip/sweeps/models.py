@@ -311,14 +311,15 @@ class RateAndState:
         base = rsf.RSFParams()
         fixed = {"a": base.a, "b": base.b, "dc": base.dc, "k": base.stiffness, "eta": base.eta, "mu0": base.mu0}
         fixed.update(v_ref=base.v_ref, law=0.0)
-        for key, raw in overrides.items():
+        for given, raw in overrides.items():
+            key = ALIASES.get(given, given)  # --set Dc=..., η=... as --vary takes them
             if key == "law":
                 fixed["law"] = float(self._law_code(raw))
             elif key in self.KEYS:
                 fixed[key] = to_si(raw, self.KEYS[key], key)
             else:
                 expected = ", ".join((*self.KEYS, "law"))
-                raise ParameterError(f"--set {key}: unknown rate-and-state key; expected one of: {expected}")
+                raise ParameterError(f"--set {given}: unknown rate-and-state key; expected one of: {expected}")
         law = self.LAW_NAMES[int(fixed["law"])]
         return fixed, f"rate-and-state, {law} law"
 
