@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import dataclasses
 import itertools
 import json
 import math
@@ -277,37 +276,78 @@ def test_transient_adapter_follows_its_contract(monkeypatch, params):
     np.testing.assert_allclose(line.get_ydata(), 2e5 * (v / 1e-4) ** 0.5, rtol=1e-12)
 
 
-def test_rate_and_state_adapter_follows_its_contract(monkeypatch):
-    import types
+# --------------------------------------------------------------------------- rate-and-state (stickslip.rsf)
+RSF_FIXED = {"a": "0.005", "b": "0.01", "Dc": "10 um", "η": "0.5 s/m"}  # the aliases --vary takes
+RSF_VARY = ["k=250 1/m,350 1/m,750 1/m,1000 1/m", "pulling_velocity=10 um/s,20 um/s"]
 
-    @dataclasses.dataclass(frozen=True)
-    class RSFParameters:
-        a: float
-        b: float
-        dc: float
-        stiffness: float
-        eta: float
-        mu0: float
-        v_ref: float
-        normal_stress: float
 
-    def simulate(p, protocol):
-        unstable = p.stiffness < p.normal_stress * (p.b - p.a) / p.dc
-        return types.SimpleNamespace(
-            regime="stick-slip" if unstable else "steady",
-            period=1.0 if unstable else None,
-            peak_friction=0.62,
-            trough_friction=0.58,
-            cycles=[1, 2, 3] if unstable else [],
-            message="stand-in",
+def rsf_kc(velocity):
+    """The Hopf point of one aging-law state with damping: kc = (b - a - eta V)/Dc (docs/rsf.md), in 1/m."""
+    return (0.01 - 0.005 - 0.5 * velocity) / 10e-6
+
+
+@pytest.fixture(scope="module")
+def rsf_sweep():
+    spec = build_spec(RSF_VARY, model="rsf", overrides=RSF_FIXED, duration="200 s")
+    return spec, stickslip.sweep(RSF_VARY, model="rsf", overrides=RSF_FIXED, duration="200 s", workers=0)
+
+
+def test_rsf_sweep_regimes_follow_the_analytic_critical_stiffness(rsf_sweep):
+    """k/kc = 0.5, 0.7 settle on a limit cycle; 1.5, 2 return to steady sliding (eta > 0: no blow-up)."""
+    _, frame = rsf_sweep
+    kc = rsf_kc(frame["pulling_velocity"])
+    np.testing.assert_allclose(frame["critical_stiffness"], kc, rtol=1e-12)
+    assert set(np.round(frame["k"] / kc, 1)) == {0.5, 0.7, 1.5, 2.0}
+    assert (frame["status"] == "ok").all()
+    below, above = frame[frame["k"] < kc], frame[frame["k"] > kc]
+    assert (below["regime"] == "stick-slip").all(), below[["k", "pulling_velocity", "regime", "growth"]]
+    assert above["regime"].isin(["decaying oscillation", "steady sliding"]).all(), above[["k", "regime"]]
+    assert (below["peak_friction"] - below["trough_friction"] > 0.03).all()
+    assert (
+        (below["trough_friction"] < below["mean_friction"]) & (below["mean_friction"] < below["peak_friction"])
+    ).all()
+    steady = 0.6 + (0.005 - 0.01) * np.log(above["pulling_velocity"] / 1e-6)  # mu_ss(V0), rsf's mu0 and v_ref
+    np.testing.assert_allclose(above["mean_friction"], steady, atol=1e-6)
+
+
+def test_rsf_sweep_rows_are_those_of_one_by_one_simulations(rsf_sweep):
+    from stickslip import protocols, rsf
+
+    spec, frame = rsf_sweep
+    fixed = spec.fixed  # the SI values the units gave ("10 um" need not be exactly 10e-6)
+    for row in frame.iloc[[0, 3, 6]].itertuples():  # a limit cycle and a stable point at each velocity
+        params = rsf.rsf_params(fixed["a"], fixed["b"], fixed["dc"], eta=fixed["eta"], stiffness=row.k)
+        run = rsf.simulate(
+            params, protocols.constant(row.pulling_velocity, 200.0), start_velocity=1.1 * row.pulling_velocity
+        )
+        assert row.regime == run.regime.name
+        np.testing.assert_allclose(
+            [row.period, row.peak_friction, row.trough_friction, row.growth],
+            [run.regime.period, run.regime.peak_friction, run.regime.trough_friction, run.regime.growth],
+            rtol=1e-9,
         )
 
-    monkeypatch.setitem(
-        sys.modules, "stickslip.rsf", types.SimpleNamespace(RSFParameters=RSFParameters, simulate=simulate)
+
+def test_rsf_phase_diagram_draws_kc_of_rsf(rsf_sweep):
+    spec, frame = rsf_sweep
+    ax = plot_phase_diagram(frame, spec, x="k", y="pulling_velocity", color="regime")
+    line = next(line for line in ax.get_lines() if line.get_label().startswith("k = kc"))
+    v = line.get_ydata() / 1e6  # drawn in um/s
+    assert v.min() == pytest.approx(10e-6) and v.max() == pytest.approx(20e-6)
+    np.testing.assert_allclose(line.get_xdata(), rsf_kc(v), rtol=1e-12)
+
+
+@pytest.mark.parametrize(
+    ("option", "expected"),
+    [
+        ("law=nagata", "--set law=nagata: expected one of aging, slip, prz"),
+        ("k=1 MPa/m", "expected a per length"),
+        ("sigma=1 MPa", "--set sigma: unknown rate-and-state key"),
+        ("dc=-1 um", "dc: expected a value > 0"),
+    ],
+)
+def test_rsf_sweep_refuses_bad_values_in_one_line(option, expected, tmp_path, capsys):
+    status, _, err = run_main(
+        capsys, "sweep", "--model", "rsf", "--vary", "pulling_velocity=1 um/s", "--set", option, "-o", str(tmp_path)
     )
-    vary = ["k=100 MPa/m..1 GPa/m:3:log", "Dc=5 um,20 um"]
-    frame = stickslip.sweep(vary, model="rsf", overrides={"normal_stress": "10 MPa"}, duration="10 s", workers=0)
-    kc = 10e6 * (0.015 - 0.010) / frame["dc"]
-    np.testing.assert_allclose(frame["critical_stiffness"], kc, rtol=1e-12)
-    assert (frame["regime"] == np.where(frame["k"] < kc, "stick-slip", "steady")).all()
-    assert frame["cycles"].tolist() == [3 if k < c else 0 for k, c in zip(frame["k"], kc, strict=True)]
+    assert status == 2 and expected in err and err.count("\n") == 1, err

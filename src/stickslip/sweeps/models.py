@@ -262,7 +262,15 @@ class Transient(BondModel):
 
 # --------------------------------------------------------------------------- rate-and-state
 class RateAndState:
-    """Rate-and-state friction on a spring-slider, ``stickslip.rsf`` (names to match that module at merge)."""
+    """Rate-and-state friction on a spring-slider, :func:`stickslip.rsf.simulate` (units as ``rsf simulate``).
+
+    ``k`` is the spring stiffness in friction per slip (1/m) and ``eta`` the radiation damping in friction
+    per velocity (s/m), as ``stickslip rsf simulate --stiffness/--eta`` take them without ``--normal-stress``;
+    a machine stiffness K in Pa/m is k = K/σ.  ``law`` is a name, kept in the fixed values as its index in
+    :attr:`LAW_NAMES` (the specification holds numbers only).  Each point starts in steady sliding at
+    :attr:`START_STEP` times the pulling velocity: from exactly the steady state an unstable slider would
+    never leave it, so the step seeds the oscillation whose fate the regime reports.
+    """
 
     name = "rsf"
     results: Mapping[str, str] = {
@@ -271,83 +279,126 @@ class RateAndState:
         "peak_friction": "float",
         "trough_friction": "float",
         "mean_friction": "float",
-        "cycles": "int",
+        "growth": "float",
         "critical_stiffness": "float",
     }
-    #: key -> (dimension, default in SI); k is the spring stiffness per area, eta the radiation damping.
-    KEYS: Mapping[str, tuple[str, float]] = {
-        "pulling_velocity": ("velocity", 1e-6),
-        "a": ("dimensionless", 0.010),
-        "b": ("dimensionless", 0.015),
-        "dc": ("length", 10e-6),
-        "k": ("stress_per_length", 1e9),
-        "eta": ("stress_per_velocity", 0.0),
-        "mu0": ("dimensionless", 0.6),
-        "v_ref": ("velocity", 1e-6),
-        "normal_stress": ("stress", 1e6),
+    #: key -> dimension; defaults are those of :class:`stickslip.rsf.RSFParams` (one source).
+    KEYS: Mapping[str, str] = {
+        "pulling_velocity": "velocity",
+        "a": "dimensionless",
+        "b": "dimensionless",
+        "dc": "length",
+        "k": "per_length",
+        "eta": "slowness",
+        "mu0": "dimensionless",
+        "v_ref": "velocity",
+        "normal_stress": "stress",
     }
+    LAW_NAMES = ("aging", "slip", "prz")  # the laws with one state variable and no further constant
+    START_STEP = 1.1
 
     def dimensions(self) -> dict[str, str]:
-        return {k: d for k, (d, _) in self.KEYS.items()}
+        return dict(self.KEYS)
 
     def check_available(self) -> None:
         _require("stickslip.rsf", self.name)
 
     def fixed_values(self, params: str | Parameters, overrides: Mapping[str, Any]) -> tuple[dict[str, float], str]:
+        """rsf's defaults, then ``--set`` (``law=slip`` by name); ``normal_stress`` only when given."""
         from ..units import to_si
 
-        fixed = {k: default for k, (_, default) in self.KEYS.items()}
-        for key, raw in overrides.items():
-            if key not in self.KEYS:
-                raise ParameterError(
-                    f"--set {key}: unknown rate-and-state key; expected one of: {', '.join(self.KEYS)}"
-                )
-            fixed[key] = to_si(raw, self.KEYS[key][0], key)
-        return fixed, "rate-and-state"
+        rsf = _require("stickslip.rsf", self.name)
+        base = rsf.RSFParams()
+        fixed = {"a": base.a, "b": base.b, "dc": base.dc, "k": base.stiffness, "eta": base.eta, "mu0": base.mu0}
+        fixed.update(v_ref=base.v_ref, law=0.0)
+        for given, raw in overrides.items():
+            key = ALIASES.get(given, given)  # --set Dc=..., η=... as --vary takes them
+            if key == "law":
+                fixed["law"] = float(self._law_code(raw))
+            elif key in self.KEYS:
+                fixed[key] = to_si(raw, self.KEYS[key], key)
+            else:
+                expected = ", ".join((*self.KEYS, "law"))
+                raise ParameterError(f"--set {given}: unknown rate-and-state key; expected one of: {expected}")
+        law = self.LAW_NAMES[int(fixed["law"])]
+        return fixed, f"rate-and-state, {law} law"
+
+    def _law_code(self, raw: Any) -> int:
+        name = str(raw).strip().lower()
+        if name not in self.LAW_NAMES:
+            raise ParameterError(f"--set law={raw}: expected one of {', '.join(self.LAW_NAMES)}")
+        return self.LAW_NAMES.index(name)
 
     def check_keys(self, varied: tuple[str, ...], fixed: Mapping[str, float]) -> None:
         return None
 
-    def critical_stiffness(self, values: Mapping[str, float]) -> float:
-        """kc = sigma (b - a) / Dc (Ruina; Rice & Ruina 1983)."""
-        return values["normal_stress"] * (values["b"] - values["a"]) / values["dc"]
+    def parameters(self, values: Mapping[str, float]) -> tuple[Any, float]:
+        """(the :class:`stickslip.rsf.RSFParams`, the pulling velocity) of one point (validated by rsf)."""
+        rsf = _require("stickslip.rsf", self.name)
+        if "pulling_velocity" not in values:
+            raise ParameterError("pulling_velocity: give --v0 V or --vary 'pulling_velocity=...'")
+        velocity = values["pulling_velocity"]
+        if not velocity > 0:
+            raise ParameterError(f"pulling_velocity: expected a value > 0 m/s, got {velocity:g}")
+        params = rsf.rsf_params(
+            values["a"],
+            values["b"],
+            values["dc"],
+            law=self.LAW_NAMES[int(values.get("law", 0))],
+            mu0=values["mu0"],
+            v_ref=values["v_ref"],
+            stiffness=values["k"],
+            eta=values["eta"],
+            normal_stress=values.get("normal_stress"),
+        )
+        return params, velocity
 
     def run(self, values: Mapping[str, float], settings: Mapping[str, Any]) -> dict[str, Any]:
         rsf = _require("stickslip.rsf", self.name)
         from ..protocols import constant
 
-        names = {k: values[k] for k in self.KEYS if k != "pulling_velocity"}
-        params = rsf.RSFParameters(**{("stiffness" if k == "k" else k): v for k, v in names.items()})
-        result = rsf.simulate(params, constant(values["pulling_velocity"], settings["duration"]))
+        params, velocity = self.parameters(values)
+        run = rsf.simulate(params, constant(velocity, settings["duration"]), start_velocity=self.START_STEP * velocity)
+        regime = run.regime
         return {
-            "regime": result.regime,
-            "period": _float(getattr(result, "period", None)),
-            "peak_friction": _float(getattr(result, "peak_friction", None)),
-            "trough_friction": _float(getattr(result, "trough_friction", None)),
-            "mean_friction": _float(getattr(result, "mean_friction", None)),
-            "cycles": _count(getattr(result, "cycles", 0)),
-            "critical_stiffness": self.critical_stiffness(values),
-            "message": result.message,
+            "regime": regime.name,
+            "period": regime.period,
+            "peak_friction": regime.peak_friction,
+            "trough_friction": regime.trough_friction,
+            "mean_friction": _settled_mean(run.time, run.friction, regime.period),
+            "growth": regime.growth,
+            "critical_stiffness": rsf.critical_stiffness(params, velocity),
+            "message": run.summary()["message"],
         }
 
     def boundaries(self, spec: Any, frame: Any, x: str, y: str) -> list[Boundary]:
-        """k = kc = sigma (b - a)/Dc: against the other axis when the stiffness k is on one."""
-        if "k" not in (x, y) or "critical_stiffness" not in frame:
+        """k = kc from :func:`stickslip.rsf.critical_stiffness`, against the other axis when k is on one."""
+        if "k" not in (x, y):
             return []
         other = y if x == "k" else x
-        kc = frame.groupby(other)["critical_stiffness"].median().dropna()
-        along, critical = kc.index.to_numpy(dtype=float), kc.to_numpy(dtype=float)
-        curve = (critical, along) if x == "k" else (along, critical)
-        return [Boundary(curve[0], curve[1], "k = kc = σ(b − a)/Dc")]
+        if other == "pulling_velocity":  # kc(V) on a fine grid (it depends on V through eta V)
+            rsf = _require("stickslip.rsf", self.name)
+            params, _ = self.parameters({**spec.fixed, "pulling_velocity": 1.0})
+            lo, hi = float(frame[other].min()), float(frame[other].max())
+            along = np.geomspace(lo, hi, 80) if lo > 0 and hi > lo else np.array([lo, hi])
+            critical = np.array([rsf.critical_stiffness(params, v) for v in along], dtype=float)
+        elif other in frame:
+            kc = frame.groupby(other)["critical_stiffness"].median().dropna()
+            along, critical = kc.index.to_numpy(dtype=float), kc.to_numpy(dtype=float)
+        else:
+            return []
+        keep = critical > 0  # kc = 0: steady sliding is stable at every stiffness there, no boundary
+        curve = (critical[keep], along[keep]) if x == "k" else (along[keep], critical[keep])
+        return [Boundary(curve[0], curve[1], "k = kc (rsf.critical_stiffness)")]
 
 
-def _count(cycles: Any) -> int:
-    """A number of cycles, given as a count or as the cycles themselves."""
-    return len(cycles) if isinstance(cycles, (list, tuple)) else int(cycles or 0)
-
-
-def _float(value: Any) -> float:
-    return NAN if value is None else float(value)
+def _settled_mean(time: np.ndarray, friction: np.ndarray, period: float) -> float:
+    """Mean friction over the last whole periods within the run's second half (over that half if none)."""
+    end = float(time[-1])
+    half = 0.5 * (end - float(time[0]))
+    span = float(np.floor(half / period) * period) if np.isfinite(period) and period > 0 else 0.0
+    inside = time >= end - (span if span > 0 else half)
+    return _mean(time[inside], friction[inside])
 
 
 MODELS: dict[str, Any] = {m.name: m for m in (QuasiStatic(), Transient(), RateAndState())}

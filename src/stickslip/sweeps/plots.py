@@ -39,7 +39,7 @@ RESULT_UNITS = {
     "peak_friction": "",
     "trough_friction": "",
     "mean_friction": "",
-    "critical_stiffness": "Pa/m",
+    "critical_stiffness": "1/m",  # rsf: friction per slip
 }
 #: Values whose largest/smallest ratio is at least this get a log axis or a log colour scale.
 DECADES = 30.0
