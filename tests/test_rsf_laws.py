@@ -220,3 +220,12 @@ def test_parameter_mapping_reads_units_and_stress_stiffness():
     assert p.states[0].dc == pytest.approx(20e-6, rel=1e-12) and p.v_ref == pytest.approx(1e-6, rel=1e-12)
     with pytest.raises(ParameterError, match="normal_stress"):
         RSFParams.from_dict({"stiffness": "30 MPa/mm"})
+
+
+def test_blow_up_under_a_soft_spring_with_the_slip_law_is_a_status_not_a_scipy_error():
+    """A case where LSODA's interpolant leaves scipy's event search without a bracket (found by a sweep)."""
+    run = simulate(
+        rsf_params(0.005, 0.02, 10e-6, law="slip", stiffness=1.0), protocols.constant(1.0, 50.0), start_velocity=1.1
+    )
+    assert run.status == "blow-up"
+    assert np.all(np.isfinite(run.friction)) and run.time[-1] < 50.0

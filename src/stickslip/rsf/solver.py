@@ -195,10 +195,20 @@ def _adaptive_piece(
         with warnings.catch_warnings():
             # LSODA's own warning on a failure is replaced by the ModelError or blow-up report below
             warnings.simplefilter("ignore", UserWarning)
-            sol = solve_ivp(
-                rhs, (t0, t1), y0, method="LSODA", args=(vlp,), jac=jac, rtol=rtol, atol=atol, events=blow_up,
-                dense_output=dense,
-            )  # fmt: skip
+            try:
+                sol = solve_ivp(
+                    rhs, (t0, t1), y0, method="LSODA", args=(vlp,), jac=jac, rtol=rtol, atol=atol, events=blow_up,
+                    dense_output=dense,
+                )  # fmt: skip
+            except ValueError:
+                # LSODA's interpolant can disagree in sign with its own step ends when the slip rate runs away,
+                # so scipy's event root-finder has no bracket; Radau's collocation polynomial passes through
+                # the step ends exactly, so the same event is bracketed there.
+                calls[0] = 0
+                sol = solve_ivp(
+                    rhs, (t0, t1), y0, method="Radau", args=(vlp,), jac=jac, rtol=rtol, atol=atol, events=blow_up,
+                    dense_output=dense,
+                )  # fmt: skip
     except _Stalled as stalled:
         raise ModelError(
             f"rate-and-state solver stalled at t = {stalled.time:.6g} s ({MAX_CALLS} evaluations in the segment "
