@@ -478,7 +478,7 @@ def fit_steady(
         interval_method=intervals,
         level=level,
         stages=tuple(progress.stages),
-        messages=tuple(progress.messages),
+        messages=tuple(data.notes() + progress.messages),
         samples=samples,
     )
 

@@ -237,6 +237,8 @@ def _select_rows(
     messages: list[str] = []
     known_rows = {int(r) for r in data.rows}
     for row in exclude:
+        if isinstance(row, bool) or not isinstance(row, (int, np.integer)):
+            raise ParameterError(f"exclude_rows: expected file row numbers (integers), got {row!r}")
         if int(row) not in known_rows:
             raise DataError(f"{data.source}: --exclude-row {row}: no such data row (rows are {sorted(known_rows)})")
     point = critical_point(params)
