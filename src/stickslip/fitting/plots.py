@@ -96,22 +96,46 @@ def steady_fit_figure(fit: SteadyFit, band: tuple[np.ndarray, ...] | None = None
 
 
 def plot_stick_fit(fit: StickFit, ax: Axes | None = None) -> Axes:
-    """Measured and fitted stick times against pulling velocity."""
+    """Stick time against pulling velocity (linear axes): data with error bars of the estimated scatter,
+    the model's value for each fitted row, and the fitted t_s(V0) as a line."""
     ax = _axes(ax)
-    data = fit.data
-    used = fit.used
-    ax.plot(data.pulling_velocity[used] * UM, data.stick_time[used], "o", color="k", ms=5, label="data (fitted)")
+    data, used = fit.data, fit.used
+    v = data.pulling_velocity * UM
+    offsets = _spread(data.pulling_velocity, used)
+    sd = fit.noise_scale if np.isfinite(fit.noise_scale) else 0.0
+    err = data.stick_time[used] * sd if sd > 0 else None
+    ax.errorbar(
+        v[used] + offsets[used], data.stick_time[used], yerr=err, fmt="o", color="k", ms=5, capsize=3,
+        label=f"data (bars: ±1 sd, {100 * sd:.2g} % from the scatter)" if sd > 0 else "data",
+    )  # fmt: skip
+    ax.plot(v[used] + offsets[used], fit.model_stick_time[used], "s", mfc="none", color="C0", ms=7, label="model, row")
     if np.any(~used):
-        ax.plot(
-            data.pulling_velocity[~used] * UM, data.stick_time[~used], "x", color="0.5", ms=6, label="data (left out)"
-        )
-    ax.plot(data.pulling_velocity[used] * UM, fit.model_stick_time[used], "s", mfc="none", color="C0", label="model")
-    ax.set_xscale("log")
-    ax.set_yscale("log")
+        ax.plot(v[~used], data.stick_time[~used], "x", color="0.5", ms=7, label="left out")
+    lo, hi = float(np.min(data.pulling_velocity[used])), float(np.max(data.pulling_velocity[used]))
+    grid = np.linspace(0.6 * lo, 1.25 * hi, 120)
+    curve, start, stiffness = fit.stick_time_curve(grid)
+    ax.plot(
+        grid * UM, curve, color="C0",
+        label=f"model t_s(V0): start {start:.4g} Pa, K = {stiffness / 1e3:.4g} kPa/m (medians of the rows)",
+    )  # fmt: skip
+    ax.set_xlim(0.0, 1.3 * hi * UM)
+    top = np.nanmax(np.concatenate([data.stick_time, fit.model_stick_time[used], curve[np.isfinite(curve)]]))
+    ax.set_ylim(0.0, 1.15 * top)
     ax.set_xlabel("pulling velocity V0 (µm/s)")
     ax.set_ylabel("stick time ts (s)")
+    ax.set_title("Stick-phase fit (Eq 15)", fontsize="medium")
     ax.legend(fontsize="small")
     return ax
+
+
+def _spread(velocity: np.ndarray, used: np.ndarray) -> np.ndarray:
+    """Small horizontal offsets (um/s) so that repeated cycles at one velocity do not hide each other."""
+    out = np.zeros(velocity.size)
+    width = 0.006 * float(np.max(velocity[used])) * UM
+    for v in np.unique(velocity[used]):
+        same = np.nonzero(used & (velocity == v))[0]
+        out[same] = (np.arange(same.size) - (same.size - 1) / 2) * width
+    return out
 
 
 def corner_figure(posterior: SteadyPosterior) -> Figure:

@@ -109,8 +109,16 @@ class SteadyFit:
     samples: dict[str, np.ndarray] | None = field(default=None, repr=False)
 
     @property
-    def reduced_chi_square(self) -> float:
-        return self.chi_square / self.dof if self.dof > 0 else float("nan")
+    def noise_estimated(self) -> bool:
+        """True when the data state no errors and the noise level is estimated from the residuals."""
+        return self.data.stress_err is None
+
+    @property
+    def reduced_chi_square(self) -> float | None:
+        """chi^2/dof with the stated errors; None when the noise is estimated from the residuals (it is 1 then)."""
+        if self.noise_estimated or self.dof <= 0:
+            return None
+        return self.chi_square / self.dof
 
     def estimate(self, key: str) -> Estimate:
         for e in (*self.estimates, *self.combinations):
@@ -144,6 +152,7 @@ class SteadyFit:
             "dof": self.dof,
             "reduced_chi_square": self.reduced_chi_square,
             "noise": self.noise,
+            "relative_noise": self.noise_scale if self.noise_estimated else None,
             "correlation": {
                 "keys": list(self.free_keys),
                 "matrix": self.correlation.tolist(),
