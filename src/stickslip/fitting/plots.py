@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+from contextlib import contextmanager
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -139,11 +141,40 @@ def _spread(velocity: np.ndarray, used: np.ndarray) -> np.ndarray:
 
 
 def corner_figure(posterior: SteadyPosterior) -> Figure:
-    """Corner plot of the posterior (the ``corner`` package), in log10 of the SI values, with Vc and sigma_c."""
+    """Corner plot of the posterior (the ``corner`` package) in units people use, with Vc and sigma_c;
+    titles give the median and the central 95 % credible interval."""
     import corner
     from matplotlib.figure import Figure
 
     samples, labels = posterior.corner_samples()
-    fig = Figure(figsize=(1.6 * len(labels) + 1, 1.6 * len(labels) + 1))
-    corner.corner(samples, labels=labels, fig=fig, quantiles=[0.025, 0.5, 0.975], show_titles=True, title_fmt=".3g")
+    size = 1.9 * len(labels) + 1
+    fig = Figure(figsize=(size, size))
+    with _corner_log_captured():
+        corner.corner(
+            samples, labels=labels, fig=fig, quantiles=[0.025, 0.5, 0.975], show_titles=True, title_fmt=".3g",
+            title_quantiles=[0.025, 0.5, 0.975], title_kwargs={"fontsize": 9}, label_kwargs={"fontsize": 10},
+            max_n_ticks=3, plot_contours=samples.shape[0] >= 200,
+        )  # fmt: skip
+    fig.suptitle(f"posterior: {samples.shape[0]} samples; titles: median and central 95 % interval", fontsize=10)
     return fig
+
+
+class _CornerLogFilter:
+    """Keeps corner's messages (it logs to the root logger) off the user's terminal; they are about contour
+    drawing only."""
+
+    def filter(self, record: Any) -> bool:
+        return "corner" not in record.pathname
+
+
+@contextmanager
+def _corner_log_captured() -> Iterator[None]:
+    import logging
+
+    root = logging.getLogger()
+    log_filter = _CornerLogFilter()
+    root.addFilter(log_filter)
+    try:
+        yield
+    finally:
+        root.removeFilter(log_filter)
