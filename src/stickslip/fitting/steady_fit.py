@@ -59,8 +59,6 @@ DEFAULT_SPLIT = 800e-6
 AGING_NEGLECT_WARNING = 0.5
 #: ln-widths beyond this give an unbounded upper end (e^700 ~ 1e304: no number, only "unbounded").
 LARGEST_LOG_WIDTH = 700.0
-#: The two-step interval is widened by the method's own bias when that exceeds this many standard errors.
-BIAS_TOLERANCE = 0.25
 #: Above this many points the joint fit's automatic intervals are the delta method's, not the profile's.
 PROFILE_MAX_POINTS = 1000
 #: Give up the fix-and-refit loop after this many rounds (never reached: each round fixes one key).
@@ -476,7 +474,7 @@ def fit_steady(
         fix, free, base, bootstrap_samples, seed, scale2, progress,
     )  # fmt: skip
     if method == "two-step" and vc.value is not None:
-        vc, sc = _flag_split_bias(vc, sc, fitted, everything, keys, level, progress)
+        vc, sc = _flag_split_bias(vc, sc, fitted, everything, keys, scale2, level, progress)
     _note_extrapolation(progress, vc, data)
     return SteadyFit(
         data=data,
@@ -549,6 +547,7 @@ def _flag_split_bias(
     fitted: Parameters,
     everything: Block,
     keys: Sequence[str],
+    scale2: float,
     level: float,
     progress: _Progress,
 ) -> tuple[Estimate, Estimate]:
@@ -557,27 +556,37 @@ def _flag_split_bias(
     The two-step fit neglects aging above the split, so even exact data give a shifted answer, and the
     shift does not shrink with more data while the interval does (docs/fitting.md).  The shift is measured
     against the joint fit of the same free keys on all points with aging, started from the two-step
-    result: the joint fit has no such approximation.  When the difference exceeds BIAS_TOLERANCE standard
-    errors the interval is extended by it towards the joint value, and said so.
+    result: the joint fit has no such approximation.  With noise the two estimates also differ by chance,
+    by up to about the larger of their standard errors (on 24 points they differ by 0-1.5 of them).  When
+    the difference exceeds that times the interval's quantile -- the bias would carry the truth out of the
+    interval -- the interval is extended by it towards the joint value, and said so.
     """
     space = Space(fitted, tuple(keys))
     try:
-        joint = space.params(minimize(space, space.vector(), everything).theta)
+        theta = minimize(space, space.vector(), everything).theta
+        joint_space = Space(space.params(theta), tuple(keys))
+        located = local_critical(joint_space.base, float(vc.value))  # type: ignore[arg-type]
+        if located is None:
+            return vc, sc
+        jac = jacobian(joint_space, theta, everything)
+        covariance = scale2 * _inverse(jac.T @ jac)
+        gradients = critical_gradient(joint_space, theta, located[0])
     except (ModelError, ParameterError):  # pragma: no cover - the two-step optimum is a valid start
         return vc, sc
-    located = local_critical(joint, float(vc.value))  # type: ignore[arg-type]
-    if located is None:
-        return vc, sc
     out = []
-    for estimate, other in ((vc, located[0]), (sc, located[1])):
-        out.append(_widened(estimate, float(estimate.value) - other, level, progress))  # type: ignore[arg-type]
+    for estimate, other, grad in zip((vc, sc), located, gradients, strict=True):
+        joint_se = other * math.sqrt(max(float(grad @ covariance @ grad), 0.0))
+        out.append(_widened(estimate, float(estimate.value) - other, joint_se, level, progress))  # type: ignore[arg-type]
     return out[0], out[1]
 
 
-def _widened(estimate: Estimate, bias: float, level: float, progress: _Progress) -> Estimate:
+def _widened(estimate: Estimate, bias: float, joint_se: float, level: float, progress: _Progress) -> Estimate:
     """``estimate`` with its estimated method bias; the interval extended by it when it is not negligible."""
     stderr = estimate.stderr
-    if estimate.interval is None or stderr is None or not stderr > 0 or abs(bias) <= BIAS_TOLERANCE * stderr:
+    if estimate.interval is None or stderr is None or not stderr > 0 or not math.isfinite(joint_se):
+        return dataclasses.replace(estimate, bias=bias)
+    quantile = float(stats.norm.ppf(0.5 + level / 2.0))
+    if abs(bias) <= quantile * max(stderr, joint_se):  # within what chance alone gives: no evidence of bias
         return dataclasses.replace(estimate, bias=bias)
     lo, hi = estimate.interval
     new_lo = None if lo is None else min(lo, lo - bias)
