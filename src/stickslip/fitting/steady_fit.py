@@ -589,19 +589,21 @@ def _widened(estimate: Estimate, bias: float, joint_se: float, level: float, pro
     if abs(bias) <= quantile * max(stderr, joint_se):  # within what chance alone gives: no evidence of bias
         return dataclasses.replace(estimate, bias=bias)
     lo, hi = estimate.interval
-    new_lo = None if lo is None else min(lo, lo - bias)
-    new_hi = None if hi is None else max(hi, hi - bias)
+    joint = float(estimate.value) - bias  # type: ignore[arg-type]
+    joint_lo, joint_hi = _log_interval(joint, joint_se / joint, quantile)
+    new_lo = None if lo is None else min(lo, joint_lo)
+    new_hi = None if hi is None or joint_hi is None else max(hi, joint_hi)
     dim, symbol, size = estimate.dimension, estimate.symbol, abs(bias) / stderr
     note = (
-        f"{estimate.note}; widened by the two-step method's own bias {human(bias, dim, 3)} ({size:.2g} standard"
-        f" errors) so that it still covers the truth at the stated level"
+        f"{estimate.note}; widened to take in the joint fit's interval: the two-step method's own bias"
+        f" {human(bias, dim, 3)} ({size:.2g} standard errors) would otherwise leave the truth outside"
     )
     progress.messages.append(
         f"warning: the two-step split approximation shifts {symbol} by {human(bias, dim, 3)} against the joint"
         f" fit of all points with aging ({size:.2g} standard errors): the {100 * level:g} % interval"
         f" {_bracket(lo, hi, dim)} alone would claim a precision the method does not have, so it is widened to"
-        f" {_bracket(new_lo, new_hi, dim)} (joint fit: {symbol} = {human(float(estimate.value) - bias, dim, 5)});"
-        " --method joint has no such bias"
+        f" {_bracket(new_lo, new_hi, dim)}, taking in the joint fit's ({symbol} = {human(joint, dim, 5)} ±"
+        f" {human(joint_se, dim, 3)}); --method joint has no such bias"
     )
     return dataclasses.replace(estimate, interval=(new_lo, new_hi), note=note, bias=bias)
 
