@@ -15,13 +15,15 @@ Vc and sigma_c (Eq 9) are computed for a random subset of the posterior
 samples (local solver around the best-fit Vc), which gives their posteriors;
 the credible band of sigma(V) comes from the same kind of subset.
 
-Sampler.  An independence Metropolis-Hastings proposal (emcee's MHMove)
-from a multivariate t (10 degrees of freedom) centred on the maximum of the
-likelihood with its Gauss-Newton covariance: exact for any target (the
-Hastings factor is included), and its draws are nearly independent where
-the posterior is close to that Gaussian; on the synthetic curve the
-autocorrelation time is 5-9 steps against 17-38 for emcee's stretch move,
-which is used instead when the covariance is not finite.  By
+Sampler.  A mixture of two exact moves: half independence Metropolis-Hastings
+proposals (emcee's MHMove) from a multivariate t (10 degrees of freedom)
+centred on the maximum of the likelihood with its Gauss-Newton covariance
+(the Hastings factor included), which give nearly independent draws where
+the posterior is close to that Gaussian, and half differential-evolution
+moves (DEMove), which carry walkers through tails the Gaussian misses.  The
+autocorrelation time is 8-13 steps on the shipped synthetic curve and 22-31
+on a harder 20-point set, against 17-38 and ~190 for the stretch move alone
+and for the independence proposal alone.  By
 default the chain runs until it passes the convergence check -- at least 50
 integrated autocorrelation times after a burn-in of 5 of them -- and stops
 there, or at ``max_steps`` with a message; ``steps`` fixes the length.
@@ -65,8 +67,8 @@ MAX_STEPS = 20000
 #: The independence proposal: t with this many degrees of freedom, scale this factor times the standard errors.
 PROPOSAL_DOF = 10.0
 PROPOSAL_SCALE = 1.0
-#: Share of the independence proposal in the mixture of moves (the rest: emcee's stretch move).
-INDEPENDENCE_WEIGHT = 1.0
+#: Share of the independence proposal in the mixture of moves (the rest: differential evolution).
+INDEPENDENCE_WEIGHT = 0.5
 
 
 class BayesUnavailable(StickslipError):
@@ -260,20 +262,30 @@ class _Independence:
 
 
 def _moves(emcee: Any, centre: np.ndarray, covariance: np.ndarray) -> Any:
-    stretch = emcee.moves.StretchMove()
+    """Half independence proposals, half differential-evolution moves (see the module docstring)."""
+    evolution = emcee.moves.DEMove()
     if not np.all(np.isfinite(covariance)):
-        return stretch
+        return [(evolution, 0.8), (emcee.moves.DESnookerMove(), 0.2)]
     try:
         proposal = _Independence(centre, covariance)
     except np.linalg.LinAlgError:
-        return stretch
-    if INDEPENDENCE_WEIGHT >= 1.0:
-        return emcee.moves.MHMove(proposal)
-    return [(emcee.moves.MHMove(proposal), INDEPENDENCE_WEIGHT), (stretch, 1.0 - INDEPENDENCE_WEIGHT)]
+        return [(evolution, 0.8), (emcee.moves.DESnookerMove(), 0.2)]
+    return [(emcee.moves.MHMove(proposal), INDEPENDENCE_WEIGHT), (evolution, 1.0 - INDEPENDENCE_WEIGHT)]
 
 
 def _autocorrelation(sampler: Any, burn: int) -> np.ndarray:
-    return np.asarray(sampler.get_autocorr_time(tol=0, discard=burn), dtype=float)
+    """Integrated autocorrelation time of each parameter (steps) after ``burn``; infinite for a parameter in
+    which some walker has not moved at all since then (emcee would divide by its zero variance, and such a
+    chain has not converged)."""
+    from emcee.autocorr import integrated_time
+
+    chain = sampler.get_chain(discard=burn)  # (steps, walkers, parameters)
+    out = np.full(chain.shape[2], np.inf)
+    for k in range(chain.shape[2]):
+        values = chain[:, :, k]
+        if np.all(np.ptp(values, axis=0) > 0):
+            out[k] = float(integrated_time(values[:, :, None], tol=0)[0])
+    return out
 
 
 def _run(sampler: Any, start: np.ndarray, steps: int | None, burn: int | None, max_steps: int) -> tuple[int, int]:
@@ -334,12 +346,18 @@ def sample_posterior(
     steps, burn = _run(sampler, start, steps, burn, max_steps)
     tau = _autocorrelation(sampler, burn)
     messages = []
-    if np.any(steps - burn < CONVERGED_TIMES * tau):
+    if not np.all(np.isfinite(tau)):
+        messages.append(
+            f"some walkers did not move in the {steps - burn} steps after burn-in: the chain has not converged and"
+            " the posterior summaries are unreliable; run more --steps or check the fit"
+        )
+    elif np.any(steps - burn < CONVERGED_TIMES * tau):
         messages.append(
             f"the chain is shorter than {CONVERGED_TIMES} autocorrelation times (τ up to {np.nanmax(tau):.3g} steps"
             f" after {burn} burn-in steps of {steps}): the posterior summaries are rough; run more --steps"
         )
-    thin = max(1, int(np.nanmin(tau) / 2)) if thin is None else thin
+    finite = tau[np.isfinite(tau)]
+    thin = (max(1, int(finite.min() / 2)) if finite.size else 1) if thin is None else thin
     chain = sampler.get_chain(discard=burn, thin=thin, flat=True)
     log_prob = sampler.get_log_prob(discard=burn, thin=thin, flat=True)
     estimates = _parameter_summaries(fit, keys, chain)

@@ -46,7 +46,7 @@ from .problem import (
     minimize,
     residuals,
 )
-from .results import Estimate, human
+from .results import Estimate, display_unit, human
 
 if TYPE_CHECKING:  # pragma: no cover
     import pandas as pd
@@ -603,7 +603,7 @@ def _widened(estimate: Estimate, bias: float, joint_se: float, level: float, pro
         f" fit of all points with aging ({size:.2g} standard errors): the {100 * level:g} % interval"
         f" {_bracket(lo, hi, dim)} alone would claim a precision the method does not have, so it is widened to"
         f" {_bracket(new_lo, new_hi, dim)}, taking in the joint fit's ({symbol} = {human(joint, dim, 5)} ±"
-        f" {human(joint_se, dim, 3)}); --method joint has no such bias"
+        f" {joint_se / display_unit(joint, dim)[1]:.2g}); --method joint has no such bias"
     )
     return dataclasses.replace(estimate, interval=(new_lo, new_hi), note=note, bias=bias)
 
