@@ -22,7 +22,7 @@ Targets: a two-step fit of 20 points <= 0.5 s; emcee, 32 walkers x 2000 steps on
   stated noise) fitted by (two-step, delta), (joint, delta) and (joint, profile); the fraction of 95 %
   intervals of Vc and sigma_c that contain the truth.  Slow (minutes), not a timing.
 
-Run: ``/work/venv/bin/python benchmarks/bench_fit.py [--coverage 100]``
+Run: ``python benchmarks/bench_fit.py [--only two-step|bayes|long|stick] [--coverage 100]`` (with the package installed)
 """
 
 from __future__ import annotations

@@ -98,7 +98,7 @@ def fit_group() -> None:
     "--steps",
     type=click.IntRange(min=10),
     default=None,
-    help="emcee steps per walker [default: until the convergence check passes, at most 20000].",
+    help="emcee steps per walker [default: until the convergence check passes, at most 10000].",
 )
 @click.option(
     "--corner",

@@ -63,7 +63,7 @@ BURN_TIMES = 5
 #: Steps run between convergence checks, the fewest steps, and the most the automatic length runs.
 CHUNK_STEPS = 100
 MIN_STEPS = 200
-MAX_STEPS = 20000
+MAX_STEPS = 10000
 #: The independence proposal: t with this many degrees of freedom, scale this factor times the standard errors.
 PROPOSAL_DOF = 10.0
 PROPOSAL_SCALE = 1.0
