@@ -16,7 +16,6 @@ from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
 
-import lmfit
 import numpy as np
 
 from ..errors import ModelError, ParameterError
@@ -287,6 +286,8 @@ class Minimum:
 
 def minimize(space: Space, start: np.ndarray, block: Block, centre: np.ndarray | None = None) -> Minimum:
     """Least squares over ``space.keys`` (lmfit, trust-region reflective, bounded search box)."""
+    import lmfit  # here: the stick fit and `stickslip --help` need not pay for importing it
+
     centre = start if centre is None else centre
     if len(space.keys) == 0:
         r = residuals(space, start, block)

@@ -29,7 +29,6 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-import lmfit
 import numpy as np
 from scipy import stats
 
@@ -40,7 +39,7 @@ from ..parameters import Parameters, key_dimension, load_parameters, replace
 from ..units import to_si
 from . import identify
 from .data import StickData, read_stick_data
-from .problem import JACOBIAN_STEP, SEARCH_BOX, lmfit_covariance_ignored, lmfit_name
+from .problem import JACOBIAN_STEP, SEARCH_BOX
 from .results import Estimate, human
 from .stick_batch import stick_times
 
@@ -253,38 +252,25 @@ class _Evaluator:
 def _minimize(
     params: Parameters, keys: Sequence[str], centre: np.ndarray, rows: _Rows, max_nfev: int | None = None
 ) -> tuple[Parameters, float, bool]:
+    """Least squares in the ln-parameters (scipy's trust-region reflective, bounded to the search box)."""
+    from scipy.optimize import least_squares
+
     theta0 = np.array([math.log(params.as_dict()[k]) for k in keys])
-    pars = lmfit.Parameters()
-    for key, t, c in zip(keys, theta0, centre, strict=True):
-        pars.add(
-            lmfit_name(key),
-            value=float(np.clip(t, c - SEARCH_BOX, c + SEARCH_BOX)),
-            min=c - SEARCH_BOX,
-            max=c + SEARCH_BOX,
-        )
-    names = [lmfit_name(k) for k in keys]
+    lower, upper = centre - SEARCH_BOX, centre + SEARCH_BOX
     evaluate = _Evaluator(params, keys, rows)
-
-    def objective(p: lmfit.Parameters) -> np.ndarray:
-        return evaluate(np.array([p[n].value for n in names]))[0]
-
-    def gradient(p: lmfit.Parameters) -> np.ndarray:
-        return evaluate(np.array([p[n].value for n in names]))[1]
-
-    # stick times are known to a few per cent: tolerances of 1e-6 are ample and save ODE solves
-    with lmfit_covariance_ignored():
-        result = lmfit.minimize(
-            objective,
-            pars,
-            method="least_squares",
-            calc_covar=False,
-            Dfun=gradient,
-            ftol=1e-6,
-            xtol=1e-6,
-            gtol=1e-6,
-            max_nfev=max_nfev,
-        )
-    fitted = _with(params, keys, [result.params[n].value for n in names])
+    # stick times are known to a few per cent: tolerances of 1e-6 are ample and save integrations
+    result = least_squares(
+        lambda theta: evaluate(theta)[0],
+        np.clip(theta0, lower, upper),
+        jac=lambda theta: evaluate(theta)[1],
+        bounds=(lower, upper),
+        method="trf",
+        ftol=1e-6,
+        xtol=1e-6,
+        gtol=1e-6,
+        max_nfev=max_nfev,
+    )
+    fitted = _with(params, keys, result.x)
     r = _residuals(fitted, rows)
     return fitted, float(r @ r), bool(result.success)
 
