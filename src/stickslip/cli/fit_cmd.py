@@ -93,7 +93,7 @@ def fit_group() -> None:
 )
 @click.option("--json", "as_json", is_flag=True, help="Print the results as JSON (SI units).")
 @click.option("--bayes", is_flag=True, help="Also sample the posterior with emcee (needs stickslip[bayes]).")
-@click.option("--walkers", type=click.IntRange(min=4), default=32, show_default=True, help="emcee walkers.")
+@click.option("--walkers", type=click.IntRange(min=4), default=16, show_default=True, help="emcee walkers.")
 @click.option(
     "--steps",
     type=click.IntRange(min=10),

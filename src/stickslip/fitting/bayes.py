@@ -310,7 +310,7 @@ def _run(sampler: Any, start: np.ndarray, steps: int | None, burn: int | None, m
 
 def sample_posterior(
     fit: SteadyFit,
-    walkers: int = 32,
+    walkers: int = 16,
     steps: int | None = None,
     burn: int | None = None,
     thin: int | None = None,
