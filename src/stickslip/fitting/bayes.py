@@ -310,7 +310,7 @@ def _run(sampler: Any, start: np.ndarray, steps: int | None, burn: int | None, m
 
 def sample_posterior(
     fit: SteadyFit,
-    walkers: int = 16,
+    walkers: int | None = None,
     steps: int | None = None,
     burn: int | None = None,
     thin: int | None = None,
@@ -320,13 +320,14 @@ def sample_posterior(
 ) -> SteadyPosterior:
     """Sample the posterior of the fit's free parameters with emcee (module docstring for the priors).
 
-    ``steps=None`` runs until the convergence check passes (at most ``max_steps``); ``burn=None`` is
-    5 autocorrelation times (a quarter of a fixed ``steps``).
+    ``walkers=None`` is max(16, 4 x the sampled keys); ``steps=None`` runs until the convergence check
+    passes (at most ``max_steps``); ``burn=None`` is 5 autocorrelation times (a quarter of a fixed ``steps``).
     """
     emcee = _emcee()
     keys = tuple(fit.free_keys)
     if not keys:
         raise ParameterError("nothing to sample: the fit has no free parameters")
+    walkers = max(16, 4 * len(keys)) if walkers is None else walkers
     if walkers < 2 * len(keys):
         raise ParameterError(f"walkers: need at least {2 * len(keys)} for {len(keys)} parameters, got {walkers}")
     if steps is not None and steps < 10:
