@@ -118,9 +118,9 @@ def plot_stick_fit(fit: StickFit, ax: Axes | None = None) -> Axes:
     curve, start, stiffness = fit.stick_time_curve(grid)
     ax.plot(
         grid * UM, curve, color="C0",
-        label=f"model t_s(V0): start {start:.4g} Pa, K = {stiffness / 1e3:.4g} kPa/m (medians of the rows)",
+        label=f"model t_s(V0): start {start:.4g} Pa, loading rate/V0 {stiffness / 1e3:.4g} kPa/m (row medians)",
     )  # fmt: skip
-    ax.set_xlim(0.0, 1.3 * hi * UM)
+    ax.set_xlim(0.0, max(1.3 * hi, 1.1 * float(np.max(data.pulling_velocity))) * UM)  # left-out rows too
     top = np.nanmax(np.concatenate([data.stick_time, fit.model_stick_time[used], curve[np.isfinite(curve)]]))
     ax.set_ylim(0.0, 1.15 * top)
     ax.set_xlabel("pulling velocity V0 (µm/s)")
