@@ -11,11 +11,18 @@ Targets: a two-step fit of 20 points <= 0.5 s; emcee, 32 walkers x 2000 steps on
 * Bayesian: ``sample_posterior`` (walkers evaluated in one batch, see stickslip.fitting.batch).
   Reference: the same emcee run with one ``steady_state`` call per walker (``vectorize=False``),
   run for 200 steps and extrapolated to 2000 (said so in the output).
+* long record (issue 12): ``fit_steady`` two-step and joint on 10^5 points (140-2000 um/s, 2 % stated
+  noise), fitted through the compressed block (Chebyshev nodes in ln V, docs/fitting.md).  Reference: the
+  same fits evaluating the model at every point (compression switched off), run on 10^4 points and
+  scaled by 10 (their cost is linear in the points; at 10^5 the two-step took 44 s and the joint did not
+  finish in 580 s).  Wall and process times; the Vc interval against the truth.
+* stick fit (issue 9): ``fit_stick`` on the paper's Table 1 (default options).  Reference: the same fit
+  with each stick time from ``stick_phase`` (scipy's adaptive Runge-Kutta per row and per Jacobian set).
 * ``--coverage N``: the coverage study behind docs/fitting.md -- N synthetic data sets (24 points, 2 %
   stated noise) fitted by (two-step, delta), (joint, delta) and (joint, profile); the fraction of 95 %
   intervals of Vc and sigma_c that contain the truth.  Slow (minutes), not a timing.
 
-Run: ``/work/venv/bin/python benchmarks/bench_fit.py [--coverage 100]``
+Run: ``python benchmarks/bench_fit.py [--only two-step|bayes|long|stick] [--coverage 100]`` (with the package installed)
 """
 
 from __future__ import annotations
@@ -101,7 +108,7 @@ def bench_two_step() -> None:
     print(f"  Vc = {vc.value * 1e6:.2f} um/s [{vc.interval[0] * 1e6:.2f}, {vc.interval[1] * 1e6:.2f}] (true 124.10)")
 
 
-def bench_bayes(walkers: int = 32, steps: int = 2000, reference_steps: int = 200) -> None:
+def bench_bayes(walkers: int = 32, steps: int | None = None, reference_steps: int = 200) -> None:
     import emcee
 
     data = synthetic(20, seed=2)
@@ -109,6 +116,7 @@ def bench_bayes(walkers: int = 32, steps: int = 2000, reference_steps: int = 200
     start = time.perf_counter()
     post = sample_posterior(fit, walkers=walkers, steps=steps, seed=1)
     ours = time.perf_counter() - start
+    steps = post.steps
     keys = post.keys
     centre = np.array([math.log(fit.parameters.as_dict()[k]) for k in keys])
 
@@ -128,9 +136,13 @@ def bench_bayes(walkers: int = 32, steps: int = 2000, reference_steps: int = 200
     sampler.run_mcmc(p0, reference_steps)
     plain = (time.perf_counter() - start) * steps / reference_steps
     vc = post.critical_velocity
-    print(f"emcee, {walkers} walkers x {steps} steps, 20 points")
-    print(f"  stickslip sample_posterior (batched walkers, incl. Vc of 200 samples): {ours:6.1f} s   (target 60 s)")
-    print(f"  plain loop, one steady_state per walker (200 steps, x10):             {plain:6.1f} s")
+    converged = "passes" if not post.messages else "FAILS"
+    print(f"emcee, {walkers} walkers x {steps} steps (default: until converged), 20 points")
+    print(
+        f"  stickslip sample_posterior (independence proposal, batched walkers, Vc of 400 samples): {ours:6.1f} s;"
+        f" tau up to {max(post.autocorrelation):.1f} steps, {converged} the 50-tau check"
+    )
+    print(f"  plain loop, stretch move, one steady_state per walker ({reference_steps} steps, scaled):  {plain:6.1f} s")
     lo, hi = vc.interval
     print(f"  Vc posterior median {vc.value * 1e6:.2f} um/s, 95 % [{lo * 1e6:.2f}, {hi * 1e6:.2f}]")
 
@@ -157,12 +169,85 @@ def coverage(seeds: int) -> None:
         )
 
 
+def _timed(func):  # (wall s, process s, result)
+    wall, cpu = time.perf_counter(), time.process_time()
+    out = func()
+    return time.perf_counter() - wall, time.process_time() - cpu, out
+
+
+def bench_long_record(points: int = 100_000, reference_points: int = 10_000) -> None:
+    from stickslip.fitting import problem
+
+    data = synthetic(points, seed=7)
+    small = synthetic(reference_points, seed=7)
+    print(f"steady fit of {points} points (wall / process time; the machine is shared, so wall is contended)")
+    for method in ("two-step", "joint"):
+        times = [_timed(lambda m=method: fit_steady(data, method=m)) for _ in range(2)]
+        wall = sorted(t[0] for t in times)
+        cpu = min(t[1] for t in times)
+        vc = times[-1][2].critical_velocity
+        lo, hi = vc.interval
+        print(
+            f"  {method:8s} stickslip: best {wall[0]:6.2f} s, median {wall[len(wall) // 2]:6.2f} s wall,"
+            f" {cpu:6.2f} s process;  Vc = {vc.value * 1e6:.2f} um/s, 95 % [{lo * 1e6:.2f}, {hi * 1e6:.2f}]"
+            " (true 124.10)"
+        )
+        saved = problem.INTERPOLATE_ABOVE
+        problem.INTERPOLATE_ABOVE = 10**12  # the plain way: the model at every point
+        try:
+            wall_ref, cpu_ref, _ = _timed(lambda m=method: fit_steady(small, method=m))
+        finally:
+            problem.INTERPOLATE_ABOVE = saved
+        scale = points / reference_points
+        print(
+            f"  {method:8s} plain (model at every point), {reference_points} points: {wall_ref:6.1f} s wall,"
+            f" {cpu_ref:6.1f} s process; x{scale:g} for {points}: ~{wall_ref * scale:6.0f} s"
+        )
+
+
+def bench_stick() -> None:
+    from stickslip.fitting import datasets, fit_stick, stick_fit
+    from stickslip.model.stick import stick_phase
+
+    table = datasets.table1_path()
+    fit_stick(table)  # warm-up
+    runs = [_timed(lambda: fit_stick(table)) for _ in range(5)]
+    wall = sorted(r[0] for r in runs)
+    fit = runs[-1][2]
+
+    def one_by_one(sets, rows, horizon_factor=None):
+        out = np.full((len(sets), rows.stick_time.size), np.nan)
+        for i, params in enumerate(sets):
+            for j, (v, s0, rate) in enumerate(zip(rows.velocity, rows.start, rows.rate, strict=True)):
+                phase = stick_phase(stick_fit._params_for_rate(params, float(v), float(rate)), float(v), float(s0))
+                out[i, j] = np.nan if phase.stick_time is None else phase.stick_time
+        return out
+
+    batched = stick_fit._stick_times
+    stick_fit._stick_times = one_by_one
+    try:
+        wall_ref, cpu_ref, reference = _timed(lambda: fit_stick(table))
+    finally:
+        stick_fit._stick_times = batched
+    nc0, ref_nc0 = fit.parameters.stick.attached_chains, reference.parameters.stick.attached_chains
+    print("stick fit of Table 1 (default options)")
+    print(
+        f"  stickslip (vectorised stick times): best {wall[0] * 1e3:6.0f} ms, median {wall[2] * 1e3:6.0f} ms wall,"
+        f" {min(r[1] for r in runs) * 1e3:6.0f} ms process   (target 1 s for the command)"
+    )
+    print(f"  plain (stick_phase per row and set): {wall_ref * 1e3:6.0f} ms wall, {cpu_ref * 1e3:6.0f} ms process")
+    print(f"  Nc0 = {nc0:.6g} vs {ref_nc0:.6g} m^-2 (relative difference {abs(nc0 / ref_nc0 - 1):.1e})")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--coverage", type=int, default=0, metavar="N", help="also run the coverage study")
+    parser.add_argument("--only", choices=["two-step", "bayes", "long", "stick"], help="run one benchmark")
     args = parser.parse_args()
-    bench_two_step()
-    bench_bayes()
+    benches = {"two-step": bench_two_step, "bayes": bench_bayes, "long": bench_long_record, "stick": bench_stick}
+    for name, bench in benches.items():
+        if args.only in (None, name):
+            bench()
     if args.coverage:
         coverage(args.coverage)
 

@@ -104,6 +104,7 @@ def test_bayes_option(tmp_path, capsys):
         "--corner", str(corner_png), "--json",
     )  # fmt: skip
     assert code == 0, err
+    assert err == ""  # no stray root-logger output from corner (issue 9)
     posterior = json.loads(out)["posterior"]
     assert posterior["walkers"] == 10 and posterior["steps"] == 20
     assert any("uniform in ln" in p for p in posterior["priors"])
@@ -135,3 +136,39 @@ def test_fit_stick(tmp_path, capsys):
     assert fitted.stick.attached_chains == pytest.approx(result["parameters"]["stick.attached_chains"]["value"])
     code, out, err = run(capsys, "fit", "stick", str(table), "--exclude-row", "7")
     assert code == 2 and "no such data row" in err
+
+
+def test_curve_output_feeds_fit_steady(tmp_path, capsys):
+    """What one command writes the next reads (issue 9): curve's extra columns are ignored with a note."""
+    curve = tmp_path / "c.csv"
+    code, _, err = run(capsys, "curve", "--format", "csv", "-o", str(curve), "--vmin", "140 um/s", "--points", "30")
+    assert code == 0, err
+    assert "bonded_fraction" in curve.read_text().splitlines()[0]
+    code, out, err = run(capsys, "fit", "steady", str(curve), "--json")
+    assert code == 0, err
+    result = json.loads(out)
+    notes = [m for m in result["messages"] if "ignored" in m]
+    assert len(notes) == 1 and "bonded_fraction" in notes[0] and "stress_slope" in notes[0]
+    assert result["reduced_chi_square"] is None  # noise estimated from the residuals
+    # an unknown column still fails, naming it
+    bad = tmp_path / "bad.csv"
+    bad.write_text(curve.read_text().replace("bonded_fraction", "friction_colour", 1))
+    code, out, err = run(capsys, "fit", "steady", str(bad))
+    assert code == 2 and "unknown column 'friction_colour'" in err and err.count("\n") == 1
+
+
+def test_absurd_stresses_are_refused_with_one_line_and_no_warnings(tmp_path, capsys):
+    path = tmp_path / "big.csv"
+    path.write_text("velocity,stress\n" + "".join(f"{v!r},{1e300 * (1 + k)!r}\n" for k, v in enumerate(
+        [1e-5, 1e-4, 1e-3, 1e-2, 1e-1])))  # fmt: skip
+    code, out, err = run(capsys, "fit", "steady", str(path))
+    assert code == 2 and out == "" and err.count("\n") == 1
+    assert "row 2, column 'stress'" in err and "outside the range of a friction stress" in err
+
+
+def test_fit_stick_report_and_plot(tmp_path, capsys):
+    png = tmp_path / "stick.png"
+    code, out, err = run(capsys, "fit", "stick", str(datasets.table1_path()), "--exclude-row", "11", "--plot", str(png))
+    assert code == 0, err
+    assert "χ²ᵣ = 1 by construction" in out and "reduced χ² =" not in out
+    assert png.read_bytes()[:4] == b"\x89PNG"

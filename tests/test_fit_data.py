@@ -59,6 +59,8 @@ def test_bare_names_are_si_and_stress_err_is_optional(tmp_path):
         ("velocity,stress_err\n1,2\n", "missing column(s) stress"),
         ("velocity,stress,stress_err\n1e-4,250,1\n2e-4,300,-1\n4e-4,400,1\n8e-4,600,1\n", "row 3, column 'stress_err'"),
         ("", "empty file"),
+        ("velocity,stress\n1e-4,250\n2e-4,1e300\n4e-4,400\n8e-4,600\n", "row 3, column 'stress': 1e+300 Pa is outside"),
+        ("velocity,stress\n1e-4,250\n2e9,300\n4e-4,400\n8e-4,600\n", "row 3, column 'velocity': 2e+09 m/s"),
     ],
 )
 def test_bad_steady_files_name_row_and_column(tmp_path, text, expected):
@@ -156,3 +158,12 @@ def test_synthetic_data_scatter_matches_the_stated_noise():
     assert np.allclose(data.stress_err / true, 0.02, atol=1e-4)
     # 24 standard normal deviates: chi-square with 24 dof lies in [9.9, 45.6] with probability 0.998
     assert 9.9 < float(z @ z) < 45.6
+
+
+def test_columns_of_the_curve_command_are_ignored_with_a_note(tmp_path):
+    text = "velocity [m/s],stress [Pa],bonded_fraction,stress_slope [Pa s/m]\n"
+    text += "".join(f"{v},{s},0.5,-1e6\n" for v, s in ((1e-4, 250), (2e-4, 300), (4e-4, 400), (8e-4, 600)))
+    data = read_steady_data(write(tmp_path, text))
+    assert data.ignored_columns == ("bonded_fraction", "stress_slope")
+    assert len(data.notes()) == 1 and "ignored" in data.notes()[0]
+    assert np.allclose(data.stress, [250, 300, 400, 600]) and data.stress_err is None

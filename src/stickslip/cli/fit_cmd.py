@@ -102,8 +102,18 @@ def fit_group() -> None:
 )
 @click.option("--json", "as_json", is_flag=True, help="Print the results as JSON (SI units).")
 @click.option("--bayes", is_flag=True, help="Also sample the posterior with emcee (needs stickslip[bayes]).")
-@click.option("--walkers", type=click.IntRange(min=4), default=32, show_default=True, help="emcee walkers.")
-@click.option("--steps", type=click.IntRange(min=10), default=2000, show_default=True, help="emcee steps per walker.")
+@click.option(
+    "--walkers",
+    type=click.IntRange(min=4),
+    default=None,
+    help="emcee walkers [default: max(16, 4 x the fitted parameters)].",
+)
+@click.option(
+    "--steps",
+    type=click.IntRange(min=10),
+    default=None,
+    help="emcee steps per walker [default: until the convergence check passes, at most 10000].",
+)
 @click.option(
     "--corner",
     "corner_path",
@@ -126,8 +136,8 @@ def steady_command(
     plot_path: Path | None,
     as_json: bool,
     bayes: bool,
-    walkers: int,
-    steps: int,
+    walkers: int | None,
+    steps: int | None,
     corner_path: Path | None,
     params_name: str,
     overrides: tuple[str, ...],

@@ -2,12 +2,20 @@
 
 :func:`stickslip.model.steady.steady_stress_many` evaluates all sets in one
 quadrature march.  A set for which the model has no finite answer makes the
-batch raise; then each set is evaluated alone so that only its row is NaN.
+batch fail; then each set is evaluated alone so that only its row is NaN.
+
+Trial parameters of an optimiser or a sampler can be absurd (a factor 1e4
+from the start in every key).  Where the model's arithmetic overflows there,
+the trial set is counted as a failure of the model (a ModelError, or a NaN
+row) instead of letting numpy's warning reach the user; valid parameters
+never warn, so nothing is hidden.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+import warnings
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
 
 import numpy as np
 
@@ -16,11 +24,30 @@ from ..model.steady import steady_state, steady_stress_many
 from ..parameters import Parameters
 
 
+@contextmanager
+def overflow_is_failure() -> Iterator[None]:
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        try:
+            yield
+        except (RuntimeWarning, FloatingPointError, OverflowError) as exc:
+            raise ModelError(f"the steady model has no finite answer for these parameters ({exc})") from None
+
+
+def model_stress(params: Parameters, velocity: np.ndarray, aging: bool = True) -> np.ndarray:
+    """sigma(V) of Eqs 6-8; ModelError where the model's arithmetic overflows or the answer is not finite."""
+    with overflow_is_failure():
+        stress = steady_state(params, velocity, aging=aging).stress
+    if not np.all(np.isfinite(stress)):
+        raise ModelError("the steady model has no finite answer for these parameters")
+    return stress
+
+
 def _loop(params_list: Sequence[Parameters], velocity: np.ndarray, aging: bool) -> np.ndarray:
     out = np.full((len(params_list), velocity.size), np.nan)
     for k, p in enumerate(params_list):
         try:
-            out[k] = steady_state(p, velocity, aging=aging).stress
+            out[k] = model_stress(p, velocity, aging=aging)
         except (ModelError, ParameterError):
             pass
     return out
@@ -30,6 +57,10 @@ def stress_many(params_list: Sequence[Parameters], velocity: np.ndarray, aging: 
     """sigma(V) of Eqs 6-8, shape (len(params_list), len(velocity)); NaN rows where the model fails."""
     velocity = np.asarray(velocity, dtype=float).ravel()
     try:
-        return steady_stress_many(list(params_list), velocity, aging=aging)
+        with overflow_is_failure():
+            out = steady_stress_many(list(params_list), velocity, aging=aging)
+        if np.all(np.isfinite(out)):
+            return out
     except (ModelError, ParameterError):
-        return _loop(params_list, velocity, aging)  # isolate the sets that fail
+        pass
+    return _loop(params_list, velocity, aging)  # isolate the sets that fail

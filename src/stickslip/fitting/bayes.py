@@ -14,6 +14,19 @@ it fixed stay fixed, for the reasons it gave.  Stated priors:
 Vc and sigma_c (Eq 9) are computed for a random subset of the posterior
 samples (local solver around the best-fit Vc), which gives their posteriors;
 the credible band of sigma(V) comes from the same kind of subset.
+
+Sampler.  A mixture of two exact moves: half independence Metropolis-Hastings
+proposals (emcee's MHMove) from a multivariate t (10 degrees of freedom)
+centred on the maximum of the likelihood with its Gauss-Newton covariance
+(the Hastings factor included), which give nearly independent draws where
+the posterior is close to that Gaussian, and half differential-evolution
+moves (DEMove), which carry walkers through tails the Gaussian misses.  The
+autocorrelation time is 8-13 steps on the shipped synthetic curve and 22-31
+on a harder 20-point set, against 17-38 and ~190 for the stretch move alone
+and for the independence proposal alone.  By
+default the chain runs until it passes the convergence check -- at least 50
+integrated autocorrelation times after a burn-in of 5 of them -- and stops
+there, or at ``max_steps`` with a message; ``steps`` fixes the length.
 """
 
 from __future__ import annotations
@@ -30,8 +43,8 @@ from ..parameters import Parameters, key_dimension
 from . import identify
 from .batch import stress_many
 from .critical_uncertainty import critical_many
-from .problem import SEARCH_BOX, Space
-from .results import Estimate
+from .problem import SEARCH_BOX, Space, jacobian, make_block, minimize
+from .results import Estimate, display_unit
 
 if TYPE_CHECKING:  # pragma: no cover
     import pandas as pd
@@ -41,8 +54,21 @@ if TYPE_CHECKING:  # pragma: no cover
     from .steady_fit import SteadyFit
 
 #: Posterior samples used for Vc, sigma_c and the credible band.
-CRITICAL_DRAWS = 200
+CRITICAL_DRAWS = 400
 BAND_DRAWS = 200
+#: Convergence check: the chain after burn-in is at least this many autocorrelation times long ...
+CONVERGED_TIMES = 50
+#: ... after a burn-in of this many autocorrelation times.
+BURN_TIMES = 5
+#: Steps run between convergence checks, the fewest steps, and the most the automatic length runs.
+CHUNK_STEPS = 100
+MIN_STEPS = 200
+MAX_STEPS = 10000
+#: The independence proposal: t with this many degrees of freedom, scale this factor times the standard errors.
+PROPOSAL_DOF = 10.0
+PROPOSAL_SCALE = 1.0
+#: Share of the independence proposal in the mixture of moves (the rest: differential evolution).
+INDEPENDENCE_WEIGHT = 0.5
 
 
 class BayesUnavailable(StickslipError):
@@ -104,14 +130,35 @@ class SteadyPosterior:
         return velocity, low, high
 
     def corner_samples(self) -> tuple[np.ndarray, list[str]]:
-        """log10 of the sampled parameters (SI) and of Vc, sigma_c on the subset where they were computed."""
+        """Samples for the corner plot in units people use (µs, µm/s, Pa...), with axis labels.
+
+        The rows are those where Vc and sigma_c were computed; a quantity whose 95 % range spans more than
+        a factor 30 is shown as log10 of its value in that unit.
+        """
         rng = np.random.default_rng(1)
         n = self.critical_samples.shape[0]
         rows = rng.choice(self.chain.shape[0], size=n, replace=False) if n < self.chain.shape[0] else np.arange(n)
-        params = self.chain[rows] / math.log(10.0)
-        both = np.column_stack([params, np.log10(self.critical_samples)])
-        labels = [f"log10 {identify.SYMBOLS.get(k, k)}" for k in self.keys] + ["log10 Vc", "log10 σc"]
-        return both, labels
+        columns = [
+            (np.exp(self.chain[rows, i]), identify.SYMBOLS.get(k, k), key_dimension(k)) for i, k in enumerate(self.keys)
+        ]
+        columns += [(self.critical_samples[:, 0], "Vc", "velocity"), (self.critical_samples[:, 1], "σc", "stress")]
+        out, labels = [], []
+        for values, symbol, dimension in columns:
+            unit, size = display_unit(float(np.median(values)), dimension)
+            power = math.floor(math.log10(abs(float(np.median(values)) / size) or 1.0))
+            if abs(power) >= 4:  # no unit for it (site densities): a power of ten in the label instead
+                size *= 10.0**power
+                unit = f"1e{power} {unit}".strip()
+            scaled = values / size
+            lo, hi = np.quantile(scaled, [0.025, 0.975])
+            suffix = f" ({unit})" if unit else ""
+            if lo > 0 and hi / lo > 30:
+                out.append(np.log10(scaled))
+                labels.append(f"log10 {symbol}{suffix}")
+            else:
+                out.append(scaled)
+                labels.append(f"{symbol}{suffix}")
+        return np.column_stack(out), labels
 
     def to_frame(self) -> pd.DataFrame:
         """The posterior samples as SI values, one column per key, and their log-probability."""
@@ -158,10 +205,19 @@ class _LogPosterior:
         centre = Space(fit.start, keys).vector()
         self.lower, self.upper = centre - SEARCH_BOX, centre + SEARCH_BOX
         data = fit.data
-        self.velocity = data.velocity
-        self.stress = data.stress
+        self.points = len(data)
         self.stated = data.stress_err is not None
-        self.error = data.stress_err if data.stress_err is not None else data.stress
+        error = data.stress_err if data.stress_err is not None else data.stress
+        # all points with aging; a long record compressed exactly (stickslip.fitting.problem.Block)
+        self.block = make_block(data.velocity, data.stress, error, True, fit.parameters)
+
+    def mode(self) -> tuple[np.ndarray, np.ndarray]:
+        """The maximum of the likelihood over the sampled keys, from the fit, and its Gauss-Newton covariance
+        (the centre and shape of the independence proposal; for two-step fits these differ from the fit's)."""
+        best = minimize(self.space, self.space.vector(), self.block)
+        jac = jacobian(Space(self.space.params(best.theta), self.space.keys), best.theta, self.block)
+        scale = 1.0 if self.stated else best.chi_square / max(self.points - len(self.space.keys), 1)
+        return best.theta, scale * np.linalg.pinv(jac.T @ jac)
 
     def __call__(self, thetas: np.ndarray) -> np.ndarray:
         out = np.full(thetas.shape[0], -np.inf)
@@ -176,53 +232,133 @@ class _LogPosterior:
             except ParameterError:  # exp overflow cannot happen inside the box, but be safe
                 sets.append(None)
         good = [k for k, p in zip(rows, sets, strict=True) if p is not None]
-        stress = stress_many([p for p in sets if p is not None], self.velocity)
-        chi = np.sum(((stress - self.stress) / self.error) ** 2, axis=1)
+        stress = stress_many([p for p in sets if p is not None], self.block.eval_points, aging=True)
+        r = self.block.residuals_of(stress)
+        chi = np.sum(r * r, axis=1) + self.block.offset
         finite = np.isfinite(chi)
         good_rows = np.asarray(good)[finite]
         chi = chi[finite]
-        out[good_rows] = -0.5 * chi if self.stated else -0.5 * self.velocity.size * np.log(chi)
+        out[good_rows] = -0.5 * chi if self.stated else -0.5 * self.points * np.log(chi)
         return out
+
+
+class _Independence:
+    """Independence proposal q(x): multivariate t around the least-squares estimate (see module docstring)."""
+
+    def __init__(self, centre: np.ndarray, covariance: np.ndarray) -> None:
+        self.centre = centre
+        self.chol = np.linalg.cholesky(PROPOSAL_SCALE**2 * covariance)
+
+    def log_q(self, x: np.ndarray) -> np.ndarray:
+        z = np.linalg.solve(self.chol, (x - self.centre).T)
+        return -0.5 * (PROPOSAL_DOF + self.centre.size) * np.log1p(np.sum(z * z, axis=0) / PROPOSAL_DOF)
+
+    def __call__(self, x0: np.ndarray, random: np.random.RandomState) -> tuple[np.ndarray, np.ndarray]:
+        count, dim = x0.shape
+        z = random.standard_normal((count, dim))
+        w = np.sqrt(PROPOSAL_DOF / random.chisquare(PROPOSAL_DOF, size=count))
+        x = self.centre + (z @ self.chol.T) * w[:, None]
+        return x, self.log_q(x0) - self.log_q(x)  # log q(x0)/q(x): the Hastings factor
+
+
+def _moves(emcee: Any, centre: np.ndarray, covariance: np.ndarray) -> Any:
+    """Half independence proposals, half differential-evolution moves (see the module docstring)."""
+    evolution = emcee.moves.DEMove()
+    if not np.all(np.isfinite(covariance)):
+        return [(evolution, 0.8), (emcee.moves.DESnookerMove(), 0.2)]
+    try:
+        proposal = _Independence(centre, covariance)
+    except np.linalg.LinAlgError:
+        return [(evolution, 0.8), (emcee.moves.DESnookerMove(), 0.2)]
+    return [(emcee.moves.MHMove(proposal), INDEPENDENCE_WEIGHT), (evolution, 1.0 - INDEPENDENCE_WEIGHT)]
+
+
+def _autocorrelation(sampler: Any, burn: int) -> np.ndarray:
+    """Integrated autocorrelation time of each parameter (steps) after ``burn``; infinite for a parameter in
+    which some walker has not moved at all since then (emcee would divide by its zero variance, and such a
+    chain has not converged)."""
+    from emcee.autocorr import integrated_time
+
+    chain = sampler.get_chain(discard=burn)  # (steps, walkers, parameters)
+    out = np.full(chain.shape[2], np.inf)
+    for k in range(chain.shape[2]):
+        values = chain[:, :, k]
+        if np.all(np.ptp(values, axis=0) > 0):
+            out[k] = float(integrated_time(values[:, :, None], tol=0)[0])
+    return out
+
+
+def _run(sampler: Any, start: np.ndarray, steps: int | None, burn: int | None, max_steps: int) -> tuple[int, int]:
+    """Run the chain: ``steps`` steps, or by default until the convergence check passes (at most
+    ``max_steps``).  Returns (steps run, burn-in)."""
+    if steps is not None:
+        sampler.run_mcmc(start, steps)
+        return steps, steps // 4 if burn is None else burn
+    state, total = start, 0
+    while True:
+        state = sampler.run_mcmc(state, CHUNK_STEPS)
+        total += CHUNK_STEPS
+        if total < MIN_STEPS:
+            continue
+        tau = float(np.max(_autocorrelation(sampler, 0)))
+        chosen = (math.ceil(BURN_TIMES * tau) if math.isfinite(tau) else total // 4) if burn is None else burn
+        chosen = min(chosen, total // 2)
+        tau = float(np.max(_autocorrelation(sampler, chosen)))
+        if (math.isfinite(tau) and total - chosen >= CONVERGED_TIMES * tau) or total >= max_steps:
+            return total, chosen
 
 
 def sample_posterior(
     fit: SteadyFit,
-    walkers: int = 32,
-    steps: int = 2000,
+    walkers: int | None = None,
+    steps: int | None = None,
     burn: int | None = None,
     thin: int | None = None,
     seed: int | None = None,
     critical_draws: int = CRITICAL_DRAWS,
-    progress: bool = False,
+    max_steps: int = MAX_STEPS,
 ) -> SteadyPosterior:
-    """Sample the posterior of the fit's free parameters with emcee (module docstring for the priors)."""
+    """Sample the posterior of the fit's free parameters with emcee (module docstring for the priors).
+
+    ``walkers=None`` is max(16, 4 x the sampled keys); ``steps=None`` runs until the convergence check
+    passes (at most ``max_steps``); ``burn=None`` is 5 autocorrelation times (a quarter of a fixed ``steps``).
+    """
     emcee = _emcee()
     keys = tuple(fit.free_keys)
     if not keys:
         raise ParameterError("nothing to sample: the fit has no free parameters")
+    walkers = max(16, 4 * len(keys)) if walkers is None else walkers
     if walkers < 2 * len(keys):
         raise ParameterError(f"walkers: need at least {2 * len(keys)} for {len(keys)} parameters, got {walkers}")
-    if steps < 10:
+    if steps is not None and steps < 10:
         raise ParameterError(f"steps: expected at least 10, got {steps}")
-    burn = steps // 4 if burn is None else burn
-    if not 0 <= burn < steps:
-        raise ParameterError(f"burn: expected 0 <= burn < steps ({steps}), got {burn}")
+    if max_steps < MIN_STEPS:
+        raise ParameterError(f"max_steps: expected at least {MIN_STEPS}, got {max_steps}")
+    if burn is not None and not 0 <= burn < (steps if steps is not None else max_steps):
+        raise ParameterError(f"burn: expected 0 <= burn < steps, got {burn}")
     rng = np.random.default_rng(seed)
     log_post = _LogPosterior(fit, keys)
-    centre = Space(fit.parameters, keys).vector()
-    sd = np.sqrt(np.clip(np.diag(fit.covariance), 1e-8, 1.0))
+    centre, covariance = log_post.mode()
+    sd = np.sqrt(np.clip(np.diag(covariance), 1e-8, 1.0))
     start = centre + 0.05 * sd * rng.standard_normal((walkers, len(keys)))
-    sampler = emcee.EnsembleSampler(walkers, len(keys), log_post, vectorize=True)
+    moves = _moves(emcee, centre, covariance)
+    sampler = emcee.EnsembleSampler(walkers, len(keys), log_post, vectorize=True, moves=moves)
     sampler.random_state = np.random.RandomState(int(rng.integers(2**31))).get_state()
-    sampler.run_mcmc(start, steps, progress=progress)
-    tau = np.asarray(sampler.get_autocorr_time(tol=0, discard=burn), dtype=float)
+    steps, burn = _run(sampler, start, steps, burn, max_steps)
+    tau = _autocorrelation(sampler, burn)
     messages = []
-    if np.any(steps - burn < 50 * tau):
+    if not np.all(np.isfinite(tau)):
         messages.append(
-            f"the chain is shorter than 50 autocorrelation times (τ up to {np.nanmax(tau):.3g} steps after {burn}"
-            " burn-in steps): the posterior summaries are rough; run more --steps"
+            f"some walkers did not move in the {steps - burn} steps after burn-in: the chain has not converged and"
+            " the posterior summaries are unreliable; run more --steps or check the fit"
         )
-    thin = max(1, int(np.nanmin(tau) / 2)) if thin is None else thin
+    elif np.any(steps - burn < CONVERGED_TIMES * tau):
+        messages.append(
+            f"the chain is shorter than {CONVERGED_TIMES} autocorrelation times (τ up to {np.nanmax(tau):.3g} steps"
+            f" after {burn} burn-in steps of {steps}): the posterior summaries are rough; run more --steps"
+        )
+    finite = tau[np.isfinite(tau)]
+    thin = (max(1, int(finite.min() / 2)) if finite.size else 1) if thin is None else thin
     chain = sampler.get_chain(discard=burn, thin=thin, flat=True)
     log_prob = sampler.get_log_prob(discard=burn, thin=thin, flat=True)
     estimates = _parameter_summaries(fit, keys, chain)

@@ -28,7 +28,7 @@ from ..errors import ModelError, ParameterError
 from ..model.critical import critical_point
 from ..model.steady import steady_state
 from ..parameters import Parameters
-from .batch import stress_many
+from .batch import overflow_is_failure, stress_many
 from .problem import FAILED_RESIDUAL, JACOBIAN_STEP, SEARCH_BOX, Block, Space
 
 #: Weight of the constraint residuals of the profile (dimensionless elasticity dln sigma/dln V): the
@@ -158,7 +158,8 @@ class Profile:
     # -- residuals -----------------------------------------------------------------
     def _state(self, theta: np.ndarray, v: float) -> tuple[np.ndarray, float, float] | None:
         try:
-            state = steady_state(self.space.params(theta), np.append(self.block.velocity, v), aging=True)
+            with overflow_is_failure():
+                state = steady_state(self.space.params(theta), np.append(self.block.eval_points, v), aging=True)
         except (ModelError, ParameterError):
             return None
         stress = float(state.stress[-1])
@@ -168,16 +169,15 @@ class Profile:
         got = self._state(theta, float(self.block.velocity[0]))
         if got is None:
             return math.inf
-        r = (got[0] - self.block.stress) / self.block.error
-        return float(r @ r)
+        return self.block.chi_square(self.block.residuals_of(got[0]))
 
     def _residual(self, theta: np.ndarray, log_v: float, log_s: float | None) -> np.ndarray:
         extra = 1 if log_s is None else 2
         got = self._state(theta, math.exp(log_v))
         if got is None:
-            return np.full(len(self.block) + extra, FAILED_RESIDUAL)
+            return np.full(self.block.residual_count + extra, FAILED_RESIDUAL)
         model, stress, elasticity = got
-        r = (model - self.block.stress) / self.block.error
+        r = self.block.residuals_of(model)
         constraints = [CONSTRAINT_WEIGHT * elasticity]
         if log_s is not None:
             constraints.append(CONSTRAINT_WEIGHT * (math.log(stress) - log_s))
@@ -186,15 +186,18 @@ class Profile:
     def _jacobian(self, theta: np.ndarray, log_v: float, log_s: float | None, with_v: bool) -> np.ndarray:
         h, d = JACOBIAN_STEP, NEWTON_DELTA
         v = math.exp(log_v)
-        velocity = np.append(self.block.velocity, v * np.exp([-d, 0.0, d]))
+        m = self.block.eval_points.size
+        velocity = np.append(self.block.eval_points, v * np.exp([-d, 0.0, d]))
         sets = []
         for k in range(theta.size):
             for sign in (1.0, -1.0):
                 shifted = np.array(theta, dtype=float)
                 shifted[k] += sign * h
                 sets.append(self.space.params(shifted))
-        stress = stress_many(sets, velocity)
-        n = len(self.block)
+        evaluated = stress_many(sets, velocity)
+        n = self.block.residual_count
+        # residual space for the data part (compressed for long records), then the three stresses around v
+        stress = np.concatenate([self.block.weighted(evaluated[:, :m]), evaluated[:, m:]], axis=1)
         rows = n + (1 if log_s is None else 2)
         out = np.zeros((rows, theta.size + (1 if with_v else 0)))
         if not np.all(np.isfinite(stress)):
@@ -202,7 +205,7 @@ class Profile:
         elasticity = (stress[:, n + 2] - stress[:, n]) / (2 * d * stress[:, n + 1])
         for k in range(theta.size):
             up, down = 2 * k, 2 * k + 1
-            out[:n, k] = (stress[up, :n] - stress[down, :n]) / (2 * h) / self.block.error
+            out[:n, k] = (stress[up, :n] - stress[down, :n]) / (2 * h)
             out[n, k] = CONSTRAINT_WEIGHT * (elasticity[up] - elasticity[down]) / (2 * h)
             if log_s is not None:
                 out[n + 1, k] = CONSTRAINT_WEIGHT * (math.log(stress[up, n + 1] / stress[down, n + 1])) / (2 * h)

@@ -6,7 +6,10 @@ name (``velocity [um/s]``), a bare name means SI, and lines starting with
 naming the file, the row (the header is row 1) and the column.
 
 Steady data (``stickslip fit steady``): ``velocity``, ``stress`` and an
-optional ``stress_err`` (one standard deviation).  Stick data (``stickslip fit
+optional ``stress_err`` (one standard deviation); the other columns that
+``stickslip curve --format csv`` writes (``bonded_fraction``,
+``stress_slope``) are recognised and ignored, with a note, so that the
+curve command's output can be fitted as it is.  Stick data (``stickslip fit
 stick``): ``pulling_velocity``, ``stick_time`` and optional ``peak_stress``,
 ``start_stress``; the other columns of the paper's Table 1 (``cycle``,
 ``stick_slope``, ``stiffness``, ``jump_velocity``) are recognised and kept but
@@ -15,6 +18,7 @@ not used by the fit.
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -38,6 +42,14 @@ MIN_STICK_ROWS = 2
 DUPLICATE_TOLERANCE = 1e-9
 
 STEADY_COLUMNS = {"velocity": "velocity", "stress": "stress", "stress_err": "stress"}
+#: Columns of ``stickslip curve --format csv`` that the fit does not use: read (so that their units are
+#: checked) and dropped with a note.  Any other column is an error.
+STEADY_IGNORED_COLUMNS = {"bonded_fraction": "dimensionless", "stress_slope": "stress_per_velocity"}
+#: The range a measured friction stress (and its error) may have, Pa: 1 TPa is above the ideal strength
+#: of any solid; beyond these the numbers are unit mistakes, and their squares would overflow the sums.
+STRESS_RANGE = (1e-9, 1e12)
+#: The range of sliding velocities, m/s (the upper end is the speed of light).
+VELOCITY_RANGE = (1e-15, 3e8)
 STICK_COLUMNS = {
     "pulling_velocity": "velocity",
     "stick_time": "time",
@@ -61,9 +73,17 @@ class SteadyData:
     stress_err: np.ndarray | None
     rows: np.ndarray
     source: str = "data"
+    ignored_columns: tuple[str, ...] = ()
 
     def __len__(self) -> int:
         return int(self.velocity.size)
+
+    def notes(self) -> list[str]:
+        """What the reader left out (one line, or none)."""
+        if not self.ignored_columns:
+            return []
+        names = ", ".join(self.ignored_columns)
+        return [f"{self.source}: column(s) {names} not used by the steady fit (ignored)"]
 
     @classmethod
     def from_arrays(cls, velocity: Any, stress: Any, stress_err: Any = None, source: str = "data") -> SteadyData:
@@ -79,7 +99,9 @@ class SteadyData:
 
     def subset(self, mask: np.ndarray) -> SteadyData:
         err = None if self.stress_err is None else self.stress_err[mask]
-        return SteadyData(self.velocity[mask], self.stress[mask], err, self.rows[mask], self.source)
+        return SteadyData(
+            self.velocity[mask], self.stress[mask], err, self.rows[mask], self.source, self.ignored_columns
+        )
 
     def to_frame(self) -> pd.DataFrame:
         import pandas as pd
@@ -161,9 +183,19 @@ class StickData:
 
 
 def read_steady_data(path: str | Path) -> SteadyData:
-    """Read and validate a steady friction curve (columns velocity, stress, optional stress_err)."""
-    table = read_table(path, STEADY_COLUMNS, required=["velocity", "stress"])
-    return _validated_steady(table)
+    """Read and validate a steady friction curve (columns velocity, stress, optional stress_err).
+
+    The extra columns of ``stickslip curve --format csv`` are ignored (:meth:`SteadyData.notes` says so).
+    """
+    table = read_table(
+        path,
+        STEADY_COLUMNS | STEADY_IGNORED_COLUMNS,
+        required=["velocity", "stress"],
+        allow_missing=tuple(STEADY_IGNORED_COLUMNS),
+    )
+    ignored = tuple(name for name in STEADY_IGNORED_COLUMNS if name in table)
+    kept = Table(table.source, {k: v for k, v in table.columns.items() if k in STEADY_COLUMNS}, table.rows)
+    return dataclasses.replace(_validated_steady(kept), ignored_columns=ignored)
 
 
 def read_stick_data(path: str | Path) -> StickData:
@@ -188,13 +220,31 @@ def _as_column(values: Any, name: str, source: str, allow_nan: bool = False) -> 
 
 def _require_positive(table: Table, names: Sequence[str]) -> None:
     """DataError at the first row (in file order) where a named column is <= 0 (NaN cells are skipped)."""
-    for k in range(len(table)):
-        for name in names:
-            if name in table and table[name][k] <= 0:
-                raise DataError(
-                    f"{table.source}: row {table.rows[k]}, column {name!r}: expected a positive value,"
-                    f" got {table[name][k]:g}"
-                )
+    present = [name for name in names if name in table]
+    if not present:
+        return
+    bad = np.column_stack([table[name] <= 0 for name in present])  # NaN <= 0 is False
+    rows = np.nonzero(bad.any(axis=1))[0]
+    if rows.size:
+        k = int(rows[0])
+        name = present[int(np.argmax(bad[k]))]
+        raise DataError(
+            f"{table.source}: row {table.rows[k]}, column {name!r}: expected a positive value, got {table[name][k]:g}"
+        )
+
+
+def _require_range(table: Table, name: str, bounds: tuple[float, float], unit: str, what: str) -> None:
+    """DataError at the first row where column ``name`` is outside ``bounds`` (after the positivity check)."""
+    if name not in table:
+        return
+    column = table[name]
+    bad = np.nonzero((column < bounds[0]) | (column > bounds[1]))[0]
+    if bad.size:
+        k = int(bad[0])
+        raise DataError(
+            f"{table.source}: row {table.rows[k]}, column {name!r}: {column[k]:g} {unit} is outside the range of"
+            f" {what} ({bounds[0]:g} to {bounds[1]:g} {unit}); check the units in the header"
+        )
 
 
 def _validated_steady(table: Table) -> SteadyData:
@@ -204,6 +254,9 @@ def _validated_steady(table: Table) -> SteadyData:
             f"{table.source}: {n} data row(s), expected at least {MIN_STEADY_POINTS} to fit a friction curve"
         )
     _require_positive(table, ["velocity", "stress", "stress_err"])
+    _require_range(table, "velocity", VELOCITY_RANGE, "m/s", "a sliding velocity")
+    for name in ("stress", "stress_err"):
+        _require_range(table, name, STRESS_RANGE, "Pa", "a friction stress")
     v = table["velocity"]
     order = np.argsort(v, kind="stable")
     close = np.nonzero(np.diff(v[order]) <= DUPLICATE_TOLERANCE * v[order][1:])[0]

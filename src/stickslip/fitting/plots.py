@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+from contextlib import contextmanager
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -96,30 +98,83 @@ def steady_fit_figure(fit: SteadyFit, band: tuple[np.ndarray, ...] | None = None
 
 
 def plot_stick_fit(fit: StickFit, ax: Axes | None = None) -> Axes:
-    """Measured and fitted stick times against pulling velocity."""
+    """Stick time against pulling velocity (linear axes): data with error bars of the estimated scatter,
+    the model's value for each fitted row, and the fitted t_s(V0) as a line."""
     ax = _axes(ax)
-    data = fit.data
-    used = fit.used
-    ax.plot(data.pulling_velocity[used] * UM, data.stick_time[used], "o", color="k", ms=5, label="data (fitted)")
+    data, used = fit.data, fit.used
+    v = data.pulling_velocity * UM
+    offsets = _spread(data.pulling_velocity, used)
+    sd = fit.noise_scale if np.isfinite(fit.noise_scale) else 0.0
+    err = data.stick_time[used] * sd if sd > 0 else None
+    ax.errorbar(
+        v[used] + offsets[used], data.stick_time[used], yerr=err, fmt="o", color="k", ms=5, capsize=3,
+        label=f"data (bars: ±1 sd, {100 * sd:.2g} % from the scatter)" if sd > 0 else "data",
+    )  # fmt: skip
+    ax.plot(v[used] + offsets[used], fit.model_stick_time[used], "s", mfc="none", color="C0", ms=7, label="model, row")
     if np.any(~used):
-        ax.plot(
-            data.pulling_velocity[~used] * UM, data.stick_time[~used], "x", color="0.5", ms=6, label="data (left out)"
-        )
-    ax.plot(data.pulling_velocity[used] * UM, fit.model_stick_time[used], "s", mfc="none", color="C0", label="model")
-    ax.set_xscale("log")
-    ax.set_yscale("log")
+        ax.plot(v[~used], data.stick_time[~used], "x", color="0.5", ms=7, label="left out")
+    lo, hi = float(np.min(data.pulling_velocity[used])), float(np.max(data.pulling_velocity[used]))
+    grid = np.linspace(0.6 * lo, 1.25 * hi, 120)
+    curve, start, stiffness = fit.stick_time_curve(grid)
+    ax.plot(
+        grid * UM, curve, color="C0",
+        label=f"model t_s(V0): start {start:.4g} Pa, loading rate/V0 {stiffness / 1e3:.4g} kPa/m (row medians)",
+    )  # fmt: skip
+    ax.set_xlim(0.0, max(1.3 * hi, 1.1 * float(np.max(data.pulling_velocity))) * UM)  # left-out rows too
+    top = np.nanmax(np.concatenate([data.stick_time, fit.model_stick_time[used], curve[np.isfinite(curve)]]))
+    ax.set_ylim(0.0, 1.15 * top)
     ax.set_xlabel("pulling velocity V0 (µm/s)")
     ax.set_ylabel("stick time ts (s)")
+    ax.set_title("Stick-phase fit (Eq 15)", fontsize="medium")
     ax.legend(fontsize="small")
     return ax
 
 
+def _spread(velocity: np.ndarray, used: np.ndarray) -> np.ndarray:
+    """Small horizontal offsets (um/s) so that repeated cycles at one velocity do not hide each other."""
+    out = np.zeros(velocity.size)
+    width = 0.006 * float(np.max(velocity[used])) * UM
+    for v in np.unique(velocity[used]):
+        same = np.nonzero(used & (velocity == v))[0]
+        out[same] = (np.arange(same.size) - (same.size - 1) / 2) * width
+    return out
+
+
 def corner_figure(posterior: SteadyPosterior) -> Figure:
-    """Corner plot of the posterior (the ``corner`` package), in log10 of the SI values, with Vc and sigma_c."""
+    """Corner plot of the posterior (the ``corner`` package) in units people use, with Vc and sigma_c;
+    titles give the median and the central 95 % credible interval."""
     import corner
     from matplotlib.figure import Figure
 
     samples, labels = posterior.corner_samples()
-    fig = Figure(figsize=(1.6 * len(labels) + 1, 1.6 * len(labels) + 1))
-    corner.corner(samples, labels=labels, fig=fig, quantiles=[0.025, 0.5, 0.975], show_titles=True, title_fmt=".3g")
+    size = 1.9 * len(labels) + 1
+    fig = Figure(figsize=(size, size))
+    with _corner_log_captured():
+        corner.corner(
+            samples, labels=labels, fig=fig, quantiles=[0.025, 0.5, 0.975], show_titles=True, title_fmt=".3g",
+            title_quantiles=[0.025, 0.5, 0.975], title_kwargs={"fontsize": 9}, label_kwargs={"fontsize": 10},
+            max_n_ticks=3, plot_contours=samples.shape[0] >= 200,
+        )  # fmt: skip
+    fig.suptitle(f"posterior: {samples.shape[0]} samples; titles: median and central 95 % interval", fontsize=10)
     return fig
+
+
+class _CornerLogFilter:
+    """Keeps corner's messages (it logs to the root logger) off the user's terminal; they are about contour
+    drawing only."""
+
+    def filter(self, record: Any) -> bool:
+        return "corner" not in record.pathname
+
+
+@contextmanager
+def _corner_log_captured() -> Iterator[None]:
+    import logging
+
+    root = logging.getLogger()
+    log_filter = _CornerLogFilter()
+    root.addFilter(log_filter)
+    try:
+        yield
+    finally:
+        root.removeFilter(log_filter)

@@ -72,7 +72,7 @@ def steady_report(fit: SteadyFit) -> str:
         f" {human(float(data.velocity.max()), 'velocity')}",
         f"- method: {fit.method}" + (f" (split at {human(fit.split, 'velocity')})" if fit.split else ""),
         f"- noise: {fit.noise}",
-        f"- χ² = {_g(fit.chi_square)}, degrees of freedom {fit.dof}, reduced χ² = {_g(fit.reduced_chi_square)}",
+        goodness_line(fit.chi_square, fit.dof, fit.noise_estimated),
         f"- intervals: {level}; parameters symmetric in ln (Wald); Vc and σc by {fit.interval_method}",
         "",
         "## Critical point (Eq 9)",
@@ -117,20 +117,43 @@ def steady_report(fit: SteadyFit) -> str:
             ],
         ),
         "",
-        "## Residuals",
-        "",
-        *_table(
-            ["row", "V (µm/s)", "σ (Pa)", "fit (Pa)", "(data − fit)/error"],
-            [
-                [str(r), _g(v * 1e6, 5), _g(s, 5), _g(m, 5), f"{z:+.2f}"]
-                for r, v, s, m, z in zip(
-                    data.rows, data.velocity, data.stress, fit.model_stress, fit.residuals, strict=True
-                )
-            ],
-        ),
-        "",
+        *_residual_table(fit),
     ]
     return "\n".join(lines)
+
+
+#: Longest residual table printed in full; longer records get a summary and their largest residuals.
+RESIDUAL_ROWS = 60
+
+
+def _residual_table(fit: SteadyFit) -> list[str]:
+    data = fit.data
+    picks = np.arange(len(data))
+    lines = ["## Residuals", ""]
+    if len(data) > RESIDUAL_ROWS:
+        z = fit.residuals
+        picks = np.sort(np.argsort(-np.abs(z), kind="stable")[:10])
+        lines += [
+            f"{len(data)} points: rms of (data − fit)/error {float(np.sqrt(np.mean(z * z))):.3g}, mean"
+            f" {float(np.mean(z)):+.3g}; the 10 largest in absolute value (all of them: --json or the Python API):",
+            "",
+        ]
+    rows = [
+        [str(data.rows[k]), _g(data.velocity[k] * 1e6, 5), _g(data.stress[k], 5), _g(fit.model_stress[k], 5),
+         f"{fit.residuals[k]:+.2f}"]
+        for k in picks
+    ]  # fmt: skip
+    return [*lines, *_table(["row", "V (µm/s)", "σ (Pa)", "fit (Pa)", "(data − fit)/error"], rows), ""]
+
+
+def goodness_line(chi_square: float, dof: int, noise_estimated: bool) -> str:
+    """The χ² line of a report: with the noise estimated from the residuals χ²ᵣ is 1 by construction."""
+    if noise_estimated:
+        return (
+            f"- χ²ᵣ = 1 by construction (the noise is estimated from the residuals, {dof} degrees of freedom),"
+            " so it does not test the fit; judge it by the residuals below"
+        )
+    return f"- χ² = {_g(chi_square)}, degrees of freedom {dof}, reduced χ² = {_g(chi_square / dof if dof else None)}"
 
 
 def stick_report(fit: StickFit) -> str:
@@ -156,7 +179,7 @@ def stick_report(fit: StickFit) -> str:
         "",
         f"- data: `{data.source}`, {int(fit.used.sum())} of {len(data)} rows fitted",
         f"- noise: {fit.noise}",
-        f"- χ² = {_g(fit.chi_square)}, degrees of freedom {fit.dof}, reduced χ² = {_g(fit.reduced_chi_square)}",
+        goodness_line(fit.chi_square, fit.dof, True),
         f"- intervals: {level}, symmetric in ln (Wald)",
         "",
         *_messages(fit.messages),

@@ -56,6 +56,7 @@ class Estimate:
     interval: tuple[float | None, float | None] | None = None
     status: str = "fitted"  # "fitted", "fixed", "derived", "undetermined"
     note: str = ""
+    bias: float | None = None  # the method's own bias, where it was estimated (two-step Vc, sigma_c)
 
     @property
     def fixed(self) -> bool:
@@ -74,6 +75,8 @@ class Estimate:
             out["status"] = self.status
         if self.note:
             out["note"] = self.note
+        if self.bias is not None:
+            out["method_bias"] = self.bias
         return out
 
     def text(self) -> str:

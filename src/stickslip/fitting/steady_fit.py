@@ -28,7 +28,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from scipy import stats
 
-from ..errors import DataError, ParameterError
+from ..errors import DataError, ModelError, ParameterError
 from ..model.critical import critical_point
 from ..model.steady import steady_state
 from ..parameters import Parameters, key_dimension, load_parameters
@@ -36,8 +36,17 @@ from ..units import to_si
 from . import identify
 from .critical_uncertainty import Profile, critical_gradient, local_critical
 from .data import SteadyData, read_steady_data
-from .problem import Block, Space, jacobian, minimize, residuals
-from .results import Estimate, human
+from .problem import (
+    INTERPOLATION_TOLERANCE,
+    Block,
+    Space,
+    interpolation_error,
+    jacobian,
+    make_block,
+    minimize,
+    residuals,
+)
+from .results import Estimate, display_unit, human
 
 if TYPE_CHECKING:  # pragma: no cover
     import pandas as pd
@@ -48,6 +57,10 @@ INTERVAL_METHODS = ("delta", "profile", "bootstrap")
 DEFAULT_SPLIT = 800e-6
 #: Above the split the two-step fit neglects aging; warn when that changes sigma by more than this many errors.
 AGING_NEGLECT_WARNING = 0.5
+#: ln-widths beyond this give an unbounded upper end (e^700 ~ 1e304: no number, only "unbounded").
+LARGEST_LOG_WIDTH = 700.0
+#: Above this many points the joint fit's automatic intervals are the delta method's, not the profile's.
+PROFILE_MAX_POINTS = 1000
 #: Give up the fix-and-refit loop after this many rounds (never reached: each round fixes one key).
 MAX_ROUNDS = 10
 
@@ -94,8 +107,16 @@ class SteadyFit:
     samples: dict[str, np.ndarray] | None = field(default=None, repr=False)
 
     @property
-    def reduced_chi_square(self) -> float:
-        return self.chi_square / self.dof if self.dof > 0 else float("nan")
+    def noise_estimated(self) -> bool:
+        """True when the data state no errors and the noise level is estimated from the residuals."""
+        return self.data.stress_err is None
+
+    @property
+    def reduced_chi_square(self) -> float | None:
+        """chi^2/dof with the stated errors; None when the noise is estimated from the residuals (it is 1 then)."""
+        if self.noise_estimated or self.dof <= 0:
+            return None
+        return self.chi_square / self.dof
 
     def estimate(self, key: str) -> Estimate:
         for e in (*self.estimates, *self.combinations):
@@ -129,6 +150,7 @@ class SteadyFit:
             "dof": self.dof,
             "reduced_chi_square": self.reduced_chi_square,
             "noise": self.noise,
+            "relative_noise": self.noise_scale if self.noise_estimated else None,
             "correlation": {
                 "keys": list(self.free_keys),
                 "matrix": self.correlation.tolist(),
@@ -184,14 +206,13 @@ def _requested(free: Sequence[str] | None, fixed: Mapping[str, float]) -> tuple[
     return explicit, explicit + defaults
 
 
-def _blocks(data: SteadyData, split: float | None) -> tuple[np.ndarray, Block, Block | None, Block | None]:
+def _blocks(data: SteadyData, split: float, params: Parameters) -> tuple[np.ndarray, Block, Block, Block]:
+    """The error column and the blocks: all points with aging, and the two-step's ranges (long ones interpolated)."""
     error = data.stress_err if data.stress_err is not None else data.stress
-    everything = Block(data.velocity, data.stress, error, aging=True)
-    if split is None:
-        return error, everything, None, None
+    everything = make_block(data.velocity, data.stress, error, True, params)
     high = data.velocity >= split
-    hi_block = Block(data.velocity[high], data.stress[high], error[high], aging=False)
-    lo_block = Block(data.velocity[~high], data.stress[~high], error[~high], aging=True)
+    hi_block = make_block(data.velocity[high], data.stress[high], error[high], False, params)
+    lo_block = make_block(data.velocity[~high], data.stress[~high], error[~high], True, params)
     return error, everything, hi_block, lo_block
 
 
@@ -199,7 +220,7 @@ def _scaled_start(params: Parameters, block: Block, free: Sequence[str]) -> Para
     """Rescale N0 so that the start curve matches the data's level (sigma is proportional to N0)."""
     if "bonds.site_density" not in free:
         return params
-    model = steady_state(params, block.velocity, aging=block.aging).stress
+    model = block.model(params)
     w = 1.0 / block.error**2
     factor = float(np.sum(w * model * block.stress) / np.sum(w * model * model))
     return params.with_overrides({"bonds.site_density": params.bonds.site_density * factor})
@@ -237,7 +258,7 @@ def _fit_block(
     while precheck and keys:
         space = Space(progress.params, tuple(keys))
         r = residuals(space, space.vector(), block)
-        scale = 1.0 if progress.noise_known else math.sqrt(float(r @ r) / (len(block) - len(keys)))
+        scale = 1.0 if progress.noise_known else math.sqrt(block.chi_square(r) / (len(block) - len(keys)))
         bad = identify.undetermined(keys, jacobian(space, space.vector(), block), scale)
         if not bad:
             break
@@ -352,8 +373,10 @@ def _quantile(level: float, dof: int, noise_known: bool) -> float:
     return float(stats.norm.ppf(tail) if noise_known else stats.t.ppf(tail, max(dof, 1)))
 
 
-def _log_interval(value: float, sd_log: float, q: float) -> tuple[float, float]:
-    return value * math.exp(-q * sd_log), value * math.exp(q * sd_log)
+def _log_interval(value: float, sd_log: float, q: float) -> tuple[float, float | None]:
+    """value e^(-q sd), value e^(q sd); the upper end is unbounded where that overflows (sd of hundreds)."""
+    width = q * sd_log
+    return value * math.exp(-width), (value * math.exp(width) if width < LARGEST_LOG_WIDTH else None)
 
 
 def fit_steady(
@@ -381,8 +404,15 @@ def fit_steady(
         data = read_steady_data(data)
     if method not in METHODS:
         raise ParameterError(f"method: expected one of {', '.join(METHODS)}, got {method!r}")
+    auto_note = ""
     if intervals is None:
-        intervals = "delta" if method == "two-step" else "profile"
+        intervals = "delta" if method == "two-step" or len(data) > PROFILE_MAX_POINTS else "profile"
+        if method == "joint" and intervals == "delta":
+            auto_note = (
+                f"intervals of Vc and σc by the delta method: with {len(data)} points the chi-square is quadratic"
+                " over the interval, where the profile likelihood gives the same ends (--intervals profile to"
+                " compute it anyway)"
+            )
     if intervals not in INTERVAL_METHODS:
         raise ParameterError(f"intervals: expected one of {', '.join(INTERVAL_METHODS)}, got {intervals!r}")
     if intervals == "profile" and method != "joint":
@@ -399,30 +429,18 @@ def fit_steady(
     base = params if isinstance(params, Parameters) else load_parameters(params or "gelatin-glass")
     base, fixed = _resolve_fix(base, fix)
     explicit, requested = _requested(free, fixed)
-    error, everything, hi, lo = _blocks(data, split)
     noise_known = data.stress_err is not None
-    progress = _Progress(base, base, tuple(explicit), noise_known, [], [], [])
-    progress.messages.append(_structure_note(requested, fixed))
-    assert hi is not None and lo is not None
-    if method == "joint":
-        _joint_start(progress, requested, hi, lo, everything, split)
-        # the two-step result is only the start: what the joint fit cannot determine is decided afresh
-        progress.messages = progress.messages[:1]
-        progress.stages = [dataclasses.replace(s, name=f"start, {s.name}") for s in progress.stages]
-        progress.undetermined = []
-        selection = identify.select_identifiable(requested, aging=True)
-        progress.messages.extend(selection.messages)
-        keys, _ = _fit_block(progress, selection.free, everything, "the joint fit", precheck=True)
-    else:
-        _two_step(progress, requested, hi, lo, split)
-        step_keys = _free_after(progress, requested)
-        keys = [k for k in step_keys if k in identify.NO_AGING_KEYS] + [
-            k for k in step_keys if k in identify.AGING_KEYS
-        ]
-        keys = [k for k in keys if _stage_has(progress.stages, k)]
+    error, everything, hi, lo = _blocks(data, split, base)
+    progress, keys = _run_method(method, data, base, requested, explicit, fixed, (everything, hi, lo), split)
+    if not _interpolation_holds((everything, hi, lo), progress.params):
+        # the curve changed shape on the way from the start: interpolate where the fit ended, and fit again
+        error, everything, hi, lo = _blocks(data, split, progress.params)
+        progress, keys = _run_method(method, data, base, requested, explicit, fixed, (everything, hi, lo), split)
     fitted = progress.params
+    if auto_note:
+        progress.messages.append(auto_note)
     full_r = residuals(Space(fitted, ()), np.zeros(0), everything)
-    chi_square = float(full_r @ full_r)
+    chi_square = everything.chi_square(full_r)
     if method == "joint":
         dof = len(data) - len(keys)
         scale2 = 1.0 if noise_known else chi_square / dof
@@ -445,7 +463,7 @@ def fit_steady(
     correlation = covariance / np.outer(sd, sd) if keys else np.zeros((0, 0))
     estimates = _parameter_estimates(fitted, base, keys, sd, q, fixed, progress)
     combos = _combination_estimates(fitted, keys, covariance, q, method)
-    model = steady_state(fitted, data.velocity).stress
+    model = everything.model(fitted)
     noise = (
         "stated stress_err (chi-square not rescaled)"
         if noise_known
@@ -455,6 +473,8 @@ def fit_steady(
         fitted, keys, covariance, q, intervals, level, dof, noise_known, everything, data, method, split,
         fix, free, base, bootstrap_samples, seed, scale2, progress,
     )  # fmt: skip
+    if method == "two-step" and vc.value is not None:
+        vc, sc = _flag_split_bias(vc, sc, fitted, everything, keys, scale2, level, progress)
     _note_extrapolation(progress, vc, data)
     return SteadyFit(
         data=data,
@@ -478,9 +498,121 @@ def fit_steady(
         interval_method=intervals,
         level=level,
         stages=tuple(progress.stages),
-        messages=tuple(progress.messages),
+        messages=tuple(data.notes() + progress.messages),
         samples=samples,
     )
+
+
+def _run_method(
+    method: str,
+    data: SteadyData,
+    base: Parameters,
+    requested: Sequence[str],
+    explicit: Sequence[str],
+    fixed: Mapping[str, float],
+    blocks: tuple[Block, Block, Block],
+    split: float,
+) -> tuple[_Progress, list[str]]:
+    """The least-squares steps of ``method`` from ``base``: the progress record and the fitted keys."""
+    everything, hi, lo = blocks
+    progress = _Progress(base, base, tuple(explicit), data.stress_err is not None, [], [], [])
+    progress.messages.append(_structure_note(requested, fixed))
+    if method == "joint":
+        _joint_start(progress, requested, hi, lo, everything, split)
+        # the two-step result is only the start: what the joint fit cannot determine is decided afresh
+        progress.messages = progress.messages[:1]
+        progress.stages = [dataclasses.replace(s, name=f"start, {s.name}") for s in progress.stages]
+        progress.undetermined = []
+        selection = identify.select_identifiable(requested, aging=True)
+        progress.messages.extend(selection.messages)
+        keys, _ = _fit_block(progress, selection.free, everything, "the joint fit", precheck=True)
+        return progress, keys
+    _two_step(progress, requested, hi, lo, split)
+    step_keys = _free_after(progress, requested)
+    keys = [k for k in step_keys if k in identify.NO_AGING_KEYS] + [k for k in step_keys if k in identify.AGING_KEYS]
+    return progress, [k for k in keys if _stage_has(progress.stages, k)]
+
+
+def _interpolation_holds(blocks: Sequence[Block], params: Parameters) -> bool:
+    """True when every interpolated block is still accurate at ``params`` (10x the tolerance it was made to)."""
+    try:
+        return all(interpolation_error(b, params) <= 10 * INTERPOLATION_TOLERANCE for b in blocks)
+    except (ModelError, ParameterError):
+        return False
+
+
+def _flag_split_bias(
+    vc: Estimate,
+    sc: Estimate,
+    fitted: Parameters,
+    everything: Block,
+    keys: Sequence[str],
+    scale2: float,
+    level: float,
+    progress: _Progress,
+) -> tuple[Estimate, Estimate]:
+    """Widen the two-step intervals of Vc and sigma_c by the method's own bias when it matters.
+
+    The two-step fit neglects aging above the split, so even exact data give a shifted answer, and the
+    shift does not shrink with more data while the interval does (docs/fitting.md).  The shift is measured
+    against the joint fit of the same free keys on all points with aging, started from the two-step
+    result: the joint fit has no such approximation.  With noise the two estimates also differ by chance,
+    by up to about the larger of their standard errors (on 24 points they differ by 0-1.5 of them).  When
+    the difference exceeds that times the interval's quantile -- the bias would carry the truth out of the
+    interval -- the interval is extended by it towards the joint value, and said so.
+    """
+    space = Space(fitted, tuple(keys))
+    try:
+        theta = minimize(space, space.vector(), everything).theta
+        joint_space = Space(space.params(theta), tuple(keys))
+        located = local_critical(joint_space.base, float(vc.value))  # type: ignore[arg-type]
+        if located is None:
+            return vc, sc
+        jac = jacobian(joint_space, theta, everything)
+        covariance = scale2 * _inverse(jac.T @ jac)
+        gradients = critical_gradient(joint_space, theta, located[0])
+    except (ModelError, ParameterError):  # pragma: no cover - the two-step optimum is a valid start
+        return vc, sc
+    out = []
+    for estimate, other, grad in zip((vc, sc), located, gradients, strict=True):
+        joint_se = other * math.sqrt(max(float(grad @ covariance @ grad), 0.0))
+        out.append(_widened(estimate, float(estimate.value) - other, joint_se, level, progress))  # type: ignore[arg-type]
+    return out[0], out[1]
+
+
+def _widened(estimate: Estimate, bias: float, joint_se: float, level: float, progress: _Progress) -> Estimate:
+    """``estimate`` with its estimated method bias; the interval extended by it when it is not negligible."""
+    stderr = estimate.stderr
+    if estimate.interval is None or stderr is None or not stderr > 0 or not math.isfinite(joint_se):
+        return dataclasses.replace(estimate, bias=bias)
+    quantile = float(stats.norm.ppf(0.5 + level / 2.0))
+    if abs(bias) <= quantile * max(stderr, joint_se):  # within what chance alone gives: no evidence of bias
+        return dataclasses.replace(estimate, bias=bias)
+    lo, hi = estimate.interval
+    joint = float(estimate.value) - bias  # type: ignore[arg-type]
+    joint_lo, joint_hi = _log_interval(joint, joint_se / joint, quantile)
+    new_lo = None if lo is None else min(lo, joint_lo)
+    new_hi = None if hi is None or joint_hi is None else max(hi, joint_hi)
+    dim, symbol, size = estimate.dimension, estimate.symbol, abs(bias) / stderr
+    note = (
+        f"{estimate.note}; widened to take in the joint fit's interval: the two-step method's own bias"
+        f" {human(bias, dim, 3)} ({size:.2g} standard errors) would otherwise leave the truth outside"
+    )
+    progress.messages.append(
+        f"warning: the two-step split approximation shifts {symbol} by {human(bias, dim, 3)} against the joint"
+        f" fit of all points with aging ({size:.2g} standard errors): the {100 * level:g} % interval"
+        f" {_bracket(lo, hi, dim)} alone would claim a precision the method does not have, so it is widened to"
+        f" {_bracket(new_lo, new_hi, dim)}, taking in the joint fit's ({symbol} = {human(joint, dim, 5)} ±"
+        f" {joint_se / display_unit(joint, dim)[1]:.2g}); --method joint has no such bias"
+    )
+    return dataclasses.replace(estimate, interval=(new_lo, new_hi), note=note, bias=bias)
+
+
+def _bracket(lo: float | None, hi: float | None, dimension: str) -> str:
+    def end(x: float | None) -> str:
+        return "unbounded" if x is None else human(x, dimension, 5)
+
+    return f"[{end(lo)}, {end(hi)}]"
 
 
 def _stage_has(stages: Sequence[Stage], key: str) -> bool:
@@ -506,8 +638,8 @@ def _structure_note(requested: Sequence[str], fixed: Mapping[str, float]) -> str
 
 
 def _warn_aging_neglected(progress: _Progress, params: Parameters, hi: Block, noise_scale: float) -> None:
-    with_aging = steady_state(params, hi.velocity, aging=True).stress
-    without = steady_state(params, hi.velocity, aging=False).stress
+    with_aging = hi.with_aging(True).model(params)
+    without = hi.with_aging(False).model(params)
     shift = np.abs(with_aging - without) / (hi.error * noise_scale)
     k = int(np.argmax(shift))
     if shift[k] > AGING_NEGLECT_WARNING:
@@ -728,15 +860,16 @@ def _bootstrap_estimates(
     for key in progress.undetermined:
         held[key] = base.as_dict()[key]
     found_v, found_s, failed = [], [], 0
+    _, everything, hi, lo = _blocks(data, split, fitted)
+    high = data.velocity >= split
     for _ in range(samples):
         fake = model + sigma * rng.standard_normal(model.size)
         if np.any(fake <= 0):
             failed += 1
             continue
-        err = data.stress_err if data.stress_err is not None else None
-        synthetic = SteadyData(data.velocity, fake, err, data.rows, data.source)
+        blocks = (everything.with_stress(fake), hi.with_stress(fake[high]), lo.with_stress(fake[~high]))
         try:
-            refit = _point_fit(synthetic, fitted, method, split, held, free)
+            refit = _point_fit(blocks, fitted, method, held, free)
         except (DataError, ParameterError):
             failed += 1
             continue
@@ -766,18 +899,16 @@ def _bootstrap_estimates(
 
 
 def _point_fit(
-    data: SteadyData,
+    blocks: tuple[Block, Block, Block],
     start: Parameters,
     method: str,
-    split: float,
     fix: Mapping[str, Any],
     free: Sequence[str] | None,
 ) -> Parameters:
     """Best-fit parameters only (no covariance, no identifiability loop): the bootstrap's refit."""
     params, fixed = _resolve_fix(start, fix)
     _, requested = _requested([k for k in free or () if k not in fixed], fixed)
-    _, everything, hi, lo = _blocks(data, split)
-    assert hi is not None and lo is not None
+    everything, hi, lo = blocks
     step1 = identify.select_identifiable([k for k in requested if k in identify.NO_AGING_KEYS], aging=False).free
     step2 = [k for k in requested if k in identify.AGING_KEYS]
     for keys, block in ((step1, hi), (step2, lo)):
