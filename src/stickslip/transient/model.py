@@ -89,7 +89,7 @@ def steady_population(params: Parameters, velocity: float, aging: bool, cell_haz
         lr = float(log_hazard(np.array(velocity * a), np.array(a), velocity, params, aging))
         step = widest if lr < -700 else min(widest, cell_hazard / math.exp(min(lr, 700.0)))
         # never step past the FENE wall; approach it geometrically
-        step = min(step, 0.5 * (t_max - a))
+        step = min(step, 0.05 * (t_max - a))  # resolves the FENE force as well as the survival
         if step <= 1e-15 * t_max:
             break
         mid = a + 0.5 * step
