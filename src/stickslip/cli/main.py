@@ -20,9 +20,9 @@ def cli() -> None:
 
 
 def _register() -> None:
-    from . import analyze_cmd, cycle_cmd, fit_cmd, params_cmd, reproduce_cmd, steady_cmd
+    from . import analyze_cmd, cycle_cmd, fit_cmd, params_cmd, reproduce_cmd, steady_cmd, transient_cmd
 
-    for module in (params_cmd, steady_cmd, cycle_cmd, fit_cmd, analyze_cmd, reproduce_cmd):
+    for module in (params_cmd, steady_cmd, cycle_cmd, fit_cmd, analyze_cmd, reproduce_cmd, transient_cmd):
         module.register(cli)
 
 

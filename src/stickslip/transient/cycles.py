@@ -40,6 +40,9 @@ def detect_cycles(
         nxt = runs[k + 1][0] if k + 1 < len(runs) else None
         slip_end = nxt if nxt is not None else time.size - 1
         jump = float(np.max(velocity[z + 1 : slip_end + 1])) if slip_end > z else float(velocity[z + 1])
+        vp = float(protocol.velocity_at(min(time[z + 1], np.nextafter(protocol.duration, 0.0))))
+        if jump <= vp:
+            continue  # the slider crept back up to the puller's pace without jumping: no slip
         stick_time = float(time[z + 1] - time[a])
         slip_time = float(time[nxt] - time[z + 1]) if nxt is not None else None
         cycles.append(

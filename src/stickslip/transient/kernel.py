@@ -349,7 +349,7 @@ def advance(
         survive = math.exp(-0.5 * hh * math.exp(min(lr_new, LOG_RATE_CAP)))
         born_alive = born * survive
         if block == 1:
-            nn1, s1, k1, u1 = _sums(n, xb, lw_new, x1, p)
+            nn1, s1, k1, _u1 = _sums(n, xb, lw_new, x1, p)
         s_ref = max(abs(s1), abs(s0), 1e-9 * p[P_M] * p[P_N0] * p[P_DLM])
         err_s += k1 * abs(x1 - x_pred)
         # a lumped newborn cohort is wrong by about its mass times the fraction of tau the step spans
@@ -423,7 +423,7 @@ def advance(
             sample_index += 1
             record = True
         if record and rows < out_max:
-            nn, ss, kk, uu = _sums(n, xb, lw, x, p)
+            nn, ss, _kk, uu = _sums(n, xb, lw, x, p)
             out[rows, 0] = t
             out[rows, 1] = ss
             out[rows, 2] = nn

@@ -168,9 +168,28 @@ def stick_chains(
     y0 = math.log(max(fraction, 1e-300))
     if collapse(0.0, np.array([y0])) >= 0:
         return StickChains(0.0, fraction, True, np.array([0.0]), np.array([fraction]))
-    sol = solve_ivp(rhs, (0.0, span), [y0], method="LSODA", rtol=1e-10, atol=1e-12, events=collapse, dense_output=False)
+    if elapsed == 0.0 and fraction == 1.0 and loading_rate >= 0.0:
+        return _fresh_chains(params, aging, stress0, loading_rate, span)
+    try:
+        sol = solve_ivp(rhs, (0.0, span), [y0], method="LSODA", rtol=1e-10, atol=1e-12, events=collapse)
+    except ValueError:  # event bracketing lost in the explosive collapse: step without events
+        sol = solve_ivp(rhs, (0.0, span), [y0], method="Radau", rtol=1e-10, atol=1e-12)
     if sol.status < 0:
         raise ModelError(f"stick chains (Eq 15): integration failed: {sol.message}")
-    done = sol.status == 1
-    t_end = float(sol.t_events[0][0]) if done else span
+    done = sol.status == 1 or log_rate(float(sol.t[-1]), float(sol.y[0, -1])) >= COLLAPSE_LOG_RATE
+    t_end = float(sol.t_events[0][0]) if sol.status == 1 else float(sol.t[-1])
     return StickChains(t_end, float(np.exp(sol.y[0, -1])), bool(done), sol.t, np.exp(sol.y[0]))
+
+
+def _fresh_chains(params: Parameters, aging: bool, stress0: float, loading_rate: float, span: float) -> StickChains:
+    """A stick from fresh chains at constant loading: the package's stick solver (model.stick, Eq 15)."""
+    from ..model.stick import stick_phase
+
+    velocity = loading_rate / params.block.effective_stiffness
+    stick = stick_phase(params, velocity, start_stress=stress0, aging=aging, horizon=span)
+    if stick.status == "slipped" and stick.stick_time is not None and stick.stick_time <= span:
+        return StickChains(stick.stick_time, 0.0, True, stick.time, stick.chain_fraction)
+    inside = stick.time < span
+    times = np.r_[stick.time[inside], span]
+    fractions = np.r_[stick.chain_fraction[inside], stick.chain_fraction_at(span)]
+    return StickChains(span, float(fractions[-1]), False, times, fractions)

@@ -14,7 +14,7 @@ from ..model.cycle import Cycle
 from ..parameters import Parameters
 from ..protocols import Protocol
 from . import kernel as K
-from .model import Population, pack_parameters, stick_chains, steady_population
+from .model import Population, pack_parameters, steady_population, stick_chains
 from .result import Bookkeeping, Snapshot, TransientResult
 
 CONTROLS = ("block", "velocity")
@@ -137,6 +137,8 @@ def run_transient(
         state.v = v_start
     elif start_velocity is not None:
         raise ParameterError("start velocity: only used with start='steady'")
+    else:
+        state.v = v_first  # no bonds: the slider moves with the puller
     sigma0 = float(np.exp(state.lw[: state.n]) @ _force(state.x - state.xb[: state.n], params)) if state.n else 0.0
     state.puller = state.x + sigma0 / k_block if control == "block" else state.x
 
@@ -258,7 +260,7 @@ def _scratch(state: _State) -> tuple[np.ndarray, np.ndarray]:
 def _sample_grid(every: float | None, duration: float) -> np.ndarray:
     if every is None:
         return np.empty(0)
-    count = int(math.floor(duration / every + 1e-9))
+    count = math.floor(duration / every + 1e-9)
     grid = every * np.arange(count + 1)
     if duration - grid[-1] > 1e-9 * every:
         grid = np.append(grid, duration)

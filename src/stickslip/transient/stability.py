@@ -138,8 +138,6 @@ def _response_kernel():  # type: ignore[no-untyped-def]
     return _KERNEL[0]
 
 
-
-
 @dataclass(frozen=True)
 class CriticalStiffness:
     """Kc (Pa/m) and how it arises; see :func:`critical_stiffness`."""
