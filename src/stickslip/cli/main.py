@@ -46,10 +46,11 @@ def _register() -> None:
         rsf_cmd,
         steady_cmd,
         sweep_cmd,
+        transient_cmd,
     )
 
-    commands = (params_cmd, steady_cmd, cycle_cmd, fit_cmd, analyze_cmd, reproduce_cmd, rsf_cmd, compare_cmd, sweep_cmd)
-    for module in commands:
+    commands = (params_cmd, steady_cmd, cycle_cmd, transient_cmd, fit_cmd, analyze_cmd, reproduce_cmd)
+    for module in (*commands, rsf_cmd, compare_cmd, sweep_cmd):
         module.register(cli)
 
 

@@ -1,0 +1,136 @@
+"""``stickslip transient``: the time-dependent population balance (Eqs 1-5) through any loading protocol."""
+
+from __future__ import annotations
+
+import io
+from pathlib import Path
+from typing import Any
+
+import click
+
+from ..errors import ParameterError
+from .common import emit_json, params_options, positive, resolve_params
+
+#: runs longer than this many seconds of physical time show a progress bar on a terminal
+PROGRESS_AFTER = 1.0
+
+
+def _protocol(v0_text: str | None, duration_text: str | None, segment_texts: tuple[str, ...], protocol_file: Any):
+    from ..protocols import Protocol, Segment, parse_segment, read_protocol
+
+    if protocol_file is not None:
+        if segment_texts or v0_text is not None:
+            raise ParameterError("--protocol: give either a protocol file or --v0/--duration/--segment, not both")
+        return read_protocol(protocol_file)
+    if v0_text is None or duration_text is None:
+        raise ParameterError("--v0 and --duration: both are needed (or --protocol FILE)")
+    first = Segment(
+        positive(v0_text, "velocity", "--v0", allow_zero=True), positive(duration_text, "time", "--duration")
+    )
+    return Protocol((first, *(parse_segment(text) for text in segment_texts)))
+
+
+def _trace_csv(result: Any) -> str:
+    from ..transient import TRACE_COLUMNS
+
+    out = io.StringIO()
+    out.write(",".join(TRACE_COLUMNS) + "\n")
+    columns = [getattr(result, name) for name in TRACE_COLUMNS]
+    for row in zip(*columns, strict=True):
+        out.write(",".join(repr(float(v)) for v in row) + "\n")
+    return out.getvalue()
+
+
+@click.command("transient")
+@click.option("--v0", "v0_text", metavar="V", help='Velocity of the first segment, e.g. "50 um/s".')
+@click.option("--duration", "duration_text", metavar="T", help='Length of the first segment, e.g. "25 s".')
+@click.option(
+    "--control",
+    type=click.Choice(["block", "velocity"]),
+    default="block",
+    show_default=True,
+    help="block: the protocol moves the puller; velocity: it moves the slider (rigid rig).",
+)
+@click.option("--start", type=click.Choice(["empty", "steady"]), default="empty", show_default=True)
+@click.option("--start-velocity", "start_v_text", metavar="V", help="Steady start at this velocity [first segment's].")
+@click.option("--segment", "segment_texts", multiple=True, metavar='"V:T"', help='Further segments, e.g. "1 mm/s:2 s".')
+@click.option("--protocol", "protocol_file", type=click.Path(dir_okay=False, path_type=Path), help="Protocol CSV.")
+@click.option("--no-aging", is_flag=True, help="Drop the aging term of Eq 1.")
+@click.option("--stick-population", is_flag=True, help="Add the paper's attached chains (Eqs 13-15) at rest.")
+@click.option("--every", "every_text", metavar="DT", help="Sample the trace every DT (the solver lands on the grid).")
+@click.option("--rtol", default=1e-4, show_default=True, type=float, help="Local error tolerance (relative).")
+@click.option("-o", "--output", type=click.Path(dir_okay=False, path_type=Path), help="Write the trace (CSV, SI).")
+@click.option("--plot", "plot_path", type=click.Path(dir_okay=False, path_type=Path), help="Save σ(t) and V(t) here.")
+@click.option("--json", "as_json", is_flag=True, help="Print the summary as JSON (SI units).")
+@params_options
+def transient_command(
+    v0_text: str | None,
+    duration_text: str | None,
+    control: str,
+    start: str,
+    start_v_text: str | None,
+    segment_texts: tuple[str, ...],
+    protocol_file: Path | None,
+    no_aging: bool,
+    stick_population: bool,
+    every_text: str | None,
+    rtol: float,
+    output: Path | None,
+    plot_path: Path | None,
+    as_json: bool,
+    params_name: str,
+    overrides: tuple[str, ...],
+) -> None:
+    """Solve the full time-dependent population balance (Eq 1, history form of Eq 3) through a protocol.
+
+    With --control block the protocol is the puller's velocity and the block
+    (Eq 17) couples it to the slider; with --control velocity it is the
+    slider's own velocity.  The regime is "steady", "stick-slip", "stuck" or
+    "undetermined" (still changing at the end of the run).
+    """
+    from ..fileio import atomic_path, atomic_write_text, refuse_input_as_output
+    from ..transient import run_transient
+
+    protocol = _protocol(v0_text, duration_text, segment_texts, protocol_file)
+    refuse_input_as_output([protocol_file], [("-o", output), ("--plot", plot_path)])
+    start_velocity = None if start_v_text is None else positive(start_v_text, "velocity", "--start-velocity")
+    every = None if every_text is None else positive(every_text, "time", "--every")
+    params = resolve_params(params_name, overrides)
+    kwargs = dict(control=control, start=start, start_velocity=start_velocity, aging=not no_aging,
+                  stick_population=stick_population, every=every, rtol=rtol)  # fmt: skip
+    if protocol.duration > PROGRESS_AFTER and click.get_text_stream("stderr").isatty():
+        from rich.progress import Progress
+
+        with Progress(transient=True) as bar:
+            task = bar.add_task("transient", total=1.0)
+            result = run_transient(params, protocol, progress=lambda f: bar.update(task, completed=f), **kwargs)
+    else:
+        result = run_transient(params, protocol, **kwargs)
+    if output is not None:
+        atomic_write_text(output, _trace_csv(result))
+    if plot_path is not None:
+        ax = result.plot()
+        ax.set_title(f"{protocol.describe()}: {result.regime}", fontsize=9)
+        with atomic_path(plot_path) as temp:
+            ax.figure.savefig(temp, dpi=120, bbox_inches="tight", format=plot_path.suffix.lstrip(".") or "png")
+    if as_json:
+        emit_json(result.summary())
+        return
+    click.echo(f"{protocol.describe()} ({control} control, {start} start)")
+    click.echo(f"  regime: {result.regime}")
+    click.echo(f"  {result.message}")
+    click.echo(
+        f"  at t = {result.time[-1]:.6g} s: σ = {result.final_stress:.6g} Pa,"
+        f" N/N0 = {result.final_bonded_fraction:.6g},"
+        f" V = {result.slider_velocity[-1] * 1e6:.6g} µm/s ({result.steps} steps)"
+    )
+    for c in result.cycles:
+        slip = "—" if c.slip_time is None else f"{c.slip_time:.4g} s"
+        click.echo(
+            f"  cycle {c.index + 1}: stick {c.stick_time:.4g} s, σs = {c.peak_stress:.5g} Pa,"
+            f" jump to {c.jump_velocity * 1e6:.4g} µm/s, slip {slip}"
+        )
+
+
+def register(cli: click.Group) -> None:
+    cli.add_command(transient_command)

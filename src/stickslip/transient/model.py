@@ -1,0 +1,195 @@
+r"""Eq 1 in the cohort (history) form: parameters for the kernel, the steady population, the stick chains.
+
+``docs/transient.md`` derives everything here.  The one modelling choice that
+differs from the printed equations: the chain extension of a bond is the
+slider's travel since the bond formed, X(t) - X(t - t_a), not t_a V(t)
+(Eq 3), which equals it only at constant velocity.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import ModelError
+from ..parameters import Parameters
+from . import kernel as K
+
+
+def pack_parameters(params: Parameters, aging: bool, stiffness: float) -> np.ndarray:
+    """The float vector the kernel reads (layout: kernel.P_*)."""
+    b, g = params.bonds, params.aging
+    p = np.zeros(10)
+    p[K.P_LOG_U0_TAU] = math.log(b.breakage_weight / b.bond_time)
+    p[K.P_TAU] = b.bond_time
+    p[K.P_FORCE_SENS] = b.force_sensitivity
+    p[K.P_M] = b.chain_stiffness
+    p[K.P_DLM] = b.max_extension
+    p[K.P_INV_TAU_A] = 1.0 / g.aging_time
+    p[K.P_VA] = g.aging_velocity
+    p[K.P_N0] = b.site_density
+    p[K.P_K] = stiffness
+    p[K.P_AGING] = 1.0 if aging else 0.0
+    return p
+
+
+def chain_force(extension: np.ndarray, params: Parameters) -> np.ndarray:
+    """Eq 3 with the history extension: M e / (1 - (e/dl_m)^2)."""
+    b = params.bonds
+    y = extension / b.max_extension
+    return b.chain_stiffness * extension / (1.0 - y * y)
+
+
+def log_hazard(extension: np.ndarray, age: np.ndarray, velocity: float, params: Parameters, aging: bool) -> np.ndarray:
+    """ln of the breakage rate of Eq 1 (1/s), finite inside the FENE limit."""
+    b, g = params.bonds, params.aging
+    out = math.log(b.breakage_weight / b.bond_time) + b.force_sensitivity * chain_force(extension, params)
+    if aging:
+        out = out - age / g.aging_time * math.exp(-velocity / g.aging_velocity)
+    return out
+
+
+@dataclass(frozen=True)
+class Population:
+    """Cohorts: extension (m), age (s) and weight (bonds per m^2), oldest last."""
+
+    extension: np.ndarray
+    age: np.ndarray
+    weight: np.ndarray
+
+    @property
+    def bonded(self) -> float:
+        return float(self.weight.sum())
+
+
+#: steady populations: largest hazard increment per age cell, and where the survival counts as zero
+CELL_HAZARD = 0.01
+HAZARD_END = 45.0
+
+
+def steady_population(params: Parameters, velocity: float, aging: bool, cell_hazard: float = CELL_HAZARD) -> Population:
+    """The steady age distribution of Eqs 6-7 at ``velocity`` as cohorts (midpoint cells in age).
+
+    The cells follow the hazard: each spans at most ``cell_hazard`` of cumulative
+    hazard and at most 1/200 of the time to full extension, so the survival
+    is resolved wherever it falls (near t_a = 0, on an aging plateau or at the
+    FENE cliff).
+    """
+    b = params.bonds
+    if not velocity > 0:
+        raise ModelError(f"steady start: expected a positive sliding velocity, got {velocity!r} m/s")
+    t_max = b.max_extension / velocity
+    ages = [0.0]
+    hazard = [0.0]
+    a, big_h = 0.0, 0.0
+    widest = t_max / 200.0
+    while big_h < HAZARD_END and a < t_max:
+        lr = float(log_hazard(np.array(velocity * a), np.array(a), velocity, params, aging))
+        step = widest if lr < -700 else min(widest, cell_hazard / math.exp(min(lr, 700.0)))
+        # never step past the FENE wall; approach it geometrically
+        step = min(step, 0.05 * (t_max - a))  # resolves the FENE force as well as the survival
+        if step <= 1e-15 * t_max:
+            break
+        mid = a + 0.5 * step
+        end = a + step
+        # Simpson on the cell for the cumulative hazard
+        rates = np.exp(
+            np.minimum(
+                log_hazard(velocity * np.array([a, mid, end]), np.array([a, mid, end]), velocity, params, aging), 700.0
+            )
+        )
+        big_h += step * (rates[0] + 4 * rates[1] + rates[2]) / 6.0
+        a = end
+        ages.append(a)
+        hazard.append(big_h)
+    edges = np.array(ages)
+    cum = np.array(hazard)
+    mid_age = 0.5 * (edges[1:] + edges[:-1])
+    width = np.diff(edges)
+    # survival integrated exactly over each cell for a hazard linear in the cell: (e^-H0 - e^-H1)/(H1-H0)*width
+    dh = np.diff(cum)
+    s0 = np.exp(-cum[:-1])
+    cell = np.where(dh > 1e-12, s0 * -np.expm1(-dh) / np.where(dh > 1e-12, dh, 1.0), s0 * (1.0 - 0.5 * dh)) * width
+    birth = b.site_density / (b.bond_time + cell.sum())  # Eq 7: n(0) = N0/(tau + I)
+    return Population(extension=velocity * mid_age, age=mid_age, weight=birth * cell)
+
+
+# --------------------------------------------------------------------------- the paper's stick chains (Eqs 13-15)
+#: the collapse counts as complete when the per-chain breakage rate passes e^COLLAPSE_LOG_RATE per second
+COLLAPSE_LOG_RATE = 60.0
+
+
+@dataclass(frozen=True)
+class StickChains:
+    """Outcome of a stick with the attached chains of Eq 15 over a stretch of constant puller velocity."""
+
+    duration: float  # time spent in this stretch (s)
+    fraction: float  # Nc/Nc0 at its end
+    collapsed: bool
+    times: np.ndarray
+    fractions: np.ndarray
+
+
+def stick_chains(
+    params: Parameters,
+    aging: bool,
+    stress0: float,
+    loading_rate: float,
+    elapsed: float,
+    fraction: float,
+    span: float,
+) -> StickChains:
+    """Integrate Eq 15 from ``elapsed`` s after the stick, at stress ``stress0 + loading_rate * t``, for ``span`` s.
+
+    ln(Nc/Nc0) is integrated (LSODA, rtol 1e-10) until the per-chain rate exceeds
+    e^60 per second: the remaining chains then go in less than e^-60 s.
+    """
+    from scipy.integrate import solve_ivp
+
+    st = params.stick
+    c = params.bonds.force_sensitivity / st.attached_chains
+    inv_age = 1.0 / st.aging_time if aging else 0.0
+    log_r = math.log(st.break_rate)
+
+    def log_rate(t: float, y: float) -> float:
+        stress = stress0 + loading_rate * t
+        return log_r + c * stress * math.exp(-y) - (elapsed + t) * inv_age
+
+    def rhs(t: float, y: np.ndarray) -> list[float]:
+        return [-math.exp(min(log_rate(t, y[0]), COLLAPSE_LOG_RATE + 5.0))]
+
+    def collapse(t: float, y: np.ndarray) -> float:
+        return log_rate(t, y[0]) - COLLAPSE_LOG_RATE
+
+    collapse.terminal = True  # type: ignore[attr-defined]
+    collapse.direction = 1  # type: ignore[attr-defined]
+    y0 = math.log(max(fraction, 1e-300))
+    if collapse(0.0, np.array([y0])) >= 0:
+        return StickChains(0.0, fraction, True, np.array([0.0]), np.array([fraction]))
+    if elapsed == 0.0 and fraction == 1.0 and loading_rate >= 0.0:
+        return _fresh_chains(params, aging, stress0, loading_rate, span)
+    try:
+        sol = solve_ivp(rhs, (0.0, span), [y0], method="LSODA", rtol=1e-10, atol=1e-12, events=collapse)
+    except ValueError:  # event bracketing lost in the explosive collapse: step without events
+        sol = solve_ivp(rhs, (0.0, span), [y0], method="Radau", rtol=1e-10, atol=1e-12)
+    if sol.status < 0:
+        raise ModelError(f"stick chains (Eq 15): integration failed: {sol.message}")
+    done = sol.status == 1 or log_rate(float(sol.t[-1]), float(sol.y[0, -1])) >= COLLAPSE_LOG_RATE
+    t_end = float(sol.t_events[0][0]) if sol.status == 1 else float(sol.t[-1])
+    return StickChains(t_end, float(np.exp(sol.y[0, -1])), bool(done), sol.t, np.exp(sol.y[0]))
+
+
+def _fresh_chains(params: Parameters, aging: bool, stress0: float, loading_rate: float, span: float) -> StickChains:
+    """A stick from fresh chains at constant loading: the package's stick solver (model.stick, Eq 15)."""
+    from ..model.stick import stick_phase
+
+    velocity = loading_rate / params.block.effective_stiffness
+    stick = stick_phase(params, velocity, start_stress=stress0, aging=aging, horizon=span)
+    if stick.status == "slipped" and stick.stick_time is not None and stick.stick_time <= span:
+        return StickChains(stick.stick_time, 0.0, True, stick.time, stick.chain_fraction)
+    inside = stick.time < span
+    times = np.r_[stick.time[inside], span]
+    fractions = np.r_[stick.chain_fraction[inside], stick.chain_fraction_at(span)]
+    return StickChains(span, float(fractions[-1]), False, times, fractions)

@@ -1,0 +1,109 @@
+"""The result of a time-dependent run: the trace, its cycles, snapshots of the bond population."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from ..model.cycle import Cycle
+
+if TYPE_CHECKING:  # pragma: no cover
+    import pandas as pd
+    from matplotlib.axes import Axes
+
+#: Trace columns, in order (SI units).
+TRACE_COLUMNS = ("time", "stress", "bonded_fraction", "slider_velocity", "slider_position", "puller_position")
+TRACE_UNITS = {
+    "time": "s",
+    "stress": "Pa",
+    "bonded_fraction": "",
+    "slider_velocity": "m/s",
+    "slider_position": "m",
+    "puller_position": "m",
+}
+
+
+@dataclass(frozen=True)
+class Snapshot:
+    """The bond population at one instant: one entry per cohort (oldest first)."""
+
+    time: float
+    age: np.ndarray  # s
+    extension: np.ndarray  # m, slider travel since the bond formed
+    weight: np.ndarray  # bonds per m^2 in the cohort
+
+    def to_frame(self) -> pd.DataFrame:
+        import pandas as pd
+
+        return pd.DataFrame({"age": self.age, "extension": self.extension, "weight": self.weight})
+
+
+@dataclass(frozen=True)
+class Bookkeeping:
+    """Running totals at each trace row (per m^2): bonds born and broken, puller work, dissipation, energies."""
+
+    born: np.ndarray
+    broken: np.ndarray
+    work: np.ndarray  # J/m^2 done by the puller (velocity control: by the rig on the slider)
+    dissipation: np.ndarray  # elastic energy of the chains lost when they broke
+    bond_energy: np.ndarray  # FENE energy stored in the attached chains
+    block_energy: np.ndarray  # sigma^2/(2K) (zero under velocity control)
+
+
+@dataclass(frozen=True)
+class TransientResult:
+    """A run of the time-dependent population balance (Eqs 1-5); arrays in SI units."""
+
+    time: np.ndarray
+    stress: np.ndarray
+    bonded_fraction: np.ndarray
+    slider_velocity: np.ndarray
+    slider_position: np.ndarray
+    puller_position: np.ndarray
+    regime: str
+    cycles: tuple[Cycle, ...]
+    message: str
+    control: str
+    stiffness: float
+    snapshots: tuple[Snapshot, ...] = field(default=(), repr=False)
+    bookkeeping: Bookkeeping | None = field(default=None, repr=False)
+    chain_fraction: np.ndarray | None = field(default=None, repr=False)  # Nc/Nc0 (stick population only)
+    steps: int = 0
+    rejected: int = 0
+
+    @property
+    def final_stress(self) -> float:
+        return float(self.stress[-1])
+
+    @property
+    def final_bonded_fraction(self) -> float:
+        return float(self.bonded_fraction[-1])
+
+    def summary(self) -> dict[str, Any]:
+        """The JSON summary (SI units)."""
+        return {
+            "regime": self.regime,
+            "final_stress": self.final_stress,
+            "final_bonded_fraction": self.final_bonded_fraction,
+            "final_velocity": float(self.slider_velocity[-1]),
+            "end_time": float(self.time[-1]),
+            "control": self.control,
+            "stiffness": self.stiffness,
+            "steps": self.steps,
+            "cycles": [c.as_dict() for c in self.cycles],
+            "message": self.message,
+        }
+
+    def to_frame(self) -> pd.DataFrame:
+        """The trace: columns :data:`TRACE_COLUMNS`, SI units."""
+        import pandas as pd
+
+        return pd.DataFrame({name: getattr(self, name) for name in TRACE_COLUMNS})
+
+    def plot(self, ax: Axes | None = None, **kwargs: Any) -> Axes:
+        """Stress against time (and the slider velocity on a twin axis); returns the Axes."""
+        from .plots import plot_transient
+
+        return plot_transient(self, ax=ax, **kwargs)

@@ -1,0 +1,169 @@
+"""The time-dependent population balance (Eqs 1-5), each number against something independent."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import stickslip
+from stickslip.errors import ParameterError
+from stickslip.protocols import constant, segments
+from stickslip.transient import critical_stiffness, interface_response, run_transient
+from stickslip.transient.model import steady_population, stick_chains
+
+TAU = 224e-6
+
+
+@pytest.fixture(scope="module")
+def params():
+    return stickslip.load_parameters("gelatin-glass")
+
+
+def _final(params, velocity, aging, divisions, duration):
+    run = run_transient(
+        params, constant(velocity, duration), control="velocity", aging=aging, rtol=0.1, max_step=TAU / divisions
+    )
+    return np.array([run.final_stress, run.final_bonded_fraction])
+
+
+@pytest.mark.parametrize("velocity", [350e-6, 2000e-6])
+@pytest.mark.parametrize("aging", [True, False])
+def test_constant_velocity_relaxes_to_the_steady_curve(params, velocity, aging):
+    """From an empty surface to sigma(V), N/N0 of Eqs 6-8: fixed steps tau/20, tau/40, Richardson (order 2)."""
+    ref = stickslip.steady_state(params, velocity, aging=aging)
+    expected = np.array([float(ref.stress), float(ref.bonded_fraction)])
+    coarse = _final(params, velocity, aging, 20, 0.012)
+    fine = _final(params, velocity, aging, 40, 0.012)
+    extrapolated = (4 * fine - coarse) / 3
+    assert np.all(np.abs(fine / expected - 1) < 5e-4)
+    assert np.all(np.abs(extrapolated / expected - 1) < 2e-6)
+
+
+def test_slow_constant_velocity_with_aging(params):
+    """50 um/s with aging: bonds live to the FENE cliff (21 ms); relaxed in 0.12 s."""
+    ref = stickslip.steady_state(params, 50e-6)
+    coarse = _final(params, 50e-6, True, 8, 0.12)
+    fine = _final(params, 50e-6, True, 16, 0.12)
+    extrapolated = (4 * fine - coarse) / 3
+    expected = np.array([float(ref.stress), float(ref.bonded_fraction)])
+    assert np.all(np.abs(extrapolated / expected - 1) < 3e-5)
+
+
+def _startup_closed_form(t, params, velocity):
+    """lambda = 0, no aging, FENE irrelevant: docs/transient.md section 4."""
+    b = params.bonds
+    u0, tau, n0, m = b.breakage_weight, b.bond_time, b.site_density, b.chain_stiffness
+    k, c, mm = u0 / tau, (1 + u0) / tau, 1 / tau
+    bonded = n0 / (1 + u0) * -np.expm1(-c * t)
+    first = (1 - np.exp(-k * t) * (1 + k * t)) / k**2
+    second = np.exp(-c * t) * (np.exp(mm * t) * (mm * t - 1) + 1) / mm**2
+    stress = m * velocity * n0 / (tau * (1 + u0)) * (u0 * first + second)
+    return bonded, stress
+
+
+def test_startup_closed_form_and_convergence_order(params):
+    p = params.with_overrides({"bonds.activation_length": 0.0, "bonds.max_extension": 1.0})
+    v = 350e-6
+    errors = []
+    for divisions in (5, 10, 20):
+        run = run_transient(
+            p, constant(v, 4e-3), control="velocity", aging=False, rtol=0.1, max_step=TAU / divisions, every=2e-4
+        )
+        bonded, stress = _startup_closed_form(run.time[1:], p, v)
+        e_n = np.max(np.abs(run.bonded_fraction[1:] * p.bonds.site_density / bonded - 1))
+        e_s = np.max(np.abs(run.stress[1:] / stress - 1))
+        errors.append(max(e_n, e_s))
+    orders = np.log2(np.array(errors[:-1]) / np.array(errors[1:]))
+    assert errors[-1] < 2e-3
+    assert np.all((orders > 1.7) & (orders < 2.4))
+
+
+def test_bookkeeping_bonds_and_energy(params):
+    run = run_transient(params, segments([(350e-6, 0.004), (200e-6, 0.004)]), start="steady", rtol=1e-5)
+    book = run.bookkeeping
+    n0 = params.bonds.site_density
+    start_bonds = run.bonded_fraction[0] * n0
+    bonds = start_bonds + book.born - book.broken
+    assert np.allclose(bonds / n0, run.bonded_fraction, rtol=0, atol=1e-9)
+    stored = book.bond_energy + book.block_energy
+    balance = book.work - (stored - stored[0]) - book.dissipation
+    assert abs(balance[-1]) < 1e-3 * book.work[-1]
+
+
+def test_block_step_settles_at_sigma_350(params):
+    """300 -> 350 um/s through a block; stiffness x100 so that the quasi-static relaxation takes 18 ms."""
+    stiff = 100 * params.block.effective_stiffness
+    run = run_transient(
+        params, constant(350e-6, 0.2), start="steady", start_velocity=300e-6, stiffness=stiff, rtol=1e-4
+    )
+    assert run.regime == "steady"
+    assert run.final_stress == pytest.approx(391.53, abs=0.01)
+    assert run.slider_velocity[-1] == pytest.approx(350e-6, rel=1e-4)
+
+
+def test_one_population_holds_the_block(params):
+    """From rest the bonds of Eq 1 age into place: the block is stuck, sigma = K V0 t, creeping at K V0/(N0 M)."""
+    run = run_transient(params, constant(50e-6, 0.5), rtol=1e-3)
+    k = params.block.effective_stiffness
+    assert run.regime == "stuck"
+    assert run.final_stress == pytest.approx(k * 50e-6 * 0.5, rel=1e-3)
+    creep = k * 50e-6 / (params.bonds.site_density * params.bonds.chain_stiffness)
+    assert run.slider_velocity[-1] == pytest.approx(creep, rel=0.05)
+
+
+def test_stick_chains_match_the_stick_solver(params):
+    """Eq 15 by LSODA (chains set aside at a later age) against model.stick's theta integration."""
+    k = params.block.effective_stiffness
+    ref = stickslip.stick_phase(params, 50e-6, start_stress=259.0)
+    first = stick_chains(params, True, 259.0, k * 50e-6, 0.0, 1.0, 5.0)  # model.stick path
+    rest = stick_chains(params, True, 259.0 + k * 50e-6 * 5.0, k * 50e-6, 5.0, first.fraction, 100.0)
+    assert 5.0 + rest.duration == pytest.approx(ref.stick_time, rel=1e-5)
+
+
+def test_quasi_static_limit_of_the_interface_response(params):
+    """Z(s)/s -> dsigma/dV of the steady solver as s -> 0, on both branches."""
+    for v in (80e-6, 350e-6):
+        z = interface_response(params, v, np.array([1e-3]))
+        slope = float(stickslip.steady_state(params, v).stress_slope)
+        assert (z.z[0] / z.s[0]).real == pytest.approx(slope, rel=2e-3)
+
+
+def test_critical_stiffness_is_zero_above_vc_and_checked_by_direct_runs(params):
+    assert critical_stiffness(params, 350e-6) == 0.0
+    v0 = 120e-6
+    kc = critical_stiffness(params, v0)
+    assert 1e7 < kc < 1e9
+    amplitudes = []
+    for factor in (0.7, 1.4):
+        run = run_transient(
+            params, segments([(v0 * 1.001, 0.002), (v0, 0.25)]), start="steady", start_velocity=v0,
+            stiffness=factor * kc, rtol=1e-5,
+        )  # fmt: skip
+        v = run.slider_velocity
+        early = np.ptp(v[(run.time > 0.01) & (run.time < 0.06)])
+        late = np.ptp(v[run.time > 0.2])
+        amplitudes.append(late / early)
+    assert amplitudes[0] > 1.0 > amplitudes[1]
+
+
+def test_bad_input_is_one_clear_error(params):
+    with pytest.raises(ParameterError, match="control"):
+        run_transient(params, constant(1e-4, 1.0), control="rigid")
+    with pytest.raises(ParameterError, match="start velocity"):
+        run_transient(params, constant(1e-4, 1.0), start="steady", start_velocity=0.0)
+    with pytest.raises(ParameterError, match="stick_population"):
+        run_transient(params, constant(1e-4, 1.0), control="velocity", stick_population=True)
+
+
+def test_snapshots_and_frame(params):
+    run = run_transient(params, constant(350e-6, 2e-3), control="velocity", start="steady", rtol=1e-3, every=5e-4)
+    assert np.allclose(run.time, np.arange(5) * 5e-4)
+    frame = run.to_frame()
+    assert list(frame.columns) == ["time", "stress", "bonded_fraction", "slider_velocity", "slider_position",
+                                   "puller_position"]  # fmt: skip
+    snap = run.snapshots[-1]
+    pop = steady_population(params, 350e-6, True)
+    assert snap.weight.sum() == pytest.approx(pop.bonded, rel=1e-3)
+    assert math.isfinite(run.final_stress)
