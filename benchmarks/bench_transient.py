@@ -39,7 +39,7 @@ def method_of_lines(params, velocity, duration, cells=400):  # type: ignore[no-u
     rate = (
         b.breakage_weight
         / b.bond_time
-        * np.exp(b.force_sensitivity * f - age / g.aging_time * np.exp(-velocity / g.aging_velocity))
+        * np.exp(np.minimum(b.force_sensitivity * f - age / g.aging_time * np.exp(-velocity / g.aging_velocity), 700.0))
     )
 
     def rhs(t, n):  # type: ignore[no-untyped-def]

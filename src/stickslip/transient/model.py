@@ -174,8 +174,10 @@ def stick_chains(
         sol = solve_ivp(rhs, (0.0, span), [y0], method="LSODA", rtol=1e-10, atol=1e-12, events=collapse)
     except ValueError:  # event bracketing lost in the explosive collapse: step without events
         sol = solve_ivp(rhs, (0.0, span), [y0], method="Radau", rtol=1e-10, atol=1e-12)
-    if sol.status < 0:
+    if sol.status < 0 and not log_rate(float(sol.t[-1]), float(sol.y[0, -1])) > 0.0:
         raise ModelError(f"stick chains (Eq 15): integration failed: {sol.message}")
+    if sol.status < 0:  # the step size collapsed inside the explosive end: the chains are going at > 1/s
+        return StickChains(float(sol.t[-1]), 0.0, True, sol.t, np.exp(sol.y[0]))
     done = sol.status == 1 or log_rate(float(sol.t[-1]), float(sol.y[0, -1])) >= COLLAPSE_LOG_RATE
     t_end = float(sol.t_events[0][0]) if sol.status == 1 else float(sol.t[-1])
     return StickChains(t_end, float(np.exp(sol.y[0, -1])), bool(done), sol.t, np.exp(sol.y[0]))

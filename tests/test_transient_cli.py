@@ -1,0 +1,36 @@
+"""``stickslip transient``: trace columns, JSON summary, one-line errors (every value with its unit)."""
+
+from __future__ import annotations
+
+import json
+
+import pandas as pd
+from click.testing import CliRunner
+from tests.cli_helpers import run, run_main
+
+import stickslip
+
+
+def test_velocity_step_trace_and_json(tmp_path):
+    trace = tmp_path / "trace.csv"
+    out = run(
+        CliRunner(), "transient", "--v0", "350 um/s", "--duration", "4 ms", "--control", "velocity", "--start",
+        "steady", "--segment", "1 mm/s:3 ms", "--every", "0.5 ms", "-o", str(trace), "--json",
+    )  # fmt: skip
+    summary = json.loads(out)
+    assert set(summary) >= {"regime", "final_stress", "final_bonded_fraction", "cycles", "message"}
+    expected = float(stickslip.steady_state(stickslip.load_parameters("gelatin-glass"), 1e-3).stress)
+    assert abs(summary["final_stress"] / expected - 1) < 1e-3
+    frame = pd.read_csv(trace)
+    assert list(frame.columns) == ["time", "stress", "bonded_fraction", "slider_velocity", "slider_position",
+                                   "puller_position"]  # fmt: skip
+    assert len(frame) == 15
+
+
+def test_bad_protocols_are_one_line(capsys, tmp_path):
+    code, _, err = run_main(capsys, "transient", "--v0", "50 um/s", "--duration", "-1 s")
+    assert code == 2 and err.count("\n") == 1 and "--duration" in err
+    bad = tmp_path / "p.csv"
+    bad.write_text("time,velocity\n0,1e-4\n2,1e-4\n1,1e-4\n")
+    code, _, err = run_main(capsys, "transient", "--protocol", str(bad))
+    assert code == 2 and err.count("\n") == 1 and "does not increase" in err
