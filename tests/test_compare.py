@@ -29,7 +29,7 @@ def test_quasi_static_fallback_follows_the_steady_curve_and_says_so(monkeypatch)
     assert np.isnan(hold.stress[0]) and "holds" in hold.note
 
 
-def test_time_dependent_model_is_used_when_importable(monkeypatch):
+def test_time_dependent_model_is_used_when_asked_for(monkeypatch):
     fake = types.ModuleType("stickslip.transient")
 
     def run_transient(params, protocol, control="velocity", start="steady"):
@@ -39,8 +39,10 @@ def test_time_dependent_model_is_used_when_importable(monkeypatch):
     fake.run_transient = run_transient
     monkeypatch.setitem(sys.modules, "stickslip.transient", fake)
     monkeypatch.setattr("stickslip.transient", fake, raising=False)
-    trace = cmp.bond_response(PARAMS, protocols.constant(1e-4, 1.0))
+    trace = cmp.bond_response(PARAMS, protocols.constant(1e-4, 1.0), model="transient")
     assert trace.source == "time-dependent bond model" and np.all(trace.stress == 42.0)
+    default = cmp.bond_response(PARAMS, protocols.constant(1e-4, 1.0), times=[0.5])
+    assert default.source == "quasi-static bond model"  # the slow model only when asked for
 
 
 def test_rsf_of_bond_states_a_minus_b_as_the_steady_slope(monkeypatch):

@@ -29,6 +29,13 @@ from .rsf_cmd import save_figure, sidecar, write
 @click.option("--hold", default="1 s", show_default=True, help="Hold time of the slide-hold-slide.")
 @click.option("--pull", default="50 um/s", show_default=True, help="Pulling velocity of the stick-slip pair.")
 @click.option("--duration", default="120 s", show_default=True, help="Duration of the stick-slip pair.")
+@click.option(
+    "--bond-model",
+    type=click.Choice(["quasi-static", "transient"]),
+    default="quasi-static",
+    show_default=True,
+    help="Bond model of the step and slide-hold-slide panels; transient (Eqs 1-5) costs ~1 min CPU per 10 ms.",
+)
 @click.option("--eta", default=None, help="RSF radiation damping (s/m) [a/(100 V0)].")
 @click.option("--a", "rsf_a", default=None, help="Override the RSF a standing for the bond model.")
 @click.option("--b", "rsf_b", default=None, help="Override the RSF b.")
@@ -51,12 +58,12 @@ def compare_command(**options: Any) -> None:
     eta = None if options["eta"] is None else positive(options["eta"], "slowness", "--eta", allow_zero=True)
     refuse_input_as_output([options["params_name"]], [("-o", options["output"])])
 
-    rsf = _override(rsf_of_bond(params, v0, v1, step_time), options)
+    rsf = _override(rsf_of_bond(params, v0, v1, step_time, model=options["bond_model"]), options)
     step = protocols.velocity_steps([v0, v1], [step_time, step_time])
     shs = protocols.slide_hold_slide(v0, step_time, hold)
     panels = {}
     for name, protocol in (("velocity step", step), ("slide-hold-slide", shs)):
-        bond = bond_response(params, protocol, "velocity")
+        bond = bond_response(params, protocol, "velocity", model=options["bond_model"])
         run = simulate(rsf.params, protocol, every=protocol.duration / 800)
         panels[name] = (bond, run)
     local = _override(rsf_of_bond(params, pull / 1.05, pull * 1.05), options)

@@ -69,11 +69,20 @@ def _transient() -> Any:
     return getattr(transient, "run_transient", None)
 
 
-def bond_response(params: Any, protocol: Protocol, control: str = "velocity", times: Any = None) -> BondTrace:
-    """The bond model's stress under ``protocol`` (``control``: "velocity" of the slider, or "block" pulled)."""
+def bond_response(
+    params: Any, protocol: Protocol, control: str = "velocity", times: Any = None, model: str = "quasi-static"
+) -> BondTrace:
+    """The bond model's stress under ``protocol`` (``control``: "velocity" of the slider, or "block" pulled).
+
+    ``model="transient"`` runs the time-dependent model (Eqs 1-5).  It is opt-in because it resolves the
+    bond time tau (224 us for gelatin): about a minute of CPU per 10 ms of sliding, so only millisecond
+    protocols are practical with it; the quasi-static model is the default.
+    """
     if control not in ("velocity", "block"):
         raise ParameterError(f"control: expected 'velocity' or 'block', got {control!r}")
-    run_transient = _transient()
+    if model not in ("quasi-static", "transient"):
+        raise ParameterError(f"bond model: expected 'quasi-static' or 'transient', got {model!r}")
+    run_transient = _transient() if model == "transient" else None
     if run_transient is not None:
         result = run_transient(params, protocol, control=control, start="steady")
         return BondTrace(np.asarray(result.time, float), np.asarray(result.stress, float), "time-dependent bond model",
@@ -113,8 +122,13 @@ def _critical(params: Any) -> tuple[float, float]:
     return float(cp.velocity), float(cp.stress)
 
 
-def rsf_of_bond(params: Any, v0: float, v1: float, duration: float = 1.0, stiffness: float = 1e9) -> BondRSF:
-    """RSF a, b, Dc standing for the bond model between velocities ``v0`` and ``v1`` (see the module notes)."""
+def rsf_of_bond(
+    params: Any, v0: float, v1: float, duration: float = 1.0, stiffness: float = 1e9, model: str = "quasi-static"
+) -> BondRSF:
+    """RSF a, b, Dc standing for the bond model between velocities ``v0`` and ``v1`` (see the module notes).
+
+    With ``model="transient"`` a, b and Dc are fitted to the time-dependent model's velocity step.
+    """
     from ..model.steady import steady_state
 
     sigma_c = _critical(params)[1]
@@ -123,7 +137,7 @@ def rsf_of_bond(params: Any, v0: float, v1: float, duration: float = 1.0, stiffn
     stress = np.ravel(steady.stress)
     a_minus_b = float(np.ravel(steady.stress_slope)[1] * vm / sigma_c)
     mu0 = float(stress[0] / sigma_c)
-    if _transient() is not None:
+    if model == "transient" and _transient() is not None:
         return _fitted_rsf(params, v0, v1, duration, stiffness, a_minus_b, mu0, sigma_c)
     dl_m = float(params.bonds.max_extension)
     a = abs(a_minus_b)
@@ -143,7 +157,7 @@ def _fitted_rsf(
     from .fit import fit_record
 
     protocol = velocity_steps([v0, v1], [duration, duration])
-    trace = bond_response(params, protocol, "velocity")
+    trace = bond_response(params, protocol, "velocity", model="transient")
     t = trace.time
     record = LabRecord.from_arrays(t, protocol.displacement_at(t), trace.stress / sigma_c, source="bond model")
     fit = fit_record(record, stiffness=stiffness, protocol=protocol)

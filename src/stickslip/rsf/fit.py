@@ -285,7 +285,7 @@ def _report(
         se = par.stderr if par.stderr is not None and math.isfinite(par.stderr) else None
         if key.startswith("log_"):
             value = math.exp(par.value)
-            interval = (math.exp(par.value - Z95 * se), math.exp(par.value + Z95 * se)) if se is not None else None
+            interval = (_exp(par.value - Z95 * se), _exp(par.value + Z95 * se)) if se is not None else None
             stderr = value * se if se is not None else None
         else:
             value = par.value
@@ -335,3 +335,8 @@ def _posterior(residual: Any, result: Any, steps: int, seed: int | None) -> dict
         lo, med, hi = np.percentile(chain, [2.5, 50, 97.5])
         out[_PUBLIC[key]] = {"median": float(med), "interval": [float(lo), float(hi)]}
     return out
+
+
+def _exp(x: float) -> float:
+    """exp that reports an interval end beyond the float range as inf (shown as unbounded), not OverflowError."""
+    return math.exp(x) if x < 709.0 else math.inf
