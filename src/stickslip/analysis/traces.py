@@ -25,6 +25,7 @@ import numpy as np
 
 from ..errors import DataError, ParameterError
 from ..tables import Table, read_table, read_text_cells
+from ..trace_columns import MODEL_COLUMNS
 
 #: Fewest usable (finite-stress) samples a trace must have.
 MIN_SAMPLES = 20
@@ -32,23 +33,6 @@ MIN_SAMPLES = 20
 MAX_MAGNITUDE = 1e100
 
 TRACE_DIMENSIONS = {"time": "time", "stress": "stress", "force": "force"}
-#: Columns of the package's model traces that the analysis does not use: ``simulate -o``
-#: (stickslip.model.cycle.CYCLE_COLUMNS), the time-dependent bond model and rate-and-state traces.
-MODEL_COLUMNS = (
-    "velocity",
-    "slider_displacement",
-    "puller_displacement",
-    "block_shear",
-    "chain_fraction",
-    "phase",
-    "bonded_fraction",
-    "slider_velocity",
-    "slider_position",
-    "puller_position",
-    "friction",
-    "state",
-    "load_point_displacement",
-)
 
 
 @dataclass(frozen=True)

@@ -36,6 +36,7 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..parameters import Parameters
+from ..trace_columns import QUASI_STATIC
 from .jump import Jump, check_curve, jump_velocity, require_critical_point
 from .slip import SlipPhase, slip_phase
 from .steady import require_parameters
@@ -46,16 +47,7 @@ if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.axes import Axes
 
 #: Trace columns, in order (SI units: s, Pa, m/s, m, m, m, Nc/Nc0, phase name).
-CYCLE_COLUMNS = (
-    "time",
-    "stress",
-    "velocity",
-    "slider_displacement",
-    "puller_displacement",
-    "block_shear",
-    "chain_fraction",
-    "phase",
-)
+CYCLE_COLUMNS = QUASI_STATIC
 COLUMN_UNITS = {
     "time": "s",
     "stress": "Pa",

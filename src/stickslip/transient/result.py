@@ -8,13 +8,14 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..model.cycle import Cycle
+from ..trace_columns import TRANSIENT
 
 if TYPE_CHECKING:  # pragma: no cover
     import pandas as pd
     from matplotlib.axes import Axes
 
 #: Trace columns, in order (SI units).
-TRACE_COLUMNS = ("time", "stress", "bonded_fraction", "slider_velocity", "slider_position", "puller_position")
+TRACE_COLUMNS = TRANSIENT
 TRACE_UNITS = {
     "time": "s",
     "stress": "Pa",
