@@ -42,6 +42,11 @@ LIGHTEST = 1e-30
 P_LOG_U0_TAU, P_TAU, P_FORCE_SENS, P_M, P_DLM, P_INV_TAU_A, P_VA, P_N0, P_K, P_AGING = range(10)
 # integer status returned by advance()
 DONE, FULL, STEPS, STICK, FAILED = 0, 1, 2, 3, 4
+#: half-distance of the two Gauss-Legendre points from the middle of a step, as a fraction of the step
+GAUSS = 0.5 / math.sqrt(3.0)
+#: four-point Gauss-Legendre rule on [-1, 1]
+GL4_X = np.array([-0.8611363115940526, -0.3399810435848563, 0.3399810435848563, 0.8611363115940526])
+GL4_W = np.array([0.3478548451374538, 0.6521451548625461, 0.6521451548625461, 0.3478548451374538])
 
 
 def _jit(func):  # type: ignore[no-untyped-def]
@@ -216,6 +221,79 @@ def _sums(n, xb, lw, x, p):  # type: ignore[no-untyped-def]
     return nn, s, k, u
 
 
+def _balance_weights(x, puller, n, xb, w, p):  # type: ignore[no-untyped-def]
+    """X with sum w f(X - x_b) = K (puller - X), weights given (not logs): Newton inside the FENE bracket."""
+    lo = -np.inf
+    hi = np.inf
+    for i in range(n):  # the FENE wall of the oldest live chain
+        if w[i] > 0.0:
+            hi = min(hi, xb[i] + p[P_DLM] * (1.0 - 1e-15))
+    if x >= hi:
+        x = hi - 1e-3 * p[P_DLM]
+    for _ in range(100):
+        s = 0.0
+        k = p[P_K]
+        for i in range(n):
+            if w[i] == 0.0:
+                continue
+            e = x - xb[i]
+            s += w[i] * _chain_force(e, p[P_M], p[P_DLM])
+            k += w[i] * _chain_stiffness(e, p[P_M], p[P_DLM])
+        g = s - p[P_K] * (puller - x)
+        if g > 0.0:
+            hi = min(hi, x)
+        else:
+            lo = max(lo, x)
+        x_new = x - g / k
+        if not (lo < x_new < hi):  # FENE walls: stay inside the bracket
+            x_new = 0.5 * (lo + hi) if (lo > -np.inf and hi < np.inf) else x - 0.5 * g / k
+        if abs(x_new - x) <= 1e-15 * max(abs(x), p[P_DLM]):
+            return x_new
+        x = x_new
+    return x
+
+
+def _hermite(theta, h, l0, d0, l1, d1):  # type: ignore[no-untyped-def]
+    """The cubic with values l0, l1 and slopes d0, d1 at the ends of a step of length h, at theta = u/h."""
+    t2 = theta * theta
+    t3 = t2 * theta
+    return (
+        (2.0 * t3 - 3.0 * t2 + 1.0) * l0
+        + (t3 - 2.0 * t2 + theta) * h * d0
+        + (-2.0 * t3 + 3.0 * t2) * l1
+        + (t3 - t2) * h * d1
+    )
+
+
+def _vacancy(u, q0, tau, h, l0, d0, l1, d1):  # type: ignore[no-untyped-def]
+    """Q(u) for dQ/du = -Q/tau + L(u), L the Hermite cubic of the breakage rate over the step.
+
+    Exact for the cubic: Gauss-Legendre (4 points, degree 7) when u < tau, where the exponential kernel is
+    smooth on [0, u]; the closed form by parts (no cancellation once u >= tau) otherwise.
+    """
+    if u <= 0.0:
+        return q0
+    dec = math.exp(-u / tau)
+    if u < tau:
+        total = 0.0
+        for j in range(4):
+            s = 0.5 * u * (1.0 + GL4_X[j])
+            total += GL4_W[j] * _hermite(s / h, h, l0, d0, l1, d1) * math.exp(-(u - s) / tau)
+        return q0 * dec + 0.5 * u * total
+    # L = a + b s + c s^2 + e s^3, and the integral of L(s) e^{-(u-s)/tau} over [0, u] is F(u) - e^{-u/tau} F(0)
+    # with F = tau (L - tau dL + tau^2 d2L - tau^3 d3L)
+    a = l0
+    b = d0
+    c = (3.0 * (l1 - l0) / h - 2.0 * d0 - d1) / h
+    e = (2.0 * (l0 - l1) / h + d0 + d1) / (h * h)
+    lu = a + u * (b + u * (c + u * e))
+    dlu = b + u * (2.0 * c + 3.0 * u * e)
+    ddlu = 2.0 * c + 6.0 * u * e
+    f_u = tau * (lu - tau * dlu + tau * tau * ddlu - tau * tau * tau * 6.0 * e)
+    f_0 = tau * (a - tau * b + tau * tau * 2.0 * c - tau * tau * tau * 6.0 * e)
+    return q0 * dec + f_u - dec * f_0
+
+
 def advance(
     t,
     t_end,
@@ -234,6 +312,7 @@ def advance(
     rate0,
     lc,
     aa,
+    w1,
     acc,
     p,
     rtol,
@@ -247,19 +326,33 @@ def advance(
 ):  # type: ignore[no-untyped-def]
     """Integrate from t to t_end (one protocol piece).  Returns (status, t, x, v, h, n, sample_index, rows).
 
+    One step (docs/transient.md section 2): every cohort's log weight by the trapezoid rule of its hazard
+    along its characteristic; the step's births (the exact exponential of the vacancy's 1/tau relaxation)
+    lumped into one cohort at mid-step; under block control the slider then put where the bonds balance the
+    block (sigma = K (P - X) exactly) and its velocity taken as the stable root of g.  The local error
+    estimate is of third order in h, as the method's local error: the trapezoid's h^2/12 |r'(t1) - r'(t0)|
+    per cohort, the lumping of births (h r)^2/24 of their mass, and, under block control, the effect of
+    the predicted slider position and velocity on the hazards.
+
     ``acc`` accumulates [born, broken, puller work, dissipation, steps, rejected].  Rows written to
     ``out`` (time, sigma, N, V, X, P, born, broken, work, dissipation, bond energy): every accepted step
     when ``sample_times`` is empty, else only at those times (the steps land on them exactly).
     ``block``: 1 for block control (vp is the puller's velocity), 0 for velocity control (v = vp).
     """
     big = p[P_N0]
+    beta = p[P_FORCE_SENS]
+    m = p[P_M]
+    dlm = p[P_DLM]
     rows = 0
     steps = 0
     n_samples = sample_times.shape[0]
+    v_prev = v
+    h_prev = 0.0
+    s_floor = 1e-9 * m * big * dlm
     while t < t_end:
         if steps >= max_steps:
             return STEPS, t, x, v, h, n, sample_index, rows
-        if n + 1 >= xb.shape[0]:
+        if n + 3 >= xb.shape[0]:
             return FULL, t, x, v, h, n, sample_index, rows
         hh = min(h, h_max, t_end - t)
         landing = False
@@ -270,114 +363,206 @@ def advance(
             hh = t_end - t
         if hh <= 0.0:
             hh = t_end - t
-        # ---- stage 1 at t, and the Euler predictor
+        t1 = t + hh
+        # ---- the slider's path over the step: exact (velocity control) or predicted (block control)
         if block == 0:
             v0 = vp
+            v1p = vp
         else:
             v0 = v
+            v1p = v + (v - v_prev) * (hh / h_prev) if h_prev > 0.0 else v
+            if v1p < 0.0:
+                v1p = 0.0
+        x1p = x + 0.5 * hh * (v0 + v1p)
+        x_mid = x + 0.5 * hh * v0 + 0.125 * hh * (v1p - v0)
+        slope0 = _aging_factor(v0, p)
+        slope1 = _aging_factor(v1p, p)
+        accel = (v1p - v0) / hh
+        aging_on = p[P_AGING] > 0.0
+        # ---- one pass over the cohorts: hazards at both ends, corrected trapezoid, error terms, sums
         nn0 = 0.0
         s0 = 0.0
-        slope0 = _aging_factor(v0, p)
-        for i in range(n):
-            e = x - xb[i]
-            lr = _log_rate(e, t - tb[i], slope0, p)
-            r0 = math.exp(min(lr, LOG_RATE_CAP))
-            rate0[i] = r0
-            lw_new[i] = lw[i] - hh * r0
-            w = math.exp(lw[i])
-            nn0 += w
-            if lr < np.inf:
-                s0 += w * _chain_force(e, p[P_M], p[P_DLM])
-        t1 = t + hh
-        x_pred = x + hh * v0
-        if block == 1:
-            vp_end = vp
-            v1 = _slider_velocity(v0, vp_end, n, xb, tb, lw_new, x_pred, t1, p, lc, aa)
-        else:
-            v1 = vp
-        x1 = x + 0.5 * hh * (v0 + v1)
-        # ---- corrector (trapezoid) with one re-evaluation of V at the corrected state
-        err_s = 0.0
-        err_n = 0.0
-        broken = 0.0
-        dissip = 0.0
         nn1 = 0.0
         s1 = 0.0
-        k1 = 0.0
-        x_half = 0.5 * (x + x1)
-        slope1 = _aging_factor(v1, p)
+        loss0 = 0.0  # breakage rate (bonds per m^2 per s) at both ends of the step
+        loss1 = 0.0
+        dloss0 = 0.0  # and its time derivative
+        dloss1 = 0.0
+        broken = 0.0
+        dissip = 0.0
+        rate_s0 = 0.0  # sum r w f: the stress lost to breakage per unit time, at both ends
+        rate_s1 = 0.0
+        kint0 = 0.0  # sum w f': the interface stiffness, at both ends
+        kint1 = 0.0
+        err_s = 0.0
+        err_n = 0.0
+        sens_x = 0.0  # sum w f r beta f': how the step's stress loss depends on the slider position
+        sens_a = 0.0  # sum w f r t_a: how it depends on the aging slope
         for i in range(n):
-            e1 = x1 - xb[i]
-            lr = _log_rate(e1, t1 - tb[i], slope1, p)
-            r1 = math.exp(min(lr, LOG_RATE_CAP))
-            new = lw[i] - 0.5 * hh * (rate0[i] + r1)
-            w_old = math.exp(lw[i])
-            w_eul = math.exp(lw_new[i])
-            if lr == np.inf:
-                f1 = 0.0
-                w_new = 0.0
-                new = -np.inf
-                u_mid = _chain_energy(x - xb[i], p[P_M], p[P_DLM]) if abs(x - xb[i]) < p[P_DLM] else 0.0
-            else:
-                w_new = math.exp(new)
-                f1 = _chain_force(e1, p[P_M], p[P_DLM])
-                u_mid = _chain_energy(x_half - xb[i], p[P_M], p[P_DLM]) if w_old > w_new else 0.0
-                nn1 += w_new
-                s1 += w_new * f1
-                k1 += w_new * _chain_stiffness(e1, p[P_M], p[P_DLM])
-            dw = abs(w_new - w_eul)
+            w0 = math.exp(lw[i])
+            e0 = x - xb[i]
+            e1 = x1p - xb[i]
+            nn0 += w0
+            if e0 >= dlm or -e0 >= dlm:  # beyond the FENE wall already (cannot happen for a live cohort)
+                lw_new[i] = -np.inf
+                rate0[i] = np.inf
+                w1[i] = 0.0
+                broken += w0
+                continue
+            f0 = _chain_force(e0, m, dlm)
+            s0 += w0 * f0
+            if e1 >= dlm or -e1 >= dlm:  # the chain reaches full extension within the step
+                lw_new[i] = -np.inf
+                rate0[i] = np.inf
+                w1[i] = 0.0
+                broken += w0
+                dissip += w0 * _chain_energy(e0, m, dlm)
+                err_s += w0 * abs(f0)
+                err_n += w0
+                continue
+            age0 = t - tb[i]
+            age1 = t1 - tb[i]
+            f1 = _chain_force(e1, m, dlm)
+            r0 = math.exp(min(p[P_LOG_U0_TAU] + beta * abs(f0) - age0 * slope0, LOG_RATE_CAP))
+            r1 = math.exp(min(p[P_LOG_U0_TAU] + beta * abs(f1) - age1 * slope1, LOG_RATE_CAP))
+            # d ln r/dt along the characteristic at both ends (force, age, and the velocity's effect on aging)
+            k0 = _chain_stiffness(e0, m, dlm)
+            k1 = _chain_stiffness(e1, m, dlm)
+            g0 = beta * (1.0 if f0 >= 0.0 else -1.0) * k0 * v0 - slope0
+            g1 = beta * (1.0 if f1 >= 0.0 else -1.0) * k1 * v1p - slope1
+            if aging_on and accel != 0.0:
+                g0 += age0 * slope0 * accel / p[P_VA] * (1.0 if v0 >= 0.0 else -1.0)
+                g1 += age1 * slope1 * accel / p[P_VA] * (1.0 if v1p >= 0.0 else -1.0)
+            trap = 0.5 * hh * (r0 + r1)
+            corr = hh * hh / 12.0 * (r1 * g1 - r0 * g0)  # Euler-Maclaurin end correction: fourth order
+            limit = 0.5 * trap
+            corr = min(max(corr, -limit), limit)
+            new = lw[i] - trap + corr
+            wn = math.exp(new)
+            dw = min(wn * math.expm1(min(abs(corr), 50.0)), w0)
             err_s += abs(f1) * dw
             err_n += dw
-            broken += w_old - w_new
-            dissip += (w_old - w_new) * u_mid
+            sens_x += wn * abs(f1) * r1 * beta * k1
+            sens_a += wn * abs(f1) * r1 * age1
+            loss0 += w0 * r0
+            loss1 += wn * r1
+            dloss0 += w0 * r0 * (g0 - r0)
+            dloss1 += wn * r1 * (g1 - r1)
+            broken += w0 - wn
+            if trap < 0.5:  # dissipation r w u by the end-corrected trapezoid (fourth order)
+                u0 = _chain_energy(e0, m, dlm)
+                u1 = _chain_energy(e1, m, dlm)
+                phi0 = r0 * w0 * u0
+                phi1 = r1 * wn * u1
+                dphi0 = phi0 * (g0 - r0) + r0 * w0 * f0 * v0
+                dphi1 = phi1 * (g1 - r1) + r1 * wn * f1 * v1p
+                dissip += 0.5 * hh * (phi0 + phi1) - hh * hh / 12.0 * (dphi1 - dphi0)
+            else:  # a cohort breaking within the step: its lost mass at the mid-step energy
+                dissip += (w0 - wn) * _chain_energy(x_mid - xb[i], m, dlm)
+            rate_s0 += w0 * r0 * f0
+            rate_s1 += wn * r1 * f1
+            kint0 += w0 * k0
+            kint1 += wn * k1
+            nn1 += wn
+            s1 += wn * f1
             lw_new[i] = new
+            w1[i] = wn
             rate0[i] = r1  # kept for the merging of quiet cohorts after the step
-        if block == 1:  # put the slider where the bonds balance the block exactly (sigma = K (P - X))
-            x1 = _balance_position(x1, puller0 + vp * (t1 - t0), n, xb, lw_new, p)
-            v1 = _slider_velocity(v1, vp, n, xb, tb, lw_new, x1, t1, p, lc, aa)
-        # births: the vacancy Q = N0 - N relaxes at 1/tau and is refilled by the breakage of this step
+        # ---- births over the step, as two cohorts at the Gauss-Legendre points (fourth order in h): the
+        # vacancy Q = N0 - N relaxes at 1/tau and is refilled by breakage, a Hermite cubic over the step;
+        # the newborns' own breakage joins it (fixed-point passes, for their mass and rate at t1)
         q0 = big - nn0
-        decay = math.exp(-hh / p[P_TAU])
-        loss_rate = broken / hh
-        q1 = q0 * decay + loss_rate * p[P_TAU] * (1.0 - decay)
-        born = q0 - q1 + broken
-        if born < 0.0:
+        tau = p[P_TAU]
+        r_birth = math.exp(p[P_LOG_U0_TAU])  # hazard at age 0, extension 0
+        dloss0 += r_birth * q0 / tau
+        born = 0.0
+        born_alive = 0.0
+        newborn_loss = 0.0
+        newborn_dloss = 0.0
+        newborn_dissip = 0.0
+        q_end = q0
+        e_nb = 0.0
+        for _sweep in range(3):
+            l1 = loss1 + newborn_loss
+            d1 = dloss1 + newborn_dloss + r_birth * q_end / tau
             born = 0.0
-        # the newborn cohort, born mid-step; its hazard over the half step it has lived
-        x_mid = 0.5 * (x + x1)
-        lr_new = _log_rate(x1 - x_mid, 0.5 * hh, _aging_factor(v1, p), p)
-        survive = math.exp(-0.5 * hh * math.exp(min(lr_new, LOG_RATE_CAP)))
-        born_alive = born * survive
+            born_alive = 0.0
+            newborn_loss = 0.0
+            newborn_dloss = 0.0
+            newborn_dissip = 0.0
+            for k in range(2):
+                u = hh * (0.5 - GAUSS if k == 0 else 0.5 + GAUSS)
+                q = _vacancy(u, q0, tau, hh, loss0, dloss0, l1, d1)
+                mass = 0.5 * hh * max(q, 0.0) / tau
+                d = hh - u  # its age at t1
+                x_k = x + u * v0 + 0.5 * (v1p - v0) * u * u / hh
+                e_k = x1p - x_k
+                r_end = math.exp(min(_log_rate(e_k, d, slope1, p), LOG_RATE_CAP))
+                g_end = beta * _chain_stiffness(e_k, m, dlm) * v1p - slope1
+                g_start = beta * m * (v0 + accel * u) - _aging_factor(v0 + accel * u, p)
+                trap = 0.5 * d * (r_birth + r_end)
+                corr = d * d / 12.0 * (r_end * g_end - r_birth * g_start)
+                corr = min(max(corr, -0.5 * trap), 0.5 * trap)
+                alive = mass * math.exp(-trap + corr)
+                born += mass
+                born_alive += alive
+                newborn_dissip += (mass - alive) * _chain_energy(0.5 * e_k, m, dlm)
+                newborn_loss += alive * r_end
+                newborn_dloss += alive * r_end * (g_end - r_end)
+                xb[n + k] = x_k
+                tb[n + k] = t + u
+                lw_new[n + k] = math.log(alive) if alive > 0.0 else -np.inf
+                w1[n + k] = alive
+                rate0[n + k] = r_end
+                if k == 1:
+                    e_nb = e_k
+            q_end = max(big - nn1 - born_alive, 0.0)
+        # the error one lumped cohort would make (the Gauss pair's is far smaller): a conservative estimate
+        z = r_birth * hh
+        err_n += born_alive * z * z / 24.0
+        err_s += born_alive * z * z / 24.0 * abs(_chain_force(x1p - x_mid, m, dlm))
+        x1 = x1p
+        v1 = v1p
         if block == 1:
-            nn1, s1, k1, _u1 = _sums(n, xb, lw_new, x1, p)
-        s_ref = max(abs(s1), abs(s0), 1e-9 * p[P_M] * p[P_N0] * p[P_DLM])
-        err_s += k1 * abs(x1 - x_pred)
-        # a lumped newborn cohort is wrong by about its mass times the fraction of tau the step spans
-        err_n += born * min(1.0, hh * math.exp(p[P_LOG_U0_TAU]))
+            # the slider where the bonds balance the block exactly, then its velocity (the stable root of g)
+            x1 = _balance_weights(x1p, puller0 + vp * (t1 - t0), n + 2, xb, w1, p)
+            v1 = _slider_velocity(v1p, vp, n + 2, xb, tb, lw_new, x1, t1, p, lc, aa)
+            # the hazards used the predicted slider position and velocity
+            err_s += 0.5 * hh * (abs(x1 - x1p) * sens_x + abs(_aging_factor(v1, p) - slope1) * sens_a)
+            s1 = p[P_K] * (puller0 + vp * (t1 - t0) - x1)
+        else:
+            s1 += w1[n] * _chain_force(x1p - xb[n], m, dlm) + w1[n + 1] * _chain_force(e_nb, m, dlm)
+        nn1 += born_alive
+        s_ref = max(abs(s1), abs(s0), s_floor)
         err = max(err_s / (rtol * s_ref), err_n / (rtol * big))
         if not (err <= 1.0) and hh > 1e-15 * max(t, p[P_TAU]):
             acc[5] += 1.0
-            factor = 0.9 / math.sqrt(err) if err == err else 0.1
-            h = hh * max(0.1, min(0.5, factor))
+            factor = 0.9 * err ** (-1.0 / 3.0) if err == err else 0.1
+            h = hh * max(0.1, min(0.7, factor))
             continue
         # ---- accept
-        for i in range(n):
+        for i in range(n + 2):
             lw[i] = lw_new[i]
-        xb[n] = x_mid
-        tb[n] = t + 0.5 * hh
-        lw[n] = math.log(born_alive) if born_alive > 0.0 else -np.inf
-        n += 1
+        n += 2
         broken += born - born_alive
-        dissip += 0.0  # a newborn chain breaking in its first half step carries no energy to first order
         acc[0] += born
         acc[1] += broken
+        # puller work by the end-corrected trapezoid; dsigma/dt = K (Vp - V) (block) or k_int V - sum r w f
         if block == 1:
-            s_new_block = p[P_K] * (puller0 + vp * (t1 - t0) - x1)
-            acc[2] += 0.5 * (p[P_K] * (puller0 + vp * (t - t0) - x) + s_new_block) * vp * hh
+            sigma0 = p[P_K] * (puller0 + vp * (t - t0) - x)
+            acc[2] += (0.5 * (sigma0 + s1) - hh / 12.0 * p[P_K] * (v0 - v1)) * vp * hh
         else:
-            acc[2] += 0.5 * (s0 + s1) * vp * hh
-        acc[3] += dissip
+            for k in range(2):
+                e_k = x1 - xb[n - 2 + k]
+                kint1 += w1[n - 2 + k] * _chain_stiffness(e_k, m, dlm)
+                rate_s1 += w1[n - 2 + k] * rate0[n - 2 + k] * _chain_force(e_k, m, dlm)
+            ds0 = kint0 * vp - rate_s0
+            ds1 = kint1 * vp - rate_s1
+            acc[2] += (0.5 * (s0 + s1) - hh / 12.0 * (ds1 - ds0)) * vp * hh
+        acc[3] += dissip + newborn_dissip
         acc[4] += 1.0
+        v_prev = v
+        h_prev = hh
         t = t1
         x = x1
         v = v1
@@ -387,10 +572,11 @@ def advance(
         # same slider position: the merged cohort keeps the weight and the mean extension, so the stress
         # changes only through the FENE curvature, by far less than rtol
         quiet = 1e-3 * rtol / max(t_end - t, 1.0)
-        gap = 1e-4 * math.sqrt(rtol) * p[P_DLM]
+        gap = 1e-4 * math.sqrt(rtol) * dlm
         keep = 0
+        floor = math.log(LIGHTEST * big)
         for i in range(n):
-            if lw[i] > math.log(LIGHTEST * big):
+            if lw[i] > floor:
                 if (
                     keep > 0
                     and rate0[i] < quiet
@@ -411,12 +597,12 @@ def advance(
                 lw[keep] = lw[i]
                 rate0[keep] = rate0[i]
                 keep += 1
-            else:
+            elif lw[i] > -np.inf:
                 w = math.exp(lw[i])
                 acc[1] += w
-                acc[3] += w * _chain_energy(x - xb[i], p[P_M], p[P_DLM]) if abs(x - xb[i]) < p[P_DLM] else 0.0
+                acc[3] += w * _chain_energy(x - xb[i], m, dlm) if abs(x - xb[i]) < dlm else 0.0
         n = keep
-        factor = 0.9 / math.sqrt(max(err, 1e-10))
+        factor = 0.9 * max(err, 1e-12) ** (-1.0 / 3.0)
         h = min(hh * min(4.0, max(0.2, factor)), h_max) if not landing else max(h, hh)
         record = n_samples == 0
         if landing:
@@ -451,13 +637,22 @@ def compiled() -> dict[str, object]:
     if not _COMPILED:
         g = globals()
         # compile helpers first so that the jitted callers bind to jitted callees
-        for name in ("_chain_force", "_chain_stiffness", "_chain_energy", "_aging_factor", "_log_rate"):
+        for name in (
+            "_chain_force",
+            "_chain_stiffness",
+            "_chain_energy",
+            "_aging_factor",
+            "_log_rate",
+            "_hermite",
+            "_vacancy",
+        ):
             g[name] = _jit(g[name])
         for name in (
             "_velocity_prepare",
             "_velocity_residual",
             "_slider_velocity",
             "_balance_position",
+            "_balance_weights",
             "_sums",
             "advance",
         ):

@@ -153,7 +153,6 @@ def run_transient(
     sample_index = 1 if times.size else 0  # t = 0 is already a row
     out = np.empty((CHUNK, 11))
     h_max = math.inf if max_step is None else float(max_step)
-    steps_total = 0
     snap_index = 0
     if chains_on:
         events.append(("stick", 0.0, sigma0, 0.0))
@@ -194,7 +193,7 @@ def run_transient(
                         protocol,
                         control,
                         k_block,
-                        steps_total,
+                        int(state.acc[4]),
                         stop=f"the chains collapse at sigma_s = {sigma_s:.6g} Pa, beyond the"
                         " steady curve's reach: the paper's jump has no landing point",
                     )
@@ -217,13 +216,12 @@ def run_transient(
                 )
             stick_v = STICK_FRACTION * vp if (stick_population and vp > 0) else 0.0
             puller0 = state.puller - vp * state.t  # puller position extrapolated to t = 0 of this piece's line
-            lw_new, rate0, lc, aa = (np.empty(state.xb.size) for _ in range(4))
+            lw_new, rate0, lc, aa, w1 = (np.empty(state.xb.size) for _ in range(5))
             status, t, x, v, h, n, sample_index, count = advance(
                 state.t, t1, state.x, state.v, state.h, puller0, vp, 0.0, 1 if control == "block" else 0,
-                state.n, state.xb, state.tb, state.lw, lw_new, rate0, lc, aa, state.acc, p, float(rtol), h_max,
+                state.n, state.xb, state.tb, state.lw, lw_new, rate0, lc, aa, w1, state.acc, p, float(rtol), h_max,
                 times, sample_index, out, CHUNK, stick_v, CHUNK,
             )  # fmt: skip
-            steps_total += int(count)
             state.t, state.x, state.v, state.h, state.n = float(t), float(x), float(v), float(h), int(n)
             state.puller = puller0 + vp * state.t if control == "block" else state.x
             if count:
@@ -244,7 +242,7 @@ def run_transient(
     while snap_index < len(wanted):
         snapshots.append(_snapshot(state))
         snap_index += 1
-    return _finish(rows, chain_rows, events, snapshots, state, params, protocol, control, k_block, steps_total)
+    return _finish(rows, chain_rows, events, snapshots, state, params, protocol, control, k_block, int(state.acc[4]))
 
 
 def _force(extension: np.ndarray, params: Parameters) -> np.ndarray:
