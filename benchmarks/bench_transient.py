@@ -69,6 +69,22 @@ def main() -> None:
         f"  method of lines (400 age cells, BDF): {best:.3f} s, cpu {cpu:.3f} s, sigma error "
         f"{abs(out[0] / float(ref.stress) - 1):.2e}"
     )
+    best, med, cpu, run = timed(lambda: run_transient(p, constant(v, 0.012), control="velocity", rtol=1e-5), 3)
+    err = abs(run.final_stress / float(ref.stress) - 1)
+    print(f"  same at rtol 1e-5: best {best:.3f} s, median {med:.3f} s, {run.steps} steps, sigma error {err:.2e}")
+    for rtol in (1e-3, 1e-4):
+        best, med, cpu, run = timed(
+            lambda rtol=rtol: run_transient(
+                p, constant(50e-6, 25.0), start="steady", start_velocity=350e-6, rtol=rtol, stick_population=True
+            ),
+            1,
+        )
+        c = run.cycles[0]
+        print(
+            f"block, 350 -> 50 um/s with the stick chains, 25 s (slide, stick, jump, slip), rtol {rtol:g}: "
+            f"{best:.2f} s wall, cpu {cpu:.2f} s, {run.steps} steps; stick {c.stick_time:.4f} s, "
+            f"sigma_s {c.peak_stress:.3f} Pa, jump {c.jump_velocity * 1e6:.2f} um/s, slip {c.slip_time} s"
+        )
     best, med, cpu, run = timed(lambda: run_transient(p, constant(50e-6, 25.0), rtol=1e-3), 1)
     print(
         f"block, 50 um/s from rest, 25 s, rtol 1e-3: {best:.2f} s wall, cpu {cpu:.2f} s, {run.steps} steps, "
