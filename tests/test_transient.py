@@ -214,3 +214,19 @@ def test_slide_hold_slide_peaks_grow_with_hold_and_converge(params):
     fine = np.array([peaks[1e-4, h] for h in (1e-3, 1e-2, 1e-1)])
     assert np.all(np.diff(fine) > 0)
     assert np.all(np.abs(coarse / fine - 1) < 2e-3)
+
+
+def test_every_grid_through_a_stick_of_the_chains(params):
+    """--every with the stick chains: the trace stays on the grid through the stick (it once hung there), plus
+    the jump's instant."""
+    run = run_transient(params, constant(100e-6, 15.0), start="steady", start_velocity=350e-6, rtol=1e-3,
+                        stick_population=True, every=0.05)  # fmt: skip
+    grid = np.arange(301) * 0.05
+    on_grid = np.abs(run.time[:, None] - grid[None, :]).min(axis=1) < 1e-9
+    assert on_grid.sum() == grid.size
+    # the only other row is the instant of the jump (the chains' collapse), where the velocity is discontinuous
+    assert run.cycles and run.time[~on_grid] == pytest.approx([run.cycles[0].start_time + run.cycles[0].stick_time])
+    assert run.cycles[0].peak_stress == pytest.approx(556.40, abs=0.01)
+    stuck = (run.time > 5.0) & (run.time < 13.5)
+    k = params.block.effective_stiffness
+    assert np.allclose(np.diff(run.stress[stuck]), k * 100e-6 * 0.05, rtol=1e-9)

@@ -57,7 +57,12 @@ def _trace_csv(result: Any) -> str:
 @click.option("--protocol", "protocol_file", type=click.Path(dir_okay=False, path_type=Path), help="Protocol CSV.")
 @click.option("--no-aging", is_flag=True, help="Drop the aging term of Eq 1.")
 @click.option("--stick-population", is_flag=True, help="Add the paper's attached chains (Eqs 13-15) at rest.")
-@click.option("--every", "every_text", metavar="DT", help="Sample the trace every DT (the solver lands on the grid).")
+@click.option(
+    "--every",
+    "every_text",
+    metavar="DT",
+    help="Sample the trace every DT (the solver lands on the grid; jumps of the stick chains add their instant).",
+)
 @click.option("--rtol", default=1e-4, show_default=True, type=float, help="Local error tolerance (relative).")
 @click.option("-o", "--output", type=click.Path(dir_okay=False, path_type=Path), help="Write the trace (CSV, SI).")
 @click.option("--plot", "plot_path", type=click.Path(dir_okay=False, path_type=Path), help="Save σ(t) and V(t) here.")

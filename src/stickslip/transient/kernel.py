@@ -351,6 +351,8 @@ def advance(
     v_prev = v
     h_prev = 0.0
     s_floor = 1e-9 * m * big * dlm
+    while sample_index < n_samples and sample_times[sample_index] <= t:  # grid points already passed
+        sample_index += 1
     while t < t_end:
         if steps >= max_steps:
             return STEPS, t, x, v, h, n, sample_index, rows
