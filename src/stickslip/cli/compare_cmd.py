@@ -34,7 +34,7 @@ from .rsf_cmd import save_figure, sidecar, write
     type=click.Choice(["quasi-static", "transient"]),
     default="quasi-static",
     show_default=True,
-    help="Bond model of the step and slide-hold-slide panels; transient (Eqs 1-5) costs ~1 min CPU per 10 ms.",
+    help="Bond model of the step and slide-hold-slide panels; transient (Eqs 1-5): seconds of CPU per second.",
 )
 @click.option("--eta", default=None, help="RSF radiation damping (s/m) [a/(100 V0)].")
 @click.option("--a", "rsf_a", default=None, help="Override the RSF a standing for the bond model.")

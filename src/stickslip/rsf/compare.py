@@ -75,8 +75,8 @@ def bond_response(
     """The bond model's stress under ``protocol`` (``control``: "velocity" of the slider, or "block" pulled).
 
     ``model="transient"`` runs the time-dependent model (Eqs 1-5).  It is opt-in because it resolves the
-    bond time tau (224 us for gelatin): about a minute of CPU per 10 ms of sliding, so only millisecond
-    protocols are practical with it; the quasi-static model is the default.
+    bond time tau (224 us for gelatin): one to a few seconds of CPU per second of sliding; the quasi-static
+    model (instant, no memory) is the default.
     """
     if control not in ("velocity", "block"):
         raise ParameterError(f"control: expected 'velocity' or 'block', got {control!r}")

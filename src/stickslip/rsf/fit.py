@@ -234,12 +234,14 @@ def _least_squares(
     log_dc = (math.log(1e-9), math.log(start["max_dc"]))
     pars = lmfit.Parameters()
     pars.add("mu0", value=start["mu0"])
-    pars.add("a", value=min(max(start["a"], 2e-5), 0.19), min=1e-5, max=0.2)
-    pars.add("b", value=min(max(start["b"], -0.19), 0.19), min=-0.2, max=0.2)
+    # rock friction has |a|, |b| < 0.2; a record normalised otherwise (the bond model's sigma/sigma_c) may not
+    bound = max(0.2, 5.0 * float(np.ptp(record.friction[np.isfinite(record.friction)])))
+    pars.add("a", value=min(max(start["a"], 2e-5), 0.95 * bound), min=1e-5, max=bound)
+    pars.add("b", value=min(max(start["b"], -0.95 * bound), 0.95 * bound), min=-bound, max=bound)
     pars.add("log_dc", value=min(max(math.log(start["dc"]), log_dc[0] + 1), log_dc[1] - 0.1), min=log_dc[0],
              max=log_dc[1])  # fmt: skip
     if states == 2:
-        pars.add("b2", value=start["b2"], min=-0.2, max=0.2)
+        pars.add("b2", value=start["b2"], min=-bound, max=bound)
         pars.add("log_dc2", value=min(max(math.log(start["dc2"]), log_dc[0] + 1), log_dc[1] - 0.1), min=log_dc[0],
                  max=log_dc[1])  # fmt: skip
     if fit_stiffness:
