@@ -85,6 +85,14 @@ def main() -> None:
             f"{best:.2f} s wall, cpu {cpu:.2f} s, {run.steps} steps; stick {c.stick_time:.4f} s, "
             f"sigma_s {c.peak_stress:.3f} Pa, jump {c.jump_velocity * 1e6:.2f} um/s, slip {c.slip_time} s"
         )
+    for rtol in (1e-3, 1e-4):
+        best, med, cpu, run = timed(
+            lambda rtol=rtol: run_transient(p, constant(350e-6, 1.0), start="steady", rtol=rtol, every=1e-3), 1
+        )
+        print(
+            f"block, steady sliding at 350 um/s, 1 s, rtol {rtol:g}: {best:.2f} s wall, cpu {cpu:.2f} s, "
+            f"{run.steps} steps, final sigma {run.final_stress:.4f} Pa (steady solver {float(ref.stress):.4f})"
+        )
     best, med, cpu, run = timed(lambda: run_transient(p, constant(50e-6, 25.0), rtol=1e-3), 1)
     print(
         f"block, 50 um/s from rest, 25 s, rtol 1e-3: {best:.2f} s wall, cpu {cpu:.2f} s, {run.steps} steps, "
