@@ -61,3 +61,22 @@ def test_compare_with_the_time_dependent_bond_model(capsys):
     assert fitted["fitted"] is True
     # one aging state does not describe the bond model's step (docs/transient.md): the fit says so itself
     assert fitted["warnings"]
+
+
+def test_transient_trace_into_analyze_gives_the_same_cycle(capsys, tmp_path):
+    """transient -o trace.csv --json, then analyze trace.csv --json: the same stick, peak, jump and slip."""
+    trace = tmp_path / "trace.csv"
+    status, out, err = run_main(capsys, "transient", "--v0", "100 um/s", "--duration", "20 s", "--start", "steady",
+                                "--start-velocity", "350 um/s", "--stick-population", "--rtol", "1e-3", "-o",
+                                str(trace), "--json")  # fmt: skip
+    assert status == 0, err
+    own = json.loads(out)["cycles"][0]
+    status, out, err = run_main(capsys, "analyze", str(trace), "--v0", "100 um/s", "--json")
+    assert status == 0, err
+    read = json.loads(out)["cycles"][0]
+    assert read["complete"]
+    assert read["peak_stress"] == pytest.approx(own["peak_stress"], rel=1e-9)
+    assert read["stick_time"] == pytest.approx(own["stick_time"], abs=1e-3)
+    assert read["jump_velocity"] == pytest.approx(own["jump_velocity"], rel=1e-3)
+    assert read["slip_time"] == pytest.approx(own["slip_time"], abs=1e-3)
+    assert read["stiffness"] == pytest.approx(400e3, rel=1e-9)  # the Eq 17 block read back from the stick slope
