@@ -7,10 +7,10 @@ obeys d ln w/dt = -r with the hazard of Eq 1,
 
     r = (u0/tau) exp( (lambda/kT) f(e) - (t_a/tau_a) exp(-V/V_a) ),   f(e) = M e / (1 - (e/dl_m)^2)  (Eq 3).
 
-Births, (N0 - N)/tau per unit time, make one new cohort per step, placed at
-the middle of the step.  The vacancy N0 - N is advanced with the exact
-exponential of its linear birth term, so steps may be much longer than tau
-when nothing else moves (a stuck block).
+Births, (N0 - N)/tau per unit time, make two new cohorts per step, at the
+Gauss-Legendre points of the step; the vacancy N0 - N between them solves its
+linear equation exactly for a Hermite-cubic breakage rate, so steps may be
+much longer than tau when nothing else moves (a stuck block).
 
 Block control: sigma = K (P - X) at every instant.  Differentiating it with
 sigma = sum w f(e) gives the slider velocity as the root of
@@ -21,9 +21,10 @@ which is explicit without aging and a scalar root otherwise; the root is
 followed by continuity (the nearest crossing with g' > 0, the stable one for
 any small mass), and when it disappears the slider jumps to the next one.
 
-Time stepping: Heun's method (trapezoidal hazard, trapezoidal slider
-velocity) with the explicit-Euler predictor as embedded error estimate,
-measured in stress (sum f |dw| + k_int |dX|) and in bonds (sum |dw|).
+Time stepping (fourth order; see ``advance`` and docs/transient.md section 2):
+each cohort's log weight by the trapezoid rule of its hazard with the
+Euler-Maclaurin end correction, births at the Gauss points, and under block
+control the slider put where the bonds balance the block.
 Everything is SI.
 """
 
