@@ -230,3 +230,13 @@ def test_every_grid_through_a_stick_of_the_chains(params):
     stuck = (run.time > 5.0) & (run.time < 13.5)
     k = params.block.effective_stiffness
     assert np.allclose(np.diff(run.stress[stuck]), k * 100e-6 * 0.05, rtol=1e-9)
+
+
+@pytest.mark.parametrize("velocity", [50e-6, 350e-6])
+def test_a_steady_start_stays_steady(params, velocity):
+    """The steady population (Eqs 6-8 on Gauss cells) under constant velocity: sigma and N/N0 stay on the steady
+    solver's to 1e-6 while every initial bond dies and is replaced (25 ms > the bond lifetime at 50 um/s)."""
+    ref = stickslip.steady_state(params, velocity)
+    run = run_transient(params, constant(velocity, 0.025), control="velocity", start="steady", rtol=1e-6, every=1e-3)
+    assert np.all(np.abs(run.stress / float(ref.stress) - 1) < 1e-6)
+    assert np.all(np.abs(run.bonded_fraction / float(ref.bonded_fraction) - 1) < 1e-6)

@@ -17,6 +17,9 @@ from ..errors import ModelError
 from ..parameters import Parameters
 from . import kernel as K
 
+#: half-distance of the Gauss-Legendre points from a cell's middle, as a fraction of the cell
+GAUSS = 0.5 / math.sqrt(3.0)
+
 
 def pack_parameters(params: Parameters, aging: bool, stiffness: float) -> np.ndarray:
     """The float vector the kernel reads (layout: kernel.P_*)."""
@@ -65,17 +68,23 @@ class Population:
 
 
 #: steady populations: largest hazard increment per age cell, and where the survival counts as zero
-CELL_HAZARD = 0.01
+CELL_HAZARD = 0.05
 HAZARD_END = 45.0
 
 
-def steady_population(params: Parameters, velocity: float, aging: bool, cell_hazard: float = CELL_HAZARD) -> Population:
-    """The steady age distribution of Eqs 6-7 at ``velocity`` as cohorts (midpoint cells in age).
+def steady_population(
+    params: Parameters, velocity: float, aging: bool, cell_hazard: float = CELL_HAZARD, rule: str = "gauss"
+) -> Population:
+    """The steady age distribution of Eqs 6-7 at ``velocity`` as cohorts.
 
     The cells follow the hazard: each spans at most ``cell_hazard`` of cumulative
-    hazard and at most 1/200 of the time to full extension, so the survival
+    hazard and at most 1/1000 of the time to full extension, so the survival
     is resolved wherever it falls (near t_a = 0, on an aging plateau or at the
-    FENE cliff).
+    FENE cliff); the last bound also keeps the cohorts closer than the width of
+    the FENE cliff they will reach, so that a steady start stays steady.
+    ``rule="gauss"``: two cohorts per cell at its Gauss-Legendre points
+    (fourth order, the solver's start); ``"midpoint"``: one per cell at its
+    middle, cells tiling the ages (the linear-stability quadrature's layout).
     """
     b = params.bonds
     if not velocity > 0:
@@ -84,7 +93,7 @@ def steady_population(params: Parameters, velocity: float, aging: bool, cell_haz
     ages = [0.0]
     hazard = [0.0]
     a, big_h = 0.0, 0.0
-    widest = t_max / 200.0
+    widest = t_max / 1000.0
     while big_h < HAZARD_END and a < t_max:
         lr = float(log_hazard(np.array(velocity * a), np.array(a), velocity, params, aging))
         step = widest if lr < -700 else min(widest, cell_hazard / math.exp(min(lr, 700.0)))
@@ -106,12 +115,34 @@ def steady_population(params: Parameters, velocity: float, aging: bool, cell_haz
         hazard.append(big_h)
     edges = np.array(ages)
     cum = np.array(hazard)
+    if rule == "midpoint":
+        return _midpoint_cells(params, velocity, edges, cum)
+    # two cohorts per cell at its Gauss-Legendre points (fourth order in the cell width): their survival from the
+    # cumulative hazard at the cell's start plus Simpson's rule over the part of the cell before the point
+    a0, width = edges[:-1], np.diff(edges)
+    ages_g, weights_g = [], []
+    for offset in (0.5 - GAUSS, 0.5 + GAUSS):
+        ag = a0 + offset * width
+        mid = 0.5 * (a0 + ag)
+        rates = [np.exp(np.minimum(log_hazard(velocity * a, a, velocity, params, aging), 700.0)) for a in (a0, mid, ag)]
+        part = (ag - a0) * (rates[0] + 4.0 * rates[1] + rates[2]) / 6.0
+        ages_g.append(ag)
+        weights_g.append(0.5 * width * np.exp(-(cum[:-1] + part)))
+    age = np.stack(ages_g, axis=1).ravel()
+    survival = np.stack(weights_g, axis=1).ravel()
+    birth = b.site_density / (b.bond_time + survival.sum())  # Eq 7: n(0) = N0/(tau + I)
+    return Population(extension=velocity * age, age=age, weight=birth * survival)
+
+
+def _midpoint_cells(params: Parameters, velocity: float, edges: np.ndarray, cum: np.ndarray) -> Population:
+    """One cohort per cell at its middle, weighted by its survival integrated exactly for a hazard linear in it."""
+    b = params.bonds
     mid_age = 0.5 * (edges[1:] + edges[:-1])
     width = np.diff(edges)
-    # survival integrated exactly over each cell for a hazard linear in the cell: (e^-H0 - e^-H1)/(H1-H0)*width
     dh = np.diff(cum)
     s0 = np.exp(-cum[:-1])
-    cell = np.where(dh > 1e-12, s0 * -np.expm1(-dh) / np.where(dh > 1e-12, dh, 1.0), s0 * (1.0 - 0.5 * dh)) * width
+    safe = np.where(dh > 1e-12, dh, 1.0)
+    cell = np.where(dh > 1e-12, s0 * -np.expm1(-dh) / safe, s0 * (1.0 - 0.5 * dh)) * width
     birth = b.site_density / (b.bond_time + cell.sum())  # Eq 7: n(0) = N0/(tau + I)
     return Population(extension=velocity * mid_age, age=mid_age, weight=birth * cell)
 

@@ -69,7 +69,7 @@ def interface_response(params: Parameters, velocity: float, s: np.ndarray, aging
 def _cells(params: Parameters, velocity: float, aging: bool) -> tuple[np.ndarray, ...]:
     """Steady cohorts at ``velocity`` with force, stiffness, hazard and aging sensitivity (cached)."""
     g = params.aging
-    pop = steady_population(params, velocity, aging, cell_hazard=CELL_HAZARD)
+    pop = steady_population(params, velocity, aging, cell_hazard=CELL_HAZARD, rule="midpoint")
     a, w, e = pop.age, pop.weight, pop.extension
     f = chain_force(e, params)
     fp = _stiffness(e, params)
