@@ -256,7 +256,7 @@ def test_transient_adapter_follows_its_contract(monkeypatch, params):
 
     calls = []
 
-    def run_transient(p, protocol, control, start):
+    def run_transient(p, protocol, control, start, stick_population=False):
         calls.append((control, start, protocol.initial_velocity, protocol.duration))
         return stickslip.simulate(p, protocol.initial_velocity, protocol.duration)
 

@@ -80,3 +80,13 @@ def test_transient_trace_into_analyze_gives_the_same_cycle(capsys, tmp_path):
     assert read["jump_velocity"] == pytest.approx(own["jump_velocity"], rel=1e-3)
     assert read["slip_time"] == pytest.approx(own["slip_time"], abs=1e-3)
     assert read["stiffness"] == pytest.approx(400e3, rel=1e-9)  # the Eq 17 block read back from the stick slope
+
+
+def test_sweep_stick_population_only_for_the_time_dependent_model(capsys, tmp_path):
+    from stickslip.sweeps import build_spec
+
+    spec = build_spec(["pulling_velocity=100 um/s"], model="transient", stick_population=True)
+    assert spec.settings["stick_population"] is True
+    status, _, err = run_main(capsys, "sweep", "--model", "rsf", "--stick-population", "--vary", "a=0.01", "-o",
+                              str(tmp_path / "s"))  # fmt: skip
+    assert status == 2 and err.count("\n") == 1 and "--model transient" in err

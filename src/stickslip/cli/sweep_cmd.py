@@ -43,6 +43,11 @@ MODEL_NAMES = ("quasi-static", "transient", "rsf")
     "--jump-curve", type=click.Choice(["aging", "no-aging"]), default="aging", show_default=True, help="As in simulate."
 )
 @click.option(
+    "--stick-population",
+    is_flag=True,
+    help="--model transient: add the paper's stick chains (Eqs 13-16); without them Eq 1 never lets a stuck block go.",
+)
+@click.option(
     "-o", "--output", type=click.Path(file_okay=False, path_type=Path), default=None, help="Output folder OUT."
 )
 @click.option("--workers", type=int, default=None, help="Local worker processes [default: one per core]; 0: no dask.")
@@ -74,6 +79,7 @@ def _run(
     v0_text: str | None,
     duration_text: str,
     jump_curve: str,
+    stick_population: bool,
     output: Path | None,
     workers: int | None,
     scheduler: str | None,
@@ -108,6 +114,7 @@ def _run(
         samples=samples,
         seed=seed,
         jump_curve=jump_curve,
+        stick_population=stick_population,
     )
     store = run_sweep(
         spec,

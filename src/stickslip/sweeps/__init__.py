@@ -47,6 +47,7 @@ def build_spec(
     samples: int | None = None,
     seed: int = 0,
     jump_curve: str = "aging",
+    stick_population: bool = False,
 ) -> SweepSpec:
     """The specification of a sweep, validated: every key known, every value of the right unit and in range.
 
@@ -68,6 +69,10 @@ def build_spec(
     settings: dict[str, Any] = {"duration": _duration(duration)}
     if model != "rsf":
         settings["jump_curve"] = jump_curve
+    if stick_population and model != "transient":
+        raise ParameterError("--stick-population: only the time-dependent model (--model transient) takes it")
+    if model == "transient":
+        settings["stick_population"] = bool(stick_population)
     spec = SweepSpec(
         model=model,
         fixed=fixed,
@@ -126,8 +131,9 @@ def sweep(
     >>> frame = sweep({"block.height": "5 mm..2 cm:4"}, pulling_velocity="50 um/s", samples=None)  # doctest: +SKIP
 
     ``specification`` are the keywords of :func:`build_spec` (``model``, ``params``, ``overrides``,
-    ``pulling_velocity``, ``duration``, ``samples``, ``seed``, ``jump_curve``); ``workers``, ``scheduler``
-    and ``overwrite`` those of :func:`run_sweep`; ``quiet=False`` shows progress on standard error.
+    ``pulling_velocity``, ``duration``, ``samples``, ``seed``, ``jump_curve``, ``stick_population``);
+    ``workers``, ``scheduler`` and ``overwrite`` those of :func:`run_sweep`; ``quiet=False`` shows progress on
+    standard error.
 
     With ``output`` the rows are also kept there as Parquet chunks, and a
     second call with the same arguments resumes (or just reads) them.  The

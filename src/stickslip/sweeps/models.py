@@ -213,7 +213,13 @@ class Transient(BondModel):
 
         params, velocity = self.parameters(values)
         protocol = constant(velocity, settings["duration"])
-        result = transient.run_transient(params, protocol, control="block", start=settings.get("start", "steady"))
+        result = transient.run_transient(
+            params,
+            protocol,
+            control="block",
+            start=settings.get("start", "steady"),
+            stick_population=bool(settings.get("stick_population", False)),
+        )
         whole = [c for c in result.cycles if getattr(c, "period", None) is not None]
         time, stress = np.asarray(result.time, dtype=float), np.asarray(result.stress, dtype=float)
         row: dict[str, Any] = {
