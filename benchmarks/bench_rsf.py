@@ -21,9 +21,6 @@ Run: ``PYTHONPATH=src python benchmarks/bench_rsf.py``
 
 from __future__ import annotations
 
-import statistics
-import time
-
 import numpy as np
 from scipy.integrate import solve_ivp
 
@@ -31,24 +28,13 @@ from stickslip import protocols
 from stickslip.rsf import rsf_params, simulate
 from stickslip.rsf.data import LabRecord
 from stickslip.rsf.fit import fit_record
-from timing import best_of
+from timing import best_of, timed
 
 PUBLISHED = np.array([0.6] * 11 + [0.60720485, 0.60186637, 0.5840091, 0.58563096, 0.58899543, 0.58998186,
                                    0.58879751, 0.58803412, 0.58825653, 0.58858313, 0.58860319, 0.58848625,
                                    0.58844431, 0.58847472, 0.58849913, 0.58849522, 0.58848506, 0.58848348,
                                    0.58848674, 0.5884883, 0.58848756, 0.58848677, 0.5884868, 0.58848711,
                                    0.58848718, 0.5884871, 0.58848704, 0.58848706, 0.58848708, 0.58848708])  # fmt: skip
-
-
-def timed(func, repeat: int) -> tuple[float, float, float, object]:
-    """(best wall, median wall, median CPU, last result)."""
-    walls, cpus, out = [], [], None
-    for _ in range(repeat):
-        w, c = time.perf_counter(), time.process_time()
-        out = func()
-        walls.append(time.perf_counter() - w)
-        cpus.append(time.process_time() - c)
-    return min(walls), statistics.median(walls), statistics.median(cpus), out
 
 
 def plain_rsf(a, b, dc, v0, k, mu0, eta, pieces, t_eval, y0=None):

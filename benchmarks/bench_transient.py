@@ -6,24 +6,12 @@ median) and the accuracy reached against the steady solver.
 
 from __future__ import annotations
 
-import statistics
-import time
-
 import numpy as np
 
 import stickslip
 from stickslip.protocols import constant
 from stickslip.transient import run_transient
-
-
-def timed(func, repeat):  # type: ignore[no-untyped-def]
-    walls, cpus, out = [], [], None
-    for _ in range(repeat):
-        w, c = time.perf_counter(), time.process_time()
-        out = func()
-        walls.append(time.perf_counter() - w)
-        cpus.append(time.process_time() - c)
-    return min(walls), statistics.median(walls), min(cpus), out
+from timing import timed
 
 
 def method_of_lines(params, velocity, duration, cells=400):  # type: ignore[no-untyped-def]

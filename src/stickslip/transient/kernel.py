@@ -173,39 +173,6 @@ def _slider_velocity(v_prev, vp, n, xb, tb, lw, x, t, p, lc, aa):  # type: ignor
     return v
 
 
-def _balance_position(x, puller, n, xb, lw, p):  # type: ignore[no-untyped-def]
-    """X with sum w f(X - x_b) = K (puller - X): Newton on a strictly increasing function."""
-    lo = -np.inf
-    hi = np.inf
-    for i in range(n):  # the FENE wall of the oldest live chain
-        if lw[i] > -np.inf:
-            hi = min(hi, xb[i] + p[P_DLM] * (1.0 - 1e-15))
-    if x >= hi:
-        x = hi - 1e-3 * p[P_DLM]
-    for _ in range(100):
-        s = 0.0
-        k = p[P_K]
-        for i in range(n):
-            w = math.exp(lw[i])
-            if w == 0.0:
-                continue
-            e = x - xb[i]
-            s += w * _chain_force(e, p[P_M], p[P_DLM])
-            k += w * _chain_stiffness(e, p[P_M], p[P_DLM])
-        g = s - p[P_K] * (puller - x)
-        if g > 0.0:
-            hi = min(hi, x)
-        else:
-            lo = max(lo, x)
-        x_new = x - g / k
-        if not (lo < x_new < hi):  # FENE walls: stay inside the bracket
-            x_new = 0.5 * (lo + hi) if (lo > -np.inf and hi < np.inf) else x - 0.5 * g / k
-        if abs(x_new - x) <= 1e-15 * max(abs(x), p[P_DLM]):
-            return x_new
-        x = x_new
-    return x
-
-
 def _sums(n, xb, lw, x, p):  # type: ignore[no-untyped-def]
     """(N, sigma, k_int, bond energy) of the population at slider position x."""
     nn = 0.0
@@ -671,7 +638,6 @@ def compiled() -> dict[str, object]:
             "_velocity_prepare",
             "_velocity_residual",
             "_slider_velocity",
-            "_balance_position",
             "_balance_weights",
             "_sums",
             "advance",

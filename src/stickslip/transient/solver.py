@@ -211,7 +211,8 @@ def run_transient(
                 state.h = b.bond_time * 1e-3
                 chains_on = False
                 # put the slider where the new bonds carry sigma_s
-                state.x = functions["_balance_position"](state.x, state.puller, state.n, state.xb, state.lw, p)
+                weights = np.exp(state.lw[: state.n])
+                state.x = functions["_balance_weights"](state.x, state.puller, state.n, state.xb, weights, p)
                 state.v = slider_velocity(
                     vs, vp, state.n, state.xb, state.tb, state.lw, state.x, state.t, p, *_scratch(state)
                 )
