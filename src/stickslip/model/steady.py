@@ -86,7 +86,10 @@ WIDTH_RATIO = 1.5
 MAX_BISECTIONS = 40
 #: A panel narrower than this many ulps of the position cannot be sampled (its nodes would round onto
 #: each other, and L changes by O(1) per ulp): when not even that is good, the survival steps to 0 there.
-STEP_ULPS = 64.0
+#: 2^20 ulps (~1e-10 of the position) moves i and j by < 1e-10 relative; the step's ln V derivative is
+#: added in _march (with alpha ~ 1e14 L changes by ~0.1 per ulp, so a cliff a few thousand ulps wide only
+#: gives noise).
+STEP_ULPS = float(2**20)
 _LOG_WIDTH_RATIO = float(np.log(WIDTH_RATIO))
 #: The width search starts this far (in ln w) below the left end's cap, where the widest good width usually lies,
 #: and first moves by 2 FIRST_REACH (doubling on).
@@ -211,7 +214,9 @@ def _panel_width(x: np.ndarray, y: np.ndarray, s: _Scales, q: QuadratureSettings
     l_left, slope_left = _log_hazard_and_slope(x, y, s)
     log_slope_left = np.log(np.maximum(slope_left, _TINY))
     log_step, log_resolved = np.log(q.log_hazard_step), np.log(q.hazard_step)
-    log_negligible = np.log(q.negligible_hazard)
+    # dH/d ln V = int (beta x - 1) e^L: a stretch is only negligible when (1 + beta) times its hazard is (with
+    # beta ~ 1e14 a hazard of 1e-13 ahead of the FENE cliff moves the slope by O(1))
+    log_negligible = np.log(q.negligible_hazard) - np.log1p(s.beta)
     # the left end's share of the tests: resolved needs ln w below cap_resolved, negligible below cap_negligible
     cap_resolved = np.minimum(log_resolved - l_left, log_step - log_slope_left)
     cap_negligible = log_negligible - l_left
@@ -222,7 +227,7 @@ def _panel_width(x: np.ndarray, y: np.ndarray, s: _Scales, q: QuadratureSettings
         log_integral = l_right + log_w
         resolved = (log_w <= lanes.cap_resolved) & (slope_right * w <= q.log_hazard_step)
         resolved &= log_integral <= log_resolved
-        return resolved | ((log_w <= lanes.cap_negligible) & (log_integral <= log_negligible))
+        return resolved | ((log_w <= lanes.cap_negligible) & (log_integral <= lanes.log_negligible))
 
     log_w = log_widest.copy()
     step = np.zeros(x.size, dtype=bool)
@@ -230,12 +235,16 @@ def _panel_width(x: np.ndarray, y: np.ndarray, s: _Scales, q: QuadratureSettings
     searching = (log_widest > cap_resolved) & (log_widest > cap_negligible)
     tried = np.nonzero(~searching)[0]
     if tried.size:
-        lanes = _Lanes(x[tried], y[tried], _take(s, tried), cap_resolved[tried], cap_negligible[tried])
+        lanes = _Lanes(
+            x[tried], y[tried], _take(s, tried), cap_resolved[tried], cap_negligible[tried], log_negligible[tried]
+        )
         searching[tried] = ~good(log_widest[tried], lanes)
     open_ = np.nonzero(searching)[0]
     if open_.size == 0:
         return np.exp(log_w), step
-    lanes = _Lanes(x[open_], y[open_], _take(s, open_), cap_resolved[open_], cap_negligible[open_])
+    lanes = _Lanes(
+        x[open_], y[open_], _take(s, open_), cap_resolved[open_], cap_negligible[open_], log_negligible[open_]
+    )
     # bracket [low, top]: top is not good; low is good once confirmed (before that it is the floor, STEP_ULPS
     # ulps of the position).  Gallop from the left end's cap (usually within a few times w*) with steps in ln w
     # that double, then bisect: a few tests per panel, and at most ~2 log2(745) however deep the dip.
@@ -287,9 +296,12 @@ class _Lanes:
     s: _Scales
     cap_resolved: np.ndarray
     cap_negligible: np.ndarray
+    log_negligible: np.ndarray
 
     def take(self, k: np.ndarray) -> _Lanes:
-        return _Lanes(self.x[k], self.y[k], _take(self.s, k), self.cap_resolved[k], self.cap_negligible[k])
+        return _Lanes(
+            self.x[k], self.y[k], _take(self.s, k), self.cap_resolved[k], self.cap_negligible[k], self.log_negligible[k]
+        )
 
 
 def _take(s: _Scales, k: np.ndarray | slice) -> _Scales:
@@ -332,6 +344,17 @@ def _march(s: _Scales, q: QuadratureSettings, keep_nodes: bool = False) -> _Inte
     for _ in range(MAX_PANELS):
         w, step = _panel_width(x_left, y_left, sub, q)
         w[step] = 0.0  # the survival steps to 0 within a few ulps: nothing more to integrate
+        if step.any():
+            # ... but where that step lies moves with V: dx_s/d ln V = -(dL/d ln V)/L' = (1 - beta x)/L', and the
+            # step carries i and j's boundary terms S_s dx_s/d ln V and S_s x/(1-x^2) dx_s/d ln V (this is what
+            # an integral across the cliff gives, where L cannot be resolved in floating point)
+            k = np.nonzero(step)[0]
+            xs, ys, sk = x_left[k], y_left[k], _take(sub, k)
+            d = ys * (1.0 + xs)
+            rise = sk.a * (1.0 + xs * xs) / (d * d) - sk.alpha
+            shift = np.exp(-hazard[k]) * (sk.beta * xs - 1.0) / rise  # -S_s dx_s/d ln V
+            sums[2, k] += shift
+            sums[3, k] += shift * (xs / d)
         offset = t_half * w
         x = offset + x_left
         y = np.subtract(y_left, offset, out=offset)
