@@ -199,7 +199,7 @@ def stick_chains(
     y0 = math.log(max(fraction, 1e-300))
     if collapse(0.0, np.array([y0])) >= 0:
         return StickChains(0.0, fraction, True, np.array([0.0]), np.array([fraction]))
-    if elapsed == 0.0 and fraction == 1.0 and loading_rate >= 0.0:
+    if elapsed == 0.0 and fraction == 1.0 and loading_rate > 0.0:
         return _fresh_chains(params, aging, stress0, loading_rate, span)
     try:
         sol = solve_ivp(rhs, (0.0, span), [y0], method="LSODA", rtol=1e-10, atol=1e-12, events=collapse)

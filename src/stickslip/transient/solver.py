@@ -222,7 +222,9 @@ def run_transient(
                 state.v = slider_velocity(
                     state.v, vp, state.n, state.xb, state.tb, state.lw, state.x, state.t, p, *_scratch(state)
                 )
-            stick_v = STICK_FRACTION * vp if (stick_population and vp > 0) else 0.0
+            # in a hold (vp = 0) the slider counts as stopped below 1 % of the protocol's sliding velocity
+            pace = vp if vp > 0 else float(np.max(protocol.velocities))
+            stick_v = STICK_FRACTION * pace if (stick_population and pace > 0) else 0.0
             puller0 = state.puller - vp * state.t  # puller position extrapolated to t = 0 of this piece's line
             lw_new, rate0, lc, aa, w1 = (np.empty(state.xb.size) for _ in range(5))
             status, t, x, v, h, n, sample_index, count = advance(
