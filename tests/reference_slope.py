@@ -23,7 +23,7 @@ import math
 
 import numpy as np
 
-from reference_steady import DP_A, DP_B, DP_E, FAST, KB, MAX_STEPS, SLOPE_FLOOR
+from reference_steady import DP_A, DP_B, DP_E, FAST, MAX_STEPS, SLOPE_FLOOR, case_groups
 
 SLOPE_RTOL = 1e-11
 #: e-folds of the survival integrated after the hazard has become fast (H_V grows at most like (1+beta) H)
@@ -66,18 +66,10 @@ def _rates(z, log_t, a, alpha, beta):
 
 
 def _groups(cases):
-    n = len(cases)
-    log_t, a, alpha, beta, birth, scale, velocity = (np.empty(n) for _ in range(7))
-    for k, (params, v, aging) in enumerate(cases):
-        b, g = params.bonds, params.aging
-        t_max = b.max_extension / v
-        log_t[k] = math.log(b.breakage_weight) + math.log(t_max) - math.log(b.bond_time)
-        a[k] = b.activation_length * b.chain_stiffness * b.max_extension / (KB * b.temperature)
-        alpha[k] = (t_max / g.aging_time) * math.exp(-v / g.aging_velocity) if aging else 0.0
-        beta[k] = alpha[k] * (1.0 + v / g.aging_velocity)
-        birth[k] = b.bond_time * v / b.max_extension
-        scale[k] = b.chain_stiffness * b.site_density * b.max_extension
-        velocity[k] = v
+    log_t, a, alpha, birth, scale = case_groups(cases)
+    velocity = np.array([v for _, v, _ in cases], dtype=float)
+    ratio = np.array([v / params.aging.aging_velocity for params, v, _ in cases])
+    beta = alpha * (1.0 + ratio)
     return log_t, a, alpha, beta, birth, scale, velocity
 
 

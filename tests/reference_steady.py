@@ -186,8 +186,8 @@ def _many_rates(z, log_t, a, alpha):
     return np.stack([speed, -speed, np.exp(log_h - log_g), survival, survival * fene])
 
 
-def reference_many(cases) -> tuple[np.ndarray, np.ndarray]:
-    """(stress, bonded_fraction) arrays for ``cases``, a sequence of (params, velocity, aging)."""
+def case_groups(cases) -> tuple[np.ndarray, ...]:
+    """The dimensionless groups (ln T, a, alpha, birth, stress scale) of each (params, velocity, aging) case."""
     log_t, a, alpha, birth, scale = (np.empty(len(cases)) for _ in range(5))
     for k, (params, velocity, aging) in enumerate(cases):
         b, g = params.bonds, params.aging
@@ -197,6 +197,12 @@ def reference_many(cases) -> tuple[np.ndarray, np.ndarray]:
         alpha[k] = (t_max / g.aging_time) * math.exp(-velocity / g.aging_velocity) if aging else 0.0
         birth[k] = b.bond_time * velocity / b.max_extension
         scale[k] = b.chain_stiffness * b.site_density * b.max_extension
+    return log_t, a, alpha, birth, scale
+
+
+def reference_many(cases) -> tuple[np.ndarray, np.ndarray]:
+    """(stress, bonded_fraction) arrays for ``cases``, a sequence of (params, velocity, aging)."""
+    log_t, a, alpha, birth, scale = case_groups(cases)
     i, j = _integrate_many(log_t, a, alpha)
     return scale * j / (birth + i), i / (birth + i)
 
