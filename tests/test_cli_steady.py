@@ -75,6 +75,7 @@ def test_critical_without_minimum_says_so_and_exits_zero(runner):
 
 def test_curve_json_default_range(runner):
     data = json.loads(run(runner, "curve", "--format", "json"))
+    assert data.pop("units") == {"bonded_fraction": "1", "stress": "Pa", "stress_slope": "Pa s/m", "velocity": "m/s"}
     assert set(data) == {"velocity", "stress", "bonded_fraction", "stress_slope"}
     assert {len(v) for v in data.values()} == {50}
     np.testing.assert_allclose(data["velocity"], np.geomspace(10e-6, 10e-3, 50), rtol=1e-13)
@@ -122,7 +123,7 @@ def test_curve_no_aging(runner):
 def test_curve_csv_header_and_round_trip(runner, tmp_path):
     out = run(runner, "curve", "--format", "csv", "--points", "6")
     lines = out.splitlines()
-    assert lines[0] == "velocity [m/s],stress [Pa],bonded_fraction,stress_slope [Pa s/m]"
+    assert lines[0] == "velocity [m/s],stress [Pa],bonded_fraction [1],stress_slope [Pa s/m]"
     assert len(lines) == 7
     values = np.array([[float(x) for x in line.split(",")] for line in lines[1:]])
     np.testing.assert_allclose(values[:, 0], np.geomspace(10e-6, 10e-3, 6), rtol=1e-14)

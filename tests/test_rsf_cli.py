@@ -24,8 +24,9 @@ def test_simulate_writes_trace_parameters_and_summary(tmp_path, capsys):
     assert set(summary) >= {"regime", "final_friction", "period", "peak_friction", "trough_friction", "message"}
     assert summary["final_friction"] == pytest.approx(0.6 - 0.005 * math.log(10), abs=2e-6)  # still ringing at 40 s
     frame = pd.read_csv(trace)
-    assert list(frame.columns) == ["time", "friction", "slider_velocity", "state", "load_point_displacement",
-                                   "slider_displacement"]  # fmt: skip
+    assert list(frame.columns) == ["time [s]", "friction [1]", "slider_velocity [m/s]", "state [s]",
+                                   "load_point_displacement [m]", "slider_displacement [m]"]  # fmt: skip
+    frame.columns = [c.split(" [")[0] for c in frame.columns]
     # rsfmodel's published friction at t = 11 s (tests/test_rsf_rsfmodel.py has the full comparison)
     assert frame["friction"].iloc[11] == pytest.approx(0.60720485, abs=1e-7)
     assert (tmp_path / "run.png").stat().st_size > 0

@@ -23,8 +23,9 @@ def test_velocity_step_trace_and_json(tmp_path):
     expected = float(stickslip.steady_state(stickslip.load_parameters("gelatin-glass"), 1e-3).stress)
     assert abs(summary["final_stress"] / expected - 1) < 1e-3
     frame = pd.read_csv(trace)
-    assert list(frame.columns) == ["time", "stress", "bonded_fraction", "slider_velocity", "slider_position",
-                                   "puller_position"]  # fmt: skip
+    assert list(frame.columns) == ["time [s]", "stress [Pa]", "bonded_fraction [1]", "slider_velocity [m/s]",
+                                   "slider_position [m]", "puller_position [m]"]  # fmt: skip
+    frame.columns = [c.split(" [")[0] for c in frame.columns]
     assert len(frame) == 15
 
 

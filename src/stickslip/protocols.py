@@ -22,6 +22,7 @@ from typing import Any
 
 import numpy as np
 
+from .columns import with_units
 from .errors import DataError, ParameterError
 
 __all__ = [
@@ -123,7 +124,7 @@ class Protocol:
         import pandas as pd
 
         b = self.boundaries
-        return pd.DataFrame({"start": b[:-1], "end": b[1:], "velocity": self.velocities})
+        return with_units(pd.DataFrame({"start": b[:-1], "end": b[1:], "velocity": self.velocities}))
 
     def describe(self) -> str:
         """One line a person can read: ``100 um/s for 10 s, then 1000 um/s for 20 s``."""

@@ -173,7 +173,7 @@ def _read_header(
         if name not in dimensions:
             continue
         try:
-            factor = to_si(f"1 {unit}", dimensions[name], f"column {name!r}") if unit and unit.strip() else 1.0
+            factor = _unit_factor(unit, dimensions[name], name)
         except UnitError as exc:
             raise DataError(f"{source}: {exc}") from None
         factors[name] = factor
@@ -181,6 +181,14 @@ def _read_header(
     if missing:
         raise DataError(f"{source}: missing column(s) {', '.join(missing)}; found {', '.join(names)}")
     return _Header(header_row, names, factors)
+
+
+def _unit_factor(unit: str | None, dimension: str, name: str) -> float:
+    """SI factor of a header's unit; ``[1]`` (and an empty bracket) mark a pure number, as the package writes it."""
+    text = (unit or "").strip()
+    if not text or (text == "1" and dimension == "dimensionless"):
+        return 1.0
+    return to_si(f"1 {text}", dimension, f"column {name!r}")
 
 
 def _read_rows(

@@ -20,6 +20,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from scipy.optimize import minimize_scalar
 
+from ..columns import with_units
 from ..parameters import Parameters
 from .cycles import CycleResult, TraceAnalysis
 
@@ -77,7 +78,7 @@ class Comparison:
         """The model's trace on the record's time axis (time, stress; SI units)."""
         import pandas as pd
 
-        return pd.DataFrame({"time": self.model_time, "stress": self.model_stress})
+        return with_units(pd.DataFrame({"time": self.model_time, "stress": self.model_stress}))
 
     def plot(self, ax: Axes | None = None, **kwargs: Any) -> Axes:
         """The record with its detected phases and the model on top; returns the Axes."""

@@ -30,6 +30,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ..columns import with_units
 from ..errors import DataError, ParameterError
 from ..parameters import Parameters, load_parameters
 from .detect import MEDIAN_WIDTH, Coarse, coarse_segments, rise_start
@@ -144,7 +145,7 @@ class TraceAnalysis:
         import pandas as pd
 
         columns = [name for name in CycleResult.__dataclass_fields__ if name not in _PRIVATE_FIELDS]
-        return pd.DataFrame([c.as_dict() for c in self.cycles], columns=columns)
+        return with_units(pd.DataFrame([c.as_dict() for c in self.cycles], columns=columns))
 
     def plot(self, ax: Axes | None = None, **kwargs: Any) -> Axes:
         from .plots import plot_analysis

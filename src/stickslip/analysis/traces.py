@@ -23,6 +23,7 @@ from typing import Any
 
 import numpy as np
 
+from ..columns import with_units
 from ..errors import DataError, ParameterError
 from ..tables import Table, read_table, read_text_cells
 from ..trace_columns import MODEL_COLUMNS
@@ -57,7 +58,7 @@ class Trace:
     def to_frame(self) -> Any:
         import pandas as pd
 
-        return pd.DataFrame({"time": self.time, "stress": self.stress})
+        return with_units(pd.DataFrame({"time": self.time, "stress": self.stress}))
 
 
 def read_trace(path: str | Path, contact_area: float | None = None) -> Trace:

@@ -147,8 +147,7 @@ def json_safe(obj: Any) -> Any:
     if isinstance(obj, np.ndarray):
         return [json_safe(v) for v in obj.tolist()]
     if isinstance(obj, (np.floating, float)):
-        value = float(obj)
-        return value if math.isfinite(value) else None
+        return _for_people(float(obj))
     if isinstance(obj, np.integer):
         return int(obj)
     if isinstance(obj, np.bool_):
@@ -156,9 +155,27 @@ def json_safe(obj: Any) -> Any:
     return obj
 
 
+def _for_people(value: float) -> float | None:
+    """None for a non-finite value; else the value at 15 significant digits, which drops float noise
+    such as 0.0007999999999999999 (for 8e-4) and changes no value by more than 5e-16 of itself."""
+    if not math.isfinite(value):
+        return None
+    return float(f"{value:.15g}")
+
+
+def json_text(obj: Any) -> str:
+    """The JSON text of a result: SI numbers, and a top-level ``units`` map naming them."""
+    from ..columns import JSON_KEY, json_units
+
+    document = json_safe(obj)
+    if isinstance(document, dict) and JSON_KEY not in document:
+        document[JSON_KEY] = json_units(document)
+    return json.dumps(document, indent=2)
+
+
 def emit_json(obj: Any, output: Path | None = None) -> None:
-    """Write JSON (SI units) to stdout or a file."""
-    text = json.dumps(json_safe(obj), indent=2)
+    """Write JSON (SI units, named in a top-level ``units`` map) to stdout or a file."""
+    text = json_text(obj)
     if output is None:
         click.echo(text)
     else:

@@ -10,14 +10,13 @@ model and, in words, which bond model ran (time-dependent or quasi-static).
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 from typing import Any
 
 import click
 
 from ..fileio import refuse_input_as_output
-from .common import json_safe, params_options, positive, resolve_params
+from .common import json_text, params_options, positive, resolve_params
 from .rsf_cmd import save_figure, sidecar, write
 
 
@@ -81,12 +80,12 @@ def compare_command(**options: Any) -> None:
         },
     }
     if options["as_json"]:
-        click.echo(json.dumps(json_safe(summary), indent=2))
+        click.echo(json_text(summary))
     else:
         click.echo(_text(summary))
     if options["output"] is not None:
         save_figure(_figure(panels, pair, rsf, local), options["output"])
-        write(sidecar(options["output"]), json.dumps(json_safe(summary), indent=2) + "\n")
+        write(sidecar(options["output"]), json_text(summary) + "\n")
 
 
 def _override(rsf: Any, options: dict[str, Any]) -> Any:

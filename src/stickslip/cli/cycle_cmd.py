@@ -38,11 +38,13 @@ def _stress(text: str | None) -> float | None:
     return positive(text, "stress", "--start-stress", allow_zero=True)
 
 
-def _csv(columns: dict[str, Any], units: dict[str, str]) -> str:
+def _csv(columns: dict[str, Any]) -> str:
     """CSV with units in the header brackets (``time [s],...``), numbers in SI with every digit."""
+    from ..columns import header_cell, unit_of
+
     out = io.StringIO()
     names = list(columns)
-    out.write(",".join(f"{n} [{units[n]}]" if units.get(n) else n for n in names) + "\n")
+    out.write(",".join(header_cell(n, unit_of(n)) for n in names) + "\n")
     for row in zip(*(columns[n] for n in names), strict=True):
         out.write(",".join(v if isinstance(v, str) else repr(float(v)) for v in row) + "\n")
     return out.getvalue()
@@ -95,7 +97,7 @@ def simulate_command(
     regime is "stick-slip", "steady" (V0 >= Vc: the slip settles at V0),
     "stuck" (a stick never ends) or "undetermined" (the model has no answer).
     """
-    from ..model.cycle import COLUMN_UNITS, CYCLE_COLUMNS, simulate
+    from ..model.cycle import CYCLE_COLUMNS, simulate
 
     refuse_overwriting_inputs([], [("-o", output), ("--plot", plot_path)], params_name)
     v0 = _velocity(v0_text)
@@ -104,7 +106,7 @@ def simulate_command(
     params = resolve_params(params_name, overrides)
     sim = simulate(params, v0, duration, start_stress=start, jump_curve=jump_curve)
     if output is not None:
-        write_text(output, _csv({n: getattr(sim, n) for n in CYCLE_COLUMNS}, COLUMN_UNITS))
+        write_text(output, _csv({n: getattr(sim, n) for n in CYCLE_COLUMNS}))
     if plot_path is not None:
         from ..cycle_plots import plot_simulation
 
@@ -205,7 +207,7 @@ def stick_command(
     jump = _jump_after(params, stick)
     columns = {"time": stick.time, "stress": stick.stress, "chain_fraction": stick.chain_fraction}
     if output is not None:
-        write_text(output, _csv(columns, {"time": "s", "stress": "Pa"}))
+        write_text(output, _csv(columns))
     if plot_path is not None:
         from ..cycle_plots import plot_stick
 

@@ -8,7 +8,6 @@ with ``--params``.
 
 from __future__ import annotations
 
-import io
 import json
 import math
 from collections.abc import Callable
@@ -19,7 +18,7 @@ import click
 
 from ..errors import ParameterError, UnitError
 from ..fileio import atomic_path, atomic_write_text, refuse_input_as_output
-from .common import json_safe, quantity
+from .common import json_text, quantity
 
 LAW_NAMES = ("aging", "slip", "prz", "nagata")
 
@@ -163,9 +162,10 @@ def build_protocol(segment: tuple[str, ...], protocol_file: Path | None, fallbac
 
 
 def trace_csv(frame: Any) -> str:
-    buffer = io.StringIO()
-    frame.to_csv(buffer, index=False, float_format="%.12g")
-    return buffer.getvalue()
+    """The trace as CSV, units in the header brackets (:mod:`stickslip.columns`)."""
+    from ..columns import csv_text
+
+    return csv_text(frame)
 
 
 def sidecar(path: Path) -> Path:
@@ -230,7 +230,7 @@ def simulate_command(**options: Any) -> None:
         write(sidecar(output), run.metadata_json())
     summary = run.summary()
     if options["as_json"]:
-        click.echo(json.dumps(json_safe(summary), indent=2))
+        click.echo(json_text(summary))
     elif output is None:
         click.echo(trace_csv(run.to_frame()), nl=False)
     else:
@@ -263,7 +263,7 @@ def stability_command(**options: Any) -> None:
     params = build_params(options)
     reports = [stability(params, _positive(v, "velocity", "--velocity")).as_dict() for v in options["velocities"]]
     if options["as_json"]:
-        click.echo(json.dumps(json_safe(reports if len(reports) > 1 else reports[0]), indent=2))
+        click.echo(json_text(reports if len(reports) > 1 else reports[0]))
     else:
         for r in reports:
             period = r["neutral_period"]
@@ -341,9 +341,9 @@ def fit_command(**options: Any) -> None:
     report = fit.summary()
     if output is not None:
         write(output, fit.to_toml())
-        write(sidecar(output), json.dumps(json_safe({"parameters": fit.params.to_dict(), "fit": report}), indent=2))
+        write(sidecar(output), json_text({"parameters": fit.params.to_dict(), "fit": report}))
     if options["as_json"]:
-        click.echo(json.dumps(json_safe(report), indent=2))
+        click.echo(json_text(report))
     else:
         click.echo(_fit_text(fit))
     if plot_path is not None:

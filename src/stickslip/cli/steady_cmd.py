@@ -13,6 +13,7 @@ from typing import Any
 import click
 import numpy as np
 
+from ..columns import header_cell, unit_of
 from ..errors import ParameterError
 from .common import (
     emit_json,
@@ -35,13 +36,8 @@ CHUNK = 8192
 TABLE_ROWS = 100
 #: Most velocities in --format json (one document in memory); csv has no such limit.
 JSON_POINTS = 100_000
-#: Columns of csv/json output, with the SI unit written in the csv header.
-COLUMNS = (
-    ("velocity", "m/s"),
-    ("stress", "Pa"),
-    ("bonded_fraction", ""),
-    ("stress_slope", "Pa s/m"),
-)
+#: Columns of csv/json output, with the SI unit written in the csv header (:mod:`stickslip.columns`).
+COLUMNS = tuple((name, unit_of(name)) for name in ("velocity", "stress", "bonded_fraction", "stress_slope"))
 
 
 def _velocity(text: str, name: str) -> float:
@@ -76,7 +72,7 @@ def curve_csv(columns: dict[str, np.ndarray]) -> str:
 
 
 def _csv_header() -> bytes:
-    return (",".join(f"{name} [{unit}]" if unit else name for name, unit in COLUMNS) + "\n").encode()
+    return (",".join(header_cell(name, unit) for name, unit in COLUMNS) + "\n").encode()
 
 
 def _csv_rows(columns: dict[str, np.ndarray]) -> bytes:

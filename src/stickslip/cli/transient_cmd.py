@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import io
 from pathlib import Path
 from typing import Any
 
@@ -31,14 +30,9 @@ def _protocol(v0_text: str | None, duration_text: str | None, segment_texts: tup
 
 
 def _trace_csv(result: Any) -> str:
-    from ..transient import TRACE_COLUMNS
+    from ..columns import csv_text
 
-    out = io.StringIO()
-    out.write(",".join(TRACE_COLUMNS) + "\n")
-    columns = [getattr(result, name) for name in TRACE_COLUMNS]
-    for row in zip(*columns, strict=True):
-        out.write(",".join(repr(float(v)) for v in row) + "\n")
-    return out.getvalue()
+    return csv_text(result.to_frame())
 
 
 @click.command("transient")

@@ -37,6 +37,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ..columns import with_units
 from ..errors import ParameterError, StickslipError
 from ..model.steady import steady_state
 from ..parameters import Parameters, key_dimension
@@ -166,7 +167,7 @@ class SteadyPosterior:
 
         frame = pd.DataFrame(np.exp(self.chain), columns=list(self.keys))
         frame["log_prob"] = self.log_prob
-        return frame
+        return with_units(frame)
 
     def as_dict(self) -> dict[str, Any]:
         return {

@@ -26,6 +26,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ..columns import with_units
 from ..errors import DataError
 from ..tables import Table, read_table
 
@@ -109,7 +110,7 @@ class SteadyData:
         frame = {"row": self.rows, "velocity": self.velocity, "stress": self.stress}
         if self.stress_err is not None:
             frame["stress_err"] = self.stress_err
-        return pd.DataFrame(frame)
+        return with_units(pd.DataFrame(frame))
 
     def plot(self, ax: Axes | None = None, **kwargs: Any) -> Axes:
         """Stress against log velocity (um/s), with error bars where given."""
@@ -179,7 +180,7 @@ class StickData:
         if self.start_stress is not None:
             frame["start_stress"] = self.start_stress
         frame.update(self.extra)
-        return pd.DataFrame(frame)
+        return with_units(pd.DataFrame(frame), {name: None for name in self.extra})
 
 
 def read_steady_data(path: str | Path) -> SteadyData:

@@ -28,6 +28,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from scipy import stats
 
+from ..columns import with_units
 from ..errors import DataError, ModelError, ParameterError
 from ..model.critical import critical_point
 from ..model.steady import steady_state
@@ -133,7 +134,7 @@ class SteadyFit:
         frame = self.data.to_frame()
         frame["model_stress"] = self.model_stress
         frame["residual"] = self.residuals
-        return frame
+        return with_units(frame)
 
     def as_dict(self) -> dict[str, Any]:
         """The JSON summary (SI units)."""

@@ -32,6 +32,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from scipy.special import stdtrit
 
+from ..columns import with_units
 from ..errors import DataError, ParameterError
 from ..model.critical import critical_point
 from ..model.stick import stick_phase
@@ -95,7 +96,7 @@ class StickFit:
         frame["loading_rate"] = self.loading_rate
         frame["model_stick_time"] = self.model_stick_time
         frame["model_peak_stress"] = self.model_peak_stress
-        return frame
+        return with_units(frame)
 
     def as_dict(self) -> dict[str, Any]:
         return {

@@ -34,6 +34,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ..columns import with_units
 from ..errors import ParameterError
 from ..parameters import Parameters
 from ..trace_columns import QUASI_STATIC
@@ -48,16 +49,6 @@ if TYPE_CHECKING:  # pragma: no cover
 
 #: Trace columns, in order (SI units: s, Pa, m/s, m, m, m, Nc/Nc0, phase name).
 CYCLE_COLUMNS = QUASI_STATIC
-COLUMN_UNITS = {
-    "time": "s",
-    "stress": "Pa",
-    "velocity": "m/s",
-    "slider_displacement": "m",
-    "puller_displacement": "m",
-    "block_shear": "m",
-    "chain_fraction": "",
-    "phase": "",
-}
 REGIMES = ("stick-slip", "steady", "stuck", "undetermined")
 #: Long runs are thinned so that the trace stays below about this many rows (phase ends are always kept).
 MAX_ROWS = 1_000_000
@@ -141,7 +132,7 @@ class Simulation:
         """The trace, one row per sample, columns :data:`CYCLE_COLUMNS` (SI units)."""
         import pandas as pd
 
-        return pd.DataFrame({name: getattr(self, name) for name in CYCLE_COLUMNS})
+        return with_units(pd.DataFrame({name: getattr(self, name) for name in CYCLE_COLUMNS}))
 
     def plot(self, ax: Axes | None = None, **kwargs: Any) -> Axes:
         """sigma(t) over the cycles (Fig 5a-c); returns the Axes."""

@@ -42,6 +42,7 @@ from numpy.polynomial import chebyshev as cheb
 from scipy.optimize import brentq
 from scipy.special import exprel
 
+from ..columns import with_units
 from ..errors import ModelError, ParameterError
 from ..parameters import Parameters
 from .jump import (
@@ -269,13 +270,15 @@ class SlipPhase:
         """time [s], velocity [m/s], stress [Pa], slider_displacement [m]."""
         import pandas as pd
 
-        return pd.DataFrame(
-            {
-                "time": self.time,
-                "velocity": self.velocity,
-                "stress": self.stress,
-                "slider_displacement": self.slider_displacement,
-            }
+        return with_units(
+            pd.DataFrame(
+                {
+                    "time": self.time,
+                    "velocity": self.velocity,
+                    "stress": self.stress,
+                    "slider_displacement": self.slider_displacement,
+                }
+            )
         )
 
     def plot(self, ax: Axes | None = None, **kwargs: Any) -> Axes:

@@ -33,6 +33,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ..columns import with_units
 from ..errors import ModelError, ParameterError
 from ..numerics.quadrature import panel_rule
 from ..parameters import BOLTZMANN, Parameters
@@ -122,7 +123,7 @@ class SteadyState:
         """One row per velocity, SI units."""
         import pandas as pd
 
-        return pd.DataFrame(
+        frame = pd.DataFrame(
             {
                 "velocity": np.ravel(self.velocity),
                 "stress": np.ravel(self.stress),
@@ -130,6 +131,7 @@ class SteadyState:
                 "stress_slope": np.ravel(self.stress_slope),
             }
         )
+        return with_units(frame)
 
     def plot(self, ax: Axes | None = None, **kwargs: Any) -> Axes:
         """sigma against log V; returns the Axes (never shows the figure)."""

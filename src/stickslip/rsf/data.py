@@ -25,6 +25,7 @@ from typing import Any
 
 import numpy as np
 
+from ..columns import with_units
 from ..errors import DataError, ParameterError
 from ..protocols import Protocol, Segment
 
@@ -71,8 +72,10 @@ class LabRecord:
     def to_frame(self) -> Any:
         import pandas as pd
 
-        return pd.DataFrame({"time": self.time, "load_point_displacement": self.displacement,
-                             "friction": self.friction})  # fmt: skip
+        frame = pd.DataFrame(
+            {"time": self.time, "load_point_displacement": self.displacement, "friction": self.friction}
+        )
+        return with_units(frame)
 
     def plot(self, ax: Any = None) -> Any:
         from ..plotting import apply_style, new_axes

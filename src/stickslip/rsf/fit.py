@@ -24,6 +24,7 @@ from typing import Any
 
 import numpy as np
 
+from ..columns import with_units
 from ..errors import DataError, ModelError, ParameterError
 from ..protocols import Protocol
 from .data import LabRecord, find_segments
@@ -105,7 +106,7 @@ class RSFFit:
         frame = self.record.to_frame()
         frame["model"] = self.model_friction
         frame["residual"] = self.residuals
-        return frame
+        return with_units(frame)
 
     def plot(self, ax: Any = None) -> Any:
         from .plots import plot_fit

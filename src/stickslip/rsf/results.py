@@ -10,6 +10,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ..columns import with_units
 from ..protocols import Protocol
 from .params import RSFParams
 
@@ -70,7 +71,7 @@ class RSFRun:
             columns["state" if i == 0 else f"state{i + 1}"] = row
         columns["load_point_displacement"] = self.load_point_displacement
         columns["slider_displacement"] = self.slider_displacement
-        return pd.DataFrame(columns)
+        return with_units(pd.DataFrame(columns))
 
     def summary(self) -> dict[str, Any]:
         """The JSON summary: regime, final friction, period, peak and trough friction, message."""

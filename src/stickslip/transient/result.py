@@ -7,6 +7,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ..columns import with_units
 from ..model.cycle import Cycle
 from ..trace_columns import TRANSIENT
 
@@ -16,14 +17,6 @@ if TYPE_CHECKING:  # pragma: no cover
 
 #: Trace columns, in order (SI units).
 TRACE_COLUMNS = TRANSIENT
-TRACE_UNITS = {
-    "time": "s",
-    "stress": "Pa",
-    "bonded_fraction": "",
-    "slider_velocity": "m/s",
-    "slider_position": "m",
-    "puller_position": "m",
-}
 
 
 @dataclass(frozen=True)
@@ -38,7 +31,7 @@ class Snapshot:
     def to_frame(self) -> pd.DataFrame:
         import pandas as pd
 
-        return pd.DataFrame({"age": self.age, "extension": self.extension, "weight": self.weight})
+        return with_units(pd.DataFrame({"age": self.age, "extension": self.extension, "weight": self.weight}))
 
 
 @dataclass(frozen=True)
@@ -101,7 +94,7 @@ class TransientResult:
         """The trace: columns :data:`TRACE_COLUMNS`, SI units."""
         import pandas as pd
 
-        return pd.DataFrame({name: getattr(self, name) for name in TRACE_COLUMNS})
+        return with_units(pd.DataFrame({name: getattr(self, name) for name in TRACE_COLUMNS}))
 
     def plot(self, ax: Axes | None = None, **kwargs: Any) -> Axes:
         """Stress against time (and the slider velocity on a twin axis); returns the Axes."""

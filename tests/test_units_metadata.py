@@ -1,0 +1,205 @@
+"""Every output names its units: frames, CSV headers, Parquet metadata and JSON, each read back."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pint
+import pytest
+
+import stickslip
+from cli_helpers import run_main
+from stickslip import columns, protocols
+from stickslip.columns import csv_text, json_units, parquet_table, read_parquet, unit_of, with_units
+from stickslip.tables import read_table
+
+_UREG = pint.UnitRegistry()
+TABLE1 = Path(stickslip.__file__).parent / "data" / "table1.csv"
+
+
+def test_every_registered_unit_is_a_unit_pint_reads():
+    """A unit string nobody can parse names nothing; '1' is the unit one."""
+    for name, unit in columns.UNITS.items():
+        if unit is None or unit == columns.DIMENSIONLESS:
+            continue
+        quantity = _UREG.Quantity(1.0, unit.replace("^", "**"))
+        assert quantity.to_base_units().magnitude == pytest.approx(1.0), name  # SI base, factor one
+
+
+def test_parameter_keys_have_their_si_unit():
+    assert unit_of("bonds.bond_time") == "s"
+    assert unit_of("block.stiffness") == "Pa/m"
+    assert unit_of("bonds.breakage_weight") == "1"
+    with pytest.raises(KeyError, match="no unit registered"):
+        unit_of("no_such_column")
+
+
+def _results(params):
+    """One small result of each kind the package returns (seconds in all)."""
+    from stickslip.rsf import RSFParams, StateVariable
+    from stickslip.rsf import simulate as rsf_simulate
+    from stickslip.transient import run_transient
+
+    rsf = RSFParams(a=0.01, states=(StateVariable("aging", 0.015, 10e-6),), stiffness=1e3)
+    yield "steady", stickslip.steady_state(params, np.geomspace(1e-5, 1e-3, 5))
+    yield "stick", stickslip.stick_phase(params, 100e-6)
+    yield "simulate", stickslip.simulate(params, pulling_velocity=100e-6, duration=20.0)
+    yield "transient", run_transient(params, protocols.constant(350e-6, 1e-3), control="velocity")
+    yield "rsf", rsf_simulate(rsf, protocols.segments([(1e-6, 5.0), (10e-6, 5.0)]), every=0.5)
+    yield "protocol", protocols.segments([(1e-6, 5.0), (10e-6, 5.0)])
+
+
+def test_every_frame_names_the_unit_of_every_column(params):
+    for kind, result in _results(params):
+        frame = result.to_frame()
+        units = frame.attrs.get("units")
+        assert units is not None, kind
+        assert set(units) == {str(c) for c in frame.columns}, kind
+        assert units["time" if "time" in units else next(iter(units))] is not None or kind == "protocol"
+
+
+def test_csv_header_carries_units_and_read_table_converts_them(tmp_path):
+    frame = with_units(pd.DataFrame({"time": [0.0, 1.0], "stress": [1.0, 2.0], "bonded_fraction": [0.5, 0.25]}))
+    path = tmp_path / "t.csv"
+    path.write_text(csv_text(frame))
+    assert path.read_text().splitlines()[0] == "time [s],stress [Pa],bonded_fraction [1]"
+    table = read_table(path, {"time": "time", "stress": "stress", "bonded_fraction": "dimensionless"}, ["time"])
+    np.testing.assert_array_equal(table["bonded_fraction"], [0.5, 0.25])
+    # a header in other units is converted by the reader: the brackets are read, not decoration
+    path.write_text("time [ms],stress [kPa],bonded_fraction [1]\n1000,1,0.5\n2000,2,0.25\n")
+    table = read_table(path, {"time": "time", "stress": "stress", "bonded_fraction": "dimensionless"}, ["time"])
+    np.testing.assert_allclose(table["time"], [1.0, 2.0])
+    np.testing.assert_allclose(table["stress"], [1000.0, 2000.0])
+
+
+def test_csv_numbers_round_trip_exactly():
+    values = np.array([1 / 3, 8e-4, np.pi * 1e-300, 1e300])
+    frame = with_units(pd.DataFrame({"time": values}))
+    text = csv_text(frame)
+    back = [float(x) for x in text.splitlines()[1:]]
+    assert back == list(values)
+
+
+def test_parquet_keeps_units_for_pandas_and_pyarrow(tmp_path):
+    import pyarrow.parquet as pq
+
+    frame = with_units(pd.DataFrame({"pulling_velocity": [5e-5], "block.stiffness": [4e5], "regime": ["steady"]}))
+    path = tmp_path / "x.parquet"
+    pq.write_table(parquet_table(frame), path)
+    schema = pq.read_schema(path)
+    assert schema.field("block.stiffness").metadata[b"unit"] == b"Pa/m"
+    assert schema.field("regime").metadata is None
+    back = read_parquet(path)
+    assert back.attrs["units"] == {"pulling_velocity": "m/s", "block.stiffness": "Pa/m", "regime": None}
+    # a plain pandas user recovers them from the schema metadata
+    stored = json.loads(pq.read_schema(path).metadata[columns.PARQUET_KEY])
+    assert stored["pulling_velocity"] == "m/s"
+
+
+def test_json_units_map_names_the_keys_present():
+    document = {"critical_velocity": 1.2e-4, "cycles": [{"stick_time": 9.7, "peak_stress": 556.4}], "regime": "x"}
+    assert json_units(document) == {
+        "critical_velocity": "m/s",
+        "peak_stress": "Pa",
+        "stick_time": "s",
+    }
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ("critical", "--json"),
+        ("simulate", "--v0", "100 um/s", "--duration", "30 s", "--json"),
+        ("transient", "--v0", "350 um/s", "--duration", "2 ms", "--control", "velocity", "--json"),
+        ("stick", "--v0", "100 um/s", "--json"),
+        ("curve", "--points", "3", "--format", "json"),
+        (
+            "rsf",
+            "simulate",
+            "--a",
+            "0.01",
+            "--b",
+            "0.015",
+            "--dc",
+            "10 um",
+            "--stiffness",
+            "1e-3 1/um",
+            "--segment",
+            "1 um/s:5 s",
+            "--segment",
+            "10 um/s:5 s",
+            "--json",
+        ),
+        ("rsf", "stability", "--a", "0.01", "--b", "0.015", "--dc", "10 um", "--velocity", "1 um/s", "--json"),
+        ("fit", "stick", str(TABLE1), "--json"),
+        ("fit", "steady", str(TABLE1.with_name("synthetic_steady.csv")), "--json"),
+    ],
+)
+def test_cli_json_has_a_units_map_for_its_numbers(capsys, argv):
+    """Every key holding a number (or numbers) is in the document's units map, or is registered as a count."""
+    code, out, err = run_main(capsys, *argv)
+    assert code == 0, err
+    document = json.loads(out)
+    units = document.pop("units")
+    for key, parent in _numeric_keys(document):
+        if key in columns.INHERITED:
+            assert parent in units or unit_of(parent) is None, f"{parent}/{key}"
+        else:
+            assert key in units or unit_of(key) is None, key
+
+
+def _numeric_keys(obj, parent=""):
+    """(key, enclosing key) of every key that holds a number or a list of numbers."""
+    if isinstance(obj, dict):
+        for key, value in obj.items():
+            leaves = value if isinstance(value, list) else [value]
+            if any(isinstance(v, (int, float)) and not isinstance(v, bool) for v in leaves):
+                yield key, parent
+            yield from _numeric_keys(value, key)
+    elif isinstance(obj, list):
+        for item in obj:
+            yield from _numeric_keys(item, parent)
+
+
+def test_json_drops_float_noise(capsys):
+    """8e-4 typed by a person is written as 0.0008, not 0.0007999999999999999."""
+    from stickslip.cli.common import json_safe
+
+    assert json_safe({"x": 800e-6 * 1.0000000000000002})["x"] == 0.0008
+    assert json_safe({"x": float("nan")})["x"] is None
+
+
+@pytest.mark.parametrize(
+    ("argv", "header"),
+    [
+        (("simulate", "--v0", "100 um/s", "--duration", "30 s"), "time [s],stress [Pa],velocity [m/s]"),
+        (("transient", "--v0", "350 um/s", "--duration", "2 ms", "--control", "velocity"), "time [s],stress [Pa]"),
+        (
+            (
+                "rsf",
+                "simulate",
+                "--a",
+                "0.01",
+                "--b",
+                "0.015",
+                "--dc",
+                "10 um",
+                "--stiffness",
+                "1e-3 1/um",
+                "--segment",
+                "1 um/s:5 s",
+                "--every",
+                "1 s",
+            ),
+            "time [s],friction [1]",
+        ),
+    ],
+)
+def test_trace_csv_headers_name_units(capsys, tmp_path, argv, header):
+    out = tmp_path / "trace.csv"
+    code, _, err = run_main(capsys, *argv, "-o", str(out))
+    assert code == 0, err
+    assert out.read_text().splitlines()[0].startswith(header)
