@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
 
 import numpy as np
@@ -166,10 +167,15 @@ def _numeric_keys(obj, parent=""):
 
 def test_json_drops_float_noise(capsys):
     """8e-4 typed by a person is written as 0.0008, not 0.0007999999999999999."""
-    from stickslip.cli.common import json_safe
+    from stickslip.cli.common import json_text
 
-    assert json_safe({"x": 800e-6 * 1.0000000000000002})["x"] == 0.0008
-    assert json_safe({"x": float("nan")})["x"] is None
+    noisy = math.nextafter(0.0008, 0.0)  # 0.0007999999999999999, as a unit conversion can give it
+    assert noisy != 0.0008
+    assert json.loads(json_text({"split_velocity": noisy, "x": float("nan")})) == {
+        "split_velocity": 0.0008,
+        "x": None,
+        "units": {"split_velocity": "m/s"},
+    }
 
 
 @pytest.mark.parametrize(

@@ -136,18 +136,25 @@ def positive(text: str | float, dimension: str, name: str, allow_zero: bool = Fa
     return value
 
 
-def json_safe(obj: Any) -> Any:
-    """Replace non-finite floats by None and numpy types by Python ones, recursively."""
+def json_safe(obj: Any, digits: int | None = None) -> Any:
+    """Replace non-finite floats by None and numpy types by Python ones, recursively.
+
+    ``digits``: write floats at that many significant digits (15 drops float noise such as
+    0.0007999999999999999 for 8e-4 and moves no value by more than 5e-16 of itself); None keeps every bit.
+    """
     import numpy as np
 
     if isinstance(obj, dict):
-        return {str(k): json_safe(v) for k, v in obj.items()}
+        return {str(k): json_safe(v, digits) for k, v in obj.items()}
     if isinstance(obj, (list, tuple)):
-        return [json_safe(v) for v in obj]
+        return [json_safe(v, digits) for v in obj]
     if isinstance(obj, np.ndarray):
-        return [json_safe(v) for v in obj.tolist()]
+        return [json_safe(v, digits) for v in obj.tolist()]
     if isinstance(obj, (np.floating, float)):
-        return _for_people(float(obj))
+        value = float(obj)
+        if not math.isfinite(value):
+            return None
+        return value if digits is None else float(f"{value:.{digits}g}")
     if isinstance(obj, np.integer):
         return int(obj)
     if isinstance(obj, np.bool_):
@@ -155,19 +162,15 @@ def json_safe(obj: Any) -> Any:
     return obj
 
 
-def _for_people(value: float) -> float | None:
-    """None for a non-finite value; else the value at 15 significant digits, which drops float noise
-    such as 0.0007999999999999999 (for 8e-4) and changes no value by more than 5e-16 of itself."""
-    if not math.isfinite(value):
-        return None
-    return float(f"{value:.15g}")
+#: Significant digits of the numbers in the JSON people read (see :func:`json_safe`).
+JSON_DIGITS = 15
 
 
 def json_text(obj: Any) -> str:
-    """The JSON text of a result: SI numbers, and a top-level ``units`` map naming them."""
+    """The JSON text of a result: SI numbers without float noise, and a top-level ``units`` map naming them."""
     from ..columns import JSON_KEY, json_units
 
-    document = json_safe(obj)
+    document = json_safe(obj, JSON_DIGITS)
     if isinstance(document, dict) and JSON_KEY not in document:
         document[JSON_KEY] = json_units(document)
     return json.dumps(document, indent=2)
