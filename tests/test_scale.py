@@ -125,7 +125,7 @@ def test_curve_csv_in_chunks_equals_one_evaluation(capsys, monkeypatch, tmp_path
     code, out, err = run_main(capsys, "curve", "--points", "50", "--format", "csv", "-o", str(path))
     assert code == 0 and out == "" and err == ""
     lines = path.read_text().splitlines()
-    assert lines[0] == "velocity [m/s],stress [Pa],bonded_fraction,stress_slope [Pa s/m]" and len(lines) == 51
+    assert lines[0] == "velocity [m/s],stress [Pa],bonded_fraction [1],stress_slope [Pa s/m]" and len(lines) == 51
     values = np.array([[float(v) for v in line.split(",")] for line in lines[1:]])
     whole = steady_state(load_parameters(), np.geomspace(10e-6, 10e-3, 50))
     for k, name in enumerate(("velocity", "stress", "bonded_fraction", "stress_slope")):
