@@ -18,7 +18,7 @@ from typing import Any
 import click
 
 from ..errors import ParameterError, UnitError
-from ..fileio import atomic_path, atomic_write_text, refuse_input_as_output
+from ..fileio import atomic_path, atomic_write_text, protect_inputs, refuse_input_as_output
 from .common import json_safe, quantity
 
 LAW_NAMES = ("aging", "slip", "prz", "nagata")
@@ -104,6 +104,7 @@ def load_params_mapping(path: Path) -> dict[str, Any]:
     path = Path(path)
     if not path.is_file():
         raise DataError(f"--params {path}: file not found")
+    protect_inputs([path])  # `rsf simulate --params run.params.json -o run.csv` must not rewrite it
     text = path.read_text(encoding="utf-8")
     try:
         if path.suffix.lower() == ".toml":
@@ -223,11 +224,16 @@ def simulate_command(**options: Any) -> None:
         start = _positive(options["start_velocity"], "velocity", "--start-velocity")
     every = None if options["every"] is None else _positive(options["every"], "time", "--every")
     output, plot_path = options["output"], options["plot_path"]
-    refuse_input_as_output([options["protocol_file"], options["params_file"]], [("-o", output), ("--plot", plot_path)])
+    side = sidecar(output) if output is not None and str(output) != "-" else None
+    refuse_input_as_output(
+        [options["protocol_file"], options["params_file"]],
+        [("-o", output), ("-o (its NAME.params.json)", side), ("--plot", plot_path)],
+    )
     run = simulate(params, protocol, start_velocity=start, every=every)
     if output is not None:
         write(output, trace_csv(run.to_frame()))
-        write(sidecar(output), run.metadata_json())
+        if side is not None:
+            write(side, run.metadata_json())
     summary = run.summary()
     if options["as_json"]:
         click.echo(json.dumps(json_safe(summary), indent=2))
