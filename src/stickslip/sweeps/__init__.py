@@ -17,7 +17,7 @@ from typing import Any
 from ..errors import DataError, ParameterError
 from ..parameters import Parameters
 from ..units import to_si
-from .engine import compute, dask_client, default_batch_size, read_results
+from .engine import check_scheduler_address, compute, dask_client, default_batch_size, read_results
 from .models import ALIASES, MODELS, get_model
 from .progress import Silent, reporter
 from .spec import Axis, SweepSpec, check_design, parse_vary
@@ -124,6 +124,8 @@ def run_sweep(
         batch_size = _whole(batch_size, "batch_size", minimum=1)
     if scheduler is not None and not isinstance(scheduler, str):
         raise ParameterError(f"scheduler: expected an address such as 'tcp://HOST:8786', got {scheduler!r}")
+    if scheduler is not None:
+        check_scheduler_address(scheduler)
     store = open_store(output, spec, batch_size or default_batch_size(spec.size), overwrite=overwrite)
     shown = progress if progress is not None else Silent()
     try:

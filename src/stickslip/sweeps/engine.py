@@ -17,7 +17,7 @@ from functools import lru_cache
 from pathlib import Path
 from typing import Any
 
-from ..errors import DataError, StickslipError
+from ..errors import DataError, ParameterError, StickslipError
 from .models import get_model, result_columns, run_point
 from .spec import SweepSpec
 from .store import SweepStore, arrow_schema
@@ -63,6 +63,20 @@ def to_table(spec: SweepSpec, columns: dict[str, list[Any]]) -> Any:
     import pyarrow as pa
 
     return pa.Table.from_pydict(columns, schema=arrow_schema(spec.keys, result_columns(get_model(spec.model))))
+
+
+def check_scheduler_address(scheduler: str) -> None:
+    """Refuse an address that is not one (before any folder is touched or cluster contacted)."""
+    from distributed.comm.addressing import get_address_host_port, parse_address
+
+    try:
+        scheme, _ = parse_address(scheduler)
+        if scheme in ("tcp", "tls", "ws", "wss"):
+            get_address_host_port(scheduler)
+    except (ValueError, TypeError) as exc:
+        raise ParameterError(
+            f"--scheduler {scheduler}: not a scheduler address ({exc}); expected e.g. tcp://HOST:8786"
+        ) from None
 
 
 @contextlib.contextmanager

@@ -129,13 +129,19 @@ def open_store(folder: str | Path, spec: SweepSpec, batch_size: int, overwrite: 
     resume every chunk is checked against the ledger (or, unrecorded, read);
     a damaged one is removed and listed in ``SweepStore.damaged``.
     """
-    path = _folder(folder)
     if isinstance(batch_size, bool) or not isinstance(batch_size, int) or batch_size < 1:
         raise ParameterError(f"batch_size: expected a positive whole number of points, got {batch_size!r}")
+    created = not os.path.lexists(folder) if str(folder).strip() else False
+    path = _folder(folder)
     lock = _lock_folder(path, folder)
     try:
         store = _open_locked(path, folder, spec, batch_size, overwrite)
     except BaseException:
+        if created:  # refused before anything was written: leave no empty folder behind
+            with contextlib.suppress(OSError):
+                (path / LOCK).unlink()
+                (path / MANIFEST).unlink(missing_ok=True)
+                path.rmdir()
         os.close(lock)
         raise
     store.lock = lock
