@@ -145,6 +145,14 @@ def _refuse_protected(target: Path, shown: str | Path) -> None:
         raise DataError(f"{shown}: that is the input file {source}; refusing to overwrite it (choose another name)")
 
 
+def _is_regular(path: str | Path) -> bool:
+    """A regular file (a device or FIFO read as input is not destroyed by writing into it)."""
+    try:
+        return stat.S_ISREG(os.stat(path).st_mode)
+    except (OSError, ValueError):
+        return False
+
+
 def same_file(a: str | Path, b: str | Path) -> bool:
     """True if both names exist and are one file (same device and inode: links and hard links included)."""
     try:
@@ -163,7 +171,7 @@ def refuse_input_as_output(inputs: list[str | Path | None], outputs: list[tuple[
     later that was not listed here (a side file) cannot replace them either.
     """
     protect_inputs(inputs)
-    existing = [p for p in inputs if p is not None and str(p) != STDOUT]
+    existing = [p for p in inputs if p is not None and str(p) != STDOUT and _is_regular(p)]
     for option, out in outputs:
         if out is None or str(out) == STDOUT:
             continue
