@@ -50,6 +50,19 @@ REFUSED = [
     # the rerun workflow of docs/rsf.md: its NAME.params.json side file would replace the --params input
     (["rsf", "simulate", "--params", "{d}/run.params.json", "--a", "0.02", "-o", "{d}/run.csv"], "run.params.json"),
     (["rsf", "simulate", "--params", "{d}/run.params.json", "-o", "{d}/run.params.json"], "run.params.json"),
+    (
+        [
+            "rsf",
+            "stability",
+            "--params",
+            "{d}/run.params.json",
+            "--velocity",
+            "1 um/s",
+            "--plot",
+            "{d}/run.params.json",
+        ],
+        "run.params.json",
+    ),
 ]
 
 

@@ -17,7 +17,7 @@ from typing import Any
 
 import click
 
-from ..errors import ParameterError, UnitError
+from ..errors import ParameterError, StickslipError, UnitError
 from ..fileio import atomic_path, atomic_write_text, protect_inputs, refuse_input_as_output
 from .common import json_safe, quantity
 
@@ -178,6 +178,8 @@ def save_figure(fig: Any, path: Path) -> None:
     try:
         with atomic_path(path) as temp:
             fig.savefig(temp, dpi=120, bbox_inches="tight", format=path.suffix.lstrip(".") or "png")
+    except StickslipError:  # a refusal (an input named as output) is already one line
+        raise
     except (OSError, ValueError) as exc:
         raise click.FileError(str(path), hint=str(exc)) from None
 
@@ -267,6 +269,7 @@ def stability_command(**options: Any) -> None:
     from ..rsf import stability
 
     params = build_params(options)
+    refuse_input_as_output([options.get("params_file")], [("--plot", options["plot_path"])])
     reports = [stability(params, _positive(v, "velocity", "--velocity")).as_dict() for v in options["velocities"]]
     if options["as_json"]:
         click.echo(json.dumps(json_safe(reports if len(reports) > 1 else reports[0]), indent=2))

@@ -8,7 +8,7 @@ from typing import Any
 
 import click
 
-from ..errors import DataError, ParameterError
+from ..errors import DataError, ParameterError, StickslipError
 from .common import echo_err, params_options, require_unit
 
 MODEL_NAMES = ("quasi-static", "transient", "rsf")
@@ -190,6 +190,8 @@ def plot_command(folder: Path, x: str, y: str, color: str, output: Path | None) 
     try:
         with atomic_path(target) as temp:
             ax.figure.savefig(temp, format=target.suffix.lstrip(".") or "png", dpi=120, bbox_inches="tight")
+    except StickslipError:
+        raise
     except (OSError, ValueError) as exc:
         raise click.FileError(str(target), hint=str(exc)) from None
     click.echo(f"phase diagram: {target}")
