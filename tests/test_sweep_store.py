@@ -277,3 +277,12 @@ def test_memory_does_not_grow_with_the_number_of_batches(tmp_path):
         tracemalloc.stop()
         store.close()
     assert peak < 10_000_000, f"{peak / 1e6:.0f} MB for 3 batches out of 2e6"  # the old code took 198 MB
+
+
+def test_the_python_api_warns_of_damaged_chunks_it_recomputed(reference, tmp_path):
+    folder, expected = reference
+    copy = _copy(folder, tmp_path / "out")
+    _truncated(copy)
+    with pytest.warns(UserWarning, match=r"1 damaged chunk\(s\) .* recomputed: part-000002.parquet \(unreadable"):
+        frame = sweep([VELOCITIES, "block.height=1 cm,2 cm"], copy, duration="60 s", workers=0)
+    pd.testing.assert_frame_equal(frame.drop(columns="wall_time"), expected)
