@@ -283,6 +283,6 @@ def test_the_python_api_warns_of_damaged_chunks_it_recomputed(reference, tmp_pat
     folder, expected = reference
     copy = _copy(folder, tmp_path / "out")
     _truncated(copy)
-    with pytest.warns(UserWarning, match=r"1 damaged chunk\(s\) .* recomputed: part-000002.parquet \(unreadable"):
+    with pytest.warns(UserWarning, match=r"1 damaged chunk\(s\) .* recomputed: part-000002.parquet \(its bytes differ"):
         frame = sweep([VELOCITIES, "block.height=1 cm,2 cm"], copy, duration="60 s", workers=0)
     pd.testing.assert_frame_equal(frame.drop(columns="wall_time"), expected)
