@@ -135,6 +135,15 @@ def test_a_link_to_the_process_stdout_is_written_through_and_kept(tmp_path, capf
     assert _only_names(tmp_path) == ["stdout"]
 
 
+def test_bytes_to_the_own_stdout_keep_their_place_among_the_process_output(tmp_path, capfd):
+    link = tmp_path / "stdout"
+    link.symlink_to("/proc/self/fd/1")  # fd 1 is a file here (pytest's capture), as after a shell's `>`
+    os.write(1, b"before\n")
+    atomic_write_bytes(link, PAYLOAD)
+    os.write(1, b"after\n")
+    assert capfd.readouterr().out == "before\n" + PAYLOAD.decode() + "after\n"
+
+
 def test_dash_is_standard_output(tmp_path, capsys, monkeypatch):
     monkeypatch.chdir(tmp_path)
     atomic_write_text("-", PAYLOAD.decode())

@@ -85,16 +85,23 @@ def _through_fd_link(path: Path) -> bool:
     Their target is an open file of some process (a pipe, a terminal, a file
     a shell opened with ``>``): it must be written through, never replaced.
     """
+    return _fd_link(path) is not None
+
+
+def _fd_link(path: str | Path) -> tuple[int, int] | None:
+    """(process id, descriptor) of the first ``/proc/PID/fd/N`` on ``path``'s chain of links, or None."""
     current = Path(os.path.abspath(path))
     for _ in range(40):  # the kernel's own limit on link chains
         folder = os.path.realpath(current.parent)
-        if re.fullmatch(r"/proc/(self|thread-self|\d+)(/task/\d+)?/fd|/dev/fd", folder):
-            return True
+        match = re.fullmatch(r"/proc/(\d+)(?:/task/\d+)?/fd|/dev/fd", folder)
+        if match:
+            pid = int(match.group(1)) if match.group(1) else os.getpid()
+            return (pid, int(current.name)) if current.name.isdigit() else (pid, -1)
         if not current.is_symlink():
-            return False
+            return None
         link = os.readlink(current)
         current = Path(os.path.normpath(Path(folder) / link))
-    return False
+    return None
 
 
 def _real_target(path: Path) -> Path:
@@ -253,7 +260,22 @@ def _write_stdout(data: bytes) -> None:
 
 
 def _write_stream(path: str | Path, data: bytes) -> None:
-    """Write to a device, FIFO or open-file link as it is: no rename, no truncation of what it points at."""
+    """Write to a device, FIFO or open-file link as it is: no rename, no truncation of what it points at.
+
+    A link to one of this process's own descriptors (``/dev/stdout``) is
+    written through that descriptor, so the bytes land where the process's
+    other output to it goes, in order (a fresh ``open`` would have an offset
+    of its own in a file the shell opened with ``>``).
+    """
+    link = _fd_link(path)
+    if link is not None and link[0] == os.getpid() and link[1] >= 0:
+        for stream in (sys.stdout, sys.stderr):
+            with contextlib.suppress(Exception):
+                stream.flush()
+        view = memoryview(data)
+        while view:
+            view = view[os.write(link[1], view) :]
+        return
     descriptor = os.open(path, os.O_WRONLY | os.O_APPEND)
     with os.fdopen(descriptor, "wb") as handle:
         handle.write(data)
