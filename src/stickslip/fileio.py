@@ -191,11 +191,13 @@ def refuse_input_as_output(inputs: list[str | Path | None], outputs: list[tuple[
 
 # --------------------------------------------------------------------------- writing
 @contextlib.contextmanager
-def atomic_path(path: str | Path, suffix: str | None = None) -> Iterator[Path]:
+def atomic_path(path: str | Path, suffix: str | None = None, clean: bool = True) -> Iterator[Path]:
     """Yield a temporary path to write; on success its content goes to ``path`` as the module note says.
 
     For writers that want a file name (``savefig``, ``to_parquet``).  On any
     exception the temporary file is removed and ``path`` is untouched.
+    ``clean=False`` skips the scan of the folder for stale temporaries (a
+    writer of many files in one folder cleans it once, not at every file).
     """
     kind = output_kind(path)
     tail = (suffix if suffix is not None else Path(str(path)).suffix) + ".tmp"
@@ -207,7 +209,8 @@ def atomic_path(path: str | Path, suffix: str | None = None) -> Iterator[Path]:
     target = _real_target(Path(path))
     _refuse_protected(target, path)
     folder = target.parent
-    remove_stale_temporaries(target)
+    if clean:
+        remove_stale_temporaries(target)
     handle, temp_name = tempfile.mkstemp(prefix=f".{target.name}.", suffix=tail, dir=folder)
     temp = Path(temp_name)
     try:

@@ -194,7 +194,8 @@ def plot_command(folder: Path, x: str, y: str, color: str, output: Path | None) 
         raise
     except (OSError, ValueError) as exc:
         raise click.FileError(str(target), hint=str(exc)) from None
-    click.echo(f"phase diagram: {target}")
+    if str(target) != "-":  # the image itself went to standard output
+        click.echo(f"phase diagram: {target}")
 
 
 def _refuse_inside(folder: Path, target: Path) -> None:

@@ -102,7 +102,7 @@ class SweepStore:
         if table.num_rows != stop - start:
             raise DataError(f"batch {batch}: {table.num_rows} rows for points {start}..{stop - 1}; nothing written")
         target = self.folder / chunk_name(batch)
-        with atomic_path(target) as temp:
+        with atomic_path(target, clean=False) as temp:  # the folder was cleaned when opened, under its lock
             pq.write_table(table, temp)
             entry = {"batch": batch, "start": start, "stop": stop, **_fingerprint(temp)}
             _append_line(self.folder / LEDGER, json.dumps(entry, sort_keys=True))  # before the rename: see module
