@@ -228,6 +228,7 @@ def test_the_lock_of_a_live_process_refuses_and_dies_with_it(tmp_path, capsys):
         (lambda: sweep(["pulling_velocity=1 um/s..1 mm/s"], samples=2.5, workers=0), "samples: expected a whole"),
         (lambda: sweep([VELOCITIES], workers=-1), "workers: expected a whole number >= 0"),
         (lambda: sweep([VELOCITIES], model=3), "model: expected a name"),
+        (lambda: sweep([VELOCITIES], "", workers=0), "output: the folder name is empty"),
         (lambda: sweep([VELOCITIES], overrides=["bonds.bond_time=1 ms"], workers=0), "overrides: expected a mapping"),
     ],
 )

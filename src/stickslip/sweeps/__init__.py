@@ -171,6 +171,8 @@ def sweep(
     returned frame holds every row in memory: for sweeps too large for that,
     give ``output`` and read the folder with pyarrow datasets instead.
     """
+    if output is not None and not str(output).strip():  # Path("") would be the current folder
+        raise ParameterError("output: the folder name is empty; give a folder, or None for no folder")
     spec = build_spec(vary, **specification)
     folder = Path(output) if output is not None else Path(tempfile.mkdtemp(prefix="stickslip-sweep-"))
     try:
