@@ -159,7 +159,7 @@ def _edited_batch_size(folder):
 
 
 def _unrecorded_but_whole(folder):
-    (folder / LEDGER).unlink()  # as after a kill between a chunk's rename and its ledger line: read, and kept
+    (folder / LEDGER).unlink()  # a folder from before the ledger: its chunks are read, and kept
     return []
 
 

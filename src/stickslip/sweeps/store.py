@@ -291,7 +291,7 @@ def _chunk_problem(store: SweepStore, batch: int, path: Path, entry: dict[str, A
         if _fingerprint(path) == {"bytes": entry.get("bytes"), "sha256": entry.get("sha256")}:
             return None
         return "its bytes differ from those written"
-    why = _read_problem(store, path, start, stop)  # unrecorded (killed after the rename) or recorded otherwise
+    why = _read_problem(store, path, start, stop)  # unrecorded (older folder, lost ledger) or recorded otherwise
     if why is None:
         _append_line(store.folder / LEDGER, json.dumps({"batch": batch, "start": start, "stop": stop,
                                                         **_fingerprint(path)}, sort_keys=True))  # fmt: skip
