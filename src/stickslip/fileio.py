@@ -1,41 +1,221 @@
-"""Files written atomically: a temporary name in the same folder, then a rename.
+"""Writing output files without ever destroying what an output name points at.
 
-A reader (or a user who kills the program mid-write) sees either the old file
-or the whole new one, never a half-written or empty file.  Every output of the
-package goes through here; nothing else opens a file for writing.
+What happens depends on what the name is:
+
+* a new path or a regular file: written under a temporary name in the same
+  folder, then renamed over it, so a reader (or a user who kills the program
+  mid-write) sees either the old file or the whole new one;
+* a symbolic link: followed; its final target is replaced as above (in the
+  target's folder), and the link stays a link;
+* a character device (``/dev/null``), a FIFO, a socket, or a name that leads
+  through ``/proc/*/fd`` or ``/dev/fd`` (``/dev/stdout``): written as it is,
+  appending, never replaced;
+* ``-``: standard output.
+
+Temporary files are named ``.NAME.XXXXXXXX[.SUFFIX].tmp`` and locked
+(``flock``) while written; a killed write leaves one behind, and the next
+write to the same target removes those of its name that no one holds and that
+are older than this process.  A file of any other name is never touched.
+
+Inside a command-line invocation every input file is remembered (see
+:func:`protect_inputs`), and a write that would replace one of them is refused
+with :class:`~stickslip.errors.DataError`: same device and inode, so a symbolic
+or hard link to an input is recognised too.
 """
 
 from __future__ import annotations
 
 import contextlib
 import os
+import re
 import stat
+import sys
 import tempfile
-from collections.abc import Iterator
+import time
+from collections.abc import Iterable, Iterator
 from pathlib import Path
 from typing import IO, Any
 
 from .errors import DataError
 
-__all__ = ["atomic_path", "atomic_write_bytes", "atomic_write_text", "refuse_input_as_output"]
+__all__ = [
+    "STDOUT",
+    "atomic_open",
+    "atomic_path",
+    "atomic_write_bytes",
+    "atomic_write_text",
+    "output_kind",
+    "protect_inputs",
+    "refuse_input_as_output",
+    "same_file",
+]
+
+#: The output name that means standard output.
+STDOUT = "-"
+
+#: When this process started, near enough: temporary files older than this are not being written by it.
+_STARTED = time.time()
+
+#: Temporary names this module makes: ``.NAME.`` + mkstemp's 8 characters + optional suffix + ``.tmp``.
+_TEMP_TAIL = r"\.[a-z0-9_]{8}(?:\.[A-Za-z0-9_-]{1,16})?\.tmp"
+
+#: Key of the protected inputs in the click context of a command-line invocation.
+_META_KEY = "stickslip.fileio.inputs"
 
 
+# --------------------------------------------------------------------------- what an output name is
+def output_kind(path: str | Path) -> str:
+    """``"stdout"`` for ``-``; ``"stream"`` for a device, FIFO, socket or /proc fd link; else ``"file"``."""
+    if str(path) == STDOUT:
+        return "stdout"
+    if _through_fd_link(Path(path)):
+        return "stream"
+    try:
+        mode = os.stat(path).st_mode  # follows symbolic links: the kind of the target
+    except OSError:
+        return "file"  # new (or a dangling link): created as a regular file
+    if stat.S_ISREG(mode) or stat.S_ISDIR(mode):
+        return "file"  # a folder fails at the rename with a clear OSError
+    return "stream"
+
+
+def _through_fd_link(path: Path) -> bool:
+    """True if following ``path``'s links passes through ``/proc/*/fd/N`` or ``/dev/fd/N`` (e.g. /dev/stdout).
+
+    Their target is an open file of some process (a pipe, a terminal, a file
+    a shell opened with ``>``): it must be written through, never replaced.
+    """
+    return _fd_link(path) is not None
+
+
+def _fd_link(path: str | Path) -> tuple[int, int] | None:
+    """(process id, descriptor) of the first ``/proc/PID/fd/N`` on ``path``'s chain of links, or None."""
+    current = Path(os.path.abspath(path))
+    for _ in range(40):  # the kernel's own limit on link chains
+        folder = os.path.realpath(current.parent)
+        match = re.fullmatch(r"/proc/(\d+)(?:/task/\d+)?/fd|/dev/fd", folder)
+        if match:
+            pid = int(match.group(1)) if match.group(1) else os.getpid()
+            return (pid, int(current.name)) if current.name.isdigit() else (pid, -1)
+        if not current.is_symlink():
+            return None
+        link = os.readlink(current)
+        current = Path(os.path.normpath(Path(folder) / link))
+    return None
+
+
+def _real_target(path: Path) -> Path:
+    """The file a rename must replace: the final target of a chain of links (also a dangling one)."""
+    return Path(os.path.realpath(path))
+
+
+# --------------------------------------------------------------------------- inputs that no output may replace
+def _invocation_meta() -> dict[str, Any] | None:
+    """The click context's ``meta`` of the running command, if any (one per invocation, so nothing leaks)."""
+    click = sys.modules.get("click")
+    if click is None:
+        return None
+    ctx = click.get_current_context(silent=True)
+    return None if ctx is None else ctx.meta
+
+
+def protect_inputs(paths: Iterable[str | Path | None]) -> None:
+    """Remember these input files for the running command: no later write may replace them.
+
+    Outside a command-line invocation (the Python API) this does nothing.
+    Names that are not existing regular files (a built-in parameter set's
+    name, ``None``) are skipped.
+    """
+    meta = _invocation_meta()
+    if meta is None:
+        return
+    known: dict[tuple[int, int], str] = meta.setdefault(_META_KEY, {})
+    for path in paths:
+        if path is None or str(path) == STDOUT:
+            continue
+        with contextlib.suppress(OSError, ValueError):
+            info = os.stat(path)
+            if stat.S_ISREG(info.st_mode):
+                known.setdefault((info.st_dev, info.st_ino), str(path))
+
+
+def _refuse_protected(target: Path, shown: str | Path) -> None:
+    meta = _invocation_meta()
+    if not meta or not meta.get(_META_KEY):
+        return
+    try:
+        info = os.stat(target)
+    except (OSError, ValueError):
+        return
+    source = meta[_META_KEY].get((info.st_dev, info.st_ino))
+    if source is not None:
+        raise DataError(f"{shown}: that is the input file {source}; refusing to overwrite it (choose another name)")
+
+
+def _is_regular(path: str | Path) -> bool:
+    """A regular file (a device or FIFO read as input is not destroyed by writing into it)."""
+    try:
+        return stat.S_ISREG(os.stat(path).st_mode)
+    except (OSError, ValueError):
+        return False
+
+
+def same_file(a: str | Path, b: str | Path) -> bool:
+    """True if both names exist and are one file (same device and inode: links and hard links included)."""
+    try:
+        first, second = os.stat(a), os.stat(b)
+    except (OSError, ValueError):
+        return False
+    return (first.st_dev, first.st_ino) == (second.st_dev, second.st_ino)
+
+
+def refuse_input_as_output(inputs: list[str | Path | None], outputs: list[tuple[str, str | Path | None]]) -> None:
+    """Raise :class:`DataError` if any output names the same file as an input; remember the inputs.
+
+    ``outputs`` are ``(option name, path)`` pairs, so the message can say which
+    option would have overwritten which input.  The inputs are also kept for
+    the rest of the invocation (:func:`protect_inputs`), so a file written
+    later that was not listed here (a side file) cannot replace them either.
+    """
+    protect_inputs(inputs)
+    existing = [p for p in inputs if p is not None and str(p) != STDOUT and _is_regular(p)]
+    for option, out in outputs:
+        if out is None or str(out) == STDOUT:
+            continue
+        for source in existing:
+            if same_file(source, out):
+                raise DataError(
+                    f"{option} {out}: that is the input file; refusing to overwrite it (choose another name)"
+                )
+
+
+# --------------------------------------------------------------------------- writing
 @contextlib.contextmanager
-def atomic_path(path: str | Path, suffix: str | None = None) -> Iterator[Path]:
-    """Yield a temporary path beside ``path``; on success rename it onto ``path``.
+def atomic_path(path: str | Path, suffix: str | None = None, clean: bool = True) -> Iterator[Path]:
+    """Yield a temporary path to write; on success its content goes to ``path`` as the module note says.
 
     For writers that want a file name (``savefig``, ``to_parquet``).  On any
     exception the temporary file is removed and ``path`` is untouched.
+    ``clean=False`` skips the scan of the folder for stale temporaries (a
+    writer of many files in one folder cleans it once, not at every file).
     """
-    target = Path(path)
-    folder = target.parent if str(target.parent) else Path(".")
-    handle, temp_name = tempfile.mkstemp(
-        prefix=f".{target.name}.", suffix=(suffix if suffix is not None else target.suffix) + ".tmp", dir=folder
-    )
-    os.close(handle)
+    kind = output_kind(path)
+    tail = (suffix if suffix is not None else Path(str(path)).suffix) + ".tmp"
+    if kind != "file":
+        with _scratch_file(tail) as temp:
+            yield temp
+            _copy_to_stream(temp, path, kind)
+        return
+    target = _real_target(Path(path))
+    _refuse_protected(target, path)
+    folder = target.parent
+    if clean:
+        remove_stale_temporaries(target)
+    handle, temp_name = tempfile.mkstemp(prefix=f".{target.name}.", suffix=tail, dir=folder)
     temp = Path(temp_name)
-    _set_mode(temp, target)
     try:
+        _lock(handle)  # tells a later cleaner that this temporary is alive
+        _set_mode(temp, target)
         yield temp
         _fsync_file(temp)
         os.replace(temp, target)
@@ -43,17 +223,24 @@ def atomic_path(path: str | Path, suffix: str | None = None) -> Iterator[Path]:
         with contextlib.suppress(OSError):
             temp.unlink()
         raise
+    finally:
+        os.close(handle)
 
 
 def atomic_write_text(path: str | Path, text: str, encoding: str = "utf-8") -> Path:
-    """Write ``text`` to ``path`` atomically; returns the path."""
+    """Write ``text`` to ``path`` (atomically when it is a file); returns the path."""
     return atomic_write_bytes(path, text.encode(encoding))
 
 
 def atomic_write_bytes(path: str | Path, data: bytes) -> Path:
-    """Write ``data`` to ``path`` atomically; returns the path."""
-    with atomic_path(path) as temp:
-        with open(temp, "wb") as handle:
+    """Write ``data`` to ``path`` (atomically when it is a file); returns the path."""
+    kind = output_kind(path)
+    if kind == "stdout":
+        _write_stdout(data)
+    elif kind == "stream":
+        _write_stream(path, data)
+    else:
+        with atomic_path(path) as temp, open(temp, "wb") as handle:
             handle.write(data)
     return Path(path)
 
@@ -65,29 +252,107 @@ def atomic_open(path: str | Path, mode: str = "w", **kwargs: Any) -> Iterator[IO
         yield handle
 
 
-def refuse_input_as_output(inputs: list[str | Path | None], outputs: list[tuple[str, str | Path | None]]) -> None:
-    """Raise :class:`DataError` if any output names the same file as an input.
+def _write_stdout(data: bytes) -> None:
+    sys.stdout.flush()
+    stream = getattr(sys.stdout, "buffer", None)
+    if stream is None:  # a text-only stand-in for stdout
+        sys.stdout.write(data.decode("utf-8", errors="replace"))
+    else:
+        stream.write(data)
+        stream.flush()
 
-    ``outputs`` are ``(option name, path)`` pairs, so the message can say which
-    option would have overwritten which input.
+
+def _write_stream(path: str | Path, data: bytes) -> None:
+    """Write to a device, FIFO or open-file link as it is: no rename, no truncation of what it points at.
+
+    A link to one of this process's own descriptors (``/dev/stdout``) is
+    written through that descriptor, so the bytes land where the process's
+    other output to it goes, in order (a fresh ``open`` would have an offset
+    of its own in a file the shell opened with ``>``).
     """
-    existing = [Path(p) for p in inputs if p is not None and Path(p).exists()]
-    for option, out in outputs:
-        if out is None:
-            continue
-        target = Path(out)
-        for source in existing:
-            if target.exists() and _same_file(source, target):
-                raise DataError(
-                    f"{option} {out}: that is the input file; refusing to overwrite it (choose another name)"
-                )
+    link = _fd_link(path)
+    if link is not None and link[0] == os.getpid() and link[1] >= 0:
+        for stream in (sys.stdout, sys.stderr):
+            with contextlib.suppress(Exception):
+                stream.flush()
+        view = memoryview(data)
+        while view:
+            view = view[os.write(link[1], view) :]
+        return
+    descriptor = os.open(path, os.O_WRONLY | os.O_APPEND)
+    with os.fdopen(descriptor, "wb") as handle:
+        handle.write(data)
 
 
-def _same_file(a: Path, b: Path) -> bool:
+def _copy_to_stream(temp: Path, path: str | Path, kind: str) -> None:
+    data = temp.read_bytes()
+    if kind == "stdout":
+        _write_stdout(data)
+    else:
+        _write_stream(path, data)
+
+
+@contextlib.contextmanager
+def _scratch_file(tail: str) -> Iterator[Path]:
+    handle, name = tempfile.mkstemp(prefix=".stickslip.", suffix=tail)
+    os.close(handle)
     try:
-        return os.path.samefile(a, b)
+        yield Path(name)
+    finally:
+        with contextlib.suppress(OSError):
+            os.unlink(name)
+
+
+# --------------------------------------------------------------------------- temporaries of killed writes
+def remove_stale_temporaries(target: str | Path) -> list[Path]:
+    """Remove this module's temporaries for ``target`` left by killed writes; returns those removed.
+
+    Only names of the exact pattern this module makes for ``target``'s name,
+    only if older than this process and not locked by a live writer.
+    """
+    target = Path(target)
+    pattern = re.compile(re.escape(f".{target.name}") + _TEMP_TAIL)
+    removed = []
+    try:
+        entries = list(os.scandir(target.parent))
     except OSError:
-        return a.resolve() == b.resolve()
+        return removed
+    for entry in entries:
+        if pattern.fullmatch(entry.name) and _remove_if_stale(Path(entry.path)):
+            removed.append(Path(entry.path))
+    return removed
+
+
+def _remove_if_stale(path: Path) -> bool:
+    """Remove ``path`` if it is a regular file, older than this process and unlocked; True if removed."""
+    try:
+        info = path.lstat()
+        if not stat.S_ISREG(info.st_mode) or info.st_mtime >= _STARTED:
+            return False
+        descriptor = os.open(path, os.O_RDONLY)
+    except OSError:
+        return False
+    try:
+        try:
+            _lock(descriptor, wait=False)
+        except OSError:  # a live writer holds it
+            return False
+        path.unlink()
+        return True
+    except OSError:
+        return False
+    finally:
+        os.close(descriptor)
+
+
+def _lock(descriptor: int, wait: bool = True) -> None:
+    try:
+        import fcntl
+    except ImportError:  # pragma: no cover - no flock on this platform: no liveness marks, nothing removed
+        if not wait:
+            raise OSError("no file locks on this platform") from None
+        return
+    fcntl.flock(descriptor, fcntl.LOCK_EX | (0 if wait else fcntl.LOCK_NB))
 
 
 def _set_mode(temp: Path, target: Path) -> None:

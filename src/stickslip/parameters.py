@@ -43,6 +43,7 @@ from pathlib import Path
 from typing import Any
 
 from .errors import ParameterError
+from .fileio import protect_inputs
 from .units import format_quantity, format_si, shorten, to_si
 
 if sys.version_info >= (3, 11):
@@ -297,6 +298,7 @@ def read_parameter_file(path: str | Path) -> Parameters:
             f"parameter file {shown} is {info.st_size} bytes; a parameter file is at most"
             f" {MAX_PARAMETER_FILE_BYTES} bytes"
         )
+    protect_inputs([path])  # in a command, no output may replace its parameter file
     try:
         with open(path, "rb") as handle:
             text = handle.read(MAX_PARAMETER_FILE_BYTES + 1).decode("utf-8")

@@ -24,6 +24,7 @@ import numpy as np
 
 from .columns import with_units
 from .errors import DataError, ParameterError
+from .fileio import protect_inputs
 
 __all__ = [
     "Protocol",
@@ -204,6 +205,7 @@ def read_protocol(path: str | Path) -> Protocol:
     path = Path(path)
     if not path.is_file():
         raise DataError(f"{path}: protocol file not found (expected a CSV with columns time,velocity)")
+    protect_inputs([path])  # in a command, no output may replace the protocol
     try:
         frame = pd.read_csv(path, sep=None, engine="python", comment="#", nrows=1_000_000)
     except (ValueError, OSError, UnicodeDecodeError, pd.errors.ParserError) as exc:

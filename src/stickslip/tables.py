@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from .errors import DataError, UnitError
+from .fileio import protect_inputs
 from .units import to_si
 
 _HEADER = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*)\s*(?:\[(.*)\])?\s*$")
@@ -67,6 +68,7 @@ def read_table(
     read row by row, which names the first offending row and column.
     """
     path = Path(path)
+    protect_inputs([path])  # in a command, no output may replace what was read
     source = str(path)
     header = _read_header(path, source, dimensions, required, ignore)
     fast = _read_columnar(path, header, allow_missing)

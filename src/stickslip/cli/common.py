@@ -23,8 +23,8 @@ from typing import Any
 
 import click
 
-from ..errors import ParameterError, UnitError
-from ..fileio import atomic_path, atomic_write_text, refuse_input_as_output
+from ..errors import ParameterError, StickslipError, UnitError
+from ..fileio import atomic_path, atomic_write_text, protect_inputs, refuse_input_as_output
 from ..parameters import Parameters, key_dimension, load_parameters
 from ..units import DIMENSIONS, bare_number, shorten, to_si
 
@@ -79,6 +79,7 @@ def resolve_params(params_name: str, overrides: Sequence[str]) -> Parameters:
         key, value = key.strip(), value.strip()
         require_unit(value, key_dimension(key), f"--set {key}=")
         mapping[key] = value
+    protect_inputs([params_name])  # a TOML file is an input: no output of this command may replace it
     return load_parameters(params_name, overrides=mapping)
 
 
@@ -88,6 +89,8 @@ def refuse_overwriting_inputs(
     """Refuse (DataError, one line) any output that names an input: a data file, or the --params TOML file.
 
     Call it before computing anything, so the user does not wait for a refusal.
+    The inputs stay protected for the rest of the command (:func:`stickslip.fileio.protect_inputs`):
+    a side file written later cannot replace them either.  An output ``-`` is standard output.
     """
     files: list[str | Path | None] = list(inputs)
     if params_name is not None:
@@ -200,6 +203,8 @@ def save_figure(fig: Any, path: Path) -> None:
     try:
         with atomic_path(path, suffix=f".{fmt}") as temp:
             fig.savefig(temp, format=fmt, dpi=120, bbox_inches="tight")
+    except StickslipError:
+        raise
     except (OSError, ValueError) as exc:
         hint = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
         raise click.FileError(shorten(str(path)), hint=hint) from None
@@ -232,6 +237,7 @@ class InputFile(click.ParamType):
             self.fail(f"{shown} is not a regular file (save a pipe or device to a file first)", param, ctx)
         if info.st_size > self.max_bytes:
             self.fail(f"{shown} is {info.st_size} bytes; at most {self.max_bytes} bytes are read", param, ctx)
+        protect_inputs([path])
         return path
 
 

@@ -16,8 +16,8 @@ from typing import Any
 
 import click
 
-from ..errors import ParameterError, UnitError
-from ..fileio import atomic_path, atomic_write_text, refuse_input_as_output
+from ..errors import ParameterError, StickslipError, UnitError
+from ..fileio import atomic_path, atomic_write_text, protect_inputs, refuse_input_as_output
 from .common import json_text, quantity
 
 LAW_NAMES = ("aging", "slip", "prz", "nagata")
@@ -103,6 +103,7 @@ def load_params_mapping(path: Path) -> dict[str, Any]:
     path = Path(path)
     if not path.is_file():
         raise DataError(f"--params {path}: file not found")
+    protect_inputs([path])  # `rsf simulate --params run.params.json -o run.csv` must not rewrite it
     text = path.read_text(encoding="utf-8")
     try:
         if path.suffix.lower() == ".toml":
@@ -177,6 +178,8 @@ def save_figure(fig: Any, path: Path) -> None:
     try:
         with atomic_path(path) as temp:
             fig.savefig(temp, dpi=120, bbox_inches="tight", format=path.suffix.lstrip(".") or "png")
+    except StickslipError:  # a refusal (an input named as output) is already one line
+        raise
     except (OSError, ValueError) as exc:
         raise click.FileError(str(path), hint=str(exc)) from None
 
@@ -223,11 +226,16 @@ def simulate_command(**options: Any) -> None:
         start = _positive(options["start_velocity"], "velocity", "--start-velocity")
     every = None if options["every"] is None else _positive(options["every"], "time", "--every")
     output, plot_path = options["output"], options["plot_path"]
-    refuse_input_as_output([options["protocol_file"], options["params_file"]], [("-o", output), ("--plot", plot_path)])
+    side = sidecar(output) if output is not None and str(output) != "-" else None
+    refuse_input_as_output(
+        [options["protocol_file"], options["params_file"]],
+        [("-o", output), ("-o (its NAME.params.json)", side), ("--plot", plot_path)],
+    )
     run = simulate(params, protocol, start_velocity=start, every=every)
     if output is not None:
         write(output, trace_csv(run.to_frame()))
-        write(sidecar(output), run.metadata_json())
+        if side is not None:
+            write(side, run.metadata_json())
     summary = run.summary()
     if options["as_json"]:
         click.echo(json_text(summary))
@@ -261,6 +269,7 @@ def stability_command(**options: Any) -> None:
     from ..rsf import stability
 
     params = build_params(options)
+    refuse_input_as_output([options.get("params_file")], [("--plot", options["plot_path"])])
     reports = [stability(params, _positive(v, "velocity", "--velocity")).as_dict() for v in options["velocities"]]
     if options["as_json"]:
         click.echo(json_text(reports if len(reports) > 1 else reports[0]))

@@ -2,13 +2,14 @@
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 from typing import Any
 
 import click
 
-from ..errors import ParameterError
-from .common import echo_err, params_options
+from ..errors import DataError, ParameterError, StickslipError
+from .common import echo_err, params_options, require_unit
 
 MODEL_NAMES = ("quasi-static", "transient", "rsf")
 
@@ -47,9 +48,7 @@ MODEL_NAMES = ("quasi-static", "transient", "rsf")
     is_flag=True,
     help="--model transient: add the paper's stick chains (Eqs 13-16); without them Eq 1 never lets a stuck block go.",
 )
-@click.option(
-    "-o", "--output", type=click.Path(file_okay=False, path_type=Path), default=None, help="Output folder OUT."
-)
+@click.option("-o", "--output", default=None, metavar="OUT", help="Output folder OUT.")
 @click.option("--workers", type=int, default=None, help="Local worker processes [default: one per core]; 0: no dask.")
 @click.option("--scheduler", default=None, metavar="ADDRESS", help="Use a running cluster, e.g. tcp://HOST:8786.")
 @click.option("--batch-size", type=int, default=None, help="Points per task [default: up to 256, at least 64 tasks].")
@@ -80,7 +79,7 @@ def _run(
     duration_text: str,
     jump_curve: str,
     stick_population: bool,
-    output: Path | None,
+    output: str | None,
     workers: int | None,
     scheduler: str | None,
     batch_size: int | None,
@@ -89,11 +88,13 @@ def _run(
     params_name: str,
     overrides: tuple[str, ...],
 ) -> None:
-    from ..sweeps import build_spec, run_sweep
+    from ..sweeps import build_spec, damage_note, run_sweep
     from ..sweeps.progress import reporter
 
     if output is None:
         raise ParameterError("-o OUT: give the output folder of the sweep")
+    if not output.strip() or output.strip() == "-":
+        raise ParameterError(f"-o {output!r}: a sweep writes a folder; give its name, e.g. -o sweep-out")
     if not vary:
         raise ParameterError(
             "--vary: give at least one varied key, e.g. --vary 'pulling_velocity=5 um/s..5 mm/s:20:log'"
@@ -115,6 +116,7 @@ def _run(
         seed=seed,
         jump_curve=jump_curve,
         stick_population=stick_population,
+        unit_check=require_unit,
     )
     store = run_sweep(
         spec,
@@ -125,8 +127,11 @@ def _run(
         progress=reporter(quiet),
         batch_size=batch_size,
     )
+    if store.damaged:  # said even with --quiet: the folder was not as the last run left it
+        echo_err(damage_note(store))
+    summary = _summary(store.folder, spec.size)
     if not quiet:
-        echo_err(_summary(store.folder, spec.size))
+        echo_err(summary)
 
 
 def _set_values(overrides: tuple[str, ...]) -> dict[str, str]:
@@ -146,11 +151,14 @@ def _summary(folder: Path, total: int) -> str:
     import pyarrow.dataset as ds
 
     regimes: Counter[str] = Counter()
-    errors = 0
+    errors = rows = 0
     for batch in ds.dataset(folder, format="parquet").to_batches(columns=["status", "regime"]):
         frame = batch.to_pydict()
+        rows += len(frame["status"])
         errors += sum(s != "ok" for s in frame["status"])
         regimes.update(r for r, s in zip(frame["regime"], frame["status"], strict=True) if s == "ok")
+    if rows != total:  # never report success on a folder that does not hold exactly the sweep
+        raise DataError(f"{folder}: holds {rows} rows for {total} points; run the same command again to repair it")
     shown = ", ".join(f"{name} {count}" for name, count in regimes.most_common())
     return f"sweep: {total} points in {folder} ({errors} failed){'; regimes: ' + shown if shown else ''}"
 
@@ -175,15 +183,29 @@ def plot_command(folder: Path, x: str, y: str, color: str, output: Path | None) 
     from ..sweeps import load_sweep
     from ..sweeps.plots import plot_phase_diagram
 
-    frame, spec = load_sweep(folder)
     target = output if output is not None else folder.parent / f"{folder.name}-{color}.png"
+    _refuse_inside(folder, target)
+    frame, spec = load_sweep(folder)
     ax = plot_phase_diagram(frame, spec, x=x, y=y, color=color)
     try:
         with atomic_path(target) as temp:
             ax.figure.savefig(temp, format=target.suffix.lstrip(".") or "png", dpi=120, bbox_inches="tight")
+    except StickslipError:
+        raise
     except (OSError, ValueError) as exc:
         raise click.FileError(str(target), hint=str(exc)) from None
-    click.echo(f"phase diagram: {target}")
+    if str(target) != "-":  # the image itself went to standard output
+        click.echo(f"phase diagram: {target}")
+
+
+def _refuse_inside(folder: Path, target: Path) -> None:
+    """An image inside the sweep folder would be a foreign file there, and poison every later resume."""
+    if str(target) == "-":
+        return
+    real_folder = Path(os.path.realpath(folder))
+    real_target = Path(os.path.realpath(target))
+    if real_folder == real_target or real_folder in real_target.parents:
+        raise ParameterError(f"-o {target}: inside the sweep folder {folder}; write the image beside it instead")
 
 
 def register(cli: click.Group) -> None:

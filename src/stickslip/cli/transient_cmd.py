@@ -91,7 +91,7 @@ def transient_command(
     from ..transient import run_transient
 
     protocol = _protocol(v0_text, duration_text, segment_texts, protocol_file)
-    refuse_input_as_output([protocol_file], [("-o", output), ("--plot", plot_path)])
+    refuse_input_as_output([protocol_file, params_name], [("-o", output), ("--plot", plot_path)])
     start_velocity = None if start_v_text is None else positive(start_v_text, "velocity", "--start-velocity")
     every = None if every_text is None else positive(every_text, "time", "--every")
     params = resolve_params(params_name, overrides)

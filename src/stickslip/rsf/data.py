@@ -27,6 +27,7 @@ import numpy as np
 
 from ..columns import with_units
 from ..errors import DataError, ParameterError
+from ..fileio import protect_inputs
 from ..protocols import Protocol, Segment
 
 __all__ = ["LabRecord", "find_segments", "parse_columns", "read_record"]
@@ -113,6 +114,7 @@ def read_record(
     path = Path(path)
     if not path.is_file():
         raise DataError(f"{path}: record not found")
+    protect_inputs([path])  # in a command, no output may replace the record
     d_scale = to_si(f"1 {displacement_unit}", "length", "--displacement-unit")
     t_scale = to_si(f"1 {time_unit}", "time", "--time-unit")
     try:

@@ -6,20 +6,22 @@ a pandas DataFrame; ``stickslip sweep`` is the command line.  See docs/sweep.md.
 
 from __future__ import annotations
 
+import numbers
 import shutil
 import tempfile
-from collections.abc import Mapping, Sequence
+import warnings
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-from ..errors import ParameterError
+from ..errors import DataError, ParameterError
 from ..parameters import Parameters
 from ..units import to_si
-from .engine import compute, dask_client, default_batch_size, read_results
+from .engine import check_scheduler_address, compute, dask_client, default_batch_size, read_results
 from .models import ALIASES, MODELS, get_model
 from .progress import Silent, reporter
 from .spec import Axis, SweepSpec, check_design, parse_vary
-from .store import SweepStore, open_store, read_manifest
+from .store import SweepStore, checked_manifest, open_store, read_manifest
 
 __all__ = [
     "MODELS",
@@ -48,18 +50,29 @@ def build_spec(
     seed: int = 0,
     jump_curve: str = "aging",
     stick_population: bool = False,
+    unit_check: Callable[[str, str, str], None] | None = None,
 ) -> SweepSpec:
     """The specification of a sweep, validated: every key known, every value of the right unit and in range.
 
     ``vary`` is a list of ``--vary`` texts (``"KEY=LO..HI:N[:log]"``, ``"KEY=V1,V2"``) or a mapping
     ``{key: "LO..HI:N" or [values]}``; ``samples`` makes it a Latin hypercube over ranges ``LO..HI[:log]``.
+    Bare numbers are SI.  ``unit_check(text, dimension, prefix)``, given by the command line, refuses
+    them in every value typed there (``--v0``, ``--set``, ``--vary``), as every other command does.
     """
+    if not isinstance(model, str):
+        raise ParameterError(f"model: expected a name, one of {', '.join(MODELS)}; got {model!r}")
     adapter = get_model(model)
     adapter.check_available()
     dimensions = adapter.dimensions()
-    axes = tuple(_axis(item, dimensions) for item in _vary_texts(vary))
+    seed = _whole(seed, "seed", minimum=0)
+    samples = None if samples is None else _whole(samples, "samples", minimum=1)
+    axes = tuple(_axis(item, dimensions, unit_check) for item in _vary_texts(vary))
     design = check_design(axes, samples)
+    if not isinstance(overrides, (Mapping, type(None))):
+        raise ParameterError(f"overrides: expected a mapping {{'section.key': value}}, got {type(overrides).__name__}")
     given = dict(overrides or {})
+    if unit_check is not None:
+        _check_typed_units(given, pulling_velocity, dimensions, unit_check)
     if pulling_velocity is not None and "pulling_velocity" in {a.key for a in axes}:
         raise ParameterError("--v0 and --vary pulling_velocity: give the pulling velocity once")
     if pulling_velocity is not None:
@@ -97,21 +110,39 @@ def run_sweep(
     progress: Silent | None = None,
     batch_size: int | None = None,
 ) -> SweepStore:
-    """Run (or resume) ``spec`` into the folder ``output``; ``workers=0`` runs in this process, without dask."""
+    """Run (or resume) ``spec`` into the folder ``output``; ``workers=0`` runs in this process, without dask.
+
+    One process writes a folder at a time (a second is refused with
+    :class:`~stickslip.errors.DataError`).  Chunks found damaged on resume are
+    recomputed and named in the returned store's ``damaged``.
+    """
+    if not isinstance(spec, SweepSpec):
+        raise ParameterError(f"spec: expected a SweepSpec (see build_spec), got {type(spec).__name__}")
+    if workers is not None:
+        workers = _whole(workers, "workers", minimum=0)
+    if batch_size is not None:
+        batch_size = _whole(batch_size, "batch_size", minimum=1)
+    if scheduler is not None and not isinstance(scheduler, str):
+        raise ParameterError(f"scheduler: expected an address such as 'tcp://HOST:8786', got {scheduler!r}")
+    if scheduler is not None:
+        check_scheduler_address(scheduler)
     store = open_store(output, spec, batch_size or default_batch_size(spec.size), overwrite=overwrite)
     shown = progress if progress is not None else Silent()
-    finished = store.finished()
-    shown.start(spec.size, store.rows_done(finished))
     try:
-        if len(finished) == store.batches:
-            pass  # all done already: no cluster to start
-        elif workers == 0 and scheduler is None:
-            compute(store, None, shown.advance)
-        else:
-            with dask_client(workers, scheduler) as client:
-                compute(store, client, shown.advance)
+        finished = store.finished()
+        shown.start(spec.size, store.rows_done(finished))
+        try:
+            if len(finished) == store.batches:
+                pass  # all done already: no cluster to start
+            elif workers == 0 and scheduler is None:
+                compute(store, None, shown.advance)
+            else:
+                with dask_client(workers, scheduler) as client:
+                    compute(store, client, shown.advance)
+        finally:
+            shown.close()
     finally:
-        shown.close()
+        store.close()
     return store
 
 
@@ -140,10 +171,16 @@ def sweep(
     returned frame holds every row in memory: for sweeps too large for that,
     give ``output`` and read the folder with pyarrow datasets instead.
     """
+    if output is not None and not str(output).strip():  # Path("") would be the current folder
+        raise ParameterError("output: the folder name is empty; give a folder, or None for no folder")
     spec = build_spec(vary, **specification)
     folder = Path(output) if output is not None else Path(tempfile.mkdtemp(prefix="stickslip-sweep-"))
     try:
-        run_sweep(spec, folder, workers=workers, scheduler=scheduler, overwrite=overwrite, progress=reporter(quiet))
+        store = run_sweep(
+            spec, folder, workers=workers, scheduler=scheduler, overwrite=overwrite, progress=reporter(quiet)
+        )
+        if store.damaged:
+            warnings.warn(damage_note(store), UserWarning, stacklevel=2)
         return read_results(folder)
     finally:
         if output is None:
@@ -152,29 +189,78 @@ def sweep(
 
 def load_sweep(folder: str | Path) -> tuple[Any, SweepSpec]:
     """(the rows written so far as a DataFrame, the specification) of a sweep output folder."""
-    manifest = read_manifest(folder)
+    folder = Path(folder)
+    if not folder.is_dir():
+        raise DataError(f"{folder}: not a sweep output folder (not a folder)")
+    manifest = checked_manifest(folder)
     return read_results(folder), SweepSpec.from_dict(manifest["specification"])
+
+
+def damage_note(store: SweepStore) -> str:
+    """One line naming the chunks found damaged on resume (removed and recomputed)."""
+    shown = ", ".join(store.damaged[:3]) + (f" and {len(store.damaged) - 3} more" if len(store.damaged) > 3 else "")
+    return f"sweep: {len(store.damaged)} damaged chunk(s) in {store.folder} recomputed: {shown}"
+
+
+def _whole(value: Any, name: str, minimum: int) -> int:
+    """A whole number >= minimum (an integral float such as 3.0 too); anything else is one ParameterError."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise ParameterError(f"{name}: expected a whole number, got {value!r}")
+    if isinstance(value, numbers.Integral):
+        number = int(value)
+    elif float(value).is_integer():
+        number = int(value)
+    else:
+        raise ParameterError(f"{name}: expected a whole number, got {value!r}")
+    if number < minimum:
+        raise ParameterError(f"{name}: expected a whole number >= {minimum}, got {number}")
+    return number
 
 
 def _vary_texts(vary: Sequence[str] | Mapping[str, Any]) -> list[str]:
     if isinstance(vary, str):
         return [vary]
     if isinstance(vary, Mapping):
-        texts = []
-        for key, body in vary.items():
-            if isinstance(body, str):
-                texts.append(f"{key}={body}")
-            else:
-                texts.append(f"{key}=" + ",".join(repr(float(v)) if not isinstance(v, str) else v for v in body))
-        return texts
+        return [_vary_text(key, body) for key, body in vary.items()]
+    if not isinstance(vary, Sequence) or not all(isinstance(v, str) for v in vary):
+        raise ParameterError(
+            "vary: expected 'KEY=LO..HI:N' texts or a mapping {key: 'LO..HI:N' or [values]},"
+            f" got {type(vary).__name__}"
+        )
     return list(vary)
 
 
-def _axis(text: str, dimensions: Mapping[str, str]) -> Axis:
+def _vary_text(key: Any, body: Any) -> str:
+    if isinstance(body, str):
+        return f"{key}={body}"
+    if isinstance(body, (Sequence, tuple)) and body and all(isinstance(v, (str, numbers.Real)) for v in body):
+        return f"{key}=" + ",".join(v if isinstance(v, str) else repr(float(v)) for v in body)
+    raise ParameterError(
+        f"vary[{key!r}]: expected a range text 'LO..HI:N[:log]' or a non-empty list of values, got {body!r}"
+        + (f" (one value: [{body!r}])" if isinstance(body, numbers.Real) else "")
+    )
+
+
+def _axis(text: str, dimensions: Mapping[str, str], unit_check: Callable[[str, str, str], None] | None) -> Axis:
     key, sep, body = text.partition("=")
     if sep and key.strip() in ALIASES:
         text = f"{ALIASES[key.strip()]}={body}"
-    return parse_vary(text, dimensions)
+    return parse_vary(text, dimensions, unit_check=unit_check)
+
+
+def _check_typed_units(
+    given: Mapping[str, Any],
+    pulling_velocity: Any,
+    dimensions: Mapping[str, str],
+    unit_check: Callable[[str, str, str], None],
+) -> None:
+    """Values typed on the command line carry their units (``--v0 50`` is refused, as in every command)."""
+    if isinstance(pulling_velocity, str):
+        unit_check(pulling_velocity, "velocity", "--v0 ")
+    for key, value in given.items():
+        dimension = dimensions.get(ALIASES.get(key, key))
+        if isinstance(value, str) and dimension is not None:
+            unit_check(value, dimension, f"--set {key}=")
 
 
 def _duration(value: float | str) -> float:

@@ -17,7 +17,7 @@ from functools import lru_cache
 from pathlib import Path
 from typing import Any
 
-from ..errors import StickslipError
+from ..errors import DataError, ParameterError, StickslipError
 from .models import get_model, result_columns, run_point
 from .spec import SweepSpec
 from .store import SweepStore, arrow_schema
@@ -65,6 +65,20 @@ def to_table(spec: SweepSpec, columns: dict[str, list[Any]]) -> Any:
     return pa.Table.from_pydict(columns, schema=arrow_schema(spec.keys, result_columns(get_model(spec.model))))
 
 
+def check_scheduler_address(scheduler: str) -> None:
+    """Refuse an address that is not one (before any folder is touched or cluster contacted)."""
+    from distributed.comm.addressing import get_address_host_port, parse_address
+
+    try:
+        scheme, _ = parse_address(scheduler)
+        if scheme in ("tcp", "tls", "ws", "wss"):
+            get_address_host_port(scheduler)
+    except (ValueError, TypeError) as exc:
+        raise ParameterError(
+            f"--scheduler {scheduler}: not a scheduler address ({exc}); expected e.g. tcp://HOST:8786"
+        ) from None
+
+
 @contextlib.contextmanager
 def dask_client(workers: int | None = None, scheduler: str | None = None) -> Iterator[Any]:
     """A client of the cluster at ``scheduler``, or of a local cluster of ``workers`` processes started here."""
@@ -75,7 +89,7 @@ def dask_client(workers: int | None = None, scheduler: str | None = None) -> Ite
     if scheduler is not None:
         try:
             client = Client(scheduler, timeout="20s")
-        except (OSError, TimeoutError) as exc:
+        except (OSError, TimeoutError, ValueError, TypeError) as exc:  # ValueError: not an address at all
             raise StickslipError(f"--scheduler {scheduler}: cannot connect ({exc})") from None
         with client:
             yield client
@@ -108,17 +122,20 @@ def compute(
 ) -> int:
     """Run every batch whose chunk is missing; ``progress(points)`` after each one.  Returns the batches run."""
     spec_json = store.spec.to_json()
-    todo = sorted(set(range(store.batches)) - store.finished())
+    done = store.finished()
+    todo = (batch for batch in range(store.batches) if batch not in done)  # lazily: memory flat in the batches
+    ran = 0
     if client is None:  # in this process: for tiny sweeps and tests of the writer
         for batch in todo:
             start, stop = store.batch_range(batch)
             store.write(batch, to_table(store.spec, run_batch(spec_json, start, stop)))
             progress(stop - start)
-        return len(todo)
+            ran += 1
+        return ran
     from distributed import as_completed
 
     threads = sum(client.nthreads().values()) or 1
-    pending = iter(todo)
+    pending = todo
 
     def submit(batch: int) -> Any:
         start, stop = store.batch_range(batch)
@@ -140,15 +157,20 @@ def compute(
         store.write(batch, to_table(store.spec, columns))
         future.release()
         progress(len(columns["point"]))
+        ran += 1
         following = next(pending, None)
         if following is not None:
             finished.add(submit(following))
-    return len(todo)
+    return ran
 
 
 def read_results(folder: str | Path) -> Any:
     """The rows written so far, sorted by point, as a pandas DataFrame."""
     import pandas as pd
 
+    from .store import is_chunk
+
+    if not any(is_chunk(p.name) for p in Path(folder).iterdir()):
+        raise DataError(f"{folder}: no finished batch yet (no part-*.parquet); run or resume the sweep first")
     frame = pd.read_parquet(folder)
     return frame.sort_values("point", kind="stable").reset_index(drop=True)

@@ -16,7 +16,7 @@ from __future__ import annotations
 import json
 import math
 import re
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -27,6 +27,10 @@ from ..units import to_si
 from .sampling import grid_values, latin_hypercube
 
 DESIGNS = ("grid", "latin-hypercube")
+#: Values of one grid axis at most: the manifest lists each of them.
+MAX_AXIS_VALUES = 1_000_000
+#: Points of a Latin hypercube at most (indices stay exact in float64 and int64); the disk refuses far fewer.
+MAX_SAMPLES = 2**53
 _RANGE = re.compile(r"^(?P<lo>.+?)\.\.(?P<hi>[^:]+)(?::(?P<n>[^:]*))?(?::(?P<scale>[^:]*))?$")
 
 
@@ -132,13 +136,18 @@ class SweepSpec:
         return cls.from_dict(json.loads(text))
 
 
-def parse_vary(text: str, dimensions: Mapping[str, str]) -> Axis:
+def parse_vary(
+    text: str, dimensions: Mapping[str, str], unit_check: Callable[[str, str, str], None] | None = None
+) -> Axis:
     """``KEY=LO..HI:N[:log]``, ``KEY=LO..HI[:log]`` or ``KEY=V1,V2,...`` as an :class:`Axis` (SI values).
 
     ``dimensions`` maps each key the model accepts to its dimension; an
     unknown key, a malformed range or a value of the wrong unit is a
     :class:`~stickslip.errors.ParameterError` naming the ``--vary`` text.
+    ``unit_check(value, dimension, prefix)`` (the command line's) refuses bare numbers.
     """
+    if not isinstance(text, str):
+        raise ParameterError(f"--vary: expected a text 'KEY=LO..HI:N[:log]', got {text!r}")
     where = f"--vary {text!r}"
     key, sep, body = text.partition("=")
     key, body = key.strip(), body.strip()
@@ -149,11 +158,19 @@ def parse_vary(text: str, dimensions: Mapping[str, str]) -> Axis:
     if key not in dimensions:
         raise ParameterError(f"{where}: unknown key {key!r}; expected one of: {', '.join(dimensions)}")
     dimension = dimensions[key]
+
+    def value(text: str) -> float:
+        if unit_check is not None:
+            unit_check(text.strip(), dimension, f"--vary {key}=")
+        return _value(text, dimension, where)
+
     match = _RANGE.match(body)
     if match is None:
-        values = tuple(_value(v, dimension, where) for v in body.split(","))
-        return Axis(key, values=values)
-    low, high = _value(match["lo"], dimension, where), _value(match["hi"], dimension, where)
+        items = body.split(",")
+        if len(items) > MAX_AXIS_VALUES:
+            raise ParameterError(f"{where}: {len(items)} values; at most {MAX_AXIS_VALUES} per key")
+        return Axis(key, values=tuple(value(v) for v in items))
+    low, high = value(match["lo"]), value(match["hi"])
     count_text, scale = match["n"], match["scale"]
     if count_text is not None and count_text.strip() == "log" and scale is None:
         count_text, scale = None, "log"
@@ -193,6 +210,11 @@ def _count(text: str, where: str) -> int:
         raise ParameterError(f"{where}: the number of points must be a whole number, got {text.strip()!r}") from None
     if count < 1:
         raise ParameterError(f"{where}: the number of points must be at least 1, got {count}")
+    if count > MAX_AXIS_VALUES:
+        raise ParameterError(
+            f"{where}: {count} points on one key; at most {MAX_AXIS_VALUES} (the manifest lists every value);"
+            " for more, sample the range with --samples N"
+        )
     return count
 
 
@@ -223,8 +245,8 @@ def check_design(axes: Sequence[Axis], samples: int | None) -> str:
                 " for a grid write LO..HI:N"
             )
         return "grid"
-    if samples < 1:
-        raise ParameterError(f"--samples: expected a positive number of points, got {samples}")
+    if samples < 1 or samples > MAX_SAMPLES:
+        raise ParameterError(f"--samples: expected a number of points from 1 to {MAX_SAMPLES}, got {samples}")
     lists = [a.key for a in axes if not a.is_range]
     if lists:
         raise ParameterError(

@@ -1,11 +1,18 @@
-"""The output folder of a sweep: a manifest and one Parquet chunk per finished batch.
+"""The output folder of a sweep: a manifest, one Parquet chunk per finished batch, a ledger of the chunks.
 
 ``OUT/_manifest.json`` holds the specification, the package version and the
-batch size; ``OUT/part-000123.parquet`` holds batch 123.  Each chunk appears
-under its name only when whole (written under a temporary ``.part-...``
-name, then renamed), so a chunk that exists is done, and resuming is "run
-the batches whose chunk is missing": after ``kill -9`` at any moment nothing
-is lost, nothing is duplicated and nothing is half-written.  Parquet readers
+batch size; ``OUT/part-000123.parquet`` holds batch 123; ``OUT/_chunks.jsonl``
+records, for every chunk written, its points, rows, size and SHA-256.  Each
+chunk appears under its name only when whole (written under a temporary
+``.part-...`` name, recorded in the ledger, then renamed), so resuming is "run
+the batches whose chunk is missing or fails its check": after ``kill -9`` at
+any moment nothing is lost, nothing is duplicated and nothing is
+half-written, and a chunk damaged afterwards (truncated, replaced, from
+another batch size) is found, removed, recomputed and reported.
+
+One process writes a folder at a time: it holds an exclusive ``flock`` on
+``OUT/.stickslip.lock`` (released by the kernel when the process ends, even
+by ``kill -9``), and a second writer is refused in one line.  Parquet readers
 skip names that start with ``_`` or ``.``, so ``pandas.read_parquet(OUT)``
 reads exactly the finished rows.
 """
@@ -13,10 +20,13 @@ reads exactly the finished rows.
 from __future__ import annotations
 
 import contextlib
+import hashlib
 import json
+import os
 import re
+import shutil
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -25,9 +35,21 @@ from ..fileio import atomic_path, atomic_write_text
 from .spec import SweepSpec
 
 MANIFEST = "_manifest.json"
+LEDGER = "_chunks.jsonl"
+LOCK = ".stickslip.lock"
 FORMAT = "stickslip-sweep/1"
 _CHUNK = re.compile(r"^part-(\d{6,})\.parquet$")
-_TEMPORARY = re.compile(r"^\.(part-\d{6,}\.parquet|_manifest\.json)\..*\.tmp$")
+_TEMPORARY = re.compile(r"^\.(part-\d{6,}\.parquet|_manifest\.json|_chunks\.jsonl)\..*\.tmp$")
+_OWN = (MANIFEST, LEDGER, LOCK)
+#: Bytes a row takes at least in its chunk: 8 per number that differs from row to row (floats do not compress).
+_BYTES_PER_NUMBER = 8
+#: Disk space a sweep leaves free, beyond its estimated size.
+_DISK_MARGIN = 100_000_000
+
+
+def is_chunk(name: str) -> bool:
+    """True for a chunk's file name, ``part-NNNNNN.parquet``."""
+    return _CHUNK.match(name) is not None
 
 
 def chunk_name(batch: int) -> str:
@@ -47,12 +69,15 @@ def arrow_schema(inputs: tuple[str, ...], columns: Mapping[str, str]) -> Any:
 
 @dataclass
 class SweepStore:
-    """An output folder opened for one specification."""
+    """An output folder opened (and locked) for one specification; :meth:`close` releases it."""
 
     folder: Path
     spec: SweepSpec
     batch_size: int
     version: str
+    done: set[int] = field(default_factory=set)  # batches whose chunk is whole and checked
+    damaged: list[str] = field(default_factory=list)  # "part-000003.parquet (why)": removed, to recompute
+    lock: int | None = None  # descriptor holding the folder's flock
 
     @property
     def batches(self) -> int:
@@ -63,60 +88,232 @@ class SweepStore:
         return start, min(start + self.batch_size, self.spec.size)
 
     def finished(self) -> set[int]:
-        """Batches whose chunk exists (whole, by construction)."""
-        done = set()
-        for path in self.folder.iterdir():
-            match = _CHUNK.match(path.name)
-            if match and int(match.group(1)) < self.batches:
-                done.add(int(match.group(1)))
-        return done
+        """Batches whose chunk is whole and belongs to this specification (checked when the folder was opened)."""
+        return set(self.done)
 
     def rows_done(self, done: set[int]) -> int:
         return sum(stop - start for start, stop in map(self.batch_range, done))
 
     def write(self, batch: int, table: Any) -> Path:
-        """Write one batch's rows (a pyarrow Table) as its chunk, atomically."""
+        """Write one batch's rows (a pyarrow Table) as its chunk, atomically, and record it in the ledger."""
         import pyarrow.parquet as pq
 
+        start, stop = self.batch_range(batch)
+        if table.num_rows != stop - start:
+            raise DataError(f"batch {batch}: {table.num_rows} rows for points {start}..{stop - 1}; nothing written")
         target = self.folder / chunk_name(batch)
-        with atomic_path(target) as temp:
+        with atomic_path(target, clean=False) as temp:  # the folder was cleaned when opened, under its lock
             pq.write_table(table, temp)
+            entry = {"batch": batch, "start": start, "stop": stop, **_fingerprint(temp)}
+            _append_line(self.folder / LEDGER, json.dumps(entry, sort_keys=True))  # before the rename: see module
+        self.done.add(batch)
         return target
+
+    def close(self) -> None:
+        """Release the folder's lock (also released by the kernel if the process dies)."""
+        if self.lock is not None:
+            os.close(self.lock)
+            self.lock = None
+
+    def __enter__(self) -> SweepStore:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
 
 
 def open_store(folder: str | Path, spec: SweepSpec, batch_size: int, overwrite: bool = False) -> SweepStore:
-    """Create ``folder`` for ``spec``, or reopen it to resume; refuse a folder made for another specification."""
+    """Create ``folder`` for ``spec``, or reopen it to resume; refuse a folder made for another specification.
+
+    The folder is locked for this process until :meth:`SweepStore.close`.  On
+    resume every chunk is checked against the ledger (or, unrecorded, read);
+    a damaged one is removed and listed in ``SweepStore.damaged``.
+    """
+    if isinstance(batch_size, bool) or not isinstance(batch_size, int) or batch_size < 1:
+        raise ParameterError(f"batch_size: expected a positive whole number of points, got {batch_size!r}")
+    created = not os.path.lexists(folder) if str(folder).strip() else False
+    path = _folder(folder)
+    lock = _lock_folder(path, folder)
+    try:
+        store = _open_locked(path, folder, spec, batch_size, overwrite)
+    except BaseException:
+        if created:  # refused before anything was written: leave no empty folder behind
+            with contextlib.suppress(OSError):
+                (path / LOCK).unlink()
+                (path / MANIFEST).unlink(missing_ok=True)
+                path.rmdir()
+        os.close(lock)
+        raise
+    store.lock = lock
+    return store
+
+
+def _open_locked(path: Path, folder: str | Path, spec: SweepSpec, batch_size: int, overwrite: bool) -> SweepStore:
     from .. import __version__
 
-    path = Path(folder)
-    if path.exists() and not path.is_dir():
-        raise DataError(f"-o {folder}: is a file; a sweep writes a folder of Parquet chunks")
-    path.mkdir(parents=True, exist_ok=True)
     _remove_temporaries(path)
-    foreign = sorted(p.name for p in path.iterdir() if p.name != MANIFEST and not _CHUNK.match(p.name))
+    foreign = sorted(p.name for p in path.iterdir() if p.name not in _OWN and not _CHUNK.match(p.name))
     if foreign:
         raise DataError(
             f"-o {folder}: holds files that are not a sweep's ({', '.join(foreign[:3])}); choose a new or empty folder"
         )
-    manifest = read_manifest(path) if (path / MANIFEST).exists() else None
-    if manifest is not None and not overwrite:
+    manifest = checked_manifest(path) if (path / MANIFEST).exists() and not overwrite else None
+    if manifest is not None:
         if manifest["specification"] != json.loads(spec.to_json()):
             why = f"another specification ({_difference(manifest['specification'], spec)})"
         elif manifest["version"] != __version__:
             why = f"the same specification but stickslip {manifest['version']} (this is {__version__})"
         else:
-            return SweepStore(path, spec, int(manifest["batch_size"]), __version__)
+            store = SweepStore(path, spec, manifest["batch_size"], __version__)
+            _check_chunks(store)
+            return store
         raise ParameterError(
             f"-o {folder}: holds a sweep of {why}; give another output folder, or --overwrite to replace it"
         )
-    if manifest is None and any(_CHUNK.match(p.name) for p in path.iterdir()) and not overwrite:
+    if not (path / MANIFEST).exists() and any(_CHUNK.match(p.name) for p in path.iterdir()) and not overwrite:
         raise DataError(f"-o {folder}: holds Parquet chunks but no {MANIFEST}; give --overwrite to replace them")
-    for old in path.iterdir():
-        if _CHUNK.match(old.name) or old.name == MANIFEST:
-            old.unlink()
     store = SweepStore(path, spec, batch_size, __version__)
+    _refuse_too_large(store, folder)
+    for old in path.iterdir():
+        if _CHUNK.match(old.name) or old.name in (MANIFEST, LEDGER):
+            old.unlink()
     atomic_write_text(path / MANIFEST, json.dumps(_manifest(store), indent=2) + "\n")
     return store
+
+
+def _folder(folder: str | Path) -> Path:
+    """The output folder, created; every way it can be wrong is one line."""
+    if str(folder).strip() == "":
+        raise ParameterError("-o: the output folder name is empty; give a folder, e.g. -o sweep-out")
+    path = Path(folder)
+    if path.exists() and not path.is_dir():
+        raise DataError(f"-o {folder}: is a file; a sweep writes a folder of Parquet chunks")
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+        probe = path / LOCK
+        os.close(os.open(probe, os.O_RDWR | os.O_CREAT, 0o644))
+    except OSError as exc:
+        raise DataError(f"-o {folder}: cannot create or write the folder ({exc.strerror or exc})") from None
+    return path
+
+
+def _lock_folder(path: Path, folder: str | Path) -> int:
+    """An exclusive, non-blocking flock on the folder's lock file; a second writer is refused."""
+    import fcntl
+
+    descriptor = os.open(path / LOCK, os.O_RDWR | os.O_CREAT, 0o644)
+    try:
+        fcntl.flock(descriptor, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except OSError:
+        holder = os.pread(descriptor, 32, 0).decode("ascii", errors="replace").strip()
+        os.close(descriptor)
+        who = f" (process {holder})" if holder.isdigit() else ""
+        raise DataError(
+            f"-o {folder}: another sweep is writing into this folder{who}; wait for it to end or choose another folder"
+        ) from None
+    os.ftruncate(descriptor, 0)
+    os.pwrite(descriptor, f"{os.getpid()}\n".encode(), 0)
+    return descriptor
+
+
+def _refuse_too_large(store: SweepStore, folder: str | Path) -> None:
+    """Refuse, before any work, a sweep whose rows cannot fit on the folder's disk."""
+    from .models import get_model, result_columns
+
+    numbers = 1 + len(store.spec.keys) + sum(k == "float" for k in result_columns(get_model(store.spec.model)).values())
+    need = store.spec.size * numbers * _BYTES_PER_NUMBER + store.batches * 200  # the ledger's lines
+    free = shutil.disk_usage(store.folder).free
+    if need + _DISK_MARGIN > free:
+        raise ParameterError(
+            f"-o {folder}: {store.spec.size:.4g} points need at least {_size(need)} of Parquet and the disk has"
+            f" {_size(free)} free; sweep fewer points (or into a folder on a larger disk)"
+        )
+
+
+def _size(count: float) -> str:
+    for unit in ("bytes", "kB", "MB", "GB", "TB", "PB"):
+        if count < 1000 or unit == "PB":
+            return f"{count:.3g} {unit}"
+        count /= 1000
+    return f"{count:.3g} PB"  # pragma: no cover
+
+
+def _fingerprint(path: Path) -> dict[str, Any]:
+    digest = hashlib.sha256()
+    size = 0
+    with open(path, "rb") as handle:
+        for block in iter(lambda: handle.read(1 << 20), b""):
+            digest.update(block)
+            size += len(block)
+    return {"bytes": size, "sha256": digest.hexdigest()}
+
+
+def _append_line(path: Path, line: str) -> None:
+    with open(path, "a", encoding="utf-8") as handle:
+        handle.write(line + "\n")
+        handle.flush()
+        os.fsync(handle.fileno())
+
+
+def _ledger(folder: Path) -> dict[int, dict[str, Any]]:
+    """The last entry of each batch (a torn last line of a killed run is skipped)."""
+    entries: dict[int, dict[str, Any]] = {}
+    with contextlib.suppress(FileNotFoundError), open(folder / LEDGER, encoding="utf-8", errors="replace") as lines:
+        for line in lines:
+            with contextlib.suppress(ValueError, TypeError, KeyError):
+                entry = json.loads(line)
+                entries[int(entry["batch"])] = entry
+    return entries
+
+
+def _check_chunks(store: SweepStore) -> None:
+    """Keep the chunks that are whole and of this sweep's batches; remove (and list) the others."""
+    ledger = _ledger(store.folder)
+    for path in sorted(store.folder.iterdir()):
+        match = _CHUNK.match(path.name)
+        if not match:
+            continue
+        batch = int(match.group(1))
+        why = _chunk_problem(store, batch, path, ledger.get(batch))
+        if why is None:
+            store.done.add(batch)
+            continue
+        store.damaged.append(f"{path.name} ({why})")
+        path.unlink()
+
+
+def _chunk_problem(store: SweepStore, batch: int, path: Path, entry: dict[str, Any] | None) -> str | None:
+    """Why the chunk of ``batch`` cannot be kept, or None if it is whole and belongs here."""
+    if batch >= store.batches:
+        return f"batch {batch} is beyond the sweep's {store.batches} batches"
+    start, stop = store.batch_range(batch)
+    if entry is not None and (entry.get("start"), entry.get("stop")) == (start, stop):
+        if _fingerprint(path) == {"bytes": entry.get("bytes"), "sha256": entry.get("sha256")}:
+            return None
+        return "its bytes differ from those written"
+    why = _read_problem(store, path, start, stop)  # unrecorded (older folder, lost ledger) or recorded otherwise
+    if why is None:
+        _append_line(store.folder / LEDGER, json.dumps({"batch": batch, "start": start, "stop": stop,
+                                                        **_fingerprint(path)}, sort_keys=True))  # fmt: skip
+    return why
+
+
+def _read_problem(store: SweepStore, path: Path, start: int, stop: int) -> str | None:
+    """Read a chunk the ledger does not vouch for: the right schema and exactly points start..stop-1."""
+    import pyarrow.parquet as pq
+
+    from .models import get_model, result_columns
+
+    try:
+        table = pq.read_table(path)
+    except Exception as exc:  # pyarrow raises ArrowInvalid, OSError, ... on a damaged file
+        return f"unreadable: {type(exc).__name__}"
+    expected = arrow_schema(store.spec.keys, result_columns(get_model(store.spec.model)))
+    if not table.schema.equals(expected, check_metadata=False):
+        return "not the columns of this sweep"
+    if table.column("point").to_pylist() != list(range(start, stop)):
+        return f"not the points {start}..{stop - 1} of its batch"
+    return None
 
 
 def _manifest(store: SweepStore) -> dict[str, Any]:
@@ -142,6 +339,24 @@ def read_manifest(folder: str | Path) -> dict[str, Any]:
         raise DataError(f"{path}: cannot be read as a sweep manifest ({exc})") from None
     if not isinstance(data, dict) or data.get("format") != FORMAT:
         raise DataError(f"{path}: not a stickslip sweep manifest (expected format {FORMAT})")
+    return data
+
+
+def checked_manifest(folder: Path) -> dict[str, Any]:
+    """The manifest, with every field a resume relies on present and sane (else one line)."""
+    data = read_manifest(folder)
+    where = f"{folder / MANIFEST}"
+    batch_size = data.get("batch_size")
+    if isinstance(batch_size, bool) or not isinstance(batch_size, int) or batch_size < 1:
+        raise DataError(f"{where}: batch_size is {batch_size!r}, not a positive whole number; --overwrite starts again")
+    if not isinstance(data.get("version"), str):
+        raise DataError(f"{where}: no version; --overwrite starts again")
+    try:
+        SweepSpec.from_dict(data["specification"])
+    except (KeyError, TypeError, ValueError, AttributeError) as exc:
+        raise DataError(
+            f"{where}: the specification is missing or damaged ({type(exc).__name__}: {exc}); --overwrite starts again"
+        ) from None
     return data
 
 
