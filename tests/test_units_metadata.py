@@ -209,3 +209,39 @@ def test_trace_csv_headers_name_units(capsys, tmp_path, argv, header):
     code, _, err = run_main(capsys, *argv, "-o", str(out))
     assert code == 0, err
     assert out.read_text().splitlines()[0].startswith(header)
+
+
+def test_sweep_parquet_names_its_units_for_pandas_and_pyarrow(tmp_path):
+    import pyarrow.parquet as pq
+
+    from stickslip.sweeps import read_results
+
+    out = tmp_path / "sweep"
+    code = _sweep(out)
+    assert code == 0
+    back = read_results(out)
+    assert back.attrs["units"]["pulling_velocity"] == "m/s"
+    assert back.attrs["units"]["mean_stress"] == "Pa"
+    assert back.attrs["units"]["regime"] is None
+    chunk = next(out.glob("part-*.parquet"))
+    assert pq.read_schema(chunk).field("pulling_velocity").metadata[b"unit"] == b"m/s"
+
+
+def _sweep(out):
+    from click.testing import CliRunner
+
+    from stickslip.cli.main import cli
+
+    args = ["sweep", "--vary", "pulling_velocity=50 um/s..500 um/s:3:log", "-o", str(out), "--workers", "1", "--quiet"]
+    return CliRunner().invoke(cli, args, catch_exceptions=False).exit_code
+
+
+def test_every_sweep_model_column_and_axis_has_a_unit():
+    from stickslip.sweeps.models import MODELS, result_columns
+    from stickslip.units import DIMENSIONS
+
+    for model in MODELS.values():
+        for column in result_columns(model):
+            unit_of(column)  # KeyError names what is missing
+        for key, dimension in model.dimensions().items():  # the model's own dimensions agree with the registry
+            assert unit_of(key) == (DIMENSIONS[dimension][1] or "1"), (model.name, key)

@@ -156,6 +156,7 @@ UNITS: dict[str, str | None] = {
     "residuals": DIMENSIONLESS,  # (data - fit) / error
     "dof": None,  # counts
     "steps": None,
+    "wall_time": _TIME,  # a sweep point's computing time
 }
 #: Keys whose numbers are in the unit of the key that holds them (``{"bonds.bond_time": {"value": ...}}``).
 INHERITED = frozenset({"value", "stderr", "interval", "method_bias", "lower", "upper", "median", "scaled_interval"})

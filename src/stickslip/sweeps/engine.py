@@ -166,11 +166,15 @@ def compute(
 
 def read_results(folder: str | Path) -> Any:
     """The rows written so far, sorted by point, as a pandas DataFrame."""
-    import pandas as pd
 
     from .store import is_chunk
 
     if not any(is_chunk(p.name) for p in Path(folder).iterdir()):
         raise DataError(f"{folder}: no finished batch yet (no part-*.parquet); run or resume the sweep first")
-    frame = pd.read_parquet(folder)
-    return frame.sort_values("point", kind="stable").reset_index(drop=True)
+    from ..columns import read_parquet
+
+    frame = read_parquet(folder)
+    units = frame.attrs["units"]
+    frame = frame.sort_values("point", kind="stable").reset_index(drop=True)
+    frame.attrs["units"] = units  # the units each chunk's schema names (stickslip.columns)
+    return frame

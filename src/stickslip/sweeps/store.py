@@ -60,11 +60,18 @@ def arrow_schema(inputs: tuple[str, ...], columns: Mapping[str, str]) -> Any:
     """The one schema of every chunk: point index, inputs (SI floats), then the model's columns."""
     import pyarrow as pa
 
+    from ..columns import PARQUET_KEY, unit_of
+
     kinds = {"float": pa.float64(), "int": pa.int64(), "str": pa.string()}
-    fields = [pa.field("point", pa.int64())]
-    fields += [pa.field(key, pa.float64()) for key in inputs]
-    fields += [pa.field(name, kinds[kind]) for name, kind in columns.items()]
-    return pa.schema(fields)
+    types = {"point": pa.int64(), **dict.fromkeys(inputs, pa.float64())}
+    types.update({name: kinds[kind] for name, kind in columns.items()})
+    units = {name: unit_of(name) for name in types}  # every column names its unit (pyarrow field metadata)
+    fields = [pa.field(name, kind, metadata=_unit_metadata(units[name])) for name, kind in types.items()]
+    return pa.schema(fields, metadata={PARQUET_KEY: json.dumps(units).encode()})
+
+
+def _unit_metadata(unit: str | None) -> dict[bytes, bytes] | None:
+    return None if unit is None else {b"unit": unit.encode()}
 
 
 @dataclass
