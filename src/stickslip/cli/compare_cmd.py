@@ -73,8 +73,7 @@ def compare_command(**options: Any) -> None:
         "rsf_of_bond_model": rsf.as_dict(),
         "bond_model": panels["velocity step"][0].note,
         "panels": {
-            name: {"rsf": None if run is None else run.summary(), "problem": problem}
-            for name, (_, run, problem) in panels.items()
+            name: _panel_summary(bond, run, problem, rsf.sigma_c) for name, (bond, run, problem) in panels.items()
         },
         "stick_slip": {
             "pulling_velocity": pull,
@@ -116,6 +115,20 @@ def _rsf_panel(rsf: Any, protocol: Any, times: Any) -> tuple[Any, str | None]:
     if run.status != "ok":
         return run, f"the RSF run failed: {run.message}"
     return run, check_friction(run.time, run.friction)
+
+
+def _panel_summary(bond: Any, run: Any, problem: str | None, sigma_c: float) -> dict[str, Any]:
+    """What one panel shows: the extremes of both sides (friction = stress / sigma_c) and what went wrong."""
+    mu = np.asarray(bond.stress, float) / sigma_c
+    known = mu[np.isfinite(mu)]
+    return {
+        "bond_max": float(known.max()) if known.size else None,
+        "bond_final": float(known[-1]) if known.size else None,
+        "rsf_max": None if run is None else float(np.max(run.friction)),
+        "rsf_min": None if run is None else float(np.min(run.friction)),
+        "rsf": None if run is None else run.summary(),
+        "problem": problem,
+    }
 
 
 def _failures(rsf: Any, panels: dict[str, Any], pair: dict[str, Any]) -> list[str]:
