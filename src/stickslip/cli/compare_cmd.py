@@ -230,7 +230,7 @@ def _figure(panels: dict[str, Any], pair: dict[str, Any], rsf: Any) -> Any:
         regime = "failed" if pair["problem"] else run.regime.name
         ax.plot(run.time, shown, color="#c0392b", lw=1.0, label=f"RSF: {regime}")
     if pair["problem"]:
-        _say(ax, "RSF: " + pair["problem"])
+        _say(ax, "RSF: " + pair["problem"], top=False)  # the cycle fills the top; friction below sigma_c is empty
     ax.set_ylim(bottom=0.0)
     ax.set_title("stick-slip at the same V0, stiffness, σc", fontsize=10)
     ax.set_xlabel("time (s)")
@@ -243,10 +243,11 @@ def _figure(panels: dict[str, Any], pair: dict[str, Any], rsf: Any) -> Any:
     return fig
 
 
-def _say(ax: Any, text: str) -> None:
+def _say(ax: Any, text: str, top: bool = True) -> None:
     import textwrap
 
-    ax.text(0.02, 0.98, textwrap.fill(text, 60), transform=ax.transAxes, fontsize=6.5, color="#c0392b", va="top")
+    ax.text(0.02, 0.98 if top else 0.02, textwrap.fill(text, 60), transform=ax.transAxes, fontsize=6.5,
+            color="#c0392b", va="top" if top else "bottom")  # fmt: skip
 
 
 def register(cli: click.Group) -> None:
