@@ -48,6 +48,7 @@ __all__ = [
     "fit_bond_step",
     "physical_problem",
     "rsf_of_bond",
+    "step_guess",
     "stick_slip_pair",
 ]
 
