@@ -106,7 +106,7 @@ def test_cycles_csv_reads_back_with_units(capsys, record, tmp_path):
     code, _, _ = run_main(capsys, "analyze", str(record["path"]), "--v0", "50 um/s", "-o", str(target))
     assert code == 0
     header = target.read_text(encoding="utf-8").splitlines()[0]
-    assert "critical_stress [Pa]" in header and "stiffness [Pa/m]" in header and "jump_velocity [m/s]" in header
+    assert "critical_stress [Pa]" in header and "stiffness [Pa/m]" in header and "model_jump_velocity [m/s]" in header
     dimensions = {"s": "time", "Pa": "stress", "Pa/s": "stress_rate", "Pa/m": "stress_per_length", "m/s": "velocity"}
     columns = {}
     for cell in header.split(","):
@@ -117,6 +117,26 @@ def test_cycles_csv_reads_back_with_units(capsys, record, tmp_path):
     assert list(table["complete"]) == [0, 1, 1, 0]
     assert np.isnan(table["critical_stress"][0])
     assert table["peak_stress"][1] == pytest.approx(HIGHS[1], abs=2.9)
+
+
+def test_model_derived_vs_is_marked_in_text_csv_and_json(capsys, record, tmp_path):
+    """Vs comes from the model's steady curve: another bond time moves it while the measured columns stay put."""
+    runs = {}
+    for name, extra in (("default", ()), ("bond_time", ("--set", "bonds.bond_time=100 us"))):
+        target = tmp_path / f"{name}.csv"
+        code, out, err = run_main(capsys, "analyze", str(record["path"]), "--v0", "50 um/s", "--json", "-o",
+                                  str(target), *extra)  # fmt: skip
+        assert code == 0, err
+        runs[name] = (json.loads(out), target.read_text(encoding="utf-8").splitlines()[0])
+    (base, header), (other, _) = runs["default"], runs["bond_time"]
+    first, moved = base["cycles"][1], other["cycles"][1]
+    assert moved["peak_stress"] == first["peak_stress"] and moved["stick_time"] == first["stick_time"]
+    assert moved["jump_velocity"] > 1.5 * first["jump_velocity"]  # the parameter set, not the record, sets Vs
+    assert "jump_velocity" in base["model_derived"] and "model" in base["model_derived"]["jump_velocity"]
+    assert "model_jump_velocity [m/s]" in header.split(",") and "jump_velocity [m/s]" not in header.split(",")
+    code, out, err = run_main(capsys, "analyze", str(record["path"]), "--v0", "50 um/s")
+    assert code == 0, err
+    assert "Vs [µm/s] (model)" in out and "model-derived, not measured" in out
 
 
 def test_force_with_contact_area_gives_the_same_stress(capsys, record):

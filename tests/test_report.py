@@ -249,9 +249,67 @@ def test_classification_rules() -> None:
     assert classify(n, 110.0, echo=True) == "erratum"  # an echo that does not match: the paper's arithmetic
     assert classify(n, 101.9, echo=False) == "agrees"
     assert classify(n, 103.5, echo=False) == "scatter"
-    assert classify(n, 106.0, echo=False) == "erratum"
-    assert classify(replace(n, explanation="limitation"), 80.0, echo=False) == "limitation"
+    assert classify(n, 106.0, echo=False) == "limitation"  # a difference from a measurement is the model's
+    contradiction = replace(n, explanation="erratum", contradiction="the text and the table give different values")
+    assert classify(contradiction, 106.0, echo=False) == "erratum"
     assert classify(replace(n, paper_unit="1/m^2"), 100.0, echo=False) == "erratum"
+    with pytest.raises(ValueError, match="contradicts itself"):
+        replace(n, explanation="erratum")  # a paper error must say how the paper contradicts itself
+
+
+def test_differences_from_the_model_are_not_filed_as_paper_errors(rows: dict) -> None:
+    """A paper error is the paper contradicting itself (wrong unit, own arithmetic, own numbers), never the size of
+    a difference between the model and a measurement or a number the paper computed with unstated inputs."""
+    # 9.6 % between the nominal 400 kPa/m and Table 1's mean; the paper's simulated stick times +5.4 %, +4.9 %
+    # (reproduced by G_d/h = 420 kPa/m, which the paper does not state): limitations of the model's inputs
+    for key in ("stiffness_against_table1", "stick_time_50", "stick_time_100"):
+        assert rows[key]["class"] == "limitation", key
+        assert rows[key]["relative_difference"] > 0.04  # beyond the tolerance: a real difference, not agreement
+    for key, row in rows.items():
+        if row["class"] == "erratum":
+            assert (
+                row.get("difference") == "units differ"
+                or "contradicts itself" in row["class_reason"]
+                or ("own numbers" in row["class_reason"])
+            ), key
+        if row["kind"] == "measured" and row["class"] == "erratum":
+            assert "contradicts itself" in row["class_reason"], key
+        assert row["class_reason"], key
+    # the stated contradictions hold on the paper's own numbers
+    table = {r["key"]: r["paper"] for r in rows.values()}
+    assert 116.0 * 7.51 > table["table1_slip_stress_350_1"]  # slope x ts above sigma_s, even from rest
+    assert 116.0 / (350e-6 * 0.766) < 0.95 * table["table1_stiffness_350_1"]
+    assert table["table1_slip_stress_50_3"] < table["table1_slip_stress_50_1"]  # lower sigma_s ...
+    assert table["table1_jump_velocity_50_3"] > table["table1_jump_velocity_50_1"]  # ... yet higher Vs
+    assert table["table1_slip_stress_100_3"] < table["table1_slip_stress_100_2"]
+    assert table["table1_jump_velocity_100_3"] == table["table1_jump_velocity_100_2"]
+    assert table["stick_time_table_50"] > max(table[f"table1_stick_time_50_{k}"] for k in (1, 2, 3)) * 1.02
+
+
+def test_phase_diagram_caption_states_the_models_boundary_beside_the_grid(report: Path, results: dict, params):
+    from stickslip.model.stick import stick_phase
+
+    floor = results["model"]["lowest_velocity_with_a_jump"]
+    critical = results["model"]["critical_point"]
+    # the floor is where the stick's sigma_s reaches the steady curve's maximum (independent check of its meaning)
+    top = critical_point(params).turnover_stress
+    assert stick_phase(params, floor * 1.001).peak_stress < top < stick_phase(params, floor * 0.999).peak_stress
+    html = unescape((report / "report.html").read_text(encoding="utf-8"))
+    caption = html.split("the grid's stick-slip points run from", 1)[1].split("Made with", 1)[0]
+    assert (
+        f"from {floor * 1e6:.4g} µm/s" in caption and f"Vc = {critical['critical_velocity'] * 1e6:.4g} µm/s" in caption
+    )
+    assert "13.4 µm/s: stuck" in caption and "158 µm/s: steady" in caption  # the grid's neighbours bracket it
+
+
+def test_stick_slip_band_brackets_the_grid_and_names_the_theory() -> None:
+    from stickslip.report.sweep_section import stick_slip_band
+
+    text = stick_slip_band([30e-6, 10e-6, 50e-6, 200e-6], ["stick-slip", "stuck", "stick-slip", "steady"], 20.46e-6,
+                           124.1e-6, 400e3)  # fmt: skip
+    assert "run from 30 to 50 µm/s" in text and "10 µm/s: stuck" in text and "200 µm/s: steady" in text
+    assert "stick-slip from 20.46 µm/s" in text and "Vc = 124.1 µm/s" in text
+    assert "no grid point" in stick_slip_band([1e-5], ["stuck"], None, None, 400e3)
 
 
 def test_scatter_bands_are_the_cycles_the_paper_calls_the_same() -> None:
@@ -275,7 +333,7 @@ def test_one_stiffness_fact_counted_once(rows: dict, params) -> None:
         assert row["alternative"]["value"] == pytest.approx(factor * 400e3 * v_um * 1e-6, rel=1e-9)
         ks.append(slope / (v_um * 1e-6) / factor)
     whole = rows["stiffness_against_table1"]
-    assert whole["computed"] == pytest.approx(sum(ks) / len(ks), rel=1e-9) and whole["class"] == "erratum"
+    assert whole["computed"] == pytest.approx(sum(ks) / len(ks), rel=1e-9) and whole["class"] == "limitation"
     # the paper's own arithmetic, slope/(0.766 V0), fails only in the 350 um/s column (432.5 vs 457 kPa/m)
     assert rows["table1_stiffness_350_1"]["class"] == "erratum"
     assert all(rows[f"table1_stiffness_{c}"]["class"] == "input" for c in ("50_1", "50_2", "100_1", "100_4"))

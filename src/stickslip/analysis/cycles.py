@@ -72,6 +72,13 @@ CYCLE_QUANTITIES = {
 }
 
 
+#: Per-cycle quantities that come from the model, not from the record: field -> how (they change with the
+#: parameter set, e.g. ``--set bonds.bond_time=...``; every other quantity is read off the record alone).
+MODEL_DERIVED = {
+    "jump_velocity": "model-derived, not measured: where the bond model's aging steady curve (Eq 8) carries the "
+    "measured peak stress sigma_s; it changes with the parameter set",
+}
+
 #: CycleResult fields kept for plotting, not reported.
 _PRIVATE_FIELDS = ("line", "stick_from", "stick_to")
 
@@ -138,6 +145,7 @@ class TraceAnalysis:
             "drop_threshold": self.threshold,
             "cycles": [c.as_dict() for c in self.cycles],
             "summary": self.summary,
+            "model_derived": dict(MODEL_DERIVED),
         }
 
     def to_frame(self) -> pd.DataFrame:

@@ -26,7 +26,7 @@ from .common import (
 )
 from .params_cmd import print_rich
 
-#: Columns of ``-o cycles.csv``: (field, SI unit).
+#: Columns of ``-o cycles.csv``: (field, SI unit).  A model-derived field's column is named ``model_<field>``.
 CSV_COLUMNS = (
     ("cycle", ""),
     ("complete", ""),
@@ -56,7 +56,7 @@ TABLE_ROWS = (
     ("stiffness", "Gd/h [kPa/m]", 1e-3, 4),
     ("peak_stress", "σs [Pa]", 1.0, 4),
     ("stick_time", "ts [s]", 1.0, 4),
-    ("jump_velocity", "Vs [µm/s]", 1e6, 4),
+    ("jump_velocity", "Vs [µm/s] (model)", 1e6, 4),
     ("slip_time", "slip time [s]", 1.0, 4),
     ("period", "period [s]", 1.0, 4),
 )
@@ -135,13 +135,21 @@ def analyze_command(
 def cycles_csv(analysis: Any) -> str:
     """The cycles as CSV, SI units in the header brackets; empty cells where a value is not in the record."""
     out = io.StringIO()
-    out.write(",".join(f"{name} [{unit}]" if unit else name for name, unit in CSV_COLUMNS) + "\n")
+    out.write(",".join(_csv_heading(name, unit) for name, unit in CSV_COLUMNS) + "\n")
     for cycle in analysis.cycles:
         data = cycle.as_dict()
         data["cycle"] = cycle.index
         data["complete"] = int(cycle.complete)
         out.write(",".join(_cell(data[name]) for name, _ in CSV_COLUMNS) + "\n")
     return out.getvalue()
+
+
+def _csv_heading(name: str, unit: str) -> str:
+    """``name [unit]``; a model-derived quantity is named ``model_<name>`` so that no reader takes it as measured."""
+    from ..analysis.cycles import MODEL_DERIVED
+
+    label = f"model_{name}" if name in MODEL_DERIVED else name
+    return f"{label} [{unit}]" if unit else label
 
 
 def _cell(value: Any) -> str:
@@ -181,6 +189,7 @@ def _report(analysis: Any, comparison: Any) -> list[Any]:
                 escape(heading), *cells, "" if stats["mean"] is None else f"{stats['mean'] * factor:.{digits}g}{spread}"
             )
         parts.append(table)
+        parts.append(escape(_model_note()))
         if len(shown) < len(analysis.cycles):
             parts.append(
                 f"the table shows the first {len(shown)} of {len(analysis.cycles)} cycles;"
@@ -198,6 +207,13 @@ def _report(analysis: Any, comparison: Any) -> list[Any]:
     if comparison is not None:
         parts.append(escape(_comparison_text(comparison)))
     return parts
+
+
+def _model_note() -> str:
+    from ..analysis.cycles import MODEL_DERIVED
+
+    headings = {name: heading for name, heading, _, _ in TABLE_ROWS}
+    return "(model) " + "; ".join(f"{headings[name].split(' [')[0]}: {how}" for name, how in MODEL_DERIVED.items())
 
 
 def _comparison_text(comparison: Any) -> str:

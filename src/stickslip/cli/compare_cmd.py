@@ -14,6 +14,7 @@ from pathlib import Path
 from typing import Any
 
 import click
+import numpy as np
 
 from ..fileio import refuse_input_as_output
 from .common import json_text, params_options, positive, resolve_params
@@ -44,7 +45,6 @@ from .rsf_cmd import save_figure, sidecar, write
 def compare_command(**options: Any) -> None:
     """The bond model beside rate-and-state friction fitted to it: velocity step, slide-hold-slide, stick-slip."""
     from .. import protocols
-    from ..rsf import simulate
     from ..rsf.compare import bond_response, rsf_of_bond, stick_slip_pair
 
     params = resolve_params(options["params_name"], options["overrides"])
@@ -63,20 +63,24 @@ def compare_command(**options: Any) -> None:
     panels = {}
     for name, protocol in (("velocity step", step), ("slide-hold-slide", shs)):
         bond = bond_response(params, protocol, "velocity", model=options["bond_model"])
-        run = simulate(rsf.params, protocol, every=protocol.duration / 800)
-        panels[name] = (bond, run)
-    local = _override(rsf_of_bond(params, pull / 1.05, pull * 1.05), options)
-    pair = stick_slip_pair(params, pull, duration, local, eta)
+        panels[name] = (bond, *_rsf_panel(rsf, protocol, bond.time))
+    pair = stick_slip_pair(params, pull, duration, rsf, eta)
+    failures = _failures(rsf, panels, pair)
     summary = {
+        "status": "failed" if failures else "ok",
+        "failures": failures,
         "rsf_of_bond_model": rsf.as_dict(),
         "bond_model": panels["velocity step"][0].note,
+        "panels": {
+            name: _panel_summary(bond, run, problem, rsf.sigma_c) for name, (bond, run, problem) in panels.items()
+        },
         "stick_slip": {
             "pulling_velocity": pull,
             "stiffness": pair["stiffness"],
             "eta": pair["eta"],
-            "rsf_parameters": local.as_dict(),
             "bond": {"regime": pair["bond"].regime, "message": pair["bond"].message},
-            "rsf": pair["rsf"].summary(),
+            "rsf": None if pair["rsf"] is None else pair["rsf"].summary(),
+            "problem": pair["problem"],
         },
     }
     if options["as_json"]:
@@ -84,8 +88,55 @@ def compare_command(**options: Any) -> None:
     else:
         click.echo(_text(summary))
     if options["output"] is not None:
-        save_figure(_figure(panels, pair, rsf, local), options["output"])
+        save_figure(_figure(panels, pair, rsf), options["output"])
         write(sidecar(options["output"]), json_text(summary) + "\n")
+    if failures:
+        click.echo("stickslip: the rate-and-state side failed: " + failures[0], err=True)
+        raise SystemExit(FAILED)
+
+
+#: Exit status when the RSF side failed (the fit, or negative friction in a panel); 2 is bad input.
+FAILED = 3
+
+
+def _rsf_panel(rsf: Any, protocol: Any, times: Any) -> tuple[Any, str | None]:
+    """The RSF run of one panel and what is wrong with it (None when fine); not run when the fit failed."""
+    from ..rsf import simulate
+    from ..rsf.compare import check_friction
+
+    if not rsf.usable:
+        return None, "not run: the RSF fit failed"
+    # on the bond model's own instants (dense where it changes fast) and a regular grid: no peak falls between
+    grid = np.linspace(0.0, protocol.duration, 801)
+    inside = np.asarray(times, float)
+    inside = inside[np.isfinite(inside) & (inside >= 0.0) & (inside <= protocol.duration)]
+    run = simulate(rsf.params, protocol, times=np.unique(np.concatenate([grid, inside])))
+    if run.status != "ok":
+        return run, f"the RSF run failed: {run.message}"
+    return run, check_friction(run.time, run.friction)
+
+
+def _panel_summary(bond: Any, run: Any, problem: str | None, sigma_c: float) -> dict[str, Any]:
+    """What one panel shows: the extremes of both sides (friction = stress / sigma_c) and what went wrong."""
+    mu = np.asarray(bond.stress, float) / sigma_c
+    known = mu[np.isfinite(mu)]
+    return {
+        "bond_max": float(known.max()) if known.size else None,
+        "bond_final": float(known[-1]) if known.size else None,
+        "rsf_max": None if run is None else float(np.max(run.friction)),
+        "rsf_min": None if run is None else float(np.min(run.friction)),
+        "rsf": None if run is None else run.summary(),
+        "problem": problem,
+    }
+
+
+def _failures(rsf: Any, panels: dict[str, Any], pair: dict[str, Any]) -> list[str]:
+    if not rsf.usable:
+        return [rsf.note]
+    found = [f"{name}: {problem}" for name, (_, _, problem) in panels.items() if problem]
+    if pair["problem"]:
+        found.append(f"stick-slip: {pair['problem']}")
+    return found
 
 
 def _override(rsf: Any, options: dict[str, Any]) -> Any:
@@ -103,28 +154,46 @@ def _override(rsf: Any, options: dict[str, Any]) -> Any:
     a = quantity(given["rsf_a"], "dimensionless", "--a") if "rsf_a" in given else p.a
     b = quantity(given["rsf_b"], "dimensionless", "--b") if "rsf_b" in given else s.b
     dc = positive(given["rsf_dc"], "length", "--dc") if "rsf_dc" in given else s.dc
-    note = rsf.note + "; overridden on the command line: " + ", ".join(f"{k[4:]} = {v}" for k, v in given.items())
+    from ..rsf.compare import physical_problem
+
+    shown = ", ".join(f"{k[4:]} = {v}" for k, v in given.items())
     params = p.replace(a=a, states=(StateVariable(s.law, b, dc, s.c),))
-    return dataclasses.replace(rsf, params=params, a_minus_b=a - b, note=note)
+    kept = "" if len(given) == 3 else f"; the rest from the bond model ({rsf.status}: {rsf.note})"
+    problem = physical_problem(params)
+    if problem is not None:
+        return dataclasses.replace(rsf, params=params, status="failed", note=f"given on the command line ({shown}) "
+                                   f"but not physical: {problem}")  # fmt: skip
+    return dataclasses.replace(rsf, params=params, status="given", note=f"given on the command line: {shown}{kept}")
 
 
 def _text(summary: dict[str, Any]) -> str:
     r = summary["rsf_of_bond_model"]
     s = summary["stick_slip"]
-    return "\n".join([
-        f"RSF standing for the bond model near {r['velocity'] * 1e6:.4g} um/s (friction = stress / sigma_c, "
-        f"sigma_c = {r['sigma_c']:.4g} Pa): a = {r['a']:.4g}, b = {r['b']:.4g}, Dc = {r['dc'] * 1e6:.4g} um",
+    lines = [
+        f"one RSF parameter set for every panel (friction = stress / sigma_c, sigma_c = {r['sigma_c']:.4g} Pa): "
+        f"a = {r['a']:.4g}, b = {r['b']:.4g}, Dc = {r['dc'] * 1e6:.4g} um ({_how(r['status'])})",
         f"  {r['note']}",
+        f"  the bond model's steady slope (1/sigma_c) dsigma/dlnV at {r['velocity'] * 1e6:.4g} um/s: "
+        f"{r['bond_steady_slope']:.4g} (RSF a - b = {r['rsf_a_minus_b']:.4g})",
         f"bond model: {summary['bond_model']}",
+    ]
+    for name, panel in summary["panels"].items():
+        lines.append(f"{name}: RSF " + (f"FAILED: {panel['problem']}" if panel["problem"] else "ok"))
+    lines += [
         f"stick-slip at {s['pulling_velocity'] * 1e6:.4g} um/s, k = {s['stiffness']:.4g} 1/m, "
         f"eta = {s['eta']:.4g} s/m:",
         f"  bond model: {s['bond']['message']}",
-        f"  RSF (a = {s['rsf_parameters']['a']:.4g}, b = {s['rsf_parameters']['b']:.4g}): {s['rsf']['regime']}; "
-        f"{s['rsf']['message']}",
-    ])  # fmt: skip
+        "  RSF: " + (f"FAILED: {s['problem']}" if s["problem"] else f"{s['rsf']['regime']}; {s['rsf']['message']}"),
+        f"status: {summary['status']}",
+    ]
+    return "\n".join(lines)
 
 
-def _figure(panels: dict[str, Any], pair: dict[str, Any], rsf: Any, local: Any) -> Any:
+def _how(status: str) -> str:
+    return {"fitted": "fitted to the bond model's step", "given": "given on the command line"}.get(status, "FIT FAILED")
+
+
+def _figure(panels: dict[str, Any], pair: dict[str, Any], rsf: Any) -> Any:
     from matplotlib.figure import Figure
 
     from ..plotting import apply_style
@@ -132,29 +201,52 @@ def _figure(panels: dict[str, Any], pair: dict[str, Any], rsf: Any, local: Any) 
     fig = Figure(figsize=(12, 4.2), layout="constrained")
     axes = fig.subplots(1, 3)
     sc = rsf.sigma_c
-    for ax, (name, (bond, run)) in zip(axes[:2], panels.items(), strict=True):
-        ax.plot(bond.time, bond.stress / sc, color="#1f4e9c", lw=1.6, label=bond.source)
-        ax.plot(run.time, run.friction, color="#c0392b", lw=1.2, ls="--", label="rate-and-state")
+    label = f"rate-and-state ({_how(rsf.status)})"
+    for ax, (name, (bond, run, problem)) in zip(axes[:2], panels.items(), strict=True):
+        ax.plot(bond.time, np.where(bond.stress > 0, bond.stress / sc, np.nan), color="#1f4e9c", lw=1.6,
+                label=bond.source)  # fmt: skip
+        if run is not None:
+            shown = np.where(run.friction > 0, run.friction, np.nan)  # negative friction is not drawn
+            ax.plot(run.time, shown, color="#c0392b", lw=1.2, ls="--", label=label)
+        if problem:
+            _say(ax, "RSF: " + problem)
+        if name == "slide-hold-slide":
+            # log: the re-sliding peak of the bond model can be 10^3 times its sliding stress; both must show
+            ax.set_yscale("log")
+        else:
+            ax.set_ylim(bottom=0.0)  # friction is not negative: an RSF curve that reaches 0 is cut there
+            ax.ticklabel_format(axis="y", useOffset=False)
         ax.set_title(name, fontsize=10)
         ax.set_xlabel("time (s)")
         ax.set_ylabel("stress / σc")
-        ax.legend(fontsize=7, frameon=False)
+        ax.legend(fontsize=7, frameon=False, loc="lower right")
         apply_style(ax)
     ax = axes[2]
     bond, run = pair["bond"], pair["rsf"]
-    ax.plot(bond.time, bond.stress / local.sigma_c, color="#1f4e9c", lw=1.4, label="bond model: jump cycle")
-    ax.plot(run.time, run.friction, color="#c0392b", lw=1.0, label=f"RSF: {run.regime.name}")
+    ax.plot(bond.time, bond.stress / sc, color="#1f4e9c", lw=1.4, label="bond model: jump cycle")
+    if run is not None:
+        shown = np.where(run.friction >= 0, run.friction, np.nan)
+        regime = "failed" if pair["problem"] else run.regime.name
+        ax.plot(run.time, shown, color="#c0392b", lw=1.0, label=f"RSF: {regime}")
+    if pair["problem"]:
+        _say(ax, "RSF: " + pair["problem"], top=False)  # the cycle fills the top; friction below sigma_c is empty
+    ax.set_ylim(bottom=0.0)
     ax.set_title("stick-slip at the same V0, stiffness, σc", fontsize=10)
     ax.set_xlabel("time (s)")
     ax.set_ylabel("stress / σc")
-    ax.legend(fontsize=7, frameon=False)
+    ax.legend(fontsize=7, frameon=False, loc="lower right")
     apply_style(ax)
     p = rsf.params
-    how = "fitted" if rsf.determined else "a, Dc assumed: quasi-static bond model"
-    if "overridden" in rsf.note:
-        how = "given on the command line"
-    fig.suptitle(f"RSF of the bond model: a = {p.a:.3g}, b = {p.b:.3g}, Dc = {p.dc * 1e6:.3g} µm ({how})", fontsize=9)
+    fig.suptitle(f"One RSF set for all panels: a = {p.a:.3g}, b = {p.b:.3g}, Dc = {p.dc * 1e6:.3g} µm "
+                 f"({_how(rsf.status)})", fontsize=9)  # fmt: skip
     return fig
+
+
+def _say(ax: Any, text: str, top: bool = True) -> None:
+    import textwrap
+
+    ax.text(0.02, 0.98 if top else 0.02, textwrap.fill(text, 60), transform=ax.transAxes, fontsize=6.5,
+            color="#c0392b", va="top" if top else "bottom")  # fmt: skip
 
 
 def register(cli: click.Group) -> None:

@@ -12,9 +12,15 @@ unit has another dimension: "units differ").  Every row is put in one class
 3. **scatter**: a measurement whose computed value lies inside the band the
    paper states ("259 ± 5 Pa", "0.4 kPa") or shows (the cycles at the same
    V0 that it calls the same, widened by the tolerance).
-4. otherwise the row's declared explanation: **paper error** (an erratum
-   in errata.md says what is wrong in the paper) or **model limitation**
-   (the model cannot have it; the erratum says why).
+4. otherwise **model limitation**: the model, with the paper's stated
+   inputs, does not give the number (the erratum entry says why, e.g. the
+   nominal stiffness below the measured one, or aging before shearing that the
+   model lacks); or **paper error**, but only where the paper contradicts
+   itself, which the row states (:data:`~.paper.PAPER_CONTRADICTIONS`).  The
+   size of a difference never makes it the paper's error: a difference between
+   the model and a measurement is the model's, not the paper's.
+
+Every row carries its reason in words (:func:`class_reason`).
 """
 
 from __future__ import annotations
@@ -25,7 +31,7 @@ from typing import Any
 
 from .paper import PAPER_NUMBERS, TOLERANCE, PaperNumber
 
-__all__ = ["CLASSES", "TOLERANCE", "Comparison", "Computed", "classify", "compare", "count_classes"]
+__all__ = ["CLASSES", "TOLERANCE", "Comparison", "Computed", "class_reason", "classify", "compare", "count_classes"]
 
 #: Class -> how the report names it, in the order the headline counts them.
 CLASSES = {
@@ -71,6 +77,27 @@ def classify(number: PaperNumber, computed: float | None, echo: bool) -> str:
     return number.explanation
 
 
+def class_reason(number: PaperNumber, computed: float | None, echo: bool) -> str:
+    """Why the row is in its class, in words."""
+    cls = classify(number, computed, echo)
+    if cls == "input":
+        return "the paper's own input (or arithmetic on its numbers) handed back: not a prediction"
+    if cls == "agrees":
+        return f"within {100 * TOLERANCE:g} %"
+    if cls == "scatter":
+        low, high = number.scatter or (math.nan, math.nan)
+        return f"inside the scatter the paper states or shows ({low:.4g} to {high:.4g} {number.unit})"
+    if number.units_differ:
+        return "the paper prints the number with a wrong unit"
+    if number.contradiction:
+        return "the paper contradicts itself: " + number.contradiction
+    if echo:
+        return "the paper's arithmetic on its own numbers does not give its printed value"
+    if cls == "erratum":
+        return "the paper contradicts itself: " + number.contradiction
+    return "the model with the paper's stated inputs does not give this number; the linked erratum says why"
+
+
 def relative_difference(number: PaperNumber, computed: float | None) -> float | None:
     if computed is None or number.units_differ:
         return None
@@ -100,6 +127,10 @@ class Comparison:
         return classify(self.number, self.computed, self.echo)
 
     @property
+    def reason(self) -> str:
+        return class_reason(self.number, self.computed, self.echo)
+
+    @property
     def flagged(self) -> bool:
         """True when the row is neither an echoed input nor an agreement within the tolerance."""
         return self.classification not in ("input", "agrees")
@@ -119,6 +150,7 @@ class Comparison:
             "unit": n.unit,
             "relative_difference": self.relative_difference,
             "class": self.classification,
+            "class_reason": self.reason,
             "how": self.how,
         }
         if n.units_differ:

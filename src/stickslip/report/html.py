@@ -65,7 +65,7 @@ def difference_text(row: Comparison) -> str:
 
 def class_badge(row: Comparison) -> str:
     c = row.classification
-    return f'<span class="class class-{c}">{escape(CLASSES[c])}</span>'
+    return f'<span class="class class-{c}" title="{escape(row.reason)}">{escape(CLASSES[c])}</span>'
 
 
 def _errata_link(row: Comparison, errata: Errata) -> str:
@@ -231,8 +231,10 @@ def summary_sentence(rows: Sequence[Comparison]) -> str:
         f"{len(rows)} numbers stated in the paper are compared with this package's computation: "
         f"{counts['input']} are the paper's own inputs handed back (parameters and arithmetic on them, not counted "
         f"as agreement); {counts['agrees']} agree within {100 * TOLERANCE:g} %; {counts['scatter']} lie within the "
-        f"scatter the paper states or shows; {counts['erratum']} differ because of an error in the paper (each links "
-        f"its erratum); {counts['limitation']} are limitations of the model (each explained)."
+        f"scatter the paper states or shows; {counts['erratum']} differ because of an error in the paper (where "
+        f"the paper contradicts itself; each links its erratum); {counts['limitation']} are limitations of the "
+        "model (the model with the paper's stated inputs does not give them; each explained). A difference between "
+        "the model and a measurement is never counted as the paper's error."
     )
     return escape(text)
 
@@ -242,9 +244,12 @@ def stiffness_paragraph(rows: Sequence[Comparison]) -> str:
     below = [-100 * d for r in rows if r.number.key.startswith("table1_stick_slope_") and
              (d := r.alternative_difference) is not None]  # fmt: skip
     span = f"{min(below):.0f}–{max(below):.0f} %" if below else "about 10 %"
+    fact = next((r for r in rows if r.number.key == "stiffness_against_table1"), None)
+    gap = "" if fact is None or fact.relative_difference is None else f", {format_percent(fact.relative_difference)}"
     return (
         "<p><strong>Stiffness.</strong> The nominal stiffness 0.766 × 400 kPa/m gives stick slopes "
-        f"{span} below Table 1's: one fact, counted once (the row “Gd/h = 400 kPa/m compares well”). So that it "
+        f"{span} below Table 1's: one fact, counted once, as a limitation of the model's nominal block (the row "
+        f"“Gd/h = 400 kPa/m compares well”{gap}: not an error in the paper). So that it "
         "is not counted again in every slope, Gd/h and stick time, Table 1's σs and ts are computed with the "
         "stiffness each column's own slope implies (K = slope / V0), and the model with the nominal stiffness is "
         "shown beside (“nominal”). The start-up sticks (100 µm/s cycle 1, where σs − slope × ts = 21 Pa, and the "

@@ -44,7 +44,16 @@ class PaperNumber:
     paper_unit: str | None = None  # SI unit of the paper value, set only where the printed unit is wrong
     note: str = ""  # context a reader needs beside the number
     scatter: tuple[float, float] | None = None  # SI band the paper states (or shows) for this measurement
-    explanation: str = "erratum"  # the class of a difference beyond tolerance and scatter: "erratum" or "limitation"
+    # the class of a difference beyond tolerance and scatter: "limitation" (the model with the paper's stated inputs
+    # does not give the number) unless the paper contradicts itself there, then "erratum" with ``contradiction``
+    explanation: str = "limitation"
+    contradiction: str = ""  # how the paper contradicts itself (required for explanation="erratum")
+
+    def __post_init__(self) -> None:
+        if self.explanation not in ("erratum", "limitation"):
+            raise ValueError(f"{self.key}: explanation must be 'erratum' or 'limitation', not {self.explanation!r}")
+        if self.explanation == "erratum" and not self.contradiction:
+            raise ValueError(f"{self.key}: a paper error must say how the paper contradicts itself")
 
     @property
     def units_differ(self) -> bool:
@@ -389,9 +398,24 @@ TABLE1_KINDS = {
 #: Relative difference up to which a computed value agrees with the paper's; also the margin of the scatter bands.
 TOLERANCE = 0.02
 
-#: (Table 1 row, (V0 um/s, cycle)) -> the class of a difference beyond tolerance and scatter, where it is not a
-#: paper error: the start-up sticks lack the aging before shearing began (the paper's own explanation of 658 Pa).
-TABLE1_LIMITATIONS = {("slip_stress", (100, 1)), ("stick_time", (100, 1)), ("slip_stress", (350, 1))}
+#: The only rows where a difference beyond tolerance and scatter is an error in the paper: there the paper
+#: contradicts itself (its own numbers, not the model, show it), and the text says how.  A difference between the
+#: model and a measurement, or between the model and a number the paper computed with inputs it does not state, is
+#: never the paper's error: every other such row is a limitation of the model (its erratum entry explains it).
+#: Wrong printed units and echoes that do not match are errors by rule (comparisons.classify).
+PAPER_CONTRADICTIONS = {
+    "stick_time_table_50": "the text's 18.9 s contradicts Table 1's own 18.3, 18.3 and 17.8 s at 50 µm/s (E9)",
+    "table1_stiffness_350_1": "457 kPa/m is not the column's own slope 116 Pa/s over 0.766 V0 (432.7 kPa/m), the"
+    " rule every other column follows (E14)",
+    "table1_stick_time_350_1": "the column contradicts itself: 116 Pa/s × 7.51 s = 871 Pa is more than its"
+    " σs = 800 Pa even from rest (E9)",
+    "table1_jump_velocity_50_3": "Vs does not follow the paper's own curve: 720 µm/s for σs = 552 Pa but 702 µm/s for"
+    " the larger 554 and 556 Pa (E15)",
+    "table1_jump_velocity_100_3": "Vs does not follow the paper's own curve: the same 702 µm/s for σs = 542 Pa as"
+    " for 549 and 554 Pa (E15)",
+    "table1_jump_velocity_350_1": "σs = 800 Pa with Vs = 760 µm/s lies on neither of the paper's curves, which carry"
+    " 800 Pa at 1643 µm/s (aging) and 1651 µm/s (no aging) (E13)",
+}
 
 
 def table1_value(key: str, velocity: float, cycle: int) -> float | None:
@@ -415,6 +439,13 @@ def scatter_band(key: str, velocity: float) -> tuple[float, float] | None:
     if len(values) < 2:
         return None
     return min(values) * (1.0 - TOLERANCE), max(values) * (1.0 + TOLERANCE)
+
+
+def _explanation(key: str) -> dict[str, str]:
+    """The class of a difference beyond tolerance and scatter for row ``key`` (see PAPER_CONTRADICTIONS)."""
+    if key in PAPER_CONTRADICTIONS:
+        return {"explanation": "erratum", "contradiction": PAPER_CONTRADICTIONS[key]}
+    return {"explanation": "limitation"}
 
 
 def _table1_numbers() -> tuple[PaperNumber, ...]:
@@ -441,7 +472,7 @@ def _table1_numbers() -> tuple[PaperNumber, ...]:
                     source="Table 1",
                     note=TABLE1_NOTES.get((velocity, cycle), ""),
                     scatter=scatter,
-                    explanation="limitation" if (key, (v_um, cycle)) in TABLE1_LIMITATIONS else "erratum",
+                    **_explanation(f"table1_{key}_{v_um}_{cycle}"),
                 )
             )
     return tuple(out)
@@ -460,7 +491,12 @@ TEXT_SCATTER = {
 
 #: Every number the paper states, in report order.
 PAPER_NUMBERS: tuple[PaperNumber, ...] = (
-    tuple(replace(n, scatter=scatter_band(*TEXT_SCATTER[n.key])) if n.key in TEXT_SCATTER else n for n in TEXT_NUMBERS)
+    tuple(
+        replace(
+            n, scatter=scatter_band(*TEXT_SCATTER[n.key]) if n.key in TEXT_SCATTER else n.scatter, **_explanation(n.key)
+        )
+        for n in TEXT_NUMBERS
+    )
     + TABLE1_NUMBERS
 )
 

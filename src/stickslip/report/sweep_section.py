@@ -7,7 +7,7 @@ drawn with the quasi-static boundary V0 = Vc (Eq 9).
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 
 from .computations import ModelRun
 from .figures import ReportFigure
@@ -40,13 +40,8 @@ def phase_diagram_figure(run: ModelRun) -> ReportFigure:
     ax.set_title("Regimes over pulling velocity and block stiffness (quasi-static model)", fontsize=11)
     counts = frame["regime"].value_counts()
     at_paper = frame[(frame["block.stiffness"] - stiffness).abs() <= 1e-9 * stiffness]
-    slipping = at_paper.loc[at_paper["regime"] == "stick-slip", "pulling_velocity"]
-    band = (
-        f"at the paper's block (dotted line, G/h = {stiffness / 1e3:.0f} kPa/m) stick-slip is found from"
-        f" {slipping.min() * 1e6:.3g} to {slipping.max() * 1e6:.3g} µm/s"
-        if len(slipping)
-        else "at the paper's block (dotted line) no grid point is in stick-slip"
-    )
+    vc = run.critical.velocity if run.critical is not None else None
+    band = stick_slip_band(at_paper["pulling_velocity"], at_paper["regime"], run.jump_floor, vc, stiffness)
     caption = (
         f"Regime of {len(frame)} runs of the quasi-static cycle (a {VELOCITIES.split(':')[1]} × {count} grid, log"
         f" spaced: V0 = 5 µm/s to 5 mm/s, block stiffness G/h from {low:g} to {high:g} times the paper's, set through"
@@ -54,9 +49,40 @@ def phase_diagram_figure(run: ModelRun) -> ReportFigure:
         f" = {run.critical.velocity * 1e6 if run.critical and run.critical.velocity else float('nan'):.1f} µm/s"
         " (Eq 9): above it the slip settles onto the steady curve; below it a stick that ends is followed by"
         f" stick-slip, and at low V0 or a soft block the chains age faster than they are loaded and the block stays"
-        f" stuck. {band[0].upper() + band[1:]}. Made with `stickslip sweep` (docs/sweep.md)."
+        f" stuck. {band} Made with `stickslip sweep` (docs/sweep.md)."
     )
     return ReportFigure("phase_diagram", "Phase diagram", "Stick-slip, steady sliding and sticking", caption, ax.figure)
+
+
+def stick_slip_band(
+    velocities: Iterable[float], regimes: Iterable[str], jump_floor: float | None, vc: float | None, stiffness: float
+) -> str:
+    """Where the grid finds stick-slip at the paper's block, beside where the theory puts it.
+
+    The grid can only bracket a boundary between two of its points; the theory's boundaries are computed: Vc
+    (Eq 9) above, and below the lowest V0 whose σs the steady curve still carries (Eqs 15, 8).
+    """
+    points = sorted(zip(velocities, regimes, strict=True))
+    slipping = [k for k, (_, regime) in enumerate(points) if regime == "stick-slip"]
+    where = f"At the paper's block (dotted line, G/h = {stiffness / 1e3:.0f} kPa/m)"
+    if slipping:
+        first, last = slipping[0], slipping[-1]
+        below = f"{points[first - 1][0] * 1e6:.3g} µm/s: {points[first - 1][1]}" if first > 0 else None
+        above = f"{points[last + 1][0] * 1e6:.3g} µm/s: {points[last + 1][1]}" if last + 1 < len(points) else None
+        outside = "; ".join(x for x in (below, above) if x)
+        grid = (
+            f"{where} the grid's stick-slip points run from {points[first][0] * 1e6:.3g} to"
+            f" {points[last][0] * 1e6:.3g} µm/s" + (f" (its next points: {outside})" if outside else "")
+        )
+    else:
+        grid = f"{where} no grid point is in stick-slip"
+    if jump_floor is None or vc is None:
+        return grid + "; the theory's boundary could not be computed here."
+    return (
+        f"{grid}. The model's own boundary, which the grid only brackets: stick-slip from"
+        f" {jump_floor * 1e6:.4g} µm/s (below it the stick's σs exceeds the steady curve's maximum: no jump, Eqs"
+        f" 15, 8) to Vc = {vc * 1e6:.4g} µm/s (Eq 9)."
+    )
 
 
 SWEEP_FIGURES: list[tuple[str, Callable[[ModelRun], ReportFigure]]] = [

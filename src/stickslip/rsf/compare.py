@@ -2,19 +2,29 @@
 
 The bond-model side is one small pluggable function, :func:`bond_response`: it
 uses the time-dependent bond model (``stickslip.transient.run_transient``) when
-that module is importable, and otherwise falls back on the quasi-static model:
+asked for and importable, and otherwise the quasi-static model:
 ``steady_state`` under velocity control (its response to a velocity change is
 instantaneous: the steady curve has no state, so there is no transient to
 compare, and a hold has no steady value) and ``simulate`` (the jump cycle)
 under block control.  ``BondTrace.note`` says which was used, in words.
 
 Friction on both sides is stress over the critical stress sigma_c of the bond
-model (Eq 9), so the two share one axis.  The RSF parameters of the bond model
-(:func:`rsf_of_bond`): ``a - b`` is the bond model's steady slope
-(1/sigma_c) dsigma/dlnV at the step's mean velocity; with the time-dependent
-model, a, b and Dc are fitted to its velocity-step response; without it a and
-Dc are not determined by the model, and the assumption made for the figure
-(Dc = the bond's maximum extension dl_m, a = |a - b|) is stated in the output.
+model (Eq 9), so the two share one axis.  ONE set of RSF parameters stands for
+the bond model in every panel (:func:`rsf_of_bond`), fitted to the velocity
+step the bond model actually makes:
+
+* the quasi-static model jumps at once to the new steady stress, so its step
+  is exactly a rate-only law: a = (mu1 - mu0)/ln(V1/V0), b = 0, and Dc has no
+  effect (it is not determined; it is set to the bond's dl_m and said so);
+* the time-dependent model's step is fitted by :func:`stickslip.rsf.fit.fit_record`
+  with the protocol given (the compare command knows it).
+
+Negative friction has no physical meaning, so a parameter set with a < 0,
+b < 0 or Dc <= 0 is reported as a **failed** fit (with the values the fit
+wanted), not used; and a panel in which the RSF friction goes below zero is
+reported as failed there (:func:`check_friction`).  We report rather than
+constrain: a fit pinned at b = 0 by a bound would not describe the step either,
+and the reason (e.g. "the step rises without a direct effect") is the finding.
 """
 
 from __future__ import annotations
@@ -25,12 +35,22 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import ModelError, ParameterError
+from ..errors import DataError, ModelError, ParameterError
 from ..protocols import Protocol
 from .params import RSFParams, StateVariable
 from .solver import simulate as rsf_simulate
 
-__all__ = ["BondRSF", "BondTrace", "bond_response", "rsf_of_bond", "stick_slip_pair"]
+__all__ = [
+    "BondRSF",
+    "BondTrace",
+    "bond_response",
+    "check_friction",
+    "fit_bond_step",
+    "physical_problem",
+    "rsf_of_bond",
+    "step_guess",
+    "stick_slip_pair",
+]
 
 
 @dataclass(frozen=True)
@@ -45,20 +65,58 @@ class BondTrace:
 
 @dataclass(frozen=True)
 class BondRSF:
-    """Rate-and-state parameters that stand for the bond model near ``velocity``."""
+    """Rate-and-state parameters that stand for the bond model near ``velocity``.
+
+    ``status`` is "fitted" (to the bond model's step), "given" (on the command line) or "failed" (``note`` says
+    why; ``params`` then holds what the fit wanted, for the record, and is not used).
+    """
 
     params: RSFParams
-    a_minus_b: float
+    a_minus_b: float  # the bond model's steady slope (1/sigma_c) dsigma/dlnV at ``velocity``
     velocity: float
     sigma_c: float
-    determined: bool
+    status: str
     note: str
     extra: dict[str, Any] = field(default_factory=dict)
 
+    @property
+    def usable(self) -> bool:
+        return self.status != "failed"
+
+    @property
+    def determined(self) -> bool:
+        return self.status == "fitted"
+
     def as_dict(self) -> dict[str, Any]:
         s = self.params.states[0]
-        return {"a": self.params.a, "b": s.b, "dc": s.dc, "a_minus_b": self.a_minus_b, "velocity": self.velocity,
-                "sigma_c": self.sigma_c, "fitted": self.determined, "note": self.note, **self.extra}  # fmt: skip
+        return {"a": self.params.a, "b": s.b, "dc": s.dc, "rsf_a_minus_b": self.params.a - s.b,
+                "bond_steady_slope": self.a_minus_b, "velocity": self.velocity, "sigma_c": self.sigma_c,
+                "status": self.status, "fitted": self.determined, "note": self.note, **self.extra}  # fmt: skip
+
+
+def physical_problem(params: RSFParams) -> str | None:
+    """Why an RSF parameter set is physically meaningless (a < 0, b < 0, Dc <= 0), or None."""
+    problems = [f"a = {params.a:.3g} < 0" if params.a < 0 else ""]
+    for k, state in enumerate(params.states):
+        name = "" if len(params.states) == 1 else str(k + 1)
+        problems.append(f"b{name} = {state.b:.3g} < 0 (weakening with hold time)" if state.b < 0 else "")
+        problems.append(f"Dc{name} = {state.dc:.3g} m is not positive" if not state.dc > 0 else "")
+    found = [p for p in problems if p]
+    return "; ".join(found) if found else None
+
+
+def check_friction(time: np.ndarray, friction: np.ndarray) -> str | None:
+    """None when the RSF friction stays positive; else where it goes below zero (meaningless), in words."""
+    friction = np.asarray(friction, float)
+    bad = ~np.isfinite(friction) | (friction < 0)
+    if not bad.any():
+        return None
+    k = int(np.argmax(bad))
+    low = float(np.nanmin(friction)) if np.isfinite(friction).any() else math.nan
+    return (
+        f"the RSF friction goes below zero from t = {float(time[k]):.4g} s (minimum {low:.3g}): negative friction"
+        " has no physical meaning, so this parameter set does not describe the bond model here"
+    )
 
 
 def _transient() -> Any:
@@ -125,59 +183,124 @@ def _critical(params: Any) -> tuple[float, float]:
 def rsf_of_bond(
     params: Any, v0: float, v1: float, duration: float = 1.0, stiffness: float = 1e9, model: str = "quasi-static"
 ) -> BondRSF:
-    """RSF a, b, Dc standing for the bond model between velocities ``v0`` and ``v1`` (see the module notes).
+    """RSF a, b, Dc fitted to the bond model's velocity step ``v0`` -> ``v1`` (see the module notes).
 
-    With ``model="transient"`` a, b and Dc are fitted to the time-dependent model's velocity step.
+    ``duration`` is the time spent at each velocity; ``stiffness`` (1/m) that of the RSF rig that copies the
+    slider (stiff: the bond model is under velocity control).
     """
     from ..model.steady import steady_state
 
+    if model not in ("quasi-static", "transient"):
+        raise ParameterError(f"bond model: expected 'quasi-static' or 'transient', got {model!r}")
     sigma_c = _critical(params)[1]
     vm = math.sqrt(v0 * v1)
     steady = steady_state(params, np.array([v0, vm, v1]))
     stress = np.ravel(steady.stress)
-    a_minus_b = float(np.ravel(steady.stress_slope)[1] * vm / sigma_c)
-    mu0 = float(stress[0] / sigma_c)
+    slope = float(np.ravel(steady.stress_slope)[1] * vm / sigma_c)
     if model == "transient" and _transient() is not None:
-        return _fitted_rsf(params, v0, v1, duration, stiffness, a_minus_b, mu0, sigma_c)
+        return _fitted_rsf(params, v0, v1, duration, stiffness, slope, sigma_c)
+    mu0, mu1 = float(stress[0] / sigma_c), float(stress[2] / sigma_c)
+    a = (mu1 - mu0) / math.log(v1 / v0)
     dl_m = float(params.bonds.max_extension)
-    a = abs(a_minus_b)
-    rsf = RSFParams(a=a, states=(StateVariable("aging", a - a_minus_b, dl_m),), mu0=mu0, v_ref=v0,
+    # a failed set is kept for the record only; RSFParams needs a > 0, so it holds |a| (the note gives a)
+    rsf = RSFParams(a=max(abs(a), 1e-12), states=(StateVariable("aging", 0.0, dl_m),), mu0=mu0, v_ref=v0,
                     stiffness=stiffness)  # fmt: skip
-    note = (f"a - b = {a_minus_b:.4g} is the bond model's steady slope (1/sigma_c) dsigma/dlnV at {vm * 1e6:.4g} um/s; "
-            "the quasi-static bond model has no state, so a and Dc are not determined by it: assumed a = |a - b| "
-            f"and Dc = dl_m = {dl_m * 1e6:.4g} um (the bond's maximum extension)")  # fmt: skip
-    return BondRSF(rsf, a_minus_b, vm, sigma_c, False, note)
+    step = f"{v0 * 1e6:.4g} -> {v1 * 1e6:.4g} um/s"
+    if a <= 0:
+        why = (f"fit failed: the quasi-static bond model's stress falls in the step {step} (mu {mu0:.4g} -> "
+               f"{mu1:.4g}), so a rate-only law would need a = {a:.3g} <= 0: no positive direct effect")  # fmt: skip
+        return BondRSF(rsf, slope, vm, sigma_c, "failed", why)
+    note = (f"fitted to the quasi-static bond model's step {step}: it jumps at once from mu = {mu0:.4g} to "
+            f"{mu1:.4g} (no transient, no state), which is exactly a = (mu1 - mu0)/ln(V1/V0) = {a:.4g}, b = 0; "
+            f"Dc has no effect with b = 0 and is not determined (set to dl_m = {dl_m * 1e6:.4g} um)")  # fmt: skip
+    return BondRSF(rsf, slope, vm, sigma_c, "fitted", note)
 
 
 def _fitted_rsf(
-    params: Any, v0: float, v1: float, duration: float, stiffness: float, a_minus_b: float, mu0: float, sigma_c: float
+    params: Any, v0: float, v1: float, duration: float, stiffness: float, slope: float, sigma_c: float
 ) -> BondRSF:
     from ..protocols import velocity_steps
-    from .data import LabRecord
-    from .fit import fit_record
 
     protocol = velocity_steps([v0, v1], [duration, duration])
     trace = bond_response(params, protocol, "velocity", model="transient")
-    t = trace.time
-    record = LabRecord.from_arrays(t, protocol.displacement_at(t), trace.stress / sigma_c, source="bond model")
-    fit = fit_record(record, stiffness=stiffness, protocol=protocol)
-    note = f"a, b, Dc fitted to the {trace.source}'s velocity step {v0 * 1e6:.4g} -> {v1 * 1e6:.4g} um/s"
-    return BondRSF(fit.params, a_minus_b, math.sqrt(v0 * v1), sigma_c, True, note,
-                   {"rms": fit.rms, "warnings": list(fit.warnings)})  # fmt: skip
+    return fit_bond_step(trace, protocol, sigma_c, slope)
+
+
+def step_guess(time: np.ndarray, friction: np.ndarray, protocol: Protocol) -> dict[str, float]:
+    """RSF starting values read off a velocity-step trace: the levels give a - b, the peak (the direct effect) a,
+    the slip over which the peak decays by e Dc, and the slip of the rise the rig stiffness."""
+    v0, v1 = protocol.segments[0].velocity, protocol.segments[1].velocity
+    change = protocol.boundaries[1]
+    before, after = time < change, time >= change
+    mu0 = float(np.median(friction[before][-max(before.sum() // 10, 1) :]))
+    tail = friction[after]
+    mu1 = float(np.median(tail[-max(tail.size // 10, 1) :]))
+    log_ratio = math.log(v1 / v0)
+    up = v1 > v0
+    k = int(np.argmax(tail) if up else np.argmin(tail))
+    peak, t_after = float(tail[k]), time[after]
+    overshoot = (peak - mu1) if up else (mu1 - peak)
+    a = (peak - mu0) / log_ratio if overshoot > 0 else 1.5 * (mu1 - mu0) / log_ratio
+    b = a - (mu1 - mu0) / log_ratio
+    excess = np.abs(tail[k:] - mu1)
+    decayed = np.nonzero(excess < excess[0] / math.e)[0]
+    dc = v1 * float(t_after[k + decayed[0]] - t_after[k]) if decayed.size and overshoot > 0 else 1e-6
+    rise = v1 * max(float(t_after[k] - change), 1e-12)
+    return {"mu0": mu0, "a": abs(a), "b": b, "dc": max(dc, 1e-9), "stiffness": max(abs(peak - mu0) / rise, 1.0)}
+
+
+def fit_bond_step(trace: BondTrace, protocol: Protocol, sigma_c: float, slope: float) -> BondRSF:
+    """RSF fitted to a bond-model trace of the velocity step ``protocol`` (the protocol given, not detected).
+
+    The rig stiffness is fitted too: the bond model's stress rises over the slip that stretches its bonds
+    (a fraction of a micrometre), which a rigid RSF rig would make instantaneous.
+    """
+    from .data import LabRecord
+    from .fit import fit_record
+
+    t = np.asarray(trace.time, float)
+    friction = np.asarray(trace.stress, float) / sigma_c
+    record = LabRecord.from_arrays(t, protocol.displacement_at(t), friction, source=trace.source)
+    v0, v1 = protocol.segments[0].velocity, protocol.segments[1].velocity
+    step = f"{v0 * 1e6:.4g} -> {v1 * 1e6:.4g} um/s"
+    vm = math.sqrt(v0 * v1)
+    try:
+        fit = fit_record(record, protocol=protocol, guess=step_guess(t, friction, protocol))
+    except (ModelError, DataError) as exc:
+        fallback = RSFParams(a=max(slope, 0.0), states=(StateVariable("aging", 0.0, 1e-6),), mu0=1.0, v_ref=v0)
+        return BondRSF(fallback, slope, vm, sigma_c, "failed", f"fit to the {trace.source}'s step {step} failed: {exc}")
+    p, s = fit.params, fit.params.states[0]
+    values = f"a = {p.a:.3g}, b = {s.b:.3g}, Dc = {s.dc * 1e6:.3g} um, rig stiffness {p.stiffness:.3g} 1/m"
+    extra = {"rms": fit.rms, "rig_stiffness": p.stiffness, "fit_success": fit.success, "warnings": list(fit.warnings)}
+    jump = float(np.ptp(friction))
+    problem = physical_problem(p)
+    if problem is None and not fit.success:
+        problem = f"the least-squares search did not converge ({fit.message})"
+    if problem is None and jump > 0 and fit.rms > 0.05 * jump:
+        problem = f"it does not describe the step: rms misfit {fit.rms:.3g} is over 5 % of the step's range {jump:.3g}"
+    if problem is not None:
+        note = f"fit failed: the best RSF fit to the {trace.source}'s velocity step {step} ({values}) is not usable: "
+        return BondRSF(p, slope, vm, sigma_c, "failed", note + problem, extra)
+    note = f"fitted to the {trace.source}'s velocity step {step} ({values}), rms misfit {fit.rms:.3g}"
+    return BondRSF(p, slope, vm, sigma_c, "fitted", note, extra)
 
 
 def stick_slip_pair(params: Any, v0: float, duration: float, rsf: BondRSF, eta: float | None = None) -> dict[str, Any]:
-    """The bond model's jump cycle and the RSF spring-slider at the same V0, stiffness and sigma_c."""
+    """The bond model's jump cycle and the RSF spring-slider at the same V0, stiffness and sigma_c.
+
+    The RSF law is ``rsf``'s own (a, b, Dc, mu0 at its v_ref): only the rig (stiffness, radiation damping) is the
+    bond model's block.  With a failed ``rsf`` the RSF side is not run (``"rsf": None``).
+    """
     from ..model.cycle import simulate as bond_simulate
     from ..protocols import constant
 
     sim = bond_simulate(params, v0, duration)
     k = float(sim.stiffness) / rsf.sigma_c  # Pa/m over sigma_c: friction per metre
-    a = rsf.params.a
+    a = abs(rsf.params.a)
     eta = a / (100.0 * v0) if eta is None else eta  # damping matters only above ~100 V0
-    from ..model.steady import steady_state
-
-    mu_v0 = float(np.ravel(steady_state(params, np.array([v0])).stress)[0]) / rsf.sigma_c
-    p = rsf.params.replace(stiffness=k, eta=eta, v_ref=v0, mu0=mu_v0)
+    if not rsf.usable:
+        return {"bond": sim, "rsf": None, "stiffness": k, "eta": eta, "problem": "not run: the RSF fit failed"}
+    p = rsf.params.replace(stiffness=k, eta=eta)
     run = rsf_simulate(p, constant(v0, duration), start_velocity=1.05 * v0)
-    return {"bond": sim, "rsf": run, "stiffness": k, "eta": eta}
+    problem = check_friction(run.time, run.friction) or (None if run.status == "ok" else run.message)
+    return {"bond": sim, "rsf": run, "stiffness": k, "eta": eta, "problem": problem}
