@@ -119,21 +119,22 @@ def test_one_parameter_set_for_every_panel():
     assert (used.a, used.b, used.dc, used.mu0, used.v_ref) == (0.3, 0.6, 100e-6, 1.2, 200e-6)  # only the rig differs
 
 
-def test_compare_command_reports_negative_friction_as_a_failure(tmp_path, capsys):
+def test_compare_command_reports_negative_friction_as_what_rsf_cannot_describe(tmp_path, capsys):
     """Defaults: the rate-only law fitted to the quasi-static step has no healing, so in the hold its friction
-    falls below zero; that is a failure (exit 3), said in words, and the figure still shows what was found."""
+    falls below zero. The fit itself succeeded, so the command does too (exit 0); the panel is named, in words,
+    as one the fitted law cannot describe, and the figure still shows what was found."""
     figure = tmp_path / "compare.png"
     code, out, err = run_main(capsys, "compare", "--duration", "60 s", "--json", "-o", str(figure))
-    assert code == 3, err
+    assert code == 0, err
     summary = json.loads(out)
-    assert summary["status"] == "failed" and "below zero" in " ".join(summary["failures"])
+    assert summary["status"] == "ok" and summary["failures"] == []
+    assert "below zero" in " ".join(summary["rsf_cannot_describe"])
     r = summary["rsf_of_bond_model"]
     assert {"a", "b", "dc", "status", "note"} <= set(r) and r["status"] == "fitted" and r["b"] == 0.0
     assert "rsf_parameters" not in summary["stick_slip"]  # one set, not a second one for stick-slip
     assert "slide-hold-slide" in summary["panels"] and summary["panels"]["velocity step"]["problem"] is None
     assert summary["stick_slip"]["bond"]["regime"] == "stick-slip"
     assert figure.stat().st_size > 0 and (tmp_path / "compare.params.json").is_file()
-    assert "stickslip: the rate-and-state side failed" in err
 
 
 def test_compare_with_rsf_overrides_shows_an_rsf_oscillation(capsys):
@@ -144,7 +145,7 @@ def test_compare_with_rsf_overrides_shows_an_rsf_oscillation(capsys):
     assert (rsf["a"], rsf["b"], rsf["dc"]) == pytest.approx((0.3, 0.6, 100e-6)) and rsf["status"] == "given"
     assert "given on the command line" in rsf["note"] and not rsf["fitted"]
     assert summary["stick_slip"]["rsf"]["period"] is not None
-    assert code == (3 if summary["failures"] else 0), err
+    assert code == 0 and summary["failures"] == [], err
 
 
 def test_compare_figure_labels_the_set_by_how_it_was_obtained(monkeypatch):

@@ -56,7 +56,7 @@ def test_compare_with_the_time_dependent_bond_model(capsys):
     status, out, err = run_main(capsys, "compare", "--bond-model", "transient", "--step-time", "20 ms", "--hold",
                                 "100 ms", "--duration", "30 s", "--json")  # fmt: skip
     data = json.loads(out)
-    assert status == (3 if data["failures"] else 0), err  # 3: an RSF panel failed (negative friction), said so
+    assert status == 0 and data["failures"] == [], err  # the step fit succeeded; panels RSF misses are findings
     assert data["bond_model"] == "time-dependent bond model (stickslip.transient)"
     fitted = data["rsf_of_bond_model"]
     assert fitted["fitted"] is True
