@@ -3,9 +3,10 @@
 Source: github.com/jrleeman/rsfmodel, tests/rsf_tests.py at its HEAD (commit d04d546; the Nagata case as corrected
 in commit e64f636, "Fix values in Nagata relation test case"), MIT licence.  All eight of its published cases: aging,
 slip and PRZ with one state variable (PRZ twice), aging, slip and PRZ with two, and Nagata with c = 2.  Every case:
-V0 = 1, mu0 = 0.6, load point at 1 until t = 10 then at 10, sampled every 1 s for 40 s, slider in steady state at t = 0.  Units in rsfmodel are arbitrary (um, s); the equations are
-scale-free, so they are passed here as SI numbers.  rsfmodel integrated with odeint at rtol = atol = 1e-12
-and published 8 decimals; we require agreement to 1e-7 (friction, state) and 1e-7 relative (velocity).
+V0 = 1, mu0 = 0.6, load point at 1 until t = 10 then at 10, sampled every 1 s for 40 s, slider in steady state at
+t = 0.  Units in rsfmodel are arbitrary (um, s); the equations are scale-free, so they are passed here as SI numbers.
+rsfmodel integrated with odeint at rtol = atol = 1e-12 and published 8 decimals; we require agreement to 1e-7
+(friction, state) and 1e-7 relative (velocity).
 """
 
 # ruff: noqa: RUF005  (the published arrays read best as head + values)

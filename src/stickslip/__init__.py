@@ -53,7 +53,7 @@ _LAZY = {
     "sweep": "stickslip.sweeps",
 }
 
-__all__ = [
+__all__ = [  # every public name once: the errors (loaded now) and the lazy names above
     "CriticalPoint",
     "DataError",
     "ModelError",
@@ -65,16 +65,24 @@ __all__ = [
     "StickPhase",
     "StickslipError",
     "UnitError",
+    "analyze_trace",
     "available_parameter_sets",
+    "compare_with_model",
     "critical_point",
+    "fit_steady",
+    "fit_stick",
     "jump_velocity",
     "load_parameters",
+    "read_steady_data",
+    "read_stick_data",
+    "read_trace",
+    "sample_posterior",
     "simulate",
     "slip_phase",
     "steady_state",
     "steady_stress_many",
     "stick_phase",
-    *_LAZY,
+    "sweep",
 ]
 __version__ = "0.1.0"
 
@@ -85,3 +93,12 @@ def __getattr__(name: str) -> Any:
         globals()[name] = value
         return value
     raise AttributeError(f"module 'stickslip' has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    # The public names (loaded or not yet), the subpackages and the module's dunders; not the helpers it imports.
+    shown = {name for name in globals() if name.startswith("__") or not name.startswith("_")}
+    return sorted((shown | set(__all__)) - _PRIVATE)
+
+
+_PRIVATE = {"Any", "TYPE_CHECKING", "annotations", "import_module"}
