@@ -7,6 +7,7 @@ a pandas DataFrame; ``stickslip sweep`` is the command line.  See docs/sweep.md.
 from __future__ import annotations
 
 import shutil
+import sys
 import tempfile
 from collections.abc import Mapping, Sequence
 from pathlib import Path
@@ -16,6 +17,7 @@ from ..errors import ParameterError
 from ..parameters import Parameters
 from ..units import to_si
 from .engine import compute, dask_client, default_batch_size, read_results
+from .main_guard import unguarded_script_line
 from .models import ALIASES, MODELS, get_model
 from .progress import Silent, reporter
 from .spec import Axis, SweepSpec, check_design, parse_vary
@@ -98,6 +100,7 @@ def run_sweep(
     batch_size: int | None = None,
 ) -> SweepStore:
     """Run (or resume) ``spec`` into the folder ``output``; ``workers=0`` runs in this process, without dask."""
+    workers = _workers_for_the_caller(workers, scheduler)
     store = open_store(output, spec, batch_size or default_batch_size(spec.size), overwrite=overwrite)
     shown = progress if progress is not None else Silent()
     finished = store.finished()
@@ -113,6 +116,22 @@ def run_sweep(
     finally:
         shown.close()
     return store
+
+
+def _workers_for_the_caller(workers: int | None, scheduler: str | None) -> int | None:
+    """0 (this process) for a script that calls a sweep outside ``if __name__ == "__main__":`` (see main_guard)."""
+    if scheduler is not None or workers == 0:
+        return workers
+    unguarded = unguarded_script_line()
+    if unguarded is None:
+        return workers
+    script, line = unguarded
+    why = f"{script} line {line} calls it outside `if __name__ == '__main__':`, and worker processes rerun the script"
+    if workers is not None:
+        raise ParameterError(f"workers={workers}: {why}; put the call under that guard, or use workers=0")
+    print(f"stickslip: note: the sweep runs in this process: {why}; put the call under that guard to use them",
+          file=sys.stderr)  # fmt: skip
+    return 0
 
 
 def sweep(
