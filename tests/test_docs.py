@@ -14,11 +14,13 @@ A page steers a block with HTML comments on the lines just before its fence (inv
 * ``<!-- test: before COMMAND -->``: a shell line run first, to make the block's input files.
 
 Inline code that starts with ``stickslip`` (synopses in tables and prose) is checked too: its command must exist
-and every ``--option`` in it must be one of that command's.
+and every ``--option`` in it must be one of that command's.  Every ``stickslip.module.name`` a page mentions must
+import, every repository path (``src/...``, ``tests/...``, ``docs/...``) and every relative link must exist.
 """
 
 from __future__ import annotations
 
+import importlib
 import re
 import shlex
 import time
@@ -50,7 +52,7 @@ class Block:
 
     @property
     def where(self) -> str:
-        return f"{self.page.relative_to(ROOT)}:{self.line}"
+        return f"{_page_id(self.page)}:{self.line}"
 
     def skip_reason(self) -> str | None:
         return next((arg for kind, arg in self.markers if kind == "skip"), None)
@@ -67,7 +69,7 @@ class Block:
 
 
 def _page_id(page: Path) -> str:
-    return str(page.relative_to(ROOT))
+    return str(page.relative_to(ROOT)) if page.is_relative_to(ROOT) else str(page)
 
 
 def blocks(page: Path) -> list[Block]:
@@ -102,7 +104,7 @@ def indented_commands(page: Path) -> list[str]:
         if FENCE.match(line):
             in_fence = not in_fence
         elif not in_fence and previous_blank and re.match(r"^( {4,}|\t)(\$ )?(stickslip|python)\b", line):
-            hits.append(f"{page.relative_to(ROOT)}:{number}: {line.strip()}")
+            hits.append(f"{_page_id(page)}:{number}: {line.strip()}")
         previous_blank = not line.strip()
     return hits
 
@@ -214,8 +216,8 @@ def _synopses(page: Path) -> list[str]:
     return spans
 
 
-@pytest.mark.parametrize("page", PAGES, ids=_page_id)
-def test_inline_command_synopses_name_real_commands_and_options(page):
+def synopsis_problems(page: Path) -> list[str]:
+    """Inline ``stickslip ...`` spans naming a command or an option that does not exist."""
     commands = _commands()
     problems = []
     for span in _synopses(page):
@@ -231,4 +233,74 @@ def test_inline_command_synopses_name_real_commands_and_options(page):
         for option in re.findall(r"(?<![\w-])(--[a-z][a-z0-9-]*|-[a-zA-Z])\b", " ".join(words)):
             if option not in known:
                 problems.append(f"`{span}`: `stickslip {path}` has no option {option}")
+    return problems
+
+
+@pytest.mark.parametrize("page", PAGES, ids=_page_id)
+def test_inline_command_synopses_name_real_commands_and_options(page):
+    problems = synopsis_problems(page)
     assert not problems, f"{_page_id(page)}:\n" + "\n".join(problems)
+
+
+#: paths quoted from other projects, not files of this repository
+FOREIGN_PATHS = {"tests/rsf_tests.py"}  # rsfmodel's test suite (docs/rsf.md)
+DOTTED = re.compile(r"(?<![\w./-])(stickslip(?:\.[A-Za-z_]\w*)+)")
+REPO_PATH = re.compile(r"(?<![\w/.-])((?:src|tests|benchmarks|scripts|docs)/[\w./*-]*\w)")
+LINK = re.compile(r"\]\(([^)\s]+)\)")
+
+
+def _resolve(dotted: str) -> object:
+    parts = dotted.split(".")
+    for i in range(len(parts), 0, -1):
+        try:
+            found = importlib.import_module(".".join(parts[:i]))
+        except ImportError:
+            continue
+        for part in parts[i:]:
+            found = getattr(found, part)
+        return found
+    raise ImportError(dotted)
+
+
+@pytest.mark.parametrize("page", PAGES, ids=_page_id)
+def test_named_modules_functions_files_and_links_exist(page):
+    text = page.read_text(encoding="utf-8")
+    problems = []
+    for dotted in sorted(set(DOTTED.findall(text))):
+        try:
+            _resolve(dotted)
+        except (ImportError, AttributeError) as exc:
+            problems.append(f"{dotted}: does not resolve ({type(exc).__name__}: {exc})")
+    for path in sorted(set(REPO_PATH.findall(text)) - FOREIGN_PATHS):
+        if not (any(ROOT.glob(path)) if "*" in path else (ROOT / path).exists()):
+            problems.append(f"{path}: no such file in the repository")
+    for target in sorted(set(LINK.findall(text))):
+        if not re.match(r"[a-z]+:|#", target) and not (page.parent / target.split("#")[0]).exists():
+            problems.append(f"link ({target}): no such file")
+    assert not problems, f"{_page_id(page)}:\n" + "\n".join(problems)
+
+
+def test_the_harness_sees_markers_failures_and_unknown_names(tmp_path, capsys):
+    page = tmp_path / "page.md"
+    page.write_text(
+        "Text.\n\n<!-- test: replace 120 s -> 5 s -->\n```bash\nstickslip critical \\\n  --json  # note\n```\n"
+        "\n    stickslip curve\n\n```\nuntagged\n```\n"
+    )
+    first, second = blocks(page)
+    assert first.lang == "bash" and first.markers == [("replace", "120 s -> 5 s")] and second.lang == ""
+    assert shell_lines(first.text, "bash") == ["stickslip critical    --json  # note"]
+    assert len(indented_commands(page)) == 1
+    with pytest.raises(AssertionError, match="does not occur"):
+        first.runnable_text()
+    with pytest.raises(AssertionError, match="exited 2"):
+        run_shell_line('stickslip simulate --v0 50 --duration "1 s"', "here", capsys)
+    with pytest.raises(AssertionError, match="shell operator"):
+        run_shell_line("stickslip critical | head", "here", capsys)
+    with pytest.raises(AttributeError):
+        _resolve("stickslip.model.no_such_function")
+    cycle = tmp_path / "cycle.md"
+    cycle.write_text("Run `stickslip cycle --v0 V` or `stickslip rsf simulate --v0 V`.\n")
+    assert synopsis_problems(cycle) == [
+        "`stickslip cycle --v0 V`: no command `stickslip cycle`",
+        "`stickslip rsf simulate --v0 V`: `stickslip rsf simulate` has no option --v0",
+    ]
