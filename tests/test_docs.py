@@ -309,7 +309,8 @@ def test_the_harness_sees_markers_failures_and_unknown_names(tmp_path, capsys):
 def test_shipped_third_party_data_keeps_its_licence_and_credit():
     """The sepiolite record is MIT-licensed by its author: the licence and the credit travel with the data."""
     folder = ROOT / "src" / "stickslip" / "data" / "giacomel-sepiolite"
-    assert "MIT License" in (folder / "LICENSE").read_text() and "Piercarlo Giacomel" in (folder / "LICENSE").read_text()
+    licence = (folder / "LICENSE").read_text()
+    assert "MIT License" in licence and "Piercarlo Giacomel" in licence
     assert "pgiacomel/steadystate" in (folder / "README.md").read_text()
     assert (folder / "velstep3_TR2_exp013_sepiolite.txt").stat().st_size > 700_000  # the data, not an LFS pointer
     assert '"data/*/*"' in (ROOT / "pyproject.toml").read_text()  # package data: the wheel ships the folder
