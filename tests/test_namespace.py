@@ -29,9 +29,19 @@ def test_dir_lists_the_public_names_and_not_the_import_helpers():
 
 def test_dir_in_a_fresh_interpreter_lists_lazy_names_before_use():
     # In this process other tests may have loaded the lazy names already; a fresh one has not.
-    code = "import stickslip; d = dir(stickslip); print('steady_state' in d, 'import_module' in d)"
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
-    assert out.split() == ["True", "False"]
+    code = "import stickslip; d = dir(stickslip); print('steady_state' in d, 'import_module' in d, 'rsf' in d)"
+    env = {**os.environ, "PYTHONPATH": str(SRC)}
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True, env=env).stdout
+    assert out.split() == ["True", "False", "True"]
+
+
+def test_subpackages_are_reachable_after_a_plain_import():
+    # README: `stickslip.transient.run_transient(...)`, `stickslip.rsf`, `stickslip.protocols` after `import stickslip`
+    code = "import stickslip; print(stickslip.rsf.simulate.__name__, stickslip.protocols.read_protocol.__name__)"
+    env = {**os.environ, "PYTHONPATH": str(SRC)}
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True, env=env).stdout
+    assert out.split() == ["simulate", "read_protocol"]
+    assert stickslip.transient.run_transient is not None
 
 
 def test_star_import_gives_the_public_names():

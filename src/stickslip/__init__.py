@@ -87,18 +87,27 @@ __all__ = [  # every public name once: the errors (loaded now) and the lazy name
 __version__ = "0.1.0"
 
 
+#: subpackages and modules reachable as ``stickslip.rsf`` etc. after a plain ``import stickslip``
+_SUBMODULES = frozenset(
+    {"analysis", "errors", "fileio", "fitting", "model", "numerics", "parameters", "protocols", "report", "rsf",
+     "sweeps", "transient", "units"}
+)  # fmt: skip
+
+
 def __getattr__(name: str) -> Any:
     if name in _LAZY:
         value = getattr(import_module(_LAZY[name]), name)
         globals()[name] = value
         return value
+    if name in _SUBMODULES:
+        return import_module(f"{__name__}.{name}")
     raise AttributeError(f"module 'stickslip' has no attribute {name!r}")
 
 
 def __dir__() -> list[str]:
     # The public names (loaded or not yet), the subpackages and the module's dunders; not the helpers it imports.
     shown = {name for name in globals() if name.startswith("__") or not name.startswith("_")}
-    return sorted((shown | set(__all__)) - _PRIVATE)
+    return sorted((shown | set(__all__) | _SUBMODULES) - _PRIVATE)
 
 
 _PRIVATE = {"Any", "TYPE_CHECKING", "annotations", "import_module"}
