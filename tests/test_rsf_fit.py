@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import json
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -13,17 +12,15 @@ from scipy import stats
 from cli_helpers import run_main
 from stickslip import protocols
 from stickslip.errors import DataError, ParameterError
+from stickslip.fitting.datasets import data_path
 from stickslip.rsf import rsf_params, simulate
 from stickslip.rsf.data import LabRecord, find_segments, parse_columns, read_record
 from stickslip.rsf.fit import fit_record
 
 TRUE = rsf_params(0.008, 0.012, 20e-6, v_ref=1e-6, stiffness=3e3, mu0=0.6)
 STEP = protocols.velocity_steps([1e-6, 10e-6], [60.0, 40.0])
-ROOT = Path(__file__).resolve().parents[1]
-#: ../shared beside the repository root (or beside the folder of worktrees)
-REAL = next((p for p in (ROOT.parent / "shared", ROOT.parent.parent / "shared") if p.is_dir()), ROOT.parent / "shared")
-REAL = REAL / "data" / "giacomel-steadystate"
-REAL_FILE = REAL / "velstep3_TR2_exp013_sepiolite.txt"
+#: Giacomel's sepiolite velocity step, shipped with the package (MIT, its LICENSE and README beside it)
+REAL_FILE = data_path("giacomel-sepiolite/velstep3_TR2_exp013_sepiolite.txt")
 
 
 def synthetic(seed: int, noise: float = 2e-4, rows: int = 600) -> LabRecord:
@@ -109,7 +106,6 @@ def test_cli_fit_json_and_toml(tmp_path, capsys):
     assert json.loads(out2)["final_friction"] == pytest.approx(expected, abs=2e-4)
 
 
-@pytest.mark.skipif(not REAL_FILE.is_file(), reason=f"the Giacomel record is not at {REAL} (shared data folder)")
 def test_real_sepiolite_velocity_step_is_described():
     """docs/rsf.md: one state with a linear trend describes the record to within 3x its high-frequency noise."""
     cols = parse_columns('time="Time(s)",displacement="Displ(microns)",friction=Friction')

@@ -1,10 +1,12 @@
 """Published numbers: rsfmodel's own test suite, reproduced with stickslip's solver.
 
-Source: github.com/jrleeman/rsfmodel, tests/rsf_tests.py (commit 8b1c9dd002523a87ec6582cec5fda64d015a6911),
-MIT licence.  Every case: V0 = 1, mu0 = 0.6, load point at 1 until t = 10 then at 10, sampled every 1 s
-for 40 s, slider in steady state at t = 0.  Units in rsfmodel are arbitrary (um, s); the equations are
-scale-free, so they are passed here as SI numbers.  rsfmodel integrated with odeint at rtol = atol = 1e-12
-and published 8 decimals; we require agreement to 1e-7 (friction, state) and 1e-7 relative (velocity).
+Source: github.com/jrleeman/rsfmodel, tests/rsf_tests.py at its HEAD (commit d04d546; the Nagata case as corrected
+in commit e64f636, "Fix values in Nagata relation test case"), MIT licence.  All eight of its published cases: aging,
+slip and PRZ with one state variable (PRZ twice), aging, slip and PRZ with two, and Nagata with c = 2.  Every case:
+V0 = 1, mu0 = 0.6, load point at 1 until t = 10 then at 10, sampled every 1 s for 40 s, slider in steady state at
+t = 0.  Units in rsfmodel are arbitrary (um, s); the equations are scale-free, so they are passed here as SI numbers.
+rsfmodel integrated with odeint at rtol = atol = 1e-12 and published 8 decimals; we require agreement to 1e-7
+(friction, state) and 1e-7 relative (velocity).
 """
 
 # ruff: noqa: RUF005  (the published arrays read best as head + values)
@@ -114,19 +116,64 @@ CASES = {
                                10.00894645, 10.00729017, 10.00594089, 10.00484157, 10.00394584, 10.00321593,
                                10.00262111, 10.00213635, 10.00174128, 10.00141929, 10.00115686, 10.00094295],
     ),
+    "prz (Perrin), one state": dict(
+        a=0.01, k=1e-3, states=[("prz", 0.005, 10.0)],
+        friction=HEAD + [0.60839207, 0.61456074, 0.61610039, 0.61386731, 0.61210792, 0.61145825, 0.61134801,
+                         0.61140235, 0.61146702, 0.61150337, 0.61151606, 0.6115174, 0.61151556, 0.61151389,
+                         0.61151306, 0.61151281, 0.61151281, 0.61151286, 0.61151291, 0.61151292, 0.61151293,
+                         0.61151293, 0.61151293, 0.61151293, 0.61151293, 0.61151293, 0.61151293, 0.61151293,
+                         0.61151293, 0.61151293],
+        state=[[20.0] * 11 + [18.43306111, 11.27594869, 4.02202969, 2.08589836, 1.82377319, 1.86690475, 1.93990872,
+                              1.98492677, 2.00233846, 2.0051588, 2.00332919, 2.00133051, 2.00024915, 1.99988898,
+                              1.99986167, 1.99992165, 1.99997245, 1.99999695, 2.00000387, 2.00000357, 2.0000018,
+                              2.00000054, 2.0, 1.99999988, 1.99999991, 1.99999996, 1.99999999, 2.0, 2.0, 2.0]],
+        velocity=[1.0] * 11 + [2.41090004, 5.71219864, 11.15638292, 12.3913343, 11.11398288, 10.29388702,
+                               9.98762095, 9.92751362, 9.94838881, 9.97758477, 9.99481799, 10.00114731, 10.00201236,
+                               10.00124394, 10.00047829, 10.00007902, 9.99995219, 9.99994673, 9.99997095,
+                               9.99999023, 9.9999992, 10.00000158, 10.00000136, 10.00000066, 10.00000019,
+                               9.99999999, 9.99999995, 9.99999997, 9.99999999, 10.0],
+    ),
+    "prz, two states": dict(
+        a=0.02, k=3e-3, states=[("prz", 0.01, 5.0), ("prz", 0.005, 3.0)],
+        friction=HEAD + [0.62332749, 0.61662392, 0.60925037, 0.61102238, 0.61175384, 0.61157669, 0.61148672,
+                         0.611505, 0.61151574, 0.6115139, 0.61151263, 0.61151281, 0.61151296, 0.61151294,
+                         0.61151292, 0.61151292, 0.61151293, 0.61151293, 0.61151293, 0.61151293, 0.61151293,
+                         0.61151293, 0.61151293, 0.61151293, 0.61151293, 0.61151293, 0.61151293, 0.61151293,
+                         0.61151293, 0.61151293],
+        state=[[10.0] * 11 + [6.84431098, 0.72378553, 0.86994234, 1.03299015, 1.01865937, 0.99670972, 0.99782031,
+                              1.00032473, 1.00025833, 0.99996907, 0.99996963, 1.00000281, 1.00000355, 0.99999976,
+                              0.99999959, 1.00000002, 1.00000005, 1.0, 0.99999999, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0,
+                              1.0, 1.0, 1.0, 1.0, 1.0],
+               [6.0] * 11 + [3.4500867, 0.36317378, 0.55303551, 0.63530577, 0.60831617, 0.59630691, 0.59898905,
+                              0.60040086, 0.60012611, 0.59995714, 0.5999845, 0.60000454, 0.60000189, 0.59999953,
+                              0.59999977, 0.60000005, 0.60000003, 0.6, 0.6, 0.6, 0.6, 0.6, 0.6, 0.6, 0.6, 0.6, 0.6,
+                              0.6, 0.6, 0.6]],
+        velocity=[1.0] * 11 + [4.45620908, 17.20632436, 9.77177682, 9.46437404, 9.99361157, 10.06399985,
+                               10.00202131, 9.99274721, 9.99958814, 10.000822, 10.0000672, 9.99990739, 9.99999004,
+                               10.00001038, 10.00000139, 9.99999884, 9.99999981, 10.00000013, 10.00000002,
+                               9.99999999, 10.0, 10.0, 10.0, 10.0, 10.0, 10.0, 10.0, 10.0, 10.0, 10.0],
+    ),
+    "nagata, one state (c = 2)": dict(
+        a=0.027, k=0.01, states=[("nagata", 0.029, 3.33, 2.0)],
+        friction=HEAD + [0.60938215, 0.60034494, 0.59703287, 0.59592421, 0.59556459, 0.59544913, 0.59541219,
+                         0.59540038, 0.5953966, 0.5953954, 0.59539501, 0.59539489, 0.59539485, 0.59539484,
+                         0.59539483, 0.59539483, 0.59539483, 0.59539483, 0.59539483, 0.59539483, 0.59539483,
+                         0.59539483, 0.59539483, 0.59539483, 0.59539483, 0.59539483, 0.59539483, 0.59539483,
+                         0.59539483, 0.59539483],
+        state=[[3.33] * 11 + [0.47875177, 0.37623256, 0.34642714, 0.33724867, 0.33435315, 0.33343188, 0.33313794,
+                              0.33304407, 0.33301408, 0.3330045, 0.33300144, 0.33300046, 0.33300015, 0.33300005,
+                              0.33300001, 0.333, 0.333, 0.333, 0.333, 0.333, 0.333, 0.333, 0.333, 0.333, 0.333,
+                              0.333, 0.333, 0.333, 0.333, 0.333]],
+        velocity=[1.0] * 11 + [11.36686532, 10.53618749, 10.18376884, 10.06007654, 10.01933637, 10.00619248,
+                               10.00197996, 10.00063274, 10.00020217, 10.00006459, 10.00002064, 10.00000659,
+                               10.00000211, 10.00000067, 10.00000022, 10.00000007, 10.00000002, 10.00000001, 10.0,
+                               10.0, 10.0, 10.0, 10.0, 10.0, 10.0, 10.0, 10.0, 10.0, 10.0, 10.0],
+    ),
 }  # fmt: skip
-
-#: rsfmodel's "Nagata, one state" case (a = 0.027, b = 0.029, Dc = 3.33, c = 2, k = 0.01).  Its published numbers
-#: are those of the aging law (c = 0): in rsfmodel the Nagata term used a dmu/dt that was never updated, so c had
-#: no effect.  We reproduce them with c = 0, and check that c = 2 does change the answer (docs/rsf.md).
-NAGATA_FRICTION = HEAD + [0.63405624, 0.59077486, 0.59622046, 0.5952689, 0.59541182, 0.59539301, 0.59539492,
-                          0.59539486, 0.59539482] + [0.59539483] * 21  # fmt: skip
-NAGATA_STATE = [3.33] * 11 + [0.75351918, 0.30973464, 0.34020859, 0.33152619, 0.33327998, 0.33295162, 0.33300762,
-                              0.33299893, 0.33300012, 0.33299999] + [0.333] * 20  # fmt: skip
 
 
 def _run(case: dict) -> object:
-    states = tuple(StateVariable(law, b, dc) for law, b, dc in case["states"])
+    states = tuple(StateVariable(law, b, dc, *c) for law, b, dc, *c in case["states"])
     params = RSFParams(a=case["a"], states=states, mu0=0.6, v_ref=1.0, stiffness=case["k"])
     return simulate(params, STEP, every=1.0)
 
@@ -142,13 +189,7 @@ def test_rsfmodel_published_values(name):
     assert np.max(np.abs(run.slider_velocity / np.array(case["velocity"]) - 1)) < 1e-7
 
 
-def test_rsfmodel_nagata_case_is_the_aging_law():
-    def run(c):
-        state = StateVariable("nagata", 0.029, 3.33, c=c)
-        return simulate(RSFParams(a=0.027, states=(state,), mu0=0.6, v_ref=1.0, stiffness=0.01), STEP, every=1.0)
-
-    plain = run(0.0)
-    assert np.max(np.abs(plain.friction - NAGATA_FRICTION)) < 1e-7
-    assert np.max(np.abs(plain.state[0] - NAGATA_STATE)) < 1e-7
-    coupled = run(2.0)
-    assert np.max(np.abs(coupled.friction - NAGATA_FRICTION)) > 1e-2  # the c term matters by 0.02 in friction
+def test_rsfmodel_nagata_case_needs_its_c_term():
+    """The published Nagata numbers are not the aging law's: without the (c/b) theta dmu/dt term they are missed."""
+    case = dict(CASES["nagata, one state (c = 2)"], states=[("nagata", 0.029, 3.33, 0.0)])
+    assert np.max(np.abs(_run(case).friction - case["friction"])) > 1e-3

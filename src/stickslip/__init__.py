@@ -53,7 +53,7 @@ _LAZY = {
     "sweep": "stickslip.sweeps",
 }
 
-__all__ = [
+__all__ = [  # every public name once: the errors (loaded now) and the lazy names above
     "CriticalPoint",
     "DataError",
     "ModelError",
@@ -65,18 +65,33 @@ __all__ = [
     "StickPhase",
     "StickslipError",
     "UnitError",
+    "analyze_trace",
     "available_parameter_sets",
+    "compare_with_model",
     "critical_point",
+    "fit_steady",
+    "fit_stick",
     "jump_velocity",
     "load_parameters",
+    "read_steady_data",
+    "read_stick_data",
+    "read_trace",
+    "sample_posterior",
     "simulate",
     "slip_phase",
     "steady_state",
     "steady_stress_many",
     "stick_phase",
-    *_LAZY,
+    "sweep",
 ]
 __version__ = "0.1.0"
+
+
+#: subpackages and modules reachable as ``stickslip.rsf`` etc. after a plain ``import stickslip``
+_SUBMODULES = frozenset(
+    {"analysis", "errors", "fileio", "fitting", "model", "numerics", "parameters", "protocols", "report", "rsf",
+     "sweeps", "transient", "units"}
+)  # fmt: skip
 
 
 def __getattr__(name: str) -> Any:
@@ -84,4 +99,15 @@ def __getattr__(name: str) -> Any:
         value = getattr(import_module(_LAZY[name]), name)
         globals()[name] = value
         return value
+    if name in _SUBMODULES:
+        return import_module(f"{__name__}.{name}")
     raise AttributeError(f"module 'stickslip' has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    # The public names (loaded or not yet), the subpackages and the module's dunders; not the helpers it imports.
+    shown = {name for name in globals() if name.startswith("__") or not name.startswith("_")}
+    return sorted((shown | set(__all__) | _SUBMODULES) - _PRIVATE)
+
+
+_PRIVATE = {"Any", "TYPE_CHECKING", "annotations", "import_module"}

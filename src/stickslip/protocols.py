@@ -199,6 +199,9 @@ def read_protocol(path: str | Path) -> Protocol:
       ``time`` until the next row's; the last row marks the end of the protocol
       (its velocity is not used).  Times must increase strictly; the first
       row's time is taken as the start.
+
+    Lines starting with ``#`` are comments.  The format, with an example file shipped in the package
+    (``data/slide-hold-slide.csv``), is described in docs/protocols.md.
     """
     import pandas as pd
 

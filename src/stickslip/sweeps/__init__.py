@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import numbers
 import shutil
+import sys
 import tempfile
 import warnings
 from collections.abc import Callable, Mapping, Sequence
@@ -18,6 +19,7 @@ from ..errors import DataError, ParameterError
 from ..parameters import Parameters
 from ..units import to_si
 from .engine import check_scheduler_address, compute, dask_client, default_batch_size, read_results
+from .main_guard import unguarded_script_line
 from .models import ALIASES, MODELS, get_model
 from .progress import Silent, reporter
 from .spec import Axis, SweepSpec, check_design, parse_vary
@@ -126,6 +128,7 @@ def run_sweep(
         raise ParameterError(f"scheduler: expected an address such as 'tcp://HOST:8786', got {scheduler!r}")
     if scheduler is not None:
         check_scheduler_address(scheduler)
+    workers = _workers_for_the_caller(workers, scheduler)
     store = open_store(output, spec, batch_size or default_batch_size(spec.size), overwrite=overwrite)
     shown = progress if progress is not None else Silent()
     try:
@@ -144,6 +147,22 @@ def run_sweep(
     finally:
         store.close()
     return store
+
+
+def _workers_for_the_caller(workers: int | None, scheduler: str | None) -> int | None:
+    """0 (this process) for a script that calls a sweep outside ``if __name__ == "__main__":`` (see main_guard)."""
+    if scheduler is not None or workers == 0:
+        return workers
+    unguarded = unguarded_script_line()
+    if unguarded is None:
+        return workers
+    script, line = unguarded
+    why = f"{script} line {line} calls it outside `if __name__ == '__main__':`, and worker processes rerun the script"
+    if workers is not None:
+        raise ParameterError(f"workers={workers}: {why}; put the call under that guard, or use workers=0")
+    print(f"stickslip: note: the sweep runs in this process: {why}; put the call under that guard to use them",
+          file=sys.stderr)  # fmt: skip
+    return 0
 
 
 def sweep(
