@@ -25,7 +25,7 @@ import numpy as np
 from ..errors import ModelError, ParameterError
 from ..protocols import Protocol
 from .params import RSFParams
-from .results import RSFRun, assemble_run
+from .results import RSFRun, Solution, assemble_run
 from .system import EXP_CAP, System
 
 __all__ = ["BLOW_UP_FACTOR", "evolve_state", "simulate"]
@@ -84,12 +84,22 @@ def simulate(
     watch = grid is not None and params.eta == 0 and params.mass == 0 and _unstable_somewhere(params, protocol)
     t_parts, y_parts = [np.array([0.0])], [y[:, None]]
     status, message = "ok", ""
+    last: Solution | None = None
     for t0, t1, vlp in protocol.pieces():
-        if grid is None:
-            t_out, y_out, y_end, blown = _adaptive_piece(system, y, t0, t1, vlp, x_cap, rtol, atol)
-        else:
+        if grid is not None and not detect:  # fits: the grid only, at odeint's speed
             inside = grid[(grid > t0) & (grid <= t1)]
             t_out, y_out, y_end, blown = _sampled_piece(system, y, t0, t1, vlp, inside, x_cap, rtol, atol, watch)
+        else:
+            # the regime is read off every accepted step and the solver's interpolant, whatever the sampling
+            t_steps, y_steps, y_end, blown, dense = _adaptive_piece(
+                system, y, t0, t1, vlp, x_cap, rtol, atol, dense=detect or grid is not None
+            )
+            last = Solution(t0, np.r_[t0, t_steps], np.c_[y, y_steps], dense)
+            t_out, y_out = t_steps, y_steps
+            if grid is not None:
+                reached = float(t_steps[-1]) if t_steps.size else t0
+                t_out = grid[(grid > t0) & (grid <= min(t1, reached))]
+                y_out = dense(t_out) if t_out.size else np.empty((system.size, 0))
         t_parts.append(t_out)
         y_parts.append(y_out)
         if blown is not None:
@@ -103,7 +113,7 @@ def simulate(
         y = y_end
     t_all = np.concatenate(t_parts)
     y_all = np.concatenate(y_parts, axis=1)
-    return assemble_run(system, protocol, t_all, y_all, status, message, v_start, detect)
+    return assemble_run(system, protocol, t_all, y_all, status, message, v_start, detect, last, rtol)
 
 
 def _grid(protocol: Protocol, every: float | None, times: Any) -> np.ndarray | None:
@@ -157,8 +167,8 @@ def _dense_piece(
     system: System, y0: np.ndarray, t0: float, t1: float, vlp: float, inside: np.ndarray, x_cap: float,
     rtol: float, atol: float,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, float | None]:  # fmt: skip
-    t_end, dense, y_end, blown = _adaptive_piece(system, y0, t0, t1, vlp, x_cap, rtol, atol, dense=True)
-    keep = inside[inside <= t_end]
+    t_steps, _, y_end, blown, dense = _adaptive_piece(system, y0, t0, t1, vlp, x_cap, rtol, atol, dense=True)
+    keep = inside[inside <= (float(t_steps[-1]) if t_steps.size else t0)]
     return keep, (dense(keep) if keep.size else np.empty((system.size, 0))), y_end, blown
 
 
@@ -172,7 +182,8 @@ def _unstable_somewhere(params: RSFParams, protocol: Protocol) -> bool:
 def _adaptive_piece(
     system: System, y0: np.ndarray, t0: float, t1: float, vlp: float, x_cap: float, rtol: float, atol: float,
     dense: bool = False,
-) -> tuple[Any, Any, np.ndarray, float | None]:  # fmt: skip
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, float | None, Any]:  # fmt: skip
+    """(accepted step times after t0, states there, final state, blow-up time or None, interpolant or None)."""
     from scipy.integrate import solve_ivp
 
     o = system.offset
@@ -231,9 +242,7 @@ def _adaptive_piece(
             )
         else:
             raise ModelError(f"rate-and-state solver failed at t = {t_fail:.6g} s ({sol.message})")
-    if dense:
-        return float(sol.t[-1]), sol.sol, sol.y[:, -1], blown
-    return sol.t[1:], sol.y[:, 1:], sol.y[:, -1], blown
+    return sol.t[1:], sol.y[:, 1:], sol.y[:, -1], blown, sol.sol
 
 
 def evolve_state(
