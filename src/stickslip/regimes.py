@@ -174,7 +174,7 @@ def extremes(t: np.ndarray, y: np.ndarray, index: int, dense: Dense | None = Non
     lo, hi = max(index - 1, 0), min(index + 1, n - 1)
     is_max = (y[index] >= y[lo]) and (y[index] >= y[hi])
     sign = 1.0 if is_max else -1.0
-    if dense is not None and hi > lo:
+    if dense is not None and t[hi] > t[lo]:
         grid = np.linspace(t[lo], t[hi], 201)
         values = np.asarray(dense(grid), dtype=float)
         k = int(np.argmax(sign * values))
@@ -194,6 +194,8 @@ def extremes(t: np.ndarray, y: np.ndarray, index: int, dense: Dense | None = Non
 
 def _parabola_vertex(t: np.ndarray, v: np.ndarray) -> tuple[float, float]:
     (t0, t1, t2), (v0, v1, v2) = t.tolist(), v.tolist()
+    if not t0 < t1 < t2:
+        return math.nan, math.nan
     d0, d1 = (v1 - v0) / (t1 - t0), (v2 - v1) / (t2 - t1)
     curvature = (d1 - d0) / (t2 - t0)
     if curvature == 0 or not math.isfinite(curvature):
