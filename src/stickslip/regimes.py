@@ -275,11 +275,11 @@ def classify(
         recent = ratios[-RATIOS_NEEDED:]
         if len(recent) == RATIOS_NEEDED:
             if all(abs(r - 1) <= RATIO_TOLERANCE for r in recent):
-                return Regime(STICK_SLIP, periods, ratio, period, peak, trough, f"limit cycle: {evidence}")
+                return Regime(STICK_SLIP, periods, ratio, period, peak, trough, f"stick-slip (limit cycle): {evidence}")
             if all(r < 1 - RATIO_TOLERANCE for r in recent):
-                return Regime(DECAYING, periods, ratio, period, peak, trough, f"decaying: {evidence}")
+                return Regime(DECAYING, periods, ratio, period, peak, trough, f"decaying oscillation: {evidence}")
             if all(r > 1 + RATIO_TOLERANCE for r in recent):
-                return Regime(GROWING, periods, ratio, period, peak, trough, f"growing: {evidence}")
+                return Regime(GROWING, periods, ratio, period, peak, trough, f"growing oscillation: {evidence}")
         return Regime(UNDETERMINED, periods, ratio, period, peak, trough, f"undetermined: {evidence}")
     # not (or no longer) oscillating: steady only when the tail has stopped changing
     tail_from = last_extremum if placed else float(tw[0])
@@ -289,8 +289,9 @@ def classify(
         return Regime(UNDETERMINED, periods, ratio, period, peak, trough, "undetermined: no tail to judge")
     change, remaining = remaining_change(tw, yw, tau, dense)
     if remaining <= floor or change <= floor * 1e-3:
+        left = "nothing measurable" if math.isinf(remaining) else f"{remaining:.3g}{suffix}"
         text = (
-            f"steady: changed {change:.3g}{suffix} over the last {tau:.3g} s, {remaining:.3g}{suffix} still to come"
+            f"steady: changed {change:.3g}{suffix} over the last {tau:.3g} s, {left} still to come"
             f" (tolerance {floor:.3g}{suffix})"
         )
         if periods:

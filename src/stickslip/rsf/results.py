@@ -98,6 +98,7 @@ class RSFRun:
             "peak_friction": r.peak_friction,
             "trough_friction": r.trough_friction,
             "growth": None if math.isnan(r.growth) else r.growth,
+            "periods": r.periods,
             "status": self.status,
             "message": self.message or _default_message(r),
         }

@@ -92,8 +92,8 @@ def classify(
     vp = protocol.segments[-1].velocity
     whole = [c for c in cycles if c.period is not None]
     if found.kind == regimes.STICK_SLIP:
-        seen = found.evidence.removeprefix("limit cycle: ")
-        text = f"stick-slip: {seen}, sigma {found.trough:.6g} ... {found.peak:.6g} Pa"
+        seen = found.evidence.removeprefix("stick-slip (limit cycle): ")
+        text = f"stick-slip (limit cycle): {seen}, sigma {found.trough:.6g} ... {found.peak:.6g} Pa"
         if whole:
             c = whole[-1]
             text += (
