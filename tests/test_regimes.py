@@ -10,11 +10,10 @@ import numpy as np
 import pytest
 
 import stickslip
+from cli_helpers import run_main
 from stickslip import protocols, regimes
 from stickslip.regimes import classify
 from stickslip.rsf import critical_stiffness, rsf_params, simulate
-
-from cli_helpers import run_main
 
 
 # --------------------------------------------------------------------------- synthetic signals of known kind
@@ -92,6 +91,7 @@ def test_what_is_still_to_come_of_an_exponential_approach():
     t = np.linspace(0, 14, 1401)
     y = 391.5 - 0.5 * np.exp(-t / 1.8)
     change, remaining = regimes.remaining_change(t, y, 1.8)
+    assert change == pytest.approx(0.5 * (math.exp(-(14 - 1.8) / 1.8) - math.exp(-14 / 1.8)), rel=1e-6)
     assert remaining == pytest.approx(0.5 * math.exp(-14 / 1.8), rel=1e-6)  # 2.1e-4 Pa
     assert classify(t, y, floor=1e-4, unit="Pa").kind == regimes.UNDETERMINED
     assert classify(t, y, floor=1e-3, unit="Pa").kind == regimes.STEADY
@@ -99,8 +99,9 @@ def test_what_is_still_to_come_of_an_exponential_approach():
 
 # --------------------------------------------------------------------------- rate-and-state
 #: issue 17: the damped aging-law case, a limit cycle
-DAMPED = ["--law", "aging", "--a", "0.001", "--b", "0.0015", "--mu0", "0.6", "--v-ref", "1 um/s", "--start-velocity",
-          "1 um/s", "--dc", "3e-5 m", "--stiffness", "10 1/m", "--eta", "0.5 s/m", "--segment", "10 um/s:500 s"]  # fmt: skip
+DAMPED = ["--law", "aging", "--a", "0.001", "--b", "0.0015", "--mu0", "0.6", "--v-ref", "1 um/s",
+          "--start-velocity", "1 um/s", "--dc", "3e-5 m", "--stiffness", "10 1/m", "--eta", "0.5 s/m",
+          "--segment", "10 um/s:500 s"]  # fmt: skip
 
 
 def _damped_reference() -> tuple[float, float, float]:
