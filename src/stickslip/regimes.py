@@ -330,18 +330,17 @@ def _crossing(t: np.ndarray, y: np.ndarray, i: int, k: int, level: float, dense:
     j = i + int(below[0]) if below.size else k
     a, b = float(t[j - 1]), float(t[j])
     ya, yb = float(y[j - 1]) - level, float(y[j]) - level
-    if dense is None:
+    if dense is None or not b > a:
         return a + (b - a) * ya / (ya - yb) if ya != yb else b
-    for _ in range(60):  # bisection on the interpolant: the step is short, so this is cheap and sure
-        m = 0.5 * (a + b)
-        ym = float(np.asarray(dense(np.array([m])), dtype=float).ravel()[0]) - level
-        if ym > 0:
-            a = m
-        else:
-            b = m
-        if b - a <= 1e-13 * max(abs(b), 1.0):
-            break
-    return 0.5 * (a + b)
+    for _ in range(2):  # twice on a fine grid of the interpolant: the bracket shrinks 32-fold each time
+        grid = np.linspace(a, b, 33)
+        values = np.asarray(dense(grid), dtype=float) - level
+        below = np.flatnonzero(values <= 0)
+        m = int(below[0]) if below.size else grid.size - 1
+        if m == 0:
+            return a
+        a, b, ya, yb = float(grid[m - 1]), float(grid[m]), float(values[m - 1]), float(values[m])
+    return a + (b - a) * ya / (ya - yb) if ya != yb else b
 
 
 def _window_extremes(t: np.ndarray, y: np.ndarray, dense: Dense | None) -> tuple[float, float]:
