@@ -7,6 +7,9 @@ With ``every`` the trace is sampled on a uniform grid by the solver's own
 interpolant (ODEPACK LSODA through ``scipy.integrate.odeint``, analytic
 Jacobian); without it the trace holds the solver's own adaptive steps
 (``solve_ivp`` LSODA).  Both switch between non-stiff and stiff methods.
+The regime is read off the accepted steps of the last segment whatever the
+sampling (with a grid, that segment is integrated a second time for its
+steps), its extremes placed by the solver restarted from the step before.
 
 A quasi-static slider (no radiation damping, no mass) can reach infinite slip
 rate in finite time.  Such a run stops where the slip rate passes
@@ -61,8 +64,10 @@ def simulate(
 
     ``start_velocity`` defaults to the first segment's velocity; ``every``
     samples the trace every ``every`` seconds from t = 0; ``times`` (sorted,
-    within the protocol) samples it at given times instead.  ``detect=False``
-    skips the regime detection (for fits, which call this hundreds of times).
+    within the protocol) samples it at given times instead; neither changes
+    the regime or the summary, which come from the solver's accepted steps.
+    ``detect=False`` skips the regime detection (for fits, which call this
+    hundreds of times).
     """
     if not isinstance(params, RSFParams):
         raise ParameterError(f"params: expected RSFParams, got {type(params).__name__}")
