@@ -70,6 +70,8 @@ RATIO_TOLERANCE = 0.02
 RATIOS_NEEDED = 2
 #: a swing smaller than this fraction of the larger of its neighbours is a wiggle on a larger swing, not a period
 WIGGLE = 0.05
+#: more turning points than this and the scan keeps only swings of WIGGLE of the whole range (cost bound)
+MAX_EXTREMA = 20_000
 #: a last swing smaller than this fraction of the one before is the start of an unfinished period
 TAIL = 0.25
 
@@ -130,6 +132,8 @@ def turning_points(values: np.ndarray, delta: float) -> tuple[np.ndarray, np.nda
 def _alternating(y: np.ndarray, floor: float) -> list[int]:
     """Indices of the alternating extrema beyond ``floor``, wiggles on larger swings removed."""
     maxima, minima = turning_points(y, floor)
+    if maxima.size + minima.size > MAX_EXTREMA:  # thousands of periods: the small ones are not what decides
+        maxima, minima = turning_points(y, max(floor, WIGGLE * float(np.ptp(y))))
     ext = sorted([*maxima.tolist(), *minima.tolist()])
     # A slip's small overshoot is a pair of tiny swings inside a big one: merge it into the big one.
     while len(ext) >= 4:
@@ -243,7 +247,7 @@ def classify(
     """
     t = np.asarray(t, dtype=float)
     y = np.asarray(y, dtype=float)
-    inside = t >= (t[0] if start is None else start)
+    inside = (t >= (t[0] if start is None else start)) & np.isfinite(t) & np.isfinite(y)
     tw, yw = t[inside], y[inside]
     suffix = f" {unit}" if unit else ""
     if tw.size < 3 or not tw[-1] > tw[0]:
