@@ -227,3 +227,16 @@ def test_transient_regime_agrees_with_kc_on_both_sides():
     assert kc_bond(params, 100e-6) > k and slow.regime not in ("steady", "decaying oscillation"), slow.message
     fast = run_transient(params, protocols.constant(200e-6, 0.5), start="steady")
     assert kc_bond(params, 200e-6) < k and fast.regime == "steady", fast.message
+
+
+def test_rsf_sweep_rows_never_contradict_their_own_kc():
+    """Each row's message places k against the row's critical_stiffness the right way round (issue 17)."""
+    kc = (RSF_B - RSF_A - RSF_ETA * RSF_V) / RSF_DC
+    vary = [f"k={0.6 * kc:.6g} 1/m,{1.52 * kc:.6g} 1/m,{2.0 * kc:.6g} 1/m", "pulling_velocity=10 um/s"]
+    fixed = {"a": str(RSF_A), "b": str(RSF_B), "Dc": "10 um", "η": f"{RSF_ETA} s/m"}
+    frame = stickslip.sweep(vary, model="rsf", overrides=fixed, duration="100 s", workers=0)
+    for row in frame.itertuples():
+        below = row.k < row.critical_stiffness
+        assert ("below kc" in row.message) == below and ("above kc" in row.message) == (not below), row.message
+        expected = ("stick-slip",) if below else ("decaying oscillation", "steady sliding")
+        assert row.regime in expected, row.message
