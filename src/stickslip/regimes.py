@@ -48,6 +48,7 @@ __all__ = [
     "UNDETERMINED",
     "Regime",
     "classify",
+    "classify_cycles",
     "extremes",
     "remaining_change",
     "turning_points",
@@ -172,7 +173,7 @@ def extremes(t: np.ndarray, y: np.ndarray, index: int, dense: Dense | None = Non
     """(time, value) of the extremum at sample ``index``, placed between its neighbouring samples.
 
     With the solver's interpolant ``dense`` the extremum is found on it (a fine grid, then a parabola
-    through the best three points); without, by the parabola through the three samples around it.
+    through the best three points, kept only if it does not overshoot them); without, the sample itself.
     """
     n = t.size
     lo, hi = max(index - 1, 0), min(index + 1, n - 1)
@@ -184,9 +185,7 @@ def extremes(t: np.ndarray, y: np.ndarray, index: int, dense: Dense | None = Non
         k = int(np.argmax(sign * values))
         k = min(max(k, 1), grid.size - 2)
         tt, vv = grid[k - 1 : k + 2], values[k - 1 : k + 2]
-    elif 0 < index < n - 1:
-        tt, vv = t[index - 1 : index + 2], y[index - 1 : index + 2]
-    else:
+    else:  # without the interpolant the samples are the answer: a stick-slip peak is a kink, a parabola overshoots
         return float(t[index]), float(y[index])
     t_x, v_x = _parabola_vertex(tt, vv)
     best = float(np.max(sign * vv)) * sign
@@ -275,16 +274,7 @@ def classify(
     if oscillating:
         last = [v for (tp, v) in placed if tp >= peaks[-2][0]] if len(peaks) >= 2 else [v for _, v in placed]
         peak, trough = max(last), min(last)
-        evidence = f"{periods} period(s) of {period:.6g} s, amplitude ratio {ratio:.4g} per period"
-        recent = ratios[-RATIOS_NEEDED:]
-        if len(recent) == RATIOS_NEEDED:
-            if all(abs(r - 1) <= RATIO_TOLERANCE for r in recent):
-                return Regime(STICK_SLIP, periods, ratio, period, peak, trough, f"stick-slip (limit cycle): {evidence}")
-            if all(r < 1 - RATIO_TOLERANCE for r in recent):
-                return Regime(DECAYING, periods, ratio, period, peak, trough, f"decaying oscillation: {evidence}")
-            if all(r > 1 + RATIO_TOLERANCE for r in recent):
-                return Regime(GROWING, periods, ratio, period, peak, trough, f"growing oscillation: {evidence}")
-        return Regime(UNDETERMINED, periods, ratio, period, peak, trough, f"undetermined: {evidence}")
+        return _verdict(periods, ratios, period, peak, trough)
     # not (or no longer) oscillating: steady only when the tail has stopped changing
     tail_from = last_extremum if placed else float(tw[0])
     tau = min(relaxation if relaxation else math.inf, (float(tw[-1]) - tail_from) / 2.0, window / 2.0)
@@ -307,6 +297,36 @@ def classify(
         f"undetermined: still changing ({change:.3g}{suffix} over the last {tau:.3g} s, {left}; tolerance"
         f" {floor:.3g}{suffix})",
     )  # fmt: skip
+
+
+def _verdict(periods: int, ratios: list[float], period: float, peak: float, trough: float) -> Regime:
+    """The oscillation's kind from its period-to-period amplitude ratios (the last RATIOS_NEEDED must agree)."""
+    ratio = ratios[-1] if ratios else math.nan
+    evidence = f"{periods} period(s) of {period:.6g} s, amplitude ratio {ratio:.4g} per period"
+    recent = ratios[-RATIOS_NEEDED:]
+    if len(recent) == RATIOS_NEEDED:
+        if all(abs(r - 1) <= RATIO_TOLERANCE for r in recent):
+            return Regime(STICK_SLIP, periods, ratio, period, peak, trough, f"stick-slip (limit cycle): {evidence}")
+        if all(r < 1 - RATIO_TOLERANCE for r in recent):
+            return Regime(DECAYING, periods, ratio, period, peak, trough, f"decaying oscillation: {evidence}")
+        if all(r > 1 + RATIO_TOLERANCE for r in recent):
+            return Regime(GROWING, periods, ratio, period, peak, trough, f"growing oscillation: {evidence}")
+    return Regime(UNDETERMINED, periods, ratio, period, peak, trough, f"undetermined: {evidence}")
+
+
+def classify_cycles(peak_times: list[float], peaks: list[float], troughs: list[float]) -> Regime:
+    """Classify from exact cycles instead of a trace: the time and stress of each peak, and the trough after it.
+
+    For models that know their slips as events (the time-dependent model's stick chains collapse at a
+    known instant and stress), so the verdict needs no sampling at all.
+    """
+    amplitudes = [p - q for p, q in zip(peaks, troughs, strict=True)]
+    ratios = [b / a for a, b in itertools.pairwise(amplitudes) if a > 0]
+    periods = max(len(peak_times) - 1, 0)
+    period = float(np.mean(np.diff(peak_times[-4:]))) if len(peak_times) >= 2 else math.nan
+    peak = peaks[-1] if peaks else math.nan
+    trough = troughs[-1] if troughs else math.nan
+    return _verdict(periods, ratios, period, peak, trough)
 
 
 def _period(

@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import dataclasses
+import math
+
 import numpy as np
 
 from .. import regimes
@@ -33,7 +36,14 @@ def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
 def detect_cycles(
     time: np.ndarray, stress: np.ndarray, velocity: np.ndarray, protocol: Protocol, events: list
 ) -> tuple[Cycle, ...]:
-    """A cycle is a stick that ended in a slip; its slip lasts until the next stick (None if the run ends first)."""
+    """A cycle is a stick that ended in a slip; its slip lasts until the next stick (None if the run ends first).
+
+    With the stick chains the solver records each stick and slip as an event at its exact time and stress:
+    the cycles are read from those, whatever the sampling; otherwise from the trace.
+    """
+    from_events = _cycles_from_events(events)
+    if from_events:
+        return from_events
     stuck = stuck_mask(time, velocity, protocol)
     runs = _runs(stuck)
     cycles: list[Cycle] = []
@@ -56,6 +66,31 @@ def detect_cycles(
                 peak_stress=float(np.max(stress[a : z + 2])),
                 stick_time=stick_time,
                 jump_velocity=jump,
+                slip_time=slip_time,
+                period=None if slip_time is None else stick_time + slip_time,
+            )
+        )
+    return tuple(cycles)
+
+
+def _cycles_from_events(events: list) -> tuple[Cycle, ...]:
+    marks = [(kind, float(t), float(sigma), float(v)) for kind, t, sigma, v in events if kind in ("stick", "slip")]
+    cycles: list[Cycle] = []
+    for k, (kind, t_slip, sigma_s, v_jump) in enumerate(marks):
+        if kind != "slip" or k == 0 or marks[k - 1][0] != "stick":
+            continue
+        _, t_stick, sigma_stick, _ = marks[k - 1]
+        nxt = next((t for kind2, t, _, _ in marks[k + 1 :] if kind2 == "stick"), None)
+        stick_time = t_slip - t_stick
+        slip_time = None if nxt is None else nxt - t_slip
+        cycles.append(
+            Cycle(
+                index=len(cycles),
+                start_time=t_stick,
+                start_stress=sigma_stick,
+                peak_stress=sigma_s,
+                stick_time=stick_time,
+                jump_velocity=v_jump,
                 slip_time=slip_time,
                 period=None if slip_time is None else stick_time + slip_time,
             )
@@ -87,7 +122,9 @@ def classify(
     inside = time >= start
     scale = float(np.max(np.abs(stress[inside]))) if np.any(inside) else 0.0
     floor = (SETTLED if rtol is None else 0.1 * rtol) * max(scale, 1e-300)
-    found = regimes.classify(time, stress, floor=floor, start=start, unit="Pa")
+    found = _from_events(events, start, time, stress) or regimes.classify(
+        time, stress, floor=floor, start=start, unit="Pa"
+    )
     stuck = stuck_mask(time, velocity, protocol)
     vp = protocol.segments[-1].velocity
     whole = [c for c in cycles if c.period is not None]
@@ -124,3 +161,38 @@ def classify(
         f"{found.evidence} at the end of the run (t = {time[-1]:.6g} s, sigma = {stress[-1]:.6g} Pa,"
         f" V = {velocity[-1]:.3g} m/s): run longer to see where it goes"
     )
+
+
+def _from_events(events: list, start: float, time: np.ndarray, stress: np.ndarray) -> regimes.Regime | None:
+    """The regime from the stick chains' exact slips and sticks (time, stress), independent of ``every``.
+
+    Each slip (the chains collapse at sigma_s) and the stick that follows it (sigma where the slider stops) is
+    one period's peak and trough.  None when the run has no such cycles in its last segment, or when the last
+    of them ended more than two periods before the end (the run left stick-slip: the trace decides).  The
+    reported extremes are the events' or the trace's over the last period, whichever reaches further (both
+    are values of the solution; the slip's lowest stress can come just before the stick).
+    """
+    slips = [(t, s) for kind, t, s, _ in events if kind == "slip" and t >= start]
+    sticks = [(t, s) for kind, t, s, _ in events if kind == "stick" and t >= start]
+    times, peaks, troughs = [], [], []
+    for t_slip, sigma_s in slips:
+        after = [s for t, s in sticks if t > t_slip]
+        if not after:
+            break
+        times.append(t_slip)
+        peaks.append(sigma_s)
+        troughs.append(after[0])
+    if not times:
+        return None
+    found = regimes.classify_cycles(times, peaks, troughs)
+    last_event = max(t for _, t, _, _ in events)
+    if math.isfinite(found.period) and float(time[-1]) - last_event > 2 * found.period:
+        return None
+    last = time >= (times[-2] if len(times) >= 2 else times[-1])
+    if np.any(last):
+        found = dataclasses.replace(
+            found,
+            peak=max(found.peak, float(np.max(stress[last]))),
+            trough=min(found.trough, float(np.min(stress[last]))),
+        )
+    return found
