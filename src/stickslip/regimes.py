@@ -99,10 +99,6 @@ class Regime:
     trough: float
     evidence: str
 
-    @property
-    def settled(self) -> bool:
-        return self.kind in (STEADY, STICK_SLIP)
-
 
 def turning_points(values: np.ndarray, delta: float) -> tuple[np.ndarray, np.ndarray]:
     """(maxima, minima) indices, alternating, each extremum ``delta`` beyond its neighbours (hysteresis scan)."""
@@ -241,7 +237,8 @@ def classify(
     """Classify the signal ``y(t)`` over ``t >= start`` (default: all of it).
 
     ``floor``: changes and amplitudes at or below it are no change (the solver's tolerance in ``y``);
-    ``relaxation`` (s): the time over which a settled tail must not change (default a third of the window);
+    ``relaxation`` (s): the time scale over which the tail's approach is judged (at most half the time since
+    the last turning point, and half the window; default those);
     ``dense``: the solver's interpolant of ``y`` (extremes are then those of the solution, not of its steps).
     """
     t = np.asarray(t, dtype=float)
