@@ -164,7 +164,7 @@ def assemble_run(
         spring = friction + system.eta * velocity
     slider = lp_disp - (spring - spring[0]) / k
     regime = (
-        Regime("blow-up", math.nan, float(np.max(friction)), float(np.min(friction)), math.nan)
+        Regime(regimes.BLOW_UP, math.nan, float(np.max(friction)), float(np.min(friction)), math.nan)
         if status != "ok"
         else detect_regime(t, friction, velocity, protocol, system=system, solution=solution, rtol=rtol)
         if detect
