@@ -99,11 +99,16 @@ def test_bookkeeping_bonds_and_energy(params, control):
     assert residuals[1] < 0.02 * residuals[0]
 
 
-def test_block_step_settles_at_sigma_350(params):
-    """300 -> 350 um/s through the Eq 17 block: the quasi-static relaxation time sigma'(V)/K is 1.8 s."""
+def test_block_step_is_not_called_settled_before_it_is(params):
+    """300 -> 350 um/s through the Eq 17 block (relaxation time sigma'(V)/K = 1.8 s): after 14 s the stress is
+    still 0.0126 Pa below sigma(350) of the steady solver, more than the run's tolerance, so not "steady" (issue 17);
+    the classifier's estimate of what is still to come closes that gap."""
     run = run_transient(params, constant(350e-6, 14.0), start="steady", start_velocity=300e-6, rtol=1e-4, every=0.01)
-    assert run.regime == "steady"
-    assert run.final_stress == pytest.approx(391.53, abs=0.01)
+    target = float(stickslip.steady_state(params, 350e-6).stress)
+    assert target - run.final_stress == pytest.approx(0.0126, abs=5e-4)
+    assert run.regime == "undetermined" and "still changing" in run.message
+    to_come = float(run.message.split("about ")[1].split(" Pa still to come")[0])
+    assert run.final_stress + to_come == pytest.approx(target, abs=1e-3)
     assert run.slider_velocity[-1] == pytest.approx(350e-6, rel=1e-4)
 
 

@@ -30,6 +30,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from .. import regimes
 from ..columns import with_units
 from ..errors import DataError, ParameterError
 from ..parameters import Parameters, load_parameters
@@ -418,19 +419,21 @@ def _first_index(values: np.ndarray, test: Callable[[np.ndarray], np.ndarray]) -
 
 
 def _regime(t: np.ndarray, x: np.ndarray, coarse: Coarse, sticks: list[_Stick]) -> tuple[str, float | None]:
+    """(regime in :mod:`stickslip.regimes`' names, where steady sliding starts): a measured record is noisy, so
+    its slips are the drops beyond ten noise levels (``coarse``), not the turning points of a solution."""
     if coarse.peaks.size:
         if coarse.steady_from is not None:
-            return "steady", coarse.steady_from
-        return "stick-slip", None
+            return regimes.STEADY, coarse.steady_from
+        return regimes.STICK_SLIP, None
     whole = fit_line(t, x)
     spread = float(np.sum((x - np.mean(x)) ** 2))
     if whole is not None and spread > 0:
         r2 = 1.0 - whole.rms**2 * whole.count / spread
         rise = whole.slope * float(t[-1] - t[0])
         if rise > coarse.threshold and r2 > STUCK_R2:
-            return "stuck", None
+            return regimes.STUCK, None
     sticks.clear()
-    return "steady", float(t[0]) if coarse.steady_from is None else coarse.steady_from
+    return regimes.STEADY, float(t[0]) if coarse.steady_from is None else coarse.steady_from
 
 
 def _cycles(sticks: list[_Stick], v0: float, params: Parameters, ends_steady: bool) -> list[CycleResult]:

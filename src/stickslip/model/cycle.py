@@ -34,6 +34,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from .. import regimes
 from ..columns import with_units
 from ..errors import ParameterError
 from ..parameters import Parameters
@@ -49,7 +50,9 @@ if TYPE_CHECKING:  # pragma: no cover
 
 #: Trace columns, in order (SI units: s, Pa, m/s, m, m, m, Nc/Nc0, phase name).
 CYCLE_COLUMNS = QUASI_STATIC
-REGIMES = ("stick-slip", "steady", "stuck", "undetermined")
+#: The regimes of the quasi-static cycle, in the shared vocabulary of :mod:`stickslip.regimes`: here they follow
+#: exactly from the phases (every cycle after the first is the same cycle), not from a trace.
+REGIMES = (regimes.STICK_SLIP, regimes.STEADY, regimes.STUCK, regimes.UNDETERMINED)
 #: Long runs are thinned so that the trace stays below about this many rows (phase ends are always kept).
 MAX_ROWS = 1_000_000
 #: Runs of more cycles than this are refused (the trace would be mostly thinning).
@@ -235,18 +238,18 @@ class _Phases:
     def _solve(self, sigma: float) -> _Cycle:
         stick = stick_phase(self.params, self.v0, sigma, horizon=self.horizon)
         if stick.status != "slipped":
-            return _Cycle(stick, None, None, "stuck" if stick.stuck else "undetermined", stick.message)
+            return _Cycle(stick, None, None, regimes.STUCK if stick.stuck else regimes.UNDETERMINED, stick.message)
         assert stick.peak_stress is not None and stick.stick_time is not None
         if stick.stick_time <= 0.0:  # issue 12: was reported as a cycle
             message = (
                 f"the attached chains collapse the moment the block sticks at {sigma:.6g} Pa (stick time 0): there"
                 " is no stick phase, so no stick-slip cycle; the quasi-static model has no answer here"
             )
-            return _Cycle(stick, None, None, "undetermined", message)
+            return _Cycle(stick, None, None, regimes.UNDETERMINED, message)
         jump = jump_velocity(self.params, stick.peak_stress, self.curve)
         if not jump.reachable or jump.velocity is None:
             message = f"the chains collapse at sigma_s = {stick.peak_stress:.6g} Pa, but {jump.message}"
-            return _Cycle(stick, jump, None, "undetermined", message)
+            return _Cycle(stick, jump, None, regimes.UNDETERMINED, message)
         slip = slip_phase(self.params, self.v0, jump.velocity)
         if slip.ends == "stick" and slip.duration == 0.0:
             message = (
@@ -254,7 +257,7 @@ class _Phases:
                 f" {stick.peak_stress:.6g} Pa, no more than sigma_c, so the jump lands at Vc where the slip ends at"
                 " once and the block sticks again without moving (creep by infinitesimal slips, outside the model)"
             )
-            return _Cycle(stick, jump, slip, "undetermined", message)
+            return _Cycle(stick, jump, slip, regimes.UNDETERMINED, message)
         return _Cycle(stick, jump, slip, None)
 
     def all(self, kind: str) -> tuple[Any, ...]:
@@ -332,9 +335,9 @@ def simulate(
         t += slip.duration
         cycles[-1] = dataclasses.replace(cycles[-1], slip_time=slip.duration, period=stick.stick_time + slip.duration)
         sigma = sigma_c
-    if regime == "stick-slip":
+    if regime == regimes.STICK_SLIP:
         message += f"; {sum(c.period is not None for c in cycles)} whole cycle(s) in {end:.6g} s"
-    elif regime == "stuck" and cycles:
+    elif regime == regimes.STUCK and cycles:
         message += f" (after {len(cycles)} slip(s))"
     columns = trace.build()
     return Simulation(
@@ -365,7 +368,7 @@ def _outlook(phases: _Phases, sigma0: float, sigma_c: float) -> tuple[str, str, 
         return first.problem, first.message, None
     assert first.slip is not None
     if first.slip.ends == "steady":
-        return "steady", first.slip.message, None
+        return regimes.STEADY, first.slip.message, None
     repeat = phases.cycle(sigma_c)
     if repeat.problem is not None:
         return repeat.problem, repeat.message, None
@@ -373,10 +376,10 @@ def _outlook(phases: _Phases, sigma0: float, sigma_c: float) -> tuple[str, str, 
     stick = repeat.stick
     assert stick.stick_time is not None and stick.peak_stress is not None
     if repeat.slip.ends == "steady":
-        return "steady", repeat.slip.message, None
+        return regimes.STEADY, repeat.slip.message, None
     period = stick.stick_time + repeat.slip.duration
     return (
-        "stick-slip",
+        regimes.STICK_SLIP,
         f"stick-slip with period {period:.6g} s (stick {stick.stick_time:.6g} s, slip {repeat.slip.duration:.6g} s):"
         f" sigma_c = {sigma_c:.6g} Pa -> sigma_s = {stick.peak_stress:.6g} Pa,"
         f" jump to Vs = {repeat.jump.velocity * 1e6:.6g} um/s",

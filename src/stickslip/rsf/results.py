@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import itertools
 import json
 import math
 from dataclasses import dataclass
@@ -10,7 +9,9 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from .. import regimes
 from ..columns import with_units
+from ..errors import StickslipError
 from ..protocols import Protocol
 from .params import RSFParams
 
@@ -19,18 +20,21 @@ if TYPE_CHECKING:  # pragma: no cover
 
     from .system import System
 
-__all__ = ["RSFRun", "Regime", "assemble_run", "detect_regime"]
+__all__ = ["RSFRun", "Regime", "Solution", "assemble_run", "detect_regime"]
 
 
 @dataclass(frozen=True)
 class Regime:
-    """What the last protocol segment settled into.
+    """What the last protocol segment settled into, read off the solver's dense solution (:mod:`stickslip.regimes`).
 
     ``name``: ``steady sliding``, ``decaying oscillation``, ``stick-slip``
-    (a limit cycle), ``growing oscillation``, ``transient`` (still evolving
-    without oscillating) or ``blow-up``.  ``period`` (s) is NaN unless the
-    last segment oscillates; ``growth`` is the ratio of the last two
-    oscillation amplitudes (NaN when there are fewer than three peaks).
+    (a limit cycle), ``growing oscillation``, ``undetermined`` (the run is
+    too short to tell: ``evidence`` says what was seen), ``blow-up`` or
+    ``not analysed``.  ``period`` (s) is NaN unless the last segment
+    oscillates; ``growth`` is the amplitude ratio of the last period to the
+    one before (NaN with fewer than two); ``peak_friction`` and
+    ``trough_friction`` are the solution's extremes over the last period (over
+    the segment when it does not oscillate), whatever the output sampling.
     """
 
     name: str
@@ -38,6 +42,18 @@ class Regime:
     peak_friction: float
     trough_friction: float
     growth: float
+    periods: int = 0
+    evidence: str = ""
+
+
+@dataclass(frozen=True)
+class Solution:
+    """The solver's own solution over one protocol piece: accepted steps and the interpolant between them."""
+
+    start: float
+    t: np.ndarray
+    y: np.ndarray
+    dense: Any  # callable t -> y (scipy OdeSolution), or None
 
 
 @dataclass(frozen=True)
@@ -83,6 +99,7 @@ class RSFRun:
             "peak_friction": r.peak_friction,
             "trough_friction": r.trough_friction,
             "growth": None if math.isnan(r.growth) else r.growth,
+            "periods": r.periods,
             "status": self.status,
             "message": self.message or _default_message(r),
         }
@@ -115,12 +132,11 @@ class RSFRun:
 
 
 def _default_message(regime: Regime) -> str:
+    if regime.evidence:
+        return regime.evidence
     return {
         "steady sliding": "the slider settled into steady sliding at the load-point velocity",
-        "decaying oscillation": "oscillations decay towards steady sliding (stable: k above critical)",
         "stick-slip": "stick-slip: the oscillation settled into a limit cycle of constant amplitude",
-        "growing oscillation": "oscillations grow (unstable: k below critical) and had not settled by the end",
-        "transient": "still evolving at the end of the protocol (run longer to see where it settles)",
     }.get(regime.name, "")
 
 
@@ -133,6 +149,8 @@ def assemble_run(
     message: str,
     v_start: float,
     detect: bool = True,
+    solution: Solution | None = None,
+    rtol: float = 1e-10,
 ) -> RSFRun:
     """Turn the solver's (t, y) into the physical trace."""
     o = system.offset
@@ -147,9 +165,9 @@ def assemble_run(
         spring = friction + system.eta * velocity
     slider = lp_disp - (spring - spring[0]) / k
     regime = (
-        Regime("blow-up", math.nan, float(np.max(friction)), float(np.min(friction)), math.nan)
+        Regime(regimes.BLOW_UP, math.nan, float(np.max(friction)), float(np.min(friction)), math.nan)
         if status != "ok"
-        else detect_regime(t, friction, velocity, protocol)
+        else detect_regime(t, friction, velocity, protocol, system=system, solution=solution, rtol=rtol)
         if detect
         else Regime("not analysed", math.nan, math.nan, math.nan, math.nan)
     )
@@ -170,62 +188,79 @@ def assemble_run(
     )
 
 
-def detect_regime(t: np.ndarray, friction: np.ndarray, velocity: np.ndarray, protocol: Protocol) -> Regime:
-    """Classify the last protocol segment from its friction peaks (see :class:`Regime`).
+def detect_regime(
+    t: np.ndarray,
+    friction: np.ndarray,
+    velocity: np.ndarray,
+    protocol: Protocol,
+    *,
+    system: System | None = None,
+    solution: Solution | None = None,
+    rtol: float = 1e-10,
+) -> Regime:
+    """Classify the last protocol segment with :func:`stickslip.regimes.classify` (see :class:`Regime`).
 
-    Peaks count when their prominence exceeds 5 % of the friction range over
-    the segment's second half (and a floor far above rounding), so the small
-    overshoots that follow each slip are not taken for cycles.
+    With ``solution`` (the solver's accepted steps and interpolant over that segment, and ``system`` to turn
+    them into friction) the regime, period and extremes are those of the solution; otherwise of the trace.
     """
-    start, end = protocol.boundaries[-2], protocol.boundaries[-1]
-    mask = t >= start
-    tt, mu, v = t[mask], friction[mask], velocity[mask]
-    if tt.size < 5:
-        return Regime("transient", math.nan, float(np.max(friction)), float(np.min(friction)), math.nan)
-    span = float(np.ptp(mu[tt >= start + 0.5 * (end - start)]))
-    floor = 1e-10 * max(1.0, float(np.max(np.abs(mu))))
-    peaks = turning_points(mu, max(floor, 0.05 * span))[0]
-    vlp = protocol.segments[-1].velocity
-    if peaks.size < 3:
-        settled = vlp > 0 and abs(v[-1] / vlp - 1) < 1e-3
-        name = "steady sliding" if settled else "transient"
-        return Regime(name, math.nan, float(np.max(mu)), float(np.min(mu)), math.nan)
-    amplitude = np.array([mu[p] - np.min(mu[p:q]) for p, q in itertools.pairwise(peaks)])
-    growth = float(amplitude[-1] / amplitude[-2]) if amplitude[-2] > 0 else math.nan
-    period = float(np.mean(np.diff(tt[peaks[-4:]])))
-    last = slice(peaks[-2], None)
-    peak, trough = float(np.max(mu[last])), float(np.min(mu[last]))
-    if growth > 1.02:
-        name = "growing oscillation"
-    elif growth < 0.98:
-        name = "decaying oscillation"
+    start = float(protocol.boundaries[-2])
+    vlp = float(protocol.segments[-1].velocity)
+    dense = None
+    if solution is not None and system is not None and solution.t.size >= 2:
+        t, friction, velocity = _physical(system, solution.t, solution.y)
+        if solution.dense is not None:
+            interpolant = solution.dense
+
+            def dense(times: np.ndarray) -> np.ndarray:
+                return _physical(system, times, interpolant(times))[1]
+
+    scale = float(np.max(np.abs(friction))) if friction.size else 1.0
+    floor = max(10.0 * rtol * scale, 1e-14)
+    relaxation = (max(system.dc) / vlp) if (system is not None and vlp > 0) else None
+    found = regimes.classify(t, friction, floor=floor, start=start, relaxation=relaxation, dense=dense)
+    name = regimes.RSF_NAMES.get(found.kind, found.kind)
+    evidence = found.evidence
+    if found.kind == regimes.STEADY and vlp > 0:
+        mask = t >= start
+        v_end = float(velocity[mask][-1]) if np.any(mask) else float(velocity[-1])
+        if abs(v_end / vlp - 1) > 1e-3:  # friction flat but the slider not at the load point's pace
+            name = regimes.UNDETERMINED
+            evidence = (
+                f"undetermined: friction is flat but the slider moves at {v_end:.4g} m/s, not the load point's"
+                f" {vlp:.4g} m/s"
+            )
+    if system is not None and vlp > 0:
+        evidence += _stability_note(system, vlp, found.kind)
+    return Regime(name, found.period, found.peak, found.trough, found.amplitude_ratio, found.periods, evidence)
+
+
+def _physical(system: System, t: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    o = system.offset
+    x, psi = y[o], y[o + 1 :]
+    return t, system.friction_many(x, psi), system.v0 * np.exp(np.minimum(x, 700.0))
+
+
+def _stability_note(system: System, velocity: float, kind: str) -> str:
+    """What linear stability says at this stiffness: stated beside the regime, never as its cause unless they agree."""
+    from .stability import critical_stiffness
+
+    try:
+        kc = critical_stiffness(system.params, velocity)
+    except (StickslipError, ArithmeticError, np.linalg.LinAlgError):  # a note only: the regime stands without it
+        return ""
+    k = system.params.stiffness
+    if kc <= 0:
+        where = "steady sliding is linearly stable at every stiffness here (b <= a + eta V)"
+        stable = True
+    elif k > kc:
+        where = f"k = {k:.4g} 1/m is above kc = {kc:.4g} 1/m: steady sliding is linearly stable"
+        stable = True
     else:
-        name = "stick-slip"
-    return Regime(name, period, peak, trough, growth)
-
-
-def turning_points(values: np.ndarray, delta: float) -> tuple[np.ndarray, np.ndarray]:
-    """(maxima, minima) indices, alternating, each extremum ``delta`` beyond its neighbours (hysteresis scan).
-
-    Cheaper to import than scipy.signal and immune to wiggles smaller than ``delta``.
-    """
-    maxima: list[int] = []
-    minima: list[int] = []
-    data = np.asarray(values, dtype=float).tolist()
-    hi = lo = data[0]
-    hi_i = lo_i = 0
-    looking_for_max = True
-    for i, value in enumerate(data):
-        if value > hi:
-            hi, hi_i = value, i
-        if value < lo:
-            lo, lo_i = value, i
-        if looking_for_max and value < hi - delta:
-            maxima.append(hi_i)
-            lo, lo_i = value, i
-            looking_for_max = False
-        elif not looking_for_max and value > lo + delta:
-            minima.append(lo_i)
-            hi, hi_i = value, i
-            looking_for_max = True
-    return np.array(maxima, dtype=int), np.array(minima, dtype=int)
+        where = f"k = {k:.4g} 1/m is below kc = {kc:.4g} 1/m: steady sliding is linearly unstable"
+        stable = False
+    agrees = {regimes.DECAYING: stable, regimes.STEADY: stable, regimes.GROWING: not stable}
+    if kind in agrees and not agrees[kind]:
+        if kind == regimes.GROWING:
+            return f"; {where}, so the growth is a finite-amplitude effect or a transient, not that instability"
+        return f"; {where}, yet the run settles (the run may be too short or the start too close to steady)"
+    return f"; {where}"

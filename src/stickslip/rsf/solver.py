@@ -7,6 +7,9 @@ With ``every`` the trace is sampled on a uniform grid by the solver's own
 interpolant (ODEPACK LSODA through ``scipy.integrate.odeint``, analytic
 Jacobian); without it the trace holds the solver's own adaptive steps
 (``solve_ivp`` LSODA).  Both switch between non-stiff and stiff methods.
+The regime is read off the accepted steps of the last segment whatever the
+sampling (with a grid, that segment is integrated a second time for its
+steps), its extremes placed by the solver restarted from the step before.
 
 A quasi-static slider (no radiation damping, no mass) can reach infinite slip
 rate in finite time.  Such a run stops where the slip rate passes
@@ -25,7 +28,7 @@ import numpy as np
 from ..errors import ModelError, ParameterError
 from ..protocols import Protocol
 from .params import RSFParams
-from .results import RSFRun, assemble_run
+from .results import RSFRun, Solution, assemble_run
 from .system import EXP_CAP, System
 
 __all__ = ["BLOW_UP_FACTOR", "evolve_state", "simulate"]
@@ -61,8 +64,10 @@ def simulate(
 
     ``start_velocity`` defaults to the first segment's velocity; ``every``
     samples the trace every ``every`` seconds from t = 0; ``times`` (sorted,
-    within the protocol) samples it at given times instead.  ``detect=False``
-    skips the regime detection (for fits, which call this hundreds of times).
+    within the protocol) samples it at given times instead; neither changes
+    the regime or the summary, which come from the solver's accepted steps.
+    ``detect=False`` skips the regime detection (for fits, which call this
+    hundreds of times).
     """
     if not isinstance(params, RSFParams):
         raise ParameterError(f"params: expected RSFParams, got {type(params).__name__}")
@@ -84,12 +89,21 @@ def simulate(
     watch = grid is not None and params.eta == 0 and params.mass == 0 and _unstable_somewhere(params, protocol)
     t_parts, y_parts = [np.array([0.0])], [y[:, None]]
     status, message = "ok", ""
-    for t0, t1, vlp in protocol.pieces():
+    last: Solution | None = None
+    last_piece = len(protocol.segments) - 1
+    for index, (t0, t1, vlp) in enumerate(protocol.pieces()):
         if grid is None:
-            t_out, y_out, y_end, blown = _adaptive_piece(system, y, t0, t1, vlp, x_cap, rtol, atol)
+            t_out, y_out, y_end, blown, _ = _adaptive_piece(system, y, t0, t1, vlp, x_cap, rtol, atol)
+            t_steps, y_steps = t_out, y_out
         else:
             inside = grid[(grid > t0) & (grid <= t1)]
             t_out, y_out, y_end, blown = _sampled_piece(system, y, t0, t1, vlp, inside, x_cap, rtol, atol, watch)
+            if detect and index == last_piece and blown is None:
+                # the regime is read off every accepted step of the last segment, whatever the sampling
+                t_steps, y_steps, _, _, _ = _adaptive_piece(system, y, t0, t1, vlp, x_cap, rtol, atol)
+        if detect and index == last_piece and blown is None:
+            steps_t, steps_y = np.r_[t0, t_steps], np.c_[y, y_steps]
+            last = Solution(t0, steps_t, steps_y, _interpolant(system, vlp, steps_t, steps_y, rtol, atol))
         t_parts.append(t_out)
         y_parts.append(y_out)
         if blown is not None:
@@ -103,7 +117,7 @@ def simulate(
         y = y_end
     t_all = np.concatenate(t_parts)
     y_all = np.concatenate(y_parts, axis=1)
-    return assemble_run(system, protocol, t_all, y_all, status, message, v_start, detect)
+    return assemble_run(system, protocol, t_all, y_all, status, message, v_start, detect, last, rtol)
 
 
 def _grid(protocol: Protocol, every: float | None, times: Any) -> np.ndarray | None:
@@ -157,8 +171,10 @@ def _dense_piece(
     system: System, y0: np.ndarray, t0: float, t1: float, vlp: float, inside: np.ndarray, x_cap: float,
     rtol: float, atol: float,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, float | None]:  # fmt: skip
-    t_end, dense, y_end, blown = _adaptive_piece(system, y0, t0, t1, vlp, x_cap, rtol, atol, dense=True)
-    keep = inside[inside <= t_end]
+    t_steps, _, y_end, blown, dense = _adaptive_piece(
+        system, y0, t0, t1, vlp, x_cap, rtol, atol, dense=True, watch=True
+    )
+    keep = inside[inside <= (float(t_steps[-1]) if t_steps.size else t0)]
     return keep, (dense(keep) if keep.size else np.empty((system.size, 0))), y_end, blown
 
 
@@ -169,11 +185,49 @@ def _unstable_somewhere(params: RSFParams, protocol: Protocol) -> bool:
     return any(growth_rate(params, v) > 0 for v in speeds)
 
 
+def _interpolant(system: System, vlp: float, t_steps: np.ndarray, y_steps: np.ndarray, rtol: float, atol: float) -> Any:
+    """y at any sorted times within the steps, by the solver itself restarted from the accepted step before them.
+
+    Cheaper than keeping scipy's interpolant for every step when only a few extremes and crossings are wanted.
+    """
+    from scipy.integrate import odeint
+
+    jac = system.jacobian if system.has_jacobian else None
+
+    def evaluate(times: np.ndarray) -> np.ndarray:
+        times = np.asarray(times, dtype=float)
+        j = max(int(np.searchsorted(t_steps, times[0], side="right")) - 1, 0)
+        grid = np.r_[t_steps[j], times]
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            out = odeint(
+                system.rhs, y_steps[:, j], grid, args=(vlp,), Dfun=jac, rtol=rtol, atol=atol, tfirst=True,
+                mxstep=200_000,
+            )  # fmt: skip
+        return out[1:].T
+
+    return evaluate
+
+
 def _adaptive_piece(
     system: System, y0: np.ndarray, t0: float, t1: float, vlp: float, x_cap: float, rtol: float, atol: float,
-    dense: bool = False,
-) -> tuple[Any, Any, np.ndarray, float | None]:  # fmt: skip
+    dense: bool = False, watch: bool = False,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, float | None, Any]:  # fmt: skip
+    """(accepted step times after t0, states there, final state, blow-up time or None, interpolant or None).
+
+    Without ``watch`` the steps are taken without the blow-up event (scipy checks events at a cost of about
+    twice the integration); a run that fails or passes the cap is redone with it.
+    """
     from scipy.integrate import solve_ivp
+
+    if not watch:
+        try:
+            fast = _quiet_solve(system, y0, t0, t1, vlp, rtol, atol, dense)
+        except _Stalled as stalled:
+            raise _stall_error(stalled, t0, t1) from None
+        x = fast.y[system.offset] if fast is not None else None
+        if fast is not None and fast.status == 0 and np.all(np.isfinite(fast.y)) and np.max(x) <= x_cap:
+            return fast.t[1:], fast.y[:, 1:], fast.y[:, -1], None, fast.sol
 
     o = system.offset
 
@@ -210,11 +264,7 @@ def _adaptive_piece(
                     dense_output=dense,
                 )  # fmt: skip
     except _Stalled as stalled:
-        raise ModelError(
-            f"rate-and-state solver stalled at t = {stalled.time:.6g} s ({MAX_CALLS} evaluations in the segment "
-            f"{t0:g} ... {t1:g} s): the equations are too stiff here (e.g. the regularised form far below V0 "
-            "under a very stiff spring); loosen the spring or use the classical form"
-        ) from None
+        raise _stall_error(stalled, t0, t1) from None
     blown = float(sol.t_events[0][0]) if sol.t_events[0].size else None
     if blown is None and sol.status != 0:
         t_fail = float(sol.t[-1])
@@ -231,9 +281,40 @@ def _adaptive_piece(
             )
         else:
             raise ModelError(f"rate-and-state solver failed at t = {t_fail:.6g} s ({sol.message})")
-    if dense:
-        return float(sol.t[-1]), sol.sol, sol.y[:, -1], blown
-    return sol.t[1:], sol.y[:, 1:], sol.y[:, -1], blown
+    return sol.t[1:], sol.y[:, 1:], sol.y[:, -1], blown, sol.sol
+
+
+def _stall_error(stalled: _Stalled, t0: float, t1: float) -> ModelError:
+    return ModelError(
+        f"rate-and-state solver stalled at t = {stalled.time:.6g} s ({MAX_CALLS} evaluations in the segment "
+        f"{t0:g} ... {t1:g} s): the equations are too stiff here (e.g. the regularised form far below V0 "
+        "under a very stiff spring); loosen the spring or use the classical form"
+    )
+
+
+def _quiet_solve(
+    system: System, y0: np.ndarray, t0: float, t1: float, vlp: float, rtol: float, atol: float, dense: bool
+) -> Any:
+    """solve_ivp (LSODA) without events; None where it raises (the watched path then reports)."""
+    from scipy.integrate import solve_ivp
+
+    jac = system.jacobian if system.has_jacobian else None
+    calls = [0]
+
+    def rhs(t: float, y: np.ndarray, vlp: float) -> list[float]:
+        calls[0] += 1
+        if calls[0] > MAX_CALLS:
+            raise _Stalled(t)
+        return system.rhs(t, y, vlp)
+
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            return solve_ivp(
+                rhs, (t0, t1), y0, method="LSODA", args=(vlp,), jac=jac, rtol=rtol, atol=atol, dense_output=dense
+            )
+    except (ValueError, ArithmeticError):
+        return None
 
 
 def evolve_state(

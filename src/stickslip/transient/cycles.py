@@ -2,15 +2,21 @@
 
 from __future__ import annotations
 
+import dataclasses
+import math
+
 import numpy as np
 
+from .. import regimes
 from ..model.cycle import Cycle
 from ..protocols import Protocol
 
 #: the slider counts as stuck below this fraction of the puller velocity
 STUCK_FRACTION = 0.01
-#: steady: over the last fifth of the final segment sigma and V vary by less than this (relative)
+#: steady under block control: the slider's velocity within this fraction of the puller's
 STEADY_TOLERANCE = 1e-3
+#: steady: the stress has stopped changing within this fraction of it (a tenth of the solver's default rtol)
+SETTLED = 1e-5
 
 
 def stuck_mask(time: np.ndarray, velocity: np.ndarray, protocol: Protocol) -> np.ndarray:
@@ -30,7 +36,14 @@ def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
 def detect_cycles(
     time: np.ndarray, stress: np.ndarray, velocity: np.ndarray, protocol: Protocol, events: list
 ) -> tuple[Cycle, ...]:
-    """A cycle is a stick that ended in a slip; its slip lasts until the next stick (None if the run ends first)."""
+    """A cycle is a stick that ended in a slip; its slip lasts until the next stick (None if the run ends first).
+
+    With the stick chains the solver records each stick and slip as an event at its exact time and stress:
+    the cycles are read from those, whatever the sampling; otherwise from the trace.
+    """
+    from_events = _cycles_from_events(events)
+    if from_events:
+        return from_events
     stuck = stuck_mask(time, velocity, protocol)
     runs = _runs(stuck)
     cycles: list[Cycle] = []
@@ -60,6 +73,31 @@ def detect_cycles(
     return tuple(cycles)
 
 
+def _cycles_from_events(events: list) -> tuple[Cycle, ...]:
+    marks = [(kind, float(t), float(sigma), float(v)) for kind, t, sigma, v in events if kind in ("stick", "slip")]
+    cycles: list[Cycle] = []
+    for k, (kind, t_slip, sigma_s, v_jump) in enumerate(marks):
+        if kind != "slip" or k == 0 or marks[k - 1][0] != "stick":
+            continue
+        _, t_stick, sigma_stick, _ = marks[k - 1]
+        nxt = next((t for kind2, t, _, _ in marks[k + 1 :] if kind2 == "stick"), None)
+        stick_time = t_slip - t_stick
+        slip_time = None if nxt is None else nxt - t_slip
+        cycles.append(
+            Cycle(
+                index=len(cycles),
+                start_time=t_stick,
+                start_stress=sigma_stick,
+                peak_stress=sigma_s,
+                stick_time=stick_time,
+                jump_velocity=v_jump,
+                slip_time=slip_time,
+                period=None if slip_time is None else stick_time + slip_time,
+            )
+        )
+    return tuple(cycles)
+
+
 def classify(
     time: np.ndarray,
     stress: np.ndarray,
@@ -69,36 +107,92 @@ def classify(
     events: list,
     control: str,
     stop: str | None,
+    rtol: float | None = None,
 ) -> tuple[str, str]:
-    """(regime, message): "stick-slip", "steady", "stuck" or "undetermined"."""
+    """(regime, message) of the last protocol segment, by :func:`stickslip.regimes.classify` on the stress.
+
+    "stick-slip" (a limit cycle: the amplitude constant over the last periods), "steady" (stress and, under
+    block control, the slider's velocity settled), "decaying oscillation", "growing oscillation", "stuck"
+    (no slip, the slider below 1 % of the puller's pace at the end) or "undetermined" with the evidence.
+    ``rtol``: the run's tolerance; "settled" means within a tenth of it (default :data:`SETTLED`).
+    """
     if stop is not None:
-        return "undetermined", stop
+        return regimes.UNDETERMINED, stop
+    start = float(protocol.boundaries[-2])
+    inside = time >= start
+    scale = float(np.max(np.abs(stress[inside]))) if np.any(inside) else 0.0
+    floor = (SETTLED if rtol is None else 0.1 * rtol) * max(scale, 1e-300)
+    found = _from_events(events, start, time, stress) or regimes.classify(
+        time, stress, floor=floor, start=start, unit="Pa"
+    )
     stuck = stuck_mask(time, velocity, protocol)
-    whole = [c for c in cycles if c.period is not None]
-    t_last = protocol.boundaries[-2]
-    tail = time >= t_last + 0.8 * (time[-1] - t_last)
     vp = protocol.segments[-1].velocity
-    if len(whole) >= 1:
-        c = whole[-1]
-        return "stick-slip", (
-            f"stick-slip: {len(cycles)} slip(s), {len(whole)} whole cycle(s); last: stick {c.stick_time:.4g} s up to"
-            f" sigma_s = {c.peak_stress:.5g} Pa, jump to {c.jump_velocity * 1e6:.4g} um/s, slip {c.slip_time:.4g} s"
-        )
-    if stuck[-1]:
+    whole = [c for c in cycles if c.period is not None]
+    if found.kind == regimes.STICK_SLIP:
+        seen = found.evidence.removeprefix("stick-slip (limit cycle): ")
+        text = f"stick-slip (limit cycle): {seen}, sigma {found.trough:.6g} ... {found.peak:.6g} Pa"
+        if whole:
+            c = whole[-1]
+            text += (
+                f"; {len(cycles)} slip(s), last: stick {c.stick_time:.4g} s up to sigma_s = {c.peak_stress:.5g} Pa,"
+                f" jump to {c.jump_velocity * 1e6:.4g} um/s, slip {c.slip_time:.4g} s"
+            )
+        return regimes.STICK_SLIP, text
+    if found.kind in (regimes.DECAYING, regimes.GROWING):
+        return found.kind, found.evidence
+    if stuck[-1] and found.periods == 0 and time.size > 1:
         slipped = f" after {len(cycles)} slip(s)" if cycles else ""
-        return "stuck", (
+        return regimes.STUCK, (
             f"stuck{slipped}: at t = {time[-1]:.6g} s the slider creeps at {velocity[-1]:.3g} m/s under"
             f" sigma = {stress[-1]:.6g} Pa"
         )
-    s_tail, v_tail = stress[tail], velocity[tail]
-    settled = np.ptp(s_tail) <= STEADY_TOLERANCE * max(abs(stress[-1]), 1e-300)
-    if control == "block" and vp > 0:
-        settled = settled and abs(v_tail[-1] - vp) <= STEADY_TOLERANCE * vp and np.ptp(v_tail) <= STEADY_TOLERANCE * vp
-    if settled:
-        return "steady", (
-            f"steady sliding at {velocity[-1] * 1e6:.6g} um/s: sigma = {stress[-1]:.6g} Pa at t = {time[-1]:.6g} s"
+    if found.kind == regimes.STEADY:
+        v_end = float(velocity[-1])
+        if control == "block" and vp > 0 and abs(v_end - vp) > STEADY_TOLERANCE * vp:
+            return regimes.UNDETERMINED, (
+                f"undetermined: the stress is flat but the slider moves at {v_end * 1e6:.6g} um/s, not the"
+                f" puller's {vp * 1e6:.6g} um/s (t = {time[-1]:.6g} s)"
+            )
+        return regimes.STEADY, (
+            f"steady sliding at {v_end * 1e6:.6g} um/s: sigma = {stress[-1]:.6g} Pa at t = {time[-1]:.6g} s"
+            f" ({found.evidence.removeprefix('steady: ')})"
         )
-    return "undetermined", (
-        f"still changing at the end of the run (t = {time[-1]:.6g} s, sigma = {stress[-1]:.6g} Pa,"
+    return regimes.UNDETERMINED, (
+        f"{found.evidence} at the end of the run (t = {time[-1]:.6g} s, sigma = {stress[-1]:.6g} Pa,"
         f" V = {velocity[-1]:.3g} m/s): run longer to see where it goes"
     )
+
+
+def _from_events(events: list, start: float, time: np.ndarray, stress: np.ndarray) -> regimes.Regime | None:
+    """The regime from the stick chains' exact slips and sticks (time, stress), independent of ``every``.
+
+    Each slip (the chains collapse at sigma_s) and the stick that follows it (sigma where the slider stops) is
+    one period's peak and trough.  None when the run has no such cycles in its last segment, or when the last
+    of them ended more than two periods before the end (the run left stick-slip: the trace decides).  The
+    reported extremes are the events' or the trace's over the last period, whichever reaches further (both
+    are values of the solution; the slip's lowest stress can come just before the stick).
+    """
+    slips = [(t, s) for kind, t, s, _ in events if kind == "slip" and t >= start]
+    sticks = [(t, s) for kind, t, s, _ in events if kind == "stick" and t >= start]
+    times, peaks, troughs = [], [], []
+    for t_slip, sigma_s in slips:
+        after = [s for t, s in sticks if t > t_slip]
+        if not after:
+            break
+        times.append(t_slip)
+        peaks.append(sigma_s)
+        troughs.append(after[0])
+    if not times:
+        return None
+    found = regimes.classify_cycles(times, peaks, troughs)
+    last_event = max(t for _, t, _, _ in events)
+    if math.isfinite(found.period) and float(time[-1]) - last_event > 2 * found.period:
+        return None
+    last = time >= (times[-2] if len(times) >= 2 else times[-1])
+    if np.any(last):
+        found = dataclasses.replace(
+            found,
+            peak=max(found.peak, float(np.max(stress[last]))),
+            trough=min(found.trough, float(np.min(stress[last]))),
+        )
+    return found

@@ -1,0 +1,369 @@
+"""One regime classifier for every model: what a run settled into, read off its dense solution.
+
+The classifier sees a signal (stress or friction) at the solver's own steps,
+optionally with the solver's interpolant to place each extremum exactly, and
+answers with one of :data:`KINDS` and the evidence: how many oscillation
+periods it saw and how their amplitude changed from one period to the next.
+It never depends on how the output is sampled, and it says "undetermined"
+rather than guess when the run is too short to tell.
+
+Kinds (the names the CLI, JSON and sweep tables print):
+
+* ``steady``: the signal no longer changes (within ``floor``), and the
+  extrapolated remaining change of its exponential approach is within
+  ``floor`` too;
+* ``decaying oscillation``: the amplitude falls by more than
+  :data:`RATIO_TOLERANCE` per period over the last periods;
+* ``stick-slip``: a limit cycle, the amplitude constant within
+  :data:`RATIO_TOLERANCE` over the last periods;
+* ``growing oscillation``: the amplitude grows by more than
+  :data:`RATIO_TOLERANCE` per period over the last periods;
+* ``stuck``, ``blow-up``: decided by the model (the slider stopped; the slip
+  rate ran away), passed through;
+* ``undetermined``: none of the above can be shown from the run; the
+  evidence says what was seen (e.g. "2 periods, amplitude ratio 0.93").
+
+Rate-and-state keeps its historical name ``steady sliding`` for ``steady``
+(:data:`RSF_NAMES`).
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = [
+    "BLOW_UP",
+    "DECAYING",
+    "GROWING",
+    "KINDS",
+    "RATIO_TOLERANCE",
+    "STEADY",
+    "STICK_SLIP",
+    "STUCK",
+    "UNDETERMINED",
+    "Regime",
+    "classify",
+    "classify_cycles",
+    "extremes",
+    "remaining_change",
+    "turning_points",
+]
+
+STEADY = "steady"
+DECAYING = "decaying oscillation"
+STICK_SLIP = "stick-slip"
+GROWING = "growing oscillation"
+STUCK = "stuck"
+BLOW_UP = "blow-up"
+UNDETERMINED = "undetermined"
+KINDS = (STEADY, DECAYING, STICK_SLIP, GROWING, STUCK, BLOW_UP, UNDETERMINED)
+#: rate-and-state's names where they differ (kept for its JSON and sweep tables)
+RSF_NAMES = {STEADY: "steady sliding"}
+
+#: amplitude ratio per period within 1 +- this counts as constant (a limit cycle)
+RATIO_TOLERANCE = 0.02
+#: a verdict on an oscillation needs this many consecutive period-to-period ratios that agree
+RATIOS_NEEDED = 2
+#: a swing smaller than this fraction of the larger of its neighbours is a wiggle on a larger swing, not a period
+WIGGLE = 0.05
+#: more turning points than this and the scan keeps only swings of WIGGLE of the whole range (cost bound)
+MAX_EXTREMA = 20_000
+#: a last swing smaller than this fraction of the one before is the start of an unfinished period
+TAIL = 0.25
+
+Dense = Callable[[np.ndarray], np.ndarray]
+
+
+@dataclass(frozen=True)
+class Regime:
+    """A classified run: the kind, and the evidence for it.
+
+    ``periods``: whole oscillation periods seen in the analysed window;
+    ``amplitude_ratio``: the last period's peak-to-trough amplitude over the
+    one before (NaN with fewer than two); ``period`` (s): mean of the last
+    periods (NaN unless oscillating); ``peak``/``trough``: extremes of the
+    solution over the last period (over the window when not oscillating);
+    ``evidence``: the same in words.
+    """
+
+    kind: str
+    periods: int
+    amplitude_ratio: float
+    period: float
+    peak: float
+    trough: float
+    evidence: str
+
+
+def turning_points(values: np.ndarray, delta: float) -> tuple[np.ndarray, np.ndarray]:
+    """(maxima, minima) indices, alternating, each extremum ``delta`` beyond its neighbours (hysteresis scan)."""
+    maxima: list[int] = []
+    minima: list[int] = []
+    data = np.asarray(values, dtype=float).tolist()
+    if not data:
+        return np.array([], dtype=int), np.array([], dtype=int)
+    hi = lo = data[0]
+    hi_i = lo_i = 0
+    looking_for_max = True
+    for i, value in enumerate(data):
+        if value > hi:
+            hi, hi_i = value, i
+        if value < lo:
+            lo, lo_i = value, i
+        if looking_for_max and value < hi - delta:
+            maxima.append(hi_i)
+            lo, lo_i = value, i
+            looking_for_max = False
+        elif not looking_for_max and value > lo + delta:
+            minima.append(lo_i)
+            hi, hi_i = value, i
+            looking_for_max = True
+    return np.array(maxima, dtype=int), np.array(minima, dtype=int)
+
+
+def _alternating(y: np.ndarray, floor: float) -> list[int]:
+    """Indices of the alternating extrema beyond ``floor``, wiggles on larger swings removed."""
+    maxima, minima = turning_points(y, floor)
+    if maxima.size + minima.size > MAX_EXTREMA:  # thousands of periods: the small ones are not what decides
+        maxima, minima = turning_points(y, max(floor, WIGGLE * float(np.ptp(y))))
+    ext = sorted([*maxima.tolist(), *minima.tolist()])
+    # A slip's small overshoot is a pair of tiny swings inside a big one: merge it into the big one.
+    while len(ext) >= 4:
+        swings = np.abs(np.diff(y[ext]))
+        around = np.maximum(swings[:-2], swings[2:])
+        relative = swings[1:-1] / np.where(around > 0, around, np.inf)
+        j = int(np.argmin(relative)) + 1
+        if not relative[j - 1] < WIGGLE:
+            break
+        up = y[ext[j - 1]] > y[ext[j]]  # ext[j - 1] and ext[j + 1] are maxima
+        first = _outer(y, ext[j - 1], ext[j + 1], up)
+        second = _outer(y, ext[j], ext[j + 2], not up)
+        if not first < second:
+            break
+        ext[j - 1 : j + 3] = [first, second]
+    # the swings after the last full one are a period the run did not finish (an overshoot at most): not counted
+    while len(ext) >= 3 and abs(y[ext[-1]] - y[ext[-2]]) < TAIL * max(abs(np.diff(y[ext[-3:-1]]))):
+        ext.pop()
+    return ext
+
+
+def _outer(y: np.ndarray, i: int, k: int, highest: bool) -> int:
+    return i if (y[i] >= y[k]) == highest else k
+
+
+def _kinds(y: np.ndarray, ext: list[int]) -> list[bool]:
+    """True where the alternating extremum is a maximum."""
+    if not ext:
+        return []
+    e = ext[0]
+    first_max = bool(y[e] > y[e + 1]) if e + 1 < y.size else bool(y[e] > y[e - 1])
+    return [first_max == (k % 2 == 0) for k in range(len(ext))]
+
+
+def extremes(t: np.ndarray, y: np.ndarray, index: int, dense: Dense | None = None) -> tuple[float, float]:
+    """(time, value) of the extremum at sample ``index``, placed between its neighbouring samples.
+
+    With the solver's interpolant ``dense`` the extremum is found on it (a fine grid, then a parabola
+    through the best three points, kept only if it does not overshoot them); without, the sample itself.
+    """
+    n = t.size
+    lo, hi = max(index - 1, 0), min(index + 1, n - 1)
+    is_max = (y[index] >= y[lo]) and (y[index] >= y[hi])
+    sign = 1.0 if is_max else -1.0
+    if dense is not None and t[hi] > t[lo]:
+        grid = np.linspace(t[lo], t[hi], 201)
+        values = np.asarray(dense(grid), dtype=float)
+        k = int(np.argmax(sign * values))
+        k = min(max(k, 1), grid.size - 2)
+        tt, vv = grid[k - 1 : k + 2], values[k - 1 : k + 2]
+    else:  # without the interpolant the samples are the answer: a stick-slip peak is a kink, a parabola overshoots
+        return float(t[index]), float(y[index])
+    t_x, v_x = _parabola_vertex(tt, vv)
+    best = float(np.max(sign * vv)) * sign
+    if not (math.isfinite(v_x) and tt[0] <= t_x <= tt[-1]) or sign * v_x < sign * best:
+        k = int(np.argmax(sign * vv))
+        return float(tt[k]), float(vv[k])
+    return t_x, v_x
+
+
+def _parabola_vertex(t: np.ndarray, v: np.ndarray) -> tuple[float, float]:
+    (t0, t1, t2), (v0, v1, v2) = t.tolist(), v.tolist()
+    if not t0 < t1 < t2:
+        return math.nan, math.nan
+    d0, d1 = (v1 - v0) / (t1 - t0), (v2 - v1) / (t2 - t1)
+    curvature = (d1 - d0) / (t2 - t0)
+    if curvature == 0 or not math.isfinite(curvature):
+        return math.nan, math.nan
+    # p(t) = v0 + d0 (t - t0) + curvature (t - t0)(t - t1) has p'(t) = 0 at:
+    t_x = 0.5 * (t0 + t1) - d0 / (2 * curvature)
+    return t_x, v0 + d0 * (t_x - t0) + curvature * (t_x - t0) * (t_x - t1)
+
+
+def remaining_change(t: np.ndarray, y: np.ndarray, tau: float, dense: Dense | None = None) -> tuple[float, float]:
+    """(change over the last ``tau``, change still to come if the approach is exponential; inf if it is not).
+
+    The tail is read at T - 2 tau, T - tau and T (the interpolant or linear interpolation between steps);
+    with successive changes d1, d2 of one sign and q = d2/d1 < 1, what is left is d2 q/(1 - q).
+    """
+    end = float(t[-1])
+    points = np.array([end - 2 * tau, end - tau, end])
+    values = np.asarray(dense(points), dtype=float) if dense is not None else np.interp(points, t, y)
+    d1, d2 = float(values[1] - values[0]), float(values[2] - values[1])
+    if d2 == 0.0:
+        return 0.0, 0.0
+    q = d2 / d1 if d1 != 0 else math.inf
+    if q <= 0:  # the tail turned: an oscillation too small to count, bounded by the last change
+        return abs(d2), abs(d2)
+    if q >= 1:
+        return abs(d2), math.inf
+    return abs(d2), abs(d2) * q / (1 - q)
+
+
+def classify(
+    t: np.ndarray,
+    y: np.ndarray,
+    *,
+    floor: float,
+    start: float | None = None,
+    relaxation: float | None = None,
+    dense: Dense | None = None,
+    unit: str = "",
+) -> Regime:
+    """Classify the signal ``y(t)`` over ``t >= start`` (default: all of it).
+
+    ``floor``: changes and amplitudes at or below it are no change (the solver's tolerance in ``y``);
+    ``relaxation`` (s): the time scale over which the tail's approach is judged (at most half the time since
+    the last turning point, and half the window; default those);
+    ``dense``: the solver's interpolant of ``y`` (extremes are then those of the solution, not of its steps).
+    """
+    t = np.asarray(t, dtype=float)
+    y = np.asarray(y, dtype=float)
+    inside = (t >= (t[0] if start is None else start)) & np.isfinite(t) & np.isfinite(y)
+    tw, yw = t[inside], y[inside]
+    suffix = f" {unit}" if unit else ""
+    if tw.size < 3 or not tw[-1] > tw[0]:
+        span = float(tw[-1] - tw[0]) if tw.size else 0.0
+        hi, lo = float(np.max(yw, initial=-math.inf)), float(np.min(yw, initial=math.inf))
+        text = f"undetermined: too short to tell ({tw.size} points over {span:.3g} s)"
+        return Regime(UNDETERMINED, 0, math.nan, math.nan, hi, lo, text)
+    window = float(tw[-1] - tw[0])
+    floor = max(float(floor), 0.0)
+    # an extremum at the window's first point is where the window starts, not a turning point of the solution
+    ext = [i for i in _alternating(yw, floor) if i > 0]
+    placed = [extremes(tw, yw, i, dense) for i in ext]
+    is_max = _kinds(yw, ext)
+    peaks = [placed[k] for k in range(len(ext)) if is_max[k]]
+    amplitudes = [
+        placed[k][1] - placed[k + 1][1] for k in range(len(ext) - 1) if is_max[k] and placed[k][1] > placed[k + 1][1]
+    ]
+    periods = max(len(peaks) - 1, 0)
+    ratios = [b / a for a, b in itertools.pairwise(amplitudes) if a > 0]
+    ratio = ratios[-1] if ratios else math.nan
+    period = _period(tw, yw, ext, is_max, placed, dense)
+    last_extremum = placed[-1][0] if placed else float(tw[0])
+    quiet = float(tw[-1]) - last_extremum
+    oscillating = periods >= 1 and not (math.isfinite(period) and quiet > 2 * period)
+    if oscillating:
+        last = [v for (tp, v) in placed if tp >= peaks[-2][0]] if len(peaks) >= 2 else [v for _, v in placed]
+        peak, trough = max(last), min(last)
+        return _verdict(periods, ratios, period, peak, trough)
+    # not (or no longer) oscillating: steady only when the tail has stopped changing
+    tail_from = last_extremum if placed else float(tw[0])
+    tau = min(relaxation if relaxation else math.inf, (float(tw[-1]) - tail_from) / 2.0, window / 2.0)
+    peak, trough = _window_extremes(tw, yw, dense)
+    if not tau > 0:
+        return Regime(UNDETERMINED, periods, ratio, period, peak, trough, "undetermined: no tail to judge")
+    change, remaining = remaining_change(tw, yw, tau, dense)
+    if remaining <= floor or change <= floor * 1e-3:
+        left = "nothing measurable" if math.isinf(remaining) else f"{remaining:.3g}{suffix}"
+        text = (
+            f"steady: changed {change:.3g}{suffix} over the last {tau:.3g} s, {left} still to come"
+            f" (tolerance {floor:.3g}{suffix})"
+        )
+        if periods:
+            text += f" after {periods} decayed period(s)"
+        return Regime(STEADY, periods, ratio, math.nan, peak, trough, text)
+    left = "no exponential approach" if math.isinf(remaining) else f"about {remaining:.3g}{suffix} still to come"
+    return Regime(
+        UNDETERMINED, periods, ratio, math.nan, peak, trough,
+        f"undetermined: still changing ({change:.3g}{suffix} over the last {tau:.3g} s, {left}; tolerance"
+        f" {floor:.3g}{suffix})",
+    )  # fmt: skip
+
+
+def _verdict(periods: int, ratios: list[float], period: float, peak: float, trough: float) -> Regime:
+    """The oscillation's kind from its period-to-period amplitude ratios (the last RATIOS_NEEDED must agree)."""
+    ratio = ratios[-1] if ratios else math.nan
+    evidence = f"{periods} period(s) of {period:.6g} s, amplitude ratio {ratio:.4g} per period"
+    recent = ratios[-RATIOS_NEEDED:]
+    if len(recent) == RATIOS_NEEDED:
+        if all(abs(r - 1) <= RATIO_TOLERANCE for r in recent):
+            return Regime(STICK_SLIP, periods, ratio, period, peak, trough, f"stick-slip (limit cycle): {evidence}")
+        if all(r < 1 - RATIO_TOLERANCE for r in recent):
+            return Regime(DECAYING, periods, ratio, period, peak, trough, f"decaying oscillation: {evidence}")
+        if all(r > 1 + RATIO_TOLERANCE for r in recent):
+            return Regime(GROWING, periods, ratio, period, peak, trough, f"growing oscillation: {evidence}")
+    return Regime(UNDETERMINED, periods, ratio, period, peak, trough, f"undetermined: {evidence}")
+
+
+def classify_cycles(peak_times: list[float], peaks: list[float], troughs: list[float]) -> Regime:
+    """Classify from exact cycles instead of a trace: the time and stress of each peak, and the trough after it.
+
+    For models that know their slips as events (the time-dependent model's stick chains collapse at a
+    known instant and stress), so the verdict needs no sampling at all.
+    """
+    amplitudes = [p - q for p, q in zip(peaks, troughs, strict=True)]
+    ratios = [b / a for a, b in itertools.pairwise(amplitudes) if a > 0]
+    periods = max(len(peak_times) - 1, 0)
+    period = float(np.mean(np.diff(peak_times[-4:]))) if len(peak_times) >= 2 else math.nan
+    peak = peaks[-1] if peaks else math.nan
+    trough = troughs[-1] if troughs else math.nan
+    return _verdict(periods, ratios, period, peak, trough)
+
+
+def _period(
+    t: np.ndarray, y: np.ndarray, ext: list[int], is_max: list[bool], placed: list[tuple[float, float]],
+    dense: Dense | None,
+) -> float:  # fmt: skip
+    """Mean of the last (up to three) intervals between the falls through mid-level, one per period.
+
+    A fall through the middle of the swing is steep, so its time is well defined; a flat peak's is not.
+    """
+    falls = []
+    for k in range(len(ext) - 1):
+        if not is_max[k]:
+            continue
+        level = 0.5 * (placed[k][1] + placed[k + 1][1])
+        falls.append(_crossing(t, y, ext[k], ext[k + 1], level, dense))
+    if len(falls) < 2:
+        return math.nan
+    return float(np.mean(np.diff(falls[-4:])))
+
+
+def _crossing(t: np.ndarray, y: np.ndarray, i: int, k: int, level: float, dense: Dense | None) -> float:
+    """Time where y falls through ``level`` between samples i < k (a maximum and the minimum after it)."""
+    below = np.flatnonzero(y[i : k + 1] < level)
+    j = i + int(below[0]) if below.size else k
+    a, b = float(t[j - 1]), float(t[j])
+    ya, yb = float(y[j - 1]) - level, float(y[j]) - level
+    if dense is None or not b > a:
+        return a + (b - a) * ya / (ya - yb) if ya != yb else b
+    for _ in range(2):  # twice on a fine grid of the interpolant: the bracket shrinks 32-fold each time
+        grid = np.linspace(a, b, 33)
+        values = np.asarray(dense(grid), dtype=float) - level
+        below = np.flatnonzero(values <= 0)
+        m = int(below[0]) if below.size else grid.size - 1
+        if m == 0:
+            return a
+        a, b, ya, yb = float(grid[m - 1]), float(grid[m]), float(values[m - 1]), float(values[m])
+    return a + (b - a) * ya / (ya - yb) if ya != yb else b
+
+
+def _window_extremes(t: np.ndarray, y: np.ndarray, dense: Dense | None) -> tuple[float, float]:
+    hi, lo = int(np.argmax(y)), int(np.argmin(y))
+    return extremes(t, y, hi, dense)[1], extremes(t, y, lo, dense)[1]
