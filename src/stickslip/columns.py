@@ -157,6 +157,8 @@ UNITS: dict[str, str | None] = {
     "dof": None,  # counts
     "steps": None,
     "wall_time": _TIME,  # a sweep point's computing time
+    "periods": None,  # how many periods the regime classifier saw
+    "amplitude_ratio": DIMENSIONLESS,
 }
 #: Keys whose numbers are in the unit of the key that holds them (``{"bonds.bond_time": {"value": ...}}``).
 INHERITED = frozenset({"value", "stderr", "interval", "method_bias", "lower", "upper", "median", "scaled_interval"})
