@@ -54,6 +54,8 @@ WARN_CHI2 = 2.0
 #: an F test at this level decides whether the friction responds to velocity at all
 NO_RESPONSE_LEVEL = 1e-3
 _CORE = ("a", "b", "dc")
+#: friction the solver reproduces at the fits' tolerances: the noise floor of a noise-free record
+MODEL_PRECISION = 1e-9
 
 
 @dataclass(frozen=True)
@@ -297,7 +299,8 @@ def _initial_guess(
 ) -> dict[str, float]:
     """Starting values from the record: steady levels before and after the first change give a - b."""
     f = record.friction
-    noise = max(_noise(f), 1e-12)
+    # the solver reproduces friction to ~1e-9 (rtol 1e-8 in fits): a noise-free record is known no better
+    noise = max(_noise(f), MODEL_PRECISION * max(1.0, float(np.median(np.abs(f)))))
     change = protocol.boundaries[1] if len(protocol.segments) > 1 else record.time[-1]
     before = f[record.time < change]
     after = f[(record.time >= change) & (record.time < protocol.boundaries[min(2, len(protocol.segments))])]
