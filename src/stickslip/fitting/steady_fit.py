@@ -97,7 +97,7 @@ class SteadyFit:
     noise: str
     noise_scale: float
     model_stress: np.ndarray
-    residuals: np.ndarray  # (data - model)/error
+    residuals: np.ndarray  # (data - model)/(error * noise_scale): in units of the noise, stated or estimated
     critical_velocity: Estimate
     critical_stress: Estimate
     interval_method: str
@@ -492,7 +492,8 @@ def fit_steady(
         noise=noise,
         noise_scale=noise_scale,
         model_stress=model,
-        residuals=(data.stress - model) / error,
+        # with the noise estimated, error is the stress itself (relative weights): scale it to the noise found
+        residuals=(data.stress - model) / (error * noise_scale),
         critical_velocity=vc,
         critical_stress=sc,
         interval_method=intervals,
