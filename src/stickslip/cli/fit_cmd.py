@@ -271,7 +271,7 @@ def stick_command(
         include_steady=include_steady,
         level=level,
     )
-    if output is not None and fit.success:
+    if output is not None:
         fitted = _fitted_set(
             fit.parameters, f"stick fit of {table.name}", f"stickslip fit stick of {table}, from {params.name}"
         )
