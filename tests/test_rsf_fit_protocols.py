@@ -108,3 +108,18 @@ def test_constant_friction_carries_no_information_and_the_fit_says_so():
     fit = fit_record(flat)
     assert fit.status == "failed" and not fit.success
     assert "no significant response" in fit.reason
+
+
+def test_a_drift_in_time_is_fitted_with_trend_time_or_the_fit_fails():
+    """A load cell's drift linear in time: --trend both recovers the truth; a slip trend alone misses it and the
+    fit fails (it reported a, b, Dc, k all outside their intervals with status ok)."""
+    rec = lab_record("1-10-1-3", 1, slip_drift=0.0)
+    drifting = LabRecord.from_arrays(rec.time, rec.displacement, rec.friction + 2e-5 * rec.time, length_unit="um")
+    fit = fit_record(drifting, trend="both")
+    assert fit.status == "ok", fit.reason
+    assert fit.parameters["time_trend"].value == pytest.approx(2e-5, rel=0.1)
+    for key, true in TRUE.items():
+        lo, hi = fit.parameters[key].scaled_interval or fit.parameters[key].interval
+        assert lo <= true <= hi, (key, fit.parameters[key].text())
+    missed = fit_record(drifting, trend="slip")
+    assert missed.status == "failed" and "drift" in missed.reason

@@ -295,7 +295,14 @@ def stability_command(**options: Any) -> None:
 @click.option("--stiffness", default=None, help='Fixed spring stiffness ("1e-3 1/um", or Pa/m with --normal-stress).')
 @click.option("--normal-stress", default=None, help="Normal stress, to read a stiffness in Pa/m.")
 @click.option("--fit-stiffness", is_flag=True, help="Fit the stiffness (the default when --stiffness is not given).")
-@click.option("--trend", is_flag=True, help="Fit a linear slip-dependent trend as well.")
+@click.option(
+    "--trend",
+    type=click.Choice(["slip", "time", "both"]),
+    is_flag=False,
+    flag_value="slip",
+    default=None,
+    help="Fit a linear drift as well: in slip (--trend alone), in time, or both.",
+)
 @click.option(
     "--segment",
     multiple=True,
@@ -349,7 +356,7 @@ def fit_command(**options: Any) -> None:
     elif options["segment"]:
         protocol = protocols.Protocol(tuple(protocols.parse_segment(s) for s in options["segment"]))
     fit = fit_record(record, law=options["law"], states=options["states"], stiffness=stiffness,
-                     fit_stiffness=True if options["fit_stiffness"] else None, trend=options["trend"],
+                     fit_stiffness=True if options["fit_stiffness"] else None, trend=options["trend"] or False,
                      protocol=protocol, mcmc_steps=options["mcmc_steps"], seed=options["seed"])  # fmt: skip
     report = fit.summary()
     if output is not None and fit.status == "ok":

@@ -6,7 +6,8 @@ first segment's velocity at the record's start, with ``V0`` = that velocity, so
 ``mu0`` is the initial steady friction.  Free: ``mu0``, ``a``, ``b`` and ``Dc``
 (and ``b2``, ``Dc2`` with two states), optionally the stiffness and a linear
 trend ``mu += trend * (load-point displacement)`` (slow drifts common in rock
-and gouge records).  ``Dc`` and ``k`` are fitted in log space (they span
+and gouge records: wear, gouge growth), a trend in time ``mu += time_trend * t``
+(a load cell's thermal drift), or both (``trend="both"``).  ``Dc`` and ``k`` are fitted in log space (they span
 decades); their intervals are exp(log value +- 1.96 se), so asymmetric.
 
 The noise is estimated from the record itself (the robust scatter of second
@@ -24,7 +25,8 @@ converge, the covariance could not be estimated, chi-square_r is absurd
 (> :data:`ABSURD_CHI2`: the model or the load-point history does not describe
 the record), the physical parameters did not move from their starting values,
 the friction shows no velocity dependence (an F test against constant friction,
-plus the trend when fitted), or a, b or Dc is not constrained (at a bound of its
+plus the trend when fitted), chi-square_r > 2 with a linear drift in slip and time
+explaining > 20 % of the residuals (a drift the model misses), or a, b or Dc is not constrained (at a bound of its
 range, or known only to within a factor e).  Unconstrained parameters show no
 interval, with a note saying why.
 """
@@ -54,6 +56,9 @@ WARN_CHI2 = 2.0
 #: an F test at this level decides whether the friction responds to velocity at all
 NO_RESPONSE_LEVEL = 1e-3
 _CORE = ("a", "b", "dc")
+#: with chi-square_r > WARN_CHI2, a fit fails when a linear drift (in slip and time) explains this share of the
+#: residuals: the intervals cannot hold while the model misses a drift
+DRIFT_SHARE = 0.2
 #: friction the solver reproduces at the fits' tolerances: the noise floor of a noise-free record
 MODEL_PRECISION = 1e-9
 
@@ -170,6 +175,7 @@ class RSFFit:
                 "velocity": f"{unit}/s",
                 "stiffness": f"1/{unit}",
                 "trend": f"1/{unit}",
+                "time_trend": "1/s",
                 "friction": "dimensionless",
             },
             "record": {"source": self.record.source, "rows": len(self.record), "t0": self.record.t0},
@@ -212,7 +218,8 @@ def _model(record: LabRecord, protocol: Protocol, base: RSFParams, values: dict[
     run = simulate(params, protocol, times=record.time, rtol=1e-8, atol=1e-10, detect=False)
     if run.status != "ok" or run.time.size != record.time.size:
         return np.full(record.time.size, np.nan)
-    return run.friction + values.get("trend", 0.0) * record.displacement
+    drift = values.get("trend", 0.0) * record.displacement + values.get("time_trend", 0.0) * record.time
+    return run.friction + drift
 
 
 def fit_record(
@@ -222,7 +229,7 @@ def fit_record(
     states: int = 1,
     stiffness: float | None = None,
     fit_stiffness: bool | None = None,
-    trend: bool = False,
+    trend: bool | str = False,
     protocol: Protocol | None = None,
     guess: dict[str, float] | None = None,
     mcmc_steps: int = 0,
@@ -231,11 +238,14 @@ def fit_record(
     """Fit rate-and-state friction to ``record`` (see the module notes).
 
     ``stiffness`` (1/m) is fixed unless ``fit_stiffness``; with neither it is
-    fitted.  ``mcmc_steps > 0`` adds an emcee posterior (medians and 2.5/97.5 %
-    percentiles) started from the least-squares fit.
+    fitted.  ``trend``: False, True or ``"slip"`` (linear in load-point
+    displacement), ``"time"`` (linear in time) or ``"both"``.  ``mcmc_steps > 0``
+    adds an emcee posterior (medians and 2.5/97.5 % percentiles) started from
+    the least-squares fit.
     """
     if states not in (1, 2):
         raise ParameterError(f"states: expected 1 or 2 state variables, got {states!r}")
+    trend = _trend_kinds(trend)
     source = "given" if protocol is not None else "found from the load-point displacement"
     protocol = _covering(protocol, record) if protocol is not None else find_segments(record.time, record.displacement)
     if protocol.initial_velocity <= 0:
@@ -243,12 +253,14 @@ def fit_record(
     if fit_stiffness is None:
         fit_stiffness = stiffness is None
     start = _initial_guess(record, protocol, guess or {}, stiffness)
+    if "time" in trend:  # without the time drift first: with it free from the start the search can lose its way
+        first, _ = _least_squares(record, protocol, law, 1, start, fit_stiffness, trend - {"time"})
+        start = {**start, **_start_values(first.params.valuesdict())}
     if states == 2:  # a one-state fit first: the two-state search starts from its answer, with a slower second state
         first, _ = _least_squares(record, protocol, law, 1, start, fit_stiffness, trend)
-        start = {**start, **first.params.valuesdict()}
-        start["dc"], start["dc2"] = math.exp(start["log_dc"]), 10 * math.exp(start["log_dc"])
+        start = {**start, **_start_values(first.params.valuesdict())}
+        start["dc2"] = 10 * start["dc"]
         start["b2"] = 0.2 * start["b"]
-        start["stiffness"] = math.exp(start["log_k"]) if "log_k" in start else start["stiffness"]
     result, residual = _least_squares(record, protocol, law, states, start, fit_stiffness, trend)
     base = _base(record, protocol, law, states, start)
     values = result.params.valuesdict()
@@ -263,6 +275,13 @@ def fit_record(
     table, corr, warns = _report(result, values, fit_stiffness, start["stiffness"], trend, redchi, units)
     derived = {"a-b": _difference(result, table, redchi)}
     problems = _problems(result, record, table, redchi, noise, trend)
+    drift = _residual_drift(record, resid)
+    if redchi > WARN_CHI2 and drift > DRIFT_SHARE:
+        problems.append(
+            f"a linear drift in slip and time explains {100 * drift:.0f} % of the residuals (reduced chi-square "
+            f"{redchi:.3g}): the model misses a drift, so its values and intervals are biased; fit the drift with "
+            "--trend slip, time or both"
+        )
     if redchi > WARN_CHI2:
         warns.append(
             f"reduced chi-square {redchi:.3g} > {WARN_CHI2:g}: the residuals are larger than the record's noise "
@@ -277,6 +296,15 @@ def fit_record(
         message=str(result.message), nfev=int(result.nfev), posterior=posterior,
         status="failed" if problems else "ok", reason="; ".join(problems), derived=derived, protocol_source=source,
     )  # fmt: skip
+
+
+def _start_values(values: dict[str, float]) -> dict[str, float]:
+    """A fit's values as starting values (log Dc, log k back to Dc, k)."""
+    out = {k: v for k, v in values.items() if not k.startswith("log_")}
+    out["dc"] = math.exp(values["log_dc"])
+    if "log_k" in values:
+        out["stiffness"] = math.exp(values["log_k"])
+    return out
 
 
 def _covering(protocol: Protocol, record: LabRecord) -> Protocol:
@@ -297,14 +325,22 @@ def _covering(protocol: Protocol, record: LabRecord) -> Protocol:
 def _initial_guess(
     record: LabRecord, protocol: Protocol, guess: dict[str, float], stiffness: float | None
 ) -> dict[str, float]:
-    """Starting values from the record: steady levels before and after the first change give a - b."""
+    """Starting values from the record: steady levels either side of the first step between two sliding
+    velocities give a - b."""
     f = record.friction
     # the solver reproduces friction to ~1e-9 (rtol 1e-8 in fits): a noise-free record is known no better
     noise = max(_noise(f), MODEL_PRECISION * max(1.0, float(np.median(np.abs(f)))))
-    change = protocol.boundaries[1] if len(protocol.segments) > 1 else record.time[-1]
-    before = f[record.time < change]
-    after = f[(record.time >= change) & (record.time < protocol.boundaries[min(2, len(protocol.segments))])]
-    v1, v2 = protocol.segments[0].velocity, protocol.segments[min(1, len(protocol.segments) - 1)].velocity
+    edges, speeds = protocol.boundaries, protocol.velocities
+    sliding_steps = [
+        i for i in range(1, speeds.size) if min(speeds[i], speeds[i - 1]) > 0 and speeds[i] != speeds[i - 1]
+    ]
+    step = sliding_steps[0] if sliding_steps else None
+    v1 = v2 = speeds[0]
+    before = after = f[:0]
+    if step is not None:
+        v1, v2 = speeds[step - 1], speeds[step]
+        before = f[(record.time >= edges[step - 1]) & (record.time < edges[step])]
+        after = f[(record.time >= edges[step]) & (record.time < edges[step + 1])]
     slip = max(float(record.displacement[-1]), 1e-9)
     dc = guess.get("dc", min(max(slip / 100, 1e-7), 1e-3))
     a = guess.get("a", 0.01)
@@ -317,7 +353,7 @@ def _initial_guess(
     return {
         "mu0": guess.get("mu0", float(np.median(f[: max(5, f.size // 50)]))), "a": a, "b": b, "dc": dc,
         "b2": guess.get("b2", 0.002), "dc2": guess.get("dc2", 10 * dc), "stiffness": k,
-        "trend": guess.get("trend", 0.0), "noise": noise, "max_dc": slip,
+        "trend": guess.get("trend", 0.0), "time_trend": guess.get("time_trend", 0.0), "noise": noise, "max_dc": slip,
     }  # fmt: skip
 
 
@@ -335,7 +371,7 @@ def _base(record: LabRecord, protocol: Protocol, law: str, states: int, start: d
 
 def _least_squares(
     record: LabRecord, protocol: Protocol, law: str, states: int, start: dict[str, float], fit_stiffness: bool,
-    trend: bool,
+    trend: frozenset[str],
 ) -> Any:  # fmt: skip
     import lmfit
 
@@ -356,8 +392,10 @@ def _least_squares(
                  max=log_dc[1])  # fmt: skip
     if fit_stiffness:
         pars.add("log_k", value=math.log(start["stiffness"]), min=math.log(1e-2), max=math.log(1e12))
-    if trend:
+    if "slip" in trend:
         pars.add("trend", value=start["trend"])
+    if "time" in trend:
+        pars.add("time_trend", value=start["time_trend"])
 
     def residual(p: Any) -> np.ndarray:
         model = _model(record, protocol, base, p.valuesdict())
@@ -385,7 +423,19 @@ def _final_params(base: RSFParams, values: dict[str, float]) -> RSFParams:
 
 
 _PUBLIC = {"mu0": "mu0", "a": "a", "b": "b", "log_dc": "dc", "b2": "b2", "log_dc2": "dc2", "log_k": "stiffness",
-           "trend": "trend"}  # fmt: skip
+           "trend": "trend", "time_trend": "time_trend"}  # fmt: skip
+
+
+def _trend_kinds(trend: bool | str | None) -> frozenset[str]:
+    """The drifts to fit: {"slip"}, {"time"}, both or none."""
+    if trend is None or trend is False:
+        return frozenset()
+    if trend is True:
+        return frozenset({"slip"})
+    kinds = {"slip": {"slip"}, "time": {"time"}, "both": {"slip", "time"}, "none": set()}
+    if not isinstance(trend, str) or trend.strip().lower() not in kinds:
+        raise ParameterError(f"trend: expected slip, time, both or none, got {trend!r}")
+    return frozenset(kinds[trend.strip().lower()])
 
 
 def _length_scale(unit: str) -> float:
@@ -399,11 +449,12 @@ def _units(length_unit: str) -> dict[str, tuple[str, float]]:
     """Public name -> (unit label, SI per unit) for the values that carry a length."""
     scale = _length_scale(length_unit)
     per = (f"1/{length_unit}", 1.0 / scale)
-    return {"dc": (length_unit, scale), "dc2": (length_unit, scale), "stiffness": per, "trend": per}
+    return {"dc": (length_unit, scale), "dc2": (length_unit, scale), "stiffness": per, "trend": per,
+            "time_trend": ("1/s", 1.0)}  # fmt: skip
 
 
 def _report(
-    result: Any, values: dict[str, float], fit_stiffness: bool, k_fixed: float, trend: bool, redchi: float,
+    result: Any, values: dict[str, float], fit_stiffness: bool, k_fixed: float, trend: frozenset[str], redchi: float,
     units: dict[str, tuple[str, float]],
 ) -> tuple[dict[str, FitParameter], dict[str, float], list[str]]:  # fmt: skip
     table: dict[str, FitParameter] = {}
@@ -427,7 +478,7 @@ def _report(
     if not fit_stiffness:
         unit, scale = units["stiffness"]
         table["stiffness"] = FitParameter("stiffness", k_fixed, None, None, fixed=True, unit=unit, scale=scale)
-    if not trend:
+    if "slip" not in trend:
         unit, scale = units["trend"]
         table["trend"] = FitParameter("trend", 0.0, None, None, fixed=True, unit=unit, scale=scale)
     corr: dict[str, float] = {}
@@ -495,7 +546,12 @@ def _difference(result: Any, table: dict[str, FitParameter], redchi: float) -> F
 
 
 def _problems(
-    result: Any, record: LabRecord, table: dict[str, FitParameter], redchi: float, noise: float, trend: bool
+    result: Any,
+    record: LabRecord,
+    table: dict[str, FitParameter],
+    redchi: float,
+    noise: float,
+    trend: frozenset[str],
 ) -> list[str]:
     """Why the fit cannot be trusted (empty when it can)."""
     problems = []
@@ -515,7 +571,7 @@ def _problems(
     if p_value > NO_RESPONSE_LEVEL:
         problems.append(
             f"the friction shows no significant response to the velocity changes (F test against constant friction"
-            f"{' with the trend' if trend else ''}: p = {p_value:.2g}), so a, b and Dc are not determined"
+            f"{' with the trends' if trend else ''}: p = {p_value:.2g}), so a, b and Dc are not determined"
         )
     loose = [f"{k} ({table[k].note})" for k in _CORE if not table[k].constrained]
     if loose:
@@ -523,16 +579,25 @@ def _problems(
     return problems
 
 
+def _residual_drift(record: LabRecord, resid: np.ndarray) -> float:
+    """Share of the residuals' sum of squares a straight line in slip and time explains."""
+    design = np.column_stack([np.ones(len(record)), record.displacement, record.time])
+    coef, *_ = np.linalg.lstsq(design, resid, rcond=None)
+    total = float(np.sum(resid**2))
+    return 1.0 - float(np.sum((resid - design @ coef) ** 2)) / total if total > 0 else 0.0
+
+
 def _moved(par: Any) -> bool:
     start = par.init_value if par.init_value is not None else par.value
     return abs(par.value - start) > 1e-9 * max(1.0, abs(start))
 
 
-def _response_p_value(result: Any, record: LabRecord, noise: float, trend: bool) -> float:
+def _response_p_value(result: Any, record: LabRecord, noise: float, trend: frozenset[str]) -> float:
     """p of the rate-and-state fit's improvement over constant friction (plus the trend) arising by chance."""
     from scipy import stats
 
-    columns = [np.ones(len(record))] + ([record.displacement] if trend else [])
+    columns = [np.ones(len(record))] + ([record.displacement] if "slip" in trend else [])
+    columns += [record.time] if "time" in trend else []
     design = np.column_stack(columns)
     coef, *_ = np.linalg.lstsq(design, record.friction, rcond=None)
     null = float(np.sum(((record.friction - design @ coef) / noise) ** 2))
