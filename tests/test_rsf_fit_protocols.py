@@ -123,3 +123,25 @@ def test_a_drift_in_time_is_fitted_with_trend_time_or_the_fit_fails():
         assert lo <= true <= hi, (key, fit.parameters[key].text())
     missed = fit_record(drifting, trend="slip")
     assert missed.status == "failed" and "drift" in missed.reason
+
+
+def test_a_history_that_does_not_follow_the_displacement_fails():
+    rec = lab_record("1-10-1", 0, slip_drift=0.0)
+    fit = fit_record(rec, protocol=protocols.velocity_steps([1 * UM, 10 * UM, 1 * UM], [100, 150, 50]))
+    assert fit.status == "failed" and "does not follow the record's displacement" in fit.reason
+
+
+def test_the_issue_command_line_round_trip(tmp_path, capsys):
+    """Issue 17's commands verbatim: simulate 1 -> 10 -> 1 um/s to t.csv (SI), then fit t.csv."""
+    trace = tmp_path / "t.csv"
+    code, _, err = run_main(capsys, "rsf", "simulate", "--a", "0.010", "--b", "0.015", "--dc", "20 um", "--stiffness",
+                            "1e-3 1/um", "--segment", "1 um/s:100 s", "--segment", "10 um/s:100 s", "--segment",
+                            "1 um/s:100 s", "--every", "0.1 s", "-o", str(trace))  # fmt: skip
+    assert code == 0, err
+    code, out, err = run_main(capsys, "rsf", "fit", str(trace), "--json", "--plot", str(tmp_path / "fit.png"))
+    assert code == 0, err
+    report = json.loads(out)
+    assert report["status"] == "ok" and len(report["protocol"]) == 3
+    values = {k: report["parameters"][k]["value"] for k in ("a", "b", "dc", "stiffness")}
+    assert values == pytest.approx({"a": 0.010, "b": 0.015, "dc": 20e-6, "stiffness": 1e3}, rel=1e-4)
+    assert report["parameters"]["dc"]["unit"] == "m"

@@ -21,14 +21,16 @@ the covariance (a and b are strongly correlated: their separate errors cannot
 give it).
 
 A fit is ``failed`` (never ``ok``) with a ``reason`` when the search did not
-converge, the covariance could not be estimated, chi-square_r is absurd
+converge; the covariance could not be estimated; chi-square_r is absurd
 (> :data:`ABSURD_CHI2`: the model or the load-point history does not describe
-the record), the physical parameters did not move from their starting values,
-the friction shows no velocity dependence (an F test against constant friction,
-plus the trend when fitted), chi-square_r > 2 with a linear drift in slip and time
-explaining > 20 % of the residuals (a drift the model misses), or a, b or Dc is not constrained (at a bound of its
-range, or known only to within a factor e).  Unconstrained parameters show no
-interval, with a note saying why.
+the record); a, b and Dc did not move from their starting values; the history
+strays from the record's displacement by more than 10 % of its span; the
+friction shows no velocity dependence (an F test against constant friction,
+plus the trends when fitted); chi-square_r > 2 with a linear drift in slip and
+time explaining > 20 % of the residuals (a drift the model misses); or a, b or
+Dc is not constrained (at a bound of its range, no standard error, or known
+only to within a factor e).  Unconstrained parameters show no interval, with a
+note saying why.
 """
 
 from __future__ import annotations
@@ -59,6 +61,8 @@ _CORE = ("a", "b", "dc")
 #: with chi-square_r > WARN_CHI2, a fit fails when a linear drift (in slip and time) explains this share of the
 #: residuals: the intervals cannot hold while the model misses a drift
 DRIFT_SHARE = 0.2
+#: a history whose displacement strays from the record's by more than this share of its span is not the record's
+MISMATCH_SHARE = 0.1
 #: friction the solver reproduces at the fits' tolerances: the noise floor of a noise-free record
 MODEL_PRECISION = 1e-9
 
@@ -275,6 +279,9 @@ def fit_record(
     table, corr, warns = _report(result, values, fit_stiffness, start["stiffness"], trend, redchi, units)
     derived = {"a-b": _difference(result, table, redchi)}
     problems = _problems(result, record, table, redchi, noise, trend)
+    mismatch = _history_mismatch(record, protocol)
+    if mismatch:
+        problems.insert(0, mismatch)
     drift = _residual_drift(record, resid)
     if redchi > WARN_CHI2 and drift > DRIFT_SHARE:
         problems.append(
@@ -577,6 +584,21 @@ def _problems(
     if loose:
         problems.append("not constrained by the record: " + ", ".join(loose))
     return problems
+
+
+def _history_mismatch(record: LabRecord, protocol: Protocol) -> str:
+    """'' when the history's displacement follows the record's; otherwise how far apart they drift."""
+    expected = protocol.displacement_at(record.time)
+    span = max(float(np.ptp(record.displacement)), float(np.ptp(expected)), 1e-300)
+    off = float(np.max(np.abs(expected - record.displacement)))
+    if off <= MISMATCH_SHARE * span:
+        return ""
+    scale = _length_scale(record.length_unit)
+    return (
+        f"the load-point history does not follow the record's displacement: they differ by up to "
+        f"{off / scale:.4g} {record.length_unit} of {span / scale:.4g} {record.length_unit} (check --segment or "
+        "--protocol)"
+    )
 
 
 def _residual_drift(record: LabRecord, resid: np.ndarray) -> float:
