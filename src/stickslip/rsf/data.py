@@ -168,7 +168,7 @@ def find_segments(
     n = t.size
     if n < 2 * min_points:
         return Protocol((Segment(max(_line(t, d)[0], 0.0), float(t[-1] - t[0])),), name="from displacement")
-    breaks = _merge(t, d, _pelt(t, d, min_points), min_change)
+    breaks = _merge(t, d, _segment(t, d, min_points), min_change)
     if len(breaks) - 1 > max_segments:
         raise DataError(
             f"load-point displacement: {len(breaks) - 1} straight pieces found, more than {max_segments}; "
@@ -215,6 +215,34 @@ def _misfit(sums: list[np.ndarray], lo: np.ndarray, hi: np.ndarray) -> np.ndarra
     vd = sdd - sd * sd / c
     slope = np.divide(cov, vt, out=np.zeros_like(cov), where=vt > 0)
     return np.maximum(vd - slope * cov, 0.0)
+
+
+#: above this many rows the search runs on block means and each break is then placed on the full record
+SEARCH_ROWS = 2000
+
+
+def _segment(t: np.ndarray, d: np.ndarray, min_points: int) -> list[int]:
+    """PELT's breaks; on a long record found on block means (the pruning keeps every candidate inside a straight
+    piece, so the search grows as n^2 there), then each break moved to its best row between its neighbours."""
+    n = t.size
+    block = math.ceil(n / SEARCH_ROWS)
+    if block <= 1:
+        return _pelt(t, d, min_points)
+    rows = (n // block) * block
+    coarse_t = t[:rows].reshape(-1, block).mean(axis=1)
+    coarse_d = d[:rows].reshape(-1, block).mean(axis=1)
+    coarse = _pelt(coarse_t, coarse_d, max(3, math.ceil(min_points / block)))
+    breaks = [0, *[b * block for b in coarse[1:-1]], n]
+    sums = _cumulative_sums(t, d)
+    for k in range(1, len(breaks) - 1):
+        lo = max(breaks[k - 1] + min_points, breaks[k] - 2 * block)
+        hi = min(breaks[k + 1] - min_points, breaks[k] + 2 * block)
+        if hi <= lo:
+            continue
+        j = np.arange(lo, hi + 1)
+        cost = _misfit(sums, np.full_like(j, breaks[k - 1]), j) + _misfit(sums, j, np.full_like(j, breaks[k + 1]))
+        breaks[k] = int(j[np.argmin(cost)])
+    return breaks
 
 
 def _pelt(t: np.ndarray, d: np.ndarray, min_points: int) -> list[int]:
