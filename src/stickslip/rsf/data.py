@@ -234,6 +234,20 @@ def _segment(t: np.ndarray, d: np.ndarray, min_points: int) -> list[int]:
     coarse = _pelt(coarse_t, coarse_d, max(3, math.ceil(min_points / block)))
     breaks = [0, *[b * block for b in coarse[1:-1]], n]
     sums = _cumulative_sums(t, d)
+    breaks = _refine(sums, breaks, block, min_points)
+    # a block straddling a change can leave a sliver piece; below 4 blocks a piece is beyond the search's resolution
+    while len(breaks) > 2 and min(np.diff(breaks)) < 4 * block:
+        i = int(np.argmin(np.diff(breaks)))
+        options = [k for k in (i, i + 1) if 0 < k < len(breaks) - 1]
+        merged = [_misfit(sums, np.array([breaks[k - 1]]), np.array([breaks[k + 1]]))[0] for k in options]
+        del breaks[options[int(np.argmin(merged))]]
+        breaks = _refine(sums, breaks, block, min_points)
+    return breaks
+
+
+def _refine(sums: list[np.ndarray], breaks: list[int], block: int, min_points: int) -> list[int]:
+    """Each interior break moved to its best row within two blocks, between its neighbours."""
+    breaks = list(breaks)
     for k in range(1, len(breaks) - 1):
         lo = max(breaks[k - 1] + min_points, breaks[k] - 2 * block)
         hi = min(breaks[k + 1] - min_points, breaks[k] + 2 * block)
