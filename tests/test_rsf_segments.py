@@ -52,3 +52,18 @@ def test_a_long_record_is_segmented_quickly_and_exactly():
     assert time.perf_counter() - start < 3.0  # the full-resolution search took 13 s
     assert found.velocities == pytest.approx(truth.velocities, abs=1e-3 * UM)
     assert found.boundaries == pytest.approx(truth.boundaries, abs=0.05)
+
+
+def test_a_record_with_the_load_point_velocity_instead_of_displacement(tmp_path):
+    from stickslip.rsf.data import read_record
+
+    truth = protocols.velocity_steps([v * UM for v in (1, 10, 1, 3)], [50, 20, 200, 70])
+    t = np.arange(0.0, truth.duration + 1e-9, 0.1)
+    path = tmp_path / "rig.txt"
+    rows = zip(t, truth.velocity_at(t) / UM, 0.6 + 0 * t, strict=True)
+    path.write_text("Time(s)\tVel(um/s)\tFriction\n" + "\n".join(f"{a:.2f}\t{v:g}\t{f}" for a, v, f in rows) + "\n")
+    record = read_record(path, {"time": "Time(s)", "velocity": "Vel(um/s)", "friction": "Friction"}, "um")
+    found = find_segments(record.time, record.displacement)
+    assert found.velocities == pytest.approx(truth.velocities, rel=1e-6)
+    assert found.boundaries == pytest.approx(truth.boundaries, abs=0.1)  # the record knows a step to one row
+    assert record.length_unit == "um"

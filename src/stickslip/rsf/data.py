@@ -4,7 +4,10 @@ A record has time, load-point displacement and friction.  Columns are found
 by name: the package's own trace CSV (``time``, ``load_point_displacement``,
 ``friction``), or any header mapped with ``columns={"time": "Time(s)",
 "displacement": "Displ(microns)", "friction": "Friction"}`` and a
-``displacement_unit`` such as ``"um"``.  Tab, comma, semicolon or whitespace
+``displacement_unit`` such as ``"um"``.  A record without a displacement column
+but with the load point's velocity (``load_point_velocity``, ``velocity`` or a
+mapped ``velocity=...``, in displacement units per time unit) has it integrated
+(trapezoids) into the displacement.  Tab, comma, semicolon or whitespace
 separated; ``#`` comments are skipped.
 
 The load point's velocity history comes from the displacement record:
@@ -29,11 +32,12 @@ from ..protocols import Protocol, Segment
 
 __all__ = ["LabRecord", "find_segments", "parse_columns", "read_record"]
 
-ROLES = ("time", "displacement", "friction")
+ROLES = ("time", "displacement", "friction", "velocity")
 _DEFAULT_NAMES = {
     "time": ("time", "time(s)", "time_s", "t"),
     "displacement": ("load_point_displacement", "displacement", "displ", "lp_disp", "displ(m)"),
     "friction": ("friction", "mu", "friction_coefficient"),
+    "velocity": ("load_point_velocity", "velocity", "lp_velocity", "lp_vel"),
 }
 
 
@@ -97,7 +101,7 @@ def parse_columns(text: str | None) -> dict[str, str]:
     for item in re.findall(r'(\w+)\s*=\s*("[^"]*"|\'[^\']*\'|[^,]*)', text):
         role, name = item[0].strip().lower(), item[1].strip().strip("\"'")
         if role not in ROLES:
-            raise ParameterError(f"--columns: unknown role {role!r}; expected time, displacement, friction")
+            raise ParameterError(f"--columns: unknown role {role!r}; expected time, displacement, friction or velocity")
         mapping[role] = name
     if not mapping:
         raise ParameterError(f'--columns {text!r}: expected ROLE=HEADER pairs, e.g. time="Time(s)",friction=Friction')
@@ -128,6 +132,8 @@ def read_record(
     lower = {k.lower(): v for k, v in headers.items()}
     chosen = {}
     for role in ROLES:
+        if role == "velocity" and "displacement" in chosen:
+            continue
         if columns and role in columns:
             wanted = columns[role]
             if wanted not in headers:
@@ -136,6 +142,11 @@ def read_record(
             chosen[role] = headers[wanted]
             continue
         match = next((lower[n] for n in _DEFAULT_NAMES[role] if n in lower), None)
+        if match is None and role == "displacement" and not (columns and "velocity" in columns):
+            if any(n in lower for n in _DEFAULT_NAMES["velocity"]):
+                continue  # the velocity column gives it
+        if match is None and role == "displacement" and columns and "velocity" in columns:
+            continue
         if match is None:
             found = ", ".join(headers) or "none"
             raise DataError(
@@ -144,9 +155,22 @@ def read_record(
             )
         chosen[role] = match
     data = {role: pd.to_numeric(frame[col], errors="coerce").to_numpy(dtype=float) for role, col in chosen.items()}
+    if "displacement" not in data:
+        data["displacement"] = _integrated(data["time"], data["velocity"], path)
     return LabRecord.from_arrays(
         data["time"] * t_scale, data["displacement"] * d_scale, data["friction"], str(path), displacement_unit.strip()
     )
+
+
+def _integrated(time: np.ndarray, velocity: np.ndarray, path: Path) -> np.ndarray:
+    """Displacement from the load point's velocity by trapezoids (in the record's units)."""
+    bad = ~np.isfinite(velocity)
+    if bad.any():
+        raise DataError(f"{path}: row {int(np.argmax(bad)) + 1}: velocity is not a finite number")
+    if velocity.size < 2:
+        return np.zeros_like(velocity)
+    steps = 0.5 * (velocity[1:] + velocity[:-1]) * np.diff(time)
+    return np.concatenate([[0.0], np.cumsum(steps)])
 
 
 def find_segments(
