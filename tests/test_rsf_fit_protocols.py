@@ -145,3 +145,18 @@ def test_the_issue_command_line_round_trip(tmp_path, capsys):
     values = {k: report["parameters"][k]["value"] for k in ("a", "b", "dc", "stiffness")}
     assert values == pytest.approx({"a": 0.010, "b": 0.015, "dc": 20e-6, "stiffness": 1e3}, rel=1e-4)
     assert report["parameters"]["dc"]["unit"] == "m"
+
+
+def test_a_step_without_a_transient_leaves_dc_unconstrained_but_a_minus_b_known():
+    """Friction that steps by (a - b) ln 10 instantly: no evolution to fit, so Dc (and a, b apart) are not
+    determined; the fit fails saying so, and a - b still has its interval around the truth."""
+    history = protocols.velocity_steps([1 * UM, 10 * UM, 1 * UM], [100, 100, 100])
+    t = np.arange(0.0, 300.0 + 1e-9, 0.1)
+    friction = 0.6 - 0.005 * np.log(history.velocity_at(t) / UM)
+    friction += 2e-4 * np.random.default_rng(0).standard_normal(t.size)
+    fit = fit_record(LabRecord.from_arrays(t, history.displacement_at(t), friction, length_unit="um"))
+    assert fit.status == "failed" and "not constrained by the record: dc" in fit.reason
+    assert not fit.parameters["dc"].constrained and fit.parameters["dc"].interval is None
+    assert "not constrained" in fit.parameters["dc"].text()
+    lo, hi = fit.derived["a-b"].scaled_interval or fit.derived["a-b"].interval  # chi2_r > 2: no instant step
+    assert lo <= -0.005 <= hi and hi - lo < 1e-4
