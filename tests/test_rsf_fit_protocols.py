@@ -82,6 +82,7 @@ def test_the_issue_example_fits_from_displacement_and_a_wrong_history_fails_with
     assert code == 3
     report = json.loads(out)
     assert report["status"] == "failed" and report["success"] is False
+    assert "succeeded" not in report["message"] and report["message"].startswith("fit failed")
     assert "did not move" in report["reason"] or "covariance" in report["reason"]
     assert "fit failed" in err and not out_toml.exists()
 

@@ -170,7 +170,9 @@ class RSFFit:
             "correlations": self.correlations,
             "warnings": list(self.warnings),
             "success": self.success,
-            "message": self.message,
+            # the optimiser's own words ("Fit succeeded.") only beside a verdict that cannot contradict them
+            "message": self.message if self.status == "ok" else f"fit failed: {self.reason}",
+            "optimizer_message": self.message,
             "protocol": self.protocol_rows(),
             "protocol_source": self.protocol_source,
             "units": {
