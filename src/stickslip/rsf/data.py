@@ -258,15 +258,33 @@ def _segment(t: np.ndarray, d: np.ndarray, min_points: int) -> list[int]:
     coarse = _pelt(coarse_t, coarse_d, max(3, math.ceil(min_points / block)))
     breaks = [0, *[b * block for b in coarse[1:-1]], n]
     sums = _cumulative_sums(t, d)
+    penalty = _penalty(sums, n)
     breaks = _refine(sums, breaks, block, min_points)
-    # a block straddling a change can leave a sliver piece; below 4 blocks a piece is beyond the search's resolution
-    while len(breaks) > 2 and min(np.diff(breaks)) < 4 * block:
-        i = int(np.argmin(np.diff(breaks)))
-        options = [k for k in (i, i + 1) if 0 < k < len(breaks) - 1]
-        merged = [_misfit(sums, np.array([breaks[k - 1]]), np.array([breaks[k + 1]]))[0] for k in options]
-        del breaks[options[int(np.argmin(merged))]]
-        breaks = _refine(sums, breaks, block, min_points)
+    # a block straddling a change looks like a short piece of its own: drop every break the full record's
+    # penalised misfit does not pay for (each drop re-placing the others)
+    improved = True
+    while improved and len(breaks) > 2:
+        improved = False
+        current = _objective(sums, breaks, penalty)
+        for k in range(1, len(breaks) - 1):
+            fewer = _refine(sums, breaks[:k] + breaks[k + 1 :], block, min_points)
+            if _objective(sums, fewer, penalty) < current:
+                breaks, improved = fewer, True
+                break
     return breaks
+
+
+def _penalty(sums: list[np.ndarray], n: int) -> float:
+    """The cost of one more piece: 4 sigma^2 ln n in the running sums' scaled units."""
+    scaled = sums[2][1:] - sums[2][:-1]
+    # the floor sits above the cancellation error of the running sums (relative 1e-16 * n)
+    sigma = max(_noise(scaled), 3e-7)
+    return 4.0 * sigma**2 * math.log(n)
+
+
+def _objective(sums: list[np.ndarray], breaks: list[int], penalty: float) -> float:
+    lo, hi = np.array(breaks[:-1]), np.array(breaks[1:])
+    return float(np.sum(_misfit(sums, lo, hi))) + penalty * (len(breaks) - 1)
 
 
 def _refine(sums: list[np.ndarray], breaks: list[int], block: int, min_points: int) -> list[int]:
@@ -287,10 +305,7 @@ def _pelt(t: np.ndarray, d: np.ndarray, min_points: int) -> list[int]:
     """Break indices ``[0, ..., n]`` minimising total misfit + penalty per piece (pruned exact search)."""
     n = t.size
     sums = _cumulative_sums(t, d)
-    dc = sums[2][1:] - sums[2][:-1]
-    # the floor sits above the cancellation error of the running sums (relative 1e-16 * n)
-    sigma = max(_noise(dc), 3e-7)
-    penalty = 4.0 * sigma**2 * math.log(n)
+    penalty = _penalty(sums, n)
     best = np.full(n + 1, np.inf)
     best[0] = -penalty
     previous = np.zeros(n + 1, dtype=int)

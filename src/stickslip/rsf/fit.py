@@ -259,15 +259,16 @@ def fit_record(
     if fit_stiffness is None:
         fit_stiffness = stiffness is None
     start = _initial_guess(record, protocol, guess or {}, stiffness)
-    if "time" in trend:  # without the time drift first: with it free from the start the search can lose its way
-        first, _ = _least_squares(record, protocol, law, 1, start, fit_stiffness, trend - {"time"})
-        start = {**start, **_start_values(first.params.valuesdict())}
-    if states == 2:  # a one-state fit first: the two-state search starts from its answer, with a slower second state
-        first, _ = _least_squares(record, protocol, law, 1, start, fit_stiffness, trend)
-        start = {**start, **_start_values(first.params.valuesdict())}
-        start["dc2"] = 10 * start["dc"]
-        start["b2"] = 0.2 * start["b"]
-    result, residual = _least_squares(record, protocol, law, states, start, fit_stiffness, trend)
+    result, residual = _search(record, protocol, law, states, start, fit_stiffness, trend)
+    for factor in RETRY_DC_FACTORS:  # a troubled search may sit in a local minimum: start it elsewhere in Dc
+        if not _troubled(result):
+            break
+        other = {**start, "dc": min(max(start["dc"] * factor, 2e-9), 0.5 * start["max_dc"])}
+        if stiffness is None and "stiffness" not in (guess or {}):
+            other["stiffness"] = start["stiffness"] * start["dc"] / other["dc"]
+        retry, retry_residual = _search(record, protocol, law, states, other, fit_stiffness, trend)
+        if retry.chisqr < result.chisqr * (1 - 1e-9) or (_troubled(result) and not _troubled(retry)):
+            result, residual = retry, retry_residual
     base = _base(record, protocol, law, states, start)
     values = result.params.valuesdict()
     model = _model(record, protocol, base, values)
@@ -305,6 +306,38 @@ def fit_record(
         message=str(result.message), nfev=int(result.nfev), posterior=posterior,
         status="failed" if problems else "ok", reason="; ".join(problems), derived=derived, protocol_source=source,
     )  # fmt: skip
+
+
+#: Dc starts tried (x the first start) when a search fails or leaves a, b or Dc unconstrained
+RETRY_DC_FACTORS = (0.1, 10.0, 0.01)
+
+
+def _search(
+    record: LabRecord, protocol: Protocol, law: str, states: int, start: dict[str, float], fit_stiffness: bool,
+    trend: frozenset[str],
+) -> Any:  # fmt: skip
+    """The least-squares fit from ``start``, in stages where one stage alone can lose its way."""
+    if "time" in trend:  # without the time drift first: with it free from the start the search can lose its way
+        first, _ = _least_squares(record, protocol, law, 1, start, fit_stiffness, trend - {"time"})
+        start = {**start, **_start_values(first.params.valuesdict())}
+    if states == 2:  # a one-state fit first: the two-state search starts from its answer, with a slower second state
+        first, _ = _least_squares(record, protocol, law, 1, start, fit_stiffness, trend)
+        start = {**start, **_start_values(first.params.valuesdict())}
+        start["dc2"] = 10 * start["dc"]
+        start["b2"] = 0.2 * start["b"]
+    return _least_squares(record, protocol, law, states, start, fit_stiffness, trend)
+
+
+def _troubled(result: Any) -> bool:
+    """The search did not converge, has no covariance, or leaves a, b or Dc unconstrained."""
+    if not result.success or not result.errorbars:
+        return True
+    for key in ("a", "b", "log_dc"):
+        par = result.params[key]
+        se = par.stderr if par.stderr is not None and math.isfinite(par.stderr) else None
+        if _unconstrained(key, par, se):
+            return True
+    return False
 
 
 def _start_values(values: dict[str, float]) -> dict[str, float]:
