@@ -259,9 +259,10 @@ def fit_record(
     if fit_stiffness is None:
         fit_stiffness = stiffness is None
     start = _initial_guess(record, protocol, guess or {}, stiffness)
+    mismatch = _history_mismatch(record, protocol)
     result, residual = _search(record, protocol, law, states, start, fit_stiffness, trend)
     for factor in RETRY_DC_FACTORS:  # a troubled search may sit in a local minimum: start it elsewhere in Dc
-        if not _troubled(result):
+        if mismatch or not _troubled(result):  # (no start helps a history that is not the record's)
             break
         other = {**start, "dc": min(max(start["dc"] * factor, 2e-9), 0.5 * start["max_dc"])}
         if stiffness is None and "stiffness" not in (guess or {}):
@@ -282,7 +283,6 @@ def fit_record(
     table, corr, warns = _report(result, values, fit_stiffness, start["stiffness"], trend, redchi, units)
     derived = {"a-b": _difference(result, table, redchi)}
     problems = _problems(result, record, table, redchi, noise, trend)
-    mismatch = _history_mismatch(record, protocol)
     if mismatch:
         problems.insert(0, mismatch)
     drift = _residual_drift(record, resid)
