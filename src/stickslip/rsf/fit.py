@@ -308,7 +308,7 @@ def fit_record(
     )  # fmt: skip
 
 
-#: Dc starts tried (x the first start) when a search fails or leaves a, b or Dc unconstrained
+#: Dc starts tried (x the first start) when a search fails, fits badly or leaves a, b or Dc unconstrained
 RETRY_DC_FACTORS = (0.1, 10.0, 0.01)
 
 
@@ -329,8 +329,9 @@ def _search(
 
 
 def _troubled(result: Any) -> bool:
-    """The search did not converge, has no covariance, or leaves a, b or Dc unconstrained."""
-    if not result.success or not result.errorbars:
+    """The search did not converge, has no covariance, leaves residuals beyond the noise (chi-square_r > 2: often
+    a local minimum) or leaves a, b or Dc unconstrained."""
+    if not result.success or not result.errorbars or result.chisqr > WARN_CHI2 * max(result.nfree, 1):
         return True
     for key in ("a", "b", "log_dc"):
         par = result.params[key]
