@@ -268,8 +268,11 @@ def fit_record(
         if stiffness is None and "stiffness" not in (guess or {}):
             other["stiffness"] = start["stiffness"] * start["dc"] / other["dc"]
         retry, retry_residual = _search(record, protocol, law, states, other, fit_stiffness, trend)
+        same = abs(retry.chisqr - result.chisqr) <= 1e-4 * result.chisqr
         if retry.chisqr < result.chisqr * (1 - 1e-9) or (_troubled(result) and not _troubled(retry)):
             result, residual = retry, retry_residual
+        if same and _troubled(retry):  # another start, the same answer: the record, not the start, is the cause
+            break
     base = _base(record, protocol, law, states, start)
     values = result.params.valuesdict()
     model = _model(record, protocol, base, values)
