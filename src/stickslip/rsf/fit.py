@@ -301,6 +301,14 @@ def fit_record(
             f"({noise:.3g}), so the intervals, which assume that noise, are too narrow; the scaled intervals "
             f"(x sqrt({redchi:.3g}) = x{math.sqrt(redchi):.2g}) are offered beside them"
         )
+    curvature = _quadratic_check(result, residual)
+    if curvature is not None and not (QUADRATIC_RANGE[0] <= curvature <= QUADRATIC_RANGE[1]):
+        warns.append(
+            f"the chi-square surface is not quadratic over the intervals: two standard errors along the least "
+            f"determined direction raise chi-square by {4 * curvature:.3g} instead of 4, so the intervals "
+            f"(from the curvature at the best fit) are approximate{' and too narrow' if curvature < 1 else ''}; "
+            "--mcmc N gives a posterior that does not assume it"
+        )
     posterior = _posterior(residual, result, mcmc_steps, seed) if mcmc_steps > 0 else None
     return RSFFit(
         params=_final_params(base, values), parameters=table, correlations=corr, reduced_chi_square=redchi,
@@ -329,6 +337,34 @@ def _search(
         start["dc2"] = 10 * start["dc"]
         start["b2"] = 0.2 * start["b"]
     return _least_squares(record, protocol, law, states, start, fit_stiffness, trend)
+
+
+#: chi-square rise two standard errors out, over the quadratic's 4, outside this range: the intervals are approximate
+QUADRATIC_RANGE = (0.5, 2.0)
+
+
+def _quadratic_check(result: Any, residual: Any) -> float | None:
+    """Rise of chi-square two standard errors either way along the covariance's widest direction, over 4 (the
+    quadratic's): the smaller side (None without a covariance)."""
+    covar = result.covar
+    if covar is None or not np.all(np.isfinite(covar)):
+        return None
+    values, vectors = np.linalg.eigh(covar)
+    if values[-1] <= 0:
+        return None
+    step = 2.0 * math.sqrt(values[-1]) * vectors[:, -1]
+    rises = []
+    for sign in (1.0, -1.0):
+        trial = result.params.copy()
+        for name, delta in zip(result.var_names, step, strict=True):
+            par = trial[name]
+            moved = par.value + sign * delta
+            if (par.min is not None and moved < par.min) or (par.max is not None and moved > par.max):
+                return None  # the bound, not the curvature, limits the parameter there
+            par.value = moved
+        r = residual(trial)
+        rises.append((float(np.sum(r**2)) - float(result.chisqr)) / 4.0)
+    return min(rises)
 
 
 def _troubled(result: Any) -> bool:
