@@ -51,6 +51,8 @@ __all__ = ["FitParameter", "RSFFit", "fit_record"]
 
 Z95 = 1.959963984540054
 METHOD_MAX_NFEV = 1500
+#: the solver's relative tolerance during fits
+FIT_RTOL = 1e-8
 #: chi-square_r above this: the residuals are >10x the noise, the model does not describe the record
 ABSURD_CHI2 = 100.0
 #: chi-square_r above this: warn that the intervals assume a noise level the residuals contradict
@@ -221,7 +223,7 @@ def _model(record: LabRecord, protocol: Protocol, base: RSFParams, values: dict[
         a=values["a"], mu0=values["mu0"], states=tuple(states),
         stiffness=math.exp(values["log_k"]) if "log_k" in values else base.stiffness,
     )  # fmt: skip
-    run = simulate(params, protocol, times=record.time, rtol=1e-8, atol=1e-10, detect=False)
+    run = simulate(params, protocol, times=record.time, rtol=FIT_RTOL, atol=FIT_RTOL * 1e-2, detect=False)
     if run.status != "ok" or run.time.size != record.time.size:
         return np.full(record.time.size, np.nan)
     drift = values.get("trend", 0.0) * record.displacement + values.get("time_trend", 0.0) * record.time
