@@ -109,6 +109,9 @@ def test_constant_friction_carries_no_information_and_the_fit_says_so():
     fit = fit_record(flat)
     assert fit.status == "failed" and not fit.success
     assert "no significant response" in fit.reason
+    for key in ("a", "b", "dc", "stiffness"):  # no interval: it was a = 0.00178152 [0.00178151, 0.00178153]
+        assert fit.parameters[key].interval is None and not fit.parameters[key].constrained
+    assert "no velocity dependence" in fit.summary()["parameters"]["a"]["note"]
 
 
 def test_a_drift_in_time_is_fitted_with_trend_time_or_the_fit_fails():

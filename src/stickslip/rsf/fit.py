@@ -36,7 +36,7 @@ note saying why.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -59,6 +59,7 @@ ABSURD_CHI2 = 100.0
 WARN_CHI2 = 2.0
 #: an F test at this level decides whether the friction responds to velocity at all
 NO_RESPONSE_LEVEL = 1e-3
+NO_RESPONSE_TEXT = "the friction shows no significant response to the velocity changes"
 _CORE = ("a", "b", "dc")
 #: with chi-square_r > WARN_CHI2, a fit fails when a linear drift (in slip and time) explains this share of the
 #: residuals: the intervals cannot hold while the model misses a drift
@@ -288,6 +289,11 @@ def fit_record(
     table, corr, warns = _report(result, values, fit_stiffness, start["stiffness"], trend, redchi, units)
     derived = {"a-b": _difference(result, table, redchi)}
     problems = _problems(result, record, table, redchi, noise, trend)
+    if any(p.startswith(NO_RESPONSE_TEXT) for p in problems):  # then no interval of the friction law means anything
+        why = "the friction shows no velocity dependence"
+        for key in ("a", "b", "dc", "b2", "dc2", "stiffness"):
+            if key in table and not table[key].fixed:
+                table[key] = replace(table[key], interval=None, scaled_interval=None, constrained=False, note=why)
     if mismatch:
         problems.insert(0, mismatch)
     drift = _residual_drift(record, resid)
@@ -654,7 +660,7 @@ def _problems(
     p_value = _response_p_value(result, record, noise, trend)
     if p_value > NO_RESPONSE_LEVEL:
         problems.append(
-            f"the friction shows no significant response to the velocity changes (F test against constant friction"
+            f"{NO_RESPONSE_TEXT} (F test against constant friction"
             f"{' with the trends' if trend else ''}: p = {p_value:.2g}), so a, b and Dc are not determined"
         )
     loose = [f"{k} ({table[k].note})" for k in _CORE if not table[k].constrained]
