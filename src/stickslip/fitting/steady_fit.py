@@ -537,8 +537,9 @@ def _problems(
         problems.append(f"the search did not converge in {', '.join(stuck)}")
     if keys and not np.all(np.isfinite(covariance)):
         problems.append("the covariance could not be estimated: the data cannot tell the free parameters apart")
-    if keys and all(_unmoved(fitted, base, k) for k in keys):
-        problems.append("the free parameters did not move from their start values")
+    stated_misfit = data.stress_err is not None and chi_square > 2.0 * max(len(data) - len(keys), 1)
+    if keys and all(_unmoved(fitted, base, k) for k in keys) and stated_misfit:  # a start that fits is no failure
+        problems.append("the free parameters did not move from their start values, which do not fit the data")
     p_value = _response_p_value(everything, chi_square, len(keys), data)
     if p_value > NO_RESPONSE_LEVEL:
         problems.append(

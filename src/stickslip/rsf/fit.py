@@ -655,7 +655,7 @@ def _problems(
             "(check the load-point history: give it with --protocol or --segment)"
         )
     moved = [k for k in ("a", "b", "log_dc") if _moved(result.params[k])]
-    if not moved:
+    if not moved and (redchi > WARN_CHI2 or not result.errorbars):  # (a start that already fits is no failure)
         problems.append("a, b and Dc did not move from their starting values")
     p_value = _response_p_value(result, record, noise, trend)
     if p_value > NO_RESPONSE_LEVEL:
