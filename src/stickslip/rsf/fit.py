@@ -23,7 +23,7 @@ give it).
 A fit is ``failed`` (never ``ok``) with a ``reason`` when the search did not
 converge; the covariance could not be estimated; chi-square_r is absurd
 (> :data:`ABSURD_CHI2`: the model or the load-point history does not describe
-the record); a, b and Dc did not move from their starting values; the history
+the record); a, b and Dc did not move from starting values that do not fit; the history
 strays from the record's displacement by more than 10 % of its span; the
 friction shows no velocity dependence (an F test against constant friction,
 plus the trends when fitted); chi-square_r > 2 with a linear drift in slip and
