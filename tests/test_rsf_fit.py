@@ -112,10 +112,20 @@ def test_real_sepiolite_velocity_step_is_described():
     rec = read_record(REAL_FILE, cols, displacement_unit="um")
     assert len(rec) == 16466
     fit = fit_record(rec, trend=True)
-    assert fit.success
-    assert fit.protocol.velocities == pytest.approx([0.2e-6, 2e-6], rel=0.01)
+    assert fit.success and fit.status == "ok"
+    speeds = fit.protocol.velocities
+    assert [speeds[0], speeds[-1]] == pytest.approx([0.2e-6, 2e-6], rel=0.01)
+    assert sum(s.duration for s in fit.protocol.segments[1:-1]) < 5.0  # at most the servo's few-second ramp
     assert fit.rms < 3 * fit.noise * math.sqrt(10)  # residual rms ~ 1.1e-3 against noise 3.4e-4 (drifts remain)
     assert 0.5 < (fit.parameters["a"].value - fit.parameters["b"].value) * math.log(10) / 0.05 < 1.5
+    # chi-square_r ~ 10: the intervals assume the record's noise, so a warning offers them widened by sqrt(chi2_r)
+    assert fit.reduced_chi_square > 2
+    assert any("reduced chi-square" in w and "scaled" in w for w in fit.warnings)
+    a = fit.parameters["a"]
+    widths = (a.scaled_interval[1] - a.scaled_interval[0]) / (a.interval[1] - a.interval[0])
+    assert widths == pytest.approx(math.sqrt(fit.reduced_chi_square), rel=1e-9)
+    report = fit.summary()
+    assert report["parameters"]["dc"]["unit"] == "um" and 1 < report["parameters"]["dc"]["value"] < 1000
 
 
 def test_optional_emcee_posterior():

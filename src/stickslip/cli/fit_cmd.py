@@ -171,7 +171,7 @@ def steady_command(
     posterior = None
     if posterior_module is not None:
         posterior = posterior_module.sample_posterior(fit, walkers=walkers, steps=steps, seed=seed)
-    if output is not None:
+    if output is not None and fit.success:
         fitted = _fitted_set(
             fit.parameters,
             f"fit of {data.name}",
@@ -203,6 +203,10 @@ def steady_command(
         emit_json(result)
     else:
         click.echo(report)
+    if not fit.success:
+        unwritten = f" ({output} not written)" if output is not None else ""
+        click.echo(f"stickslip: fit failed: {fit.reason}{unwritten}", err=True)
+        raise SystemExit(3)  # as `rsf fit`: 3 is a fit that ran but cannot be trusted (2 is bad input)
 
 
 def _bayes_module() -> Any:

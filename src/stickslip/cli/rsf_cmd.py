@@ -304,12 +304,26 @@ def stability_command(**options: Any) -> None:
 @click.option("--stiffness", default=None, help='Fixed spring stiffness ("1e-3 1/um", or Pa/m with --normal-stress).')
 @click.option("--normal-stress", default=None, help="Normal stress, to read a stiffness in Pa/m.")
 @click.option("--fit-stiffness", is_flag=True, help="Fit the stiffness (the default when --stiffness is not given).")
-@click.option("--trend", is_flag=True, help="Fit a linear slip-dependent trend as well.")
+@click.option(
+    "--trend",
+    type=click.Choice(["slip", "time", "both"]),
+    is_flag=False,
+    flag_value="slip",
+    default=None,
+    help="Fit a linear drift as well: in slip (--trend alone), in time, or both.",
+)
 @click.option(
     "--segment",
     multiple=True,
     metavar="V:T",
     help="Load-point history from the record's start (default: found from the displacement).",
+)
+@click.option(
+    "--protocol",
+    "protocol_file",
+    type=click.Path(dir_okay=False, path_type=Path),
+    default=None,
+    help="Load-point history as a protocol CSV (time,velocity or velocity,duration; SI), as for simulate.",
 )
 @click.option("--mcmc", "mcmc_steps", type=click.IntRange(min=0), default=0, help="emcee steps for a posterior.")
 @click.option("--seed", type=int, default=None, help="Seed of the emcee walkers.")
@@ -320,17 +334,19 @@ def fit_command(**options: Any) -> None:
     """Fit rate-and-state friction to a lab record (time, load-point displacement, friction).
 
     The load point's velocity history is found from the displacement (or
-    given with --segment); the slider starts in steady sliding.  The report
-    gives values, standard errors and 95 % intervals, correlations, reduced
-    chi-square against the record's own noise, and warnings when parameters
-    cannot be told apart.
+    given with --segment or --protocol); the slider starts in steady sliding.
+    The report gives the history used, values in the record's units with
+    standard errors and 95 % intervals, a - b with its own error, correlations,
+    reduced chi-square against the record's own noise, and warnings.  A fit
+    that cannot be trusted says why (status "failed", reason) and exits with
+    status 3; its parameters are not written to -o.
     """
     from .. import protocols
     from ..rsf.data import parse_columns, read_record
     from ..rsf.fit import fit_record
 
     output, plot_path = options["output"], options["plot_path"]
-    refuse_input_as_output([options["record_file"]], [("-o", output), ("--plot", plot_path)])
+    refuse_input_as_output([options["record_file"], options["protocol_file"]], [("-o", output), ("--plot", plot_path)])
     record = read_record(options["record_file"], parse_columns(options["columns"]), options["displacement_unit"],
                          options["time_unit"])  # fmt: skip
     sigma = None
@@ -342,13 +358,17 @@ def fit_command(**options: Any) -> None:
             raise click.UsageError("--stiffness and --fit-stiffness: give one of them")
         stiffness = _per_sigma(options["stiffness"], "per_length", "stress_per_length", sigma, "--stiffness")
     protocol = None
-    if options["segment"]:
+    if options["segment"] and options["protocol_file"] is not None:
+        raise click.UsageError("--segment and --protocol: give one of them")
+    if options["protocol_file"] is not None:
+        protocol = protocols.read_protocol(options["protocol_file"])
+    elif options["segment"]:
         protocol = protocols.Protocol(tuple(protocols.parse_segment(s) for s in options["segment"]))
     fit = fit_record(record, law=options["law"], states=options["states"], stiffness=stiffness,
-                     fit_stiffness=True if options["fit_stiffness"] else None, trend=options["trend"],
+                     fit_stiffness=True if options["fit_stiffness"] else None, trend=options["trend"] or False,
                      protocol=protocol, mcmc_steps=options["mcmc_steps"], seed=options["seed"])  # fmt: skip
     report = fit.summary()
-    if output is not None:
+    if output is not None and fit.status == "ok":
         write(output, fit.to_toml())
         write(sidecar(output), json_text({"parameters": fit.params.to_dict(), "fit": report}))
     if options["as_json"]:
@@ -359,20 +379,26 @@ def fit_command(**options: Any) -> None:
         from ..rsf.plots import fit_figure
 
         save_figure(fit_figure(fit), plot_path)
+    if fit.status != "ok":
+        unwritten = f" ({output} not written)" if output is not None else ""
+        click.echo(f"stickslip: fit failed: {fit.reason}{unwritten}", err=True)
+        # SystemExit, not click's Exit: main() runs click with standalone_mode=False, which swallows Exit's code
+        raise SystemExit(FIT_FAILED)
+
+
+#: exit status of a fit that ran but cannot be trusted (2 is bad input, 1 an internal error)
+FIT_FAILED = 3
 
 
 def _fit_text(fit: Any) -> str:
-    lines = [f"rate-and-state fit of {fit.record.source} ({len(fit.record)} rows); load point: "
-             f"{fit.protocol.describe()}"]  # fmt: skip
-    for name, p in fit.parameters.items():
-        if p.fixed:
-            lines.append(f"  {name:10s} {p.value:.6g} (fixed)")
-        elif p.interval is None:
-            lines.append(f"  {name:10s} {p.value:.6g} (no standard error)")
-        else:
-            lines.append(
-                f"  {name:10s} {p.value:.6g} ± {p.stderr:.2g}   95 % [{p.interval[0]:.6g}, {p.interval[1]:.6g}]"
-            )
+    unit = fit.record.length_unit
+    lines = [f"rate-and-state fit of {fit.record.source} ({len(fit.record)} rows): {fit.status}"
+             + (f": {fit.reason}" if fit.reason else "")]  # fmt: skip
+    lines.append(f"  load point ({fit.protocol_source}):")
+    for row in fit.protocol_rows():
+        lines.append(f"    from {row['start']:.6g} s: {row['velocity']:.6g} {unit}/s for {row['duration']:.6g} s")
+    for name, p in {**fit.parameters, **fit.derived}.items():
+        lines.append(f"  {name:10s} {p.text()}")
     lines.append(f"  reduced chi-square {fit.reduced_chi_square:.4g} (noise {fit.noise:.3g}), rms {fit.rms:.4g}")
     lines += [f"  warning: {w}" for w in fit.warnings]
     return "\n".join(lines)

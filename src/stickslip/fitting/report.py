@@ -68,6 +68,7 @@ def steady_report(fit: SteadyFit) -> str:
     lines = [
         "# Steady friction fit",
         "",
+        *([f"**Fit failed:** {fit.reason}.", ""] if fit.status != "ok" else []),
         f"- data: `{data.source}`, {len(data)} points, {human(float(data.velocity.min()), 'velocity')} to"
         f" {human(float(data.velocity.max()), 'velocity')}",
         f"- method: {fit.method}" + (f" (split at {human(fit.split, 'velocity')})" if fit.split else ""),

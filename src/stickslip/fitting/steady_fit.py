@@ -98,7 +98,7 @@ class SteadyFit:
     noise: str
     noise_scale: float
     model_stress: np.ndarray
-    residuals: np.ndarray  # (data - model)/error
+    residuals: np.ndarray  # (data - model)/(error * noise_scale): in units of the noise, stated or estimated
     critical_velocity: Estimate
     critical_stress: Estimate
     interval_method: str
@@ -106,6 +106,12 @@ class SteadyFit:
     stages: tuple[Stage, ...]
     messages: tuple[str, ...]
     samples: dict[str, np.ndarray] | None = field(default=None, repr=False)
+    status: str = "ok"  # "failed" when the fit cannot be trusted; ``reason`` says why
+    reason: str = ""
+
+    @property
+    def success(self) -> bool:
+        return self.status == "ok"
 
     @property
     def noise_estimated(self) -> bool:
@@ -139,6 +145,8 @@ class SteadyFit:
     def as_dict(self) -> dict[str, Any]:
         """The JSON summary (SI units)."""
         return {
+            "status": self.status,
+            **({"reason": self.reason} if self.reason else {}),
             "method": self.method,
             "split_velocity": self.split,
             "parameters": {e.key: e.as_dict() for e in self.estimates},
@@ -477,6 +485,13 @@ def fit_steady(
     if method == "two-step" and vc.value is not None:
         vc, sc = _flag_split_bias(vc, sc, fitted, everything, keys, scale2, level, progress)
     _note_extrapolation(progress, vc, data)
+    problems = _problems(progress, keys, fitted, base, covariance, everything, chi_square, data)
+    if any(p.startswith(NO_RESPONSE_TEXT) for p in problems):
+        why = "the data show no velocity dependence"
+        vc = Estimate("critical_velocity", "Vc", "velocity", None, status="undetermined", note=why)
+        sc = Estimate("critical_stress", "σc", "stress", None, status="undetermined", note=why)
+        estimates = tuple(_undetermined(e, why) for e in estimates)
+        combos = tuple(_undetermined(e, why) for e in combos)
     return SteadyFit(
         data=data,
         parameters=fitted,
@@ -493,7 +508,8 @@ def fit_steady(
         noise=noise,
         noise_scale=noise_scale,
         model_stress=model,
-        residuals=(data.stress - model) / error,
+        # with the noise estimated, error is the stress itself (relative weights): scale it to the noise found
+        residuals=(data.stress - model) / (error * noise_scale),
         critical_velocity=vc,
         critical_stress=sc,
         interval_method=intervals,
@@ -501,7 +517,63 @@ def fit_steady(
         stages=tuple(progress.stages),
         messages=tuple(data.notes() + progress.messages),
         samples=samples,
+        status="failed" if problems else "ok",
+        reason="; ".join(problems),
     )
+
+
+#: p above this in the F test against a constant stress: the data show no velocity dependence
+NO_RESPONSE_LEVEL = 1e-3
+NO_RESPONSE_TEXT = "the stress shows no significant velocity dependence"
+
+
+def _problems(
+    progress: _Progress, keys: Sequence[str], fitted: Parameters, base: Parameters, covariance: np.ndarray,
+    everything: Block, chi_square: float, data: SteadyData,
+) -> list[str]:  # fmt: skip
+    """Why the fit cannot be trusted (empty when it can)."""
+    problems = []
+    stuck = [s.name for s in progress.stages if not s.success]
+    if stuck:
+        problems.append(f"the search did not converge in {', '.join(stuck)}")
+    if keys and not np.all(np.isfinite(covariance)):
+        problems.append("the covariance could not be estimated: the data cannot tell the free parameters apart")
+    stated_misfit = data.stress_err is not None and chi_square > 2.0 * max(len(data) - len(keys), 1)
+    if keys and all(_unmoved(fitted, base, k) for k in keys) and stated_misfit:  # a start that fits is no failure
+        problems.append("the free parameters did not move from their start values, which do not fit the data")
+    p_value = _response_p_value(everything, chi_square, len(keys), data)
+    if p_value > NO_RESPONSE_LEVEL:
+        problems.append(
+            f"{NO_RESPONSE_TEXT} (F test against a constant stress: p = {p_value:.2g}), so Vc, σc and the"
+            " parameters are not determined"
+        )
+    return problems
+
+
+def _unmoved(fitted: Parameters, base: Parameters, key: str) -> bool:
+    now, start = fitted.as_dict()[key], base.as_dict()[key]
+    return abs(now - start) <= 1e-9 * max(abs(start), 1e-300)
+
+
+def _response_p_value(everything: Block, chi_square: float, free: int, data: SteadyData) -> float:
+    """p of the model's improvement over a constant stress (same weights) arising by chance."""
+    error = data.stress_err if data.stress_err is not None else data.stress
+    w = 1.0 / error**2
+    level = float(np.sum(w * data.stress) / np.sum(w))
+    flat = float(np.sum(w * (data.stress - level) ** 2))
+    extra, dof = free - 1, len(data) - free
+    if extra <= 0 or dof <= 0:
+        return 0.0
+    if chi_square <= 0:
+        return 0.0 if flat > 0 else 1.0
+    f_value = max(flat - chi_square, 0.0) / extra / (chi_square / dof)
+    return float(stats.f.sf(f_value, extra, dof))
+
+
+def _undetermined(estimate: Estimate, why: str) -> Estimate:
+    if estimate.status in ("fixed",) or estimate.interval is None:
+        return estimate
+    return dataclasses.replace(estimate, stderr=None, interval=None, status="undetermined", note=why)
 
 
 def _run_method(

@@ -4,14 +4,16 @@ A record has time, load-point displacement and friction.  Columns are found
 by name: the package's own trace CSV (``time``, ``load_point_displacement``,
 ``friction``), or any header mapped with ``columns={"time": "Time(s)",
 "displacement": "Displ(microns)", "friction": "Friction"}`` and a
-``displacement_unit`` such as ``"um"``.  Tab, comma, semicolon or whitespace
+``displacement_unit`` such as ``"um"``.  A record without a displacement column
+but with the load point's velocity (``load_point_velocity``, ``velocity`` or a
+mapped ``velocity=...``, in displacement units per time unit) has it integrated
+(trapezoids) into the displacement.  Tab, comma, semicolon or whitespace
 separated; ``#`` comments are skipped.
 
 The load point's velocity history comes from the displacement record:
-:func:`find_segments` splits it into straight pieces (binary segmentation of a
-piecewise-linear least-squares fit, with cumulative sums, so it costs O(n) per
-split) and a split is kept only where the two slopes differ by more than
-``min_change`` (relative) and the split explains much more than the noise.
+:func:`find_segments` splits it into straight pieces by the exact penalised
+least-squares segmentation (PELT with O(1) misfits from running sums), then
+merges neighbours whose velocities differ by less than ``min_change``.
 """
 
 from __future__ import annotations
@@ -32,29 +34,36 @@ from ..protocols import Protocol, Segment
 
 __all__ = ["LabRecord", "find_segments", "parse_columns", "read_record"]
 
-ROLES = ("time", "displacement", "friction")
+ROLES = ("time", "displacement", "friction", "velocity")
 _DEFAULT_NAMES = {
     "time": ("time", "time(s)", "time_s", "t"),
     "displacement": ("load_point_displacement", "displacement", "displ", "lp_disp", "displ(m)"),
     "friction": ("friction", "mu", "friction_coefficient"),
+    "velocity": ("load_point_velocity", "velocity", "lp_velocity", "lp_vel"),
 }
 
 
 @dataclass(frozen=True)
 class LabRecord:
-    """Time (s, from the record's start), load-point displacement (m), friction; ``t0`` is the original start."""
+    """Time (s, from the record's start), load-point displacement (m), friction; ``t0`` is the original start.
+
+    ``length_unit`` is the unit the record's displacement was written in: reports give lengths in it.
+    """
 
     time: np.ndarray
     displacement: np.ndarray
     friction: np.ndarray
     t0: float = 0.0
     source: str = "record"
+    length_unit: str = "m"
 
     def __len__(self) -> int:
         return int(self.time.size)
 
     @classmethod
-    def from_arrays(cls, time: Any, displacement: Any, friction: Any, source: str = "arrays") -> LabRecord:
+    def from_arrays(
+        cls, time: Any, displacement: Any, friction: Any, source: str = "arrays", length_unit: str = "m"
+    ) -> LabRecord:
         t = np.asarray(time, dtype=float).ravel()
         d = np.asarray(displacement, dtype=float).ravel()
         f = np.asarray(friction, dtype=float).ravel()
@@ -68,7 +77,7 @@ class LabRecord:
         if np.any(step <= 0):
             row = int(np.argmax(step <= 0)) + 2
             raise DataError(f"{source}: row {row}: time {t[row - 1]:g} s does not increase")
-        return cls(t - t[0], d - d[0], f, float(t[0]), source)
+        return cls(t - t[0], d - d[0], f, float(t[0]), source, length_unit)
 
     def to_frame(self) -> Any:
         import pandas as pd
@@ -96,7 +105,7 @@ def parse_columns(text: str | None) -> dict[str, str]:
     for item in re.findall(r'(\w+)\s*=\s*("[^"]*"|\'[^\']*\'|[^,]*)', text):
         role, name = item[0].strip().lower(), item[1].strip().strip("\"'")
         if role not in ROLES:
-            raise ParameterError(f"--columns: unknown role {role!r}; expected time, displacement, friction")
+            raise ParameterError(f"--columns: unknown role {role!r}; expected time, displacement, friction or velocity")
         mapping[role] = name
     if not mapping:
         raise ParameterError(f'--columns {text!r}: expected ROLE=HEADER pairs, e.g. time="Time(s)",friction=Friction')
@@ -128,6 +137,8 @@ def read_record(
     lower = {k.lower(): v for k, v in headers.items()}
     chosen = {}
     for role in ROLES:
+        if role == "velocity" and "displacement" in chosen:
+            continue
         if columns and role in columns:
             wanted = columns[role]
             if wanted not in headers:
@@ -136,6 +147,11 @@ def read_record(
             chosen[role] = headers[wanted]
             continue
         match = next((lower[n] for n in _DEFAULT_NAMES[role] if n in lower), None)
+        if match is None and role == "displacement" and not (columns and "velocity" in columns):
+            if any(n in lower for n in _DEFAULT_NAMES["velocity"]):
+                continue  # the velocity column gives it
+        if match is None and role == "displacement" and columns and "velocity" in columns:
+            continue
         if match is None:
             found = ", ".join(headers) or "none"
             raise DataError(
@@ -144,39 +160,55 @@ def read_record(
             )
         chosen[role] = match
     data = {role: pd.to_numeric(frame[col], errors="coerce").to_numpy(dtype=float) for role, col in chosen.items()}
-    return LabRecord.from_arrays(data["time"] * t_scale, data["displacement"] * d_scale, data["friction"], str(path))
+    if "displacement" not in data:
+        data["displacement"] = _integrated(data["time"], data["velocity"], path)
+    return LabRecord.from_arrays(
+        data["time"] * t_scale, data["displacement"] * d_scale, data["friction"], str(path), displacement_unit.strip()
+    )
+
+
+def _integrated(time: np.ndarray, velocity: np.ndarray, path: Path) -> np.ndarray:
+    """Displacement from the load point's velocity by trapezoids (in the record's units)."""
+    bad = ~np.isfinite(velocity)
+    if bad.any():
+        raise DataError(f"{path}: row {int(np.argmax(bad)) + 1}: velocity is not a finite number")
+    if velocity.size < 2:
+        return np.zeros_like(velocity)
+    steps = 0.5 * (velocity[1:] + velocity[:-1]) * np.diff(time)
+    return np.concatenate([[0.0], np.cumsum(steps)])
 
 
 def find_segments(
-    time: np.ndarray, displacement: np.ndarray, max_segments: int = 12, min_change: float = 0.2, min_points: int = 20
+    time: np.ndarray, displacement: np.ndarray, max_segments: int = 60, min_change: float = 0.2, min_points: int = 10
 ) -> Protocol:
-    """The load point's piecewise-constant velocity history from its displacement record."""
+    """The load point's piecewise-constant velocity history from its displacement record.
+
+    The optimal segmentation of the displacement into straight pieces under a
+    penalty per piece (PELT, Killick et al. 2012, exact for an additive cost):
+    each piece costs its least-squares misfit plus ``4 sigma^2 ln n``, sigma the
+    displacement's white-noise level from second differences.  Neighbouring
+    pieces whose velocities differ by less than ``min_change`` (relative) are
+    merged; a change time is where the two fitted lines meet (the load point's
+    displacement is continuous).  Raises DataError when more than
+    ``max_segments`` pieces remain (the displacement is not piecewise linear).
+    """
     t = np.asarray(time, dtype=float)
     d = np.asarray(displacement, dtype=float)
-    breaks = [0, t.size]
-    noise = max(_noise(d), 1e-300)
-    while len(breaks) - 1 < max_segments:
-        best = None
-        for i0, i1 in itertools.pairwise(breaks):
-            split = _best_split(t[i0:i1], d[i0:i1], min_points)
-            if split is None:
-                continue
-            j, gain, s_left, s_right = split
-            relative = abs(s_left - s_right) / max(abs(s_left), abs(s_right), 1e-300)
-            if relative < min_change or gain < 100 * noise**2:
-                continue
-            if best is None or gain > best[1]:
-                best = (i0 + j, gain)
-        if best is None:
-            break
-        breaks = sorted([*breaks, best[0]])
+    n = t.size
+    if n < 2 * min_points:
+        return Protocol((Segment(max(_line(t, d)[0], 0.0), float(t[-1] - t[0])),), name="from displacement")
+    breaks = _merge(t, d, _segment(t, d, min_points), min_change)
+    if len(breaks) - 1 > max_segments:
+        raise DataError(
+            f"load-point displacement: {len(breaks) - 1} straight pieces found, more than {max_segments}; "
+            "expected piecewise-constant velocity (give the history with --segment or --protocol)"
+        )
     lines = [_line(t[i0:i1], d[i0:i1]) for i0, i1 in itertools.pairwise(breaks)]
     times = [0.0]
     for j, i in enumerate(breaks[1:-1]):
         (s1, c1), (s2, c2) = lines[j], lines[j + 1]
-        # the load point's displacement is continuous: the change is where the two lines meet
         meet = (c2 - c1) / (s1 - s2) if s1 != s2 else math.nan
-        lo, hi = t[max(i - 2, 0)], t[min(i + 1, t.size - 1)]
+        lo, hi = t[max(i - 2, 0)], t[min(i + 1, n - 1)]
         times.append(meet if lo <= meet <= hi else 0.5 * (t[i - 1] + t[i]))
     times.append(float(t[-1]))
     items = [Segment(max(line[0], 0.0), b - a) for line, a, b in zip(lines, times[:-1], times[1:], strict=True)]
@@ -184,10 +216,11 @@ def find_segments(
 
 
 def _noise(d: np.ndarray) -> float:
-    """Scatter of the displacement about a smooth line (from second differences)."""
+    """White-noise level from second differences (1.4826 MAD: the kinks do not inflate it)."""
     if d.size < 4:
         return 0.0
-    return float(np.std(np.diff(d, 2)) / math.sqrt(6.0))
+    second = np.diff(d, 2)
+    return float(1.4826 * np.median(np.abs(second - np.median(second))) / math.sqrt(6.0))
 
 
 def _line(t: np.ndarray, d: np.ndarray) -> tuple[float, float]:
@@ -195,26 +228,115 @@ def _line(t: np.ndarray, d: np.ndarray) -> tuple[float, float]:
     return float(slope), float(intercept)
 
 
-def _best_split(t: np.ndarray, d: np.ndarray, min_points: int) -> tuple[int, float, float, float] | None:
-    """Index splitting [0, n) into two straight-line fits with the least total squared error, and the gain."""
+def _cumulative_sums(t: np.ndarray, d: np.ndarray) -> list[np.ndarray]:
+    """Running sums for O(1) straight-line misfits; t and d scaled to O(1) so the differences keep their digits."""
+    tc = (t - t.mean()) / max(float(np.ptp(t)), 1e-300)
+    dc = d - np.polyval(np.polyfit(tc, d, 1), tc)
+    dc = dc / max(float(np.max(np.abs(dc))), 1e-300)
+    return [np.concatenate([[0.0], np.cumsum(v)]) for v in (np.ones_like(tc), tc, dc, tc * tc, tc * dc, dc * dc)]
+
+
+def _misfit(sums: list[np.ndarray], lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """Least-squares misfit of a straight line through rows [lo, hi)."""
+    c, st, sd, stt, std, sdd = (s[hi] - s[lo] for s in sums)
+    vt = stt - st * st / c
+    cov = std - st * sd / c
+    vd = sdd - sd * sd / c
+    slope = np.divide(cov, vt, out=np.zeros_like(cov), where=vt > 0)
+    return np.maximum(vd - slope * cov, 0.0)
+
+
+#: above this many rows the search runs on block means and each break is then placed on the full record
+SEARCH_ROWS = 2000
+
+
+def _segment(t: np.ndarray, d: np.ndarray, min_points: int) -> list[int]:
+    """PELT's breaks; on a long record found on block means (the pruning keeps every candidate inside a straight
+    piece, so the search grows as n^2 there), then each break moved to its best row between its neighbours."""
     n = t.size
-    if n < 2 * min_points:
-        return None
-    tc = t - t.mean()
-    dc = d - d.mean()
-    sums = [np.concatenate([[0.0], np.cumsum(v)]) for v in (np.ones(n), tc, dc, tc * tc, tc * dc, dc * dc)]
+    block = math.ceil(n / SEARCH_ROWS)
+    if block <= 1:
+        return _pelt(t, d, min_points)
+    rows = (n // block) * block
+    coarse_t = t[:rows].reshape(-1, block).mean(axis=1)
+    coarse_d = d[:rows].reshape(-1, block).mean(axis=1)
+    coarse = _pelt(coarse_t, coarse_d, max(3, math.ceil(min_points / block)))
+    breaks = [0, *[b * block for b in coarse[1:-1]], n]
+    sums = _cumulative_sums(t, d)
+    penalty = _penalty(sums, n)
+    breaks = _refine(sums, breaks, block, min_points)
+    # a block straddling a change looks like a short piece of its own: drop every break the full record's
+    # penalised misfit does not pay for (each drop re-placing the others)
+    improved = True
+    while improved and len(breaks) > 2:
+        improved = False
+        current = _objective(sums, breaks, penalty)
+        for k in range(1, len(breaks) - 1):
+            fewer = _refine(sums, breaks[:k] + breaks[k + 1 :], block, min_points)
+            if _objective(sums, fewer, penalty) < current:
+                breaks, improved = fewer, True
+                break
+    return breaks
 
-    def sse(lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        c, st, sd, stt, std, sdd = (s[hi] - s[lo] for s in sums)
-        vt = stt - st * st / c
-        cov = std - st * sd / c
-        vd = sdd - sd * sd / c
-        slope = np.divide(cov, vt, out=np.zeros_like(cov), where=vt > 0)
-        return np.maximum(vd - slope * cov, 0.0), slope
 
-    idx = np.arange(min_points, n - min_points + 1)
-    left, s_left = sse(np.zeros_like(idx), idx)
-    right, s_right = sse(idx, np.full_like(idx, n))
-    total, _ = sse(np.array([0]), np.array([n]))
-    k = int(np.argmin(left + right))
-    return int(idx[k]), float(total[0] - left[k] - right[k]), float(s_left[k]), float(s_right[k])
+def _penalty(sums: list[np.ndarray], n: int) -> float:
+    """The cost of one more piece: 4 sigma^2 ln n in the running sums' scaled units."""
+    scaled = sums[2][1:] - sums[2][:-1]
+    # the floor sits above the cancellation error of the running sums (relative 1e-16 * n)
+    sigma = max(_noise(scaled), 3e-7)
+    return 4.0 * sigma**2 * math.log(n)
+
+
+def _objective(sums: list[np.ndarray], breaks: list[int], penalty: float) -> float:
+    lo, hi = np.array(breaks[:-1]), np.array(breaks[1:])
+    return float(np.sum(_misfit(sums, lo, hi))) + penalty * (len(breaks) - 1)
+
+
+def _refine(sums: list[np.ndarray], breaks: list[int], block: int, min_points: int) -> list[int]:
+    """Each interior break moved to its best row within two blocks, between its neighbours."""
+    breaks = list(breaks)
+    for k in range(1, len(breaks) - 1):
+        lo = max(breaks[k - 1] + min_points, breaks[k] - 2 * block)
+        hi = min(breaks[k + 1] - min_points, breaks[k] + 2 * block)
+        if hi <= lo:
+            continue
+        j = np.arange(lo, hi + 1)
+        cost = _misfit(sums, np.full_like(j, breaks[k - 1]), j) + _misfit(sums, j, np.full_like(j, breaks[k + 1]))
+        breaks[k] = int(j[np.argmin(cost)])
+    return breaks
+
+
+def _pelt(t: np.ndarray, d: np.ndarray, min_points: int) -> list[int]:
+    """Break indices ``[0, ..., n]`` minimising total misfit + penalty per piece (pruned exact search)."""
+    n = t.size
+    sums = _cumulative_sums(t, d)
+    penalty = _penalty(sums, n)
+    best = np.full(n + 1, np.inf)
+    best[0] = -penalty
+    previous = np.zeros(n + 1, dtype=int)
+    candidates = np.array([0], dtype=int)
+    for end in range(min_points, n + 1):
+        newest = end - min_points
+        if newest > 0 and np.isfinite(best[newest]):
+            candidates = np.append(candidates, newest)
+        cost = best[candidates] + _misfit(sums, candidates, np.full_like(candidates, end)) + penalty
+        k = int(np.argmin(cost))
+        best[end], previous[end] = cost[k], candidates[k]
+        candidates = candidates[cost - penalty <= best[end]]
+    breaks = [n]
+    while breaks[-1] > 0:
+        breaks.append(int(previous[breaks[-1]]))
+    return breaks[::-1]
+
+
+def _merge(t: np.ndarray, d: np.ndarray, breaks: list[int], min_change: float) -> list[int]:
+    """Drop the break between the two most similar neighbouring velocities while they differ by < min_change."""
+    breaks = list(breaks)
+    while len(breaks) > 2:
+        slopes = [_line(t[a:b], d[a:b])[0] for a, b in itertools.pairwise(breaks)]
+        change = [abs(s1 - s2) / max(abs(s1), abs(s2), 1e-300) for s1, s2 in itertools.pairwise(slopes)]
+        j = int(np.argmin(change))
+        if change[j] >= min_change:
+            break
+        del breaks[j + 1]
+    return breaks

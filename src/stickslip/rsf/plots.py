@@ -111,18 +111,37 @@ def stability_figure(params: Any, v_low: float, v_high: float) -> Any:
 
 
 def fit_figure(fit: RSFFit) -> Any:
-    """Data with the fit (top) and residuals (bottom) against load-point displacement."""
+    """Data with the fit (top), residuals, and the load-point history fitted (found or given), against
+    load-point displacement; a failed fit says so in red in the title."""
     from matplotlib.figure import Figure
 
-    fig = Figure(figsize=(8, 6), layout="constrained")
-    ax1, ax2 = fig.subplots(2, 1, sharex=True, height_ratios=[3, 1])
+    fig = Figure(figsize=(8, 7.5), layout="constrained")
+    ax1, ax2, ax3 = fig.subplots(3, 1, sharex=True, height_ratios=[3, 1, 1])
     plot_fit(fit, ax=ax1)
-    ax2.plot(fit.record.displacement * 1e6, fit.residuals, ".", ms=1.2, color="#777777")
+    disp = fit.record.displacement * 1e6
+    ax2.plot(disp, fit.residuals, ".", ms=1.2, color="#777777")
     ax2.axhline(0, color="#c0392b", lw=1)
-    ax2.set_xlabel("load-point displacement (µm)")
     ax2.set_ylabel("residual")
     apply_style(ax2)
+    speed = fit.protocol.velocity_at(fit.record.time) * 1e6
+    ax3.plot(disp, speed, color="#1f4e9c", lw=1.2, drawstyle="steps-post")
+    changes = np.interp(fit.protocol.boundaries[1:-1], fit.record.time, disp)
+    for x in changes:
+        for ax in (ax1, ax3):
+            ax.axvline(x, color="#bbbbbb", lw=0.8, ls=":")
+    if np.all(speed > 0):
+        ax3.set_yscale("log")
+    ax3.set_xlabel("load-point displacement (µm)")
+    ax3.set_ylabel(f"load point (µm/s),\n{fit.protocol_source.split(' from')[0]}", fontsize=8)
+    apply_style(ax3)
     p = fit.parameters
-    ax1.set_title(f"a = {p['a'].value:.4g}, b = {p['b'].value:.4g}, Dc = {p['dc'].value * 1e6:.4g} µm, "
-                  f"χ²ᵣ = {fit.reduced_chi_square:.3g}", fontsize=9)  # fmt: skip
+    title = (f"a = {p['a'].value:.4g}, b = {p['b'].value:.4g}, Dc = {p['dc'].value * 1e6:.4g} µm, "
+             f"χ²ᵣ = {fit.reduced_chi_square:.3g}")  # fmt: skip
+    if fit.status != "ok":
+        import textwrap
+
+        lines = textwrap.wrap(f"FIT FAILED: {fit.reason}", 130, max_lines=4, placeholder=" …")
+        ax1.set_title("\n".join([*lines, title]), fontsize=7, color="#c0392b")
+    else:
+        ax1.set_title(title, fontsize=9)
     return fig
