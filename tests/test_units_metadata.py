@@ -245,3 +245,17 @@ def test_every_sweep_model_column_and_axis_has_a_unit():
             unit_of(column)  # KeyError names what is missing
         for key, dimension in model.dimensions().items():  # the model's own dimensions agree with the registry
             assert unit_of(key) == (DIMENSIONS[dimension][1] or "1"), (model.name, key)
+
+
+def test_rsf_trace_with_units_in_its_header_is_read_by_rsf_fit_in_si(tmp_path):
+    """What `rsf simulate -o` writes (``time [s]``, ``load_point_displacement [m]``) `rsf fit` reads, units and all;
+    a header in other units is converted by the brackets, not by the --displacement-unit default."""
+    from stickslip.rsf.data import read_record
+
+    t = np.linspace(0.0, 10.0, 21)
+    path = tmp_path / "trace.csv"
+    path.write_text("time [ms],friction [1],load_point_displacement [um]\n"
+                    + "".join(f"{1e3 * x:.17g},0.6,{2.0 * x:.17g}\n" for x in t))  # fmt: skip
+    record = read_record(path)
+    np.testing.assert_allclose(record.time, t)
+    np.testing.assert_allclose(record.displacement, 2e-6 * t)

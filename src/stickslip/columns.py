@@ -35,6 +35,7 @@ __all__ = [
     "json_units",
     "parquet_table",
     "read_parquet",
+    "split_header",
     "unit_of",
     "units_of_frame",
     "with_units",
@@ -207,6 +208,16 @@ def units_of_frame(frame: pd.DataFrame) -> dict[str, str | None]:
     """The units of a frame's columns: its ``attrs["units"]``, else the registry."""
     known = frame.attrs.get("units") or {}
     return {str(c): known[str(c)] if str(c) in known else unit_of(str(c)) for c in frame.columns}
+
+
+def split_header(cell: str) -> tuple[str, str | None]:
+    """``"name [unit]"`` -> (``"name"``, ``"unit"``); a header without brackets has no unit (None)."""
+    text = cell.strip()
+    if text.endswith("]") and "[" in text:
+        name, _, unit = text[:-1].rpartition("[")
+        if name.strip():
+            return name.strip(), unit.strip()
+    return text, None
 
 
 def header_cell(name: str, unit: str | None) -> str:

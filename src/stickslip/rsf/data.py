@@ -27,7 +27,7 @@ from typing import Any
 
 import numpy as np
 
-from ..columns import with_units
+from ..columns import split_header, with_units
 from ..errors import DataError, ParameterError
 from ..fileio import protect_inputs
 from ..protocols import Protocol, Segment
@@ -134,7 +134,11 @@ def read_record(
     except (OSError, ValueError, pd.errors.ParserError) as exc:
         raise DataError(f"{path}: cannot read as delimited text ({str(exc).splitlines()[0]})") from None
     headers = {str(c).strip(): c for c in frame.columns}
+    bracketed = {str(c): split_header(str(c)) for c in frame.columns}  # "time [s]" as this package writes it
     lower = {k.lower(): v for k, v in headers.items()}
+    lower.update(
+        {name.lower(): c for c, (name, unit) in bracketed.items() if unit is not None and name.lower() not in lower}
+    )
     chosen = {}
     for role in ROLES:
         if role == "velocity" and "displacement" in chosen:
@@ -160,11 +164,21 @@ def read_record(
             )
         chosen[role] = match
     data = {role: pd.to_numeric(frame[col], errors="coerce").to_numpy(dtype=float) for role, col in chosen.items()}
-    if "displacement" not in data:
-        data["displacement"] = _integrated(data["time"], data["velocity"], path)
-    return LabRecord.from_arrays(
-        data["time"] * t_scale, data["displacement"] * d_scale, data["friction"], str(path), displacement_unit.strip()
-    )
+    unit_of_role = {role: bracketed[str(col)][1] for role, col in chosen.items()}
+
+    def in_si(role: str, dimension: str, default: float) -> np.ndarray:
+        """A column in SI: by the unit in its header's brackets (the file's word), else by the option."""
+        unit = unit_of_role.get(role)
+        factor = to_si(f"1 {unit}", dimension, f"column {chosen[role]!r}") if unit else default
+        return data[role] * factor
+
+    time = in_si("time", "time", t_scale)
+    if "displacement" in data:
+        displacement = in_si("displacement", "length", d_scale)
+    else:
+        displacement = _integrated(time, in_si("velocity", "velocity", d_scale / t_scale), path)
+    shown_unit = unit_of_role.get("displacement") or displacement_unit.strip()
+    return LabRecord.from_arrays(time, displacement, data["friction"], str(path), shown_unit)
 
 
 def _integrated(time: np.ndarray, velocity: np.ndarray, path: Path) -> np.ndarray:
