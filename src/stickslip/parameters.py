@@ -290,8 +290,10 @@ def read_parameter_file(path: str | Path) -> Parameters:
         raise ParameterError(f"parameter file {shown} not found") from None
     except (OSError, ValueError) as exc:  # ValueError: a NUL in the name
         raise ParameterError(f"parameter file {shown} cannot be read: {shorten(str(exc))}") from None
+    if stat.S_ISDIR(info.st_mode):
+        raise ParameterError(f"parameter file {shown} is a folder, not a file")
     if not stat.S_ISREG(info.st_mode):  # a FIFO would block for ever, /dev/zero never end
-        raise ParameterError(f"parameter file {shown} is not a regular file")
+        raise ParameterError(f"parameter file {shown} is not a regular file (save a pipe or device to a file first)")
     if info.st_size > MAX_PARAMETER_FILE_BYTES:
         raise ParameterError(
             f"parameter file {shown} is {info.st_size} bytes; a parameter file is at most"
@@ -299,7 +301,7 @@ def read_parameter_file(path: str | Path) -> Parameters:
         )
     try:
         with open(path, "rb") as handle:
-            text = handle.read(MAX_PARAMETER_FILE_BYTES + 1).decode("utf-8")
+            text = handle.read(MAX_PARAMETER_FILE_BYTES + 1).decode("utf-8-sig")  # a BOM (Windows editors) is no error
     except FileNotFoundError:
         raise ParameterError(f"parameter file {shown} not found") from None
     except (OSError, ValueError) as exc:  # ValueError: not UTF-8
@@ -332,7 +334,7 @@ def load_parameters(
     if text in available_parameter_sets():
         resource = resources.files("stickslip") / "parameter_sets" / f"{text}.toml"
         params = _parse_toml(resource.read_text(encoding="utf-8"), text)
-    elif text.endswith(".toml") or "/" in text or _is_file(text):
+    elif text.endswith(".toml") or "/" in text or _exists(text):
         params = read_parameter_file(text)
     else:
         raise ParameterError(
@@ -342,9 +344,10 @@ def load_parameters(
     return params.with_overrides(overrides)
 
 
-def _is_file(text: str) -> bool:
+def _exists(text: str) -> bool:
+    """Whether ``text`` names something on disk (a FIFO or a folder too: reading it then says what is wrong)."""
     try:
-        return Path(text).is_file()
+        return Path(text).exists()
     except (OSError, ValueError):  # a name too long for the system, or with a NUL byte
         return False
 

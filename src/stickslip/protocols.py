@@ -198,15 +198,19 @@ def read_protocol(path: str | Path) -> Protocol:
       (its velocity is not used).  Times must increase strictly; the first
       row's time is taken as the start.
     """
+    import csv
+    import io
+
     import pandas as pd
 
     path = Path(path)
-    if not path.is_file():
-        raise DataError(f"{path}: protocol file not found (expected a CSV with columns time,velocity)")
+    text = _protocol_text(path)
+    if not text.strip():
+        raise DataError(f"{path}: empty file, expected a CSV with columns time,velocity or velocity,duration")
     try:
-        frame = pd.read_csv(path, sep=None, engine="python", comment="#", nrows=1_000_000)
-    except (ValueError, OSError, UnicodeDecodeError, pd.errors.ParserError) as exc:
-        raise DataError(f"{path}: cannot read as CSV ({str(exc).splitlines()[0]})") from None
+        frame = pd.read_csv(io.StringIO(text), sep=None, engine="python", comment="#", nrows=1_000_000)
+    except (ValueError, csv.Error, pd.errors.ParserError) as exc:  # csv.Error: no delimiter could be found
+        raise DataError(f"{path}: cannot read as CSV ({(str(exc).splitlines() or [''])[0]})") from None
     columns = {str(c).strip().lower(): c for c in frame.columns}
     if {"velocity", "duration"} <= set(columns):
         pairs = _numeric_rows(frame, path, [columns["velocity"], columns["duration"]])
@@ -227,6 +231,34 @@ def read_protocol(path: str | Path) -> Protocol:
         return Protocol(tuple(items), name=path.name)
     found = ", ".join(str(c) for c in frame.columns) or "none"
     raise DataError(f"{path}: expected columns time,velocity or velocity,duration (SI units); found {found}")
+
+
+#: Largest protocol file read (a million change points is about 30 MB).
+MAX_PROTOCOL_BYTES = 100_000_000
+
+
+def _protocol_text(path: Path) -> str:
+    """The text of a protocol file: a regular file (a FIFO would block, /dev/zero never end), UTF-8, BOM allowed."""
+    import stat
+
+    try:
+        info = path.stat()
+    except FileNotFoundError:
+        raise DataError(f"{path}: protocol file not found (expected a CSV with columns time,velocity)") from None
+    except (OSError, ValueError) as exc:  # ValueError: a NUL in the name
+        raise DataError(f"{path}: protocol file cannot be read ({getattr(exc, 'strerror', None) or exc})") from None
+    if stat.S_ISDIR(info.st_mode):
+        raise DataError(f"{path}: is a folder, not a protocol file")
+    if not stat.S_ISREG(info.st_mode):
+        raise DataError(f"{path}: not a regular file (save a pipe or device to a file first)")
+    if info.st_size > MAX_PROTOCOL_BYTES:
+        raise DataError(f"{path}: {info.st_size} bytes; a protocol file is at most {MAX_PROTOCOL_BYTES} bytes")
+    try:
+        return path.read_bytes().decode("utf-8-sig")
+    except OSError as exc:
+        raise DataError(f"{path}: protocol file cannot be read ({exc.strerror or exc})") from None
+    except UnicodeDecodeError as exc:
+        raise DataError(f"{path}: not a text (UTF-8) CSV file ({exc.reason} at byte {exc.start})") from None
 
 
 def _numeric_rows(frame: Any, path: Path, cols: list[Any]) -> list[tuple[float, float]]:

@@ -178,6 +178,11 @@ def _string_to_si(text: str, dimension: str, name: str) -> float:
             f"{name}: cannot read {shorten(stripped)} as {_describe(dimension)}:"
             " expected a number and a unit, e.g. '350 um/s' (digits in a unit only as small exponents, m^2)"
         )
+    if match is None:  # "um/s" alone is a unit, not a value: reading it as 1 um/s would hide a forgotten number
+        raise UnitError(
+            f"{name}: {shorten(stripped)} has no number; expected {_describe(dimension)} written as a number"
+            " and a unit, e.g. '350 um/s'"
+        )
     fast = _fast_unit(unit)
     if fast is not None:
         if fast[1] != _DIMENSION_VECTORS[dimension]:

@@ -11,14 +11,16 @@ from __future__ import annotations
 import io
 import json
 import math
+import stat
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
 import click
 
-from ..errors import ParameterError, UnitError
+from ..errors import DataError, ParameterError, UnitError
 from ..fileio import atomic_path, atomic_write_text, refuse_input_as_output
+from ..units import shorten
 from .common import json_safe, quantity
 
 LAW_NAMES = ("aging", "slip", "prz", "nagata")
@@ -57,7 +59,7 @@ def build_params(options: dict[str, Any]) -> Any:
     base: dict[str, Any] = {}
     if options.get("params_file") is not None:
         base = load_params_mapping(options["params_file"])
-    states = [dict(s) for s in base.get("states", [{"law": "aging", "b": 0.01, "dc": 10e-6}])]
+    states = _base_states(base, options.get("params_file"))
     first = states[0]
     if options.get("law"):
         for s in states:
@@ -94,17 +96,39 @@ def build_params(options: dict[str, Any]) -> Any:
         mapping["mass"] = _positive(options["mass"], "mass_per_area", "--mass", allow_zero=True)
     if options.get("regularized"):
         mapping["regularized"] = True
-    return RSFParams.from_dict(mapping, source="options")
+    source = "options" if options.get("params_file") is None else f"--params {options['params_file']} (or options)"
+    return RSFParams.from_dict(mapping, source=source)
+
+
+#: Largest --params file read (one written by a run or fit is a few kB).
+MAX_PARAMS_BYTES = 1_000_000
+
+
+def _base_states(base: dict[str, Any], path: Path | None) -> list[dict[str, Any]]:
+    """The state variables of a --params file (one aging state without one), each a table."""
+    if "states" not in base:
+        return [{"law": "aging", "b": 0.01, "dc": 10e-6}]
+    states = base["states"]
+    if not isinstance(states, list) or not states or not all(isinstance(s, dict) for s in states):
+        raise ParameterError(
+            f"--params {path}: 'states' must be a non-empty list of tables with law, b, dc; got {shorten(states)}"
+        )
+    return [dict(s) for s in states]
 
 
 def load_params_mapping(path: Path) -> dict[str, Any]:
     """The parameter mapping of a ``.params.json`` (trace or fit) or a ``.toml`` file."""
-    from ..errors import DataError
+    data = load_params_file(path)
+    mapping = data.get("parameters", data)
+    if not isinstance(mapping, dict):
+        raise DataError(f"--params {path}: 'parameters' must be a table of values, got {type(mapping).__name__}")
+    return dict(mapping)
 
+
+def load_params_file(path: Path) -> dict[str, Any]:
+    """The whole top-level table of a ``--params`` file; every problem with the file is one DataError line."""
     path = Path(path)
-    if not path.is_file():
-        raise DataError(f"--params {path}: file not found")
-    text = path.read_text(encoding="utf-8")
+    text = _params_text(path)
     try:
         if path.suffix.lower() == ".toml":
             try:
@@ -114,9 +138,50 @@ def load_params_mapping(path: Path) -> dict[str, Any]:
             data = tomllib.loads(text)
         else:
             data = json.loads(text)
-    except ValueError as exc:
-        raise DataError(f"--params {path}: cannot read ({str(exc).splitlines()[0]})") from None
-    return dict(data.get("parameters", data))
+    except ValueError as exc:  # JSONDecodeError and TOMLDecodeError are ValueErrors
+        kind = "TOML" if path.suffix.lower() == ".toml" else "JSON"
+        raise DataError(f"--params {path}: malformed {kind} ({(str(exc).splitlines() or [''])[0]})") from None
+    if not isinstance(data, dict):
+        raise DataError(f"--params {path}: expected a table of parameters (a JSON object), got {type(data).__name__}")
+    return data
+
+
+def _params_text(path: Path) -> str:
+    """The text of a --params file: a regular file (a FIFO would block, /dev/zero never end), UTF-8, BOM allowed."""
+    try:
+        info = path.stat()
+    except FileNotFoundError:
+        raise DataError(f"--params {path}: file not found") from None
+    except (OSError, ValueError) as exc:  # ValueError: a NUL in the name
+        raise DataError(f"--params {path}: cannot be read ({getattr(exc, 'strerror', None) or exc})") from None
+    if stat.S_ISDIR(info.st_mode):
+        raise DataError(f"--params {path}: is a folder, not a file")
+    if not stat.S_ISREG(info.st_mode):
+        raise DataError(f"--params {path}: not a regular file (save a pipe or device to a file first)")
+    if info.st_size > MAX_PARAMS_BYTES:
+        raise DataError(f"--params {path}: {info.st_size} bytes; a parameter file is at most {MAX_PARAMS_BYTES} bytes")
+    try:
+        return path.read_bytes().decode("utf-8-sig")
+    except OSError as exc:
+        raise DataError(f"--params {path}: cannot be read ({exc.strerror or exc})") from None
+    except UnicodeDecodeError as exc:
+        raise DataError(f"--params {path}: not a text (UTF-8) file ({exc.reason} at byte {exc.start})") from None
+
+
+def _run_meta(path: Path) -> tuple[list[dict[str, Any]] | None, float | None]:
+    """The protocol and start velocity a ``.params.json`` of an earlier run carries (None where absent)."""
+    data = load_params_file(path)
+    protocol, start = data.get("protocol"), data.get("start_velocity")
+    if protocol is not None:
+        rows = protocol if isinstance(protocol, list) else None
+        if rows is None or not all(isinstance(r, dict) and {"velocity", "duration"} <= set(r) for r in rows):
+            raise DataError(
+                f'--params {path}: \'protocol\' must be a list of {{"velocity": ..., "duration": ...}} segments'
+                f" (SI), got {shorten(protocol)}"
+            )
+    if start is not None and (isinstance(start, bool) or not isinstance(start, (int, float))):
+        raise DataError(f"--params {path}: 'start_velocity' must be a number in m/s, got {shorten(start)}")
+    return protocol or None, start
 
 
 def _number(text: str, name: str) -> float:
@@ -215,8 +280,7 @@ def simulate_command(**options: Any) -> None:
     fallback = None
     start = None
     if options["params_file"] is not None and options["params_file"].suffix.lower() == ".json":
-        meta = json.loads(options["params_file"].read_text(encoding="utf-8"))
-        fallback, start = meta.get("protocol"), meta.get("start_velocity")
+        fallback, start = _run_meta(options["params_file"])
     params = build_params(options)
     protocol = build_protocol(options["segment"], options["protocol_file"], fallback)
     if options["start_velocity"] is not None:

@@ -36,6 +36,7 @@ import numpy as np
 from ..errors import ModelError, ParameterError
 from ..numerics.quadrature import panel_rule
 from ..parameters import BOLTZMANN, Parameters
+from ..units import shorten
 
 if TYPE_CHECKING:  # pragma: no cover
     import pandas as pd
@@ -468,9 +469,12 @@ def require_parameters(params: Any, name: str = "params") -> None:
 
 def _check_velocity(velocity: Any) -> np.ndarray:
     try:
-        v = np.asarray(velocity, dtype=float)
-    except (TypeError, ValueError):
-        raise ParameterError(f"velocity: expected numbers in m/s, got {velocity!r}") from None
+        raw = np.asarray(velocity)
+    except (TypeError, ValueError):  # ragged nested lists
+        raise ParameterError(f"velocity: expected numbers in m/s, got {shorten(velocity)}") from None
+    if raw.dtype.kind not in "iuf":  # True would be 1 m/s, 1+0j would lose its imaginary part, "1" is text
+        raise ParameterError(f"velocity: expected real numbers in m/s, got {shorten(velocity)}")
+    v = raw.astype(float)
     bad = ~np.isfinite(v) | (v <= 0)
     if np.any(bad):
         raise ParameterError(f"velocity: expected positive finite values in m/s, got {float(v[bad].ravel()[0])!r}")

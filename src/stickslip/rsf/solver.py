@@ -68,6 +68,7 @@ def simulate(
         raise ParameterError(f"params: expected RSFParams, got {type(params).__name__}")
     if not isinstance(protocol, Protocol):
         raise ParameterError(f"protocol: expected a Protocol, got {type(protocol).__name__}")
+    _check_tolerances(rtol, atol)
     v_start = protocol.initial_velocity if start_velocity is None else float(start_velocity)
     if not (math.isfinite(v_start) and v_start > 0):
         raise ParameterError(
@@ -106,6 +107,15 @@ def simulate(
     return assemble_run(system, protocol, t_all, y_all, status, message, v_start, detect)
 
 
+def _check_tolerances(rtol: Any, atol: Any) -> None:
+    """ODEPACK takes a NaN or negative tolerance without complaint and then integrates nonsense."""
+    for name, value in (("rtol", rtol), ("atol", atol)):
+        if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
+            raise ParameterError(f"{name}: expected a positive number, got {value!r}")
+        if not (math.isfinite(value) and 0 < value < 1):
+            raise ParameterError(f"{name}: expected a tolerance between 0 and 1, got {value!r}")
+
+
 def _grid(protocol: Protocol, every: float | None, times: Any) -> np.ndarray | None:
     if every is not None and times is not None:
         raise ParameterError("every/times: give one of them, not both")
@@ -116,7 +126,7 @@ def _grid(protocol: Protocol, every: float | None, times: Any) -> np.ndarray | N
             raise ParameterError(f"every: expected a positive time step, got {every!r}")
         count = math.floor(end / every * (1 + 1e-12)) + 1
         if count > 50_000_000:
-            raise ParameterError(f"every: {every:g} s gives {count} samples over {end:g} s; expected at most 5e7")
+            raise ParameterError(f"every: {every:g} s gives {count:.3g} samples over {end:g} s; expected at most 5e7")
         return np.arange(count) * every
     if times is None:
         return None

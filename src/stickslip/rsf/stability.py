@@ -23,6 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ParameterError
+from ..units import to_si
 from .params import RSFParams
 from .system import System
 
@@ -53,7 +54,7 @@ def _closed_form_applies(p: RSFParams) -> bool:
     return len(p.states) == 1 and p.states[0].law in _CLASSICAL and not p.regularized
 
 
-def critical_stiffness(params: RSFParams, velocity: float) -> float:
+def critical_stiffness(params: RSFParams, velocity: float | str) -> float:
     """k_c (1/m) at steady sliding velocity ``velocity``; 0 if steady sliding is stable at any stiffness."""
     velocity = _positive_velocity(velocity)
     if _closed_form_applies(params):
@@ -66,7 +67,7 @@ def critical_stiffness(params: RSFParams, velocity: float) -> float:
     return _numerical_critical(params, velocity)
 
 
-def neutral_period(params: RSFParams, velocity: float) -> float:
+def neutral_period(params: RSFParams, velocity: float | str) -> float:
     """Period (s) of the neutral oscillation at k = k_c; NaN if there is no Hopf point."""
     velocity = _positive_velocity(velocity)
     kc = critical_stiffness(params, velocity)
@@ -81,7 +82,7 @@ def neutral_period(params: RSFParams, velocity: float) -> float:
     return 2 * math.pi / omega if omega > 0 else math.nan
 
 
-def stability(params: RSFParams, velocity: float) -> Stability:
+def stability(params: RSFParams, velocity: float | str) -> Stability:
     """Everything about the stability of steady sliding at ``velocity`` with the params' stiffness."""
     velocity = _positive_velocity(velocity)
     kc = critical_stiffness(params, velocity)
@@ -111,13 +112,18 @@ def stability(params: RSFParams, velocity: float) -> Stability:
     )
 
 
-def growth_rate(params: RSFParams, velocity: float) -> float:
+def growth_rate(params: RSFParams, velocity: float | str) -> float:
     """Largest real part (1/s) of the linearised equations' eigenvalues at steady sliding: > 0 means unstable."""
     return float(np.max(_eigenvalues(params, _positive_velocity(velocity)).real))
 
 
-def _positive_velocity(velocity: float) -> float:
-    v = float(velocity)
+def _positive_velocity(velocity: float | str) -> float:
+    """The velocity in m/s: a number (SI) or a string with its unit ("1 um/s"); positive and finite."""
+    if isinstance(velocity, np.ndarray) and velocity.size == 1:
+        velocity = velocity.item()
+    if isinstance(velocity, (np.floating, np.integer)):
+        velocity = float(velocity)
+    v = to_si(velocity, "velocity", "velocity")
     if not (math.isfinite(v) and v > 0):
         raise ParameterError(f"velocity: expected a positive sliding velocity, got {velocity!r}")
     return v
