@@ -61,7 +61,7 @@ def build_params(options: dict[str, Any]) -> Any:
         base = load_params_mapping(options["params_file"])
     states = _base_states(base, options.get("params_file"))
     first = states[0]
-    if options.get("law"):
+    if options.get("law") is not None:  # --law "" is an error (unknown law), not the default
         for s in states:
             s["law"] = options["law"]
     if options.get("b") is not None:

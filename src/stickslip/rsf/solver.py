@@ -78,7 +78,7 @@ def simulate(
     system = System(params)
     grid = _grid(protocol, every, times)
     v_cap = BLOW_UP_FACTOR * max(float(np.max(protocol.velocities)), v_start)
-    x_cap = min(math.log(v_cap / params.v_ref), EXP_CAP - 10.0)
+    x_cap = _blow_up_level(params, max(float(np.max(protocol.velocities)), v_start))
     y = system.steady_y(v_start)
     # Where a quasi-static slider may run away, odeint could step over the run-away between samples:
     # sample from the adaptive solver's interpolant instead, which watches every step.
@@ -86,7 +86,11 @@ def simulate(
     t_parts, y_parts = [np.array([0.0])], [y[:, None]]
     status, message = "ok", ""
     for t0, t1, vlp in protocol.pieces():
-        if grid is None:
+        _check_clock(params, max(vlp, v_start if t0 == 0 else 0.0), t1)
+        short = _short_piece(system, y, t0, t1, vlp, grid)
+        if short is not None:
+            t_out, y_out, y_end, blown = short
+        elif grid is None:
             t_out, y_out, y_end, blown = _adaptive_piece(system, y, t0, t1, vlp, x_cap, rtol, atol)
         else:
             inside = grid[(grid > t0) & (grid <= t1)]
@@ -105,6 +109,40 @@ def simulate(
     t_all = np.concatenate(t_parts)
     y_all = np.concatenate(y_parts, axis=1)
     return assemble_run(system, protocol, t_all, y_all, status, message, v_start, detect)
+
+
+def _blow_up_level(params: RSFParams, fastest: float) -> float:
+    """ln(v_cap / v_ref), the slip rate at which a run is declared blown up; it must fit below EXP_CAP."""
+    level = math.log(fastest) - math.log(params.v_ref) + math.log(BLOW_UP_FACTOR)
+    if level > EXP_CAP - 10.0:  # the blow-up watch could not be represented: the run would stall, not report
+        ratio = level - math.log(BLOW_UP_FACTOR)
+        limit = EXP_CAP - 10.0 - math.log(BLOW_UP_FACTOR)
+        raise ParameterError(
+            f"velocity: {fastest:.3g} m/s is e^{ratio:.0f} times v_ref = {params.v_ref:.3g} m/s; the solver"
+            f" represents V/v_ref up to about e^{limit:.0f} (give velocities and v_ref of comparable size)"
+        )
+    return level
+
+
+#: Most state renewals (slip / Dc) up to a time t that the solver's clock (resolution ~1e-16 t) can follow.
+MAX_RENEWALS = 1e12
+
+
+def _check_clock(params: RSFParams, velocity: float, t_end: float) -> None:
+    """ModelError when the state's time scale Dc/V is below the resolution of the clock at t_end.
+
+    Beyond about 1e13 renewals the integrator, which steps in t, rounds its steps away and reports a
+    blow-up or stalls (measured on steady sliding with a = b: 1e12 renewals follow it, 1e13 report a false blow-up).
+    """
+    dc = min(s.dc for s in params.states)
+    renewals = velocity * t_end / dc
+    if renewals > MAX_RENEWALS:
+        raise ModelError(
+            f"the run spans {renewals:.3g} state renewals (slip V t / Dc at {velocity:.3g} m/s up to"
+            f" t = {t_end:.3g} s);"
+            f" the solver's clock (double precision) follows at most {MAX_RENEWALS:.0e}: use a shorter protocol,"
+            " a smaller velocity or a larger Dc"
+        )
 
 
 def _check_tolerances(rtol: Any, atol: Any) -> None:
@@ -161,6 +199,47 @@ def _sampled_piece(
         return _dense_piece(system, y0, t0, t1, vlp, inside, x_cap, rtol, atol)
     keep = slice(1, 1 + inside.size)
     return t_eval[keep], out[keep].T, out[-1], None
+
+
+#: A segment is "short" when its duration times the fastest rate of the linearised equations is below this.
+SHORT_PIECE = 1e-8
+
+
+def _short_piece(
+    system: System, y0: np.ndarray, t0: float, t1: float, vlp: float, grid: np.ndarray | None
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, None] | None:
+    """One Euler step over a segment far shorter than every time scale of the equations, or None.
+
+    ODEPACK cannot start on an interval of 1e-300 s (it stalls); over a step h with h ||J|| <= 1e-8 the
+    Euler step's error, about (h ||J||)^2 / 2 relative to the state's scale, is far below any tolerance.
+    """
+    h = t1 - t0
+    jac = _jacobian(system, y0, vlp)
+    rate = float(np.max(np.sum(np.abs(jac), axis=1)))  # the infinity norm bounds every eigenvalue
+    if not (math.isfinite(rate) and h * rate < SHORT_PIECE):
+        return None
+    slope = np.asarray(system.rhs(t0, y0, vlp), dtype=float)
+    if not np.all(np.isfinite(slope)):
+        return None
+
+    def state_at(t: np.ndarray) -> np.ndarray:
+        return y0[:, None] + slope[:, None] * (t - t0)[None, :]
+
+    inside = np.array([t1]) if grid is None else grid[(grid > t0) & (grid <= t1)]
+    return inside, state_at(inside), state_at(np.array([t1]))[:, 0], None
+
+
+def _jacobian(system: System, y: np.ndarray, vlp: float) -> np.ndarray:
+    if system.has_jacobian:
+        return np.asarray(system.jacobian(0.0, y, vlp), dtype=float)
+    jac = np.empty((y.size, y.size))
+    for j in range(y.size):
+        step = 1e-6 * max(1.0, abs(y[j]))
+        up, down = y.copy(), y.copy()
+        up[j] += step
+        down[j] -= step
+        jac[:, j] = (np.array(system.rhs(0.0, up, vlp)) - np.array(system.rhs(0.0, down, vlp))) / (2 * step)
+    return jac
 
 
 def _dense_piece(

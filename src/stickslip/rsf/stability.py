@@ -22,7 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import ParameterError
+from ..errors import ModelError, ParameterError
 from ..units import to_si
 from .params import RSFParams
 from .system import System
@@ -142,6 +142,11 @@ def _eigenvalues(params: RSFParams, velocity: float) -> np.ndarray:
             up[j] += h
             down[j] -= h
             jac[:, j] = (np.array(system.rhs(0.0, up, velocity)) - np.array(system.rhs(0.0, down, velocity))) / (2 * h)
+    if not np.all(np.isfinite(jac)):
+        raise ModelError(
+            f"the linearised equations at {velocity:.3g} m/s overflow the floating-point range: these parameters"
+            " (a, b, Dc, c, eta, mass, v_ref) are outside what can be computed; check their magnitudes"
+        )
     return np.linalg.eigvals(jac)
 
 
