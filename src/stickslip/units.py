@@ -121,9 +121,27 @@ def shorten(value: Any, limit: int = ECHO_LENGTH) -> str:
     return f"{text[:head]}…{text[head - limit :]} ({len(text)} characters)"
 
 
+#: How a message names a quantity of each dimension (with its article).
+_NOUNS = {
+    "dimensionless": "a dimensionless number",
+    "per_area": "a number per area",
+    "area": "an area",
+    "per_length": "an inverse length",
+    "stress_per_length": "a stress per length",
+    "stress_per_velocity": "a stress per velocity",
+    "stress_rate": "a stress rate",
+    "mass_per_area": "a mass per area",
+}
+
+
+def quantity_noun(dimension: str) -> str:
+    """``"a velocity"``, ``"an area"``: the quantity of ``dimension`` as a message names it."""
+    return _NOUNS.get(dimension, f"a {dimension.replace('_', ' ')}")
+
+
 def _describe(dimension: str) -> str:
     unit = DIMENSIONS[dimension][1]
-    return f"a {dimension.replace('_', ' ')}" + (f" (e.g. in {unit})" if unit else " number")
+    return quantity_noun(dimension) + (f" (e.g. in {unit})" if unit else "")
 
 
 def bare_number(text: str) -> float | None:

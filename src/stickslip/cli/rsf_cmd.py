@@ -20,7 +20,7 @@ import click
 
 from ..errors import DataError, ParameterError, UnitError
 from ..fileio import atomic_path, atomic_write_text, refuse_input_as_output
-from ..units import shorten
+from ..units import quantity_noun, shorten
 from .common import json_safe, quantity
 
 LAW_NAMES = ("aging", "slip", "prz", "nagata")
@@ -198,6 +198,9 @@ def _per_sigma(
     text: str, dimension: str, stress_dimension: str, sigma: float | None, name: str, allow_zero: bool = False
 ) -> float:
     """A value in friction units, or in stress units divided by the normal stress."""
+    from .common import require_unit
+
+    require_unit(text, dimension, f"{name} ")  # a bare number: say it needs a unit, not that its unit is wrong
     try:
         return _positive(text, dimension, name, allow_zero)
     except UnitError:
@@ -205,8 +208,8 @@ def _per_sigma(
             value = _positive(text, stress_dimension, name, allow_zero)
         except UnitError:
             raise UnitError(
-                f"{name}: {text!r} has the wrong dimension; expected {dimension.replace('_', ' ')} "
-                f"or {stress_dimension.replace('_', ' ')} with --normal-stress"
+                f"{name}: {text!r} has the wrong dimension; expected {quantity_noun(dimension)} "
+                f"or {quantity_noun(stress_dimension)} with --normal-stress"
             ) from None
         if sigma is None:
             raise ParameterError(f"{name} {text!r} is in stress units: give --normal-stress to convert it") from None
