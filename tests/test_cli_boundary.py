@@ -63,7 +63,7 @@ def test_bare_v0_is_refused_with_the_way_to_write_it(capsys):
         (["curve", "--velocity", "350e-6"], 'a velocity needs a unit, e.g. --velocity "350e-6 m/s"\n'),
         (["critical", "--set", "block.height=5"], 'e.g. --set block.height="5 mm" (or "5 m" if you mean SI)'),
         (["compare", "--eta", "1"], 'a slowness needs a unit, e.g. --eta "1 s/m"\n'),
-        (["analyze", "--v0", "5 um/s", "--contact-area", "15", "x.csv"], 'an area needs a unit, e.g. --contac'),
+        (["analyze", "--v0", "5 um/s", "--contact-area", "15", "x.csv"], "an area needs a unit, e.g. --contac"),
         (["rsf", "stability", "--velocity", "1 um/s", "--stiffness", "1000"], '--stiffness "1000 1/m"'),
         (["critical", "--set", "bonds.max_extension=1e300"], "--set bonds.max_extension=1e300: a length needs a unit"),
         (["critical", "--set", "aging.aging_velocity=-3"], "--set aging.aging_velocity=-3: a velocity needs a unit"),

@@ -35,6 +35,8 @@ BLOW_UP_FACTOR = 1e10
 RTOL = 1e-10
 #: Right-hand-side evaluations allowed per protocol segment before a run is declared stalled.
 MAX_CALLS = 1_000_000
+#: Evaluations after which a solver whose clock has not moved (relative 1e-12) is declared stalled.
+PROGRESS_CALLS = 20_000
 
 
 class _Stalled(Exception):
@@ -273,9 +275,15 @@ def _adaptive_piece(
     blow_up.direction = 1  # type: ignore[attr-defined]
     jac = system.jacobian if system.has_jacobian else None
     calls = [0]
+    checkpoint = [t0]
 
     def rhs(t: float, y: np.ndarray, vlp: float) -> list[float]:
         calls[0] += 1
+        if calls[0] % PROGRESS_CALLS == 0:
+            # a clock that has not moved in PROGRESS_CALLS evaluations is stuck for good: say so now
+            if t - checkpoint[0] <= 1e-12 * max(abs(t), t1 - t0):
+                raise _Stalled(t)
+            checkpoint[0] = t
         if calls[0] > MAX_CALLS:
             raise _Stalled(t)
         return system.rhs(t, y, vlp)
@@ -300,7 +308,7 @@ def _adaptive_piece(
                 )  # fmt: skip
     except _Stalled as stalled:
         raise ModelError(
-            f"rate-and-state solver stalled at t = {stalled.time:.6g} s ({MAX_CALLS} evaluations in the segment "
+            f"rate-and-state solver stalled at t = {stalled.time:.6g} s (in the segment "
             f"{t0:g} ... {t1:g} s): the equations are too stiff here (e.g. the regularised form far below V0 "
             "under a very stiff spring); loosen the spring or use the classical form"
         ) from None
@@ -319,7 +327,10 @@ def _adaptive_piece(
                 "drop the mass (the quasi-static slider is its limit; use eta for fast slip)"
             )
         else:
-            raise ModelError(f"rate-and-state solver failed at t = {t_fail:.6g} s ({sol.message})")
+            raise ModelError(
+                f"rate-and-state solver failed at t = {t_fail:.6g} s ({sol.message}): the equations cannot be"
+                " integrated with these parameters; check the magnitudes of a, b, Dc, the stiffness and v_ref"
+            )
     if dense:
         return float(sol.t[-1]), sol.sol, sol.y[:, -1], blown
     return sol.t[1:], sol.y[:, 1:], sol.y[:, -1], blown
