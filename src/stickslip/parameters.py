@@ -304,7 +304,11 @@ def read_parameter_file(path: str | Path) -> Parameters:
             text = handle.read(MAX_PARAMETER_FILE_BYTES + 1).decode("utf-8-sig")  # a BOM (Windows editors) is no error
     except FileNotFoundError:
         raise ParameterError(f"parameter file {shown} not found") from None
-    except (OSError, ValueError) as exc:  # ValueError: not UTF-8
+    except UnicodeDecodeError as exc:
+        raise ParameterError(
+            f"parameter file {shown} is not a text (UTF-8) file ({exc.reason} at byte {exc.start})"
+        ) from None
+    except (OSError, ValueError) as exc:
         raise ParameterError(f"parameter file {shown} cannot be read: {shorten(str(exc))}") from None
     if len(text) > MAX_PARAMETER_FILE_BYTES:
         raise ParameterError(f"parameter file {shown} is longer than {MAX_PARAMETER_FILE_BYTES} bytes")
@@ -331,6 +335,11 @@ def load_parameters(
     if isinstance(name_or_path, Parameters):
         return name_or_path.with_overrides(overrides)
     text = str(name_or_path)
+    if not text.strip():
+        raise ParameterError(
+            "empty parameter set name: expected a built-in name"
+            f" ({', '.join(available_parameter_sets())}) or a TOML file"
+        )
     if text in available_parameter_sets():
         resource = resources.files("stickslip") / "parameter_sets" / f"{text}.toml"
         params = _parse_toml(resource.read_text(encoding="utf-8"), text)

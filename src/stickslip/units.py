@@ -75,7 +75,9 @@ MAX_VALUE_LENGTH = 200
 ECHO_LENGTH = 60
 
 _NUMBER = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
-_NUMBER_THEN_UNIT = re.compile(rf"^({_NUMBER})\s*(.*)$", re.DOTALL)
+#: "nan s" and "inf s" are numbers with a unit (the caller's range check names them), not a unit alone.
+_NON_FINITE = r"[-+]?(?i:nan|inf(?:inity)?)(?![^\W\d])"
+_NUMBER_THEN_UNIT = re.compile(rf"^({_NUMBER}|{_NON_FINITE})\s*(.*)$", re.DOTALL)
 #: An exponent pint may see: one or two digits, optionally a short fraction, not itself raised to a power.
 _EXPONENT = re.compile(r"(?:\^|\*\*)\s*[-+]?\d{1,2}(?:\.\d{1,3})?(?!\d)(?!\s*(?:\^|\*\*))")
 #: A leading "1" of "1/m^2" (also inside parentheses).

@@ -156,16 +156,21 @@ def _numerical_critical(params: RSFParams, velocity: float) -> float:
 
     scale = max(abs(params.b - params.a), params.a) / min(s.dc for s in params.states)
     lo, hi = scale * 1e-9, scale * 1e9
+    if not (math.isfinite(hi) and lo > 0):
+        raise ModelError(
+            f"the stiffness scale |b - a|/Dc = {scale:.3g} 1/m is outside the floating-point range: check Dc"
+            f" ({min(s.dc for s in params.states):.3g} m) and a, b"
+        )
     if growth(lo) <= 0:
         return 0.0
     if growth(hi) > 0:
         return math.inf
     for _ in range(200):
-        mid = math.sqrt(lo * hi)
+        mid = math.sqrt(lo) * math.sqrt(hi)
         if growth(mid) > 0:
             lo = mid
         else:
             hi = mid
         if hi / lo - 1 < 1e-12:
             break
-    return math.sqrt(lo * hi)
+    return math.sqrt(lo) * math.sqrt(hi)
