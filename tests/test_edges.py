@@ -173,6 +173,7 @@ CASES: list[tuple[list[str], int, str]] = [
     (["rsf", "simulate", "--segment", ""], 2, "expected VELOCITY:DURATION"),
     (["rsf", "simulate", "--segment", "um/s:10 s"], 2, "'um/s' has no number"),
     (["rsf", "simulate", *SEG, "--every", "1e-300 s"], 2, "every: 1e-300 s gives 1e+301 samples over 10 s"),
+    (["rsf", "simulate", "--segment", "1 um/s:20 s", "--every", "1e-6 s"], 2, "gives 2e+07 samples over 20 s"),
     (["rsf", "simulate", *SEG, "--every", "0"], 2, "--every: expected a positive value"),
     (["rsf", "simulate", *SEG, "--every", "1e300 s", "--json"], 0, '"status": "ok"'),
     (["rsf", "simulate", *SEG, "--start-velocity", "0"], 2, "--start-velocity: expected a positive value"),

@@ -33,6 +33,8 @@ __all__ = ["BLOW_UP_FACTOR", "evolve_state", "simulate"]
 #: A run "blows up" when V exceeds this multiple of max(driving velocities, start velocity).
 BLOW_UP_FACTOR = 1e10
 RTOL = 1e-10
+#: Most samples a trace with ``every`` may hold (1e7 samples: about 2 GB and 10 s).
+MAX_SAMPLES = 10_000_000
 #: Right-hand-side evaluations allowed per protocol segment before a run is declared stalled.
 MAX_CALLS = 1_000_000
 #: Evaluations after which a solver whose clock has not moved (relative 1e-12) is declared stalled.
@@ -165,8 +167,10 @@ def _grid(protocol: Protocol, every: float | None, times: Any) -> np.ndarray | N
         if not (math.isfinite(every) and every > 0):
             raise ParameterError(f"every: expected a positive time step, got {every!r}")
         count = math.floor(end / every * (1 + 1e-12)) + 1
-        if count > 50_000_000:
-            raise ParameterError(f"every: {every:g} s gives {count:.3g} samples over {end:g} s; expected at most 5e7")
+        if count > MAX_SAMPLES:  # each sample holds about 180 bytes in memory until the trace is written
+            raise ParameterError(
+                f"every: {every:g} s gives {count:.3g} samples over {end:g} s; expected at most {MAX_SAMPLES:.0e}"
+            )
         return np.arange(count) * every
     if times is None:
         return None
