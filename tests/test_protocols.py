@@ -83,6 +83,7 @@ def test_atomic_write_and_input_guard(tmp_path):
         (b"  \n\t\n", "empty file"),
         (b"\x90\xff\x00\xc3\x28" * 20, r"not a text \(UTF-8\) CSV file"),
     ],
+    ids=["empty", "blank", "binary"],
 )
 def test_empty_and_binary_protocol_files_are_one_line(tmp_path, content, message):
     path = tmp_path / "p.csv"
