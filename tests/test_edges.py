@@ -347,6 +347,11 @@ API_CASES = [
     (lambda: _rsf_run(atol=-1.0), ParameterError, "atol: expected a tolerance between 0 and 1"),
     (lambda: _rsf_run(rtol="1e-6"), ParameterError, "rtol: expected a positive number"),
     (lambda: _rsf_run(every=1e-300), ParameterError, "gives 1e+300 samples"),
+    (lambda: _rsf_run(start_velocity="x"), UnitError, "start_velocity: 'x' has no number"),
+    (lambda: _rsf_run(start_velocity=True), UnitError, "start_velocity: expected a velocity"),
+    (lambda: _rsf_run(every="1 m"), UnitError, "every: '1 m' has dimension [length]"),
+    (lambda: _rsf_run(times=["a"]), ParameterError, "times: expected a sequence of sample times"),
+    (lambda: _rsf_run(times=[[0, 1], [1]]), ParameterError, "times: expected a sequence of sample times"),
     (lambda: _steady(1 + 0j), ParameterError, "velocity: expected real numbers in m/s"),
     (lambda: _steady(True), ParameterError, "velocity: expected real numbers in m/s"),
     (lambda: _steady(np.array([1e-4, 2e-4], dtype=complex)), ParameterError, "expected real numbers"),
@@ -372,6 +377,18 @@ def test_stability_reads_a_velocity_with_its_unit():
     assert report.velocity == 1e-6
     assert report.critical_stiffness == pytest.approx((0.015 - 0.01) / 20e-6, rel=1e-12)
     assert report.neutral_period == pytest.approx(2 * math.pi * 20e-6 / 1e-6 * math.sqrt(0.01 / 0.005), rel=1e-12)
+
+
+def test_simulate_reads_velocities_and_steps_with_their_units():
+    """start_velocity="2 um/s", every="0.1 s" are 2e-6 m/s and 0.1 s (they were a raw ValueError)."""
+    from stickslip import protocols
+    from stickslip.rsf import RSFParams, simulate
+
+    p, protocol = RSFParams(), protocols.constant(1e-6, 1.0)
+    with_units = simulate(p, protocol, start_velocity="2 um/s", every="0.1 s")
+    plain = simulate(p, protocol, start_velocity=2e-6, every=0.1)
+    assert np.array_equal(with_units.time, plain.time)
+    assert np.array_equal(with_units.friction, plain.friction)
 
 
 def test_two_state_critical_stiffness_with_a_tiny_second_length_does_not_overflow():

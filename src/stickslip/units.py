@@ -166,6 +166,8 @@ def to_si(value: Any, dimension: str, name: str = "value") -> float:
     """
     if dimension not in DIMENSIONS:
         raise KeyError(f"unknown dimension {dimension!r}")
+    if getattr(value, "shape", None) == () and hasattr(value, "item") and not hasattr(value, "dimensionality"):
+        value = value.item()  # a numpy scalar (float32, int64, 0-d array) is its Python number
     if isinstance(value, bool):
         raise UnitError(f"{name}: expected {_describe(dimension)}, got {value!r}")
     if isinstance(value, (int, float)):

@@ -24,6 +24,7 @@ import numpy as np
 
 from ..errors import ModelError, ParameterError
 from ..protocols import Protocol
+from ..units import shorten, to_si
 from .params import RSFParams
 from .results import RSFRun, assemble_run
 from .system import EXP_CAP, System
@@ -73,7 +74,9 @@ def simulate(
     if not isinstance(protocol, Protocol):
         raise ParameterError(f"protocol: expected a Protocol, got {type(protocol).__name__}")
     _check_tolerances(rtol, atol)
-    v_start = protocol.initial_velocity if start_velocity is None else float(start_velocity)
+    v_start = (
+        protocol.initial_velocity if start_velocity is None else to_si(start_velocity, "velocity", "start_velocity")
+    )
     if not (math.isfinite(v_start) and v_start > 0):
         raise ParameterError(
             f"start velocity: expected a positive velocity for the initial steady state, got {v_start:g} m/s"
@@ -163,7 +166,7 @@ def _grid(protocol: Protocol, every: float | None, times: Any) -> np.ndarray | N
         raise ParameterError("every/times: give one of them, not both")
     end = protocol.duration
     if every is not None:
-        every = float(every)
+        every = to_si(every, "time", "every")
         if not (math.isfinite(every) and every > 0):
             raise ParameterError(f"every: expected a positive time step, got {every!r}")
         count = math.floor(end / every * (1 + 1e-12)) + 1
@@ -174,7 +177,10 @@ def _grid(protocol: Protocol, every: float | None, times: Any) -> np.ndarray | N
         return np.arange(count) * every
     if times is None:
         return None
-    grid = np.asarray(times, dtype=float).ravel()
+    try:
+        grid = np.asarray(times, dtype=float).ravel()
+    except (TypeError, ValueError):
+        raise ParameterError(f"times: expected a sequence of sample times in s, got {shorten(times)}") from None
     if grid.size == 0 or not np.all(np.isfinite(grid)) or np.any(np.diff(grid) <= 0):
         raise ParameterError("times: expected finite, strictly increasing sample times")
     if grid[0] < 0 or grid[-1] > end * (1 + 1e-12):
