@@ -27,6 +27,7 @@ from ..protocols import Protocol
 from ..units import shorten, to_si
 from .params import RSFParams
 from .results import RSFRun, assemble_run
+from .stability import jacobian_at
 from .system import EXP_CAP, System
 
 __all__ = ["BLOW_UP_FACTOR", "evolve_state", "simulate"]
@@ -138,7 +139,7 @@ MAX_RENEWALS = 1e12
 def _check_clock(params: RSFParams, velocity: float, t_end: float) -> None:
     """ModelError when the state's time scale Dc/V is below the resolution of the clock at t_end.
 
-    Beyond about 1e13 renewals the integrator, which steps in t, rounds its steps away and reports a
+    Beyond about 1e12 renewals the integrator, which steps in t, rounds its steps away and reports a
     blow-up or stalls (measured on steady sliding with a = b: 1e12 renewals follow it, 1e13 report a false blow-up).
     """
     dc = min(s.dc for s in params.states)
@@ -223,10 +224,10 @@ def _short_piece(
     """One Euler step over a segment far shorter than every time scale of the equations, or None.
 
     ODEPACK cannot start on an interval of 1e-300 s (it stalls); over a step h with h ||J|| <= 1e-8 the
-    Euler step's error, about (h ||J||)^2 / 2 relative to the state's scale, is far below any tolerance.
+    Euler step's error, about h ||J|| / 2 of the step's own change, is far below any tolerance.
     """
     h = t1 - t0
-    jac = _jacobian(system, y0, vlp)
+    jac = jacobian_at(system, y0, vlp)
     rate = float(np.max(np.sum(np.abs(jac), axis=1)))  # the infinity norm bounds every eigenvalue
     if not (math.isfinite(rate) and h * rate < SHORT_PIECE):
         return None
@@ -239,19 +240,6 @@ def _short_piece(
 
     inside = np.array([t1]) if grid is None else grid[(grid > t0) & (grid <= t1)]
     return inside, state_at(inside), state_at(np.array([t1]))[:, 0], None
-
-
-def _jacobian(system: System, y: np.ndarray, vlp: float) -> np.ndarray:
-    if system.has_jacobian:
-        return np.asarray(system.jacobian(0.0, y, vlp), dtype=float)
-    jac = np.empty((y.size, y.size))
-    for j in range(y.size):
-        step = 1e-6 * max(1.0, abs(y[j]))
-        up, down = y.copy(), y.copy()
-        up[j] += step
-        down[j] -= step
-        jac[:, j] = (np.array(system.rhs(0.0, up, vlp)) - np.array(system.rhs(0.0, down, vlp))) / (2 * step)
-    return jac
 
 
 def _dense_piece(

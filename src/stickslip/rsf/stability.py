@@ -129,19 +129,25 @@ def _positive_velocity(velocity: float | str) -> float:
     return v
 
 
+def jacobian_at(system: System, y: np.ndarray, load_velocity: float) -> np.ndarray:
+    """The Jacobian of the equations at ``y``: analytic where the system has one, else central differences."""
+    if system.has_jacobian:
+        return np.asarray(system.jacobian(0.0, y, load_velocity), dtype=float)
+    jac = np.empty((y.size, y.size))
+    for j in range(y.size):
+        h = 1e-6 * max(1.0, abs(y[j]))
+        up, down = y.copy(), y.copy()
+        up[j] += h
+        down[j] -= h
+        jac[:, j] = (np.array(system.rhs(0.0, up, load_velocity)) - np.array(system.rhs(0.0, down, load_velocity))) / (
+            2 * h
+        )
+    return jac
+
+
 def _eigenvalues(params: RSFParams, velocity: float) -> np.ndarray:
     system = System(params)
-    y = system.steady_y(velocity)
-    if system.has_jacobian:
-        jac = system.jacobian(0.0, y, velocity)
-    else:
-        jac = np.empty((y.size, y.size))
-        for j in range(y.size):
-            h = 1e-6 * max(1.0, abs(y[j]))
-            up, down = y.copy(), y.copy()
-            up[j] += h
-            down[j] -= h
-            jac[:, j] = (np.array(system.rhs(0.0, up, velocity)) - np.array(system.rhs(0.0, down, velocity))) / (2 * h)
+    jac = jacobian_at(system, system.steady_y(velocity), velocity)
     if not np.all(np.isfinite(jac)):
         raise ModelError(
             f"the linearised equations at {velocity:.3g} m/s overflow the floating-point range: these parameters"
