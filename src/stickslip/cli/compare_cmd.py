@@ -10,14 +10,17 @@ model and, in words, which bond model ran (time-dependent or quasi-static).
 
 from __future__ import annotations
 
+import contextlib
 import json
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
 import click
 
+from ..errors import ModelError, ParameterError
 from ..fileio import refuse_input_as_output
-from .common import json_safe, params_options, positive, resolve_params
+from .common import json_safe, params_options, positive, quantity, resolve_params
 from .rsf_cmd import save_figure, sidecar, write
 
 
@@ -56,18 +59,27 @@ def compare_command(**options: Any) -> None:
     pull = positive(options["pull"], "velocity", "--pull")
     duration = positive(options["duration"], "time", "--duration")
     eta = None if options["eta"] is None else positive(options["eta"], "slowness", "--eta", allow_zero=True)
+    if options["rsf_a"] is not None:  # checked here, so the error names --a rather than a panel of the run
+        positive(options["rsf_a"], "dimensionless", "--a")
+    if options["rsf_b"] is not None:
+        quantity(options["rsf_b"], "dimensionless", "--b")
+    if options["rsf_dc"] is not None:
+        positive(options["rsf_dc"], "length", "--dc")
     refuse_input_as_output([options["params_name"]], [("-o", options["output"])])
 
-    rsf = _override(rsf_of_bond(params, v0, v1, step_time, model=options["bond_model"]), options)
-    step = protocols.velocity_steps([v0, v1], [step_time, step_time])
-    shs = protocols.slide_hold_slide(v0, step_time, hold)
-    panels = {}
-    for name, protocol in (("velocity step", step), ("slide-hold-slide", shs)):
-        bond = bond_response(params, protocol, "velocity", model=options["bond_model"])
-        run = simulate(rsf.params, protocol, every=protocol.duration / 800)
-        panels[name] = (bond, run)
-    local = _override(rsf_of_bond(params, pull / 1.05, pull * 1.05), options)
-    pair = stick_slip_pair(params, pull, duration, local, eta)
+    steps = f"the velocity step and slide-hold-slide (--v0 {options['v0']}, --v1 {options['v1']})"
+    with _naming(steps):
+        rsf = _override(rsf_of_bond(params, v0, v1, step_time, model=options["bond_model"]), options)
+        step = protocols.velocity_steps([v0, v1], [step_time, step_time])
+        shs = protocols.slide_hold_slide(v0, step_time, hold)
+        panels = {}
+        for name, protocol in (("velocity step", step), ("slide-hold-slide", shs)):
+            bond = bond_response(params, protocol, "velocity", model=options["bond_model"])
+            run = simulate(rsf.params, protocol, every=protocol.duration / 800)
+            panels[name] = (bond, run)
+    with _naming(f"the stick-slip pair (--pull {options['pull']})"):
+        local = _override(rsf_of_bond(params, pull / 1.05, pull * 1.05), options)
+        pair = stick_slip_pair(params, pull, duration, local, eta)
     summary = {
         "rsf_of_bond_model": rsf.as_dict(),
         "bond_model": panels["velocity step"][0].note,
@@ -89,12 +101,20 @@ def compare_command(**options: Any) -> None:
         write(sidecar(options["output"]), json.dumps(json_safe(summary), indent=2) + "\n")
 
 
+@contextlib.contextmanager
+def _naming(stage: str) -> Iterator[None]:
+    """Say which panel (and so which options) an error of the model came from: compare runs several."""
+    try:
+        yield
+    except (ParameterError, ModelError) as exc:
+        raise type(exc)(f"{stage}: {exc}") from None
+
+
 def _override(rsf: Any, options: dict[str, Any]) -> Any:
     """The RSF of the bond model with a, b, Dc replaced where the user gave them (said in its note)."""
     import dataclasses
 
     from ..rsf import StateVariable
-    from .common import quantity
 
     given = {k: options[k] for k in ("rsf_a", "rsf_b", "rsf_dc") if options.get(k) is not None}
     if not given:
