@@ -323,6 +323,25 @@ def _steady(velocity):
     return steady_state(load_parameters(), velocity)
 
 
+def _steady_quadrature(quadrature):
+    from stickslip.model.steady import steady_state
+    from stickslip.parameters import load_parameters
+
+    return steady_state(load_parameters(), 1e-4, quadrature=quadrature)
+
+
+def _protocols():
+    from stickslip import protocols
+
+    return protocols
+
+
+def _load(path="gelatin-glass", overrides=None, read=False):
+    from stickslip.parameters import load_parameters, read_parameter_file
+
+    return read_parameter_file(path) if read else load_parameters(path, overrides=overrides)
+
+
 def _stability(velocity):
     from stickslip.rsf import RSFParams, stability
 
@@ -363,6 +382,14 @@ API_CASES = [
     (lambda: _steady(True), ParameterError, "velocity: expected real numbers in m/s"),
     (lambda: _steady(np.array([1e-4, 2e-4], dtype=complex)), ParameterError, "expected real numbers"),
     (lambda: _steady("1 um/s"), ParameterError, "velocity: expected real numbers in m/s"),
+    (lambda: _steady_quadrature(None), ParameterError, "quadrature: expected QuadratureSettings"),
+    (lambda: _protocols().read_protocol(None), StickslipError, "protocol file: expected a path, got NoneType"),
+    (lambda: _protocols().velocity_steps([1e-6], "10 s"), ParameterError, "durations: expected a sequence"),
+    (lambda: _protocols().segments(None), ParameterError, "segments: expected a sequence of (velocity, duration)"),
+    (lambda: _protocols().Protocol(None), ParameterError, "protocol: expected a sequence of Segment"),
+    (lambda: _load(overrides="x"), ParameterError, "overrides: expected a mapping"),
+    (lambda: _load(overrides={1: 2}), ParameterError, "overrides: expected 'section.key' names"),
+    (lambda: _load(None, read=True), ParameterError, "parameter file: expected a path, got NoneType"),
     (lambda: _steady([[1e-4], [1e-4, 2e-4]]), ParameterError, "velocity: expected numbers in m/s"),
 ]
 

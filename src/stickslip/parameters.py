@@ -34,6 +34,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import os
 import stat
 import sys
 from collections.abc import Mapping
@@ -194,8 +195,12 @@ class Parameters:
         """A new set with ``section.key`` values replaced (numbers in SI, or strings with units)."""
         if not overrides:
             return self
+        if not isinstance(overrides, Mapping):
+            raise ParameterError(f"overrides: expected a mapping of 'section.key' to values, got {shorten(overrides)}")
         values: dict[str, Any] = self.as_dict()
         for key, raw in overrides.items():
+            if not isinstance(key, str):
+                raise ParameterError(f"overrides: expected 'section.key' names, got {shorten(key)}")
             dimension = key_dimension(key)
             values[key] = to_si(raw, dimension, key)
         return _build(values, name=self.name, description=self.description, reference=self.reference)
@@ -282,6 +287,8 @@ MAX_PARAMETER_FILE_BYTES = 1_000_000
 
 def read_parameter_file(path: str | Path) -> Parameters:
     """Read a TOML parameter file (a regular file of at most :data:`MAX_PARAMETER_FILE_BYTES`)."""
+    if not isinstance(path, (str, os.PathLike)):
+        raise ParameterError(f"parameter file: expected a path, got {type(path).__name__}")
     path = Path(path)
     shown = shorten(str(path), 240)
     try:

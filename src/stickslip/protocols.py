@@ -15,6 +15,7 @@ for the load point's history.  Everything is SI (m/s, s).
 from __future__ import annotations
 
 import math
+import os
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -65,7 +66,7 @@ class Protocol:
     name: str = "segments"
 
     def __post_init__(self) -> None:
-        items = tuple(self.segments)
+        items = tuple(_sequence(self.segments, "protocol", "Segment"))
         if not items:
             raise ParameterError("protocol: expected at least one segment (velocity and duration)")
         for item in items:
@@ -143,13 +144,24 @@ def constant(velocity: float, duration: float) -> Protocol:
 
 def segments(items: Sequence[tuple[float, float] | Segment]) -> Protocol:
     """Piecewise-constant velocities from ``[(velocity, duration), ...]``."""
-    return Protocol(tuple(_as_segment(item) for item in items), name="segments")
+    return Protocol(
+        tuple(_as_segment(item) for item in _sequence(items, "segments", "(velocity, duration) pairs")), name="segments"
+    )
+
+
+def _sequence(items: Any, name: str, what: str = "numbers in SI units") -> list[Any]:
+    """``items`` as a list; a string, None or a number is a ParameterError naming ``name``."""
+    if isinstance(items, (str, bytes)) or not hasattr(items, "__iter__"):
+        raise ParameterError(f"{name}: expected a sequence of {what}, got {items!r}")
+    return list(items)
 
 
 def velocity_steps(velocities: Sequence[float], durations: Sequence[float] | float) -> Protocol:
     """Velocity steps: ``velocities[i]`` held for ``durations[i]`` (or one duration for all)."""
-    if isinstance(durations, (int, float)):
+    velocities = _sequence(velocities, "velocities")
+    if isinstance(durations, (int, float, np.floating, np.integer)) and not isinstance(durations, bool):
         durations = [float(durations)] * len(velocities)
+    durations = _sequence(durations, "durations")
     if len(durations) != len(velocities):
         raise ParameterError(
             f"velocity_steps: {len(velocities)} velocities but {len(durations)} durations; expected one duration each"
@@ -203,6 +215,8 @@ def read_protocol(path: str | Path) -> Protocol:
 
     import pandas as pd
 
+    if not isinstance(path, (str, os.PathLike)):
+        raise DataError(f"protocol file: expected a path, got {type(path).__name__}")
     path = Path(path)
     text = _protocol_text(path)
     if not text.strip():

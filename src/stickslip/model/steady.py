@@ -513,6 +513,8 @@ def steady_state(
     of Eq 3 diverges, and the integral of Eq 8 diverges logarithmically.
     """
     require_parameters(params)
+    if not isinstance(quadrature, QuadratureSettings):
+        raise ParameterError(f"quadrature: expected QuadratureSettings, got {type(quadrature).__name__}")
     v = _check_velocity(velocity)
     _require_finite_stress(params)
     flat = np.ravel(v)
