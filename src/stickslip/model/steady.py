@@ -503,7 +503,8 @@ def steady_state(
 ) -> SteadyState:
     """The steady friction stress, bonded fraction and dsigma/dV at each sliding velocity (Eqs 6-8).
 
-    ``velocity`` is in m/s (scalar or array); ``aging=False`` drops the aging
+    ``velocity`` is in m/s (real numbers, scalar or array: True or a complex value is a
+    ParameterError, not 1 m/s or its real part); ``aging=False`` drops the aging
     term of Eq 6 (the paper's no-aging curve).  With ``distribution=True`` the
     age distribution n(t_a) of Eqs 6-7 is kept at the quadrature nodes.
     ``quadrature`` sets the panel rule (see :class:`QuadratureSettings`).
