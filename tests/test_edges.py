@@ -55,6 +55,8 @@ def _write_fixtures(folder: Path) -> None:
         "paramslist.json": '{"parameters": [1]}',
         "aunit.json": '{"a": "1 m"}',
         "good.json": '{"parameters": {"a": 0.01}, "protocol": [{"velocity": 1e-6, "duration": 1.0}]}',
+        "deep.json": "[" * 100_000 + "]" * 100_000,  # the parsers recurse: a RecursionError, not a message
+        "deep.toml": "a = " + "[" * 100_000 + "]" * 100_000 + "\n",
     }
     for name, text in texts.items():
         (folder / name).write_text(text, encoding="utf-8")
@@ -123,6 +125,9 @@ CASES: list[tuple[list[str], int, str]] = [
     (["rsf", "simulate", "--params", "bin.toml", *SEG], 2, "--params bin.toml: not a text (UTF-8) file"),
     (["rsf", "simulate", "--params", "latin1.toml", *SEG], 2, "not a text (UTF-8) file"),
     (["rsf", "simulate", "--params", "missing.json", *SEG], 2, "--params missing.json: file not found"),
+    (["rsf", "simulate", "--params", "deep.json", *SEG], 2, "--params deep.json: nested too deeply"),
+    (["rsf", "simulate", "--params", "deep.toml", *SEG], 2, "--params deep.toml: nested too deeply"),
+    (["critical", "--params", "deep.toml"], 2, "deep.toml: malformed TOML: nested too deeply"),
     (["rsf", "simulate", "--params", "fifo", *SEG], 2, "--params fifo: not a regular file"),
     (["rsf", "simulate", "--params", "zero", *SEG], 2, "--params zero: not a regular file"),
     (["rsf", "simulate", "--params", "dir", *SEG], 2, "is a directory"),

@@ -327,6 +327,8 @@ def _parse_toml(text: str, source: str) -> Parameters:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise ParameterError(f"{source}: malformed TOML: {exc}") from None
+    except RecursionError:  # "a = [[[[..." a hundred thousand deep: tomllib recurses
+        raise ParameterError(f"{source}: malformed TOML: nested too deeply to be a parameter file") from None
     return parameters_from_mapping(data, source)
 
 

@@ -141,6 +141,8 @@ def load_params_file(path: Path) -> dict[str, Any]:
     except ValueError as exc:  # JSONDecodeError and TOMLDecodeError are ValueErrors
         kind = "TOML" if path.suffix.lower() == ".toml" else "JSON"
         raise DataError(f"--params {path}: malformed {kind} ({(str(exc).splitlines() or [''])[0]})") from None
+    except RecursionError:  # "[[[[..." a hundred thousand deep: the parsers recurse
+        raise DataError(f"--params {path}: nested too deeply to be a parameter file") from None
     if not isinstance(data, dict):
         raise DataError(f"--params {path}: expected a table of parameters (a JSON object), got {type(data).__name__}")
     return data
