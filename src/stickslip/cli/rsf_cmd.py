@@ -12,6 +12,7 @@ import io
 import json
 import math
 import stat
+import sys
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -346,7 +347,9 @@ def stability_command(**options: Any) -> None:
         from ..rsf.plots import stability_figure
 
         speeds = [r["velocity"] for r in reports]
-        save_figure(stability_figure(params, min(speeds) / 100, max(speeds) * 100), options["plot_path"])
+        low = max(min(speeds) / 100, sys.float_info.min)  # two decades either side, within the floats
+        high = min(max(speeds) * 100, sys.float_info.max)
+        save_figure(stability_figure(params, low, high), options["plot_path"])
 
 
 @rsf_group.command("fit")

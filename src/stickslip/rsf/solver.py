@@ -170,12 +170,12 @@ def _grid(protocol: Protocol, every: float | None, times: Any) -> np.ndarray | N
         every = to_si(every, "time", "every")
         if not (math.isfinite(every) and every > 0):
             raise ParameterError(f"every: expected a positive time step, got {every!r}")
-        count = math.floor(end / every * (1 + 1e-12)) + 1
-        if count > MAX_SAMPLES:  # each sample holds about 180 bytes in memory until the trace is written
+        count = end / every * (1 + 1e-12) + 1  # a float: end / 5e-324 s is beyond any integer we would build
+        if not count <= MAX_SAMPLES:  # each sample holds about 180 bytes in memory until the trace is written
             raise ParameterError(
                 f"every: {every:g} s gives {count:.3g} samples over {end:g} s; expected at most {MAX_SAMPLES:.0e}"
             )
-        return np.arange(count) * every
+        return np.arange(math.floor(count)) * every
     if times is None:
         return None
     try:

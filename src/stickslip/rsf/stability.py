@@ -24,6 +24,7 @@ import numpy as np
 
 from ..errors import ModelError, ParameterError
 from ..units import to_si
+from .laws import EXP_CAP
 from .params import RSFParams
 from .system import System
 
@@ -146,6 +147,13 @@ def jacobian_at(system: System, y: np.ndarray, load_velocity: float) -> np.ndarr
 
 
 def _eigenvalues(params: RSFParams, velocity: float) -> np.ndarray:
+    ratio = math.log(velocity) - math.log(params.v_ref)
+    if abs(ratio) > EXP_CAP - 10.0:  # the equations' exponentials are capped there: their linearisation is not
+        raise ModelError(
+            f"velocity: {velocity:.3g} m/s is e^{ratio:.0f} times v_ref = {params.v_ref:.3g} m/s; the equations"
+            f" are represented for V/v_ref within about e^±{EXP_CAP - 10:.0f} (give velocities and v_ref of"
+            " comparable size)"
+        )
     system = System(params)
     jac = jacobian_at(system, system.steady_y(velocity), velocity)
     if not np.all(np.isfinite(jac)):
