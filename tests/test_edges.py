@@ -155,6 +155,7 @@ CASES: list[tuple[list[str], int, str]] = [
     (["rsf", "simulate", *STEP, "--stiffness", "1e300 1/m"], 2, "rate-and-state solver stalled"),
     (["rsf", "simulate", *SEG, "--eta", "1"], 2, '--eta 1: a slowness needs a unit, e.g. --eta "1 s/m"'),
     (["rsf", "simulate", *SEG, "--mass", "1 kg/m^2"], 2, "a slider mass needs normal_stress"),
+    (["rsf", "simulate", *STEP, "--mass", "1e-300 kg/m^2", "--normal-stress", "1 MPa"], 2, "drop the mass"),
     (["rsf", "simulate", *SEG, "--law", "foo"], 2, "law 'foo': unknown"),
     (["rsf", "simulate", *SEG, "--law", ""], 2, "law '': unknown"),
     (["rsf", "simulate", *SEG, "--law", "nagata", "--c", "-1"], 2, "c: expected a value >= 0"),

@@ -216,7 +216,12 @@ def _per_sigma(
             ) from None
         if sigma is None:
             raise ParameterError(f"{name} {text!r} is in stress units: give --normal-stress to convert it") from None
-        return value / sigma
+        converted = value / sigma
+        if value > 0 and not 0 < converted < math.inf:
+            raise ParameterError(
+                f"{name} {text!r} over --normal-stress {sigma:g} Pa is {converted:g}: outside the floating-point range"
+            ) from None
+        return converted
 
 
 def build_protocol(segment: tuple[str, ...], protocol_file: Path | None, fallback: list[dict] | None = None) -> Any:

@@ -95,14 +95,17 @@ def simulate(
     status, message = "ok", ""
     for t0, t1, vlp in protocol.pieces():
         _check_clock(params, max(vlp, v_start if t0 == 0 else 0.0), t1)
-        short = _short_piece(system, y, t0, t1, vlp, grid)
-        if short is not None:
-            t_out, y_out, y_end, blown = short
-        elif grid is None:
-            t_out, y_out, y_end, blown = _adaptive_piece(system, y, t0, t1, vlp, x_cap, rtol, atol)
-        else:
-            inside = grid[(grid > t0) & (grid <= t1)]
-            t_out, y_out, y_end, blown = _sampled_piece(system, y, t0, t1, vlp, inside, x_cap, rtol, atol, watch)
+        try:
+            short = _short_piece(system, y, t0, t1, vlp, grid)
+            if short is not None:
+                t_out, y_out, y_end, blown = short
+            elif grid is None:
+                t_out, y_out, y_end, blown = _adaptive_piece(system, y, t0, t1, vlp, x_cap, rtol, atol)
+            else:
+                inside = grid[(grid > t0) & (grid <= t1)]
+                t_out, y_out, y_end, blown = _sampled_piece(system, y, t0, t1, vlp, inside, x_cap, rtol, atol, watch)
+        except (ZeroDivisionError, OverflowError) as exc:  # e.g. m V / sigma underflowing to 0 in dV/dt
+            raise ModelError(_out_of_range(system, t0, t1, exc)) from None
         t_parts.append(t_out)
         y_parts.append(y_out)
         if blown is not None:
@@ -117,6 +120,16 @@ def simulate(
     t_all = np.concatenate(t_parts)
     y_all = np.concatenate(y_parts, axis=1)
     return assemble_run(system, protocol, t_all, y_all, status, message, v_start, detect)
+
+
+def _out_of_range(system: System, t0: float, t1: float, exc: Exception) -> str:
+    where = f"the rate-and-state equations left the floating-point range in the segment {t0:g} ... {t1:g} s ({exc})"
+    if system.inertial:
+        return (
+            f"{where}: the slider's inertia m/sigma = {system.inertia:.3g} s^2/m is too small to matter; drop the"
+            " mass (the quasi-static slider is its limit; use eta for fast slip)"
+        )
+    return f"{where}: check the magnitudes of a, b, Dc, the stiffness, eta and v_ref"
 
 
 def _blow_up_level(params: RSFParams, fastest: float) -> float:
@@ -227,7 +240,8 @@ def _short_piece(
     Euler step's error, about h ||J|| / 2 of the step's own change, is far below any tolerance.
     """
     h = t1 - t0
-    jac = jacobian_at(system, y0, vlp)
+    with np.errstate(all="ignore"):  # a Jacobian beyond the floats only means "not short": the solver decides
+        jac = jacobian_at(system, y0, vlp)
     rate = float(np.max(np.sum(np.abs(jac), axis=1)))  # the infinity norm bounds every eigenvalue
     if not (math.isfinite(rate) and h * rate < SHORT_PIECE):
         return None
