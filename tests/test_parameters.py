@@ -490,3 +490,44 @@ def test_every_dimension_has_exponents_that_pint_agrees_with(dimension):
     pint_dims = units_module.registry().parse_expression(DIMENSIONS[dimension][1] or "1").dimensionality
     expected = tuple(int(pint_dims.get(k, 0)) for k in ("[mass]", "[length]", "[time]", "[temperature]"))
     assert exponents == expected
+
+
+# --- issue 18: a unit without a number, non-finite numbers with a unit, BOMs, FIFOs, empty names ---------
+
+
+@pytest.mark.parametrize("text", ["um/s", " m/s ", "mm/s", "(um/s)"])
+def test_a_unit_without_a_number_is_refused_not_read_as_one(text):
+    with pytest.raises(UnitError, match="has no number"):
+        to_si(text, "velocity", "--v0")
+
+
+@pytest.mark.parametrize(("text", "expected"), [("nan s", math.nan), ("inf s", math.inf), ("-Infinity ms", -math.inf)])
+def test_non_finite_numbers_with_a_unit_are_numbers(text, expected):
+    value = to_si(text, "time", "t")
+    assert (math.isnan(value) and math.isnan(expected)) or value == expected
+    with pytest.raises(ParameterError, match="expected a finite number"):
+        load_parameters("gelatin-glass", overrides={"bonds.bond_time": text})
+
+
+def test_a_parameter_file_with_a_byte_order_mark_reads_like_one_without(tmp_path):
+    text = load_parameters("gelatin-glass").to_toml()
+    (tmp_path / "plain.toml").write_text(text, encoding="utf-8")
+    (tmp_path / "marked.toml").write_bytes("\ufeff".encode() + text.encode())
+    assert load_parameters(tmp_path / "marked.toml") == load_parameters(tmp_path / "plain.toml")
+
+
+def test_a_fifo_folder_binary_or_empty_name_as_parameter_set_says_what_it_is(tmp_path, monkeypatch):
+    import os
+
+    monkeypatch.chdir(tmp_path)
+    os.mkfifo("pipe")
+    (tmp_path / "folder").mkdir()
+    (tmp_path / "bin.toml").write_bytes(b"\x90\xff\x00" * 10)
+    for name, message in [
+        ("pipe", "parameter file 'pipe' is not a regular file"),  # was "unknown parameter set"
+        ("folder", "parameter file 'folder' is a folder"),
+        ("bin.toml", r"is not a text \(UTF-8\) file \(invalid start byte at byte 0\)"),
+        ("", "empty parameter set name"),
+    ]:
+        with pytest.raises(ParameterError, match=message):
+            load_parameters(name)

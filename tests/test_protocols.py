@@ -74,3 +74,37 @@ def test_atomic_write_and_input_guard(tmp_path):
     with pytest.raises(DataError, match=r"-o .*input file"):
         refuse_input_as_output([path], [("-o", path)])
     refuse_input_as_output([path], [("-o", tmp_path / "other.csv")])
+
+
+@pytest.mark.parametrize(
+    ("content", "message"),
+    [
+        (b"", "empty file"),  # pandas' sniffer: "Could not determine delimiter", an internal error (issue 18)
+        (b"  \n\t\n", "empty file"),
+        (b"\x90\xff\x00\xc3\x28" * 20, r"not a text \(UTF-8\) CSV file"),
+    ],
+    ids=["empty", "blank", "binary"],
+)
+def test_empty_and_binary_protocol_files_are_one_line(tmp_path, content, message):
+    path = tmp_path / "p.csv"
+    path.write_bytes(content)
+    with pytest.raises(DataError, match=message) as info:
+        pr.read_protocol(path)
+    assert "\n" not in str(info.value)
+
+
+def test_a_fifo_or_a_folder_is_refused_without_reading(tmp_path):
+    import os
+
+    os.mkfifo(tmp_path / "pipe")  # opening it for reading would block until a writer came
+    with pytest.raises(DataError, match="not a regular file"):
+        pr.read_protocol(tmp_path / "pipe")
+    with pytest.raises(DataError, match="is a folder"):
+        pr.read_protocol(tmp_path)
+
+
+def test_a_byte_order_mark_does_not_hide_the_header(tmp_path):
+    plain, marked = tmp_path / "plain.csv", tmp_path / "marked.csv"
+    plain.write_text("time,velocity\n0,1e-6\n10,2e-6\n12,0\n", encoding="utf-8")
+    marked.write_bytes("\ufeff".encode() + plain.read_bytes())
+    assert pr.read_protocol(marked).segments == pr.read_protocol(plain).segments

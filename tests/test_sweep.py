@@ -340,7 +340,7 @@ def test_rsf_phase_diagram_draws_kc_of_rsf(rsf_sweep):
     ("option", "expected"),
     [
         ("law=nagata", "--set law=nagata: expected one of aging, slip, prz"),
-        ("k=1 MPa/m", "expected a per length"),
+        ("k=1 MPa/m", "expected an inverse length"),
         ("sigma=1 MPa", "--set sigma: unknown rate-and-state key"),
         ("dc=-1 um", "dc: expected a value > 0"),
     ],

@@ -34,6 +34,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import os
 import stat
 import sys
 from collections.abc import Mapping
@@ -195,8 +196,12 @@ class Parameters:
         """A new set with ``section.key`` values replaced (numbers in SI, or strings with units)."""
         if not overrides:
             return self
+        if not isinstance(overrides, Mapping):
+            raise ParameterError(f"overrides: expected a mapping of 'section.key' to values, got {shorten(overrides)}")
         values: dict[str, Any] = self.as_dict()
         for key, raw in overrides.items():
+            if not isinstance(key, str):
+                raise ParameterError(f"overrides: expected 'section.key' names, got {shorten(key)}")
             dimension = key_dimension(key)
             values[key] = to_si(raw, dimension, key)
         return _build(values, name=self.name, description=self.description, reference=self.reference)
@@ -283,6 +288,8 @@ MAX_PARAMETER_FILE_BYTES = 1_000_000
 
 def read_parameter_file(path: str | Path) -> Parameters:
     """Read a TOML parameter file (a regular file of at most :data:`MAX_PARAMETER_FILE_BYTES`)."""
+    if not isinstance(path, (str, os.PathLike)):
+        raise ParameterError(f"parameter file: expected a path, got {type(path).__name__}")
     path = Path(path)
     shown = shorten(str(path), 240)
     try:
@@ -291,8 +298,10 @@ def read_parameter_file(path: str | Path) -> Parameters:
         raise ParameterError(f"parameter file {shown} not found") from None
     except (OSError, ValueError) as exc:  # ValueError: a NUL in the name
         raise ParameterError(f"parameter file {shown} cannot be read: {shorten(str(exc))}") from None
+    if stat.S_ISDIR(info.st_mode):
+        raise ParameterError(f"parameter file {shown} is a folder, not a file")
     if not stat.S_ISREG(info.st_mode):  # a FIFO would block for ever, /dev/zero never end
-        raise ParameterError(f"parameter file {shown} is not a regular file")
+        raise ParameterError(f"parameter file {shown} is not a regular file (save a pipe or device to a file first)")
     if info.st_size > MAX_PARAMETER_FILE_BYTES:
         raise ParameterError(
             f"parameter file {shown} is {info.st_size} bytes; a parameter file is at most"
@@ -301,10 +310,14 @@ def read_parameter_file(path: str | Path) -> Parameters:
     protect_inputs([path])  # in a command, no output may replace its parameter file
     try:
         with open(path, "rb") as handle:
-            text = handle.read(MAX_PARAMETER_FILE_BYTES + 1).decode("utf-8")
+            text = handle.read(MAX_PARAMETER_FILE_BYTES + 1).decode("utf-8-sig")  # a BOM (Windows editors) is no error
     except FileNotFoundError:
         raise ParameterError(f"parameter file {shown} not found") from None
-    except (OSError, ValueError) as exc:  # ValueError: not UTF-8
+    except UnicodeDecodeError as exc:
+        raise ParameterError(
+            f"parameter file {shown} is not a text (UTF-8) file ({exc.reason} at byte {exc.start})"
+        ) from None
+    except (OSError, ValueError) as exc:
         raise ParameterError(f"parameter file {shown} cannot be read: {shorten(str(exc))}") from None
     if len(text) > MAX_PARAMETER_FILE_BYTES:
         raise ParameterError(f"parameter file {shown} is longer than {MAX_PARAMETER_FILE_BYTES} bytes")
@@ -316,6 +329,8 @@ def _parse_toml(text: str, source: str) -> Parameters:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise ParameterError(f"{source}: malformed TOML: {exc}") from None
+    except RecursionError:  # "a = [[[[..." a hundred thousand deep: tomllib recurses
+        raise ParameterError(f"{source}: malformed TOML: nested too deeply to be a parameter file") from None
     return parameters_from_mapping(data, source)
 
 
@@ -331,10 +346,15 @@ def load_parameters(
     if isinstance(name_or_path, Parameters):
         return name_or_path.with_overrides(overrides)
     text = str(name_or_path)
+    if not text.strip():
+        raise ParameterError(
+            "empty parameter set name: expected a built-in name"
+            f" ({', '.join(available_parameter_sets())}) or a TOML file"
+        )
     if text in available_parameter_sets():
         resource = resources.files("stickslip") / "parameter_sets" / f"{text}.toml"
         params = _parse_toml(resource.read_text(encoding="utf-8"), text)
-    elif text.endswith(".toml") or "/" in text or _is_file(text):
+    elif text.endswith(".toml") or "/" in text or _exists(text):
         params = read_parameter_file(text)
     else:
         raise ParameterError(
@@ -344,9 +364,10 @@ def load_parameters(
     return params.with_overrides(overrides)
 
 
-def _is_file(text: str) -> bool:
+def _exists(text: str) -> bool:
+    """Whether ``text`` names something on disk (a FIFO or a folder too: reading it then says what is wrong)."""
     try:
-        return Path(text).is_file()
+        return Path(text).exists()
     except (OSError, ValueError):  # a name too long for the system, or with a NUL byte
         return False
 

@@ -15,6 +15,7 @@ for the load point's history.  Everything is SI (m/s, s).
 from __future__ import annotations
 
 import math
+import os
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -67,7 +68,7 @@ class Protocol:
     name: str = "segments"
 
     def __post_init__(self) -> None:
-        items = tuple(self.segments)
+        items = tuple(_sequence(self.segments, "protocol", "Segment"))
         if not items:
             raise ParameterError("protocol: expected at least one segment (velocity and duration)")
         for item in items:
@@ -145,13 +146,24 @@ def constant(velocity: float, duration: float) -> Protocol:
 
 def segments(items: Sequence[tuple[float, float] | Segment]) -> Protocol:
     """Piecewise-constant velocities from ``[(velocity, duration), ...]``."""
-    return Protocol(tuple(_as_segment(item) for item in items), name="segments")
+    return Protocol(
+        tuple(_as_segment(item) for item in _sequence(items, "segments", "(velocity, duration) pairs")), name="segments"
+    )
+
+
+def _sequence(items: Any, name: str, what: str = "numbers in SI units") -> list[Any]:
+    """``items`` as a list; a string, None or a number is a ParameterError naming ``name``."""
+    if isinstance(items, (str, bytes)) or not hasattr(items, "__iter__"):
+        raise ParameterError(f"{name}: expected a sequence of {what}, got {items!r}")
+    return list(items)
 
 
 def velocity_steps(velocities: Sequence[float], durations: Sequence[float] | float) -> Protocol:
     """Velocity steps: ``velocities[i]`` held for ``durations[i]`` (or one duration for all)."""
-    if isinstance(durations, (int, float)):
+    velocities = _sequence(velocities, "velocities")
+    if isinstance(durations, (int, float, np.floating, np.integer)) and not isinstance(durations, bool):
         durations = [float(durations)] * len(velocities)
+    durations = _sequence(durations, "durations")
     if len(durations) != len(velocities):
         raise ParameterError(
             f"velocity_steps: {len(velocities)} velocities but {len(durations)} durations; expected one duration each"
@@ -203,16 +215,22 @@ def read_protocol(path: str | Path) -> Protocol:
     Lines starting with ``#`` are comments.  The format, with an example file shipped in the package
     (``data/slide-hold-slide.csv``), is described in docs/protocols.md.
     """
+    import csv
+    import io
+
     import pandas as pd
 
+    if not isinstance(path, (str, os.PathLike)):
+        raise DataError(f"protocol file: expected a path, got {type(path).__name__}")
     path = Path(path)
-    if not path.is_file():
-        raise DataError(f"{path}: protocol file not found (expected a CSV with columns time,velocity)")
+    text = _protocol_text(path)
     protect_inputs([path])  # in a command, no output may replace the protocol
+    if not text.strip():
+        raise DataError(f"{path}: empty file, expected a CSV with columns time,velocity or velocity,duration")
     try:
-        frame = pd.read_csv(path, sep=None, engine="python", comment="#", nrows=1_000_000)
-    except (ValueError, OSError, UnicodeDecodeError, pd.errors.ParserError) as exc:
-        raise DataError(f"{path}: cannot read as CSV ({str(exc).splitlines()[0]})") from None
+        frame = pd.read_csv(io.StringIO(text), sep=None, engine="python", comment="#", nrows=1_000_000)
+    except (ValueError, csv.Error, pd.errors.ParserError) as exc:  # csv.Error: no delimiter could be found
+        raise DataError(f"{path}: cannot read as CSV ({(str(exc).splitlines() or [''])[0]})") from None
     columns = {str(c).strip().lower(): c for c in frame.columns}
     if {"velocity", "duration"} <= set(columns):
         pairs = _numeric_rows(frame, path, [columns["velocity"], columns["duration"]])
@@ -233,6 +251,34 @@ def read_protocol(path: str | Path) -> Protocol:
         return Protocol(tuple(items), name=path.name)
     found = ", ".join(str(c) for c in frame.columns) or "none"
     raise DataError(f"{path}: expected columns time,velocity or velocity,duration (SI units); found {found}")
+
+
+#: Largest protocol file read (a million change points is about 30 MB).
+MAX_PROTOCOL_BYTES = 100_000_000
+
+
+def _protocol_text(path: Path) -> str:
+    """The text of a protocol file: a regular file (a FIFO would block, /dev/zero never end), UTF-8, BOM allowed."""
+    import stat
+
+    try:
+        info = path.stat()
+    except FileNotFoundError:
+        raise DataError(f"{path}: protocol file not found (expected a CSV with columns time,velocity)") from None
+    except (OSError, ValueError) as exc:  # ValueError: a NUL in the name
+        raise DataError(f"{path}: protocol file cannot be read ({getattr(exc, 'strerror', None) or exc})") from None
+    if stat.S_ISDIR(info.st_mode):
+        raise DataError(f"{path}: is a folder, not a protocol file")
+    if not stat.S_ISREG(info.st_mode):
+        raise DataError(f"{path}: not a regular file (save a pipe or device to a file first)")
+    if info.st_size > MAX_PROTOCOL_BYTES:
+        raise DataError(f"{path}: {info.st_size} bytes; a protocol file is at most {MAX_PROTOCOL_BYTES} bytes")
+    try:
+        return path.read_bytes().decode("utf-8-sig")
+    except OSError as exc:
+        raise DataError(f"{path}: protocol file cannot be read ({exc.strerror or exc})") from None
+    except UnicodeDecodeError as exc:
+        raise DataError(f"{path}: not a text (UTF-8) CSV file ({exc.reason} at byte {exc.start})") from None
 
 
 def _numeric_rows(frame: Any, path: Path, cols: list[Any]) -> list[tuple[float, float]]:

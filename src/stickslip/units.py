@@ -75,7 +75,9 @@ MAX_VALUE_LENGTH = 200
 ECHO_LENGTH = 60
 
 _NUMBER = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
-_NUMBER_THEN_UNIT = re.compile(rf"^({_NUMBER})\s*(.*)$", re.DOTALL)
+#: "nan s" and "inf s" are numbers with a unit (the caller's range check names them), not a unit alone.
+_NON_FINITE = r"[-+]?(?i:nan|inf(?:inity)?)(?![^\W\d])"
+_NUMBER_THEN_UNIT = re.compile(rf"^({_NUMBER}|{_NON_FINITE})\s*(.*)$", re.DOTALL)
 #: An exponent pint may see: one or two digits, optionally a short fraction, not itself raised to a power.
 _EXPONENT = re.compile(r"(?:\^|\*\*)\s*[-+]?\d{1,2}(?:\.\d{1,3})?(?!\d)(?!\s*(?:\^|\*\*))")
 #: A leading "1" of "1/m^2" (also inside parentheses).
@@ -121,9 +123,27 @@ def shorten(value: Any, limit: int = ECHO_LENGTH) -> str:
     return f"{text[:head]}…{text[head - limit :]} ({len(text)} characters)"
 
 
+#: How a message names a quantity of each dimension (with its article).
+_NOUNS = {
+    "dimensionless": "a dimensionless number",
+    "per_area": "a number per area",
+    "area": "an area",
+    "per_length": "an inverse length",
+    "stress_per_length": "a stress per length",
+    "stress_per_velocity": "a stress per velocity",
+    "stress_rate": "a stress rate",
+    "mass_per_area": "a mass per area",
+}
+
+
+def quantity_noun(dimension: str) -> str:
+    """``"a velocity"``, ``"an area"``: the quantity of ``dimension`` as a message names it."""
+    return _NOUNS.get(dimension, f"a {dimension.replace('_', ' ')}")
+
+
 def _describe(dimension: str) -> str:
     unit = DIMENSIONS[dimension][1]
-    return f"a {dimension.replace('_', ' ')}" + (f" (e.g. in {unit})" if unit else " number")
+    return quantity_noun(dimension) + (f" (e.g. in {unit})" if unit else "")
 
 
 def bare_number(text: str) -> float | None:
@@ -146,6 +166,8 @@ def to_si(value: Any, dimension: str, name: str = "value") -> float:
     """
     if dimension not in DIMENSIONS:
         raise KeyError(f"unknown dimension {dimension!r}")
+    if getattr(value, "shape", None) == () and hasattr(value, "item") and not hasattr(value, "dimensionality"):
+        value = value.item()  # a numpy scalar (float32, int64, 0-d array) is its Python number
     if isinstance(value, bool):
         raise UnitError(f"{name}: expected {_describe(dimension)}, got {value!r}")
     if isinstance(value, (int, float)):
@@ -177,6 +199,11 @@ def _string_to_si(text: str, dimension: str, name: str) -> float:
         raise UnitError(
             f"{name}: cannot read {shorten(stripped)} as {_describe(dimension)}:"
             " expected a number and a unit, e.g. '350 um/s' (digits in a unit only as small exponents, m^2)"
+        )
+    if match is None:  # "um/s" alone is a unit, not a value: reading it as 1 um/s would hide a forgotten number
+        raise UnitError(
+            f"{name}: {shorten(stripped)} has no number; expected {_describe(dimension)} written as a number"
+            " and a unit, e.g. '350 um/s'"
         )
     fast = _fast_unit(unit)
     if fast is not None:

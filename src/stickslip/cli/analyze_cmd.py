@@ -64,15 +64,13 @@ TABLE_ROWS = (
 
 @click.command("analyze")
 @click.argument("trace", type=InputFile())
-@click.option(
-    "--v0", "v0_text", required=True, metavar="V", help='Pulling velocity, e.g. "50 um/s" (bare number: m/s).'
-)
+@click.option("--v0", "v0_text", required=True, metavar="V", help='Pulling velocity with its unit, e.g. "50 um/s".')
 @click.option(
     "--contact-area",
     "area_text",
     default=None,
     metavar="A",
-    help='Contact area, e.g. "15 cm^2", to turn a force column into stress (bare number: m^2).',
+    help='Contact area with its unit, e.g. "15 cm^2", to turn a force column into stress.',
 )
 @params_options
 @click.option("--json", "as_json", is_flag=True, help="Print the analysis as JSON (SI units).")

@@ -26,27 +26,59 @@ import click
 from ..errors import ParameterError, StickslipError, UnitError
 from ..fileio import atomic_path, atomic_write_text, protect_inputs, refuse_input_as_output
 from ..parameters import Parameters, key_dimension, load_parameters
-from ..units import DIMENSIONS, bare_number, shorten, to_si
+from ..units import DIMENSIONS, bare_number, quantity_noun, shorten, to_si
 
 #: Largest data file (CSV) a command reads: a 10^7-sample record is about 0.4 GB.
 MAX_INPUT_BYTES = 2_000_000_000
 
-#: Unit shown in the example of the "needs a unit" message (beside SI).
-_EXAMPLE_UNITS = {
-    "time": "s",
-    "length": "um",
-    "velocity": "um/s",
-    "rate": "1/s",
-    "per_area": "1/m^2",
-    "stiffness": "N/m",
-    "temperature": "K",
-    "stress": "Pa",
-    "stress_rate": "Pa/s",
-    "stress_per_length": "kPa/m",
-    "force": "N",
-    "area": "cm^2",
-    "stress_per_velocity": "Pa s/m",
+#: Units a bare number may have been meant in, per dimension: (unit, factor to SI).
+_CANDIDATE_UNITS: dict[str, tuple[tuple[str, float], ...]] = {
+    "time": (("s", 1.0), ("ms", 1e-3), ("us", 1e-6), ("ns", 1e-9), ("min", 60.0), ("h", 3600.0)),
+    "length": (("m", 1.0), ("mm", 1e-3), ("um", 1e-6), ("nm", 1e-9), ("angstrom", 1e-10)),
+    "velocity": (("m/s", 1.0), ("mm/s", 1e-3), ("um/s", 1e-6), ("nm/s", 1e-9)),
+    "rate": (("1/s", 1.0),),
+    "per_area": (("1/m^2", 1.0), ("1/um^2", 1e12)),
+    "stiffness": (("N/m", 1.0), ("mN/m", 1e-3)),
+    "temperature": (("K", 1.0),),
+    "stress": (("Pa", 1.0), ("kPa", 1e3), ("MPa", 1e6), ("GPa", 1e9)),
+    "stress_rate": (("Pa/s", 1.0), ("kPa/s", 1e3)),
+    "stress_per_length": (("Pa/m", 1.0), ("kPa/m", 1e3), ("MPa/m", 1e6)),
+    "force": (("N", 1.0), ("mN", 1e-3), ("uN", 1e-6)),
+    "area": (("m^2", 1.0), ("cm^2", 1e-4), ("mm^2", 1e-6)),
+    "stress_per_velocity": (("Pa s/m", 1.0), ("MPa s/m", 1e6)),
+    "per_length": (("1/m", 1.0), ("1/mm", 1e3), ("1/um", 1e6)),
+    "slowness": (("s/m", 1.0), ("s/mm", 1e3), ("s/um", 1e6)),
+    "mass_per_area": (("kg/m^2", 1.0), ("g/m^2", 1e-3)),
 }
+
+#: A typical size (SI) of an option's value, per dimension: a bare number is taken to be in the unit
+#: that puts it nearest this (pulling velocities of um/s to mm/s, stresses of kPa, times of seconds...).
+_TYPICAL_SI = {
+    "time": 10.0,
+    "length": 1e-5,
+    "velocity": 1e-4,
+    "rate": 1.0,
+    "per_area": 1e14,
+    "stiffness": 1e-4,
+    "temperature": 300.0,
+    "stress": 1e3,
+    "stress_rate": 1e2,
+    "stress_per_length": 1e5,
+    "force": 1.0,
+    "area": 1e-3,
+    "stress_per_velocity": 1e6,
+    "per_length": 1e3,
+    "slowness": 1.0,
+    "mass_per_area": 100.0,
+}
+
+
+def _meant_unit(number: float, dimension: str, typical: float | None) -> str:
+    """The unit that puts ``number`` nearest (in decades) to a typical value of its quantity."""
+    candidates = _CANDIDATE_UNITS.get(dimension, ((DIMENSIONS[dimension][1], 1.0),))
+    target = math.log10(typical if typical and typical > 0 else _TYPICAL_SI.get(dimension, 1.0))
+    size = math.log10(abs(number))
+    return min(candidates, key=lambda unit: abs(size + math.log10(unit[1]) - target))[0]
 
 
 def params_options(func: Callable[..., Any]) -> Callable[..., Any]:
@@ -77,7 +109,9 @@ def resolve_params(params_name: str, overrides: Sequence[str]) -> Parameters:
         if not sep or not key.strip():
             raise ParameterError(f"--set {shorten(item)}: expected SECTION.KEY=VALUE, e.g. bonds.bond_time='224 us'")
         key, value = key.strip(), value.strip()
-        require_unit(value, key_dimension(key), f"--set {key}=")
+        dimension = key_dimension(key)
+        if dimension != "dimensionless" and bare_number(value) is not None:
+            require_unit(value, dimension, f"--set {key}=", typical_value(key))
         mapping[key] = value
     protect_inputs([params_name])  # a TOML file is an input: no output of this command may replace it
     return load_parameters(params_name, overrides=mapping)
@@ -98,11 +132,13 @@ def refuse_overwriting_inputs(
     refuse_input_as_output(files, list(outputs))
 
 
-def require_unit(text: str, dimension: str, prefix: str) -> None:
+def require_unit(text: str, dimension: str, prefix: str, typical: float | None = None) -> None:
     """Refuse a bare non-zero number for a dimensional value typed on the command line.
 
     ``prefix`` is how the value was introduced (``"--v0 "``, ``"--set bonds.bond_time="``):
-    the message quotes it and shows the same option spelled with a unit.
+    the message quotes it and shows the same value with the unit it was presumably meant in,
+    the one that puts it nearest ``typical`` (SI; a typical size of that dimension by default),
+    and the SI unit beside it when that differs.
     """
     number = bare_number(text)
     if dimension == "dimensionless" or number is None or number == 0 or not math.isfinite(number):
@@ -110,10 +146,20 @@ def require_unit(text: str, dimension: str, prefix: str) -> None:
     typed = text.strip()
     if len(typed) > 40:
         typed = shorten(typed, 40)
-    unit = _EXAMPLE_UNITS.get(dimension, "")
+    unit = _meant_unit(number, dimension, typical)
     si = DIMENSIONS[dimension][1]
     hint = f'e.g. {prefix}"{typed} {unit}"' + (f' (or "{typed} {si}" if you mean SI)' if si != unit else "")
-    raise UnitError(f"{prefix}{typed}: a {dimension.replace('_', ' ')} needs a unit, {hint}")
+    raise UnitError(f"{prefix}{typed}: {quantity_noun(dimension)} needs a unit, {hint}")
+
+
+def typical_value(key: str) -> float | None:
+    """The value (SI) of a parameter key in the built-in set, the yardstick for a bare number's unit."""
+    from ..parameters import load_parameters
+
+    try:
+        return load_parameters("gelatin-glass").as_dict().get(key)
+    except ParameterError:  # pragma: no cover - the built-in set always loads
+        return None
 
 
 def quantity(text: str | float, dimension: str, name: str) -> float:

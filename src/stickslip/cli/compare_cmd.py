@@ -10,14 +10,17 @@ model and, in words, which bond model ran (time-dependent or quasi-static).
 
 from __future__ import annotations
 
+import contextlib
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
 import click
 import numpy as np
 
+from ..errors import ModelError, ParameterError
 from ..fileio import refuse_input_as_output
-from .common import json_text, params_options, positive, resolve_params
+from .common import json_text, params_options, positive, quantity, resolve_params
 from .rsf_cmd import save_figure, sidecar, write
 
 
@@ -55,16 +58,25 @@ def compare_command(**options: Any) -> None:
     pull = positive(options["pull"], "velocity", "--pull")
     duration = positive(options["duration"], "time", "--duration")
     eta = None if options["eta"] is None else positive(options["eta"], "slowness", "--eta", allow_zero=True)
+    if options["rsf_a"] is not None:  # checked here, so the error names --a rather than a panel of the run
+        positive(options["rsf_a"], "dimensionless", "--a")
+    if options["rsf_b"] is not None:
+        quantity(options["rsf_b"], "dimensionless", "--b")
+    if options["rsf_dc"] is not None:
+        positive(options["rsf_dc"], "length", "--dc")
     refuse_input_as_output([options["params_name"]], [("-o", options["output"])])
 
-    rsf = _override(rsf_of_bond(params, v0, v1, step_time, model=options["bond_model"]), options)
-    step = protocols.velocity_steps([v0, v1], [step_time, step_time])
-    shs = protocols.slide_hold_slide(v0, step_time, hold)
-    panels = {}
-    for name, protocol in (("velocity step", step), ("slide-hold-slide", shs)):
-        bond = bond_response(params, protocol, "velocity", model=options["bond_model"])
-        panels[name] = (bond, *_rsf_panel(rsf, protocol, bond.time))
-    pair = stick_slip_pair(params, pull, duration, rsf, eta)
+    steps = f"the velocity step and slide-hold-slide (--v0 {options['v0']}, --v1 {options['v1']})"
+    with _naming(steps):
+        rsf = _override(rsf_of_bond(params, v0, v1, step_time, model=options["bond_model"]), options)
+        step = protocols.velocity_steps([v0, v1], [step_time, step_time])
+        shs = protocols.slide_hold_slide(v0, step_time, hold)
+        panels = {}
+        for name, protocol in (("velocity step", step), ("slide-hold-slide", shs)):
+            bond = bond_response(params, protocol, "velocity", model=options["bond_model"])
+            panels[name] = (bond, *_rsf_panel(rsf, protocol, bond.time))
+    with _naming(f"the stick-slip pair (--pull {options['pull']})"):
+        pair = stick_slip_pair(params, pull, duration, rsf, eta)
     failures = [] if rsf.usable else [rsf.note]
     summary = {
         "status": "failed" if failures else "ok",
@@ -141,12 +153,20 @@ def _limitations(panels: dict[str, Any], pair: dict[str, Any]) -> list[str]:
     return found
 
 
+@contextlib.contextmanager
+def _naming(stage: str) -> Iterator[None]:
+    """Say which panel (and so which options) an error of the model came from: compare runs several."""
+    try:
+        yield
+    except (ParameterError, ModelError) as exc:
+        raise type(exc)(f"{stage}: {exc}") from None
+
+
 def _override(rsf: Any, options: dict[str, Any]) -> Any:
     """The RSF of the bond model with a, b, Dc replaced where the user gave them (said in its note)."""
     import dataclasses
 
     from ..rsf import StateVariable
-    from .common import quantity
 
     given = {k: options[k] for k in ("rsf_a", "rsf_b", "rsf_dc") if options.get(k) is not None}
     if not given:

@@ -57,7 +57,7 @@ def _fmt(value: float | None, scale: float = 1.0, digits: int = 5) -> str:
 # --------------------------------------------------------------------------- simulate
 @click.command("simulate")
 @click.option(
-    "--v0", "v0_text", required=True, metavar="V", help='Pulling velocity, e.g. "50 um/s" (>= 0; bare number: m/s).'
+    "--v0", "v0_text", required=True, metavar="V", help='Pulling velocity with its unit, e.g. "50 um/s" (>= 0).'
 )
 @click.option("--duration", "duration_text", required=True, metavar="T", help='Length of the run, e.g. "120 s".')
 @click.option(

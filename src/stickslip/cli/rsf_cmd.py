@@ -10,14 +10,17 @@ from __future__ import annotations
 
 import json
 import math
+import stat
+import sys
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
 import click
 
-from ..errors import ParameterError, StickslipError, UnitError
+from ..errors import DataError, ParameterError, StickslipError, UnitError
 from ..fileio import atomic_path, atomic_write_text, protect_inputs, refuse_input_as_output
+from ..units import quantity_noun, shorten
 from .common import json_text, quantity
 
 LAW_NAMES = ("aging", "slip", "prz", "nagata")
@@ -56,9 +59,9 @@ def build_params(options: dict[str, Any]) -> Any:
     base: dict[str, Any] = {}
     if options.get("params_file") is not None:
         base = load_params_mapping(options["params_file"])
-    states = [dict(s) for s in base.get("states", [{"law": "aging", "b": 0.01, "dc": 10e-6}])]
+    states = _base_states(base, options.get("params_file"))
     first = states[0]
-    if options.get("law"):
+    if options.get("law") is not None:  # --law "" is an error (unknown law), not the default
         for s in states:
             s["law"] = options["law"]
     if options.get("b") is not None:
@@ -93,18 +96,40 @@ def build_params(options: dict[str, Any]) -> Any:
         mapping["mass"] = _positive(options["mass"], "mass_per_area", "--mass", allow_zero=True)
     if options.get("regularized"):
         mapping["regularized"] = True
-    return RSFParams.from_dict(mapping, source="options")
+    source = "options" if options.get("params_file") is None else f"--params {options['params_file']} (or options)"
+    return RSFParams.from_dict(mapping, source=source)
+
+
+#: Largest --params file read (one written by a run or fit is a few kB).
+MAX_PARAMS_BYTES = 1_000_000
+
+
+def _base_states(base: dict[str, Any], path: Path | None) -> list[dict[str, Any]]:
+    """The state variables of a --params file (one aging state without one), each a table."""
+    if "states" not in base:
+        return [{"law": "aging", "b": 0.01, "dc": 10e-6}]
+    states = base["states"]
+    if not isinstance(states, list) or not states or not all(isinstance(s, dict) for s in states):
+        raise ParameterError(
+            f"--params {path}: 'states' must be a non-empty list of tables with law, b, dc; got {shorten(states)}"
+        )
+    return [dict(s) for s in states]
 
 
 def load_params_mapping(path: Path) -> dict[str, Any]:
     """The parameter mapping of a ``.params.json`` (trace or fit) or a ``.toml`` file."""
-    from ..errors import DataError
+    data = load_params_file(path)
+    mapping = data.get("parameters", data)
+    if not isinstance(mapping, dict):
+        raise DataError(f"--params {path}: 'parameters' must be a table of values, got {type(mapping).__name__}")
+    return dict(mapping)
 
+
+def load_params_file(path: Path) -> dict[str, Any]:
+    """The whole top-level table of a ``--params`` file; every problem with the file is one DataError line."""
     path = Path(path)
-    if not path.is_file():
-        raise DataError(f"--params {path}: file not found")
+    text = _params_text(path)
     protect_inputs([path])  # `rsf simulate --params run.params.json -o run.csv` must not rewrite it
-    text = path.read_text(encoding="utf-8")
     try:
         if path.suffix.lower() == ".toml":
             try:
@@ -114,9 +139,52 @@ def load_params_mapping(path: Path) -> dict[str, Any]:
             data = tomllib.loads(text)
         else:
             data = json.loads(text)
-    except ValueError as exc:
-        raise DataError(f"--params {path}: cannot read ({str(exc).splitlines()[0]})") from None
-    return dict(data.get("parameters", data))
+    except ValueError as exc:  # JSONDecodeError and TOMLDecodeError are ValueErrors
+        kind = "TOML" if path.suffix.lower() == ".toml" else "JSON"
+        raise DataError(f"--params {path}: malformed {kind} ({(str(exc).splitlines() or [''])[0]})") from None
+    except RecursionError:  # "[[[[..." a hundred thousand deep: the parsers recurse
+        raise DataError(f"--params {path}: nested too deeply to be a parameter file") from None
+    if not isinstance(data, dict):
+        raise DataError(f"--params {path}: expected a table of parameters (a JSON object), got {type(data).__name__}")
+    return data
+
+
+def _params_text(path: Path) -> str:
+    """The text of a --params file: a regular file (a FIFO would block, /dev/zero never end), UTF-8, BOM allowed."""
+    try:
+        info = path.stat()
+    except FileNotFoundError:
+        raise DataError(f"--params {path}: file not found") from None
+    except (OSError, ValueError) as exc:  # ValueError: a NUL in the name
+        raise DataError(f"--params {path}: cannot be read ({getattr(exc, 'strerror', None) or exc})") from None
+    if stat.S_ISDIR(info.st_mode):
+        raise DataError(f"--params {path}: is a folder, not a file")
+    if not stat.S_ISREG(info.st_mode):
+        raise DataError(f"--params {path}: not a regular file (save a pipe or device to a file first)")
+    if info.st_size > MAX_PARAMS_BYTES:
+        raise DataError(f"--params {path}: {info.st_size} bytes; a parameter file is at most {MAX_PARAMS_BYTES} bytes")
+    try:
+        return path.read_bytes().decode("utf-8-sig")
+    except OSError as exc:
+        raise DataError(f"--params {path}: cannot be read ({exc.strerror or exc})") from None
+    except UnicodeDecodeError as exc:
+        raise DataError(f"--params {path}: not a text (UTF-8) file ({exc.reason} at byte {exc.start})") from None
+
+
+def _run_meta(path: Path) -> tuple[list[dict[str, Any]] | None, float | None]:
+    """The protocol and start velocity a ``.params.json`` of an earlier run carries (None where absent)."""
+    data = load_params_file(path)
+    protocol, start = data.get("protocol"), data.get("start_velocity")
+    if protocol is not None:
+        rows = protocol if isinstance(protocol, list) else None
+        if rows is None or not all(isinstance(r, dict) and {"velocity", "duration"} <= set(r) for r in rows):
+            raise DataError(
+                f'--params {path}: \'protocol\' must be a list of {{"velocity": ..., "duration": ...}} segments'
+                f" (SI), got {shorten(protocol)}"
+            )
+    if start is not None and (isinstance(start, bool) or not isinstance(start, (int, float))):
+        raise DataError(f"--params {path}: 'start_velocity' must be a number in m/s, got {shorten(start)}")
+    return protocol or None, start
 
 
 def _number(text: str, name: str) -> float:
@@ -133,6 +201,9 @@ def _per_sigma(
     text: str, dimension: str, stress_dimension: str, sigma: float | None, name: str, allow_zero: bool = False
 ) -> float:
     """A value in friction units, or in stress units divided by the normal stress."""
+    from .common import require_unit
+
+    require_unit(text, dimension, f"{name} ")  # a bare number: say it needs a unit, not that its unit is wrong
     try:
         return _positive(text, dimension, name, allow_zero)
     except UnitError:
@@ -140,12 +211,17 @@ def _per_sigma(
             value = _positive(text, stress_dimension, name, allow_zero)
         except UnitError:
             raise UnitError(
-                f"{name}: {text!r} has the wrong dimension; expected {dimension.replace('_', ' ')} "
-                f"or {stress_dimension.replace('_', ' ')} with --normal-stress"
+                f"{name}: {text!r} has the wrong dimension; expected {quantity_noun(dimension)} "
+                f"or {quantity_noun(stress_dimension)} with --normal-stress"
             ) from None
         if sigma is None:
             raise ParameterError(f"{name} {text!r} is in stress units: give --normal-stress to convert it") from None
-        return value / sigma
+        converted = value / sigma
+        if value > 0 and not 0 < converted < math.inf:
+            raise ParameterError(
+                f"{name} {text!r} over --normal-stress {sigma:g} Pa is {converted:g}: outside the floating-point range"
+            ) from None
+        return converted
 
 
 def build_protocol(segment: tuple[str, ...], protocol_file: Path | None, fallback: list[dict] | None = None) -> Any:
@@ -218,8 +294,7 @@ def simulate_command(**options: Any) -> None:
     fallback = None
     start = None
     if options["params_file"] is not None and options["params_file"].suffix.lower() == ".json":
-        meta = json.loads(options["params_file"].read_text(encoding="utf-8"))
-        fallback, start = meta.get("protocol"), meta.get("start_velocity")
+        fallback, start = _run_meta(options["params_file"])
     params = build_params(options)
     protocol = build_protocol(options["segment"], options["protocol_file"], fallback)
     if options["start_velocity"] is not None:
@@ -286,7 +361,9 @@ def stability_command(**options: Any) -> None:
         from ..rsf.plots import stability_figure
 
         speeds = [r["velocity"] for r in reports]
-        save_figure(stability_figure(params, min(speeds) / 100, max(speeds) * 100), options["plot_path"])
+        low = max(min(speeds) / 100, sys.float_info.min)  # two decades either side, within the floats
+        high = min(max(speeds) * 100, sys.float_info.max)
+        save_figure(stability_figure(params, low, high), options["plot_path"])
 
 
 @rsf_group.command("fit")

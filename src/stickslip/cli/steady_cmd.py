@@ -41,7 +41,7 @@ COLUMNS = tuple((name, unit_of(name)) for name in ("velocity", "stress", "bonded
 
 
 def _velocity(text: str, name: str) -> float:
-    """A positive, finite velocity from an option value (unit optional; a bare number is m/s)."""
+    """A positive, finite velocity from an option value with its unit (a bare number other than 0 is refused)."""
     return positive(text, "velocity", name)
 
 
@@ -180,7 +180,7 @@ def curve_command(
 ) -> None:
     """The steady friction curve sigma(V) of Eqs 6-8.
 
-    Velocities accept units ("350 um/s", "1 mm/s"); a bare number is m/s.
+    Velocities carry their unit ("350 um/s", "1 mm/s"; a bare number is refused).
     csv and json are in SI base units; the table uses um/s and Pa.  csv is
     computed and written in chunks (any --points); the table shows at most
     100 rows, evenly spread; json holds at most 100,000 velocities.

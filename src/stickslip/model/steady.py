@@ -37,6 +37,7 @@ from ..columns import with_units
 from ..errors import ModelError, ParameterError
 from ..numerics.quadrature import panel_rule
 from ..parameters import BOLTZMANN, Parameters
+from ..units import shorten
 
 if TYPE_CHECKING:  # pragma: no cover
     import pandas as pd
@@ -470,9 +471,12 @@ def require_parameters(params: Any, name: str = "params") -> None:
 
 def _check_velocity(velocity: Any) -> np.ndarray:
     try:
-        v = np.asarray(velocity, dtype=float)
-    except (TypeError, ValueError):
-        raise ParameterError(f"velocity: expected numbers in m/s, got {velocity!r}") from None
+        raw = np.asarray(velocity)
+    except (TypeError, ValueError):  # ragged nested lists
+        raise ParameterError(f"velocity: expected numbers in m/s, got {shorten(velocity)}") from None
+    if raw.dtype.kind not in "iuf":  # True would be 1 m/s, 1+0j would lose its imaginary part, "1" is text
+        raise ParameterError(f"velocity: expected real numbers in m/s, got {shorten(velocity)}")
+    v = raw.astype(float)
     bad = ~np.isfinite(v) | (v <= 0)
     if np.any(bad):
         raise ParameterError(f"velocity: expected positive finite values in m/s, got {float(v[bad].ravel()[0])!r}")
@@ -501,7 +505,8 @@ def steady_state(
 ) -> SteadyState:
     """The steady friction stress, bonded fraction and dsigma/dV at each sliding velocity (Eqs 6-8).
 
-    ``velocity`` is in m/s (scalar or array); ``aging=False`` drops the aging
+    ``velocity`` is in m/s (real numbers, scalar or array: True or a complex value is a
+    ParameterError, not 1 m/s or its real part); ``aging=False`` drops the aging
     term of Eq 6 (the paper's no-aging curve).  With ``distribution=True`` the
     age distribution n(t_a) of Eqs 6-7 is kept at the quadrature nodes.
     ``quadrature`` sets the panel rule (see :class:`QuadratureSettings`).
@@ -511,6 +516,8 @@ def steady_state(
     of Eq 3 diverges, and the integral of Eq 8 diverges logarithmically.
     """
     require_parameters(params)
+    if not isinstance(quadrature, QuadratureSettings):
+        raise ParameterError(f"quadrature: expected QuadratureSettings, got {type(quadrature).__name__}")
     v = _check_velocity(velocity)
     _require_finite_stress(params)
     flat = np.ravel(v)

@@ -13,9 +13,11 @@ from collections.abc import Mapping
 from dataclasses import asdict, dataclass, field, replace
 from typing import Any
 
+import numpy as np
+
 from ..errors import ParameterError
-from ..units import to_si
-from .laws import get_law
+from ..units import shorten, to_si
+from .laws import StateLaw, get_law
 
 __all__ = ["RSFParams", "StateVariable", "rsf_params"]
 
@@ -45,6 +47,8 @@ class StateVariable:
     c: float = 0.0
 
     def __post_init__(self) -> None:
+        if not isinstance(self.law, (str, StateLaw)):
+            raise ParameterError(f"law: expected a law name such as 'aging', got {shorten(self.law)}")
         law = get_law(self.law)
         object.__setattr__(self, "law", self.law.strip().lower() if isinstance(self.law, str) else law.name)
         object.__setattr__(self, "b", _finite("b", self.b))
@@ -70,7 +74,12 @@ class RSFParams:
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "a", _finite("a", self.a, 0.0))
-        states = tuple(self.states)
+        if isinstance(self.states, StateVariable):
+            raise ParameterError("states: expected a tuple of StateVariable, got one StateVariable; write (state,)")
+        try:
+            states = tuple(self.states)
+        except TypeError:
+            raise ParameterError(f"states: expected a tuple of StateVariable, got {shorten(self.states)}") from None
         if not states:
             raise ParameterError("states: expected at least one state variable")
         for item in states:
@@ -86,6 +95,8 @@ class RSFParams:
             object.__setattr__(self, "normal_stress", _finite("normal_stress", self.normal_stress, 0.0))
         if self.mass > 0 and self.normal_stress is None:
             raise ParameterError("mass: a slider mass needs normal_stress (the inertia term is mass/normal stress)")
+        if not isinstance(self.regularized, (bool, np.bool_)):  # bool("false") is True: take no strings or numbers
+            raise ParameterError(f"regularized: expected true or false, got {shorten(self.regularized)}")
         object.__setattr__(self, "regularized", bool(self.regularized))
 
     @property
@@ -133,29 +144,16 @@ class RSFParams:
     def from_dict(cls, mapping: Mapping[str, Any], source: str = "parameters") -> RSFParams:
         """From plain values or strings with units (as written by :meth:`to_dict`); unknown keys are errors."""
         known = {"a", "states", "mu0", "v_ref", "stiffness", "eta", "mass", "normal_stress", "regularized"}
+        if not isinstance(mapping, Mapping):
+            raise ParameterError(f"{source}: expected a mapping of parameters, got {shorten(mapping)}")
         unknown = sorted(set(mapping) - known)
         if unknown:
             raise ParameterError(f"{source}: unknown key {unknown[0]!r}; expected one of {', '.join(sorted(known))}")
-        states = []
-        for i, item in enumerate(mapping.get("states", [])):
-            if not isinstance(item, Mapping):
-                raise ParameterError(f"{source}: states[{i}]: expected a table with law, b, dc")
-            extra = sorted(set(item) - {"law", "b", "dc", "c"})
-            if extra:
-                raise ParameterError(f"{source}: states[{i}]: unknown key {extra[0]!r}; expected law, b, dc, c")
-            states.append(
-                StateVariable(
-                    law=item.get("law", "aging"),
-                    b=item.get("b", 0.01),
-                    dc=to_si(item.get("dc", 10e-6), "length", f"{source}: states[{i}].dc"),
-                    c=item.get("c", 0.0),
-                )
-            )
-        values: dict[str, Any] = {"states": tuple(states) or (StateVariable(),)}
-        dims = {"v_ref": "velocity", "stiffness": "per_length", "eta": "slowness", "mass": "mass_per_area",
-                "normal_stress": "stress"}  # fmt: skip
+        values: dict[str, Any] = {"states": _states_from(mapping.get("states", _DEFAULT_STATES), source)}
+        dims = {"a": "dimensionless", "mu0": "dimensionless", "v_ref": "velocity", "stiffness": "per_length",
+                "eta": "slowness", "mass": "mass_per_area", "normal_stress": "stress"}  # fmt: skip
         for key in ("a", "mu0", "v_ref", "normal_stress", "mass", "regularized"):
-            if key in mapping:
+            if key in mapping and not (key == "normal_stress" and mapping[key] is None):
                 value = mapping[key]
                 values[key] = to_si(value, dims[key], f"{source}: {key}") if key in dims else value
         sigma = values.get("normal_stress")
@@ -163,6 +161,36 @@ class RSFParams:
             if key in mapping:
                 values[key] = _friction_units(mapping[key], dims[key], stress_dim, sigma, f"{source}: {key}")
         return cls(**values)
+
+
+_DEFAULT_STATES = ({},)
+
+
+def _states_from(items: Any, source: str) -> tuple[StateVariable, ...]:
+    """State variables from a list of tables (law, b, dc, c); an empty or missing list is an error, not a default."""
+    if isinstance(items, (str, bytes, Mapping)) or not isinstance(items, (list, tuple)) or not items:
+        raise ParameterError(
+            f"{source}: states: expected a non-empty list of tables with law, b, dc; got {shorten(items)}"
+        )
+    states = []
+    for i, item in enumerate(items):
+        if isinstance(item, StateVariable):
+            states.append(item)
+            continue
+        if not isinstance(item, Mapping):
+            raise ParameterError(f"{source}: states[{i}]: expected a table with law, b, dc; got {shorten(item)}")
+        extra = sorted(set(item) - {"law", "b", "dc", "c"})
+        if extra:
+            raise ParameterError(f"{source}: states[{i}]: unknown key {extra[0]!r}; expected law, b, dc, c")
+        states.append(
+            StateVariable(
+                law=item.get("law", "aging"),
+                b=to_si(item.get("b", 0.01), "dimensionless", f"{source}: states[{i}].b"),
+                dc=to_si(item.get("dc", 10e-6), "length", f"{source}: states[{i}].dc"),
+                c=to_si(item.get("c", 0.0), "dimensionless", f"{source}: states[{i}].c"),
+            )
+        )
+    return tuple(states)
 
 
 def _friction_units(value: Any, dimension: str, stress_dimension: str, sigma: float | None, name: str) -> float:

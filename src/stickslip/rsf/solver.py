@@ -21,14 +21,17 @@ from __future__ import annotations
 
 import math
 import warnings
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
 
 from ..errors import ModelError, ParameterError
 from ..protocols import Protocol
+from ..units import shorten, to_si
 from .params import RSFParams
 from .results import RSFRun, Solution, assemble_run
+from .stability import jacobian_at
 from .system import EXP_CAP, System
 
 __all__ = ["BLOW_UP_FACTOR", "evolve_state", "simulate"]
@@ -36,8 +39,12 @@ __all__ = ["BLOW_UP_FACTOR", "evolve_state", "simulate"]
 #: A run "blows up" when V exceeds this multiple of max(driving velocities, start velocity).
 BLOW_UP_FACTOR = 1e10
 RTOL = 1e-10
+#: Most samples a trace with ``every`` may hold (1e7 samples: about 2 GB and 10 s).
+MAX_SAMPLES = 10_000_000
 #: Right-hand-side evaluations allowed per protocol segment before a run is declared stalled.
 MAX_CALLS = 1_000_000
+#: Evaluations after which a solver whose clock has not moved (relative 1e-12) is declared stalled.
+PROGRESS_CALLS = 20_000
 
 
 class _Stalled(Exception):
@@ -73,7 +80,10 @@ def simulate(
         raise ParameterError(f"params: expected RSFParams, got {type(params).__name__}")
     if not isinstance(protocol, Protocol):
         raise ParameterError(f"protocol: expected a Protocol, got {type(protocol).__name__}")
-    v_start = protocol.initial_velocity if start_velocity is None else float(start_velocity)
+    _check_tolerances(rtol, atol)
+    v_start = (
+        protocol.initial_velocity if start_velocity is None else to_si(start_velocity, "velocity", "start_velocity")
+    )
     if not (math.isfinite(v_start) and v_start > 0):
         raise ParameterError(
             f"start velocity: expected a positive velocity for the initial steady state, got {v_start:g} m/s"
@@ -82,7 +92,7 @@ def simulate(
     system = System(params)
     grid = _grid(protocol, every, times)
     v_cap = BLOW_UP_FACTOR * max(float(np.max(protocol.velocities)), v_start)
-    x_cap = min(math.log(v_cap / params.v_ref), EXP_CAP - 10.0)
+    x_cap = _blow_up_level(params, max(float(np.max(protocol.velocities)), v_start))
     y = system.steady_y(v_start)
     # Where a quasi-static slider may run away, odeint could step over the run-away between samples:
     # sample from the adaptive solver's interpolant instead, which watches every step.
@@ -92,16 +102,24 @@ def simulate(
     last: Solution | None = None
     last_piece = len(protocol.segments) - 1
     for index, (t0, t1, vlp) in enumerate(protocol.pieces()):
-        if grid is None:
-            t_out, y_out, y_end, blown, _ = _adaptive_piece(system, y, t0, t1, vlp, x_cap, rtol, atol)
-            t_steps, y_steps = t_out, y_out
-        else:
-            inside = grid[(grid > t0) & (grid <= t1)]
-            t_out, y_out, y_end, blown = _sampled_piece(system, y, t0, t1, vlp, inside, x_cap, rtol, atol, watch)
-            if detect and index == last_piece and blown is None:
-                # the regime is read off every accepted step of the last segment, whatever the sampling
-                t_steps, y_steps, _, _, _ = _adaptive_piece(system, y, t0, t1, vlp, x_cap, rtol, atol)
-        if detect and index == last_piece and blown is None:
+        _check_clock(params, max(vlp, v_start if t0 == 0 else 0.0), t1)
+        short = None
+        try:
+            short = _short_piece(system, y, t0, t1, vlp, grid)
+            if short is not None:
+                t_out, y_out, y_end, blown = short
+            elif grid is None:
+                t_out, y_out, y_end, blown, _ = _adaptive_piece(system, y, t0, t1, vlp, x_cap, rtol, atol)
+                t_steps, y_steps = t_out, y_out
+            else:
+                inside = grid[(grid > t0) & (grid <= t1)]
+                t_out, y_out, y_end, blown = _sampled_piece(system, y, t0, t1, vlp, inside, x_cap, rtol, atol, watch)
+                if detect and index == last_piece and blown is None:
+                    # the regime is read off every accepted step of the last segment, whatever the sampling
+                    t_steps, y_steps, _, _, _ = _adaptive_piece(system, y, t0, t1, vlp, x_cap, rtol, atol)
+        except (ZeroDivisionError, OverflowError) as exc:  # e.g. m V / sigma underflowing to 0 in dV/dt
+            raise ModelError(_out_of_range(system, t0, t1, exc)) from None
+        if detect and index == last_piece and blown is None and short is None:  # a one-step piece has no steps
             steps_t, steps_y = np.r_[t0, t_steps], np.c_[y, y_steps]
             last = Solution(t0, steps_t, steps_y, _interpolant(system, vlp, steps_t, steps_y, rtol, atol))
         t_parts.append(t_out)
@@ -120,21 +138,79 @@ def simulate(
     return assemble_run(system, protocol, t_all, y_all, status, message, v_start, detect, last, rtol)
 
 
+def _out_of_range(system: System, t0: float, t1: float, exc: Exception) -> str:
+    where = f"the rate-and-state equations left the floating-point range in the segment {t0:g} ... {t1:g} s ({exc})"
+    if system.inertial:
+        return (
+            f"{where}: the slider's inertia m/sigma = {system.inertia:.3g} s^2/m is too small to matter; drop the"
+            " mass (the quasi-static slider is its limit; use eta for fast slip)"
+        )
+    return f"{where}: check the magnitudes of a, b, Dc, the stiffness, eta and v_ref"
+
+
+def _blow_up_level(params: RSFParams, fastest: float) -> float:
+    """ln(v_cap / v_ref), the slip rate at which a run is declared blown up; it must fit below EXP_CAP."""
+    level = math.log(fastest) - math.log(params.v_ref) + math.log(BLOW_UP_FACTOR)
+    if level > EXP_CAP - 10.0:  # the blow-up watch could not be represented: the run would stall, not report
+        ratio = level - math.log(BLOW_UP_FACTOR)
+        limit = EXP_CAP - 10.0 - math.log(BLOW_UP_FACTOR)
+        raise ParameterError(
+            f"velocity: {fastest:.3g} m/s is e^{ratio:.0f} times v_ref = {params.v_ref:.3g} m/s; the solver"
+            f" represents V/v_ref up to about e^{limit:.0f} (give velocities and v_ref of comparable size)"
+        )
+    return level
+
+
+#: Most state renewals (slip / Dc) up to a time t that the solver's clock (resolution ~1e-16 t) can follow.
+MAX_RENEWALS = 1e12
+
+
+def _check_clock(params: RSFParams, velocity: float, t_end: float) -> None:
+    """ModelError when the state's time scale Dc/V is below the resolution of the clock at t_end.
+
+    Beyond about 1e12 renewals the integrator, which steps in t, rounds its steps away and reports a
+    blow-up or stalls (measured on steady sliding with a = b: 1e12 renewals follow it, 1e13 report a false blow-up).
+    """
+    dc = min(s.dc for s in params.states)
+    renewals = velocity * t_end / dc
+    if renewals > MAX_RENEWALS:
+        raise ModelError(
+            f"the run spans {renewals:.3g} state renewals (slip V t / Dc at {velocity:.3g} m/s up to"
+            f" t = {t_end:.3g} s);"
+            f" the solver's clock (double precision) follows at most {MAX_RENEWALS:.0e}: use a shorter protocol,"
+            " a smaller velocity or a larger Dc"
+        )
+
+
+def _check_tolerances(rtol: Any, atol: Any) -> None:
+    """ODEPACK takes a NaN or negative tolerance without complaint and then integrates nonsense."""
+    for name, value in (("rtol", rtol), ("atol", atol)):
+        if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
+            raise ParameterError(f"{name}: expected a positive number, got {value!r}")
+        if not (math.isfinite(value) and 0 < value < 1):
+            raise ParameterError(f"{name}: expected a tolerance between 0 and 1, got {value!r}")
+
+
 def _grid(protocol: Protocol, every: float | None, times: Any) -> np.ndarray | None:
     if every is not None and times is not None:
         raise ParameterError("every/times: give one of them, not both")
     end = protocol.duration
     if every is not None:
-        every = float(every)
+        every = to_si(every, "time", "every")
         if not (math.isfinite(every) and every > 0):
             raise ParameterError(f"every: expected a positive time step, got {every!r}")
-        count = math.floor(end / every * (1 + 1e-12)) + 1
-        if count > 50_000_000:
-            raise ParameterError(f"every: {every:g} s gives {count} samples over {end:g} s; expected at most 5e7")
-        return np.arange(count) * every
+        count = end / every * (1 + 1e-12) + 1  # a float: end / 5e-324 s is beyond any integer we would build
+        if not count <= MAX_SAMPLES:  # each sample holds about 180 bytes in memory until the trace is written
+            raise ParameterError(
+                f"every: {every:g} s gives {count:.3g} samples over {end:g} s; expected at most {MAX_SAMPLES:.0e}"
+            )
+        return np.arange(math.floor(count)) * every
     if times is None:
         return None
-    grid = np.asarray(times, dtype=float).ravel()
+    try:
+        grid = np.asarray(times, dtype=float).ravel()
+    except (TypeError, ValueError):
+        raise ParameterError(f"times: expected a sequence of sample times in s, got {shorten(times)}") from None
     if grid.size == 0 or not np.all(np.isfinite(grid)) or np.any(np.diff(grid) <= 0):
         raise ParameterError("times: expected finite, strictly increasing sample times")
     if grid[0] < 0 or grid[-1] > end * (1 + 1e-12):
@@ -165,6 +241,35 @@ def _sampled_piece(
         return _dense_piece(system, y0, t0, t1, vlp, inside, x_cap, rtol, atol)
     keep = slice(1, 1 + inside.size)
     return t_eval[keep], out[keep].T, out[-1], None
+
+
+#: A segment is "short" when its duration times the fastest rate of the linearised equations is below this.
+SHORT_PIECE = 1e-8
+
+
+def _short_piece(
+    system: System, y0: np.ndarray, t0: float, t1: float, vlp: float, grid: np.ndarray | None
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, None] | None:
+    """One Euler step over a segment far shorter than every time scale of the equations, or None.
+
+    ODEPACK cannot start on an interval of 1e-300 s (it stalls); over a step h with h ||J|| <= 1e-8 the
+    Euler step's error, about h ||J|| / 2 of the step's own change, is far below any tolerance.
+    """
+    h = t1 - t0
+    with np.errstate(all="ignore"):  # a Jacobian beyond the floats only means "not short": the solver decides
+        jac = jacobian_at(system, y0, vlp)
+    rate = float(np.max(np.sum(np.abs(jac), axis=1)))  # the infinity norm bounds every eigenvalue
+    if not (math.isfinite(rate) and h * rate < SHORT_PIECE):
+        return None
+    slope = np.asarray(system.rhs(t0, y0, vlp), dtype=float)
+    if not np.all(np.isfinite(slope)):
+        return None
+
+    def state_at(t: np.ndarray) -> np.ndarray:
+        return y0[:, None] + slope[:, None] * (t - t0)[None, :]
+
+    inside = np.array([t1]) if grid is None else grid[(grid > t0) & (grid <= t1)]
+    return inside, state_at(inside), state_at(np.array([t1]))[:, 0], None
 
 
 def _dense_piece(
@@ -237,31 +342,22 @@ def _adaptive_piece(
     blow_up.terminal = True  # type: ignore[attr-defined]
     blow_up.direction = 1  # type: ignore[attr-defined]
     jac = system.jacobian if system.has_jacobian else None
-    calls = [0]
-
-    def rhs(t: float, y: np.ndarray, vlp: float) -> list[float]:
-        calls[0] += 1
-        if calls[0] > MAX_CALLS:
-            raise _Stalled(t)
-        return system.rhs(t, y, vlp)
-
     try:
         with warnings.catch_warnings():
             # LSODA's own warning on a failure is replaced by the ModelError or blow-up report below
             warnings.simplefilter("ignore", UserWarning)
             try:
                 sol = solve_ivp(
-                    rhs, (t0, t1), y0, method="LSODA", args=(vlp,), jac=jac, rtol=rtol, atol=atol, events=blow_up,
-                    dense_output=dense,
+                    _counted(system, t0, t1), (t0, t1), y0, method="LSODA", args=(vlp,), jac=jac, rtol=rtol,
+                    atol=atol, events=blow_up, dense_output=dense,
                 )  # fmt: skip
             except ValueError:
                 # LSODA's interpolant can disagree in sign with its own step ends when the slip rate runs away,
                 # so scipy's event root-finder has no bracket; Radau's collocation polynomial passes through
                 # the step ends exactly, so the same event is bracketed there.
-                calls[0] = 0
                 sol = solve_ivp(
-                    rhs, (t0, t1), y0, method="Radau", args=(vlp,), jac=jac, rtol=rtol, atol=atol, events=blow_up,
-                    dense_output=dense,
+                    _counted(system, t0, t1), (t0, t1), y0, method="Radau", args=(vlp,), jac=jac, rtol=rtol,
+                    atol=atol, events=blow_up, dense_output=dense,
                 )  # fmt: skip
     except _Stalled as stalled:
         raise _stall_error(stalled, t0, t1) from None
@@ -280,13 +376,35 @@ def _adaptive_piece(
                 "drop the mass (the quasi-static slider is its limit; use eta for fast slip)"
             )
         else:
-            raise ModelError(f"rate-and-state solver failed at t = {t_fail:.6g} s ({sol.message})")
+            raise ModelError(
+                f"rate-and-state solver failed at t = {t_fail:.6g} s ({sol.message}): the equations cannot be"
+                " integrated with these parameters; check the magnitudes of a, b, Dc, the stiffness and v_ref"
+            )
     return sol.t[1:], sol.y[:, 1:], sol.y[:, -1], blown, sol.sol
+
+
+def _counted(system: System, t0: float, t1: float) -> Callable[[float, np.ndarray, float], Any]:
+    """The right-hand side, raising _Stalled after MAX_CALLS evaluations or as soon as the clock stops moving."""
+    calls = [0]
+    checkpoint = [t0]
+
+    def rhs(t: float, y: np.ndarray, vlp: float) -> Any:
+        calls[0] += 1
+        if calls[0] > MAX_CALLS:
+            raise _Stalled(t)
+        if calls[0] % PROGRESS_CALLS == 0:
+            # a clock that has not moved in PROGRESS_CALLS evaluations is stuck for good: say so now
+            if t - checkpoint[0] <= 1e-12 * max(abs(t), t1 - t0):
+                raise _Stalled(t)
+            checkpoint[0] = t
+        return system.rhs(t, y, vlp)
+
+    return rhs
 
 
 def _stall_error(stalled: _Stalled, t0: float, t1: float) -> ModelError:
     return ModelError(
-        f"rate-and-state solver stalled at t = {stalled.time:.6g} s ({MAX_CALLS} evaluations in the segment "
+        f"rate-and-state solver stalled at t = {stalled.time:.6g} s (in the segment "
         f"{t0:g} ... {t1:g} s): the equations are too stiff here (e.g. the regularised form far below V0 "
         "under a very stiff spring); loosen the spring or use the classical form"
     )
@@ -299,20 +417,13 @@ def _quiet_solve(
     from scipy.integrate import solve_ivp
 
     jac = system.jacobian if system.has_jacobian else None
-    calls = [0]
-
-    def rhs(t: float, y: np.ndarray, vlp: float) -> list[float]:
-        calls[0] += 1
-        if calls[0] > MAX_CALLS:
-            raise _Stalled(t)
-        return system.rhs(t, y, vlp)
-
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             return solve_ivp(
-                rhs, (t0, t1), y0, method="LSODA", args=(vlp,), jac=jac, rtol=rtol, atol=atol, dense_output=dense
-            )
+                _counted(system, t0, t1), (t0, t1), y0, method="LSODA", args=(vlp,), jac=jac, rtol=rtol, atol=atol,
+                dense_output=dense,
+            )  # fmt: skip
     except (ValueError, ArithmeticError):
         return None
 

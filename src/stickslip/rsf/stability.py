@@ -22,7 +22,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import ParameterError
+from ..errors import ModelError, ParameterError
+from ..units import to_si
+from .laws import EXP_CAP
 from .params import RSFParams
 from .system import System
 
@@ -53,7 +55,7 @@ def _closed_form_applies(p: RSFParams) -> bool:
     return len(p.states) == 1 and p.states[0].law in _CLASSICAL and not p.regularized
 
 
-def critical_stiffness(params: RSFParams, velocity: float) -> float:
+def critical_stiffness(params: RSFParams, velocity: float | str) -> float:
     """k_c (1/m) at steady sliding velocity ``velocity``; 0 if steady sliding is stable at any stiffness."""
     velocity = _positive_velocity(velocity)
     if _closed_form_applies(params):
@@ -66,7 +68,7 @@ def critical_stiffness(params: RSFParams, velocity: float) -> float:
     return _numerical_critical(params, velocity)
 
 
-def neutral_period(params: RSFParams, velocity: float) -> float:
+def neutral_period(params: RSFParams, velocity: float | str) -> float:
     """Period (s) of the neutral oscillation at k = k_c; NaN if there is no Hopf point."""
     velocity = _positive_velocity(velocity)
     kc = critical_stiffness(params, velocity)
@@ -81,7 +83,7 @@ def neutral_period(params: RSFParams, velocity: float) -> float:
     return 2 * math.pi / omega if omega > 0 else math.nan
 
 
-def stability(params: RSFParams, velocity: float) -> Stability:
+def stability(params: RSFParams, velocity: float | str) -> Stability:
     """Everything about the stability of steady sliding at ``velocity`` with the params' stiffness."""
     velocity = _positive_velocity(velocity)
     kc = critical_stiffness(params, velocity)
@@ -111,31 +113,54 @@ def stability(params: RSFParams, velocity: float) -> Stability:
     )
 
 
-def growth_rate(params: RSFParams, velocity: float) -> float:
+def growth_rate(params: RSFParams, velocity: float | str) -> float:
     """Largest real part (1/s) of the linearised equations' eigenvalues at steady sliding: > 0 means unstable."""
     return float(np.max(_eigenvalues(params, _positive_velocity(velocity)).real))
 
 
-def _positive_velocity(velocity: float) -> float:
-    v = float(velocity)
+def _positive_velocity(velocity: float | str) -> float:
+    """The velocity in m/s: a number (SI) or a string with its unit ("1 um/s"); positive and finite."""
+    if isinstance(velocity, np.ndarray) and velocity.size == 1:
+        velocity = velocity.item()
+    if isinstance(velocity, (np.floating, np.integer)):
+        velocity = float(velocity)
+    v = to_si(velocity, "velocity", "velocity")
     if not (math.isfinite(v) and v > 0):
         raise ParameterError(f"velocity: expected a positive sliding velocity, got {velocity!r}")
     return v
 
 
-def _eigenvalues(params: RSFParams, velocity: float) -> np.ndarray:
-    system = System(params)
-    y = system.steady_y(velocity)
+def jacobian_at(system: System, y: np.ndarray, load_velocity: float) -> np.ndarray:
+    """The Jacobian of the equations at ``y``: analytic where the system has one, else central differences."""
     if system.has_jacobian:
-        jac = system.jacobian(0.0, y, velocity)
-    else:
-        jac = np.empty((y.size, y.size))
-        for j in range(y.size):
-            h = 1e-6 * max(1.0, abs(y[j]))
-            up, down = y.copy(), y.copy()
-            up[j] += h
-            down[j] -= h
-            jac[:, j] = (np.array(system.rhs(0.0, up, velocity)) - np.array(system.rhs(0.0, down, velocity))) / (2 * h)
+        return np.asarray(system.jacobian(0.0, y, load_velocity), dtype=float)
+    jac = np.empty((y.size, y.size))
+    for j in range(y.size):
+        h = 1e-6 * max(1.0, abs(y[j]))
+        up, down = y.copy(), y.copy()
+        up[j] += h
+        down[j] -= h
+        jac[:, j] = (np.array(system.rhs(0.0, up, load_velocity)) - np.array(system.rhs(0.0, down, load_velocity))) / (
+            2 * h
+        )
+    return jac
+
+
+def _eigenvalues(params: RSFParams, velocity: float) -> np.ndarray:
+    ratio = math.log(velocity) - math.log(params.v_ref)
+    if abs(ratio) > EXP_CAP - 10.0:  # the equations' exponentials are capped there: their linearisation is not
+        raise ModelError(
+            f"velocity: {velocity:.3g} m/s is e^{ratio:.0f} times v_ref = {params.v_ref:.3g} m/s; the equations"
+            f" are represented for V/v_ref within about e^±{EXP_CAP - 10:.0f} (give velocities and v_ref of"
+            " comparable size)"
+        )
+    system = System(params)
+    jac = jacobian_at(system, system.steady_y(velocity), velocity)
+    if not np.all(np.isfinite(jac)):
+        raise ModelError(
+            f"the linearised equations at {velocity:.3g} m/s overflow the floating-point range: these parameters"
+            " (a, b, Dc, c, eta, mass, v_ref) are outside what can be computed; check their magnitudes"
+        )
     return np.linalg.eigvals(jac)
 
 
@@ -145,16 +170,21 @@ def _numerical_critical(params: RSFParams, velocity: float) -> float:
 
     scale = max(abs(params.b - params.a), params.a) / min(s.dc for s in params.states)
     lo, hi = scale * 1e-9, scale * 1e9
+    if not (math.isfinite(hi) and lo > 0):
+        raise ModelError(
+            f"the stiffness scale |b - a|/Dc = {scale:.3g} 1/m is outside the floating-point range: check Dc"
+            f" ({min(s.dc for s in params.states):.3g} m) and a, b"
+        )
     if growth(lo) <= 0:
         return 0.0
     if growth(hi) > 0:
         return math.inf
     for _ in range(200):
-        mid = math.sqrt(lo * hi)
+        mid = math.sqrt(lo) * math.sqrt(hi)
         if growth(mid) > 0:
             lo = mid
         else:
             hi = mid
         if hi / lo - 1 < 1e-12:
             break
-    return math.sqrt(lo * hi)
+    return math.sqrt(lo) * math.sqrt(hi)

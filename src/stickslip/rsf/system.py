@@ -166,7 +166,7 @@ class System:
     # ------------------------------------------------------------------ states
     def steady_y(self, velocity: float) -> np.ndarray:
         """The steady state at slider velocity ``velocity`` (> 0)."""
-        x = math.log(velocity / self.v0)
+        x = math.log(velocity) - math.log(self.v0)  # the ratio itself can overflow (v0 = 5e-324 m/s)
         psi = [-x] * self.n
         head = [self.friction(x, psi) + self.eta * velocity] if self.inertial else []
         return np.array([*head, x, *psi])
