@@ -249,6 +249,10 @@ def step_guess(time: np.ndarray, friction: np.ndarray, protocol: Protocol) -> di
     return {"mu0": mu0, "a": abs(a), "b": b, "dc": max(dc, 1e-9), "stiffness": max(abs(peak - mu0) / rise, 1.0)}
 
 
+#: The precision (fraction of the step's friction range) at which RSF is asked to describe the bond model's step.
+STEP_PRECISION = 0.01
+
+
 def fit_bond_step(trace: BondTrace, protocol: Protocol, sigma_c: float, slope: float) -> BondRSF:
     """RSF fitted to a bond-model trace of the velocity step ``protocol`` (the protocol given, not detected).
 
@@ -264,18 +268,20 @@ def fit_bond_step(trace: BondTrace, protocol: Protocol, sigma_c: float, slope: f
     v0, v1 = protocol.segments[0].velocity, protocol.segments[1].velocity
     step = f"{v0 * 1e6:.4g} -> {v1 * 1e6:.4g} um/s"
     vm = math.sqrt(v0 * v1)
+    jump = float(np.ptp(friction))
     try:
-        fit = fit_record(record, protocol=protocol, guess=step_guess(t, friction, protocol))
+        # a model's output has no noise: the fit is judged at a stated precision, 1 % of the step's range
+        precision = STEP_PRECISION * jump if jump > 0 else None
+        fit = fit_record(record, protocol=protocol, guess=step_guess(t, friction, protocol), noise=precision)
     except (ModelError, DataError) as exc:
         fallback = RSFParams(a=max(slope, 0.0), states=(StateVariable("aging", 0.0, 1e-6),), mu0=1.0, v_ref=v0)
         return BondRSF(fallback, slope, vm, sigma_c, "failed", f"fit to the {trace.source}'s step {step} failed: {exc}")
     p, s = fit.params, fit.params.states[0]
     values = f"a = {p.a:.3g}, b = {s.b:.3g}, Dc = {s.dc * 1e6:.3g} um, rig stiffness {p.stiffness:.3g} 1/m"
     extra = {"rms": fit.rms, "rig_stiffness": p.stiffness, "fit_success": fit.success, "warnings": list(fit.warnings)}
-    jump = float(np.ptp(friction))
     problem = physical_problem(p)
     if problem is None and not fit.success:
-        problem = f"the least-squares search did not converge ({fit.message})"
+        problem = f"the fit failed: {fit.reason}"
     if problem is None and jump > 0 and fit.rms > 0.05 * jump:
         problem = f"it does not describe the step: rms misfit {fit.rms:.3g} is over 5 % of the step's range {jump:.3g}"
     if problem is not None:

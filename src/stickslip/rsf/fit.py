@@ -244,6 +244,7 @@ def fit_record(
     guess: dict[str, float] | None = None,
     mcmc_steps: int = 0,
     seed: int | None = None,
+    noise: float | None = None,
 ) -> RSFFit:
     """Fit rate-and-state friction to ``record`` (see the module notes).
 
@@ -251,8 +252,11 @@ def fit_record(
     fitted.  ``trend``: False, True or ``"slip"`` (linear in load-point
     displacement), ``"time"`` (linear in time) or ``"both"``.  ``mcmc_steps > 0``
     adds an emcee posterior (medians and 2.5/97.5 % percentiles) started from
-    the least-squares fit.
+    the least-squares fit.  ``noise``: the friction noise to judge the fit by, where it is known (a model's
+    noise-free output fitted to a stated precision); by default it is estimated from the record.
     """
+    if noise is not None and not (isinstance(noise, (int, float)) and math.isfinite(noise) and noise > 0):
+        raise ParameterError(f"noise: expected a positive friction level, got {noise!r}")
     if states not in (1, 2):
         raise ParameterError(f"states: expected 1 or 2 state variables, got {states!r}")
     trend = _trend_kinds(trend)
@@ -263,6 +267,8 @@ def fit_record(
     if fit_stiffness is None:
         fit_stiffness = stiffness is None
     start = _initial_guess(record, protocol, guess or {}, stiffness)
+    if noise is not None:
+        start["noise"] = float(noise)
     mismatch = _history_mismatch(record, protocol)
     result, residual = _search(record, protocol, law, states, start, fit_stiffness, trend)
     for factor in RETRY_DC_FACTORS:  # a troubled search may sit in a local minimum: start it elsewhere in Dc

@@ -300,7 +300,9 @@ def _interpolant(system: System, vlp: float, t_steps: np.ndarray, y_steps: np.nd
     jac = system.jacobian if system.has_jacobian else None
 
     def evaluate(times: np.ndarray) -> np.ndarray:
-        times = np.asarray(times, dtype=float)
+        # within the steps only: a tail reading before the segment's start (a segment shorter than the
+        # relaxation time) is read at the start
+        times = np.clip(np.asarray(times, dtype=float), t_steps[0], t_steps[-1])
         j = max(int(np.searchsorted(t_steps, times[0], side="right")) - 1, 0)
         grid = np.r_[t_steps[j], times]
         with warnings.catch_warnings():
