@@ -70,6 +70,8 @@ class Population:
 #: steady populations: largest hazard increment per age cell, and where the survival counts as zero
 CELL_HAZARD = 0.05
 HAZARD_END = 45.0
+#: most age cells a steady population may take (the gel's set takes ~2000-20000)
+MAX_CELLS = 1_000_000
 
 
 def steady_population(
@@ -94,7 +96,9 @@ def steady_population(
     hazard = [0.0]
     a, big_h = 0.0, 0.0
     widest = t_max / 1000.0
-    while big_h < HAZARD_END and a < t_max:
+    for _ in range(MAX_CELLS):
+        if not (big_h < HAZARD_END and a < t_max):
+            break
         lr = float(log_hazard(np.array(velocity * a), np.array(a), velocity, params, aging))
         step = widest if lr < -700 else min(widest, cell_hazard / math.exp(min(lr, 700.0)))
         # never step past the FENE wall; approach it geometrically
@@ -113,6 +117,11 @@ def steady_population(
         a = end
         ages.append(a)
         hazard.append(big_h)
+    else:
+        raise ModelError(
+            f"steady population at {velocity:.3g} m/s: more than {MAX_CELLS} age cells (the hazard changes on scales"
+            " below float resolution of the bond's life); the velocity is far outside the parameter set's range"
+        )
     edges = np.array(ages)
     cum = np.array(hazard)
     if rule == "midpoint":

@@ -136,6 +136,12 @@ def run_transient(
     k_block = params.block.effective_stiffness if stiffness is None else _finite(stiffness, "stiffness")
     if not (math.isfinite(k_block) and k_block > 0):
         raise ParameterError(f"stiffness: expected a positive finite value in Pa/m, got {stiffness!r}")
+    rigid = RIGID * params.bonds.site_density * params.bonds.chain_stiffness
+    if control == "block" and k_block > rigid:
+        raise ParameterError(
+            f"block stiffness {k_block:.3g} Pa/m is more than {RIGID:.0e} x the bonds' own (N0 M = {rigid / RIGID:.3g}"
+            " Pa/m): the block is rigid, the slider follows the puller (use control='velocity', --control velocity)"
+        )
     duration = protocol.duration
     if every is not None and not (isinstance(every, (int, float)) and math.isfinite(every) and 0 < every <= duration):
         raise ParameterError(f"every: expected a positive time no longer than the run ({duration:g} s), got {every!r}")
@@ -479,6 +485,8 @@ def _steady_start_below_vc(
     )
 
 
+#: a block stiffer than this many times the interface stiffness N0 M is rigid (sigma = K (P - X) loses its digits)
+RIGID = 1e6
 #: a steady start below Vc starts this fraction above Vc (the stable side; sigma within ~1e-6 of sigma_c)
 STABLE_SIDE = 1e-3
 #: rough CPU cost of one step (s) at ~100 cohorts, and what one protocol segment costs in steps
