@@ -103,7 +103,7 @@ def steady_population(
         step = widest if lr < -700 else min(widest, cell_hazard / math.exp(min(lr, 700.0)))
         # never step past the FENE wall; approach it geometrically
         step = min(step, 0.05 * (t_max - a))  # resolves the FENE force as well as the survival
-        if step <= 1e-15 * t_max:
+        if step <= 1e-15 * a:  # no progress left in floating point (the FENE wall approached geometrically)
             break
         mid = a + 0.5 * step
         end = a + step
