@@ -271,7 +271,7 @@ def run_transient(
             status, t, x, v, h, n, sample_index, count = advance(
                 state.t, t1, state.x, state.v, state.h, puller0, vp, 0.0, 1 if control == "block" else 0,
                 state.n, state.xb, state.tb, state.lw, lw_new, rate0, lc, aa, w1, state.acc, p, float(rtol), h_max,
-                times, sample_index, out, CHUNK, stick_v, CHUNK,
+                times, sample_index, out, CHUNK, stick_v, max(1, min(CHUNK, budget + 1 - int(state.acc[4]))),
             )  # fmt: skip
             state.t, state.x, state.v, state.h, state.n = float(t), float(x), float(v), float(h), int(n)
             state.puller = puller0 + vp * state.t if control == "block" else state.x
