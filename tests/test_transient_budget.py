@@ -68,8 +68,8 @@ def test_bad_api_input_is_a_typed_error_at_once(call, error, words):
 def test_lambda_zero_is_fine_while_no_chain_can_reach_the_wall():
     """The closed-form start-up (docs section 4) uses lambda = 0 with a 1 m wall: that stays allowed."""
     params = GEL.with_overrides({"bonds.activation_length": 0.0, "bonds.max_extension": 1.0})
-    run = run_transient(params, constant(350e-6, 1e-3), control="velocity")
-    assert np.all(np.isfinite(run.stress))
+    run = run_transient(params, constant(350e-6, 2e-4), control="velocity")
+    assert np.all(np.isfinite(run.stress)) and run.final_stress > 0
 
 
 def test_a_run_that_outgrows_its_budget_stops_with_the_reason():
@@ -98,8 +98,8 @@ def test_bonded_fraction_never_exceeds_one_on_a_stuck_block():
     """
     run = run_transient(GEL, constant(1e-3, 5.0))
     assert run.bonded_fraction.max() <= 1.0 + 1e-12
-    fine = run_transient(GEL, constant(1e-3, 1.0), max_step=GEL.bonds.bond_time, max_steps=10**5)
-    for t in (0.05, 0.1, 0.3, 1.0):
+    fine = run_transient(GEL, constant(1e-3, 0.3), max_step=GEL.bonds.bond_time, max_steps=10**5)
+    for t in (0.05, 0.1, 0.3):
         got = np.interp(t, run.time, run.bonded_fraction)
         want = np.interp(t, fine.time, fine.bonded_fraction)
         assert abs(got - want) <= 1e-4, (t, got, want)

@@ -51,7 +51,7 @@ def require_within(
         return
     shown = "an unbounded number of" if not math.isfinite(steps) else f"about {steps:.2g}"
     raise ParameterError(
-        f"{what}: would take {shown} steps ({estimate.basis}), above the budget of {max_steps:.3g} steps;"
+        f"{what}: would take {shown} steps ({estimate.basis}), above the budget of {max_steps:g} steps;"
         f" shorten the run or {hint}"
     )
 
@@ -59,7 +59,7 @@ def require_within(
 def over_budget(what: str, steps: int, max_steps: int, reached: float, duration: float) -> ParameterError:
     """The error for a run that used up its budget before its end (the estimate was too low)."""
     return ParameterError(
-        f"{what}: used the budget of {max_steps:.3g} steps at t = {reached:.6g} s of {duration:.6g} s"
+        f"{what}: used the budget of {max_steps:g} steps at t = {reached:.6g} s of {duration:.6g} s"
         f" ({steps} steps); shorten the run or raise the budget (max_steps, --max-steps)"
     )
 
