@@ -186,3 +186,12 @@ def test_cli_never_overwrites_the_parameter_file(capsys, tmp_path):
 
 def test_default_budget_is_stated():
     assert DEFAULT_MAX_STEPS == 3_000_000
+
+
+def test_no_progress_bar_in_a_pipe_even_for_a_long_run(capsys):
+    """A run estimated at > 2 s (25 s through the block: ~7 s estimated, 0.3 s taken) is silent off a terminal."""
+    from stickslip.transient.solver import estimate_cost as cost
+
+    assert cost(GEL, constant(50e-6, 25.0)).seconds > 2.0
+    status, out, err = run_main(capsys, "transient", "--v0", "50 um/s", "--duration", "25 s", "--rtol", "1e-3")
+    assert status == 0 and err == "" and "regime: stuck" in out

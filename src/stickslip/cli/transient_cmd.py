@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import io
 import stat
+import sys
 import tempfile
 from pathlib import Path
 from typing import Any
@@ -163,7 +164,7 @@ def transient_command(
                   stick_population=stick_population, every=every, rtol=rtol, max_steps=max_steps)  # fmt: skip
     cost = estimate_cost(params, protocol, control=control, start_velocity=start_velocity, rtol=rtol, every=every,
                          aging=not no_aging)  # fmt: skip
-    if cost.seconds > PROGRESS_AFTER_SECONDS and not as_json and click.get_text_stream("stderr").isatty():
+    if cost.seconds > PROGRESS_AFTER_SECONDS and not as_json and sys.stderr.isatty():
         from rich.console import Console
         from rich.progress import Progress
 
