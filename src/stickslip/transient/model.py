@@ -105,15 +105,20 @@ def steady_population(
         step = min(step, 0.05 * (t_max - a))  # resolves the FENE force as well as the survival
         if step <= 1e-15 * a:  # no progress left in floating point (the FENE wall approached geometrically)
             break
-        mid = a + 0.5 * step
-        end = a + step
-        # Simpson on the cell for the cumulative hazard
-        rates = np.exp(
-            np.minimum(
-                log_hazard(velocity * np.array([a, mid, end]), np.array([a, mid, end]), velocity, params, aging), 700.0
-            )
-        )
-        big_h += step * (rates[0] + 4 * rates[1] + rates[2]) / 6.0
+        # Simpson on the cell for the cumulative hazard; a cell over which the hazard climbs (a force cliff the
+        # hazard at its start does not foresee) is shrunk until it holds a few times cell_hazard: sized from its
+        # start alone, one cell swallowed the whole population in corners of the box (two cohorts, sigma 100 % off)
+        while True:
+            mid = a + 0.5 * step
+            end = a + step
+            nodes = np.array([a, mid, end])
+            rates = np.exp(np.minimum(log_hazard(velocity * nodes, nodes, velocity, params, aging), 700.0))
+            increment = step * (rates[0] + 4 * rates[1] + rates[2]) / 6.0
+            steady = increment <= 2.0 * cell_hazard and rates[2] <= 2.0 * rates[0] + 1e-300
+            if steady or increment <= 0.1 * cell_hazard or step <= 1e-12 * max(a, t_max):
+                break
+            step *= 0.25
+        big_h += increment
         a = end
         ages.append(a)
         hazard.append(big_h)
