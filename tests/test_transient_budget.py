@@ -195,3 +195,16 @@ def test_no_progress_bar_in_a_pipe_even_for_a_long_run(capsys):
     assert cost(GEL, constant(50e-6, 25.0)).seconds > 2.0
     status, out, err = run_main(capsys, "transient", "--v0", "50 um/s", "--duration", "25 s", "--rtol", "1e-3")
     assert status == 0 and err == "" and "regime: stuck" in out
+
+
+def test_a_transient_sweep_does_not_store_lambda_zero_as_ok(capsys, tmp_path):
+    """Issue 18: a transient sweep stored lambda = 0 (a diverging stress) as status ok."""
+    import pandas as pd
+
+    out = tmp_path / "sweep"
+    status, _, err = run_main(capsys, "sweep", "--model", "transient", "--v0", "350 um/s", "--vary",
+                              "bonds.activation_length=0 m", "--duration", "0.1 s", "--workers", "0", "--quiet",
+                              "-o", str(out))  # fmt: skip
+    assert status == 0, err
+    row = pd.read_parquet(out).iloc[0]
+    assert row["status"] != "ok" and "activation_length" in row["message"]
