@@ -208,3 +208,20 @@ def test_a_transient_sweep_does_not_store_lambda_zero_as_ok(capsys, tmp_path):
     assert status == 0, err
     row = pd.read_parquet(out).iloc[0]
     assert row["status"] != "ok" and "activation_length" in row["message"]
+
+
+@pytest.mark.parametrize(
+    ("segment", "start_velocity", "words"),
+    [((1e-6, 1e-300), None, "too short to step"), ((1e-6, 10.0), 1e300, "budget")],
+)
+def test_rate_and_state_refuses_the_unsteppable_at_once(segment, start_velocity, words):
+    """rsf simulate --segment "1 um/s:1e-300 s" / --start-velocity "1e300 m/s" stalled for 17-36 s, then advised
+    loosening the spring; the cost check at the top of rsf.simulate refuses them in one line."""
+    from stickslip.protocols import Protocol, Segment
+    from stickslip.rsf import simulate as rsf_simulate
+    from stickslip.rsf.params import RSFParams
+
+    start = time.process_time()
+    with pytest.raises(ParameterError, match=words):
+        rsf_simulate(RSFParams(), Protocol((Segment(*segment),)), start_velocity=start_velocity)
+    assert time.process_time() - start < 2.0
