@@ -2,16 +2,62 @@
 
 from __future__ import annotations
 
+import stat
+import sys
+import tempfile
 from pathlib import Path
 from typing import Any
 
 import click
 
 from ..errors import ParameterError
-from .common import emit_json, params_options, positive, resolve_params
+from ..units import shorten
+from .common import (
+    emit_json,
+    params_options,
+    positive,
+    refuse_overwriting_inputs,
+    resolve_params,
+    save_figure,
+    write_text,
+)
 
-#: runs longer than this many seconds of physical time show a progress bar on a terminal
-PROGRESS_AFTER = 1.0
+
+def _check_output(option: str, path: Path | None, plot: bool = False) -> None:
+    """Refuse, before computing, an output that cannot be written: no name, no such folder, an unknown format."""
+    if path is None:
+        return
+    text = str(path)
+    if not text.strip() or text == ".":
+        raise ParameterError(f"{option}: expected a file name, got an empty one")
+    folder = path.parent if str(path.parent) else Path(".")
+    if not folder.is_dir():
+        raise ParameterError(f"{option} {shorten(text)}: the folder {shorten(str(folder))} does not exist")
+    try:
+        info = path.stat()
+    except OSError:
+        info = None
+    if info is not None and stat.S_ISDIR(info.st_mode):
+        raise ParameterError(f"{option} {shorten(text)}: that is a folder, not a file")
+    if info is None or stat.S_ISREG(info.st_mode):  # written beside, then renamed: the folder must take a file
+        try:
+            with tempfile.TemporaryFile(dir=folder):
+                pass
+        except OSError as exc:
+            reason = exc.strerror or str(exc)
+            raise ParameterError(
+                f"{option} {shorten(text)}: cannot write in {shorten(str(folder))} ({reason})"
+            ) from None
+    if plot:
+        from matplotlib.figure import Figure
+
+        formats = Figure().canvas.get_supported_filetypes()
+        suffix = path.suffix[1:].lower() or "png"
+        if suffix not in formats:
+            raise ParameterError(
+                f"{option} {shorten(text)}: unknown figure format .{suffix};"
+                f" expected one of {', '.join(sorted(formats))}"
+            )
 
 
 def _protocol(v0_text: str | None, duration_text: str | None, segment_texts: tuple[str, ...], protocol_file: Any):
@@ -58,6 +104,12 @@ def _trace_csv(result: Any) -> str:
     help="Sample the trace every DT (the solver lands on the grid; jumps of the stick chains add their instant).",
 )
 @click.option("--rtol", default=1e-4, show_default=True, type=float, help="Local error tolerance (relative).")
+@click.option(
+    "--max-steps",
+    type=click.IntRange(min=1),
+    default=None,
+    help="Step budget: runs estimated to need more are refused, runs that get there stop [3e6].",
+)
 @click.option("-o", "--output", type=click.Path(dir_okay=False, path_type=Path), help="Write the trace (CSV, SI).")
 @click.option("--plot", "plot_path", type=click.Path(dir_okay=False, path_type=Path), help="Save σ(t) and V(t) here.")
 @click.option("--json", "as_json", is_flag=True, help="Print the summary as JSON (SI units).")
@@ -74,6 +126,7 @@ def transient_command(
     stick_population: bool,
     every_text: str | None,
     rtol: float,
+    max_steps: int | None,
     output: Path | None,
     plot_path: Path | None,
     as_json: bool,
@@ -86,32 +139,40 @@ def transient_command(
     (Eq 17) couples it to the slider; with --control velocity it is the
     slider's own velocity.  The regime is "steady", "stick-slip", "stuck" or
     "undetermined" (still changing at the end of the run).
-    """
-    from ..fileio import atomic_path, atomic_write_text, refuse_input_as_output
-    from ..transient import run_transient
 
+    The work is estimated before the run starts; a run estimated to need more
+    than the step budget (--max-steps, default 3e6) is refused in one line.
+    """
+    from ..numerics.budget import PROGRESS_AFTER_SECONDS
+    from ..transient import run_transient
+    from ..transient.solver import estimate_cost
+
+    _check_output("-o", output)
+    _check_output("--plot", plot_path, plot=True)
     protocol = _protocol(v0_text, duration_text, segment_texts, protocol_file)
-    refuse_input_as_output([protocol_file, params_name], [("-o", output), ("--plot", plot_path)])
+    refuse_overwriting_inputs([protocol_file], [("-o", output), ("--plot", plot_path)], params_name)
     start_velocity = None if start_v_text is None else positive(start_v_text, "velocity", "--start-velocity")
     every = None if every_text is None else positive(every_text, "time", "--every")
     params = resolve_params(params_name, overrides)
     kwargs = dict(control=control, start=start, start_velocity=start_velocity, aging=not no_aging,
-                  stick_population=stick_population, every=every, rtol=rtol)  # fmt: skip
-    if protocol.duration > PROGRESS_AFTER and click.get_text_stream("stderr").isatty():
+                  stick_population=stick_population, every=every, rtol=rtol, max_steps=max_steps)  # fmt: skip
+    cost = estimate_cost(params, protocol, control=control, start_velocity=start_velocity, rtol=rtol, every=every,
+                         aging=not no_aging)  # fmt: skip
+    if cost.seconds > PROGRESS_AFTER_SECONDS and not as_json and sys.stderr.isatty():
+        from rich.console import Console
         from rich.progress import Progress
 
-        with Progress(transient=True) as bar:
+        with Progress(console=Console(stderr=True), transient=True) as bar:
             task = bar.add_task("transient", total=1.0)
             result = run_transient(params, protocol, progress=lambda f: bar.update(task, completed=f), **kwargs)
     else:
         result = run_transient(params, protocol, **kwargs)
     if output is not None:
-        atomic_write_text(output, _trace_csv(result))
+        write_text(output, _trace_csv(result))
     if plot_path is not None:
         ax = result.plot()
         ax.set_title(f"{protocol.describe()}: {result.regime}", fontsize=9)
-        with atomic_path(plot_path) as temp:
-            ax.figure.savefig(temp, dpi=120, bbox_inches="tight", format=plot_path.suffix.lstrip(".") or "png")
+        save_figure(ax.figure, plot_path)
     if as_json:
         emit_json(result.summary())
         return

@@ -70,6 +70,8 @@ class Population:
 #: steady populations: largest hazard increment per age cell, and where the survival counts as zero
 CELL_HAZARD = 0.05
 HAZARD_END = 45.0
+#: most age cells a steady population may take (the gel's set takes ~2000-20000)
+MAX_CELLS = 1_000_000
 
 
 def steady_population(
@@ -94,25 +96,37 @@ def steady_population(
     hazard = [0.0]
     a, big_h = 0.0, 0.0
     widest = t_max / 1000.0
-    while big_h < HAZARD_END and a < t_max:
+    for _ in range(MAX_CELLS):
+        if not (big_h < HAZARD_END and a < t_max):
+            break
         lr = float(log_hazard(np.array(velocity * a), np.array(a), velocity, params, aging))
         step = widest if lr < -700 else min(widest, cell_hazard / math.exp(min(lr, 700.0)))
         # never step past the FENE wall; approach it geometrically
         step = min(step, 0.05 * (t_max - a))  # resolves the FENE force as well as the survival
-        if step <= 1e-15 * t_max:
+        if step <= 1e-15 * a:  # no progress left in floating point (the FENE wall approached geometrically)
             break
-        mid = a + 0.5 * step
-        end = a + step
-        # Simpson on the cell for the cumulative hazard
-        rates = np.exp(
-            np.minimum(
-                log_hazard(velocity * np.array([a, mid, end]), np.array([a, mid, end]), velocity, params, aging), 700.0
-            )
-        )
-        big_h += step * (rates[0] + 4 * rates[1] + rates[2]) / 6.0
+        # Simpson on the cell for the cumulative hazard; a cell over which the hazard climbs (a force cliff the
+        # hazard at its start does not foresee) is shrunk until it holds a few times cell_hazard: sized from its
+        # start alone, one cell swallowed the whole population in corners of the box (two cohorts, sigma 100 % off)
+        while True:
+            mid = a + 0.5 * step
+            end = a + step
+            nodes = np.array([a, mid, end])
+            rates = np.exp(np.minimum(log_hazard(velocity * nodes, nodes, velocity, params, aging), 700.0))
+            increment = step * (rates[0] + 4 * rates[1] + rates[2]) / 6.0
+            steady = increment <= 2.0 * cell_hazard and rates[2] <= 2.0 * rates[0] + 1e-300
+            if steady or increment <= 0.1 * cell_hazard or step <= 1e-12 * max(a, t_max):
+                break
+            step *= 0.25
+        big_h += increment
         a = end
         ages.append(a)
         hazard.append(big_h)
+    else:
+        raise ModelError(
+            f"steady population at {velocity:.3g} m/s: more than {MAX_CELLS} age cells (the hazard changes on scales"
+            " below float resolution of the bond's life); the velocity is far outside the parameter set's range"
+        )
     edges = np.array(ages)
     cum = np.array(hazard)
     if rule == "midpoint":

@@ -11,6 +11,7 @@ import numpy as np
 
 from ..errors import ModelError, ParameterError
 from ..model.cycle import Cycle
+from ..numerics.budget import CostEstimate, check_max_steps, over_budget, require_within
 from ..parameters import Parameters
 from ..protocols import Protocol
 from . import kernel as K
@@ -85,6 +86,7 @@ def run_transient(
     stiffness: float | None = None,
     snapshot_times: Any = None,
     max_step: float | None = None,
+    max_steps: int | None = None,
 ) -> TransientResult:
     """Solve Eqs 1-5 (history form of Eq 3) through ``protocol``.
 
@@ -105,21 +107,59 @@ def run_transient(
     ``progress`` is called with the fraction done.  ``snapshot_times`` (s):
     extra instants to keep the age/extension distribution at (the start, the
     end of every protocol segment and the end are always kept).
+
+    A steady start below Vc through the block, at the first segment's
+    velocity, would sit on the unstable branch of the steady curve: the run
+    then starts at the critical point's stable side (steady sliding at Vc,
+    sigma_c), from where the slider decelerates and sticks near sigma_c, the
+    paper's path into stick-slip; the message says so.  An explicit
+    ``start_velocity`` below Vc is honoured (a stiff block, K > Kc(V), can
+    slide steadily there) and the message notes the branch.
+
+    The work is estimated first (:func:`estimate_cost`); a run above
+    ``max_steps`` (default :data:`stickslip.numerics.budget.DEFAULT_MAX_STEPS`)
+    is refused before it starts, or stopped when it gets there.
     """
+    if not isinstance(params, Parameters):
+        raise ParameterError(f"params: expected stickslip Parameters, got {type(params).__name__}")
     _check_choice(control, CONTROLS, "control")
     _check_choice(start, STARTS, "start")
+    for flag, name in ((aging, "aging"), (stick_population, "stick_population")):
+        if not isinstance(flag, (bool, np.bool_)):
+            raise ParameterError(f"{name}: expected True or False, got {flag!r}")
     if not isinstance(protocol, Protocol):
         raise ParameterError(f"protocol: expected a stickslip.protocols.Protocol, got {type(protocol).__name__}")
     if not (isinstance(rtol, (int, float)) and 1e-12 <= rtol <= 1e-1):
         raise ParameterError(f"rtol: expected a number between 1e-12 and 0.1, got {rtol!r}")
     if stick_population and control != "block":
         raise ParameterError("stick_population: the attached chains need block control (control='block')")
-    k_block = params.block.effective_stiffness if stiffness is None else float(stiffness)
+    k_block = params.block.effective_stiffness if stiffness is None else _finite(stiffness, "stiffness")
     if not (math.isfinite(k_block) and k_block > 0):
         raise ParameterError(f"stiffness: expected a positive finite value in Pa/m, got {stiffness!r}")
+    rigid = RIGID * params.bonds.site_density * params.bonds.chain_stiffness
+    if control == "block" and k_block > rigid:
+        raise ParameterError(
+            f"block stiffness {k_block:.3g} Pa/m is more than {RIGID:.0e} x the bonds' own (N0 M = {rigid / RIGID:.3g}"
+            " Pa/m): the block is rigid, the slider follows the puller (use control='velocity', --control velocity)"
+        )
     duration = protocol.duration
-    if every is not None and not (math.isfinite(every) and 0 < every <= duration):
+    if every is not None and not (isinstance(every, (int, float)) and math.isfinite(every) and 0 < every <= duration):
         raise ParameterError(f"every: expected a positive time no longer than the run ({duration:g} s), got {every!r}")
+    if max_step is not None and not (isinstance(max_step, (int, float)) and math.isfinite(max_step) and max_step > 0):
+        raise ParameterError(f"max_step: expected a positive time in s, got {max_step!r}")
+    if start_velocity is not None:
+        start_velocity = _finite(start_velocity, "start velocity")
+    budget = check_max_steps(max_steps)
+    _require_finite_chains(params, protocol, control, start, start_velocity, k_block)
+    require_within(
+        estimate_cost(params, protocol, control=control, start_velocity=start_velocity, rtol=rtol, every=every,
+                      max_step=max_step, aging=aging),
+        budget,
+        "transient",
+    )  # fmt: skip
+    note = ""
+    if start == "steady" and control == "block" and aging:
+        start_velocity, note = _steady_start_below_vc(params, protocol, start_velocity)
     functions = K.compiled()
     advance = functions["advance"]
     slider_velocity = functions["_slider_velocity"]
@@ -201,6 +241,7 @@ def run_transient(
                         control,
                         k_block,
                         int(state.acc[4]),
+                        note=note,
                         stop=f"the chains collapse at sigma_s = {sigma_s:.6g} Pa, beyond the"
                         " steady curve's reach: the paper's jump has no landing point",
                     )
@@ -230,7 +271,7 @@ def run_transient(
             status, t, x, v, h, n, sample_index, count = advance(
                 state.t, t1, state.x, state.v, state.h, puller0, vp, 0.0, 1 if control == "block" else 0,
                 state.n, state.xb, state.tb, state.lw, lw_new, rate0, lc, aa, w1, state.acc, p, float(rtol), h_max,
-                times, sample_index, out, CHUNK, stick_v, CHUNK,
+                times, sample_index, out, CHUNK, stick_v, max(1, min(CHUNK, budget + 1 - int(state.acc[4]))),
             )  # fmt: skip
             state.t, state.x, state.v, state.h, state.n = float(t), float(x), float(v), float(h), int(n)
             state.puller = puller0 + vp * state.t if control == "block" else state.x
@@ -244,6 +285,8 @@ def run_transient(
                 events.append(("stick", state.t, k_block * (state.puller - state.x), state.v))
             if not all(math.isfinite(q) for q in (state.t, state.x, state.v, state.h)):
                 raise ModelError(f"transient solver failed at t = {state.t:.6g} s (non-finite state)")
+            if state.acc[4] > budget:
+                raise over_budget("transient", int(state.acc[4]), budget, state.t, duration)
             if progress is not None:
                 progress(min(1.0, state.t / duration))
             while snap_index < len(wanted) and wanted[snap_index] <= state.t + 1e-15 and wanted[snap_index] < t1:
@@ -252,7 +295,9 @@ def run_transient(
     while snap_index < len(wanted):
         snapshots.append(_snapshot(state))
         snap_index += 1
-    return _finish(rows, chain_rows, events, snapshots, state, params, protocol, control, k_block, int(state.acc[4]))
+    return _finish(
+        rows, chain_rows, events, snapshots, state, params, protocol, control, k_block, int(state.acc[4]), note=note
+    )
 
 
 def _force(extension: np.ndarray, params: Parameters) -> np.ndarray:
@@ -331,6 +376,7 @@ def _finish(
     k_block: float,
     steps: int,
     stop: str | None = None,
+    note: str = "",
 ) -> TransientResult:
     from .cycles import classify, detect_cycles
 
@@ -345,6 +391,13 @@ def _finish(
     bonded = np.where(np.isnan(bonded), 0.0, bonded)  # the bonds of Eq 1 are set aside while the chains hold
     cycles = detect_cycles(time, sigma, v, protocol, events)
     regime, message = classify(time, sigma, v, protocol, cycles, events, control, stop)
+    message = message + note
+    if regime == "stuck" and not cycles and not stick_population_used(events):
+        message += (
+            "; one population of Eq 1 never lets go: its aging term makes a resting bond unbreakable within"
+            " milliseconds (docs/transient.md section 7); stick_population=True (--stick-population) adds the"
+            " paper's attached chains, which give its stick-slip cycle"
+        )
     chain = table[:, 12] if chain_rows else None
     book = Bookkeeping(
         born=table[:, 6], broken=table[:, 7], work=table[:, 8], dissipation=table[:, 9], bond_energy=table[:, 10],
@@ -370,4 +423,126 @@ def _finish(
     )
 
 
-__all__ = ["Cycle", "run_transient"]
+def stick_population_used(events: list[tuple[str, float, float, float]]) -> bool:
+    return any(kind == "stick" for kind, *_ in events)
+
+
+def _finite(value: Any, name: str) -> float:
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        raise ParameterError(f"{name}: expected a number (SI), got {value!r}") from None
+    if not math.isfinite(number):
+        raise ParameterError(f"{name}: expected a finite number (SI), got {value!r}")
+    return number
+
+
+def _travel(protocol: Protocol) -> float:
+    return float(sum(abs(vp) * (t1 - t0) for t0, t1, vp in protocol.pieces()))
+
+
+def _require_finite_chains(
+    params: Parameters, protocol: Protocol, control: str, start: str, start_velocity: float | None, k_block: float
+) -> None:
+    """With lambda = 0 a sliding chain is only stopped by the FENE wall, where Eq 3's force is infinite."""
+    b = params.bonds
+    if b.activation_length != 0.0:
+        return
+    reach = _travel(protocol)
+    if start == "steady" or reach >= b.max_extension:
+        raise ModelError(
+            "bonds.activation_length = 0: sliding bonds survive to full extension, where the FENE force (Eq 3) is"
+            " infinite, so the stress diverges (as in the steady solver); use a positive activation length"
+            + ("" if start == "steady" else f" (the slider may travel {reach:.3g} m, Δl_m is {b.max_extension:.3g} m)")
+        )
+
+
+def _steady_start_below_vc(
+    params: Parameters, protocol: Protocol, start_velocity: float | None
+) -> tuple[float | None, str]:
+    """(start velocity, note): below Vc the default steady start moves to the stable side of the critical point."""
+    from ..model.critical import critical_point
+
+    v_start = protocol.initial_velocity if start_velocity is None else start_velocity
+    if not v_start > 0:
+        return start_velocity, ""
+    try:
+        cp = critical_point(params)
+    except (ModelError, ParameterError):
+        return start_velocity, ""
+    if not cp.exists or cp.velocity is None or v_start >= cp.velocity:
+        return start_velocity, ""
+    if start_velocity is not None:
+        return start_velocity, (
+            f" (steady start at {v_start:.4g} m/s, below Vc = {cp.velocity:.4g} m/s: on the unstable branch of"
+            " the steady curve unless the block is stiffer than Kc(V), transient.critical_stiffness)"
+        )
+    v_stable = cp.velocity * (1.0 + STABLE_SIDE)
+    return v_stable, (
+        f" (steady start: {v_start:.4g} m/s is below Vc = {cp.velocity:.4g} m/s, where steady sliding is unstable,"
+        f" so the run starts on the stable side of the critical point, sliding at Vc under sigma_c ="
+        f" {cp.stress:.6g} Pa; give start_velocity / --start-velocity to start elsewhere)"
+    )
+
+
+#: a block stiffer than this many times the interface stiffness N0 M is rigid (sigma = K (P - X) loses its digits)
+RIGID = 1e6
+#: a steady start below Vc starts this fraction above Vc (the stable side; sigma within ~1e-6 of sigma_c)
+STABLE_SIDE = 1e-3
+#: rough CPU cost of one step (s) at ~100 cohorts, and what one protocol segment costs in steps
+STEP_SECONDS = 20e-6
+SEGMENT_STEPS = 10.0
+#: through the block the slider slides only part of the time (a stuck block takes long steps): measured 0.04-0.4
+#: of the velocity-control estimate (350 um/s sliding steadily: 0.42; 350 -> 50 um/s with the chains: 0.04)
+BLOCK_SHARE = 0.4
+
+
+def estimate_cost(
+    params: Parameters,
+    protocol: Protocol,
+    *,
+    control: str = "block",
+    start_velocity: float | None = None,
+    rtol: float = RTOL,
+    every: float | None = None,
+    max_step: float | None = None,
+    aging: bool = True,
+) -> CostEstimate:
+    """The steps a run needs, from the time scales it must resolve (no step taken).
+
+    While sliding at V the steps resolve the births (a few per tau/(1+u0)), the
+    climb of the hazard (ln r grows at g = (lambda/kT) M V less the aging
+    slope: a bond dies within ~1/g) and the FENE wall (V/dl_m); calibrated on
+    the gel's set from 10 um/s to 1 m/s and the audit set of issue 17 (the
+    estimate is within 0.4-5x of the steps taken while sliding; a stuck block
+    takes far fewer, and through the block the estimate is scaled by
+    :data:`BLOCK_SHARE`).  Every protocol segment and every sampling instant
+    costs at least a step.
+    """
+    b, g = params.bonds, params.aging
+    scale = (1e-4 / rtol) ** 0.25
+    v_start = 0.0 if start_velocity is None else abs(start_velocity)
+    steps = 0.0
+    fastest = 0.0
+    for t0, t1, vp in protocol.pieces():
+        v = max(abs(vp), v_start) if control == "block" else abs(vp)
+        fastest = max(fastest, v)
+        slope = math.exp(-v / g.aging_velocity) / g.aging_time if aging else 0.0
+        climb = max(b.force_sensitivity * b.chain_stiffness * v - slope, 0.0)
+        rate = 4.0 * (1.0 + b.breakage_weight) / b.bond_time + 10.0 * climb + 100.0 * v / b.max_extension
+        steps += scale * rate * (t1 - t0) * (BLOCK_SHARE if control == "block" else 1.0) + SEGMENT_STEPS
+    duration = protocol.duration
+    if every is not None:
+        steps += duration / every
+    if max_step is not None:
+        steps = max(steps, duration / max_step)
+    natural = b.max_extension / b.bond_time
+    basis = f"{duration:.3g} s at up to {fastest:.3g} m/s, resolving tau = {b.bond_time:.3g} s"
+    if fastest > 100.0 * natural:
+        basis += (
+            f"; {fastest:.3g} m/s is {fastest / natural:.2g} x the set's dl_m/tau = {natural:.3g} m/s: check the unit"
+        )
+    return CostEstimate(steps, basis, steps * STEP_SECONDS)
+
+
+__all__ = ["Cycle", "estimate_cost", "run_transient"]

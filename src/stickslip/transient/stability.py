@@ -33,6 +33,8 @@ from .model import chain_force, log_hazard, steady_population
 
 #: frequencies / growth rates scanned, in units of 1/tau: from 1e-6 to 1e4
 SCAN = np.geomspace(1e-6, 1e6, 561)
+#: fastest velocity analysed, in units of dl_m/tau (beyond it the steady cohorts are below float resolution)
+FASTEST = 1e6
 #: age cells of the steady population used for Z (finer than the solver's default)
 CELL_HAZARD = 0.002
 
@@ -58,6 +60,12 @@ def interface_response(params: Parameters, velocity: float, s: np.ndarray, aging
     if not (isinstance(velocity, (int, float)) and math.isfinite(velocity) and velocity > 0):
         raise ParameterError(f"velocity: expected a positive sliding velocity in m/s, got {velocity!r}")
     b = params.bonds
+    fastest = FASTEST * b.max_extension / b.bond_time
+    if velocity > fastest:
+        raise ParameterError(
+            f"velocity: {velocity:.3g} m/s is beyond {FASTEST:.0e} x the set's dl_m/tau ({fastest:.3g} m/s): chains"
+            " would reach full extension in a negligible fraction of a bond's life; check the unit"
+        )
     a, w, width, f, fp, r, gv = _cells(params, float(velocity), aging)
     birth = (b.site_density - w.sum()) / b.bond_time
     s = np.atleast_1d(np.asarray(s, dtype=complex))

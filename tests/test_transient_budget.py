@@ -1,0 +1,227 @@
+"""Issues 17/18 on the time-dependent model: bad input is one typed line, every run has a cost bound,
+a steady start below Vc is defined, N/N0 never exceeds 1, and a stuck block says why."""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import pytest
+from tests.cli_helpers import run_main
+
+import stickslip
+from stickslip.errors import ModelError, ParameterError
+from stickslip.model.cycle import simulate
+from stickslip.numerics.budget import DEFAULT_MAX_STEPS
+from stickslip.protocols import constant
+from stickslip.transient import critical_stiffness, run_transient
+from stickslip.transient.solver import estimate_cost
+
+GEL = stickslip.load_parameters("gelatin-glass")
+SHORT = constant(350e-6, 0.01)
+
+
+@pytest.mark.parametrize(
+    ("call", "error", "words"),
+    [
+        (lambda: run_transient(None, SHORT), ParameterError, "params"),
+        (lambda: run_transient(GEL, SHORT, aging="no"), ParameterError, "aging"),
+        (lambda: run_transient(GEL, SHORT, stick_population="yes"), ParameterError, "stick_population"),
+        (lambda: run_transient(GEL, SHORT, max_step=0), ParameterError, "max_step"),
+        (lambda: run_transient(GEL, SHORT, max_step=1e-300), ParameterError, "budget"),
+        (lambda: run_transient(GEL, SHORT, every=1e-300), ParameterError, "budget"),
+        (lambda: run_transient(GEL, SHORT, max_steps=0), ParameterError, "max_steps"),
+        (lambda: run_transient(GEL, SHORT, start="steady", start_velocity=float("nan")), ParameterError, "finite"),
+        (lambda: run_transient(GEL, constant(350e-6, 1e6)), ParameterError, "budget"),
+        (lambda: run_transient(GEL, constant(350e-6, 1e300)), ParameterError, "budget"),
+        # 50 m/s: a plausible slip of units (issue 17); it ran for over 120 s without a word
+        (lambda: run_transient(GEL, constant(50.0, 0.01), control="velocity", start="steady"), ParameterError, "unit"),
+        (lambda: run_transient(GEL, SHORT, stiffness=1e303), ParameterError, "rigid"),
+        (
+            lambda: run_transient(GEL.with_overrides({"bonds.breakage_weight": 1e300}), SHORT),
+            ParameterError,
+            "budget",
+        ),
+        (lambda: run_transient(GEL.with_overrides({"bonds.bond_time": 1e-300}), SHORT), ParameterError, "budget"),
+        (lambda: run_transient(GEL.with_overrides({"block.height": 1e-300}), SHORT), ParameterError, "rigid"),
+        # lambda = 0: the stress diverges at the FENE wall, as the steady solver says
+        (
+            lambda: run_transient(GEL.with_overrides({"bonds.activation_length": 0.0}), SHORT, start="steady"),
+            ModelError,
+            "activation_length",
+        ),
+        (
+            lambda: run_transient(GEL.with_overrides({"bonds.activation_length": 0.0}), constant(350e-6, 1.0)),
+            ModelError,
+            "activation_length",
+        ),
+        (lambda: critical_stiffness(GEL, 1e300), ParameterError, "velocity"),
+    ],
+)
+def test_bad_api_input_is_a_typed_error_at_once(call, error, words):
+    start = time.process_time()
+    with pytest.raises(error, match=words):
+        call()
+    assert time.process_time() - start < 2.0
+
+
+def test_lambda_zero_is_fine_while_no_chain_can_reach_the_wall():
+    """The closed-form start-up (docs section 4) uses lambda = 0 with a 1 m wall: that stays allowed."""
+    params = GEL.with_overrides({"bonds.activation_length": 0.0, "bonds.max_extension": 1.0})
+    run = run_transient(params, constant(350e-6, 2e-4), control="velocity")
+    assert np.all(np.isfinite(run.stress)) and run.final_stress > 0
+
+
+def test_a_run_that_outgrows_its_budget_stops_with_the_reason():
+    """At 1 m/s the steps are finer than the estimate (2.9e8/s taken, 1.2e8/s estimated): the run still stops."""
+    protocol = constant(1.0, 1e-5)
+    assert estimate_cost(GEL, protocol, control="velocity").steps < 2000
+    with pytest.raises(ParameterError, match="used the budget of 2000 steps"):
+        run_transient(GEL, protocol, control="velocity", max_steps=2000)
+
+
+def test_estimate_is_within_its_stated_factor_of_the_steps_taken():
+    """Velocity control from empty: the estimate is within 0.4-5x of the steps (docstring of estimate_cost)."""
+    for velocity, duration in ((350e-6, 0.012), (100e-6, 0.05), (0.1, 1e-4)):
+        protocol = constant(velocity, duration)
+        run = run_transient(GEL, protocol, control="velocity")
+        ratio = estimate_cost(GEL, protocol, control="velocity").steps / run.steps
+        assert 0.3 <= ratio <= 6.0, (velocity, ratio)
+
+
+def test_bonded_fraction_never_exceeds_one_on_a_stuck_block():
+    """Issue 17: 1 mm/s through the block from empty reported N/N0 = 1.00005.
+
+    Cause: over steps much longer than tau (the stuck block), the births rested on a Hermite cubic of the
+    breakage rate across the whole step, which the young bonds' aging (1/tau_a) makes wrong.  Reference: the
+    same run with steps below tau (max_step = tau), where the cubic is accurate.
+    """
+    run = run_transient(GEL, constant(1e-3, 5.0))
+    assert run.bonded_fraction.max() <= 1.0 + 1e-12
+    fine = run_transient(GEL, constant(1e-3, 0.3), max_step=GEL.bonds.bond_time, max_steps=10**5)
+    for t in (0.05, 0.1, 0.3):
+        got = np.interp(t, run.time, run.bonded_fraction)
+        want = np.interp(t, fine.time, fine.bonded_fraction)
+        assert abs(got - want) <= 1e-4, (t, got, want)
+    assert "--stick-population" in run.message and "aging" in run.message
+
+
+def test_a_steady_start_below_vc_starts_at_the_critical_point_and_cycles(critical):
+    """Issue 17: at 50 um/s a steady start sat on the unstable branch and stopped at t = 0, 'undetermined'.
+
+    Now it starts sliding at Vc (the stable side), sticks near sigma_c and cycles with the stick chains; the
+    cycle agrees with the quasi-static model.cycle.simulate (stick time, peak, jump) to 1 %.
+    """
+    run = run_transient(GEL, constant(50e-6, 25.0), start="steady", stick_population=True, rtol=1e-3)
+    assert run.regime == "stick-slip" and "below Vc" in run.message
+    assert run.slider_velocity[0] == pytest.approx(critical.velocity, rel=2e-3)
+    cycle = run.cycles[0]
+    reference = simulate(GEL, 50e-6, 25.0).cycles[0]
+    assert cycle.stick_time == pytest.approx(reference.stick_time, rel=1e-2)
+    assert cycle.peak_stress == pytest.approx(reference.peak_stress, rel=1e-2)
+    assert cycle.jump_velocity == pytest.approx(reference.jump_velocity, rel=1e-2)
+
+
+def test_a_transient_sweep_below_vc_is_stick_slip(capsys, tmp_path):
+    """The phase diagram of the full model covers the paper's range: 100 um/s with the chains is stick-slip."""
+    import pandas as pd
+
+    out = tmp_path / "sweep"
+    status, _, err = run_main(capsys, "sweep", "--model", "transient", "--stick-population", "--vary",
+                              "pulling_velocity=100 um/s", "--duration", "17 s", "--workers", "0", "--quiet", "-o",
+                              str(out))  # fmt: skip
+    assert status == 0, err
+    row = pd.read_parquet(out).iloc[0]
+    reference = simulate(GEL, 100e-6, 17.0).cycles[0]
+    assert row["regime"] == "stick-slip"
+    assert row["stick_time"] == pytest.approx(reference.stick_time, rel=1e-2)
+    assert row["peak_stress"] == pytest.approx(reference.peak_stress, rel=1e-2)
+
+
+CLI_BASE = ("transient", "--v0", "50 um/s", "--duration", "1 s")
+
+
+@pytest.mark.parametrize(
+    ("args", "words"),
+    [
+        (("transient", "--v0", "50 um/s", "--duration", "1e6 s"), "budget"),
+        (("transient", "--v0", "50 um/s", "--duration", "1e300 s"), "budget"),
+        (("transient", "--v0", "1e9 m/s", "--duration", "1 s"), "check the unit"),
+        (("transient", "--v0", "1e3 c", "--duration", "1 s"), "check the unit"),
+        ((*CLI_BASE, "--set", "bonds.breakage_weight=1e300"), "budget"),
+        ((*CLI_BASE, "--set", "bonds.bond_time=1e-300 s"), "budget"),
+        ((*CLI_BASE, "--set", "bonds.activation_length=0", "--start", "steady"), "activation_length"),
+        (("transient", "--v0", "350 um/s", "--duration", "1 s", "--set", "bonds.activation_length=0"), "diverges"),
+        ((*CLI_BASE, "--every", "1e-300 s"), "budget"),
+        ((*CLI_BASE, "--max-steps", "10"), "budget of 10 steps"),
+        ((*CLI_BASE, "-o", "/nonexistent/x.csv"), "does not exist"),
+        ((*CLI_BASE, "-o", ""), "file name"),
+        ((*CLI_BASE, "--plot", ""), "file name"),
+        ((*CLI_BASE, "--plot", "x.unknownext"), "unknown figure format"),
+    ],
+)
+def test_cli_refusals_are_one_line_and_fast(capsys, args, words):
+    start = time.perf_counter()
+    status, _, err = run_main(capsys, *args)
+    assert status == 2 and err.count("\n") == 1 and words in err, err
+    assert time.perf_counter() - start < 5.0
+
+
+def test_cli_output_into_a_folder_that_takes_no_file(capsys, tmp_path):
+    """-o into a folder where no file can be created (here: /proc, as for -o /proc/version) is refused up front."""
+    status, _, err = run_main(capsys, *CLI_BASE, "-o", "/proc/version")
+    assert status == 2 and err.count("\n") == 1 and "/proc" in err
+
+
+def test_cli_never_overwrites_the_parameter_file(capsys, tmp_path):
+    """Issue 18: transient --params p.toml -o p.toml overwrote the parameter file."""
+    toml = tmp_path / "p.toml"
+    status, _, err = run_main(capsys, "params", "export", "-o", str(toml))
+    assert status == 0, err
+    before = toml.read_bytes()
+    status, _, err = run_main(capsys, "transient", "--params", str(toml), "--v0", "350 um/s", "--duration", "1 ms",
+                              "-o", str(toml))  # fmt: skip
+    assert status == 2 and "input" in err and toml.read_bytes() == before
+
+
+def test_default_budget_is_stated():
+    assert DEFAULT_MAX_STEPS == 3_000_000
+
+
+def test_no_progress_bar_in_a_pipe_even_for_a_long_run(capsys):
+    """A run estimated at > 2 s (25 s through the block: ~7 s estimated, 0.3 s taken) is silent off a terminal."""
+    from stickslip.transient.solver import estimate_cost as cost
+
+    assert cost(GEL, constant(50e-6, 25.0)).seconds > 2.0
+    status, out, err = run_main(capsys, "transient", "--v0", "50 um/s", "--duration", "25 s", "--rtol", "1e-3")
+    assert status == 0 and err == "" and "regime: stuck" in out
+
+
+def test_a_transient_sweep_does_not_store_lambda_zero_as_ok(capsys, tmp_path):
+    """Issue 18: a transient sweep stored lambda = 0 (a diverging stress) as status ok."""
+    import pandas as pd
+
+    out = tmp_path / "sweep"
+    status, _, err = run_main(capsys, "sweep", "--model", "transient", "--v0", "350 um/s", "--vary",
+                              "bonds.activation_length=0 m", "--duration", "0.1 s", "--workers", "0", "--quiet",
+                              "-o", str(out))  # fmt: skip
+    assert status == 0, err
+    row = pd.read_parquet(out).iloc[0]
+    assert row["status"] != "ok" and "activation_length" in row["message"]
+
+
+@pytest.mark.parametrize(
+    ("segment", "start_velocity", "words"),
+    [((1e-6, 1e-300), None, "too short to step"), ((1e-6, 10.0), 1e300, "budget")],
+)
+def test_rate_and_state_refuses_the_unsteppable_at_once(segment, start_velocity, words):
+    """rsf simulate --segment "1 um/s:1e-300 s" / --start-velocity "1e300 m/s" stalled for 17-36 s, then advised
+    loosening the spring; the cost check at the top of rsf.simulate refuses them in one line."""
+    from stickslip.protocols import Protocol, Segment
+    from stickslip.rsf import simulate as rsf_simulate
+    from stickslip.rsf.params import RSFParams
+
+    start = time.process_time()
+    with pytest.raises(ParameterError, match=words):
+        rsf_simulate(RSFParams(), Protocol((Segment(*segment),)), start_velocity=start_velocity)
+    assert time.process_time() - start < 2.0
