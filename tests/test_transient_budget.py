@@ -112,7 +112,8 @@ def test_a_steady_start_below_vc_starts_at_the_critical_point_and_cycles(critica
     Now it starts sliding at Vc (the stable side), sticks near sigma_c and cycles with the stick chains; the
     cycle agrees with the quasi-static model.cycle.simulate (stick time, peak, jump) to 1 %.
     """
-    run = run_transient(GEL, constant(50e-6, 25.0), start="steady", stick_population=True, rtol=1e-3)
+    # 70 s: three slips, two whole periods, the least from which the classifier calls a limit cycle
+    run = run_transient(GEL, constant(50e-6, 70.0), start="steady", stick_population=True, rtol=1e-3)
     assert run.regime == "stick-slip" and "below Vc" in run.message
     assert run.slider_velocity[0] == pytest.approx(critical.velocity, rel=2e-3)
     cycle = run.cycles[0]
@@ -123,12 +124,13 @@ def test_a_steady_start_below_vc_starts_at_the_critical_point_and_cycles(critica
 
 
 def test_a_transient_sweep_below_vc_is_stick_slip(capsys, tmp_path):
-    """The phase diagram of the full model covers the paper's range: 100 um/s with the chains is stick-slip."""
+    """The phase diagram of the full model covers the paper's range: 100 um/s with the chains is stick-slip
+    (50 s: three slips each followed by its stick, two whole periods: enough to call a limit cycle)."""
     import pandas as pd
 
     out = tmp_path / "sweep"
     status, _, err = run_main(capsys, "sweep", "--model", "transient", "--stick-population", "--vary",
-                              "pulling_velocity=100 um/s", "--duration", "17 s", "--workers", "0", "--quiet", "-o",
+                              "pulling_velocity=100 um/s", "--duration", "50 s", "--workers", "0", "--quiet", "-o",
                               str(out))  # fmt: skip
     assert status == 0, err
     row = pd.read_parquet(out).iloc[0]
@@ -208,20 +210,3 @@ def test_a_transient_sweep_does_not_store_lambda_zero_as_ok(capsys, tmp_path):
     assert status == 0, err
     row = pd.read_parquet(out).iloc[0]
     assert row["status"] != "ok" and "activation_length" in row["message"]
-
-
-@pytest.mark.parametrize(
-    ("segment", "start_velocity", "words"),
-    [((1e-6, 1e-300), None, "too short to step"), ((1e-6, 10.0), 1e300, "budget")],
-)
-def test_rate_and_state_refuses_the_unsteppable_at_once(segment, start_velocity, words):
-    """rsf simulate --segment "1 um/s:1e-300 s" / --start-velocity "1e300 m/s" stalled for 17-36 s, then advised
-    loosening the spring; the cost check at the top of rsf.simulate refuses them in one line."""
-    from stickslip.protocols import Protocol, Segment
-    from stickslip.rsf import simulate as rsf_simulate
-    from stickslip.rsf.params import RSFParams
-
-    start = time.process_time()
-    with pytest.raises(ParameterError, match=words):
-        rsf_simulate(RSFParams(), Protocol((Segment(*segment),)), start_velocity=start_velocity)
-    assert time.process_time() - start < 2.0

@@ -27,7 +27,6 @@ from typing import Any
 import numpy as np
 
 from ..errors import ModelError, ParameterError
-from ..numerics.budget import require_rsf_budget
 from ..protocols import Protocol
 from ..units import shorten, to_si
 from .params import RSFParams
@@ -77,7 +76,6 @@ def simulate(
     ``detect=False`` skips the regime detection (for fits, which call this
     hundreds of times).
     """
-    require_rsf_budget(params, protocol, start_velocity)
     if not isinstance(params, RSFParams):
         raise ParameterError(f"params: expected RSFParams, got {type(params).__name__}")
     if not isinstance(protocol, Protocol):
