@@ -17,7 +17,6 @@ from stickslip.report.report_figures import chain_fraction_figure
 from stickslip.sweeps import build_spec, load_sweep, run_sweep
 from stickslip.sweeps.plots import plot_phase_diagram
 
-
 #: Fig 6 of the paper: simulated stick times (V0 in µm/s, ts in s).
 PAPER_STICK_TIMES = ((50, 18.3), (100, 9.3))
 
