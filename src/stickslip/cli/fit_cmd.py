@@ -170,7 +170,12 @@ def steady_command(
     )
     posterior = None
     if posterior_module is not None:
-        posterior = posterior_module.sample_posterior(fit, walkers=walkers, steps=steps, seed=seed)
+        # a bar on a terminal only (never with --json); a chain that did not converge is said on stderr too
+        posterior = posterior_module.sample_posterior(
+            fit, walkers=walkers, steps=steps, seed=seed, progress=False if as_json else None
+        )
+        if not posterior.converged:
+            click.echo(f"stickslip: warning: Bayesian fit: {posterior.messages[0]}", err=True)
     if output is not None:
         fitted = _fitted_set(
             fit.parameters,

@@ -1,0 +1,75 @@
+"""The Bayesian steady fit's length and progress (issue 19): it converges on a hard 20-point record within a
+bounded number of steps, says plainly when it stops unconverged, and shows progress only on a terminal."""
+
+from __future__ import annotations
+
+import io
+import json
+
+import numpy as np
+import pytest
+
+from cli_helpers import run_main
+from stickslip.fitting import SteadyData, fit_steady
+from stickslip.fitting.bayes import CONVERGED_TIMES, MIN_STEPS, sample_posterior
+from stickslip.fitting.datasets import synthetic_steady_path
+from stickslip.model.steady import steady_state
+from stickslip.parameters import load_parameters
+from stickslip.progress import Silent, progress
+
+pytest.importorskip("emcee")
+
+
+@pytest.fixture(scope="module")
+def hard_fit():
+    """benchmarks/bench_fit.py's "harder 20-point set": gelatin-glass, 140-2000 µm/s, 2 % noise, seed 2 -- a
+    skewed, strongly correlated posterior on which the sampler used to run into its 10000-step cap."""
+    velocity = np.geomspace(140e-6, 2000e-6, 20)
+    true = steady_state(load_parameters("gelatin-glass"), velocity).stress
+    noisy = true * (1 + 0.02 * np.random.default_rng(2).standard_normal(20))
+    return fit_steady(SteadyData.from_arrays(velocity, noisy, 0.02 * true))
+
+
+def test_the_default_length_converges_on_a_hard_record_in_a_few_thousand_steps(hard_fit):
+    post = sample_posterior(hard_fit, seed=1, critical_draws=100)
+    assert post.converged and not post.messages
+    assert post.steps <= 3000  # was 10000 (the cap) and unconverged, tau up to ~200 steps
+    assert post.steps - post.burn >= CONVERGED_TIMES * np.max(post.autocorrelation)
+    # the posterior of Vc overlaps the least-squares interval (the posterior is skewed: medians differ)
+    lo, hi = post.critical_velocity.interval
+    lsq_lo, lsq_hi = hard_fit.critical_velocity.interval
+    assert lo < lsq_hi and lsq_lo < hi
+
+
+def test_a_chain_stopped_short_says_it_did_not_converge(hard_fit):
+    post = sample_posterior(hard_fit, seed=1, max_steps=MIN_STEPS, critical_draws=20)
+    assert not post.converged and post.messages[0].startswith("NOT CONVERGED")
+    assert f"limit of {MIN_STEPS} steps" in post.messages[0]
+    assert "NOT CONVERGED" in post.report() and post.as_dict()["converged"] is False
+
+
+def test_cli_warns_on_stderr_and_in_json_when_the_chain_did_not_converge(capsys):
+    args = ["fit", "steady", str(synthetic_steady_path()), "--bayes", "--walkers", "10", "--steps", "20"]
+    status, out, err = run_main(capsys, *args, "--seed", "3", "--json")
+    assert status == 0 and json.loads(out)["posterior"]["converged"] is False
+    assert err.startswith("stickslip: warning: Bayesian fit: NOT CONVERGED") and err.count("\n") == 1
+    assert "\r" not in err and "━" not in err  # no progress bar with --json or off a terminal
+
+
+def test_progress_is_silent_off_a_terminal_and_a_bar_on_one(monkeypatch):
+    stream = io.StringIO()
+    monkeypatch.setattr("sys.stderr", stream)
+    with progress("work", total=10, unit="steps") as bar:
+        assert type(bar) is Silent
+        bar.update(5, total=20, note="half")
+    assert stream.getvalue() == ""
+
+    class Terminal(io.StringIO):
+        def isatty(self) -> bool:
+            return True
+
+    screen = Terminal()
+    monkeypatch.setattr("sys.stderr", screen)
+    with progress("work", total=10, unit="steps") as bar:
+        bar.update(7, note="τ ≈ 3 steps")
+    assert "work" in screen.getvalue()
