@@ -48,12 +48,17 @@ def test_a_chain_stopped_short_says_it_did_not_converge(hard_fit):
     assert "NOT CONVERGED" in post.report() and post.as_dict()["converged"] is False
 
 
-def test_cli_warns_on_stderr_and_in_json_when_the_chain_did_not_converge(capsys):
-    args = ["fit", "steady", str(synthetic_steady_path()), "--bayes", "--walkers", "10", "--steps", "20"]
-    status, out, err = run_main(capsys, *args, "--seed", "3", "--json")
+def test_cli_warns_on_stderr_and_in_json_when_the_chain_did_not_converge(capsys, monkeypatch):
+    from stickslip.fitting import bayes
+
+    monkeypatch.setattr(bayes, "MAX_STEPS", MIN_STEPS)  # the automatic length stops at this cap, unconverged
+    args = ["fit", "steady", str(synthetic_steady_path()), "--bayes", "--walkers", "10", "--seed", "3"]
+    status, out, err = run_main(capsys, *args, "--json")
     assert status == 0 and json.loads(out)["posterior"]["converged"] is False
     assert err.startswith("stickslip: warning: Bayesian fit: NOT CONVERGED") and err.count("\n") == 1
     assert "\r" not in err and "━" not in err  # no progress bar with --json or off a terminal
+    status, out, err = run_main(capsys, *args, "--steps", "20", "--json")  # a length the user fixed
+    assert status == 0 and err == "" and json.loads(out)["posterior"]["converged"] is False
 
 
 def test_progress_is_silent_off_a_terminal_and_a_bar_on_one(monkeypatch):
