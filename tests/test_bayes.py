@@ -78,3 +78,22 @@ def test_progress_is_silent_off_a_terminal_and_a_bar_on_one(monkeypatch):
     with progress("work", total=10, unit="steps") as bar:
         bar.update(7, note="τ ≈ 3 steps")
     assert "work" in screen.getvalue()
+
+
+def test_the_kernel_density_of_the_fitted_proposal_is_scipys():
+    """The proposal's kernel estimate (samples whitened once) against scipy's gaussian_kde: density and draws."""
+    from scipy.stats import gaussian_kde
+
+    from stickslip.fitting.bayes import _Kernels
+
+    rng = np.random.default_rng(0)
+    mixing = np.array([[1, 0.9, 0, 0], [0, 0.3, 0, 0], [0, 0, 2, 0], [0.5, 0, 0, 0.1]])
+    samples = rng.standard_normal((2400, 4)) @ mixing + 3
+    ours, scipy = _Kernels(samples), gaussian_kde(samples.T)
+    points = rng.standard_normal((16, 4)) * 2 + 3
+    np.testing.assert_allclose(ours.log_density(points), scipy.logpdf(points.T), rtol=0, atol=1e-8)
+    drawn = ours.draw(200_000, np.random.RandomState(1))
+    # a draw is a sample plus kernel noise: mean of the samples, covariance (1 + factor^2) x theirs
+    factor2 = 2400 ** (-2 / 8)
+    np.testing.assert_allclose(drawn.mean(axis=0), samples.mean(axis=0), atol=0.02)
+    np.testing.assert_allclose(np.cov(drawn.T), (1 + factor2) * np.cov(samples.T), atol=0.03)

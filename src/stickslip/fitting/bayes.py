@@ -279,6 +279,30 @@ class _Independence:
         return x, self.log_q(x0) - self.log_q(x)  # log q(x0)/q(x): the Hastings factor
 
 
+class _Kernels:
+    """Gaussian kernel density estimate with Scott's bandwidth, as scipy's gaussian_kde, but with the samples
+    whitened once: gaussian_kde.logpdf re-whitens all of them at every call (most of the sampler's time)."""
+
+    def __init__(self, samples: np.ndarray) -> None:
+        count, dim = samples.shape
+        factor = count ** (-1.0 / (dim + 4))  # Scott's rule
+        self.chol = np.linalg.cholesky(factor**2 * np.cov(samples.T))
+        self.white = np.linalg.solve(self.chol, samples.T).T  # (count, dim)
+        self.samples = samples
+        self.norm = -math.log(count) - 0.5 * dim * math.log(2 * math.pi) - float(np.sum(np.log(np.diag(self.chol))))
+
+    def log_density(self, x: np.ndarray) -> np.ndarray:
+        from scipy.special import logsumexp
+
+        z = np.linalg.solve(self.chol, x.T).T  # (points, dim)
+        squared = np.sum((z[:, None, :] - self.white[None, :, :]) ** 2, axis=2)
+        return logsumexp(-0.5 * squared, axis=1) + self.norm
+
+    def draw(self, count: int, random: np.random.RandomState) -> np.ndarray:
+        centres = self.samples[random.randint(self.samples.shape[0], size=count)]
+        return centres + random.standard_normal(centres.shape) @ self.chol.T
+
+
 class _Fitted:
     """Independence proposal fitted to pilot samples: q = (1 - w) KDE(pilot) + w t(pilot mean, scaled covariance).
 
@@ -289,9 +313,7 @@ class _Fitted:
     """
 
     def __init__(self, samples: np.ndarray) -> None:
-        from scipy.stats import gaussian_kde
-
-        self.kde = gaussian_kde(samples.T)
+        self.kde = _Kernels(samples)
         self.tail = _Independence(samples.mean(axis=0), DEFENSIVE_SCALE**2 * np.cov(samples.T))
         dim = samples.shape[1]
         # normalising constant of the t (log_q of _Independence leaves it out), to mix it with the KDE's density
@@ -303,14 +325,14 @@ class _Fitted:
         )
 
     def log_q(self, x: np.ndarray) -> np.ndarray:
-        kde = self.kde.logpdf(x.T) + math.log1p(-DEFENSIVE_WEIGHT)
+        kde = self.kde.log_density(x) + math.log1p(-DEFENSIVE_WEIGHT)
         tail = self.tail.log_q(x) + self.tail_norm + math.log(DEFENSIVE_WEIGHT)
         return np.logaddexp(kde, tail)
 
     def __call__(self, x0: np.ndarray, random: np.random.RandomState) -> tuple[np.ndarray, np.ndarray]:
         count, _ = x0.shape
         from_tail = random.uniform(size=count) < DEFENSIVE_WEIGHT
-        x = self.kde.resample(count, seed=random).T
+        x = self.kde.draw(count, random)
         if np.any(from_tail):
             x[from_tail] = self.tail(x0[from_tail], random)[0]
         return x, self.log_q(x0) - self.log_q(x)
