@@ -81,7 +81,7 @@ PILOT_STEPS = (150, 150, 150)
 #: The fitted proposal: a kernel density estimate of the pilot samples, with this share of a t (PROPOSAL_DOF,
 #: the pilot's covariance times DEFENSIVE_SCALE**2) that keeps its tails heavier than the posterior's ...
 DEFENSIVE_WEIGHT = 0.3
-DEFENSIVE_SCALE = 2.0
+DEFENSIVE_SCALE = 3.0
 #: ... mixed with differential-evolution moves in this share (they explore where the pilot has not been).
 FITTED_WEIGHT = 0.5
 
