@@ -23,8 +23,8 @@ half differential-evolution moves (DEMove).  After each round an independence
 proposal is fitted to the round's samples: a kernel density estimate mixed
 with a defensive t of heavier tails (:class:`_Fitted`); the last one is fixed
 for the main run (half that proposal, half DEMove), an exact chain, and the
-rounds are discarded.  The autocorrelation time is 4-5 steps on the shipped
-synthetic curve and 8-10 on a harder 20-point set, against 8-13 and 190-200
+rounds are discarded.  The autocorrelation time is 4-6 steps on the shipped
+synthetic curve and 10-36 on a harder 20-point set, against 8-13 and 190-200
 for the mixture alone (which hit the 10000-step cap unconverged there).  By
 default the chain runs until it passes the convergence check -- at least 50
 integrated autocorrelation times after a burn-in of 5 of them -- and stops
