@@ -76,6 +76,9 @@ PROPOSAL_DOF = 10.0
 PROPOSAL_SCALE = 1.0
 #: Share of the independence proposal in the mixture of moves (the rest: differential evolution).
 INDEPENDENCE_WEIGHT = 0.5
+#: A key whose log posterior, at the prior's edge with the others refitted, is less than this below the peak
+#: is reported as not bounded by the data on that side.
+UNBOUNDED_DROP = 10.0
 #: Burn-in rounds (steps each): the first with the mixture of moves, then the proposal fitted to the last round.
 PILOT_STEPS = (150, 150, 150)
 #: The fitted proposal: a kernel density estimate of the pilot samples, with this share of a t (PROPOSAL_DOF,
@@ -258,6 +261,33 @@ class _LogPosterior:
         chi = chi[finite]
         out[good_rows] = -0.5 * chi if self.stated else -0.5 * self.points * np.log(chi)
         return out
+
+
+def _unbounded(log_post: _LogPosterior, centre: np.ndarray) -> list[str]:
+    """Keys the data do not bound on one side: with the key at the prior's edge and the others refitted, the log
+    posterior is within UNBOUNDED_DROP of its peak (a plateau reaching the edge, which the chain may barely have
+    entered and its convergence check cannot see)."""
+    peak = float(log_post(centre[None, :])[0])
+    keys = log_post.space.keys
+    notes = []
+    for i, key in enumerate(keys):
+        others = tuple(k for k in keys if k != key)
+        for edge, side in ((log_post.lower[i], "below"), (log_post.upper[i], "above")):
+            theta = centre.copy()
+            theta[i] = edge
+            try:
+                space = Space(log_post.space.params(theta), others)
+                best = minimize(space, space.vector(), log_post.block)
+            except StickslipError:
+                continue
+            at_edge = -0.5 * best.chi_square if log_post.stated else -0.5 * log_post.points * math.log(best.chi_square)
+            if math.isfinite(at_edge) and peak - at_edge < UNBOUNDED_DROP:
+                notes.append(
+                    f"{key}: the data do not bound it {side}: at the prior's edge ({math.exp(edge):.3g} SI), with the"
+                    f" other parameters refitted, the log posterior is only {peak - at_edge:.2g} below its peak;"
+                    f" its posterior {side} the peak is set by the prior's box, not by the data"
+                )
+    return notes
 
 
 class _Independence:
@@ -485,6 +515,7 @@ def sample_posterior(
             " --steps"
         )
     converged = not messages
+    messages += _unbounded(log_post, centre)
     finite = tau[np.isfinite(tau)]
     thin = (max(1, int(finite.min() / 2)) if finite.size else 1) if thin is None else thin
     chain = sampler.get_chain(discard=burn - pilot, thin=thin, flat=True)
