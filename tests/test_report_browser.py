@@ -172,3 +172,53 @@ def test_page_fits_an_800_pixel_window(page) -> None:
         assert widths[0] <= widths[1] and widths[2] <= widths[1], f"page overflows at 800 px: {widths}"
     finally:
         driver.set_window_size(1280, 1024)
+
+
+#: Window widths the report is checked at: a small laptop or tablet, a common laptop, a desktop.
+WIDTHS = (760, 1280, 1920)
+#: The tables that must show every column without scrolling from this window width on (issue 19).
+WHOLE_FROM = 1280
+
+
+def _tables_at(driver, width: int) -> list[dict]:
+    driver.set_window_size(width, 1000)
+    try:
+        return driver.execute_script(
+            "return Array.from(document.querySelectorAll('main table')).map(t => {"
+            " const box = t.parentElement, hint = box.querySelector(':scope > .scroll-hint');"
+            " return {table: t.className, window: window.innerWidth, scrolls: box.scrollWidth > box.clientWidth + 1,"
+            " hint: !!hint && hint.getBoundingClientRect().height > 0"
+            " && getComputedStyle(hint).visibility === 'visible',"
+            " right: box.getBoundingClientRect().right, page: document.documentElement.clientWidth}; })"
+        )
+    finally:
+        driver.set_window_size(1280, 1024)
+
+
+@pytest.mark.parametrize("width", WIDTHS)
+def test_a_table_wider_than_the_window_says_so_and_the_main_ones_fit_on_a_laptop(page, width: int) -> None:
+    """A table that scrolls sideways shows the line saying so (and only then); from 1280 px on, Table 1 at a
+    glance and the full comparison table show every column, "Computed from" included, without scrolling."""
+    driver, _ = page
+    tables = _tables_at(driver, width)
+    assert tables and {"table1", "comparisons"} <= {t["table"] for t in tables}
+    for table in tables:
+        assert table["scrolls"] == table["hint"], f"at {width} px: {table}"
+        assert table["right"] <= table["page"] + 0.5, f"at {width} px the page itself scrolls: {table}"
+        if width >= WHOLE_FROM and table["table"] in ("table1", "comparisons"):
+            assert not table["scrolls"], f"at {width} px {table['table']} hides columns behind a scroll: {table}"
+
+
+def test_every_figure_is_drawn_near_its_own_size_at_760_pixels(page) -> None:
+    """Figures are drawn at the report's width (760 px PNGs): shown in a 760 px window they are scaled by no less
+    than 0.85, so that their 8-10 pt text stays readable (the Eq 1 figure was 1473 px wide, shown at 0.48)."""
+    driver, _ = page
+    driver.set_window_size(760, 1000)
+    try:
+        scales = driver.execute_script(
+            "return Array.from(document.images).map(i => [i.alt, i.getBoundingClientRect().width / i.naturalWidth])"
+        )
+    finally:
+        driver.set_window_size(1280, 1024)
+    small = [(alt, round(scale, 2)) for alt, scale in scales if scale < 0.85]
+    assert scales and not small, f"figures shrunk below 0.85 of their size at 760 px: {small}"

@@ -125,10 +125,21 @@ def figure_cycles(
         ax.set_title(f"({chr(ord('a') + k)}) V0 = {_um(sim.pulling_velocity)}: {sim.regime}", fontsize=10, loc="left")
         if k < len(simulations) - 1:
             ax.set_xlabel("")
-    axes[0].legend(loc="upper right", frameon=False, fontsize=8, ncols=4)
+    legend_of_all_panels(fig)
     if title:
         fig.suptitle(title, fontsize=11)
     return fig
+
+
+def legend_of_all_panels(fig: Figure, **kwargs: Any) -> None:
+    """One legend, on the first panel, naming every line of every panel once (a phase that only a later panel
+    shows, such as the steady part of Fig 5c, included)."""
+    handles: dict[str, Any] = {}
+    for ax in fig.axes:
+        for handle, label in zip(*ax.get_legend_handles_labels(), strict=True):
+            handles.setdefault(label, handle)
+    options = {"loc": "upper right", "frameon": False, "fontsize": 8, "ncols": 4, **kwargs}
+    fig.axes[0].legend(list(handles.values()), list(handles), **options)
 
 
 def _trace_arrays(item: Any) -> tuple[np.ndarray, np.ndarray]:

@@ -170,7 +170,18 @@ def steady_command(
     )
     posterior = None
     if posterior_module is not None:
-        posterior = posterior_module.sample_posterior(fit, walkers=walkers, steps=steps, seed=seed)
+        # a bar on a terminal only (never with --json); a chain that stopped at the cap unconverged is said on
+        # stderr too (a length fixed by --steps is the user's choice: the report and the JSON say it)
+        posterior = posterior_module.sample_posterior(
+            fit,
+            walkers=walkers,
+            steps=steps,
+            seed=seed,
+            max_steps=posterior_module.MAX_STEPS,
+            progress=False if as_json else None,
+        )
+        if steps is None and not posterior.converged:
+            click.echo(f"stickslip: warning: Bayesian fit: {posterior.messages[0]}", err=True)
     if output is not None and fit.success:
         fitted = _fitted_set(
             fit.parameters,

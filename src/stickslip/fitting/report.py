@@ -200,6 +200,15 @@ def stick_report(fit: StickFit) -> str:
     return "\n".join(lines)
 
 
+def _convergence(post: SteadyPosterior) -> str:
+    from .bayes import CONVERGED_TIMES
+
+    tau = float(max(post.autocorrelation))
+    times = f"{(post.steps - post.burn) / tau:.0f}" if 0 < tau < float("inf") else "no measurable number of"
+    verdict = "passed" if post.converged else "NOT CONVERGED"
+    return f"{verdict}: {times} autocorrelation times after burn-in (the check asks for {CONVERGED_TIMES})"
+
+
 def posterior_report(post: SteadyPosterior) -> str:
     lines = [
         "# Bayesian steady fit (emcee)",
@@ -208,6 +217,7 @@ def posterior_report(post: SteadyPosterior) -> str:
         f"- sampler: {post.walkers} walkers × {post.steps} steps, first {post.burn} discarded, thinned by {post.thin};"
         f" {post.chain.shape[0]} samples; mean acceptance {post.acceptance:.2f}",
         f"- autocorrelation time (steps): {', '.join(_g(t, 3) for t in post.autocorrelation)}",
+        f"- convergence: {_convergence(post)}",
         "",
         "## Priors",
         "",

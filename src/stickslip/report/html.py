@@ -17,6 +17,13 @@ from .figures import Curve, ReportFigure, data_uri
 from .formatting import DISPLAY_UNITS, format_parameter, format_percent, format_quantity
 from .paper import TABLE1_COLUMNS, TABLE1_ROWS, PaperNumber
 
+#: Opening of a wide table's box: it scrolls sideways when the window is too narrow, and then says so
+#: (style.css shows the line only while the box can scroll).
+WIDE = (
+    '<div class="wide"><p class="scroll-hint">Wider than the window: scroll sideways in this table to see every'
+    " column →</p>"
+)
+
 KIND_LABELS = {
     "model": "model result",
     "parameter": "parameter",
@@ -89,7 +96,7 @@ def _alternative(row: Comparison, display: str, digits: int = 4) -> str:
 
 def comparison_table(rows: Sequence[Comparison], errata: Errata) -> str:
     head = (
-        '<div class="wide"><table class="comparisons">\n<thead><tr><th>Quantity</th><th>Kind</th><th>Paper</th>'
+        f'{WIDE}<table class="comparisons">\n<thead><tr><th>Quantity</th><th>Kind</th><th>Paper</th>'
         "<th>Source</th>"
         "<th>Computed</th><th>Difference</th><th>Class</th><th>Erratum</th><th>Computed from</th></tr></thead>\n"
         "<tbody>"
@@ -124,7 +131,7 @@ def table1_matrix(rows: Sequence[Comparison]) -> str:
     stiffness) with the difference and its class, and the model at the nominal stiffness."""
     by_key = {r.number.key: r for r in rows}
     head = "".join(f"<th>{round(v * 1e6)} µm/s<br>cycle {c}</th>" for v, c in TABLE1_COLUMNS)
-    out = [f'<div class="wide"><table class="table1">\n<thead><tr><th></th>{head}</tr></thead>\n<tbody>']
+    out = [f'{WIDE}<table class="table1">\n<thead><tr><th></th>{head}</tr></thead>\n<tbody>']
     for key, label, _unit, display, _values, _scale in TABLE1_ROWS:
         cells = []
         for velocity, cycle in TABLE1_COLUMNS:
@@ -159,10 +166,7 @@ def trace_table(analyses: Mapping[int, TraceAnalysis]) -> str:
     At 100 µm/s the paper's mean leaves out cycle 1, which the paper sets apart (extra aging).
     """
     head = "".join(f"<th>{escape(label)}</th>" for _key, label, *_ in TABLE1_ROWS)
-    out = [
-        f'<div class="wide"><table class="traces">\n<thead><tr><th>V0</th><th></th>{head}<th>cycles</th></tr></thead>'
-        "\n<tbody>"
-    ]
+    out = [f'{WIDE}<table class="traces">\n<thead><tr><th>V0</th><th></th>{head}<th>cycles</th></tr></thead>\n<tbody>']
     for velocity_um, analysis in analyses.items():
         velocity = velocity_um * 1e-6
         columns = [

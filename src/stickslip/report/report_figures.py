@@ -20,6 +20,8 @@ if TYPE_CHECKING:  # pragma: no cover
 
 UM = 1e6
 PAPER_COLOR = "#e67e22"
+#: Figure 6's simulated stick times: (V0 in µm/s, ts in s).
+PAPER_STICK_TIMES = ((50, 18.3), (100, 9.3))
 
 
 def steady_figure(run: ModelRun) -> ReportFigure:
@@ -76,7 +78,13 @@ def chain_fraction_figure(run: ModelRun) -> ReportFigure:
     sims = [run.simulations[50], run.simulations[100]]
     fig = figure_chain_fraction(sims, labels=["V0 = 50 µm/s", "V0 = 100 µm/s"], title="Attached chains (Figs 3 and 6)")
     ax = fig.axes[0]
-    ax.plot([18.3, 9.3], [0.0, 0.0], "v", color=PAPER_COLOR, markersize=8, zorder=8, label="paper: ts = 18.3 s, 9.3 s")
+    # each paper triangle in the colour of the model curve it belongs to (the model's own ts is the dot)
+    curves = [line for line in ax.get_lines() if not line.get_label().startswith("_")]
+    for line, (velocity, paper_ts) in zip(curves, PAPER_STICK_TIMES, strict=True):
+        ax.plot(
+            [paper_ts], [0.0], "v", color=line.get_color(), markeredgecolor="black", markeredgewidth=0.6,
+            markersize=9, zorder=8, label=f"paper, V0 = {velocity} µm/s: ts = {paper_ts} s",
+        )  # fmt: skip
     ax.legend(loc="lower left", frameon=False, fontsize=8)
     ts50, ts100 = (s.cycles[0].stick_time for s in sims)
     stick = run.params.stick
@@ -87,7 +95,8 @@ def chain_fraction_figure(run: ModelRun) -> ReportFigure:
         f"τa = {stick.aging_time:g} s), starting at σc. As in the paper, it falls slowly while the load is "
         "shared by many chains, then collapses: each chain that lets go loads the others more (Eq 14). "
         f"The collapse gives the stick time ts = {ts50:.2f} s at 50 µm/s and {ts100:.2f} s at 100 µm/s; the "
-        "paper's simulation gives 18.3 s and 9.3 s (orange triangles; see the table and errata E18, E5)."
+        "paper's simulation gives 18.3 s and 9.3 s (triangles in the colour of each curve; see the table and "
+        "errata E18, E5)."
     )
     return ReportFigure("fig3-6_chain_fraction", "Figs 3 and 6", "Attached chains in the stick phase", caption, fig)
 
@@ -117,13 +126,15 @@ def cycles_figure(run: ModelRun) -> ReportFigure:
 
 def _label_critical_stress_and_clear_peaks(fig: Figure, critical_stress: float) -> None:
     """Name the dashed σc line in the legend, and leave room above the peaks so the legend covers no data."""
+    from ..cycle_plots import legend_of_all_panels
+
     for index, ax in enumerate(fig.axes):
         for line in ax.get_lines():
             if line.get_linestyle() == "--":
                 line.set_label(f"σc = {critical_stress:.1f} Pa" if index == 0 else "_σc")
         low, high = ax.get_ylim()
         ax.set_ylim(low, high + 0.25 * (high - low))
-    fig.axes[0].legend(loc="upper right", frameon=False, fontsize=8, ncols=4)
+    legend_of_all_panels(fig)
 
 
 def slip_velocity_figure(run: ModelRun) -> ReportFigure:

@@ -46,8 +46,10 @@ def transient_figure(run: ModelRun) -> ReportFigure:
     steps = run_transient(params, segments(list(VELOCITY_STEPS)), control="velocity", start="steady", rtol=1e-5)
     peaks = [_hold_peak(params, hold) for hold in HOLDS]
 
-    fig = Figure(figsize=(13.5, 4.2))
-    ax_cycle, ax_step, ax_hold = fig.subplots(1, 3)
+    # the width of the report's other figures (readable on a phone-sized page): the cycle on top, two panels below
+    fig = Figure(figsize=(6.8, 7.0))
+    grid = fig.add_gridspec(2, 2)
+    ax_cycle, ax_step, ax_hold = fig.add_subplot(grid[0, :]), fig.add_subplot(grid[1, 0]), fig.add_subplot(grid[1, 1])
     ax_cycle.plot(*_thin(alone.time, alone.stress), color="C2", lw=2.4, label="Eq 1 alone")
     ax_cycle.plot(*_thin(full.time, full.stress), color="C0", lw=1.2, label="Eq 1 + stick chains")
     if full.cycles:
@@ -56,7 +58,7 @@ def transient_figure(run: ModelRun) -> ReportFigure:
     ax_cycle.set_xlim(0, duration)
     ax_cycle.set_xlabel("time (s)")
     ax_cycle.set_ylabel("stress σ (Pa)")
-    ax_cycle.set_title(f"{high * UM:.0f} → {low * UM:.0f} µm/s through the block", fontsize="small")
+    ax_cycle.set_title(f"{high * UM:.0f} → {low * UM:.0f} µm/s through the block", fontsize=10)
     ax_cycle.legend(fontsize="small", loc="upper left")
 
     for start, label, color in ((VELOCITY_STEPS[0][1], "step up", "C0"), (_second_step(), "step down", "C1")):
@@ -66,13 +68,13 @@ def transient_figure(run: ModelRun) -> ReportFigure:
         ax_step.plot(slip[near], steps.stress[after][near], color=color, lw=1.2, label=label)
     ax_step.set_xlabel("slip since the step (µm)")
     ax_step.set_ylabel("stress σ (Pa)")
-    ax_step.set_title("100 → 1000 → 100 µm/s, velocity control", fontsize="small")
+    ax_step.set_title("100 → 1000 → 100 µm/s (velocity control)", fontsize=9)
     ax_step.legend(fontsize="small")
 
     ax_hold.loglog(HOLDS, peaks, "o-", color="C3", label="peak on re-sliding")
     ax_hold.set_xlabel("hold time (s)")
     ax_hold.set_ylabel("peak stress (Pa)")
-    ax_hold.set_title("slide-hold-slide at 100 µm/s", fontsize="small")
+    ax_hold.set_title("slide-hold-slide at 100 µm/s", fontsize=9)
     for ax in (ax_cycle, ax_step, ax_hold):
         apply_style(ax)
     fig.tight_layout()
@@ -136,13 +138,13 @@ def _caption(run, full, alone, quasi, steps, peaks) -> str:  # type: ignore[no-u
     holds = ", ".join(f"{h:g} s: {p:.3g} Pa" for h, p in zip(HOLDS, peaks, strict=True))
     return (
         "The paper writes its model as a time-dependent population balance (Eq 1) and solves only quasi-static "
-        f"reductions of it; stickslip.transient solves Eq 1 itself (docs/transient.md). Left: {stick_alone}; "
+        f"reductions of it; stickslip.transient solves Eq 1 itself (docs/transient.md). Top: {stick_alone}; "
         f"{cycle_text}. The slip phase of the full model is quasi-static to about 2 %, and the jump is the "
-        "paper's, imposed at the chains' collapse: stick-slip does not emerge from Eq 1 alone. Middle: a velocity "
+        "paper's, imposed at the chains' collapse: stick-slip does not emerge from Eq 1 alone. Bottom left: a velocity "
         f"step up first lowers σ (aging is erased at once), then σ peaks at {peak:.1f} Pa and relaxes over a "
         f"fraction of a micrometre to σ(1000 µm/s) = {high:.2f} Pa; back down, σ dips and recovers to "
         f"{low:.2f} Pa. In rate-and-state terms a ≈ {(peak - low) / ln10:.0f} Pa and a − b ≈ "
-        f"{(high - low) / ln10:.0f} Pa (velocity strengthening above Vc). Right: the peak on re-sliding after a "
+        f"{(high - low) / ln10:.0f} Pa (velocity strengthening above Vc). Bottom right: the peak on re-sliding after a "
         f"hold ({holds}) grows almost in proportion to the hold, to 10⁵ times the sliding stress: held bonds age "
         "past breaking, which gels do not show (their static threshold grows about logarithmically); a model "
         f"limitation, and the reason the paper needs a separate stick population. Local tolerance {RTOL:g}."
