@@ -132,7 +132,7 @@ def test_fifo_and_device_inputs_are_refused_without_blocking(tmp_path):
     assert "not a regular file" in done.stderr
     done = _subprocess("params", "show", "/dev/zero", timeout=60)
     _one_error_line(done.returncode, done.stderr)
-    assert "'/dev/zero' is not a regular file" in done.stderr
+    assert "'/dev/zero': not a regular file" in done.stderr
 
 
 def test_input_files_must_exist_be_files_and_fit_the_limit(tmp_path):

@@ -524,9 +524,9 @@ def test_a_fifo_folder_binary_or_empty_name_as_parameter_set_says_what_it_is(tmp
     (tmp_path / "folder").mkdir()
     (tmp_path / "bin.toml").write_bytes(b"\x90\xff\x00" * 10)
     for name, message in [
-        ("pipe", "parameter file 'pipe' is not a regular file"),  # was "unknown parameter set"
-        ("folder", "parameter file 'folder' is a folder"),
-        ("bin.toml", r"is not a text \(UTF-8\) file \(invalid start byte at byte 0\)"),
+        ("pipe", "parameter file 'pipe': not a regular file"),  # was "unknown parameter set"
+        ("folder", "parameter file 'folder': is a folder"),
+        ("bin.toml", r"not a text \(UTF-8\) file \(invalid start byte at byte 0\)"),
         ("", "empty parameter set name"),
     ]:
         with pytest.raises(ParameterError, match=message):

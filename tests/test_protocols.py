@@ -81,7 +81,7 @@ def test_atomic_write_and_input_guard(tmp_path):
     [
         (b"", "empty file"),  # pandas' sniffer: "Could not determine delimiter", an internal error (issue 18)
         (b"  \n\t\n", "empty file"),
-        (b"\x90\xff\x00\xc3\x28" * 20, r"not a text \(UTF-8\) CSV file"),
+        (b"\x90\xff\x00\xc3\x28" * 20, r"not a text \(UTF-8\) file"),
     ],
     ids=["empty", "blank", "binary"],
 )

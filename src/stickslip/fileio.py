@@ -46,6 +46,7 @@ __all__ = [
     "atomic_write_text",
     "output_kind",
     "protect_inputs",
+    "read_input_text",
     "refuse_input_as_output",
     "same_file",
 ]
@@ -117,6 +118,31 @@ def _invocation_meta() -> dict[str, Any] | None:
         return None
     ctx = click.get_current_context(silent=True)
     return None if ctx is None else ctx.meta
+
+
+def read_input_text(path: str | Path, subject: str, max_bytes: int, error: type[Exception] = DataError) -> str:
+    """The text of an input file, checked before it is read: a regular file (a FIFO would block, /dev/zero never
+    end) of at most ``max_bytes``, UTF-8 (a byte-order mark is fine).  Every problem is one ``error`` line that
+    starts with ``subject`` (``"--params run.json"``, ``"protocol file p.csv"``)."""
+    path = Path(path)
+    try:
+        info = path.stat()
+    except FileNotFoundError:
+        raise error(f"{subject}: file not found") from None
+    except (OSError, ValueError) as exc:  # ValueError: a NUL in the name
+        raise error(f"{subject}: cannot be read ({getattr(exc, 'strerror', None) or exc})") from None
+    if stat.S_ISDIR(info.st_mode):
+        raise error(f"{subject}: is a folder, not a file")
+    if not stat.S_ISREG(info.st_mode):
+        raise error(f"{subject}: not a regular file (save a pipe or device to a file first)")
+    if info.st_size > max_bytes:
+        raise error(f"{subject}: {info.st_size} bytes; at most {max_bytes} bytes are read")
+    try:
+        return path.read_bytes().decode("utf-8-sig")
+    except OSError as exc:
+        raise error(f"{subject}: cannot be read ({exc.strerror or exc})") from None
+    except UnicodeDecodeError as exc:
+        raise error(f"{subject}: not a text (UTF-8) file ({exc.reason} at byte {exc.start})") from None
 
 
 def protect_inputs(paths: Iterable[str | Path | None]) -> None:

@@ -35,7 +35,6 @@ from __future__ import annotations
 import dataclasses
 import math
 import os
-import stat
 import sys
 from collections.abc import Mapping
 from dataclasses import dataclass, field, fields
@@ -44,7 +43,7 @@ from pathlib import Path
 from typing import Any
 
 from .errors import ParameterError
-from .fileio import protect_inputs
+from .fileio import protect_inputs, read_input_text
 from .units import format_quantity, format_si, shorten, to_si
 
 if sys.version_info >= (3, 11):
@@ -291,36 +290,8 @@ def read_parameter_file(path: str | Path) -> Parameters:
     if not isinstance(path, (str, os.PathLike)):
         raise ParameterError(f"parameter file: expected a path, got {type(path).__name__}")
     path = Path(path)
-    shown = shorten(str(path), 240)
-    try:
-        info = path.stat()
-    except FileNotFoundError:
-        raise ParameterError(f"parameter file {shown} not found") from None
-    except (OSError, ValueError) as exc:  # ValueError: a NUL in the name
-        raise ParameterError(f"parameter file {shown} cannot be read: {shorten(str(exc))}") from None
-    if stat.S_ISDIR(info.st_mode):
-        raise ParameterError(f"parameter file {shown} is a folder, not a file")
-    if not stat.S_ISREG(info.st_mode):  # a FIFO would block for ever, /dev/zero never end
-        raise ParameterError(f"parameter file {shown} is not a regular file (save a pipe or device to a file first)")
-    if info.st_size > MAX_PARAMETER_FILE_BYTES:
-        raise ParameterError(
-            f"parameter file {shown} is {info.st_size} bytes; a parameter file is at most"
-            f" {MAX_PARAMETER_FILE_BYTES} bytes"
-        )
+    text = read_input_text(path, f"parameter file {shorten(str(path), 240)}", MAX_PARAMETER_FILE_BYTES, ParameterError)
     protect_inputs([path])  # in a command, no output may replace its parameter file
-    try:
-        with open(path, "rb") as handle:
-            text = handle.read(MAX_PARAMETER_FILE_BYTES + 1).decode("utf-8-sig")  # a BOM (Windows editors) is no error
-    except FileNotFoundError:
-        raise ParameterError(f"parameter file {shown} not found") from None
-    except UnicodeDecodeError as exc:
-        raise ParameterError(
-            f"parameter file {shown} is not a text (UTF-8) file ({exc.reason} at byte {exc.start})"
-        ) from None
-    except (OSError, ValueError) as exc:
-        raise ParameterError(f"parameter file {shown} cannot be read: {shorten(str(exc))}") from None
-    if len(text) > MAX_PARAMETER_FILE_BYTES:
-        raise ParameterError(f"parameter file {shown} is longer than {MAX_PARAMETER_FILE_BYTES} bytes")
     return _parse_toml(text, str(path))
 
 

@@ -25,7 +25,7 @@ import numpy as np
 
 from .columns import with_units
 from .errors import DataError, ParameterError
-from .fileio import protect_inputs
+from .fileio import protect_inputs, read_input_text
 
 __all__ = [
     "Protocol",
@@ -258,27 +258,7 @@ MAX_PROTOCOL_BYTES = 100_000_000
 
 
 def _protocol_text(path: Path) -> str:
-    """The text of a protocol file: a regular file (a FIFO would block, /dev/zero never end), UTF-8, BOM allowed."""
-    import stat
-
-    try:
-        info = path.stat()
-    except FileNotFoundError:
-        raise DataError(f"{path}: protocol file not found (expected a CSV with columns time,velocity)") from None
-    except (OSError, ValueError) as exc:  # ValueError: a NUL in the name
-        raise DataError(f"{path}: protocol file cannot be read ({getattr(exc, 'strerror', None) or exc})") from None
-    if stat.S_ISDIR(info.st_mode):
-        raise DataError(f"{path}: is a folder, not a protocol file")
-    if not stat.S_ISREG(info.st_mode):
-        raise DataError(f"{path}: not a regular file (save a pipe or device to a file first)")
-    if info.st_size > MAX_PROTOCOL_BYTES:
-        raise DataError(f"{path}: {info.st_size} bytes; a protocol file is at most {MAX_PROTOCOL_BYTES} bytes")
-    try:
-        return path.read_bytes().decode("utf-8-sig")
-    except OSError as exc:
-        raise DataError(f"{path}: protocol file cannot be read ({exc.strerror or exc})") from None
-    except UnicodeDecodeError as exc:
-        raise DataError(f"{path}: not a text (UTF-8) CSV file ({exc.reason} at byte {exc.start})") from None
+    return read_input_text(path, f"protocol file {path}", MAX_PROTOCOL_BYTES)
 
 
 def _numeric_rows(frame: Any, path: Path, cols: list[Any]) -> list[tuple[float, float]]:

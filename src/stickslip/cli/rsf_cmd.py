@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import json
 import math
-import stat
 import sys
 from collections.abc import Callable
 from pathlib import Path
@@ -19,7 +18,7 @@ from typing import Any
 import click
 
 from ..errors import DataError, ParameterError, StickslipError, UnitError
-from ..fileio import atomic_path, atomic_write_text, protect_inputs, refuse_input_as_output
+from ..fileio import atomic_path, atomic_write_text, protect_inputs, read_input_text, refuse_input_as_output
 from ..units import quantity_noun, shorten
 from .common import json_text, quantity
 
@@ -150,25 +149,7 @@ def load_params_file(path: Path) -> dict[str, Any]:
 
 
 def _params_text(path: Path) -> str:
-    """The text of a --params file: a regular file (a FIFO would block, /dev/zero never end), UTF-8, BOM allowed."""
-    try:
-        info = path.stat()
-    except FileNotFoundError:
-        raise DataError(f"--params {path}: file not found") from None
-    except (OSError, ValueError) as exc:  # ValueError: a NUL in the name
-        raise DataError(f"--params {path}: cannot be read ({getattr(exc, 'strerror', None) or exc})") from None
-    if stat.S_ISDIR(info.st_mode):
-        raise DataError(f"--params {path}: is a folder, not a file")
-    if not stat.S_ISREG(info.st_mode):
-        raise DataError(f"--params {path}: not a regular file (save a pipe or device to a file first)")
-    if info.st_size > MAX_PARAMS_BYTES:
-        raise DataError(f"--params {path}: {info.st_size} bytes; a parameter file is at most {MAX_PARAMS_BYTES} bytes")
-    try:
-        return path.read_bytes().decode("utf-8-sig")
-    except OSError as exc:
-        raise DataError(f"--params {path}: cannot be read ({exc.strerror or exc})") from None
-    except UnicodeDecodeError as exc:
-        raise DataError(f"--params {path}: not a text (UTF-8) file ({exc.reason} at byte {exc.start})") from None
+    return read_input_text(path, f"--params {path}", MAX_PARAMS_BYTES)
 
 
 def _run_meta(path: Path) -> tuple[list[dict[str, Any]] | None, float | None]:
