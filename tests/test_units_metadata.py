@@ -259,3 +259,26 @@ def test_rsf_trace_with_units_in_its_header_is_read_by_rsf_fit_in_si(tmp_path):
     record = read_record(path)
     np.testing.assert_allclose(record.time, t)
     np.testing.assert_allclose(record.displacement, 2e-6 * t)
+
+
+def test_transient_trace_with_the_stick_chains_shows_what_holds_the_block(params, tmp_path, capsys):
+    """While the slider is stuck the chains carry the load (bonded_fraction reads 0 then): the frame and the CSV
+    say so (chain_fraction, held_by), and analyze still reads the file."""
+    from stickslip.transient import run_transient
+
+    run = run_transient(params, protocols.constant(100e-6, 12.0), start="steady", stick_population=True, rtol=1e-3)
+    frame = run.to_frame()
+    stuck = frame["slider_velocity"] == 0.0
+    assert stuck.any() and (~stuck).any()
+    assert set(frame.loc[stuck, "held_by"]) == {"chains"} and set(frame.loc[~stuck, "held_by"]) == {"bonds"}
+    assert frame.loc[stuck, "chain_fraction"].between(0.0, 1.0).all()
+    assert frame.loc[~stuck, "chain_fraction"].isna().all()
+    assert frame.attrs["units"]["chain_fraction"] == "1" and frame.attrs["units"]["held_by"] is None
+    trace = tmp_path / "trace.csv"
+    code, _, err = run_main(capsys, "transient", "--v0", "100 um/s", "--duration", "12 s", "--start", "steady",
+                            "--stick-population", "-o", str(trace))  # fmt: skip
+    assert code == 0, err
+    assert trace.read_text().splitlines()[0].endswith(",chain_fraction [1],held_by")
+    code, out, err = run_main(capsys, "analyze", str(trace), "--v0", "100 um/s", "--json")
+    assert code == 0, err
+    assert json.loads(out)["cycles"][0]["stick_time"] == pytest.approx(run.cycles[0].stick_time, abs=1e-2)

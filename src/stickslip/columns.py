@@ -69,6 +69,7 @@ UNITS: dict[str, str | None] = {
     "state": _TIME,
     "state2": _TIME,
     "phase": None,
+    "held_by": None,  # what holds the block: "bonds" or the stick "chains"
     # bond population snapshots
     "age": _TIME,
     "extension": _LENGTH,

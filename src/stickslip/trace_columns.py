@@ -18,10 +18,14 @@ QUASI_STATIC = (
 )
 #: ``transient -o`` (the time-dependent bond model, Eqs 1-5).
 TRANSIENT = ("time", "stress", "bonded_fraction", "slider_velocity", "slider_position", "puller_position")
+#: ``transient --stick-population -o`` adds these: Nc/Nc0 where the chains hold, and what holds the block.
+TRANSIENT_CHAINS = ("chain_fraction", "held_by")
 #: ``rsf simulate -o`` (rate-and-state; a second state variable adds ``state2``).
 RATE_AND_STATE = ("time", "friction", "slider_velocity", "state", "load_point_displacement", "slider_displacement")
 
 #: Every column of the package's own traces beyond time and stress: ``analyze`` reads them as known, unused.
 MODEL_COLUMNS = tuple(
-    dict.fromkeys(c for c in (*QUASI_STATIC, *TRANSIENT, *RATE_AND_STATE) if c not in ("time", "stress"))
+    dict.fromkeys(
+        c for c in (*QUASI_STATIC, *TRANSIENT, *TRANSIENT_CHAINS, *RATE_AND_STATE) if c not in ("time", "stress")
+    )
 )

@@ -90,11 +90,25 @@ class TransientResult:
             "message": self.message,
         }
 
+    @property
+    def held_by(self) -> np.ndarray:
+        """What holds the block at each row: ``"bonds"`` (Eq 1's population) or ``"chains"`` (the paper's stick
+        chains, which take the load while the slider is stuck; Eq 1's bonds are set aside then, and
+        ``bonded_fraction`` reads 0)."""
+        if self.chain_fraction is None:
+            return np.full(self.time.size, "bonds", dtype=object)
+        return np.where(np.isfinite(self.chain_fraction), "chains", "bonds").astype(object)
+
     def to_frame(self) -> pd.DataFrame:
-        """The trace: columns :data:`TRACE_COLUMNS`, SI units."""
+        """The trace: columns :data:`TRACE_COLUMNS`, SI units; with the stick chains also ``chain_fraction``
+        (Nc/Nc0, empty where they do not hold) and ``held_by`` (bonds or chains)."""
         import pandas as pd
 
-        return with_units(pd.DataFrame({name: getattr(self, name) for name in TRACE_COLUMNS}))
+        columns = {name: getattr(self, name) for name in TRACE_COLUMNS}
+        if self.chain_fraction is not None:
+            columns["chain_fraction"] = self.chain_fraction
+            columns["held_by"] = self.held_by
+        return with_units(pd.DataFrame(columns))
 
     def plot(self, ax: Axes | None = None, **kwargs: Any) -> Axes:
         """Stress against time (and the slider velocity on a twin axis); returns the Axes."""
