@@ -258,3 +258,16 @@ def test_transient_cycles_come_from_the_slips_not_the_samples():
     assert cycle.period == pytest.approx(quasi.period, rel=0.01)
     assert cycle.peak_stress == pytest.approx(quasi.peak_stress, rel=0.01)
     assert run.regime == "undetermined" and "1 period(s)" in run.message, run.message
+
+
+def test_a_stuck_slider_at_rest_is_not_said_to_creep():
+    """Issue 19: 'creeps at 0 m/s' for a slider the stick chains hold at rest."""
+    from stickslip.protocols import constant
+    from stickslip.transient.cycles import classify
+
+    t = np.linspace(0.0, 10.0, 101)
+    stress = 100.0 + 15.0 * t  # loading at K V0 while stuck
+    regime, message = classify(t, stress, np.zeros_like(t), constant(50e-6, 10.0), (), [], "block", None)
+    assert regime == "stuck" and "at rest" in message and "creeps" not in message
+    regime, message = classify(t, stress, np.full_like(t, 1.25e-9), constant(50e-6, 10.0), (), [], "block", None)
+    assert regime == "stuck" and "creeps at 1.25 nm/s" in message

@@ -142,9 +142,14 @@ def classify(
         return found.kind, found.evidence
     if stuck[-1] and found.periods == 0 and time.size > 1:
         slipped = f" after {len(cycles)} slip(s)" if cycles else ""
-        return regimes.STUCK, (
-            f"stuck{slipped}: at t = {time[-1]:.6g} s the slider creeps at {velocity[-1]:.3g} m/s under"
-            f" sigma = {stress[-1]:.6g} Pa"
+        motion = (
+            "is at rest (the stick chains hold it)"
+            if velocity[-1] == 0.0
+            else f"creeps at {velocity[-1] * 1e9:.3g} nm/s"
+        )
+        return (
+            regimes.STUCK,
+            f"stuck{slipped}: at t = {time[-1]:.6g} s the slider {motion} under sigma = {stress[-1]:.6g} Pa",
         )
     if found.kind == regimes.STEADY:
         v_end = float(velocity[-1])
