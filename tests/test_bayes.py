@@ -124,3 +124,29 @@ def test_a_key_the_data_do_not_bound_is_named_with_its_drop_at_the_prior_edge(ha
     synthetic = fit_steady(read_steady_data(synthetic_steady_path()))
     log_post = _LogPosterior(synthetic, tuple(synthetic.free_keys))
     assert _unbounded(log_post, log_post.mode()[0]) == []
+
+
+def test_compare_and_transient_show_progress_on_a_terminal_only(monkeypatch, capsys):
+    """Issue 19: compare and long transient runs showed nothing while they ran; a bar on a terminal, never with
+    --json (the bar's text is what rich draws on the terminal stand-in)."""
+
+    class Terminal(io.StringIO):
+        def isatty(self) -> bool:
+            return True
+
+    screen = Terminal()
+    monkeypatch.setattr("sys.stderr", screen)
+    from stickslip.cli.main import main
+
+    for argv in (["compare", "--duration", "20 s"], ["transient", "--v0", "50 um/s", "--duration", "25 s"]):
+        with pytest.raises(SystemExit) as done:
+            main(argv)
+        assert done.value.code == 0
+    drawn = screen.getvalue()
+    assert "compare" in drawn and "stages" in drawn and "transient" in drawn
+    screen.truncate(0)
+    screen.seek(0)
+    with pytest.raises(SystemExit):
+        main(["compare", "--duration", "20 s", "--json"])
+    assert "stages" not in screen.getvalue()
+    capsys.readouterr()

@@ -20,6 +20,7 @@ import numpy as np
 
 from ..errors import ModelError, ParameterError
 from ..fileio import refuse_input_as_output
+from ..progress import progress
 from .common import json_text, params_options, positive, quantity, resolve_params
 from .rsf_cmd import save_figure, sidecar, write
 
@@ -67,16 +68,21 @@ def compare_command(**options: Any) -> None:
     refuse_input_as_output([options["params_name"]], [("-o", options["output"])])
 
     steps = f"the velocity step and slide-hold-slide (--v0 {options['v0']}, --v1 {options['v1']})"
-    with _naming(steps):
-        rsf = _override(rsf_of_bond(params, v0, v1, step_time, model=options["bond_model"]), options)
-        step = protocols.velocity_steps([v0, v1], [step_time, step_time])
-        shs = protocols.slide_hold_slide(v0, step_time, hold)
-        panels = {}
-        for name, protocol in (("velocity step", step), ("slide-hold-slide", shs)):
-            bond = bond_response(params, protocol, "velocity", model=options["bond_model"])
-            panels[name] = (bond, *_rsf_panel(rsf, protocol, bond.time))
-    with _naming(f"the stick-slip pair (--pull {options['pull']})"):
-        pair = stick_slip_pair(params, pull, duration, rsf, eta)
+    # four stages (the fit, two panels, the stick-slip pair): a bar on a terminal, nothing in a pipe or with --json
+    with progress("compare", total=4, unit="stages", enabled=False if options["as_json"] else None) as bar:
+        with _naming(steps):
+            rsf = _override(rsf_of_bond(params, v0, v1, step_time, model=options["bond_model"]), options)
+            bar.advance(note="RSF fitted to the step")
+            step = protocols.velocity_steps([v0, v1], [step_time, step_time])
+            shs = protocols.slide_hold_slide(v0, step_time, hold)
+            panels = {}
+            for name, protocol in (("velocity step", step), ("slide-hold-slide", shs)):
+                bond = bond_response(params, protocol, "velocity", model=options["bond_model"])
+                panels[name] = (bond, *_rsf_panel(rsf, protocol, bond.time))
+                bar.advance(note=name)
+        with _naming(f"the stick-slip pair (--pull {options['pull']})"):
+            pair = stick_slip_pair(params, pull, duration, rsf, eta)
+            bar.advance(note="stick-slip")
     failures = [] if rsf.usable else [rsf.note]
     summary = {
         "status": "failed" if failures else "ok",

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import stat
-import sys
 import tempfile
 from pathlib import Path
 from typing import Any
@@ -144,6 +143,7 @@ def transient_command(
     than the step budget (--max-steps, default 3e6) is refused in one line.
     """
     from ..numerics.budget import PROGRESS_AFTER_SECONDS
+    from ..progress import progress
     from ..transient import run_transient
     from ..transient.solver import estimate_cost
 
@@ -158,15 +158,9 @@ def transient_command(
                   stick_population=stick_population, every=every, rtol=rtol, max_steps=max_steps)  # fmt: skip
     cost = estimate_cost(params, protocol, control=control, start_velocity=start_velocity, rtol=rtol, every=every,
                          aging=not no_aging)  # fmt: skip
-    if cost.seconds > PROGRESS_AFTER_SECONDS and not as_json and sys.stderr.isatty():
-        from rich.console import Console
-        from rich.progress import Progress
-
-        with Progress(console=Console(stderr=True), transient=True) as bar:
-            task = bar.add_task("transient", total=1.0)
-            result = run_transient(params, protocol, progress=lambda f: bar.update(task, completed=f), **kwargs)
-    else:
-        result = run_transient(params, protocol, **kwargs)
+    shown = None if cost.seconds > PROGRESS_AFTER_SECONDS and not as_json else False  # None: on a terminal
+    with progress("transient", total=protocol.duration, unit="s", enabled=shown) as bar:
+        result = run_transient(params, protocol, progress=lambda f: bar.update(f * protocol.duration), **kwargs)
     if output is not None:
         write_text(output, _trace_csv(result))
     if plot_path is not None:
