@@ -266,15 +266,15 @@ def run_transient(
             # in a hold (vp = 0) the slider counts as stopped below 1 % of the protocol's sliding velocity
             pace = vp if vp > 0 else float(np.max(protocol.velocities))
             stick_v = STICK_FRACTION * pace if (stick_population and pace > 0) else 0.0
-            puller0 = state.puller - vp * state.t  # puller position extrapolated to t = 0 of this piece's line
+            puller0 = state.puller - vp * (state.t - t0)  # puller position at the start t0 of this piece
             lw_new, rate0, lc, aa, w1 = (np.empty(state.xb.size) for _ in range(5))
             status, t, x, v, h, n, sample_index, count = advance(
-                state.t, t1, state.x, state.v, state.h, puller0, vp, 0.0, 1 if control == "block" else 0,
+                state.t, t1, state.x, state.v, state.h, puller0, vp, t0, 1 if control == "block" else 0,
                 state.n, state.xb, state.tb, state.lw, lw_new, rate0, lc, aa, w1, state.acc, p, float(rtol), h_max,
                 times, sample_index, out, CHUNK, stick_v, max(1, min(CHUNK, budget + 1 - int(state.acc[4]))),
             )  # fmt: skip
             state.t, state.x, state.v, state.h, state.n = float(t), float(x), float(v), float(h), int(n)
-            state.puller = puller0 + vp * state.t if control == "block" else state.x
+            state.puller = puller0 + vp * (state.t - t0) if control == "block" else state.x
             if count:
                 rows.extend(_kernel_rows(out[:count], k_block, control))
             if status == K.FULL:
