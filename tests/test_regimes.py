@@ -271,3 +271,27 @@ def test_a_stuck_slider_at_rest_is_not_said_to_creep():
     assert regime == "stuck" and "at rest" in message and "creeps" not in message
     regime, message = classify(t, stress, np.full_like(t, 1.25e-9), constant(50e-6, 10.0), (), [], "block", None)
     assert regime == "stuck" and "creeps at 1.25 nm/s" in message
+
+
+def test_rsf_extremes_fall_back_to_the_accepted_steps_when_the_restart_fails(monkeypatch, capsys, damped_reference):
+    """The interpolant restarts odeint from an accepted step; where that restart fails (here forced), the summary
+    is read off the accepted steps themselves, coarser but never made up: no NaN, the same regime and period."""
+    import scipy.integrate
+
+    real = scipy.integrate.odeint
+
+    def failing(*args, **kwargs):  # every restart fails, as odeint reports it (NaN rows and its message)
+        out = real(*args, **kwargs)
+        if kwargs.get("full_output"):
+            return np.full_like(out[0], np.nan), {**out[1], "message": "Excess work done on this call."}
+        return np.full_like(out, np.nan)
+
+    monkeypatch.setattr(scipy.integrate, "odeint", failing)
+    code, out, err = run_main(capsys, "rsf", "simulate", *DAMPED, "--json")
+    assert code == 0, err
+    summary = json.loads(out)
+    period, peak, trough = damped_reference
+    assert summary["regime"] == "stick-slip", summary["message"]
+    assert summary["period"] == pytest.approx(period, rel=1e-3)
+    assert summary["peak_friction"] == pytest.approx(peak, abs=1e-4)
+    assert summary["trough_friction"] == pytest.approx(trough, abs=1e-4)

@@ -306,11 +306,15 @@ def _interpolant(system: System, vlp: float, t_steps: np.ndarray, y_steps: np.nd
         j = max(int(np.searchsorted(t_steps, times[0], side="right")) - 1, 0)
         grid = np.r_[t_steps[j], times]
         with warnings.catch_warnings():
+            # a failed restart is detected from odeint's report below (its warning adds nothing)
             warnings.simplefilter("ignore")
-            out = odeint(
+            out, info = odeint(
                 system.rhs, y_steps[:, j], grid, args=(vlp,), Dfun=jac, rtol=rtol, atol=atol, tfirst=True,
-                mxstep=200_000,
+                mxstep=200_000, full_output=True,
             )  # fmt: skip
+        if info.get("message") != "Integration successful." or not np.all(np.isfinite(out)):
+            # the accepted steps themselves, linearly between them: coarser, never invented
+            return np.array([np.interp(times, t_steps, row) for row in y_steps])
         return out[1:].T
 
     return evaluate
