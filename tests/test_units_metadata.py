@@ -18,6 +18,8 @@ from stickslip.columns import csv_text, json_units, parquet_table, read_parquet,
 from stickslip.tables import read_table
 
 _UREG = pint.UnitRegistry()
+#: rsf simulate with one aging state (the command lines below share it)
+RSF_MODEL = ("rsf", "simulate", "--a", "0.01", "--b", "0.015", "--dc", "10 um", "--stiffness", "1e-3 1/um")
 TABLE1 = Path(stickslip.__file__).parent / "data" / "table1.csv"
 
 
@@ -118,16 +120,7 @@ def test_json_units_map_names_the_keys_present():
         ("stick", "--v0", "100 um/s", "--json"),
         ("curve", "--points", "3", "--format", "json"),
         (
-            "rsf",
-            "simulate",
-            "--a",
-            "0.01",
-            "--b",
-            "0.015",
-            "--dc",
-            "10 um",
-            "--stiffness",
-            "1e-3 1/um",
+            *RSF_MODEL,
             "--segment",
             "1 um/s:5 s",
             "--segment",
@@ -185,16 +178,7 @@ def test_json_drops_float_noise(capsys):
         (("transient", "--v0", "350 um/s", "--duration", "2 ms", "--control", "velocity"), "time [s],stress [Pa]"),
         (
             (
-                "rsf",
-                "simulate",
-                "--a",
-                "0.01",
-                "--b",
-                "0.015",
-                "--dc",
-                "10 um",
-                "--stiffness",
-                "1e-3 1/um",
+                *RSF_MODEL,
                 "--segment",
                 "1 um/s:5 s",
                 "--every",
