@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from stickslip.transient.plots import plot_transient
+from stickslip.plots.transient import plot_transient
 from stickslip.transient.result import TransientResult
 
 

@@ -381,7 +381,7 @@ def test_posterior_agrees_with_the_least_squares_fit(two_step):
     assert np.all(lo <= hi)
     inside = (two_step.curve(v) >= lo) & (two_step.curve(v) <= hi)
     assert inside.mean() > 0.9
-    fig = __import__("stickslip.fitting.plots", fromlist=["corner_figure"]).corner_figure(post)
+    fig = __import__("stickslip.plots.fits", fromlist=["corner_figure"]).corner_figure(post)
     assert len(fig.axes) == (len(two_step.free_keys) + 2) ** 2
     labels = {ax.get_xlabel() for ax in fig.axes} - {""}
     assert {"τ (µs)", "Vc (µm/s)", "σc (Pa)"} <= labels  # human units, not log10 of SI values

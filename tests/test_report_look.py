@@ -12,10 +12,10 @@ from matplotlib.colors import to_rgba
 from stickslip.cycle_plots import figure_cycles
 from stickslip.model.cycle import simulate
 from stickslip.parameters import load_parameters
+from stickslip.plots.sweeps import plot_phase_diagram
 from stickslip.report.computations import DURATIONS, ModelRun
 from stickslip.report.report_figures import chain_fraction_figure
 from stickslip.sweeps import build_spec, load_sweep, run_sweep
-from stickslip.sweeps.plots import plot_phase_diagram
 
 #: Fig 6 of the paper: simulated stick times (V0 in µm/s, ts in s).
 PAPER_STICK_TIMES = ((50, 18.3), (100, 9.3))
@@ -91,7 +91,7 @@ def test_phase_diagram_axes_name_the_quantity_and_follow_log_spacing(narrow_log_
     ],
 )
 def test_parameter_axes_use_the_parameters_own_names(key, dimension, label):
-    from stickslip.sweeps.plots import _label
+    from stickslip.plots.sweeps import _label
 
     assert _label(key, dimension) == label
     assert not re.search(r"\b[a-z]+_[a-z]+\b", label)  # no raw key left in a label

@@ -14,9 +14,9 @@ import pytest
 import stickslip
 from cli_helpers import run_main
 from stickslip.errors import DataError, ParameterError
+from stickslip.plots.sweeps import plot_phase_diagram
 from stickslip.sweeps import build_spec, load_sweep, run_sweep
 from stickslip.sweeps.models import get_model
-from stickslip.sweeps.plots import plot_phase_diagram
 from stickslip.sweeps.sampling import latin_hypercube, permute
 from stickslip.sweeps.spec import parse_vary
 from stickslip.sweeps.store import MANIFEST

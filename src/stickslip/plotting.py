@@ -1,214 +1,32 @@
-"""Figures of the steady friction curve (the paper's Fig 1 and Fig 4), and shared plot helpers.
+"""Old home of the steady-curve figures and the common style, kept for code that imports it from here.
 
-Figures are built on :class:`matplotlib.figure.Figure` directly, never through
-pyplot, so nothing here touches global state or opens a window: safe in
-scripts, tests and headless servers.  Axes show velocities in um/s and
-stresses in Pa; the objects passed in hold SI values.
+The drawing now lives in :mod:`stickslip.plots` (:mod:`~stickslip.plots.steady`, :mod:`~stickslip.plots.style`).
 """
 
-from __future__ import annotations
+from .plots.steady import figure_steady_curve, plot_steady, protocol_plot
+from .plots.style import (
+    AGING_COLOR,
+    CRITICAL_COLOR,
+    DATA_COLOR,
+    NO_AGING_COLOR,
+    STRESS_LABEL,
+    UM_PER_S,
+    VELOCITY_LABEL,
+    apply_style,
+    new_axes,
+)
 
-from collections.abc import Mapping
-from typing import TYPE_CHECKING, Any
-
-import numpy as np
-
-if TYPE_CHECKING:  # pragma: no cover
-    from matplotlib.axes import Axes
-    from matplotlib.figure import Figure
-
-    from .model.steady import SteadyState
-    from .parameters import Parameters
-
-#: Display scale of velocities: SI (m/s) times this gives um/s.
-UM_PER_S = 1e6
-VELOCITY_LABEL = "sliding velocity V (µm/s)"
-STRESS_LABEL = "friction stress σ (Pa)"
-AGING_COLOR = "#1f4e9c"
-NO_AGING_COLOR = "#c0392b"
-CRITICAL_COLOR = "#222222"
-DATA_COLOR = "#333333"
-
-
-def new_axes(ax: Axes | None = None, figsize: tuple[float, float] = (6.4, 4.4)) -> Axes:
-    """``ax`` itself, or the single Axes of a new pyplot-free Figure."""
-    if ax is not None:
-        return ax
-    from matplotlib.figure import Figure
-
-    fig = Figure(figsize=figsize, layout="constrained")
-    return fig.add_subplot()
-
-
-def apply_style(ax: Axes) -> Axes:
-    """The package's common look: light grid, no top/right spines, outward ticks."""
-    ax.grid(True, which="major", alpha=0.35, linewidth=0.6)
-    ax.grid(True, which="minor", alpha=0.12, linewidth=0.4)
-    for side in ("top", "right"):
-        ax.spines[side].set_visible(False)
-    ax.tick_params(direction="out", which="both")
-    return ax
-
-
-def plot_steady(result: SteadyState, ax: Axes | None = None, **kwargs: Any) -> Axes:
-    """sigma against log V for one :class:`~stickslip.model.steady.SteadyState`; returns the Axes.
-
-    ``kwargs`` go to ``Axes.plot`` (``label`` defaults to "with aging" or
-    "without aging").  Velocities are shown in um/s on a log axis.
-    """
-    ax = new_axes(ax)
-    velocity = np.ravel(result.velocity) * UM_PER_S
-    stress = np.ravel(result.stress)
-    order = np.argsort(velocity)
-    kwargs.setdefault("label", "with aging" if result.aging else "without aging")
-    kwargs.setdefault("color", AGING_COLOR if result.aging else NO_AGING_COLOR)
-    if velocity.size == 1:
-        kwargs.setdefault("marker", "o")
-    ax.plot(velocity[order], stress[order], **kwargs)
-    ax.set_xscale("log")
-    ax.set_xlabel(VELOCITY_LABEL)
-    ax.set_ylabel(STRESS_LABEL)
-    apply_style(ax)
-    return ax
-
-
-def _data_arrays(data: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
-    """(velocity, stress, stress error or None), SI, from a table, mapping, object or pair."""
-    if isinstance(data, tuple) and len(data) in (2, 3):
-        v, s = data[0], data[1]
-        err = data[2] if len(data) == 3 else None
-    else:
-        try:
-            v, s = data["velocity"], data["stress"]
-            err = data["stress_err"] if _has_key(data, "stress_err") else None
-        except (TypeError, KeyError, IndexError):
-            v, s = getattr(data, "velocity", None), getattr(data, "stress", None)
-            err = getattr(data, "stress_err", None)
-            if v is None or s is None:
-                raise TypeError(
-                    "data: expected (velocity, stress[, stress_err]) arrays, a mapping or table with "
-                    f"'velocity' and 'stress', or an object with those attributes; got {type(data).__name__}"
-                ) from None
-    v, s = np.asarray(v, dtype=float).ravel(), np.asarray(s, dtype=float).ravel()
-    if v.shape != s.shape:
-        raise ValueError(f"data: velocity has {v.size} values but stress has {s.size}")
-    if err is not None:
-        err = np.asarray(err, dtype=float).ravel()
-        if err.shape != v.shape or not np.any(np.isfinite(err)):
-            err = None
-    return v, s, err
-
-
-def _has_key(data: Any, key: str) -> bool:
-    if isinstance(data, Mapping):
-        return key in data
-    try:
-        return key in data
-    except TypeError:
-        return False
-
-
-def figure_steady_curve(
-    params: Parameters,
-    vmin: float = 10e-6,
-    vmax: float = 10e-3,
-    data: Any = None,
-    points: int = 300,
-    title: str | None = None,
-) -> Figure:
-    """The paper's Fig 1 / Fig 4: sigma against log V with and without aging.
-
-    The critical point (Vc, sigma_c) of Eq 9 is marked when it lies in
-    [``vmin``, ``vmax``] (m/s), and the two branches are labelled: velocity
-    weakening to its left, velocity strengthening to its right.  ``data``
-    (optional, SI) adds measured points: a pair/triple of arrays
-    ``(velocity, stress[, stress_err])``, or anything indexable or with
-    attributes ``velocity``, ``stress`` (and optionally ``stress_err``).
-    """
-    from matplotlib.figure import Figure
-
-    from .model.critical import critical_point
-    from .model.steady import steady_state
-
-    if not (0 < vmin < vmax) or not np.isfinite(vmax):
-        raise ValueError(f"figure_steady_curve: expected 0 < vmin < vmax, got vmin={vmin!r}, vmax={vmax!r}")
-    grid = np.geomspace(vmin, vmax, max(int(points), 2))
-    aging = steady_state(params, grid, aging=True)
-    plain = steady_state(params, grid, aging=False)
-    critical = critical_point(params)
-
-    fig = Figure(figsize=(6.8, 4.6), layout="constrained")
-    ax = fig.add_subplot()
-    plot_steady(plain, ax=ax, linestyle=":", linewidth=1.8, label="without aging")
-    plot_steady(aging, ax=ax, linewidth=2.0, label="with aging")
-
-    tops = [float(np.max(plain.stress))]
-    if data is not None:
-        v, s, err = _data_arrays(data)
-        ax.errorbar(
-            v * UM_PER_S,
-            s,
-            yerr=err,
-            fmt="o",
-            markersize=4,
-            color=DATA_COLOR,
-            ecolor=DATA_COLOR,
-            label="data",
-            zorder=5,
-        )
-        if np.any(np.isfinite(s)):
-            tops.append(float(np.nanmax(s)))
-    if critical.exists and vmin <= critical.velocity <= vmax:
-        _mark_critical(ax, critical.velocity, critical.stress, grid, aging.stress)
-        tops.append(critical.stress)
-    # the aging curve climbs steeply below Vc (Fig 4); keep the interesting range in view
-    top = 1.25 * max(tops)
-    bottom = min(0.0, float(np.min(plain.stress)))
-    if float(np.min(aging.stress)) < top:
-        ax.set_ylim(bottom, top)
-    ax.set_xlim(vmin * UM_PER_S, vmax * UM_PER_S)
-    ax.legend(loc="lower right", frameon=False)
-    ax.set_title(title if title is not None else f"Steady friction curve ({params.name})", fontsize=11)
-    return fig
-
-
-def _mark_critical(ax: Axes, vc: float, sc: float, grid: np.ndarray, stress: np.ndarray) -> None:
-    """Vc and sigma_c with a guide line, and the two branch labels on either side of Vc."""
-    from matplotlib.transforms import blended_transform_factory
-
-    x = vc * UM_PER_S
-    box = {"boxstyle": "round,pad=0.25", "facecolor": "white", "edgecolor": "none", "alpha": 0.85}
-    ax.axvline(x, color=CRITICAL_COLOR, linestyle="--", linewidth=0.8, alpha=0.7)
-    ax.plot(
-        [x], [sc], marker="o", markersize=7, color=CRITICAL_COLOR, zorder=6, linestyle="none", label="critical point"
-    )
-    ax.annotate(
-        f"$V_c$ = {x:.4g} µm/s\n$\\sigma_c$ = {sc:.4g} Pa",
-        xy=(x, sc),
-        xytext=(-12, -12),
-        textcoords="offset points",
-        ha="right",
-        va="top",
-        fontsize=9,
-        bbox=box,
-        zorder=7,
-    )
-    # x in data units, y in axes units: the labels sit on either side of Vc, high in the frame
-    where = blended_transform_factory(ax.transData, ax.transAxes)
-    style = {"transform": where, "fontsize": 9, "va": "top", "bbox": box, "zorder": 7}
-    if np.count_nonzero(grid < vc) >= 2:
-        ax.text(x / 2.0, 0.82, "velocity weakening\n(dσ/dV < 0)  ←", ha="right", **style)
-    if np.count_nonzero(grid > vc) >= 2:
-        ax.text(x * 1.5, 0.82, "→  velocity strengthening\n    (dσ/dV > 0)", ha="left", **style)
-
-
-def protocol_plot(protocol: Any, ax: Axes | None = None) -> Axes:
-    """The load-point velocity of a :class:`~stickslip.protocols.Protocol` against time (a staircase)."""
-    ax = new_axes(ax)
-    b = protocol.boundaries
-    v = np.append(protocol.velocities, protocol.velocities[-1]) * UM_PER_S
-    ax.step(b, v, where="post", color=AGING_COLOR)
-    ax.set_xlabel("time (s)")
-    ax.set_ylabel("load-point velocity (µm/s)")
-    ax.set_title(protocol.describe(), fontsize="small")
-    return apply_style(ax)
+__all__ = [
+    "AGING_COLOR",
+    "CRITICAL_COLOR",
+    "DATA_COLOR",
+    "NO_AGING_COLOR",
+    "STRESS_LABEL",
+    "UM_PER_S",
+    "VELOCITY_LABEL",
+    "apply_style",
+    "figure_steady_curve",
+    "new_axes",
+    "plot_steady",
+    "protocol_plot",
+]

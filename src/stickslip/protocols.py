@@ -134,7 +134,7 @@ class Protocol:
         return ", then ".join(parts)
 
     def plot(self, ax: Any = None) -> Any:
-        from .plotting import protocol_plot
+        from .plots.steady import protocol_plot
 
         return protocol_plot(self, ax=ax)
 

@@ -82,7 +82,7 @@ class Comparison:
 
     def plot(self, ax: Axes | None = None, **kwargs: Any) -> Axes:
         """The record with its detected phases and the model on top; returns the Axes."""
-        from .plots import plot_analysis
+        from ..plots.traces import plot_analysis
 
         assert self.analysis is not None
         return plot_analysis(self.analysis, ax=ax, comparison=self, **kwargs)

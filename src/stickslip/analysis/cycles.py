@@ -157,7 +157,7 @@ class TraceAnalysis:
         return with_units(pd.DataFrame([c.as_dict() for c in self.cycles], columns=columns))
 
     def plot(self, ax: Axes | None = None, **kwargs: Any) -> Axes:
-        from .plots import plot_analysis
+        from ..plots.traces import plot_analysis
 
         return plot_analysis(self, ax=ax, **kwargs)
 

@@ -225,7 +225,7 @@ def _how(status: str) -> str:
 def _figure(panels: dict[str, Any], pair: dict[str, Any], rsf: Any) -> Any:
     from matplotlib.figure import Figure
 
-    from ..plotting import apply_style
+    from ..plots.style import apply_style
 
     fig = Figure(figsize=(12, 4.2), layout="constrained")
     axes = fig.subplots(1, 3)

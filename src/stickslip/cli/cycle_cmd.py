@@ -108,7 +108,7 @@ def simulate_command(
     if output is not None:
         write_text(output, _csv({n: getattr(sim, n) for n in CYCLE_COLUMNS}))
     if plot_path is not None:
-        from ..cycle_plots import plot_simulation
+        from ..plots.cycles import plot_simulation
 
         ax = plot_simulation(sim)
         ax.legend(loc="upper right", frameon=False, fontsize=8)
@@ -209,7 +209,7 @@ def stick_command(
     if output is not None:
         write_text(output, _csv(columns))
     if plot_path is not None:
-        from ..cycle_plots import plot_stick
+        from ..plots.cycles import plot_stick
 
         ax = plot_stick(stick)
         ax.legend(loc="lower left", frameon=False, fontsize=8)

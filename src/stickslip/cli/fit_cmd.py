@@ -199,12 +199,12 @@ def steady_command(
     if report_path is not None:
         write_text(report_path, report)
     if plot_path is not None:
-        from ..fitting.plots import steady_fit_figure
+        from ..plots.fits import steady_fit_figure
 
         band = posterior.stress_band() if posterior is not None else None
         _figure_to(plot_path, lambda: steady_fit_figure(fit, band=band))
     if corner_path is not None and posterior is not None:
-        from ..fitting.plots import corner_figure
+        from ..plots.fits import corner_figure
 
         _figure_to(corner_path, lambda: corner_figure(posterior))
     if as_json:
@@ -296,10 +296,10 @@ def stick_command(
     if report_path is not None:
         write_text(report_path, report)
     if plot_path is not None:
-        from ..fitting.plots import new_axes, plot_stick_fit
+        from ..plots.fits import panels, plot_stick_fit
 
         def make() -> Any:
-            fig, (ax,) = new_axes()
+            fig, (ax,) = panels()
             plot_stick_fit(fit, ax)
             return fig
 

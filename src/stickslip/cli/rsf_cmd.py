@@ -300,7 +300,7 @@ def simulate_command(**options: Any) -> None:
     else:
         click.echo(_summary_text(summary), err=True)
     if plot_path is not None:
-        from ..rsf.plots import run_figure
+        from ..plots.rsf import run_figure
 
         save_figure(run_figure(run), plot_path)
 
@@ -339,7 +339,7 @@ def stability_command(**options: Any) -> None:
                 + f"; {r['message']}"
             )
     if options["plot_path"] is not None:
-        from ..rsf.plots import stability_figure
+        from ..plots.rsf import stability_figure
 
         speeds = [r["velocity"] for r in reports]
         low = max(min(speeds) / 100, sys.float_info.min)  # two decades either side, within the floats
@@ -434,7 +434,7 @@ def fit_command(**options: Any) -> None:
     else:
         click.echo(_fit_text(fit))
     if plot_path is not None:
-        from ..rsf.plots import fit_figure
+        from ..plots.rsf import fit_figure
 
         save_figure(fit_figure(fit), plot_path)
     if fit.status != "ok":

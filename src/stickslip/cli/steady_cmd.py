@@ -222,7 +222,8 @@ def _save_curve_plot(
     no_aging: bool,
     path: Path,
 ) -> None:
-    from ..plotting import UM_PER_S, figure_steady_curve
+    from ..plots.steady import figure_steady_curve
+    from ..plots.style import UM_PER_S
 
     fig = figure_steady_curve(params, vmin=lo, vmax=hi)
     if mark and stress is not None:  # the requested velocities, on the curve they were computed with

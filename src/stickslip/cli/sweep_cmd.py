@@ -180,8 +180,8 @@ def _summary(folder: Path, total: int) -> str:
 def plot_command(folder: Path, x: str, y: str, color: str, output: Path | None) -> None:
     """Draw the phase diagram of the sweep in OUT, with the model's analytic stability boundary."""
     from ..fileio import atomic_path
+    from ..plots.sweeps import plot_phase_diagram
     from ..sweeps import load_sweep
-    from ..sweeps.plots import plot_phase_diagram
 
     target = output if output is not None else folder.parent / f"{folder.name}-{color}.png"
     _refuse_inside(folder, target)

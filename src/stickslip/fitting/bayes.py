@@ -214,7 +214,7 @@ class SteadyPosterior:
 
     def plot(self, ax: Axes | None = None) -> Axes:
         """The fit with the 95 % credible band of sigma(V)."""
-        from .plots import plot_steady_fit
+        from ..plots.fits import plot_steady_fit
 
         return plot_steady_fit(self.fit, ax=ax, band=self.stress_band())
 

@@ -114,7 +114,7 @@ class SteadyData:
 
     def plot(self, ax: Axes | None = None, **kwargs: Any) -> Axes:
         """Stress against log velocity (um/s), with error bars where given."""
-        from .plots import plot_steady_data
+        from ..plots.fits import plot_steady_data
 
         return plot_steady_data(self, ax=ax, **kwargs)
 

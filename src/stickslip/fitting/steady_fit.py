@@ -176,7 +176,7 @@ class SteadyFit:
 
     def plot(self, ax: Axes | None = None, **kwargs: Any) -> Axes:
         """Data, fitted curve (extended below the data to show the minimum) and Vc; returns the Axes."""
-        from .plots import plot_steady_fit
+        from ..plots.fits import plot_steady_fit
 
         return plot_steady_fit(self, ax=ax, **kwargs)
 

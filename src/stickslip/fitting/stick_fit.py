@@ -150,7 +150,7 @@ class StickFit:
         return stick_report(self)
 
     def plot(self, ax: Axes | None = None) -> Axes:
-        from .plots import plot_stick_fit
+        from ..plots.fits import plot_stick_fit
 
         return plot_stick_fit(self, ax=ax)
 

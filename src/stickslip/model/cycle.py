@@ -139,7 +139,7 @@ class Simulation:
 
     def plot(self, ax: Axes | None = None, **kwargs: Any) -> Axes:
         """sigma(t) over the cycles (Fig 5a-c); returns the Axes."""
-        from ..cycle_plots import plot_simulation
+        from ..plots.cycles import plot_simulation
 
         return plot_simulation(self, ax=ax, **kwargs)
 

@@ -283,7 +283,7 @@ class SlipPhase:
 
     def plot(self, ax: Axes | None = None, **kwargs: Any) -> Axes:
         """V(t) during the slip (Fig 5d); returns the Axes."""
-        from ..cycle_plots import plot_slip
+        from ..plots.cycles import plot_slip
 
         return plot_slip(self, ax=ax, **kwargs)
 

@@ -136,7 +136,7 @@ class SteadyState:
 
     def plot(self, ax: Axes | None = None, **kwargs: Any) -> Axes:
         """sigma against log V; returns the Axes (never shows the figure)."""
-        from ..plotting import plot_steady
+        from ..plots.steady import plot_steady
 
         return plot_steady(self, ax=ax, **kwargs)
 

@@ -147,7 +147,7 @@ class StickPhase:
 
     def plot(self, ax: Axes | None = None, **kwargs: Any) -> Axes:
         """Nc/Nc0 against time (Figs 3, 6); returns the Axes."""
-        from ..cycle_plots import plot_stick
+        from ..plots.cycles import plot_stick
 
         return plot_stick(self, ax=ax, **kwargs)
 

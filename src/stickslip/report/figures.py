@@ -1,64 +1,22 @@
-"""Report figures: saving them (PNG, SVG) and exporting every plotted curve as CSV.
+"""The report's figures: which of the paper's figures each one reproduces, and writing it (PNG, SVG).
 
-The CSV files are read back from the matplotlib artists themselves, so they
-hold exactly what is drawn: every line and every set of points drawn in data
-coordinates (reference lines such as ``axvline`` and shaded spans are not
-curves and are skipped).  Columns are named after the axis labels.
+Drawing, PNG/SVG bytes and the export of every plotted curve as CSV are :mod:`stickslip.plots.export`'s; the
+names build.py and html.py use are imported here from there.
 """
 
 from __future__ import annotations
 
-import base64
-import io
-import re
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-import numpy as np
-
 from ..fileio import atomic_write_bytes
+from ..plots.export import PNG_DPI, Curve, data_uri, extract_curves, png_bytes, svg_bytes
 
 if TYPE_CHECKING:  # pragma: no cover
-    from matplotlib.axes import Axes
     from matplotlib.figure import Figure
 
-#: Resolution of the PNG files and of the images embedded in report.html.
-PNG_DPI = 110
-
-_TEX = {
-    r"\sigma": "σ",
-    r"\tau": "τ",
-    r"\lambda": "λ",
-    r"\Delta": "Δ",
-    r"\mu": "µ",
-    r"\alpha": "α",
-    r"\,": " ",
-    r"\ ": " ",
-    r"\cdot": "·",
-    r"\times": "×",
-    r"\mathrm": "",
-    r"\rm": "",
-}
-
-
-@dataclass(frozen=True)
-class Curve:
-    """One plotted curve: the x and y values as drawn, with the axis labels as column names."""
-
-    name: str  # file stem, unique within the report
-    figure_id: str
-    panel: str
-    label: str
-    x_name: str
-    y_name: str
-    x: np.ndarray
-    y: np.ndarray
-
-    def to_csv(self) -> str:
-        lines = [f"{_csv_field(self.x_name)},{_csv_field(self.y_name)}"]
-        lines += [f"{_num(a)},{_num(b)}" for a, b in zip(self.x, self.y, strict=True)]
-        return "\n".join(lines) + "\n"
+__all__ = ["PNG_DPI", "Curve", "ReportFigure", "data_uri", "extract_curves", "save_figure_files"]
 
 
 @dataclass(frozen=True)
@@ -72,114 +30,13 @@ class ReportFigure:
     figure: Figure
 
     def png(self) -> bytes:
-        buffer = io.BytesIO()
-        self.figure.savefig(buffer, format="png", dpi=PNG_DPI, bbox_inches="tight")
-        return buffer.getvalue()
+        return png_bytes(self.figure)
 
     def svg(self) -> bytes:
-        buffer = io.BytesIO()
-        self.figure.savefig(buffer, format="svg", bbox_inches="tight")
-        return buffer.getvalue()
+        return svg_bytes(self.figure)
 
     def curves(self) -> list[Curve]:
         return extract_curves(self.figure, self.id)
-
-
-def data_uri(png: bytes) -> str:
-    return "data:image/png;base64," + base64.b64encode(png).decode("ascii")
-
-
-def plain_label(text: str) -> str:
-    """Axis or legend text without mathtext markup: ``$\\sigma$ (Pa)`` -> ``σ (Pa)``."""
-    for tex, plain in _TEX.items():
-        text = text.replace(tex, plain)
-    text = text.replace("$", "").replace("{", "").replace("}", "").replace("\\", "")
-    return " ".join(text.split())
-
-
-def _column(label: str, fallback: str) -> str:
-    text = plain_label(label) or fallback
-    # "sliding velocity V (µm/s)" -> "sliding velocity V [µm/s]", the units convention of the package's tables
-    return re.sub(r"\s*\(([^()]*)\)\s*$", r" [\1]", text)
-
-
-def _axis_label(ax: Axes, which: str) -> str:
-    get = ax.get_xlabel if which == "x" else ax.get_ylabel
-    if get():
-        return get()
-    shared = ax.get_shared_x_axes() if which == "x" else ax.get_shared_y_axes()
-    for other in shared.get_siblings(ax):
-        text = other.get_xlabel() if which == "x" else other.get_ylabel()
-        if text:
-            return text
-    return ""
-
-
-#: Longest curve name taken from a legend label, in characters.
-SLUG_LENGTH = 40
-
-
-def _slug(text: str) -> str:
-    text = plain_label(text).lower().replace("µ", "u").replace("σ", "sigma").replace("τ", "tau")
-    slug = re.sub(r"[^a-z0-9]+", "-", text).strip("-")
-    if len(slug) > SLUG_LENGTH:
-        slug = slug[: SLUG_LENGTH + 1].rsplit("-", 1)[0]
-    return slug
-
-
-def _in_data_coordinates(artist: object, ax: Axes) -> bool:
-    transform = artist.get_transform()  # type: ignore[attr-defined]
-    return transform == ax.transData
-
-
-def _errorbar_parts(ax: Axes) -> tuple[dict[int, str], set[int]]:
-    """Error bars: their data line carries the label of its container; the caps are not curves."""
-    from matplotlib.container import ErrorbarContainer
-
-    labels: dict[int, str] = {}
-    caps: set[int] = set()
-    for container in ax.containers:
-        if isinstance(container, ErrorbarContainer):
-            data_line, caplines, _ = container.lines
-            if data_line is not None:
-                labels[id(data_line)] = str(container.get_label())
-            caps |= {id(line) for line in caplines}
-    return labels, caps
-
-
-def extract_curves(figure: Figure, figure_id: str) -> list[Curve]:
-    """Every line and point set of ``figure`` drawn in data coordinates, panel by panel."""
-    curves: list[Curve] = []
-    used: set[str] = set()
-    panels = [ax for ax in figure.axes if ax.get_lines() or ax.collections]
-    for index, ax in enumerate(panels):
-        panel = chr(ord("a") + index) if len(panels) > 1 else ""
-        x_name = _column(_axis_label(ax, "x"), "x")
-        y_name = _column(_axis_label(ax, "y"), "y")
-        found: list[tuple[str, np.ndarray, np.ndarray]] = []
-        labels, caps = _errorbar_parts(ax)
-        for line in ax.get_lines():
-            if not _in_data_coordinates(line, ax) or id(line) in caps:
-                continue
-            x = np.asarray(line.get_xdata(), dtype=float).ravel()
-            y = np.asarray(line.get_ydata(), dtype=float).ravel()
-            if x.size and x.size == y.size:
-                found.append((labels.get(id(line), str(line.get_label())), x, y))
-        for collection in ax.collections:
-            offsets = np.asarray(collection.get_offsets(), dtype=float)
-            if offsets.ndim != 2 or offsets.shape[0] == 0 or collection.get_offset_transform() != ax.transData:
-                continue
-            found.append((str(collection.get_label()), offsets[:, 0], offsets[:, 1]))
-        for k, (label, x, y) in enumerate(found):
-            shown = "" if label.startswith("_") else plain_label(label)
-            unnamed = f"{'point' if x.size == 1 else 'curve'}-{k + 1}"
-            stem = "_".join(s for s in (figure_id, panel, _slug(shown) or unnamed) if s)
-            name, n = stem, 2
-            while name in used:
-                name, n = f"{stem}-{n}", n + 1
-            used.add(name)
-            curves.append(Curve(name, figure_id, panel, shown, x_name, y_name, x, y))
-    return curves
 
 
 def save_figure_files(figure: ReportFigure, folder: Path) -> tuple[bytes, list[Path]]:
@@ -189,13 +46,3 @@ def save_figure_files(figure: ReportFigure, folder: Path) -> tuple[bytes, list[P
     atomic_write_bytes(png_path, png)
     atomic_write_bytes(svg_path, figure.svg())
     return png, [png_path, svg_path]
-
-
-def _num(value: float) -> str:
-    return "" if not np.isfinite(value) else repr(float(value))
-
-
-def _csv_field(text: str) -> str:
-    if any(c in text for c in ',"\n'):
-        return '"' + text.replace('"', '""') + '"'
-    return text

@@ -1,7 +1,7 @@
 """The report's figures, in the paper's order, each built from a :class:`ModelRun`.
 
-The drawing itself is the package's (:mod:`stickslip.plotting`,
-:mod:`stickslip.cycle_plots`); this module chooses what the paper shows and
+The drawing itself is the package's (:mod:`stickslip.plots.steady`,
+:mod:`stickslip.plots.cycles`); this module chooses what the paper shows and
 adds the paper's own numbers where they can be set beside the model.
 """
 
@@ -25,7 +25,7 @@ PAPER_STICK_TIMES = ((50, 18.3), (100, 9.3))
 
 
 def steady_figure(run: ModelRun) -> ReportFigure:
-    from ..plotting import figure_steady_curve
+    from ..plots.steady import figure_steady_curve
 
     fig = figure_steady_curve(run.params, vmin=10e-6, vmax=10e-3, title="Steady friction curve (Figs 1 and 4)")
     ax = fig.axes[0]
@@ -56,7 +56,7 @@ def steady_figure(run: ModelRun) -> ReportFigure:
 
 
 def cycle_path_figure(run: ModelRun) -> ReportFigure:
-    from ..cycle_plots import figure_cycle_path
+    from ..plots.cycles import figure_cycle_path
 
     sim = run.simulations[50]
     fig = figure_cycle_path(run.params, sim, title="Stick-slip cycle on the σ-V diagram (Fig 2), V0 = 50 µm/s")
@@ -73,7 +73,7 @@ def cycle_path_figure(run: ModelRun) -> ReportFigure:
 
 
 def chain_fraction_figure(run: ModelRun) -> ReportFigure:
-    from ..cycle_plots import figure_chain_fraction
+    from ..plots.cycles import figure_chain_fraction
 
     sims = [run.simulations[50], run.simulations[100]]
     fig = figure_chain_fraction(sims, labels=["V0 = 50 µm/s", "V0 = 100 µm/s"], title="Attached chains (Figs 3 and 6)")
@@ -102,7 +102,7 @@ def chain_fraction_figure(run: ModelRun) -> ReportFigure:
 
 
 def cycles_figure(run: ModelRun) -> ReportFigure:
-    from ..cycle_plots import figure_cycles
+    from ..plots.cycles import figure_cycles
 
     sims = [run.simulations[v] for v in (50, 100, 350)]
     fig = figure_cycles(sims, title="Stick-slip cycles (Fig 5a-c)")
@@ -126,7 +126,7 @@ def cycles_figure(run: ModelRun) -> ReportFigure:
 
 def _label_critical_stress_and_clear_peaks(fig: Figure, critical_stress: float) -> None:
     """Name the dashed σc line in the legend, and leave room above the peaks so the legend covers no data."""
-    from ..cycle_plots import legend_of_all_panels
+    from ..plots.cycles import legend_of_all_panels
 
     for index, ax in enumerate(fig.axes):
         for line in ax.get_lines():
@@ -138,7 +138,7 @@ def _label_critical_stress_and_clear_peaks(fig: Figure, critical_stress: float) 
 
 
 def slip_velocity_figure(run: ModelRun) -> ReportFigure:
-    from ..cycle_plots import figure_slip_velocity
+    from ..plots.cycles import figure_slip_velocity
 
     s50, s100, s350 = (run.simulations[v] for v in (50, 100, 350))
     first_100 = run.table1_first_slip_100

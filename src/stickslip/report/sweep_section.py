@@ -21,8 +21,8 @@ DURATION = "20 s"
 def phase_diagram_figure(run: ModelRun) -> ReportFigure:
     import tempfile
 
+    from ..plots.sweeps import plot_phase_diagram
     from ..sweeps import build_spec, load_sweep, run_sweep
-    from ..sweeps.plots import plot_phase_diagram
 
     params = run.params
     low, high, count = STIFFNESS_FACTORS

@@ -29,10 +29,8 @@ HOLDS = (1e-3, 1e-2, 1e-1, 1.0, 10.0)
 
 
 def transient_figure(run: ModelRun) -> ReportFigure:
-    from matplotlib.figure import Figure
-
     from ..model.cycle import simulate
-    from ..plotting import apply_style
+    from ..plots.transient import figure_transient_runs
     from ..protocols import constant, segments
     from ..transient import run_transient
 
@@ -46,54 +44,23 @@ def transient_figure(run: ModelRun) -> ReportFigure:
     steps = run_transient(params, segments(list(VELOCITY_STEPS)), control="velocity", start="steady", rtol=1e-5)
     peaks = [_hold_peak(params, hold) for hold in HOLDS]
 
-    # the width of the report's other figures (readable on a phone-sized page): the cycle on top, two panels below
-    fig = Figure(figsize=(6.8, 7.0))
-    grid = fig.add_gridspec(2, 2)
-    ax_cycle, ax_step, ax_hold = fig.add_subplot(grid[0, :]), fig.add_subplot(grid[1, 0]), fig.add_subplot(grid[1, 1])
-    ax_cycle.plot(*_thin(alone.time, alone.stress), color="C2", lw=2.4, label="Eq 1 alone")
-    ax_cycle.plot(*_thin(full.time, full.stress), color="C0", lw=1.2, label="Eq 1 + stick chains")
-    if full.cycles:
-        shift = full.cycles[0].start_time
-        ax_cycle.plot(quasi.time + shift, quasi.stress, color="k", lw=0.8, ls="--", label="quasi-static, shifted")
-    ax_cycle.set_xlim(0, duration)
-    ax_cycle.set_xlabel("time (s)")
-    ax_cycle.set_ylabel("stress σ (Pa)")
-    ax_cycle.set_title(f"{high * UM:.0f} → {low * UM:.0f} µm/s through the block", fontsize=10)
-    ax_cycle.legend(fontsize="small", loc="upper left")
-
-    for start, label, color in ((VELOCITY_STEPS[0][1], "step up", "C0"), (_second_step(), "step down", "C1")):
-        after = steps.time >= start
-        slip = (steps.slider_position[after] - steps.slider_position[after][0]) * UM
-        near = slip <= 2.0
-        ax_step.plot(slip[near], steps.stress[after][near], color=color, lw=1.2, label=label)
-    ax_step.set_xlabel("slip since the step (µm)")
-    ax_step.set_ylabel("stress σ (Pa)")
-    ax_step.set_title("100 → 1000 → 100 µm/s (velocity control)", fontsize=9)
-    ax_step.legend(fontsize="small")
-
-    ax_hold.loglog(HOLDS, peaks, "o-", color="C3", label="peak on re-sliding")
-    ax_hold.set_xlabel("hold time (s)")
-    ax_hold.set_ylabel("peak stress (Pa)")
-    ax_hold.set_title("slide-hold-slide at 100 µm/s", fontsize=9)
-    for ax in (ax_cycle, ax_step, ax_hold):
-        apply_style(ax)
-    fig.tight_layout()
+    fig = figure_transient_runs(
+        alone,
+        full,
+        quasi,
+        STEP_DOWN,
+        steps,
+        (VELOCITY_STEPS[0][1], _second_step()),
+        "100 → 1000 → 100 µm/s (velocity control)",
+        HOLDS,
+        peaks,
+    )
     caption = _caption(run, full, alone, quasi, steps, peaks)
     return ReportFigure("transient_eq1", "Eq 1", "The full time-dependent model (Eq 1), solved", caption, fig)
 
 
 def _second_step() -> float:
     return VELOCITY_STEPS[0][1] + VELOCITY_STEPS[1][1]
-
-
-def _thin(time: np.ndarray, values: np.ndarray, points: int = 4000) -> tuple[np.ndarray, np.ndarray]:
-    """About ``points`` samples of a long trace for drawing, keeping every local extremum's neighbourhood."""
-    if time.size <= points:
-        return time, values
-    grid = np.searchsorted(time, np.linspace(time[0], time[-1], points))
-    turning = np.flatnonzero(np.diff(np.sign(np.diff(values))) != 0) + 1
-    keep = np.unique(np.r_[0, np.minimum(grid, time.size - 1), turning, time.size - 1])
-    return time[keep], values[keep]
 
 
 def _hold_peak(params, hold: float) -> float:  # type: ignore[no-untyped-def]

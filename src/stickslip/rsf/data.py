@@ -88,13 +88,9 @@ class LabRecord:
         return with_units(frame)
 
     def plot(self, ax: Any = None) -> Any:
-        from ..plotting import apply_style, new_axes
+        from ..plots.rsf import plot_record
 
-        ax = new_axes(ax)
-        ax.plot(self.displacement * 1e6, self.friction, ".", ms=1.5, color="#777777")
-        ax.set_xlabel("load-point displacement (µm)")
-        ax.set_ylabel("friction μ")
-        return apply_style(ax)
+        return plot_record(self, ax=ax)
 
 
 def parse_columns(text: str | None) -> dict[str, str]:

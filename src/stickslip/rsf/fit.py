@@ -211,7 +211,7 @@ class RSFFit:
         return with_units(frame)
 
     def plot(self, ax: Any = None) -> Any:
-        from .plots import plot_fit
+        from ..plots.rsf import plot_fit
 
         return plot_fit(self, ax=ax)
 

@@ -121,12 +121,12 @@ class RSFRun:
         return json.dumps(json_safe(self.metadata()), indent=2) + "\n"
 
     def plot(self, ax: Axes | None = None, **kwargs: Any) -> Axes:
-        from .plots import plot_run
+        from ..plots.rsf import plot_run
 
         return plot_run(self, ax=ax, **kwargs)
 
     def phase_plot(self, ax: Axes | None = None, **kwargs: Any) -> Axes:
-        from .plots import phase_plot
+        from ..plots.rsf import phase_plot
 
         return phase_plot(self, ax=ax, **kwargs)
 

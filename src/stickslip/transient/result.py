@@ -112,6 +112,6 @@ class TransientResult:
 
     def plot(self, ax: Axes | None = None, **kwargs: Any) -> Axes:
         """Stress against time (and the slider velocity on a twin axis); returns the Axes."""
-        from .plots import plot_transient
+        from ..plots.transient import plot_transient
 
         return plot_transient(self, ax=ax, **kwargs)

@@ -9,8 +9,8 @@ import numpy as np
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.axes import Axes
 
-    from .compare import Comparison
-    from .cycles import TraceAnalysis
+    from ..analysis.compare import Comparison
+    from ..analysis.cycles import TraceAnalysis
 
 
 def plot_analysis(

@@ -6,13 +6,13 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..plotting import apply_style, new_axes
+from .style import apply_style, new_axes
 
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.axes import Axes
 
-    from .fit import RSFFit
-    from .results import RSFRun
+    from ..rsf.fit import RSFFit
+    from ..rsf.results import RSFRun
 
 
 def plot_run(run: RSFRun, ax: Axes | None = None, x: str = "time", **kwargs: Any) -> Axes:
@@ -50,6 +50,15 @@ def phase_plot(run: RSFRun, ax: Axes | None = None, **kwargs: Any) -> Axes:
     ax.set_xlabel("ln(V/V₀)")
     ax.set_ylabel("friction μ")
     ax.legend(fontsize=8, frameon=False)
+    return apply_style(ax)
+
+
+def plot_record(record: Any, ax: Axes | None = None) -> Axes:
+    """A measured friction record (:class:`~stickslip.rsf.data.LabRecord`) against load-point displacement."""
+    ax = new_axes(ax)
+    ax.plot(record.displacement * 1e6, record.friction, ".", ms=1.5, color="#777777")
+    ax.set_xlabel("load-point displacement (µm)")
+    ax.set_ylabel("friction μ")
     return apply_style(ax)
 
 
@@ -95,7 +104,7 @@ def stability_figure(params: Any, v_low: float, v_high: float) -> Any:
     """Critical stiffness against sliding velocity, with the spring's stiffness as a line."""
     from matplotlib.figure import Figure
 
-    from .stability import critical_stiffness
+    from ..rsf.stability import critical_stiffness
 
     fig = Figure(figsize=(6.4, 4.4), layout="constrained")
     ax = fig.add_subplot()

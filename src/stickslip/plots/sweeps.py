@@ -12,9 +12,9 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..errors import ParameterError
-from ..plotting import apply_style, new_axes
+from ..sweeps.models import get_model
 from ..units import DIMENSIONS
-from .models import get_model
+from .style import apply_style, new_axes
 
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.axes import Axes

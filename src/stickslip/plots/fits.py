@@ -12,15 +12,16 @@ if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.axes import Axes
     from matplotlib.figure import Figure
 
-    from .bayes import SteadyPosterior
-    from .data import SteadyData
-    from .steady_fit import SteadyFit
-    from .stick_fit import StickFit
+    from ..fitting.bayes import SteadyPosterior
+    from ..fitting.data import SteadyData
+    from ..fitting.steady_fit import SteadyFit
+    from ..fitting.stick_fit import StickFit
 
 UM = 1e6  # m/s -> um/s on the axes
 
 
-def new_axes(rows: int = 1, height: float = 4.0) -> tuple[Figure, list[Axes]]:
+def panels(rows: int = 1, height: float = 4.0) -> tuple[Figure, list[Axes]]:
+    """A new Figure of ``rows`` panels stacked on one shared x axis (the first three times as tall)."""
     from matplotlib.figure import Figure
 
     fig = Figure(figsize=(6.4, height * rows), constrained_layout=True)
@@ -31,7 +32,7 @@ def new_axes(rows: int = 1, height: float = 4.0) -> tuple[Figure, list[Axes]]:
 
 
 def _axes(ax: Axes | None) -> Axes:
-    return new_axes()[1][0] if ax is None else ax
+    return panels()[1][0] if ax is None else ax
 
 
 def plot_steady_data(data: SteadyData, ax: Axes | None = None, **kwargs: Any) -> Axes:
@@ -90,7 +91,7 @@ def plot_residuals(fit: SteadyFit, ax: Axes | None = None) -> Axes:
 
 def steady_fit_figure(fit: SteadyFit, band: tuple[np.ndarray, ...] | None = None) -> Figure:
     """Two panels: the fit and its normalised residuals."""
-    fig, (top, bottom) = new_axes(rows=2, height=2.4)
+    fig, (top, bottom) = panels(rows=2, height=2.4)
     plot_steady_fit(fit, top, band=band)
     top.set_xlabel("")
     plot_residuals(fit, bottom)

@@ -1,0 +1,40 @@
+"""The package's common look: Axes and Figure makers, display units, colours, axis labels.
+
+Axes show velocities in um/s and stresses in Pa; the objects drawn hold SI values.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:  # pragma: no cover
+    from matplotlib.axes import Axes
+
+#: Display scale of velocities: SI (m/s) times this gives um/s.
+UM_PER_S = 1e6
+VELOCITY_LABEL = "sliding velocity V (µm/s)"
+STRESS_LABEL = "friction stress σ (Pa)"
+AGING_COLOR = "#1f4e9c"
+NO_AGING_COLOR = "#c0392b"
+CRITICAL_COLOR = "#222222"
+DATA_COLOR = "#333333"
+
+
+def new_axes(ax: Axes | None = None, figsize: tuple[float, float] = (6.4, 4.4)) -> Axes:
+    """``ax`` itself, or the single Axes of a new pyplot-free Figure."""
+    if ax is not None:
+        return ax
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=figsize, layout="constrained")
+    return fig.add_subplot()
+
+
+def apply_style(ax: Axes) -> Axes:
+    """The package's common look: light grid, no top/right spines, outward ticks."""
+    ax.grid(True, which="major", alpha=0.35, linewidth=0.6)
+    ax.grid(True, which="minor", alpha=0.12, linewidth=0.4)
+    for side in ("top", "right"):
+        ax.spines[side].set_visible(False)
+    ax.tick_params(direction="out", which="both")
+    return ax
