@@ -166,7 +166,13 @@ def _summary(folder: Path, total: int) -> str:
 @sweep_command.command("plot")
 @click.argument("folder", type=click.Path(exists=True, file_okay=False, path_type=Path), metavar="OUT")
 @click.option("--x", "x", default="pulling_velocity", show_default=True, help="Key on the horizontal axis.")
-@click.option("--y", "y", required=True, help="Key on the vertical axis.")
+@click.option(
+    "--y",
+    "y",
+    default=None,
+    help="Key on the vertical axis; none for a sweep of one key: its results against --x "
+    "(--color: the columns, comma-separated; regime: period, peak and mean).",
+)
 @click.option(
     "--color", "color", default="regime", show_default=True, help="Column shown in colour (regime: discrete)."
 )
@@ -177,7 +183,7 @@ def _summary(folder: Path, total: int) -> str:
     default=None,
     help="Image [default: OUT-COLOR.png].",
 )
-def plot_command(folder: Path, x: str, y: str, color: str, output: Path | None) -> None:
+def plot_command(folder: Path, x: str, y: str | None, color: str, output: Path | None) -> None:
     """Draw the phase diagram of the sweep in OUT, with the model's analytic stability boundary."""
     from ..fileio import atomic_path
     from ..plots.sweeps import plot_phase_diagram

@@ -10,6 +10,7 @@ from .style import apply_style, new_axes
 
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
 
     from ..rsf.fit import RSFFit
     from ..rsf.results import RSFRun
@@ -75,7 +76,7 @@ def plot_fit(fit: RSFFit, ax: Axes | None = None) -> Axes:
     return apply_style(ax)
 
 
-def run_figure(run: RSFRun) -> Any:
+def run_figure(run: RSFRun) -> Figure:
     """Friction, slip rate and state against time, and the phase plane, in one Figure."""
     from matplotlib.figure import Figure
 
@@ -100,7 +101,7 @@ def run_figure(run: RSFRun) -> Any:
     return fig
 
 
-def stability_figure(params: Any, v_low: float, v_high: float) -> Any:
+def stability_figure(params: Any, v_low: float, v_high: float) -> Figure:
     """Critical stiffness against sliding velocity, with the spring's stiffness as a line."""
     from matplotlib.figure import Figure
 
@@ -119,7 +120,7 @@ def stability_figure(params: Any, v_low: float, v_high: float) -> Any:
     return fig
 
 
-def fit_figure(fit: RSFFit) -> Any:
+def fit_figure(fit: RSFFit) -> Figure:
     """Data with the fit (top), residuals, and the load-point history fitted (found or given), against
     load-point displacement; a failed fit says so in red in the title."""
     from matplotlib.figure import Figure

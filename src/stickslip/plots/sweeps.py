@@ -1,12 +1,17 @@
-"""Phase diagrams of a sweep: two varied keys on the axes, a result in colour, the analytic boundary drawn on.
+"""Plots of a sweep: the phase diagram of two varied keys, or the results against one, with the model's boundary.
 
-Regimes are discrete colours; numbers a colour scale (logarithmic where they
-span decades).  A full grid is drawn as cells, anything else (a Latin
-hypercube) as points.  Failed points are grey crosses.
+Phase diagram (two keys): regimes are discrete colours; numbers a colour scale
+(logarithmic where they span decades).  A full grid is drawn as cells, anything
+else (a Latin hypercube) as points.  Failed points are grey crosses.
+
+One key (:func:`figure_sweep_1d`): the chosen result columns against the key,
+one panel each, every point's marker in the colour of its regime, and the
+model's boundary on that key (V0 = Vc, k = kc) as a vertical line.
 """
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -18,12 +23,16 @@ from .style import apply_style, new_axes
 
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
 
 REGIME_COLORS = {
     "stick-slip": "#c0392b",
     "steady": "#1f4e9c",
     "stuck": "#7f8c8d",
     "undetermined": "#f1c40f",
+    "steady sliding": "#1f4e9c",  # rate-and-state's names
+    "decaying oscillation": "#5dade2",
+    "growing oscillation": "#e67e22",
 }
 #: Display units: velocities in µm/s, everything else in SI.
 DISPLAY = {"velocity": (1e6, "µm/s")}
@@ -54,13 +63,47 @@ RESULT_UNITS = {
     "trough_friction": "",
     "mean_friction": "",
     "critical_stiffness": "1/m",  # rsf: friction per slip
+    "growth": "",
+    "cycles": "",
 }
+#: Axis names of the result columns (a column not named here is shown by its key).
+RESULT_NAMES = {
+    "period": "period",
+    "stick_time": "stick time ts",
+    "peak_stress": "peak stress σs",
+    "mean_stress": "mean stress",
+    "jump_velocity": "jump velocity Vs",
+    "critical_velocity": "critical velocity Vc",
+    "peak_friction": "peak friction μ",
+    "trough_friction": "trough friction μ",
+    "mean_friction": "mean friction μ",
+    "critical_stiffness": "critical stiffness kc",
+    "growth": "amplitude growth per period",
+    "cycles": "whole cycles",
+    "wall_time": "wall time",
+}
+#: The columns a 1-D plot shows by default, those of the model's results that exist, in this order.
+ONE_KEY_COLUMNS = ("period", "peak_stress", "mean_stress", "peak_friction", "mean_friction")
+#: Columns that are not results.
+NOT_RESULTS = ("point", "status", "message")
 #: Values whose largest/smallest ratio is at least this get a log axis or a log colour scale.
 DECADES = 30.0
 
 
-def plot_phase_diagram(frame: Any, spec: Any, x: str, y: str, color: str = "regime", ax: Axes | None = None) -> Axes:
-    """The phase diagram of a sweep's rows ``frame`` (see :func:`stickslip.sweeps.load_sweep`); returns the Axes."""
+def plot_phase_diagram(
+    frame: Any, spec: Any, x: str, y: str | None = None, color: str = "regime", ax: Axes | None = None
+) -> Axes:
+    """The phase diagram of a sweep's rows ``frame`` (see :func:`stickslip.sweeps.load_sweep`); returns the Axes.
+
+    With ``y`` None (a sweep of one key) it draws :func:`figure_sweep_1d` instead, ``color`` naming the result
+    column(s) to show (comma-separated; ``regime``: the default columns), and returns the first panel (its
+    ``.figure`` is the whole figure).
+    """
+    if y is None:
+        if ax is not None:
+            raise ParameterError("plot_phase_diagram: a 1-D plot (y=None) draws its own figure; give no ax")
+        columns = None if color == "regime" else [c.strip() for c in color.split(",") if c.strip()]
+        return figure_sweep_1d(frame, spec, x, columns).axes[0]
     for option, key in (("--x", x), ("--y", y)):
         if key not in spec.keys:
             raise ParameterError(
@@ -184,9 +227,7 @@ def _draw_categories(
 ) -> None:
     from matplotlib.colors import ListedColormap
 
-    names = [n for n in REGIME_COLORS if n in set(labels)] + sorted(set(labels) - set(REGIME_COLORS))
-    spare = iter(["#8e44ad", "#16a085", "#d35400", "#2c3e50", "#27ae60"] * 4)
-    colors = [REGIME_COLORS.get(n) or next(spare) for n in names]
+    names, colors = (list(column) for column in zip(*_regime_colors(labels), strict=True))
     codes = np.array([names.index(label) for label in labels], dtype=float)
     if cells:
         ex, ey, grid = _cells(xs, ys, codes, logs)
@@ -213,3 +254,116 @@ def _draw_numbers(
         mappable = ax.scatter(xs, ys, c=values, s=14, cmap="viridis", norm=norm, plotnonfinite=False)
     unit = RESULT_UNITS.get(name, "")
     ax.figure.colorbar(mappable, ax=ax, label=f"{name} ({unit}); blank: none" if unit else f"{name}; blank: none")
+
+
+# --------------------------------------------------------------------------- one key
+def figure_sweep_1d(frame: Any, spec: Any, x: str, columns: Sequence[str] | None = None) -> Figure:
+    """The results of a sweep against one varied key ``x``: one panel per column, sharing the x axis.
+
+    ``columns`` default to those of :data:`ONE_KEY_COLUMNS` the sweep holds (period, peak and mean stress, or
+    friction for rate-and-state).  Each point's marker has the colour of its regime (a point whose value is
+    blank, such as the period of steady sliding, is absent from that panel only); failed points are grey crosses
+    on the x axis.  The model's boundary on ``x`` (V0 = Vc, k = kc), where it gives one, is a dashed vertical
+    line.  The x axis is logarithmic for a log-spaced key, a y axis where its values span decades.
+    """
+    from matplotlib.figure import Figure
+
+    if len(spec.keys) != 1:
+        raise ParameterError(
+            f"--y: this sweep varies {', '.join(spec.keys)}; give --y KEY (a plot without --y needs a sweep of one key)"
+        )
+    if x not in spec.keys:
+        raise ParameterError(f"--x {x}: not the varied key of this sweep; expected {spec.keys[0]}")
+    chosen = _one_key_columns(frame, columns)
+    model = get_model(spec.model)
+    dimensions = model.dimensions()
+    ok = frame[frame["status"] == "ok"]
+    xs = _scaled(ok[x].to_numpy(dtype=float), dimensions[x])
+    regimes = ok["regime"].astype(str).to_numpy() if "regime" in ok else np.full(xs.size, "ok")
+    fig = Figure(figsize=(6.8, 1.2 + 2.4 * len(chosen)), layout="constrained")
+    axes = fig.subplots(len(chosen), 1, sharex=True, squeeze=False)[:, 0]
+    for ax, column in zip(axes, chosen, strict=True):
+        _draw_column(ax, xs, ok[column].to_numpy(dtype=float), regimes, column)
+        apply_style(ax)
+    failed = frame[frame["status"] != "ok"]
+    if len(failed):
+        from matplotlib.transforms import blended_transform_factory
+
+        where = blended_transform_factory(axes[-1].transData, axes[-1].transAxes)
+        fx = _scaled(failed[x].to_numpy(dtype=float), dimensions[x])
+        axes[-1].plot(fx, np.zeros(fx.size), "x", color="#555555", transform=where, clip_on=False,
+                      label=f"failed ({len(failed)})")  # fmt: skip
+    for boundary in model.boundaries(spec, ok, x, None):
+        if boundary.x.size and np.all(np.isnan(boundary.y)) and np.isfinite(boundary.x[0]):
+            for k, ax in enumerate(axes):
+                ax.axvline(_scaled(boundary.x, dimensions[x])[0], color="black", linewidth=1.4, linestyle="--",
+                           label=boundary.label if k == 0 else None)  # fmt: skip
+    if _log_axis(spec, x, xs):
+        axes[-1].set_xscale("log")
+    axes[-1].set_xlabel(_label(x, dimensions[x]))
+    _legend_of_all_panels(fig, axes)
+    axes[0].set_title(f"{spec.label or spec.model}: results against {x} ({len(frame)} points)", fontsize=10)
+    return fig
+
+
+def _one_key_columns(frame: Any, columns: Sequence[str] | None) -> list[str]:
+    """The numeric result columns to draw: the ones asked for (checked), or the default ones the sweep holds."""
+    numeric = [
+        c for c in frame.columns if c not in NOT_RESULTS and c != "regime" and np.issubdtype(frame[c].dtype, np.number)
+    ]
+    if columns is None:
+        chosen = [c for c in ONE_KEY_COLUMNS if c in numeric]
+        return chosen or numeric[:1]
+    if not columns:
+        raise ParameterError(f"--color: name a result column; expected one of {', '.join(numeric)}")
+    for column in columns:
+        if column not in numeric:
+            raise ParameterError(
+                f"--color {column}: not a numeric result of this sweep; expected one of {', '.join(numeric)}"
+            )
+    return list(columns)
+
+
+def _draw_column(ax: Axes, xs: np.ndarray, values: np.ndarray, regimes: np.ndarray, column: str) -> None:
+    """The column against x: a thin line through the points in x order, each marker in its regime's colour."""
+    dimension = RESULT_DIMENSIONS.get(column)
+    shown = _scaled(values, dimension) if dimension else values
+    order = np.argsort(xs, kind="stable")
+    finite = order[np.isfinite(shown[order])]
+    ax.plot(xs[finite], shown[finite], color="#999999", linewidth=0.8, zorder=1, label="_trend")
+    for name, color in _regime_colors(regimes):
+        mask = (regimes == name) & np.isfinite(shown)
+        ax.scatter(xs[mask], shown[mask], s=22, color=color, label=name, zorder=3, edgecolors="none")
+    if _spans_decades(shown):
+        ax.set_yscale("log")
+    ax.set_ylabel(_result_label(column))
+
+
+#: Result columns shown in a display unit (velocities in µm/s).
+RESULT_DIMENSIONS = {"jump_velocity": "velocity", "critical_velocity": "velocity"}
+
+
+def _result_label(column: str) -> str:
+    """``peak stress σs (Pa)``: the quantity's name and its display unit."""
+    dimension = RESULT_DIMENSIONS.get(column)
+    unit = DISPLAY[dimension][1] if dimension in DISPLAY else RESULT_UNITS.get(column, "")
+    name = RESULT_NAMES.get(column, column.replace("_", " "))
+    return f"{name} ({unit})" if unit else name
+
+
+def _regime_colors(regimes: np.ndarray) -> list[tuple[str, str]]:
+    """(regime, colour) in the order of REGIME_COLORS, then any other regime with a spare colour."""
+    present = set(regimes.tolist())
+    names = [n for n in REGIME_COLORS if n in present] + sorted(present - set(REGIME_COLORS))
+    spare = iter(["#8e44ad", "#16a085", "#d35400", "#2c3e50", "#27ae60"] * 4)
+    return [(n, REGIME_COLORS.get(n) or next(spare)) for n in names]
+
+
+def _legend_of_all_panels(fig: Figure, axes: Sequence[Axes]) -> None:
+    """One legend, on the first panel, naming every regime, the boundary and the failed points once."""
+    handles: dict[str, Any] = {}
+    for ax in axes:
+        for handle, label in zip(*ax.get_legend_handles_labels(), strict=True):
+            handles.setdefault(label, handle)
+    if handles:
+        axes[0].legend(list(handles.values()), list(handles), loc="best", fontsize=8, framealpha=0.85)

@@ -391,6 +391,8 @@ class RateAndState:
         elif other in frame:
             kc = frame.groupby(other)["critical_stiffness"].median().dropna()
             along, critical = kc.index.to_numpy(dtype=float), kc.to_numpy(dtype=float)
+        elif other is None and "critical_stiffness" in frame:  # k alone varied: one kc, a vertical line
+            critical, along = np.full(2, float(frame["critical_stiffness"].median())), np.full(2, np.nan)
         else:
             return []
         keep = critical > 0  # kc = 0: steady sliding is stable at every stiffness there, no boundary
