@@ -222,3 +222,12 @@ def test_sweep_plot_without_y_on_a_two_key_sweep_says_give_y(tmp_path: Path, cap
     run_sweep(spec, tmp_path / "two", workers=0)
     status, _, err = run_main(capsys, "sweep", "plot", str(tmp_path / "two"), "-o", str(tmp_path / "x.png"))
     assert status == 2 and "give --y KEY" in err and err.count("\n") == 1
+
+
+def test_one_key_plot_of_a_sweep_whose_every_point_failed_draws_the_crosses(qs_one_key) -> None:
+    spec, frame, _ = qs_one_key
+    failed = frame.assign(status="error", message="boom", period=np.nan, peak_stress=np.nan, mean_stress=np.nan)
+    fig = figure_sweep_1d(failed, spec, "pulling_velocity")
+    assert [line.get_label() for line in fig.axes[-1].get_lines()] == ["_trend", "failed (4)"]
+    assert not any(ax.collections for ax in fig.axes)  # no point in any regime colour, and no boundary line
+    assert not [line for ax in fig.axes for line in ax.get_lines() if line.get_linestyle() == "--"]
