@@ -182,6 +182,7 @@ def test_one_key_plot_colours_each_point_by_regime_and_leaves_blanks_out(qs_one_
     fig = figure_sweep_1d(frame, spec, "pulling_velocity")
     period, _, mean = fig.axes
     assert [ax.get_ylabel() for ax in fig.axes] == ["period (s)", "peak stress σs (Pa)", "mean stress (Pa)"]
+    assert period.get_title() == "gelatin-glass: results against pulling velocity V0 (4 points)"
     assert mean.get_xlabel() == "pulling velocity V0 (µm/s)" and mean.get_xscale() == "log"  # 50x: decades
     red, blue, grey = (REGIME_COLORS[r] for r in ("stick-slip", "steady", "stuck"))
     assert {k: list(v) for k, v in _points_by_colour(period).items()} == {red: [50.0, 100.0]}

@@ -163,8 +163,13 @@ def _scaled(values: np.ndarray, dimension: str) -> np.ndarray:
 def _label(key: str, dimension: str) -> str:
     """The quantity's name and its display unit: ``block stiffness Gd/h (kPa/m)``, not the raw key."""
     unit = DISPLAY.get(dimension, (1.0, DIMENSIONS[dimension][1]))[1]
-    name = KEY_NAMES.get(key) or _parameter_name(key) or key.replace("_", " ")
+    name = _name(key)
     return f"{name} ({unit})" if unit else name
+
+
+def _name(key: str) -> str:
+    """The quantity a key stands for: ``pulling velocity V0``, ``block stiffness Gd/h``, a parameter's description."""
+    return KEY_NAMES.get(key) or _parameter_name(key) or key.replace("_", " ")
 
 
 def _parameter_name(key: str) -> str | None:
@@ -302,7 +307,7 @@ def figure_sweep_1d(frame: Any, spec: Any, x: str, columns: Sequence[str] | None
         axes[-1].set_xscale("log")
     axes[-1].set_xlabel(_label(x, dimensions[x]))
     _legend_of_all_panels(fig, axes)
-    axes[0].set_title(f"{spec.label or spec.model}: results against {x} ({len(frame)} points)", fontsize=10)
+    axes[0].set_title(f"{spec.label or spec.model}: results against {_name(x)} ({len(frame)} points)", fontsize=10)
     return fig
 
 
