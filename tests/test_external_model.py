@@ -14,6 +14,7 @@ mu(V) = mu0 - c ln(V/Vr), capped at the static peak mu_s (the slider sticks at V
 from __future__ import annotations
 
 import math
+from typing import ClassVar
 
 import numpy as np
 import pytest
@@ -30,8 +31,9 @@ class VelocityWeakening(FrictionModel):
     name = "velocity-weakening"
     description = "spring-slider, mu = mu0 - c ln(V/Vr) with a static peak"
     capabilities = Capabilities(controls=("spring",), protocols="constant", damping=True, mass=True)
-    defaults = {"mu0": 0.5, "c": 0.01, "v_ref": 1e-3, "mu_s": 0.6, "normal_stress": 1e3, "stiffness": 1e4,
-                "damping": 100.0, "mass": 1.0}  # fmt: skip
+    defaults: ClassVar[dict[str, float]] = dict(
+        mu0=0.5, c=0.01, v_ref=1e-3, mu_s=0.6, normal_stress=1e3, stiffness=1e4, damping=100.0, mass=1.0
+    )
 
     def sweep_start(self, protocol):
         return 1.1 * protocol.segments[0].velocity  # steady sliding, pushed: the disturbance whose fate we see
@@ -57,9 +59,10 @@ class VelocityWeakening(FrictionModel):
 
     def run(self, params, protocol, rig=None, *, start=None, **settings):
         rig = self.check(protocol, rig, settings)
-        p = {**params, **{k: v for k, v in (("stiffness", rig.stiffness), ("damping", rig.damping),
-                                            ("mass", rig.mass)) if v is not None}}  # fmt: skip
-        sigma, k, eta, m, vp = p["normal_stress"], p["stiffness"], p["damping"], p["mass"], protocol.segments[0].velocity
+        rig_values = {"stiffness": rig.stiffness, "damping": rig.damping, "mass": rig.mass}
+        p = {**params, **{key: value for key, value in rig_values.items() if value is not None}}
+        sigma, k, eta, m = p["normal_stress"], p["stiffness"], p["damping"], p["mass"]
+        vp = protocol.segments[0].velocity
 
         def mu(v):
             return np.minimum(p["mu_s"], p["mu0"] - p["c"] * np.log(np.maximum(v, 1e-300) / p["v_ref"]))
