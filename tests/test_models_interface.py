@@ -147,3 +147,40 @@ def test_a_run_from_a_trace_is_classified_by_the_one_classifier():
     assert run.period == pytest.approx(5.0, rel=1e-3)
     assert run.mean == pytest.approx(110.0, rel=1e-3)
     assert math.isnan(run.friction[0]) if run.friction is not None else run.friction is None
+
+
+def test_the_old_results_convert_to_the_same_run():
+    p = stickslip.load_parameters()
+    sim = stickslip.simulate(p, 50e-6, 60.0)
+    direct = stickslip.run("quasi-static", p, protocols.constant(50e-6, 60.0))
+    columns = get_model("quasi-static").sweep_columns
+    assert sim.to_run().row(columns) == direct.row(columns)
+    rsf = stickslip.rsf.simulate(stickslip.rsf.rsf_params(0.005, 0.01, 10e-6), protocols.constant(1e-6, 20.0))
+    assert rsf.to_run().regime_name == rsf.regime.name
+
+
+def test_an_installed_package_registers_by_its_entry_point(monkeypatch):
+    """A ``stickslip.models`` entry point is found by name, without any import by the user."""
+    from importlib import metadata
+
+    from stickslip.models import registry
+
+    class Plugin(FrictionModel):
+        name = "plugin-model"
+
+        def dimensions(self):
+            return {}
+
+        def parameters(self, spec=None, overrides=None):
+            return {}
+
+        def run(self, params, protocol, rig=None, *, start=None, **settings):
+            raise AssertionError
+
+    entry = metadata.EntryPoint("plugin-model", f"{__name__}:PLUGIN", "stickslip.models")
+    monkeypatch.setitem(globals(), "PLUGIN", Plugin())
+    monkeypatch.setattr(registry.metadata, "entry_points", lambda group: [entry] if group == "stickslip.models" else [])
+    monkeypatch.setitem(registry._LOADED, "entry points", False)
+    monkeypatch.setattr(registry, "_MODELS", dict(registry._MODELS))
+    assert get_model("plugin-model") is PLUGIN  # noqa: F821 - set above
+    assert "plugin-model" in available_models()
