@@ -184,3 +184,12 @@ def test_an_installed_package_registers_by_its_entry_point(monkeypatch):
     monkeypatch.setattr(registry, "_MODELS", dict(registry._MODELS))
     assert get_model("plugin-model") is PLUGIN  # noqa: F821 - set above
     assert "plugin-model" in available_models()
+
+
+def test_rsf_keys_refuse_a_second_state_variable_rather_than_drop_it():
+    rsf = get_model("rsf")
+    two = stickslip.rsf.rsf_params(0.005, 0.01, 10e-6, b2=0.005, dc2=100e-6)
+    assert rsf.parameters(two) is two  # as given, without keys
+    with pytest.raises(ParameterError, match="one state variable") as info:
+        rsf.parameters(two, {"a": 0.006})
+    assert "\n" not in str(info.value)
