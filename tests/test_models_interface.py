@@ -193,3 +193,29 @@ def test_rsf_keys_refuse_a_second_state_variable_rather_than_drop_it():
     with pytest.raises(ParameterError, match="one state variable") as info:
         rsf.parameters(two, {"a": 0.006})
     assert "\n" not in str(info.value)
+
+
+@pytest.mark.parametrize(("v0", "kind"), [(50e-6, "stick-slip"), (300e-6, "steady")])
+def test_the_quasi_static_phases_agree_with_the_one_classifier_on_the_trace(v0, kind):
+    """The phase-based verdict (both sides of Vc = 124 um/s, Eq 9) is what regimes.classify reads off the trace."""
+    from stickslip import regimes
+
+    run = stickslip.run("quasi-static", None, protocols.constant(v0, 150.0))
+    found = regimes.classify(run.time, run.stress, floor=1e-6 * float(np.max(run.stress)))
+    assert run.regime.kind == found.kind == kind, found.evidence
+    if kind == "stick-slip":
+        assert found.period == pytest.approx(run.period, rel=1e-3)
+        assert found.peak == pytest.approx(run.peak, rel=1e-9)
+
+
+def test_a_sample_repeated_at_an_extremum_does_not_flip_peaks_and_troughs():
+    """A trace that writes a phase boundary twice (same time, same stress) is the same signal (regimes._kinds)."""
+    from stickslip import regimes
+
+    t = np.linspace(0.0, 40.0, 4001)
+    y = 10.0 + np.where((t % 4.0) < 3.0, (t % 4.0), 3.0 - 3.0 * ((t % 4.0) - 3.0))  # slow rise, fast fall
+    peaks = np.flatnonzero(np.isclose(t % 4.0, 3.0))
+    tt, yy = np.insert(t, peaks + 1, t[peaks]), np.insert(y, peaks + 1, y[peaks])
+    plain, doubled = regimes.classify(t, y, floor=1e-9), regimes.classify(tt, yy, floor=1e-9)
+    assert plain.kind == doubled.kind == "stick-slip"
+    assert doubled.period == pytest.approx(4.0, rel=1e-6) and doubled.peak == pytest.approx(13.0)
