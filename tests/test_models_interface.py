@@ -219,3 +219,10 @@ def test_a_sample_repeated_at_an_extremum_does_not_flip_peaks_and_troughs():
     plain, doubled = regimes.classify(t, y, floor=1e-9), regimes.classify(tt, yy, floor=1e-9)
     assert plain.kind == doubled.kind == "stick-slip"
     assert doubled.period == pytest.approx(4.0, rel=1e-6) and doubled.peak == pytest.approx(13.0)
+
+
+def test_an_rsf_sweep_refuses_a_pulling_velocity_it_cannot_start_from_up_front():
+    from stickslip.sweeps import build_spec
+
+    with pytest.raises(ParameterError, match=r"pulling_velocity: expected a value > 0 m/s"):
+        build_spec(["pulling_velocity=0 um/s,1 um/s"], model="rsf")

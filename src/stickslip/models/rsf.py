@@ -61,7 +61,10 @@ class RSFModel(FrictionModel):
 
     @classmethod
     def sweep_start(cls, protocol: Protocol) -> float:
-        return cls.START_STEP * protocol.segments[0].velocity
+        velocity = protocol.segments[0].velocity
+        if not velocity > 0:  # the start is steady sliding at a step above it
+            raise ParameterError(f"pulling_velocity: expected a value > 0 m/s, got {velocity:g}")
+        return cls.START_STEP * velocity
 
     def dimensions(self) -> dict[str, str]:
         return dict(self.KEYS)
