@@ -195,21 +195,22 @@ def _override(rsf: Any, options: dict[str, Any]) -> Any:
 
 
 def _text(summary: dict[str, Any]) -> str:
+    from ..display import velocity
+
     r = summary["rsf_of_bond_model"]
     s = summary["stick_slip"]
     lines = [
-        f"one RSF parameter set for every panel (friction = stress / sigma_c, sigma_c = {r['sigma_c']:.4g} Pa): "
-        f"a = {r['a']:.4g}, b = {r['b']:.4g}, Dc = {r['dc'] * 1e6:.4g} um ({_how(r['status'])})",
+        f"one RSF parameter set for every panel (friction = stress / σc, σc = {r['sigma_c']:.4g} Pa): "
+        f"a = {r['a']:.4g}, b = {r['b']:.4g}, Dc = {r['dc'] * 1e6:.4g} µm ({_how(r['status'])})",
         f"  {r['note']}",
-        f"  the bond model's steady slope (1/sigma_c) dsigma/dlnV at {r['velocity'] * 1e6:.4g} um/s: "
-        f"{r['bond_steady_slope']:.4g} (RSF a - b = {r['rsf_a_minus_b']:.4g})",
+        f"  the bond model's steady slope (1/σc) dσ/dlnV at {velocity(r['velocity'], 4)}: "
+        f"{r['bond_steady_slope']:.4g} (RSF a − b = {r['rsf_a_minus_b']:.4g})",
         f"bond model: {summary['bond_model']}",
     ]
     for name, panel in summary["panels"].items():
         lines.append(f"{name}: RSF " + (f"cannot describe it: {panel['problem']}" if panel["problem"] else "ok"))
     lines += [
-        f"stick-slip at {s['pulling_velocity'] * 1e6:.4g} um/s, k = {s['stiffness']:.4g} 1/m, "
-        f"eta = {s['eta']:.4g} s/m:",
+        f"stick-slip at {velocity(s['pulling_velocity'], 4)}, k = {s['stiffness']:.4g} 1/m, η = {s['eta']:.4g} s/m:",
         f"  bond model: {s['bond']['message']}",
         "  RSF: "
         + (f"cannot describe it: {s['problem']}" if s["problem"] else f"{s['rsf']['regime']}; {s['rsf']['message']}"),

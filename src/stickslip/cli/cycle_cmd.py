@@ -163,7 +163,7 @@ def _simulation_report(sim: Any, name: str) -> list[Any]:
 @click.option(
     "--start-stress", "start_text", default=None, metavar="S", help="Stress at the instant of sticking [default: σc]."
 )
-@click.option("--no-aging", is_flag=True, help="Drop the aging term of Eq 15 (tau_a -> infinity).")
+@click.option("--no-aging", is_flag=True, help="Drop the aging term of Eq 15 (τa → ∞).")
 @click.option(
     "--until",
     "until_text",

@@ -449,7 +449,9 @@ FIT_FAILED = 3
 
 
 def _fit_text(fit: Any) -> str:
-    unit = fit.record.length_unit
+    from ..display import unit as shown_unit
+
+    unit = shown_unit(fit.record.length_unit)
     lines = [f"rate-and-state fit of {fit.record.source} ({len(fit.record)} rows): {fit.status}"
              + (f": {fit.reason}" if fit.reason else "")]  # fmt: skip
     lines.append(f"  load point ({fit.protocol_source}):")

@@ -205,14 +205,14 @@ def rsf_of_bond(
     # a failed set is kept for the record only; RSFParams needs a > 0, so it holds |a| (the note gives a)
     rsf = RSFParams(a=max(abs(a), 1e-12), states=(StateVariable("aging", 0.0, dl_m),), mu0=mu0, v_ref=v0,
                     stiffness=stiffness)  # fmt: skip
-    step = f"{v0 * 1e6:.4g} -> {v1 * 1e6:.4g} um/s"
+    step = f"{v0 * 1e6:.4g} -> {v1 * 1e6:.4g} µm/s"
     if a <= 0:
-        why = (f"fit failed: the quasi-static bond model's stress falls in the step {step} (mu {mu0:.4g} -> "
+        why = (f"fit failed: the quasi-static bond model's stress falls in the step {step} (μ {mu0:.4g} -> "
                f"{mu1:.4g}), so a rate-only law would need a = {a:.3g} <= 0: no positive direct effect")  # fmt: skip
         return BondRSF(rsf, slope, vm, sigma_c, "failed", why)
-    note = (f"fitted to the quasi-static bond model's step {step}: it jumps at once from mu = {mu0:.4g} to "
-            f"{mu1:.4g} (no transient, no state), which is exactly a = (mu1 - mu0)/ln(V1/V0) = {a:.4g}, b = 0; "
-            f"Dc has no effect with b = 0 and is not determined (set to dl_m = {dl_m * 1e6:.4g} um)")  # fmt: skip
+    note = (f"fitted to the quasi-static bond model's step {step}: it jumps at once from μ = {mu0:.4g} to "
+            f"{mu1:.4g} (no transient, no state), which is exactly a = (μ1 − μ0)/ln(V1/V0) = {a:.4g}, b = 0; "
+            f"Dc has no effect with b = 0 and is not determined (set to Δlm = {dl_m * 1e6:.4g} µm)")  # fmt: skip
     return BondRSF(rsf, slope, vm, sigma_c, "fitted", note)
 
 

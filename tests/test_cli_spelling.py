@@ -1,0 +1,126 @@
+"""One spelling per quantity in what people read (issue 19): µm/s, σs, σc, τa, Δlm, never um/s, sigma_s, tau_a.
+
+Every command that prints prose is run here, through the cases whose messages come from the models
+(stick-slip, stuck, undetermined, steady, the RSF fit's report in the record's unit).  What a user types
+stays ASCII ("350 um/s"): the arguments below are chosen so that none is echoed back.  JSON keys and CSV
+headers are for machines and are not checked.
+"""
+
+from __future__ import annotations
+
+import re
+
+import pytest
+from click.testing import CliRunner
+
+from stickslip.cli.main import cli
+from stickslip.fitting import datasets
+
+#: ASCII spellings that must not reach a person's eyes (the paper's symbols are σs, σc, τ, τa, Δlm).
+ASCII_SPELLINGS = re.compile(r"um/s|\bum\b|sigma|tau_?a?\b|\bdl_m\b|\bmu\b")
+
+SEPIOLITE = str(datasets.data_path("giacomel-sepiolite/velstep3_TR2_exp013_sepiolite.txt"))
+
+COMMANDS = {
+    "params show": ["params", "show"],
+    "critical": ["critical"],
+    "stick slips": ["stick", "--v0", "50 um/s"],
+    "stick stuck": ["stick", "--v0", "15 um/s"],
+    "stick undetermined": ["stick", "--v0", "20 um/s"],
+    "simulate stick-slip": ["simulate", "--v0", "50 um/s", "--duration", "60 s"],
+    "simulate undetermined": ["simulate", "--v0", "20 um/s", "--duration", "60 s"],
+    "simulate stuck": ["simulate", "--v0", "10 um/s", "--duration", "60 s"],
+    "transient stuck": ["transient", "--v0", "50 um/s", "--duration", "0.2 s", "--rtol", "1e-3"],
+    "transient steady": [
+        "transient",
+        "--control",
+        "velocity",
+        "--start",
+        "steady",
+        "--v0",
+        "350 um/s",
+        "--duration",
+        "5 ms",
+        "--segment",
+        "1 mm/s:5 ms",
+        "--rtol",
+        "1e-3",
+    ],
+    "rsf simulate": [
+        "rsf",
+        "simulate",
+        "--a",
+        "0.005",
+        "--b",
+        "0.01",
+        "--dc",
+        "10 um",
+        "--stiffness",
+        "1e-3 1/um",
+        "--segment",
+        "1 um/s:10 s",
+        "--segment",
+        "10 um/s:30 s",
+        "--every",
+        "0.1 s",
+        "-o",
+        "t.csv",
+    ],
+    "rsf stability": [
+        "rsf",
+        "stability",
+        "--a",
+        "0.01",
+        "--b",
+        "0.015",
+        "--dc",
+        "20 um",
+        "--stiffness",
+        "100 1/m",
+        "--velocity",
+        "1 um/s",
+    ],
+    "fit steady": ["fit", "steady", str(datasets.synthetic_steady_path())],
+    "fit stick": ["fit", "stick", str(datasets.table1_path()), "--exclude-row", "11"],
+    "rsf fit": [
+        "rsf",
+        "fit",
+        SEPIOLITE,
+        "--columns",
+        "time=Time(s),displacement=Displ(microns),friction=Friction",
+        "--displacement-unit",
+        "um",
+        "--trend",
+    ],
+    "compare": ["compare"],
+}
+
+
+def offending_lines(text: str) -> list[str]:
+    return [line.strip() for line in text.splitlines() if ASCII_SPELLINGS.search(line)]
+
+
+@pytest.mark.parametrize("name", list(COMMANDS))
+def test_text_output_spells_quantities_one_way(name, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    result = CliRunner().invoke(cli, COMMANDS[name], catch_exceptions=False)
+    assert result.exit_code == 0, result.output
+    assert offending_lines(result.output) == []
+
+
+def test_analyze_of_a_simulated_trace_spells_quantities_one_way(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    runner = CliRunner()
+    made = runner.invoke(cli, ["simulate", "--v0", "50 um/s", "--duration", "100 s", "-o", "trace.csv"])
+    assert made.exit_code == 0, made.output
+    result = runner.invoke(cli, ["analyze", "trace.csv", "--v0", "50 um/s", "--compare"], catch_exceptions=False)
+    assert result.exit_code == 0, result.output
+    assert offending_lines(result.output) == []
+
+
+def test_the_check_sees_the_old_spellings():
+    """The pattern catches what the models used to print (a check that cannot fail is a defect)."""
+    for old in ("sigma_s = 552.9 Pa", "jump to 702 um/s", "-t/tau_a grows", "sigma = 30 Pa", "set to dl_m = 1 um"):
+        assert offending_lines(old) == [old]
+    for new in ("σs = 552.9 Pa", "jump to 702 µm/s", "−t/τa grows", "σ = 30 Pa", "Δlm = 1.074 µm", "1 mm/s"):
+        assert offending_lines(new) == []
