@@ -24,6 +24,7 @@ if TYPE_CHECKING:
     from .model.slip import SlipPhase, slip_phase
     from .model.steady import SteadyState, steady_state, steady_stress_many
     from .model.stick import StickPhase, stick_phase
+    from .models import FrictionModel, Rig, Run, available_models, get_model, register_model, run
     from .parameters import Parameters, available_parameter_sets, load_parameters
 
 _LAZY = {
@@ -51,14 +52,24 @@ _LAZY = {
     "read_trace": "stickslip.analysis",
     "compare_with_model": "stickslip.analysis",
     "sweep": "stickslip.sweeps",
+    "run": "stickslip.models",
+    "Run": "stickslip.models",
+    "Rig": "stickslip.models",
+    "FrictionModel": "stickslip.models",
+    "register_model": "stickslip.models",
+    "get_model": "stickslip.models",
+    "available_models": "stickslip.models",
 }
 
 __all__ = [  # every public name once: the errors (loaded now) and the lazy names above
     "CriticalPoint",
     "DataError",
+    "FrictionModel",
     "ModelError",
     "ParameterError",
     "Parameters",
+    "Rig",
+    "Run",
     "Simulation",
     "SlipPhase",
     "SteadyState",
@@ -66,16 +77,20 @@ __all__ = [  # every public name once: the errors (loaded now) and the lazy name
     "StickslipError",
     "UnitError",
     "analyze_trace",
+    "available_models",
     "available_parameter_sets",
     "compare_with_model",
     "critical_point",
     "fit_steady",
     "fit_stick",
+    "get_model",
     "jump_velocity",
     "load_parameters",
     "read_steady_data",
     "read_stick_data",
     "read_trace",
+    "register_model",
+    "run",
     "sample_posterior",
     "simulate",
     "slip_phase",
@@ -89,8 +104,8 @@ __version__ = "0.1.0"
 
 #: subpackages and modules reachable as ``stickslip.rsf`` etc. after a plain ``import stickslip``
 _SUBMODULES = frozenset(
-    {"analysis", "errors", "fileio", "fitting", "model", "numerics", "parameters", "protocols", "report", "rsf",
-     "sweeps", "transient", "units"}
+    {"analysis", "errors", "fileio", "fitting", "model", "models", "numerics", "parameters", "protocols", "report",
+     "rsf", "sweeps", "transient", "units"}
 )  # fmt: skip
 
 

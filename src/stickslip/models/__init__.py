@@ -1,0 +1,58 @@
+"""Friction models behind one interface (see docs/architecture.md and docs/models.md).
+
+    >>> import stickslip
+    >>> from stickslip import protocols
+    >>> run = stickslip.run("quasi-static", None, protocols.constant(50e-6, 20.0))  # doctest: +SKIP
+    >>> run.regime.kind, run.period  # doctest: +SKIP
+
+A model is a :class:`FrictionModel` (parameters, equations, its own solver); a protocol
+(:mod:`stickslip.protocols`) says what the load point does, a :class:`Rig` how it reaches the slider;
+every model returns a :class:`Run`.  :func:`register_model` adds a model from outside the package.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+from .base import CONTROLS, Boundary, Capabilities, FrictionModel, Rig
+from .registry import available_models, get_model, register_model
+from .run import Run
+
+__all__ = [
+    "CONTROLS",
+    "Boundary",
+    "Capabilities",
+    "FrictionModel",
+    "Rig",
+    "Run",
+    "available_models",
+    "get_model",
+    "register_model",
+    "run",
+]
+
+
+def run(
+    model: str | FrictionModel,
+    params: Any = None,
+    protocol: Any = None,
+    rig: Rig | None = None,
+    *,
+    start: Any = None,
+    **settings: Any,
+) -> Run:
+    """Run ``protocol`` on ``model`` (a name, ``module:attr``, or a model) and return its :class:`Run`.
+
+    ``params``: the model's parameter object, or what its ``parameters()`` takes (a set name, a file, a
+    mapping; None for the model's defaults).  ``rig``: default a spring of the model's own stiffness.
+    """
+    from ..errors import ParameterError
+
+    found = get_model(model)
+    if protocol is None:
+        raise ParameterError("protocol: expected a stickslip.protocols.Protocol, e.g. protocols.constant(50e-6, 20)")
+    if params is None or isinstance(params, (str, Path, Mapping)):
+        params = found.parameters(params)
+    return found.run(params, protocol, rig, start=start, **settings)

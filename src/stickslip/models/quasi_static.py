@@ -1,0 +1,128 @@
+"""The quasi-static bond model (stick -> jump -> slip cycles, :func:`stickslip.simulate`) behind the interface."""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from .. import regimes
+from ..parameters import Parameters
+from ..protocols import Protocol
+from .base import Boundary, Capabilities, Rig
+from .bond import BondModel
+from .run import Run, time_mean
+
+NAN = math.nan
+
+
+class QuasiStatic(BondModel):
+    """Juvekar & Singh's cycle: one constant pulling velocity through the block's spring (Eq 17), no inertia.
+
+    ``start``: the stress (Pa) of the first stick (default sigma_c); setting ``jump_curve`` ("aging" or
+    "no-aging").  The regime follows from the phases (every cycle after the first is the same cycle), so
+    its amplitude ratio is exactly 1 once a cycle repeats.
+    """
+
+    name = "quasi-static"
+    aliases = ("quasistatic", "cycle", "simulate")
+    description = "bond model, quasi-static stick-jump-slip cycles (Eqs 6-17)"
+    capabilities = Capabilities(controls=("spring",), protocols="constant", settings=("jump_curve",))
+
+    def run(
+        self, params: Parameters, protocol: Protocol, rig: Rig | None = None, *, start: Any = None, **settings: Any
+    ) -> Run:
+        from ..model.cycle import simulate
+
+        rig = self.check(protocol, rig, settings)
+        params = self.with_rig(_checked(params), rig)
+        velocity, duration = protocol.segments[0].velocity, protocol.segments[0].duration
+        sim = simulate(params, velocity, duration, start_stress=start, jump_curve=settings.get("jump_curve", "aging"))
+        return simulation_run(sim)
+
+    def stability_boundary(self, fixed: Any, x: str, y: str, frame: Any = None) -> list[Boundary]:
+        """V0 = Vc: the critical velocity against the other axis (from the rows' own Vc)."""
+        if frame is None or "pulling_velocity" not in (x, y) or "critical_velocity" not in frame:
+            return []
+        other = y if x == "pulling_velocity" else x
+        if other in frame:
+            vc = frame.groupby(other)["critical_velocity"].median().dropna()
+            along, critical = vc.index.to_numpy(dtype=float), vc.to_numpy(dtype=float)
+        else:
+            critical = np.full(2, float(frame["critical_velocity"].median()))
+            along = np.array([np.nan, np.nan])
+        curve = (critical, along) if x == "pulling_velocity" else (along, critical)
+        return [Boundary(curve[0], curve[1], "V0 = Vc (Eq 9)")]
+
+
+def _checked(params: Any) -> Parameters:
+    from ..model.steady import require_parameters
+
+    require_parameters(params)
+    return params
+
+
+def simulation_run(sim: Any) -> Run:
+    """The :class:`Run` of a :class:`stickslip.Simulation` (its phases give the regime and the cycle's numbers)."""
+    summary = cycle_numbers(sim)
+    whole = [c for c in sim.cycles if c.period is not None]
+    time, stress = sim.time, sim.stress
+    period = summary["period"]
+    if math.isfinite(period) and whole:  # the repeating cycle's extremes, from the trace of the last whole one
+        last = whole[-1]
+        inside = (time >= last.start_time) & (time <= last.start_time + period)
+        peak, trough = float(np.max(stress[inside])), float(np.min(stress[inside]))
+    else:
+        peak, trough = float(np.max(stress)), float(np.min(stress))
+    ratio = 1.0 if sim.regime == regimes.STICK_SLIP and len(whole) >= 2 else NAN
+    regime = regimes.Regime(sim.regime, len(whole), ratio, period, peak, trough, sim.message)
+    return Run(
+        model=QuasiStatic.name,
+        time=time,
+        stress=stress,
+        friction=None,
+        slider_velocity=sim.velocity,
+        slider_position=sim.slider_displacement,
+        load_point_position=sim.puller_displacement,
+        regime=regime,
+        mean=summary["mean_stress"],
+        states={"block_shear": sim.block_shear, "chain_fraction": sim.chain_fraction, "phase": sim.phase},
+        state_units={"block_shear": "m", "chain_fraction": "1", "phase": None},
+        summary=summary,
+        message=sim.message,
+        native=sim,
+    )
+
+
+def cycle_numbers(sim: Any) -> dict[str, Any]:
+    """The repeating cycle's numbers (SI): period, stick time, sigma_s, Vs, the mean stress over the cycle."""
+    row: dict[str, Any] = {
+        "regime": sim.regime,
+        "period": NAN,
+        "stick_time": NAN,
+        "peak_stress": NAN,
+        "jump_velocity": NAN,
+        "mean_stress": time_mean(sim.time, sim.stress),
+        "cycles": sum(c.period is not None for c in sim.cycles),
+        "critical_velocity": sim.critical_velocity,
+    }
+    # the first stick starts at sigma_c, so the first phases are those of the repeating cycle
+    if sim.slip_phases and sim.jumps and sim.jumps[0].velocity is not None:
+        stick, slip = sim.stick_phases[0], sim.slip_phases[0]
+        row.update(stick_time=stick.stick_time, peak_stress=stick.peak_stress, jump_velocity=sim.jumps[0].velocity)
+        if sim.regime == regimes.STICK_SLIP:
+            row["period"] = stick.stick_time + slip.duration
+            row["mean_stress"] = _cycle_mean(stick, slip, sim.stiffness, sim.pulling_velocity)
+        elif sim.regime == regimes.STEADY:
+            row["mean_stress"] = slip.end_stress
+    return row
+
+
+def _cycle_mean(stick: Any, slip: Any, stiffness: float, velocity: float) -> float:
+    """Mean stress over the repeating cycle: the stick's is linear in time (Eq 12), the slip's by trapezoids."""
+    ts = stick.stick_time
+    stick_integral = stick.start_stress * ts + 0.5 * stiffness * velocity * ts * ts
+    t, s = slip.time, slip.stress
+    slip_integral = float(np.sum(np.diff(t) * (s[1:] + s[:-1])) / 2.0) if t.size > 1 else 0.0
+    return (stick_integral + slip_integral) / (ts + slip.duration)

@@ -1,0 +1,140 @@
+"""The registry of friction models: built-ins, ``stickslip.models`` entry points, and ``module:attr`` paths.
+
+A package outside stickslip makes its model available by declaring, in its ``pyproject.toml``::
+
+    [project.entry-points."stickslip.models"]
+    my-model = "my_package.friction:MODEL"
+
+or a script calls :func:`register_model` (then ``--model my-model`` works in that process), or the command
+line names it as an import path, ``--model my_package.friction:MODEL``.
+"""
+
+from __future__ import annotations
+
+import importlib
+from importlib import metadata
+from typing import Any
+
+from ..errors import ParameterError
+from .base import FrictionModel
+
+__all__ = ["ENTRY_POINT_GROUP", "available_models", "get_model", "register_model"]
+
+ENTRY_POINT_GROUP = "stickslip.models"
+_MODELS: dict[str, FrictionModel] = {}
+_ALIASES: dict[str, str] = {}
+_LOADED = {"builtins": False, "entry points": False}
+_REQUIRED = ("name", "dimensions", "parameters", "run")
+
+
+def register_model(model: Any, *, replace: bool = False) -> FrictionModel:
+    """Make ``model`` (a :class:`FrictionModel` instance, or a class to instantiate) available by its name and
+    aliases; returns it.  A name already taken by another model is refused unless ``replace=True``."""
+    if isinstance(model, type):
+        model = model()
+    missing = [attr for attr in _REQUIRED if not hasattr(model, attr)]
+    if missing:
+        raise ParameterError(
+            f"register_model: {type(model).__name__} is not a friction model (no {', '.join(missing)});"
+            " subclass stickslip.models.FrictionModel"
+        )
+    name = model.name
+    if not isinstance(name, str) or not name.strip() or ":" in name or "," in name:
+        raise ParameterError(f"register_model: a model's name must be a word without ':' or ',', got {name!r}")
+    _builtins()
+    names = (name, *getattr(model, "aliases", ()))
+    for alias in names:
+        owner = _ALIASES.get(alias, alias if alias in _MODELS else None)
+        if owner is not None and _MODELS[owner] is not model and not replace:
+            raise ParameterError(f"register_model: the name {alias!r} is taken by model {owner!r}; pass replace=True")
+    _MODELS[name] = model
+    for alias in names[1:]:
+        _ALIASES[alias] = name
+    return model
+
+
+def get_model(name: Any) -> FrictionModel:
+    """The model called ``name`` (or one of its aliases), or ``module:attr`` imported; a model is returned as is."""
+    if not isinstance(name, str):
+        if all(hasattr(name, attr) for attr in _REQUIRED):
+            return name
+        raise ParameterError(f"model: expected a name, one of {', '.join(available_models())}; got {name!r}")
+    key = name.strip()
+    if ":" in key:
+        return _imported(key)
+    _builtins()
+    found = _lookup(key)
+    if found is None:
+        _entry_points()
+        found = _lookup(key)
+    if found is None:
+        raise ParameterError(f"--model {name!r}: expected one of {', '.join(available_models())} (or module:attr)")
+    return found
+
+
+def available_models() -> dict[str, FrictionModel]:
+    """Every registered model by name (built-ins first, then those of installed packages and of this process)."""
+    _builtins()
+    _entry_points()
+    return dict(_MODELS)
+
+
+def _lookup(key: str) -> FrictionModel | None:
+    if key in _MODELS:
+        return _MODELS[key]
+    if key in _ALIASES:
+        return _MODELS[_ALIASES[key]]
+    return None
+
+
+def _builtins() -> None:
+    if _LOADED["builtins"]:
+        return
+    _LOADED["builtins"] = True
+    from .quasi_static import QuasiStatic
+    from .rsf import RSFModel
+    from .transient import Transient
+
+    for model in (QuasiStatic(), Transient(), RSFModel()):
+        register_model(model)
+
+
+def _entry_points() -> None:
+    if _LOADED["entry points"]:
+        return
+    _LOADED["entry points"] = True
+    for entry in metadata.entry_points(group=ENTRY_POINT_GROUP):
+        if _lookup(entry.name) is not None:
+            continue  # a built-in or a model registered in this process wins
+        try:
+            model = entry.load()
+        except Exception as exc:  # a broken plug-in is that plug-in's problem: say so, keep the others
+            import warnings
+
+            warnings.warn(f"stickslip: model entry point {entry.name!r} ({entry.value}) failed to load: {exc}",
+                          UserWarning, stacklevel=3)  # fmt: skip
+            continue
+        register_model(model)
+
+
+def _imported(path: str) -> FrictionModel:
+    """``module:attr`` (attr may be dotted): the model there, registered under its name."""
+    module_name, _, attr = path.partition(":")
+    if not module_name or not attr:
+        raise ParameterError(f"--model {path!r}: expected an import path MODULE:ATTRIBUTE, e.g. my_models:MODEL")
+    try:
+        target: Any = importlib.import_module(module_name)
+    except ImportError as exc:
+        raise ParameterError(f"--model {path!r}: cannot import {module_name!r} ({exc})") from None
+    for part in attr.split("."):
+        if not hasattr(target, part):
+            raise ParameterError(f"--model {path!r}: module {module_name!r} has no attribute {attr!r}")
+        target = getattr(target, part)
+    model = target() if isinstance(target, type) else target
+    if not all(hasattr(model, a) for a in _REQUIRED):
+        raise ParameterError(f"--model {path!r}: {attr} is not a friction model (subclass stickslip.FrictionModel)")
+    _builtins()
+    known = _lookup(model.name)
+    if known is None or type(known) is type(model):
+        return known or register_model(model)
+    return model

@@ -1,0 +1,223 @@
+"""Rate-and-state friction on a spring-slider (:func:`stickslip.rsf.simulate`) behind the interface."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from typing import Any, ClassVar
+
+import numpy as np
+
+from .. import regimes
+from ..errors import ParameterError
+from ..protocols import Protocol
+from .base import Boundary, Capabilities, FrictionModel, Rig
+from .run import Run, settled_mean
+
+NAN = math.nan
+#: Other spellings accepted for keys (the issue's symbols).
+ALIASES = {"Dc": "dc", "η": "eta"}
+
+
+class RSFModel(FrictionModel):
+    """Rate-and-state friction (one state variable from keys, or any :class:`stickslip.rsf.RSFParams`).
+
+    ``k`` is the spring stiffness in friction per slip (1/m) and ``eta`` the radiation damping in friction per
+    velocity (s/m); a rig's K (Pa/m), damping (Pa s/m) and mass need ``normal_stress`` to be read in those
+    terms.  ``start``: the slider's velocity (m/s) in the initial steady state (default: the first segment's).
+    """
+
+    name = "rsf"
+    aliases = ("rate-and-state", "rate-state")
+    description = "rate-and-state friction on a spring-slider (Dieterich-Ruina laws)"
+    capabilities = Capabilities(
+        controls=("spring",), protocols="any", damping=True, mass=True, settings=("every", "times", "rtol", "atol")
+    )
+    sweep_columns: ClassVar[Mapping[str, str]] = {
+        "regime": "str",
+        "period": "float",
+        "peak_friction": "float",
+        "trough_friction": "float",
+        "mean_friction": "float",
+        "growth": "float",
+        "critical_stiffness": "float",
+    }
+    #: key -> dimension (``law`` is taken too: a name, kept in a sweep's numbers as its index in LAW_NAMES)
+    KEYS: Mapping[str, str] = {
+        "a": "dimensionless",
+        "b": "dimensionless",
+        "dc": "length",
+        "k": "per_length",
+        "eta": "slowness",
+        "mu0": "dimensionless",
+        "v_ref": "velocity",
+        "normal_stress": "stress",
+    }
+    LAW_NAMES = ("aging", "slip", "prz")  # the laws with one state variable and no further constant
+    #: a sweep point starts in steady sliding at this times the pulling velocity: from exactly the steady
+    #: state an unstable slider would never leave it, so the step seeds the oscillation whose fate is reported
+    START_STEP = 1.1
+
+    @classmethod
+    def sweep_start(cls, protocol: Protocol) -> float:
+        return cls.START_STEP * protocol.segments[0].velocity
+
+    def dimensions(self) -> dict[str, str]:
+        return dict(self.KEYS)
+
+    def parameters(self, spec: Any = None, overrides: Mapping[str, Any] | None = None) -> Any:
+        """:class:`stickslip.rsf.RSFParams` from ``spec`` (RSFParams, a mapping as in a TOML file, or None for
+        the defaults) and ``overrides`` of :attr:`KEYS` and ``law`` (a name, or its index in :attr:`LAW_NAMES`)."""
+        from ..rsf import RSFParams, rsf_params
+        from ..units import to_si
+
+        if overrides is not None and not isinstance(overrides, Mapping):
+            raise ParameterError(f"overrides: expected a mapping {{key: value}}, got {type(overrides).__name__}")
+        if spec is None:
+            base = RSFParams()
+        elif isinstance(spec, RSFParams):
+            base = spec
+        elif isinstance(spec, Mapping):
+            base = RSFParams.from_dict(spec)
+        else:
+            raise ParameterError(f"rsf parameters: expected RSFParams or a mapping, got {type(spec).__name__}")
+        if not overrides:
+            return base
+        if len(base.states) != 1 or base.states[0].law not in self.LAW_NAMES:
+            raise ParameterError("rsf parameters: keys override one state variable of the aging, slip or prz law")
+        values = self.values(base)
+        for given, raw in overrides.items():
+            key = ALIASES.get(given, given)  # --set Dc=..., η=... as --vary takes them
+            if key == "law":
+                values["law"] = float(self._law_code(raw))
+            elif key in self.KEYS:
+                values[key] = to_si(raw, self.KEYS[key], key)
+            else:
+                expected = ", ".join((*self.KEYS, "law"))
+                raise ParameterError(f"--set {given}: unknown rate-and-state key; expected one of: {expected}")
+        return rsf_params(
+            values["a"],
+            values["b"],
+            values["dc"],
+            law=self.LAW_NAMES[int(values.get("law", 0))],
+            mu0=values["mu0"],
+            v_ref=values["v_ref"],
+            stiffness=values["k"],
+            eta=values["eta"],
+            normal_stress=values.get("normal_stress"),
+        )
+
+    def _law_code(self, raw: Any) -> int:
+        if isinstance(raw, (int, float)) and not isinstance(raw, bool) and float(raw) in range(len(self.LAW_NAMES)):
+            return int(raw)
+        name = str(raw).strip().lower()
+        if name not in self.LAW_NAMES:
+            raise ParameterError(f"--set law={raw}: expected one of {', '.join(self.LAW_NAMES)}")
+        return self.LAW_NAMES.index(name)
+
+    def values(self, params: Any) -> dict[str, float]:
+        state = params.states[0]
+        law = self.LAW_NAMES.index(state.law) if state.law in self.LAW_NAMES else 0
+        fixed = {"a": params.a, "b": state.b, "dc": state.dc, "k": params.stiffness, "eta": params.eta}
+        fixed.update(mu0=params.mu0, v_ref=params.v_ref, law=float(law))
+        if params.normal_stress is not None:
+            fixed["normal_stress"] = params.normal_stress
+        return fixed
+
+    def label(self, params: Any) -> str:
+        return f"rate-and-state, {params.states[0].law} law"
+
+    def run(
+        self, params: Any, protocol: Protocol, rig: Rig | None = None, *, start: Any = None, **settings: Any
+    ) -> Run:
+        from ..rsf import RSFParams, simulate
+
+        rig = self.check(protocol, rig, settings)
+        if not isinstance(params, RSFParams):
+            raise ParameterError(f"params: expected RSFParams (model rsf), got {type(params).__name__}")
+        params = _with_rig(params, rig)
+        result = simulate(params, protocol, start_velocity=start, **settings)
+        return rsf_run(result)
+
+    def stability_boundary(self, fixed: Any, x: str, y: str, frame: Any = None) -> list[Boundary]:
+        """k = kc from :func:`stickslip.rsf.critical_stiffness`, against the other axis when k is on one."""
+        from ..rsf import critical_stiffness
+
+        if frame is None or "k" not in (x, y):
+            return []
+        other = y if x == "k" else x
+        if other == "pulling_velocity":  # kc(V) on a fine grid (it depends on V through eta V)
+            params = self.parameters(None, {k: v for k, v in fixed.items() if k != "pulling_velocity"})
+            lo, hi = float(frame[other].min()), float(frame[other].max())
+            along = np.geomspace(lo, hi, 80) if lo > 0 and hi > lo else np.array([lo, hi])
+            critical = np.array([critical_stiffness(params, v) for v in along], dtype=float)
+        elif other in frame:
+            kc = frame.groupby(other)["critical_stiffness"].median().dropna()
+            along, critical = kc.index.to_numpy(dtype=float), kc.to_numpy(dtype=float)
+        else:
+            return []
+        keep = critical > 0  # kc = 0: steady sliding is stable at every stiffness there, no boundary
+        curve = (critical[keep], along[keep]) if x == "k" else (along[keep], critical[keep])
+        return [Boundary(curve[0], curve[1], "k = kc (rsf.critical_stiffness)")]
+
+
+def _with_rig(params: Any, rig: Rig) -> Any:
+    """The spring, damping and mass of the rig in rate-and-state's terms (per unit normal stress)."""
+    given = {"stiffness": rig.stiffness, "eta": rig.damping, "mass": rig.mass}
+    given = {k: v for k, v in given.items() if v is not None}
+    if not given:
+        return params
+    sigma = params.normal_stress
+    if sigma is None:
+        raise ParameterError(
+            f"rig {', '.join(given)}: rate-and-state reads a rig in friction units; set normal_stress, or give"
+            " k (1/m) and eta (s/m) in the parameters instead"
+        )
+    changes = {k: (v if k == "mass" else v / sigma) for k, v in given.items()}
+    return params.replace(**changes)
+
+
+def rsf_run(result: Any) -> Run:
+    """The :class:`Run` of a :class:`stickslip.rsf.RSFRun` (its regime is already the classifier's, from the
+    solver's dense solution)."""
+    from ..rsf import critical_stiffness
+
+    r = result.regime
+    params, protocol = result.params, result.protocol
+    kind = {"steady sliding": regimes.STEADY, "not analysed": regimes.UNDETERMINED}.get(r.name, r.name)
+    sigma = params.normal_stress
+    scale = 1.0 if sigma is None else sigma
+    regime = regimes.Regime(
+        kind, r.periods, r.growth, r.period, r.peak_friction * scale, r.trough_friction * scale,
+        r.evidence or result.summary()["message"],
+    )  # fmt: skip
+    mean = settled_mean(result.time, result.friction, r.period)
+    velocity = protocol.segments[-1].velocity  # the last segment's, whose regime is reported
+    kc = critical_stiffness(params, velocity) if velocity > 0 else NAN
+    summary = {
+        "regime": r.name,
+        "period": r.period,
+        "peak_friction": r.peak_friction,
+        "trough_friction": r.trough_friction,
+        "mean_friction": mean,
+        "growth": r.growth,
+        "critical_stiffness": kc,
+    }
+    states = {"state" if i == 0 else f"state{i + 1}": row for i, row in enumerate(result.state)}
+    return Run(
+        model=RSFModel.name,
+        time=result.time,
+        stress=None if sigma is None else result.friction * sigma,
+        friction=result.friction,
+        slider_velocity=result.slider_velocity,
+        slider_position=result.slider_displacement,
+        load_point_position=result.load_point_displacement,
+        regime=regime,
+        mean=mean * scale,
+        states=states,
+        state_units=dict.fromkeys(states, "s"),
+        summary=summary,
+        message=result.summary()["message"],
+        status="ok" if result.status == "ok" else "failed",
+        native=result,
+    )

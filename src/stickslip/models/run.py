@@ -1,0 +1,332 @@
+"""One result type for every model: :class:`Run` (the trace with units, and what it settled into).
+
+Columns (SI): ``time`` (s), ``stress`` (Pa; the friction stress, where the model has one), ``friction``
+(mu = stress / normal stress, where a normal stress exists), ``slider_velocity`` (m/s), ``slider_position`` (m),
+``load_point_position`` (m), then the model's own state columns with their units.  ``regime`` is a
+:class:`stickslip.regimes.Regime` from the one classifier, given by the model from its dense solution (its
+interpolant, or exact events); a Run built from a trace alone is classified on that trace.
+"""
+
+from __future__ import annotations
+
+import io
+import json
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from .. import regimes
+from ..errors import DataError, ParameterError
+
+if TYPE_CHECKING:  # pragma: no cover
+    import pandas as pd
+    from matplotlib.axes import Axes
+
+__all__ = ["BASE_COLUMNS", "Run", "settled_mean", "time_mean"]
+
+#: The columns every run has (``stress`` or ``friction`` may be absent), in order, with their SI units.
+BASE_COLUMNS: dict[str, str | None] = {
+    "time": "s",
+    "stress": "Pa",
+    "friction": "1",
+    "slider_velocity": "m/s",
+    "slider_position": "m",
+    "load_point_position": "m",
+}
+#: The first line of a Run CSV: a comment the trace readers skip, holding what the columns cannot.
+CSV_MARK = "# stickslip run "
+NAN = float("nan")
+
+
+def time_mean(time: np.ndarray, values: np.ndarray) -> float:
+    """Time average by the trapezoidal rule (the last value for a single instant; NaN for none)."""
+    span = float(time[-1] - time[0]) if time.size else 0.0
+    if span <= 0:
+        return float(values[-1]) if values.size else NAN
+    return float(np.sum(np.diff(time) * (values[1:] + values[:-1])) / (2.0 * span))
+
+
+def settled_mean(time: np.ndarray, values: np.ndarray, period: float) -> float:
+    """Mean over the last whole periods within the run's second half (over that half if it does not oscillate)."""
+    end = float(time[-1])
+    half = 0.5 * (end - float(time[0]))
+    span = float(np.floor(half / period) * period) if np.isfinite(period) and period > 0 else 0.0
+    inside = time >= end - (span if span > 0 else half)
+    return time_mean(time[inside], values[inside])
+
+
+def _column(values: Any, name: str, size: int | None) -> np.ndarray:
+    array = np.asarray(values, dtype=float) if not _is_text(values) else np.asarray(values, dtype=object)
+    if array.ndim != 1:
+        raise ParameterError(f"run column {name}: expected one value per time, got an array of shape {array.shape}")
+    if size is not None and array.size != size:
+        raise ParameterError(f"run column {name}: {array.size} values for {size} times")
+    return array
+
+
+def _is_text(values: Any) -> bool:
+    array = np.asarray(values)
+    return array.dtype.kind in "OUS"
+
+
+@dataclass(frozen=True)
+class Run:
+    """A model run: the trace (SI, one row per solver output), its regime, and its summary numbers.
+
+    ``period``, ``peak``, ``trough`` come from ``regime`` (the settled cycle's, or the window's extremes when
+    it does not oscillate); ``mean`` is the model's mean over the settled cycle.  ``summary`` holds the model's
+    own scalar results (e.g. ``stick_time``), ``native`` the model's own result object (not compared, not
+    written).  ``status`` is "ok" or "failed" (then ``message`` says why).
+    """
+
+    model: str
+    time: np.ndarray
+    stress: np.ndarray | None
+    friction: np.ndarray | None
+    slider_velocity: np.ndarray
+    slider_position: np.ndarray
+    load_point_position: np.ndarray
+    regime: regimes.Regime
+    mean: float = NAN
+    states: Mapping[str, np.ndarray] = field(default_factory=dict)
+    state_units: Mapping[str, str | None] = field(default_factory=dict)
+    summary: Mapping[str, Any] = field(default_factory=dict)
+    message: str = ""
+    status: str = "ok"
+    native: Any = field(default=None, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        time = _column(self.time, "time", None)
+        object.__setattr__(self, "time", time)
+        for name in ("stress", "friction"):
+            value = getattr(self, name)
+            object.__setattr__(self, name, None if value is None else _column(value, name, time.size))
+        if self.stress is None and self.friction is None:
+            raise ParameterError("run: expected a stress or a friction column, got neither")
+        for name in ("slider_velocity", "slider_position", "load_point_position"):
+            object.__setattr__(self, name, _column(getattr(self, name), name, time.size))
+        states = {str(k): _column(v, str(k), time.size) for k, v in self.states.items()}
+        clash = sorted(set(states) & set(BASE_COLUMNS))
+        if clash:
+            raise ParameterError(f"run state column {clash[0]!r}: the name of a base column; name it otherwise")
+        object.__setattr__(self, "states", states)
+        object.__setattr__(self, "state_units", {k: self.state_units.get(k) for k in states})
+        if not isinstance(self.regime, regimes.Regime):
+            raise ParameterError(f"run regime: expected a stickslip.regimes.Regime, got {type(self.regime).__name__}")
+        if self.status not in ("ok", "failed"):
+            raise ParameterError(f"run status: expected 'ok' or 'failed', got {self.status!r}")
+
+    # ---------------------------------------------------------------- building
+    @classmethod
+    def from_trace(
+        cls,
+        model: str,
+        time: Any,
+        *,
+        stress: Any = None,
+        friction: Any = None,
+        slider_velocity: Any,
+        slider_position: Any,
+        load_point_position: Any,
+        states: Mapping[str, Any] | None = None,
+        state_units: Mapping[str, str | None] | None = None,
+        regime: regimes.Regime | None = None,
+        floor: float | None = None,
+        dense: regimes.Dense | None = None,
+        start: float | None = None,
+        **extra: Any,
+    ) -> Run:
+        """A Run from the model's solution; without ``regime`` it is classified on the stress (or friction)
+        by :func:`stickslip.regimes.classify`, with ``dense`` the solver's interpolant of that signal if there is
+        one, over ``t >= start``, changes below ``floor`` (default 1e-9 of the signal's scale) counting as none."""
+        t = np.asarray(time, dtype=float)
+        signal = np.asarray(stress if stress is not None else friction, dtype=float)
+        if regime is None:
+            if floor is None:
+                scale = float(np.max(np.abs(signal[np.isfinite(signal)]), initial=0.0))
+                floor = 1e-9 * scale if scale > 0 else 1e-300
+            regime = regimes.classify(t, signal, floor=floor, start=start, dense=dense)
+        run = cls(
+            model=model, time=t, stress=stress, friction=friction, slider_velocity=slider_velocity,
+            slider_position=slider_position, load_point_position=load_point_position, regime=regime,
+            states=states or {}, state_units=state_units or {}, **extra,
+        )  # fmt: skip
+        if "mean" not in extra and t.size:
+            object.__setattr__(run, "mean", settled_mean(t, run.signal, regime.period))
+        return run
+
+    # ---------------------------------------------------------------- what it settled into
+    @property
+    def signal(self) -> np.ndarray:
+        """The classified signal: the stress where there is one, else the friction coefficient."""
+        return self.stress if self.stress is not None else self.friction  # type: ignore[return-value]
+
+    @property
+    def signal_unit(self) -> str:
+        return "Pa" if self.stress is not None else "1"
+
+    @property
+    def period(self) -> float:
+        return float(self.regime.period)
+
+    @property
+    def peak(self) -> float:
+        return float(self.regime.peak)
+
+    @property
+    def trough(self) -> float:
+        return float(self.regime.trough)
+
+    @property
+    def regime_name(self) -> str:
+        """The regime as the model names it (rate-and-state keeps "steady sliding")."""
+        return str(self.summary.get("regime", self.regime.kind))
+
+    def row(self, columns: Mapping[str, str]) -> dict[str, Any]:
+        """One sweep row: each of ``columns`` (name -> kind) from the model's summary, else from the Run."""
+        generic = {
+            "regime": self.regime_name,
+            "period": self.period,
+            "peak_stress": self.peak if self.stress is not None else NAN,
+            "trough_stress": self.trough if self.stress is not None else NAN,
+            "mean_stress": self.mean if self.stress is not None else NAN,
+            "peak_friction": self.peak if self.stress is None else NAN,
+            "trough_friction": self.trough if self.stress is None else NAN,
+            "mean_friction": self.mean if self.stress is None else NAN,
+            "growth": self.regime.amplitude_ratio,
+            "cycles": self.regime.periods,
+        }
+        row: dict[str, Any] = {}
+        for name, kind in columns.items():
+            if name in self.summary:
+                row[name] = self.summary[name]
+            elif name in generic:
+                row[name] = generic[name]
+            else:
+                row[name] = None if kind == "str" else 0 if kind == "int" else NAN
+        row["message"] = self.message or self.regime.evidence
+        return row
+
+    # ---------------------------------------------------------------- tables and files
+    @property
+    def units(self) -> dict[str, str | None]:
+        return {**BASE_COLUMNS, **self.state_units}
+
+    def to_frame(self) -> pd.DataFrame:
+        """The trace as a DataFrame, ``attrs["units"]`` naming every column's unit."""
+        import pandas as pd
+
+        from ..columns import with_units
+
+        columns: dict[str, Any] = {"time": self.time}
+        for name in ("stress", "friction"):
+            if getattr(self, name) is not None:
+                columns[name] = getattr(self, name)
+        for name in ("slider_velocity", "slider_position", "load_point_position"):
+            columns[name] = getattr(self, name)
+        columns.update(self.states)
+        return with_units(pd.DataFrame(columns), extra=self.units)
+
+    def metadata(self) -> dict[str, Any]:
+        """What the columns cannot hold: the model, the regime and its evidence, the summary."""
+        from ..cli.common import json_safe  # plain-data helper, no CLI machinery
+
+        r = self.regime
+        return json_safe({
+            "model": self.model, "status": self.status, "message": self.message, "mean": self.mean,
+            "regime": {"kind": r.kind, "periods": r.periods, "amplitude_ratio": r.amplitude_ratio,
+                       "period": r.period, "peak": r.peak, "trough": r.trough, "evidence": r.evidence},
+            "summary": dict(self.summary),
+        })  # fmt: skip
+
+    def to_csv(self, path: str | Path) -> Path:
+        """Write the trace as CSV (units in the header, every digit), the regime in a first comment line.
+
+        Written atomically (a symlink's target, a FIFO or a device as it is); ``stickslip analyze`` reads it
+        as a measured trace, :meth:`read` as a Run.
+        """
+        from ..columns import csv_text
+        from ..fileio import atomic_write_text
+
+        head = CSV_MARK + json.dumps(self.metadata(), separators=(",", ":"), allow_nan=False) + "\n"
+        return atomic_write_text(path, head + csv_text(self.to_frame()))
+
+    @classmethod
+    def read(cls, path: str | Path) -> Run:
+        """A Run from a CSV written by :meth:`to_csv` (any other trace with the base columns is classified anew)."""
+        import pandas as pd
+
+        from ..columns import split_header
+        from ..fileio import read_input_text
+
+        text = read_input_text(path, "run", 1 << 31)
+        first, _, body = text.partition("\n")
+        meta: dict[str, Any] = {}
+        if first.startswith(CSV_MARK):
+            try:
+                meta = json.loads(first[len(CSV_MARK) :], parse_constant=lambda _: NAN)
+            except ValueError:
+                raise DataError(f"{path}: row 1: the run's metadata line is not valid JSON") from None
+        else:
+            body = text
+
+        try:
+            frame = pd.read_csv(io.StringIO(body), comment=None)
+        except (ValueError, pd.errors.ParserError) as exc:
+            raise DataError(f"{path}: not a CSV run trace ({str(exc).splitlines()[0]})") from None
+        names = {}
+        units = {}
+        for cell in frame.columns:
+            name, unit = split_header(str(cell))
+            names[cell] = name
+            units[name] = unit
+        frame = frame.rename(columns=names)
+        for need in ("time", "slider_velocity", "slider_position", "load_point_position"):
+            if need not in frame:
+                raise DataError(f"{path}: missing column {need!r}; a run trace has {', '.join(BASE_COLUMNS)}")
+        for name, unit in units.items():
+            if name in BASE_COLUMNS and unit != BASE_COLUMNS[name]:
+                raise DataError(f"{path}: column {name!r} in [{unit}]; a run trace holds it in [{BASE_COLUMNS[name]}]")
+        states = {n: frame[n].to_numpy() for n in frame.columns if n not in BASE_COLUMNS}
+        regime = None
+        if "regime" in meta:
+            r = meta["regime"]
+            regime = regimes.Regime(
+                r["kind"], int(r["periods"]), _number(r["amplitude_ratio"]), _number(r["period"]), _number(r["peak"]),
+                _number(r["trough"]), r["evidence"],
+            )  # fmt: skip
+        summary = {k: NAN if v is None else v for k, v in meta.get("summary", {}).items()}
+        extra: dict[str, Any] = {"summary": summary, "message": meta.get("message", "")}
+        extra["status"] = meta.get("status", "ok")
+        if "mean" in meta:
+            extra["mean"] = _number(meta["mean"])
+        number = {n: _floats(frame, n, path) for n in BASE_COLUMNS if n in frame}
+        return cls.from_trace(
+            meta.get("model", "trace"), number["time"], stress=number.get("stress"), friction=number.get("friction"),
+            slider_velocity=number["slider_velocity"], slider_position=number["slider_position"],
+            load_point_position=number["load_point_position"],
+            states=states, state_units={n: units[n] for n in states}, regime=regime, **extra,
+        )  # fmt: skip
+
+    def plot(self, ax: Axes | None = None, **kwargs: Any) -> Axes:
+        """Stress (or friction) against time, the slider velocity on a twin axis; returns the Axes."""
+        from ..plots.run import plot_run
+
+        return plot_run(self, ax=ax, **kwargs)
+
+
+def _floats(frame: pd.DataFrame, name: str, path: str | Path) -> np.ndarray:
+    import pandas as pd
+
+    values = pd.to_numeric(frame[name], errors="coerce").to_numpy(dtype=float)
+    bad = np.flatnonzero(np.isnan(values) & frame[name].notna().to_numpy())
+    if bad.size:
+        raise DataError(f"{path}: column {name!r}: not a number in data row {bad[0] + 1}: {frame[name].iloc[bad[0]]!r}")
+    return values
+
+
+def _number(value: Any) -> float:
+    return NAN if value is None else float(value)

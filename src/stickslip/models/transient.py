@@ -1,0 +1,144 @@
+"""The time-dependent bond model (Eqs 1-5, :func:`stickslip.transient.run_transient`) behind the interface."""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from .. import regimes
+from ..parameters import Parameters
+from ..protocols import Protocol
+from .base import Boundary, Capabilities, Rig
+from .bond import STIFFNESS_KEYS, BondModel
+from .run import Run, time_mean
+
+NAN = math.nan
+
+
+class Transient(BondModel):
+    """The population balance of bonds under any piecewise-constant protocol, rigid or through the block.
+
+    ``start``: "empty" (no bonds, no stress; the default) or "steady" (the steady population at the first
+    segment's velocity, or at the setting ``start_velocity``).  Settings: those of ``run_transient``
+    (``stick_population``, ``aging``, ``start_velocity``, ``every``, ``rtol``, ``max_step``, ``max_steps``,
+    ``snapshot_times``, ``progress``).
+    """
+
+    name = "transient"
+    aliases = ("time-dependent", "population-balance")
+    description = "bond model, time-dependent population balance (Eqs 1-5)"
+    capabilities = Capabilities(
+        controls=("spring", "velocity"),
+        protocols="any",
+        settings=(
+            "stick_population", "aging", "start_velocity", "every", "rtol", "max_step", "max_steps",
+            "snapshot_times", "progress",
+        ),
+    )  # fmt: skip
+    sweep_start = "steady"
+
+    def run(
+        self, params: Parameters, protocol: Protocol, rig: Rig | None = None, *, start: Any = None, **settings: Any
+    ) -> Run:
+        from ..transient import run_transient
+
+        rig = self.check(protocol, rig, settings)
+        control = "velocity" if rig.control == "velocity" else "block"
+        result = run_transient(
+            params, protocol, control=control, start="empty" if start is None else start, stiffness=rig.stiffness,
+            **settings,
+        )  # fmt: skip
+        return transient_run(result, protocol)
+
+    def stability_boundary(self, fixed: Any, x: str, y: str, frame: Any = None) -> list[Boundary]:
+        """Kc(V0) of the linear stability of steady sliding, in the plane (V0, a stiffness key)."""
+        from ..transient import critical_stiffness
+
+        stiffness_axes = ("block.height", *STIFFNESS_KEYS)
+        if frame is None or "pulling_velocity" not in (x, y) or not ({x, y} & set(stiffness_axes)):
+            return []
+        other = y if x == "pulling_velocity" else x
+        params = self.parameters(None, {k: v for k, v in fixed.items() if k != "pulling_velocity"})
+        lo, hi = float(frame["pulling_velocity"].min()), float(frame["pulling_velocity"].max())
+        velocity = np.geomspace(max(lo, 1e-12), max(hi, 2e-12), 80)
+        kc = np.array([critical_stiffness(params, v) for v in velocity], dtype=float)
+        good = np.isfinite(kc) & (kc > 0)
+        along = self.stiffness_of(other, params, kc[good])
+        curve = (velocity[good], along) if x == "pulling_velocity" else (along, velocity[good])
+        return [Boundary(curve[0], curve[1], "K = Kc(V0), linear stability")]
+
+
+def transient_run(result: Any, protocol: Protocol) -> Run:
+    """The :class:`Run` of a :class:`stickslip.transient.TransientResult` (regime from its slip events)."""
+    summary = last_cycle_numbers(result)
+    states: dict[str, Any] = {"bonded_fraction": result.bonded_fraction}
+    units: dict[str, str | None] = {"bonded_fraction": "1"}
+    if result.chain_fraction is not None:
+        states.update(chain_fraction=result.chain_fraction, held_by=result.held_by)
+        units.update(chain_fraction="1", held_by=None)
+    return Run(
+        model=Transient.name,
+        time=result.time,
+        stress=result.stress,
+        friction=None,
+        slider_velocity=result.slider_velocity,
+        slider_position=result.slider_position,
+        load_point_position=result.puller_position,
+        regime=_regime(result, protocol),
+        mean=summary["mean_stress"],
+        states=states,
+        state_units=units,
+        summary=summary,
+        message=result.message,
+        native=result,
+    )
+
+
+def _regime(result: Any, protocol: Protocol) -> regimes.Regime:
+    """The solver's verdict, with the evidence of the one classifier: the slips' exact peaks and the sticks'
+    troughs (cycles) in the last segment when it oscillates, the classifier on the solver's steps otherwise."""
+    start = float(protocol.boundaries[-2])
+    whole = [c for c in result.cycles if c.period is not None and c.start_time >= start]
+    time, stress = np.asarray(result.time, dtype=float), np.asarray(result.stress, dtype=float)
+    if len(whole) >= 2 and result.regime in (regimes.STICK_SLIP, regimes.DECAYING, regimes.GROWING):
+        peaks = [c.peak_stress for c in whole]
+        troughs = [c.start_stress for c in whole[1:]] + [float(np.min(stress[time >= whole[-1].start_time]))]
+        found = regimes.classify_cycles([c.start_time + c.stick_time for c in whole], peaks, troughs)
+    else:
+        from ..transient.cycles import SETTLED
+
+        inside = time >= start
+        scale = float(np.max(np.abs(stress[inside]))) if np.any(inside) else 0.0
+        found = regimes.classify(time, stress, floor=SETTLED * max(scale, 1e-300), start=start, unit="Pa")
+    return regimes.Regime(
+        result.regime, found.periods, found.amplitude_ratio, found.period, found.peak, found.trough, result.message
+    )
+
+
+def last_cycle_numbers(result: Any) -> dict[str, Any]:
+    """The last whole cycle's numbers (the run has settled onto its cycle by then, if ever) and the mean stress
+    over the whole cycles (over the run when there are none)."""
+    whole = [c for c in result.cycles if getattr(c, "period", None) is not None]
+    time, stress = np.asarray(result.time, dtype=float), np.asarray(result.stress, dtype=float)
+    row: dict[str, Any] = {
+        "regime": result.regime,
+        "period": NAN,
+        "stick_time": NAN,
+        "peak_stress": NAN,
+        "jump_velocity": NAN,
+        "mean_stress": time_mean(time, stress),
+        "cycles": len(whole),
+        "critical_velocity": NAN,
+    }
+    if whole:
+        last = whole[-1]
+        row.update(
+            period=last.period, stick_time=last.stick_time, peak_stress=last.peak_stress,
+            jump_velocity=last.jump_velocity,
+        )  # fmt: skip
+        inside = (time >= whole[0].start_time) & (time <= last.start_time + last.period)
+        if np.count_nonzero(inside) > 1:
+            row["mean_stress"] = time_mean(time[inside], stress[inside])
+    return row

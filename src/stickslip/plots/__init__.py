@@ -1,0 +1,1 @@
+"""Every figure of the package, one module per subject (see docs/architecture.md)."""

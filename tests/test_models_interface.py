@@ -1,0 +1,149 @@
+"""The model interface (stickslip.models): the rig, what each model refuses, the registry, one Run per model."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import stickslip
+from stickslip import protocols
+from stickslip.errors import ModelError, ParameterError
+from stickslip.models import FrictionModel, Rig, Run, available_models, get_model, register_model
+from stickslip.models.bond import with_stiffness
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "words"),
+    [
+        ({"control": "force"}, "rig control: expected one of velocity, spring"),
+        ({"stiffness": -1.0}, "rig stiffness: expected a finite value > 0 Pa/m"),
+        ({"stiffness": 0.0}, "rig stiffness"),
+        ({"damping": float("nan")}, "rig damping"),
+        ({"mass": "heavy"}, "rig mass: expected a number"),
+        ({"control": "velocity", "stiffness": 1e5}, "velocity control has no spring"),
+    ],
+)
+def test_rig_refuses_bad_values_in_one_line(kwargs, words):
+    with pytest.raises(ParameterError, match=words) as info:
+        Rig(**kwargs)
+    assert "\n" not in str(info.value)
+
+
+def test_the_public_names_are_there():
+    for name in ("run", "Run", "Rig", "register_model", "get_model", "available_models", "FrictionModel"):
+        assert name in stickslip.__all__ and getattr(stickslip, name) is not None
+    assert {"quasi-static", "transient", "rsf"} <= set(available_models())
+    assert get_model("rate-and-state") is get_model("rsf")
+    assert get_model("stickslip.models.quasi_static:QuasiStatic").name == "quasi-static"
+
+
+@pytest.mark.parametrize("name", ["nope", "stickslip.models:nothing", "no_such_module_xyz:MODEL", ":"])
+def test_unknown_models_are_one_line_errors(name):
+    with pytest.raises(ParameterError) as info:
+        get_model(name)
+    assert "\n" not in str(info.value)
+
+
+def test_the_quasi_static_model_refuses_what_it_cannot_do():
+    qs = get_model("quasi-static")
+    params = qs.parameters()
+    steps = protocols.velocity_steps([50e-6, 100e-6], 10.0)
+    with pytest.raises(ModelError, match="one constant pulling velocity only"):
+        qs.run(params, steps)
+    with pytest.raises(ModelError, match="no velocity control"):
+        qs.run(params, protocols.constant(50e-6, 10.0), Rig("velocity"))
+    with pytest.raises(ModelError, match="damping is not part"):
+        qs.run(params, protocols.constant(50e-6, 10.0), Rig(damping=1.0))
+    with pytest.raises(ParameterError, match="unknown setting 'every'"):
+        qs.run(params, protocols.constant(50e-6, 10.0), every=1.0)
+    with pytest.raises(ParameterError, match="no_such"):
+        qs.parameters(None, {"bonds.no_such": 1.0})
+
+
+def test_a_rig_spring_is_the_blocks_effective_stiffness():
+    """The rig's K replaces Eq 17's; the stick is then loaded at K V0 (Eq 12), checked on the trace."""
+    qs = get_model("quasi-static")
+    k_rig, v0 = 2.0e5, 50e-6
+    run = qs.run(qs.parameters(), protocols.constant(v0, 30.0), Rig(stiffness=k_rig))
+    stick = run.states["phase"] == "stick"
+    t, s = run.time[stick], run.stress[stick]
+    first = t < t[0] + 1.0
+    slope = np.polyfit(t[first], s[first], 1)[0]
+    assert slope == pytest.approx(k_rig * v0, rel=1e-9)
+    same = qs.run(with_stiffness(qs.parameters(), {"block.effective_stiffness": k_rig}), protocols.constant(v0, 30.0))
+    assert np.array_equal(same.stress, run.stress)
+
+
+def test_quasi_static_run_is_the_simulation_and_its_period():
+    """Period = stick time + slip time of the Simulation's phases; the repeating cycle's extremes are
+    sigma_s (Eq 16) and sigma_c (Eq 9)."""
+    p = stickslip.load_parameters()
+    sim = stickslip.simulate(p, 50e-6, 100.0)
+    run = stickslip.run("quasi-static", p, protocols.constant(50e-6, 100.0))
+    assert run.regime.kind == sim.regime == "stick-slip"
+    assert run.period == pytest.approx(sim.stick_phases[0].stick_time + sim.slip_phases[0].duration, rel=1e-14)
+    assert run.peak == pytest.approx(sim.stick_phases[0].peak_stress, rel=1e-12)
+    assert run.trough == pytest.approx(sim.critical_stress, rel=1e-9)
+    assert run.regime.amplitude_ratio == 1.0
+    assert np.array_equal(run.stress, sim.stress)
+    assert run.trough < run.mean < run.peak
+
+
+def test_rsf_run_keeps_its_regime_and_reads_a_rig_through_the_normal_stress():
+    rsf = get_model("rsf")
+    params = rsf.parameters(None, {"normal_stress": "1 MPa", "k": 2e3})
+    run = rsf.run(params, protocols.constant(1e-6, 100.0), start=1.1e-6)
+    native = stickslip.rsf.simulate(params, protocols.constant(1e-6, 100.0), start_velocity=1.1e-6)
+    assert np.array_equal(run.friction, native.friction)
+    assert np.allclose(run.stress, native.friction * 1e6, rtol=1e-15)
+    assert run.regime_name == native.regime.name and run.regime.evidence == native.regime.evidence
+    # K = k sigma through the rig gives the same run as k in the parameters
+    by_rig = rsf.run(rsf.parameters(None, {"normal_stress": "1 MPa"}), protocols.constant(1e-6, 100.0),
+                     Rig(stiffness=2e3 * 1e6), start=1.1e-6)  # fmt: skip
+    assert np.allclose(by_rig.friction, run.friction, rtol=1e-12, atol=0)
+    with pytest.raises(ParameterError, match="set normal_stress"):
+        rsf.run(rsf.parameters(), protocols.constant(1e-6, 10.0), Rig(stiffness=1e9))
+
+
+def test_transient_under_velocity_control_settles_to_the_steady_curve():
+    """A rigid rig at V0 above Vc ends on sigma(V0) of the steady curve (Eqs 6-8), an independent solver."""
+    p = stickslip.load_parameters()
+    v0 = 300e-6
+    run = stickslip.run("transient", p, protocols.constant(v0, 0.3), Rig("velocity"), start="steady")
+    assert run.regime.kind == "steady"
+    assert run.stress[-1] == pytest.approx(stickslip.steady_state(p, v0).stress, rel=1e-4)
+    assert np.allclose(run.slider_velocity, v0)
+
+
+def test_register_model_refuses_a_taken_name_and_non_models():
+    class Copy(FrictionModel):
+        name = "rsf"
+
+        def dimensions(self):
+            return {}
+
+        def parameters(self, spec=None, overrides=None):
+            return None
+
+        def run(self, params, protocol, rig=None, *, start=None, **settings):
+            raise AssertionError
+
+    with pytest.raises(ParameterError, match="taken by model 'rsf'"):
+        register_model(Copy())
+    with pytest.raises(ParameterError, match="not a friction model"):
+        register_model(object())
+
+
+def test_a_run_from_a_trace_is_classified_by_the_one_classifier():
+    """A synthetic limit cycle (a sawtooth of constant amplitude) is stick-slip with its exact period."""
+    t = np.linspace(0.0, 50.0, 20001)
+    stress = 100.0 + 20.0 * ((t / 5.0) % 1.0)
+    zeros = np.zeros_like(t)
+    run = Run.from_trace("test", t, stress=stress, slider_velocity=zeros, slider_position=zeros,
+                         load_point_position=zeros)  # fmt: skip
+    assert run.regime.kind == "stick-slip"
+    assert run.period == pytest.approx(5.0, rel=1e-3)
+    assert run.mean == pytest.approx(110.0, rel=1e-3)
+    assert math.isnan(run.friction[0]) if run.friction is not None else run.friction is None
