@@ -142,7 +142,7 @@ def settings_of(texts: tuple[str, ...], every_text: str | None) -> dict[str, Any
             settings[key] = value.lower() == "true"
             continue
         try:
-            settings[key] = float(value)
+            settings[key] = int(value) if value.lstrip("+-").isdigit() else float(value)
             continue
         except ValueError:
             pass
@@ -173,6 +173,7 @@ def run_summary(run: Any, protocol: Any, rig: Any) -> dict[str, Any]:
         f"peak_{signal}": run.peak,
         f"trough_{signal}": run.trough,
         f"mean_{signal}": run.mean,
+        f"final_{signal}": float(run.signal[-1]) if run.time.size else None,
         "end_time": float(run.time[-1]) if run.time.size else None,
         "summary": dict(run.summary),
     }
