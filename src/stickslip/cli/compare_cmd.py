@@ -97,7 +97,7 @@ def compare_command(**options: Any) -> None:
             "pulling_velocity": pull,
             "stiffness": pair["stiffness"],
             "eta": pair["eta"],
-            "bond": {"regime": pair["bond"].regime, "message": pair["bond"].message},
+            "bond": {"regime": pair["bond"].regime_name, "message": pair["bond"].message},
             "rsf": None if pair["rsf"] is None else pair["rsf"].summary(),
             "problem": pair["problem"],
         },
