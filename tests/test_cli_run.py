@@ -8,8 +8,6 @@ a measured record, and a user's model imported as ``module:attr``.
 from __future__ import annotations
 
 import json
-import sys
-import textwrap
 
 import numpy as np
 import pytest
@@ -73,49 +71,16 @@ def test_rsf_takes_its_stiffness_in_friction_per_slip_or_as_its_key():
     assert "mean_friction" in by_option and "mean_stress" not in by_option
 
 
-USER_MODEL = '''
-import numpy as np
-from stickslip.models import Capabilities, FrictionModel, Run
-
-
-class Viscous(FrictionModel):
-    """A test model: stress = c V on a rigid rig, and a run that can be told to fail."""
-
-    name = "test-viscous"
-    capabilities = Capabilities(controls=("velocity",), settings=("fail",))
-
-    def dimensions(self):
-        return {"c": "stress_per_velocity"}
-
-    def parameters(self, spec=None, overrides=None):
-        from stickslip.units import to_si
-
-        return {"c": to_si((overrides or {}).get("c", 1e6), "stress_per_velocity", "c")}
-
-    def run(self, params, protocol, rig=None, *, start=None, **settings):
-        self.check(protocol, rig, settings)
-        t = np.linspace(0.0, protocol.duration, 201)
-        v = protocol.velocity_at(t)
-        x = np.concatenate([[0.0], np.cumsum(np.diff(t) * v[1:])])
-        status = "failed" if settings.get("fail") else "ok"
-        return Run.from_trace(self.name, t, stress=params["c"] * v, slider_velocity=v, slider_position=x,
-                              load_point_position=x, status=status, message="told to fail" if status != "ok" else "")
-
-
-MODEL = Viscous()
-'''
-
-
 @pytest.fixture
-def user_model(tmp_path, monkeypatch):
-    (tmp_path / "user_friction.py").write_text(textwrap.dedent(USER_MODEL), encoding="utf-8")
-    monkeypatch.syspath_prepend(str(tmp_path))
-    yield "user_friction:MODEL"
-    sys.modules.pop("user_friction", None)
+def viscous():
+    import viscous_model
+
+    yield "viscous_model:MODEL"
+    viscous_model.forget()
 
 
-def test_a_model_from_outside_the_package_runs_by_its_import_path(user_model, capsys):
-    argv = ["run", "--model", user_model, "--control", "velocity", "--v0", "2 mm/s", "--duration", "1 s"]
+def test_a_model_from_outside_the_package_runs_by_its_import_path(viscous, capsys):
+    argv = ["run", "--model", viscous, "--control", "velocity", "--v0", "2 mm/s", "--duration", "1 s"]
     out = as_json(*argv, "--set", "c=5 MPa s/m")
     assert out["model"] == "test-viscous" and out["regime"] == "steady"
     assert out["mean_stress"] == pytest.approx(5e6 * 2e-3, rel=1e-12)
