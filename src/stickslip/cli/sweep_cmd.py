@@ -9,9 +9,9 @@ from typing import Any
 import click
 
 from ..errors import DataError, ParameterError, StickslipError
-from .common import echo_err, params_options, require_unit
+from .common import echo_err, require_unit
 
-MODEL_NAMES = ("quasi-static", "transient", "rsf")
+MODEL_NAMES = ("quasi-static", "transient", "rsf")  # the built-ins; any registered model or module:attr is taken
 
 
 @click.group(
@@ -33,7 +33,13 @@ MODEL_NAMES = ("quasi-static", "transient", "rsf")
     "--samples", type=int, default=None, help="Latin-hypercube sample of N points over ranges 'KEY=LO..HI[:log]'."
 )
 @click.option("--seed", type=int, default=0, show_default=True, help="Seed of the Latin-hypercube sample.")
-@click.option("--model", type=click.Choice(MODEL_NAMES), default="quasi-static", show_default=True)
+@click.option(
+    "--model",
+    default="quasi-static",
+    show_default=True,
+    metavar="NAME|MODULE:ATTR",
+    help=f"A registered model ({', '.join(MODEL_NAMES)}, or one an installed package registers) or an import path.",
+)
 @click.option(
     "--v0", "v0_text", default=None, metavar="V", help="Pulling velocity when it is not varied, e.g. '50 um/s'."
 )
@@ -54,7 +60,20 @@ MODEL_NAMES = ("quasi-static", "transient", "rsf")
 @click.option("--batch-size", type=int, default=None, help="Points per task [default: up to 256, at least 64 tasks].")
 @click.option("--quiet", is_flag=True, help="No progress and no summary.")
 @click.option("--overwrite", is_flag=True, help="Replace a sweep of another specification in OUT.")
-@params_options
+@click.option(
+    "--set",
+    "overrides",
+    multiple=True,
+    metavar="KEY=VALUE",
+    help="Fix one of the model's keys, with its unit, e.g. bonds.bond_time='224 us'; repeatable.",
+)
+@click.option(
+    "--params",
+    "params_name",
+    default=None,
+    metavar="NAME|FILE",
+    help="The model's parameter set [default: its own; gelatin-glass for the bond models].",
+)
 @click.pass_context
 def sweep_command(ctx: click.Context, **options: Any) -> None:
     """Run the model over a grid or a Latin hypercube of parameters, on dask, into the Parquet folder OUT.
@@ -85,7 +104,7 @@ def _run(
     batch_size: int | None,
     quiet: bool,
     overwrite: bool,
-    params_name: str,
+    params_name: str | None,
     overrides: tuple[str, ...],
 ) -> None:
     from ..sweeps import build_spec, damage_note, run_sweep

@@ -121,6 +121,8 @@ class FrictionModel(ABC):
     description: str = ""
     capabilities: Capabilities = Capabilities()
     sweep_start: Any = None
+    #: modules the model needs (an install without them refuses the model in one line, see check_available)
+    requires: tuple[str, ...] = ()
     #: the columns of a sweep row (name -> "str", "float" or "int"), read off the Run (:meth:`Run.row`)
     sweep_columns: Mapping[str, str] = CYCLE_RESULTS
 
@@ -159,6 +161,20 @@ class FrictionModel(ABC):
         return []
 
     # ------------------------------------------------------------------ checks every implementation shares
+    def check_available(self) -> None:
+        """Refuse, in one line, a model whose modules this installation does not have."""
+        from importlib import import_module
+
+        for module in self.requires:
+            try:
+                import_module(module)
+            except ModuleNotFoundError as exc:
+                if exc.name is not None and module.startswith(exc.name):
+                    raise ParameterError(
+                        f"--model {self.name}: this version of stickslip has no {module} module; use another model"
+                    ) from None
+                raise
+
     def check(self, protocol: Protocol, rig: Rig | None, settings: Mapping[str, Any] | None = None) -> Rig:
         """The rig (default: a spring of the model's own stiffness), after refusing what the model cannot do."""
         from ..protocols import Protocol

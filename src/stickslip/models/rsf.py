@@ -43,6 +43,7 @@ class RSFModel(FrictionModel):
         "critical_stiffness": "float",
     }
     #: key -> dimension (``law`` is taken too: a name, kept in a sweep's numbers as its index in LAW_NAMES)
+    requires = ("stickslip.rsf",)
     KEYS: Mapping[str, str] = {
         "a": "dimensionless",
         "b": "dimensionless",

@@ -15,6 +15,8 @@ from .bond import STIFFNESS_KEYS, BondModel
 from .run import Run, time_mean
 
 NAN = math.nan
+#: relative stress change that counts as none (stickslip.transient.cycles.SETTLED, the solver's own verdict's)
+SETTLED = 1e-5
 
 
 class Transient(BondModel):
@@ -38,6 +40,7 @@ class Transient(BondModel):
         ),
     )  # fmt: skip
     sweep_start = "steady"
+    requires = ("stickslip.transient",)
 
     def run(
         self, params: Parameters, protocol: Protocol, rig: Rig | None = None, *, start: Any = None, **settings: Any
@@ -46,10 +49,9 @@ class Transient(BondModel):
 
         rig = self.check(protocol, rig, settings)
         control = "velocity" if rig.control == "velocity" else "block"
-        result = run_transient(
-            params, protocol, control=control, start="empty" if start is None else start, stiffness=rig.stiffness,
-            **settings,
-        )  # fmt: skip
+        if rig.stiffness is not None:
+            settings["stiffness"] = rig.stiffness
+        result = run_transient(params, protocol, control=control, start="empty" if start is None else start, **settings)
         return transient_run(result, protocol)
 
     def stability_boundary(self, fixed: Any, x: str, y: str, frame: Any = None) -> list[Boundary]:
@@ -73,19 +75,23 @@ class Transient(BondModel):
 def transient_run(result: Any, protocol: Protocol) -> Run:
     """The :class:`Run` of a :class:`stickslip.transient.TransientResult` (regime from its slip events)."""
     summary = last_cycle_numbers(result)
-    states: dict[str, Any] = {"bonded_fraction": result.bonded_fraction}
-    units: dict[str, str | None] = {"bonded_fraction": "1"}
-    if result.chain_fraction is not None:
-        states.update(chain_fraction=result.chain_fraction, held_by=result.held_by)
-        units.update(chain_fraction="1", held_by=None)
+    states: dict[str, Any] = {}
+    units: dict[str, str | None] = {}
+    if getattr(result, "bonded_fraction", None) is not None:
+        states["bonded_fraction"], units["bonded_fraction"] = result.bonded_fraction, "1"
+    if getattr(result, "chain_fraction", None) is not None:
+        states["chain_fraction"], units["chain_fraction"] = result.chain_fraction, "1"
+        if hasattr(result, "held_by"):
+            states["held_by"], units["held_by"] = result.held_by, None
     return Run(
         model=Transient.name,
         time=result.time,
         stress=result.stress,
         friction=None,
-        slider_velocity=result.slider_velocity,
-        slider_position=result.slider_position,
-        load_point_position=result.puller_position,
+        # the names of a TransientResult, or of the quasi-static Simulation a stand-in solver may return
+        slider_velocity=_first(result, "slider_velocity", "velocity"),
+        slider_position=_first(result, "slider_position", "slider_displacement"),
+        load_point_position=_first(result, "puller_position", "puller_displacement"),
         regime=_regime(result, protocol),
         mean=summary["mean_stress"],
         states=states,
@@ -94,6 +100,10 @@ def transient_run(result: Any, protocol: Protocol) -> Run:
         message=result.message,
         native=result,
     )
+
+
+def _first(result: Any, *names: str) -> Any:
+    return next(getattr(result, n) for n in names if hasattr(result, n))
 
 
 def _regime(result: Any, protocol: Protocol) -> regimes.Regime:
@@ -107,8 +117,6 @@ def _regime(result: Any, protocol: Protocol) -> regimes.Regime:
         troughs = [c.start_stress for c in whole[1:]] + [float(np.min(stress[time >= whole[-1].start_time]))]
         found = regimes.classify_cycles([c.start_time + c.stick_time for c in whole], peaks, troughs)
     else:
-        from ..transient.cycles import SETTLED
-
         inside = time >= start
         scale = float(np.max(np.abs(stress[inside]))) if np.any(inside) else 0.0
         found = regimes.classify(time, stress, floor=SETTLED * max(scale, 1e-300), start=start, unit="Pa")

@@ -44,7 +44,7 @@ def build_spec(
     vary: Sequence[str] | Mapping[str, Any],
     *,
     model: str = "quasi-static",
-    params: str | Parameters = "gelatin-glass",
+    params: str | Parameters | None = None,
     overrides: Mapping[str, Any] | None = None,
     pulling_velocity: float | str | None = None,
     duration: float | str = DEFAULT_DURATION,
@@ -81,13 +81,7 @@ def build_spec(
         given["pulling_velocity"] = pulling_velocity
     fixed, label = adapter.fixed_values(params, given)
     adapter.check_keys(tuple(a.key for a in axes), fixed)
-    settings: dict[str, Any] = {"duration": _duration(duration)}
-    if model != "rsf":
-        settings["jump_curve"] = jump_curve
-    if stick_population and model != "transient":
-        raise ParameterError("--stick-population: only the time-dependent model (--model transient) takes it")
-    if model == "transient":
-        settings["stick_population"] = bool(stick_population)
+    settings = _settings(adapter, _duration(duration), jump_curve=jump_curve, stick_population=stick_population)
     spec = SweepSpec(
         model=model,
         fixed=fixed,
@@ -180,7 +174,8 @@ def sweep(
     >>> frame = sweep(["pulling_velocity=10 um/s..1 mm/s:5:log"], workers=0)  # doctest: +SKIP
     >>> frame = sweep({"block.height": "5 mm..2 cm:4"}, pulling_velocity="50 um/s", samples=None)  # doctest: +SKIP
 
-    ``specification`` are the keywords of :func:`build_spec` (``model``, ``params``, ``overrides``,
+    ``specification`` are the keywords of :func:`build_spec` (``model``: a registered name or ``module:attr``;
+    ``params``: the model's parameter set, default its own; ``overrides``,
     ``pulling_velocity``, ``duration``, ``samples``, ``seed``, ``jump_curve``, ``stick_population``);
     ``workers``, ``scheduler`` and ``overwrite`` those of :func:`run_sweep`; ``quiet=False`` shows progress on
     standard error.
@@ -287,6 +282,24 @@ def _duration(value: float | str) -> float:
     if not seconds > 0 or seconds == float("inf"):
         raise ParameterError(f"--duration: expected a positive finite time, got {value!r}")
     return seconds
+
+
+#: Run settings a sweep passes on to the models that take them, with the value that means "not asked for".
+OPTIONAL_SETTINGS = {"jump_curve": "aging", "stick_population": False}
+
+
+def _settings(adapter: Any, duration: float, **asked: Any) -> dict[str, Any]:
+    """The duration and each optional setting the model takes; one asked of a model that does not is refused."""
+    settings: dict[str, Any] = {"duration": duration}
+    for name, value in asked.items():
+        if adapter.takes(name):
+            settings[name] = bool(value) if isinstance(OPTIONAL_SETTINGS[name], bool) else value
+        elif value != OPTIONAL_SETTINGS[name]:
+            takers = [f"--model {n}" for n, m in MODELS.items() if m.takes(name)]
+            option = "--" + name.replace("_", "-")
+            who = " or ".join(takers) or "no model"
+            raise ParameterError(f"{option}: only {who} takes it, not --model {adapter.name}")
+    return settings
 
 
 def _check_corners(adapter: Any, spec: SweepSpec) -> None:
