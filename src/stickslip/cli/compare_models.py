@@ -15,6 +15,7 @@ from typing import Any
 import click
 
 from ..errors import ModelError, ParameterError
+from ..progress import progress
 from ..units import shorten
 from .common import emit_json, refuse_overwriting_inputs, require_unit, save_figure
 from .protocol_options import build_protocol, control_name
@@ -96,12 +97,15 @@ def compare_models(options: dict[str, Any]) -> None:
         model.check(protocol, rig, {})
     routed = routed_overrides(models, options["overrides"])
     runs = {}
-    for model in models:
-        try:
-            params = model_parameters(model, params_name, routed[model.name])
-            runs[model.name] = model.run(params, protocol, rig)
-        except (ParameterError, ModelError) as exc:
-            raise type(exc)(f"model {model.name}: {exc}") from None
+    # one stage per model: a bar on a terminal, nothing in a pipe or with --json
+    with progress("compare", total=len(models), unit="models", enabled=False if options["as_json"] else None) as bar:
+        for model in models:
+            try:
+                params = model_parameters(model, params_name, routed[model.name])
+                runs[model.name] = model.run(params, protocol, rig)
+            except (ParameterError, ModelError) as exc:
+                raise type(exc)(f"model {model.name}: {exc}") from None
+            bar.advance(note=model.name)
     summaries = {name: run_summary(run, protocol, rig) for name, run in runs.items()}
     document = {
         "protocol": [{"velocity": s.velocity, "duration": s.duration} for s in protocol.segments],

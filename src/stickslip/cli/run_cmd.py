@@ -15,6 +15,7 @@ from typing import Any
 import click
 
 from ..errors import ParameterError, UnitError
+from ..progress import progress
 from ..units import shorten
 from .common import emit_json, refuse_overwriting_inputs, require_unit, save_figure
 from .protocol_options import build_protocol, control_name, protocol_options
@@ -264,7 +265,11 @@ def run_command(
     params = model_parameters(model, params_name, mapping)
     settings = settings_of(setting_texts, every_text)
     model.check(protocol, rig, settings)  # what the model cannot do, before any work
-    run = model.run(params, protocol, rig, start=start_value(start_text), **settings)
+    start = start_value(start_text)
+    with progress(model.name, total=protocol.duration, unit="s", enabled=False if as_json else None) as bar:
+        if "progress" in model.capabilities.settings and "progress" not in settings:  # a bar on a terminal only
+            settings["progress"] = lambda fraction: bar.update(fraction * protocol.duration)
+        run = model.run(params, protocol, rig, start=start, **settings)
     summary = run_summary(run, protocol, rig)
     if output is not None:
         _write_run(run, output)
