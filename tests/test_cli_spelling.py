@@ -1,4 +1,4 @@
-"""One spelling per quantity in what people read (issue 19): µm/s, σs, σc, τa, Δlm, never um/s, sigma_s, tau_a.
+"""One spelling per quantity in what people read (issue 19): µm/s, σs, σc, τa, Δl_m, never um/s, sigma_s, tau_a.
 
 Every command that prints prose is run here, through the cases whose messages come from the models
 (stick-slip, stuck, undetermined, steady, the RSF fit's report in the record's unit).  What a user types
@@ -16,7 +16,7 @@ from click.testing import CliRunner
 from stickslip.cli.main import cli
 from stickslip.fitting import datasets
 
-#: ASCII spellings that must not reach a person's eyes (the paper's symbols are σs, σc, τ, τa, Δlm).
+#: ASCII spellings that must not reach a person's eyes (the paper's symbols are σs, σc, τ, τa, Δl_m).
 ASCII_SPELLINGS = re.compile(r"um/s|\bum\b|sigma|tau_?a?\b|\bdl_m\b|\bmu\b")
 
 SEPIOLITE = str(datasets.data_path("giacomel-sepiolite/velstep3_TR2_exp013_sepiolite.txt"))
@@ -137,5 +137,5 @@ def test_the_check_sees_the_old_spellings():
         assert offending_lines(old) == [old]
     assert offending_lines('--v0 V  Pulling velocity, e.g. "50 um/s".', typed_examples=True) == []
     assert offending_lines("--no-aging  Drop the aging term (tau_a -> infinity).", typed_examples=True) != []
-    for new in ("σs = 552.9 Pa", "jump to 702 µm/s", "−t/τa grows", "σ = 30 Pa", "Δlm = 1.074 µm", "1 mm/s"):
+    for new in ("σs = 552.9 Pa", "jump to 702 µm/s", "−t/τa grows", "σ = 30 Pa", "Δl_m = 1.074 µm", "1 mm/s"):
         assert offending_lines(new) == []

@@ -1,7 +1,7 @@
 """How quantities are written for people: one spelling per quantity in every message, table and figure.
 
 Machines get SI and ASCII (CSV headers, JSON keys, TOML files); people get the
-paper's symbols (σs, τa, Δlm) and µm/s.  What a user types stays ASCII
+paper's symbols (σs, τa, Δl_m) and µm/s.  What a user types stays ASCII
 (``--v0 "350 um/s"``): :func:`unit` turns such a unit into the one shown.
 """
 
@@ -12,7 +12,7 @@ SYMBOLS = {
     "tau": "τ",
     "tau_a": "τa",
     "lambda": "λ",
-    "dl_m": "Δlm",
+    "dl_m": "Δl_m",
     "V_a": "Va",
     "G_d": "Gd",
     "uc/tau": "uc/τ",

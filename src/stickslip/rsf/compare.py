@@ -225,7 +225,7 @@ def rsf_of_bond(
         return BondRSF(rsf, slope, vm, sigma_c, "failed", why)
     note = (f"fitted to the quasi-static bond model's step {step}: it jumps at once from μ = {mu0:.4g} to "
             f"{mu1:.4g} (no transient, no state), which is exactly a = (μ1 − μ0)/ln(V1/V0) = {a:.4g}, b = 0; "
-            f"Dc has no effect with b = 0 and is not determined (set to Δlm = {dl_m * 1e6:.4g} µm)")  # fmt: skip
+            f"Dc has no effect with b = 0 and is not determined (set to Δl_m = {dl_m * 1e6:.4g} µm)")  # fmt: skip
     return BondRSF(rsf, slope, vm, sigma_c, "fitted", note)
 
 

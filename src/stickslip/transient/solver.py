@@ -539,7 +539,9 @@ def estimate_cost(
     natural = b.max_extension / b.bond_time
     basis = f"{duration:.3g} s at up to {fastest:.3g} m/s, resolving τ = {b.bond_time:.3g} s"
     if fastest > 100.0 * natural:
-        basis += f"; {fastest:.3g} m/s is {fastest / natural:.2g} × the set's Δlm/τ = {natural:.3g} m/s: check the unit"
+        basis += (
+            f"; {fastest:.3g} m/s is {fastest / natural:.2g} × the set's Δl_m/τ = {natural:.3g} m/s: check the unit"
+        )
     return CostEstimate(steps, basis, steps * STEP_SECONDS)
 
 
