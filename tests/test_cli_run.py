@@ -112,6 +112,8 @@ REFUSALS = [
         "--stiffness",
     ),
     (["run", "--model", "quasi-static"], "give the protocol"),
+    ([*QS, "-o", "/no-such-folder-of-stickslip/run.csv"], "does not exist"),  # refused before the run, not after
+    ([*QS, "--plot", "run.xyz"], "unknown figure format .xyz"),
 ]
 
 

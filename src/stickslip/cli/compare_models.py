@@ -17,7 +17,7 @@ import click
 from ..errors import ModelError, ParameterError
 from ..progress import progress
 from ..units import shorten
-from .common import emit_json, refuse_overwriting_inputs, require_unit, save_figure
+from .common import check_output, emit_json, refuse_overwriting_inputs, require_unit, save_figure
 from .protocol_options import build_protocol, control_name
 from .run_cmd import model_parameters, run_summary
 
@@ -88,6 +88,7 @@ def compare_models(options: dict[str, Any]) -> None:
     params_given = ctx.get_parameter_source("params_name") not in (None, click.core.ParameterSource.DEFAULT)
     params_name = options["params_name"] if params_given else None
     refuse_overwriting_inputs([options["protocol_file"], params_name], [("-o", output)])
+    check_output("-o", output, plot=True)
     _refuse_classic_options(ctx)
     models = model_list(options["models"])
     protocol = build_protocol(options["v0_text"], options["duration_text"], options["segment_texts"],

@@ -17,7 +17,7 @@ import click
 from ..errors import ParameterError, UnitError
 from ..progress import progress
 from ..units import shorten
-from .common import emit_json, refuse_overwriting_inputs, require_unit, save_figure
+from .common import check_output, emit_json, refuse_overwriting_inputs, require_unit, save_figure
 from .protocol_options import build_protocol, control_name, protocol_options
 
 #: Exit status of a run the model could not finish (status "failed"); 2 is bad input.
@@ -258,6 +258,8 @@ def run_command(
     with status 3.
     """
     refuse_overwriting_inputs([protocol_file, params_name], [("-o", output), ("--plot", plot_path)])
+    check_output("-o", output)
+    check_output("--plot", plot_path, plot=True)
     model = load_model(model_name)
     protocol = build_protocol(v0_text, duration_text, segment_texts, protocol_file)
     mapping = model_overrides(model, overrides)

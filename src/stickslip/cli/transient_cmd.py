@@ -2,16 +2,13 @@
 
 from __future__ import annotations
 
-import stat
-import tempfile
 from pathlib import Path
 from typing import Any
 
 import click
 
-from ..errors import ParameterError
-from ..units import shorten
 from .common import (
+    check_output,
     emit_json,
     params_options,
     positive,
@@ -21,43 +18,6 @@ from .common import (
     write_text,
 )
 from .protocol_options import build_protocol, control_name, protocol_options, refuse_unsupported, stiffness
-
-
-def _check_output(option: str, path: Path | None, plot: bool = False) -> None:
-    """Refuse, before computing, an output that cannot be written: no name, no such folder, an unknown format."""
-    if path is None:
-        return
-    text = str(path)
-    if not text.strip() or text == ".":
-        raise ParameterError(f"{option}: expected a file name, got an empty one")
-    folder = path.parent if str(path.parent) else Path(".")
-    if not folder.is_dir():
-        raise ParameterError(f"{option} {shorten(text)}: the folder {shorten(str(folder))} does not exist")
-    try:
-        info = path.stat()
-    except OSError:
-        info = None
-    if info is not None and stat.S_ISDIR(info.st_mode):
-        raise ParameterError(f"{option} {shorten(text)}: that is a folder, not a file")
-    if info is None or stat.S_ISREG(info.st_mode):  # written beside, then renamed: the folder must take a file
-        try:
-            with tempfile.TemporaryFile(dir=folder):
-                pass
-        except OSError as exc:
-            reason = exc.strerror or str(exc)
-            raise ParameterError(
-                f"{option} {shorten(text)}: cannot write in {shorten(str(folder))} ({reason})"
-            ) from None
-    if plot:
-        from matplotlib.figure import Figure
-
-        formats = Figure().canvas.get_supported_filetypes()
-        suffix = path.suffix[1:].lower() or "png"
-        if suffix not in formats:
-            raise ParameterError(
-                f"{option} {shorten(text)}: unknown figure format .{suffix};"
-                f" expected one of {', '.join(sorted(formats))}"
-            )
 
 
 def _trace_csv(result: Any) -> str:
@@ -125,8 +85,8 @@ def transient_command(
     from ..transient import run_transient
     from ..transient.solver import estimate_cost
 
-    _check_output("-o", output)
-    _check_output("--plot", plot_path, plot=True)
+    check_output("-o", output)
+    check_output("--plot", plot_path, plot=True)
     protocol = build_protocol(v0_text, duration_text, segment_texts, protocol_file)
     refuse_unsupported("transient", protocol, control, stiffness_text)
     control = control_name(control)
