@@ -135,8 +135,7 @@ def test_the_ring_down_above_v_star_has_the_linear_period():
 
 
 def test_a_sweep_finds_the_closed_form_boundary_v_star():
-    frame = stickslip.sweep(["pulling_velocity=0.03,0.07,0.14,0.3"], model="velocity-weakening", duration=2.0,
-                            workers=0)  # fmt: skip
+    frame = stickslip.sweep(["pulling_velocity=0.03,0.07,0.14,0.3"], model=MODEL, duration=2.0, workers=0)
     assert list(frame["status"]) == ["ok"] * 4, list(frame["message"])
     below, above = frame[frame.pulling_velocity < V_STAR], frame[frame.pulling_velocity > V_STAR]
     assert set(below["regime"]) == {"stick-slip"}, list(frame["message"])

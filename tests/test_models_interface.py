@@ -147,3 +147,82 @@ def test_a_run_from_a_trace_is_classified_by_the_one_classifier():
     assert run.period == pytest.approx(5.0, rel=1e-3)
     assert run.mean == pytest.approx(110.0, rel=1e-3)
     assert math.isnan(run.friction[0]) if run.friction is not None else run.friction is None
+
+
+def test_the_old_results_convert_to_the_same_run():
+    p = stickslip.load_parameters()
+    sim = stickslip.simulate(p, 50e-6, 60.0)
+    direct = stickslip.run("quasi-static", p, protocols.constant(50e-6, 60.0))
+    columns = get_model("quasi-static").sweep_columns
+    assert sim.to_run().row(columns) == direct.row(columns)
+    rsf = stickslip.rsf.simulate(stickslip.rsf.rsf_params(0.005, 0.01, 10e-6), protocols.constant(1e-6, 20.0))
+    assert rsf.to_run().regime_name == rsf.regime.name
+
+
+def test_an_installed_package_registers_by_its_entry_point(monkeypatch):
+    """A ``stickslip.models`` entry point is found by name, without any import by the user."""
+    from importlib import metadata
+
+    from stickslip.models import registry
+
+    class Plugin(FrictionModel):
+        name = "plugin-model"
+
+        def dimensions(self):
+            return {}
+
+        def parameters(self, spec=None, overrides=None):
+            return {}
+
+        def run(self, params, protocol, rig=None, *, start=None, **settings):
+            raise AssertionError
+
+    entry = metadata.EntryPoint("plugin-model", f"{__name__}:PLUGIN", "stickslip.models")
+    monkeypatch.setitem(globals(), "PLUGIN", Plugin())
+    monkeypatch.setattr(registry.metadata, "entry_points", lambda group: [entry] if group == "stickslip.models" else [])
+    monkeypatch.setitem(registry._LOADED, "entry points", False)
+    monkeypatch.setattr(registry, "_MODELS", dict(registry._MODELS))
+    assert get_model("plugin-model") is PLUGIN  # noqa: F821 - set above
+    assert "plugin-model" in available_models()
+
+
+def test_rsf_keys_refuse_a_second_state_variable_rather_than_drop_it():
+    rsf = get_model("rsf")
+    two = stickslip.rsf.rsf_params(0.005, 0.01, 10e-6, b2=0.005, dc2=100e-6)
+    assert rsf.parameters(two) is two  # as given, without keys
+    with pytest.raises(ParameterError, match="one state variable") as info:
+        rsf.parameters(two, {"a": 0.006})
+    assert "\n" not in str(info.value)
+
+
+@pytest.mark.parametrize(("v0", "kind"), [(50e-6, "stick-slip"), (300e-6, "steady")])
+def test_the_quasi_static_phases_agree_with_the_one_classifier_on_the_trace(v0, kind):
+    """The phase-based verdict (both sides of Vc = 124 um/s, Eq 9) is what regimes.classify reads off the trace."""
+    from stickslip import regimes
+
+    run = stickslip.run("quasi-static", None, protocols.constant(v0, 150.0))
+    found = regimes.classify(run.time, run.stress, floor=1e-6 * float(np.max(run.stress)))
+    assert run.regime.kind == found.kind == kind, found.evidence
+    if kind == "stick-slip":
+        assert found.period == pytest.approx(run.period, rel=1e-3)
+        assert found.peak == pytest.approx(run.peak, rel=1e-9)
+
+
+def test_a_sample_repeated_at_an_extremum_does_not_flip_peaks_and_troughs():
+    """A trace that writes a phase boundary twice (same time, same stress) is the same signal (regimes._kinds)."""
+    from stickslip import regimes
+
+    t = np.linspace(0.0, 40.0, 4001)
+    y = 10.0 + np.where((t % 4.0) < 3.0, (t % 4.0), 3.0 - 3.0 * ((t % 4.0) - 3.0))  # slow rise, fast fall
+    peaks = np.flatnonzero(np.isclose(t % 4.0, 3.0))
+    tt, yy = np.insert(t, peaks + 1, t[peaks]), np.insert(y, peaks + 1, y[peaks])
+    plain, doubled = regimes.classify(t, y, floor=1e-9), regimes.classify(tt, yy, floor=1e-9)
+    assert plain.kind == doubled.kind == "stick-slip"
+    assert doubled.period == pytest.approx(4.0, rel=1e-6) and doubled.peak == pytest.approx(13.0)
+
+
+def test_an_rsf_sweep_refuses_a_pulling_velocity_it_cannot_start_from_up_front():
+    from stickslip.sweeps import build_spec
+
+    with pytest.raises(ParameterError, match=r"pulling_velocity: expected a value > 0 m/s"):
+        build_spec(["pulling_velocity=0 um/s,1 um/s"], model="rsf")

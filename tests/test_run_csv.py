@@ -91,3 +91,18 @@ def test_plot_returns_the_axes(quasi_static_run):
     assert quasi_static_run.plot(ax=ax) is ax
     assert "stick-slip" in ax.get_title()
     plt.close(fig)
+
+
+def test_a_rate_and_state_run_without_normal_stress_round_trips_its_friction_and_state(tmp_path):
+    rsf = stickslip.get_model("rsf")
+    run = rsf.run(rsf.parameters(None, {"b": 0.015, "k": 400.0, "eta": 1e3}), protocols.constant(1e-6, 200.0),
+                  start=1.1e-6)  # fmt: skip
+    assert run.stress is None and run.signal is run.friction
+    path = tmp_path / "rsf.csv"
+    run.to_csv(path)
+    assert path.read_text().splitlines()[1].startswith("time [s],friction [1],slider_velocity [m/s]")
+    back = Run.read(path)
+    assert back.stress is None and np.array_equal(back.friction, run.friction)
+    assert np.array_equal(back.states["state"], run.states["state"]) and back.state_units["state"] == "s"
+    a, b = back.row(rsf.sweep_columns), run.row(rsf.sweep_columns)
+    assert a.keys() == b.keys() and all(_same(a[k], b[k]) if isinstance(a[k], float) else a[k] == b[k] for k in a)

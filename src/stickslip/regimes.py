@@ -161,7 +161,13 @@ def _kinds(y: np.ndarray, ext: list[int]) -> list[bool]:
     if not ext:
         return []
     e = ext[0]
-    first_max = bool(y[e] > y[e + 1]) if e + 1 < y.size else bool(y[e] > y[e - 1])
+    # the nearest sample of another value decides: a trace may repeat a sample (a phase boundary written twice)
+    after = np.flatnonzero(y[e + 1 :] != y[e])
+    before = np.flatnonzero(y[:e] != y[e])
+    if after.size:
+        first_max = bool(y[e] > y[e + 1 + after[0]])
+    else:
+        first_max = bool(before.size and y[e] > y[before[-1]])
     return [first_max == (k % 2 == 0) for k in range(len(ext))]
 
 

@@ -147,7 +147,7 @@ class FrictionModel(ABC):
             return {k: float(v) for k, v in params.as_dict().items()}
         out = {}
         for key in self.dimensions():
-            value = getattr(params, key, None)
+            value = params.get(key) if isinstance(params, Mapping) else getattr(params, key, None)
             if isinstance(value, (int, float)) and not isinstance(value, bool):
                 out[key] = float(value)
         return out

@@ -61,7 +61,10 @@ class RSFModel(FrictionModel):
 
     @classmethod
     def sweep_start(cls, protocol: Protocol) -> float:
-        return cls.START_STEP * protocol.segments[0].velocity
+        velocity = protocol.segments[0].velocity
+        if not velocity > 0:  # the start is steady sliding at a step above it
+            raise ParameterError(f"pulling_velocity: expected a value > 0 m/s, got {velocity:g}")
+        return cls.START_STEP * velocity
 
     def dimensions(self) -> dict[str, str]:
         return dict(self.KEYS)
@@ -84,8 +87,6 @@ class RSFModel(FrictionModel):
             raise ParameterError(f"rsf parameters: expected RSFParams or a mapping, got {type(spec).__name__}")
         if not overrides:
             return base
-        if len(base.states) != 1 or base.states[0].law not in self.LAW_NAMES:
-            raise ParameterError("rsf parameters: keys override one state variable of the aging, slip or prz law")
         values = self.values(base)
         for given, raw in overrides.items():
             key = ALIASES.get(given, given)  # --set Dc=..., η=... as --vary takes them
@@ -117,8 +118,14 @@ class RSFModel(FrictionModel):
         return self.LAW_NAMES.index(name)
 
     def values(self, params: Any) -> dict[str, float]:
+        """The keys' SI values (``law`` as its index in LAW_NAMES): one state variable of those laws only."""
         state = params.states[0]
-        law = self.LAW_NAMES.index(state.law) if state.law in self.LAW_NAMES else 0
+        if len(params.states) != 1 or state.law not in self.LAW_NAMES:
+            raise ParameterError(
+                f"rsf parameters: keys hold one state variable of the {', '.join(self.LAW_NAMES)} law, got"
+                f" {len(params.states)} of the {', '.join(s.law for s in params.states)} law"
+            )
+        law = self.LAW_NAMES.index(state.law)
         fixed = {"a": params.a, "b": state.b, "dc": state.dc, "k": params.stiffness, "eta": params.eta}
         fixed.update(mu0=params.mu0, v_ref=params.v_ref, law=float(law))
         if params.normal_stress is not None:

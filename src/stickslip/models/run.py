@@ -72,7 +72,7 @@ def _is_text(values: Any) -> bool:
     return array.dtype.kind in "OUS"
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # arrays: equality is not a truth value; compare columns instead
 class Run:
     """A model run: the trace (SI, one row per solver output), its regime, and its summary numbers.
 

@@ -72,8 +72,9 @@ class Transient(BondModel):
         return [Boundary(curve[0], curve[1], "K = Kc(V0), linear stability")]
 
 
-def transient_run(result: Any, protocol: Protocol) -> Run:
-    """The :class:`Run` of a :class:`stickslip.transient.TransientResult` (regime from its slip events)."""
+def transient_run(result: Any, protocol: Protocol | None = None) -> Run:
+    """The :class:`Run` of a :class:`stickslip.transient.TransientResult` (regime from its slip events, in the
+    protocol's last segment; over the whole run without the protocol)."""
     summary = last_cycle_numbers(result)
     states: dict[str, Any] = {}
     units: dict[str, str | None] = {}
@@ -106,10 +107,10 @@ def _first(result: Any, *names: str) -> Any:
     return next(getattr(result, n) for n in names if hasattr(result, n))
 
 
-def _regime(result: Any, protocol: Protocol) -> regimes.Regime:
+def _regime(result: Any, protocol: Protocol | None) -> regimes.Regime:
     """The solver's verdict, with the evidence of the one classifier: the slips' exact peaks and the sticks'
     troughs (cycles) in the last segment when it oscillates, the classifier on the solver's steps otherwise."""
-    start = float(protocol.boundaries[-2])
+    start = float(protocol.boundaries[-2]) if protocol is not None else float(result.time[0])
     whole = [c for c in result.cycles if c.period is not None and c.start_time >= start]
     time, stress = np.asarray(result.time, dtype=float), np.asarray(result.stress, dtype=float)
     if len(whole) >= 2 and result.regime in (regimes.STICK_SLIP, regimes.DECAYING, regimes.GROWING):

@@ -61,8 +61,7 @@ def build_spec(
     Bare numbers are SI.  ``unit_check(text, dimension, prefix)``, given by the command line, refuses
     them in every value typed there (``--v0``, ``--set``, ``--vary``), as every other command does.
     """
-    if not isinstance(model, str):
-        raise ParameterError(f"model: expected a name, one of {', '.join(MODELS)}; got {model!r}")
+    model = _model_name(model)
     adapter = get_model(model)
     adapter.check_available()
     dimensions = adapter.dimensions()
@@ -214,6 +213,24 @@ def damage_note(store: SweepStore) -> str:
     """One line naming the chunks found damaged on resume (removed and recomputed)."""
     shown = ", ".join(store.damaged[:3]) + (f" and {len(store.damaged) - 3} more" if len(store.damaged) > 3 else "")
     return f"sweep: {len(store.damaged)} damaged chunk(s) in {store.folder} recomputed: {shown}"
+
+
+def _model_name(model: Any) -> str:
+    """A model's name: given as is, or a model object (registered under its name, so workers find it by it)."""
+    from ..models import get_model as find_model
+    from ..models import register_model
+
+    if isinstance(model, str):
+        return model
+    if not all(hasattr(model, attr) for attr in ("name", "dimensions", "parameters", "run")):
+        raise ParameterError(f"model: expected a name, one of {', '.join(MODELS)}; got {model!r}")
+    try:
+        known = find_model(model.name)
+    except ParameterError:
+        known = None
+    if known is not model:
+        register_model(model)
+    return model.name
 
 
 def _whole(value: Any, name: str, minimum: int) -> int:

@@ -74,15 +74,22 @@ class SweepModel:
         velocity = values["pulling_velocity"]
         if not velocity >= 0:
             raise ParameterError(f"pulling_velocity: expected a value >= 0 m/s, got {velocity:g}")
+        self.start(velocity, 1.0)  # a velocity the model cannot start from is refused with the other values
         return self.model.parameters(None, {k: v for k, v in values.items() if k not in PROTOCOL_KEYS}), velocity
+
+    def start(self, velocity: float, duration: float) -> Any:
+        """The model's ``sweep_start`` for a run at ``velocity``."""
+        from ..protocols import constant
+
+        start = self.model.sweep_start
+        return start(constant(velocity, duration)) if callable(start) else start
 
     def run(self, values: Mapping[str, float], settings: Mapping[str, Any]) -> dict[str, Any]:
         from ..protocols import constant
 
         params, velocity = self.parameters(values)
         protocol = constant(velocity, settings["duration"])
-        start = self.model.sweep_start
-        start = start(protocol) if callable(start) else start
+        start = self.start(velocity, settings["duration"])
         taken = {k: v for k, v in settings.items() if self.takes(k)}
         return self.model.run(params, protocol, Rig(), start=start, **taken).row(self.results)
 
