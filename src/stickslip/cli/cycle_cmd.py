@@ -23,7 +23,7 @@ from .common import (
     write_text,
 )
 from .params_cmd import print_rich
-from .protocol_options import build_protocol, protocol_options, refuse_unsupported, stiffness, with_stiffness
+from .protocol_options import build_protocol, protocol_options, refuse_unsupported, stiffness
 
 #: Rows of the Nc/Nc0 table printed by ``stick`` (the whole curve is in --json and -o).
 STICK_TABLE_ROWS = 11
@@ -105,17 +105,19 @@ def simulate_command(
     regime is "stick-slip", "steady" (V0 >= Vc: the slip settles at V0),
     "stuck" (a stick never ends) or "undetermined" (the model has no answer).
     """
-    from ..model.cycle import CYCLE_COLUMNS, simulate
+    from ..model.cycle import CYCLE_COLUMNS
+    from ..models import Rig, get_model
 
     refuse_overwriting_inputs([protocol_file], [("-o", output), ("--plot", plot_path)], params_name)
     protocol = build_protocol(v0_text, duration_text, segment_texts, protocol_file)
     refuse_unsupported("simulate (the quasi-static model)", protocol, control, stiffness_text, controls=("spring",),
                        one_segment=True, instead="stickslip transient runs any protocol and rig")  # fmt: skip
-    v0, duration = protocol.segments[0].velocity, protocol.segments[0].duration
+    v0 = protocol.segments[0].velocity
     k = stiffness(stiffness_text)
     start = _stress(start_text)
-    params = with_stiffness(resolve_params(params_name, overrides), k)
-    sim = simulate(params, v0, duration, start_stress=start, jump_curve=jump_curve)
+    params = resolve_params(params_name, overrides)
+    run = get_model("quasi-static").run(params, protocol, Rig(stiffness=k), start=start, jump_curve=jump_curve)
+    sim = run.native  # the Simulation: its phases and cycles make the table below
     if output is not None:
         write_text(output, _csv({n: getattr(sim, n) for n in CYCLE_COLUMNS}))
     if plot_path is not None:

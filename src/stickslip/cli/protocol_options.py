@@ -130,11 +130,3 @@ def refuse_unsupported(
 def stiffness(text: str | None) -> float | None:
     """``--stiffness`` of the bond models: K in Pa/m (None when not given)."""
     return None if text is None else positive(text, "stress_per_length", "--stiffness")
-
-
-def with_stiffness(params: Any, k: float | None) -> Any:
-    """The bond parameters with effective stiffness K (Eq 17), reached through the block's height."""
-    if k is None:
-        return params
-    block = params.block
-    return params.with_overrides({"block.height": block.shear_modulus * block.geometric_factor / k})

@@ -273,7 +273,7 @@ def simulate_command(**options: Any) -> None:
     load_point_displacement, slider_displacement (SI).  With -o the
     parameters go beside it in NAME.params.json.
     """
-    from ..rsf import simulate
+    from ..models import Rig, get_model
 
     fallback = None
     start = None
@@ -294,7 +294,7 @@ def simulate_command(**options: Any) -> None:
         [options["protocol_file"], options["params_file"]],
         [("-o", output), ("-o (its NAME.params.json)", side), ("--plot", plot_path)],
     )
-    run = simulate(params, protocol, start_velocity=start, every=every)
+    run = get_model("rsf").run(params, protocol, Rig(), start=start, every=every).native  # the RSFRun
     if output is not None:
         write(output, trace_csv(run.to_frame()))
         if side is not None:

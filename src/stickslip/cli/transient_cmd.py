@@ -80,9 +80,9 @@ def transient_command(
     The work is estimated before the run starts; a run estimated to need more
     than the step budget (--max-steps, default 3e6) is refused in one line.
     """
+    from ..models import Rig, get_model
     from ..numerics.budget import PROGRESS_AFTER_SECONDS
     from ..progress import progress
-    from ..transient import run_transient
     from ..transient.solver import estimate_cost
 
     check_output("-o", output)
@@ -96,13 +96,16 @@ def transient_command(
     start_velocity = None if start_v_text is None else positive(start_v_text, "velocity", "--start-velocity")
     every = None if every_text is None else positive(every_text, "time", "--every")
     params = resolve_params(params_name, overrides)
-    kwargs = dict(control=solver_control, stiffness=k, start=start, start_velocity=start_velocity, aging=not no_aging,
-                  stick_population=stick_population, every=every, rtol=rtol, max_steps=max_steps)  # fmt: skip
+    rig = Rig(control=control, stiffness=k)
+    settings = dict(start_velocity=start_velocity, aging=not no_aging, stick_population=stick_population, every=every,
+                    rtol=rtol, max_steps=max_steps)  # fmt: skip
     cost = estimate_cost(params, protocol, control=solver_control, start_velocity=start_velocity, rtol=rtol,
                          every=every, aging=not no_aging)  # fmt: skip
     shown = None if cost.seconds > PROGRESS_AFTER_SECONDS and not as_json else False  # None: on a terminal
     with progress("transient", total=protocol.duration, unit="s", enabled=shown) as bar:
-        result = run_transient(params, protocol, progress=lambda f: bar.update(f * protocol.duration), **kwargs)
+        run = get_model("transient").run(params, protocol, rig, start=start,
+                                         progress=lambda f: bar.update(f * protocol.duration), **settings)  # fmt: skip
+    result = run.native  # the TransientResult: its trace columns, cycles and summary are printed below
     if output is not None:
         write_text(output, _trace_csv(result))
     if plot_path is not None:
