@@ -1,7 +1,8 @@
 """One spelling per quantity in what people read (issue 19): µm/s, σs, σc, τa, Δl_m, never um/s, sigma_s, tau_a.
 
 Every command that prints prose is run here, through the cases whose messages come from the models
-(stick-slip, stuck, undetermined, steady, the RSF fit's report in the record's unit).  What a user types
+(stick-slip, stuck, undetermined, steady).  The RSF fit's report in the record's unit (µm) is checked in
+test_rsf_fit_protocols.  What a user types
 stays ASCII ("350 um/s"): the arguments below are chosen so that none is echoed back.  JSON keys and CSV
 headers are for machines and are not checked.
 """
@@ -19,7 +20,6 @@ from stickslip.fitting import datasets
 #: ASCII spellings that must not reach a person's eyes (the paper's symbols are σs, σc, τ, τa, Δl_m).
 ASCII_SPELLINGS = re.compile(r"um/s|\bum\b|sigma|tau_?a?\b|\bdl_m\b|\bmu\b")
 
-SEPIOLITE = str(datasets.data_path("giacomel-sepiolite/velstep3_TR2_exp013_sepiolite.txt"))
 
 COMMANDS = {
     "params show": ["params", "show"],
@@ -82,16 +82,6 @@ COMMANDS = {
     ],
     "fit steady": ["fit", "steady", str(datasets.synthetic_steady_path())],
     "fit stick": ["fit", "stick", str(datasets.table1_path()), "--exclude-row", "11"],
-    "rsf fit": [
-        "rsf",
-        "fit",
-        SEPIOLITE,
-        "--columns",
-        "time=Time(s),displacement=Displ(microns),friction=Friction",
-        "--displacement-unit",
-        "um",
-        "--trend",
-    ],
     "compare": ["compare"],
     "run": ["run", "--model", "quasi-static", "--v0", "20 um/s", "--duration", "60 s"],
     "compare --models": ["compare", "--models", "quasi-static,rsf", "--v0", "50 um/s", "--duration", "60 s"],
