@@ -23,7 +23,7 @@ TRANSIENT_CHAINS = ("chain_fraction", "held_by")
 #: ``rsf simulate -o`` (rate-and-state; a second state variable adds ``state2``).
 RATE_AND_STATE = ("time", "friction", "slider_velocity", "state", "load_point_displacement", "slider_displacement")
 #: ``Run.to_csv`` (any model through stickslip.models): these, then the model's own state columns.
-RUN = ("time", "stress", "friction", "slider_velocity", "slider_position", "load_point_position", "block_shear")
+RUN = ("time", "stress", "friction", "slider_velocity", "slider_position", "load_point_position")
 
 #: Every column of the package's own traces beyond time and stress: ``analyze`` reads them as known, unused.
 MODEL_COLUMNS = tuple(

@@ -165,6 +165,10 @@ class Run:
         return self.stress if self.stress is not None else self.friction  # type: ignore[return-value]
 
     @property
+    def signal_name(self) -> str:
+        return "stress" if self.stress is not None else "friction"
+
+    @property
     def signal_unit(self) -> str:
         return "Pa" if self.stress is not None else "1"
 
@@ -237,6 +241,7 @@ class Run:
         r = self.regime
         return json_safe({
             "model": self.model, "status": self.status, "message": self.message, "mean": self.mean,
+            "units": f"SI; regime period s, peak, trough and mean in {self.signal_unit} (the {self.signal_name})",
             "regime": {"kind": r.kind, "periods": r.periods, "amplitude_ratio": r.amplitude_ratio,
                        "period": r.period, "peak": r.peak, "trough": r.trough, "evidence": r.evidence},
             "summary": dict(self.summary),
