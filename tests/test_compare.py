@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import json
-import sys
 import types
 
 import numpy as np
@@ -31,17 +30,19 @@ def test_quasi_static_fallback_follows_the_steady_curve_and_says_so(monkeypatch)
 
 
 def test_time_dependent_model_is_used_when_asked_for(monkeypatch):
-    fake = types.ModuleType("stickslip.transient")
+    """bond_response runs the bond models through the model interface: the transient one only when asked for."""
+    asked = []
 
-    def run_transient(params, protocol, control="velocity", start="steady"):
-        t = np.linspace(0, protocol.duration, 5)
-        return types.SimpleNamespace(time=t, stress=np.full(5, 42.0))
+    class FakeTransient:
+        def run(self, params, protocol, rig=None, *, start=None):
+            asked.append((rig.control, start))
+            return types.SimpleNamespace(time=np.linspace(0, protocol.duration, 5), stress=np.full(5, 42.0))
 
-    fake.run_transient = run_transient
-    monkeypatch.setitem(sys.modules, "stickslip.transient", fake)
-    monkeypatch.setattr("stickslip.transient", fake, raising=False)
+    real = cmp._bond_model
+    monkeypatch.setattr(cmp, "_bond_model", lambda name: FakeTransient() if name == "transient" else real(name))
     trace = cmp.bond_response(PARAMS, protocols.constant(1e-4, 1.0), model="transient")
     assert trace.source == "time-dependent bond model" and np.all(trace.stress == 42.0)
+    assert asked == [("velocity", "steady")]
     default = cmp.bond_response(PARAMS, protocols.constant(1e-4, 1.0), times=[0.5])
     assert default.source == "quasi-static bond model"  # the slow model only when asked for
 

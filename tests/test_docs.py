@@ -299,10 +299,10 @@ def test_the_harness_sees_markers_failures_and_unknown_names(tmp_path, capsys):
     with pytest.raises(AttributeError):
         _resolve("stickslip.model.no_such_function")
     cycle = tmp_path / "cycle.md"
-    cycle.write_text("Run `stickslip cycle --v0 V` or `stickslip rsf simulate --v0 V`.\n")
+    cycle.write_text("Run `stickslip cycle --v0 V` or `stickslip rsf simulate --pull V`.\n")
     assert synopsis_problems(cycle) == [
         "`stickslip cycle --v0 V`: no command `stickslip cycle`",
-        "`stickslip rsf simulate --v0 V`: `stickslip rsf simulate` has no option --v0",
+        "`stickslip rsf simulate --pull V`: `stickslip rsf simulate` has no option --pull",
     ]
 
 

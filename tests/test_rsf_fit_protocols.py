@@ -97,8 +97,8 @@ def test_a_given_protocol_file_is_used(tmp_path, capsys):
     code, out, err = run_main(capsys, "rsf", "fit", str(path), "--displacement-unit", "um", "--protocol",
                               str(history), "--trend")  # fmt: skip
     assert code == 0, err
-    assert "load point (given)" in out and "from 200 s: 10 um/s for 30 s" in out
-    assert "a-b" in out and "dc" in out and " um " in out
+    assert "load point (given)" in out and "from 200 s: 10 µm/s for 30 s" in out
+    assert "a-b" in out and "dc" in out and " µm " in out
 
 
 def test_constant_friction_carries_no_information_and_the_fit_says_so():

@@ -48,7 +48,7 @@ def test_sweep_of_the_time_dependent_model_reads_back(capsys, tmp_path):
     assert list(frame["regime"]) == ["steady", "steady"]
     params = stickslip.load_parameters("gelatin-glass")
     expected = stickslip.steady_state(params, frame["pulling_velocity"].to_numpy()).stress
-    finals = [float(m.split("sigma = ")[1].split(" Pa")[0]) for m in frame["message"]]
+    finals = [float(m.split("σ = ")[1].split(" Pa")[0]) for m in frame["message"]]
     assert finals == pytest.approx(list(expected), rel=1e-5)
 
 

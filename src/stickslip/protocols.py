@@ -129,8 +129,8 @@ class Protocol:
         return with_units(pd.DataFrame({"start": b[:-1], "end": b[1:], "velocity": self.velocities}))
 
     def describe(self) -> str:
-        """One line a person can read: ``100 um/s for 10 s, then 1000 um/s for 20 s``."""
-        parts = [f"{s.velocity * 1e6:g} um/s for {s.duration:g} s" for s in self.segments]
+        """One line a person can read: ``100 µm/s for 10 s, then 1000 µm/s for 20 s``."""
+        parts = [f"{s.velocity * 1e6:g} µm/s for {s.duration:g} s" for s in self.segments]
         return ", then ".join(parts)
 
     def plot(self, ax: Any = None) -> Any:

@@ -1,6 +1,6 @@
 """Laying the model over a measured record: alignment, RMS misfit, per-cycle differences.
 
-The model (:func:`stickslip.model.cycle.simulate`, Eqs 10-17) is run at the
+The quasi-static model (Eqs 10-17, through the model interface :mod:`stickslip.models`) is run at the
 record's pulling velocity.  Its first cycle starts stuck at sigma_c, so it
 is aligned with the record's first *whole* cycle: the model's time zero is
 put at the record's first start corner that begins a complete cycle (or,
@@ -92,7 +92,8 @@ def compare_with_model(
     analysis: TraceAnalysis, params: Parameters | None = None, jump_curve: str = "aging"
 ) -> Comparison:
     """Simulate the model at the record's V0, align it with the first whole cycle, and measure the misfit."""
-    from ..model.cycle import simulate
+    from ..models import Rig, get_model
+    from ..protocols import constant
 
     params = analysis.parameters if params is None else params
     t, x = analysis.time, analysis.stress
@@ -101,7 +102,9 @@ def compare_with_model(
     duration = float(t[-1]) - shift
     if duration <= 0:  # the anchor is the last instant of the record: nothing to overlay
         duration = max(float(t[-1] - t[0]), 1e-9)
-    sim = simulate(params, analysis.pulling_velocity, duration + ALIGN_WINDOW * duration, jump_curve=jump_curve)
+    protocol = constant(analysis.pulling_velocity, duration + ALIGN_WINDOW * duration)
+    # the Run's native result is the Simulation: its phases give the per-cycle comparison
+    sim = get_model("quasi-static").run(params, protocol, Rig(), jump_curve=jump_curve).native
     if anchor is not None:
         shift = _refine_shift(analysis, sim, shift, aligned)
     model_time = sim.time + shift

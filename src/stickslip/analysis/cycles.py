@@ -77,7 +77,7 @@ CYCLE_QUANTITIES = {
 #: parameter set, e.g. ``--set bonds.bond_time=...``; every other quantity is read off the record alone).
 MODEL_DERIVED = {
     "jump_velocity": "model-derived, not measured: where the bond model's aging steady curve (Eq 8) carries the "
-    "measured peak stress sigma_s; it changes with the parameter set",
+    "measured peak stress σs; it changes with the parameter set",
 }
 
 #: CycleResult fields kept for plotting, not reported.

@@ -100,7 +100,7 @@ def analyze_command(
     plot_path: Path | None,
     compare: bool,
 ) -> None:
-    """Analyse a measured stress record: regime, and per cycle sigma_c, slope, Gd/h, sigma_s, ts, Vs.
+    """Analyse a measured stress record: regime, and per cycle σc, slope, Gd/h, σs, ts, Vs.
 
     TRACE is a CSV file with columns ``time`` and ``stress`` (or ``force``
     with --contact-area), units in header brackets (``time [s],stress [kPa]``;

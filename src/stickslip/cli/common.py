@@ -17,6 +17,7 @@ import json
 import math
 import stat
 import sys
+import tempfile
 from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
@@ -285,6 +286,43 @@ class InputFile(click.ParamType):
             self.fail(f"{shown} is {info.st_size} bytes; at most {self.max_bytes} bytes are read", param, ctx)
         protect_inputs([path])
         return path
+
+
+def check_output(option: str, path: Path | None, plot: bool = False) -> None:
+    """Refuse, before computing, an output that cannot be written: no name, no such folder, an unknown format."""
+    if path is None:
+        return
+    text = str(path)
+    if not text.strip() or text == ".":
+        raise ParameterError(f"{option}: expected a file name, got an empty one")
+    folder = path.parent if str(path.parent) else Path(".")
+    if not folder.is_dir():
+        raise ParameterError(f"{option} {shorten(text)}: the folder {shorten(str(folder))} does not exist")
+    try:
+        info = path.stat()
+    except OSError:
+        info = None
+    if info is not None and stat.S_ISDIR(info.st_mode):
+        raise ParameterError(f"{option} {shorten(text)}: that is a folder, not a file")
+    if info is None or stat.S_ISREG(info.st_mode):  # written beside, then renamed: the folder must take a file
+        try:
+            with tempfile.TemporaryFile(dir=folder):
+                pass
+        except OSError as exc:
+            reason = exc.strerror or str(exc)
+            raise ParameterError(
+                f"{option} {shorten(text)}: cannot write in {shorten(str(folder))} ({reason})"
+            ) from None
+    if plot:
+        from matplotlib.figure import Figure
+
+        formats = Figure().canvas.get_supported_filetypes()
+        suffix = path.suffix[1:].lower() or "png"
+        if suffix not in formats:
+            raise ParameterError(
+                f"{option} {shorten(text)}: unknown figure format .{suffix};"
+                f" expected one of {', '.join(sorted(formats))}"
+            )
 
 
 def echo_err(message: str) -> None:

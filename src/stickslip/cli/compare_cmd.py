@@ -22,17 +22,30 @@ from ..errors import ModelError, ParameterError
 from ..fileio import refuse_input_as_output
 from ..progress import progress
 from .common import json_text, params_options, positive, quantity, resolve_params
+from .protocol_options import protocol_options
 from .rsf_cmd import save_figure, sidecar, write
+
+#: The classic compare's --v0 and --duration when not given (with --models they are the protocol's first segment).
+CLASSIC_V0, CLASSIC_DURATION = "200 um/s", "120 s"
 
 
 @click.command("compare")
 @params_options
-@click.option("--v0", default="200 um/s", show_default=True, help="Velocity before the step (and of the slides).")
+@click.option(
+    "--models",
+    "models",
+    default=None,
+    metavar="A,B[,...]",
+    help="Run these models (registered names or module:attr) on one protocol and rig, side by side: a table of"
+    " regime, period, peak, trough and mean, and an overlay figure (-o).",
+)
+@protocol_options(
+    stiffness_help="--models: the rig's spring K for every model, in Pa/m, e.g. \"400 kPa/m\" [each model's own]."
+)
 @click.option("--v1", default="2 mm/s", show_default=True, help="Velocity after the step.")
 @click.option("--step-time", default="2 s", show_default=True, help="Duration of each velocity of the step.")
 @click.option("--hold", default="1 s", show_default=True, help="Hold time of the slide-hold-slide.")
 @click.option("--pull", default="50 um/s", show_default=True, help="Pulling velocity of the stick-slip pair.")
-@click.option("--duration", default="120 s", show_default=True, help="Duration of the stick-slip pair.")
 @click.option(
     "--bond-model",
     type=click.Choice(["quasi-static", "transient"]),
@@ -47,7 +60,21 @@ from .rsf_cmd import save_figure, sidecar, write
 @click.option("--json", "as_json", is_flag=True, help="Print the summary as JSON (SI units).")
 @click.option("-o", "--output", type=click.Path(dir_okay=False, path_type=Path), help="Save the figure here.")
 def compare_command(**options: Any) -> None:
-    """The bond model beside rate-and-state friction fitted to it: velocity step, slide-hold-slide, stick-slip."""
+    """The bond model beside rate-and-state friction fitted to it: velocity step, slide-hold-slide, stick-slip.
+
+    Without --models: the classic comparison (--v0 is the velocity before the step [200 um/s], --duration that
+    of the stick-slip pair [120 s]).  With --models A,B: every model runs the protocol of --v0/--duration/
+    --segment/--protocol through the rig of --control/--stiffness; --set KEY=VALUE goes to each model that has
+    the key (stickslip.models).  A run that failed makes the exit status 3.
+    """
+    if options["models"] is not None:
+        from .compare_models import compare_models
+
+        compare_models(options)
+        return
+    _refuse_model_options(options)
+    options["v0"] = options["v0_text"] or CLASSIC_V0
+    options["duration"] = options["duration_text"] or CLASSIC_DURATION
     from .. import protocols
     from ..rsf.compare import bond_response, rsf_of_bond, stick_slip_pair
 
@@ -97,7 +124,7 @@ def compare_command(**options: Any) -> None:
             "pulling_velocity": pull,
             "stiffness": pair["stiffness"],
             "eta": pair["eta"],
-            "bond": {"regime": pair["bond"].regime, "message": pair["bond"].message},
+            "bond": {"regime": pair["bond"].regime_name, "message": pair["bond"].message},
             "rsf": None if pair["rsf"] is None else pair["rsf"].summary(),
             "problem": pair["problem"],
         },
@@ -112,6 +139,20 @@ def compare_command(**options: Any) -> None:
     if failures:
         click.echo("stickslip: the rate-and-state side failed: " + failures[0], err=True)
         raise SystemExit(FAILED)
+
+
+def _refuse_model_options(options: dict[str, Any]) -> None:
+    """The protocol and rig words belong to --models; the classic comparison runs its own three experiments."""
+    ctx = click.get_current_context()
+    given = [name for key, name in (("segment_texts", "--segment"), ("protocol_file", "--protocol"),
+                                     ("stiffness_text", "--stiffness")) if options[key]]  # fmt: skip
+    if ctx.get_parameter_source("control") not in (None, click.core.ParameterSource.DEFAULT):
+        given.append("--control")
+    if given:
+        raise ParameterError(
+            f"{given[0]}: only with --models A,B; without it compare runs its own velocity step, slide-hold-slide"
+            " and stick-slip"
+        )
 
 
 #: Exit status when the RSF side could not be fitted (or a given set is unphysical); 2 is bad input.
@@ -195,21 +236,22 @@ def _override(rsf: Any, options: dict[str, Any]) -> Any:
 
 
 def _text(summary: dict[str, Any]) -> str:
+    from ..display import velocity
+
     r = summary["rsf_of_bond_model"]
     s = summary["stick_slip"]
     lines = [
-        f"one RSF parameter set for every panel (friction = stress / sigma_c, sigma_c = {r['sigma_c']:.4g} Pa): "
-        f"a = {r['a']:.4g}, b = {r['b']:.4g}, Dc = {r['dc'] * 1e6:.4g} um ({_how(r['status'])})",
+        f"one RSF parameter set for every panel (friction = stress / σc, σc = {r['sigma_c']:.4g} Pa): "
+        f"a = {r['a']:.4g}, b = {r['b']:.4g}, Dc = {r['dc'] * 1e6:.4g} µm ({_how(r['status'])})",
         f"  {r['note']}",
-        f"  the bond model's steady slope (1/sigma_c) dsigma/dlnV at {r['velocity'] * 1e6:.4g} um/s: "
-        f"{r['bond_steady_slope']:.4g} (RSF a - b = {r['rsf_a_minus_b']:.4g})",
+        f"  the bond model's steady slope (1/σc) dσ/dlnV at {velocity(r['velocity'], 4)}: "
+        f"{r['bond_steady_slope']:.4g} (RSF a − b = {r['rsf_a_minus_b']:.4g})",
         f"bond model: {summary['bond_model']}",
     ]
     for name, panel in summary["panels"].items():
         lines.append(f"{name}: RSF " + (f"cannot describe it: {panel['problem']}" if panel["problem"] else "ok"))
     lines += [
-        f"stick-slip at {s['pulling_velocity'] * 1e6:.4g} um/s, k = {s['stiffness']:.4g} 1/m, "
-        f"eta = {s['eta']:.4g} s/m:",
+        f"stick-slip at {velocity(s['pulling_velocity'], 4)}, k = {s['stiffness']:.4g} 1/m, η = {s['eta']:.4g} s/m:",
         f"  bond model: {s['bond']['message']}",
         "  RSF: "
         + (f"cannot describe it: {s['problem']}" if s["problem"] else f"{s['rsf']['regime']}; {s['rsf']['message']}"),

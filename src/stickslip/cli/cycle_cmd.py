@@ -23,6 +23,7 @@ from .common import (
     write_text,
 )
 from .params_cmd import print_rich
+from .protocol_options import build_protocol, protocol_options, refuse_unsupported, stiffness
 
 #: Rows of the Nc/Nc0 table printed by ``stick`` (the whole curve is in --json and -o).
 STICK_TABLE_ROWS = 11
@@ -56,10 +57,9 @@ def _fmt(value: float | None, scale: float = 1.0, digits: int = 5) -> str:
 
 # --------------------------------------------------------------------------- simulate
 @click.command("simulate")
-@click.option(
-    "--v0", "v0_text", required=True, metavar="V", help='Pulling velocity with its unit, e.g. "50 um/s" (>= 0).'
+@protocol_options(
+    stiffness_help='Effective stiffness K of the block (Eq 17), e.g. "400 kPa/m" [from the block: Gd/h and B/l].'
 )
-@click.option("--duration", "duration_text", required=True, metavar="T", help='Length of the run, e.g. "120 s".')
 @click.option(
     "--start-stress",
     "start_text",
@@ -81,8 +81,12 @@ def _fmt(value: float | None, scale: float = 1.0, digits: int = 5) -> str:
 @click.option("--json", "as_json", is_flag=True, help="Print the summary as JSON (SI units).")
 @params_options
 def simulate_command(
-    v0_text: str,
-    duration_text: str,
+    v0_text: str | None,
+    duration_text: str | None,
+    segment_texts: tuple[str, ...],
+    protocol_file: Path | None,
+    stiffness_text: str | None,
+    control: str,
     start_text: str | None,
     jump_curve: str,
     output: Path | None,
@@ -93,18 +97,27 @@ def simulate_command(
 ) -> None:
     """Simulate stick-slip: stick -> jump -> slip -> jump -> ... for a pulling velocity and duration.
 
+    The quasi-static model is a spring (the block, or --stiffness K) pulled at
+    one constant velocity: --v0 V --duration T (or one --segment "V:T", or a
+    one-segment --protocol file); other protocols and --control velocity are
+    refused (stickslip transient runs them).
     The block starts stuck at σc (or --start-stress) with fresh chains.  The
     regime is "stick-slip", "steady" (V0 >= Vc: the slip settles at V0),
     "stuck" (a stick never ends) or "undetermined" (the model has no answer).
     """
-    from ..model.cycle import CYCLE_COLUMNS, simulate
+    from ..model.cycle import CYCLE_COLUMNS
+    from ..models import Rig, get_model
 
-    refuse_overwriting_inputs([], [("-o", output), ("--plot", plot_path)], params_name)
-    v0 = _velocity(v0_text)
-    duration = positive(duration_text, "time", "--duration")
+    refuse_overwriting_inputs([protocol_file], [("-o", output), ("--plot", plot_path)], params_name)
+    protocol = build_protocol(v0_text, duration_text, segment_texts, protocol_file)
+    refuse_unsupported("simulate (the quasi-static model)", protocol, control, stiffness_text, controls=("spring",),
+                       one_segment=True, instead="stickslip transient runs any protocol and rig")  # fmt: skip
+    v0 = protocol.segments[0].velocity
+    k = stiffness(stiffness_text)
     start = _stress(start_text)
     params = resolve_params(params_name, overrides)
-    sim = simulate(params, v0, duration, start_stress=start, jump_curve=jump_curve)
+    run = get_model("quasi-static").run(params, protocol, Rig(stiffness=k), start=start, jump_curve=jump_curve)
+    sim = run.native  # the Simulation: its phases and cycles make the table below
     if output is not None:
         write_text(output, _csv({n: getattr(sim, n) for n in CYCLE_COLUMNS}))
     if plot_path is not None:
@@ -163,7 +176,7 @@ def _simulation_report(sim: Any, name: str) -> list[Any]:
 @click.option(
     "--start-stress", "start_text", default=None, metavar="S", help="Stress at the instant of sticking [default: σc]."
 )
-@click.option("--no-aging", is_flag=True, help="Drop the aging term of Eq 15 (tau_a -> infinity).")
+@click.option("--no-aging", is_flag=True, help="Drop the aging term of Eq 15 (τa → ∞).")
 @click.option(
     "--until",
     "until_text",

@@ -193,7 +193,7 @@ def steady_command(
         if vc.value is not None and sc.value is not None:
             from ..fitting.results import human  # not at module level: it imports lmfit (start-up time)
 
-            header.append(f"Vc = {human(vc.value, 'velocity')}, sigma_c = {human(sc.value, 'stress')} (Eq 9).")
+            header.append(f"Vc = {human(vc.value, 'velocity')}, σc = {human(sc.value, 'stress')} (Eq 9).")
         write_text(output, _toml_with_header(fitted, header))
     report = fit.report() if posterior is None else fit.report() + "\n" + posterior.report()
     if report_path is not None:

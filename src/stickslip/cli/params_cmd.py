@@ -18,6 +18,7 @@ from typing import Any
 
 import click
 
+from ..display import symbol
 from ..parameters import BOLTZMANN, SECTIONS, Parameters, available_parameter_sets, load_parameters
 from ..units import DIMENSIONS
 from .common import params_options, refuse_overwriting_inputs, resolve_params, stdout_is_terminal, write_text
@@ -106,7 +107,7 @@ def parameter_table(params: Parameters, changed: Sequence[str] = ()) -> Any:
             key = f"{s}.{f.name}"
             value = human(getattr(getattr(params, s), f.name), f.metadata["dimension"])
             flag = " (set)" if key in changed else ""
-            table.add_row(key + flag, f.metadata["symbol"], value, f.metadata["doc"])
+            table.add_row(key + flag, symbol(f.metadata["symbol"]), value, f.metadata["doc"])
     return table
 
 
@@ -123,13 +124,13 @@ def derived_rows(params: Parameters) -> list[tuple[str, str, str, str]]:
             f"{b.stretch_sensitivity:.6g} 1/m = {b.stretch_sensitivity * 1e-6:.6g} 1/µm",
             "Eyring exponent per unit chain extension (Eq 6); the paper's '2.47e12 m^-2'",
         ),
-        ("block stiffness", "G_d/h", human(k.stiffness, "stress_per_length"), "shear modulus over height (Eq 5)"),
+        ("block stiffness", "Gd/h", human(k.stiffness, "stress_per_length"), "shear modulus over height (Eq 5)"),
         ("geometric factor", "ln(B/l)/(B/l-1)", f"{k.geometric_factor:.6g}", "trapezoid correction (Eq 17)"),
         (
             "effective stiffness",
             "K",
             human(k.effective_stiffness, "stress_per_length"),
-            "G_d/h times the factor (Eq 17)",
+            "Gd/h times the factor (Eq 17)",
         ),
     ]
 

@@ -8,6 +8,7 @@ with ``--params``.
 
 from __future__ import annotations
 
+import functools
 import json
 import math
 import sys
@@ -21,12 +22,21 @@ from ..errors import DataError, ParameterError, StickslipError, UnitError
 from ..fileio import atomic_path, atomic_write_text, protect_inputs, read_input_text, refuse_input_as_output
 from ..units import quantity_noun, shorten
 from .common import json_text, quantity
+from .protocol_options import build_protocol as build_run_protocol
+from .protocol_options import protocol_options, refuse_unsupported
 
 LAW_NAMES = ("aging", "slip", "prz", "nagata")
 
 
-def model_options(func: Callable[..., Any]) -> Callable[..., Any]:
-    """The friction law and spring-slider options shared by simulate and stability."""
+#: Help of ``--stiffness`` on the rate-and-state commands.
+STIFFNESS_HELP = 'Spring stiffness: friction per slip ("1e-3 1/um") or Pa/m with --normal-stress.'
+
+
+def model_options(func: Callable[..., Any], stiffness: bool = True) -> Callable[..., Any]:
+    """The friction law and spring-slider options shared by simulate and stability.
+
+    ``stiffness=False`` leaves ``--stiffness`` to :func:`~stickslip.cli.protocol_options.protocol_options`.
+    """
     options = [
         click.option("--params", "params_file", type=click.Path(dir_okay=False, path_type=Path), default=None,
                      help="Start from parameters written by an earlier run or fit (.params.json or .toml)."),
@@ -39,8 +49,7 @@ def model_options(func: Callable[..., Any]) -> Callable[..., Any]:
         click.option("--c", "nagata_c", default=None, help="Nagata's c (nagata law only)."),
         click.option("--mu0", default=None, help="Reference friction mu0 [0.6]."),
         click.option("--v-ref", default=None, help='Reference velocity V0, e.g. "1 um/s" [1 um/s].'),
-        click.option("--stiffness", default=None,
-                     help='Spring stiffness: friction per slip ("1e-3 1/um") or Pa/m with --normal-stress.'),
+        *([click.option("--stiffness", default=None, help=STIFFNESS_HELP)] if stiffness else []),
         click.option("--eta", default=None, help='Radiation damping: "s/m" (friction per velocity) or Pa s/m.'),
         click.option("--mass", default=None, help='Slider mass per area, e.g. "100 kg/m^2" (needs --normal-stress).'),
         click.option("--normal-stress", default=None, help='Normal stress, e.g. "30 MPa".'),
@@ -205,18 +214,11 @@ def _per_sigma(
         return converted
 
 
-def build_protocol(segment: tuple[str, ...], protocol_file: Path | None, fallback: list[dict] | None = None) -> Any:
+def _fallback_protocol(fallback: list[dict] | None) -> Any:
+    """The protocol an earlier run's ``.params.json`` carries (None without one)."""
     from .. import protocols
 
-    if segment and protocol_file is not None:
-        raise click.UsageError("--segment and --protocol: give one of them")
-    if protocol_file is not None:
-        return protocols.read_protocol(protocol_file)
-    if segment:
-        return protocols.Protocol(tuple(protocols.parse_segment(s) for s in segment))
-    if fallback:
-        return protocols.segments([(s["velocity"], s["duration"]) for s in fallback])
-    raise click.UsageError('expected at least one --segment "V:T" (e.g. "1 um/s:100 s") or --protocol FILE')
+    return protocols.segments([(s["velocity"], s["duration"]) for s in fallback]) if fallback else None
 
 
 def trace_csv(frame: Any) -> str:
@@ -254,11 +256,9 @@ def rsf_group() -> None:
 
 
 @rsf_group.command("simulate")
-@model_options
+@functools.partial(model_options, stiffness=False)
+@protocol_options(stiffness_help=STIFFNESS_HELP)
 @click.option("--start-velocity", default=None, help="Steady sliding at this velocity at t = 0 [first segment's].")
-@click.option("--segment", multiple=True, metavar="V:T", help='Load-point velocity and duration, "1 um/s:100 s".')
-@click.option("--protocol", "protocol_file", type=click.Path(dir_okay=False, path_type=Path), default=None,
-              help="Protocol CSV (time,velocity or velocity,duration; SI).")  # fmt: skip
 @click.option("--every", default=None, help='Sample the trace every DT (e.g. "0.1 s"); default: the solver\'s steps.')
 @click.option("-o", "--output", type=click.Path(dir_okay=False, path_type=Path), help="Write the trace CSV here.")
 @click.option("--json", "as_json", is_flag=True, help="Print the summary as JSON.")
@@ -266,18 +266,25 @@ def rsf_group() -> None:
 def simulate_command(**options: Any) -> None:
     """Run a loading protocol on the rate-and-state spring-slider.
 
+    The protocol in the words of every run command: --v0 V --duration T, then
+    any --segment "V:T" (or --segment alone, or --protocol FILE); the rig is a
+    spring (--stiffness), so --control velocity is refused.
     The trace has columns time, friction, slider_velocity, state,
     load_point_displacement, slider_displacement (SI).  With -o the
     parameters go beside it in NAME.params.json.
     """
-    from ..rsf import simulate
+    from ..models import Rig, get_model
 
     fallback = None
     start = None
     if options["params_file"] is not None and options["params_file"].suffix.lower() == ".json":
         fallback, start = _run_meta(options["params_file"])
+    options["stiffness"] = options.pop("stiffness_text")
     params = build_params(options)
-    protocol = build_protocol(options["segment"], options["protocol_file"], fallback)
+    protocol = build_run_protocol(options["v0_text"], options["duration_text"], options["segment_texts"],
+                                  options["protocol_file"], _fallback_protocol(fallback))  # fmt: skip
+    refuse_unsupported("rsf simulate (the rate-and-state spring-slider)", protocol, options["control"],
+                       options["stiffness"], controls=("spring",))  # fmt: skip
     if options["start_velocity"] is not None:
         start = _positive(options["start_velocity"], "velocity", "--start-velocity")
     every = None if options["every"] is None else _positive(options["every"], "time", "--every")
@@ -287,7 +294,7 @@ def simulate_command(**options: Any) -> None:
         [options["protocol_file"], options["params_file"]],
         [("-o", output), ("-o (its NAME.params.json)", side), ("--plot", plot_path)],
     )
-    run = simulate(params, protocol, start_velocity=start, every=every)
+    run = get_model("rsf").run(params, protocol, Rig(), start=start, every=every).native  # the RSFRun
     if output is not None:
         write(output, trace_csv(run.to_frame()))
         if side is not None:
@@ -449,7 +456,9 @@ FIT_FAILED = 3
 
 
 def _fit_text(fit: Any) -> str:
-    unit = fit.record.length_unit
+    from ..display import unit as shown_unit
+
+    unit = shown_unit(fit.record.length_unit)
     lines = [f"rate-and-state fit of {fit.record.source} ({len(fit.record)} rows): {fit.status}"
              + (f": {fit.reason}" if fit.reason else "")]  # fmt: skip
     lines.append(f"  load point ({fit.protocol_source}):")

@@ -163,7 +163,7 @@ def curve_table(columns: dict[str, np.ndarray], title: str) -> Any:
     "--plot",
     "plot_path",
     type=click.Path(dir_okay=False, path_type=Path),
-    help="Also save the figure of Fig 1/Fig 4 (sigma against log V, with and without aging).",
+    help="Also save the figure of Fig 1/Fig 4 (σ against log V, with and without aging).",
 )
 @params_options
 def curve_command(
@@ -178,10 +178,10 @@ def curve_command(
     params_name: str,
     overrides: tuple[str, ...],
 ) -> None:
-    """The steady friction curve sigma(V) of Eqs 6-8.
+    """The steady friction curve σ(V) of Eqs 6-8.
 
     Velocities carry their unit ("350 um/s", "1 mm/s"; a bare number is refused).
-    csv and json are in SI base units; the table uses um/s and Pa.  csv is
+    csv and json are in SI base units; the table uses µm/s and Pa.  csv is
     computed and written in chunks (any --points); the table shows at most
     100 rows, evenly spread; json holds at most 100,000 velocities.
     """
@@ -238,7 +238,7 @@ def _save_curve_plot(
 @click.option("--json", "as_json", is_flag=True, help="Print JSON in SI units.")
 @params_options
 def critical_command(as_json: bool, params_name: str, overrides: tuple[str, ...]) -> None:
-    """Vc and sigma_c (Eq 9): the minimum of the aging curve.
+    """Vc and σc (Eq 9): the minimum of the aging curve.
 
     Also prints the maximum (turnover) of the no-aging curve.  When the
     curve has no minimum the message says why, and the exit status is 0.

@@ -170,7 +170,7 @@ def critical_point(params: Parameters) -> CriticalPoint:
     minima = [e for e in extrema if e.kind == "minimum"]
     if minima:
         v, s = minima[0].velocity, minima[0].stress
-        message = f"minimum of the aging curve at Vc = {v:.6g} m/s, sigma_c = {s:.6g} Pa"
+        message = f"minimum of the aging curve at Vc = {v:.6g} m/s, σc = {s:.6g} Pa"
     else:
         v = s = None
         message = _no_minimum_message(params, extrema)

@@ -254,13 +254,13 @@ class _Phases:
             return _Cycle(stick, None, None, regimes.UNDETERMINED, message)
         jump = jump_velocity(self.params, stick.peak_stress, self.curve)
         if not jump.reachable or jump.velocity is None:
-            message = f"the chains collapse at sigma_s = {stick.peak_stress:.6g} Pa, but {jump.message}"
+            message = f"the chains collapse at σs = {stick.peak_stress:.6g} Pa, but {jump.message}"
             return _Cycle(stick, jump, None, regimes.UNDETERMINED, message)
         slip = slip_phase(self.params, self.v0, jump.velocity)
         if slip.ends == "stick" and slip.duration == 0.0:
             message = (
-                f"degenerate cycle: the chains collapse after {stick.stick_time:.6g} s at sigma_s ="
-                f" {stick.peak_stress:.6g} Pa, no more than sigma_c, so the jump lands at Vc where the slip ends at"
+                f"degenerate cycle: the chains collapse after {stick.stick_time:.6g} s at σs ="
+                f" {stick.peak_stress:.6g} Pa, no more than σc, so the jump lands at Vc where the slip ends at"
                 " once and the block sticks again without moving (creep by infinitesimal slips, outside the model)"
             )
             return _Cycle(stick, jump, slip, regimes.UNDETERMINED, message)
@@ -387,7 +387,7 @@ def _outlook(phases: _Phases, sigma0: float, sigma_c: float) -> tuple[str, str, 
     return (
         regimes.STICK_SLIP,
         f"stick-slip with period {period:.6g} s (stick {stick.stick_time:.6g} s, slip {repeat.slip.duration:.6g} s):"
-        f" sigma_c = {sigma_c:.6g} Pa -> sigma_s = {stick.peak_stress:.6g} Pa,"
-        f" jump to Vs = {repeat.jump.velocity * 1e6:.6g} um/s",
+        f" σc = {sigma_c:.6g} Pa -> σs = {stick.peak_stress:.6g} Pa,"
+        f" jump to Vs = {repeat.jump.velocity * 1e6:.6g} µm/s",
         period,
     )

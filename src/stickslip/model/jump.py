@@ -294,7 +294,7 @@ def jump_velocity(params: Parameters, stress: float, curve: str = "aging") -> Ju
             None,
             False,
             curve,
-            f"sigma = {stress:.6g} Pa is {where} the stresses {s_low:.6g}-{s_max:.6g} Pa of the {curve} curve's"
+            f"σ = {stress:.6g} Pa is {where} the stresses {s_low:.6g}-{s_max:.6g} Pa of the {curve} curve's"
             f" right branch (Vc = {cp.velocity:.6g} m/s to its maximum at {v_max:.6g} m/s): no jump velocity",
             s_low,
             s_max,

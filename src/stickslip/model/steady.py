@@ -175,7 +175,7 @@ LARGEST_RATE = 1e200
 
 def _check_scales(s: _Scales) -> None:
     """A one-line ModelError where the dimensionless groups leave floating point (far outside any physical box)."""
-    groups = (("FENE strength a = lambda M dl_m/kT", s.a), ("aging rate dl_m/(V tau_a) e^(-V/V_a)", s.alpha))
+    groups = (("FENE strength a = λMΔl_m/kT", s.a), ("aging rate Δl_m/(V τa) e^(−V/Va)", s.alpha))
     for name, values in groups:
         bad = ~(np.abs(values) <= LARGEST_RATE)
         if np.any(bad):
@@ -185,7 +185,7 @@ def _check_scales(s: _Scales) -> None:
             )
     bad = ~(np.isfinite(s.log_t) & np.isfinite(s.birth))
     if np.any(bad):
-        raise ModelError("the breakage rate u0 dl_m/(V tau) or tau V/dl_m is not finite for these parameters")
+        raise ModelError("the breakage rate u0 Δl_m/(V τ) or τV/Δl_m is not finite for these parameters")
 
 
 def _log_hazard_and_slope(x: np.ndarray, y: np.ndarray, s: _Scales) -> tuple[np.ndarray, np.ndarray]:

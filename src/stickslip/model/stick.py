@@ -31,7 +31,7 @@ generous horizon the answer is "undetermined", never an invented number.
 
 Below a threshold pulling velocity (:func:`stuck_threshold`, 19.14 µm/s for
 ``gelatin-glass`` from sigma_c) Eq 15 keeps the block stuck for ever: its
-aging term -t/tau_a grows without bound and outgrows the load.  That is a
+aging term −t/τa grows without bound and outgrows the load.  That is a
 limitation of Eq 15, not a prediction: Baumberger et al. saw stick-slip of
 the same gel down to 10 µm/s (docs/stick-phase.md §5).
 """
@@ -71,8 +71,8 @@ SHORTEST_LOG_TIME = 690.0
 SAMPLES = 400
 #: Said whenever Eq 15 keeps a pulled block stuck for ever (docs/stick-phase.md §5).
 STUCK_LIMITATION = (
-    "this is a limitation of Eq 15, whose aging term -t/tau_a grows without bound, not a prediction:"
-    " Baumberger et al. saw stick-slip of the same gel down to 10 um/s"
+    "this is a limitation of Eq 15, whose aging term −t/τa grows without bound, not a prediction:"
+    " Baumberger et al. saw stick-slip of the same gel down to 10 µm/s"
 )
 #: Largest bound of the aging exponent accepted by the bounded-aging extension (e^-100: aging has long won).
 MAX_AGING_CAP = 100.0
@@ -298,7 +298,7 @@ def stick_phase(
     if aging_cap is not None:
         cap = _number(aging_cap, "aging_cap", "aging times")
         if not 0 <= cap <= MAX_AGING_CAP:
-            raise ParameterError(f"aging_cap: expected a bound of t/tau_a from 0 to {MAX_AGING_CAP:g}, got {cap!r}")
+            raise ParameterError(f"aging_cap: expected a bound of t/τa from 0 to {MAX_AGING_CAP:g}, got {cap!r}")
     stiffness = params.block.effective_stiffness
     b = params.bonds.force_sensitivity
     nc0 = params.stick.attached_chains
@@ -370,9 +370,7 @@ def stick_phase(
         time[-1], n[-1] = ts, 0.0
         sigma_s = sigma0 + stiffness * v0 * ts
         status, stuck = "slipped", False
-        message = (
-            f"the attached chains collapse at ts = {ts:.6g} s, sigma_s = {sigma_s:.6g} Pa (Eqs 15-16): the block slips"
-        )
+        message = f"the attached chains collapse at ts = {ts:.6g} s, σs = {sigma_s:.6g} Pa (Eqs 15-16): the block slips"
         stick_time, peak = ts, sigma_s
     elif result.reason == "decided":
         status, stuck, stick_time, peak = "stuck", True, None, None
@@ -490,6 +488,6 @@ def stuck_threshold(
         velocity,
         lower,
         upper,
-        f"from {sigma0:.6g} Pa the block never slips below V0 = {velocity * 1e6:.5g} um/s (Eq 15 with"
-        f" tau_a = {params.stick.aging_time:g} s; every V0 above {ceiling * 1e6:.5g} um/s slips); {STUCK_LIMITATION}",
+        f"from {sigma0:.6g} Pa the block never slips below V0 = {velocity * 1e6:.5g} µm/s (Eq 15 with"
+        f" τa = {params.stick.aging_time:g} s; every V0 above {ceiling * 1e6:.5g} µm/s slips); {STUCK_LIMITATION}",
     )

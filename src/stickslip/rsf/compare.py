@@ -140,10 +140,9 @@ def bond_response(
         raise ParameterError(f"control: expected 'velocity' or 'block', got {control!r}")
     if model not in ("quasi-static", "transient"):
         raise ParameterError(f"bond model: expected 'quasi-static' or 'transient', got {model!r}")
-    run_transient = _transient() if model == "transient" else None
-    if run_transient is not None:
-        result = run_transient(params, protocol, control=control, start="steady")
-        return BondTrace(np.asarray(result.time, float), np.asarray(result.stress, float), "time-dependent bond model",
+    if model == "transient" and _transient() is not None:
+        run = _bond_model("transient").run(params, protocol, _rig(control), start="steady")
+        return BondTrace(np.asarray(run.time, float), np.asarray(run.stress, float), "time-dependent bond model",
                          "time-dependent bond model (stickslip.transient)")  # fmt: skip
     if control == "velocity":
         from ..model.steady import steady_state
@@ -159,16 +158,30 @@ def bond_response(
                 "memory), so it shows no transient" + ("; during holds it has no steady value (blank)"
                                                          if not moving.all() else ""))  # fmt: skip
         return BondTrace(t, stress, "quasi-static bond model", note)
-    from ..model.cycle import simulate
+    from ..protocols import constant
 
     if len(set(protocol.velocities.tolist())) != 1:
         raise ModelError(
             "the quasi-static bond model runs only constant pulling under block control; a changing protocol "
             "needs the time-dependent bond model (stickslip.transient), not available here"
         )
-    sim = simulate(params, protocol.initial_velocity, protocol.duration)
-    return BondTrace(sim.time, sim.stress, "quasi-static bond model (jump cycles)",
-                     f"quasi-static bond model, jump cycles: {sim.message}")  # fmt: skip
+    run = _bond_model("quasi-static").run(params, constant(protocol.initial_velocity, protocol.duration), _rig(control))
+    return BondTrace(run.time, run.stress, "quasi-static bond model (jump cycles)",
+                     f"quasi-static bond model, jump cycles: {run.message}")  # fmt: skip
+
+
+def _bond_model(name: str) -> Any:
+    """A bond model behind the model interface (:mod:`stickslip.models`)."""
+    from ..models import get_model
+
+    return get_model(name)
+
+
+def _rig(control: str) -> Any:
+    """The interface's rig for compare's control: the slider's velocity, or the block ("block") as the spring."""
+    from ..models import Rig
+
+    return Rig(control="velocity" if control == "velocity" else "spring")
 
 
 def _critical(params: Any) -> tuple[float, float]:
@@ -205,14 +218,14 @@ def rsf_of_bond(
     # a failed set is kept for the record only; RSFParams needs a > 0, so it holds |a| (the note gives a)
     rsf = RSFParams(a=max(abs(a), 1e-12), states=(StateVariable("aging", 0.0, dl_m),), mu0=mu0, v_ref=v0,
                     stiffness=stiffness)  # fmt: skip
-    step = f"{v0 * 1e6:.4g} -> {v1 * 1e6:.4g} um/s"
+    step = f"{v0 * 1e6:.4g} -> {v1 * 1e6:.4g} µm/s"
     if a <= 0:
-        why = (f"fit failed: the quasi-static bond model's stress falls in the step {step} (mu {mu0:.4g} -> "
+        why = (f"fit failed: the quasi-static bond model's stress falls in the step {step} (μ {mu0:.4g} -> "
                f"{mu1:.4g}), so a rate-only law would need a = {a:.3g} <= 0: no positive direct effect")  # fmt: skip
         return BondRSF(rsf, slope, vm, sigma_c, "failed", why)
-    note = (f"fitted to the quasi-static bond model's step {step}: it jumps at once from mu = {mu0:.4g} to "
-            f"{mu1:.4g} (no transient, no state), which is exactly a = (mu1 - mu0)/ln(V1/V0) = {a:.4g}, b = 0; "
-            f"Dc has no effect with b = 0 and is not determined (set to dl_m = {dl_m * 1e6:.4g} um)")  # fmt: skip
+    note = (f"fitted to the quasi-static bond model's step {step}: it jumps at once from μ = {mu0:.4g} to "
+            f"{mu1:.4g} (no transient, no state), which is exactly a = (μ1 − μ0)/ln(V1/V0) = {a:.4g}, b = 0; "
+            f"Dc has no effect with b = 0 and is not determined (set to Δl_m = {dl_m * 1e6:.4g} µm)")  # fmt: skip
     return BondRSF(rsf, slope, vm, sigma_c, "fitted", note)
 
 
@@ -294,14 +307,15 @@ def fit_bond_step(trace: BondTrace, protocol: Protocol, sigma_c: float, slope: f
 def stick_slip_pair(params: Any, v0: float, duration: float, rsf: BondRSF, eta: float | None = None) -> dict[str, Any]:
     """The bond model's jump cycle and the RSF spring-slider at the same V0, stiffness and sigma_c.
 
+    ``"bond"`` is the quasi-static model's :class:`stickslip.models.Run` (through the model interface).
+
     The RSF law is ``rsf``'s own (a, b, Dc, mu0 at its v_ref): only the rig (stiffness, radiation damping) is the
     bond model's block.  With a failed ``rsf`` the RSF side is not run (``"rsf": None``).
     """
-    from ..model.cycle import simulate as bond_simulate
     from ..protocols import constant
 
-    sim = bond_simulate(params, v0, duration)
-    k = float(sim.stiffness) / rsf.sigma_c  # Pa/m over sigma_c: friction per metre
+    sim = _bond_model("quasi-static").run(params, constant(v0, duration), _rig("block"))  # a Run: the jump cycles
+    k = float(params.block.effective_stiffness) / rsf.sigma_c  # Pa/m over sigma_c: friction per metre
     a = abs(rsf.params.a)
     eta = a / (100.0 * v0) if eta is None else eta  # damping matters only above ~100 V0
     if not rsf.usable:

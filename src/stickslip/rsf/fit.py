@@ -110,8 +110,10 @@ class FitParameter:
         return out
 
     def text(self) -> str:
-        """``0.0123 ± 0.0004 um  95 % [..]`` in the record's units."""
-        k, unit = self.scale, f" {self.unit}" if self.unit else ""
+        """``0.0123 ± 0.0004 µm  95 % [..]`` in the record's units."""
+        from ..display import unit as shown_unit
+
+        k, unit = self.scale, f" {shown_unit(self.unit)}" if self.unit else ""
         if self.fixed:
             return f"{self.value / k:.6g}{unit} (fixed)"
         if not self.constrained:

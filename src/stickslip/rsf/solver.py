@@ -142,7 +142,7 @@ def _out_of_range(system: System, t0: float, t1: float, exc: Exception) -> str:
     where = f"the rate-and-state equations left the floating-point range in the segment {t0:g} ... {t1:g} s ({exc})"
     if system.inertial:
         return (
-            f"{where}: the slider's inertia m/sigma = {system.inertia:.3g} s^2/m is too small to matter; drop the"
+            f"{where}: the slider's inertia m/σ = {system.inertia:.3g} s^2/m is too small to matter; drop the"
             " mass (the quasi-static slider is its limit; use eta for fast slip)"
         )
     return f"{where}: check the magnitudes of a, b, Dc, the stiffness, eta and v_ref"
@@ -377,7 +377,7 @@ def _adaptive_piece(
             v = system.v0 * math.exp(min(x_fail, EXP_CAP))
             tau = system.inertia * v / system.a
             raise ModelError(
-                f"rate-and-state solver failed at t = {t_fail:.6g} s: the slider's inertial time m V/(sigma a) = "
+                f"rate-and-state solver failed at t = {t_fail:.6g} s: the slider's inertial time mV/(σa) = "
                 f"{tau:.3g} s is too short beside the run ({t1 - t0:.3g} s); inertia this small does not matter, "
                 "drop the mass (the quasi-static slider is its limit; use eta for fast slip)"
             )

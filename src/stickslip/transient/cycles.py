@@ -130,12 +130,12 @@ def classify(
     whole = [c for c in cycles if c.period is not None]
     if found.kind == regimes.STICK_SLIP:
         seen = found.evidence.removeprefix("stick-slip (limit cycle): ")
-        text = f"stick-slip (limit cycle): {seen}, sigma {found.trough:.6g} ... {found.peak:.6g} Pa"
+        text = f"stick-slip (limit cycle): {seen}, σ {found.trough:.6g} ... {found.peak:.6g} Pa"
         if whole:
             c = whole[-1]
             text += (
-                f"; {len(cycles)} slip(s), last: stick {c.stick_time:.4g} s up to sigma_s = {c.peak_stress:.5g} Pa,"
-                f" jump to {c.jump_velocity * 1e6:.4g} um/s, slip {c.slip_time:.4g} s"
+                f"; {len(cycles)} slip(s), last: stick {c.stick_time:.4g} s up to σs = {c.peak_stress:.5g} Pa,"
+                f" jump to {c.jump_velocity * 1e6:.4g} µm/s, slip {c.slip_time:.4g} s"
             )
         return regimes.STICK_SLIP, text
     if found.kind in (regimes.DECAYING, regimes.GROWING):
@@ -149,21 +149,21 @@ def classify(
         )
         return (
             regimes.STUCK,
-            f"stuck{slipped}: at t = {time[-1]:.6g} s the slider {motion} under sigma = {stress[-1]:.6g} Pa",
+            f"stuck{slipped}: at t = {time[-1]:.6g} s the slider {motion} under σ = {stress[-1]:.6g} Pa",
         )
     if found.kind == regimes.STEADY:
         v_end = float(velocity[-1])
         if control == "block" and vp > 0 and abs(v_end - vp) > STEADY_TOLERANCE * vp:
             return regimes.UNDETERMINED, (
-                f"undetermined: the stress is flat but the slider moves at {v_end * 1e6:.6g} um/s, not the"
-                f" puller's {vp * 1e6:.6g} um/s (t = {time[-1]:.6g} s)"
+                f"undetermined: the stress is flat but the slider moves at {v_end * 1e6:.6g} µm/s, not the"
+                f" puller's {vp * 1e6:.6g} µm/s (t = {time[-1]:.6g} s)"
             )
         return regimes.STEADY, (
-            f"steady sliding at {v_end * 1e6:.6g} um/s: sigma = {stress[-1]:.6g} Pa at t = {time[-1]:.6g} s"
+            f"steady sliding at {v_end * 1e6:.6g} µm/s: σ = {stress[-1]:.6g} Pa at t = {time[-1]:.6g} s"
             f" ({found.evidence.removeprefix('steady: ')})"
         )
     return regimes.UNDETERMINED, (
-        f"{found.evidence} at the end of the run (t = {time[-1]:.6g} s, sigma = {stress[-1]:.6g} Pa,"
+        f"{found.evidence} at the end of the run (t = {time[-1]:.6g} s, σ = {stress[-1]:.6g} Pa,"
         f" V = {velocity[-1]:.3g} m/s): run longer to see where it goes"
     )
 

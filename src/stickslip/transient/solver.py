@@ -242,7 +242,7 @@ def run_transient(
                         k_block,
                         int(state.acc[4]),
                         note=note,
-                        stop=f"the chains collapse at sigma_s = {sigma_s:.6g} Pa, beyond the"
+                        stop=f"the chains collapse at σs = {sigma_s:.6g} Pa, beyond the"
                         " steady curve's reach: the paper's jump has no landing point",
                     )
                 events.append(("slip", state.t, sigma_s, vs))
@@ -480,7 +480,7 @@ def _steady_start_below_vc(
     v_stable = cp.velocity * (1.0 + STABLE_SIDE)
     return v_stable, (
         f" (steady start: {v_start:.4g} m/s is below Vc = {cp.velocity:.4g} m/s, where steady sliding is unstable,"
-        f" so the run starts on the stable side of the critical point, sliding at Vc under sigma_c ="
+        f" so the run starts on the stable side of the critical point, sliding at Vc under σc ="
         f" {cp.stress:.6g} Pa; give start_velocity / --start-velocity to start elsewhere)"
     )
 
@@ -537,10 +537,10 @@ def estimate_cost(
     if max_step is not None:
         steps = max(steps, duration / max_step)
     natural = b.max_extension / b.bond_time
-    basis = f"{duration:.3g} s at up to {fastest:.3g} m/s, resolving tau = {b.bond_time:.3g} s"
+    basis = f"{duration:.3g} s at up to {fastest:.3g} m/s, resolving τ = {b.bond_time:.3g} s"
     if fastest > 100.0 * natural:
         basis += (
-            f"; {fastest:.3g} m/s is {fastest / natural:.2g} x the set's dl_m/tau = {natural:.3g} m/s: check the unit"
+            f"; {fastest:.3g} m/s is {fastest / natural:.2g} × the set's Δl_m/τ = {natural:.3g} m/s: check the unit"
         )
     return CostEstimate(steps, basis, steps * STEP_SECONDS)
 

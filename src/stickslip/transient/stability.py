@@ -63,7 +63,7 @@ def interface_response(params: Parameters, velocity: float, s: np.ndarray, aging
     fastest = FASTEST * b.max_extension / b.bond_time
     if velocity > fastest:
         raise ParameterError(
-            f"velocity: {velocity:.3g} m/s is beyond {FASTEST:.0e} x the set's dl_m/tau ({fastest:.3g} m/s): chains"
+            f"velocity: {velocity:.3g} m/s is beyond {FASTEST:.0e} × the set's Δl_m/τ ({fastest:.3g} m/s): chains"
             " would reach full extension in a negligible fraction of a bond's life; check the unit"
         )
     a, w, width, f, fp, r, gv = _cells(params, float(velocity), aging)

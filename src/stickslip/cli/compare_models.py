@@ -1,0 +1,160 @@
+"""``stickslip compare --models A,B``: several models, one protocol, one rig, through the model interface.
+
+Each model (a registered name or ``module:attr``) runs the same protocol (``--v0 --duration --segment
+--protocol``) through the same rig (``--control``, ``--stiffness`` in Pa/m); ``--set KEY=VALUE`` goes to every
+model that has the key, and a key no model has is refused.  The table gives each run's regime, period, peak,
+trough and mean (stress in Pa, or the friction coefficient for a model without a normal stress), from the one
+classifier; ``-o`` draws them over each other.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import click
+
+from ..errors import ModelError, ParameterError
+from ..progress import progress
+from ..units import shorten
+from .common import check_output, emit_json, refuse_overwriting_inputs, require_unit, save_figure
+from .protocol_options import build_protocol, control_name
+from .run_cmd import model_parameters, run_summary
+
+#: Exit status when a model's run failed (status "failed"); 2 is bad input.
+FAILED = 3
+
+
+def model_list(text: str) -> list[Any]:
+    """The models of ``--models A,B``: at least two, each named once."""
+    from ..models import get_model
+
+    names = [n.strip() for n in text.split(",") if n.strip()]
+    if len(names) < 2:
+        raise ParameterError(f"--models {shorten(text)}: expected two or more models, e.g. --models quasi-static,rsf")
+    models = [get_model(n) for n in names]
+    seen: dict[str, str] = {}
+    for given, model in zip(names, models, strict=True):
+        if model.name in seen:
+            raise ParameterError(f"--models: {seen[model.name]} and {given} are the same model ({model.name})")
+        seen[model.name] = given
+    return models
+
+
+def routed_overrides(models: list[Any], overrides: tuple[str, ...]) -> dict[str, dict[str, str]]:
+    """``--set KEY=VALUE`` for each model that has KEY (with its unit, as everywhere on the command line)."""
+    routed: dict[str, dict[str, str]] = {m.name: {} for m in models}
+    for item in overrides:
+        key, sep, value = item.partition("=")
+        key, value = key.strip(), value.strip()
+        if not sep or not key:
+            raise ParameterError(f"--set {shorten(item)}: expected KEY=VALUE, e.g. --set 'bonds.bond_time=224 us'")
+        owners = [m for m in models if key in m.dimensions() or (key == "law" and "law" in _extra_keys(m))]
+        if not owners:
+            names = ", ".join(m.name for m in models)
+            raise ParameterError(f"--set {key}: none of the models {names} has this key")
+        for model in owners:
+            dimension = model.dimensions().get(key)
+            if dimension is not None:
+                require_unit(value, dimension, f"--set {key}=")
+            routed[model.name][key] = value
+    return routed
+
+
+def _extra_keys(model: Any) -> tuple[str, ...]:
+    """Keys a model takes besides its dimensional ones (rate-and-state's ``law``)."""
+    return ("law",) if hasattr(model, "LAW_NAMES") else ()
+
+
+def _rig(control: str, stiffness_text: str | None) -> Any:
+    from ..models import Rig
+    from .common import positive
+
+    control = control_name(control)
+    if stiffness_text is None:
+        return Rig(control=control)
+    k = positive(stiffness_text, "stress_per_length", "--stiffness")
+    if control == "velocity":
+        raise ParameterError(
+            "--stiffness: under --control velocity the rig is rigid and has no spring; drop --stiffness"
+        )
+    return Rig(control=control, stiffness=k)
+
+
+def compare_models(options: dict[str, Any]) -> None:
+    """Run every model of ``--models`` and report them side by side (see the module notes)."""
+    output = options["output"]
+    ctx = click.get_current_context()
+    params_given = ctx.get_parameter_source("params_name") not in (None, click.core.ParameterSource.DEFAULT)
+    params_name = options["params_name"] if params_given else None
+    refuse_overwriting_inputs([options["protocol_file"], params_name], [("-o", output)])
+    check_output("-o", output, plot=True)
+    _refuse_classic_options(ctx)
+    models = model_list(options["models"])
+    protocol = build_protocol(options["v0_text"], options["duration_text"], options["segment_texts"],
+                              options["protocol_file"])  # fmt: skip
+    rig = _rig(options["control"], options["stiffness_text"])
+    for model in models:  # what a model cannot run is refused before any model runs
+        model.check(protocol, rig, {})
+    routed = routed_overrides(models, options["overrides"])
+    runs = {}
+    # one stage per model: a bar on a terminal, nothing in a pipe or with --json
+    with progress("compare", total=len(models), unit="models", enabled=False if options["as_json"] else None) as bar:
+        for model in models:
+            try:
+                params = model_parameters(model, params_name, routed[model.name])
+                runs[model.name] = model.run(params, protocol, rig)
+            except (ParameterError, ModelError) as exc:
+                raise type(exc)(f"model {model.name}: {exc}") from None
+            bar.advance(note=model.name)
+    summaries = {name: run_summary(run, protocol, rig) for name, run in runs.items()}
+    document = {
+        "protocol": [{"velocity": s.velocity, "duration": s.duration} for s in protocol.segments],
+        "rig": {"control": rig.control, "stiffness": rig.stiffness},
+        "models": summaries,
+        "status": "ok" if all(r.status == "ok" for r in runs.values()) else "failed",
+    }
+    if options["as_json"]:
+        emit_json(document)
+    else:
+        from .params_cmd import print_rich
+
+        print_rich(protocol.describe() + f" ({rig.control} control)", comparison_table(summaries))
+    if output is not None:
+        from ..plots.overlay import overlay_figure
+
+        save_figure(overlay_figure(runs, title=protocol.describe()), output)
+    failed = [name for name, run in runs.items() if run.status != "ok"]
+    if failed:
+        click.echo(f"stickslip: the run of {failed[0]} failed: {runs[failed[0]].message}", err=True)
+        raise SystemExit(FAILED)
+
+
+def _refuse_classic_options(ctx: click.Context) -> None:
+    """The classic comparison's own options mean nothing beside --models: say so rather than ignore them."""
+    classic = ("v1", "step_time", "hold", "pull", "bond_model", "eta", "rsf_a", "rsf_b", "rsf_dc")
+    for name in classic:
+        if ctx.get_parameter_source(name) not in (None, click.core.ParameterSource.DEFAULT):
+            flag = next(p.opts[0] for p in ctx.command.params if p.name == name)
+            raise ParameterError(f"{flag}: not with --models (give model keys with --set KEY=VALUE)")
+
+
+def comparison_table(summaries: dict[str, dict[str, Any]]) -> Any:
+    """A rich table: one row per model, regime and the settled numbers in the run's own unit."""
+    from rich.table import Table
+
+    table = Table(title="Same protocol and rig, each model", title_justify="left")
+    for heading in ("model", "regime", "period (s)", "peak", "trough", "mean", "unit"):
+        table.add_column(heading, justify="left" if heading in ("model", "regime") else "right")
+    for name, s in summaries.items():
+        signal, unit = ("stress", "Pa") if "peak_stress" in s else ("friction", "μ")
+        table.add_row(name, s["regime"] + ("" if s["status"] == "ok" else " (FAILED)"), _number(s["period"]),
+                      *(_number(s[f"{w}_{signal}"]) for w in ("peak", "trough", "mean")), unit)  # fmt: skip
+    return table
+
+
+def _number(value: float | None) -> str:
+    return "—" if value is None or not math.isfinite(value) else f"{value:.6g}"
+
+
+__all__ = ["compare_models", "comparison_table", "model_list", "routed_overrides"]

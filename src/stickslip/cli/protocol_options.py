@@ -1,0 +1,132 @@
+"""The protocol vocabulary shared by every model's run command: what the rig does, in the same words everywhere.
+
+``--v0 V --duration T``
+    a first segment at constant velocity (the load point's through a spring, the slider's under velocity control);
+``--segment "V:T"``
+    further segments, repeatable (alone, they are the whole protocol, as ``rsf simulate`` always took them);
+``--protocol FILE``
+    the protocol as a CSV file (docs/protocols.md), instead of the three above;
+``--stiffness K``
+    the spring between the load point and the slider (each model reads it in its own unit: Pa/m for the bond
+    models, friction per slip for rate-and-state);
+``--control spring|velocity``
+    the protocol drives the load point through the spring, or the slider itself (a rigid rig).
+    ``block`` is the older name of ``spring`` and keeps working.
+
+A model that cannot run what was asked (the quasi-static model is a spring at one constant velocity) refuses it
+in one line naming the option, before anything is computed.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from pathlib import Path
+from typing import Any
+
+import click
+
+from ..errors import ParameterError
+from .common import positive
+
+#: Rigs every run command names the same way.
+CONTROLS = ("spring", "velocity")
+#: Older spellings still accepted: ``transient --control block`` is the spring.
+CONTROL_ALIASES = {"block": "spring"}
+
+
+def protocol_options(
+    stiffness_help: str = 'Spring stiffness K between the load point and the slider, e.g. "400 kPa/m".',
+    control_default: str = "spring",
+) -> Callable[[Callable[..., Any]], Callable[..., Any]]:
+    """Add ``--v0 --duration --segment --protocol --stiffness --control`` (parameters ``v0_text``,
+    ``duration_text``, ``segment_texts``, ``protocol_file``, ``stiffness_text``, ``control``)."""
+
+    def decorate(func: Callable[..., Any]) -> Callable[..., Any]:
+        options = [
+            click.option("--v0", "v0_text", metavar="V",
+                         help='Velocity of the (first) segment, with its unit, e.g. "50 um/s" (>= 0).'),
+            click.option("--duration", "duration_text", metavar="T",
+                         help='Length of the (first) segment, e.g. "120 s".'),
+            click.option("--segment", "segment_texts", multiple=True, metavar='"V:T"',
+                         help='A (further) segment: velocity and duration, e.g. "1 mm/s:2 s"; repeatable.'),
+            click.option("--protocol", "protocol_file", type=click.Path(dir_okay=False, path_type=Path),
+                         help="The protocol as CSV (time,velocity or velocity,duration; docs/protocols.md)."),
+            click.option("--stiffness", "stiffness_text", metavar="K", default=None, help=stiffness_help),
+            click.option("--control", type=click.Choice([*CONTROLS, *CONTROL_ALIASES]), default=control_default,
+                         show_default=True,
+                         help="spring: the protocol moves the load point, a spring drives the slider (block is"
+                         " the older name); velocity: it moves the slider itself (a rigid rig)."),
+        ]  # fmt: skip
+        for option in reversed(options):
+            func = option(func)
+        return func
+
+    return decorate
+
+
+def control_name(control: str) -> str:
+    """The rig in the vocabulary's words: ``spring`` or ``velocity`` (``block`` is the spring)."""
+    return CONTROL_ALIASES.get(control, control)
+
+
+def build_protocol(
+    v0_text: str | None,
+    duration_text: str | None,
+    segment_texts: Sequence[str],
+    protocol_file: Path | None,
+    fallback: Any = None,
+) -> Any:
+    """The :class:`stickslip.protocols.Protocol` the options describe (``fallback`` when they describe none)."""
+    from ..protocols import Protocol, Segment, parse_segment, read_protocol
+
+    if protocol_file is not None:
+        if segment_texts or v0_text is not None or duration_text is not None:
+            raise ParameterError("--protocol: give either a protocol file or --v0/--duration/--segment, not both")
+        return read_protocol(protocol_file)
+    if (v0_text is None) != (duration_text is None):
+        given, missing = ("--v0", "--duration") if duration_text is None else ("--duration", "--v0")
+        raise ParameterError(f"{given} needs {missing}: the first segment is a velocity and a length of time")
+    segments = [parse_segment(text) for text in segment_texts]
+    if v0_text is not None and duration_text is not None:
+        first = Segment(
+            positive(v0_text, "velocity", "--v0", allow_zero=True), positive(duration_text, "time", "--duration")
+        )
+        segments.insert(0, first)
+    if segments:
+        return Protocol(tuple(segments))
+    if fallback is not None:
+        return fallback
+    raise ParameterError('give the protocol: --v0 V --duration T, --segment "V:T" (repeatable) or --protocol FILE')
+
+
+def refuse_unsupported(
+    command: str,
+    protocol: Any,
+    control: str,
+    stiffness_text: str | None,
+    *,
+    controls: Sequence[str] = CONTROLS,
+    one_segment: bool = False,
+    instead: str = "",
+) -> None:
+    """Refuse, in one line naming the option, a rig or protocol the model of ``command`` cannot run."""
+    control = control_name(control)
+    hint = f" ({instead})" if instead else ""
+    if control not in controls:
+        can = " or ".join(f"--control {c}" for c in controls)
+        raise ParameterError(f"--control {control}: {command} runs only with {can}{hint}")
+    if one_segment and len(protocol.segments) > 1:
+        raise ParameterError(
+            f"--segment/--protocol: {command} runs at one constant velocity, not a protocol of"
+            f" {len(protocol.segments)} segments{hint}"
+        )
+    if control == "velocity" and stiffness_text is not None:
+        raise ParameterError(
+            "--stiffness: under --control velocity the rig is rigid and has no spring; drop --stiffness"
+            " or use --control spring"
+        )
+
+
+def stiffness(text: str | None) -> float | None:
+    """``--stiffness`` of the bond models: K in Pa/m (None when not given)."""
+    return None if text is None else positive(text, "stress_per_length", "--stiffness")

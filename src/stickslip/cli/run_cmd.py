@@ -1,0 +1,300 @@
+"""``stickslip run --model NAME``: any registered friction model through the one model interface.
+
+The protocol and the rig in the words every run command shares (:mod:`.protocol_options`); the parameters
+as ``--params`` and ``--set KEY=VALUE`` (the model's own keys, with units); the result is one
+:class:`stickslip.models.Run`: ``-o`` writes its CSV (units in the header, the regime in a first comment
+line; ``stickslip analyze`` reads it as a measured trace), ``--json`` its summary, ``--plot`` its figure.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Any
+
+import click
+
+from ..errors import ParameterError, UnitError
+from ..progress import progress
+from ..units import shorten
+from .common import check_output, emit_json, refuse_overwriting_inputs, require_unit, save_figure
+from .protocol_options import build_protocol, control_name, protocol_options
+
+#: Exit status of a run the model could not finish (status "failed"); 2 is bad input.
+RUN_FAILED = 3
+
+
+def model_spec_options(func: Any) -> Any:
+    """``--model NAME`` (a registered name or ``module:attr``), ``--params``, repeatable ``--set`` and ``--start``."""
+    options = [
+        click.option("--model", "model_name", default="quasi-static", show_default=True, metavar="NAME",
+                     help="A registered model (quasi-static, transient, rsf, or one of an installed package) or"
+                     " an import path MODULE:ATTR."),
+        click.option("--params", "params_name", default=None, metavar="NAME|FILE",
+                     help="The model's parameters: a built-in set or a file [the model's defaults]."),
+        click.option("--set", "overrides", multiple=True, metavar="KEY=VALUE",
+                     help="Override one of the model's parameter keys, with its unit; repeatable."),
+    ]  # fmt: skip
+    for option in reversed(options):
+        func = option(func)
+    return func
+
+
+def load_model(model_name: str) -> Any:
+    from ..models import get_model
+
+    return get_model(model_name)
+
+
+def model_overrides(model: Any, overrides: tuple[str, ...]) -> dict[str, str]:
+    """``--set KEY=VALUE`` as {key: text}: a dimensional value needs its unit, as everywhere on the command line."""
+    dimensions = model.dimensions()
+    mapping: dict[str, str] = {}
+    for item in overrides:
+        key, sep, value = item.partition("=")
+        key, value = key.strip(), value.strip()
+        if not sep or not key:
+            raise ParameterError(f"--set {shorten(item)}: expected KEY=VALUE, e.g. --set 'bonds.bond_time=224 us'")
+        dimension = dimensions.get(key)
+        if dimension is not None:
+            require_unit(value, dimension, f"--set {key}=")
+        mapping[key] = value
+    return mapping
+
+
+def model_parameters(model: Any, params_name: str | None, overrides: dict[str, str]) -> Any:
+    """The model's parameters from ``--params`` (a name or a file; a JSON/TOML mapping for models that take one)."""
+    from ..fileio import protect_inputs
+
+    if params_name is not None:
+        protect_inputs([params_name])
+    try:
+        return model.parameters(params_name, overrides)
+    except ParameterError:
+        path = Path(params_name) if params_name is not None else None
+        if path is None or path.suffix.lower() not in (".json", ".toml") or not path.is_file():
+            raise
+    from .rsf_cmd import load_params_mapping  # a file of the mapping the model reads (rate-and-state's)
+
+    return model.parameters(load_params_mapping(path), overrides)
+
+
+def rig_of(model: Any, control: str, stiffness_text: str | None, overrides: dict[str, str]) -> Any:
+    """The :class:`stickslip.models.Rig` of ``--control`` and ``--stiffness`` (Pa/m).
+
+    A model whose own spring key ``k`` is in friction per slip (rate-and-state) also takes ``--stiffness`` in
+    that unit ("1e-3 1/um"): it then sets ``k``, as ``--set k=...`` would.
+    """
+    from ..models import Rig
+    from .common import positive
+
+    control = control_name(control)
+    if stiffness_text is None:
+        return Rig(control=control)
+    require_unit(stiffness_text, "stress_per_length", "--stiffness ")
+    try:
+        k = positive(stiffness_text, "stress_per_length", "--stiffness")
+    except UnitError:
+        own = model.dimensions().get("k")
+        if own is None:
+            raise
+        overrides["k"] = stiffness_text
+        positive(stiffness_text, own, "--stiffness")  # the one-line error in the model's unit
+        return Rig(control=control)
+    if control == "velocity":
+        raise ParameterError(
+            "--stiffness: under --control velocity the rig is rigid and has no spring; drop --stiffness"
+            " or use --control spring"
+        )
+    return Rig(control=control, stiffness=k)
+
+
+def start_value(text: str | None) -> Any:
+    """``--start``: a word ("empty", "steady") as it is, or a stress or velocity with its unit, in SI."""
+    from ..units import to_si
+
+    if text is None:
+        return None
+    if text.strip().isalpha():
+        return text.strip()
+    for dimension, prefix in (("stress", "--start "), ("velocity", "--start ")):
+        try:
+            require_unit(text, dimension, prefix)
+            return to_si(text, dimension, "--start")
+        except UnitError:
+            continue
+    raise ParameterError(
+        f"--start {shorten(text)}: expected a word (empty, steady) or a stress or velocity with its unit"
+    )
+
+
+def settings_of(texts: tuple[str, ...], every_text: str | None) -> dict[str, Any]:
+    """``--setting KEY=VALUE`` (a word, true/false, a number, or a time with its unit) and ``--every``."""
+    from ..units import to_si
+    from .common import positive
+
+    settings: dict[str, Any] = {}
+    for item in texts:
+        key, sep, value = item.partition("=")
+        key, value = key.strip(), value.strip()
+        if not sep or not key:
+            raise ParameterError(f"--setting {shorten(item)}: expected KEY=VALUE, e.g. --setting jump_curve=no-aging")
+        if value.lower() in ("true", "false"):
+            settings[key] = value.lower() == "true"
+            continue
+        try:
+            settings[key] = int(value) if value.lstrip("+-").isdigit() else float(value)
+            continue
+        except ValueError:
+            pass
+        try:
+            settings[key] = to_si(value, "time", f"--setting {key}")
+        except (UnitError, ParameterError):
+            settings[key] = value
+    if every_text is not None:
+        settings["every"] = positive(every_text, "time", "--every")
+    return settings
+
+
+def run_summary(run: Any, protocol: Any, rig: Any) -> dict[str, Any]:
+    """What a run settled into, in SI: regime with its evidence, period, peak, trough, mean, the model's own numbers."""
+    signal = "stress" if run.stress is not None else "friction"
+    r = run.regime
+    return {
+        "model": run.model,
+        "status": run.status,
+        "message": run.message,
+        "protocol": [{"velocity": s.velocity, "duration": s.duration} for s in protocol.segments],
+        "rig": {"control": rig.control, "stiffness": rig.stiffness},
+        "regime": run.regime_name,
+        "evidence": r.evidence,
+        "periods_seen": r.periods,
+        "amplitude_ratio": r.amplitude_ratio,
+        "period": run.period,
+        f"peak_{signal}": run.peak,
+        f"trough_{signal}": run.trough,
+        f"mean_{signal}": run.mean,
+        f"final_{signal}": float(run.signal[-1]) if run.time.size else None,
+        "end_time": float(run.time[-1]) if run.time.size else None,
+        "summary": dict(run.summary),
+    }
+
+
+def summary_text(summary: dict[str, Any]) -> str:
+    """The summary for people: µm/s, Pa (or μ), s; the model's message in full."""
+    from ..display import velocity
+
+    protocol = ", then ".join(f"{velocity(s['velocity'], 4)} for {s['duration']:.6g} s" for s in summary["protocol"])
+    rig = summary["rig"]
+    spring = "" if rig["stiffness"] is None else f", K = {rig['stiffness'] / 1e3:.6g} kPa/m"
+    signal, unit = ("stress", " Pa") if "peak_stress" in summary else ("friction", "")
+    lines = [
+        f"model {summary['model']}: {protocol} ({rig['control']} control{spring})",
+        f"  regime: {summary['regime']}" + ("" if summary["status"] == "ok" else " (the run FAILED)"),
+        f"  {summary['message'] or summary['evidence']}",
+    ]
+    numbers = []
+    if summary["period"] is not None and math.isfinite(summary["period"]):
+        numbers.append(f"period {summary['period']:.6g} s")
+    for word in ("peak", "trough", "mean"):
+        value = summary[f"{word}_{signal}"]
+        if value is not None and math.isfinite(value):
+            numbers.append(f"{word} {value:.6g}{unit}")
+    if numbers:
+        lines.append("  " + ", ".join(numbers))
+    return "\n".join(lines)
+
+
+@click.command("run")
+@model_spec_options
+@protocol_options(
+    stiffness_help='Spring stiffness K in Pa/m, e.g. "400 kPa/m" (rate-and-state also "1e-3 1/um") [the model\'s own].'
+)
+@click.option(
+    "--start",
+    "start_text",
+    default=None,
+    metavar="S",
+    help="The model's start: a word (transient: empty, steady) or a stress or velocity with its unit.",
+)
+@click.option("--every", "every_text", default=None, metavar="DT", help="Sample the trace every DT (if the model can).")
+@click.option(
+    "--setting",
+    "setting_texts",
+    multiple=True,
+    metavar="KEY=VALUE",
+    help="A model setting, e.g. jump_curve=no-aging, stick_population=true, rtol=1e-3; repeatable.",
+)
+@click.option(
+    "-o",
+    "--output",
+    type=click.Path(dir_okay=False, path_type=Path),
+    help="Write the Run as CSV (units in the header; stickslip analyze reads it).",
+)
+@click.option("--plot", "plot_path", type=click.Path(dir_okay=False, path_type=Path), help="Save the run's figure.")
+@click.option("--json", "as_json", is_flag=True, help="Print the summary as JSON (SI units).")
+def run_command(
+    model_name: str,
+    params_name: str | None,
+    overrides: tuple[str, ...],
+    v0_text: str | None,
+    duration_text: str | None,
+    segment_texts: tuple[str, ...],
+    protocol_file: Path | None,
+    stiffness_text: str | None,
+    control: str,
+    start_text: str | None,
+    every_text: str | None,
+    setting_texts: tuple[str, ...],
+    output: Path | None,
+    plot_path: Path | None,
+    as_json: bool,
+) -> None:
+    """Run any friction model on a protocol, through one interface, into one Run.
+
+    The model refuses, in one line, what it cannot run (the quasi-static model:
+    one constant velocity through a spring).  The run's regime comes from the
+    one classifier on the model's dense solution.  A run that failed exits
+    with status 3.
+    """
+    refuse_overwriting_inputs([protocol_file, params_name], [("-o", output), ("--plot", plot_path)])
+    check_output("-o", output)
+    check_output("--plot", plot_path, plot=True)
+    model = load_model(model_name)
+    protocol = build_protocol(v0_text, duration_text, segment_texts, protocol_file)
+    mapping = model_overrides(model, overrides)
+    rig = rig_of(model, control, stiffness_text, mapping)
+    params = model_parameters(model, params_name, mapping)
+    settings = settings_of(setting_texts, every_text)
+    model.check(protocol, rig, settings)  # what the model cannot do, before any work
+    start = start_value(start_text)
+    with progress(model.name, total=protocol.duration, unit="s", enabled=False if as_json else None) as bar:
+        if "progress" in model.capabilities.settings and "progress" not in settings:  # a bar on a terminal only
+            settings["progress"] = lambda fraction: bar.update(fraction * protocol.duration)
+        run = model.run(params, protocol, rig, start=start, **settings)
+    summary = run_summary(run, protocol, rig)
+    if output is not None:
+        _write_run(run, output)
+    if plot_path is not None:
+        save_figure(run.plot().figure, plot_path)
+    if as_json:
+        emit_json(summary)
+    else:  # beside a trace on standard output (-o -), the summary goes to stderr
+        click.echo(summary_text(summary), err=output is not None and str(output) == "-")
+    if run.status != "ok":
+        click.echo(f"stickslip: the run failed: {run.message}", err=True)
+        raise SystemExit(RUN_FAILED)
+
+
+def _write_run(run: Any, output: Path) -> None:
+    try:
+        run.to_csv(output)
+    except OSError as exc:
+        raise click.FileError(shorten(str(output)), hint=str(exc.strerror or exc)) from None
+
+
+def register(cli: click.Group) -> None:
+    cli.add_command(run_command)
+
+
+__all__ = ["run_command", "run_summary", "summary_text"]

@@ -1,0 +1,49 @@
+"""Several models' runs of one protocol on one figure (``stickslip compare --models A,B``)."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:  # pragma: no cover
+    from matplotlib.figure import Figure
+
+    from ..models.run import Run
+
+
+def overlay_figure(runs: Mapping[str, Run], title: str = "") -> Figure:
+    """Stress (Pa, left axis) or friction coefficient (right axis) of every run against time, and the slider
+    velocities (µm/s, lower panel, log scale where all are positive); each line labelled with its model and regime."""
+    import numpy as np
+    from matplotlib.figure import Figure
+
+    from ..plotting import apply_style
+
+    fig = Figure(figsize=(9, 6), layout="constrained")
+    top, bottom = fig.subplots(2, 1, sharex=True, height_ratios=(2, 1))
+    right = None
+    for k, (name, run) in enumerate(runs.items()):
+        color = f"C{k}"
+        label = f"{name}: {run.regime_name}"
+        if run.stress is not None:
+            top.plot(run.time, run.stress, color=color, lw=1.2, label=label)
+        else:
+            right = top.twinx() if right is None else right
+            right.plot(run.time, run.friction, color=color, lw=1.2, ls="--", label=label)
+        bottom.plot(run.time, np.asarray(run.slider_velocity) * 1e6, color=color, lw=0.9)
+    top.set_ylabel("friction stress (Pa)")
+    if right is not None:
+        right.set_ylabel("friction coefficient μ (dashed)")
+    handles = [h for ax in (top, right) if ax is not None for h in ax.get_legend_handles_labels()[0]]
+    labels = [lab for ax in (top, right) if ax is not None for lab in ax.get_legend_handles_labels()[1]]
+    top.legend(handles, labels, fontsize=8, frameon=False, loc="best")
+    speeds = np.concatenate([np.asarray(r.slider_velocity, float) for r in runs.values()])
+    if speeds.size and np.all(speeds[np.isfinite(speeds)] > 0):
+        bottom.set_yscale("log")
+    bottom.set_ylabel("slider velocity (µm/s)")
+    bottom.set_xlabel("time (s)")
+    for ax in (top, bottom):
+        apply_style(ax)
+    if title:
+        top.set_title(title, fontsize=9)
+    return fig

@@ -1,0 +1,119 @@
+"""``stickslip compare --models A,B``: one protocol, one rig, each model through the interface, side by side.
+
+Each row is checked against something that does not pass through compare: the model's own ``stickslip run``
+on the same protocol and rig, the steady curve a velocity step settles on, and c V for a user's viscous model.
+"""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from cli_helpers import run_main
+from stickslip import steady_state
+from stickslip.parameters import load_parameters
+
+STEP = ["--control", "velocity", "--v0", "350 um/s", "--duration", "5 ms", "--segment", "1 mm/s:10 ms"]
+
+
+@pytest.fixture
+def viscous():
+    import viscous_model
+
+    yield "viscous_model:MODEL"
+    viscous_model.forget()
+
+
+def ok_json(capsys, *argv: str) -> dict:
+    code, out, err = run_main(capsys, *argv, "--json")
+    assert code == 0, err
+    return json.loads(out)
+
+
+def test_each_model_runs_the_same_protocol_and_rig(viscous, capsys, tmp_path):
+    figure = tmp_path / "overlay.png"
+    both = ok_json(
+        capsys, "compare", "--models", f"transient,{viscous}", *STEP, "--set", "c=1 MPa s/m", "-o", str(figure)
+    )
+    assert list(both["models"]) == ["transient", "test-viscous"]
+    assert both["rig"] == {"control": "velocity", "stiffness": None} and len(both["protocol"]) == 2
+    steady = float(steady_state(load_parameters("gelatin-glass"), np.array([1e-3])).stress[0])
+    assert both["models"]["transient"]["final_stress"] == pytest.approx(steady, rel=1e-3)
+    assert both["models"]["test-viscous"]["final_stress"] == pytest.approx(1e6 * 1e-3, rel=1e-12)
+    alone = ok_json(capsys, "run", "--model", "transient", *STEP)
+    for key in ("regime", "peak_stress", "trough_stress", "mean_stress", "final_stress"):
+        assert both["models"]["transient"][key] == alone[key]
+    assert figure.read_bytes()[:4] == b"\x89PNG"
+
+
+def test_the_table_names_regime_period_peak_trough_mean(capsys):
+    argv = [
+        "compare",
+        "--models",
+        "quasi-static,rsf",
+        "--v0",
+        "50 um/s",
+        "--duration",
+        "60 s",
+        "--set",
+        "a=0.005",
+        "--set",
+        "b=0.01",
+        "--set",
+        "dc=10 um",
+    ]
+    code, out, err = run_main(capsys, *argv)
+    assert code == 0, err
+    for word in ("model", "regime", "period (s)", "peak", "trough", "mean", "quasi-static", "stick-slip", "rsf"):
+        assert word in out
+    both = ok_json(capsys, *argv)
+    qs = ok_json(capsys, "run", "--model", "quasi-static", "--v0", "50 um/s", "--duration", "60 s")
+    assert both["models"]["quasi-static"]["period"] == qs["period"]
+    assert "mean_friction" in both["models"]["rsf"]  # no normal stress: friction, not stress
+
+
+def test_a_failed_run_is_not_success(viscous, capsys):
+    code, _, err = run_main(capsys, "compare", "--models", f"transient,{viscous}", *STEP, "--set", "fail=1")
+    assert code == 3 and "the run of test-viscous failed: told to fail" in err
+
+
+REFUSALS = [
+    (
+        [
+            "compare",
+            "--models",
+            "quasi-static,transient",
+            "--v0",
+            "50 um/s",
+            "--duration",
+            "1 s",
+            "--segment",
+            "1 mm/s:1 s",
+        ],
+        "model quasi-static: one constant pulling velocity",
+    ),
+    (
+        ["compare", "--models", "quasi-static,rsf", "--v0", "50 um/s", "--duration", "1 s", "--control", "velocity"],
+        "no velocity control",
+    ),
+    (
+        ["compare", "--models", "quasi-static,rsf", "--v0", "50 um/s", "--duration", "1 s", "--set", "zz=1"],
+        "--set zz: none of the models",
+    ),
+    (["compare", "--models", "quasi-static", "--v0", "50 um/s", "--duration", "1 s"], "two or more models"),
+    (["compare", "--models", "quasi-static,simulate", "--v0", "50 um/s", "--duration", "1 s"], "the same model"),
+    (
+        ["compare", "--models", "quasi-static,rsf", "--v0", "50 um/s", "--duration", "1 s", "--hold", "2 s"],
+        "--hold: not with --models",
+    ),
+    (["compare", "--segment", "1 mm/s:1 s"], "--segment: only with --models"),
+]
+
+
+@pytest.mark.parametrize(("argv", "named"), REFUSALS, ids=[n for _, n in REFUSALS])
+def test_what_cannot_be_compared_is_one_line(argv, named, capsys):
+    code, out, err = run_main(capsys, *argv)
+    assert code == 2 and out == ""
+    assert err.startswith("stickslip: error:") and err.count("\n") == 1 and named in err
