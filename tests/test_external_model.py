@@ -22,6 +22,7 @@ from scipy.integrate import solve_ivp
 
 import stickslip
 from stickslip.models import Boundary, Capabilities, FrictionModel, Rig, Run
+from stickslip.models.registry import unregister_model
 
 
 # ----------------------------------------------------------------------------- the user's model (docs/models.md)
@@ -109,6 +110,7 @@ V_STAR = P["normal_stress"] * P["c"] / P["damping"]  # 0.1 m/s
 def registered():
     stickslip.register_model(MODEL, replace=True)
     yield
+    unregister_model(MODEL.name)  # later tests (docs/models.md) register their own copy under the same name
 
 
 def steady_stress(v0: float) -> float:

@@ -226,3 +226,13 @@ def test_an_rsf_sweep_refuses_a_pulling_velocity_it_cannot_start_from_up_front()
 
     with pytest.raises(ParameterError, match=r"pulling_velocity: expected a value > 0 m/s"):
         build_spec(["pulling_velocity=0 um/s,1 um/s"], model="rsf")
+
+
+def test_quasi_static_run_reports_the_repeating_cycle_when_started_off_sigma_c():
+    """A stick from 300 Pa is shorter than the repeating one (which starts at σc): the Run's period is the latter."""
+    params = stickslip.load_parameters("gelatin-glass")
+    from_c = stickslip.simulate(params, 50e-6, 120.0)
+    from_300 = stickslip.simulate(params, 50e-6, 120.0, start_stress=300.0)
+    assert from_300.cycles[0].period < 0.9 * from_c.cycles[0].period  # the first cycle is not the repeating one
+    assert from_300.to_run().period == pytest.approx(from_c.to_run().period, rel=1e-9)
+    assert from_300.to_run().peak == pytest.approx(from_c.to_run().peak, rel=1e-9)

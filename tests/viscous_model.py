@@ -44,5 +44,5 @@ def forget() -> None:
     """Take the model out of the registry again (``--model viscous_model:MODEL`` registers it for the process)."""
     from stickslip.models import registry
 
-    if registry._MODELS.get(MODEL.name) is MODEL:
-        del registry._MODELS[MODEL.name]
+    if registry.available_models().get(MODEL.name) is MODEL:
+        registry.unregister_model(MODEL.name)

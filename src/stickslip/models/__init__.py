@@ -17,7 +17,7 @@ from pathlib import Path
 from typing import Any
 
 from .base import CONTROLS, Boundary, Capabilities, FrictionModel, Rig
-from .registry import available_models, get_model, register_model
+from .registry import available_models, get_model, register_model, unregister_model
 from .run import Run
 
 __all__ = [
@@ -30,6 +30,7 @@ __all__ = [
     "available_models",
     "get_model",
     "register_model",
+    "unregister_model",
     "run",
 ]
 

@@ -107,16 +107,25 @@ def cycle_numbers(sim: Any) -> dict[str, Any]:
         "cycles": sum(c.period is not None for c in sim.cycles),
         "critical_velocity": sim.critical_velocity,
     }
-    # the first stick starts at sigma_c, so the first phases are those of the repeating cycle
-    if sim.slip_phases and sim.jumps and sim.jumps[0].velocity is not None:
-        stick, slip = sim.stick_phases[0], sim.slip_phases[0]
-        row.update(stick_time=stick.stick_time, peak_stress=stick.peak_stress, jump_velocity=sim.jumps[0].velocity)
+    k = _repeating_index(sim)
+    if len(sim.slip_phases) > k and len(sim.jumps) > k and sim.jumps[k].velocity is not None:
+        stick, slip = sim.stick_phases[k], sim.slip_phases[k]
+        row.update(stick_time=stick.stick_time, peak_stress=stick.peak_stress, jump_velocity=sim.jumps[k].velocity)
         if sim.regime == regimes.STICK_SLIP:
             row["period"] = stick.stick_time + slip.duration
             row["mean_stress"] = _cycle_mean(stick, slip, sim.stiffness, sim.pulling_velocity)
         elif sim.regime == regimes.STEADY:
             row["mean_stress"] = slip.end_stress
     return row
+
+
+def _repeating_index(sim: Any) -> int:
+    """The phases of the repeating cycle: every stick after a slip starts at sigma_c, so the first one does too
+    unless the run started elsewhere (``start_stress``); then the second."""
+    sticks = sim.stick_phases
+    if len(sticks) > 1 and len(sim.slip_phases) > 1 and sticks[0].start_stress != sticks[1].start_stress:
+        return 1
+    return 0
 
 
 def _cycle_mean(stick: Any, slip: Any, stiffness: float, velocity: float) -> float:

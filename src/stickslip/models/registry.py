@@ -53,6 +53,13 @@ def register_model(model: Any, *, replace: bool = False) -> FrictionModel:
     return model
 
 
+def unregister_model(name: str) -> None:
+    """Forget the model registered as ``name`` (and its aliases); a built-in model comes back on the next lookup."""
+    _MODELS.pop(name, None)
+    for alias in [a for a, owner in _ALIASES.items() if owner == name]:
+        del _ALIASES[alias]
+
+
 def get_model(name: Any) -> FrictionModel:
     """The model called ``name`` (or one of its aliases), or ``module:attr`` imported; a model is returned as is."""
     if not isinstance(name, str):
