@@ -186,7 +186,7 @@ def _parameter_name(key: str) -> str | None:
 
 
 #: Parameter symbols as printed (the metadata spells them in ASCII).
-SYMBOLS = {"tau": "τ", "tau_a": "τa", "lambda": "λ", "dl_m": "Δlm", "V_a": "Va", "G_d": "Gd"}
+SYMBOLS = {"tau": "τ", "tau_a": "τa", "lambda": "λ", "dl_m": "Δl_m", "V_a": "Va", "G_d": "Gd"}
 
 
 def _log_axis(spec: Any, key: str, values: np.ndarray) -> bool:
