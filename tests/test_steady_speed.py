@@ -1,0 +1,126 @@
+"""Issue 21: the compiled steady-state march (stickslip.model.steady_kernel) over the parameter box.
+
+Wide batches (steady.COMPILED_LANES velocities or more) are marched lane by lane in numba-compiled loops
+instead of numpy arrays.  Here the compiled march is forced on every call and checked against the
+independent references of tests/reference_steady.py and tests/reference_slope.py (no code shared with
+the panels) over random sets of the box, half in the deep-dip/cliff corner, and against the numpy march:
+the same panels, so the two agree to the quadrature's own error (a width test that ties to an ulp can
+pick another acceptable panel, which moves sigma by ~1e-12).
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import pytest
+
+from reference_slope import reference_slope_many, slope_error
+from reference_steady import box_cases, reference_many
+from stickslip import ModelError, load_parameters, steady_state
+from stickslip.model import steady
+
+GEL = load_parameters("gelatin-glass")
+#: the issue's accuracy over the box (relative); reference_many itself is good to ~1e-9
+ACCURACY = 1e-8
+
+
+@pytest.fixture
+def compiled(monkeypatch):
+    monkeypatch.setattr(steady, "COMPILED_LANES", 1)
+
+
+@pytest.fixture
+def plain(monkeypatch):
+    monkeypatch.setattr(steady, "COMPILED_LANES", 10**12)
+
+
+def _outputs(cases):
+    got = [steady_state(p, v, aging=aging) for p, v, aging in cases]
+    return tuple(np.array([float(getattr(g, name)) for g in got]) for name in ("stress", "bonded_fraction"))
+
+
+def _rel(got, ref):
+    return np.abs(np.asarray(got) / ref - 1.0)
+
+
+def test_compiled_march_over_the_box_against_the_reference(compiled):
+    cases = box_cases(seed=2101, count=500, base=GEL, corner_share=0.5)
+    ref_stress, ref_fraction = reference_many(cases)
+    stress, fraction = _outputs(cases)
+    assert float(np.max(_rel(stress, ref_stress))) <= ACCURACY, int(np.argmax(_rel(stress, ref_stress)))
+    assert float(np.max(_rel(fraction, ref_fraction))) <= ACCURACY
+
+
+def test_compiled_and_numpy_marches_agree_over_the_box(monkeypatch):
+    cases = box_cases(seed=2102, count=300, base=GEL, corner_share=0.5)
+    monkeypatch.setattr(steady, "COMPILED_LANES", 1)
+    fast = [steady_state(p, v, aging=aging) for p, v, aging in cases]
+    monkeypatch.setattr(steady, "COMPILED_LANES", 10**12)
+    plain = [steady_state(p, v, aging=aging) for p, v, aging in cases]
+    for name, tolerance in (("stress", 1e-10), ("bonded_fraction", 1e-10)):
+        a = np.array([float(getattr(g, name)) for g in fast])
+        b = np.array([float(getattr(g, name)) for g in plain])
+        assert float(np.max(_rel(a, b))) <= tolerance, name
+
+
+def test_compiled_slope_in_the_hard_corner_against_the_derivative_reference(compiled):
+    cases = box_cases(seed=2103, count=60, base=GEL, corner_share=1.0)
+    stress, ref = reference_slope_many(cases)
+    velocity = np.array([c[1] for c in cases])
+    slopes = np.array([float(steady_state(p, v, aging=aging).stress_slope) for p, v, aging in cases])
+    err = slope_error(slopes, ref, stress, velocity)
+    assert err.max() <= 1e-6, (float(err.max()), int(err.argmax()))
+
+
+def test_compiled_slope_where_the_cliff_is_a_step(monkeypatch):
+    """The sets whose FENE cliff is a step of the survival: the step's boundary terms (without them the slope
+    was off by up to 100 %).  The numpy march is checked on them against a finite difference of the reference
+    in tests/test_steady_slope.py; the compiled one must give the same slope."""
+    from test_steady_slope import STEEP_CLIFF_CASES
+
+    every = box_cases(seed=12, count=9000, base=GEL, corner_share=0.5)
+    cases = [every[k] for k in STEEP_CLIFF_CASES]
+
+    def slopes(lanes):
+        monkeypatch.setattr(steady, "COMPILED_LANES", lanes)
+        return np.array([float(steady_state(p, v, aging=aging).stress_slope) for p, v, aging in cases])
+
+    fast, plain = slopes(1), slopes(10**12)
+    assert np.all(np.abs(fast - plain) <= 1e-9 * np.abs(plain)), np.abs(fast / plain - 1).max()
+
+
+def test_a_wide_curve_runs_compiled_and_matches_the_numpy_march(monkeypatch):
+    velocity = np.geomspace(1e-6, 1e-1, steady.COMPILED_LANES)
+    calls = []
+    original = steady._march_compiled
+    monkeypatch.setattr(steady, "_march_compiled", lambda *a: calls.append(1) or original(*a))
+    wide = steady_state(GEL, velocity)
+    assert calls
+    monkeypatch.setattr(steady, "COMPILED_LANES", 10**12)
+    narrow = steady_state(GEL, velocity)
+    assert float(np.max(_rel(wide.stress, narrow.stress))) <= 1e-10
+    assert float(np.max(_rel(wide.bonded_fraction, narrow.bonded_fraction))) <= 1e-10
+    assert np.max(np.abs(wide.stress_slope - narrow.stress_slope) / np.abs(narrow.stress).max() * velocity) <= 1e-8
+
+
+def test_compiled_march_that_needs_too_many_panels_is_a_model_error(compiled, monkeypatch):
+    monkeypatch.setattr(steady, "MAX_PANELS", 2)
+    with pytest.raises(ModelError, match="did not converge: more than 2 panels"):
+        steady_state(GEL, [50e-6, 350e-6])
+
+
+def test_compiled_march_is_faster_than_the_numpy_one(monkeypatch):
+    """The benchmark's curve (1000 velocities, benchmarks/bench_steady.py) in the same process: process time."""
+    velocity = np.geomspace(10e-6, 10e-3, 1000)
+
+    def cost(lanes):
+        monkeypatch.setattr(steady, "COMPILED_LANES", lanes)
+        steady_state(GEL, velocity)  # warm (compiled code loaded)
+        start = time.process_time()
+        for _ in range(5):
+            steady_state(GEL, velocity)
+        return time.process_time() - start
+
+    plain, fast = min(cost(10**12) for _ in range(2)), min(cost(1) for _ in range(2))
+    assert fast < plain / 1.5, (plain, fast)  # measured ~3x
