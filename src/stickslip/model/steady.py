@@ -443,6 +443,8 @@ def _march_compiled(s: _Scales, q: QuadratureSettings) -> _Integrals:
             SMALLEST_GAP,
             _LOG_CAP,
             MAX_PANELS,
+            np.log(q.log_hazard_step),
+            np.log(q.hazard_step),
         ]
     )
     search = np.array(

@@ -55,18 +55,15 @@ def _width(
     log_t: float,
     a: float,
     alpha: float,
-    beta: float,
+    log_negligible: float,
     settings: np.ndarray,
     search: np.ndarray,
 ) -> tuple[float, bool]:
-    """(width of the next panel, whether the survival steps to 0 here): steady._panel_width for one lane."""
-    log_hazard_step, hazard_step, end_ratio, widest_panel, negligible = (
-        settings[0],
-        settings[1],
-        settings[2],
-        settings[3],
-        settings[4],
-    )
+    """(width of the next panel, whether the survival steps to 0 here): steady._panel_width for one lane.
+
+    ``log_negligible`` = ln(negligible_hazard) - ln(1 + beta), a constant of the lane.
+    """
+    log_hazard_step, end_ratio, widest_panel = settings[0], settings[2], settings[3]
     step_ulps, log_width_ratio, start_offset, first_reach, tiny, max_bisections = (
         search[0],
         search[1],
@@ -78,8 +75,7 @@ def _width(
     log_widest = math.log(min(widest_panel, end_ratio * y))
     l_left, slope_left = _log_hazard(x, y, log_t, a, alpha)
     log_slope_left = math.log(max(slope_left, tiny))
-    log_step, log_resolved = math.log(log_hazard_step), math.log(hazard_step)
-    log_negligible = math.log(negligible) - math.log1p(beta)
+    log_step, log_resolved = settings[10], settings[11]
     cap_resolved = min(log_resolved - l_left, log_step - log_slope_left)
     cap_negligible = log_negligible - l_left
     if not (log_widest > cap_resolved and log_widest > cap_negligible):
@@ -134,8 +130,8 @@ def march(
     """i, j, di/dlnV, dj/dlnV of every lane into out (4, n); returns MARCHED or TOO_MANY_PANELS.
 
     ``settings``: log_hazard_step, hazard_step, end_ratio, widest_panel, negligible_hazard, hazard_cutoff,
-    tail_tolerance, smallest gap, log cap, MAX_PANELS; ``search``: STEP_ULPS, ln WIDTH_RATIO, START_OFFSET,
-    FIRST_REACH, _TINY, MAX_BISECTIONS, _CLIFF_LOG_HAZARD (steady.py).
+    tail_tolerance, smallest gap, log cap, MAX_PANELS, ln log_hazard_step, ln hazard_step; ``search``:
+    STEP_ULPS, ln WIDTH_RATIO, START_OFFSET, FIRST_REACH, _TINY, MAX_BISECTIONS, _CLIFF_LOG_HAZARD (steady.py).
     """
     order = t_half.size
     cutoff, tail_tolerance, smallest_gap, log_cap = settings[5], settings[6], settings[7], settings[8]
@@ -149,11 +145,12 @@ def march(
     integrate_t = np.ascontiguousarray(integrate.T)  # (K, K+1)
     for p in range(log_t.size):
         lt, ap, al, be = log_t[p], a[p], alpha[p], beta[p]
+        log_negligible = math.log(settings[4]) - math.log1p(be)
         x_left, y_left, hazard, moment = 0.0, 1.0, 0.0, 0.0
         s0, s1, s2, s3 = 0.0, 0.0, 0.0, 0.0
         finished = False
         for _ in range(max_panels):
-            w, step = _width(x_left, y_left, lt, ap, al, be, settings, search)
+            w, step = _width(x_left, y_left, lt, ap, al, log_negligible, settings, search)
             if step:
                 # the survival steps to 0 within a few ulps; where it lies moves with V (steady._march)
                 d = y_left * (1.0 + x_left)
