@@ -176,3 +176,20 @@ def test_compiled_march_over_the_corners_of_the_box_is_finite_and_agrees(monkeyp
                             worst["slope"], float(np.max(np.abs(fast.stress_slope - plain.stress_slope) / floor))
                         )
     assert worst["stress"] <= 1e-10 and worst["bonded_fraction"] <= 1e-10 and worst["slope"] <= 1e-7, worst
+
+
+def test_critical_point_is_computed_once_per_steady_curve(monkeypatch):
+    """The report, the fits and the plots ask for the same critical point several times (~30 ms each): it is
+    solved once per steady curve (bond and aging parameters), whatever the block, stick or name."""
+    from stickslip import critical_point
+    from stickslip.model import critical
+
+    critical._critical_point_of_curve.cache_clear()
+    solved = []
+    real = critical.find_extrema
+    monkeypatch.setattr(critical, "find_extrema", lambda *a, **k: solved.append(1) or real(*a, **k))
+    first = critical_point(GEL)
+    again = critical_point(GEL.with_overrides({"block.shear_modulus": 1234.0, "stick.aging_time": 3.0}))
+    assert again is first and len(solved) == 2  # the aging and the no-aging curve, once
+    other = critical_point(GEL.with_overrides({"aging.aging_time": 20.0}))
+    assert len(solved) == 4 and other.velocity != first.velocity
