@@ -5,7 +5,7 @@ the script prints the best and the median wall time and the child's CPU time
 (user + system), beside ``python -c pass`` (the interpreter alone) and
 ``python -c "import numpy"`` as the plain references.  The target is
 <= 0.4 s for ``stickslip --help``, ``stickslip critical`` and ``stickslip curve``
-with a few velocities.
+with a few velocities, and <= 1 s for ``stickslip fit stick`` on Table 1 (issue 21).
 
     python benchmarks/bench_startup.py [--repeat N] [--compare OTHER_SRC]
 
@@ -28,6 +28,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 STICKSLIP = [sys.executable, "-m", "stickslip.cli.main"]
+TABLE1 = ROOT / "src" / "stickslip" / "data" / "table1.csv"
 CASES = (
     ("python -c pass (reference)", [sys.executable, "-c", "pass"]),
     ('python -c "import numpy" (reference)', [sys.executable, "-c", "import numpy"]),
@@ -39,6 +40,7 @@ CASES = (
         [*STICKSLIP, "curve", "--velocity", "50 um/s", "--velocity", "350 um/s", "--velocity", "1 mm/s"],
     ),
     ("stickslip params show", [*STICKSLIP, "params", "show"]),
+    ("stickslip fit stick (Table 1; target <= 1 s)", [*STICKSLIP, "fit", "stick", str(TABLE1)]),
 )
 
 

@@ -23,6 +23,7 @@ them as "far too long"); nothing is claimed about them.  Tested against
 from __future__ import annotations
 
 import numpy as np
+from scipy.special import expit
 
 #: Tolerances of the steps (t' and n are both O(1) per unit theta).
 RTOL = 1e-9
@@ -72,9 +73,14 @@ def _field(constants: tuple[np.ndarray, ...], y: np.ndarray, out: np.ndarray) ->
     log_rt, s0, k_t, aging_t = constants
     tau = y[0]
     n = np.maximum(y[1], N_GONE)
-    log_w = log_rt + np.log(n) + (s0 + k_t * tau) / n - aging_t * tau
-    out[0] = np.exp(-np.logaddexp(0.0, log_w))  # 1/(1 + w) without overflow
-    out[1] = out[0] - 1.0
+    log_w = k_t * tau
+    log_w += s0
+    log_w /= n
+    log_w -= aging_t * tau
+    log_w += np.log(n, out=n)
+    log_w += log_rt
+    expit(np.negative(log_w, out=log_w), out=out[0])  # 1/(1 + w) without overflow
+    np.subtract(out[0], 1.0, out=out[1])
 
 
 def stick_times(r: np.ndarray, s0: np.ndarray, k: np.ndarray, inv_aging: np.ndarray, horizon: np.ndarray) -> np.ndarray:
@@ -85,46 +91,44 @@ def stick_times(r: np.ndarray, s0: np.ndarray, k: np.ndarray, inv_aging: np.ndar
     """
     r, s0, k, inv_aging, horizon = (np.asarray(a, dtype=float).ravel() for a in np.broadcast_arrays(
         r, s0, k, inv_aging, horizon))  # fmt: skip
-    size = r.size
-    out = np.full(size, np.nan)
-    loaded = (s0 > 0) | (k > 0)  # without load nothing ever slips
+    out = np.full(r.size, np.nan)
     phases = _Phases(r, s0, k, inv_aging)
-    limit = horizon / phases.scale  # in t'
-    tau, n = np.zeros(size), np.ones(size)
-    step = np.full(size, 1e-2)
-    first = np.zeros((2, size))  # the field at the current point (first same as last)
-    active = np.nonzero(loaded)[0]
-    constants = phases.subset(active)
-    start = np.empty((2, active.size))
-    _field(constants, np.stack([tau[active], n[active]]), start)
-    first[:, active] = start
+    # the working arrays hold only the phases still marching (without load nothing ever slips): a step costs
+    # what those cost, and finished phases are written out and dropped
+    index = np.nonzero((s0 > 0) | (k > 0))[0]
+    constants = phases.subset(index)
+    limit = horizon[index] / phases.scale[index]  # in t'
+    y0 = np.zeros((2, index.size))
+    y0[1] = 1.0
+    step = np.full(index.size, 1e-2)
+    slopes = np.empty((7, 2, index.size))
+    _field(constants, y0, slopes[0])  # the field at the current point (first same as last)
     for _ in range(MAX_STEPS):
-        if active.size == 0:
+        if index.size == 0:
             break
-        m = active.size
-        y0 = np.stack([tau[active], n[active]])  # (2, m)
-        h = step[active]
-        slopes = np.empty((7, 2, m))
+        m = index.size
         flat = slopes.reshape(7, 2 * m)
-        slopes[0] = first[:, active]
         for j in range(1, 7):
-            y = y0 + h * (_A[j, :j] @ flat[:j]).reshape(2, m)
+            y = (_A[j, :j] @ flat[:j]).reshape(2, m)
+            y *= step
+            y += y0
             _field(constants, y, slopes[j])
-        y_new = y  # the last stage is taken at the 5th-order solution
-        err = h * (_E @ flat).reshape(2, m)
-        scale = ATOL + RTOL * np.maximum(np.abs(y0), np.abs(y_new))
-        norm = np.sqrt(0.5 * ((err[0] / scale[0]) ** 2 + (err[1] / scale[1]) ** 2))
+        # y: the last stage is taken at the 5th-order solution
+        err = (_E @ flat).reshape(2, m)
+        err *= step
+        err /= ATOL + RTOL * np.maximum(np.abs(y0), np.abs(y))
+        norm = np.sqrt(0.5 * (err[0] ** 2 + err[1] ** 2))
         ok = norm <= 1.0
         factor = np.clip(0.9 * np.where(norm > 0, norm, 1e-10) ** -0.2, 0.2, 5.0)
-        step[active] = h * np.where(ok, factor, np.minimum(factor, 1.0))
-        accepted = active[ok]
-        tau[accepted], n[accepted] = y_new[0, ok], y_new[1, ok]
-        first[:, accepted] = slopes[6][:, ok]
-        collapsed = ok & (y_new[1] < 0.0)
-        out[active[collapsed]] = y_new[0, collapsed] * phases.scale[active[collapsed]]
-        late = ok & ~collapsed & (y_new[0] > limit[active])
-        done = collapsed | late
+        step *= np.where(ok, factor, np.minimum(factor, 1.0))
+        y0[:, ok] = y[:, ok]
+        slopes[0][:, ok] = slopes[6][:, ok]
+        collapsed = ok & (y[1] < 0.0)
+        done = collapsed | (ok & (y[0] > limit))
         if done.any():
-            active = active[~done]
-            constants = phases.subset(active)
+            out[index[collapsed]] = y[0, collapsed] * phases.scale[index[collapsed]]
+            keep = ~done
+            index, limit, step, y0 = index[keep], limit[keep], step[keep], y0[:, keep]
+            slopes = np.ascontiguousarray(slopes[:, :, keep])
+            constants = tuple(c[keep] for c in constants)
     return out

@@ -35,7 +35,6 @@ from scipy.special import stdtrit
 from ..columns import with_units
 from ..errors import DataError, ParameterError
 from ..model.critical import critical_point
-from ..model.stick import stick_phase
 from ..parameters import Parameters, key_dimension, load_parameters, replace
 from ..units import to_si
 from . import identify
@@ -176,6 +175,10 @@ def _model(params: Parameters, rows: _Rows) -> tuple[np.ndarray, np.ndarray, lis
     the full solver (:func:`stick_phase`) says what happens instead (NaN and its message)."""
     times = _stick_times([params], rows)[0]
     problems = []
+    if np.all(np.isfinite(times)):
+        return times, rows.start + rows.rate * times, problems
+    from ..model.stick import stick_phase  # only here: it loads scipy.integrate (~30 ms of the command)
+
     for k in np.nonzero(~np.isfinite(times))[0]:
         v, s0, rate = float(rows.velocity[k]), float(rows.start[k]), float(rows.rate[k])
         phase = stick_phase(_params_for_rate(params, v, rate), v, start_stress=s0)

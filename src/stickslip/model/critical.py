@@ -16,15 +16,17 @@ bracket: a minimum of the converged curve, not of its noise.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
+from functools import lru_cache
 from itertools import pairwise
 
 import numpy as np
 
 from ..errors import ModelError
 from ..numerics.roots import brentq  # scipy.optimize would add 0.3 s to start-up
-from ..parameters import Parameters
+from ..parameters import BlockParameters, Parameters, StickParameters
 from .steady import ACCURATE_QUADRATURE, require_parameters, steady_state
 
 #: Velocity range searched for extrema, m/s, and the grid density per decade.
@@ -164,9 +166,26 @@ def critical_point(params: Parameters) -> CriticalPoint:
 
     Also the turnover (maximum) of the no-aging curve.  When a curve has no
     such extremum between 1 nm/s and 100 m/s the field is None and the
-    message says so in words.
+    message says so in words.  Computed once per steady curve: the point
+    depends only on the bond and aging parameters, and a report, a fit or a
+    plot asks for the same one several times (~30 ms each).
     """
-    extrema = find_extrema(params, aging=True)  # checks params
+    require_parameters(params)  # before the cache: a dict is unhashable
+    return _critical_point_of_curve(_curve_key(params))
+
+
+_ANY_STICK = StickParameters(1.0, 1.0, 1.0)
+_ANY_BLOCK = BlockParameters(1.0, 1.0, 1.0, 1.0)
+
+
+def _curve_key(params: Parameters) -> Parameters:
+    """``params`` with what the steady curve does not depend on (all but the bonds and aging) fixed."""
+    return dataclasses.replace(params, stick=_ANY_STICK, block=_ANY_BLOCK, name="", description="", reference="")
+
+
+@lru_cache(maxsize=32)
+def _critical_point_of_curve(params: Parameters) -> CriticalPoint:
+    extrema = find_extrema(params, aging=True)
     minima = [e for e in extrema if e.kind == "minimum"]
     if minima:
         v, s = minima[0].velocity, minima[0].stress

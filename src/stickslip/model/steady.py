@@ -329,6 +329,8 @@ def _march(s: _Scales, q: QuadratureSettings, keep_nodes: bool = False) -> _Inte
     The working arrays hold only the points still marching: finished ones are
     written out and dropped, so a step costs what the remaining points cost.
     """
+    if not keep_nodes and s.log_t.size >= COMPILED_LANES:
+        return _march_compiled(s, q)
     rule = panel_rule(q.order)
     # Node arrays are (K, n): the long axis innermost, so that per-point factors broadcast along rows cheaply
     # (an (n, K) layout with K = 16 runs numpy's inner loops 16 elements at a time).
@@ -415,6 +417,52 @@ def _march(s: _Scales, q: QuadratureSettings, keep_nodes: bool = False) -> _Inte
             sums = sums[:, keep]
             sub = _take(sub, keep)
     raise ModelError(f"steady-state quadrature did not converge: more than {MAX_PANELS} panels needed")
+
+
+#: From this many lanes (velocities x parameter sets) on, the march runs compiled (stickslip.model.steady_kernel),
+#: ~3x faster per lane.  Loading numba and its cached code costs ~0.2 s once per process (the numpy march of
+#: ~30k lanes), so narrow calls -- a command line's curve, the critical point's grid -- stay on numpy, and the
+#: wide ones that programs repeat (curves for plots and benchmarks, batched fits) run compiled.
+COMPILED_LANES = 1000
+
+
+def _march_compiled(s: _Scales, q: QuadratureSettings) -> _Integrals:
+    """:func:`_march` lane by lane in compiled loops: the same panels and nodes, equal to rounding."""
+    from . import steady_kernel
+
+    rule = panel_rule(q.order)
+    settings = np.array(
+        [
+            q.log_hazard_step,
+            q.hazard_step,
+            q.end_ratio,
+            q.widest_panel,
+            q.negligible_hazard,
+            q.hazard_cutoff,
+            q.tail_tolerance,
+            SMALLEST_GAP,
+            _LOG_CAP,
+            MAX_PANELS,
+            np.log(q.log_hazard_step),
+            np.log(q.hazard_step),
+        ]
+    )
+    search = np.array(
+        [STEP_ULPS, _LOG_WIDTH_RATIO, START_OFFSET, FIRST_REACH, _TINY, MAX_BISECTIONS, _CLIFF_LOG_HAZARD]
+    )
+    out = np.empty((4, s.log_t.size))
+    status = steady_kernel.compiled()(
+        *(np.ascontiguousarray(v, dtype=float) for v in (s.log_t, s.a, s.alpha, s.beta)),
+        settings,
+        search,
+        0.5 * (rule.nodes + 1.0),
+        rule.cumulative,
+        rule.weights,
+        out,
+    )
+    if status != steady_kernel.MARCHED:
+        raise ModelError(f"steady-state quadrature did not converge: more than {MAX_PANELS} panels needed")
+    return _Integrals(out[0], out[1], out[2], out[3], None)
 
 
 #: OpenBLAS runs a matrix product of fewer than about this many multiply-adds on one thread; larger ones it

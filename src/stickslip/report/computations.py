@@ -128,9 +128,18 @@ def _steady(run: ModelRun) -> None:
 
 
 def _sticks(run: ModelRun) -> None:
+    solved: dict[tuple[Parameters, float, float | None], StickPhase] = {}
+
+    def phase(params: Parameters, velocity: float, start: float | None = None) -> StickPhase:
+        # the columns of one velocity share the nominal-stiffness phase: solve each distinct one once
+        key = (params, velocity, start)
+        if key not in solved:
+            solved[key] = stick_phase(params, velocity, start)
+        return solved[key]
+
     for velocity in PULLING_VELOCITIES:
         start = 0.0 if _um(velocity) in FROM_REST else None
-        run.sticks[_um(velocity)] = stick_phase(run.params, velocity, start)
+        run.sticks[_um(velocity)] = phase(run.params, velocity, start)
     assert run.critical is not None and run.critical.stress is not None
     for velocity, cycle in TABLE1_COLUMNS:
         start = 0.0 if (velocity, cycle) in TABLE1_FROM_REST else float(run.critical.stress)
@@ -139,11 +148,11 @@ def _sticks(run: ModelRun) -> None:
             velocity,
             start,
             stiffness,
-            stick_phase(with_stiffness(run.params, stiffness), velocity, start),
-            stick_phase(run.params, velocity, start),
+            phase(with_stiffness(run.params, stiffness), velocity, start),
+            phase(run.params, velocity, start),
         )
     for velocity in (50e-6, 100e-6):
-        run.mean_sticks[_um(velocity)] = stick_phase(with_stiffness(run.params, measured_stiffness(velocity)), velocity)
+        run.mean_sticks[_um(velocity)] = phase(with_stiffness(run.params, measured_stiffness(velocity)), velocity)
     run.thresholds["from sigma_c"] = stuck_threshold(run.params)
     run.thresholds["from rest"] = stuck_threshold(run.params, start_stress=0.0)
     run.jump_floor = _jump_floor(run)
