@@ -26,6 +26,7 @@ import numpy as np
 
 from ..errors import DataError, ModelError
 from ..protocols import Protocol, Segment, velocity_steps
+from ..rsf.compare import STEP_PRECISION
 
 __all__ = [
     "LEAD",
@@ -177,19 +178,26 @@ def _from(protocol: Protocol, start: float) -> Protocol:
 
 
 def step_record(
-    time: np.ndarray, stress: np.ndarray, protocol: Protocol, sigma_c: float, name: str = "bond model", cpu: float = 0.0
+    time: np.ndarray,
+    stress: np.ndarray,
+    protocol: Protocol,
+    sigma_c: float,
+    name: str = "bond model",
+    cpu: float = 0.0,
+    window: float = WINDOW,
 ) -> StepRecord:
-    """A :class:`StepRecord` from a trace (time in s, stress in Pa) of the slider history ``protocol``."""
+    """A :class:`StepRecord` from a trace (time in s, stress in Pa) of the slider history ``protocol``, ``window``
+    of slip (m) after each change."""
     from ..rsf.data import LabRecord
 
-    t, s = resample_in_slip(time, stress, protocol)
+    t, s = resample_in_slip(time, stress, protocol, window=window)
     # the spline's own error: drop every other solver row and see how much the resampled stress moves
     keep = np.ones(np.asarray(time).size, bool)
     keep[1:-1:2] = False
     edges = np.isin(np.asarray(time, float), protocol.boundaries)
     keep |= edges
     try:
-        _, coarse = resample_in_slip(np.asarray(time)[keep], np.asarray(stress)[keep], protocol)
+        _, coarse = resample_in_slip(np.asarray(time)[keep], np.asarray(stress)[keep], protocol, window=window)
         interpolation = float(np.max(np.abs(coarse - s))) / sigma_c
     except DataError:
         interpolation = math.nan
@@ -199,7 +207,7 @@ def step_record(
 
 
 def bond_step(
-    params: Any, velocities: list[float], rtol: float = TRACE_RTOL, name: str | None = None
+    params: Any, velocities: list[float], rtol: float = TRACE_RTOL, name: str | None = None, window: float = WINDOW
 ) -> StepRecord:  # fmt: skip
     """The time-dependent bond model's response to the slider velocities ``velocities`` (m/s), from steady
     sliding at the first: ``lead`` of slip at the first velocity, then ``window`` at each of the others."""
@@ -209,30 +217,52 @@ def bond_step(
     cp = critical_point(params)
     if not cp.exists or cp.stress is None:
         raise ModelError(f"the bond model has no critical point here ({cp.message}); nothing to normalise by")
-    durations = [LEAD / velocities[0]] + [WINDOW / v for v in velocities[1:]]
+    durations = [LEAD / velocities[0]] + [window / v for v in velocities[1:]]
     protocol = velocity_steps(velocities, durations)
     start = _time.process_time()
     run = run_transient(params, protocol, control="velocity", start="steady", rtol=rtol)
     cpu = _time.process_time() - start
     label = name or " -> ".join(f"{v * 1e6:.4g}" for v in velocities) + " um/s"
-    return step_record(run.time, run.stress, protocol, float(cp.stress), label, cpu)
+    return step_record(run.time, run.stress, protocol, float(cp.stress), label, cpu, window)
 
 
 def read_step(
     step: StepRecord, law: str = "aging", states: int = 1, guess: dict[str, float] | None = None
 ) -> Reading:  # fmt: skip
-    """Fit RSF (``law``, one or two ``states``, rig stiffness free) to ``step`` at the stated precision."""
-    from ..rsf.compare import STEP_PRECISION, step_guess
+    """Fit RSF (``law``, one or two ``states``, rig stiffness free) to ``step`` at the stated precision.
+
+    Without ``guess`` the search starts from the values read off each velocity change in turn
+    (:func:`stickslip.rsf.compare.step_guess`) and the lowest chi-square is kept: on a staircase the first
+    change alone can start the search where it loses its way.
+    """
     from ..rsf.fit import fit_record
 
     friction = step.record.friction
     span = float(np.ptp(friction))
     if not span > 0:
         raise DataError(f"{step.name}: the friction does not change; there is no step to read")
-    start = guess or step_guess(step.record.time, friction, step.protocol)
     precision = STEP_PRECISION * span
-    fit = fit_record(step.record, law=law, states=states, protocol=step.protocol, guess=start, noise=precision)
-    return Reading(law, states, fit, precision, span)
+    best = None
+    for start in [guess] if guess else _guesses(step):
+        fit = fit_record(step.record, law=law, states=states, protocol=step.protocol, guess=start, noise=precision)
+        if best is None or fit.reduced_chi_square < best.reduced_chi_square * (1 - 1e-9):
+            best = fit
+    return Reading(law, states, best, precision, span)
+
+
+def _guesses(step: StepRecord) -> list[dict[str, float]]:
+    """Starting values read off each velocity change of ``step`` (mu0 is always the record's first level)."""
+    from ..rsf.compare import step_guess
+
+    time, friction = step.record.time, step.record.friction
+    edges, segments = step.protocol.boundaries, step.protocol.segments
+    out = []
+    for i in range(1, len(segments)):
+        inside = (time >= edges[i - 1]) & (time <= edges[i + 1])
+        pair = Protocol((segments[i - 1], Segment(segments[i].velocity, edges[i + 1] - edges[i])))
+        guess = step_guess(time[inside] - edges[i - 1], friction[inside], pair)
+        out.append({**guess, "mu0": float(friction[0])})
+    return out
 
 
 def f_test(one: Reading, two: Reading) -> tuple[float, float]:
