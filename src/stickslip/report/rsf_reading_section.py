@@ -43,7 +43,8 @@ def rsf_reading_figure(run: ModelRun) -> ReportFigure:
     axes[0].set_ylabel("friction σ/σc")
     axes[0].legend(fontsize="small")
     fig.tight_layout()
-    return ReportFigure("rsf_reading", "Extension", "A rate-and-state reading of the bond model", _caption(readings), fig)
+    title = "A rate-and-state reading of the bond model"
+    return ReportFigure("rsf_reading", "Extension", title, _caption(readings), fig)
 
 
 def _shown(table: dict, name: str, scale: float = 1.0) -> str:
