@@ -38,9 +38,9 @@ def rsf_reading_figure(run: ModelRun) -> ReportFigure:
         ax.plot(slip[near], record.friction[near], color=color, lw=2.4, label="bond model (Eq 1)")
         ax.plot(slip[near], reading.fit.model_friction[near], color="k", lw=1.0, ls="--", label="RSF fit (aging)")
         ax.set_xlabel("slip since the step (µm)")
+        ax.set_ylabel("friction σ/σc")
         ax.set_title(f"{velocities[0] * UM:.0f} → {velocities[1] * UM:.0f} µm/s", fontsize=9)
         apply_style(ax)
-    axes[0].set_ylabel("friction σ/σc")
     axes[0].legend(fontsize="small")
     fig.tight_layout()
     title = "A rate-and-state reading of the bond model"
