@@ -89,3 +89,15 @@ def test_the_bond_models_steps_up_and_down_read_as_documented_and_need_two_slip_
         assert read.worst < 0.1 and read.lag_one > 0.95  # close, but the misfit has structure: not noise
         found[v0 < v1] = table["dc"]
     assert found[False]["interval"][0] > 5 * found[True]["interval"][1]
+
+
+@pytest.mark.parametrize(
+    "velocities, match",
+    [([1e-4], "at least two"), ([1e-4, 0.0], r"velocities\[1\]: expected a positive"), ([1e-4, 1e-4], "repeats"),
+     ("fast", "expected a list"), ([1e-4, float("nan")], "positive")],
+)  # fmt: skip
+def test_a_step_that_cannot_be_read_is_refused_in_one_line(velocities, match):
+    from stickslip.errors import ParameterError
+
+    with pytest.raises(ParameterError, match=match):
+        reading.bond_step(None, velocities)

@@ -24,7 +24,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import DataError, ModelError
+from ..errors import DataError, ModelError, ParameterError
 from ..protocols import Protocol, Segment, velocity_steps
 from ..rsf.compare import STEP_PRECISION
 
@@ -214,6 +214,7 @@ def bond_step(
     from ..model.critical import critical_point
     from ..transient import run_transient
 
+    _check_steps(velocities, window)
     cp = critical_point(params)
     if not cp.exists or cp.stress is None:
         raise ModelError(f"the bond model has no critical point here ({cp.message}); nothing to normalise by")
@@ -224,6 +225,23 @@ def bond_step(
     cpu = _time.process_time() - start
     label = name or " -> ".join(f"{v * 1e6:.4g}" for v in velocities) + " um/s"
     return step_record(run.time, run.stress, protocol, float(cp.stress), label, cpu, window)
+
+
+def _check_steps(velocities: Any, window: float) -> None:
+    """Velocity steps to read: at least two positive velocities, each different from the one before."""
+    try:
+        speeds = [float(v) for v in velocities]
+    except (TypeError, ValueError):
+        raise ParameterError(f"velocities: expected a list of velocities in m/s, got {velocities!r}") from None
+    if len(speeds) < 2:
+        raise ParameterError(f"velocities: expected at least two (a step), got {len(speeds)}")
+    for i, v in enumerate(speeds):
+        if not (math.isfinite(v) and v > 0):
+            raise ParameterError(f"velocities[{i}]: expected a positive velocity in m/s (the slider slides), got {v!r}")
+        if i and v == speeds[i - 1]:
+            raise ParameterError(f"velocities[{i}]: {v:g} m/s repeats the one before; expected a step")
+    if not (isinstance(window, (int, float)) and math.isfinite(window) and window > 0):
+        raise ParameterError(f"window: expected a positive slip in m, got {window!r}")
 
 
 def read_step(
@@ -241,6 +259,8 @@ def read_step(
     span = float(np.ptp(friction))
     if not span > 0:
         raise DataError(f"{step.name}: the friction does not change; there is no step to read")
+    if len(step.protocol.segments) < 2:
+        raise DataError(f"{step.name}: one velocity only; there is no step to read")
     precision = STEP_PRECISION * span
     best = None
     for start in [guess] if guess else _guesses(step):
