@@ -267,31 +267,43 @@ STEP_PRECISION = 0.01
 
 
 def fit_bond_step(trace: BondTrace, protocol: Protocol, sigma_c: float, slope: float) -> BondRSF:
-    """RSF fitted to a bond-model trace of the velocity step ``protocol`` (the protocol given, not detected).
+    """RSF (aging law, one state) fitted to a bond-model trace of the velocity step ``protocol`` (given, not
+    detected), with 95 % intervals (``extra["intervals"]``, SI).
 
-    The rig stiffness is fitted too: the bond model's stress rises over the slip that stretches its bonds
-    (a fraction of a micrometre), which a rigid RSF rig would make instantaneous.
+    The trace is first resampled uniformly in slip around the step (:func:`stickslip.studies.rsf_reading.
+    step_record`), so the fit does not depend on where the solver stepped.  The rig stiffness is fitted too: the
+    bond model's stress rises over the slip that stretches its bonds (a fraction of a micrometre), which a rigid
+    RSF rig would make instantaneous.  docs/extensions.md section 3 reads the bond model's steps in full.
     """
-    from .data import LabRecord
+    from ..studies.rsf_reading import interval_table, step_record
     from .fit import fit_record
 
-    t = np.asarray(trace.time, float)
-    friction = np.asarray(trace.stress, float) / sigma_c
-    record = LabRecord.from_arrays(t, protocol.displacement_at(t), friction, source=trace.source)
     v0, v1 = protocol.segments[0].velocity, protocol.segments[1].velocity
     step = f"{v0 * 1e6:.4g} -> {v1 * 1e6:.4g} um/s"
     vm = math.sqrt(v0 * v1)
-    jump = float(np.ptp(friction))
     try:
+        sampled = step_record(trace.time, trace.stress, protocol, sigma_c, trace.source)
+        t, friction = sampled.record.time, sampled.record.friction
+        jump = float(np.ptp(friction))
         # a model's output has no noise: the fit is judged at a stated precision, 1 % of the step's range
         precision = STEP_PRECISION * jump if jump > 0 else None
-        fit = fit_record(record, protocol=protocol, guess=step_guess(t, friction, protocol), noise=precision)
+        guess = step_guess(t, friction, sampled.protocol)
+        fit = fit_record(sampled.record, protocol=sampled.protocol, guess=guess, noise=precision)
     except (ModelError, DataError) as exc:
         fallback = RSFParams(a=max(slope, 0.0), states=(StateVariable("aging", 0.0, 1e-6),), mu0=1.0, v_ref=v0)
         return BondRSF(fallback, slope, vm, sigma_c, "failed", f"fit to the {trace.source}'s step {step} failed: {exc}")
     p, s = fit.params, fit.params.states[0]
-    values = f"a = {p.a:.3g}, b = {s.b:.3g}, Dc = {s.dc * 1e6:.3g} um, rig stiffness {p.stiffness:.3g} 1/m"
-    extra = {"rms": fit.rms, "rig_stiffness": p.stiffness, "fit_success": fit.success, "warnings": list(fit.warnings)}
+    intervals = interval_table(fit)
+
+    def shown(name: str, value: float, scale: float = 1.0, unit: str = "") -> str:
+        pair = intervals.get(name, {}).get("interval")
+        where = f" [{pair[0] / scale:.3g}, {pair[1] / scale:.3g}]" if pair else ""
+        return f"{name if name != 'dc' else 'Dc'} = {value / scale:.3g}{where}{unit}"
+
+    values = ", ".join([shown("a", p.a), shown("b", s.b), shown("dc", s.dc, 1e-6, " um"),
+                        f"rig stiffness {p.stiffness:.3g} 1/m"])  # fmt: skip
+    extra = {"rms": fit.rms, "rig_stiffness": p.stiffness, "fit_success": fit.success, "warnings": list(fit.warnings),
+             "law": "aging", "intervals": intervals, "precision": precision}  # fmt: skip
     problem = physical_problem(p)
     if problem is None and not fit.success:
         problem = f"the fit failed: {fit.reason}"
@@ -300,7 +312,8 @@ def fit_bond_step(trace: BondTrace, protocol: Protocol, sigma_c: float, slope: f
     if problem is not None:
         note = f"fit failed: the best RSF fit to the {trace.source}'s velocity step {step} ({values}) is not usable: "
         return BondRSF(p, slope, vm, sigma_c, "failed", note + problem, extra)
-    note = f"fitted to the {trace.source}'s velocity step {step} ({values}), rms misfit {fit.rms:.3g}"
+    note = (f"fitted to the {trace.source}'s velocity step {step} (aging law, 95 % intervals: {values}), rms misfit "
+            f"{fit.rms:.3g} ({100 * fit.rms / jump:.2g} % of the step's range)")  # fmt: skip
     return BondRSF(p, slope, vm, sigma_c, "fitted", note, extra)
 
 

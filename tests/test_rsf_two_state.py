@@ -1,0 +1,62 @@
+"""`rsf fit` with two state variables: known parameters recovered from a synthetic noisy step, inside their
+intervals; the F test of two states against one says yes on a two-state record and no on a one-state record.
+
+(The two-state spring-slider itself is checked against rsfmodel's published values in tests/test_rsf_rsfmodel.py.)
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from stickslip import protocols
+from stickslip.rsf import RSFParams, simulate
+from stickslip.rsf.data import LabRecord
+from stickslip.rsf.fit import fit_record
+from stickslip.rsf.params import StateVariable
+from stickslip.studies.rsf_reading import Reading, f_test
+
+UM = 1e-6
+HISTORY = protocols.velocity_steps([10 * UM, 100 * UM, 10 * UM], [8.0, 4.0, 24.0])
+NOISE = 2e-4
+
+
+def record(law: str, states: tuple[tuple[float, float], ...], seed: int) -> LabRecord:
+    """The step 10 -> 100 -> 10 um/s sampled at 10 Hz with white friction noise NOISE (a = 0.012, k = 2e4 1/m)."""
+    truth = RSFParams(a=0.012, states=tuple(StateVariable(law, b, dc) for b, dc in states), mu0=0.6, v_ref=10 * UM,
+                      stiffness=2e4)  # fmt: skip
+    t = np.arange(0.0, HISTORY.duration + 1e-9, 0.1)
+    run = simulate(truth, HISTORY, times=t)
+    noisy = run.friction + NOISE * np.random.default_rng(seed).standard_normal(t.size)
+    return LabRecord.from_arrays(t, run.load_point_displacement, noisy, source=f"synthetic {law}")
+
+
+TWO = ((0.006, 5 * UM), (0.004, 60 * UM))
+
+
+@pytest.mark.parametrize("law", ["aging"])
+def test_two_state_fit_recovers_known_parameters_inside_its_intervals(law):
+    fit = fit_record(record(law, TWO, seed=3), law=law, states=2, protocol=HISTORY, noise=NOISE)
+    assert fit.status == "ok", fit.reason
+    assert fit.reduced_chi_square == pytest.approx(1.0, abs=0.15)  # the model describes the record to its noise
+    truth = {"a": 0.012, "b": TWO[0][0], "dc": TWO[0][1], "b2": TWO[1][0], "dc2": TWO[1][1], "stiffness": 2e4}
+    for key, value in truth.items():
+        lo, hi = fit.parameters[key].interval
+        assert lo <= value <= hi, (key, fit.parameters[key].text())
+        assert hi - lo < 0.5 * value, (key, fit.parameters[key].text())  # and the interval says something
+
+
+def test_f_test_finds_the_second_state_only_where_there_is_one():
+    def reading(rec: LabRecord, states: int) -> Reading:
+        fit = fit_record(rec, law="aging", states=states, protocol=HISTORY, noise=NOISE)
+        return Reading("aging", states, fit, NOISE, float(np.ptp(rec.friction)))
+
+    two = record("aging", TWO, seed=4)
+    one_fit, two_fit = reading(two, 1), reading(two, 2)
+    assert one_fit.fit.reduced_chi_square > 3  # one state leaves structure behind ...
+    assert one_fit.lag_one > 0.5 and abs(two_fit.lag_one) < 0.2  # ... correlated residuals; two states: noise
+    value, p = f_test(one_fit, two_fit)
+    assert p < 1e-10 and value > 50
+    one = record("aging", ((0.01, 20 * UM),), seed=5)
+    _, p_one = f_test(reading(one, 1), reading(one, 2))
+    assert p_one > 1e-3  # no second state to find: the two extra parameters buy nothing beyond chance
