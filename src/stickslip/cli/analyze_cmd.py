@@ -127,7 +127,9 @@ def analyze_command(
     else:
         print_rich(*_report(analysis, comparison))
     if plot_path is not None:
-        _save_plot(analysis, comparison, plot_path)
+        from ..plots.traces import figure_analysis
+
+        save_figure(figure_analysis(analysis, comparison), plot_path)
 
 
 def cycles_csv(analysis: Any) -> str:
@@ -242,18 +244,6 @@ def _number(value: float | None, factor: float, digits: int) -> str:
 
 def _signed(value: float, factor: float) -> str:
     return f"{value * factor:+.4g}"
-
-
-def _save_plot(analysis: Any, comparison: Any, path: Path) -> None:
-    from matplotlib.figure import Figure
-
-    fig = Figure(figsize=(9, 4.5))
-    ax = fig.add_subplot()
-    if comparison is None:
-        analysis.plot(ax=ax)
-    else:
-        comparison.plot(ax=ax)
-    save_figure(fig, path)
 
 
 def register(cli: click.Group) -> None:

@@ -134,7 +134,9 @@ def compare_command(**options: Any) -> None:
     else:
         click.echo(_text(summary))
     if options["output"] is not None:
-        save_figure(_figure(panels, pair, rsf), options["output"])
+        from ..plots.compare import figure_bond_and_rsf
+
+        save_figure(figure_bond_and_rsf(panels, pair, rsf, _how(rsf.status)), options["output"])
         write(sidecar(options["output"]), json_text(summary) + "\n")
     if failures:
         click.echo("stickslip: the rate-and-state side failed: " + failures[0], err=True)
@@ -262,62 +264,6 @@ def _text(summary: dict[str, Any]) -> str:
 
 def _how(status: str) -> str:
     return {"fitted": "fitted to the bond model's step", "given": "given on the command line"}.get(status, "FIT FAILED")
-
-
-def _figure(panels: dict[str, Any], pair: dict[str, Any], rsf: Any) -> Any:
-    from matplotlib.figure import Figure
-
-    from ..plots.style import apply_style
-
-    fig = Figure(figsize=(12, 4.2), layout="constrained")
-    axes = fig.subplots(1, 3)
-    sc = rsf.sigma_c
-    label = f"rate-and-state ({_how(rsf.status)})"
-    for ax, (name, (bond, run, problem)) in zip(axes[:2], panels.items(), strict=True):
-        ax.plot(bond.time, np.where(bond.stress > 0, bond.stress / sc, np.nan), color="#1f4e9c", lw=1.6,
-                label=bond.source)  # fmt: skip
-        if run is not None:
-            shown = np.where(run.friction > 0, run.friction, np.nan)  # negative friction is not drawn
-            ax.plot(run.time, shown, color="#c0392b", lw=1.2, ls="--", label=label)
-        if problem:
-            _say(ax, "RSF: " + problem)
-        if name == "slide-hold-slide":
-            # log: the re-sliding peak of the bond model can be 10^3 times its sliding stress; both must show
-            ax.set_yscale("log")
-        else:
-            ax.set_ylim(bottom=0.0)  # friction is not negative: an RSF curve that reaches 0 is cut there
-            ax.ticklabel_format(axis="y", useOffset=False)
-        ax.set_title(name, fontsize=10)
-        ax.set_xlabel("time (s)")
-        ax.set_ylabel("stress / σc")
-        ax.legend(fontsize=7, frameon=False, loc="lower right")
-        apply_style(ax)
-    ax = axes[2]
-    bond, run = pair["bond"], pair["rsf"]
-    ax.plot(bond.time, bond.stress / sc, color="#1f4e9c", lw=1.4, label="bond model: jump cycle")
-    if run is not None:
-        shown = np.where(run.friction >= 0, run.friction, np.nan)
-        regime = "failed" if pair["problem"] else run.regime.name
-        ax.plot(run.time, shown, color="#c0392b", lw=1.0, label=f"RSF: {regime}")
-    if pair["problem"]:
-        _say(ax, "RSF: " + pair["problem"], top=False)  # the cycle fills the top; friction below sigma_c is empty
-    ax.set_ylim(bottom=0.0)
-    ax.set_title("stick-slip at the same V0, stiffness, σc", fontsize=10)
-    ax.set_xlabel("time (s)")
-    ax.set_ylabel("stress / σc")
-    ax.legend(fontsize=7, frameon=False, loc="lower right")
-    apply_style(ax)
-    p = rsf.params
-    fig.suptitle(f"One RSF set for all panels: a = {p.a:.3g}, b = {p.b:.3g}, Dc = {p.dc * 1e6:.3g} µm "
-                 f"({_how(rsf.status)})", fontsize=9)  # fmt: skip
-    return fig
-
-
-def _say(ax: Any, text: str, top: bool = True) -> None:
-    import textwrap
-
-    ax.text(0.02, 0.98 if top else 0.02, textwrap.fill(text, 60), transform=ax.transAxes, fontsize=6.5,
-            color="#c0392b", va="top" if top else "bottom")  # fmt: skip
 
 
 def register(cli: click.Group) -> None:

@@ -194,7 +194,7 @@ def rsf_run(result: Any) -> Run:
 
     r = result.regime
     params, protocol = result.params, result.protocol
-    kind = {"steady sliding": regimes.STEADY, "not analysed": regimes.UNDETERMINED}.get(r.name, r.name)
+    kind = r.kind  # rate-and-state's regime is the classifier's (stickslip.rsf.Regime), in friction units
     sigma = params.normal_stress
     scale = 1.0 if sigma is None else sigma
     regime = regimes.Regime(

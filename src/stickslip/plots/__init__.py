@@ -9,7 +9,8 @@
 * :mod:`~stickslip.plots.fits` — steady and stick fits, residuals, the posterior's corner plot;
 * :mod:`~stickslip.plots.sweeps` — a sweep's phase diagram (2-D) or its results against one key (1-D);
 * :mod:`~stickslip.plots.export` — saving figures (PNG, SVG) and reading every drawn curve back as CSV;
-* ``run`` and ``overlay`` (where present) — a run of any model, and several models' runs of one protocol.
+* :mod:`~stickslip.plots.compare` — the bond model beside rate-and-state (``stickslip compare``);
+* ``run`` and ``overlay`` — a run of any model, and several models' runs of one protocol.
 
 Figures are built on :class:`matplotlib.figure.Figure`, never through pyplot: nothing here opens a window,
 calls ``show()`` or touches global state.  Every ``plot_*`` function takes ``ax=None`` (a new Figure then) and

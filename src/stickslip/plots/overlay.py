@@ -17,7 +17,7 @@ def overlay_figure(runs: Mapping[str, Run], title: str = "") -> Figure:
     import numpy as np
     from matplotlib.figure import Figure
 
-    from ..plotting import apply_style
+    from .style import apply_style
 
     fig = Figure(figsize=(9, 6), layout="constrained")
     top, bottom = fig.subplots(2, 1, sharex=True, height_ratios=(2, 1))

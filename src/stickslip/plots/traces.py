@@ -8,6 +8,7 @@ import numpy as np
 
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
 
     from ..analysis.compare import Comparison
     from ..analysis.cycles import TraceAnalysis
@@ -55,3 +56,13 @@ def plot_analysis(
     ax.set_ylabel("stress [Pa]")
     ax.legend(loc="best", fontsize="small")
     return ax
+
+
+def figure_analysis(analysis: TraceAnalysis, comparison: Comparison | None = None) -> Figure:
+    """The figure of ``stickslip analyze --plot``: :func:`plot_analysis` of the record on a Figure of its own, with
+    the model of ``comparison`` (:func:`stickslip.analysis.compare_with_model` of this analysis) on top when given."""
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(9, 4.5))
+    plot_analysis(analysis, ax=fig.add_subplot(), comparison=comparison)
+    return fig

@@ -2,7 +2,9 @@
 
 A grid sweep (:mod:`stickslip.sweeps`, in this process: no cluster for ~140
 points) of V0 = 5 µm/s … 5 mm/s by G/h × 0.1 … × 10 of the paper's block,
-drawn with the quasi-static boundary V0 = Vc (Eq 9).
+drawn with the quasi-static boundary V0 = Vc (Eq 9).  Each point is a run of
+the ``quasi-static`` model through the model interface (the sweep's only way
+to run a model: ``model.parameters`` + ``model.run`` -> Run -> one row).
 """
 
 from __future__ import annotations
@@ -16,6 +18,8 @@ from .figures import ReportFigure
 VELOCITIES = "5 um/s..5 mm/s:15:log"
 STIFFNESS_FACTORS = (0.1, 10.0, 9)
 DURATION = "20 s"
+#: the registered model the diagram sweeps (its regimes and its analytic boundary)
+MODEL = "quasi-static"
 
 
 def phase_diagram_figure(run: ModelRun) -> ReportFigure:
@@ -29,6 +33,7 @@ def phase_diagram_figure(run: ModelRun) -> ReportFigure:
     stiffness = params.block.stiffness
     spec = build_spec(
         [f"pulling_velocity={VELOCITIES}", f"block.stiffness={low * stiffness!r}..{high * stiffness!r}:{count}:log"],
+        model=MODEL,
         params=params,
         duration=DURATION,
     )

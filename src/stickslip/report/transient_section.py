@@ -1,12 +1,14 @@
 """The report's section on the full time-dependent model (Eq 1), which the paper never solves.
 
-Three runs of :mod:`stickslip.transient` with the paper's parameters, each
+Three runs of the ``transient`` model with the paper's parameters, each
 beside what the paper's quasi-static picture predicts (docs/transient.md
-section 7 has the numbers at tighter tolerances):
+section 7 has the numbers at tighter tolerances); every run goes through the
+model interface (:func:`stickslip.models.get_model` ``.run`` with a ``Rig``),
+the figure's per-cycle numbers from each Run's ``native`` result:
 
 * a step down from steady sliding at 350 µm/s to 100 µm/s through the Eq 17
   block, with Eq 1 alone and with the paper's stick chains, against
-  ``model.cycle.simulate``;
+  the ``quasi-static`` model;
 * velocity steps 100 → 1000 → 100 µm/s under velocity control;
 * slide–hold–slide: the peak on re-sliding against the hold time.
 """
@@ -14,11 +16,17 @@ section 7 has the numbers at tighter tolerances):
 from __future__ import annotations
 
 from collections.abc import Callable
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from .computations import ModelRun
 from .figures import ReportFigure
+
+if TYPE_CHECKING:  # pragma: no cover
+    from ..models import Run
+    from ..parameters import Parameters
+    from ..protocols import Protocol
 
 UM = 1e6
 #: local tolerance of the report's runs (the cycle agrees with rtol 1e-4 to 1e-5; docs/transient.md)
@@ -29,27 +37,24 @@ HOLDS = (1e-3, 1e-2, 1e-1, 1.0, 10.0)
 
 
 def transient_figure(run: ModelRun) -> ReportFigure:
-    from ..model.cycle import simulate
     from ..plots.transient import figure_transient_runs
     from ..protocols import constant, segments
-    from ..transient import run_transient
 
     params = run.params
     high, low, duration = STEP_DOWN
-    full = run_transient(
-        params, constant(low, duration), start="steady", start_velocity=high, rtol=RTOL, stick_population=True
-    )
-    alone = run_transient(params, constant(low, duration), start="steady", start_velocity=high, rtol=RTOL)
-    quasi = simulate(params, low, duration)
-    steps = run_transient(params, segments(list(VELOCITY_STEPS)), control="velocity", start="steady", rtol=1e-5)
+    down = constant(low, duration)
+    full = _run("transient", params, down, start="steady", start_velocity=high, rtol=RTOL, stick_population=True)
+    alone = _run("transient", params, down, start="steady", start_velocity=high, rtol=RTOL)
+    quasi = _run("quasi-static", params, down)
+    steps = _run("transient", params, segments(list(VELOCITY_STEPS)), "velocity", start="steady", rtol=1e-5)
     peaks = [_hold_peak(params, hold) for hold in HOLDS]
 
     fig = figure_transient_runs(
-        alone,
-        full,
-        quasi,
+        alone.native,
+        full.native,
+        quasi.native,
         STEP_DOWN,
-        steps,
+        steps.native,
         (VELOCITY_STEPS[0][1], _second_step()),
         "100 → 1000 → 100 µm/s (velocity control)",
         HOLDS,
@@ -59,20 +64,29 @@ def transient_figure(run: ModelRun) -> ReportFigure:
     return ReportFigure("transient_eq1", "Eq 1", "The full time-dependent model (Eq 1), solved", caption, fig)
 
 
+def _run(
+    model: str, params: Parameters, protocol: Protocol, control: str = "spring", *, start: Any = None, **settings: Any
+) -> Run:
+    """One run of a registered model through the interface: the paper's block (the model's own spring) or a rigid
+    rig (``control="velocity"``)."""
+    from ..models import Rig, get_model
+
+    return get_model(model).run(params, protocol, Rig(control=control), start=start, **settings)
+
+
 def _second_step() -> float:
     return VELOCITY_STEPS[0][1] + VELOCITY_STEPS[1][1]
 
 
-def _hold_peak(params, hold: float) -> float:  # type: ignore[no-untyped-def]
+def _hold_peak(params: Parameters, hold: float) -> float:
     from ..protocols import segments
-    from ..transient import run_transient
 
     protocol = segments([(100e-6, 0.002), (0.0, hold), (100e-6, 0.015)])
-    result = run_transient(params, protocol, control="velocity", start="steady", rtol=RTOL)
+    result = _run("transient", params, protocol, "velocity", start="steady", rtol=RTOL)
     return float(result.stress[result.time > 0.002 + hold].max())
 
 
-def _caption(run, full, alone, quasi, steps, peaks) -> str:  # type: ignore[no-untyped-def]
+def _caption(run: ModelRun, full: Run, alone: Run, quasi: Run, steps: Run, peaks: list[float]) -> str:
     from ..model.steady import steady_state
 
     sigma_c = run.critical.stress if run.critical is not None else float("nan")
@@ -80,15 +94,15 @@ def _caption(run, full, alone, quasi, steps, peaks) -> str:  # type: ignore[no-u
     stick_alone = (
         f"Eq 1 alone slides down the steady curve and sticks at σ = {alone.stress[stuck[0]]:.2f} Pa "
         f"(σc = {sigma_c:.2f} Pa) after {alone.time[stuck[0]]:.2f} s, then never lets go: at "
-        f"{alone.time[-1]:.0f} s σ = {alone.final_stress:.1f} Pa and the slider creeps at "
+        f"{alone.time[-1]:.0f} s σ = {alone.stress[-1]:.1f} Pa and the slider creeps at "
         f"{alone.slider_velocity[-1] * 1e9:.1f} nm/s, because Eq 1's aging (τa = 0.9 ms) makes a resting bond "
         "unbreakable within milliseconds"
         if stuck.size
         else "Eq 1 alone does not stick in this run"
     )
     cycle_text = "the stick chains give no whole cycle in this run"
-    if full.cycles and quasi.cycles:
-        c, q = full.cycles[0], quasi.cycles[0]
+    if full.native.cycles and quasi.native.cycles:  # the per-cycle numbers are each solver's own
+        c, q = full.native.cycles[0], quasi.native.cycles[0]
         slip = f"{c.slip_time:.3f} s" if c.slip_time is not None else "past the end of the run"
         q_slip = f"{q.slip_time:.3f} s" if q.slip_time is not None else "—"
         cycle_text = (

@@ -22,28 +22,37 @@ if TYPE_CHECKING:  # pragma: no cover
 
 __all__ = ["RSFRun", "Regime", "Solution", "assemble_run", "detect_regime"]
 
+#: the evidence of a run whose regime was not looked for (``simulate(..., detect=False)``, as fits run it)
+NOT_ANALYSED = "not analysed"
 
-@dataclass(frozen=True)
-class Regime:
-    """What the last protocol segment settled into, read off the solver's dense solution (:mod:`stickslip.regimes`).
 
-    ``name``: ``steady sliding``, ``decaying oscillation``, ``stick-slip``
-    (a limit cycle), ``growing oscillation``, ``undetermined`` (the run is
-    too short to tell: ``evidence`` says what was seen), ``blow-up`` or
-    ``not analysed``.  ``period`` (s) is NaN unless the last segment
-    oscillates; ``growth`` is the amplitude ratio of the last period to the
-    one before (NaN with fewer than two); ``peak_friction`` and
-    ``trough_friction`` are the solution's extremes over the last period (over
-    the segment when it does not oscillate), whatever the output sampling.
+class Regime(regimes.Regime):
+    """What the last protocol segment settled into: the one classifier's :class:`stickslip.regimes.Regime`
+    (the same fields, friction dimensionless), read off the solver's dense solution.
+
+    ``kind`` is one of :data:`stickslip.regimes.KINDS`; a run with ``detect=False`` (fits) is ``undetermined``
+    with the evidence "not analysed".  Rate-and-state's own names stay as read-only aliases: ``name`` (the
+    kind, ``steady sliding`` for ``steady``: :data:`stickslip.regimes.RSF_NAMES`), ``growth``
+    (``amplitude_ratio``), ``peak_friction`` and ``trough_friction`` (``peak`` and ``trough``).  ``period``
+    (s) is NaN unless the last segment oscillates; the extremes are over the last period (over the segment
+    when it does not oscillate), whatever the output sampling.
     """
 
-    name: str
-    period: float
-    peak_friction: float
-    trough_friction: float
-    growth: float
-    periods: int = 0
-    evidence: str = ""
+    @property
+    def name(self) -> str:
+        return regimes.RSF_NAMES.get(self.kind, self.kind)
+
+    @property
+    def growth(self) -> float:
+        return self.amplitude_ratio
+
+    @property
+    def peak_friction(self) -> float:
+        return self.peak
+
+    @property
+    def trough_friction(self) -> float:
+        return self.trough
 
 
 @dataclass(frozen=True)
@@ -171,11 +180,11 @@ def assemble_run(
         spring = friction + system.eta * velocity
     slider = lp_disp - (spring - spring[0]) / k
     regime = (
-        Regime(regimes.BLOW_UP, math.nan, float(np.max(friction)), float(np.min(friction)), math.nan)
+        Regime(regimes.BLOW_UP, 0, math.nan, math.nan, float(np.max(friction)), float(np.min(friction)), "")
         if status != "ok"
         else detect_regime(t, friction, velocity, protocol, system=system, solution=solution, rtol=rtol)
         if detect
-        else Regime("not analysed", math.nan, math.nan, math.nan, math.nan)
+        else Regime(regimes.UNDETERMINED, 0, math.nan, math.nan, math.nan, math.nan, NOT_ANALYSED)
     )
     return RSFRun(
         time=t,
@@ -224,20 +233,19 @@ def detect_regime(
     floor = max(10.0 * rtol * scale, 1e-14)
     relaxation = (max(system.dc) / vlp) if (system is not None and vlp > 0) else None
     found = regimes.classify(t, friction, floor=floor, start=start, relaxation=relaxation, dense=dense)
-    name = regimes.RSF_NAMES.get(found.kind, found.kind)
-    evidence = found.evidence
+    kind, evidence = found.kind, found.evidence
     if found.kind == regimes.STEADY and vlp > 0:
         mask = t >= start
         v_end = float(velocity[mask][-1]) if np.any(mask) else float(velocity[-1])
         if abs(v_end / vlp - 1) > 1e-3:  # friction flat but the slider not at the load point's pace
-            name = regimes.UNDETERMINED
+            kind = regimes.UNDETERMINED
             evidence = (
                 f"undetermined: friction is flat but the slider moves at {v_end:.4g} m/s, not the load point's"
                 f" {vlp:.4g} m/s"
             )
     if system is not None and vlp > 0:
         evidence += _stability_note(system, vlp, found.kind)
-    return Regime(name, found.period, found.peak, found.trough, found.amplitude_ratio, found.periods, evidence)
+    return Regime(kind, found.periods, found.amplitude_ratio, found.period, found.peak, found.trough, evidence)
 
 
 def _physical(system: System, t: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
