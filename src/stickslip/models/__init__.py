@@ -30,8 +30,8 @@ __all__ = [
     "available_models",
     "get_model",
     "register_model",
-    "unregister_model",
     "run",
+    "unregister_model",
 ]
 
 
