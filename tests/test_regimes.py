@@ -295,3 +295,16 @@ def test_rsf_extremes_fall_back_to_the_accepted_steps_when_the_restart_fails(mon
     assert summary["period"] == pytest.approx(period, rel=1e-3)
     assert summary["peak_friction"] == pytest.approx(peak, abs=1e-4)
     assert summary["trough_friction"] == pytest.approx(trough, abs=1e-4)
+
+
+def test_a_settling_oscillation_reports_its_latest_period_not_a_mean_with_the_start_up():
+    """Period 60 s, then 95 s (phase continuous), decaying 20 % a period: the last three intervals are 60, 95, 95 s;
+    their mean (83 s) is no period the signal has now, the latest interval is."""
+    t = np.linspace(0.0, 700.0, 70001)
+    switch = 480.0
+    phase = np.where(t < switch, 2 * np.pi * t / 60.0, 2 * np.pi * (switch / 60.0 + (t - switch) / 95.0))
+    period_now = np.where(t < switch, 60.0, 95.0)
+    envelope = np.exp(np.cumsum(np.log(0.8) / period_now) * (t[1] - t[0]))
+    regime = regimes.classify(t, envelope * np.sin(phase), floor=1e-9)
+    assert regime.kind == regimes.DECAYING
+    assert regime.period == pytest.approx(95.0, rel=0.02)

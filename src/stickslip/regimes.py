@@ -270,14 +270,14 @@ def classify(
     periods = max(len(peaks) - 1, 0)
     ratios = [b / a for a, b in itertools.pairwise(amplitudes) if a > 0]
     ratio = ratios[-1] if ratios else math.nan
-    period = _period(tw, yw, ext, is_max, placed, dense)
+    period, latest = _period(tw, yw, ext, is_max, placed, dense)
     last_extremum = placed[-1][0] if placed else float(tw[0])
     quiet = float(tw[-1]) - last_extremum
     oscillating = periods >= 1 and not (math.isfinite(period) and quiet > 2 * period)
     if oscillating:
         last = [v for (tp, v) in placed if tp >= peaks[-2][0]] if len(peaks) >= 2 else [v for _, v in placed]
         peak, trough = max(last), min(last)
-        return _verdict(periods, ratios, period, peak, trough)
+        return _verdict(periods, ratios, period, peak, trough, latest)
     # not (or no longer) oscillating: steady only when the tail has stopped changing
     tail_from = last_extremum if placed else float(tw[0])
     tau = min(relaxation if relaxation else math.inf, (float(tw[-1]) - tail_from) / 2.0, window / 2.0)
@@ -302,14 +302,23 @@ def classify(
     )  # fmt: skip
 
 
-def _verdict(periods: int, ratios: list[float], period: float, peak: float, trough: float) -> Regime:
-    """The oscillation's kind from its period-to-period amplitude ratios (the last RATIOS_NEEDED must agree)."""
+def _verdict(
+    periods: int, ratios: list[float], period: float, peak: float, trough: float, latest: float | None = None
+) -> Regime:
+    """The oscillation's kind from its period-to-period amplitude ratios (the last RATIOS_NEEDED must agree).
+
+    A limit cycle's period is the mean of its last intervals; any other oscillation's is the ``latest`` interval
+    (its period may still be changing, and a mean would mix in the start-up swings).
+    """
     ratio = ratios[-1] if ratios else math.nan
-    evidence = f"{periods} period(s) of {period:.6g} s, amplitude ratio {ratio:.4g} per period"
     recent = ratios[-RATIOS_NEEDED:]
+    if len(recent) == RATIOS_NEEDED and all(abs(r - 1) <= RATIO_TOLERANCE for r in recent):
+        evidence = f"{periods} period(s) of {period:.6g} s, amplitude ratio {ratio:.4g} per period"
+        return Regime(STICK_SLIP, periods, ratio, period, peak, trough, f"stick-slip (limit cycle): {evidence}")
+    if latest is not None and math.isfinite(latest):
+        period = latest
+    evidence = f"{periods} period(s), the latest {period:.6g} s, amplitude ratio {ratio:.4g} per period"
     if len(recent) == RATIOS_NEEDED:
-        if all(abs(r - 1) <= RATIO_TOLERANCE for r in recent):
-            return Regime(STICK_SLIP, periods, ratio, period, peak, trough, f"stick-slip (limit cycle): {evidence}")
         if all(r < 1 - RATIO_TOLERANCE for r in recent):
             return Regime(DECAYING, periods, ratio, period, peak, trough, f"decaying oscillation: {evidence}")
         if all(r > 1 + RATIO_TOLERANCE for r in recent):
@@ -326,17 +335,19 @@ def classify_cycles(peak_times: list[float], peaks: list[float], troughs: list[f
     amplitudes = [p - q for p, q in zip(peaks, troughs, strict=True)]
     ratios = [b / a for a, b in itertools.pairwise(amplitudes) if a > 0]
     periods = max(len(peak_times) - 1, 0)
-    period = float(np.mean(np.diff(peak_times[-4:]))) if len(peak_times) >= 2 else math.nan
+    intervals = np.diff(peak_times[-4:])
+    period = float(np.mean(intervals)) if intervals.size else math.nan
+    latest = float(intervals[-1]) if intervals.size else math.nan
     peak = peaks[-1] if peaks else math.nan
     trough = troughs[-1] if troughs else math.nan
-    return _verdict(periods, ratios, period, peak, trough)
+    return _verdict(periods, ratios, period, peak, trough, latest)
 
 
 def _period(
     t: np.ndarray, y: np.ndarray, ext: list[int], is_max: list[bool], placed: list[tuple[float, float]],
     dense: Dense | None,
-) -> float:  # fmt: skip
-    """Mean of the last (up to three) intervals between the falls through mid-level, one per period.
+) -> tuple[float, float]:  # fmt: skip
+    """(Mean of the last up to three intervals between the falls through mid-level, one per period; the last one).
 
     A fall through the middle of the swing is steep, so its time is well defined; a flat peak's is not.
     """
@@ -347,8 +358,9 @@ def _period(
         level = 0.5 * (placed[k][1] + placed[k + 1][1])
         falls.append(_crossing(t, y, ext[k], ext[k + 1], level, dense))
     if len(falls) < 2:
-        return math.nan
-    return float(np.mean(np.diff(falls[-4:])))
+        return math.nan, math.nan
+    intervals = np.diff(falls[-4:])
+    return float(np.mean(intervals)), float(intervals[-1])
 
 
 def _crossing(t: np.ndarray, y: np.ndarray, i: int, k: int, level: float, dense: Dense | None) -> float:
