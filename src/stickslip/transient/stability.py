@@ -56,8 +56,10 @@ def _stiffness(extension: np.ndarray, params: Parameters) -> np.ndarray:
     return b.chain_stiffness * (1.0 + y * y) / (d * d)
 
 
-def interface_response(params: Parameters, velocity: float, s: np.ndarray, aging: bool = True) -> Response:
-    """Z(s) of the module docstring at the complex rates ``s`` (1/s)."""
+def interface_response(
+    params: Parameters, velocity: float, s: np.ndarray, aging: bool = True, cell_hazard: float = CELL_HAZARD
+) -> Response:
+    """Z(s) of the module docstring at the complex rates ``s`` (1/s); ``cell_hazard`` sets the age grid."""
     if not (isinstance(velocity, (int, float)) and math.isfinite(velocity) and velocity > 0):
         raise ParameterError(f"velocity: expected a positive sliding velocity in m/s, got {velocity!r}")
     b = params.bonds
@@ -67,7 +69,7 @@ def interface_response(params: Parameters, velocity: float, s: np.ndarray, aging
             f"velocity: {velocity:.3g} m/s is beyond {FASTEST:.0e} x the set's dl_m/tau ({fastest:.3g} m/s): chains"
             " would reach full extension in a negligible fraction of a bond's life; check the unit"
         )
-    a, w, width, f, fp, r, gv = _cells(params, float(velocity), aging)
+    a, w, width, f, fp, r, gv = _cells(params, float(velocity), aging, cell_hazard)
     birth = (b.site_density - w.sum()) / b.bond_time
     s = np.atleast_1d(np.asarray(s, dtype=complex))
     z = _response_kernel()(s, a, w, width, f, fp, r, gv, b.force_sensitivity, birth * b.bond_time)
@@ -75,10 +77,12 @@ def interface_response(params: Parameters, velocity: float, s: np.ndarray, aging
 
 
 @lru_cache(maxsize=32)
-def _cells(params: Parameters, velocity: float, aging: bool) -> tuple[np.ndarray, ...]:
+def _cells(
+    params: Parameters, velocity: float, aging: bool, cell_hazard: float = CELL_HAZARD
+) -> tuple[np.ndarray, ...]:
     """Steady cohorts at ``velocity`` with force, stiffness, hazard and aging sensitivity (cached)."""
     g = params.aging
-    pop = steady_population(params, velocity, aging, cell_hazard=CELL_HAZARD, rule="midpoint")
+    pop = steady_population(params, velocity, aging, cell_hazard=cell_hazard, rule="midpoint")
     a, w, e = pop.age, pop.weight, pop.extension
     f = chain_force(e, params)
     fp = _stiffness(e, params)

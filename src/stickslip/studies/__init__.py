@@ -1,0 +1,1 @@
+"""Studies: computations that answer a question about the models (docs/extensions.md)."""
