@@ -104,3 +104,17 @@ def test_bad_mass_or_damping_is_one_clear_error(params):
         critical_stiffness(params, 120e-6, mass=-1.0)
     with pytest.raises(ParameterError, match="damping: expected a non-negative"):
         critical_stiffness(params, 120e-6, damping=math.nan)
+
+
+def test_cli_stability_with_a_block_mass(runner, params, capsys):
+    """``stickslip stability`` prints the API's Kc with the mass in SI, and refuses a negative mass in one line."""
+    import json
+
+    from cli_helpers import run, run_main
+
+    out = json.loads(run(runner, "stability", "--v0", "120 um/s", "--mass", "10.5 kg/m^2", "--json"))
+    row = out["rows"][0]
+    assert out["units"]["critical_stiffness"] == "Pa/m" and row["mass"] == 10.5
+    assert row["critical_stiffness"] == pytest.approx(critical_stiffness(params, 120e-6, mass=10.5), rel=1e-12)
+    code, _, err = run_main(capsys, "stability", "--v0", "120 um/s", "--mass", "-1 kg/m^2")
+    assert code == 2 and err.count("\n") == 1 and "--mass" in err
