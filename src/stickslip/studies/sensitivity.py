@@ -13,7 +13,7 @@ recomputes the predictions there:
 
 The profile is linearised (:func:`region_points` with ``refit=False``: the other free parameters follow
 their conditional mean given (tau_a, V_a) under the fit's covariance) or exact (``refit=True``: the steady
-fit rerun with tau_a and V_a fixed); :func:`delta_chi_square` checks where each point really lies.
+fit rerun with tau_a and V_a fixed); :func:`chi_square` checks where each point really lies.
 docs/extensions.md section 2; ``scripts/sensitivity_table.py`` regenerates the slow numbers.
 """
 
@@ -89,13 +89,12 @@ def steady_fit():  # type: ignore[no-untyped-def]
     return fit_steady(synthetic_steady_path(), method="joint", intervals="delta")
 
 
-def chi_square(fit, params: Parameters) -> float:  # type: ignore[no-untyped-def]
-    """Chi-square of ``params`` on the fit's data, with the fit's noise scale (stated errors: 1)."""
+def chi_square(data, params: Parameters, noise_scale: float = 1.0) -> float:  # type: ignore[no-untyped-def]
+    """Chi-square of ``params`` on steady ``data`` (SteadyData), errors x ``noise_scale`` (stated errors: 1)."""
     from ..model.steady import steady_state
 
-    data = fit.data
     model = np.array([float(steady_state(params, float(v)).stress) for v in data.velocity])
-    err = (data.stress_err if data.stress_err is not None else data.stress) * fit.noise_scale
+    err = (data.stress_err if data.stress_err is not None else data.stress) * noise_scale
     return float(np.sum(((data.stress - model) / err) ** 2))
 
 
@@ -125,7 +124,7 @@ def profile(fit, aging_time: float, aging_velocity: float, start: Parameters | N
     refit = fit_steady(fit.data, base.with_overrides(fixed), method="joint", intervals="delta", fix=fixed)
     if not refit.success:
         raise ModelError(f"profile fit at tau_a = {aging_time:.4g} s, V_a = {aging_velocity:.4g} m/s: {refit.reason}")
-    return chi_square(fit, refit.parameters), refit.parameters
+    return chi_square(fit.data, refit.parameters, fit.noise_scale), refit.parameters
 
 
 def region_points(fit, n: int = 8, level: float = LEVEL, cap: float = 8.0) -> Region:  # type: ignore[no-untyped-def]
