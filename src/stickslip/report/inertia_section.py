@@ -16,7 +16,7 @@ from .computations import ModelRun
 from .figures import ReportFigure
 
 VELOCITY = 120e-6
-BAND = (10.0, 3000.0, 40)  # rad/s: low, high, points (the Hopf crossing is at 205 rad/s)
+BAND = (10.0, 3000.0, 30)  # rad/s: low, high, points (the Hopf crossing is at 205 rad/s)
 FACTOR = 0.7
 
 
