@@ -16,7 +16,6 @@ from stickslip.transient.stability import (
     critical_stiffness,
     critical_stiffness_details,
     follow_root,
-    hopf_root,
     interface_response,
     real_growth_rates,
     unstable_root_count,
@@ -60,9 +59,17 @@ def test_roots_of_a_spring_mass_dashpot_are_the_quadratic_formula():
     assert unstable_root_count(lambda s: k + 900.0 * s, 1e5, RATES, mass, eta) == 0
 
 
+GEL_MASS = 10.5  # kg/m^2: gelatin 1050 kg/m^3 x the block's 10 mm
+
+
 @pytest.fixture(scope="module")
 def near_vc(params):
     return critical_stiffness_details(params, 120e-6)
+
+
+@pytest.fixture(scope="module")
+def gel_block(params):
+    return critical_stiffness_details(params, 120e-6, mass=GEL_MASS)
 
 
 def test_massless_limit_is_the_papers_block(params, near_vc):
@@ -72,20 +79,19 @@ def test_massless_limit_is_the_papers_block(params, near_vc):
     assert near_vc.rate / (2 * math.pi) == pytest.approx(33.0, rel=0.02)
 
 
-def test_gel_block_mass_shifts_kc_by_m_omega_squared_and_the_count_agrees(params, near_vc):
+def test_gel_block_mass_shifts_kc_by_m_omega_squared_and_the_count_agrees(params, near_vc, gel_block):
     """With eta = 0 the crossing frequency is unchanged and Kc grows by m w^2; the argument principle confirms it."""
-    mass = 1050.0 * params.block.height  # gelatin density x block height, kg/m^2
-    heavy = critical_stiffness_details(params, 120e-6, mass=mass)
+    mass, heavy = GEL_MASS, gel_block
     assert heavy.rate == pytest.approx(near_vc.rate, rel=1e-9)
     assert heavy.value - near_vc.value == pytest.approx(mass * near_vc.rate**2, rel=1e-6)
 
     def response(s):
         return interface_response(params, 120e-6, s).z
 
-    rates = SCAN[::4] / params.bonds.bond_time
+    rates = SCAN[::8] / params.bonds.bond_time
     assert unstable_root_count(response, 0.98 * heavy.value, rates, mass) == 2
     assert unstable_root_count(response, 1.02 * heavy.value, rates, mass) == 0
-    growth = hopf_root(params, 120e-6, 0.7, mass=mass)
+    growth = follow_root(response, 1j * heavy.rate, heavy.value, 0.7 * heavy.value, mass)
     assert 12.0 < growth.real < 13.5  # the massless +12.8 1/s, barely changed
 
 
@@ -106,7 +112,7 @@ def test_bad_mass_or_damping_is_one_clear_error(params):
         critical_stiffness(params, 120e-6, damping=math.nan)
 
 
-def test_cli_stability_with_a_block_mass(runner, params, capsys):
+def test_cli_stability_with_a_block_mass(runner, gel_block, capsys):
     """``stickslip stability`` prints the API's Kc with the mass in SI, and refuses a negative mass in one line."""
     import json
 
@@ -115,6 +121,6 @@ def test_cli_stability_with_a_block_mass(runner, params, capsys):
     out = json.loads(run(runner, "stability", "--v0", "120 um/s", "--mass", "10.5 kg/m^2", "--json"))
     row = out["rows"][0]
     assert out["units"]["critical_stiffness"] == "Pa/m" and row["mass"] == 10.5
-    assert row["critical_stiffness"] == pytest.approx(critical_stiffness(params, 120e-6, mass=10.5), rel=1e-12)
-    code, _, err = run_main(capsys, "stability", "--v0", "120 um/s", "--mass", "-1 kg/m^2")
+    assert row["critical_stiffness"] == pytest.approx(gel_block.value, rel=1e-12)
+    code, _, err = run_main(capsys, "stability", "--v0", "120 um/s", "--mass", "-1 kg/m^2")  # refused before any work
     assert code == 2 and err.count("\n") == 1 and "--mass" in err
