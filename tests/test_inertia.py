@@ -124,3 +124,14 @@ def test_cli_stability_with_a_block_mass(runner, gel_block, capsys):
     assert row["critical_stiffness"] == pytest.approx(gel_block.value, rel=1e-12)
     code, _, err = run_main(capsys, "stability", "--v0", "120 um/s", "--mass", "-1 kg/m^2")  # refused before any work
     assert code == 2 and err.count("\n") == 1 and "--mass" in err
+
+
+def test_gel_block_cases_are_rho_h_and_rices_radiation_damping(params):
+    """m = rho h and eta = G/(2 c_s) = sqrt(G rho)/2 for the gel (G = 4 kPa, h = 10 mm, rho = 1050 kg/m^3)."""
+    from stickslip.studies.inertia import gel_block_cases
+
+    cases = {c.label: c for c in gel_block_cases(params, density=1050.0)}
+    assert cases["gel block rho h"].mass == pytest.approx(10.5, rel=1e-12)
+    assert cases["1000 x rho h"].mass == pytest.approx(10500.0, rel=1e-12)
+    assert cases["radiation damping G/(2 c_s)"].damping == pytest.approx(math.sqrt(4000.0 * 1050.0) / 2, rel=1e-12)
+    assert cases["massless (the paper's)"].mass == cases["massless (the paper's)"].damping == 0.0

@@ -47,8 +47,8 @@ def inertia_figure(run: ModelRun) -> ReportFigure:
     gel, gel_kc = rows[1]
     heavy = rows[2][1].value / rows[0][1].value
     paper_kc = rows[0][1]
-    massless = follow_root(response, 1j * paper_kc.rate, paper_kc.value, FACTOR * paper_kc.value, 0.0, 0.0, 4)
-    root = follow_root(response, 1j * gel_kc.rate, gel_kc.value, FACTOR * gel_kc.value, gel.mass, gel.damping, 4)
+    massless = follow_root(response, 1j * paper_kc.rate, paper_kc.value, FACTOR * paper_kc.value, 0.0, 0.0, 2)
+    root = follow_root(response, 1j * gel_kc.rate, gel_kc.value, FACTOR * gel_kc.value, gel.mass, gel.damping, 2)
 
     z = response(1j * w)
     fig = Figure(figsize=(6.8, 4.2))
