@@ -58,18 +58,19 @@ def inertia_figure(run: ModelRun) -> ReportFigure:
         # the stiffness a root at i w needs, K = m w^2 - i eta w - Z(i w): a Hopf point where it is real
         need = block.mass * w * w - 1j * block.damping * w - z
         ax_im.plot(hz, need.imag, color=color, lw=1.2, label=block.label)
-        ax_re.plot(hz, need.real, color=color, lw=1.2, label=f"Kc = {kc.value:.4g} Pa/m")
-        ax_re.plot([kc.rate / (2 * math.pi)], [kc.value], "o", color=color, ms=4)
+        ax_re.plot(hz, need.real, color=color, lw=1.2, label=block.label)
+        ax_re.plot([kc.rate / (2 * math.pi)], [kc.value], "o", color=color, ms=4, label=f"Hopf point, {block.label}")
     ax_im.axhline(0.0, color="0.5", lw=0.6)
     ax_im.set_yscale("symlog", linthresh=1e6, linscale=0.4)
     ax_re.set_yscale("symlog", linthresh=1e6, linscale=0.4)
+    for ax in (ax_im, ax_re):  # decades only: the linear band around 0 would crowd its labels
+        ax.set_yticks([-1e9, -1e7, 0.0, 1e7, 1e9] + ([] if ax is ax_im else [1e11]))
     ax_re.set_xscale("log")
     ax_im.set_ylabel("Im (Pa/m)")
     ax_re.set_ylabel("Re (Pa/m)")
     ax_re.set_xlabel("frequency ω/2π (Hz)")
     ax_im.set_title(f"K = m ω² − iηω − Z(iω) puts a root at iω ({VELOCITY * 1e6:.0f} µm/s)", fontsize=9)
     ax_im.legend(fontsize="x-small")
-    ax_re.legend(fontsize="x-small")
     for ax in (ax_im, ax_re):
         apply_style(ax)
     fig.tight_layout()

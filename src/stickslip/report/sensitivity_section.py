@@ -38,20 +38,23 @@ def sensitivity_figure(run: ModelRun) -> ReportFigure:
     fig = Figure(figsize=(6.8, 3.4))
     ax_region, ax_spread = fig.subplots(1, 2, gridspec_kw={"width_ratios": [1, 1.5]})
     ring = region[1:] + region[1:2]
-    ax_region.plot([p.aging_time * 1e3 for p in ring], [p.aging_velocity * UM for p in ring], "o-", color="C0", ms=3)
+    ax_region.plot([p.aging_time * 1e3 for p in ring], [p.aging_velocity * UM for p in ring], "o-", color="C0", ms=3,
+                   label="95 % boundary")  # fmt: skip
     ax_region.plot(region[0].aging_time * 1e3, region[0].aging_velocity * UM, "k*", ms=9, label="best fit")
     ax_region.set_xlabel("τa (ms)")
     ax_region.set_ylabel("Va (µm/s)")
     ax_region.set_yscale("log")
     ax_region.set_title("95 % region (Δχ² = 5.99)", fontsize=9)
     ax_region.legend(fontsize="small")
-    for k, key in enumerate(SHOWN):
+    for k, (key, (label, _, _)) in enumerate(SHOWN.items()):
         values = np.array([r[key] for r in rows])
-        ax_spread.plot(np.full(values.size - 1, k), 100 * (values[1:] / values[0] - 1), "o", color="C0", ms=3)
+        change = 100 * (values[1:] / values[0] - 1)
+        ax_spread.plot(np.full(values.size - 1, k), change, "o", color="C0", ms=3, label=label)
     ax_spread.axhspan(-100 * TOLERANCE / 2, 100 * TOLERANCE / 2, color="0.9", zorder=0)
     ax_spread.axhline(0.0, color="k", lw=0.8)
     ax_spread.set_xticks(range(len(SHOWN)), [v[0] for v in SHOWN.values()], rotation=30, ha="right", fontsize=8)
     ax_spread.set_ylabel("change from the best fit (%)")
+    ax_spread.set_xlabel("prediction (#)")
     ax_spread.set_title("quasi-static predictions over the region", fontsize=9)
     for ax in (ax_region, ax_spread):
         apply_style(ax)
