@@ -45,13 +45,14 @@ def _register() -> None:
         reproduce_cmd,
         rsf_cmd,
         run_cmd,
+        stability_cmd,
         steady_cmd,
         sweep_cmd,
         transient_cmd,
     )
 
     commands = (params_cmd, steady_cmd, cycle_cmd, transient_cmd, fit_cmd, analyze_cmd, reproduce_cmd)
-    for module in (*commands, run_cmd, rsf_cmd, compare_cmd, sweep_cmd):
+    for module in (*commands, run_cmd, rsf_cmd, compare_cmd, sweep_cmd, stability_cmd):
         module.register(cli)
 
 

@@ -24,14 +24,16 @@ from .computations import ModelRun, computed_values, run_steps
 from .errata import Errata, load_errata
 from .figures import Curve, save_figure_files
 from .html import RenderedFigure, render_report
+from .inertia_section import INERTIA_FIGURES
 from .paper import resolve_errata
 from .report_figures import FIGURE_BUILDERS as PAPER_FIGURES
 from .rsf_reading_section import RSF_READING_FIGURES
+from .sensitivity_section import SENSITIVITY_FIGURES
 from .sweep_section import SWEEP_FIGURES
 from .transient_section import TRANSIENT_FIGURES
 
 FIGURE_BUILDERS = [*PAPER_FIGURES, *SWEEP_FIGURES, *TRANSIENT_FIGURES]
-FIGURE_BUILDERS += RSF_READING_FIGURES
+FIGURE_BUILDERS += [*SENSITIVITY_FIGURES, *RSF_READING_FIGURES, *INERTIA_FIGURES]
 
 #: Called before each step with (description, steps done, total steps), and once more at the end.
 ProgressCallback = Callable[[str, int, int], None]

@@ -22,12 +22,13 @@ negative real axis at -K (oscillation).  Kc is the largest such K.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from functools import lru_cache
 
 import numpy as np
 
-from ..errors import ParameterError
+from ..errors import ModelError, ParameterError
 from ..parameters import Parameters
 from .model import chain_force, log_hazard, steady_population
 
@@ -55,8 +56,10 @@ def _stiffness(extension: np.ndarray, params: Parameters) -> np.ndarray:
     return b.chain_stiffness * (1.0 + y * y) / (d * d)
 
 
-def interface_response(params: Parameters, velocity: float, s: np.ndarray, aging: bool = True) -> Response:
-    """Z(s) of the module docstring at the complex rates ``s`` (1/s)."""
+def interface_response(
+    params: Parameters, velocity: float, s: np.ndarray, aging: bool = True, cell_hazard: float = CELL_HAZARD
+) -> Response:
+    """Z(s) of the module docstring at the complex rates ``s`` (1/s); ``cell_hazard`` sets the age grid."""
     if not (isinstance(velocity, (int, float)) and math.isfinite(velocity) and velocity > 0):
         raise ParameterError(f"velocity: expected a positive sliding velocity in m/s, got {velocity!r}")
     b = params.bonds
@@ -66,7 +69,7 @@ def interface_response(params: Parameters, velocity: float, s: np.ndarray, aging
             f"velocity: {velocity:.3g} m/s is beyond {FASTEST:.0e} × the set's Δl_m/τ ({fastest:.3g} m/s): chains"
             " would reach full extension in a negligible fraction of a bond's life; check the unit"
         )
-    a, w, width, f, fp, r, gv = _cells(params, float(velocity), aging)
+    a, w, width, f, fp, r, gv = _cells(params, float(velocity), aging, cell_hazard)
     birth = (b.site_density - w.sum()) / b.bond_time
     s = np.atleast_1d(np.asarray(s, dtype=complex))
     z = _response_kernel()(s, a, w, width, f, fp, r, gv, b.force_sensitivity, birth * b.bond_time)
@@ -74,10 +77,12 @@ def interface_response(params: Parameters, velocity: float, s: np.ndarray, aging
 
 
 @lru_cache(maxsize=32)
-def _cells(params: Parameters, velocity: float, aging: bool) -> tuple[np.ndarray, ...]:
+def _cells(
+    params: Parameters, velocity: float, aging: bool, cell_hazard: float = CELL_HAZARD
+) -> tuple[np.ndarray, ...]:
     """Steady cohorts at ``velocity`` with force, stiffness, hazard and aging sensitivity (cached)."""
     g = params.aging
-    pop = steady_population(params, velocity, aging, cell_hazard=CELL_HAZARD, rule="midpoint")
+    pop = steady_population(params, velocity, aging, cell_hazard=cell_hazard, rule="midpoint")
     a, w, e = pop.age, pop.weight, pop.extension
     f = chain_force(e, params)
     fp = _stiffness(e, params)
@@ -156,40 +161,110 @@ class CriticalStiffness:
     message: str
 
 
-def critical_stiffness(params: Parameters, velocity: float, aging: bool = True) -> float:
+def _block_terms(mass: float, damping: float) -> tuple[float, float]:
+    """The block's mass per unit area (kg/m^2) and viscous damping (Pa s/m), checked."""
+    for name, value, unit in (("mass", mass, "kg/m^2"), ("damping", damping, "Pa s/m")):
+        if not (isinstance(value, (int, float)) and math.isfinite(value) and value >= 0):
+            raise ParameterError(f"{name}: expected a non-negative finite block {name} in {unit}, got {value!r}")
+    return float(mass), float(damping)
+
+
+def characteristic(
+    params: Parameters,
+    velocity: float,
+    s: np.ndarray,
+    stiffness: float,
+    mass: float = 0.0,
+    damping: float = 0.0,
+    aging: bool = True,
+) -> np.ndarray:
+    """D(s) = m s^2 + eta s + K + Z(s) (Pa/m): its roots are the eigenvalues of the block on the interface.
+
+    ``mass`` is the block's mass per unit area (kg/m^2), ``damping`` a viscous damping of the slider's
+    velocity (Pa s/m, e.g. radiation damping G/(2 c_s)), ``stiffness`` K (Pa/m); docs/extensions.md section 4.
+    """
+    mass, damping = _block_terms(mass, damping)
+    z = interface_response(params, velocity, s, aging)
+    return mass * z.s * z.s + damping * z.s + stiffness + z.z
+
+
+def resolved_frequency(params: Parameters, velocity: float, aging: bool = True) -> float:
+    """Highest angular frequency (1/s) the age cells of Z resolve: one radian across the widest cell.
+
+    Above it the cohort sums alias (Im Z(i w) changes sign at random), which matters once a mass
+    turns a crossing at w into a stiffness m w^2.
+    """
+    _, _, width, *_ = _cells(params, float(velocity), aging)
+    return float(1.0 / width.max())
+
+
+def critical_stiffness(
+    params: Parameters, velocity: float, aging: bool = True, mass: float = 0.0, damping: float = 0.0
+) -> float:
     """Kc (Pa/m): steady sliding at ``velocity`` through a block of stiffness K is linearly stable iff K > Kc.
 
-    Returns 0.0 when steady sliding is stable for every stiffness (never NaN).
-    :func:`critical_stiffness_details` gives the mode and a message.
+    ``mass`` (kg/m^2) and ``damping`` (Pa s/m) add the block's inertia and a viscous damping (default 0:
+    the paper's massless block).  Returns 0.0 when steady sliding is stable for every stiffness (never
+    NaN).  :func:`critical_stiffness_details` gives the mode and a message.
     """
-    return critical_stiffness_details(params, velocity, aging).value
+    return critical_stiffness_details(params, velocity, aging, mass, damping).value
 
 
-def critical_stiffness_details(params: Parameters, velocity: float, aging: bool = True) -> CriticalStiffness:
+def critical_stiffness_details(
+    params: Parameters, velocity: float, aging: bool = True, mass: float = 0.0, damping: float = 0.0
+) -> CriticalStiffness:
     """Kc with the unstable mode (real runaway or oscillation) and its rate."""
+    mass, damping = _block_terms(mass, damping)
     tau = params.bonds.bond_time
-    rates = SCAN / tau
-    real = interface_response(params, velocity, rates, aging).z.real
+
+    def response(s: np.ndarray) -> np.ndarray:
+        return interface_response(params, velocity, s, aging).z
+
+    top = math.inf if mass == 0.0 and damping == 0.0 else resolved_frequency(params, velocity, aging)
+    return critical_from_response(response, SCAN / tau, mass, damping, top)
+
+
+def critical_from_response(
+    response: Callable[[np.ndarray], np.ndarray],
+    rates: np.ndarray,
+    mass: float = 0.0,
+    damping: float = 0.0,
+    top: float = math.inf,
+) -> CriticalStiffness:
+    """Kc for any interface response Z(s) (Pa/m) loaded by a block m s^2 + eta s + K.
+
+    A real root s > 0 exists for K < -(m s^2 + eta s + Z(s)); a root crosses the imaginary axis at i w
+    where eta w + Im Z(i w) = 0, at K = m w^2 - Re Z(i w).  ``rates`` (1/s) is the scan of s and w;
+    crossings above ``top`` (1/s, the resolved frequency) are ignored.
+    """
+    real = response(rates).real + mass * rates * rates + damping * rates
     k_real = float(max(0.0, -real.min()))
     s_real = float(rates[int(np.argmin(real))])
-    z_im = interface_response(params, velocity, 1j * rates, aging).z
+
+    def crossing_terms(w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        z = response(1j * w)
+        return z.imag + damping * w, mass * w * w - z.real  # (Im D(i w), K that puts a root at i w)
+
+    im_d, k_at = crossing_terms(rates)
     k_osc, w_osc = 0.0, 0.0
-    crossing = np.flatnonzero(np.sign(z_im.imag[1:]) != np.sign(z_im.imag[:-1]))
+    crossing = np.flatnonzero(np.sign(im_d[1:]) != np.sign(im_d[:-1]))
     for k in crossing:
-        if z_im[k].real >= 0 and z_im[k + 1].real >= 0:
-            continue  # crosses the positive real axis: no stiffness K > 0 puts a root there
+        if k_at[k] <= 0 and k_at[k + 1] <= 0:
+            continue  # no stiffness K > 0 puts a root there
+        if rates[k + 1] > top:
+            continue
         lo, hi = rates[k], rates[k + 1]
-        zl, zh = z_im[k], z_im[k + 1]
-        for _ in range(30):  # bisection on Im Z(i w) in log w
+        il, kl, kh = im_d[k], k_at[k], k_at[k + 1]
+        for _ in range(30):  # bisection on Im D(i w) in log w
             mid = math.sqrt(lo * hi)
-            zm = interface_response(params, velocity, np.array([1j * mid]), aging).z[0]
-            if np.sign(zm.imag) == np.sign(zl.imag):
-                lo, zl = mid, zm
+            im, km = (float(x[0]) for x in crossing_terms(np.array([mid])))
+            if np.sign(im) == np.sign(il):
+                lo, il, kl = mid, im, km
             else:
-                hi, zh = mid, zm
-        z_cross = 0.5 * (zl + zh)
-        if -z_cross.real > k_osc:
-            k_osc, w_osc = float(-z_cross.real), float(math.sqrt(lo * hi))
+                hi, kh = mid, km
+        k_cross = 0.5 * (kl + kh)
+        if k_cross > k_osc:
+            k_osc, w_osc = float(k_cross), float(math.sqrt(lo * hi))
     if k_real == 0.0 and k_osc == 0.0:
         return CriticalStiffness(0.0, "none", 0.0, "steady sliding is linearly stable for every stiffness")
     if k_real >= k_osc:
@@ -199,3 +274,118 @@ def critical_stiffness_details(params: Parameters, velocity: float, aging: bool 
     return CriticalStiffness(
         k_osc, "oscillatory", w_osc, f"below Kc = {k_osc:.6g} Pa/m oscillations at {w_osc / (2 * math.pi):.4g} Hz grow"
     )
+
+
+def follow_root(
+    response: Callable[[np.ndarray], np.ndarray],
+    start: complex,
+    stiffness_from: float,
+    stiffness_to: float,
+    mass: float = 0.0,
+    damping: float = 0.0,
+    steps: int = 20,
+) -> complex:
+    """The root of m s^2 + eta s + K + Z(s) = 0 that is ``start`` at K = ``stiffness_from``, at ``stiffness_to``.
+
+    Continuation in K (``steps`` equal steps) with Newton's method at each; Z'(s) by a central
+    difference (Z is analytic).  Raises ModelError if Newton does not converge.
+    """
+    s = complex(start)
+    for stiffness in np.linspace(stiffness_from, stiffness_to, steps + 1)[1:]:
+        for _ in range(50):
+            h = 1e-5 * max(abs(s), 1e-12)
+            z = response(np.array([s, s + h, s - h]))
+            d = mass * s * s + damping * s + stiffness + z[0]
+            dd = 2.0 * mass * s + damping + (z[1] - z[2]) / (2.0 * h)
+            step = d / dd
+            s -= step
+            if abs(step) <= 1e-10 * max(abs(s), 1e-12):
+                break
+        else:
+            raise ModelError(
+                f"root of the characteristic equation lost near s = {s:.6g} 1/s at K = {stiffness:.6g} Pa/m"
+            )
+    return s
+
+
+def hopf_root(
+    params: Parameters,
+    velocity: float,
+    factor: float,
+    mass: float = 0.0,
+    damping: float = 0.0,
+    aging: bool = True,
+) -> complex:
+    """The eigenvalue s (1/s) born at the Hopf point, followed to K = ``factor`` x Kc: Re s is its growth rate."""
+    mass, damping = _block_terms(mass, damping)
+    kc = critical_stiffness_details(params, velocity, aging, mass, damping)
+    if kc.mode != "oscillatory":
+        raise ModelError(f"no Hopf point at {velocity:.6g} m/s (mode {kc.mode!r}): {kc.message}")
+
+    def response(s: np.ndarray) -> np.ndarray:
+        return interface_response(params, velocity, s, aging).z
+
+    return follow_root(response, 1j * kc.rate, kc.value, factor * kc.value, mass, damping)
+
+
+def real_growth_rates(
+    params: Parameters,
+    velocity: float,
+    stiffness: float,
+    mass: float = 0.0,
+    damping: float = 0.0,
+    aging: bool = True,
+) -> np.ndarray:
+    """The real positive roots (1/s) of m s^2 + eta s + K + Z(s) = 0 on the scan, ascending: runaway rates.
+
+    Found by a sign change of D on the scan and bracketed to 1e-12; an empty array when none.
+    """
+    from scipy.optimize import brentq
+
+    mass, damping = _block_terms(mass, damping)
+    rates = SCAN / params.bonds.bond_time
+
+    def d(s: float | np.ndarray) -> np.ndarray:
+        return characteristic(params, velocity, np.atleast_1d(s), stiffness, mass, damping, aging).real
+
+    values = d(rates)
+    change = np.flatnonzero(np.sign(values[1:]) != np.sign(values[:-1]))
+    roots = [
+        brentq(lambda x: float(d(x)[0]), rates[k], rates[k + 1], xtol=1e-14 * rates[k], rtol=1e-12) for k in change
+    ]
+    return np.array(roots, dtype=float)
+
+
+def unstable_root_count(
+    response: Callable[[np.ndarray], np.ndarray],
+    stiffness: float,
+    rates: np.ndarray,
+    mass: float = 0.0,
+    damping: float = 0.0,
+) -> int:
+    """Roots of m s^2 + eta s + K + Z(s) in the right half-plane, by the argument principle.
+
+    The winding of D(i w)/(i w + c)^n for w from 0 to the end of ``rates`` (1/s), n the order of the
+    block's polynomial, doubled by the symmetry D(-i w) = conj D(i w); assumes Z has no pole there
+    (the interface under velocity control is stable) and that the scan ends where D(i w) has settled.
+    The scan is refined until the phase moves by less than 0.5 rad between points.
+    """
+    order = 2 if mass > 0 else (1 if damping > 0 else 0)
+    c = float(rates[len(rates) // 2])
+
+    def f(w: np.ndarray) -> np.ndarray:
+        s = 1j * w
+        return (mass * s * s + damping * s + stiffness + response(s)) / (s + c) ** order
+
+    w = np.concatenate([[0.0], np.asarray(rates, dtype=float)])
+    values = f(w)
+    for _ in range(12):
+        jump = np.abs(np.angle(values[1:] / values[:-1]))
+        coarse = np.flatnonzero(jump > 0.5)
+        if coarse.size == 0:
+            break
+        mid = 0.5 * (w[coarse] + w[coarse + 1])
+        w = np.insert(w, coarse + 1, mid)
+        values = np.insert(values, coarse + 1, f(mid))
+    turn = float(np.sum(np.angle(values[1:] / values[:-1])))
+    return round(-turn / math.pi)
