@@ -20,6 +20,7 @@ from .result import Bookkeeping, Snapshot, TransientResult
 
 CONTROLS = ("block", "velocity")
 STARTS = ("empty", "steady")
+REDUCTIONS = ("auto", "off")
 #: the slider counts as stuck below this fraction of the puller velocity (cycle detection, stick chains)
 STICK_FRACTION = 0.01
 #: kernel calls return after this many steps (progress reports, buffer flushes)
@@ -87,6 +88,7 @@ def run_transient(
     snapshot_times: Any = None,
     max_step: float | None = None,
     max_steps: int | None = None,
+    reduction: str = "auto",
 ) -> TransientResult:
     """Solve Eqs 1-5 (history form of Eq 3) through ``protocol``.
 
@@ -116,6 +118,12 @@ def run_transient(
     ``start_velocity`` below Vc is honoured (a stiff block, K > Kc(V), can
     slide steadily there) and the message notes the branch.
 
+    ``reduction="auto"`` replaces the cohorts by the steady population of the
+    current velocity wherever the slider changes pace slowly over the bonds'
+    memory, under an error estimate kept below a tenth of ``rtol``
+    (:mod:`stickslip.transient.reduction`, docs/transient.md section 8);
+    ``reduction="off"`` keeps the cohorts throughout (the reference).
+
     The work is estimated first (:func:`estimate_cost`); a run above
     ``max_steps`` (default :data:`stickslip.numerics.budget.DEFAULT_MAX_STEPS`)
     is refused before it starts, or stopped when it gets there.
@@ -124,6 +132,7 @@ def run_transient(
         raise ParameterError(f"params: expected stickslip Parameters, got {type(params).__name__}")
     _check_choice(control, CONTROLS, "control")
     _check_choice(start, STARTS, "start")
+    _check_choice(reduction, REDUCTIONS, "reduction")
     for flag, name in ((aging, "aging"), (stick_population, "stick_population")):
         if not isinstance(flag, (bool, np.bool_)):
             raise ParameterError(f"{name}: expected True or False, got {flag!r}")
@@ -196,12 +205,21 @@ def run_transient(
     snap_index = 0
     if chains_on:
         events.append(("stick", 0.0, sigma0, 0.0))
+    reducer = None
+    if reduction == "auto":
+        reducer = _Reducer(params, p, functions, control, k_block, float(rtol), aging)
+        if start == "empty":
+            reducer.disturbed(state.x)
     for t0, t1, vp in protocol.pieces():
         while snap_index < len(wanted) and wanted[snap_index] <= t0 + 1e-15:
             snapshots.append(_snapshot(state))
             snap_index += 1
         if control == "velocity":
+            if reducer is not None and vp != state.v:
+                reducer.disturbed(state.x)
             state.v = vp
+        if reducer is not None:
+            reducer.next_try = state.acc[4]
         while state.t < t1 - 1e-12 * max(t1, 1.0):
             if chains_on:
                 # the stuck block: slider fixed, chains of Eq 15 carry sigma = K (P - X)
@@ -258,7 +276,18 @@ def run_transient(
                     vs, vp, state.n, state.xb, state.tb, state.lw, state.x, state.t, p, *_scratch(state)
                 )
                 rows.append(_row(state, params, control, k_block))
+                if reducer is not None:
+                    reducer.loaded_steady(state)
                 continue
+            if reducer is not None and state.acc[4] >= reducer.next_try:
+                glided, sample_index = reducer.attempt(state, t0, t1, vp, times, sample_index, rows)
+                if glided:
+                    while snap_index < len(wanted) and state.t + 1e-15 >= wanted[snap_index] < t1:
+                        snapshots.append(_snapshot(state))
+                        snap_index += 1
+                    if progress is not None:
+                        progress(min(1.0, state.t / duration))
+                    continue
             if control == "block":
                 state.v = slider_velocity(
                     state.v, vp, state.n, state.xb, state.tb, state.lw, state.x, state.t, p, *_scratch(state)
@@ -271,7 +300,7 @@ def run_transient(
             status, t, x, v, h, n, sample_index, count = advance(
                 state.t, t1, state.x, state.v, state.h, puller0, vp, t0, 1 if control == "block" else 0,
                 state.n, state.xb, state.tb, state.lw, lw_new, rate0, lc, aa, w1, state.acc, p, float(rtol), h_max,
-                times, sample_index, out, CHUNK, stick_v, max(1, min(CHUNK, budget + 1 - int(state.acc[4]))),
+                times, sample_index, out, CHUNK, stick_v, _chunk(state, budget, reducer),
             )  # fmt: skip
             state.t, state.x, state.v, state.h, state.n = float(t), float(x), float(v), float(h), int(n)
             state.puller = puller0 + vp * (state.t - t0) if control == "block" else state.x
@@ -298,6 +327,135 @@ def run_transient(
     return _finish(
         rows, chain_rows, events, snapshots, state, params, protocol, control, k_block, int(state.acc[4]), note=note
     )
+
+
+def _chunk(state: _State, budget: int, reducer: _Reducer | None) -> int:
+    """Steps the kernel may take in this call: the budget, and the next look for a quasi-steady stretch."""
+    steps = min(CHUNK, budget + 1 - int(state.acc[4]))
+    if reducer is not None:
+        steps = min(steps, int(reducer.next_try - state.acc[4]) if reducer.next_try > state.acc[4] else steps)
+    return max(1, steps)
+
+
+class _Reducer:
+    """Switches between the cohorts and the quasi-steady reduction (transient/reduction.py)."""
+
+    FIRST_LOOK = 32  # cohort steps between looks for a quasi-steady stretch, doubled after each miss
+    LAST_LOOK = 4096
+
+    def __init__(
+        self, params: Parameters, p: np.ndarray, functions: dict, control: str, k_block: float, rtol: float, aging: bool
+    ) -> None:
+        self.params, self.p, self.functions = params, p, functions
+        self.block = control == "block"
+        self.k_block, self.rtol, self.aging = k_block, rtol, aging
+        self.disturbed_at: float | None = None
+        self.next_try = 0.0
+        self.interval = self.FIRST_LOOK
+
+    def disturbed(self, x: float) -> None:
+        """The population is out of balance from here: no reduction before every bond born earlier is gone."""
+        self.disturbed_at = x
+        self.interval = self.FIRST_LOOK
+
+    def loaded_steady(self, state: _State) -> None:
+        self.disturbed_at = None
+        self.interval = self.FIRST_LOOK
+        self.next_try = state.acc[4]
+
+    def _miss(self, state: _State) -> tuple[bool, None]:
+        self.next_try = state.acc[4] + self.interval
+        self.interval = min(2 * self.interval, self.LAST_LOOK)
+        return False, None
+
+    def attempt(
+        self, state: _State, t0: float, t1: float, vp: float, times: np.ndarray, sample_index: int, rows: list
+    ) -> tuple[bool, int]:
+        glide = self._glide(state, t0, t1, vp, times, sample_index)
+        if glide is None:
+            self._miss(state)
+            return False, sample_index
+        rows.extend(_kernel_rows(glide.rows, self.k_block, "block" if self.block else "velocity"))
+        x_entry, t_entry = state.x, state.t
+        state.t = glide.t
+        state.v = glide.v
+        if self.block:
+            state.puller = state.puller + vp * (glide.t - t_entry)
+            state.x = state.puller - glide.sigma / self.k_block
+        else:
+            state.x = x_entry + vp * (glide.t - t_entry)
+            state.puller = state.x
+        # the cohorts again, rebuilt from the steady population (balanced against the block)
+        state.load(_steady_cohorts(self.params, glide.v, self.aging))
+        if self.block:
+            weights = np.exp(state.lw[: state.n])
+            state.x = self.functions["_balance_weights"](state.x, state.puller, state.n, state.xb, weights, self.p)
+        state.h = 1e-2 * self.params.bonds.bond_time
+        self.disturbed_at = None
+        if glide.done:
+            self.next_try = state.acc[4]
+        else:  # the reduction's error grew past its share: cohorts from here, and a look now and then
+            self.interval = self.FIRST_LOOK
+            self._miss(state)
+        return True, glide.sample_index
+
+    def _glide(self, state: _State, t0: float, t1: float, vp: float, times: np.ndarray, sample_index: int):  # type: ignore[no-untyped-def]
+        from ..model.steady import steady_state
+        from . import reduction as R
+
+        b = self.params.bonds
+        v = state.v if self.block else vp
+        if state.n == 0 or not v > 0 or not vp >= 0 or (not self.block and not vp > 0):
+            return None
+        if self.disturbed_at is not None and abs(state.x - self.disturbed_at) < b.max_extension:
+            return None
+        nn, ss, _k, uu = self.functions["_sums"](state.n, state.xb, state.lw, state.x, self.p)
+        sigma = self.k_block * (state.puller - state.x) if self.block else ss
+        tol = R.THETA * self.rtol
+        common = dict(t=state.t, t_end=t1, k_block=self.k_block, block=self.block, acc=state.acc,
+                      sample_times=times, sample_index=sample_index)  # fmt: skip
+        if vp > 0:
+            ref = steady_state(self.params, vp, self.aging)
+            s_p, n_p = float(ref.stress), float(ref.bonded_fraction) * b.site_density
+            if (
+                float(ref.stress_slope) > 0
+                and abs(sigma - s_p) <= tol * abs(sigma)
+                and abs(nn - n_p) <= tol * b.site_density
+            ):
+                return R.steady_glide(self.params, x=state.x, vp=vp, sigma=sigma, bonded=nn, energy=uu, **common)
+        if not self.block:
+            return None
+        ref = steady_state(self.params, v, self.aging)
+        if not (float(ref.stress_slope) > 0 and abs(sigma - float(ref.stress)) <= 1e-2 * abs(sigma)):
+            return None
+        branch = R.rising_branch(self.params, self.aging, v)
+        if branch is None:
+            return None
+        lo = max(branch[0] * (1 + 1e-3), min(v, vp) * 0.99 if vp > 0 else 1e-2 * v)
+        hi = min(branch[1] * (1 - 1e-3), max(v, vp) * 1.01)
+        if not lo < v < hi:
+            return None
+        m = R.manifold_for(self.params, self.aging, lo, hi, min(branch[1] * (1 - 1e-3), 3.0 * hi), self.rtol)
+        if m is None:
+            return None
+        v_entry = R.entry_velocity(m, sigma, v, vp, self.k_block, self.rtol)
+        if v_entry is None or abs(nn - float(m.bonded(math.log(v_entry))) * b.site_density) > tol * b.site_density:
+            return None
+        return R.glide(m, self.params, v=v_entry, x=state.x, puller=state.puller, vp=vp, rtol=self.rtol, bonded=nn,
+                       energy=uu, **common)  # fmt: skip
+
+
+_STEADY_COHORTS: dict[tuple[Parameters, float, bool], Population] = {}
+
+
+def _steady_cohorts(params: Parameters, velocity: float, aging: bool) -> Population:
+    """steady_population, remembered (a steady run starts and ends on the same one)."""
+    key = (params, float(velocity), bool(aging))
+    if key not in _STEADY_COHORTS:
+        if len(_STEADY_COHORTS) > 16:
+            _STEADY_COHORTS.clear()
+        _STEADY_COHORTS[key] = steady_population(params, velocity, aging)
+    return _STEADY_COHORTS[key]
 
 
 def _force(extension: np.ndarray, params: Parameters) -> np.ndarray:
