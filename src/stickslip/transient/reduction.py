@@ -41,7 +41,9 @@ ROWS = 64
 #: Chebyshev degrees: the steady stress and bonded fraction (raised until the check passes), the lag C
 DEGREE = 24
 MAX_DEGREE = 96
-LAG_DEGREE = 6
+LAG_DEGREE = 16
+#: the lag's interpolant must hold at the probes to this share of |C| (or of S' tau)
+LAG_SHARE = 0.02
 #: the steady stress interpolant must agree with the steady solver to this share of rtol between its nodes
 TABLE_SHARE = 1e-3
 
@@ -56,12 +58,25 @@ class Manifold:
     dstress: cheb.Chebyshev  # dS/dlnV
     d2stress: cheb.Chebyshev
     bonded: cheb.Chebyshev  # N/N0
-    lag_slope: cheb.Chebyshev  # C(V) S'(V), smooth through the range (C alone diverges at the fold)
-    d_lag_slope: cheb.Chebyshev
+    lag: cheb.Chebyshev  # C(ln V), Pa s^2/m
+    dlag: cheb.Chebyshev  # dC/dlnV
     energy: cheb.Chebyshev  # bond energy of the steady population (J/m^2)
 
     def covers(self, lo: float, hi: float) -> bool:
         return self.v_lo <= lo and hi <= self.v_hi
+
+    def rising(self, v: float) -> tuple[float, float] | None:
+        """The stretch of the table around v where S' > 0 (between the curve's extrema), narrowed by 1e-3."""
+        x = math.log(v)
+        if not (self.dstress(x) > 0 and self.v_lo < v < self.v_hi):
+            return None
+        roots = self.dstress.roots()
+        roots = roots[np.abs(roots.imag) < 1e-12].real
+        below = roots[roots < x]
+        above = roots[roots > x]
+        lo = max(self.v_lo, math.exp(below.max()) * (1 + 1e-3)) if below.size else self.v_lo
+        hi = min(self.v_hi, math.exp(above.min()) * (1 - 1e-3)) if above.size else self.v_hi
+        return (lo, hi) if lo < v < hi else None
 
     def values(self, v: float) -> tuple[float, float, float, float, float]:
         """(S, S', S'', C, C') at velocity v (SI)."""
@@ -71,26 +86,17 @@ class Manifold:
         sxx = float(self.d2stress(x))
         slope = sx / v
         curv = (sxx - sx) / (v * v)
-        q = float(self.lag_slope(x))
-        qv = float(self.d_lag_slope(x)) / v
-        lag = q / slope
-        dlag = (qv - lag * curv) / slope
-        return s, slope, curv, lag, dlag
+        return s, slope, curv, float(self.lag(x)), float(self.dlag(x)) / v
 
 
 def _lag(params: Parameters, velocity: float, aging: bool) -> tuple[float, float]:
     """(C, bond energy) at ``velocity``: C = d/ds[Z(s)/s] at s = 0 by a Richardson central difference."""
-    from .model import chain_force, log_hazard, steady_population
-    from .stability import _response_kernel, _stiffness
+    from .model import pack_parameters
+    from .stability import _response_kernel
 
-    b, g = params.bonds, params.aging
-    pop = steady_population(params, velocity, aging, rule="midpoint")
-    a, w, e = pop.age, pop.weight, pop.extension
-    f = chain_force(e, params)
-    fp = _stiffness(e, params)
-    r = np.exp(np.minimum(log_hazard(e, a, velocity, params, aging), 700.0))
-    gv = a * math.exp(-velocity / g.aging_velocity) / (g.aging_time * g.aging_velocity) if aging else np.zeros_like(a)
-    width = _tiling(a)  # cells tiling [0, a_end] around the midpoints
+    b = params.bonds
+    p = pack_parameters(params, aging, 1.0)
+    a, w, width, f, fp, r, gv, energy = _steady_cells()(velocity, p, CELL_HAZARD)
     birth_tau = b.site_density - w.sum()
     eps = 1e-2 * velocity / b.max_extension  # far below the population's slowest rate V/dl_m
     s = np.array([-eps, eps, -2 * eps, 2 * eps], dtype=complex)
@@ -98,18 +104,105 @@ def _lag(params: Parameters, velocity: float, aging: bool) -> tuple[float, float
     q = z / s.real
     c1 = (q[1] - q[0]) / (2 * eps)
     c2 = (q[3] - q[2]) / (4 * eps)
-    y = e / b.max_extension
-    energy = float(w @ (-0.5 * b.chain_stiffness * b.max_extension**2 * np.log1p(-y * y)))
     return (4 * c1 - c2) / 3, energy
 
 
-def _tiling(mid: np.ndarray) -> np.ndarray:
-    width = np.empty_like(mid)
-    left = 0.0
-    for k, m in enumerate(mid):
-        width[k] = 2.0 * (m - left)
-        left += width[k]
-    return width
+#: age cells for C: the steady population's midpoint cells (model.steady_population, rule="midpoint")
+CELL_HAZARD = 0.05
+_CELLS: list = []
+
+
+def _steady_cells():  # type: ignore[no-untyped-def]
+    """model.steady_population's midpoint cells with force, stiffness, hazard and aging sensitivity (numba)."""
+    if not _CELLS:
+        from numba import njit
+
+        g = globals()
+        for name in ("_force", "_stiffness", "_energy", "_log_rate"):
+            g[name] = njit(cache=True)(g[name])
+        _CELLS.append(njit(cache=True)(_cells))
+    return _CELLS[0]
+
+
+def _force(e, m, dlm):  # type: ignore[no-untyped-def]
+    y = e / dlm
+    return m * e / (1.0 - y * y)
+
+
+def _stiffness(e, m, dlm):  # type: ignore[no-untyped-def]
+    y = e / dlm
+    d = 1.0 - y * y
+    return m * (1.0 + y * y) / (d * d)
+
+
+def _energy(e, m, dlm):  # type: ignore[no-untyped-def]
+    y = e / dlm
+    return -0.5 * m * dlm * dlm * math.log1p(-y * y)
+
+
+def _log_rate(age, v, slope, p):  # type: ignore[no-untyped-def]
+    """ln r of a steady bond of this age (capped at 700), kernel.P_* layout of p."""
+    force = _force(v * age, p[3], p[4])
+    return min(p[0] + p[2] * force - age * slope, 700.0)
+
+
+def _cells(v, p, cell_hazard):  # type: ignore[no-untyped-def]
+    # layout of kernel.P_*: 0 ln(u0/tau), 1 tau, 2 lambda/kT, 3 M, 4 dl_m, 5 1/tau_a, 6 V_a, 7 N0, 8 K, 9 aging
+    dlm, m = p[4], p[3]
+    slope = p[5] * math.exp(-v / p[6]) if p[9] > 0.0 else 0.0
+    t_max = dlm / v
+    widest = t_max / 1000.0
+    edges = [0.0]
+    cum = [0.0]
+    a = 0.0
+    big_h = 0.0
+    while big_h < 45.0 and a < t_max:
+        lr = _log_rate(a, v, slope, p)
+        step = widest if lr < -700.0 else min(widest, cell_hazard / math.exp(lr))
+        step = min(step, 0.05 * (t_max - a))
+        if step <= 1e-15 * a:
+            break
+        while True:  # as model.steady_population: shrink a cell over which the hazard climbs
+            r0 = math.exp(_log_rate(a, v, slope, p))
+            r1 = math.exp(_log_rate(a + 0.5 * step, v, slope, p))
+            r2 = math.exp(_log_rate(a + step, v, slope, p))
+            increment = step * (r0 + 4.0 * r1 + r2) / 6.0
+            if (increment <= 2.0 * cell_hazard and r2 <= 2.0 * r0 + 1e-300) or increment <= 0.1 * cell_hazard:
+                break
+            if step <= 1e-12 * max(a, t_max):
+                break
+            step *= 0.25
+        big_h += increment
+        a += step
+        edges.append(a)
+        cum.append(big_h)
+    n = len(edges) - 1
+    mid = np.empty(n)
+    width = np.empty(n)
+    w = np.empty(n)
+    total = 0.0
+    for k in range(n):
+        mid[k] = 0.5 * (edges[k] + edges[k + 1])
+        width[k] = edges[k + 1] - edges[k]
+        dh = cum[k + 1] - cum[k]
+        s0 = math.exp(-cum[k])
+        w[k] = (s0 * -math.expm1(-dh) / dh if dh > 1e-12 else s0 * (1.0 - 0.5 * dh)) * width[k]
+        total += w[k]
+    birth = p[7] / (p[1] + total)
+    f = np.empty(n)
+    fp = np.empty(n)
+    r = np.empty(n)
+    gv = np.empty(n)
+    energy = 0.0
+    for k in range(n):
+        w[k] *= birth
+        e = v * mid[k]
+        f[k] = _force(e, m, dlm)
+        fp[k] = _stiffness(e, m, dlm)
+        r[k] = math.exp(_log_rate(mid[k], v, slope, p))
+        gv[k] = mid[k] * slope / p[6]
+        energy += w[k] * _energy(e, m, dlm)
+    return mid, w, width, f, fp, r, gv, energy
 
 
 def build_manifold(params: Parameters, aging: bool, v_lo: float, v_hi: float, rtol: float) -> Manifold | None:
@@ -136,12 +229,28 @@ def build_manifold(params: Parameters, aging: bool, v_lo: float, v_hi: float, rt
         if degree >= MAX_DEGREE:
             return None
         degree *= 2
-    lag_nodes = 0.5 * (domain[0] + domain[1]) + 0.5 * (domain[1] - domain[0]) * cheb.chebpts1(LAG_DEGREE + 1)
-    lags, energies = zip(*(_lag(params, float(math.exp(xk)), aging) for xk in lag_nodes), strict=True)
-    slope_nodes = stress.deriv()(lag_nodes) / np.exp(lag_nodes)
-    lag_slope = cheb.Chebyshev.fit(lag_nodes, np.array(lags) * slope_nodes, LAG_DEGREE, domain=domain)
-    energy = cheb.Chebyshev.fit(lag_nodes, np.array(energies), LAG_DEGREE, domain=domain)
-    return Manifold(v_lo, v_hi, stress, stress.deriv(), stress.deriv(2), bonded, lag_slope, lag_slope.deriv(), energy)
+    # the lag C varies over orders of magnitude towards the fold: its degree is raised until the fit holds at
+    # the probes to LAG_SHARE of |C|, or of S' tau (a lag shorter than a bond's life changes nothing)
+    lag_degree = LAG_DEGREE
+    probe_c, _u = _lags(params, aging, probe)
+    floor = np.abs(stress.deriv()(probe) / np.exp(probe)) * params.bonds.bond_time  # lags below a bond's life
+    while True:
+        x_c = 0.5 * (domain[0] + domain[1]) + 0.5 * (domain[1] - domain[0]) * cheb.chebpts1(lag_degree + 1)
+        c_nodes, u_nodes = _lags(params, aging, x_c)
+        lag = cheb.Chebyshev.fit(x_c, c_nodes, lag_degree, domain=domain)
+        if np.all(np.abs(lag(probe) - probe_c) <= LAG_SHARE * (np.abs(probe_c) + floor)):
+            break
+        if lag_degree >= MAX_DEGREE:
+            return None
+        lag_degree *= 2
+    energy = cheb.Chebyshev.fit(x_c, u_nodes, lag_degree, domain=domain)
+    return Manifold(v_lo, v_hi, stress, stress.deriv(), stress.deriv(2), bonded, lag, lag.deriv(), energy)
+
+
+def _lags(params: Parameters, aging: bool, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """C and the steady bond energy at velocities e^x."""
+    pairs = [_lag(params, float(math.exp(xk)), aging) for xk in x]
+    return np.array([c for c, _u in pairs]), np.array([u for _c, u in pairs])
 
 
 def effective(m: Manifold, v: float, vp: float, k_block: float) -> tuple[float, float, float]:
@@ -158,8 +267,10 @@ def effective(m: Manifold, v: float, vp: float, k_block: float) -> tuple[float, 
 
 def entry_velocity(m: Manifold, sigma: float, v: float, vp: float, k_block: float, rtol: float) -> float | None:
     """The velocity on the slow manifold carrying ``sigma`` near ``v``, if the state lies on it within tolerance."""
-    if not (m.v_lo < v < m.v_hi):
+    branch = m.rising(v)
+    if branch is None:
         return None
+    lo, hi = branch
     s_eff, a1, neglected = effective(m, v, vp, k_block)
     tol = THETA * rtol * abs(sigma)
     if not (math.isfinite(a1) and abs(s_eff - sigma) <= tol and neglected <= 0.5 * tol):
@@ -169,7 +280,7 @@ def entry_velocity(m: Manifold, sigma: float, v: float, vp: float, k_block: floa
         slope = m.values(v)[1]
         step = (s_eff - sigma) / slope
         v -= step
-        if not (m.v_lo < v < m.v_hi):
+        if not (lo < v < hi):
             return None
         if abs(step) <= 1e-14 * v:
             return v
@@ -217,9 +328,10 @@ def glide(
     b = params.bonds
     n0, tau = b.site_density, b.bond_time
     tol = THETA * rtol
+    lo, hi = m.rising(v) or (m.v_lo, m.v_hi)
 
     def rhs(_t: float, y: np.ndarray) -> np.ndarray:
-        vv = min(max(y[0], m.v_lo), m.v_hi)  # a trial stage may overshoot; the events end the stretch at the edges
+        vv = min(max(y[0], lo), hi)  # a trial stage may overshoot; the events end the stretch at the edges
         if block:
             s_eff, a1, _n = effective(m, vv, vp, k_block)
         else:
@@ -228,11 +340,11 @@ def glide(
         return np.array([a1, born, s_eff * vp, s_eff * vv])
 
     def off_manifold(_t: float, y: np.ndarray) -> float:
-        s_eff, _a, neglected = effective(m, min(max(y[0], m.v_lo), m.v_hi), vp, k_block)
+        s_eff, _a, neglected = effective(m, min(max(y[0], lo), hi), vp, k_block)
         return neglected - tol * abs(s_eff)
 
     def off_table(_t: float, y: np.ndarray) -> float:
-        return min(y[0] / m.v_lo - 1.0 - 1e-6, 1.0 - 1e-6 - y[0] / m.v_hi)
+        return min(y[0] / lo - 1.0 - 1e-6, 1.0 - 1e-6 - y[0] / hi)
 
     off_manifold.terminal = True  # type: ignore[attr-defined]
     off_table.terminal = True  # type: ignore[attr-defined]
@@ -300,28 +412,6 @@ def manifold_for(
         built.append((m, rtol))
         del built[:-8]
     return m
-
-
-_EXTREMA: dict[tuple[Parameters, bool], tuple[float, ...]] = {}
-
-
-def rising_branch(params: Parameters, aging: bool, v: float) -> tuple[float, float] | None:
-    """(lo, hi): the stretch of the steady curve around v between its extrema (S' changes sign at each)."""
-    from ..errors import ModelError, ParameterError
-    from ..model.critical import find_extrema
-
-    key = (params, aging)
-    if key not in _EXTREMA:
-        try:
-            _EXTREMA[key] = tuple(float(e.velocity) for e in find_extrema(params, aging=aging))
-        except (ModelError, ParameterError):
-            _EXTREMA[key] = (math.nan,)
-    ext = _EXTREMA[key]
-    if any(not math.isfinite(e) for e in ext):
-        return None
-    lo = max([e for e in ext if e < v], default=0.0)
-    hi = min([e for e in ext if e > v], default=math.inf)
-    return lo, hi
 
 
 def steady_glide(

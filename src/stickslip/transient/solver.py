@@ -428,14 +428,9 @@ class _Reducer:
         ref = steady_state(self.params, v, self.aging)
         if not (float(ref.stress_slope) > 0 and abs(sigma - float(ref.stress)) <= 1e-2 * abs(sigma)):
             return None
-        branch = R.rising_branch(self.params, self.aging, v)
-        if branch is None:
-            return None
-        lo = max(branch[0] * (1 + 1e-3), min(v, vp) * 0.99 if vp > 0 else 1e-2 * v)
-        hi = min(branch[1] * (1 - 1e-3), max(v, vp) * 1.01)
-        if not lo < v < hi:
-            return None
-        m = R.manifold_for(self.params, self.aging, lo, hi, min(branch[1] * (1 - 1e-3), 3.0 * hi), self.rtol)
+        lo = min(v, vp) * 0.99 if vp > 0 else 1e-2 * v
+        hi = max(v, vp) * 1.01
+        m = R.manifold_for(self.params, self.aging, lo, hi, 3.0 * hi, self.rtol)
         if m is None:
             return None
         v_entry = R.entry_velocity(m, sigma, v, vp, self.k_block, self.rtol)
