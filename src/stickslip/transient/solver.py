@@ -15,7 +15,7 @@ from ..numerics.budget import CostEstimate, check_max_steps, over_budget, requir
 from ..parameters import Parameters
 from ..protocols import Protocol
 from . import kernel as K
-from .model import Population, pack_parameters, steady_population, stick_chains
+from .model import Population, pack_parameters, stick_chains
 from .result import Bookkeeping, Snapshot, TransientResult
 
 CONTROLS = ("block", "velocity")
@@ -181,7 +181,7 @@ def run_transient(
         v_start = v_first if start_velocity is None else float(start_velocity)
         if not v_start > 0:
             raise ParameterError(f"start velocity: a steady start needs a positive sliding velocity, got {v_start!r}")
-        pop = steady_population(params, v_start, aging)
+        pop = _steady_cohorts(params, v_start, aging)
         state.load(pop)
         state.v = v_start
     elif start_velocity is not None:
@@ -264,7 +264,7 @@ def run_transient(
                         " steady curve's reach: the paper's jump has no landing point",
                     )
                 events.append(("slip", state.t, sigma_s, vs))
-                pop = steady_population(params, vs, aging)
+                pop = _steady_cohorts(params, vs, aging)
                 state.load(pop)
                 state.v = vs
                 state.h = b.bond_time * 1e-3
@@ -352,6 +352,17 @@ class _Reducer:
         self.disturbed_at: float | None = None
         self.next_try = 0.0
         self.interval = self.FIRST_LOOK
+        self.steady: dict[float, tuple[float, float, float]] = {}
+
+    def _steady_at(self, v: float) -> tuple[float, float, float]:
+        """(S, N, S') of the steady solver at v, remembered for the run."""
+        from ..model.steady import steady_state
+
+        if v not in self.steady:
+            ref = steady_state(self.params, v, self.aging)
+            n0 = self.params.bonds.site_density
+            self.steady[v] = (float(ref.stress), float(ref.bonded_fraction) * n0, float(ref.stress_slope))
+        return self.steady[v]
 
     def disturbed(self, x: float) -> None:
         """The population is out of balance from here: no reduction before every bond born earlier is gone."""
@@ -415,24 +426,21 @@ class _Reducer:
         common = dict(t=state.t, t_end=t1, k_block=self.k_block, block=self.block, acc=state.acc,
                       sample_times=times, sample_index=sample_index)  # fmt: skip
         if vp > 0:
-            ref = steady_state(self.params, vp, self.aging)
-            s_p, n_p = float(ref.stress), float(ref.bonded_fraction) * b.site_density
-            if (
-                float(ref.stress_slope) > 0
-                and abs(sigma - s_p) <= tol * abs(sigma)
-                and abs(nn - n_p) <= tol * b.site_density
-            ):
+            s_p, n_p, slope_p = self._steady_at(vp)
+            if slope_p > 0 and abs(sigma - s_p) <= tol * abs(sigma) and abs(nn - n_p) <= tol * b.site_density:
                 return R.steady_glide(self.params, x=state.x, vp=vp, sigma=sigma, bonded=nn, energy=uu, **common)
         if not self.block:
             return None
-        ref = steady_state(self.params, v, self.aging)
-        if not (float(ref.stress_slope) > 0 and abs(sigma - float(ref.stress)) <= 1e-2 * abs(sigma)):
-            return None
         lo = min(v, vp) * 0.99 if vp > 0 else 1e-2 * v
         hi = max(v, vp) * 1.01
-        m = R.manifold_for(self.params, self.aging, lo, hi, 3.0 * hi, self.rtol)
-        if m is None:
-            return None
+        m = R.manifold_for(self.params, self.aging, lo, hi, 3.0 * hi, self.rtol, build=False)
+        if m is None:  # worth building only where the state is near the steady curve's rising branch
+            ref = steady_state(self.params, v, self.aging)
+            if not (float(ref.stress_slope) > 0 and abs(sigma - float(ref.stress)) <= 1e-2 * abs(sigma)):
+                return None
+            m = R.manifold_for(self.params, self.aging, lo, hi, 3.0 * hi, self.rtol)
+            if m is None:
+                return None
         v_entry = R.entry_velocity(m, sigma, v, vp, self.k_block, self.rtol)
         if v_entry is None or abs(nn - float(m.bonded(math.log(v_entry))) * b.site_density) > tol * b.site_density:
             return None
@@ -449,7 +457,9 @@ def _steady_cohorts(params: Parameters, velocity: float, aging: bool) -> Populat
     if key not in _STEADY_COHORTS:
         if len(_STEADY_COHORTS) > 16:
             _STEADY_COHORTS.clear()
-        _STEADY_COHORTS[key] = steady_population(params, velocity, aging)
+        from .reduction import steady_cohorts
+
+        _STEADY_COHORTS[key] = steady_cohorts(params, velocity, aging)
     return _STEADY_COHORTS[key]
 
 
@@ -614,13 +624,13 @@ def _steady_start_below_vc(
     params: Parameters, protocol: Protocol, start_velocity: float | None
 ) -> tuple[float | None, str]:
     """(start velocity, note): below Vc the default steady start moves to the stable side of the critical point."""
-    from ..model.critical import critical_point
+    from ..model.jump import cached_critical_point, steady_curve_key
 
     v_start = protocol.initial_velocity if start_velocity is None else start_velocity
     if not v_start > 0:
         return start_velocity, ""
     try:
-        cp = critical_point(params)
+        cp = cached_critical_point(steady_curve_key(params))  # once per steady curve (the jump asks for it too)
     except (ModelError, ParameterError):
         return start_velocity, ""
     if not cp.exists or cp.velocity is None or v_start >= cp.velocity:
