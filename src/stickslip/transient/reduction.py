@@ -35,7 +35,7 @@ from numpy.polynomial import chebyshev as cheb
 from ..parameters import Parameters
 
 #: share of the local tolerance the reduction may change the stress by (entry and stay)
-THETA = 0.1
+THETA = 0.3
 #: fewest trace rows a reduced stretch writes (the classifier reads the stress of the trace)
 ROWS = 64
 #: Chebyshev degrees: the steady stress and bonded fraction (raised until the check passes), the lag C
@@ -472,8 +472,10 @@ def steady_glide(
     t: float,
     t_end: float,
     x: float,
+    puller: float,
     vp: float,
     sigma: float,
+    steady: tuple[float, float, float],
     bonded: float,
     energy: float,
     k_block: float,
@@ -482,26 +484,46 @@ def steady_glide(
     sample_times: np.ndarray,
     sample_index: int,
 ) -> Glide:
-    """Steady sliding at vp from t to t_end: the population is the steady one, sigma and N constant."""
+    """Steady sliding at vp from t to t_end, the population the steady one (S, N of the steady solver).
+
+    ``steady`` = (S, N, S') at vp.  Under velocity control sigma = S(vp) (the cohorts' limit; they are within
+    THETA rtol of it at entry).  Through the block the rest of the cohorts' stress, d = sigma - S, relaxes
+    quasi-statically, d' = -(K/S') d (the slider at vp + d/S'), exact to first order in d.
+    """
     b = params.bonds
+    s_ss, n_ss, slope = steady
     times = np.linspace(t, t_end, ROWS + 1)[1:]
     if sample_times.size:
         inside = (sample_times > t) & (sample_times <= t_end + 1e-12 * max(t_end, 1.0))
         times = sample_times[inside]
         sample_index = int(np.searchsorted(sample_times, t_end + 1e-12 * max(t_end, 1.0), side="right"))
+    birth = (b.site_density - n_ss) / b.bond_time
+    rate = k_block / slope if block else 0.0
+    d0 = sigma - s_ss if block else 0.0
+
+    def state(dt: np.ndarray) -> tuple[np.ndarray, ...]:
+        decay = np.exp(-rate * dt)
+        stress = s_ss + d0 * decay
+        velocity = vp + d0 * decay / slope if block else vp + 0.0 * dt
+        pull = puller + vp * dt
+        pos = pull - stress / k_block if block else x + vp * dt
+        # the integral of d over the stretch, with its limit d0 dt where the relaxation is slow
+        shed = d0 * dt if rate * np.max(np.atleast_1d(dt), initial=0.0) < 1e-8 else d0 * -np.expm1(-rate * dt) / rate
+        work = vp * (s_ss * dt + shed)
+        dissipation = s_ss * vp * dt + (vp + s_ss / slope) * shed if block else work
+        return stress, velocity, np.where(block, pull, pos), pos, work, dissipation
+
     dt = times - t
-    birth = (b.site_density - bonded) / b.bond_time
-    pos = x + vp * dt
-    pull = pos + sigma / k_block if block else pos
+    stress, velocity, pull, pos, work, dissipation = state(dt)
     one = np.ones_like(times)
     rows = np.c_[
-        times, sigma * one, bonded * one, vp * one, pos, pull, acc[0] + birth * dt, acc[1] + birth * dt,
-        acc[2] + sigma * vp * dt, acc[3] + sigma * vp * dt, energy * one,
+        times, stress, n_ss * one, velocity, pos, pull, acc[0] + birth * dt, acc[1] + birth * dt - (n_ss - bonded),
+        acc[2] + work, acc[3] + dissipation, energy * one,
     ]  # fmt: skip
-    span = t_end - t
-    acc[0] += birth * span
-    acc[1] += birth * span
-    acc[2] += sigma * vp * span
-    acc[3] += sigma * vp * span
+    end = state(np.array([t_end - t]))
+    acc[0] += birth * (t_end - t)
+    acc[1] += birth * (t_end - t) - (n_ss - bonded)
+    acc[2] += float(end[4][0])
+    acc[3] += float(end[5][0])
     acc[4] += 1
-    return Glide(t_end, vp, sigma, rows, True, sample_index)
+    return Glide(t_end, float(end[1][0]), float(end[0][0]), rows, True, sample_index)

@@ -208,8 +208,7 @@ def run_transient(
     reducer = None
     if reduction == "auto":
         reducer = _Reducer(params, p, functions, control, k_block, float(rtol), aging)
-        if start == "empty":
-            reducer.disturbed(state.x)
+        reducer.disturbed(state.x)  # from empty, or a steady start: the cohorts carry every bond over dl_m first
     for t0, t1, vp in protocol.pieces():
         while snap_index < len(wanted) and wanted[snap_index] <= t0 + 1e-15:
             snapshots.append(_snapshot(state))
@@ -370,8 +369,8 @@ class _Reducer:
         self.interval = self.FIRST_LOOK
 
     def loaded_steady(self, state: _State) -> None:
-        self.disturbed_at = None
-        self.interval = self.FIRST_LOOK
+        """A steady population was put in (a steady start, the jump): the cohorts first carry it over dl_m."""
+        self.disturbed(state.x)
         self.next_try = state.acc[4]
 
     def _miss(self, state: _State) -> tuple[bool, None]:
@@ -382,6 +381,10 @@ class _Reducer:
     def attempt(
         self, state: _State, t0: float, t1: float, vp: float, times: np.ndarray, sample_index: int, rows: list
     ) -> tuple[bool, int]:
+        travel = self.params.bonds.max_extension
+        if self.disturbed_at is not None and abs(state.x - self.disturbed_at) < travel:
+            self.next_try = state.acc[4] + self.FIRST_LOOK  # bonds from before the disturbance are still alive
+            return False, sample_index
         glide = self._glide(state, t0, t1, vp, times, sample_index)
         if glide is None:
             self._miss(state)
@@ -402,11 +405,11 @@ class _Reducer:
             weights = np.exp(state.lw[: state.n])
             state.x = self.functions["_balance_weights"](state.x, state.puller, state.n, state.xb, weights, self.p)
         state.h = 1e-2 * self.params.bonds.bond_time
-        self.disturbed_at = None
-        if glide.done:
+        if glide.done:  # the end of a protocol piece: the next may glide on at once (if its entry check passes)
+            self.disturbed_at = None
             self.next_try = state.acc[4]
-        else:  # the reduction's error grew past its share: cohorts from here, and a look now and then
-            self.interval = self.FIRST_LOOK
+        else:  # the reduction's error grew past its share: cohorts from here, over dl_m at least
+            self.disturbed(state.x)
             self._miss(state)
         return True, glide.sample_index
 
@@ -418,8 +421,6 @@ class _Reducer:
         v = state.v if self.block else vp
         if state.n == 0 or not v > 0 or not vp >= 0 or (not self.block and not vp > 0):
             return None
-        if self.disturbed_at is not None and abs(state.x - self.disturbed_at) < b.max_extension:
-            return None
         nn, ss, _k, uu = self.functions["_sums"](state.n, state.xb, state.lw, state.x, self.p)
         sigma = self.k_block * (state.puller - state.x) if self.block else ss
         tol = R.THETA * self.rtol
@@ -428,7 +429,8 @@ class _Reducer:
         if vp > 0:
             s_p, n_p, slope_p = self._steady_at(vp)
             if slope_p > 0 and abs(sigma - s_p) <= tol * abs(sigma) and abs(nn - n_p) <= tol * b.site_density:
-                return R.steady_glide(self.params, x=state.x, vp=vp, sigma=sigma, bonded=nn, energy=uu, **common)
+                return R.steady_glide(self.params, x=state.x, puller=state.puller, vp=vp, sigma=sigma,
+                                      steady=(s_p, n_p, slope_p), bonded=nn, energy=uu, **common)  # fmt: skip
         if not self.block:
             return None
         lo = min(v, vp) * 0.99 if vp > 0 else 1e-2 * v
