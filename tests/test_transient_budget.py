@@ -81,10 +81,11 @@ def test_a_run_that_outgrows_its_budget_stops_with_the_reason():
 
 
 def test_estimate_is_within_its_stated_factor_of_the_steps_taken():
-    """Velocity control from empty: the estimate is within 0.4-5x of the steps (docstring of estimate_cost)."""
+    """Velocity control from empty: the estimate is within 0.4-5x of the cohorts' steps (docstring of
+    estimate_cost; the quasi-steady reduction takes fewer)."""
     for velocity, duration in ((350e-6, 0.012), (100e-6, 0.05), (0.1, 1e-4)):
         protocol = constant(velocity, duration)
-        run = run_transient(GEL, protocol, control="velocity")
+        run = run_transient(GEL, protocol, control="velocity", reduction="off")
         ratio = estimate_cost(GEL, protocol, control="velocity").steps / run.steps
         assert 0.3 <= ratio <= 6.0, (velocity, ratio)
 

@@ -408,8 +408,6 @@ def glide(
         inside = (sample_times > t) & (sample_times <= t_stop + 1e-12 * max(t_stop, 1.0))
         times = np.r_[sample_times[inside]]
         sample_index = int(np.searchsorted(sample_times, t_stop + 1e-12 * max(t_stop, 1.0), side="right"))
-        if not done or times.size == 0 or times[-1] < t_stop:
-            times = np.r_[times, t_stop] if not (times.size and times[-1] >= t_stop) else times
     else:
         times = times[times > t]
     y = sol.sol(times) if times.size else np.empty((4, 0))

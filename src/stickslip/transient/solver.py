@@ -122,7 +122,8 @@ def run_transient(
     current velocity wherever the slider changes pace slowly over the bonds'
     memory, under an error estimate kept below a tenth of ``rtol``
     (:mod:`stickslip.transient.reduction`, docs/transient.md section 8);
-    ``reduction="off"`` keeps the cohorts throughout (the reference).
+    ``reduction="off"`` keeps the cohorts throughout (the reference), as does
+    a ``max_step`` (fixed-step studies of the cohort method).
 
     The work is estimated first (:func:`estimate_cost`); a run above
     ``max_steps`` (default :data:`stickslip.numerics.budget.DEFAULT_MAX_STEPS`)
@@ -206,7 +207,7 @@ def run_transient(
     if chains_on:
         events.append(("stick", 0.0, sigma0, 0.0))
     reducer = None
-    if reduction == "auto":
+    if reduction == "auto" and max_step is None:  # a bound on the cohorts' step asks for the cohorts throughout
         reducer = _Reducer(params, p, functions, control, k_block, float(rtol), aging)
         reducer.disturbed(state.x)  # from empty, or a steady start: the cohorts carry every bond over dl_m first
     for t0, t1, vp in protocol.pieces():
@@ -682,7 +683,8 @@ def estimate_cost(
     estimate is within 0.4-5x of the steps taken while sliding; a stuck block
     takes far fewer, and through the block the estimate is scaled by
     :data:`BLOCK_SHARE`).  Every protocol segment and every sampling instant
-    costs at least a step.
+    costs at least a step.  These are the cohorts' steps (``reduction="off"``):
+    the quasi-steady reduction takes fewer, so the estimate bounds a run.
     """
     b, g = params.bonds, params.aging
     scale = (1e-4 / rtol) ** 0.25
