@@ -18,6 +18,7 @@ from stickslip.errors import ParameterError
 from stickslip.protocols import Protocol, Segment, constant, segments, slide_hold_slide
 from stickslip.transient import reduction as R
 from stickslip.transient import run_transient
+from stickslip.transient.model import steady_population
 
 GEL = stickslip.load_parameters("gelatin-glass")
 
@@ -55,7 +56,7 @@ def test_block_deceleration_follows_the_cohorts(monkeypatch):
     Here the first-order lag of the population matters (sigma = S(V) + C dV/dt): with it the reduced slider
     follows the cohorts to 8e-6 of its velocity (the rtol 1e-3 cohorts' own error: against a rtol 1e-4 cohort
     run the reduced run at rtol 1e-3 is within 2e-7), without it 6e-5 off."""
-    protocol = segments([(100e-6, 1.0)])
+    protocol = segments([(100e-6, 0.6)])
     kw = {"start": "steady", "start_velocity": 200e-6, "rtol": 1e-3, "every": 0.05}
     auto, off = _pair(GEL, protocol, **kw)
     assert np.allclose(auto.time, off.time)
@@ -80,23 +81,37 @@ def test_block_deceleration_follows_the_cohorts(monkeypatch):
 
 def test_block_acceleration_follows_the_cohorts():
     """Steady sliding at 150 um/s, the puller sped up to 300 um/s: the slider climbs the steady curve."""
-    protocol = segments([(300e-6, 1.0)])
+    protocol = segments([(300e-6, 0.6)])
     auto, off = _pair(GEL, protocol, start="steady", start_velocity=150e-6, rtol=1e-3, every=0.05)
     assert np.max(np.abs(auto.stress / off.stress - 1)) < 1e-5
     assert np.max(np.abs(auto.slider_velocity / off.slider_velocity - 1)) < 2e-5
     assert auto.steps * 20 < off.steps
 
 
-def test_velocity_steps_match_the_cohorts():
-    """Velocity control 100 -> 1000 -> 100 um/s: the transients by cohorts, the settled stretches reduced."""
-    protocol = segments([(100e-6, 0.1), (1000e-6, 0.1), (100e-6, 0.1)])
-    auto, off = _pair(GEL, protocol, control="velocity", start="steady", rtol=1e-4, every=2e-4)
-    assert np.max(np.abs(auto.stress / off.stress - 1)) < 1e-4
-    assert np.max(np.abs(auto.bonded_fraction / off.bonded_fraction - 1)) < 1e-4
+def _common(run, ref):
+    _, i, j = np.intersect1d(np.round(run.time, 10), np.round(ref.time, 10), return_indices=True)
+    return i, j
+
+
+def test_velocity_steps_match_a_tight_cohort_run():
+    """Velocity control 100 -> 1000 -> 100 um/s: the transients by cohorts, the settled stretches reduced.
+
+    Against a rtol 1e-6 cohort run the reduced run at rtol 1e-4 is within half its tolerance everywhere
+    (measured 1.9e-5: the snap onto sigma(1000 um/s) 1.2 ms after the step, 0.2 rtol), closer than the plain
+    cohorts at rtol 1e-4 (8.9e-4 at the peak after the step, 0.2 ms in: the rebuilt steady population carries
+    the aged bonds' cliff more accurately than cohorts born at rtol 1e-4 steps)."""
+    protocol = segments([(100e-6, 0.015), (1000e-6, 0.01), (100e-6, 0.02)])
+    kw = {"control": "velocity", "start": "steady", "every": 2e-4}
+    auto = run_transient(GEL, protocol, rtol=1e-4, **kw)
+    tight = run_transient(GEL, protocol, rtol=1e-6, reduction="off", **kw)
+    i, j = _common(auto, tight)
+    assert i.size >= 220
+    assert np.max(np.abs(auto.stress[i] / tight.stress[j] - 1)) < 5e-5
+    assert np.max(np.abs(auto.bonded_fraction[i] / tight.bonded_fraction[j] - 1)) < 5e-5
     steady = stickslip.steady_state(GEL, np.array([1000e-6, 100e-6]))
-    assert auto.stress[np.searchsorted(auto.time, 0.2) - 1] == pytest.approx(steady.stress[0], rel=1e-5)
+    assert auto.stress[np.searchsorted(auto.time, 0.025) - 1] == pytest.approx(steady.stress[0], rel=1e-5)
     assert auto.final_stress == pytest.approx(steady.stress[1], rel=1e-5)
-    assert auto.steps * 2 < off.steps
+    assert auto.steps * 5 < tight.steps
 
 
 def test_slide_hold_slide_peak_matches_the_cohorts():
@@ -112,7 +127,7 @@ def test_slide_hold_slide_peak_matches_the_cohorts():
 
 def test_stuck_block_is_left_to_the_cohorts():
     """One population from rest through the block (stuck): never quasi-steady, the run is the plain one."""
-    auto, off = _pair(GEL, constant(50e-6, 2.0), rtol=1e-3)
+    auto, off = _pair(GEL, constant(50e-6, 1.0), rtol=1e-3)
     assert auto.regime == off.regime == "stuck"
     # the same steps (the reducer's looks only cut the kernel's calls, which restarts its velocity prediction)
     assert auto.steps == pytest.approx(off.steps, rel=0.02)
@@ -121,23 +136,28 @@ def test_stuck_block_is_left_to_the_cohorts():
 
 def test_parameter_box_velocity_step_matches_the_cohorts():
     """Random sets of the README box (half in the deep-dip/cliff corner), velocity control, a step from V to 2V
-    after a steady start: final sigma and N/N0 of the reduced run within rtol of the plain cohort run."""
+    after a steady start, each velocity held four times the oldest steady age: final sigma and N/N0 of the
+    reduced run within rtol of the plain cohort run, in fewer steps."""
     rng = np.random.default_rng(21)
-    rtol, checked = 1e-4, 0
-    for _ in range(40):
+    rtol, checked, reduced = 1e-4, 0, 0
+    for _ in range(60):
         params, velocity, aging = box_case(rng, GEL, corner=bool(rng.integers(2)))
-        oldest = params.bonds.max_extension / velocity
-        protocol = segments([(velocity, 2 * oldest), (2 * velocity, 3 * oldest)])
+        oldest = [float(np.max(steady_population(params, v, aging).age)) for v in (velocity, 2 * velocity)]
+        protocol = segments([(velocity, 4 * oldest[0]), (2 * velocity, 4 * oldest[1])])
+        kw = {"control": "velocity", "start": "steady", "aging": aging, "rtol": rtol, "max_steps": 3000}
         try:
-            off = run_transient(params, protocol, control="velocity", start="steady", aging=aging, rtol=rtol,
-                                reduction="off", max_steps=3000)  # fmt: skip
+            off = run_transient(params, protocol, reduction="off", **kw)
         except ParameterError as exc:
             assert "budget" in str(exc)
             continue
-        auto = run_transient(params, protocol, control="velocity", start="steady", aging=aging, rtol=rtol)
-        assert auto.final_stress == pytest.approx(off.final_stress, rel=rtol), (params, velocity, aging)
-        assert auto.final_bonded_fraction == pytest.approx(off.final_bonded_fraction, rel=rtol)
+        auto = run_transient(params, protocol, **kw)
+        case = (params, velocity, aging)
+        assert auto.final_stress == pytest.approx(off.final_stress, rel=rtol), case
+        assert auto.final_bonded_fraction == pytest.approx(off.final_bonded_fraction, rel=rtol), case
+        assert auto.steps <= off.steps
         checked += 1
-        if checked == 6:
+        reduced += auto.steps < off.steps / 2
+        if checked == 8:
             break
-    assert checked == 6
+    assert checked == 8
+    assert reduced >= 6

@@ -209,14 +209,14 @@ def run_transient(
     reducer = None
     if reduction == "auto" and max_step is None:  # a bound on the cohorts' step asks for the cohorts throughout
         reducer = _Reducer(params, p, functions, control, k_block, float(rtol), aging)
-        reducer.disturbed(state.x)  # from empty, or a steady start: the cohorts carry every bond over dl_m first
+        reducer.disturbed(state.t)  # from empty, or a steady start: the cohorts first replace every bond
     for t0, t1, vp in protocol.pieces():
         while snap_index < len(wanted) and wanted[snap_index] <= t0 + 1e-15:
             snapshots.append(_snapshot(state))
             snap_index += 1
         if control == "velocity":
             if reducer is not None and vp != state.v:
-                reducer.disturbed(state.x)
+                reducer.disturbed(state.t)
             state.v = vp
         if reducer is not None:
             reducer.next_try = state.acc[4]
@@ -337,6 +337,12 @@ def _chunk(state: _State, budget: int, reducer: _Reducer | None) -> int:
     return max(1, steps)
 
 
+def reduction_share(rtol: float) -> float:
+    from .reduction import THETA
+
+    return THETA * rtol
+
+
 class _Reducer:
     """Switches between the cohorts and the quasi-steady reduction (transient/reduction.py)."""
 
@@ -364,15 +370,32 @@ class _Reducer:
             self.steady[v] = (float(ref.stress), float(ref.bonded_fraction) * n0, float(ref.stress_slope))
         return self.steady[v]
 
-    def disturbed(self, x: float) -> None:
-        """The population is out of balance from here: no reduction before every bond born earlier is gone."""
-        self.disturbed_at = x
+    def disturbed(self, t: float) -> None:
+        """The population is out of balance from t: no reduction while bonds born before t carry weight."""
+        self.disturbed_at = t
         self.interval = self.FIRST_LOOK
 
     def loaded_steady(self, state: _State) -> None:
         """A steady population was put in (a steady start, the jump): the cohorts first carry it over dl_m."""
-        self.disturbed(state.x)
+        self.disturbed(state.t)
         self.next_try = state.acc[4]
+
+    def _remembers_disturbance(self, state: _State) -> bool:
+        """Bonds born before the disturbance still carry more than a hundredth of the reduction's share."""
+        if self.disturbed_at is None:
+            return False
+        n = state.n
+        old = state.tb[:n] < self.disturbed_at
+        if not old.any():
+            self.disturbed_at = None
+            return False
+        w = np.exp(state.lw[:n])
+        f = np.abs(_force(state.x - state.xb[:n], self.params))
+        share = 1e-2 * reduction_share(self.rtol)
+        if w[old].sum() <= share * w.sum() and (w * f)[old].sum() <= share * (w * f).sum():
+            self.disturbed_at = None
+            return False
+        return True
 
     def _miss(self, state: _State) -> tuple[bool, None]:
         self.next_try = state.acc[4] + self.interval
@@ -382,9 +405,8 @@ class _Reducer:
     def attempt(
         self, state: _State, t0: float, t1: float, vp: float, times: np.ndarray, sample_index: int, rows: list
     ) -> tuple[bool, int]:
-        travel = self.params.bonds.max_extension
-        if self.disturbed_at is not None and abs(state.x - self.disturbed_at) < travel:
-            self.next_try = state.acc[4] + self.FIRST_LOOK  # bonds from before the disturbance are still alive
+        if self._remembers_disturbance(state):
+            self.next_try = state.acc[4] + self.FIRST_LOOK
             return False, sample_index
         glide = self._glide(state, t0, t1, vp, times, sample_index)
         if glide is None:
@@ -410,7 +432,7 @@ class _Reducer:
             self.disturbed_at = None
             self.next_try = state.acc[4]
         else:  # the reduction's error grew past its share: cohorts from here, over dl_m at least
-            self.disturbed(state.x)
+            self.disturbed(state.t)
             self._miss(state)
         return True, glide.sample_index
 
@@ -429,7 +451,9 @@ class _Reducer:
                       sample_times=times, sample_index=sample_index)  # fmt: skip
         if vp > 0:
             s_p, n_p, slope_p = self._steady_at(vp)
-            if slope_p > 0 and abs(sigma - s_p) <= tol * abs(sigma) and abs(nn - n_p) <= tol * b.site_density:
+            # through the block only the rising branch is steady (below Vc a slider leaves it); a rigid rig holds V
+            rising = slope_p > 0 or not self.block
+            if rising and abs(sigma - s_p) <= tol * abs(sigma) and abs(nn - n_p) <= tol * b.site_density:
                 return R.steady_glide(self.params, x=state.x, puller=state.puller, vp=vp, sigma=sigma,
                                       steady=(s_p, n_p, slope_p), bonded=nn, energy=uu, **common)  # fmt: skip
         if not self.block:
@@ -481,6 +505,7 @@ def _sample_grid(every: float | None, duration: float) -> np.ndarray:
         return np.empty(0)
     count = math.floor(duration / every + 1e-9)
     grid = every * np.arange(count + 1)
+    grid = grid[grid <= duration]  # every * count may round past the end, which no step reaches
     if duration - grid[-1] > 1e-9 * every:
         grid = np.append(grid, duration)
     return grid
