@@ -36,8 +36,11 @@ from ..parameters import Parameters
 
 #: share of the local tolerance the reduction may change the stress by (entry and stay)
 THETA = 0.3
-#: fewest trace rows a reduced stretch writes (the classifier reads the stress of the trace)
+#: fewest trace rows a reduced stretch writes (the classifier reads the stress of the trace), the most, and the
+#: relative change of the slider velocity between rows
 ROWS = 64
+MAX_ROWS = 20_000
+ROW_CHANGE = 1e-3
 #: Chebyshev degrees: the steady stress and bonded fraction (raised until the check passes), the lag C
 DEGREE = 24
 MAX_DEGREE = 96
@@ -312,6 +315,13 @@ def effective(m: Manifold, v: float, vp: float, k_block: float) -> tuple[float, 
     return s_eff, a1, neglected
 
 
+def _effective_stress(m: Manifold, v: np.ndarray, vp: float, k_block: float) -> np.ndarray:
+    """S_eff at many velocities (the first element of :func:`effective`)."""
+    x = np.log(v)
+    slope = m.dstress(x) / v
+    return m.stress(x) + m.lag(x) * k_block * (vp - v) / slope
+
+
 def entry_velocity(m: Manifold, sigma: float, v: float, vp: float, k_block: float, rtol: float) -> float | None:
     """The velocity on the slow manifold carrying ``sigma`` near ``v``, if the state lies on it within tolerance."""
     branch = m.rising(v)
@@ -403,7 +413,10 @@ def glide(
     )  # fmt: skip
     t_stop = float(sol.t[-1])
     done = sol.status == 0 and t_stop >= t_end
-    times = np.unique(np.r_[sol.t, np.linspace(t, t_stop, ROWS)])
+    # rows where the velocity moves by ROW_CHANGE at most (a summary of the trace, such as a mean stress by the
+    # trapezoid rule, then reads the same as the cohorts' row per step), and at the ODE's own steps
+    turns = abs(math.log(max(float(sol.y[0, -1]), 1e-300) / v)) / ROW_CHANGE
+    times = np.unique(np.r_[sol.t, np.linspace(t, t_stop, int(min(max(turns, ROWS), MAX_ROWS)))])
     if sample_times.size:
         inside = (sample_times > t) & (sample_times <= t_stop + 1e-12 * max(t_stop, 1.0))
         times = np.r_[sample_times[inside]]
@@ -414,7 +427,7 @@ def glide(
     vel = y[0]
     logv = np.log(vel)
     if block:
-        sigma = np.array([effective(m, vv, vp, k_block)[0] for vv in vel])
+        sigma = _effective_stress(m, vel, vp, k_block)
         pull = puller + vp * (times - t)
         pos = pull - sigma / k_block
     else:
