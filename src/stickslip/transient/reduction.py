@@ -354,6 +354,8 @@ class Glide:
     rows: np.ndarray
     done: bool  # reached t_end (else the reduction's error estimate or its table ended it)
     sample_index: int
+    bonded: float  # N and bond energy at its end (the bookkeeping continues from them)
+    energy: float
 
 
 def glide(
@@ -448,9 +450,10 @@ def glide(
     acc[2] += end[2]
     nn_end = n0 * float(m.bonded(math.log(v_end)))
     acc[1] += end[1] - (nn_end - bonded)
-    acc[3] += end[3] - (float(m.energy(math.log(v_end))) - energy)
+    u_end = float(m.energy(math.log(v_end)))
+    acc[3] += end[3] - (u_end - energy)
     acc[4] += max(1, sol.t.size - 1)
-    return Glide(t_stop, v_end, sigma_end, rows, done, sample_index)
+    return Glide(t_stop, v_end, sigma_end, rows, done, sample_index, nn_end, u_end)
 
 
 #: manifolds built so far, per (parameter set, aging): a sweep or a comparison reuses them
@@ -537,4 +540,4 @@ def steady_glide(
     acc[2] += float(end[4][0])
     acc[3] += float(end[5][0])
     acc[4] += 1
-    return Glide(t_end, float(end[1][0]), float(end[0][0]), rows, True, sample_index)
+    return Glide(t_end, float(end[1][0]), float(end[0][0]), rows, True, sample_index, n_ss, energy)
