@@ -359,6 +359,7 @@ class _Reducer:
         self.next_try = 0.0
         self.interval = self.FIRST_LOOK
         self.steady: dict[float, tuple[float, float, float]] = {}
+        self.unbuildable = -math.inf  # the start of the protocol piece where a table could not be built
 
     def _steady_at(self, v: float) -> tuple[float, float, float]:
         """(S, N, S') of the steady solver at v, remembered for the run."""
@@ -463,15 +464,20 @@ class _Reducer:
                                       steady=(s_p, n_p, slope_p), bonded=nn, energy=uu, **common)  # fmt: skip
         if not self.block:
             return None
-        lo = min(v, vp) * 0.99 if vp > 0 else 1e-2 * v
+        # the table spans the velocities ahead (down to a third of v at most: a stretch ending at its edge is
+        # taken up again by a new table) and three times the fastest, for the jumps of later cycles
+        lo = max(min(v, vp), v / 3.0) * 0.99
         hi = max(v, vp) * 1.01
         m = R.manifold_for(self.params, self.aging, lo, hi, 3.0 * hi, self.rtol, build=False)
         if m is None:  # worth building only where the state is near the steady curve's rising branch
+            if self.unbuildable >= t0:
+                return None
             ref = steady_state(self.params, v, self.aging)
             if not (float(ref.stress_slope) > 0 and abs(sigma - float(ref.stress)) <= 1e-2 * abs(sigma)):
                 return None
             m = R.manifold_for(self.params, self.aging, lo, hi, 3.0 * hi, self.rtol)
-            if m is None:
+            if m is None:  # the steady curve cannot be tabulated here to its share of rtol: cohorts for this piece
+                self.unbuildable = t0
                 return None
         v_entry = R.entry_velocity(m, sigma, v, vp, self.k_block, self.rtol)
         if v_entry is None or abs(nn - float(m.bonded(math.log(v_entry))) * b.site_density) > tol * b.site_density:
