@@ -279,8 +279,11 @@ def run_transient(
                 if reducer is not None:
                     reducer.loaded_steady(state)
                 continue
+            # the solver stops at the next snapshot instant (a reduced stretch rebuilds its cohorts there)
+            upcoming = [w for w in wanted[snap_index:] if state.t + 1e-15 < w < t1]
+            t_stop = upcoming[0] if upcoming else t1
             if reducer is not None and state.acc[4] >= reducer.next_try:
-                glided, sample_index = reducer.attempt(state, t0, t1, vp, times, sample_index, rows)
+                glided, sample_index = reducer.attempt(state, t0, t_stop, vp, times, sample_index, rows)
                 if glided:
                     while snap_index < len(wanted) and state.t + 1e-15 >= wanted[snap_index] < t1:
                         snapshots.append(_snapshot(state))
@@ -298,7 +301,7 @@ def run_transient(
             puller0 = state.puller - vp * (state.t - t0)  # puller position at the start t0 of this piece
             lw_new, rate0, lc, aa, w1 = (np.empty(state.xb.size) for _ in range(5))
             status, t, x, v, h, n, sample_index, count = advance(
-                state.t, t1, state.x, state.v, state.h, puller0, vp, t0, 1 if control == "block" else 0,
+                state.t, t_stop, state.x, state.v, state.h, puller0, vp, t0, 1 if control == "block" else 0,
                 state.n, state.xb, state.tb, state.lw, lw_new, rate0, lc, aa, w1, state.acc, p, float(rtol), h_max,
                 times, sample_index, out, CHUNK, stick_v, _chunk(state, budget, reducer),
             )  # fmt: skip
