@@ -36,6 +36,8 @@ from ..parameters import Parameters
 
 #: share of the local tolerance the reduction may change the stress by (entry and stay)
 THETA = 0.3
+#: the neglected stress reported where the first-order manifold itself folds (Pa; ends a stretch)
+OFF_MANIFOLD = 1e300
 #: fewest trace rows a reduced stretch writes (the classifier reads the stress of the trace), the most, and the
 #: relative change of the slider velocity between rows
 ROWS = 64
@@ -310,9 +312,11 @@ def effective(m: Manifold, v: float, vp: float, k_block: float) -> tuple[float, 
     da0 = -k_block / s1 - k_block * (vp - v) * s2 / (s1 * s1)
     s_eff = s + c * a0
     ds_eff = s1 + c1 * a0 + c * da0
-    a1 = k_block * (vp - v) / ds_eff if ds_eff > 0.0 else math.inf
+    if not ds_eff > 0.0:  # past the first-order manifold's own fold: nothing quasi-steady is left here
+        return s_eff, 0.0, OFF_MANIFOLD
+    a1 = k_block * (vp - v) / ds_eff
     neglected = abs(c * (a1 - a0)) + abs(c * c / s1 * a1 * da0)
-    return s_eff, a1, neglected
+    return s_eff, a1, min(neglected, OFF_MANIFOLD)
 
 
 def _effective_stress(m: Manifold, v: np.ndarray, vp: float, k_block: float) -> np.ndarray:
@@ -376,7 +380,7 @@ def glide(
     energy: float,
     sample_times: np.ndarray,
     sample_index: int,
-) -> Glide:
+) -> Glide | None:
     """Advance the reduced description from t towards t_end (block: the ODE above; velocity: steady sliding).
 
     ``acc`` (born, broken, work, dissipation, steps, rejected) is updated in place; ``bonded`` and
@@ -413,6 +417,8 @@ def glide(
         rhs, (t, t_end), y0, method="DOP853", rtol=1e-3 * rtol, atol=[1e-9 * v, 1e-12 * n0, 1e-30, 1e-30],
         events=events, dense_output=True,
     )  # fmt: skip
+    if not (np.all(np.isfinite(sol.y[:, -1])) and sol.y[0, -1] > 0.0 and sol.t.size > 1):
+        return None  # the stretch could not be followed (the caller leaves it to the cohorts)
     t_stop = float(sol.t[-1])
     done = sol.status == 0 and t_stop >= t_end
     # rows where the velocity moves by ROW_CHANGE at most (a summary of the trace, such as a mean stress by the
@@ -467,7 +473,9 @@ def manifold_for(
 
     ``build=False``: only one built before (None if there is none).
     """
-    built = _BUILT.setdefault((params, aging), [])
+    from ..model.jump import steady_curve_key
+
+    built = _BUILT.setdefault((steady_curve_key(params), aging), [])  # the block's stiffness plays no part
     for m, tol in built:
         if m.covers(lo, hi) and tol <= rtol:
             return m

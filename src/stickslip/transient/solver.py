@@ -494,7 +494,9 @@ _STEADY_COHORTS: dict[tuple[Parameters, float, bool], Population] = {}
 
 def _steady_cohorts(params: Parameters, velocity: float, aging: bool) -> Population:
     """steady_population, remembered (a steady run starts and ends on the same one)."""
-    key = (params, float(velocity), bool(aging))
+    from ..model.jump import steady_curve_key
+
+    key = (steady_curve_key(params), float(velocity), bool(aging))
     if key not in _STEADY_COHORTS:
         if len(_STEADY_COHORTS) > 16:
             _STEADY_COHORTS.clear()
