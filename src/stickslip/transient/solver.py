@@ -380,7 +380,7 @@ class _Reducer:
         self.interval = self.FIRST_LOOK
 
     def loaded_steady(self, state: _State) -> None:
-        """A steady population was put in (a steady start, the jump): the cohorts first carry it over dl_m."""
+        """A steady population was put in (the jump): the cohorts replace it before a reduced stretch."""
         self.disturbed(state.t)
         self.next_try = state.acc[4]
 
@@ -401,10 +401,9 @@ class _Reducer:
             return False
         return True
 
-    def _miss(self, state: _State) -> tuple[bool, None]:
+    def _miss(self, state: _State) -> None:
         self.next_try = state.acc[4] + self.interval
         self.interval = min(2 * self.interval, self.LAST_LOOK)
-        return False, None
 
     def attempt(
         self, state: _State, t0: float, t1: float, vp: float, times: np.ndarray, sample_index: int, rows: list
@@ -440,7 +439,7 @@ class _Reducer:
         if glide.done:  # the end of a protocol piece: the next may glide on at once (if its entry check passes)
             self.disturbed_at = None
             self.next_try = state.acc[4]
-        else:  # the reduction's error grew past its share: cohorts from here, over dl_m at least
+        else:  # the reduction's error grew past its share: cohorts from here, until they replace the rebuilt bonds
             self.disturbed(state.t)
             self._miss(state)
         return True, glide.sample_index
