@@ -127,7 +127,7 @@ def test_slide_hold_slide_peak_matches_the_cohorts():
 
 def test_stuck_block_is_left_to_the_cohorts():
     """One population from rest through the block (stuck): never quasi-steady, the run is the plain one."""
-    auto, off = _pair(GEL, constant(50e-6, 1.0), rtol=1e-3)
+    auto, off = _pair(GEL, constant(50e-6, 0.5), rtol=1e-3)
     assert auto.regime == off.regime == "stuck"
     # the same steps (the reducer's looks only cut the kernel's calls, which restarts its velocity prediction)
     assert auto.steps == pytest.approx(off.steps, rel=0.02)
@@ -157,10 +157,10 @@ def test_parameter_box_velocity_step_matches_the_cohorts():
         assert auto.steps <= off.steps
         checked += 1
         reduced += auto.steps < off.steps / 2
-        if checked == 8:
+        if checked == 6:
             break
-    assert checked == 8
-    assert reduced >= 6
+    assert checked == 6
+    assert reduced >= 4
 
 
 @pytest.mark.parametrize("control", ["velocity", "block"])
