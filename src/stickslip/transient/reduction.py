@@ -21,7 +21,9 @@ population with one exponential memory, Z/s = S'/(1 + sT)), and kept below
 ``THETA * rtol * sigma``; where it grows (towards the fold of the steady curve at Vc,
 where S' -> 0) the solver switches back to cohorts rebuilt from the steady
 population.  Under velocity control the slider's velocity is piecewise constant,
-so a reduced stretch is exact steady sliding.
+so a reduced stretch is exact steady sliding.  The manifold is assumed attracting: a
+fast oscillatory instability of steady sliding (Kc(V) > K, ``stability``) is not
+looked for while reduced (for the gel Kc = 0 wherever S' > 0).
 """
 
 from __future__ import annotations
