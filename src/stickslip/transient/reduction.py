@@ -23,7 +23,7 @@ where S' -> 0) the solver switches back to cohorts rebuilt from the steady
 population.  Under velocity control the slider's velocity is piecewise constant,
 so a reduced stretch is exact steady sliding.  The manifold is assumed attracting: a
 fast oscillatory instability of steady sliding (Kc(V) > K, ``stability``) is not
-looked for while reduced (for the gel Kc = 0 wherever S' > 0).
+looked for while reduced (for the gel Kc = 0 from Vc to at least 1 mm/s).
 """
 
 from __future__ import annotations
