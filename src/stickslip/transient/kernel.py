@@ -128,7 +128,6 @@ def _slider_velocity(v_prev, vp, n, xb, tb, lw, x, t, p, lc, aa):  # type: ignor
         return v_prev
     # bracket the nearest crossing in the direction of the root (g(0) <= 0 always)
     scale = max(abs(v_prev), 1e-12)
-    gt, dt = g0, d0
     if g0 < 0.0:
         lo, hi = v_prev, np.inf
         if d0 > 0.0:
@@ -136,7 +135,7 @@ def _slider_velocity(v_prev, vp, n, xb, tb, lw, x, t, p, lc, aa):  # type: ignor
         else:
             trial = v_prev + scale
         for _ in range(400):
-            gt, dt = _velocity_residual(trial, vp, n, lc, aa, k_int, p)
+            gt, _d = _velocity_residual(trial, vp, n, lc, aa, k_int, p)
             if gt >= 0.0:
                 hi = trial
                 break
@@ -148,7 +147,7 @@ def _slider_velocity(v_prev, vp, n, xb, tb, lw, x, t, p, lc, aa):  # type: ignor
         if trial < 0.0:
             trial = 0.0
         for _ in range(400):
-            gt, dt = _velocity_residual(trial, vp, n, lc, aa, k_int, p)
+            gt, _d = _velocity_residual(trial, vp, n, lc, aa, k_int, p)
             if gt <= 0.0:
                 lo = trial
                 break
@@ -156,22 +155,21 @@ def _slider_velocity(v_prev, vp, n, xb, tb, lw, x, t, p, lc, aa):  # type: ignor
             trial = 0.5 * trial if trial > 1e-300 else 0.0
     if not hi < np.inf:
         return lo
-    # safeguarded Newton from the end of the bracket evaluated last (its residual is known: no pass repeated)
-    v, g, d = trial, gt, dt
+    v = lo if g0 < 0.0 else hi
     for _ in range(100):
+        g, d = _velocity_residual(v, vp, n, lc, aa, k_int, p)
         if g == 0.0:
             return v
+        if g < 0.0:
+            lo = v
+        else:
+            hi = v
         v_new = v - g / d if d > 0.0 else 0.5 * (lo + hi)
         if not (lo < v_new < hi):
             v_new = 0.5 * (lo + hi)
         if abs(v_new - v) <= 1e-13 * max(abs(v_new), 1e-300) or hi - lo <= 1e-14 * hi:
             return v_new
         v = v_new
-        g, d = _velocity_residual(v, vp, n, lc, aa, k_int, p)
-        if g < 0.0:
-            lo = v
-        else:
-            hi = v
     return v
 
 
