@@ -1,17 +1,26 @@
-"""Time-dependent model: the cohort solver against a plain method-of-lines solve_ivp in the same run.
+"""Time-dependent model: each workload with the quasi-steady reduction beside the plain cohort solver, same run.
 
-Run as ``PYTHONPATH=src python benchmarks/bench_transient.py``.  Prints wall and process time (best and
-median) and the accuracy reached against the steady solver.
+Run as ``PYTHONPATH=src python benchmarks/bench_transient.py`` (``--reference`` adds the rtol 1e-5 cohort run of
+the cycle, 49 s of CPU, whose numbers tests/test_transient_speed.py compares with; ``--quick`` skips the plain
+cohort runs that take more than a few seconds).  CPU time (``time.process_time``) is printed with the ratio
+to the plain solver's in the same process, and the accuracy reached: against the steady solver, or the
+cycle's stick time, peak, jump velocity and slip time against the tighter run.
 """
 
 from __future__ import annotations
 
+import sys
+import time
+
 import numpy as np
 
 import stickslip
-from stickslip.protocols import constant
-from stickslip.transient import run_transient
+from stickslip.protocols import Protocol, Segment, constant
+from stickslip.transient import reduction, run_transient
 from timing import timed
+
+CYCLE = Protocol((Segment(350e-6, 5.0), Segment(100e-6, 20.0)))
+CYCLE_KEYS = ("stick_time", "peak_stress", "jump_velocity", "slip_time")
 
 
 def method_of_lines(params, velocity, duration, cells=400):  # type: ignore[no-untyped-def]
@@ -41,50 +50,94 @@ def method_of_lines(params, velocity, duration, cells=400):  # type: ignore[no-u
     return float(n @ f * da), float(n.sum() * da / b.site_density)
 
 
+def cpu(func):  # type: ignore[no-untyped-def]
+    start = time.process_time()
+    out = func()
+    return time.process_time() - start, out
+
+
+def pair(label, func, quick=False):  # type: ignore[no-untyped-def]
+    """The workload reduced and plain: (cpu reduced, result), (cpu plain, result) or None when skipped."""
+    reduced = cpu(lambda: func("auto"))
+    plain = None if quick else cpu(lambda: func("off"))
+    text = f"{label}: reduced {reduced[0]:.3f} s CPU ({reduced[1].steps} steps)"
+    if plain is not None:
+        text += f", plain cohorts {plain[0]:.3f} s ({plain[1].steps} steps): {plain[0] / reduced[0]:.0f}x"
+    print(text, flush=True)
+    return reduced, plain
+
+
+def cycle_numbers(run):  # type: ignore[no-untyped-def]
+    c = run.cycles[0]
+    return np.array([getattr(c, key) for key in CYCLE_KEYS])
+
+
 def main() -> None:
+    quick = "--quick" in sys.argv
     p = stickslip.load_parameters("gelatin-glass")
-    run_transient(p, constant(350e-6, 1e-3), control="velocity")  # compile / load the numba cache
+    # compile / load the numba caches of the cohort kernel and of the reduction's tables, and find Vc once (a
+    # steady start through the block asks for it, ~0.07 s per parameter set)
+    run_transient(p, constant(350e-6, 1e-3), control="velocity")
+    run_transient(p, constant(350e-6, 1e-3), start="steady")
+    reduction.steady_cohorts(p, 350e-6, True)
+    reduction._lag(p, 350e-6, True)
+
     v = 350e-6
     ref = stickslip.steady_state(p, v)
-    best, med, cpu, run = timed(lambda: run_transient(p, constant(v, 0.012), control="velocity", rtol=1e-4), 3)
-    err = abs(run.final_stress / float(ref.stress) - 1)
-    print(
-        f"constant V = 350 um/s from empty, 12 ms (54 tau), rtol 1e-4: best {best:.3f} s, median {med:.3f} s, "
-        f"cpu {cpu:.3f} s, {run.steps} steps, sigma error {err:.2e}"
-    )
-    best, med, cpu, out = timed(lambda: method_of_lines(p, v, 0.012), 1)
-    print(
-        f"  method of lines (400 age cells, BDF): {best:.3f} s, cpu {cpu:.3f} s, sigma error "
-        f"{abs(out[0] / float(ref.stress) - 1):.2e}"
-    )
-    best, med, cpu, run = timed(lambda: run_transient(p, constant(v, 0.012), control="velocity", rtol=1e-5), 3)
-    err = abs(run.final_stress / float(ref.stress) - 1)
-    print(f"  same at rtol 1e-5: best {best:.3f} s, median {med:.3f} s, {run.steps} steps, sigma error {err:.2e}")
-    for rtol in (1e-3, 1e-4):
-        best, med, cpu, run = timed(
-            lambda rtol=rtol: run_transient(
-                p, constant(50e-6, 25.0), start="steady", start_velocity=350e-6, rtol=rtol, stick_population=True
+    for mode in ("off", "auto"):
+        best, med, t_cpu, run = timed(
+            lambda mode=mode: run_transient(p, constant(v, 0.012), control="velocity", rtol=1e-4, reduction=mode), 3
+        )
+        print(
+            f"constant V = 350 um/s from empty, 12 ms (54 tau), rtol 1e-4, reduction {mode}: best {best:.3f} s, "
+            f"median {med:.3f} s, cpu {t_cpu:.3f} s, {run.steps} steps, "
+            f"sigma error {abs(run.final_stress / float(ref.stress) - 1):.2e}"
+        )
+    if not quick:
+        best, med, t_cpu, out = timed(lambda: method_of_lines(p, v, 0.012), 1)
+        print(
+            f"  method of lines (400 age cells, BDF): {best:.3f} s, cpu {t_cpu:.3f} s, sigma error "
+            f"{abs(out[0] / float(ref.stress) - 1):.2e}"
+        )
+
+    for rtol in (1e-4, 1e-3):
+        (_cpu, r_run), plain = pair(
+            f"block, steady sliding at 350 um/s, 1 s, rtol {rtol:g}",
+            lambda mode, rtol=rtol: run_transient(p, constant(v, 1.0), start="steady", rtol=rtol, reduction=mode),
+        )
+        errors = f"sigma {abs(r_run.final_stress / float(ref.stress) - 1):.1e} off the steady solver (reduced)"
+        if plain is not None:
+            errors += f", {abs(plain[1].final_stress / float(ref.stress) - 1):.1e} (plain)"
+        print("  " + errors)
+
+    tight = None
+    if "--reference" in sys.argv:
+        t_cpu, tight_run = cpu(
+            lambda: run_transient(p, CYCLE, start="steady", stick_population=True, rtol=1e-5, reduction="off")
+        )
+        tight = cycle_numbers(tight_run)
+        print(f"cycle reference (plain cohorts, rtol 1e-5): {t_cpu:.1f} s CPU, {tight_run.steps} steps, " + ", ".join(
+            f"{key} {value!r}" for key, value in zip(CYCLE_KEYS, tight, strict=True)))  # fmt: skip
+    for rtol in (1e-4, 1e-3):
+        (_cpu, r_run), plain = pair(
+            f"one cycle, 350 um/s 5 s then 100 um/s 20 s with the stick chains, rtol {rtol:g}",
+            lambda mode, rtol=rtol: run_transient(
+                p, CYCLE, start="steady", stick_population=True, rtol=rtol, reduction=mode
             ),
-            1,
+            quick=quick,
         )
-        c = run.cycles[0]
-        print(
-            f"block, 350 -> 50 um/s with the stick chains, 25 s (slide, stick, jump, slip), rtol {rtol:g}: "
-            f"{best:.2f} s wall, cpu {cpu:.2f} s, {run.steps} steps; stick {c.stick_time:.4f} s, "
-            f"sigma_s {c.peak_stress:.3f} Pa, jump {c.jump_velocity * 1e6:.2f} um/s, slip {c.slip_time} s"
-        )
-    for rtol in (1e-3, 1e-4):
-        best, med, cpu, run = timed(
-            lambda rtol=rtol: run_transient(p, constant(350e-6, 1.0), start="steady", rtol=rtol, every=1e-3), 1
-        )
-        print(
-            f"block, steady sliding at 350 um/s, 1 s, rtol {rtol:g}: {best:.2f} s wall, cpu {cpu:.2f} s, "
-            f"{run.steps} steps, final sigma {run.final_stress:.4f} Pa (steady solver {float(ref.stress):.4f})"
-        )
-    best, med, cpu, run = timed(lambda: run_transient(p, constant(50e-6, 25.0), rtol=1e-3), 1)
+        got = cycle_numbers(r_run)
+        print("  reduced: " + ", ".join(f"{k} {x:.6g}" for k, x in zip(CYCLE_KEYS, got, strict=True)))
+        if plain is not None:
+            diff = np.max(np.abs(got / cycle_numbers(plain[1]) - 1))
+            print(f"  largest relative difference from the plain run: {diff:.1e}")
+        if tight is not None:
+            print(f"  largest relative difference from the rtol 1e-5 run: {np.max(np.abs(got / tight - 1)):.1e}")
+
+    best, med, t_cpu, run = timed(lambda: run_transient(p, constant(50e-6, 25.0), rtol=1e-3), 1)
     print(
-        f"block, 50 um/s from rest, 25 s, rtol 1e-3: {best:.2f} s wall, cpu {cpu:.2f} s, {run.steps} steps, "
-        f"regime {run.regime}, final sigma {run.final_stress:.4g} Pa (K V0 t = "
+        f"block, 50 um/s from rest, 25 s, rtol 1e-3 (stuck: never quasi-steady): cpu {t_cpu:.2f} s, "
+        f"{run.steps} steps, regime {run.regime}, final sigma {run.final_stress:.4g} Pa (K V0 t = "
         f"{p.block.effective_stiffness * 50e-6 * 25:.4g} Pa)"
     )
 

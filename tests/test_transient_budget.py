@@ -73,18 +73,20 @@ def test_lambda_zero_is_fine_while_no_chain_can_reach_the_wall():
 
 
 def test_a_run_that_outgrows_its_budget_stops_with_the_reason():
-    """At 1 m/s the steps are finer than the estimate (2.9e8/s taken, 1.2e8/s estimated): the run still stops."""
+    """At 1 m/s the cohorts' steps are finer than the estimate (2.9e8/s taken, 1.2e8/s estimated): the run still
+    stops (the quasi-steady reduction would settle it in a few hundred steps)."""
     protocol = constant(1.0, 1e-5)
     assert estimate_cost(GEL, protocol, control="velocity").steps < 2000
     with pytest.raises(ParameterError, match="used the budget of 2000 steps"):
-        run_transient(GEL, protocol, control="velocity", max_steps=2000)
+        run_transient(GEL, protocol, control="velocity", max_steps=2000, reduction="off")
 
 
 def test_estimate_is_within_its_stated_factor_of_the_steps_taken():
-    """Velocity control from empty: the estimate is within 0.4-5x of the steps (docstring of estimate_cost)."""
+    """Velocity control from empty: the estimate is within 0.4-5x of the cohorts' steps (docstring of
+    estimate_cost; the quasi-steady reduction takes fewer)."""
     for velocity, duration in ((350e-6, 0.012), (100e-6, 0.05), (0.1, 1e-4)):
         protocol = constant(velocity, duration)
-        run = run_transient(GEL, protocol, control="velocity")
+        run = run_transient(GEL, protocol, control="velocity", reduction="off")
         ratio = estimate_cost(GEL, protocol, control="velocity").steps / run.steps
         assert 0.3 <= ratio <= 6.0, (velocity, ratio)
 

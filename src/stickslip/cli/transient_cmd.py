@@ -40,6 +40,11 @@ def _trace_csv(result: Any) -> str:
 )
 @click.option("--rtol", default=1e-4, show_default=True, type=float, help="Local error tolerance (relative).")
 @click.option(
+    "--no-reduce",
+    is_flag=True,
+    help="Cohorts throughout: no quasi-steady reduction where the slider changes pace slowly (the reference).",
+)
+@click.option(
     "--max-steps",
     type=click.IntRange(min=1),
     default=None,
@@ -62,6 +67,7 @@ def transient_command(
     stick_population: bool,
     every_text: str | None,
     rtol: float,
+    no_reduce: bool,
     max_steps: int | None,
     output: Path | None,
     plot_path: Path | None,
@@ -98,7 +104,7 @@ def transient_command(
     params = resolve_params(params_name, overrides)
     rig = Rig(control=control, stiffness=k)
     settings = dict(start_velocity=start_velocity, aging=not no_aging, stick_population=stick_population, every=every,
-                    rtol=rtol, max_steps=max_steps)  # fmt: skip
+                    rtol=rtol, max_steps=max_steps, reduction="off" if no_reduce else "auto")  # fmt: skip
     cost = estimate_cost(params, protocol, control=solver_control, start_velocity=start_velocity, rtol=rtol,
                          every=every, aging=not no_aging)  # fmt: skip
     shown = None if cost.seconds > PROGRESS_AFTER_SECONDS and not as_json else False  # None: on a terminal

@@ -25,7 +25,7 @@ class Transient(BondModel):
     ``start``: "empty" (no bonds, no stress; the default) or "steady" (the steady population at the first
     segment's velocity, or at the setting ``start_velocity``).  Settings: those of ``run_transient``
     (``stick_population``, ``aging``, ``start_velocity``, ``every``, ``rtol``, ``max_step``, ``max_steps``,
-    ``snapshot_times``, ``progress``).
+    ``reduction``, ``snapshot_times``, ``progress``).
     """
 
     name = "transient"
@@ -35,7 +35,7 @@ class Transient(BondModel):
         controls=("spring", "velocity"),
         protocols="any",
         settings=(
-            "stick_population", "aging", "start_velocity", "every", "rtol", "max_step", "max_steps",
+            "stick_population", "aging", "start_velocity", "every", "rtol", "max_step", "max_steps", "reduction",
             "snapshot_times", "progress",
         ),
     )  # fmt: skip

@@ -15,11 +15,12 @@ from ..numerics.budget import CostEstimate, check_max_steps, over_budget, requir
 from ..parameters import Parameters
 from ..protocols import Protocol
 from . import kernel as K
-from .model import Population, pack_parameters, steady_population, stick_chains
+from .model import Population, pack_parameters, stick_chains
 from .result import Bookkeeping, Snapshot, TransientResult
 
 CONTROLS = ("block", "velocity")
 STARTS = ("empty", "steady")
+REDUCTIONS = ("auto", "off")
 #: the slider counts as stuck below this fraction of the puller velocity (cycle detection, stick chains)
 STICK_FRACTION = 0.01
 #: kernel calls return after this many steps (progress reports, buffer flushes)
@@ -87,6 +88,7 @@ def run_transient(
     snapshot_times: Any = None,
     max_step: float | None = None,
     max_steps: int | None = None,
+    reduction: str = "auto",
 ) -> TransientResult:
     """Solve Eqs 1-5 (history form of Eq 3) through ``protocol``.
 
@@ -116,6 +118,13 @@ def run_transient(
     ``start_velocity`` below Vc is honoured (a stiff block, K > Kc(V), can
     slide steadily there) and the message notes the branch.
 
+    ``reduction="auto"`` replaces the cohorts by the steady population of the
+    current velocity wherever the slider changes pace slowly over the bonds'
+    memory, under an error estimate kept below a tenth of ``rtol``
+    (:mod:`stickslip.transient.reduction`, docs/transient.md section 8);
+    ``reduction="off"`` keeps the cohorts throughout (the reference), as does
+    a ``max_step`` (fixed-step studies of the cohort method).
+
     The work is estimated first (:func:`estimate_cost`); a run above
     ``max_steps`` (default :data:`stickslip.numerics.budget.DEFAULT_MAX_STEPS`)
     is refused before it starts, or stopped when it gets there.
@@ -124,6 +133,7 @@ def run_transient(
         raise ParameterError(f"params: expected stickslip Parameters, got {type(params).__name__}")
     _check_choice(control, CONTROLS, "control")
     _check_choice(start, STARTS, "start")
+    _check_choice(reduction, REDUCTIONS, "reduction")
     for flag, name in ((aging, "aging"), (stick_population, "stick_population")):
         if not isinstance(flag, (bool, np.bool_)):
             raise ParameterError(f"{name}: expected True or False, got {flag!r}")
@@ -172,7 +182,7 @@ def run_transient(
         v_start = v_first if start_velocity is None else float(start_velocity)
         if not v_start > 0:
             raise ParameterError(f"start velocity: a steady start needs a positive sliding velocity, got {v_start!r}")
-        pop = steady_population(params, v_start, aging)
+        pop = _steady_cohorts(params, v_start, aging)
         state.load(pop)
         state.v = v_start
     elif start_velocity is not None:
@@ -196,12 +206,20 @@ def run_transient(
     snap_index = 0
     if chains_on:
         events.append(("stick", 0.0, sigma0, 0.0))
+    reducer = None
+    if reduction == "auto" and max_step is None:  # a bound on the cohorts' step asks for the cohorts throughout
+        reducer = _Reducer(params, p, functions, control, k_block, float(rtol), aging)
+        reducer.disturbed(state.t)  # from empty, or a steady start: the cohorts first replace every bond
     for t0, t1, vp in protocol.pieces():
         while snap_index < len(wanted) and wanted[snap_index] <= t0 + 1e-15:
             snapshots.append(_snapshot(state))
             snap_index += 1
         if control == "velocity":
+            if reducer is not None and vp != state.v:
+                reducer.disturbed(state.t)
             state.v = vp
+        if reducer is not None:
+            reducer.next_try = state.acc[4]
         while state.t < t1 - 1e-12 * max(t1, 1.0):
             if chains_on:
                 # the stuck block: slider fixed, chains of Eq 15 carry sigma = K (P - X)
@@ -246,7 +264,7 @@ def run_transient(
                         " steady curve's reach: the paper's jump has no landing point",
                     )
                 events.append(("slip", state.t, sigma_s, vs))
-                pop = steady_population(params, vs, aging)
+                pop = _steady_cohorts(params, vs, aging)
                 state.load(pop)
                 state.v = vs
                 state.h = b.bond_time * 1e-3
@@ -258,7 +276,21 @@ def run_transient(
                     vs, vp, state.n, state.xb, state.tb, state.lw, state.x, state.t, p, *_scratch(state)
                 )
                 rows.append(_row(state, params, control, k_block))
+                if reducer is not None:
+                    reducer.loaded_steady(state)
                 continue
+            # the solver stops at the next snapshot instant (a reduced stretch rebuilds its cohorts there)
+            upcoming = [w for w in wanted[snap_index:] if state.t + 1e-15 < w < t1]
+            t_stop = upcoming[0] if upcoming else t1
+            if reducer is not None and state.acc[4] >= reducer.next_try:
+                glided, sample_index = reducer.attempt(state, t0, t_stop, vp, times, sample_index, rows)
+                if glided:
+                    while snap_index < len(wanted) and state.t + 1e-15 >= wanted[snap_index] < t1:
+                        snapshots.append(_snapshot(state))
+                        snap_index += 1
+                    if progress is not None:
+                        progress(min(1.0, state.t / duration))
+                    continue
             if control == "block":
                 state.v = slider_velocity(
                     state.v, vp, state.n, state.xb, state.tb, state.lw, state.x, state.t, p, *_scratch(state)
@@ -269,9 +301,9 @@ def run_transient(
             puller0 = state.puller - vp * (state.t - t0)  # puller position at the start t0 of this piece
             lw_new, rate0, lc, aa, w1 = (np.empty(state.xb.size) for _ in range(5))
             status, t, x, v, h, n, sample_index, count = advance(
-                state.t, t1, state.x, state.v, state.h, puller0, vp, t0, 1 if control == "block" else 0,
+                state.t, t_stop, state.x, state.v, state.h, puller0, vp, t0, 1 if control == "block" else 0,
                 state.n, state.xb, state.tb, state.lw, lw_new, rate0, lc, aa, w1, state.acc, p, float(rtol), h_max,
-                times, sample_index, out, CHUNK, stick_v, max(1, min(CHUNK, budget + 1 - int(state.acc[4]))),
+                times, sample_index, out, CHUNK, stick_v, _chunk(state, budget, reducer),
             )  # fmt: skip
             state.t, state.x, state.v, state.h, state.n = float(t), float(x), float(v), float(h), int(n)
             state.puller = puller0 + vp * (state.t - t0) if control == "block" else state.x
@@ -300,6 +332,179 @@ def run_transient(
     )
 
 
+def _chunk(state: _State, budget: int, reducer: _Reducer | None) -> int:
+    """Steps the kernel may take in this call: the budget, and the next look for a quasi-steady stretch."""
+    steps = min(CHUNK, budget + 1 - int(state.acc[4]))
+    if reducer is not None:
+        steps = min(steps, int(reducer.next_try - state.acc[4]) if reducer.next_try > state.acc[4] else steps)
+    return max(1, steps)
+
+
+def reduction_share(rtol: float) -> float:
+    from .reduction import THETA
+
+    return THETA * rtol
+
+
+class _Reducer:
+    """Switches between the cohorts and the quasi-steady reduction (transient/reduction.py)."""
+
+    FIRST_LOOK = 32  # cohort steps between looks for a quasi-steady stretch, doubled after each miss
+    LAST_LOOK = 4096
+
+    def __init__(
+        self, params: Parameters, p: np.ndarray, functions: dict, control: str, k_block: float, rtol: float, aging: bool
+    ) -> None:
+        self.params, self.p, self.functions = params, p, functions
+        self.block = control == "block"
+        self.k_block, self.rtol, self.aging = k_block, rtol, aging
+        self.disturbed_at: float | None = None
+        self.next_try = 0.0
+        self.interval = self.FIRST_LOOK
+        self.steady: dict[float, tuple[float, float, float]] = {}
+        self.unbuildable = -math.inf  # the start of the protocol piece where a table could not be built
+
+    def _steady_at(self, v: float) -> tuple[float, float, float]:
+        """(S, N, S') of the steady solver at v, remembered for the run."""
+        from ..model.steady import steady_state
+
+        if v not in self.steady:
+            ref = steady_state(self.params, v, self.aging)
+            n0 = self.params.bonds.site_density
+            self.steady[v] = (float(ref.stress), float(ref.bonded_fraction) * n0, float(ref.stress_slope))
+        return self.steady[v]
+
+    def disturbed(self, t: float) -> None:
+        """The population is out of balance from t: no reduction while bonds born before t carry weight."""
+        self.disturbed_at = t
+        self.interval = self.FIRST_LOOK
+
+    def loaded_steady(self, state: _State) -> None:
+        """A steady population was put in (the jump): the cohorts replace it before a reduced stretch."""
+        self.disturbed(state.t)
+        self.next_try = state.acc[4]
+
+    def _remembers_disturbance(self, state: _State) -> bool:
+        """Bonds born before the disturbance still carry more than a hundredth of the reduction's share."""
+        if self.disturbed_at is None:
+            return False
+        n = state.n
+        old = state.tb[:n] < self.disturbed_at
+        if not old.any():
+            self.disturbed_at = None
+            return False
+        w = np.exp(state.lw[:n])
+        f = np.abs(_force(state.x - state.xb[:n], self.params))
+        share = 1e-2 * reduction_share(self.rtol)
+        if w[old].sum() <= share * w.sum() and (w * f)[old].sum() <= share * (w * f).sum():
+            self.disturbed_at = None
+            return False
+        return True
+
+    def _miss(self, state: _State) -> None:
+        self.next_try = state.acc[4] + self.interval
+        self.interval = min(2 * self.interval, self.LAST_LOOK)
+
+    def attempt(
+        self, state: _State, t0: float, t1: float, vp: float, times: np.ndarray, sample_index: int, rows: list
+    ) -> tuple[bool, int]:
+        if self._remembers_disturbance(state):
+            self.next_try = state.acc[4] + self.FIRST_LOOK
+            return False, sample_index
+        glide = self._glide(state, t0, t1, vp, times, sample_index)
+        if glide is None:
+            self._miss(state)
+            return False, sample_index
+        rows.extend(_kernel_rows(glide.rows, self.k_block, "block" if self.block else "velocity"))
+        x_entry, t_entry = state.x, state.t
+        state.t = glide.t
+        state.v = glide.v
+        if self.block:
+            state.puller = state.puller + vp * (glide.t - t_entry)
+            state.x = state.puller - glide.sigma / self.k_block
+        else:
+            state.x = x_entry + vp * (glide.t - t_entry)
+            state.puller = state.x
+        # the cohorts again, rebuilt from the steady population (balanced against the block)
+        state.load(_steady_cohorts(self.params, glide.v, self.aging))
+        if self.block:
+            weights = np.exp(state.lw[: state.n])
+            state.x = self.functions["_balance_weights"](state.x, state.puller, state.n, state.xb, weights, self.p)
+        # the rebuilt cohorts' N and bond energy differ from the reduction's by its tabulation: the difference is
+        # booked as broken bonds and dissipated energy, so that both balances stay exact across the switch
+        nn, _ss, _k, uu = self.functions["_sums"](state.n, state.xb, state.lw, state.x, self.p)
+        state.acc[1] += glide.bonded - nn
+        state.acc[3] += glide.energy - uu
+        state.h = 1e-2 * self.params.bonds.bond_time
+        if glide.done:  # the end of a protocol piece: the next may glide on at once (if its entry check passes)
+            self.disturbed_at = None
+            self.next_try = state.acc[4]
+        else:  # the reduction's error grew past its share: cohorts from here, until they replace the rebuilt bonds
+            self.disturbed(state.t)
+            self._miss(state)
+        return True, glide.sample_index
+
+    def _glide(self, state: _State, t0: float, t1: float, vp: float, times: np.ndarray, sample_index: int):  # type: ignore[no-untyped-def]
+        from ..model.steady import steady_state
+        from . import reduction as R
+
+        b = self.params.bonds
+        v = state.v if self.block else vp
+        if state.n == 0 or not v > 0 or not vp >= 0 or (not self.block and not vp > 0):
+            return None
+        nn, ss, _k, uu = self.functions["_sums"](state.n, state.xb, state.lw, state.x, self.p)
+        sigma = self.k_block * (state.puller - state.x) if self.block else ss
+        tol = R.THETA * self.rtol
+        common = dict(t=state.t, t_end=t1, k_block=self.k_block, block=self.block, acc=state.acc,
+                      sample_times=times, sample_index=sample_index)  # fmt: skip
+        if vp > 0:
+            s_p, n_p, slope_p = self._steady_at(vp)
+            # through the block only the rising branch is steady (below Vc a slider leaves it); a rigid rig holds V
+            rising = slope_p > 0 or not self.block
+            if rising and abs(sigma - s_p) <= tol * abs(sigma) and abs(nn - n_p) <= tol * b.site_density:
+                return R.steady_glide(self.params, x=state.x, puller=state.puller, vp=vp, sigma=sigma,
+                                      steady=(s_p, n_p, slope_p), bonded=nn, energy=uu, **common)  # fmt: skip
+        if not self.block:
+            return None
+        # the table spans the velocities ahead (down to a third of v at most: a stretch ending at its edge is
+        # taken up again by a new table) and three times the fastest, for the jumps of later cycles
+        lo = max(min(v, vp), v / 3.0) * 0.99
+        hi = max(v, vp) * 1.01
+        m = R.manifold_for(self.params, self.aging, lo, hi, 3.0 * hi, self.rtol, build=False)
+        if m is None:  # worth building only where the state is near the steady curve's rising branch
+            if self.unbuildable >= t0:
+                return None
+            ref = steady_state(self.params, v, self.aging)
+            if not (float(ref.stress_slope) > 0 and abs(sigma - float(ref.stress)) <= 1e-2 * abs(sigma)):
+                return None
+            m = R.manifold_for(self.params, self.aging, lo, hi, 3.0 * hi, self.rtol)
+            if m is None:  # the steady curve cannot be tabulated here to its share of rtol: cohorts for this piece
+                self.unbuildable = t0
+                return None
+        v_entry = R.entry_velocity(m, sigma, v, vp, self.k_block, self.rtol)
+        if v_entry is None or abs(nn - float(m.bonded(math.log(v_entry))) * b.site_density) > tol * b.site_density:
+            return None
+        return R.glide(m, self.params, v=v_entry, x=state.x, puller=state.puller, vp=vp, rtol=self.rtol, bonded=nn,
+                       energy=uu, **common)  # fmt: skip
+
+
+_STEADY_COHORTS: dict[tuple[Parameters, float, bool], Population] = {}
+
+
+def _steady_cohorts(params: Parameters, velocity: float, aging: bool) -> Population:
+    """steady_population, remembered (a steady run starts and ends on the same one)."""
+    from ..model.jump import steady_curve_key
+
+    key = (steady_curve_key(params), float(velocity), bool(aging))
+    if key not in _STEADY_COHORTS:
+        if len(_STEADY_COHORTS) > 16:
+            _STEADY_COHORTS.clear()
+        from .reduction import steady_cohorts
+
+        _STEADY_COHORTS[key] = steady_cohorts(params, velocity, aging)
+    return _STEADY_COHORTS[key]
+
+
 def _force(extension: np.ndarray, params: Parameters) -> np.ndarray:
     from .model import chain_force
 
@@ -315,6 +520,7 @@ def _sample_grid(every: float | None, duration: float) -> np.ndarray:
         return np.empty(0)
     count = math.floor(duration / every + 1e-9)
     grid = every * np.arange(count + 1)
+    grid = grid[grid <= duration]  # every * count may round past the end, which no step reaches
     if duration - grid[-1] > 1e-9 * every:
         grid = np.append(grid, duration)
     return grid
@@ -461,13 +667,13 @@ def _steady_start_below_vc(
     params: Parameters, protocol: Protocol, start_velocity: float | None
 ) -> tuple[float | None, str]:
     """(start velocity, note): below Vc the default steady start moves to the stable side of the critical point."""
-    from ..model.critical import critical_point
+    from ..model.jump import cached_critical_point, steady_curve_key
 
     v_start = protocol.initial_velocity if start_velocity is None else start_velocity
     if not v_start > 0:
         return start_velocity, ""
     try:
-        cp = critical_point(params)
+        cp = cached_critical_point(steady_curve_key(params))  # once per steady curve (the jump asks for it too)
     except (ModelError, ParameterError):
         return start_velocity, ""
     if not cp.exists or cp.velocity is None or v_start >= cp.velocity:
@@ -517,7 +723,8 @@ def estimate_cost(
     estimate is within 0.4-5x of the steps taken while sliding; a stuck block
     takes far fewer, and through the block the estimate is scaled by
     :data:`BLOCK_SHARE`).  Every protocol segment and every sampling instant
-    costs at least a step.
+    costs at least a step.  These are the cohorts' steps (``reduction="off"``):
+    the quasi-steady reduction takes fewer, so the estimate bounds a run.
     """
     b, g = params.bonds, params.aging
     scale = (1e-4 / rtol) ** 0.25

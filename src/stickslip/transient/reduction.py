@@ -1,0 +1,553 @@
+r"""The quasi-steady reduction of Eq 1: where the slider changes pace slowly, the bonds are the steady population.
+
+The bonds relax over a few bond lifetimes (tau = 224 us for the gel) while a slip
+changes the slider velocity over seconds.  Along such a stretch the population is
+the steady one of the current velocity up to a known order in the acceleration:
+linearising the cohorts about steady sliding (``stability.interface_response``)
+gives sigma = Z(s)/s V for a velocity perturbation, and Z(s)/s = S'(V) + C(V) s + ...,
+so
+
+    sigma = S(V) + C(V) dV/dt + O((dV/dt)^2, d^2V/dt^2),
+
+S the steady stress of Eqs 6-8 (the steady solver) and C the first-order lag of the
+population (Pa s^2/m).  Through the block, sigma = K (P - X) and d sigma/dt = K (Vp - V);
+with the closure dV/dt ~ a0 = K (Vp - V)/S'(V) the slider obeys
+
+    sigma = S_eff(V) = S(V) + C(V) K (Vp - V)/S'(V),        dV/dt = K (Vp - V)/S_eff'(V),
+
+a scalar ODE in place of ~2000 cohorts.  What the reduction neglects is estimated by
+the next order, C (a1 - a0) + (C^2/S') da/dt (the second term is exact for a
+population with one exponential memory, Z/s = S'/(1 + sT)), and kept below
+``THETA * rtol * sigma``; where it grows (towards the fold of the steady curve at Vc,
+where S' -> 0) the solver switches back to cohorts rebuilt from the steady
+population.  Under velocity control the slider's velocity is piecewise constant,
+so a reduced stretch is exact steady sliding.  The manifold is assumed attracting: a
+fast oscillatory instability of steady sliding (Kc(V) > K, ``stability``) is not
+looked for while reduced (for the gel Kc = 0 from Vc to at least 1 mm/s).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.polynomial import chebyshev as cheb
+
+from ..parameters import Parameters
+
+#: share of the local tolerance the reduction may change the stress by (entry and stay)
+THETA = 0.3
+#: the neglected stress reported where the first-order manifold itself folds (Pa; ends a stretch)
+OFF_MANIFOLD = 1e300
+#: fewest trace rows a reduced stretch writes (the classifier reads the stress of the trace), the most, and the
+#: relative change of the slider velocity between rows
+ROWS = 64
+MAX_ROWS = 20_000
+ROW_CHANGE = 1e-3
+#: Chebyshev degrees: the steady stress and bonded fraction (raised until the check passes), the lag C
+DEGREE = 24
+MAX_DEGREE = 96
+LAG_DEGREE = 16
+#: the lag's interpolant must hold at the probes to this share of |C| (or of S' tau)
+LAG_SHARE = 0.02
+#: the steady stress interpolant must agree with the steady solver to this share of rtol between its nodes
+TABLE_SHARE = 1e-3
+
+
+@dataclass
+class Manifold:
+    """Chebyshev interpolants in ln V over [v_lo, v_hi] of the steady state and its first-order lag."""
+
+    v_lo: float
+    v_hi: float
+    stress: cheb.Chebyshev  # S(ln V), Pa
+    dstress: cheb.Chebyshev  # dS/dlnV
+    d2stress: cheb.Chebyshev
+    bonded: cheb.Chebyshev  # N/N0
+    lag: cheb.Chebyshev  # C(ln V), Pa s^2/m
+    dlag: cheb.Chebyshev  # dC/dlnV
+    energy: cheb.Chebyshev  # bond energy of the steady population (J/m^2)
+
+    def covers(self, lo: float, hi: float) -> bool:
+        return self.v_lo <= lo and hi <= self.v_hi
+
+    def rising(self, v: float) -> tuple[float, float] | None:
+        """The stretch of the table around v where S' > 0 (between the curve's extrema), narrowed by 1e-3."""
+        x = math.log(v)
+        if not (self.dstress(x) > 0 and self.v_lo < v < self.v_hi):
+            return None
+        roots = self.dstress.roots()
+        roots = roots[np.abs(roots.imag) < 1e-12].real
+        below = roots[roots < x]
+        above = roots[roots > x]
+        lo = max(self.v_lo, math.exp(below.max()) * (1 + 1e-3)) if below.size else self.v_lo
+        hi = min(self.v_hi, math.exp(above.min()) * (1 - 1e-3)) if above.size else self.v_hi
+        return (lo, hi) if lo < v < hi else None
+
+    def values(self, v: float) -> tuple[float, float, float, float, float]:
+        """(S, S', S'', C, C') at velocity v (SI)."""
+        x = math.log(v)
+        s = float(self.stress(x))
+        sx = float(self.dstress(x))
+        sxx = float(self.d2stress(x))
+        slope = sx / v
+        curv = (sxx - sx) / (v * v)
+        return s, slope, curv, float(self.lag(x)), float(self.dlag(x)) / v
+
+
+def _lag(params: Parameters, velocity: float, aging: bool) -> tuple[float, float]:
+    """(C, bond energy) at ``velocity``: C = d/ds[Z(s)/s] at s = 0 by a Richardson central difference."""
+    from .model import pack_parameters
+    from .stability import _response_kernel
+
+    b = params.bonds
+    p = pack_parameters(params, aging, 1.0)
+    a, w, width, f, fp, r, gv, energy = _steady_cells()(velocity, p, CELL_HAZARD)
+    birth_tau = b.site_density - w.sum()
+    eps = 1e-2 * velocity / b.max_extension  # far below the population's slowest rate V/dl_m
+    s = np.array([-eps, eps, -2 * eps, 2 * eps], dtype=complex)
+    z = _response_kernel()(s, a, w, width, f, fp, r, gv, b.force_sensitivity, birth_tau).real
+    q = z / s.real
+    c1 = (q[1] - q[0]) / (2 * eps)
+    c2 = (q[3] - q[2]) / (4 * eps)
+    return (4 * c1 - c2) / 3, energy
+
+
+#: age cells for C: the steady population's midpoint cells (model.steady_population, rule="midpoint")
+CELL_HAZARD = 0.05
+GAUSS = 0.5 / math.sqrt(3.0)
+MAX_CELLS = 1_000_000  # model.MAX_CELLS
+_CELLS: list = []
+
+
+def _steady_cells():  # type: ignore[no-untyped-def]
+    """model.steady_population's midpoint cells with force, stiffness, hazard and aging sensitivity (numba)."""
+    if not _CELLS:
+        from numba import njit
+
+        g = globals()
+        for name in ("_force", "_stiffness", "_energy", "_log_rate", "_march"):
+            g[name] = njit(cache=True)(g[name])
+        _CELLS.append(njit(cache=True)(_cells))
+        _CELLS.append(njit(cache=True)(_gauss))
+    return _CELLS[0]
+
+
+def steady_cohorts(params: Parameters, velocity: float, aging: bool):  # type: ignore[no-untyped-def]
+    """model.steady_population(params, velocity, aging) (the Gauss rule), compiled: the same cohorts, faster."""
+    from .model import MAX_CELLS, Population, pack_parameters, steady_population
+
+    if not (velocity > 0 and math.isfinite(velocity)):
+        return steady_population(params, velocity, aging)  # its error, in words
+    _steady_cells()
+    age, weight = _CELLS[1](float(velocity), pack_parameters(params, aging, 1.0), CELL_HAZARD)
+    if age.size >= 2 * MAX_CELLS:
+        return steady_population(params, velocity, aging)  # its error, in words
+    return Population(extension=velocity * age, age=age, weight=weight)
+
+
+def _force(e, m, dlm):  # type: ignore[no-untyped-def]
+    y = e / dlm
+    return m * e / (1.0 - y * y)
+
+
+def _stiffness(e, m, dlm):  # type: ignore[no-untyped-def]
+    y = e / dlm
+    d = 1.0 - y * y
+    return m * (1.0 + y * y) / (d * d)
+
+
+def _energy(e, m, dlm):  # type: ignore[no-untyped-def]
+    y = e / dlm
+    return -0.5 * m * dlm * dlm * math.log1p(-y * y)
+
+
+def _log_rate(age, v, slope, p):  # type: ignore[no-untyped-def]
+    """ln r of a steady bond of this age (capped at 700), kernel.P_* layout of p."""
+    force = _force(v * age, p[3], p[4])
+    return min(p[0] + p[2] * force - age * slope, 700.0)
+
+
+def _march(v, p, cell_hazard):  # type: ignore[no-untyped-def]
+    """Cell edges in age and the cumulative hazard at them: model.steady_population's march, compiled."""
+    # layout of kernel.P_*: 0 ln(u0/tau), 1 tau, 2 lambda/kT, 3 M, 4 dl_m, 5 1/tau_a, 6 V_a, 7 N0, 8 K, 9 aging
+    slope = p[5] * math.exp(-v / p[6]) if p[9] > 0.0 else 0.0
+    t_max = p[4] / v
+    widest = t_max / 1000.0
+    edges = [0.0]
+    cum = [0.0]
+    a = 0.0
+    big_h = 0.0
+    while big_h < 45.0 and a < t_max and len(edges) <= MAX_CELLS:
+        lr = _log_rate(a, v, slope, p)
+        step = widest if lr < -700.0 else min(widest, cell_hazard / math.exp(lr))
+        step = min(step, 0.05 * (t_max - a))
+        if step <= 1e-15 * a:
+            break
+        while True:  # as model.steady_population: shrink a cell over which the hazard climbs
+            r0 = math.exp(_log_rate(a, v, slope, p))
+            r1 = math.exp(_log_rate(a + 0.5 * step, v, slope, p))
+            r2 = math.exp(_log_rate(a + step, v, slope, p))
+            increment = step * (r0 + 4.0 * r1 + r2) / 6.0
+            if (increment <= 2.0 * cell_hazard and r2 <= 2.0 * r0 + 1e-300) or increment <= 0.1 * cell_hazard:
+                break
+            if step <= 1e-12 * max(a, t_max):
+                break
+            step *= 0.25
+        big_h += increment
+        a += step
+        edges.append(a)
+        cum.append(big_h)
+    return np.array(edges), np.array(cum), slope
+
+
+def _gauss(v, p, cell_hazard):  # type: ignore[no-untyped-def]
+    """(age, weight) of model.steady_population(rule="gauss"): two cohorts per cell at its Gauss points."""
+    edges, cum, slope = _march(v, p, cell_hazard)
+    n = edges.size - 1
+    age = np.empty(2 * n)
+    weight = np.empty(2 * n)
+    total = 0.0
+    for k in range(n):
+        a0 = edges[k]
+        width = edges[k + 1] - a0
+        r0 = math.exp(_log_rate(a0, v, slope, p))
+        for j in range(2):
+            ag = a0 + (0.5 - GAUSS if j == 0 else 0.5 + GAUSS) * width
+            r_mid = math.exp(_log_rate(0.5 * (a0 + ag), v, slope, p))
+            r_end = math.exp(_log_rate(ag, v, slope, p))
+            part = (ag - a0) * (r0 + 4.0 * r_mid + r_end) / 6.0
+            age[2 * k + j] = ag
+            weight[2 * k + j] = 0.5 * width * math.exp(-(cum[k] + part))
+            total += weight[2 * k + j]
+    birth = p[7] / (p[1] + total)
+    for k in range(2 * n):
+        weight[k] *= birth
+    return age, weight
+
+
+def _cells(v, p, cell_hazard):  # type: ignore[no-untyped-def]
+    dlm, m = p[4], p[3]
+    edges, cum, slope = _march(v, p, cell_hazard)
+    n = len(edges) - 1
+    mid = np.empty(n)
+    width = np.empty(n)
+    w = np.empty(n)
+    total = 0.0
+    for k in range(n):
+        mid[k] = 0.5 * (edges[k] + edges[k + 1])
+        width[k] = edges[k + 1] - edges[k]
+        dh = cum[k + 1] - cum[k]
+        s0 = math.exp(-cum[k])
+        w[k] = (s0 * -math.expm1(-dh) / dh if dh > 1e-12 else s0 * (1.0 - 0.5 * dh)) * width[k]
+        total += w[k]
+    birth = p[7] / (p[1] + total)
+    f = np.empty(n)
+    fp = np.empty(n)
+    r = np.empty(n)
+    gv = np.empty(n)
+    energy = 0.0
+    for k in range(n):
+        w[k] *= birth
+        e = v * mid[k]
+        f[k] = _force(e, m, dlm)
+        fp[k] = _stiffness(e, m, dlm)
+        r[k] = math.exp(_log_rate(mid[k], v, slope, p))
+        gv[k] = mid[k] * slope / p[6]
+        energy += w[k] * _energy(e, m, dlm)
+    return mid, w, width, f, fp, r, gv, energy
+
+
+def build_manifold(params: Parameters, aging: bool, v_lo: float, v_hi: float, rtol: float) -> Manifold | None:
+    """The interpolants over [v_lo, v_hi]; None when the steady stress cannot be tabulated to its share of rtol."""
+    from ..model.steady import steady_state
+
+    domain = [math.log(v_lo), math.log(v_hi)]
+
+    def steady(x: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        ss = steady_state(params, np.exp(x), aging)
+        return np.asarray(ss.stress, float), np.asarray(ss.bonded_fraction, float), np.asarray(ss.stress_slope, float)
+
+    degree = DEGREE
+    while True:
+        nodes = cheb.chebpts1(degree + 1)
+        x = 0.5 * (domain[0] + domain[1]) + 0.5 * (domain[1] - domain[0]) * nodes
+        probe = 0.5 * (domain[0] + domain[1]) + 0.5 * (domain[1] - domain[0]) * np.linspace(-0.97, 0.97, 9)
+        s_all, n_all, _ = steady(np.r_[x, probe])
+        stress = cheb.Chebyshev.fit(x, s_all[: x.size], degree, domain=domain)
+        bonded = cheb.Chebyshev.fit(x, n_all[: x.size], degree, domain=domain)
+        miss = np.max(np.abs(stress(probe) - s_all[x.size :]) / np.abs(s_all[x.size :]))
+        if miss <= TABLE_SHARE * rtol:
+            break
+        if degree >= MAX_DEGREE:
+            return None
+        degree *= 2
+    # the lag C varies over orders of magnitude towards the fold: its degree is raised until the fit holds at
+    # the probes to LAG_SHARE of |C|, or of S' tau (a lag shorter than a bond's life changes nothing)
+    lag_degree = LAG_DEGREE
+    probe_c, _u = _lags(params, aging, probe)
+    floor = np.abs(stress.deriv()(probe) / np.exp(probe)) * params.bonds.bond_time  # lags below a bond's life
+    while True:
+        x_c = 0.5 * (domain[0] + domain[1]) + 0.5 * (domain[1] - domain[0]) * cheb.chebpts1(lag_degree + 1)
+        c_nodes, u_nodes = _lags(params, aging, x_c)
+        lag = cheb.Chebyshev.fit(x_c, c_nodes, lag_degree, domain=domain)
+        if np.all(np.abs(lag(probe) - probe_c) <= LAG_SHARE * (np.abs(probe_c) + floor)):
+            break
+        if lag_degree >= MAX_DEGREE:
+            return None
+        lag_degree *= 2
+    energy = cheb.Chebyshev.fit(x_c, u_nodes, lag_degree, domain=domain)
+    return Manifold(v_lo, v_hi, stress, stress.deriv(), stress.deriv(2), bonded, lag, lag.deriv(), energy)
+
+
+def _lags(params: Parameters, aging: bool, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """C and the steady bond energy at velocities e^x."""
+    pairs = [_lag(params, float(math.exp(xk)), aging) for xk in x]
+    return np.array([c for c, _u in pairs]), np.array([u for _c, u in pairs])
+
+
+def effective(m: Manifold, v: float, vp: float, k_block: float) -> tuple[float, float, float]:
+    """(S_eff(V), dV/dt, neglected stress) on the first-order slow manifold through the block."""
+    s, s1, s2, c, c1 = m.values(v)
+    a0 = k_block * (vp - v) / s1
+    da0 = -k_block / s1 - k_block * (vp - v) * s2 / (s1 * s1)
+    s_eff = s + c * a0
+    ds_eff = s1 + c1 * a0 + c * da0
+    if not ds_eff > 0.0:  # past the first-order manifold's own fold: nothing quasi-steady is left here
+        return s_eff, 0.0, OFF_MANIFOLD
+    a1 = k_block * (vp - v) / ds_eff
+    neglected = abs(c * (a1 - a0)) + abs(c * c / s1 * a1 * da0)
+    return s_eff, a1, min(neglected, OFF_MANIFOLD)
+
+
+def _effective_stress(m: Manifold, v: np.ndarray, vp: float, k_block: float) -> np.ndarray:
+    """S_eff at many velocities (the first element of :func:`effective`)."""
+    x = np.log(v)
+    slope = m.dstress(x) / v
+    return m.stress(x) + m.lag(x) * k_block * (vp - v) / slope
+
+
+def entry_velocity(m: Manifold, sigma: float, v: float, vp: float, k_block: float, rtol: float) -> float | None:
+    """The velocity on the slow manifold carrying ``sigma`` near ``v``, if the state lies on it within tolerance."""
+    branch = m.rising(v)
+    if branch is None:
+        return None
+    lo, hi = branch
+    s_eff, a1, neglected = effective(m, v, vp, k_block)
+    tol = THETA * rtol * abs(sigma)
+    if not (math.isfinite(a1) and abs(s_eff - sigma) <= tol and neglected <= 0.5 * tol):
+        return None
+    for _ in range(30):  # Newton on S_eff(V) = sigma (S_eff' ~ S' > 0 on the stable branch)
+        s_eff, _a, _n = effective(m, v, vp, k_block)
+        slope = m.values(v)[1]
+        step = (s_eff - sigma) / slope
+        v -= step
+        if not (lo < v < hi):
+            return None
+        if abs(step) <= 1e-14 * v:
+            return v
+    return None
+
+
+@dataclass
+class Glide:
+    """A reduced stretch: its rows (kernel layout) and where it ended."""
+
+    t: float
+    v: float
+    sigma: float
+    rows: np.ndarray
+    done: bool  # reached t_end (else the reduction's error estimate or its table ended it)
+    sample_index: int
+    bonded: float  # N and bond energy at its end (the bookkeeping continues from them)
+    energy: float
+
+
+def glide(
+    m: Manifold,
+    params: Parameters,
+    *,
+    t: float,
+    t_end: float,
+    v: float,
+    x: float,
+    puller: float,
+    vp: float,
+    k_block: float,
+    block: bool,
+    rtol: float,
+    acc: np.ndarray,
+    bonded: float,
+    energy: float,
+    sample_times: np.ndarray,
+    sample_index: int,
+) -> Glide | None:
+    """Advance the reduced description from t towards t_end (block: the ODE above; velocity: steady sliding).
+
+    ``acc`` (born, broken, work, dissipation, steps, rejected) is updated in place; ``bonded`` and
+    ``energy`` are the cohorts' N and bond energy at entry, so that the bookkeeping stays continuous.
+    """
+    from scipy.integrate import solve_ivp
+
+    b = params.bonds
+    n0, tau = b.site_density, b.bond_time
+    tol = THETA * rtol
+    lo, hi = m.rising(v) or (m.v_lo, m.v_hi)
+
+    def rhs(_t: float, y: np.ndarray) -> np.ndarray:
+        vv = min(max(y[0], lo), hi)  # a trial stage may overshoot; the events end the stretch at the edges
+        if block:
+            s_eff, a1, _n = effective(m, vv, vp, k_block)
+        else:
+            s_eff, a1 = float(m.stress(math.log(vv))), 0.0
+        born = (n0 - n0 * float(m.bonded(math.log(vv)))) / tau
+        return np.array([a1, born, s_eff * vp, s_eff * vv])
+
+    def off_manifold(_t: float, y: np.ndarray) -> float:
+        s_eff, _a, neglected = effective(m, min(max(y[0], lo), hi), vp, k_block)
+        return neglected - tol * abs(s_eff)
+
+    def off_table(_t: float, y: np.ndarray) -> float:
+        return min(y[0] / lo - 1.0 - 1e-6, 1.0 - 1e-6 - y[0] / hi)
+
+    off_manifold.terminal = True  # type: ignore[attr-defined]
+    off_table.terminal = True  # type: ignore[attr-defined]
+    events = [off_manifold, off_table] if block else []
+    y0 = np.array([v, 0.0, 0.0, 0.0])
+    sol = solve_ivp(
+        rhs, (t, t_end), y0, method="DOP853", rtol=1e-3 * rtol, atol=[1e-9 * v, 1e-12 * n0, 1e-30, 1e-30],
+        events=events, dense_output=True,
+    )  # fmt: skip
+    if not (np.all(np.isfinite(sol.y[:, -1])) and sol.y[0, -1] > 0.0 and sol.t.size > 1):
+        return None  # the stretch could not be followed (the caller leaves it to the cohorts)
+    t_stop = float(sol.t[-1])
+    done = sol.status == 0 and t_stop >= t_end
+    # rows where the velocity moves by ROW_CHANGE at most (a summary of the trace, such as a mean stress by the
+    # trapezoid rule, then reads the same as the cohorts' row per step), and at the ODE's own steps
+    turns = abs(math.log(max(float(sol.y[0, -1]), 1e-300) / v)) / ROW_CHANGE
+    times = np.unique(np.r_[sol.t, np.linspace(t, t_stop, int(min(max(turns, ROWS), MAX_ROWS)))])
+    if sample_times.size:
+        inside = (sample_times > t) & (sample_times <= t_stop + 1e-12 * max(t_stop, 1.0))
+        times = np.r_[sample_times[inside]]
+        sample_index = int(np.searchsorted(sample_times, t_stop + 1e-12 * max(t_stop, 1.0), side="right"))
+    else:
+        times = times[times > t]
+    y = sol.sol(times) if times.size else np.empty((4, 0))
+    vel = y[0]
+    logv = np.log(vel)
+    if block:
+        sigma = _effective_stress(m, vel, vp, k_block)
+        pull = puller + vp * (times - t)
+        pos = pull - sigma / k_block
+    else:
+        sigma = m.stress(logv)
+        pos = x + vp * (times - t)
+        pull = pos
+    nn = n0 * m.bonded(logv)
+    uu = m.energy(logv)
+    born = acc[0] + y[1]
+    broken = acc[1] + y[1] - (nn - bonded)
+    work = acc[2] + y[2]
+    dissipation = acc[3] + y[3] - (uu - energy)
+    rows = np.c_[times, sigma, nn, vel, pos, pull, born, broken, work, dissipation, uu]
+    end = sol.sol(t_stop)
+    v_end = float(end[0])
+    sigma_end = effective(m, v_end, vp, k_block)[0] if block else float(m.stress(math.log(v_end)))
+    acc[0] += end[1]
+    acc[2] += end[2]
+    nn_end = n0 * float(m.bonded(math.log(v_end)))
+    acc[1] += end[1] - (nn_end - bonded)
+    u_end = float(m.energy(math.log(v_end)))
+    acc[3] += end[3] - (u_end - energy)
+    acc[4] += max(1, sol.t.size - 1)
+    return Glide(t_stop, v_end, sigma_end, rows, done, sample_index, nn_end, u_end)
+
+
+#: manifolds built so far, per (parameter set, aging): a sweep or a comparison reuses them
+_BUILT: dict[tuple[Parameters, bool], list[tuple[Manifold, float]]] = {}
+
+
+def manifold_for(
+    params: Parameters, aging: bool, lo: float, hi: float, build_hi: float, rtol: float, build: bool = True
+) -> Manifold | None:
+    """A manifold covering [lo, hi] at ``rtol``, built up to ``build_hi`` so that later stretches reuse it.
+
+    ``build=False``: only one built before (None if there is none).
+    """
+    from ..model.jump import steady_curve_key
+
+    built = _BUILT.setdefault((steady_curve_key(params), aging), [])  # the block's stiffness plays no part
+    for m, tol in built:
+        if m.covers(lo, hi) and tol <= rtol:
+            return m
+    if not build:
+        return None
+    m = build_manifold(params, aging, lo, max(hi, build_hi), rtol)
+    if m is not None:
+        built.append((m, rtol))
+        del built[:-8]
+    return m
+
+
+def steady_glide(
+    params: Parameters,
+    *,
+    t: float,
+    t_end: float,
+    x: float,
+    puller: float,
+    vp: float,
+    sigma: float,
+    steady: tuple[float, float, float],
+    bonded: float,
+    energy: float,
+    k_block: float,
+    block: bool,
+    acc: np.ndarray,
+    sample_times: np.ndarray,
+    sample_index: int,
+) -> Glide:
+    """Steady sliding at vp from t to t_end, the population the steady one (S, N of the steady solver).
+
+    ``steady`` = (S, N, S') at vp.  Under velocity control sigma = S(vp) (the cohorts' limit; they are within
+    THETA rtol of it at entry).  Through the block the rest of the cohorts' stress, d = sigma - S, relaxes
+    quasi-statically, d' = -(K/S') d (the slider at vp + d/S'), exact to first order in d.
+    """
+    b = params.bonds
+    s_ss, n_ss, slope = steady
+    times = np.linspace(t, t_end, ROWS + 1)[1:]
+    if sample_times.size:
+        inside = (sample_times > t) & (sample_times <= t_end + 1e-12 * max(t_end, 1.0))
+        times = sample_times[inside]
+        sample_index = int(np.searchsorted(sample_times, t_end + 1e-12 * max(t_end, 1.0), side="right"))
+    birth = (b.site_density - n_ss) / b.bond_time
+    rate = k_block / slope if block else 0.0
+    d0 = sigma - s_ss if block else 0.0
+
+    def state(dt: np.ndarray) -> tuple[np.ndarray, ...]:
+        decay = np.exp(-rate * dt)
+        stress = s_ss + d0 * decay
+        velocity = vp + d0 * decay / slope if block else vp + 0.0 * dt
+        pull = puller + vp * dt
+        pos = pull - stress / k_block if block else x + vp * dt
+        # the integral of d over the stretch, with its limit d0 dt where the relaxation is slow
+        shed = d0 * dt if rate * np.max(np.atleast_1d(dt), initial=0.0) < 1e-8 else d0 * -np.expm1(-rate * dt) / rate
+        work = vp * (s_ss * dt + shed)
+        dissipation = s_ss * vp * dt + (vp + s_ss / slope) * shed if block else work
+        return stress, velocity, np.where(block, pull, pos), pos, work, dissipation
+
+    dt = times - t
+    stress, velocity, pull, pos, work, dissipation = state(dt)
+    one = np.ones_like(times)
+    rows = np.c_[
+        times, stress, n_ss * one, velocity, pos, pull, acc[0] + birth * dt, acc[1] + birth * dt - (n_ss - bonded),
+        acc[2] + work, acc[3] + dissipation, energy * one,
+    ]  # fmt: skip
+    end = state(np.array([t_end - t]))
+    acc[0] += birth * (t_end - t)
+    acc[1] += birth * (t_end - t) - (n_ss - bonded)
+    acc[2] += float(end[4][0])
+    acc[3] += float(end[5][0])
+    acc[4] += 1
+    return Glide(t_end, float(end[1][0]), float(end[0][0]), rows, True, sample_index, n_ss, energy)
