@@ -108,7 +108,7 @@ CASES: list[tuple[list[str], int, str]] = [
     (["rsf", "simulate", "--protocol", "longdur.csv"], 2, "state renewals"),
     (["rsf", "simulate", "--protocol", "bom.csv", "--json"], 0, '"regime": "steady sliding"'),
     (["rsf", "simulate", "--protocol", "semi.csv", "--json"], 0, '"regime": "steady sliding"'),
-    (["rsf", "simulate", *SEG, "--protocol", "empty.csv"], 2, "--protocol: give either a protocol file or --v0/--duration/--segment, not both"),
+    (["rsf", "simulate", *SEG, "--protocol", "empty.csv"], 2, "--protocol: give either a protocol file or --v0"),
     # --- rsf simulate --params: not a parameter file (issue 18: internal errors)
     (["rsf", "simulate", "--params", "bad.json", *SEG], 2, "--params bad.json: malformed JSON"),
     (["rsf", "simulate", "--params", "list.json", *SEG], 2, "expected a table of parameters (a JSON object), got list"),
