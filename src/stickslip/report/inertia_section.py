@@ -74,7 +74,7 @@ def inertia_figure(run: ModelRun) -> ReportFigure:
     for ax in (ax_im, ax_re):
         apply_style(ax)
     fig.tight_layout()
-    return ReportFigure("inertia_hopf", "Issue 22 Q4", "Inertia and radiation damping at the Hopf point",
+    return ReportFigure("inertia_hopf", "Extension", "Inertia and radiation damping at the Hopf point",
                         _caption(rows, root, massless, gel, heavy), fig)  # fmt: skip
 
 

@@ -60,7 +60,7 @@ def sensitivity_figure(run: ModelRun) -> ReportFigure:
         apply_style(ax)
     fig.tight_layout()
     return ReportFigure(
-        "sensitivity_aging", "Issue 22 Q2", "What the predictions rest on: τa and Va", _caption(region, table), fig
+        "sensitivity_aging", "Extension", "What the predictions rest on: τa and Va", _caption(region, table), fig
     )
 
 
