@@ -7,10 +7,14 @@ The run is a list of named steps so that a caller can show progress
 from __future__ import annotations
 
 import json
+import multiprocessing
+import os
 import stat
+import sys
 import time
-from collections.abc import Callable
-from dataclasses import dataclass
+from collections.abc import Callable, Iterator
+from concurrent.futures import ProcessPoolExecutor
+from dataclasses import dataclass, replace
 from datetime import datetime, timezone
 from pathlib import Path
 from typing import Any
@@ -102,6 +106,7 @@ def build_report(
     folder: str | Path = "stickslip-report",
     progress: ProgressCallback | None = None,
     params: Parameters | None = None,
+    workers: int | None = None,
 ) -> Report:
     """Reproduce the paper's figures and numbers into ``folder``; returns what was written.
 
@@ -109,7 +114,9 @@ def build_report(
     PNG and one SVG per figure and one CSV per plotted curve.  ``params``
     defaults to the built-in ``gelatin-glass`` set, the paper's.  ``folder``
     must be new, empty or hold an earlier report (a DataError otherwise), and
-    every file is written atomically.
+    every file is written atomically.  ``workers``: processes drawing the
+    figures (default: one per available core, at most two; 1 draws them in
+    this process); the report is the same whatever the number.
     """
     started = time.perf_counter()
     folder = prepare_report_folder(folder)
@@ -134,16 +141,10 @@ def build_report(
     rendered: list[RenderedFigure] = []
     figure_paths: list[Path] = []
     curve_paths: list[Path] = []
-    for description, builder in FIGURE_BUILDERS:
-        step(description)
-        figure = builder(run)
-        png, paths = _write(lambda f=figure: save_figure_files(f, folder))
+    for item, paths, csvs in _rendered_figures(run, folder, step, workers):
+        rendered.append(item)
         figure_paths += paths
-        curves = tuple(figure.curves())
-        for curve in curves:
-            curve_paths.append(_write_text(folder / f"{curve.name}.csv", curve.to_csv()))
-        rendered.append(RenderedFigure(figure, png, curves))
-        figure.figure.clear()
+        curve_paths += csvs
 
     step("Comparing every number the paper states")
     links = resolve_errata({e.id: e.title for e in errata.entries})
@@ -243,6 +244,61 @@ def _version() -> str:
     from .. import __version__
 
     return __version__
+
+
+def _render(run: ModelRun, index: int, folder: Path) -> tuple[RenderedFigure, list[Path], list[Path]]:
+    """Build figure ``index`` of FIGURE_BUILDERS, write its PNG, SVG and curve CSVs; what the HTML needs of it."""
+    figure = FIGURE_BUILDERS[index][1](run)
+    png, paths = _write(lambda: save_figure_files(figure, folder))
+    curves = tuple(figure.curves())
+    csvs = [_write_text(folder / f"{curve.name}.csv", curve.to_csv()) for curve in curves]
+    figure.figure.clear()
+    return RenderedFigure(replace(figure, figure=None), png, curves), paths, csvs
+
+
+#: The model run the forked figure workers read (set only while they run; a fork shares it without pickling).
+_SHARED_RUN: ModelRun | None = None
+
+
+def _render_in_worker(index: int, folder: Path) -> tuple[RenderedFigure, list[Path], list[Path]]:
+    assert _SHARED_RUN is not None
+    return _render(_SHARED_RUN, index, folder)
+
+
+def _figure_workers(workers: int | None) -> int:
+    """Processes to draw the figures in: forked ones only where fork exists (they share the model run)."""
+    if workers is not None:
+        return max(1, int(workers))
+    if sys.platform != "linux" or "fork" not in multiprocessing.get_all_start_methods():
+        return 1
+    return min(2, len(os.sched_getaffinity(0)))
+
+
+def _rendered_figures(
+    run: ModelRun, folder: Path, step: Callable[[str], None], workers: int | None
+) -> Iterator[tuple[RenderedFigure, list[Path], list[Path]]]:
+    """Every figure of FIGURE_BUILDERS in order; drawn in forked processes when there is more than one core.
+
+    The figures are independent of one another once the model steps ran, and drawing them is most of the
+    report's time: two processes halve it on two cores.
+    """
+    count = _figure_workers(workers)
+    if count == 1:
+        for index, (description, _) in enumerate(FIGURE_BUILDERS):
+            step(description)
+            yield _render(run, index, folder)
+        return
+    global _SHARED_RUN
+    _SHARED_RUN = run
+    try:
+        context = multiprocessing.get_context("fork")
+        with ProcessPoolExecutor(max_workers=count, mp_context=context) as pool:
+            futures = [pool.submit(_render_in_worker, i, folder) for i in range(len(FIGURE_BUILDERS))]
+            for (description, _), future in zip(FIGURE_BUILDERS, futures, strict=True):
+                step(description)
+                yield future.result()
+    finally:
+        _SHARED_RUN = None
 
 
 def _write(action: Callable[[], Any]) -> Any:

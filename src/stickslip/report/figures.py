@@ -27,7 +27,7 @@ class ReportFigure:
     number: str  # the paper's numbering, e.g. "Figs 1 and 4"
     title: str
     caption: str  # plain text
-    figure: Figure
+    figure: Figure | None  # None once drawn and written (what the HTML and results.json need stays)
 
     def png(self) -> bytes:
         return png_bytes(self.figure)
