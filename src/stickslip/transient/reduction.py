@@ -35,6 +35,7 @@ import numpy as np
 from numpy.polynomial import chebyshev as cheb
 
 from ..parameters import Parameters
+from . import kernel
 
 #: share of the local tolerance the reduction may change the stress by (entry and stay)
 THETA = 0.3
@@ -127,7 +128,9 @@ def _steady_cells():  # type: ignore[no-untyped-def]
         from numba import njit
 
         g = globals()
-        for name in ("_force", "_stiffness", "_energy", "_log_rate", "_march"):
+        kernel.compiled()  # the kernel's chain functions, compiled in place
+        g["_force"], g["_stiffness"], g["_energy"] = kernel._chain_force, kernel._chain_stiffness, kernel._chain_energy
+        for name in ("_log_rate", "_march"):
             g[name] = njit(cache=True)(g[name])
         _CELLS.append(njit(cache=True)(_cells))
         _CELLS.append(njit(cache=True)(_gauss))
@@ -147,20 +150,8 @@ def steady_cohorts(params: Parameters, velocity: float, aging: bool):  # type: i
     return Population(extension=velocity * age, age=age, weight=weight)
 
 
-def _force(e, m, dlm):  # type: ignore[no-untyped-def]
-    y = e / dlm
-    return m * e / (1.0 - y * y)
-
-
-def _stiffness(e, m, dlm):  # type: ignore[no-untyped-def]
-    y = e / dlm
-    d = 1.0 - y * y
-    return m * (1.0 + y * y) / (d * d)
-
-
-def _energy(e, m, dlm):  # type: ignore[no-untyped-def]
-    y = e / dlm
-    return -0.5 * m * dlm * dlm * math.log1p(-y * y)
+# the chain's force, stiffness and energy are the kernel's (Eq 3), one definition
+_force, _stiffness, _energy = kernel._chain_force, kernel._chain_stiffness, kernel._chain_energy
 
 
 def _log_rate(age, v, slope, p):  # type: ignore[no-untyped-def]
