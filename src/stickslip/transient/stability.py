@@ -29,7 +29,7 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..parameters import Parameters
-from .model import chain_force, log_hazard, steady_population
+from .model import aging_age, chain_force, log_hazard, steady_population
 
 #: frequencies / growth rates scanned, in units of 1/tau: from 1e-6 to 1e4
 SCAN = np.geomspace(1e-6, 1e6, 561)
@@ -82,7 +82,8 @@ def _cells(params: Parameters, velocity: float, aging: bool) -> tuple[np.ndarray
     f = chain_force(e, params)
     fp = _stiffness(e, params)
     r = np.exp(np.minimum(log_hazard(e, a, velocity, params, aging), 700.0))
-    gv = a * math.exp(-velocity / g.aging_velocity) / (g.aging_time * g.aging_velocity) if aging else np.zeros_like(a)
+    aged = aging_age(a, params)  # t_a, or the saturating extension's t_s (1 - e^(-t_a/t_s))
+    gv = aged * math.exp(-velocity / g.aging_velocity) / (g.aging_time * g.aging_velocity) if aging else np.zeros_like(a)
     # cell widths: the midpoints a_k are centred in cells that tile [0, a_end]
     width = np.empty_like(a)
     left = 0.0
