@@ -57,7 +57,8 @@ BOLTZMANN = 1.380649e-23  # J/K, exact in the 2019 SI
 
 
 def _spec(dimension: str, symbol: str, doc: str, zero_allowed: bool = False, optional: bool = False) -> Any:
-    metadata = {"dimension": dimension, "symbol": symbol, "doc": doc, "zero_allowed": zero_allowed, "optional": optional}
+    metadata = {"dimension": dimension, "symbol": symbol, "doc": doc, "zero_allowed": zero_allowed}
+    metadata["optional"] = optional
     if optional:  # an extension's key: absent (None) means the paper's model
         return field(default=None, metadata=metadata)
     return field(metadata=metadata)

@@ -83,7 +83,7 @@ def _cells(params: Parameters, velocity: float, aging: bool) -> tuple[np.ndarray
     fp = _stiffness(e, params)
     r = np.exp(np.minimum(log_hazard(e, a, velocity, params, aging), 700.0))
     aged = aging_age(a, params)  # t_a, or the saturating extension's t_s (1 - e^(-t_a/t_s))
-    gv = aged * math.exp(-velocity / g.aging_velocity) / (g.aging_time * g.aging_velocity) if aging else np.zeros_like(a)
+    gv = aged * (math.exp(-velocity / g.aging_velocity) / (g.aging_time * g.aging_velocity)) if aging else 0.0 * a
     # cell widths: the midpoints a_k are centred in cells that tile [0, a_end]
     width = np.empty_like(a)
     left = 0.0
