@@ -26,6 +26,8 @@ KEYS = ("aging.aging_time", "aging.aging_velocity", "aging.saturation_age")
 #: where the maximum (creep/slip) and the minimum (Vc) of the N-shaped curve are looked for, m/s
 PEAK_RANGE = (1e-8, 6e-5)
 MINIMUM_RANGE = (2e-5, 4e-4)
+#: residual of a trial set whose curve has no minimum near Vc
+FAILED_RESIDUAL = 1e3
 
 
 @dataclass(frozen=True)
@@ -108,7 +110,10 @@ def fit_saturation(params: Parameters, velocity: np.ndarray, stress: np.ndarray,
 
     def residuals(theta: np.ndarray) -> np.ndarray:
         p = at(theta)
-        peak, minimum = curve_extrema(p)
+        try:
+            peak, minimum = curve_extrema(p)
+        except ModelError:  # no minimum near Vc: a curve Table 1 rules out; the optimiser steps back
+            return np.full(velocity.size + 2, FAILED_RESIDUAL)
         peak_stress = peak.stress if peak is not None else 0.0  # no maximum: the model has no static threshold
         steady = (steady_state(p, velocity).stress - stress) / error
         return np.r_[steady, (peak_stress - peak_goal) / peak_err, (minimum.stress - min_goal) / min_err]

@@ -19,6 +19,7 @@ from ..errors import DataError
 from ..fileio import atomic_write_text
 from ..parameters import Parameters, load_parameters
 from ..units import shorten
+from .aging_section import AGING_FIGURES
 from .comparisons import TOLERANCE, Comparison, compare, count_classes
 from .computations import ModelRun, computed_values, run_steps
 from .errata import Errata, load_errata
@@ -29,7 +30,7 @@ from .report_figures import FIGURE_BUILDERS as PAPER_FIGURES
 from .sweep_section import SWEEP_FIGURES
 from .transient_section import TRANSIENT_FIGURES
 
-FIGURE_BUILDERS = [*PAPER_FIGURES, *SWEEP_FIGURES, *TRANSIENT_FIGURES]
+FIGURE_BUILDERS = [*PAPER_FIGURES, *SWEEP_FIGURES, *TRANSIENT_FIGURES, *AGING_FIGURES]
 
 #: Called before each step with (description, steps done, total steps), and once more at the end.
 ProgressCallback = Callable[[str, int, int], None]
