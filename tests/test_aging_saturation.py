@@ -133,3 +133,58 @@ def test_saturation_makes_the_steady_curve_n_shaped() -> None:
     assert np.min(stress[top:]) < stress[top]
     # the paper's curve rises without a maximum as V falls
     assert np.all(np.diff(steady_state(GEL, v[v < 1e-4]).stress) < 0)
+
+
+def test_fit_recovers_a_known_saturation_age() -> None:
+    """Steady data and Table-1-like stresses made from a known set: the fit, started elsewhere, finds it again."""
+    import pandas as pd
+
+    from stickslip.fitting.saturation_fit import curve_extrema, fit_saturation
+
+    peak, minimum = curve_extrema(SAT)
+    assert peak is not None
+    velocity = np.geomspace(140e-6, 2e-3, 12)
+    stress = steady_state(SAT, velocity).stress
+    spread = np.array([-2.0, 0.0, 2.0])  # Pa: the cycles scatter about the curve's extrema
+    table = pd.DataFrame(
+        {
+            "pulling_velocity": [50e-6] * 3 + [100e-6],
+            "cycle": [1, 2, 3, 1],
+            "peak_stress": [*(peak.stress + spread), 5000.0],  # the first cycle at 100 um/s starts from rest: left out
+            "start_stress": [*(minimum.stress + spread), minimum.stress],
+        }
+    )
+    start = GEL.with_overrides({"aging.saturation_age": "4 ms"})
+    fit = fit_saturation(start, velocity, stress, 0.02 * stress, table)
+    assert fit.values["aging.saturation_age"] == pytest.approx(TS, rel=1e-4)
+    assert fit.values["aging.aging_time"] == pytest.approx(0.6456e-3, rel=1e-4)
+    lo, hi = fit.intervals["aging.saturation_age"]
+    assert lo < TS < hi
+    assert fit.peak.stress == pytest.approx(peak.stress, rel=1e-5)
+
+
+def test_quasi_static_stick_time_against_a_quadrature() -> None:
+    """The report's cycle (trapezoid in sigma on the creep branch) against Gauss-Legendre in ln V with the
+    analytic slope: t = int dsigma/dV dV / (K (V0 - V)) from the landing at sigma_c to the maximum."""
+    from scipy.optimize import brentq
+
+    from stickslip.fitting.saturation_fit import curve_extrema
+    from stickslip.report.aging_section import quasi_static_cycle
+
+    peak, minimum = curve_extrema(SAT)
+    assert peak is not None
+    v0 = 50e-6
+    _t, _s, stick, slip, jump = quasi_static_cycle(SAT, v0, peak, minimum, 30.0)
+    k = SAT.block.effective_stiffness
+    landing = brentq(
+        lambda lv: float(steady_state(SAT, math.exp(lv)).stress) - minimum.stress, -40.0, math.log(peak.velocity)
+    )
+    nodes, weights = np.polynomial.legendre.leggauss(120)
+    lo, hi = landing, math.log(peak.velocity)
+    ln_v = 0.5 * (hi - lo) * nodes + 0.5 * (hi + lo)
+    v = np.exp(ln_v)
+    slope = steady_state(SAT, v).stress_slope
+    exact = 0.5 * (hi - lo) * float(np.sum(weights * slope * v / (k * (v0 - v))))
+    assert stick == pytest.approx(exact, rel=1e-5)
+    assert float(steady_state(SAT, jump).stress) == pytest.approx(peak.stress, rel=1e-9)
+    assert 0.0 < slip < stick
