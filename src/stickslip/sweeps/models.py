@@ -85,7 +85,7 @@ class BondModel:
 
     def parameters(self, values: Mapping[str, float]) -> tuple[Parameters, float]:
         """(the parameter set, the pulling velocity) of one point."""
-        params = _parameter_set(tuple(values[k] for k in parameter_keys()))
+        params = _parameter_set(tuple(values.get(k) for k in parameter_keys()))  # an extension's key may be absent
         block = params.block
         if "block.stiffness" in values:
             params = params.with_overrides({"block.height": block.shear_modulus / _positive(values, "block.stiffness")})
@@ -116,10 +116,12 @@ class BondModel:
 
 
 @lru_cache(maxsize=64)
-def _parameter_set(values: tuple[float, ...]) -> Parameters:
+def _parameter_set(values: tuple[float | None, ...]) -> Parameters:
     """Parameters from the SI values of :func:`parameter_keys`, in that order (validated)."""
     nested: dict[str, dict[str, float]] = {}
     for key, value in zip(parameter_keys(), values, strict=True):
+        if value is None:  # an extension's optional key left out: the paper's model
+            continue
         section, _, name = key.partition(".")
         nested.setdefault(section, {})[name] = value
     return parameters_from_mapping({"name": "sweep point", **nested}, "sweep point")
