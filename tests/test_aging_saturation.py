@@ -124,6 +124,17 @@ def test_steady_curve_with_saturation_against_an_ode(velocity: float) -> None:
     assert float(got.stress_slope) * velocity == pytest.approx(float(diff), rel=1e-5, abs=1e-6 * stress)
 
 
+def test_a_batch_mixing_sets_with_and_without_saturation_matches_each_set() -> None:
+    """steady_stress_many (fits, sweeps) in one march: the paper's lanes exactly as alone, the extension's too."""
+    from stickslip.model.steady import steady_stress_many
+
+    v = np.array([20e-6, 124e-6, 350e-6])
+    both = steady_stress_many([GEL, SAT, GEL], v)
+    assert np.array_equal(both[0], steady_state(GEL, v).stress)
+    assert np.array_equal(both[2], steady_state(GEL, v).stress)
+    assert np.allclose(both[1], steady_state(SAT, v).stress, rtol=1e-12, atol=0)
+
+
 def test_saturation_makes_the_steady_curve_n_shaped() -> None:
     """With saturation the curve has a low-velocity maximum (the static threshold) before the minimum at Vc."""
     v = np.geomspace(1e-7, 3e-4, 60)

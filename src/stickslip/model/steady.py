@@ -150,10 +150,11 @@ class _Scales:
     alpha: np.ndarray
     beta: np.ndarray  # -d(alpha)/d(ln V) / ... : alpha (1 + V/V_a)
     birth: np.ndarray  # tau V / dl_m = u0/T
-    # the saturating-aging extension (docs/extensions.md): 1/x_s = dl_m/(V t_s), 0 for the paper's linear aging,
-    # and V/V_a; the aging term -alpha x becomes -alpha (1 - e^(-x/x_s)) x_s
-    sat: np.ndarray
-    ratio: np.ndarray
+    # the saturating-aging extension (docs/extensions.md): 1/x_s = dl_m/(V t_s) (0 in a lane without it) and
+    # V/V_a; the aging term -alpha x becomes -alpha (1 - e^(-x/x_s)) x_s.  None when no lane has it: the
+    # paper's model then runs exactly the code it always did, at no extra cost
+    sat: np.ndarray | None = None
+    ratio: np.ndarray | None = None
 
 
 def _scales(params: Parameters, velocity: np.ndarray, aging: bool) -> _Scales:
@@ -169,29 +170,29 @@ def _scales(params: Parameters, velocity: np.ndarray, aging: bool) -> _Scales:
         alpha = np.zeros_like(velocity)
         beta = np.zeros_like(velocity)
     ts = g.saturation_age
-    sat = np.zeros_like(velocity) if ts is None or not aging else b.max_extension / (velocity * ts)
+    saturating = ts is not None and aging
     return _Scales(
         log_t=log_t,
         a=np.full_like(velocity, a),
         alpha=alpha,
         beta=beta,
         birth=b.bond_time * velocity / b.max_extension,
-        sat=sat,
-        ratio=velocity / g.aging_velocity,
+        sat=b.max_extension / (velocity * ts) if saturating else None,
+        ratio=velocity / g.aging_velocity if saturating else None,
     )
 
 
-def _aged(x: np.ndarray, sat: np.ndarray) -> np.ndarray:
+def _aged(x: np.ndarray, sat: np.ndarray | None) -> np.ndarray:
     """The scaled age the aging term sees: x (the paper), or (1 - e^(-x sat))/sat with saturation."""
-    if not np.any(sat > 0.0):
+    if sat is None:
         return x
     safe = np.where(sat > 0.0, sat, 1.0)
     return np.where(sat > 0.0, -np.expm1(-x * safe) / safe, x)
 
 
-def _aged_rate(x: np.ndarray, sat: np.ndarray) -> np.ndarray | float:
+def _aged_rate(x: np.ndarray, sat: np.ndarray | None) -> np.ndarray | float:
     """d(aged)/dx: 1, or e^(-x sat) with saturation."""
-    if not np.any(sat > 0.0):
+    if sat is None:
         return 1.0
     return np.exp(-x * sat)
 
@@ -202,7 +203,7 @@ def _ln_v_moment(x: np.ndarray, s: _Scales) -> np.ndarray:
     With saturation the aging term is -(t_s/tau_a) e^(-V/V_a) (1 - e^(-x/x_s)), x_s = t_s V/dl_m; at fixed x
     its ln V derivative is alpha (ratio (1 - e^(-u))/sat + x e^(-u)), u = x sat (docs/extensions.md).
     """
-    if not np.any(s.sat > 0.0):
+    if s.sat is None or s.ratio is None:
         return x
     return (s.ratio * _aged(x, s.sat) + x * _aged_rate(x, s.sat)) / (1.0 + s.ratio)
 
@@ -224,6 +225,21 @@ def _check_scales(s: _Scales) -> None:
     bad = ~(np.isfinite(s.log_t) & np.isfinite(s.birth))
     if np.any(bad):
         raise ModelError("the breakage rate u0 dl_m/(V tau) or tau V/dl_m is not finite for these parameters")
+
+
+def _join(parts: Sequence[_Scales]) -> _Scales:
+    """One _Scales of many lanes; the saturation fields are zeros (sat) in lanes without the extension."""
+    columns = {}
+    for f in dataclasses.fields(_Scales):
+        pieces = [getattr(part, f.name) for part in parts]
+        if all(piece is None for piece in pieces):
+            columns[f.name] = None
+            continue
+        fill = 1.0 if f.name == "ratio" else 0.0
+        pairs = zip(parts, pieces, strict=True)
+        filled = [np.full(part.log_t.shape, fill) if piece is None else piece for part, piece in pairs]
+        columns[f.name] = np.concatenate(filled)
+    return _Scales(**columns)
 
 
 def _log_hazard_and_slope(x: np.ndarray, y: np.ndarray, s: _Scales) -> tuple[np.ndarray, np.ndarray]:
@@ -349,7 +365,9 @@ class _Lanes:
 
 def _take(s: _Scales, k: np.ndarray | slice) -> _Scales:
     """The lanes ``k`` of ``s``."""
-    return _Scales(s.log_t[k], s.a[k], s.alpha[k], s.beta[k], s.birth[k], s.sat[k], s.ratio[k])
+    sat = None if s.sat is None else s.sat[k]
+    ratio = None if s.ratio is None else s.ratio[k]
+    return _Scales(s.log_t[k], s.a[k], s.alpha[k], s.beta[k], s.birth[k], sat, ratio)
 
 
 @dataclass
@@ -625,7 +643,7 @@ def steady_stress_many(
     else:
         parts = [_scales(p, v, aging) for p in params_list]
         scale = np.repeat([_stress_scale(p) for p in params_list], v.size)
-    joined = _Scales(*(np.concatenate([getattr(part, f.name) for part in parts]) for f in dataclasses.fields(_Scales)))
+    joined = _join(parts)
     _check_scales(joined)
     got = _march(joined, quadrature)
     stress = scale * got.j / (joined.birth + got.i)

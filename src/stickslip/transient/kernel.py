@@ -110,7 +110,12 @@ def _velocity_prepare(n, xb, tb, lw, x, t, p, lc, aa):  # type: ignore[no-untype
         k_int += w * _chain_stiffness(e, p[P_M], p[P_DLM])
         f = _chain_force(e, p[P_M], p[P_DLM])
         lc[i] = lw[i] + math.log(f) + p[P_LOG_U0_TAU] + p[P_FORCE_SENS] * f if f > 0.0 else -np.inf
-        aa[i] = _aging_clock(t - tb[i], p)[0] * p[P_INV_TAU_A] if p[P_AGING] > 0.0 else 0.0
+        if p[P_AGING] == 0.0:
+            aa[i] = 0.0
+        elif p[P_SATURATION] > 0.0:
+            aa[i] = _aging_clock(t - tb[i], p)[0] * p[P_INV_TAU_A]
+        else:  # the paper's linear aging, kept branch-free of the extension
+            aa[i] = (t - tb[i]) * p[P_INV_TAU_A]
     return k_int
 
 
@@ -362,6 +367,7 @@ def advance(
         slope1 = _aging_factor(v1p, p)
         accel = (v1p - v0) / hh
         aging_on = p[P_AGING] > 0.0
+        saturating = p[P_SATURATION] > 0.0
         # ---- one pass over the cohorts: hazards at both ends, corrected trapezoid, error terms, sums
         nn0 = 0.0
         s0 = 0.0
@@ -407,8 +413,12 @@ def advance(
                 err_s += w0 * abs(f0)
                 err_n += w0
                 continue
-            age0, clock0 = _aging_clock(t - tb[i], p)  # the age the aging term sees, and its rate
-            age1, clock1 = _aging_clock(t1 - tb[i], p)
+            if saturating:  # the age the aging term sees, and its rate
+                age0, clock0 = _aging_clock(t - tb[i], p)
+                age1, clock1 = _aging_clock(t1 - tb[i], p)
+            else:
+                age0, clock0 = t - tb[i], 1.0
+                age1, clock1 = t1 - tb[i], 1.0
             f1 = _chain_force(e1, m, dlm)
             lr0 = min(p[P_LOG_U0_TAU] + beta * abs(f0) - age0 * slope0, LOG_RATE_CAP)
             lr1 = min(p[P_LOG_U0_TAU] + beta * abs(f1) - age1 * slope1, LOG_RATE_CAP)
