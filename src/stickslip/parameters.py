@@ -20,6 +20,8 @@ bonds.temperature         T        absolute temperature
 bonds.max_extension       dl_m     maximum chain extension (FENE, Eq 3)
 aging.aging_time          tau_a    aging time constant of Eq 1 / Eq 6
 aging.aging_velocity      V_a      characteristic aging velocity (Eq 1 / Eq 6)
+aging.saturation_age      t_s      optional: age past which a bond stops strengthening (the
+                                   saturating-aging extension, docs/extensions.md; absent = the paper)
 stick.attached_chains     Nc0      attached chains per area at the stick (Eq 15)
 stick.break_rate          uc/tau   chain breakage rate at the stick (Eq 15)
 stick.aging_time          tau_a    aging time constant of Eq 15
@@ -54,8 +56,16 @@ else:  # pragma: no cover - exercised on Python 3.10 only
 BOLTZMANN = 1.380649e-23  # J/K, exact in the 2019 SI
 
 
-def _spec(dimension: str, symbol: str, doc: str, zero_allowed: bool = False) -> Any:
-    return field(metadata={"dimension": dimension, "symbol": symbol, "doc": doc, "zero_allowed": zero_allowed})
+def _spec(dimension: str, symbol: str, doc: str, zero_allowed: bool = False, optional: bool = False) -> Any:
+    metadata = {"dimension": dimension, "symbol": symbol, "doc": doc, "zero_allowed": zero_allowed}
+    metadata["optional"] = optional
+    if optional:  # an extension's key: absent (None) means the paper's model
+        return field(default=None, metadata=metadata)
+    return field(metadata=metadata)
+
+
+def _optional(f: Any) -> bool:
+    return bool(f.metadata.get("optional", False))
 
 
 class _Validated:
@@ -67,6 +77,8 @@ class _Validated:
         for f in fields(self):  # type: ignore[arg-type]
             key = f"{self._section}.{f.name}"
             raw = getattr(self, f.name)
+            if raw is None and _optional(f):
+                continue
             if isinstance(raw, bool) or not isinstance(raw, (int, float)):
                 raise ParameterError(f"{key}: expected a number in SI units, got {shorten(raw)}")
             value = float(raw)
@@ -111,6 +123,11 @@ class AgingParameters(_Validated):
     _section = "aging"
     aging_time: float = _spec("time", "tau_a", "aging time constant")
     aging_velocity: float = _spec("velocity", "V_a", "characteristic aging velocity")
+    #: the saturating-aging extension (docs/extensions.md): the aging term's age t_a becomes
+    #: t_s (1 - exp(-t_a/t_s)); None is the paper's linear aging
+    saturation_age: float | None = _spec(
+        "time", "t_s", "age past which a bond stops strengthening (extension; none = the paper)", optional=True
+    )
 
 
 @dataclass(frozen=True)
@@ -166,6 +183,11 @@ def parameter_keys() -> list[str]:
     return [f"{s}.{f.name}" for s, cls in SECTIONS.items() for f in fields(cls)]
 
 
+def optional_keys() -> list[str]:
+    """The keys an extension adds: absent means the paper's model."""
+    return [f"{s}.{f.name}" for s, cls in SECTIONS.items() for f in fields(cls) if _optional(f)]
+
+
 def key_dimension(key: str) -> str:
     """The dimension (see :data:`stickslip.units.DIMENSIONS`) of a canonical key."""
     section, _, name = key.partition(".")
@@ -188,8 +210,13 @@ class Parameters:
     reference: str = ""
 
     def as_dict(self) -> dict[str, float]:
-        """Flat mapping ``section.key -> SI float``."""
-        return {f"{s}.{f.name}": getattr(getattr(self, s), f.name) for s, cls in SECTIONS.items() for f in fields(cls)}
+        """Flat mapping ``section.key -> SI float`` (an optional key left out is absent)."""
+        return {
+            f"{s}.{f.name}": getattr(getattr(self, s), f.name)
+            for s, cls in SECTIONS.items()
+            for f in fields(cls)
+            if getattr(getattr(self, s), f.name) is not None
+        }
 
     def with_overrides(self, overrides: Mapping[str, Any] | None) -> Parameters:
         """A new set with ``section.key`` values replaced (numbers in SI, or strings with units)."""
@@ -211,6 +238,8 @@ class Parameters:
         for s, cls in SECTIONS.items():
             for f in fields(cls):
                 value = getattr(getattr(self, s), f.name)
+                if value is None:
+                    continue
                 out.append(
                     (
                         f"{s}.{f.name}",
@@ -231,6 +260,8 @@ class Parameters:
         for s, cls in SECTIONS.items():
             lines += ["", f"[{s}]"]
             for f in fields(cls):
+                if getattr(getattr(self, s), f.name) is None:
+                    continue
                 dimension = f.metadata["dimension"]
                 text = format_quantity(getattr(getattr(self, s), f.name), dimension)
                 shown = text if dimension == "dimensionless" else _toml_str(text)
@@ -245,7 +276,7 @@ def _toml_str(text: str) -> str:
 def _build(values: Mapping[str, float], **meta: str) -> Parameters:
     sections = {}
     for s, cls in SECTIONS.items():
-        sections[s] = cls(**{f.name: values[f"{s}.{f.name}"] for f in fields(cls)})
+        sections[s] = cls(**{f.name: values[f"{s}.{f.name}"] for f in fields(cls) if f"{s}.{f.name}" in values})
     return Parameters(**sections, **meta)
 
 
@@ -269,7 +300,7 @@ def parameters_from_mapping(data: Mapping[str, Any], source: str = "parameters")
         for name, raw in content.items():
             key = f"{top}.{name}"
             values[key] = to_si(raw, key_dimension(key), f"{source}: {key}")
-    missing = [k for k in parameter_keys() if k not in values]
+    missing = [k for k in parameter_keys() if k not in values and k not in optional_keys()]
     if missing:
         raise ParameterError(f"{source}: missing parameter(s) {', '.join(missing)}")
     return _build(values, **meta)

@@ -105,6 +105,8 @@ def parameter_table(params: Parameters, changed: Sequence[str] = ()) -> Any:
     for s, cls in SECTIONS.items():
         for f in dataclasses.fields(cls):
             key = f"{s}.{f.name}"
+            if getattr(getattr(params, s), f.name) is None:  # an extension's key left out: the paper's model
+                continue
             value = human(getattr(getattr(params, s), f.name), f.metadata["dimension"])
             flag = " (set)" if key in changed else ""
             table.add_row(key + flag, symbol(f.metadata["symbol"]), value, f.metadata["doc"])

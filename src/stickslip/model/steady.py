@@ -150,6 +150,11 @@ class _Scales:
     alpha: np.ndarray
     beta: np.ndarray  # -d(alpha)/d(ln V) / ... : alpha (1 + V/V_a)
     birth: np.ndarray  # tau V / dl_m = u0/T
+    # the saturating-aging extension (docs/extensions.md): 1/x_s = dl_m/(V t_s) (0 in a lane without it) and
+    # V/V_a; the aging term -alpha x becomes -alpha (1 - e^(-x/x_s)) x_s.  None when no lane has it: the
+    # paper's model then runs exactly the code it always did, at no extra cost
+    sat: np.ndarray | None = None
+    ratio: np.ndarray | None = None
 
 
 def _scales(params: Parameters, velocity: np.ndarray, aging: bool) -> _Scales:
@@ -164,9 +169,43 @@ def _scales(params: Parameters, velocity: np.ndarray, aging: bool) -> _Scales:
     else:
         alpha = np.zeros_like(velocity)
         beta = np.zeros_like(velocity)
+    ts = g.saturation_age
+    saturating = ts is not None and aging
     return _Scales(
-        log_t=log_t, a=np.full_like(velocity, a), alpha=alpha, beta=beta, birth=b.bond_time * velocity / b.max_extension
+        log_t=log_t,
+        a=np.full_like(velocity, a),
+        alpha=alpha,
+        beta=beta,
+        birth=b.bond_time * velocity / b.max_extension,
+        sat=b.max_extension / (velocity * ts) if saturating else None,
+        ratio=velocity / g.aging_velocity if saturating else None,
     )
+
+
+def _aged(x: np.ndarray, sat: np.ndarray | None) -> np.ndarray:
+    """The scaled age the aging term sees: x (the paper), or (1 - e^(-x sat))/sat with saturation."""
+    if sat is None:
+        return x
+    safe = np.where(sat > 0.0, sat, 1.0)
+    return np.where(sat > 0.0, -np.expm1(-x * safe) / safe, x)
+
+
+def _aged_rate(x: np.ndarray, sat: np.ndarray | None) -> np.ndarray | float:
+    """d(aged)/dx: 1, or e^(-x sat) with saturation."""
+    if sat is None:
+        return 1.0
+    return np.exp(-x * sat)
+
+
+def _ln_v_moment(x: np.ndarray, s: _Scales) -> np.ndarray:
+    """m(x) with d(aging term)/d ln V = beta m(x): x for linear aging, else (ratio aged + x aged')/(1 + ratio).
+
+    With saturation the aging term is -(t_s/tau_a) e^(-V/V_a) (1 - e^(-x/x_s)), x_s = t_s V/dl_m; at fixed x
+    its ln V derivative is alpha (ratio (1 - e^(-u))/sat + x e^(-u)), u = x sat (docs/extensions.md).
+    """
+    if s.sat is None or s.ratio is None:
+        return x
+    return (s.ratio * _aged(x, s.sat) + x * _aged_rate(x, s.sat)) / (1.0 + s.ratio)
 
 
 #: FENE strength and aging rate beyond which the log-hazard's terms could overflow (the box needs < 1e17).
@@ -188,10 +227,27 @@ def _check_scales(s: _Scales) -> None:
         raise ModelError("the breakage rate u0 Δl_m/(V τ) or τV/Δl_m is not finite for these parameters")
 
 
+def _join(parts: Sequence[_Scales]) -> _Scales:
+    """One _Scales of many lanes; the saturation fields are zeros (sat) in lanes without the extension."""
+    columns = {}
+    for f in dataclasses.fields(_Scales):
+        pieces = [getattr(part, f.name) for part in parts]
+        if all(piece is None for piece in pieces):
+            columns[f.name] = None
+            continue
+        fill = 1.0 if f.name == "ratio" else 0.0
+        pairs = zip(parts, pieces, strict=True)
+        filled = [np.full(part.log_t.shape, fill) if piece is None else piece for part, piece in pairs]
+        columns[f.name] = np.concatenate(filled)
+    return _Scales(**columns)
+
+
 def _log_hazard_and_slope(x: np.ndarray, y: np.ndarray, s: _Scales) -> tuple[np.ndarray, np.ndarray]:
     """L and |L'| at x (y = 1 - x), sharing the FENE denominator."""
     d = y * (1.0 + x)
-    return s.log_t + s.a * x / d - s.alpha * x, np.abs(s.a * (1.0 + x * x) / (d * d) - s.alpha)
+    return s.log_t + s.a * x / d - s.alpha * _aged(x, s.sat), np.abs(
+        s.a * (1.0 + x * x) / (d * d) - s.alpha * _aged_rate(x, s.sat)
+    )
 
 
 def _panel_width(x: np.ndarray, y: np.ndarray, s: _Scales, q: QuadratureSettings) -> tuple[np.ndarray, np.ndarray]:
@@ -309,7 +365,9 @@ class _Lanes:
 
 def _take(s: _Scales, k: np.ndarray | slice) -> _Scales:
     """The lanes ``k`` of ``s``."""
-    return _Scales(s.log_t[k], s.a[k], s.alpha[k], s.beta[k], s.birth[k])
+    sat = None if s.sat is None else s.sat[k]
+    ratio = None if s.ratio is None else s.ratio[k]
+    return _Scales(s.log_t[k], s.a[k], s.alpha[k], s.beta[k], s.birth[k], sat, ratio)
 
 
 @dataclass
@@ -356,8 +414,8 @@ def _march(s: _Scales, q: QuadratureSettings, keep_nodes: bool = False) -> _Inte
             k = np.nonzero(step)[0]
             xs, ys, sk = x_left[k], y_left[k], _take(sub, k)
             d = ys * (1.0 + xs)
-            rise = sk.a * (1.0 + xs * xs) / (d * d) - sk.alpha
-            shift = np.exp(-hazard[k]) * (sk.beta * xs - 1.0) / rise  # -S_s dx_s/d ln V
+            rise = sk.a * (1.0 + xs * xs) / (d * d) - sk.alpha * _aged_rate(xs, sk.sat)
+            shift = np.exp(-hazard[k]) * (sk.beta * _ln_v_moment(xs, sk) - 1.0) / rise  # -S_s dx_s/d ln V
             sums[2, k] += shift
             sums[3, k] += shift * (xs / d)
         offset = t_half * w
@@ -367,7 +425,7 @@ def _march(s: _Scales, q: QuadratureSettings, keep_nodes: bool = False) -> _Inte
         stretch *= y
         np.divide(x, stretch, out=stretch)  # x/(1-x^2), the FENE factor
         h = stretch * sub.a
-        h -= x * sub.alpha
+        h -= _aged(x, sub.sat) * sub.alpha
         h += sub.log_t  # the log-hazard L
         np.minimum(h, _LOG_CAP, out=h)
         np.exp(h, out=h)
@@ -375,7 +433,11 @@ def _march(s: _Scales, q: QuadratureSettings, keep_nodes: bool = False) -> _Inte
         h *= half  # e^L times the panel's half-width: the integrals below need no further scaling
         # H and G = int x e^L at the nodes and (last row) over the whole panel
         cumulative_h = _one_thread_product(integrate, h)
-        x *= h
+        moment_weight = _ln_v_moment(x, sub)  # x, or its saturating-aging counterpart
+        if moment_weight is x:
+            x *= h
+        else:
+            x = moment_weight * h
         cumulative_g = _one_thread_product(integrate, x)
         big_h = cumulative_h[:-1]
         big_h += hazard
@@ -629,7 +691,7 @@ def steady_stress_many(
     else:
         parts = [_scales(p, v, aging) for p in params_list]
         scale = np.repeat([_stress_scale(p) for p in params_list], v.size)
-    joined = _Scales(*(np.concatenate([getattr(part, f.name) for part in parts]) for f in dataclasses.fields(_Scales)))
+    joined = _join(parts)
     _check_scales(joined)
     got = _march(joined, quadrature)
     stress = scale * got.j / (joined.birth + got.i)

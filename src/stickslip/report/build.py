@@ -23,6 +23,7 @@ from ..errors import DataError
 from ..fileio import atomic_write_text
 from ..parameters import Parameters, load_parameters
 from ..units import shorten
+from .aging_section import AGING_FIGURES
 from .comparisons import TOLERANCE, Comparison, compare, count_classes
 from .computations import ModelRun, computed_values, run_steps
 from .errata import Errata, load_errata
@@ -37,7 +38,7 @@ from .sweep_section import SWEEP_FIGURES
 from .transient_section import TRANSIENT_FIGURES
 
 FIGURE_BUILDERS = [*PAPER_FIGURES, *SWEEP_FIGURES, *TRANSIENT_FIGURES]
-FIGURE_BUILDERS += [*SENSITIVITY_FIGURES, *RSF_READING_FIGURES, *INERTIA_FIGURES]
+FIGURE_BUILDERS += [*AGING_FIGURES, *SENSITIVITY_FIGURES, *RSF_READING_FIGURES, *INERTIA_FIGURES]
 
 #: Called before each step with (description, steps done, total steps), and once more at the end.
 ProgressCallback = Callable[[str, int, int], None]

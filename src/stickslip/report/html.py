@@ -220,6 +220,7 @@ def parameter_rows(params: Parameters) -> list[tuple[str, str, float, str, str]]
          f.metadata["doc"])
         for s, cls in SECTIONS.items()
         for f in fields(cls)
+        if getattr(getattr(params, s), f.name) is not None  # an extension's key left out
     ]  # fmt: skip
 
 

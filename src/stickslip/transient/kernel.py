@@ -40,7 +40,7 @@ LOG_RATE_CAP = 700.0
 LIGHTEST = 1e-30
 
 # float parameter vector layout (see pack_parameters in model.py)
-P_LOG_U0_TAU, P_TAU, P_FORCE_SENS, P_M, P_DLM, P_INV_TAU_A, P_VA, P_N0, P_K, P_AGING = range(10)
+P_LOG_U0_TAU, P_TAU, P_FORCE_SENS, P_M, P_DLM, P_INV_TAU_A, P_VA, P_N0, P_K, P_AGING, P_SATURATION = range(11)
 # integer status returned by advance()
 DONE, FULL, STEPS, STICK, FAILED = 0, 1, 2, 3, 4
 #: half-distance of the two Gauss-Legendre points from the middle of a step, as a fraction of the step
@@ -79,16 +79,26 @@ def _aging_factor(v, p):  # type: ignore[no-untyped-def]
     return p[P_INV_TAU_A] * math.exp(-abs(v) / p[P_VA]) if p[P_AGING] > 0.0 else 0.0
 
 
+def _aging_clock(age, p):  # type: ignore[no-untyped-def]
+    """(A, dA/dt_a): the age the aging term sees and its rate.  A = t_a (the paper's Eq 1), or, with the
+    saturating-aging extension (p[P_SATURATION] = t_s > 0), A = t_s (1 - e^(-t_a/t_s)), dA/dt_a = e^(-t_a/t_s)."""
+    ts = p[P_SATURATION]
+    if ts > 0.0:
+        decay = math.exp(-age / ts)
+        return -ts * math.expm1(-age / ts), decay
+    return age, 1.0
+
+
 def _log_rate(e, age, slope, p):  # type: ignore[no-untyped-def]
     """ln r of Eq 1 for extension e and age, with slope = _aging_factor(V); +inf past the FENE limit."""
     if e >= p[P_DLM] or -e >= p[P_DLM]:
         return np.inf
     f = _chain_force(e, p[P_M], p[P_DLM])
-    return p[P_LOG_U0_TAU] + p[P_FORCE_SENS] * abs(f) - age * slope
+    return p[P_LOG_U0_TAU] + p[P_FORCE_SENS] * abs(f) - _aging_clock(age, p)[0] * slope
 
 
 def _velocity_prepare(n, xb, tb, lw, x, t, p, lc, aa):  # type: ignore[no-untyped-def]
-    """k_int; fills lc = ln(w f r) without the aging term and aa = t_a/tau_a for the cohorts."""
+    """k_int; fills lc = ln(w f r) without the aging term and aa = A(t_a)/tau_a for the cohorts."""
     k_int = 0.0
     for i in range(n):
         e = x - xb[i]
@@ -100,7 +110,12 @@ def _velocity_prepare(n, xb, tb, lw, x, t, p, lc, aa):  # type: ignore[no-untype
         k_int += w * _chain_stiffness(e, p[P_M], p[P_DLM])
         f = _chain_force(e, p[P_M], p[P_DLM])
         lc[i] = lw[i] + math.log(f) + p[P_LOG_U0_TAU] + p[P_FORCE_SENS] * f if f > 0.0 else -np.inf
-        aa[i] = (t - tb[i]) * p[P_INV_TAU_A] if p[P_AGING] > 0.0 else 0.0
+        if p[P_AGING] == 0.0:
+            aa[i] = 0.0
+        elif p[P_SATURATION] > 0.0:
+            aa[i] = _aging_clock(t - tb[i], p)[0] * p[P_INV_TAU_A]
+        else:  # the paper's linear aging, kept branch-free of the extension
+            aa[i] = (t - tb[i]) * p[P_INV_TAU_A]
     return k_int
 
 
@@ -352,6 +367,7 @@ def advance(
         slope1 = _aging_factor(v1p, p)
         accel = (v1p - v0) / hh
         aging_on = p[P_AGING] > 0.0
+        saturating = p[P_SATURATION] > 0.0
         # ---- one pass over the cohorts: hazards at both ends, corrected trapezoid, error terms, sums
         nn0 = 0.0
         s0 = 0.0
@@ -397,8 +413,12 @@ def advance(
                 err_s += w0 * abs(f0)
                 err_n += w0
                 continue
-            age0 = t - tb[i]
-            age1 = t1 - tb[i]
+            if saturating:  # the age the aging term sees, and its rate
+                age0, clock0 = _aging_clock(t - tb[i], p)
+                age1, clock1 = _aging_clock(t1 - tb[i], p)
+            else:
+                age0, clock0 = t - tb[i], 1.0
+                age1, clock1 = t1 - tb[i], 1.0
             f1 = _chain_force(e1, m, dlm)
             lr0 = min(p[P_LOG_U0_TAU] + beta * abs(f0) - age0 * slope0, LOG_RATE_CAP)
             lr1 = min(p[P_LOG_U0_TAU] + beta * abs(f1) - age1 * slope1, LOG_RATE_CAP)
@@ -407,8 +427,8 @@ def advance(
             # d ln r/dt along the characteristic at both ends (force, age, and the velocity's effect on aging)
             k0 = _chain_stiffness(e0, m, dlm)
             k1 = _chain_stiffness(e1, m, dlm)
-            g0 = beta * (1.0 if f0 >= 0.0 else -1.0) * k0 * v0 - slope0
-            g1 = beta * (1.0 if f1 >= 0.0 else -1.0) * k1 * v1p - slope1
+            g0 = beta * (1.0 if f0 >= 0.0 else -1.0) * k0 * v0 - slope0 * clock0
+            g1 = beta * (1.0 if f1 >= 0.0 else -1.0) * k1 * v1p - slope1 * clock1
             if aging_on and accel != 0.0:
                 g0 += age0 * slope0 * accel / p[P_VA] * (1.0 if v0 >= 0.0 else -1.0)
                 g1 += age1 * slope1 * accel / p[P_VA] * (1.0 if v1p >= 0.0 else -1.0)
@@ -501,7 +521,7 @@ def advance(
                 e_k = x1p - x_k
                 lr_end = min(_log_rate(e_k, d, slope1, p), LOG_RATE_CAP)
                 r_end = math.exp(lr_end)
-                g_end = beta * _chain_stiffness(e_k, m, dlm) * v1p - slope1
+                g_end = beta * _chain_stiffness(e_k, m, dlm) * v1p - slope1 * _aging_clock(d, p)[1]
                 g_start = beta * m * (v0 + accel * u) - _aging_factor(v0 + accel * u, p)
                 trap = 0.5 * d * (r_birth + r_end)
                 lr_birth = p[P_LOG_U0_TAU]
@@ -703,6 +723,7 @@ def compiled() -> dict[str, object]:
             "_chain_stiffness",
             "_chain_energy",
             "_aging_factor",
+            "_aging_clock",
             "_log_rate",
             "_hermite",
             "_vacancy",

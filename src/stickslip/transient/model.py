@@ -24,7 +24,7 @@ GAUSS = 0.5 / math.sqrt(3.0)
 def pack_parameters(params: Parameters, aging: bool, stiffness: float) -> np.ndarray:
     """The float vector the kernel reads (layout: kernel.P_*)."""
     b, g = params.bonds, params.aging
-    p = np.zeros(10)
+    p = np.zeros(11)
     p[K.P_LOG_U0_TAU] = math.log(b.breakage_weight / b.bond_time)
     p[K.P_TAU] = b.bond_time
     p[K.P_FORCE_SENS] = b.force_sensitivity
@@ -35,7 +35,20 @@ def pack_parameters(params: Parameters, aging: bool, stiffness: float) -> np.nda
     p[K.P_N0] = b.site_density
     p[K.P_K] = stiffness
     p[K.P_AGING] = 1.0 if aging else 0.0
+    p[K.P_SATURATION] = 0.0 if g.saturation_age is None else g.saturation_age  # 0: the paper's linear aging
     return p
+
+
+def aging_age(age: np.ndarray, params: Parameters) -> np.ndarray:
+    """The age the aging term of Eq 1 sees: t_a (the paper), or t_s (1 - e^(-t_a/t_s)) with saturation.
+
+    The saturating-aging extension (docs/extensions.md): a bond's barrier grows at kT/tau_a per unit age
+    while young and levels off at kT t_s/tau_a, first-order kinetics of the contact's maturation.
+    """
+    ts = params.aging.saturation_age
+    if ts is None:
+        return age
+    return -ts * np.expm1(-np.asarray(age) / ts)
 
 
 def chain_force(extension: np.ndarray, params: Parameters) -> np.ndarray:
@@ -50,7 +63,7 @@ def log_hazard(extension: np.ndarray, age: np.ndarray, velocity: float, params: 
     b, g = params.bonds, params.aging
     out = math.log(b.breakage_weight / b.bond_time) + b.force_sensitivity * chain_force(extension, params)
     if aging:
-        out = out - age / g.aging_time * math.exp(-velocity / g.aging_velocity)
+        out = out - aging_age(age, params) / g.aging_time * math.exp(-velocity / g.aging_velocity)
     return out
 
 

@@ -130,6 +130,7 @@ def _steady_cells():  # type: ignore[no-untyped-def]
         g = globals()
         kernel.compiled()  # the kernel's chain functions, compiled in place
         g["_force"], g["_stiffness"], g["_energy"] = kernel._chain_force, kernel._chain_stiffness, kernel._chain_energy
+        g["_aging_clock"] = kernel._aging_clock
         for name in ("_log_rate", "_march"):
             g[name] = njit(cache=True)(g[name])
         _CELLS.append(njit(cache=True)(_cells))
@@ -152,12 +153,13 @@ def steady_cohorts(params: Parameters, velocity: float, aging: bool):  # type: i
 
 # the chain's force, stiffness and energy are the kernel's (Eq 3), one definition
 _force, _stiffness, _energy = kernel._chain_force, kernel._chain_stiffness, kernel._chain_energy
+_aging_clock = kernel._aging_clock  # the age the aging term sees (the saturating-aging extension changes it)
 
 
 def _log_rate(age, v, slope, p):  # type: ignore[no-untyped-def]
     """ln r of a steady bond of this age (capped at 700), kernel.P_* layout of p."""
     force = _force(v * age, p[3], p[4])
-    return min(p[0] + p[2] * force - age * slope, 700.0)
+    return min(p[0] + p[2] * force - _aging_clock(age, p)[0] * slope, 700.0)
 
 
 def _march(v, p, cell_hazard):  # type: ignore[no-untyped-def]
@@ -245,7 +247,7 @@ def _cells(v, p, cell_hazard):  # type: ignore[no-untyped-def]
         f[k] = _force(e, m, dlm)
         fp[k] = _stiffness(e, m, dlm)
         r[k] = math.exp(_log_rate(mid[k], v, slope, p))
-        gv[k] = mid[k] * slope / p[6]
+        gv[k] = _aging_clock(mid[k], p)[0] * slope / p[6]
         energy += w[k] * _energy(e, m, dlm)
     return mid, w, width, f, fp, r, gv, energy
 

@@ -598,7 +598,8 @@ def _finish(
     cycles = detect_cycles(time, sigma, v, protocol, events)
     regime, message = classify(time, sigma, v, protocol, cycles, events, control, stop)
     message = message + note
-    if regime == "stuck" and not cycles and not stick_population_used(events):
+    saturating = params.aging.saturation_age is not None  # the extension lets go: its stuck is its own answer
+    if regime == "stuck" and not cycles and not stick_population_used(events) and not saturating:
         message += (
             "; one population of Eq 1 never lets go: its aging term makes a resting bond unbreakable within"
             " milliseconds (docs/transient.md section 7); stick_population=True (--stick-population) adds the"

@@ -30,7 +30,7 @@ import numpy as np
 
 from ..errors import ModelError, ParameterError
 from ..parameters import Parameters
-from .model import chain_force, log_hazard, steady_population
+from .model import aging_age, chain_force, log_hazard, steady_population
 
 #: frequencies / growth rates scanned, in units of 1/tau: from 1e-6 to 1e4
 SCAN = np.geomspace(1e-6, 1e6, 561)
@@ -87,7 +87,8 @@ def _cells(
     f = chain_force(e, params)
     fp = _stiffness(e, params)
     r = np.exp(np.minimum(log_hazard(e, a, velocity, params, aging), 700.0))
-    gv = a * math.exp(-velocity / g.aging_velocity) / (g.aging_time * g.aging_velocity) if aging else np.zeros_like(a)
+    aged = aging_age(a, params)  # t_a, or the saturating extension's t_s (1 - e^(-t_a/t_s))
+    gv = aged * (math.exp(-velocity / g.aging_velocity) / (g.aging_time * g.aging_velocity)) if aging else 0.0 * a
     # cell widths: the midpoints a_k are centred in cells that tile [0, a_end]
     width = np.empty_like(a)
     left = 0.0
