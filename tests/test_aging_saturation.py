@@ -218,3 +218,23 @@ def test_the_quasi_steady_reduction_carries_the_saturating_clock():
         off = run_transient(p, protocol, control=control, start="steady", reduction="off")
         assert auto.stress[-1] == pytest.approx(off.stress[-1], rel=1e-5), control
         assert auto.slider_velocity[-1] == pytest.approx(off.slider_velocity[-1], rel=1e-5), control
+
+
+def test_the_shipped_saturating_set_is_the_fit_of_the_shipped_data():
+    """`--params gelatin-glass-saturating` holds what fit_saturation finds (to the file's five digits)."""
+    from stickslip.fitting.data import read_steady_data
+    from stickslip.fitting.datasets import synthetic_steady_path, table1
+    from stickslip.fitting.saturation_fit import fit_saturation
+    from stickslip.report.aging_section import START_SATURATION
+
+    shipped = stickslip.load_parameters("gelatin-glass-saturating")
+    paper = stickslip.load_parameters("gelatin-glass")
+    data = read_steady_data(synthetic_steady_path())
+    start = paper.with_overrides({"aging.saturation_age": START_SATURATION})
+    fit = fit_saturation(
+        start, np.asarray(data.velocity), np.asarray(data.stress), np.asarray(data.stress_err), table1()
+    )
+    assert shipped.aging.saturation_age == pytest.approx(fit.values["aging.saturation_age"], rel=5e-5)
+    assert shipped.aging.aging_time == pytest.approx(fit.values["aging.aging_time"], rel=5e-5)
+    assert shipped.aging.aging_velocity == pytest.approx(fit.values["aging.aging_velocity"], rel=5e-5)
+    assert shipped.bonds == paper.bonds and shipped.stick == paper.stick and shipped.block == paper.block
