@@ -238,3 +238,12 @@ def test_the_shipped_saturating_set_is_the_fit_of_the_shipped_data():
     assert shipped.aging.aging_time == pytest.approx(fit.values["aging.aging_time"], rel=5e-5)
     assert shipped.aging.aging_velocity == pytest.approx(fit.values["aging.aging_velocity"], rel=5e-5)
     assert shipped.bonds == paper.bonds and shipped.stick == paper.stick and shipped.block == paper.block
+
+
+def test_a_wide_steady_curve_with_saturation_is_the_same_curve():
+    """1000 velocities (the compiled march's width) give what 999 give: the saturating clock is never dropped."""
+    p = stickslip.load_parameters("gelatin-glass-saturating")
+    velocity = np.geomspace(1e-6, 2e-3, 1000)
+    wide = steady_state(p, velocity).stress
+    narrow = np.concatenate([steady_state(p, velocity[:999]).stress, steady_state(p, velocity[999:]).stress])
+    np.testing.assert_allclose(wide, narrow, rtol=1e-12)

@@ -236,3 +236,16 @@ def test_quasi_static_run_reports_the_repeating_cycle_when_started_off_sigma_c()
     assert from_300.cycles[0].period < 0.9 * from_c.cycles[0].period  # the first cycle is not the repeating one
     assert from_300.to_run().period == pytest.approx(from_c.to_run().period, rel=1e-9)
     assert from_300.to_run().peak == pytest.approx(from_c.to_run().peak, rel=1e-9)
+
+
+def test_a_sweep_point_of_plain_values_takes_the_cached_fast_path_with_or_without_an_extension_key():
+    from stickslip.models.bond import _parameter_set
+
+    model = get_model("quasi-static")
+    for name in ("gelatin-glass", "gelatin-glass-saturating"):
+        params = stickslip.load_parameters(name)
+        values = model.values(params)
+        _parameter_set.cache_clear()
+        again = [model.parameters(None, values) for _ in range(3)]
+        assert _parameter_set.cache_info().hits == 2, name  # not load_parameters at every point (0.8 ms each)
+        assert all(p.as_dict() == params.as_dict() for p in again)

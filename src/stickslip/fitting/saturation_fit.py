@@ -73,7 +73,7 @@ def curve_extrema(params: Parameters, points: int = 60) -> tuple[Extremum | None
     low = extremum(*PEAK_RANGE, -1.0)
     high = extremum(*MINIMUM_RANGE, 1.0)
     if high is None:
-        raise ModelError("saturating aging: the steady curve has no minimum between 20 and 400 um/s")
+        raise ModelError("saturating aging: the steady curve has no minimum between 20 and 400 µm/s")
     return low, high
 
 
@@ -122,7 +122,14 @@ def fit_saturation(params: Parameters, velocity: np.ndarray, stress: np.ndarray,
     solution = least_squares(residuals, start, diff_step=1e-4, x_scale=1.0)
     chi_square = float(2.0 * solution.cost)
     dof = solution.fun.size - start.size
-    covariance = np.linalg.inv(solution.jac.T @ solution.jac) * max(chi_square / dof, 1.0)
+    try:
+        covariance = np.linalg.inv(solution.jac.T @ solution.jac) * max(chi_square / dof, 1.0)
+    except np.linalg.LinAlgError:
+        raise ModelError(
+            "saturating-aging fit failed: the data do not constrain tau_a, V_a and t_s together (singular Jacobian)"
+        ) from None
+    if dof <= 0 or not np.all(np.isfinite(covariance)):
+        raise ModelError(f"saturating-aging fit failed: no covariance ({solution.fun.size} residuals for 3 parameters)")
     half = student.ppf(0.975, dof) * np.sqrt(np.diag(covariance))
     fitted = at(solution.x)
     values = {k: math.exp(v) for k, v in zip(KEYS, solution.x, strict=True)}

@@ -387,7 +387,8 @@ def _march(s: _Scales, q: QuadratureSettings, keep_nodes: bool = False) -> _Inte
     The working arrays hold only the points still marching: finished ones are
     written out and dropped, so a step costs what the remaining points cost.
     """
-    if not keep_nodes and s.log_t.size >= COMPILED_LANES:
+    # the compiled march ages linearly (the paper's Eq 1): the saturating-aging extension stays on numpy
+    if not keep_nodes and s.log_t.size >= COMPILED_LANES and s.sat is None:
         return _march_compiled(s, q)
     rule = panel_rule(q.order)
     # Node arrays are (K, n): the long axis innermost, so that per-point factors broadcast along rows cheaply

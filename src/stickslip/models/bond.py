@@ -9,7 +9,14 @@ from typing import Any, ClassVar
 import numpy as np
 
 from ..errors import ParameterError
-from ..parameters import Parameters, key_dimension, load_parameters, parameter_keys, parameters_from_mapping
+from ..parameters import (
+    Parameters,
+    key_dimension,
+    load_parameters,
+    optional_keys,
+    parameter_keys,
+    parameters_from_mapping,
+)
 from .base import CYCLE_RESULTS, FrictionModel, Rig
 
 #: Keys that set the block's stiffness directly (through its height): G_d/h, and K = (G_d/h) ln(B/l)/(B/l - 1).
@@ -36,10 +43,12 @@ class BondModel(FrictionModel):
         given = dict(overrides or {})
         stiffness = {k: to_si(given.pop(k), d, k) for k, d in STIFFNESS_KEYS.items() if k in given}
         keys = parameter_keys()
-        if spec is None and set(keys) <= set(given) and all(_is_number(given[k]) for k in keys):
-            if len(given) > len(keys):
+        required = set(keys) - set(optional_keys())  # an extension's key (aging.saturation_age) may be absent
+        present = [k for k in keys if k in given]
+        if spec is None and required <= set(given) and all(_is_number(given[k]) for k in present):
+            if len(given) > len(present):
                 key_dimension(next(k for k in given if k not in keys))  # the one-line error naming the key
-            params = _parameter_set(tuple(float(given[k]) for k in keys))
+            params = _parameter_set(tuple(float(given[k]) if k in given else None for k in keys))
         else:
             params = load_parameters(DEFAULT_SET if spec is None else spec, given)
         return with_stiffness(params, stiffness)
@@ -85,10 +94,13 @@ def _is_number(value: Any) -> bool:
 
 
 @lru_cache(maxsize=64)
-def _parameter_set(values: tuple[float, ...]) -> Parameters:
-    """Parameters from the SI values of :func:`parameter_keys`, in that order (validated)."""
+def _parameter_set(values: tuple[float | None, ...]) -> Parameters:
+    """Parameters from the SI values of :func:`parameter_keys`, in that order (validated; None: an optional key
+    left out)."""
     nested: dict[str, dict[str, float]] = {}
     for key, value in zip(parameter_keys(), values, strict=True):
+        if value is None:
+            continue
         section, _, name = key.partition(".")
         nested.setdefault(section, {})[name] = value
     return parameters_from_mapping({"name": "sweep point", **nested}, "sweep point")

@@ -12,7 +12,7 @@ if TYPE_CHECKING:  # pragma: no cover
 
 def plot_run(run: Run, ax: Axes | None = None, *, velocity: bool = True) -> Axes:
     """Draw ``run`` on ``ax`` (a new figure's Axes by default) and return it; the title names the regime."""
-    from .style import new_axes
+    from .style import UM_PER_S, apply_style, new_axes
 
     ax = new_axes(ax, figsize=(7, 4))
     if run.stress is not None:
@@ -24,7 +24,7 @@ def plot_run(run: Run, ax: Axes | None = None, *, velocity: bool = True) -> Axes
     ax.set_xlabel("time (s)")
     if velocity:
         twin = ax.twinx()
-        twin.plot(run.time, run.slider_velocity, color="C1", lw=0.8, alpha=0.7)
-        twin.set_ylabel("slider velocity (m/s)", color="C1")
+        twin.plot(run.time, run.slider_velocity * UM_PER_S, color="C1", lw=0.8, alpha=0.7)
+        twin.set_ylabel("slider velocity (µm/s)", color="C1")
     ax.set_title(f"{run.model}: {run.regime_name}")
-    return ax
+    return apply_style(ax)

@@ -101,7 +101,7 @@ def main() -> None:  # pragma: no cover - prints the tables of docs/extensions.m
     from ..parameters import load_parameters
 
     params = load_parameters("gelatin-glass")
-    print("velocity um/s | block | m kg/m^2 | eta Pa s/m | Kc Pa/m | f_Hopf Hz | growth at 0.7 Kc 1/s | f there Hz")
+    print("velocity µm/s | block | m kg/m^2 | eta Pa s/m | Kc Pa/m | f_Hopf Hz | growth at 0.7 Kc 1/s | f there Hz")
     for velocity in (100e-6, 120e-6, 124e-6):
         for block in gel_block_cases(params):
             r = hopf_row(params, velocity, block)
@@ -109,13 +109,13 @@ def main() -> None:  # pragma: no cover - prints the tables of docs/extensions.m
                 f"{velocity * 1e6:g} | {block.label} | {block.mass:.4g} | {block.damping:.4g} | "
                 f"{r.critical_stiffness:.5g} | {r.frequency:.4g} | {r.growth:+.4g} | {r.growth_frequency:.4g}"
             )
-    print("convergence (gel block, 120 um/s): cell_hazard | Kc | f | growth")
+    print("convergence (gel block, 120 µm/s): cell_hazard | Kc | f | growth")
     gel = gel_block_cases(params)[1]
     for hazard in (0.004, 0.002, 0.001):
         r = hopf_row(params, 120e-6, gel, cell_hazard=hazard)
         print(f"{hazard} | {r.critical_stiffness:.7g} | {r.frequency:.6g} | {r.growth:+.6g}")
     for velocity in (50e-6, 120e-6):
-        print(f"Z(inf) at {velocity * 1e6:g} um/s = {high_frequency_stiffness(params, velocity):.4g} Pa/m")
+        print(f"Z(inf) at {velocity * 1e6:g} µm/s = {high_frequency_stiffness(params, velocity):.4g} Pa/m")
         for mass, rate in fastest_runaway(params, velocity, (1e-6, 1e-3, 10.5, 105.0, 10500.0)):
             print(f"  m = {mass:g} kg/m^2: fastest real growth {rate:.4g} 1/s")
 

@@ -223,7 +223,7 @@ def bond_step(
     start = _time.process_time()
     run = run_transient(params, protocol, control="velocity", start="steady", rtol=rtol)
     cpu = _time.process_time() - start
-    label = name or " -> ".join(f"{v * 1e6:.4g}" for v in velocities) + " um/s"
+    label = name or " -> ".join(f"{v * 1e6:.4g}" for v in velocities) + " µm/s"
     return step_record(run.time, run.stress, protocol, float(cp.stress), label, cpu, window)
 
 
