@@ -713,8 +713,9 @@ FOLD_MARGIN = 1.02
 STUCK_STEPS = 2500.0
 #: steps no budget allows even with the reduction (the fold's velocity is not looked for then)
 HOPELESS = 1e9
-#: share of rtol dl_m (of tau) that the rounding of a position (of the clock) may take
+#: share of rtol dl_m that the rounding of a position may take, and of tau that the rounding of the clock may take
 PRECISION = 1e-2
+CLOCK = 0.1
 
 
 def estimate_cost(
@@ -806,16 +807,16 @@ def estimate_cost(
 def _require_resolvable(params: Parameters, protocol: Protocol, rtol: float, unit: str) -> None:
     """Refuse a run whose positions or times outgrow double precision (a reduced stretch costs few steps whatever
     its length, so the step budget no longer bounds the duration): the bonds' extensions, differences of positions
-    of the size of the travel, must keep rtol of dl_m, and the clock must resolve a hundredth of tau."""
+    of the size of the travel, must keep rtol of dl_m, and the clock must resolve a tenth of tau."""
     b = params.bonds
     eps = float(np.finfo(float).eps)
     travel, duration = _travel(protocol), protocol.duration
-    if travel * eps > PRECISION * rtol * b.max_extension or duration * eps > PRECISION * b.bond_time:
+    if travel * eps > PRECISION * rtol * b.max_extension or duration * eps > CLOCK * b.bond_time:
         raise ParameterError(
             f"transient: {duration:.3g} s ({travel:.3g} m of travel) is beyond what double precision resolves: the"
             f" bonds' extensions (Δl_m = {b.max_extension:.3g} m) to rtol {rtol:g} need a travel below"
             f" {PRECISION * rtol * b.max_extension / eps:.3g} m, the clock (τ = {b.bond_time:.3g} s) a run shorter"
-            f" than {PRECISION * b.bond_time / eps:.3g} s; shorten the run{unit}"
+            f" than {CLOCK * b.bond_time / eps:.3g} s; shorten the run{unit}"
         )
 
 
