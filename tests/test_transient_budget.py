@@ -139,7 +139,7 @@ HANDFUL = [
 def test_estimate_with_the_reduction_is_within_its_stated_factor(protocol, settings):
     """estimate_cost's docstring: 0.2-15x the steps taken where the reduction applies."""
     run = run_transient(GEL, protocol, **settings)
-    keys = ("control", "start")
+    keys = ("control", "start", "stick_population")
     ratio = estimate_cost(GEL, protocol, **{k: v for k, v in settings.items() if k in keys}).steps / run.steps
     assert 0.2 <= ratio <= 15.0, ratio
 

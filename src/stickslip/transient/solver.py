@@ -163,7 +163,8 @@ def run_transient(
     _require_finite_chains(params, protocol, control, start, start_velocity, k_block)
     require_within(
         estimate_cost(params, protocol, control=control, start_velocity=start_velocity, rtol=rtol, every=every,
-                      max_step=max_step, aging=aging, reduction=reduction, start=start),
+                      max_step=max_step, aging=aging, reduction=reduction, start=start,
+                      stick_population=bool(stick_population)),
         budget,
         "transient",
     )  # fmt: skip
@@ -730,6 +731,7 @@ def estimate_cost(
     aging: bool = True,
     reduction: str = "auto",
     start: str = "empty",
+    stick_population: bool = False,
 ) -> CostEstimate:
     """The steps a run needs, from the time scales it must resolve (no step taken).
 
@@ -750,7 +752,8 @@ def estimate_cost(
     stretch starts) and :data:`REDUCED_STEPS` for the stretch, whatever its
     length (calibrated from 20 um/s to 10 mm/s; above 100 dl_m/tau, 0.48 m/s
     for the gel, a likely slip of units, the cohorts are counted); a block
-    from rest (``start="empty"``) adds :data:`STUCK_STEPS` for its first stick.
+    from rest (``start="empty"``) adds :data:`STUCK_STEPS` for its first stick
+    (none with ``stick_population``: the chains carry a stuck block).
     Holds, a block below the fold (creep, stick, stick-slip) and
     ``reduction="off"`` cost the cohorts' steps throughout.  Measured
     (docs/transient.md section 9, tests/test_transient_budget.py): 0.2-15x the
@@ -786,7 +789,7 @@ def estimate_cost(
                     cohorts = settle
                     reduced += 1
         steps += cohorts + SEGMENT_STEPS
-    if control == "block" and start == "empty" and reduced:
+    if control == "block" and start == "empty" and not stick_population and reduced:  # chains hold a stuck block
         steps += STUCK_STEPS
     duration = protocol.duration
     if every is not None:
