@@ -757,7 +757,7 @@ def estimate_cost(
     Holds, a block below the fold (creep, stick, stick-slip) and
     ``reduction="off"`` cost the cohorts' steps throughout.  Measured
     (docs/transient.md section 9, tests/test_transient_budget.py): 0.2-15x the
-    steps taken where the reduction applies, 2-50x below the fold (stick-slip:
+    steps taken where the reduction applies, 1.8-45x below the fold (stick-slip:
     the cohorts' bound); a run that takes more than the budget after all is
     stopped with the reason.
     """
