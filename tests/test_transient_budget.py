@@ -115,6 +115,8 @@ def test_a_long_quasi_steady_run_is_accepted_and_finishes_fast(capsys):
         (segments([(100e-6, 0.01), (0.0, 1000.0)]), dict(control="velocity", start="steady"), "a long hold"),
         (constant(120e-6, 1000.0), dict(start="steady"), "creeping at the fold (Vc = 124 um/s)"),
         (constant(1e-3, 100.0), dict(start="steady", max_step=1e-4), "a bounded cohort step"),
+        # Kc = 7.1e8 Pa/m at 10 mm/s: steady sliding through the gel's block is unstable, the reduction does not apply
+        (constant(1e-2, 100.0), dict(start="steady"), "through the block above dl_m/tau"),
     ],
 )
 def test_runs_that_are_really_too_expensive_are_still_refused(protocol, settings, what):

@@ -710,6 +710,11 @@ REDUCED_STEPS = 100.0
 #: through the block a piece is reduced only this far above the fold of the steady curve at Vc: below it the slider
 #: decelerates, creeps along the fold and sticks (cohorts), or slips in cycles whose approach to the stick is cohorts
 FOLD_MARGIN = 1.02
+#: through the block a piece is counted as reduced up to this many dl_m/tau (4.8 mm/s for the gel): faster, steady
+#: sliding can be oscillatory-unstable (the gel: Kc = 0 up to 5 mm/s, 7.1e8 Pa/m at 10 mm/s), which the reduction
+#: does not follow (docs/transient.md section 9, Limits); under velocity control up to 100 dl_m/tau (beyond: a likely
+#: slip of units, where the refusal says "check the unit")
+BLOCK_FASTEST = 1.0
 #: a block from rest first sticks under Eq 1 alone, in slowly lengthening steps (1712 steps for 0.1 s, 2413 for 100 s)
 STUCK_STEPS = 2500.0
 #: steps no budget allows even with the reduction (the fold's velocity is not looked for then)
@@ -750,8 +755,9 @@ def estimate_cost(
     is stable) costs the cohorts' steps over :data:`SETTLE` bond memories
     dl_m/Vp (the bonds born before the piece must be gone before a reduced
     stretch starts) and :data:`REDUCED_STEPS` for the stretch, whatever its
-    length (calibrated from 20 um/s to 10 mm/s; above 100 dl_m/tau, 0.48 m/s
-    for the gel, a likely slip of units, the cohorts are counted); a block
+    length (calibrated from 20 um/s to 10 mm/s; the cohorts are counted through
+    the block above :data:`BLOCK_FASTEST` dl_m/tau, under velocity control above
+    100 dl_m/tau, a likely slip of units); a block
     from rest (``start="empty"``) adds :data:`STUCK_STEPS` for its first stick
     (none with ``stick_population``: the chains carry a stuck block).
     Holds, a block below the fold (creep, stick, stick-slip) and
@@ -780,7 +786,7 @@ def estimate_cost(
         rate = 4.0 * (1.0 + b.breakage_weight) / b.bond_time + 10.0 * climb + 100.0 * v / b.max_extension
         rate *= scale * (BLOCK_SHARE if control == "block" else 1.0)
         cohorts = rate * (t1 - t0)
-        if reducing and 0 < vp <= 100.0 * natural:  # faster: a slip of units, or uncalibrated
+        if reducing and 0 < vp <= (BLOCK_FASTEST if control == "block" else 100.0) * natural:
             settle = rate * SETTLE * b.max_extension / vp + REDUCED_STEPS
             if settle < min(cohorts, HOPELESS):  # beyond HOPELESS the fold is not worth finding
                 if reduced_from is None:
