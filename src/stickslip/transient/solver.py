@@ -163,7 +163,8 @@ def run_transient(
     _require_finite_chains(params, protocol, control, start, start_velocity, k_block)
     require_within(
         estimate_cost(params, protocol, control=control, start_velocity=start_velocity, rtol=rtol, every=every,
-                      max_step=max_step, aging=aging),
+                      max_step=max_step, aging=aging, reduction=reduction, start=start,
+                      stick_population=bool(stick_population)),
         budget,
         "transient",
     )  # fmt: skip
@@ -702,6 +703,26 @@ SEGMENT_STEPS = 10.0
 #: through the block the slider slides only part of the time (a stuck block takes long steps): measured 0.04-0.4
 #: of the velocity-control estimate (350 um/s sliding steadily: 0.42; 350 -> 50 um/s with the chains: 0.04)
 BLOCK_SHARE = 0.4
+#: with the quasi-steady reduction a piece is cohorts until the bonds born before its start are gone (at most the
+#: travel dl_m, where the FENE wall breaks them), for SETTLE such memories (the looks for a stretch double their
+#: interval after each miss), then a reduced stretch of about REDUCED_STEPS ODE steps
+SETTLE = 4.0
+REDUCED_STEPS = 100.0
+#: through the block a piece is reduced only this far above the fold of the steady curve at Vc: below it the slider
+#: decelerates, creeps along the fold and sticks (cohorts), or slips in cycles whose approach to the stick is cohorts
+FOLD_MARGIN = 1.02
+#: through the block a piece is counted as reduced up to this many dl_m/tau (4.8 mm/s for the gel): faster, steady
+#: sliding can be oscillatory-unstable (the gel: Kc = 0 up to 5 mm/s, 7.1e8 Pa/m at 10 mm/s), which the reduction
+#: does not follow (docs/transient.md section 9, Limits); under velocity control up to 100 dl_m/tau (beyond: a likely
+#: slip of units, where the refusal says "check the unit")
+BLOCK_FASTEST = 1.0
+#: a block from rest first sticks under Eq 1 alone, in slowly lengthening steps (1712 steps for 0.1 s, 2413 for 100 s)
+STUCK_STEPS = 2500.0
+#: steps no budget allows even with the reduction (the fold's velocity is not looked for then)
+HOPELESS = 1e9
+#: share of rtol dl_m that the rounding of a position may take, and of tau that the rounding of the clock may take
+PRECISION = 1e-2
+CLOCK = 0.1
 
 
 def estimate_cost(
@@ -714,43 +735,114 @@ def estimate_cost(
     every: float | None = None,
     max_step: float | None = None,
     aging: bool = True,
+    reduction: str = "auto",
+    start: str = "empty",
+    stick_population: bool = False,
 ) -> CostEstimate:
     """The steps a run needs, from the time scales it must resolve (no step taken).
 
-    While sliding at V the steps resolve the births (a few per tau/(1+u0)), the
-    climb of the hazard (ln r grows at g = (lambda/kT) M V less the aging
-    slope: a bond dies within ~1/g) and the FENE wall (V/dl_m); calibrated on
-    the gel's set from 10 um/s to 1 m/s and the audit set of issue 17 (the
-    estimate is within 0.4-5x of the steps taken while sliding; a stuck block
+    While sliding at V the cohorts' steps resolve the births (a few per
+    tau/(1+u0)), the climb of the hazard (ln r grows at g = (lambda/kT) M V less
+    the aging slope: a bond dies within ~1/g) and the FENE wall (V/dl_m);
+    calibrated on the gel's set from 10 um/s to 1 m/s and the audit set of
+    issue 17 (within 0.4-5x of the cohorts' steps while sliding; a stuck block
     takes far fewer, and through the block the estimate is scaled by
     :data:`BLOCK_SHARE`).  Every protocol segment and every sampling instant
-    costs at least a step.  These are the cohorts' steps (``reduction="off"``):
-    the quasi-steady reduction takes fewer, so the estimate bounds a run.
+    costs at least a step.
+
+    With ``reduction="auto"`` (and no ``max_step``) a piece the quasi-steady
+    reduction can take (any sliding piece under velocity control; through the
+    block, a puller faster than :data:`FOLD_MARGIN` x Vc, where steady sliding
+    is stable) costs the cohorts' steps over :data:`SETTLE` bond memories
+    dl_m/Vp (the bonds born before the piece must be gone before a reduced
+    stretch starts) and :data:`REDUCED_STEPS` for the stretch, whatever its
+    length (calibrated from 20 um/s to 10 mm/s; the cohorts are counted through
+    the block above :data:`BLOCK_FASTEST` dl_m/tau, under velocity control above
+    100 dl_m/tau, a likely slip of units); a block
+    from rest (``start="empty"``) adds :data:`STUCK_STEPS` for its first stick
+    (none with ``stick_population``: the chains carry a stuck block).
+    Holds, a block below the fold (creep, stick, stick-slip) and
+    ``reduction="off"`` cost the cohorts' steps throughout.  Measured
+    (docs/transient.md section 9, tests/test_transient_budget.py): 0.2-15x the
+    steps taken where the reduction applies, 1.8-45x below the fold (stick-slip:
+    the cohorts' bound); a run that takes more than the budget after all is
+    stopped with the reason.
     """
+    _check_choice(reduction, REDUCTIONS, "reduction")
+    _check_choice(start, STARTS, "start")
     b, g = params.bonds, params.aging
     scale = (1e-4 / rtol) ** 0.25
     v_start = 0.0 if start_velocity is None else abs(start_velocity)
+    reducing = reduction == "auto" and max_step is None
+    reduced_from: float | None = None  # the fold's velocity, found only when a piece would gain by the reduction
     steps = 0.0
     fastest = 0.0
+    reduced = 0
+    natural = b.max_extension / b.bond_time
     for t0, t1, vp in protocol.pieces():
         v = max(abs(vp), v_start) if control == "block" else abs(vp)
         fastest = max(fastest, v)
         slope = math.exp(-v / g.aging_velocity) / g.aging_time if aging else 0.0
         climb = max(b.force_sensitivity * b.chain_stiffness * v - slope, 0.0)
         rate = 4.0 * (1.0 + b.breakage_weight) / b.bond_time + 10.0 * climb + 100.0 * v / b.max_extension
-        steps += scale * rate * (t1 - t0) * (BLOCK_SHARE if control == "block" else 1.0) + SEGMENT_STEPS
+        rate *= scale * (BLOCK_SHARE if control == "block" else 1.0)
+        cohorts = rate * (t1 - t0)
+        if reducing and 0 < vp <= (BLOCK_FASTEST if control == "block" else 100.0) * natural:
+            settle = rate * SETTLE * b.max_extension / vp + REDUCED_STEPS
+            if settle < min(cohorts, HOPELESS):  # beyond HOPELESS the fold is not worth finding
+                if reduced_from is None:
+                    reduced_from = _reduced_from(params, control, aging)
+                if vp >= reduced_from:
+                    cohorts = settle
+                    reduced += 1
+        steps += cohorts + SEGMENT_STEPS
+    if control == "block" and start == "empty" and not stick_population and reduced:  # chains hold a stuck block
+        steps += STUCK_STEPS
     duration = protocol.duration
     if every is not None:
         steps += duration / every
     if max_step is not None:
         steps = max(steps, duration / max_step)
-    natural = b.max_extension / b.bond_time
     basis = f"{duration:.3g} s at up to {fastest:.3g} m/s, resolving τ = {b.bond_time:.3g} s"
+    if reduced:
+        basis += f", {reduced} of {len(protocol.segments)} segments quasi-steady"
+    unit = ""
     if fastest > 100.0 * natural:
-        basis += (
-            f"; {fastest:.3g} m/s is {fastest / natural:.2g} × the set's Δl_m/τ = {natural:.3g} m/s: check the unit"
-        )
+        unit = f"; {fastest:.3g} m/s is {fastest / natural:.2g} × the set's Δl_m/τ = {natural:.3g} m/s: check the unit"
+    _require_resolvable(params, protocol, rtol, unit)
+    basis += unit
     return CostEstimate(steps, basis, steps * STEP_SECONDS)
+
+
+def _require_resolvable(params: Parameters, protocol: Protocol, rtol: float, unit: str) -> None:
+    """Refuse a run whose positions or times outgrow double precision (a reduced stretch costs few steps whatever
+    its length, so the step budget no longer bounds the duration): the bonds' extensions, differences of positions
+    of the size of the travel, must keep rtol of dl_m, and the clock must resolve a tenth of tau."""
+    b = params.bonds
+    eps = float(np.finfo(float).eps)
+    travel, duration = _travel(protocol), protocol.duration
+    if travel * eps > PRECISION * rtol * b.max_extension or duration * eps > CLOCK * b.bond_time:
+        raise ParameterError(
+            f"transient: {duration:.3g} s ({travel:.3g} m of travel) is beyond what double precision resolves: the"
+            f" bonds' extensions (Δl_m = {b.max_extension:.3g} m) to rtol {rtol:g} need a travel below"
+            f" {PRECISION * rtol * b.max_extension / eps:.3g} m, the clock (τ = {b.bond_time:.3g} s) a run shorter"
+            f" than {CLOCK * b.bond_time / eps:.3g} s; shorten the run{unit}"
+        )
+
+
+def _reduced_from(params: Parameters, control: str, aging: bool) -> float:
+    """The slowest puller velocity whose pieces the quasi-steady reduction takes (0: all; inf: none)."""
+    if control != "block" or not aging:  # a rigid rig holds V; without aging the steady curve has no fold
+        return 0.0
+    from ..model.jump import cached_critical_point, steady_curve_key
+
+    try:
+        cp = cached_critical_point(steady_curve_key(params))
+    except (ModelError, ParameterError):
+        return math.inf  # no critical point to be found: count the cohorts throughout
+    if not cp.exists or cp.velocity is None:
+        return 0.0
+    return FOLD_MARGIN * float(cp.velocity)
 
 
 __all__ = ["Cycle", "estimate_cost", "run_transient"]
