@@ -8,6 +8,7 @@ import math
 import numpy as np
 
 from .. import regimes
+from ..display import velocity as show_velocity
 from ..model.cycle import Cycle
 from ..protocols import Protocol
 
@@ -164,7 +165,7 @@ def classify(
         )
     return regimes.UNDETERMINED, (
         f"{found.evidence} at the end of the run (t = {time[-1]:.6g} s, σ = {stress[-1]:.6g} Pa,"
-        f" V = {velocity[-1]:.3g} m/s): run longer to see where it goes"
+        f" V = {show_velocity(velocity[-1], 3)}): run longer to see where it goes"
     )
 
 

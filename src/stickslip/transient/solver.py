@@ -9,6 +9,7 @@ from typing import Any
 
 import numpy as np
 
+from ..display import velocity as show_velocity
 from ..errors import ModelError, ParameterError
 from ..model.cycle import Cycle
 from ..numerics.budget import CostEstimate, check_max_steps, over_budget, require_within
@@ -682,12 +683,13 @@ def _steady_start_below_vc(
         return start_velocity, ""
     if start_velocity is not None:
         return start_velocity, (
-            f" (steady start at {v_start:.4g} m/s, below Vc = {cp.velocity:.4g} m/s: on the unstable branch of"
-            " the steady curve unless the block is stiffer than Kc(V), transient.critical_stiffness)"
+            f" (steady start at {show_velocity(v_start, 4)}, below Vc = {show_velocity(cp.velocity, 4)}: on the"
+            " unstable branch of the steady curve unless the block is stiffer than Kc(V), transient.critical_stiffness)"
         )
     v_stable = cp.velocity * (1.0 + STABLE_SIDE)
     return v_stable, (
-        f" (steady start: {v_start:.4g} m/s is below Vc = {cp.velocity:.4g} m/s, where steady sliding is unstable,"
+        f" (steady start: {show_velocity(v_start, 4)} is below Vc = {show_velocity(cp.velocity, 4)}, where steady"
+        " sliding is unstable,"
         f" so the run starts on the stable side of the critical point, sliding at Vc under σc ="
         f" {cp.stress:.6g} Pa; give start_velocity / --start-velocity to start elsewhere)"
     )
