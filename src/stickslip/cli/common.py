@@ -104,18 +104,51 @@ def params_options(func: Callable[..., Any]) -> Callable[..., Any]:
 
 def resolve_params(params_name: str, overrides: Sequence[str]) -> Parameters:
     """Parameters from ``--params`` and ``--set`` values."""
-    mapping: dict[str, str] = {}
-    for item in overrides:
-        key, sep, value = item.partition("=")
-        if not sep or not key.strip():
-            raise ParameterError(f"--set {shorten(item)}: expected SECTION.KEY=VALUE, e.g. bonds.bond_time='224 us'")
-        key, value = key.strip(), value.strip()
-        dimension = key_dimension(key)
-        if dimension != "dimensionless" and bare_number(value) is not None:
-            require_unit(value, dimension, f"--set {key}=", typical_value(key))
-        mapping[key] = value
+    mapping = set_values(overrides, key_dimension, typical_of=typical_value, form="SECTION.KEY=VALUE")
     protect_inputs([params_name])  # a TOML file is an input: no output of this command may replace it
     return load_parameters(params_name, overrides=mapping)
+
+
+#: How ``--set`` is written, in its messages.
+SET_EXAMPLE = "--set 'bonds.bond_time=224 us'"
+
+
+def key_value(item: str, flag: str = "--set", form: str = "KEY=VALUE", example: str = SET_EXAMPLE) -> tuple[str, str]:
+    """One ``FLAG KEY=VALUE`` text as (key, value), both stripped; one line naming the item when it is no pair."""
+    key, sep, value = item.partition("=")
+    key, value = key.strip(), value.strip()
+    if not sep or not key:
+        raise ParameterError(f"{flag} {shorten(item)}: expected {form}, e.g. {example}")
+    return key, value
+
+
+def set_values(
+    items: Sequence[str],
+    dimension_of: Callable[[str], str | None] = lambda key: None,
+    *,
+    typical_of: Callable[[str], float | None] | None = None,
+    form: str = "KEY=VALUE",
+) -> dict[str, str]:
+    """Repeated ``--set KEY=VALUE`` as {key: text}, the one parser of every command.
+
+    ``dimension_of(key)`` names a key's dimension (None: not known here, the model reads the value); a dimensional
+    value then needs its unit, as everywhere on the command line, and ``typical_of(key)`` sizes the unit suggested.
+    """
+    mapping: dict[str, str] = {}
+    for item in items:
+        key, value = key_value(item, "--set", form)
+        check_unit(key, value, dimension_of(key), typical_of)
+        mapping[key] = value
+    return mapping
+
+
+def check_unit(
+    key: str, value: str, dimension: str | None, typical_of: Callable[[str], float | None] | None = None
+) -> None:
+    """Refuse ``--set KEY=VALUE`` with a bare number for a dimensional key (None or dimensionless: any value)."""
+    if dimension is None or dimension == "dimensionless" or bare_number(value) is None:
+        return
+    require_unit(value, dimension, f"--set {key}=", None if typical_of is None else typical_of(key))
 
 
 def refuse_overwriting_inputs(
