@@ -13,7 +13,6 @@ bounded size: a FIFO or /dev/zero is refused instead of read for ever).
 
 from __future__ import annotations
 
-import json
 import math
 import stat
 import sys
@@ -24,6 +23,9 @@ from typing import Any
 
 import click
 
+from ..columns import JSON_DIGITS as JSON_DIGITS  # re-exported: the JSON helpers live in stickslip.columns
+from ..columns import json_safe as json_safe
+from ..columns import json_text
 from ..errors import ParameterError, StickslipError, UnitError
 from ..fileio import atomic_path, atomic_write_text, protect_inputs, refuse_input_as_output
 from ..parameters import Parameters, key_dimension, load_parameters
@@ -217,46 +219,6 @@ def positive(text: str | float, dimension: str, name: str, allow_zero: bool = Fa
         expected = "a value >= 0" if allow_zero else "a positive value"
         raise ParameterError(f"{name}: expected {expected}, got {shorten(text)}")
     return value
-
-
-def json_safe(obj: Any, digits: int | None = None) -> Any:
-    """Replace non-finite floats by None and numpy types by Python ones, recursively.
-
-    ``digits``: write floats at that many significant digits (15 drops float noise such as
-    0.0007999999999999999 for 8e-4 and moves no value by more than 5e-16 of itself); None keeps every bit.
-    """
-    import numpy as np
-
-    if isinstance(obj, dict):
-        return {str(k): json_safe(v, digits) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [json_safe(v, digits) for v in obj]
-    if isinstance(obj, np.ndarray):
-        return [json_safe(v, digits) for v in obj.tolist()]
-    if isinstance(obj, (np.floating, float)):
-        value = float(obj)
-        if not math.isfinite(value):
-            return None
-        return value if digits is None else float(f"{value:.{digits}g}")
-    if isinstance(obj, np.integer):
-        return int(obj)
-    if isinstance(obj, np.bool_):
-        return bool(obj)
-    return obj
-
-
-#: Significant digits of the numbers in the JSON people read (see :func:`json_safe`).
-JSON_DIGITS = 15
-
-
-def json_text(obj: Any) -> str:
-    """The JSON text of a result: SI numbers without float noise, and a top-level ``units`` map naming them."""
-    from ..columns import JSON_KEY, json_units
-
-    document = json_safe(obj, JSON_DIGITS)
-    if isinstance(document, dict) and JSON_KEY not in document:
-        document[JSON_KEY] = json_units(document)
-    return json.dumps(document, indent=2)
 
 
 def emit_json(obj: Any, output: Path | None = None) -> None:
