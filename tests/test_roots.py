@@ -52,7 +52,7 @@ def test_same_errors_as_scipy():
 def test_critical_point_is_the_same_with_scipys_solver(params, monkeypatch):
     ours = critical_module.critical_point(params)
     monkeypatch.setattr(critical_module, "brentq", scipy_brentq)
-    critical_module._critical_point_of_curve.cache_clear()  # computed once per curve: solve it again
+    critical_module.cached_critical_point.cache_clear()  # computed once per curve: solve it again
     theirs = critical_module.critical_point(params)
     assert ours.as_dict() == theirs.as_dict()  # exact: every float identical
     assert ours.velocity == pytest.approx(124.1e-6, rel=2e-3)  # the paper's Vc, as a sanity anchor

@@ -184,7 +184,7 @@ def test_critical_point_is_computed_once_per_steady_curve(monkeypatch):
     from stickslip import critical_point
     from stickslip.model import critical
 
-    critical._critical_point_of_curve.cache_clear()
+    critical.cached_critical_point.cache_clear()
     solved = []
     real = critical.find_extrema
     monkeypatch.setattr(critical, "find_extrema", lambda *a, **k: solved.append(1) or real(*a, **k))

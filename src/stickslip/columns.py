@@ -29,9 +29,12 @@ if TYPE_CHECKING:  # pragma: no cover
 __all__ = [
     "DIMENSIONLESS",
     "INHERITED",
+    "JSON_DIGITS",
     "UNITS",
     "csv_text",
     "header_cell",
+    "json_safe",
+    "json_text",
     "json_units",
     "parquet_table",
     "read_parquet",
@@ -313,3 +316,41 @@ def json_units(document: Mapping[str, Any], extra: Mapping[str, str | None] | No
         if unit is not None:
             units[key] = unit
     return dict(sorted(units.items()))
+
+
+def json_safe(obj: Any, digits: int | None = None) -> Any:
+    """Replace non-finite floats by None and numpy types by Python ones, recursively.
+
+    ``digits``: write floats at that many significant digits (15 drops float noise such as
+    0.0007999999999999999 for 8e-4 and moves no value by more than 5e-16 of itself); None keeps every bit.
+    """
+    import numpy as np
+
+    if isinstance(obj, dict):
+        return {str(k): json_safe(v, digits) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [json_safe(v, digits) for v in obj]
+    if isinstance(obj, np.ndarray):
+        return [json_safe(v, digits) for v in obj.tolist()]
+    if isinstance(obj, (np.floating, float)):
+        value = float(obj)
+        if not math.isfinite(value):
+            return None
+        return value if digits is None else float(f"{value:.{digits}g}")
+    if isinstance(obj, np.integer):
+        return int(obj)
+    if isinstance(obj, np.bool_):
+        return bool(obj)
+    return obj
+
+
+#: Significant digits of the numbers in the JSON people read (see :func:`json_safe`).
+JSON_DIGITS = 15
+
+
+def json_text(obj: Any) -> str:
+    """The JSON text of a result: SI numbers without float noise, and a top-level ``units`` map naming them."""
+    document = json_safe(obj, JSON_DIGITS)
+    if isinstance(document, dict) and JSON_KEY not in document:
+        document[JSON_KEY] = json_units(document)
+    return json.dumps(document, indent=2)

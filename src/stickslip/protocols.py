@@ -24,6 +24,7 @@ from typing import Any
 import numpy as np
 
 from .columns import with_units
+from .display import velocity as velocity_text
 from .errors import DataError, ParameterError
 from .fileio import protect_inputs, read_input_text
 
@@ -130,7 +131,7 @@ class Protocol:
 
     def describe(self) -> str:
         """One line a person can read: ``100 µm/s for 10 s, then 1000 µm/s for 20 s``."""
-        parts = [f"{s.velocity * 1e6:g} µm/s for {s.duration:g} s" for s in self.segments]
+        parts = [f"{velocity_text(s.velocity)} for {s.duration:g} s" for s in self.segments]
         return ", then ".join(parts)
 
     def plot(self, ax: Any = None) -> Any:

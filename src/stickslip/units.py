@@ -24,7 +24,7 @@ import re
 from functools import lru_cache
 from typing import Any
 
-from .errors import UnitError
+from .errors import ParameterError, UnitError
 
 #: Dimensions used by the model, as pint dimensionality strings, with the
 #: unit used to *display* a value of that dimension.
@@ -144,6 +144,21 @@ def quantity_noun(dimension: str) -> str:
 def _describe(dimension: str) -> str:
     unit = DIMENSIONS[dimension][1]
     return quantity_noun(dimension) + (f" (e.g. in {unit})" if unit else "")
+
+
+def checked_number(name: str, value: Any, unit: str, *, strict: bool = False) -> float:
+    """A number given by code in SI ``unit`` (no text), as a float: finite and >= 0 (> 0 with ``strict``).
+
+    Otherwise a ParameterError naming ``name``; a bool is no number.  The rig's and the stability analysis'
+    stiffness, damping and mass are checked by it alike.
+    """
+    if isinstance(value, bool) or not (isinstance(value, (int, float)) or hasattr(value, "__float__")):
+        raise ParameterError(f"{name}: expected a number in {unit}, got {shorten(value)}")
+    number = float(value)
+    if not math.isfinite(number) or number < 0 or (strict and number == 0):
+        expected = f"a finite value > 0 {unit}" if strict else f"a non-negative finite value in {unit}"
+        raise ParameterError(f"{name}: expected {expected}, got {shorten(value)}")
+    return number
 
 
 def bare_number(text: str) -> float | None:

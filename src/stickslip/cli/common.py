@@ -13,7 +13,6 @@ bounded size: a FIFO or /dev/zero is refused instead of read for ever).
 
 from __future__ import annotations
 
-import json
 import math
 import stat
 import sys
@@ -24,6 +23,9 @@ from typing import Any
 
 import click
 
+from ..columns import JSON_DIGITS as JSON_DIGITS  # re-exported: the JSON helpers live in stickslip.columns
+from ..columns import json_safe as json_safe
+from ..columns import json_text
 from ..errors import ParameterError, StickslipError, UnitError
 from ..fileio import atomic_path, atomic_write_text, protect_inputs, refuse_input_as_output
 from ..parameters import Parameters, key_dimension, load_parameters
@@ -104,18 +106,51 @@ def params_options(func: Callable[..., Any]) -> Callable[..., Any]:
 
 def resolve_params(params_name: str, overrides: Sequence[str]) -> Parameters:
     """Parameters from ``--params`` and ``--set`` values."""
-    mapping: dict[str, str] = {}
-    for item in overrides:
-        key, sep, value = item.partition("=")
-        if not sep or not key.strip():
-            raise ParameterError(f"--set {shorten(item)}: expected SECTION.KEY=VALUE, e.g. bonds.bond_time='224 us'")
-        key, value = key.strip(), value.strip()
-        dimension = key_dimension(key)
-        if dimension != "dimensionless" and bare_number(value) is not None:
-            require_unit(value, dimension, f"--set {key}=", typical_value(key))
-        mapping[key] = value
+    mapping = set_values(overrides, key_dimension, typical_of=typical_value, form="SECTION.KEY=VALUE")
     protect_inputs([params_name])  # a TOML file is an input: no output of this command may replace it
     return load_parameters(params_name, overrides=mapping)
+
+
+#: How ``--set`` is written, in its messages.
+SET_EXAMPLE = "--set 'bonds.bond_time=224 us'"
+
+
+def key_value(item: str, flag: str = "--set", form: str = "KEY=VALUE", example: str = SET_EXAMPLE) -> tuple[str, str]:
+    """One ``FLAG KEY=VALUE`` text as (key, value), both stripped; one line naming the item when it is no pair."""
+    key, sep, value = item.partition("=")
+    key, value = key.strip(), value.strip()
+    if not sep or not key:
+        raise ParameterError(f"{flag} {shorten(item)}: expected {form}, e.g. {example}")
+    return key, value
+
+
+def set_values(
+    items: Sequence[str],
+    dimension_of: Callable[[str], str | None] = lambda key: None,
+    *,
+    typical_of: Callable[[str], float | None] | None = None,
+    form: str = "KEY=VALUE",
+) -> dict[str, str]:
+    """Repeated ``--set KEY=VALUE`` as {key: text}, the one parser of every command.
+
+    ``dimension_of(key)`` names a key's dimension (None: not known here, the model reads the value); a dimensional
+    value then needs its unit, as everywhere on the command line, and ``typical_of(key)`` sizes the unit suggested.
+    """
+    mapping: dict[str, str] = {}
+    for item in items:
+        key, value = key_value(item, "--set", form)
+        check_unit(key, value, dimension_of(key), typical_of)
+        mapping[key] = value
+    return mapping
+
+
+def check_unit(
+    key: str, value: str, dimension: str | None, typical_of: Callable[[str], float | None] | None = None
+) -> None:
+    """Refuse ``--set KEY=VALUE`` with a bare number for a dimensional key (None or dimensionless: any value)."""
+    if dimension is None or dimension == "dimensionless" or bare_number(value) is None:
+        return
+    require_unit(value, dimension, f"--set {key}=", None if typical_of is None else typical_of(key))
 
 
 def refuse_overwriting_inputs(
@@ -184,46 +219,6 @@ def positive(text: str | float, dimension: str, name: str, allow_zero: bool = Fa
         expected = "a value >= 0" if allow_zero else "a positive value"
         raise ParameterError(f"{name}: expected {expected}, got {shorten(text)}")
     return value
-
-
-def json_safe(obj: Any, digits: int | None = None) -> Any:
-    """Replace non-finite floats by None and numpy types by Python ones, recursively.
-
-    ``digits``: write floats at that many significant digits (15 drops float noise such as
-    0.0007999999999999999 for 8e-4 and moves no value by more than 5e-16 of itself); None keeps every bit.
-    """
-    import numpy as np
-
-    if isinstance(obj, dict):
-        return {str(k): json_safe(v, digits) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [json_safe(v, digits) for v in obj]
-    if isinstance(obj, np.ndarray):
-        return [json_safe(v, digits) for v in obj.tolist()]
-    if isinstance(obj, (np.floating, float)):
-        value = float(obj)
-        if not math.isfinite(value):
-            return None
-        return value if digits is None else float(f"{value:.{digits}g}")
-    if isinstance(obj, np.integer):
-        return int(obj)
-    if isinstance(obj, np.bool_):
-        return bool(obj)
-    return obj
-
-
-#: Significant digits of the numbers in the JSON people read (see :func:`json_safe`).
-JSON_DIGITS = 15
-
-
-def json_text(obj: Any) -> str:
-    """The JSON text of a result: SI numbers without float noise, and a top-level ``units`` map naming them."""
-    from ..columns import JSON_KEY, json_units
-
-    document = json_safe(obj, JSON_DIGITS)
-    if isinstance(document, dict) and JSON_KEY not in document:
-        document[JSON_KEY] = json_units(document)
-    return json.dumps(document, indent=2)
 
 
 def emit_json(obj: Any, output: Path | None = None) -> None:

@@ -17,8 +17,8 @@ import click
 from ..errors import ModelError, ParameterError
 from ..progress import progress
 from ..units import shorten
-from .common import check_output, emit_json, refuse_overwriting_inputs, require_unit, save_figure
-from .protocol_options import build_protocol, control_name
+from .common import check_output, check_unit, emit_json, key_value, refuse_overwriting_inputs, save_figure
+from .protocol_options import build_protocol, build_rig
 from .run_cmd import model_parameters, run_summary
 
 #: Exit status when a model's run failed (status "failed"); 2 is bad input.
@@ -45,18 +45,13 @@ def routed_overrides(models: list[Any], overrides: tuple[str, ...]) -> dict[str,
     """``--set KEY=VALUE`` for each model that has KEY (with its unit, as everywhere on the command line)."""
     routed: dict[str, dict[str, str]] = {m.name: {} for m in models}
     for item in overrides:
-        key, sep, value = item.partition("=")
-        key, value = key.strip(), value.strip()
-        if not sep or not key:
-            raise ParameterError(f"--set {shorten(item)}: expected KEY=VALUE, e.g. --set 'bonds.bond_time=224 us'")
+        key, value = key_value(item)
         owners = [m for m in models if key in m.dimensions() or (key == "law" and "law" in _extra_keys(m))]
         if not owners:
             names = ", ".join(m.name for m in models)
             raise ParameterError(f"--set {key}: none of the models {names} has this key")
         for model in owners:
-            dimension = model.dimensions().get(key)
-            if dimension is not None:
-                require_unit(value, dimension, f"--set {key}=")
+            check_unit(key, value, model.dimensions().get(key))
             routed[model.name][key] = value
     return routed
 
@@ -64,21 +59,6 @@ def routed_overrides(models: list[Any], overrides: tuple[str, ...]) -> dict[str,
 def _extra_keys(model: Any) -> tuple[str, ...]:
     """Keys a model takes besides its dimensional ones (rate-and-state's ``law``)."""
     return ("law",) if hasattr(model, "LAW_NAMES") else ()
-
-
-def _rig(control: str, stiffness_text: str | None) -> Any:
-    from ..models import Rig
-    from .common import positive
-
-    control = control_name(control)
-    if stiffness_text is None:
-        return Rig(control=control)
-    k = positive(stiffness_text, "stress_per_length", "--stiffness")
-    if control == "velocity":
-        raise ParameterError(
-            "--stiffness: under --control velocity the rig is rigid and has no spring; drop --stiffness"
-        )
-    return Rig(control=control, stiffness=k)
 
 
 def compare_models(options: dict[str, Any]) -> None:
@@ -93,10 +73,12 @@ def compare_models(options: dict[str, Any]) -> None:
     models = model_list(options["models"])
     protocol = build_protocol(options["v0_text"], options["duration_text"], options["segment_texts"],
                               options["protocol_file"])  # fmt: skip
-    rig = _rig(options["control"], options["stiffness_text"])
+    rig, own_spring = build_rig(options["control"], options["stiffness_text"], models)
     for model in models:  # what a model cannot run is refused before any model runs
         model.check(protocol, rig, {})
     routed = routed_overrides(models, options["overrides"])
+    for name, text in own_spring.items():
+        routed[name]["k"] = text
     runs = {}
     # one stage per model: a bar on a terminal, nothing in a pipe or with --json
     with progress("compare", total=len(models), unit="models", enabled=False if options["as_json"] else None) as bar:

@@ -23,7 +23,7 @@ from .common import (
     write_text,
 )
 from .params_cmd import print_rich
-from .protocol_options import build_protocol, protocol_options, refuse_unsupported, stiffness
+from .protocol_options import build_protocol, build_rig, protocol_options, refuse_unsupported
 
 #: Rows of the Nc/Nc0 table printed by ``stick`` (the whole curve is in --json and -o).
 STICK_TABLE_ROWS = 11
@@ -106,17 +106,17 @@ def simulate_command(
     "stuck" (a stick never ends) or "undetermined" (the model has no answer).
     """
     from ..model.cycle import CYCLE_COLUMNS
-    from ..models import Rig, get_model
+    from ..models import get_model
 
     refuse_overwriting_inputs([protocol_file], [("-o", output), ("--plot", plot_path)], params_name)
     protocol = build_protocol(v0_text, duration_text, segment_texts, protocol_file)
-    refuse_unsupported("simulate (the quasi-static model)", protocol, control, stiffness_text, controls=("spring",),
+    refuse_unsupported("simulate (the quasi-static model)", protocol, control, controls=("spring",),
                        one_segment=True, instead="stickslip transient runs any protocol and rig")  # fmt: skip
     v0 = protocol.segments[0].velocity
-    k = stiffness(stiffness_text)
+    rig, _ = build_rig(control, stiffness_text)
     start = _stress(start_text)
     params = resolve_params(params_name, overrides)
-    run = get_model("quasi-static").run(params, protocol, Rig(stiffness=k), start=start, jump_curve=jump_curve)
+    run = get_model("quasi-static").run(params, protocol, rig, start=start, jump_curve=jump_curve)
     sim = run.native  # the Simulation: its phases and cycles make the table below
     if output is not None:
         write_text(output, _csv({n: getattr(sim, n) for n in CYCLE_COLUMNS}))

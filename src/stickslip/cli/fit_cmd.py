@@ -12,10 +12,13 @@ from typing import Any
 
 import click
 
+from ..errors import ParameterError
 from ..parameters import Parameters, key_dimension
+from ..units import shorten
 from .common import (
     InputFile,
     emit_json,
+    key_value,
     params_options,
     positive,
     refuse_overwriting_inputs,
@@ -31,16 +34,13 @@ SPLIT_DEFAULT = "800 um/s"
 def _fix_values(items: tuple[str, ...]) -> dict[str, Any]:
     out: dict[str, Any] = {}
     for item in items:
-        key, sep, value = item.partition("=")
-        key = key.strip()
-        if not sep or not key or not value.strip():
-            raise click.BadParameter(
-                f"{item!r}: expected KEY=VALUE, e.g. bonds.max_extension='1 um'", param_hint="--fix"
-            )
-        require_unit(value.strip(), key_dimension(key), f"--fix {key}=")  # unknown keys: ParameterError
+        key, value = key_value(item, "--fix", example="--fix 'bonds.max_extension=1 um'")
+        if not value:
+            raise ParameterError(f"--fix {shorten(item)}: expected a value after '=', e.g. --fix '{key}=1 um'")
+        require_unit(value, key_dimension(key), f"--fix {key}=")  # unknown keys: ParameterError
         if key in out:
-            raise click.BadParameter(f"{key} given twice", param_hint="--fix")
-        out[key] = value.strip()
+            raise ParameterError(f"--fix {key}: given twice")
+        out[key] = value
     return out
 
 

@@ -25,8 +25,8 @@ from typing import Any
 
 import click
 
-from ..errors import ParameterError
-from .common import positive
+from ..errors import ParameterError, UnitError
+from .common import positive, require_unit
 
 #: Rigs every run command names the same way.
 CONTROLS = ("spring", "velocity")
@@ -103,7 +103,6 @@ def refuse_unsupported(
     command: str,
     protocol: Any,
     control: str,
-    stiffness_text: str | None,
     *,
     controls: Sequence[str] = CONTROLS,
     one_segment: bool = False,
@@ -120,13 +119,32 @@ def refuse_unsupported(
             f"--segment/--protocol: {command} runs at one constant velocity, not a protocol of"
             f" {len(protocol.segments)} segments{hint}"
         )
-    if control == "velocity" and stiffness_text is not None:
+
+
+def build_rig(control: str, stiffness_text: str | None, models: Sequence[Any] = ()) -> tuple[Any, dict[str, str]]:
+    """The :class:`stickslip.models.Rig` of ``--control`` and ``--stiffness`` (K in Pa/m), the one rig builder.
+
+    Models whose own spring key ``k`` is in another unit (rate-and-state: friction per slip) also take
+    ``--stiffness`` in that unit ("1e-3 1/um") when every model of ``models`` has such a key: it then sets ``k``
+    in each, as ``--set k=...`` would.  Returns the rig and those settings, {model name: stiffness text}.
+    """
+    from ..models import Rig
+
+    control = control_name(control)
+    if stiffness_text is None:
+        return Rig(control=control), {}
+    if control == "velocity":
         raise ParameterError(
             "--stiffness: under --control velocity the rig is rigid and has no spring; drop --stiffness"
             " or use --control spring"
         )
-
-
-def stiffness(text: str | None) -> float | None:
-    """``--stiffness`` of the bond models: K in Pa/m (None when not given)."""
-    return None if text is None else positive(text, "stress_per_length", "--stiffness")
+    require_unit(stiffness_text, "stress_per_length", "--stiffness ")
+    try:
+        return Rig(control=control, stiffness=positive(stiffness_text, "stress_per_length", "--stiffness")), {}
+    except UnitError:
+        own = [m.dimensions().get("k") for m in models]
+        if not own or None in own:
+            raise
+    for dimension in own:
+        positive(stiffness_text, dimension, "--stiffness")  # the one-line error in the model's unit
+    return Rig(control=control), {m.name: stiffness_text for m in models}

@@ -284,7 +284,7 @@ def simulate_command(**options: Any) -> None:
     protocol = build_run_protocol(options["v0_text"], options["duration_text"], options["segment_texts"],
                                   options["protocol_file"], _fallback_protocol(fallback))  # fmt: skip
     refuse_unsupported("rsf simulate (the rate-and-state spring-slider)", protocol, options["control"],
-                       options["stiffness"], controls=("spring",))  # fmt: skip
+                       controls=("spring",))  # fmt: skip
     if options["start_velocity"] is not None:
         start = _positive(options["start_velocity"], "velocity", "--start-velocity")
     every = None if options["every"] is None else _positive(options["every"], "time", "--every")

@@ -17,8 +17,16 @@ import click
 from ..errors import ParameterError, UnitError
 from ..progress import progress
 from ..units import shorten
-from .common import check_output, emit_json, refuse_overwriting_inputs, require_unit, save_figure
-from .protocol_options import build_protocol, control_name, protocol_options
+from .common import (
+    check_output,
+    emit_json,
+    key_value,
+    refuse_overwriting_inputs,
+    require_unit,
+    save_figure,
+    set_values,
+)
+from .protocol_options import build_protocol, build_rig, protocol_options
 
 #: Exit status of a run the model could not finish (status "failed"); 2 is bad input.
 RUN_FAILED = 3
@@ -48,18 +56,7 @@ def load_model(model_name: str) -> Any:
 
 def model_overrides(model: Any, overrides: tuple[str, ...]) -> dict[str, str]:
     """``--set KEY=VALUE`` as {key: text}: a dimensional value needs its unit, as everywhere on the command line."""
-    dimensions = model.dimensions()
-    mapping: dict[str, str] = {}
-    for item in overrides:
-        key, sep, value = item.partition("=")
-        key, value = key.strip(), value.strip()
-        if not sep or not key:
-            raise ParameterError(f"--set {shorten(item)}: expected KEY=VALUE, e.g. --set 'bonds.bond_time=224 us'")
-        dimension = dimensions.get(key)
-        if dimension is not None:
-            require_unit(value, dimension, f"--set {key}=")
-        mapping[key] = value
-    return mapping
+    return set_values(overrides, model.dimensions().get)
 
 
 def model_parameters(model: Any, params_name: str | None, overrides: dict[str, str]) -> Any:
@@ -77,36 +74,6 @@ def model_parameters(model: Any, params_name: str | None, overrides: dict[str, s
     from .rsf_cmd import load_params_mapping  # a file of the mapping the model reads (rate-and-state's)
 
     return model.parameters(load_params_mapping(path), overrides)
-
-
-def rig_of(model: Any, control: str, stiffness_text: str | None, overrides: dict[str, str]) -> Any:
-    """The :class:`stickslip.models.Rig` of ``--control`` and ``--stiffness`` (Pa/m).
-
-    A model whose own spring key ``k`` is in friction per slip (rate-and-state) also takes ``--stiffness`` in
-    that unit ("1e-3 1/um"): it then sets ``k``, as ``--set k=...`` would.
-    """
-    from ..models import Rig
-    from .common import positive
-
-    control = control_name(control)
-    if stiffness_text is None:
-        return Rig(control=control)
-    require_unit(stiffness_text, "stress_per_length", "--stiffness ")
-    try:
-        k = positive(stiffness_text, "stress_per_length", "--stiffness")
-    except UnitError:
-        own = model.dimensions().get("k")
-        if own is None:
-            raise
-        overrides["k"] = stiffness_text
-        positive(stiffness_text, own, "--stiffness")  # the one-line error in the model's unit
-        return Rig(control=control)
-    if control == "velocity":
-        raise ParameterError(
-            "--stiffness: under --control velocity the rig is rigid and has no spring; drop --stiffness"
-            " or use --control spring"
-        )
-    return Rig(control=control, stiffness=k)
 
 
 def start_value(text: str | None) -> Any:
@@ -135,10 +102,7 @@ def settings_of(texts: tuple[str, ...], every_text: str | None) -> dict[str, Any
 
     settings: dict[str, Any] = {}
     for item in texts:
-        key, sep, value = item.partition("=")
-        key, value = key.strip(), value.strip()
-        if not sep or not key:
-            raise ParameterError(f"--setting {shorten(item)}: expected KEY=VALUE, e.g. --setting jump_curve=no-aging")
+        key, value = key_value(item, "--setting", example="--setting jump_curve=no-aging")
         if value.lower() in ("true", "false"):
             settings[key] = value.lower() == "true"
             continue
@@ -263,7 +227,9 @@ def run_command(
     model = load_model(model_name)
     protocol = build_protocol(v0_text, duration_text, segment_texts, protocol_file)
     mapping = model_overrides(model, overrides)
-    rig = rig_of(model, control, stiffness_text, mapping)
+    rig, own_spring = build_rig(control, stiffness_text, [model])
+    if own_spring:  # a stiffness in the model's own unit sets its key k, as --set k=... would
+        mapping["k"] = own_spring[model.name]
     params = model_parameters(model, params_name, mapping)
     settings = settings_of(setting_texts, every_text)
     model.check(protocol, rig, settings)  # what the model cannot do, before any work

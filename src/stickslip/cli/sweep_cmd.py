@@ -9,7 +9,7 @@ from typing import Any
 import click
 
 from ..errors import DataError, ParameterError, StickslipError
-from .common import echo_err, require_unit
+from .common import echo_err, require_unit, set_values
 
 MODEL_NAMES = ("quasi-static", "transient", "rsf")  # the built-ins; any registered model or module:attr is taken
 
@@ -128,7 +128,7 @@ def _run(
         list(vary),
         model=model,
         params=params_name,
-        overrides=_set_values(overrides),
+        overrides=set_values(overrides),
         pulling_velocity=v0_text,
         duration=duration_text,
         samples=samples,
@@ -151,16 +151,6 @@ def _run(
     summary = _summary(store.folder, spec.size)
     if not quiet:
         echo_err(summary)
-
-
-def _set_values(overrides: tuple[str, ...]) -> dict[str, str]:
-    values = {}
-    for item in overrides:
-        key, sep, value = item.partition("=")
-        if not sep or not key.strip():
-            raise ParameterError(f"--set {item!r}: expected KEY=VALUE, e.g. bonds.bond_time='224 us'")
-        values[key.strip()] = value.strip()
-    return values
 
 
 def _summary(folder: Path, total: int) -> str:

@@ -17,7 +17,7 @@ from .common import (
     save_figure,
     write_text,
 )
-from .protocol_options import build_protocol, control_name, protocol_options, refuse_unsupported, stiffness
+from .protocol_options import build_protocol, build_rig, control_name, protocol_options, refuse_unsupported
 
 
 def _trace_csv(result: Any) -> str:
@@ -86,7 +86,7 @@ def transient_command(
     The work is estimated before the run starts; a run estimated to need more
     than the step budget (--max-steps, default 3e6) is refused in one line.
     """
-    from ..models import Rig, get_model
+    from ..models import get_model
     from ..numerics.budget import PROGRESS_AFTER_SECONDS
     from ..progress import progress
     from ..transient.solver import estimate_cost
@@ -94,15 +94,14 @@ def transient_command(
     check_output("-o", output)
     check_output("--plot", plot_path, plot=True)
     protocol = build_protocol(v0_text, duration_text, segment_texts, protocol_file)
-    refuse_unsupported("transient", protocol, control, stiffness_text)
+    refuse_unsupported("transient", protocol, control)
     control = control_name(control)
     solver_control = "block" if control == "spring" else control  # run_transient's name of the spring
-    k = stiffness(stiffness_text)
+    rig, _ = build_rig(control, stiffness_text)
     refuse_overwriting_inputs([protocol_file], [("-o", output), ("--plot", plot_path)], params_name)
     start_velocity = None if start_v_text is None else positive(start_v_text, "velocity", "--start-velocity")
     every = None if every_text is None else positive(every_text, "time", "--every")
     params = resolve_params(params_name, overrides)
-    rig = Rig(control=control, stiffness=k)
     settings = dict(start_velocity=start_velocity, aging=not no_aging, stick_population=stick_population, every=every,
                     rtol=rtol, max_steps=max_steps, reduction="off" if no_reduce else "auto")  # fmt: skip
     cost = estimate_cost(params, protocol, control=solver_control, start_velocity=start_velocity, rtol=rtol,

@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ModelError
+from ..model.critical import Extremum, find_extrema
 from ..model.steady import steady_state
 from ..parameters import Parameters
 
@@ -28,12 +29,6 @@ PEAK_RANGE = (1e-8, 6e-5)
 MINIMUM_RANGE = (2e-5, 4e-4)
 #: residual of a trial set whose curve has no minimum near Vc
 FAILED_RESIDUAL = 1e3
-
-
-@dataclass(frozen=True)
-class Extremum:
-    velocity: float  # m/s
-    stress: float  # Pa
 
 
 @dataclass(frozen=True)
@@ -49,32 +44,15 @@ class SaturationFit:
     minimum: Extremum  # Vc, sigma_c
 
 
-def curve_extrema(params: Parameters, points: int = 60) -> tuple[Extremum | None, Extremum]:
+def curve_extrema(params: Parameters) -> tuple[Extremum | None, Extremum]:
     """The low-velocity maximum (None if the curve has none) and the minimum of the steady curve with aging."""
-    from scipy.optimize import minimize_scalar
-
-    def stress(log_v: float) -> float:
-        return float(steady_state(params, math.exp(log_v)).stress)
-
-    def extremum(lo: float, hi: float, sign: float) -> Extremum | None:
-        grid = np.geomspace(lo, hi, points)
-        values = sign * steady_state(params, grid).stress
-        k = int(np.argmin(values))
-        if k in (0, points - 1):
-            return None
-        found = minimize_scalar(
-            lambda lv: sign * stress(lv),
-            bounds=(math.log(grid[k - 1]), math.log(grid[k + 1])),
-            method="bounded",
-            options={"xatol": 1e-9},
-        )
-        return Extremum(math.exp(found.x), sign * float(found.fun))
-
-    low = extremum(*PEAK_RANGE, -1.0)
-    high = extremum(*MINIMUM_RANGE, 1.0)
-    if high is None:
+    extrema = find_extrema(params, aging=True, search_range=(PEAK_RANGE[0], MINIMUM_RANGE[1]))
+    peaks = [e for e in extrema if e.kind == "maximum" and PEAK_RANGE[0] < e.velocity < PEAK_RANGE[1]]
+    minima = [e for e in extrema if e.kind == "minimum" and MINIMUM_RANGE[0] < e.velocity < MINIMUM_RANGE[1]]
+    if not minima:
         raise ModelError("saturating aging: the steady curve has no minimum between 20 and 400 µm/s")
-    return low, high
+    peak = max(peaks, key=lambda e: e.stress) if peaks else None
+    return peak, min(minima, key=lambda e: e.stress)
 
 
 def table1_targets(table: object) -> tuple[float, float, float, float]:

@@ -171,20 +171,25 @@ def critical_point(params: Parameters) -> CriticalPoint:
     plot asks for the same one several times (~30 ms each).
     """
     require_parameters(params)  # before the cache: a dict is unhashable
-    return _critical_point_of_curve(_curve_key(params))
+    return cached_critical_point(steady_curve_key(params))
 
 
 _ANY_STICK = StickParameters(1.0, 1.0, 1.0)
 _ANY_BLOCK = BlockParameters(1.0, 1.0, 1.0, 1.0)
 
 
-def _curve_key(params: Parameters) -> Parameters:
-    """``params`` with what the steady curve does not depend on (all but the bonds and aging) fixed."""
+def steady_curve_key(params: Parameters) -> Parameters:
+    """``params`` with all but the bonds and aging sections replaced by fixed values: the cache key of the curve.
+
+    The steady curve (Eqs 6-8), its critical point and its branch depend on nothing else, so a sweep over the
+    block's stiffness or the stick parameters (or a renamed set) reuses them instead of solving them again.
+    """
     return dataclasses.replace(params, stick=_ANY_STICK, block=_ANY_BLOCK, name="", description="", reference="")
 
 
 @lru_cache(maxsize=32)
-def _critical_point_of_curve(params: Parameters) -> CriticalPoint:
+def cached_critical_point(params: Parameters) -> CriticalPoint:
+    """The critical point of one steady curve; callers pass :func:`steady_curve_key` (the one cache of the point)."""
     extrema = find_extrema(params, aging=True)
     minima = [e for e in extrema if e.kind == "minimum"]
     if minima:

@@ -23,7 +23,6 @@ method finds the root of the series.
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -35,8 +34,8 @@ from numpy.polynomial import chebyshev as cheb
 from scipy.optimize import brentq
 
 from ..errors import ModelError, ParameterError
-from ..parameters import BlockParameters, Parameters, StickParameters
-from .critical import CriticalPoint, critical_point
+from ..parameters import Parameters
+from .critical import CriticalPoint, cached_critical_point, steady_curve_key
 from .steady import ACCURATE_QUADRATURE, require_parameters, steady_state
 
 CURVES = ("aging", "no-aging")
@@ -117,25 +116,6 @@ def to_unit(x: np.ndarray | float, lo: float, hi: float) -> np.ndarray:
 
 
 # --------------------------------------------------------------------------- the steady curve, cached
-_ANY_STICK = StickParameters(1.0, 1.0, 1.0)
-_ANY_BLOCK = BlockParameters(1.0, 1.0, 1.0, 1.0)
-
-
-def steady_curve_key(params: Parameters) -> Parameters:
-    """``params`` with all but the bonds and aging sections replaced by fixed values: the cache key of the curve.
-
-    The steady curve (Eqs 6-8), its critical point and its branch depend on nothing else, so a sweep over the
-    block's stiffness or the stick parameters (or a renamed set) reuses them instead of solving them again.
-    """
-    return dataclasses.replace(params, stick=_ANY_STICK, block=_ANY_BLOCK, name="", description="", reference="")
-
-
-@lru_cache(maxsize=32)
-def cached_critical_point(params: Parameters) -> CriticalPoint:
-    """:func:`critical_point` once per key (callers pass :func:`steady_curve_key`: once per steady curve)."""
-    return critical_point(params)
-
-
 def require_critical_point(params: Parameters) -> CriticalPoint:
     """The critical point, or a ModelError saying why stick-slip is undefined without it."""
     require_parameters(params)  # before the cache: a dict is unhashable

@@ -10,13 +10,13 @@ do in its :class:`Capabilities` and refuses anything else in one line.
 
 from __future__ import annotations
 
-import math
 from abc import ABC, abstractmethod
 from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from ..errors import ModelError, ParameterError
+from ..units import checked_number
 
 if TYPE_CHECKING:  # pragma: no cover
     import numpy as np
@@ -41,15 +41,7 @@ CONTROLS = ("velocity", "spring")
 
 
 def _optional_positive(name: str, value: Any, unit: str, strict: bool) -> float | None:
-    if value is None:
-        return None
-    if isinstance(value, bool) or not (isinstance(value, (int, float)) or hasattr(value, "__float__")):
-        raise ParameterError(f"rig {name}: expected a number in {unit}, got {value!r}")
-    number = float(value)
-    if not math.isfinite(number) or number < 0 or (strict and number == 0):
-        relation = "> 0" if strict else ">= 0"
-        raise ParameterError(f"rig {name}: expected a finite value {relation} {unit}, got {value!r}")
-    return number
+    return None if value is None else checked_number(f"rig {name}", value, unit, strict=strict)
 
 
 @dataclass(frozen=True)

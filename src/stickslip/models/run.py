@@ -236,7 +236,7 @@ class Run:
 
     def metadata(self) -> dict[str, Any]:
         """What the columns cannot hold: the model, the regime and its evidence, the summary."""
-        from ..cli.common import json_safe  # plain-data helper, no CLI machinery
+        from ..columns import json_safe
 
         r = self.regime
         return json_safe({

@@ -18,7 +18,18 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .style import AGING_COLOR, CRITICAL_COLOR, DATA_COLOR, NO_AGING_COLOR, UM_PER_S, apply_style, new_axes
+from ..display import velocity as _velocity_text
+from .style import (
+    AGING_COLOR,
+    CRITICAL_COLOR,
+    DATA_COLOR,
+    NO_AGING_COLOR,
+    UM_PER_S,
+    VELOCITY_LABEL,
+    apply_style,
+    legend_of_all_panels,
+    new_axes,
+)
 
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.axes import Axes
@@ -35,11 +46,10 @@ STEADY_COLOR = "#27ae60"
 PHASE_COLORS = {"stick": STICK_COLOR, "slip": SLIP_COLOR, "steady": STEADY_COLOR}
 TIME_LABEL = "time t (s)"
 STRESS_LABEL = "shear stress σ (Pa)"
-VELOCITY_LABEL = "sliding velocity V (µm/s)"
 
 
 def _um(v: float) -> str:
-    return f"{v * UM_PER_S:.4g} µm/s"
+    return _velocity_text(v, digits=4)
 
 
 # --------------------------------------------------------------------------- single results on an Axes
@@ -129,17 +139,6 @@ def figure_cycles(
     if title:
         fig.suptitle(title, fontsize=11)
     return fig
-
-
-def legend_of_all_panels(fig: Figure, **kwargs: Any) -> None:
-    """One legend, on the first panel, naming every line of every panel once (a phase that only a later panel
-    shows, such as the steady part of Fig 5c, included)."""
-    handles: dict[str, Any] = {}
-    for ax in fig.axes:
-        for handle, label in zip(*ax.get_legend_handles_labels(), strict=True):
-            handles.setdefault(label, handle)
-    options = {"loc": "upper right", "frameon": False, "fontsize": 8, "ncols": 4, **kwargs}
-    fig.axes[0].legend(list(handles.values()), list(handles), **options)
 
 
 def _trace_arrays(item: Any) -> tuple[np.ndarray, np.ndarray]:

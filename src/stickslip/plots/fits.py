@@ -8,6 +8,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from .style import UM_PER_S, VELOCITY_LABEL
+
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.axes import Axes
     from matplotlib.figure import Figure
@@ -16,8 +18,6 @@ if TYPE_CHECKING:  # pragma: no cover
     from ..fitting.data import SteadyData
     from ..fitting.steady_fit import SteadyFit
     from ..fitting.stick_fit import StickFit
-
-UM = 1e6  # m/s -> um/s on the axes
 
 
 def panels(rows: int = 1, height: float = 4.0) -> tuple[Figure, list[Axes]]:
@@ -39,9 +39,9 @@ def plot_steady_data(data: SteadyData, ax: Axes | None = None, **kwargs: Any) ->
     ax = _axes(ax)
     style = {"fmt": "o", "color": "k", "ms": 4, "capsize": 2, "label": "data"} | kwargs
     err = None if data.stress_err is None else data.stress_err
-    ax.errorbar(data.velocity * UM, data.stress, yerr=err, **style)
+    ax.errorbar(data.velocity * UM_PER_S, data.stress, yerr=err, **style)
     ax.set_xscale("log")
-    ax.set_xlabel("sliding velocity V (µm/s)")
+    ax.set_xlabel(VELOCITY_LABEL)
     ax.set_ylabel("friction stress σ (Pa)")
     return ax
 
@@ -57,22 +57,24 @@ def plot_steady_fit(fit: SteadyFit, ax: Axes | None = None, band: tuple[np.ndarr
     """Data, fitted curve (with aging; without aging dashed) and Vc with its interval."""
     ax = plot_steady_data(fit.data, _axes(ax))
     v = _curve_range(fit)
-    ax.plot(v * UM, fit.curve(v), color="C0", label=f"fit ({fit.method})")
-    ax.plot(v * UM, fit.curve(v, aging=False), color="C0", ls="--", lw=1, label="fit without aging")
+    ax.plot(v * UM_PER_S, fit.curve(v), color="C0", label=f"fit ({fit.method})")
+    ax.plot(v * UM_PER_S, fit.curve(v, aging=False), color="C0", ls="--", lw=1, label="fit without aging")
     if band is not None:
         bv, lo, hi = band
-        ax.fill_between(bv * UM, lo, hi, color="C0", alpha=0.25, lw=0, label="95 % credible band")
+        ax.fill_between(bv * UM_PER_S, lo, hi, color="C0", alpha=0.25, lw=0, label="95 % credible band")
     vc, sc = fit.critical_velocity, fit.critical_stress
     if vc.value is not None and sc.value is not None:
         xerr = None
         if vc.interval is not None and None not in vc.interval:
-            xerr = [[(vc.value - vc.interval[0]) * UM], [(vc.interval[1] - vc.value) * UM]]  # type: ignore[operator]
+            xerr = [[(vc.value - vc.interval[0]) * UM_PER_S], [(vc.interval[1] - vc.value) * UM_PER_S]]  # type: ignore[operator]
         yerr = None
         if sc.interval is not None and None not in sc.interval:
             yerr = [[sc.value - sc.interval[0]], [sc.interval[1] - sc.value]]  # type: ignore[operator]
-        ax.errorbar([vc.value * UM], [sc.value], xerr=xerr, yerr=yerr, fmt="s", color="C3", capsize=3, label="Vc, σc")
+        ax.errorbar(
+            [vc.value * UM_PER_S], [sc.value], xerr=xerr, yerr=yerr, fmt="s", color="C3", capsize=3, label="Vc, σc"
+        )
     if fit.split is not None:
-        ax.axvline(fit.split * UM, color="0.6", ls=":", lw=1, label="split (two-step)")
+        ax.axvline(fit.split * UM_PER_S, color="0.6", ls=":", lw=1, label="split (two-step)")
     top = float(np.max(fit.data.stress)) * 1.4
     ax.set_ylim(0, top)
     ax.legend(fontsize="small")
@@ -82,9 +84,9 @@ def plot_steady_fit(fit: SteadyFit, ax: Axes | None = None, band: tuple[np.ndarr
 def plot_residuals(fit: SteadyFit, ax: Axes | None = None) -> Axes:
     ax = _axes(ax)
     ax.axhline(0.0, color="0.5", lw=1)
-    ax.plot(fit.data.velocity * UM, fit.residuals, "o", color="k", ms=4)
+    ax.plot(fit.data.velocity * UM_PER_S, fit.residuals, "o", color="k", ms=4)
     ax.set_xscale("log")
-    ax.set_xlabel("sliding velocity V (µm/s)")
+    ax.set_xlabel(VELOCITY_LABEL)
     ax.set_ylabel("(data − fit)/error")
     return ax
 
@@ -103,7 +105,7 @@ def plot_stick_fit(fit: StickFit, ax: Axes | None = None) -> Axes:
     the model's value for each fitted row, and the fitted t_s(V0) as a line."""
     ax = _axes(ax)
     data, used = fit.data, fit.used
-    v = data.pulling_velocity * UM
+    v = data.pulling_velocity * UM_PER_S
     offsets = _spread(data.pulling_velocity, used)
     sd = fit.noise_scale if np.isfinite(fit.noise_scale) else 0.0
     err = data.stick_time[used] * sd if sd > 0 else None
@@ -118,10 +120,10 @@ def plot_stick_fit(fit: StickFit, ax: Axes | None = None) -> Axes:
     grid = np.linspace(0.6 * lo, 1.25 * hi, 120)
     curve, start, stiffness = fit.stick_time_curve(grid)
     ax.plot(
-        grid * UM, curve, color="C0",
+        grid * UM_PER_S, curve, color="C0",
         label=f"model t_s(V0): start {start:.4g} Pa, loading rate/V0 {stiffness / 1e3:.4g} kPa/m (row medians)",
     )  # fmt: skip
-    ax.set_xlim(0.0, max(1.3 * hi, 1.1 * float(np.max(data.pulling_velocity))) * UM)  # left-out rows too
+    ax.set_xlim(0.0, max(1.3 * hi, 1.1 * float(np.max(data.pulling_velocity))) * UM_PER_S)  # left-out rows too
     top = np.nanmax(np.concatenate([data.stick_time, fit.model_stick_time[used], curve[np.isfinite(curve)]]))
     ax.set_ylim(0.0, 1.15 * top)
     ax.set_xlabel("pulling velocity V0 (µm/s)")
@@ -134,7 +136,7 @@ def plot_stick_fit(fit: StickFit, ax: Axes | None = None) -> Axes:
 def _spread(velocity: np.ndarray, used: np.ndarray) -> np.ndarray:
     """Small horizontal offsets (um/s) so that repeated cycles at one velocity do not hide each other."""
     out = np.zeros(velocity.size)
-    width = 0.006 * float(np.max(velocity[used])) * UM
+    width = 0.006 * float(np.max(velocity[used])) * UM_PER_S
     for v in np.unique(velocity[used]):
         same = np.nonzero(used & (velocity == v))[0]
         out[same] = (np.arange(same.size) - (same.size - 1) / 2) * width

@@ -5,10 +5,13 @@ Axes show velocities in um/s and stresses in Pa; the objects drawn hold SI value
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:  # pragma: no cover
+    from collections.abc import Sequence
+
     from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
 
 #: Display scale of velocities: SI (m/s) times this gives um/s.
 UM_PER_S = 1e6
@@ -38,3 +41,16 @@ def apply_style(ax: Axes) -> Axes:
         ax.spines[side].set_visible(False)
     ax.tick_params(direction="out", which="both")
     return ax
+
+
+def legend_of_all_panels(fig: Figure, axes: Sequence[Axes] | None = None, **kwargs: Any) -> None:
+    """One legend, on the first panel, naming every line of every panel once (a phase that only a later panel
+    shows, such as the steady part of Fig 5c, included).  ``axes``: the panels (default: all of ``fig``'s)."""
+    panels = list(fig.axes if axes is None else axes)
+    handles: dict[str, Any] = {}
+    for ax in panels:
+        for handle, label in zip(*ax.get_legend_handles_labels(), strict=True):
+            handles.setdefault(label, handle)
+    if handles:
+        options = {"loc": "upper right", "frameon": False, "fontsize": 8, "ncols": 4, **kwargs}
+        panels[0].legend(list(handles.values()), list(handles), **options)

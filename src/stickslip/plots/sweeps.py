@@ -16,10 +16,11 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ..display import symbol
 from ..errors import ParameterError
 from ..sweeps.models import get_model
 from ..units import DIMENSIONS
-from .style import apply_style, new_axes
+from .style import apply_style, legend_of_all_panels, new_axes
 
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.axes import Axes
@@ -182,11 +183,7 @@ def _parameter_name(key: str) -> str | None:
     found = next((f for f in fields(SECTIONS[section]) if f.name == name), None) if section in SECTIONS else None
     if found is None:
         return None
-    return f"{found.metadata['doc']} {SYMBOLS.get(found.metadata['symbol'], found.metadata['symbol'])}"
-
-
-#: Parameter symbols as printed (the metadata spells them in ASCII).
-SYMBOLS = {"tau": "τ", "tau_a": "τa", "lambda": "λ", "dl_m": "Δl_m", "V_a": "Va", "G_d": "Gd"}
+    return f"{found.metadata['doc']} {symbol(found.metadata['symbol'])}"
 
 
 def _log_axis(spec: Any, key: str, values: np.ndarray) -> bool:
@@ -306,7 +303,7 @@ def figure_sweep_1d(frame: Any, spec: Any, x: str, columns: Sequence[str] | None
     if _log_axis(spec, x, xs):
         axes[-1].set_xscale("log")
     axes[-1].set_xlabel(_label(x, dimensions[x]))
-    _legend_of_all_panels(fig, axes)
+    legend_of_all_panels(fig, axes, loc="best", frameon=True, ncols=1, framealpha=0.85)
     axes[0].set_title(f"{spec.label or spec.model}: results against {_name(x)} ({len(frame)} points)", fontsize=10)
     return fig
 
@@ -362,13 +359,3 @@ def _regime_colors(regimes: np.ndarray) -> list[tuple[str, str]]:
     names = [n for n in REGIME_COLORS if n in present] + sorted(present - set(REGIME_COLORS))
     spare = iter(["#8e44ad", "#16a085", "#d35400", "#2c3e50", "#27ae60"] * 4)
     return [(n, REGIME_COLORS.get(n) or next(spare)) for n in names]
-
-
-def _legend_of_all_panels(fig: Figure, axes: Sequence[Axes]) -> None:
-    """One legend, on the first panel, naming every regime, the boundary and the failed points once."""
-    handles: dict[str, Any] = {}
-    for ax in axes:
-        for handle, label in zip(*ax.get_legend_handles_labels(), strict=True):
-            handles.setdefault(label, handle)
-    if handles:
-        axes[0].legend(list(handles.values()), list(handles), loc="best", fontsize=8, framealpha=0.85)

@@ -194,7 +194,7 @@ def _results(
     built: str,
     elapsed: float,
 ) -> dict[str, Any]:
-    from ..cli.common import json_safe
+    from ..columns import json_safe
 
     flagged = [c for c in comparisons if c.flagged]
     return json_safe(

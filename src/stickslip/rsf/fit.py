@@ -382,16 +382,23 @@ def _polish(
     return result, residual
 
 
-def _downhill(result: Any, residual: Any) -> Any:
-    """The parameters two standard errors either way along the covariance's widest direction with the lower
-    chi-square, when it is below the fit's (None otherwise)."""
+def _widest_step(result: Any) -> np.ndarray | None:
+    """Two standard errors along the covariance's widest direction (None without a usable covariance)."""
     covar = result.covar
     if covar is None or not np.all(np.isfinite(covar)):
         return None
     values, vectors = np.linalg.eigh(covar)
     if values[-1] <= 0:
         return None
-    step = 2.0 * math.sqrt(values[-1]) * vectors[:, -1]
+    return 2.0 * math.sqrt(values[-1]) * vectors[:, -1]
+
+
+def _downhill(result: Any, residual: Any) -> Any:
+    """The parameters two standard errors either way along the covariance's widest direction with the lower
+    chi-square, when it is below the fit's (None otherwise)."""
+    step = _widest_step(result)
+    if step is None:
+        return None
     best, best_chi = None, float(result.chisqr)
     for sign in (1.0, -1.0):
         trial = result.params.copy()
@@ -411,13 +418,9 @@ QUADRATIC_RANGE = (0.5, 2.0)
 def _quadratic_check(result: Any, residual: Any) -> float | None:
     """Rise of chi-square two standard errors either way along the covariance's widest direction, over 4 (the
     quadratic's): the smaller side (None without a covariance)."""
-    covar = result.covar
-    if covar is None or not np.all(np.isfinite(covar)):
+    step = _widest_step(result)
+    if step is None:
         return None
-    values, vectors = np.linalg.eigh(covar)
-    if values[-1] <= 0:
-        return None
-    step = 2.0 * math.sqrt(values[-1]) * vectors[:, -1]
     rises = []
     for sign in (1.0, -1.0):
         trial = result.params.copy()

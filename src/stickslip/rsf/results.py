@@ -125,7 +125,7 @@ class RSFRun:
         }
 
     def metadata_json(self) -> str:
-        from ..cli.common import json_safe  # plain-data helper, no CLI machinery
+        from ..columns import json_safe
 
         return json.dumps(json_safe(self.metadata()), indent=2) + "\n"
 

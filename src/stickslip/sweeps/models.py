@@ -17,13 +17,14 @@ from ..errors import ParameterError, StickslipError
 from ..models import FrictionModel, Rig, available_models
 from ..models import get_model as find_model
 from ..models.base import Boundary
+from ..models.rsf import ALIASES as RSF_ALIASES
 
 __all__ = ["ALIASES", "MODELS", "PROTOCOL_KEYS", "Boundary", "SweepModel", "get_model", "result_columns", "run_point"]
 
 #: The keys a sweep adds to the model's own: the protocol's constant pulling velocity.
 PROTOCOL_KEYS = {"pulling_velocity": "velocity"}
-#: Other spellings accepted for keys (the issue's symbols).
-ALIASES = {"Dc": "dc", "η": "eta", "V0": "pulling_velocity"}
+#: Other spellings accepted for keys (the issue's symbols): rate-and-state's own, and V0 for the protocol's.
+ALIASES = {**RSF_ALIASES, "V0": "pulling_velocity"}
 NAN = float("nan")
 
 
@@ -54,9 +55,11 @@ class SweepModel:
 
         dimensions = self.dimensions()
         given = {ALIASES.get(k, k) if ALIASES.get(k, k) in dimensions else k: v for k, v in overrides.items()}
-        held = set(self.model.values(self.model.parameters(params)))
+        base = self.model.parameters(params)
+        held = set(self.model.values(base))
         apart = {k: v for k, v in given.items() if k in dimensions and k not in held}
-        built = self.model.parameters(params, {k: v for k, v in given.items() if k not in apart} or None)
+        inside = {k: v for k, v in given.items() if k not in apart}
+        built = self.model.parameters(base, inside) if inside else base
         fixed = self.model.values(built)
         for key, raw in apart.items():
             fixed[key] = to_si(raw, dimensions[key], key)
@@ -69,13 +72,18 @@ class SweepModel:
 
     def parameters(self, values: Mapping[str, float]) -> tuple[Any, float]:
         """(the model's parameters, the pulling velocity) of one point (validated)."""
+        params, velocity, _start = self.point(values, 1.0)
+        return params, velocity
+
+    def point(self, values: Mapping[str, float], duration: float) -> tuple[Any, float, Any]:
+        """(the model's parameters, the pulling velocity, the start) of one point of ``duration`` (validated)."""
         if "pulling_velocity" not in values:
             raise ParameterError("pulling_velocity: give --v0 V or --vary 'pulling_velocity=...'")
         velocity = values["pulling_velocity"]
         if not velocity >= 0:
             raise ParameterError(f"pulling_velocity: expected a value >= 0 m/s, got {velocity:g}")
-        self.start(velocity, 1.0)  # a velocity the model cannot start from is refused with the other values
-        return self.model.parameters(None, {k: v for k, v in values.items() if k not in PROTOCOL_KEYS}), velocity
+        start = self.start(velocity, duration)  # a velocity the model cannot start from is refused with the others
+        return self.model.parameters(None, {k: v for k, v in values.items() if k not in PROTOCOL_KEYS}), velocity, start
 
     def start(self, velocity: float, duration: float) -> Any:
         """The model's ``sweep_start`` for a run at ``velocity``."""
@@ -87,9 +95,8 @@ class SweepModel:
     def run(self, values: Mapping[str, float], settings: Mapping[str, Any]) -> dict[str, Any]:
         from ..protocols import constant
 
-        params, velocity = self.parameters(values)
+        params, velocity, start = self.point(values, settings["duration"])
         protocol = constant(velocity, settings["duration"])
-        start = self.start(velocity, settings["duration"])
         taken = {k: v for k, v in settings.items() if self.takes(k)}
         return self.model.run(params, protocol, Rig(), start=start, **taken).row(self.results)
 

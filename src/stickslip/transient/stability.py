@@ -29,7 +29,9 @@ from functools import lru_cache
 import numpy as np
 
 from ..errors import ModelError, ParameterError
+from ..numerics.roots import brentq  # scipy.optimize would add 0.3 s to start-up
 from ..parameters import Parameters
+from ..units import checked_number
 from .model import aging_age, chain_force, log_hazard, steady_population
 
 #: frequencies / growth rates scanned, in units of 1/tau: from 1e-6 to 1e4
@@ -164,10 +166,12 @@ class CriticalStiffness:
 
 def _block_terms(mass: float, damping: float) -> tuple[float, float]:
     """The block's mass per unit area (kg/m^2) and viscous damping (Pa s/m), checked."""
-    for name, value, unit in (("mass", mass, "kg/m^2"), ("damping", damping, "Pa s/m")):
-        if not (isinstance(value, (int, float)) and math.isfinite(value) and value >= 0):
-            raise ParameterError(f"{name}: expected a non-negative finite block {name} in {unit}, got {value!r}")
-    return float(mass), float(damping)
+    return checked_number("mass", mass, "kg/m^2"), checked_number("damping", damping, "Pa s/m")
+
+
+def _block_polynomial(s: np.ndarray | complex, stiffness: float, mass: float, damping: float) -> np.ndarray | complex:
+    """m s^2 + eta s + K (Pa/m): the block's part of the characteristic function D(s) = block + Z(s)."""
+    return mass * s * s + damping * s + stiffness
 
 
 def characteristic(
@@ -186,7 +190,7 @@ def characteristic(
     """
     mass, damping = _block_terms(mass, damping)
     z = interface_response(params, velocity, s, aging)
-    return mass * z.s * z.s + damping * z.s + stiffness + z.z
+    return _block_polynomial(z.s, stiffness, mass, damping) + z.z
 
 
 def resolved_frequency(params: Parameters, velocity: float, aging: bool = True) -> float:
@@ -238,13 +242,13 @@ def critical_from_response(
     where eta w + Im Z(i w) = 0, at K = m w^2 - Re Z(i w).  ``rates`` (1/s) is the scan of s and w;
     crossings above ``top`` (1/s, the resolved frequency) are ignored.
     """
-    real = response(rates).real + mass * rates * rates + damping * rates
+    real = response(rates).real + _block_polynomial(rates, 0.0, mass, damping)
     k_real = float(max(0.0, -real.min()))
     s_real = float(rates[int(np.argmin(real))])
 
     def crossing_terms(w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        z = response(1j * w)
-        return z.imag + damping * w, mass * w * w - z.real  # (Im D(i w), K that puts a root at i w)
+        d = _block_polynomial(1j * w, 0.0, mass, damping) + response(1j * w)  # D(i w) at K = 0
+        return d.imag, -d.real  # (Im D(i w), K that puts a root at i w)
 
     im_d, k_at = crossing_terms(rates)
     k_osc, w_osc = 0.0, 0.0
@@ -296,7 +300,7 @@ def follow_root(
         for _ in range(50):
             h = 1e-5 * max(abs(s), 1e-12)
             z = response(np.array([s, s + h, s - h]))
-            d = mass * s * s + damping * s + stiffness + z[0]
+            d = _block_polynomial(s, stiffness, mass, damping) + z[0]
             dd = 2.0 * mass * s + damping + (z[1] - z[2]) / (2.0 * h)
             step = d / dd
             s -= step
@@ -341,8 +345,6 @@ def real_growth_rates(
 
     Found by a sign change of D on the scan and bracketed to 1e-12; an empty array when none.
     """
-    from scipy.optimize import brentq
-
     mass, damping = _block_terms(mass, damping)
     rates = SCAN / params.bonds.bond_time
 
@@ -376,7 +378,7 @@ def unstable_root_count(
 
     def f(w: np.ndarray) -> np.ndarray:
         s = 1j * w
-        return (mass * s * s + damping * s + stiffness + response(s)) / (s + c) ** order
+        return (_block_polynomial(s, stiffness, mass, damping) + response(s)) / (s + c) ** order
 
     w = np.concatenate([[0.0], np.asarray(rates, dtype=float)])
     values = f(w)
