@@ -598,6 +598,13 @@ def advance(
             # the hazards used the predicted slider position and velocity
             err_s += 0.5 * hh * (abs(x1 - x1p) * sens_x + abs(_aging_factor(v1, p) - slope1) * sens_a)
             s1 = p[P_K] * (puller0 + vp * (t1 - t0) - x1)
+            # that estimate is linear in the correction, and the hazard near the FENE wall is not: a cohort the
+            # predicted position left just short of the wall can sit on its cliff (ln r at the cap) at the
+            # balanced one, where g keeps no slow root and the slider's velocity comes out ~1e178 m/s (a creeping
+            # steady start, 40 s at 100 um/s, went non-finite so).  A step whose end velocity would carry the
+            # slider over a whole chain extension within the step does not follow the path it assumed: shorter.
+            if not (hh * abs(v1 - v1p) <= dlm):
+                err_s = np.inf
         else:
             s1 += w1[n] * _chain_force(x1p - xb[n], m, dlm) + w1[n + 1] * _chain_force(e_nb, m, dlm)
         nn1 += born_alive
