@@ -378,7 +378,7 @@ def glide(
 ) -> Glide | None:
     """Advance the reduced description from t towards t_end (block: the ODE above; velocity: steady sliding).
 
-    ``acc`` (born, broken, work, dissipation, steps, rejected) is updated in place; ``bonded`` and
+    ``acc`` (born, broken, work, dissipation, steps, rejected, integral of sigma dt) is updated in place; ``bonded`` and
     ``energy`` are the cohorts' N and bond energy at entry, so that the bookkeeping stays continuous.
     """
     from scipy.integrate import solve_ivp
@@ -443,7 +443,12 @@ def glide(
     broken = acc[1] + y[1] - (nn - bonded)
     work = acc[2] + y[2]
     dissipation = acc[3] + y[3] - (uu - energy)
-    rows = np.c_[times, sigma, nn, vel, pos, pull, born, broken, work, dissipation, uu]
+    impulse, impulse_end = _stress_integral(sol, m, vp, k_block, block, (lo, hi), t, t_stop, times)
+    inner = sol.t[(sol.t > t) & (sol.t <= t_stop)]
+    v_inner = np.clip(sol.y[0][(sol.t > t) & (sol.t <= t_stop)], lo, hi)
+    sigma_inner = _effective_stress(m, v_inner, vp, k_block) if block else m.stress(np.log(v_inner))
+    lowest = _lowest_per_row(sigma, times, inner, sigma_inner, acc)
+    rows = np.c_[times, sigma, nn, vel, pos, pull, born, broken, work, dissipation, uu, acc[6] + impulse, lowest]
     end = sol.sol(t_stop)
     v_end = float(end[0])
     sigma_end = effective(m, v_end, vp, k_block)[0] if block else float(m.stress(math.log(v_end)))
@@ -454,7 +459,37 @@ def glide(
     u_end = float(m.energy(math.log(v_end)))
     acc[3] += end[3] - (u_end - energy)
     acc[4] += max(1, sol.t.size - 1)
+    acc[6] += impulse_end
     return Glide(t_stop, v_end, sigma_end, rows, done, sample_index, nn_end, u_end)
+
+
+def _lowest_per_row(sigma, times, inner, sigma_inner, acc):  # type: ignore[no-untyped-def]
+    """The lowest stress of the ODE's accepted steps closed by each row (the solver's own states, not the rows);
+    the steps after the last row are left in acc[7] for the next row."""
+    lowest = np.array(sigma, dtype=float)
+    closing = np.searchsorted(times, inner, side="left")
+    ahead = closing < times.size
+    np.minimum.at(lowest, closing[ahead], sigma_inner[ahead])
+    rest = float(np.min(sigma_inner[~ahead], initial=np.inf))
+    if times.size:
+        lowest[0] = min(lowest[0], acc[7])
+        acc[7] = rest
+    else:
+        acc[7] = min(acc[7], rest)
+    return lowest
+
+
+def _stress_integral(sol, m, vp, k_block, block, bounds, t, t_stop, times):  # type: ignore[no-untyped-def]
+    """The integral of sigma dt from t at ``times`` and at t_stop: Gauss (4 points) over the ODE's own steps
+    on its dense output, so that a mean stress does not depend on which rows are written."""
+    cut = np.r_[t, sol.t[(sol.t > t) & (sol.t < t_stop)], times[(times > t) & (times < t_stop)], t_stop]
+    edges = np.unique(cut)
+    half = 0.5 * np.diff(edges)
+    nodes = (0.5 * (edges[1:] + edges[:-1]))[:, None] + half[:, None] * kernel.GL4_X[None, :]
+    vel = np.clip(sol.sol(nodes.ravel())[0], *bounds)
+    sigma = _effective_stress(m, vel, vp, k_block) if block else m.stress(np.log(vel))
+    total = np.r_[0.0, np.cumsum((sigma.reshape(nodes.shape) @ kernel.GL4_W) * half)]
+    return np.interp(times, edges, total), float(total[-1])
 
 
 #: manifolds built so far, per (parameter set, aging): a sweep or a comparison reuses them
@@ -528,19 +563,21 @@ def steady_glide(
         shed = d0 * dt if rate * np.max(np.atleast_1d(dt), initial=0.0) < 1e-8 else d0 * -np.expm1(-rate * dt) / rate
         work = vp * (s_ss * dt + shed)
         dissipation = s_ss * vp * dt + (vp + s_ss / slope) * shed if block else work
-        return stress, velocity, np.where(block, pull, pos), pos, work, dissipation
+        return stress, velocity, np.where(block, pull, pos), pos, work, dissipation, s_ss * dt + shed
 
     dt = times - t
-    stress, velocity, pull, pos, work, dissipation = state(dt)
+    stress, velocity, pull, pos, work, dissipation, impulse = state(dt)
     one = np.ones_like(times)
+    end = state(np.array([t_end - t]))
     rows = np.c_[
         times, stress, n_ss * one, velocity, pos, pull, acc[0] + birth * dt, acc[1] + birth * dt - (n_ss - bonded),
-        acc[2] + work, acc[3] + dissipation, energy * one,
+        acc[2] + work, acc[3] + dissipation, energy * one, acc[6] + impulse,
+        _lowest_per_row(stress, times, np.r_[times, t_end], np.r_[stress, end[0]], acc),
     ]  # fmt: skip
-    end = state(np.array([t_end - t]))
     acc[0] += birth * (t_end - t)
     acc[1] += birth * (t_end - t) - (n_ss - bonded)
     acc[2] += float(end[4][0])
     acc[3] += float(end[5][0])
     acc[4] += 1
+    acc[6] += float(end[6][0])
     return Glide(t_end, float(end[1][0]), float(end[0][0]), rows, True, sample_index, n_ss, energy)
