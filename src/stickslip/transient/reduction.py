@@ -41,11 +41,8 @@ from . import kernel
 THETA = 0.3
 #: the neglected stress reported where the first-order manifold itself folds (Pa; ends a stretch)
 OFF_MANIFOLD = 1e300
-#: fewest trace rows a reduced stretch writes (the classifier reads the stress of the trace), the most, and the
-#: relative change of the slider velocity between rows
+#: fewest trace rows a reduced stretch writes (besides the ODE's steps; a plot of the trace)
 ROWS = 64
-MAX_ROWS = 20_000
-ROW_CHANGE = 1e-3
 #: Chebyshev degrees: the steady stress and bonded fraction (raised until the check passes), the lag C
 DEGREE = 24
 MAX_DEGREE = 96
@@ -416,10 +413,9 @@ def glide(
         return None  # the stretch could not be followed (the caller leaves it to the cohorts)
     t_stop = float(sol.t[-1])
     done = sol.status == 0 and t_stop >= t_end
-    # rows where the velocity moves by ROW_CHANGE at most (a summary of the trace, such as a mean stress by the
-    # trapezoid rule, then reads the same as the cohorts' row per step), and at the ODE's own steps
-    turns = abs(math.log(max(float(sol.y[0, -1]), 1e-300) / v)) / ROW_CHANGE
-    times = np.unique(np.r_[sol.t, np.linspace(t, t_stop, int(min(max(turns, ROWS), MAX_ROWS)))])
+    # rows at the ODE's own steps, and at least ROWS over the stretch (a plot of the trace); the summaries come
+    # from the solution (the integral of sigma dt, the lowest stress of the steps), not from the rows
+    times = np.unique(np.r_[sol.t, np.linspace(t, t_stop, ROWS)])
     if sample_times.size:
         inside = (sample_times > t) & (sample_times <= t_stop + 1e-12 * max(t_stop, 1.0))
         times = np.r_[sample_times[inside]]
