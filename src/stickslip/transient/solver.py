@@ -322,7 +322,7 @@ def run_transient(
                 chain_state = {"elapsed": 0.0, "fraction": 1.0}
                 events.append(("stick", state.t, k_block * (state.puller - state.x), state.v))
             if not all(math.isfinite(q) for q in (state.t, state.x, state.v, state.h)):
-                raise ModelError(f"transient solver failed at t = {state.t:.6g} s (non-finite state)")
+                raise ModelError(_non_finite(state.t, out[:count], rows, float(np.max(protocol.velocities))))
             if state.acc[4] > budget:
                 raise over_budget("transient", int(state.acc[4]), budget, state.t, duration)
             if progress is not None:
@@ -336,6 +336,24 @@ def run_transient(
     return _finish(
         rows, chain_rows, events, snapshots, state, params, protocol, control, k_block, int(state.acc[4]), note=note
     )
+
+
+#: a slider faster than this many times the protocol's fastest velocity has run away (no inertia holds it)
+RUNAWAY = 1e6
+
+
+def _non_finite(t: float, block: np.ndarray, rows: list[np.ndarray], pace: float) -> str:
+    """The failure in words: a runaway slip (the bonds gave way faster than an inertia-free block can follow)."""
+    finite = [r for r in (*rows[-1:], *np.atleast_2d(block)) if r.size and np.all(np.isfinite(r[[0, 1, 3, 4]]))]
+    fast = [r for r in finite if r[3] > RUNAWAY * max(pace, 1e-300)]
+    if fast:  # the first row past the bound: what followed is the runaway itself
+        t_run, sigma, v = float(fast[0][0]), float(fast[0][1]), float(fast[0][3])
+        return (
+            f"transient solver failed at t = {t_run:.6g} s: the slider ran away ({v:.3g} m/s under σ = {sigma:.6g}"
+            " Pa): the bonds gave way faster than a block without inertia can follow, and Eq 1 through the block"
+            " has no finite slip velocity from there (a steady start on the unstable branch below Vc does this)"
+        )
+    return f"transient solver failed at t = {t:.6g} s (non-finite state)"
 
 
 def _chunk(state: _State, budget: int, reducer: _Reducer | None) -> int:
