@@ -79,6 +79,8 @@ def test_transient_trough_does_not_depend_on_the_sampling(sampled_runs):
     assert ref.regime.trough < min(c.start_stress for c in ref.native.cycles)  # the turn, not the stick event
     for every in (0.1, 1.0):
         run = sampled_runs[every]
-        assert run.regime.trough == pytest.approx(ref.regime.trough, rel=1e-6)
-        assert run.regime.peak == pytest.approx(ref.regime.peak, rel=1e-6)
-        assert run.regime.amplitude_ratio == pytest.approx(ref.regime.amplitude_ratio, rel=1e-6)
+        # to a tenth of the local tolerance: 0.1 s rows make the solver land on them (other steps), and the
+        # reduction's tables are shared within a process (built at other ranges by earlier runs)
+        assert run.regime.trough == pytest.approx(ref.regime.trough, rel=1e-5)
+        assert run.regime.peak == pytest.approx(ref.regime.peak, rel=1e-5)
+        assert run.regime.amplitude_ratio == pytest.approx(ref.regime.amplitude_ratio, rel=1e-5)

@@ -36,6 +36,8 @@ from numpy.polynomial import chebyshev as cheb
 
 from ..parameters import Parameters
 from . import kernel
+from .kernel import P_AGING, P_DLM, P_FORCE_SENS, P_INV_TAU_A, P_LOG_U0_TAU, P_M, P_N0, P_TAU, P_VA
+from .model import CELL_HAZARD, GAUSS, MAX_CELLS
 
 #: share of the local tolerance the reduction may change the stress by (entry and stay)
 THETA = 0.3
@@ -112,10 +114,7 @@ def _lag(params: Parameters, velocity: float, aging: bool) -> tuple[float, float
     return (4 * c1 - c2) / 3, energy
 
 
-#: age cells for C: the steady population's midpoint cells (model.steady_population, rule="midpoint")
-CELL_HAZARD = 0.05
-GAUSS = 0.5 / math.sqrt(3.0)
-MAX_CELLS = 1_000_000  # model.MAX_CELLS
+#: the compiled steady cells (model.steady_population's, with its CELL_HAZARD, GAUSS and MAX_CELLS)
 _CELLS: list = []
 
 
@@ -137,7 +136,7 @@ def _steady_cells():  # type: ignore[no-untyped-def]
 
 def steady_cohorts(params: Parameters, velocity: float, aging: bool):  # type: ignore[no-untyped-def]
     """model.steady_population(params, velocity, aging) (the Gauss rule), compiled: the same cohorts, faster."""
-    from .model import MAX_CELLS, Population, pack_parameters, steady_population
+    from .model import Population, pack_parameters, steady_population
 
     if not (velocity > 0 and math.isfinite(velocity)):
         return steady_population(params, velocity, aging)  # its error, in words
@@ -155,15 +154,14 @@ _aging_clock = kernel._aging_clock  # the age the aging term sees (the saturatin
 
 def _log_rate(age, v, slope, p):  # type: ignore[no-untyped-def]
     """ln r of a steady bond of this age (capped at 700), kernel.P_* layout of p."""
-    force = _force(v * age, p[3], p[4])
-    return min(p[0] + p[2] * force - _aging_clock(age, p)[0] * slope, 700.0)
+    force = _force(v * age, p[P_M], p[P_DLM])
+    return min(p[P_LOG_U0_TAU] + p[P_FORCE_SENS] * force - _aging_clock(age, p)[0] * slope, 700.0)
 
 
 def _march(v, p, cell_hazard):  # type: ignore[no-untyped-def]
     """Cell edges in age and the cumulative hazard at them: model.steady_population's march, compiled."""
-    # layout of kernel.P_*: 0 ln(u0/tau), 1 tau, 2 lambda/kT, 3 M, 4 dl_m, 5 1/tau_a, 6 V_a, 7 N0, 8 K, 9 aging
-    slope = p[5] * math.exp(-v / p[6]) if p[9] > 0.0 else 0.0
-    t_max = p[4] / v
+    slope = p[P_INV_TAU_A] * math.exp(-v / p[P_VA]) if p[P_AGING] > 0.0 else 0.0
+    t_max = p[P_DLM] / v
     widest = t_max / 1000.0
     edges = [0.0]
     cum = [0.0]
@@ -211,14 +209,14 @@ def _gauss(v, p, cell_hazard):  # type: ignore[no-untyped-def]
             age[2 * k + j] = ag
             weight[2 * k + j] = 0.5 * width * math.exp(-(cum[k] + part))
             total += weight[2 * k + j]
-    birth = p[7] / (p[1] + total)
+    birth = p[P_N0] / (p[P_TAU] + total)
     for k in range(2 * n):
         weight[k] *= birth
     return age, weight
 
 
 def _cells(v, p, cell_hazard):  # type: ignore[no-untyped-def]
-    dlm, m = p[4], p[3]
+    dlm, m = p[P_DLM], p[P_M]
     edges, cum, slope = _march(v, p, cell_hazard)
     n = len(edges) - 1
     mid = np.empty(n)
@@ -232,7 +230,7 @@ def _cells(v, p, cell_hazard):  # type: ignore[no-untyped-def]
         s0 = math.exp(-cum[k])
         w[k] = (s0 * -math.expm1(-dh) / dh if dh > 1e-12 else s0 * (1.0 - 0.5 * dh)) * width[k]
         total += w[k]
-    birth = p[7] / (p[1] + total)
+    birth = p[P_N0] / (p[P_TAU] + total)
     f = np.empty(n)
     fp = np.empty(n)
     r = np.empty(n)
@@ -244,7 +242,7 @@ def _cells(v, p, cell_hazard):  # type: ignore[no-untyped-def]
         f[k] = _force(e, m, dlm)
         fp[k] = _stiffness(e, m, dlm)
         r[k] = math.exp(_log_rate(mid[k], v, slope, p))
-        gv[k] = _aging_clock(mid[k], p)[0] * slope / p[6]
+        gv[k] = _aging_clock(mid[k], p)[0] * slope / p[P_VA]
         energy += w[k] * _energy(e, m, dlm)
     return mid, w, width, f, fp, r, gv, energy
 
