@@ -320,8 +320,8 @@ def advance(
     the predicted slider position and velocity on the hazards.
 
     ``acc`` accumulates [born, broken, puller work, dissipation, steps, rejected, integral of sigma dt, lowest
-    sigma since the last row] (the integral
-    last by the same end-corrected trapezoid as the work).  Rows written to ``out`` (time, sigma, N, V, X, P,
+    sigma since the last row] (the integral by the same end-corrected trapezoid as the work).  Rows written
+    to ``out`` (time, sigma, N, V, X, P,
     born, broken, work, dissipation, bond energy, integral of sigma dt, lowest stress of the steps since the
     previous row: acc[7], reset there): every accepted step
     when ``sample_times`` is empty, else only at those times (the steps land on them exactly).
