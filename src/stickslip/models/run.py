@@ -54,8 +54,16 @@ def settled_mean(time: np.ndarray, values: np.ndarray, period: float) -> float:
     end = float(time[-1])
     half = 0.5 * (end - float(time[0]))
     span = float(np.floor(half / period) * period) if np.isfinite(period) and period > 0 else 0.0
-    inside = time >= end - (span if span > 0 else half)
-    return time_mean(time[inside], values[inside])
+    return window_mean(time, values, end - (span if span > 0 else half))
+
+
+def window_mean(time: np.ndarray, values: np.ndarray, start: float) -> float:
+    """Time average from ``start`` to the last row, the trace interpolated linearly to ``start`` (the window
+    starts where it says, not at the next row: the mean must not depend on how the output is sampled)."""
+    if not time.size or start <= float(time[0]):
+        return time_mean(time, values)
+    inside = time > start
+    return time_mean(np.r_[start, time[inside]], np.r_[np.interp(start, time, values), values[inside]])
 
 
 def _column(values: Any, name: str, size: int | None) -> np.ndarray:

@@ -115,7 +115,7 @@ def _regime(result: Any, protocol: Protocol | None) -> regimes.Regime:
     time, stress = np.asarray(result.time, dtype=float), np.asarray(result.stress, dtype=float)
     if len(whole) >= 2 and result.regime in (regimes.STICK_SLIP, regimes.DECAYING, regimes.GROWING):
         peaks = [c.peak_stress for c in whole]
-        troughs = [c.start_stress for c in whole[1:]] + [float(np.min(stress[time >= whole[-1].start_time]))]
+        troughs = [c.start_stress for c in whole[1:]] + [_last_trough(result, whole[-1].start_time)]
         found = regimes.classify_cycles([c.start_time + c.stick_time for c in whole], peaks, troughs)
     else:
         inside = time >= start
@@ -130,14 +130,14 @@ def last_cycle_numbers(result: Any) -> dict[str, Any]:
     """The last whole cycle's numbers (the run has settled onto its cycle by then, if ever) and the mean stress
     over the whole cycles (over the run when there are none)."""
     whole = [c for c in result.cycles if getattr(c, "period", None) is not None]
-    time, stress = np.asarray(result.time, dtype=float), np.asarray(result.stress, dtype=float)
+    time = np.asarray(result.time, dtype=float)
     row: dict[str, Any] = {
         "regime": result.regime,
         "period": NAN,
         "stick_time": NAN,
         "peak_stress": NAN,
         "jump_velocity": NAN,
-        "mean_stress": time_mean(time, stress),
+        "mean_stress": _mean_stress(result, time[0], time[-1]),
         "cycles": len(whole),
         "critical_velocity": NAN,
     }
@@ -147,7 +147,55 @@ def last_cycle_numbers(result: Any) -> dict[str, Any]:
             period=last.period, stick_time=last.stick_time, peak_stress=last.peak_stress,
             jump_velocity=last.jump_velocity,
         )  # fmt: skip
-        inside = (time >= whole[0].start_time) & (time <= last.start_time + last.period)
-        if np.count_nonzero(inside) > 1:
-            row["mean_stress"] = time_mean(time[inside], stress[inside])
+        end = last.start_time + last.period
+        following = [c.start_stress for c in result.cycles if c.index == last.index + 1]
+        row["mean_stress"] = _mean_stress(result, whole[0].start_time, end, whole[0].start_stress, *following[:1])
     return row
+
+
+def _mean_stress(result: Any, start: float, end: float, *exact: float) -> float:
+    """Mean stress over [start, end] from the integral of sigma dt the solver keeps (not from the rows written:
+    ``every`` must not change it); ``exact``: sigma at start (and end) where known (a stick event)."""
+    time, stress = np.asarray(result.time, dtype=float), np.asarray(result.stress, dtype=float)
+    book = getattr(result, "bookkeeping", None)
+    integral = getattr(book, "stress_integral", None)
+    if integral is None or not end > start or not np.all(np.isfinite(integral)):  # a stand-in's trace
+        inside = (time >= start) & (time <= end)
+        return time_mean(time[inside], stress[inside]) if np.count_nonzero(inside) > 1 else time_mean(time, stress)
+    chains = getattr(result, "chain_fraction", None)
+    stuck = np.isfinite(chains) if chains is not None else np.zeros(time.size, dtype=bool)
+    at = [_integral_at(time, stress, integral, stuck, t, *exact[k : k + 1]) for k, t in enumerate((start, end))]
+    return (at[1] - at[0]) / (end - start)
+
+
+def _integral_at(
+    time: np.ndarray, stress: np.ndarray, integral: np.ndarray, stuck: np.ndarray, t: float, *sigma: float
+) -> float:
+    """The integral at t between rows: back from the next row by the trapezoid, with sigma(t) given, or on the
+    line through the next two rows where the chains hold the block (sigma = K (P - X) is linear there: exact),
+    else interpolated."""
+    k = int(np.searchsorted(time, t, side="left"))
+    if k >= time.size:
+        return float(integral[-1])
+    if time[k] == t or k == 0:
+        return float(integral[k])
+    if sigma:
+        here = sigma[0]
+    elif k + 1 < time.size and stuck[k] and stuck[k + 1]:
+        here = float(stress[k] + (stress[k + 1] - stress[k]) * (t - time[k]) / (time[k + 1] - time[k]))
+    else:
+        here = float(np.interp(t, time, stress))
+    return float(integral[k] - 0.5 * (here + stress[k]) * (time[k] - t))
+
+
+def _last_trough(result: Any, start: float) -> float:
+    """The lowest stress from ``start`` on, from the solver's accepted states (each row carries the lowest of the
+    steps it closes: ``every`` must not move the trough) and the stick events' exact stresses."""
+    time, stress = np.asarray(result.time, dtype=float), np.asarray(result.stress, dtype=float)
+    lowest = getattr(result, "lowest_stress", None)
+    inside = np.flatnonzero(time >= start)
+    values = stress[inside].tolist()
+    if lowest is not None and inside.size > 1:  # the first row's steps began before start: its own stress only
+        values += np.asarray(lowest, dtype=float)[inside[1:]].tolist()
+    sticks = [c.start_stress for c in result.cycles if c.start_time >= start]
+    return float(min([*values, *sticks]))

@@ -319,8 +319,11 @@ def advance(
     per cohort, the lumping of births (h r)^2/24 of their mass, and, under block control, the effect of
     the predicted slider position and velocity on the hazards.
 
-    ``acc`` accumulates [born, broken, puller work, dissipation, steps, rejected].  Rows written to
-    ``out`` (time, sigma, N, V, X, P, born, broken, work, dissipation, bond energy): every accepted step
+    ``acc`` accumulates [born, broken, puller work, dissipation, steps, rejected, integral of sigma dt, lowest
+    sigma since the last row] (the integral by the same end-corrected trapezoid as the work).  Rows written
+    to ``out`` (time, sigma, N, V, X, P,
+    born, broken, work, dissipation, bond energy, integral of sigma dt, lowest stress of the steps since the
+    previous row: acc[7], reset there): every accepted step
     when ``sample_times`` is empty, else only at those times (the steps land on them exactly).
     ``t0``: the start of the protocol's piece (puller0 is the puller there; bonds born before it were born
     at other steps).  ``block``: 1 for block control (vp is the puller's velocity), 0 for velocity control (v = vp).
@@ -598,6 +601,13 @@ def advance(
             # the hazards used the predicted slider position and velocity
             err_s += 0.5 * hh * (abs(x1 - x1p) * sens_x + abs(_aging_factor(v1, p) - slope1) * sens_a)
             s1 = p[P_K] * (puller0 + vp * (t1 - t0) - x1)
+            # that estimate is linear in the correction, and the hazard near the FENE wall is not: a cohort the
+            # predicted position left just short of the wall can sit on its cliff (ln r at the cap) at the
+            # balanced one, where g keeps no slow root and the slider's velocity comes out ~1e178 m/s (a creeping
+            # steady start, 40 s at 100 um/s, went non-finite so).  A step whose end velocity would carry the
+            # slider over a whole chain extension within the step does not follow the path it assumed: shorter.
+            if not (hh * abs(v1 - v1p) <= dlm):
+                err_s = np.inf
         else:
             s1 += w1[n] * _chain_force(x1p - xb[n], m, dlm) + w1[n + 1] * _chain_force(e_nb, m, dlm)
         nn1 += born_alive
@@ -629,7 +639,9 @@ def advance(
         # puller work by the end-corrected trapezoid; dsigma/dt = K (Vp - V) (block) or k_int V - sum r w f
         if block == 1:
             sigma0 = p[P_K] * (puller0 + vp * (t - t0) - x)
-            acc[2] += (0.5 * (sigma0 + s1) - hh / 12.0 * p[P_K] * (v0 - v1)) * vp * hh
+            mean = 0.5 * (sigma0 + s1) - hh / 12.0 * p[P_K] * (v0 - v1)  # over the step
+            acc[2] += mean * vp * hh
+            acc[6] += mean * hh
         else:
             for k in range(2):
                 e_k = x1 - xb[n - 2 + k]
@@ -637,9 +649,12 @@ def advance(
                 rate_s1 += w1[n - 2 + k] * rate0[n - 2 + k] * _chain_force(e_k, m, dlm)
             ds0 = kint0 * vp - rate_s0
             ds1 = kint1 * vp - rate_s1
-            acc[2] += (0.5 * (s0 + s1) - hh / 12.0 * (ds1 - ds0)) * vp * hh
+            mean = 0.5 * (s0 + s1) - hh / 12.0 * (ds1 - ds0)
+            acc[2] += mean * vp * hh
+            acc[6] += mean * hh
         acc[3] += dissip + newborn_dissip
         acc[4] += 1.0
+        acc[7] = min(acc[7], s1)  # the lowest stress of the accepted steps since the last row
         v_prev = v
         h_prev = hh
         t = t1
@@ -702,6 +717,9 @@ def advance(
             out[rows, 8] = acc[2]
             out[rows, 9] = acc[3]
             out[rows, 10] = uu
+            out[rows, 11] = acc[6]
+            out[rows, 12] = min(acc[7], ss)
+            acc[7] = np.inf
             rows += 1
             if rows >= out_max:
                 return STEPS, t, x, v, h, n, sample_index, rows

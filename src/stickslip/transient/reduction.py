@@ -36,16 +36,15 @@ from numpy.polynomial import chebyshev as cheb
 
 from ..parameters import Parameters
 from . import kernel
+from .kernel import P_AGING, P_DLM, P_FORCE_SENS, P_INV_TAU_A, P_LOG_U0_TAU, P_M, P_N0, P_TAU, P_VA
+from .model import CELL_HAZARD, GAUSS, MAX_CELLS
 
 #: share of the local tolerance the reduction may change the stress by (entry and stay)
 THETA = 0.3
 #: the neglected stress reported where the first-order manifold itself folds (Pa; ends a stretch)
 OFF_MANIFOLD = 1e300
-#: fewest trace rows a reduced stretch writes (the classifier reads the stress of the trace), the most, and the
-#: relative change of the slider velocity between rows
+#: fewest trace rows a reduced stretch writes (besides the ODE's steps; a plot of the trace)
 ROWS = 64
-MAX_ROWS = 20_000
-ROW_CHANGE = 1e-3
 #: Chebyshev degrees: the steady stress and bonded fraction (raised until the check passes), the lag C
 DEGREE = 24
 MAX_DEGREE = 96
@@ -115,10 +114,7 @@ def _lag(params: Parameters, velocity: float, aging: bool) -> tuple[float, float
     return (4 * c1 - c2) / 3, energy
 
 
-#: age cells for C: the steady population's midpoint cells (model.steady_population, rule="midpoint")
-CELL_HAZARD = 0.05
-GAUSS = 0.5 / math.sqrt(3.0)
-MAX_CELLS = 1_000_000  # model.MAX_CELLS
+#: the compiled steady cells (model.steady_population's, with its CELL_HAZARD, GAUSS and MAX_CELLS)
 _CELLS: list = []
 
 
@@ -140,7 +136,7 @@ def _steady_cells():  # type: ignore[no-untyped-def]
 
 def steady_cohorts(params: Parameters, velocity: float, aging: bool):  # type: ignore[no-untyped-def]
     """model.steady_population(params, velocity, aging) (the Gauss rule), compiled: the same cohorts, faster."""
-    from .model import MAX_CELLS, Population, pack_parameters, steady_population
+    from .model import Population, pack_parameters, steady_population
 
     if not (velocity > 0 and math.isfinite(velocity)):
         return steady_population(params, velocity, aging)  # its error, in words
@@ -158,15 +154,14 @@ _aging_clock = kernel._aging_clock  # the age the aging term sees (the saturatin
 
 def _log_rate(age, v, slope, p):  # type: ignore[no-untyped-def]
     """ln r of a steady bond of this age (capped at 700), kernel.P_* layout of p."""
-    force = _force(v * age, p[3], p[4])
-    return min(p[0] + p[2] * force - _aging_clock(age, p)[0] * slope, 700.0)
+    force = _force(v * age, p[P_M], p[P_DLM])
+    return min(p[P_LOG_U0_TAU] + p[P_FORCE_SENS] * force - _aging_clock(age, p)[0] * slope, 700.0)
 
 
 def _march(v, p, cell_hazard):  # type: ignore[no-untyped-def]
     """Cell edges in age and the cumulative hazard at them: model.steady_population's march, compiled."""
-    # layout of kernel.P_*: 0 ln(u0/tau), 1 tau, 2 lambda/kT, 3 M, 4 dl_m, 5 1/tau_a, 6 V_a, 7 N0, 8 K, 9 aging
-    slope = p[5] * math.exp(-v / p[6]) if p[9] > 0.0 else 0.0
-    t_max = p[4] / v
+    slope = p[P_INV_TAU_A] * math.exp(-v / p[P_VA]) if p[P_AGING] > 0.0 else 0.0
+    t_max = p[P_DLM] / v
     widest = t_max / 1000.0
     edges = [0.0]
     cum = [0.0]
@@ -214,14 +209,14 @@ def _gauss(v, p, cell_hazard):  # type: ignore[no-untyped-def]
             age[2 * k + j] = ag
             weight[2 * k + j] = 0.5 * width * math.exp(-(cum[k] + part))
             total += weight[2 * k + j]
-    birth = p[7] / (p[1] + total)
+    birth = p[P_N0] / (p[P_TAU] + total)
     for k in range(2 * n):
         weight[k] *= birth
     return age, weight
 
 
 def _cells(v, p, cell_hazard):  # type: ignore[no-untyped-def]
-    dlm, m = p[4], p[3]
+    dlm, m = p[P_DLM], p[P_M]
     edges, cum, slope = _march(v, p, cell_hazard)
     n = len(edges) - 1
     mid = np.empty(n)
@@ -235,7 +230,7 @@ def _cells(v, p, cell_hazard):  # type: ignore[no-untyped-def]
         s0 = math.exp(-cum[k])
         w[k] = (s0 * -math.expm1(-dh) / dh if dh > 1e-12 else s0 * (1.0 - 0.5 * dh)) * width[k]
         total += w[k]
-    birth = p[7] / (p[1] + total)
+    birth = p[P_N0] / (p[P_TAU] + total)
     f = np.empty(n)
     fp = np.empty(n)
     r = np.empty(n)
@@ -247,7 +242,7 @@ def _cells(v, p, cell_hazard):  # type: ignore[no-untyped-def]
         f[k] = _force(e, m, dlm)
         fp[k] = _stiffness(e, m, dlm)
         r[k] = math.exp(_log_rate(mid[k], v, slope, p))
-        gv[k] = _aging_clock(mid[k], p)[0] * slope / p[6]
+        gv[k] = _aging_clock(mid[k], p)[0] * slope / p[P_VA]
         energy += w[k] * _energy(e, m, dlm)
     return mid, w, width, f, fp, r, gv, energy
 
@@ -378,7 +373,7 @@ def glide(
 ) -> Glide | None:
     """Advance the reduced description from t towards t_end (block: the ODE above; velocity: steady sliding).
 
-    ``acc`` (born, broken, work, dissipation, steps, rejected) is updated in place; ``bonded`` and
+    ``acc`` (born, broken, work, dissipation, steps, rejected, integral of sigma dt) is updated in place; ``bonded`` and
     ``energy`` are the cohorts' N and bond energy at entry, so that the bookkeeping stays continuous.
     """
     from scipy.integrate import solve_ivp
@@ -416,10 +411,9 @@ def glide(
         return None  # the stretch could not be followed (the caller leaves it to the cohorts)
     t_stop = float(sol.t[-1])
     done = sol.status == 0 and t_stop >= t_end
-    # rows where the velocity moves by ROW_CHANGE at most (a summary of the trace, such as a mean stress by the
-    # trapezoid rule, then reads the same as the cohorts' row per step), and at the ODE's own steps
-    turns = abs(math.log(max(float(sol.y[0, -1]), 1e-300) / v)) / ROW_CHANGE
-    times = np.unique(np.r_[sol.t, np.linspace(t, t_stop, int(min(max(turns, ROWS), MAX_ROWS)))])
+    # rows at the ODE's own steps, and at least ROWS over the stretch (a plot of the trace); the summaries come
+    # from the solution (the integral of sigma dt, the lowest stress of the steps), not from the rows
+    times = np.unique(np.r_[sol.t, np.linspace(t, t_stop, ROWS)])
     if sample_times.size:
         inside = (sample_times > t) & (sample_times <= t_stop + 1e-12 * max(t_stop, 1.0))
         times = np.r_[sample_times[inside]]
@@ -443,7 +437,12 @@ def glide(
     broken = acc[1] + y[1] - (nn - bonded)
     work = acc[2] + y[2]
     dissipation = acc[3] + y[3] - (uu - energy)
-    rows = np.c_[times, sigma, nn, vel, pos, pull, born, broken, work, dissipation, uu]
+    impulse, impulse_end = _stress_integral(sol, m, vp, k_block, block, (lo, hi), t, t_stop, times)
+    inner = sol.t[(sol.t > t) & (sol.t <= t_stop)]
+    v_inner = np.clip(sol.y[0][(sol.t > t) & (sol.t <= t_stop)], lo, hi)
+    sigma_inner = _effective_stress(m, v_inner, vp, k_block) if block else m.stress(np.log(v_inner))
+    lowest = _lowest_per_row(sigma, times, inner, sigma_inner, acc)
+    rows = np.c_[times, sigma, nn, vel, pos, pull, born, broken, work, dissipation, uu, acc[6] + impulse, lowest]
     end = sol.sol(t_stop)
     v_end = float(end[0])
     sigma_end = effective(m, v_end, vp, k_block)[0] if block else float(m.stress(math.log(v_end)))
@@ -454,7 +453,37 @@ def glide(
     u_end = float(m.energy(math.log(v_end)))
     acc[3] += end[3] - (u_end - energy)
     acc[4] += max(1, sol.t.size - 1)
+    acc[6] += impulse_end
     return Glide(t_stop, v_end, sigma_end, rows, done, sample_index, nn_end, u_end)
+
+
+def _lowest_per_row(sigma, times, inner, sigma_inner, acc):  # type: ignore[no-untyped-def]
+    """The lowest stress of the ODE's accepted steps closed by each row (the solver's own states, not the rows);
+    the steps after the last row are left in acc[7] for the next row."""
+    lowest = np.array(sigma, dtype=float)
+    closing = np.searchsorted(times, inner, side="left")
+    ahead = closing < times.size
+    np.minimum.at(lowest, closing[ahead], sigma_inner[ahead])
+    rest = float(np.min(sigma_inner[~ahead], initial=np.inf))
+    if times.size:
+        lowest[0] = min(lowest[0], acc[7])
+        acc[7] = rest
+    else:
+        acc[7] = min(acc[7], rest)
+    return lowest
+
+
+def _stress_integral(sol, m, vp, k_block, block, bounds, t, t_stop, times):  # type: ignore[no-untyped-def]
+    """The integral of sigma dt from t at ``times`` and at t_stop: Gauss (4 points) over the ODE's own steps
+    on its dense output, so that a mean stress does not depend on which rows are written."""
+    cut = np.r_[t, sol.t[(sol.t > t) & (sol.t < t_stop)], times[(times > t) & (times < t_stop)], t_stop]
+    edges = np.unique(cut)
+    half = 0.5 * np.diff(edges)
+    nodes = (0.5 * (edges[1:] + edges[:-1]))[:, None] + half[:, None] * kernel.GL4_X[None, :]
+    vel = np.clip(sol.sol(nodes.ravel())[0], *bounds)
+    sigma = _effective_stress(m, vel, vp, k_block) if block else m.stress(np.log(vel))
+    total = np.r_[0.0, np.cumsum((sigma.reshape(nodes.shape) @ kernel.GL4_W) * half)]
+    return np.interp(times, edges, total), float(total[-1])
 
 
 #: manifolds built so far, per (parameter set, aging): a sweep or a comparison reuses them
@@ -528,19 +557,21 @@ def steady_glide(
         shed = d0 * dt if rate * np.max(np.atleast_1d(dt), initial=0.0) < 1e-8 else d0 * -np.expm1(-rate * dt) / rate
         work = vp * (s_ss * dt + shed)
         dissipation = s_ss * vp * dt + (vp + s_ss / slope) * shed if block else work
-        return stress, velocity, np.where(block, pull, pos), pos, work, dissipation
+        return stress, velocity, np.where(block, pull, pos), pos, work, dissipation, s_ss * dt + shed
 
     dt = times - t
-    stress, velocity, pull, pos, work, dissipation = state(dt)
+    stress, velocity, pull, pos, work, dissipation, impulse = state(dt)
     one = np.ones_like(times)
+    end = state(np.array([t_end - t]))
     rows = np.c_[
         times, stress, n_ss * one, velocity, pos, pull, acc[0] + birth * dt, acc[1] + birth * dt - (n_ss - bonded),
-        acc[2] + work, acc[3] + dissipation, energy * one,
+        acc[2] + work, acc[3] + dissipation, energy * one, acc[6] + impulse,
+        _lowest_per_row(stress, times, np.r_[times, t_end], np.r_[stress, end[0]], acc),
     ]  # fmt: skip
-    end = state(np.array([t_end - t]))
     acc[0] += birth * (t_end - t)
     acc[1] += birth * (t_end - t) - (n_ss - bonded)
     acc[2] += float(end[4][0])
     acc[3] += float(end[5][0])
     acc[4] += 1
+    acc[6] += float(end[6][0])
     return Glide(t_end, float(end[1][0]), float(end[0][0]), rows, True, sample_index, n_ss, energy)

@@ -44,6 +44,8 @@ class Bookkeeping:
     dissipation: np.ndarray  # elastic energy of the chains lost when they broke
     bond_energy: np.ndarray  # FENE energy stored in the attached chains
     block_energy: np.ndarray  # sigma^2/(2K) (zero under velocity control)
+    #: the integral of sigma dt from the start (Pa s), as the solver integrates it (mean stresses come from it)
+    stress_integral: np.ndarray | None = None
 
 
 @dataclass(frozen=True)
@@ -66,6 +68,8 @@ class TransientResult:
     chain_fraction: np.ndarray | None = field(default=None, repr=False)  # Nc/Nc0 (stick population only)
     steps: int = 0
     rejected: int = 0
+    #: the lowest stress of the solver's accepted states since the previous row (Pa): troughs from the solution
+    lowest_stress: np.ndarray | None = field(default=None, repr=False)
 
     @property
     def final_stress(self) -> float:

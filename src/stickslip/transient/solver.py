@@ -41,7 +41,8 @@ class _State:
     xb: np.ndarray
     tb: np.ndarray
     lw: np.ndarray
-    acc: np.ndarray = field(default_factory=lambda: np.zeros(6))
+    # kernel.advance's running totals: ..., the integral of sigma dt, the lowest sigma since the last row
+    acc: np.ndarray = field(default_factory=lambda: np.r_[np.zeros(7), np.inf])
 
     def grow(self) -> None:
         size = 2 * self.xb.size
@@ -203,7 +204,7 @@ def run_transient(
     events: list[tuple[str, float, float, float]] = []  # (kind, time, stress, velocity)
     chain_state = {"elapsed": 0.0, "fraction": 1.0}
     sample_index = 1 if times.size else 0  # t = 0 is already a row
-    out = np.empty((CHUNK, 11))
+    out = np.empty((CHUNK, 13))
     h_max = math.inf if max_step is None else float(max_step)
     snap_index = 0
     if chains_on:
@@ -236,10 +237,15 @@ def run_transient(
                     for tt in times[inside]:
                         ff = float(np.interp(tt - state.t, res.times, res.fractions))
                         rows.append(_stuck_row(state, params, float(tt), vp, k_block, ff))
+                    # sigma rises while stuck: the stretch's lowest is its start, in its first row
+                    start_sigma = min(state.acc[7], k_block * (state.puller - state.x))
+                    state.acc[7] = np.inf if np.any(inside) else start_sigma
                     sample_index = max(sample_index, int(np.searchsorted(times, t_new, side="right")))
                 else:
                     for tt, ff in zip(res.times[1:], res.fractions[1:], strict=True):
                         rows.append(_stuck_row(state, params, state.t + tt, vp, k_block, ff))
+                    state.acc[7] = np.inf if res.times.size > 1 else state.acc[7]
+                state.acc[6] += _stuck_impulse(state, vp, k_block, res.duration)
                 state.puller += vp * res.duration
                 state.t = t_new
                 chain_state["elapsed"] += res.duration
@@ -318,7 +324,7 @@ def run_transient(
                 chain_state = {"elapsed": 0.0, "fraction": 1.0}
                 events.append(("stick", state.t, k_block * (state.puller - state.x), state.v))
             if not all(math.isfinite(q) for q in (state.t, state.x, state.v, state.h)):
-                raise ModelError(f"transient solver failed at t = {state.t:.6g} s (non-finite state)")
+                raise ModelError(_non_finite(state.t, out[:count], rows, float(np.max(protocol.velocities))))
             if state.acc[4] > budget:
                 raise over_budget("transient", int(state.acc[4]), budget, state.t, duration)
             if progress is not None:
@@ -332,6 +338,24 @@ def run_transient(
     return _finish(
         rows, chain_rows, events, snapshots, state, params, protocol, control, k_block, int(state.acc[4]), note=note
     )
+
+
+#: a slider faster than this many times the protocol's fastest velocity has run away (no inertia holds it)
+RUNAWAY = 1e6
+
+
+def _non_finite(t: float, block: np.ndarray, rows: list[np.ndarray], pace: float) -> str:
+    """The failure in words: a runaway slip (the bonds gave way faster than an inertia-free block can follow)."""
+    finite = [r for r in (*rows[-1:], *np.atleast_2d(block)) if r.size and np.all(np.isfinite(r[[0, 1, 3, 4]]))]
+    fast = [r for r in finite if r[3] > RUNAWAY * max(pace, 1e-300)]
+    if fast:  # the first row past the bound: what followed is the runaway itself
+        t_run, sigma, v = float(fast[0][0]), float(fast[0][1]), float(fast[0][3])
+        return (
+            f"transient solver failed at t = {t_run:.6g} s: the slider ran away ({v:.3g} m/s under σ = {sigma:.6g}"
+            " Pa): the bonds gave way faster than a block without inertia can follow, and Eq 1 through the block"
+            " has no finite slip velocity from there (a steady start on the unstable branch below Vc does this)"
+        )
+    return f"transient solver failed at t = {t:.6g} s (non-finite state)"
 
 
 def _chunk(state: _State, budget: int, reducer: _Reducer | None) -> int:
@@ -537,9 +561,11 @@ def _row(state: _State, params: Parameters, control: str, k_block: float) -> np.
     y = pop.extension / b.max_extension
     energy = float(pop.weight @ (-0.5 * b.chain_stiffness * b.max_extension**2 * np.log1p(-y * y)))
     acc = state.acc
+    lowest = min(acc[7], sigma)
+    acc[7] = np.inf  # this row closes the stretch of steps it summarises
     return np.array(
         [state.t, sigma, pop.bonded, state.v, state.x, state.puller, acc[0], acc[1], acc[2], acc[3], energy,
-         block_energy, np.nan]
+         block_energy, np.nan, acc[6], lowest]
     )  # fmt: skip
 
 
@@ -549,14 +575,20 @@ def _stuck_row(state: _State, params: Parameters, t: float, vp: float, k_block: 
     acc = state.acc
     return np.array(
         [t, sigma, np.nan, 0.0, state.x, puller, acc[0], acc[1], np.nan, np.nan, np.nan, sigma**2 / (2 * k_block),
-         fraction]
+         fraction, acc[6] + _stuck_impulse(state, vp, k_block, t - state.t),
+         min(acc[7], k_block * (state.puller - state.x), sigma)]
     )  # fmt: skip
+
+
+def _stuck_impulse(state: _State, vp: float, k_block: float, dt: float) -> float:
+    """The integral of sigma = K (P - X) over dt from state.t with the slider held (exact: sigma is linear)."""
+    return k_block * ((state.puller - state.x) * dt + 0.5 * vp * dt * dt)
 
 
 def _kernel_rows(block: np.ndarray, k_block: float, control: str) -> list[np.ndarray]:
     sigma = block[:, 1]
     block_energy = sigma**2 / (2 * k_block) if control == "block" else np.zeros_like(sigma)
-    full = np.c_[block, block_energy, np.full(sigma.size, np.nan)]
+    full = np.c_[block[:, :11], block_energy, np.full(sigma.size, np.nan), block[:, 11:13]]
     return [full]
 
 
@@ -610,8 +642,9 @@ def _finish(
     chain = table[:, 12] if chain_rows else None
     book = Bookkeeping(
         born=table[:, 6], broken=table[:, 7], work=table[:, 8], dissipation=table[:, 9], bond_energy=table[:, 10],
-        block_energy=table[:, 11],
+        block_energy=table[:, 11], stress_integral=table[:, 13],
     )  # fmt: skip
+    lowest = table[:, 14]
     return TransientResult(
         time=time,
         stress=sigma,
@@ -629,6 +662,7 @@ def _finish(
         chain_fraction=chain,
         steps=steps,
         rejected=int(state.acc[5]),
+        lowest_stress=lowest,
     )
 
 
