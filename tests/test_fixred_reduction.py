@@ -4,6 +4,7 @@ hazard cliff at the balanced one); the reduction's look-ups only changed where t
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
 import stickslip
@@ -87,3 +88,32 @@ def test_near_the_gel_below_vc_the_runs_finish_or_say_why():
         if auto != "ran away":
             assert auto[1] == pytest.approx(off[1], rel=1e-3), (index, verdicts)  # the local tolerance
     assert cases[4] is not None
+
+
+def test_fast_sliding_through_the_block_is_left_to_the_cohorts_and_a_runaway_says_so():
+    """At 10 mm/s (above Δl_m/τ; Kc = 7.1e8 Pa/m, far above the block's) steady sliding is oscillatory-unstable and
+    the inertia-free slider may run away: the reduction never glides there, and the run either finishes or says in
+    words why it cannot (never a non-finite state passed off as a result)."""
+    import stickslip
+    from stickslip.errors import ModelError
+    from stickslip.protocols import constant
+    from stickslip.transient import run_transient, solver
+
+    glides = []
+    original = solver._Reducer._glide
+
+    def counting(self, *args, **kwargs):  # type: ignore[no-untyped-def]
+        found = original(self, *args, **kwargs)
+        glides.append(found is not None)
+        return found
+
+    params = stickslip.load_parameters("gelatin-glass")
+    solver._Reducer._glide = counting
+    try:
+        result = run_transient(params, constant(1e-2, 0.1), start="steady")
+        assert np.all(np.isfinite(result.stress))
+    except ModelError as exc:
+        assert "ran away" in str(exc) and "Δl_m/τ" in str(exc)
+    finally:
+        solver._Reducer._glide = original
+    assert glides and not any(glides)

@@ -353,7 +353,9 @@ def _non_finite(t: float, block: np.ndarray, rows: list[np.ndarray], pace: float
         return (
             f"transient solver failed at t = {t_run:.6g} s: the slider ran away ({v:.3g} m/s under σ = {sigma:.6g}"
             " Pa): the bonds gave way faster than a block without inertia can follow, and Eq 1 through the block"
-            " has no finite slip velocity from there (a steady start on the unstable branch below Vc does this)"
+            " has no finite slip velocity from there (a steady start on the unstable branch below Vc does this, and"
+            " so can sliding faster than Δl_m/τ, where steady sliding through the block is oscillatory-unstable:"
+            " transient.critical_stiffness)"
         )
     return f"transient solver failed at t = {t:.6g} s (non-finite state)"
 
@@ -478,6 +480,8 @@ class _Reducer:
         v = state.v if self.block else vp
         if state.n == 0 or not v > 0 or not vp >= 0 or (not self.block and not vp > 0):
             return None
+        if self.block and max(v, vp) > BLOCK_FASTEST * b.max_extension / b.bond_time:
+            return None  # where sliding through the block may be oscillatory-unstable: the cohorts follow it
         nn, ss, _k, uu = self.functions["_sums"](state.n, state.xb, state.lw, state.x, self.p)
         sigma = self.k_block * (state.puller - state.x) if self.block else ss
         tol = R.THETA * self.rtol
