@@ -206,6 +206,39 @@ def _sums(n, xb, lw, x, p):  # type: ignore[no-untyped-def]
     return nn, s, k, u
 
 
+def _sums_keeping(n, xb, tb, lw, x, t, slope, p, cache):  # type: ignore[no-untyped-def]
+    """(N, sigma, bond energy) as _sums, keeping each cohort's weight, force, stiffness, energy and hazard at
+    (x, t, slope) in ``cache``: exactly what the next step computes at its start (so it reuses them, bit for bit).
+    Returns ok = False (nothing kept) if a cohort is dead or beyond the FENE wall."""
+    nn = 0.0
+    s = 0.0
+    u = 0.0
+    ok = True
+    saturating = p[P_SATURATION] > 0.0
+    for i in range(n):
+        w = math.exp(lw[i])
+        e = x - xb[i]
+        if w == 0.0 or e >= p[P_DLM] or -e >= p[P_DLM]:
+            ok = False
+            if w == 0.0:
+                continue
+        f = _chain_force(e, p[P_M], p[P_DLM])
+        energy = _chain_energy(e, p[P_M], p[P_DLM])
+        nn += w
+        s += w * f
+        u += w * energy
+        if ok:
+            age = _aging_clock(t - tb[i], p)[0] if saturating else t - tb[i]
+            lr = min(p[P_LOG_U0_TAU] + p[P_FORCE_SENS] * abs(f) - age * slope, LOG_RATE_CAP)
+            cache[0, i] = w
+            cache[1, i] = f
+            cache[2, i] = _chain_stiffness(e, p[P_M], p[P_DLM])
+            cache[3, i] = energy
+            cache[4, i] = lr
+            cache[5, i] = math.exp(lr)
+    return nn, s, u, ok
+
+
 def _balance_weights(x, puller, n, xb, w, p):  # type: ignore[no-untyped-def]
     """X with sum w f(X - x_b) = K (puller - X), weights given (not logs): Newton inside the FENE bracket."""
     lo = -np.inf
@@ -340,6 +373,8 @@ def advance(
     s_floor = 1e-9 * m * big * dlm
     while sample_index < n_samples and sample_times[sample_index] <= t:  # grid points already passed
         sample_index += 1
+    cache = np.empty((6, xb.shape[0]))  # the cohorts' values at the start of the step, when ``cached``
+    cached = False
     while t < t_end:
         if steps >= max_steps:
             return STEPS, t, x, v, h, n, sample_index, rows
@@ -394,7 +429,7 @@ def advance(
         cliff = 0.0  # stress dying at a hazard cliff steeper than the step (see below)
         cliff_old = 0.0  # the same for bonds born before this piece of the protocol
         for i in range(n):
-            w0 = math.exp(lw[i])
+            w0 = cache[0, i] if cached else math.exp(lw[i])
             e0 = x - xb[i]
             e1 = x1p - xb[i]
             nn0 += w0
@@ -404,7 +439,7 @@ def advance(
                 w1[i] = 0.0
                 broken += w0
                 continue
-            f0 = _chain_force(e0, m, dlm)
+            f0 = cache[1, i] if cached else _chain_force(e0, m, dlm)
             s0 += w0 * f0
             if e1 >= dlm or -e1 >= dlm:  # the chain reaches full extension within the step
                 lw_new[i] = -np.inf
@@ -423,12 +458,16 @@ def advance(
                 age0, clock0 = t - tb[i], 1.0
                 age1, clock1 = t1 - tb[i], 1.0
             f1 = _chain_force(e1, m, dlm)
-            lr0 = min(p[P_LOG_U0_TAU] + beta * abs(f0) - age0 * slope0, LOG_RATE_CAP)
+            if cached:
+                lr0 = cache[4, i]
+                r0 = cache[5, i]
+            else:
+                lr0 = min(p[P_LOG_U0_TAU] + beta * abs(f0) - age0 * slope0, LOG_RATE_CAP)
+                r0 = math.exp(lr0)
             lr1 = min(p[P_LOG_U0_TAU] + beta * abs(f1) - age1 * slope1, LOG_RATE_CAP)
-            r0 = math.exp(lr0)
             r1 = math.exp(lr1)
             # d ln r/dt along the characteristic at both ends (force, age, and the velocity's effect on aging)
-            k0 = _chain_stiffness(e0, m, dlm)
+            k0 = cache[2, i] if cached else _chain_stiffness(e0, m, dlm)
             k1 = _chain_stiffness(e1, m, dlm)
             g0 = beta * (1.0 if f0 >= 0.0 else -1.0) * k0 * v0 - slope0 * clock0
             g1 = beta * (1.0 if f1 >= 0.0 else -1.0) * k1 * v1p - slope1 * clock1
@@ -473,7 +512,7 @@ def advance(
             dloss1 += wn * r1 * (g1 - r1)
             broken += w0 - wn
             if trap < 0.5:  # dissipation r w u by the end-corrected trapezoid (fourth order)
-                u0 = _chain_energy(e0, m, dlm)
+                u0 = cache[3, i] if cached else _chain_energy(e0, m, dlm)
                 u1 = _chain_energy(e1, m, dlm)
                 phi0 = r0 * w0 * u0
                 phi1 = r1 * wn * u1
@@ -630,6 +669,7 @@ def advance(
             h = hh * max(0.1, min(0.7, factor))
             continue
         # ---- accept
+        cached = False
         for i in range(n + 2):
             lw[i] = lw_new[i]
         n += 2
@@ -705,7 +745,8 @@ def advance(
             sample_index += 1
             record = True
         if record and rows < out_max:
-            nn, ss, _kk, uu = _sums(n, xb, lw, x, p)
+            # the next step starts from this state: its opening values are kept (rejected steps keep them too)
+            nn, ss, uu, cached = _sums_keeping(n, xb, tb, lw, x, t, _aging_factor(v if block == 1 else vp, p), p, cache)
             out[rows, 0] = t
             out[rows, 1] = ss
             out[rows, 2] = nn
@@ -753,6 +794,7 @@ def compiled() -> dict[str, object]:
             "_slider_velocity",
             "_balance_weights",
             "_sums",
+            "_sums_keeping",
             "advance",
         ):
             g[name] = _jit(g[name])
