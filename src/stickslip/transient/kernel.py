@@ -55,7 +55,9 @@ GL4_W = np.array([0.3478548451374538, 0.6521451548625461, 0.6521451548625461, 0.
 def _jit(func):  # type: ignore[no-untyped-def]
     from numba import njit
 
-    return njit(cache=True, fastmath=False, nogil=True)(func)
+    # error_model="numpy": IEEE division (no zero-divisor test on every division; a zero divisor gives inf or nan,
+    # which the solver reports as a non-finite state instead of a raw ZeroDivisionError)
+    return njit(cache=True, fastmath=False, nogil=True, error_model="numpy")(func)
 
 
 def _chain_force(e, m, dlm):  # type: ignore[no-untyped-def]
