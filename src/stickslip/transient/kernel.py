@@ -99,8 +99,10 @@ def _log_rate(e, age, slope, p):  # type: ignore[no-untyped-def]
     return p[P_LOG_U0_TAU] + p[P_FORCE_SENS] * abs(f) - _aging_clock(age, p)[0] * slope
 
 
-def _velocity_prepare(n, xb, tb, lw, x, t, p, lc, aa):  # type: ignore[no-untyped-def]
-    """k_int; fills lc = ln(w f r) without the aging term and aa = A(t_a)/tau_a for the cohorts."""
+def _velocity_prepare(n, xb, tb, lw, x, t, p, lc, aa, known):  # type: ignore[no-untyped-def]
+    """k_int; fills lc = ln(w f r) without the aging term and aa = A(t_a)/tau_a for the cohorts.
+
+    ``known[i]``: exp(lw[i]) where the caller has it (bit for bit), negative where not."""
     k_int = 0.0
     for i in range(n):
         e = x - xb[i]
@@ -108,7 +110,7 @@ def _velocity_prepare(n, xb, tb, lw, x, t, p, lc, aa):  # type: ignore[no-untype
             lc[i] = -np.inf
             aa[i] = 0.0
             continue
-        w = math.exp(lw[i])
+        w = known[i] if known[i] >= 0.0 else math.exp(lw[i])
         k_int += w * _chain_stiffness(e, p[P_M], p[P_DLM])
         f = _chain_force(e, p[P_M], p[P_DLM])
         lc[i] = lw[i] + math.log(f) + p[P_LOG_U0_TAU] + p[P_FORCE_SENS] * f if f > 0.0 else -np.inf
@@ -135,9 +137,9 @@ def _velocity_residual(v, vp, n, lc, aa, k_int, p):  # type: ignore[no-untyped-d
     return (k_int + p[P_K]) * v - p[P_K] * vp - loss, (k_int + p[P_K]) - dloss
 
 
-def _slider_velocity(v_prev, vp, n, xb, tb, lw, x, t, p, lc, aa):  # type: ignore[no-untyped-def]
+def _slider_velocity(v_prev, vp, n, xb, tb, lw, x, t, p, lc, aa, known):  # type: ignore[no-untyped-def]
     """The stable root of g nearest v_prev (block control): safeguarded Newton inside a bracket."""
-    k_int = _velocity_prepare(n, xb, tb, lw, x, t, p, lc, aa)
+    k_int = _velocity_prepare(n, xb, tb, lw, x, t, p, lc, aa, known)
     g0, d0 = _velocity_residual(v_prev, vp, n, lc, aa, k_int, p)
     if p[P_AGING] == 0.0:  # g is linear in V
         return v_prev - g0 / d0
@@ -208,9 +210,10 @@ def _sums(n, xb, lw, x, p):  # type: ignore[no-untyped-def]
     return nn, s, k, u
 
 
-def _sums_keeping(n, xb, tb, lw, x, t, slope, p, cache):  # type: ignore[no-untyped-def]
+def _sums_keeping(n, xb, tb, lw, x, t, slope, p, cache, known):  # type: ignore[no-untyped-def]
     """(N, sigma, bond energy) as _sums, keeping each cohort's weight, force, stiffness, energy and hazard at
-    (x, t, slope) in ``cache``: exactly what the next step computes at its start (so it reuses them, bit for bit).
+    (x, t, slope) in ``cache``: exactly what the next step computes at its start (so it reuses them, bit for bit);
+    ``known`` as for _velocity_prepare.
     Returns ok = False (nothing kept) if a cohort is dead or beyond the FENE wall."""
     nn = 0.0
     s = 0.0
@@ -218,7 +221,7 @@ def _sums_keeping(n, xb, tb, lw, x, t, slope, p, cache):  # type: ignore[no-unty
     ok = True
     saturating = p[P_SATURATION] > 0.0
     for i in range(n):
-        w = math.exp(lw[i])
+        w = known[i] if known[i] >= 0.0 else math.exp(lw[i])
         e = x - xb[i]
         if w == 0.0 or e >= p[P_DLM] or -e >= p[P_DLM]:
             ok = False
@@ -376,6 +379,7 @@ def advance(
     while sample_index < n_samples and sample_times[sample_index] <= t:  # grid points already passed
         sample_index += 1
     cache = np.empty((6, xb.shape[0]))  # the cohorts' values at the start of the step, when ``cached``
+    known = np.full(xb.shape[0], -1.0)  # exp(lw_new) (then exp(lw)) where computed exactly so, else -1
     cached = False
     while t < t_end:
         if steps >= max_steps:
@@ -439,6 +443,7 @@ def advance(
                 lw_new[i] = -np.inf
                 rate0[i] = np.inf
                 w1[i] = 0.0
+                known[i] = -1.0
                 broken += w0
                 continue
             f0 = cache[1, i] if cached else _chain_force(e0, m, dlm)
@@ -447,6 +452,7 @@ def advance(
                 lw_new[i] = -np.inf
                 rate0[i] = np.inf
                 w1[i] = 0.0
+                known[i] = -1.0
                 broken += w0
                 walled += w0
                 dissip += w0 * _chain_energy(e0, m, dlm)
@@ -483,6 +489,7 @@ def advance(
                 # the 2 % of young bonds that age into permanence; its error from the curvature of ln r
                 integral = hh * (r1 - r0) / (lr1 - lr0)
                 wn = w0 * math.exp(-integral)
+                known[i] = -1.0
                 new = lw[i] - integral
                 delta = abs(g1 - g0) * hh / 8.0 * integral
                 dw = min(wn * math.expm1(min(delta, 50.0)), w0) + abs(wn - w0 * math.exp(-min(trap, 745.0))) * 1e-3
@@ -503,6 +510,7 @@ def advance(
                 corr = min(max(corr, -limit), limit)
                 new = lw[i] - trap + corr
                 wn = math.exp(new)
+                known[i] = wn
                 dw = abs(wn - w0 * math.exp(-min(trap, 745.0)))  # against the plain trapezoid
             err_s += abs(f1) * dw
             err_n += dw
@@ -592,6 +600,7 @@ def advance(
                 tb[n + k] = t + u
                 lw_new[n + k] = math.log(alive) if alive > 0.0 else -np.inf
                 w1[n + k] = alive
+                known[n + k] = -1.0
                 rate0[n + k] = r_end
                 if k == 1:
                     e_nb = e_k
@@ -638,7 +647,7 @@ def advance(
         if block == 1:
             # the slider where the bonds balance the block exactly, then its velocity (the stable root of g)
             x1 = _balance_weights(x1p, puller0 + vp * (t1 - t0), n + 2, xb, w1, p)
-            v1 = _slider_velocity(v1p, vp, n + 2, xb, tb, lw_new, x1, t1, p, lc, aa)
+            v1 = _slider_velocity(v1p, vp, n + 2, xb, tb, lw_new, x1, t1, p, lc, aa, known)
             # the hazards used the predicted slider position and velocity
             err_s += 0.5 * hh * (abs(x1 - x1p) * sens_x + abs(_aging_factor(v1, p) - slope1) * sens_a)
             s1 = p[P_K] * (puller0 + vp * (t1 - t0) - x1)
@@ -728,11 +737,13 @@ def advance(
                     xb[keep - 1] = (wa * xb[keep - 1] + wb * xb[i]) / wt
                     tb[keep - 1] = (wa * tb[keep - 1] + wb * tb[i]) / wt
                     lw[keep - 1] = math.log(wt)
+                    known[keep - 1] = -1.0
                     rate0[keep - 1] = max(rate0[keep - 1], rate0[i])
                     continue
                 xb[keep] = xb[i]
                 tb[keep] = tb[i]
                 lw[keep] = lw[i]
+                known[keep] = known[i]
                 rate0[keep] = rate0[i]
                 keep += 1
             elif lw[i] > -np.inf:
@@ -748,7 +759,9 @@ def advance(
             record = True
         if record and rows < out_max:
             # the next step starts from this state: its opening values are kept (rejected steps keep them too)
-            nn, ss, uu, cached = _sums_keeping(n, xb, tb, lw, x, t, _aging_factor(v if block == 1 else vp, p), p, cache)
+            nn, ss, uu, cached = _sums_keeping(
+                n, xb, tb, lw, x, t, _aging_factor(v if block == 1 else vp, p), p, cache, known
+            )
             out[rows, 0] = t
             out[rows, 1] = ss
             out[rows, 2] = nn
