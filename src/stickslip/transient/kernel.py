@@ -147,6 +147,9 @@ def _slider_velocity(v_prev, vp, n, xb, tb, lw, x, t, p, lc, aa, known):  # type
         return v_prev
     # bracket the nearest crossing in the direction of the root (g(0) <= 0 always)
     scale = max(abs(v_prev), 1e-12)
+    # g and g' at the end of the bracket where Newton starts, already evaluated (the residual costs an exp per
+    # cohort; evaluating it again there would give the same numbers)
+    g_start, d_start = g0, d0
     if g0 < 0.0:
         lo, hi = v_prev, np.inf
         if d0 > 0.0:
@@ -154,11 +157,12 @@ def _slider_velocity(v_prev, vp, n, xb, tb, lw, x, t, p, lc, aa, known):  # type
         else:
             trial = v_prev + scale
         for _ in range(400):
-            gt, _d = _velocity_residual(trial, vp, n, lc, aa, k_int, p)
+            gt, dt = _velocity_residual(trial, vp, n, lc, aa, k_int, p)
             if gt >= 0.0:
                 hi = trial
                 break
             lo = trial
+            g_start, d_start = gt, dt
             trial = lo + 2.0 * (lo - v_prev) + scale
     else:
         lo, hi = 0.0, v_prev
@@ -166,17 +170,21 @@ def _slider_velocity(v_prev, vp, n, xb, tb, lw, x, t, p, lc, aa, known):  # type
         if trial < 0.0:
             trial = 0.0
         for _ in range(400):
-            gt, _d = _velocity_residual(trial, vp, n, lc, aa, k_int, p)
+            gt, dt = _velocity_residual(trial, vp, n, lc, aa, k_int, p)
             if gt <= 0.0:
                 lo = trial
                 break
             hi = trial
+            g_start, d_start = gt, dt
             trial = 0.5 * trial if trial > 1e-300 else 0.0
     if not hi < np.inf:
         return lo
     v = lo if g0 < 0.0 else hi
-    for _ in range(100):
-        g, d = _velocity_residual(v, vp, n, lc, aa, k_int, p)
+    for iteration in range(100):
+        if iteration == 0:
+            g, d = g_start, d_start
+        else:
+            g, d = _velocity_residual(v, vp, n, lc, aa, k_int, p)
         if g == 0.0:
             return v
         if g < 0.0:
