@@ -102,17 +102,23 @@ def _log_rate(e, age, slope, p):  # type: ignore[no-untyped-def]
 def _velocity_prepare(n, xb, tb, lw, x, t, p, lc, aa, known):  # type: ignore[no-untyped-def]
     """k_int; fills lc = ln(w f r) without the aging term and aa = A(t_a)/tau_a for the cohorts.
 
-    ``known[i]``: exp(lw[i]) where the caller has it (bit for bit), negative where not."""
+    ``known[0, i]``: exp(lw[i]) where the caller has it (bit for bit), negative where not; on return it holds
+    exp(lw[i]), and known[1, i], known[2, i] the chain force and stiffness at x (nan for a dead cohort)."""
     k_int = 0.0
     for i in range(n):
         e = x - xb[i]
         if lw[i] == -np.inf or e >= p[P_DLM] or -e >= p[P_DLM]:
             lc[i] = -np.inf
             aa[i] = 0.0
+            known[1, i] = np.nan
             continue
-        w = known[i] if known[i] >= 0.0 else math.exp(lw[i])
-        k_int += w * _chain_stiffness(e, p[P_M], p[P_DLM])
+        w = known[0, i] if known[0, i] >= 0.0 else math.exp(lw[i])
+        stiffness = _chain_stiffness(e, p[P_M], p[P_DLM])
+        k_int += w * stiffness
         f = _chain_force(e, p[P_M], p[P_DLM])
+        known[0, i] = w
+        known[1, i] = f
+        known[2, i] = stiffness
         lc[i] = lw[i] + math.log(f) + p[P_LOG_U0_TAU] + p[P_FORCE_SENS] * f if f > 0.0 else -np.inf
         if p[P_AGING] == 0.0:
             aa[i] = 0.0
@@ -218,10 +224,10 @@ def _sums(n, xb, lw, x, p):  # type: ignore[no-untyped-def]
     return nn, s, k, u
 
 
-def _sums_keeping(n, xb, tb, lw, x, t, slope, p, cache, known):  # type: ignore[no-untyped-def]
+def _sums_keeping(n, xb, tb, lw, x, t, slope, p, cache, known, prepared):  # type: ignore[no-untyped-def]
     """(N, sigma, bond energy) as _sums, keeping each cohort's weight, force, stiffness, energy and hazard at
     (x, t, slope) in ``cache``: exactly what the next step computes at its start (so it reuses them, bit for bit);
-    ``known`` as for _velocity_prepare.
+    ``known`` as _velocity_prepare leaves it (its force and stiffness used where ``prepared``).
     Returns ok = False (nothing kept) if a cohort is dead or beyond the FENE wall."""
     nn = 0.0
     s = 0.0
@@ -229,13 +235,14 @@ def _sums_keeping(n, xb, tb, lw, x, t, slope, p, cache, known):  # type: ignore[
     ok = True
     saturating = p[P_SATURATION] > 0.0
     for i in range(n):
-        w = known[i] if known[i] >= 0.0 else math.exp(lw[i])
+        w = known[0, i] if known[0, i] >= 0.0 else math.exp(lw[i])
         e = x - xb[i]
         if w == 0.0 or e >= p[P_DLM] or -e >= p[P_DLM]:
             ok = False
             if w == 0.0:
                 continue
-        f = _chain_force(e, p[P_M], p[P_DLM])
+        have = prepared and known[1, i] == known[1, i]
+        f = known[1, i] if have else _chain_force(e, p[P_M], p[P_DLM])
         energy = _chain_energy(e, p[P_M], p[P_DLM])
         nn += w
         s += w * f
@@ -245,7 +252,7 @@ def _sums_keeping(n, xb, tb, lw, x, t, slope, p, cache, known):  # type: ignore[
             lr = min(p[P_LOG_U0_TAU] + p[P_FORCE_SENS] * abs(f) - age * slope, LOG_RATE_CAP)
             cache[0, i] = w
             cache[1, i] = f
-            cache[2, i] = _chain_stiffness(e, p[P_M], p[P_DLM])
+            cache[2, i] = known[2, i] if have else _chain_stiffness(e, p[P_M], p[P_DLM])
             cache[3, i] = energy
             cache[4, i] = lr
             cache[5, i] = math.exp(lr)
@@ -387,7 +394,8 @@ def advance(
     while sample_index < n_samples and sample_times[sample_index] <= t:  # grid points already passed
         sample_index += 1
     cache = np.empty((6, xb.shape[0]))  # the cohorts' values at the start of the step, when ``cached``
-    known = np.full(xb.shape[0], -1.0)  # exp(lw_new) (then exp(lw)) where computed exactly so, else -1
+    # exp(lw_new) (then exp(lw)) where computed exactly so, else -1; force and stiffness at the step's end (block)
+    known = np.full((3, xb.shape[0]), -1.0)
     cached = False
     while t < t_end:
         if steps >= max_steps:
@@ -451,7 +459,7 @@ def advance(
                 lw_new[i] = -np.inf
                 rate0[i] = np.inf
                 w1[i] = 0.0
-                known[i] = -1.0
+                known[0, i] = -1.0
                 broken += w0
                 continue
             f0 = cache[1, i] if cached else _chain_force(e0, m, dlm)
@@ -460,7 +468,7 @@ def advance(
                 lw_new[i] = -np.inf
                 rate0[i] = np.inf
                 w1[i] = 0.0
-                known[i] = -1.0
+                known[0, i] = -1.0
                 broken += w0
                 walled += w0
                 dissip += w0 * _chain_energy(e0, m, dlm)
@@ -497,7 +505,7 @@ def advance(
                 # the 2 % of young bonds that age into permanence; its error from the curvature of ln r
                 integral = hh * (r1 - r0) / (lr1 - lr0)
                 wn = w0 * math.exp(-integral)
-                known[i] = -1.0
+                known[0, i] = -1.0
                 new = lw[i] - integral
                 delta = abs(g1 - g0) * hh / 8.0 * integral
                 dw = min(wn * math.expm1(min(delta, 50.0)), w0) + abs(wn - w0 * math.exp(-min(trap, 745.0))) * 1e-3
@@ -518,7 +526,7 @@ def advance(
                 corr = min(max(corr, -limit), limit)
                 new = lw[i] - trap + corr
                 wn = math.exp(new)
-                known[i] = wn
+                known[0, i] = wn
                 dw = abs(wn - w0 * math.exp(-min(trap, 745.0)))  # against the plain trapezoid
             err_s += abs(f1) * dw
             err_n += dw
@@ -608,7 +616,7 @@ def advance(
                 tb[n + k] = t + u
                 lw_new[n + k] = math.log(alive) if alive > 0.0 else -np.inf
                 w1[n + k] = alive
-                known[n + k] = -1.0
+                known[0, n + k] = -1.0
                 rate0[n + k] = r_end
                 if k == 1:
                     e_nb = e_k
@@ -745,13 +753,16 @@ def advance(
                     xb[keep - 1] = (wa * xb[keep - 1] + wb * xb[i]) / wt
                     tb[keep - 1] = (wa * tb[keep - 1] + wb * tb[i]) / wt
                     lw[keep - 1] = math.log(wt)
-                    known[keep - 1] = -1.0
+                    known[0, keep - 1] = -1.0
+                    known[1, keep - 1] = np.nan
                     rate0[keep - 1] = max(rate0[keep - 1], rate0[i])
                     continue
                 xb[keep] = xb[i]
                 tb[keep] = tb[i]
                 lw[keep] = lw[i]
-                known[keep] = known[i]
+                known[0, keep] = known[0, i]
+                known[1, keep] = known[1, i]
+                known[2, keep] = known[2, i]
                 rate0[keep] = rate0[i]
                 keep += 1
             elif lw[i] > -np.inf:
@@ -768,7 +779,7 @@ def advance(
         if record and rows < out_max:
             # the next step starts from this state: its opening values are kept (rejected steps keep them too)
             nn, ss, uu, cached = _sums_keeping(
-                n, xb, tb, lw, x, t, _aging_factor(v if block == 1 else vp, p), p, cache, known
+                n, xb, tb, lw, x, t, _aging_factor(v if block == 1 else vp, p), p, cache, known, block == 1
             )
             out[rows, 0] = t
             out[rows, 1] = ss

@@ -543,7 +543,7 @@ def _force(extension: np.ndarray, params: Parameters) -> np.ndarray:
 
 def _scratch(state: _State) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Work arrays of kernel._slider_velocity (no weight known beforehand: the third, all -1)."""
-    return np.empty(state.xb.size), np.empty(state.xb.size), np.full(state.xb.size, -1.0)
+    return np.empty(state.xb.size), np.empty(state.xb.size), np.full((3, state.xb.size), -1.0)
 
 
 def _sample_grid(every: float | None, duration: float) -> np.ndarray:
