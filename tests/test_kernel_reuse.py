@@ -1,0 +1,88 @@
+"""The cohort kernel's reuse of values it already has (issue 21, one cycle <= 0.5 s): bit for bit the same numbers.
+
+The kernel keeps, from the row it records after a step, each cohort's weight, force, stiffness, energy and hazard
+for the start of the next step, reuses the weights it computed as exp(new log weight) and the slider balance's
+force and stiffness, and starts the slider's Newton iteration from a residual already evaluated.  Each shortcut
+must give exactly what the direct formula gives (the plain cohort solver's results do not move at all).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+import stickslip
+from stickslip.transient import kernel as K
+from stickslip.transient.model import pack_parameters
+from stickslip.transient.reduction import steady_cohorts
+
+GEL = stickslip.load_parameters("gelatin-glass")
+
+
+def _population(velocity: float = 128e-6):
+    """A steady population at ``velocity`` as the kernel holds it (oldest first), slider at 0."""
+    pop = steady_cohorts(GEL, velocity, True)
+    order = np.argsort(-pop.age)
+    xb = -pop.extension[order]
+    tb = -pop.age[order]
+    lw = np.log(pop.weight[order])
+    return xb, tb, lw
+
+
+def test_row_sums_keep_exactly_what_the_next_step_computes():
+    functions = K.compiled()
+    p = pack_parameters(GEL, True, GEL.block.effective_stiffness)
+    xb, tb, lw = _population()
+    n = xb.size
+    x, t, v = 2e-9, 1e-6, 128e-6
+    slope = math.exp(-v / p[K.P_VA]) * p[K.P_INV_TAU_A]
+    cache = np.empty((6, n))
+    unknown = np.full((3, n), -1.0)
+    nn, ss, uu, ok = functions["_sums_keeping"](n, xb, tb, lw, x, t, slope, p, cache, unknown, False)
+    assert ok
+    direct_n, direct_sigma, _k, direct_energy = functions["_sums"](n, xb, lw, x, p)
+    assert (nn, ss, uu) == (direct_n, direct_sigma, direct_energy)
+    e = x - xb
+    y = e / p[K.P_DLM]
+    force = p[K.P_M] * e / (1.0 - y * y)
+    log_rate = np.minimum(p[K.P_LOG_U0_TAU] + p[K.P_FORCE_SENS] * np.abs(force) - (t - tb) * slope, K.LOG_RATE_CAP)
+    assert np.array_equal(cache[0], [math.exp(q) for q in lw])  # libm's exp, as the kernel
+    assert np.array_equal(cache[1], force)
+    assert np.array_equal(cache[2], p[K.P_M] * (1.0 + y * y) / ((1.0 - y * y) * (1.0 - y * y)))
+    half_m_dlm2 = 0.5 * p[K.P_M] * p[K.P_DLM] * p[K.P_DLM]
+    assert np.array_equal(cache[3], [-half_m_dlm2 * math.log1p(-q * q) for q in y])
+    assert np.array_equal(cache[4], log_rate)
+    assert np.array_equal(cache[5], [math.exp(q) for q in log_rate])
+    # the slider balance's force and stiffness, when given, are the same numbers
+    lc, aa = np.empty(n), np.empty(n)
+    known = np.full((3, n), -1.0)
+    functions["_velocity_prepare"](n, xb, tb, lw, x, t, p, lc, aa, known)
+    again = np.empty((6, n))
+    assert functions["_sums_keeping"](n, xb, tb, lw, x, t, slope, p, again, known, True) == (nn, ss, uu, True)
+    assert np.array_equal(again, cache)
+
+
+def test_a_dead_cohort_keeps_nothing():
+    functions = K.compiled()
+    p = pack_parameters(GEL, True, GEL.block.effective_stiffness)
+    xb, tb, lw = _population()
+    lw[3] = -np.inf
+    n = xb.size
+    *_sums, ok = functions["_sums_keeping"](
+        n, xb, tb, lw, 0.0, 0.0, 0.0, p, np.empty((6, n)), np.full((3, n), -1.0), False
+    )
+    assert not ok
+
+
+def test_slider_velocity_does_not_depend_on_the_weights_given():
+    functions = K.compiled()
+    p = pack_parameters(GEL, True, GEL.block.effective_stiffness)
+    xb, tb, lw = _population()
+    n = xb.size
+    args = (1.3e-4, 1e-4, n, xb, tb, lw, 1e-9, 0.0, p, np.empty(n), np.empty(n))
+    blind = functions["_slider_velocity"](*args, np.full((3, n), -1.0))
+    given = np.full((3, n), -1.0)
+    given[0] = [math.exp(q) for q in lw]
+    assert functions["_slider_velocity"](*args, given) == blind
+    assert 0.0 < blind < 1e-2
