@@ -261,6 +261,11 @@ def _sums_keeping(n, xb, tb, lw, x, t, slope, p, cache, known, prepared):  # typ
 
 def _balance_weights(x, puller, n, xb, w, p):  # type: ignore[no-untyped-def]
     """X with sum w f(X - x_b) = K (puller - X), weights given (not logs): Newton inside the FENE bracket."""
+    return _balance_from(x, puller, n, xb, w, p, np.empty((2, 0)), False)
+
+
+def _balance_from(x, puller, n, xb, w, p, at_x, given):  # type: ignore[no-untyped-def]
+    """_balance_weights, with the chains' force and stiffness at the starting x in ``at_x`` where ``given``."""
     lo = -np.inf
     hi = np.inf
     for i in range(n):  # the FENE wall of the oldest live chain
@@ -268,15 +273,24 @@ def _balance_weights(x, puller, n, xb, w, p):  # type: ignore[no-untyped-def]
             hi = min(hi, xb[i] + p[P_DLM] * (1.0 - 1e-15))
     if x >= hi:
         x = hi - 1e-3 * p[P_DLM]
+        given = False
     for _ in range(100):
         s = 0.0
         k = p[P_K]
-        for i in range(n):
-            if w[i] == 0.0:
-                continue
-            e = x - xb[i]
-            s += w[i] * _chain_force(e, p[P_M], p[P_DLM])
-            k += w[i] * _chain_stiffness(e, p[P_M], p[P_DLM])
+        if given:  # the same numbers, already computed
+            for i in range(n):
+                if w[i] == 0.0:
+                    continue
+                s += w[i] * at_x[0, i]
+                k += w[i] * at_x[1, i]
+            given = False
+        else:
+            for i in range(n):
+                if w[i] == 0.0:
+                    continue
+                e = x - xb[i]
+                s += w[i] * _chain_force(e, p[P_M], p[P_DLM])
+                k += w[i] * _chain_stiffness(e, p[P_M], p[P_DLM])
         g = s - p[P_K] * (puller - x)
         if g > 0.0:
             hi = min(hi, x)
@@ -396,6 +410,7 @@ def advance(
     cache = np.empty((6, xb.shape[0]))  # the cohorts' values at the start of the step, when ``cached``
     # exp(lw_new) (then exp(lw)) where computed exactly so, else -1; force and stiffness at the step's end (block)
     known = np.full((3, xb.shape[0]), -1.0)
+    predicted = np.empty((2, xb.shape[0]))  # force and stiffness at the step's predicted end x1p
     cached = False
     while t < t_end:
         if steps >= max_steps:
@@ -493,6 +508,8 @@ def advance(
             # d ln r/dt along the characteristic at both ends (force, age, and the velocity's effect on aging)
             k0 = cache[2, i] if cached else _chain_stiffness(e0, m, dlm)
             k1 = _chain_stiffness(e1, m, dlm)
+            predicted[0, i] = f1
+            predicted[1, i] = k1
             g0 = beta * (1.0 if f0 >= 0.0 else -1.0) * k0 * v0 - slope0 * clock0
             g1 = beta * (1.0 if f1 >= 0.0 else -1.0) * k1 * v1p - slope1 * clock1
             if aging_on and accel != 0.0:
@@ -587,6 +604,8 @@ def advance(
                 d = hh - u  # its age at t1
                 x_k = x + u * v0 + 0.5 * (v1p - v0) * u * u / hh
                 e_k = x1p - x_k
+                predicted[0, n + k] = _chain_force(e_k, m, dlm)
+                predicted[1, n + k] = _chain_stiffness(e_k, m, dlm)
                 lr_end = min(_log_rate(e_k, d, slope1, p), LOG_RATE_CAP)
                 r_end = math.exp(lr_end)
                 g_end = beta * _chain_stiffness(e_k, m, dlm) * v1p - slope1 * _aging_clock(d, p)[1]
@@ -662,7 +681,7 @@ def advance(
         v1 = v1p
         if block == 1:
             # the slider where the bonds balance the block exactly, then its velocity (the stable root of g)
-            x1 = _balance_weights(x1p, puller0 + vp * (t1 - t0), n + 2, xb, w1, p)
+            x1 = _balance_from(x1p, puller0 + vp * (t1 - t0), n + 2, xb, w1, p, predicted, True)
             v1 = _slider_velocity(v1p, vp, n + 2, xb, tb, lw_new, x1, t1, p, lc, aa, known)
             # the hazards used the predicted slider position and velocity
             err_s += 0.5 * hh * (abs(x1 - x1p) * sens_x + abs(_aging_factor(v1, p) - slope1) * sens_a)
@@ -826,6 +845,7 @@ def compiled() -> dict[str, object]:
             "_velocity_prepare",
             "_velocity_residual",
             "_slider_velocity",
+            "_balance_from",
             "_balance_weights",
             "_sums",
             "_sums_keeping",
