@@ -80,15 +80,20 @@ def test_startup_closed_form_and_convergence_order(params):
     assert np.all((orders > 3.6) & (orders < 4.6)), orders
 
 
-@pytest.mark.parametrize("control", ["velocity", "block"])
-def test_bookkeeping_bonds_and_energy(params, control):
+@pytest.mark.parametrize(
+    ("control", "block"),
+    [("velocity", {}), ("block", {}), ("block", {"mass": 10.5}), ("block", {"mass": 10.5, "damping": 1025.0})],
+)
+def test_bookkeeping_bonds_and_energy(params, control, block):
     """Bonds: N(0) + born - broken = N(t).  Energy: puller work = stored (chains + block) + dissipated, with a
-    residual below the tolerance that falls as the tolerance does."""
+    residual below the tolerance that falls as the tolerance does.  With the block's mass (the gel's rho h) and
+    damping (G/(2 c_s)): the block's energy is its spring's and its kinetic energy, and the damping's eta V^2
+    is dissipated (docs/extensions.md section 4)."""
     protocol = segments([(350e-6, 0.002), (200e-6, 0.003)])
     n0 = params.bonds.site_density
     residuals = []
     for rtol in (1e-4, 1e-6):  # the cohorts' balance (the reduced run's: tests/test_transient_speed.py)
-        run = run_transient(params, protocol, start="steady", control=control, rtol=rtol, reduction="off")
+        run = run_transient(params, protocol, start="steady", control=control, rtol=rtol, reduction="off", **block)
         book = run.bookkeeping
         bonds = run.bonded_fraction[0] * n0 + book.born - book.broken
         assert np.allclose(bonds / n0, run.bonded_fraction, rtol=0, atol=1e-9)

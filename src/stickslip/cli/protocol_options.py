@@ -121,8 +121,33 @@ def refuse_unsupported(
         )
 
 
-def build_rig(control: str, stiffness_text: str | None, models: Sequence[Any] = ()) -> tuple[Any, dict[str, str]]:
-    """The :class:`stickslip.models.Rig` of ``--control`` and ``--stiffness`` (K in Pa/m), the one rig builder.
+def inertia_options(func: Callable[..., Any]) -> Callable[..., Any]:
+    """``--mass`` and ``--damping``: the block's inertia and viscous damping (a spring rig's; build_rig reads them)."""
+    func = click.option(
+        "--damping",
+        "damping_text",
+        default=None,
+        metavar="ETA",
+        help='Viscous (radiation) damping of the block, e.g. "1025 Pa s/m" (needs --mass).',
+    )(func)
+    return click.option(
+        "--mass",
+        "mass_text",
+        default=None,
+        metavar="M",
+        help='Block mass per area, e.g. "10.5 kg/m^2" [none: the paper\'s massless block].',
+    )(func)
+
+
+def build_rig(
+    control: str,
+    stiffness_text: str | None,
+    models: Sequence[Any] = (),
+    mass_text: str | None = None,
+    damping_text: str | None = None,
+) -> tuple[Any, dict[str, str]]:
+    """The :class:`stickslip.models.Rig` of ``--control``, ``--stiffness`` (K in Pa/m), ``--mass`` (kg/m^2) and
+    ``--damping`` (Pa s/m), the one rig builder.
 
     Models whose own spring key ``k`` is in another unit (rate-and-state: friction per slip) also take
     ``--stiffness`` in that unit ("1e-3 1/um") when every model of ``models`` has such a key: it then sets ``k``
@@ -131,8 +156,9 @@ def build_rig(control: str, stiffness_text: str | None, models: Sequence[Any] = 
     from ..models import Rig
 
     control = control_name(control)
+    inertia = _inertia(control, mass_text, damping_text)
     if stiffness_text is None:
-        return Rig(control=control), {}
+        return Rig(control=control, **inertia), {}
     if control == "velocity":
         raise ParameterError(
             "--stiffness: under --control velocity the rig is rigid and has no spring; drop --stiffness"
@@ -140,11 +166,28 @@ def build_rig(control: str, stiffness_text: str | None, models: Sequence[Any] = 
         )
     require_unit(stiffness_text, "stress_per_length", "--stiffness ")
     try:
-        return Rig(control=control, stiffness=positive(stiffness_text, "stress_per_length", "--stiffness")), {}
+        stiffness = positive(stiffness_text, "stress_per_length", "--stiffness")
+        return Rig(control=control, stiffness=stiffness, **inertia), {}
     except UnitError:
         own = [m.dimensions().get("k") for m in models]
         if not own or None in own:
             raise
     for dimension in own:
         positive(stiffness_text, dimension, "--stiffness")  # the one-line error in the model's unit
-    return Rig(control=control), {m.name: stiffness_text for m in models}
+    return Rig(control=control, **inertia), {m.name: stiffness_text for m in models}
+
+
+def _inertia(control: str, mass_text: str | None, damping_text: str | None) -> dict[str, float]:
+    """{mass, damping} of --mass and --damping (SI), refused in one line under --control velocity."""
+    given = {"mass": mass_text, "damping": damping_text}
+    if control == "velocity" and any(v is not None for v in given.values()):
+        name = "--mass" if mass_text is not None else "--damping"
+        raise ParameterError(
+            f"{name}: under --control velocity the rig is rigid and has no block; use --control spring"
+        )
+    dimensions = {"mass": "mass_per_area", "damping": "stress_per_velocity"}
+    return {
+        key: positive(text, dimensions[key], f"--{key}", allow_zero=True)
+        for key, text in given.items()
+        if text is not None
+    }

@@ -26,7 +26,7 @@ from .common import (
     save_figure,
     set_values,
 )
-from .protocol_options import build_protocol, build_rig, protocol_options
+from .protocol_options import build_protocol, build_rig, inertia_options, protocol_options
 
 #: Exit status of a run the model could not finish (status "failed"); 2 is bad input.
 RUN_FAILED = 3
@@ -197,6 +197,7 @@ def summary_text(summary: dict[str, Any]) -> str:
 )
 @click.option("--plot", "plot_path", type=click.Path(dir_okay=False, path_type=Path), help="Save the run's figure.")
 @click.option("--json", "as_json", is_flag=True, help="Print the summary as JSON (SI units).")
+@inertia_options
 def run_command(
     model_name: str,
     params_name: str | None,
@@ -213,6 +214,8 @@ def run_command(
     output: Path | None,
     plot_path: Path | None,
     as_json: bool,
+    mass_text: str | None,
+    damping_text: str | None,
 ) -> None:
     """Run any friction model on a protocol, through one interface, into one Run.
 
@@ -227,7 +230,7 @@ def run_command(
     model = load_model(model_name)
     protocol = build_protocol(v0_text, duration_text, segment_texts, protocol_file)
     mapping = model_overrides(model, overrides)
-    rig, own_spring = build_rig(control, stiffness_text, [model])
+    rig, own_spring = build_rig(control, stiffness_text, [model], mass_text, damping_text)
     if own_spring:  # a stiffness in the model's own unit sets its key k, as --set k=... would
         mapping["k"] = own_spring[model.name]
     params = model_parameters(model, params_name, mapping)

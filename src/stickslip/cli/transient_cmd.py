@@ -17,7 +17,14 @@ from .common import (
     save_figure,
     write_text,
 )
-from .protocol_options import build_protocol, build_rig, control_name, protocol_options, refuse_unsupported
+from .protocol_options import (
+    build_protocol,
+    build_rig,
+    control_name,
+    inertia_options,
+    protocol_options,
+    refuse_unsupported,
+)
 
 
 def _trace_csv(result: Any) -> str:
@@ -28,6 +35,7 @@ def _trace_csv(result: Any) -> str:
 
 @click.command("transient")
 @protocol_options(stiffness_help='Spring stiffness K with --control spring, e.g. "400 kPa/m" [the block\'s, Eq 17].')
+@inertia_options
 @click.option("--start", type=click.Choice(["empty", "steady"]), default="empty", show_default=True)
 @click.option("--start-velocity", "start_v_text", metavar="V", help="Steady start at this velocity [first segment's].")
 @click.option("--no-aging", is_flag=True, help="Drop the aging term of Eq 1.")
@@ -61,6 +69,8 @@ def transient_command(
     protocol_file: Path | None,
     stiffness_text: str | None,
     control: str,
+    mass_text: str | None,
+    damping_text: str | None,
     start: str,
     start_v_text: str | None,
     no_aging: bool,
@@ -78,7 +88,8 @@ def transient_command(
     """Solve the full time-dependent population balance (Eq 1, history form of Eq 3) through a protocol.
 
     With --control spring (or block) the protocol is the puller's velocity and
-    the block (Eq 17, or --stiffness K) couples it to the slider; with
+    the block (Eq 17, or --stiffness K) couples it to the slider, without
+    inertia unless --mass (and --damping) give the block's; with
     --control velocity it is the slider's own velocity.  The protocol:
     --v0 V --duration T, then any --segment "V:T"; or --protocol FILE.  The regime is "steady", "stick-slip", "stuck" or
     "undetermined" (still changing at the end of the run).
@@ -97,13 +108,14 @@ def transient_command(
     refuse_unsupported("transient", protocol, control)
     control = control_name(control)
     solver_control = "block" if control == "spring" else control  # run_transient's name of the spring
-    rig, _ = build_rig(control, stiffness_text)
+    rig, _ = build_rig(control, stiffness_text, mass_text=mass_text, damping_text=damping_text)
     refuse_overwriting_inputs([protocol_file], [("-o", output), ("--plot", plot_path)], params_name)
     start_velocity = None if start_v_text is None else positive(start_v_text, "velocity", "--start-velocity")
     every = None if every_text is None else positive(every_text, "time", "--every")
     params = resolve_params(params_name, overrides)
+    reduction = "off" if no_reduce or rig.has_mass else "auto"  # a block with mass keeps the cohorts throughout
     settings = dict(start_velocity=start_velocity, aging=not no_aging, stick_population=stick_population, every=every,
-                    rtol=rtol, max_steps=max_steps, reduction="off" if no_reduce else "auto")  # fmt: skip
+                    rtol=rtol, max_steps=max_steps, reduction=reduction)  # fmt: skip
     cost = estimate_cost(params, protocol, control=solver_control, start_velocity=start_velocity, rtol=rtol,
                          every=every, aging=not no_aging, reduction=settings["reduction"])  # fmt: skip
     shown = None if cost.seconds > PROGRESS_AFTER_SECONDS and not as_json else False  # None: on a terminal
@@ -120,7 +132,8 @@ def transient_command(
     if as_json:
         emit_json(result.summary())
         return
-    click.echo(f"{protocol.describe()} ({control} control, {start} start)")
+    block = f", block mass {rig.mass:g} kg/m², damping {rig.damping or 0:g} Pa·s/m" if rig.has_mass else ""
+    click.echo(f"{protocol.describe()} ({control} control{block}, {start} start)")
     click.echo(f"  regime: {result.regime}")
     click.echo(f"  {result.message}")
     click.echo(

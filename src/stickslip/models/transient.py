@@ -23,7 +23,8 @@ class Transient(BondModel):
     """The population balance of bonds under any piecewise-constant protocol, rigid or through the block.
 
     ``start``: "empty" (no bonds, no stress; the default) or "steady" (the steady population at the first
-    segment's velocity, or at the setting ``start_velocity``).  Settings: those of ``run_transient``
+    segment's velocity, or at the setting ``start_velocity``).  A spring rig's ``mass`` and ``damping`` give the
+    block inertia (run_transient's ``mass``, ``damping``).  Settings: those of ``run_transient``
     (``stick_population``, ``aging``, ``start_velocity``, ``every``, ``rtol``, ``max_step``, ``max_steps``,
     ``reduction``, ``snapshot_times``, ``progress``).
     """
@@ -34,6 +35,8 @@ class Transient(BondModel):
     capabilities = Capabilities(
         controls=("spring", "velocity"),
         protocols="any",
+        damping=True,
+        mass=True,
         settings=(
             "stick_population", "aging", "start_velocity", "every", "rtol", "max_step", "max_steps", "reduction",
             "snapshot_times", "progress",
@@ -51,6 +54,8 @@ class Transient(BondModel):
         control = "velocity" if rig.control == "velocity" else "block"
         if rig.stiffness is not None:
             settings["stiffness"] = rig.stiffness
+        if rig.has_mass or rig.has_damping:  # the block's inertia and damping (docs/extensions.md section 4)
+            settings.update(mass=rig.mass, damping=rig.damping)
         result = run_transient(params, protocol, control=control, start="empty" if start is None else start, **settings)
         return transient_run(result, protocol)
 

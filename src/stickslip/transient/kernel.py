@@ -12,7 +12,10 @@ Gauss-Legendre points of the step; the vacancy N0 - N between them solves its
 linear equation exactly for a Hermite-cubic breakage rate, so steps may be
 much longer than tau when nothing else moves (a stuck block).
 
-Block control: sigma = K (P - X) at every instant.  Differentiating it with
+Block control with a mass m (and a viscous damping eta) per unit area, m X'' = K (P - X) - eta X' - sigma:
+the slider's position and velocity are states, advanced by the trapezoid rule (implicit in the end position,
+a monotone scalar equation; second order), with the population over the step along the predicted path as
+below.  Without a mass (the paper's block), sigma = K (P - X) at every instant.  Differentiating it with
 sigma = sum w f(e) gives the slider velocity as the root of
 
     g(V) = (k_int + K) V - K V_p - sum r_i(V) w_i f_i = 0,     k_int = sum w_i f'(e_i),
@@ -40,7 +43,21 @@ LOG_RATE_CAP = 700.0
 LIGHTEST = 1e-30
 
 # float parameter vector layout (see pack_parameters in model.py)
-P_LOG_U0_TAU, P_TAU, P_FORCE_SENS, P_M, P_DLM, P_INV_TAU_A, P_VA, P_N0, P_K, P_AGING, P_SATURATION = range(11)
+(
+    P_LOG_U0_TAU,
+    P_TAU,
+    P_FORCE_SENS,
+    P_M,
+    P_DLM,
+    P_INV_TAU_A,
+    P_VA,
+    P_N0,
+    P_K,
+    P_AGING,
+    P_SATURATION,
+    P_MASS,
+    P_DAMPING,
+) = range(13)
 # integer status returned by advance()
 DONE, FULL, STEPS, STICK, FAILED = 0, 1, 2, 3, 4
 #: half-distance of the two Gauss-Legendre points from the middle of a step, as a fraction of the step
@@ -305,6 +322,61 @@ def _balance_from(x, puller, n, xb, w, p, at_x, given):  # type: ignore[no-untyp
     return x
 
 
+def _inertial_step(d, x0, v0, force0, h, puller1, n, xb, w, p, at_x):  # type: ignore[no-untyped-def]
+    """(d, sigma, k_int) at the end of a step of the block with mass: the slider's travel d over the step by the
+    trapezoid rule, m (v1 - v0) = h/2 (F0 + F1), x1 = x0 + d, v1 = 2 d/h - v0, F = K (P - X) - eta V - sigma,
+    with the weights w at the step's end; sigma and k_int there.  G(d) = m (v1 - v0) - h/2 (F0 + F1) rises with d
+    (dG/dd = 2 m/h + h (K + k_int)/2 + eta, the chains' stiffness positive) from -inf at one FENE wall to +inf at
+    the other: Newton inside that bracket.  ``at_x``: force and stiffness at the starting d (the predicted end).
+    The travel, not the end position, is the unknown: v1 keeps its digits however far the slider has gone."""
+    k_spring = p[P_K]
+    mass = p[P_MASS]
+    eta = p[P_DAMPING]
+    dlm = p[P_DLM]
+    lo = -np.inf
+    hi = np.inf
+    for i in range(n):  # the FENE walls of the live chains, as travels from x0
+        if w[i] > 0.0:
+            hi = min(hi, xb[i] - x0 + dlm * (1.0 - 1e-15))
+            lo = max(lo, xb[i] - x0 - dlm * (1.0 - 1e-15))
+    given = True
+    if not (lo < d < hi):
+        d = 0.5 * (lo + hi) if (lo > -np.inf and hi < np.inf) else 0.0
+        given = False
+    s = 0.0
+    k = 0.0
+    for _ in range(200):
+        s = 0.0
+        k = 0.0
+        for i in range(n):
+            if w[i] == 0.0:
+                continue
+            if given:  # the same numbers, already computed
+                s += w[i] * at_x[0, i]
+                k += w[i] * at_x[1, i]
+            else:
+                e = (x0 - xb[i]) + d
+                s += w[i] * _chain_force(e, p[P_M], dlm)
+                k += w[i] * _chain_stiffness(e, p[P_M], dlm)
+        given = False
+        v1 = 2.0 * d / h - v0
+        force1 = k_spring * (puller1 - x0 - d) - eta * v1 - s
+        g = mass * (v1 - v0) - 0.5 * h * (force0 + force1)
+        slope = 2.0 * mass / h + 0.5 * h * (k_spring + k) + eta
+        if g > 0.0:
+            hi = min(hi, d)
+        else:
+            lo = max(lo, d)
+        d_new = d - g / slope
+        if not (lo < d_new < hi):
+            d_new = 0.5 * (lo + hi) if (lo > -np.inf and hi < np.inf) else d - 0.5 * g / slope
+        # v1 = 2 d/h - v0 to ~1e-15 of the slider's pace (a step landing on a sample can be ~1e-20 s long)
+        if abs(d_new - d) <= 1e-15 * (abs(d) + h * abs(v0)) or d_new == d:
+            break
+        d = d_new
+    return d, s, k
+
+
 def _hermite(theta, h, l0, d0, l1, d1):  # type: ignore[no-untyped-def]
     """The cubic with values l0, l1 and slopes d0, d1 at the ends of a step of length h, at theta = u/h."""
     t2 = theta * theta
@@ -412,6 +484,12 @@ def advance(
     known = np.full((3, xb.shape[0]), -1.0)
     predicted = np.empty((2, xb.shape[0]))  # force and stiffness at the step's predicted end x1p
     cached = False
+    # the block with a mass: the slider's acceleration now and at the previous step's start (for the predictor)
+    inertial = block == 1 and p[P_MASS] > 0.0
+    accel_now = 0.0
+    if inertial:
+        accel_now = (p[P_K] * (puller0 + vp * (t - t0) - x) - p[P_DAMPING] * v - _sums(n, xb, lw, x, p)[1]) / p[P_MASS]
+    accel_prev = accel_now
     while t < t_end:
         if steps >= max_steps:
             return STEPS, t, x, v, h, n, sample_index, rows
@@ -431,13 +509,23 @@ def advance(
         if block == 0:
             v0 = vp
             v1p = vp
+        elif inertial:
+            v0 = v
+            # the jerk from the last step, unless that step was much shorter (one landing on a sample time), where
+            # the difference quotient amplifies the acceleration's rounding
+            jerk = (accel_now - accel_prev) / h_prev if h_prev > 0.25 * hh else 0.0
+            v1p = v + hh * accel_now + 0.5 * hh * hh * jerk
         else:
             v0 = v
             v1p = v + (v - v_prev) * (hh / h_prev) if h_prev > 0.0 else v
             if v1p < 0.0:
                 v1p = 0.0
-        x1p = x + 0.5 * hh * (v0 + v1p)
-        x_mid = x + 0.5 * hh * v0 + 0.125 * hh * (v1p - v0)
+        if inertial:  # Taylor's cubic of the slider's path (its acceleration known, its jerk from the last step)
+            x1p = x + hh * (v0 + hh * (0.5 * accel_now + hh * jerk / 6.0))
+            x_mid = x + 0.5 * hh * (v0 + 0.5 * hh * (0.5 * accel_now + 0.5 * hh * jerk / 6.0))
+        else:
+            x1p = x + 0.5 * hh * (v0 + v1p)
+            x_mid = x + 0.5 * hh * v0 + 0.125 * hh * (v1p - v0)
         slope0 = _aging_factor(v0, p)
         slope1 = _aging_factor(v1p, p)
         accel = (v1p - v0) / hh
@@ -679,7 +767,23 @@ def advance(
             err_s += min(z4, 1.0) * carried
         x1 = x1p
         v1 = v1p
-        if block == 1:
+        spring0 = p[P_K] * (puller0 + vp * (t - t0) - x)  # the block's force (massless: sigma) at the step's start
+        if inertial:
+            # the slider's travel by the trapezoid rule against the end population; the hazards used the predicted
+            # path, and the rule's own error (Milne's: a sixth of the corrector's distance from the predictor,
+            # whose error is five times the trapezoid's) counts in the stress of the block's mode
+            force0 = spring0 - p[P_DAMPING] * v0 - s0
+            travel, s1, k_end = _inertial_step(
+                x1p - x, x, v0, force0, hh, puller0 + vp * (t1 - t0), n + 2, xb, w1, p, predicted
+            )
+            x1 = x + travel
+            v1 = 2.0 * travel / hh - v0
+            err_s += 0.5 * hh * (abs(x1 - x1p) * sens_x + abs(_aging_factor(v1, p) - slope1) * sens_a)
+            k_mode = p[P_K] + k_end
+            err_s += (math.sqrt(p[P_MASS] * k_mode) * abs(v1 - v1p) + k_mode * abs(x1 - x1p)) / 6.0
+            if not (hh * abs(v1 - v1p) <= dlm):
+                err_s = np.inf
+        elif block == 1:
             # the slider where the bonds balance the block exactly, then its velocity (the stable root of g)
             x1 = _balance_from(x1p, puller0 + vp * (t1 - t0), n + 2, xb, w1, p, predicted, True)
             v1 = _slider_velocity(v1p, vp, n + 2, xb, tb, lw_new, x1, t1, p, lc, aa, known)
@@ -723,9 +827,8 @@ def advance(
         acc[0] += born
         acc[1] += broken
         # puller work by the end-corrected trapezoid; dsigma/dt = K (Vp - V) (block) or k_int V - sum r w f
-        if block == 1:
-            sigma0 = p[P_K] * (puller0 + vp * (t - t0) - x)
-            mean = 0.5 * (sigma0 + s1) - hh / 12.0 * p[P_K] * (v0 - v1)  # over the step
+        if block == 1 and not inertial:
+            mean = 0.5 * (spring0 + s1) - hh / 12.0 * p[P_K] * (v0 - v1)  # over the step
             acc[2] += mean * vp * hh
             acc[6] += mean * hh
         else:
@@ -733,12 +836,17 @@ def advance(
                 e_k = x1 - xb[n - 2 + k]
                 kint1 += w1[n - 2 + k] * _chain_stiffness(e_k, m, dlm)
                 rate_s1 += w1[n - 2 + k] * rate0[n - 2 + k] * _chain_force(e_k, m, dlm)
-            ds0 = kint0 * vp - rate_s0
-            ds1 = kint1 * vp - rate_s1
+            ds0 = kint0 * v0 - rate_s0
+            ds1 = kint1 * v1 - rate_s1
             mean = 0.5 * (s0 + s1) - hh / 12.0 * (ds1 - ds0)
-            acc[2] += mean * vp * hh
             acc[6] += mean * hh
+            if inertial:  # the puller works against the block's spring, not the interface
+                spring1 = p[P_K] * (puller0 + vp * (t1 - t0) - x1)
+                mean = 0.5 * (spring0 + spring1) - hh / 12.0 * p[P_K] * (v0 - v1)
+            acc[2] += mean * vp * hh
         acc[3] += dissip + newborn_dissip
+        if inertial:  # the damping's share, eta V^2 over the step
+            acc[3] += 0.5 * hh * p[P_DAMPING] * (v0 * v0 + v1 * v1)
         acc[4] += 1.0
         acc[7] = min(acc[7], s1)  # the lowest stress of the accepted steps since the last row
         v_prev = v
@@ -746,6 +854,9 @@ def advance(
         t = t1
         x = x1
         v = v1
+        if inertial:
+            accel_prev = accel_now
+            accel_now = (p[P_K] * (puller0 + vp * (t - t0) - x) - p[P_DAMPING] * v - s1) / p[P_MASS]
         steps += 1
         # drop dead cohorts (their weight counts as broken already, up to LIGHTEST * N0), and merge
         # neighbours that are quiet (negligible breakage for the rest of the piece) and born at nearly the
@@ -798,7 +909,17 @@ def advance(
         if record and rows < out_max:
             # the next step starts from this state: its opening values are kept (rejected steps keep them too)
             nn, ss, uu, cached = _sums_keeping(
-                n, xb, tb, lw, x, t, _aging_factor(v if block == 1 else vp, p), p, cache, known, block == 1
+                n,
+                xb,
+                tb,
+                lw,
+                x,
+                t,
+                _aging_factor(v if block == 1 else vp, p),
+                p,
+                cache,
+                known,
+                block == 1 and not inertial,
             )
             out[rows, 0] = t
             out[rows, 1] = ss
@@ -847,6 +968,7 @@ def compiled() -> dict[str, object]:
             "_slider_velocity",
             "_balance_from",
             "_balance_weights",
+            "_inertial_step",
             "_sums",
             "_sums_keeping",
             "advance",

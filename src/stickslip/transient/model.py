@@ -21,10 +21,13 @@ from . import kernel as K
 GAUSS = 0.5 / math.sqrt(3.0)
 
 
-def pack_parameters(params: Parameters, aging: bool, stiffness: float) -> np.ndarray:
-    """The float vector the kernel reads (layout: kernel.P_*)."""
+def pack_parameters(
+    params: Parameters, aging: bool, stiffness: float, mass: float = 0.0, damping: float = 0.0
+) -> np.ndarray:
+    """The float vector the kernel reads (layout: kernel.P_*); ``mass`` (kg/m^2) and ``damping`` (Pa s/m): the
+    block's inertia and viscous damping (0: the paper's massless block)."""
     b, g = params.bonds, params.aging
-    p = np.zeros(11)
+    p = np.zeros(13)
     p[K.P_LOG_U0_TAU] = math.log(b.breakage_weight / b.bond_time)
     p[K.P_TAU] = b.bond_time
     p[K.P_FORCE_SENS] = b.force_sensitivity
@@ -36,6 +39,8 @@ def pack_parameters(params: Parameters, aging: bool, stiffness: float) -> np.nda
     p[K.P_K] = stiffness
     p[K.P_AGING] = 1.0 if aging else 0.0
     p[K.P_SATURATION] = 0.0 if g.saturation_age is None else g.saturation_age  # 0: the paper's linear aging
+    p[K.P_MASS] = mass
+    p[K.P_DAMPING] = damping
     return p
 
 

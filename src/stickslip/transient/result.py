@@ -70,6 +70,9 @@ class TransientResult:
     rejected: int = 0
     #: the lowest stress of the solver's accepted states since the previous row (Pa): troughs from the solution
     lowest_stress: np.ndarray | None = field(default=None, repr=False)
+    #: the block's mass (kg/m^2) and viscous damping (Pa s/m); 0: the paper's massless block
+    mass: float = 0.0
+    damping: float = 0.0
 
     @property
     def final_stress(self) -> float:

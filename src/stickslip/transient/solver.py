@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -91,6 +91,8 @@ def run_transient(
     max_step: float | None = None,
     max_steps: int | None = None,
     reduction: str = "auto",
+    mass: float | None = None,
+    damping: float | None = None,
 ) -> TransientResult:
     """Solve Eqs 1-5 (history form of Eq 3) through ``protocol``.
 
@@ -127,6 +129,13 @@ def run_transient(
     ``reduction="off"`` keeps the cohorts throughout (the reference), as does
     a ``max_step`` (fixed-step studies of the cohort method).
 
+    ``mass`` (kg/m^2) gives the block inertia, ``damping`` (Pa s/m, with a
+    mass) a viscous or radiation damping: m X'' = K (P - X) - eta X' - sigma,
+    the slider's position and velocity advanced by the trapezoid rule
+    (second order; docs/extensions.md section 4).  The stress of the trace is
+    then the interface's, sigma = sum w f; the block's spring carries
+    K (P - X).  Such a run keeps the cohorts throughout (no reduction).
+
     The work is estimated first (:func:`estimate_cost`); a run above
     ``max_steps`` (default :data:`stickslip.numerics.budget.DEFAULT_MAX_STEPS`)
     is refused before it starts, or stopped when it gets there.
@@ -145,6 +154,8 @@ def run_transient(
         raise ParameterError(f"rtol: expected a number between 1e-12 and 0.1, got {rtol!r}")
     if stick_population and control != "block":
         raise ParameterError("stick_population: the attached chains need block control (control='block')")
+    mass, damping = _block_inertia(mass, damping, control, stick_population)
+    inertial = mass > 0
     k_block = params.block.effective_stiffness if stiffness is None else _finite(stiffness, "stiffness")
     if not (math.isfinite(k_block) and k_block > 0):
         raise ParameterError(f"stiffness: expected a positive finite value in Pa/m, got {stiffness!r}")
@@ -165,7 +176,7 @@ def run_transient(
     _require_finite_chains(params, protocol, control, start, start_velocity, k_block)
     require_within(
         estimate_cost(params, protocol, control=control, start_velocity=start_velocity, rtol=rtol, every=every,
-                      max_step=max_step, aging=aging, reduction=reduction, start=start,
+                      max_step=max_step, aging=aging, reduction="off" if inertial else reduction, start=start,
                       stick_population=bool(stick_population)),
         budget,
         "transient",
@@ -176,7 +187,7 @@ def run_transient(
     functions = K.compiled()
     advance = functions["advance"]
     slider_velocity = functions["_slider_velocity"]
-    p = pack_parameters(params, aging, k_block)
+    p = pack_parameters(params, aging, k_block, mass, damping)
     b = params.bonds
 
     state = _State(0.0, 0.0, 0.0, b.bond_time * 1e-3, 0.0, 0, np.empty(4096), np.empty(4096), np.empty(4096))
@@ -193,12 +204,13 @@ def run_transient(
     else:
         state.v = v_first  # no bonds: the slider moves with the puller
     sigma0 = float(np.exp(state.lw[: state.n]) @ _force(state.x - state.xb[: state.n], params)) if state.n else 0.0
-    state.puller = state.x + sigma0 / k_block if control == "block" else state.x
+    # the block in balance with the bonds (and the damping, which a moving slider meets)
+    state.puller = state.x + (sigma0 + damping * state.v) / k_block if control == "block" else state.x
 
     times = _sample_grid(every, duration)
     wanted = sorted(set([0.0, duration, *protocol.boundaries.tolist(), *np.atleast_1d(snapshot_times or []).tolist()]))
     snapshots: list[Snapshot] = []
-    rows: list[np.ndarray] = [_row(state, params, control, k_block)]
+    rows: list[np.ndarray] = [_row(state, params, control, k_block, mass)]
     chain_rows: list[np.ndarray] = []
     chains_on = stick_population and start == "empty"
     events: list[tuple[str, float, float, float]] = []  # (kind, time, stress, velocity)
@@ -210,7 +222,7 @@ def run_transient(
     if chains_on:
         events.append(("stick", 0.0, sigma0, 0.0))
     reducer = None
-    if reduction == "auto" and max_step is None:  # a bound on the cohorts' step asks for the cohorts throughout
+    if reduction == "auto" and max_step is None and not inertial:  # a bound on the step: cohorts throughout
         reducer = _Reducer(params, p, functions, control, k_block, float(rtol), aging)
         reducer.disturbed(state.t)  # from empty, or a steady start: the cohorts first replace every bond
     for t0, t1, vp in protocol.pieces():
@@ -299,7 +311,7 @@ def run_transient(
                     if progress is not None:
                         progress(min(1.0, state.t / duration))
                     continue
-            if control == "block":
+            if control == "block" and not inertial:  # with a mass the velocity is a state of its own
                 state.v = slider_velocity(
                     state.v, vp, state.n, state.xb, state.tb, state.lw, state.x, state.t, p, *_scratch(state)
                 )
@@ -316,7 +328,7 @@ def run_transient(
             state.t, state.x, state.v, state.h, state.n = float(t), float(x), float(v), float(h), int(n)
             state.puller = puller0 + vp * (state.t - t0) if control == "block" else state.x
             if count:
-                rows.extend(_kernel_rows(out[:count], k_block, control))
+                rows.extend(_kernel_rows(out[:count], k_block, control, mass))
             if status == K.FULL:
                 state.grow()
             elif status == K.STICK:
@@ -324,7 +336,7 @@ def run_transient(
                 chain_state = {"elapsed": 0.0, "fraction": 1.0}
                 events.append(("stick", state.t, k_block * (state.puller - state.x), state.v))
             if not all(math.isfinite(q) for q in (state.t, state.x, state.v, state.h)):
-                raise ModelError(_non_finite(state.t, out[:count], rows, float(np.max(protocol.velocities))))
+                raise ModelError(_non_finite(state.t, out[:count], rows, float(np.max(protocol.velocities)), inertial))
             if state.acc[4] > budget:
                 raise over_budget("transient", int(state.acc[4]), budget, state.t, duration)
             if progress is not None:
@@ -335,17 +347,20 @@ def run_transient(
     while snap_index < len(wanted):
         snapshots.append(_snapshot(state))
         snap_index += 1
-    return _finish(
+    result = _finish(
         rows, chain_rows, events, snapshots, state, params, protocol, control, k_block, int(state.acc[4]), note=note
     )
+    return replace(result, mass=mass, damping=damping) if inertial else result
 
 
 #: a slider faster than this many times the protocol's fastest velocity has run away (no inertia holds it)
 RUNAWAY = 1e6
 
 
-def _non_finite(t: float, block: np.ndarray, rows: list[np.ndarray], pace: float) -> str:
+def _non_finite(t: float, block: np.ndarray, rows: list[np.ndarray], pace: float, inertial: bool = False) -> str:
     """The failure in words: a runaway slip (the bonds gave way faster than an inertia-free block can follow)."""
+    if inertial:
+        return f"transient solver failed at t = {t:.6g} s (non-finite state of the block with mass)"
     finite = [r for r in (*rows[-1:], *np.atleast_2d(block)) if r.size and np.all(np.isfinite(r[[0, 1, 3, 4]]))]
     fast = [r for r in finite if r[3] > RUNAWAY * max(pace, 1e-300)]
     if fast:  # the first row past the bound: what followed is the runaway itself
@@ -557,11 +572,13 @@ def _sample_grid(every: float | None, duration: float) -> np.ndarray:
     return grid
 
 
-def _row(state: _State, params: Parameters, control: str, k_block: float) -> np.ndarray:
+def _row(state: _State, params: Parameters, control: str, k_block: float, mass: float = 0.0) -> np.ndarray:
     pop = state.population()
     f = _force(pop.extension, params)
     sigma = float(pop.weight @ f)
     block_energy = sigma * sigma / (2 * k_block) if control == "block" else 0.0
+    if mass > 0:  # the spring's own stretch, and the moving block's kinetic energy
+        block_energy = 0.5 * k_block * (state.puller - state.x) ** 2 + 0.5 * mass * state.v**2
     b = params.bonds
     y = pop.extension / b.max_extension
     energy = float(pop.weight @ (-0.5 * b.chain_stiffness * b.max_extension**2 * np.log1p(-y * y)))
@@ -590,9 +607,11 @@ def _stuck_impulse(state: _State, vp: float, k_block: float, dt: float) -> float
     return k_block * ((state.puller - state.x) * dt + 0.5 * vp * dt * dt)
 
 
-def _kernel_rows(block: np.ndarray, k_block: float, control: str) -> list[np.ndarray]:
+def _kernel_rows(block: np.ndarray, k_block: float, control: str, mass: float = 0.0) -> list[np.ndarray]:
     sigma = block[:, 1]
     block_energy = sigma**2 / (2 * k_block) if control == "block" else np.zeros_like(sigma)
+    if mass > 0:  # sigma is the interface's: the spring's stretch P - X, and the kinetic energy
+        block_energy = 0.5 * k_block * (block[:, 5] - block[:, 4]) ** 2 + 0.5 * mass * block[:, 3] ** 2
     full = np.c_[block[:, :11], block_energy, np.full(sigma.size, np.nan), block[:, 11:13]]
     return [full]
 
@@ -673,6 +692,31 @@ def _finish(
 
 def stick_population_used(events: list[tuple[str, float, float, float]]) -> bool:
     return any(kind == "stick" for kind, *_ in events)
+
+
+def _block_inertia(mass: Any, damping: Any, control: str, stick_population: bool) -> tuple[float, float]:
+    """(m, eta) of the block, checked: non-negative and finite; a damping only with a mass; neither under
+    velocity control, nor with the paper's attached chains (whose jump the mass would resolve instead)."""
+    values = []
+    for value, name, unit in ((mass, "mass", "kg/m^2"), (damping, "damping", "Pa s/m")):
+        number = 0.0 if value is None else _finite(value, name)
+        if number < 0:
+            raise ParameterError(f"{name}: expected a non-negative value in {unit}, got {value!r}")
+        values.append(number)
+    m, eta = values
+    if (m > 0 or eta > 0) and control != "block":
+        raise ParameterError("mass/damping: a rigid rig (control='velocity') has no block; use control='block'")
+    if eta > 0 and m == 0:
+        raise ParameterError(
+            "damping: the time-dependent model takes a damping only with a block mass (mass > 0 kg/m^2);"
+            " the gel block's own is about 10 kg/m^2 (docs/extensions.md section 4)"
+        )
+    if m > 0 and stick_population:
+        raise ParameterError(
+            "mass: the paper's attached chains (stick_population) impose the jump that a block with mass resolves;"
+            " use one or the other"
+        )
+    return m, eta
 
 
 def _finite(value: Any, name: str) -> float:
