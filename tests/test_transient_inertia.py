@@ -188,3 +188,30 @@ def test_gel_block_departs_at_the_fastest_real_root(params):
     window = (run.time > 6 / rate) & (run.time < 9 / rate)
     growth = np.polyfit(run.time[window], np.log(np.abs(run.slider_velocity[window] - v0)), 1)[0]
     assert growth == pytest.approx(rate, rel=0.01)
+
+
+def test_run_passes_the_rig_mass_to_every_model(capsys):
+    """--mass is the one rig builder's: rate-and-state takes it (in its own units, through the normal stress)
+    and says so in one line without one; the quasi-static model refuses it."""
+    base = ["run", "--v0", "10 um/s", "--duration", "0.5 s", "--mass", "100 kg/m^2"]
+    code, _, err = run_main(capsys, *base, "--model", "rsf")
+    assert code == 2 and "rig mass" in err and "normal_stress" in err
+    code, out, _ = run_main(capsys, *base, "--model", "rsf", "--set", "normal_stress=10 MPa", "--json")
+    assert code == 0 and '"regime"' in out
+    code, _, err = run_main(capsys, *base, "--model", "quasi-static")
+    assert code == 2 and "mass (inertia) is not part of this model" in err
+
+
+@pytest.mark.parametrize("mass", [GEL_MASS, 1.0])
+def test_cost_estimate_counts_the_ringing_of_a_light_block(params, mass):
+    """A block with mass rings at sqrt((K + N0 M)/m)/(2 pi) after every change of the protocol, lightly damped
+    against resting bonds (a hold): the estimate counts it, within 0.5-10x of the steps taken, and grows as the
+    block gets lighter (m^-1/2)."""
+    from stickslip.transient.solver import estimate_cost
+
+    protocol = segments([(200e-6, 0.01), (0.0, 0.05), (300e-6, 0.02)])
+    run = run_transient(params, protocol, start="steady", mass=mass)
+    estimate = estimate_cost(params, protocol, mass=mass, start="steady").steps
+    assert 0.5 < estimate / run.steps < 10, (estimate, run.steps)
+    lighter = estimate_cost(params, protocol, mass=mass / 100, start="steady").steps
+    assert lighter > 5 * estimate

@@ -117,7 +117,8 @@ def transient_command(
     settings = dict(start_velocity=start_velocity, aging=not no_aging, stick_population=stick_population, every=every,
                     rtol=rtol, max_steps=max_steps, reduction=reduction)  # fmt: skip
     cost = estimate_cost(params, protocol, control=solver_control, start_velocity=start_velocity, rtol=rtol,
-                         every=every, aging=not no_aging, reduction=settings["reduction"])  # fmt: skip
+                         every=every, aging=not no_aging, reduction=settings["reduction"], mass=rig.mass or 0.0,
+                         stiffness=rig.stiffness)  # fmt: skip
     shown = None if cost.seconds > PROGRESS_AFTER_SECONDS and not as_json else False  # None: on a terminal
     with progress("transient", total=protocol.duration, unit="s", enabled=shown) as bar:
         run = get_model("transient").run(params, protocol, rig, start=start,

@@ -345,7 +345,7 @@ def _inertial_step(d, x0, v0, force0, h, puller1, n, xb, w, p, at_x):  # type: i
         given = False
     s = 0.0
     k = 0.0
-    for _ in range(200):
+    for iteration in range(201):
         s = 0.0
         k = 0.0
         for i in range(n):
@@ -359,6 +359,8 @@ def _inertial_step(d, x0, v0, force0, h, puller1, n, xb, w, p, at_x):  # type: i
                 s += w[i] * _chain_force(e, p[P_M], dlm)
                 k += w[i] * _chain_stiffness(e, p[P_M], dlm)
         given = False
+        if iteration == 200:  # not converged (never seen): the sums at the d returned
+            break
         v1 = 2.0 * d / h - v0
         force1 = k_spring * (puller1 - x0 - d) - eta * v1 - s
         g = mass * (v1 - v0) - 0.5 * h * (force0 + force1)
@@ -506,6 +508,7 @@ def advance(
             hh = t_end - t
         t1 = t + hh
         # ---- the slider's path over the step: exact (velocity control) or predicted (block control)
+        jerk = 0.0
         if block == 0:
             v0 = vp
             v1p = vp
@@ -690,7 +693,10 @@ def advance(
                 q = _vacancy(u, q0, tau, hh, loss0, dloss0, l1, d1)
                 mass = 0.5 * hh * max(q, 0.0) / tau
                 d = hh - u  # its age at t1
-                x_k = x + u * v0 + 0.5 * (v1p - v0) * u * u / hh
+                if inertial:  # on the predicted cubic path
+                    x_k = x + u * (v0 + u * (0.5 * accel_now + u * jerk / 6.0))
+                else:
+                    x_k = x + u * v0 + 0.5 * (v1p - v0) * u * u / hh
                 e_k = x1p - x_k
                 predicted[0, n + k] = _chain_force(e_k, m, dlm)
                 predicted[1, n + k] = _chain_stiffness(e_k, m, dlm)
