@@ -215,3 +215,23 @@ def test_cost_estimate_counts_the_ringing_of_a_light_block(params, mass):
     assert 0.5 < estimate / run.steps < 10, (estimate, run.steps)
     lighter = estimate_cost(params, protocol, mass=mass / 100, start="steady").steps
     assert lighter > 5 * estimate
+
+
+@pytest.mark.parametrize(
+    ("ratio", "kind"), [(1.0, "stick-slip"), (1.05, "growing oscillation"), (0.95, "decaying oscillation")]
+)
+def test_an_oscillation_within_the_tolerance_is_not_judged(ratio, kind):
+    """A block with mass rang against resting bonds at ~2 x the tolerance with ~4 steps a period and was read
+    as growing, or as a limit cycle, while it decays: a swing below 10 x rtol x sigma is undetermined, in words;
+    the same signal from a run 100 x tighter is judged."""
+    from stickslip.transient.cycles import classify
+
+    time = np.linspace(0.0, 0.02, 4001)
+    swing = 0.5 * ratio ** (time / 1.6e-4 - 0.02 / 1.6e-4)  # Pa peak to trough at the end, 1.6e-4 s period
+    stress = 2511.0 + 0.5 * swing * np.sin(2 * np.pi * time / 1.6e-4)
+    velocity = np.full(time.size, 1e-7)
+    protocol = constant(50e-6, 0.02)
+    loose = classify(time, stress, velocity, protocol, (), [], "block", None, resolution=1e-4)
+    assert loose[0] == "undetermined" and "within 10 × the solver's tolerance" in loose[1]
+    tight = classify(time, stress, velocity, protocol, (), [], "block", None, resolution=1e-6)
+    assert tight[0] == kind

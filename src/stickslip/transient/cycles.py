@@ -18,6 +18,8 @@ STUCK_FRACTION = 0.01
 STEADY_TOLERANCE = 1e-3
 #: steady: the stress has stopped changing within this fraction of it (a tenth of the solver's default rtol)
 SETTLED = 1e-5
+#: an oscillation's growth or decay is judged only above this many times the solver's tolerance, peak to trough
+RESOLVED = 10.0
 
 
 def stuck_mask(time: np.ndarray, velocity: np.ndarray, protocol: Protocol) -> np.ndarray:
@@ -109,6 +111,7 @@ def classify(
     control: str,
     stop: str | None,
     rtol: float | None = None,
+    resolution: float | None = None,
 ) -> tuple[str, str]:
     """(regime, message) of the last protocol segment, by :func:`stickslip.regimes.classify` on the stress.
 
@@ -116,6 +119,11 @@ def classify(
     block control, the slider's velocity settled), "decaying oscillation", "growing oscillation", "stuck"
     (no slip, the slider below 1 % of the puller's pace at the end) or "undetermined" with the evidence.
     ``rtol``: the run's tolerance; "settled" means within a tenth of it (default :data:`SETTLED`).
+    ``resolution``: the solver's local error tolerance (relative).  Whether an oscillation grows, decays or
+    repeats (a limit cycle) is judged only when its peak-to-trough stress is :data:`RESOLVED` times that
+    tolerance of the stress or more: a smaller one is within what the steps may get wrong (a block with mass
+    ringing against resting bonds at rtol 1e-4 swung by 2 x the tolerance, ~4 steps a period, and read as
+    growing, or as a limit cycle, while it decays).
     """
     if stop is not None:
         return regimes.UNDETERMINED, stop
@@ -129,6 +137,15 @@ def classify(
     stuck = stuck_mask(time, velocity, protocol)
     vp = protocol.segments[-1].velocity
     whole = [c for c in cycles if c.period is not None]
+    swing = found.peak - found.trough
+    oscillating = found.kind in (regimes.STICK_SLIP, regimes.DECAYING, regimes.GROWING)
+    if oscillating and resolution is not None and swing < RESOLVED * resolution * scale:
+        return regimes.UNDETERMINED, (
+            f"undetermined: an oscillation of {swing:.3g} Pa peak to trough ({found.evidence}), within"
+            f" {RESOLVED:g} × the solver's tolerance (rtol {resolution:g} of {scale:.6g} Pa): whether it grows,"
+            f" decays or repeats is not resolved; a smaller rtol resolves it (t = {time[-1]:.6g} s,"
+            f" V = {show_velocity(velocity[-1], 3)})"
+        )
     if found.kind == regimes.STICK_SLIP:
         seen = found.evidence.removeprefix("stick-slip (limit cycle): ")
         text = f"stick-slip (limit cycle): {seen}, σ {found.trough:.6g} ... {found.peak:.6g} Pa"

@@ -348,8 +348,9 @@ def run_transient(
         snapshots.append(_snapshot(state))
         snap_index += 1
     result = _finish(
-        rows, chain_rows, events, snapshots, state, params, protocol, control, k_block, int(state.acc[4]), note=note
-    )
+        rows, chain_rows, events, snapshots, state, params, protocol, control, k_block, int(state.acc[4]), note=note,
+        resolution=float(rtol),
+    )  # fmt: skip
     return replace(result, mass=mass, damping=damping) if inertial else result
 
 
@@ -641,6 +642,7 @@ def _finish(
     steps: int,
     stop: str | None = None,
     note: str = "",
+    resolution: float | None = None,
 ) -> TransientResult:
     from .cycles import classify, detect_cycles
 
@@ -654,7 +656,7 @@ def _finish(
     bonded = bonded / n0
     bonded = np.where(np.isnan(bonded), 0.0, bonded)  # the bonds of Eq 1 are set aside while the chains hold
     cycles = detect_cycles(time, sigma, v, protocol, events)
-    regime, message = classify(time, sigma, v, protocol, cycles, events, control, stop)
+    regime, message = classify(time, sigma, v, protocol, cycles, events, control, stop, resolution=resolution)
     message = message + note
     saturating = params.aging.saturation_age is not None  # the extension lets go: its stuck is its own answer
     if regime == "stuck" and not cycles and not stick_population_used(events) and not saturating:
