@@ -113,9 +113,8 @@ def transient_command(
     start_velocity = None if start_v_text is None else positive(start_v_text, "velocity", "--start-velocity")
     every = None if every_text is None else positive(every_text, "time", "--every")
     params = resolve_params(params_name, overrides)
-    reduction = "off" if no_reduce or rig.has_mass else "auto"  # a block with mass keeps the cohorts throughout
     settings = dict(start_velocity=start_velocity, aging=not no_aging, stick_population=stick_population, every=every,
-                    rtol=rtol, max_steps=max_steps, reduction=reduction)  # fmt: skip
+                    rtol=rtol, max_steps=max_steps, reduction="off" if no_reduce else "auto")  # fmt: skip
     cost = estimate_cost(params, protocol, control=solver_control, start_velocity=start_velocity, rtol=rtol,
                          every=every, aging=not no_aging, reduction=settings["reduction"], mass=rig.mass or 0.0,
                          stiffness=rig.stiffness)  # fmt: skip

@@ -110,7 +110,6 @@ def classify(
     events: list,
     control: str,
     stop: str | None,
-    rtol: float | None = None,
     resolution: float | None = None,
 ) -> tuple[str, str]:
     """(regime, message) of the last protocol segment, by :func:`stickslip.regimes.classify` on the stress.
@@ -118,7 +117,7 @@ def classify(
     "stick-slip" (a limit cycle: the amplitude constant over the last periods), "steady" (stress and, under
     block control, the slider's velocity settled), "decaying oscillation", "growing oscillation", "stuck"
     (no slip, the slider below 1 % of the puller's pace at the end) or "undetermined" with the evidence.
-    ``rtol``: the run's tolerance; "settled" means within a tenth of it (default :data:`SETTLED`).
+    "Settled" means within :data:`SETTLED` of the stress (a tenth of the solver's default rtol).
     ``resolution``: the solver's local error tolerance (relative).  Whether an oscillation grows, decays or
     repeats (a limit cycle) is judged only when its peak-to-trough stress is :data:`RESOLVED` times that
     tolerance of the stress or more: a smaller one is within what the steps may get wrong (a block with mass
@@ -130,7 +129,7 @@ def classify(
     start = float(protocol.boundaries[-2])
     inside = time >= start
     scale = float(np.max(np.abs(stress[inside]))) if np.any(inside) else 0.0
-    floor = (SETTLED if rtol is None else 0.1 * rtol) * max(scale, 1e-300)
+    floor = SETTLED * max(scale, 1e-300)
     found = _from_events(events, start, time, stress) or regimes.classify(
         time, stress, floor=floor, start=start, unit="Pa"
     )

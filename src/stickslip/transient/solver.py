@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -15,6 +15,7 @@ from ..model.cycle import Cycle
 from ..numerics.budget import CostEstimate, check_max_steps, over_budget, require_within
 from ..parameters import Parameters
 from ..protocols import Protocol
+from ..units import checked_number
 from . import kernel as K
 from .model import Population, pack_parameters, stick_chains
 from .result import Bookkeeping, Snapshot, TransientResult
@@ -347,11 +348,10 @@ def run_transient(
     while snap_index < len(wanted):
         snapshots.append(_snapshot(state))
         snap_index += 1
-    result = _finish(
+    return _finish(
         rows, chain_rows, events, snapshots, state, params, protocol, control, k_block, int(state.acc[4]), note=note,
-        resolution=float(rtol),
+        resolution=float(rtol), mass=mass, damping=damping,
     )  # fmt: skip
-    return replace(result, mass=mass, damping=damping) if inertial else result
 
 
 #: a slider faster than this many times the protocol's fastest velocity has run away (no inertia holds it)
@@ -643,6 +643,8 @@ def _finish(
     stop: str | None = None,
     note: str = "",
     resolution: float | None = None,
+    mass: float = 0.0,
+    damping: float = 0.0,
 ) -> TransientResult:
     from .cycles import classify, detect_cycles
 
@@ -689,6 +691,8 @@ def _finish(
         steps=steps,
         rejected=int(state.acc[5]),
         lowest_stress=lowest,
+        mass=mass,
+        damping=damping,
     )
 
 
@@ -699,13 +703,10 @@ def stick_population_used(events: list[tuple[str, float, float, float]]) -> bool
 def _block_inertia(mass: Any, damping: Any, control: str, stick_population: bool) -> tuple[float, float]:
     """(m, eta) of the block, checked: non-negative and finite; a damping only with a mass; neither under
     velocity control, nor with the paper's attached chains (whose jump the mass would resolve instead)."""
-    values = []
-    for value, name, unit in ((mass, "mass", "kg/m^2"), (damping, "damping", "Pa s/m")):
-        number = 0.0 if value is None else _finite(value, name)
-        if number < 0:
-            raise ParameterError(f"{name}: expected a non-negative value in {unit}, got {value!r}")
-        values.append(number)
-    m, eta = values
+    m, eta = (
+        0.0 if value is None else checked_number(name, _finite(value, name), unit)
+        for value, name, unit in ((mass, "mass", "kg/m^2"), (damping, "damping", "Pa s/m"))
+    )
     if (m > 0 or eta > 0) and control != "block":
         raise ParameterError("mass/damping: a rigid rig (control='velocity') has no block; use control='block'")
     if eta > 0 and m == 0:
