@@ -173,3 +173,63 @@ def test_it_refuses_what_it_declares_it_cannot_do():
         MODEL.run(MODEL.parameters(), stickslip.protocols.velocity_steps([0.1, 0.2], 1.0))
     with pytest.raises(ModelError, match="no velocity control"):
         MODEL.run(MODEL.parameters(), stickslip.protocols.constant(0.1, 1.0), Rig("velocity"))
+
+
+def test_the_cli_sweeps_it_over_its_own_keys_with_their_units(tmp_path, capsys):
+    """Issue 28 item 5: a plug-in's own keys (unknown to the package's column registry) are varied, their units
+    come from the model's ``dimensions()`` into the Parquet metadata, and the phase diagram labels them."""
+    import pyarrow.parquet as pq
+
+    from cli_helpers import run_main
+
+    out = tmp_path / "own"
+    args = ["sweep", "--model", f"{__name__}:MODEL", "--vary", "mu0=0.4,0.55", "--vary", "damping=50 Pa*s/m,2 kPa*s/m",
+            "--v0", "0.3 m/s", "--duration", "1 s", "-o", str(out), "--workers", "0", "--quiet"]  # fmt: skip
+    status, _, err = run_main(capsys, *args)
+    assert status == 0, err
+    frame, _ = stickslip.sweeps.load_sweep(out)
+    assert sorted(frame["damping"].unique()) == [50.0, 2000.0]  # SI, as written
+    assert frame.attrs["units"]["mu0"] == "1" and frame.attrs["units"]["damping"] == "Pa s/m"
+    schema = pq.read_schema(next(out.glob("part-*.parquet")))
+    assert schema.field("damping").metadata == {b"unit": b"Pa s/m"}
+    assert (frame["status"] == "ok").all(), list(frame["message"])
+    # steady sliding where eta V0 > sigma c (V* = 0.1 m/s at eta = 100): the stress is the closed form
+    steady = frame[frame["damping"] == 2000.0]
+    expected = 1e3 * (steady["mu0"] - 0.01 * math.log(0.3 / 1e-3)) + 2000.0 * 0.3
+    assert np.allclose(steady["mean_stress"], expected, rtol=1e-3)
+    png = tmp_path / "own.png"
+    status, _, err = run_main(capsys, "sweep", "plot", str(out), "--x", "mu0", "--y", "damping", "-o", str(png))
+    assert status == 0 and png.stat().st_size > 0, err
+
+
+def test_a_velocity_controlled_plugin_sweeps_under_velocity_control(tmp_path, capsys, monkeypatch):
+    """A plug-in that declares no spring is driven directly (it used to fail every point: 'no spring control')."""
+    from cli_helpers import run_main
+
+    monkeypatch.syspath_prepend(str(__import__("pathlib").Path(__file__).parent))
+    out = tmp_path / "viscous"
+    status, _, err = run_main(
+        capsys,
+        "sweep",
+        "--model",
+        "viscous_model:MODEL",
+        "--vary",
+        "c=1 MPa*s/m,2 MPa*s/m",
+        "--v0",
+        "3 um/s",
+        "--duration",
+        "1 s",
+        "-o",
+        str(out),
+        "--workers",
+        "0",
+        "--quiet",
+    )
+    assert status == 0, err
+    frame, _ = stickslip.sweeps.load_sweep(out)
+    assert (frame["status"] == "ok").all(), list(frame["message"])
+    assert np.allclose(frame["mean_stress"], frame["c"] * 3e-6, rtol=1e-12)  # stress = c V exactly
+    assert frame.attrs["units"]["c"] == "Pa s/m"
+    import viscous_model
+
+    viscous_model.forget()

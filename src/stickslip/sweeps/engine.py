@@ -18,7 +18,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import DataError, ParameterError, StickslipError
-from .models import get_model, result_columns, run_point
+from .models import get_model, key_units, result_columns, run_point
 from .spec import SweepSpec
 from .store import SweepStore, arrow_schema
 
@@ -62,7 +62,8 @@ def to_table(spec: SweepSpec, columns: dict[str, list[Any]]) -> Any:
     """A batch's columns as a pyarrow Table of the sweep's one schema."""
     import pyarrow as pa
 
-    return pa.Table.from_pydict(columns, schema=arrow_schema(spec.keys, result_columns(get_model(spec.model))))
+    model = get_model(spec.model)
+    return pa.Table.from_pydict(columns, schema=arrow_schema(spec.keys, result_columns(model), key_units(model)))
 
 
 def check_scheduler_address(scheduler: str) -> None:

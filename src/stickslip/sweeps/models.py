@@ -19,7 +19,17 @@ from ..models import get_model as find_model
 from ..models.base import Boundary
 from ..models.rsf import ALIASES as RSF_ALIASES
 
-__all__ = ["ALIASES", "MODELS", "PROTOCOL_KEYS", "Boundary", "SweepModel", "get_model", "result_columns", "run_point"]
+__all__ = [
+    "ALIASES",
+    "MODELS",
+    "PROTOCOL_KEYS",
+    "Boundary",
+    "SweepModel",
+    "get_model",
+    "key_units",
+    "result_columns",
+    "run_point",
+]
 
 #: The keys a sweep adds to the model's own: the protocol's constant pulling velocity.
 PROTOCOL_KEYS = {"pulling_velocity": "velocity"}
@@ -38,6 +48,22 @@ class SweepModel:
 
     def dimensions(self) -> dict[str, str]:
         return {**PROTOCOL_KEYS, **self.model.dimensions()}
+
+    def key_units(self) -> dict[str, str | None]:
+        """The SI unit of each of the model's keys, from its own ``dimensions()`` (a plug-in's keys are unknown to
+        the package's column registry, so their units must come from the model)."""
+        from ..columns import DIMENSIONLESS
+        from ..units import DIMENSIONS
+
+        units: dict[str, str | None] = {}
+        for key, dimension in self.dimensions().items():
+            if dimension not in DIMENSIONS:
+                known = ", ".join(sorted(DIMENSIONS))
+                raise ParameterError(
+                    f"model {self.name!r}: key {key!r} has dimension {dimension!r}; expected one of {known}"
+                )
+            units[key] = DIMENSIONS[dimension][1] or DIMENSIONLESS
+        return units
 
     def check_available(self) -> None:
         self.model.check_available()
@@ -98,7 +124,11 @@ class SweepModel:
         params, velocity, start = self.point(values, settings["duration"])
         protocol = constant(velocity, settings["duration"])
         taken = {k: v for k, v in settings.items() if self.takes(k)}
-        return self.model.run(params, protocol, Rig(), start=start, **taken).row(self.results)
+        return self.model.run(params, protocol, self.rig(), start=start, **taken).row(self.results)
+
+    def rig(self) -> Rig:
+        """The model's own spring; a model that runs only under velocity control is driven directly."""
+        return Rig() if "spring" in self.model.capabilities.controls else Rig(control="velocity")
 
     def boundaries(self, spec: Any, frame: Any, x: str, y: str) -> list[Boundary]:
         """The model's analytic stability boundaries in the (x, y) plane; none if it has none."""
@@ -124,6 +154,11 @@ MODELS: Mapping[str, SweepModel] = _Models()
 def get_model(name: str) -> SweepModel:
     """The model of ``--model NAME`` (or ``module:attr``), as a sweep sees it."""
     return SweepModel(find_model(name))
+
+
+def key_units(model: SweepModel) -> dict[str, str | None]:
+    """The units of a sweep's input columns as the model states them (see :meth:`SweepModel.key_units`)."""
+    return model.key_units()
 
 
 def result_columns(model: SweepModel) -> dict[str, str]:

@@ -56,8 +56,13 @@ def chunk_name(batch: int) -> str:
     return f"part-{batch:06d}.parquet"
 
 
-def arrow_schema(inputs: tuple[str, ...], columns: Mapping[str, str]) -> Any:
-    """The one schema of every chunk: point index, inputs (SI floats), then the model's columns."""
+def arrow_schema(
+    inputs: tuple[str, ...], columns: Mapping[str, str], key_units: Mapping[str, str | None] | None = None
+) -> Any:
+    """The one schema of every chunk: point index, inputs (SI floats), then the model's columns.
+
+    ``key_units`` gives the units of the model's own keys (a plug-in's keys are not in the package's registry).
+    """
     import pyarrow as pa
 
     from ..columns import PARQUET_KEY, unit_of
@@ -65,7 +70,7 @@ def arrow_schema(inputs: tuple[str, ...], columns: Mapping[str, str]) -> Any:
     kinds = {"float": pa.float64(), "int": pa.int64(), "str": pa.string()}
     types = {"point": pa.int64(), **dict.fromkeys(inputs, pa.float64())}
     types.update({name: kinds[kind] for name, kind in columns.items()})
-    units = {name: unit_of(name) for name in types}  # every column names its unit (pyarrow field metadata)
+    units = {name: unit_of(name, key_units) for name in types}  # every column names its unit (pyarrow field metadata)
     fields = [pa.field(name, kind, metadata=_unit_metadata(units[name])) for name, kind in types.items()]
     return pa.schema(fields, metadata={PARQUET_KEY: json.dumps(units).encode()})
 
@@ -309,13 +314,14 @@ def _read_problem(store: SweepStore, path: Path, start: int, stop: int) -> str |
     """Read a chunk the ledger does not vouch for: the right schema and exactly points start..stop-1."""
     import pyarrow.parquet as pq
 
-    from .models import get_model, result_columns
+    from .models import get_model, key_units, result_columns
 
     try:
         table = pq.read_table(path)
     except Exception as exc:  # pyarrow raises ArrowInvalid, OSError, ... on a damaged file
         return f"unreadable: {type(exc).__name__}"
-    expected = arrow_schema(store.spec.keys, result_columns(get_model(store.spec.model)))
+    model = get_model(store.spec.model)
+    expected = arrow_schema(store.spec.keys, result_columns(model), key_units(model))
     if not table.schema.equals(expected, check_metadata=False):
         return "not the columns of this sweep"
     if table.column("point").to_pylist() != list(range(start, stop)):
