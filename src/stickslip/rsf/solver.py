@@ -22,6 +22,7 @@ from __future__ import annotations
 import math
 import warnings
 from collections.abc import Callable
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -135,7 +136,20 @@ def simulate(
         y = y_end
     t_all = np.concatenate(t_parts)
     y_all = np.concatenate(y_parts, axis=1)
-    return assemble_run(system, protocol, t_all, y_all, status, message, v_start, detect, last, rtol)
+    run = assemble_run(system, protocol, t_all, y_all, status, message, v_start, detect, last, rtol)
+    return _requested(run, grid) if times is not None else run
+
+
+def _requested(run: RSFRun, grid: np.ndarray) -> RSFRun:
+    """The run at the requested times only: the start (t = 0, always computed) is dropped when not asked for."""
+    if grid[0] == 0.0 or run.time.size == 0 or run.time[0] != 0.0:
+        return run
+    keep = slice(1, None)
+    return replace(
+        run, time=run.time[keep], friction=run.friction[keep], slider_velocity=run.slider_velocity[keep],
+        state=run.state[:, keep], load_point_displacement=run.load_point_displacement[keep],
+        slider_displacement=run.slider_displacement[keep], load_point_velocity=run.load_point_velocity[keep],
+    )  # fmt: skip
 
 
 def _out_of_range(system: System, t0: float, t1: float, exc: Exception) -> str:
@@ -191,6 +205,10 @@ def _check_tolerances(rtol: Any, atol: Any) -> None:
             raise ParameterError(f"{name}: expected a tolerance between 0 and 1, got {value!r}")
 
 
+#: sample times this close (relative) beyond the protocol's ends are read at the end
+END_SLACK = 1e-9
+
+
 def _grid(protocol: Protocol, every: float | None, times: Any) -> np.ndarray | None:
     if every is not None and times is not None:
         raise ParameterError("every/times: give one of them, not both")
@@ -213,8 +231,14 @@ def _grid(protocol: Protocol, every: float | None, times: Any) -> np.ndarray | N
         raise ParameterError(f"times: expected a sequence of sample times in s, got {shorten(times)}") from None
     if grid.size == 0 or not np.all(np.isfinite(grid)) or np.any(np.diff(grid) <= 0):
         raise ParameterError("times: expected finite, strictly increasing sample times")
-    if grid[0] < 0 or grid[-1] > end * (1 + 1e-12):
+    # a time within rounding of the end (a record's last row against a history summed from its pieces) is the
+    # end: it is sampled there, never dropped
+    slack = END_SLACK * max(end, float(np.max(np.abs(grid))))
+    if grid[0] < -slack or grid[-1] > end + slack:
         raise ParameterError(f"times: expected times within the protocol, 0 ... {end:g} s")
+    grid = np.clip(grid, 0.0, end)
+    if np.any(np.diff(grid) <= 0):
+        raise ParameterError(f"times: two sample times within rounding ({END_SLACK:g} relative) of the protocol's end")
     return grid
 
 
