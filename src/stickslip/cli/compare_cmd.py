@@ -42,6 +42,22 @@ CLASSIC_V0, CLASSIC_DURATION = "200 um/s", "120 s"
 @protocol_options(
     stiffness_help="--models: the rig's spring K for every model, in Pa/m, e.g. \"400 kPa/m\" [each model's own]."
 )
+@click.option(
+    "--start",
+    "start_texts",
+    multiple=True,
+    metavar="[MODEL=]S",
+    help="--models: a model's start, as run --start takes it (transient: empty, steady; rsf: a velocity;"
+    " quasi-static: a stress); MODEL=S for one model, S for every model; repeatable.",
+)
+@click.option(
+    "--setting",
+    "setting_texts",
+    multiple=True,
+    metavar="KEY=VALUE",
+    help="--models: a run setting (e.g. stick_population=true) for each model that takes it; repeatable.",
+)
+@click.option("--every", "every_text", default=None, metavar="DT", help="--models: sample each trace every DT.")
 @click.option("--v1", default="2 mm/s", show_default=True, help="Velocity after the step.")
 @click.option("--step-time", default="2 s", show_default=True, help="Duration of each velocity of the step.")
 @click.option("--hold", default="1 s", show_default=True, help="Hold time of the slide-hold-slide.")
@@ -146,8 +162,9 @@ def compare_command(**options: Any) -> None:
 def _refuse_model_options(options: dict[str, Any]) -> None:
     """The protocol and rig words belong to --models; the classic comparison runs its own three experiments."""
     ctx = click.get_current_context()
-    given = [name for key, name in (("segment_texts", "--segment"), ("protocol_file", "--protocol"),
-                                     ("stiffness_text", "--stiffness")) if options[key]]  # fmt: skip
+    words = (("segment_texts", "--segment"), ("protocol_file", "--protocol"), ("stiffness_text", "--stiffness"),
+             ("start_texts", "--start"), ("setting_texts", "--setting"), ("every_text", "--every"))  # fmt: skip
+    given = [name for key, name in words if options[key]]
     if ctx.get_parameter_source("control") not in (None, click.core.ParameterSource.DEFAULT):
         given.append("--control")
     if given:

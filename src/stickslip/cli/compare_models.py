@@ -19,7 +19,7 @@ from ..progress import progress
 from ..units import shorten
 from .common import check_output, check_unit, emit_json, key_value, refuse_overwriting_inputs, save_figure
 from .protocol_options import build_protocol, build_rig
-from .run_cmd import model_parameters, run_summary
+from .run_cmd import model_parameters, run_summary, settings_of, start_value
 
 #: Exit status when a model's run failed (status "failed"); 2 is bad input.
 FAILED = 3
@@ -56,6 +56,41 @@ def routed_overrides(models: list[Any], overrides: tuple[str, ...]) -> dict[str,
     return routed
 
 
+def routed_settings(models: list[Any], texts: tuple[str, ...], every_text: str | None) -> dict[str, dict[str, Any]]:
+    """``--setting KEY=VALUE`` (and ``--every``) for each model that takes the setting; one no model takes is
+    refused."""
+    settings = settings_of(texts, every_text)
+    routed: dict[str, dict[str, Any]] = {m.name: {} for m in models}
+    for key, value in settings.items():
+        owners = [m for m in models if key in m.capabilities.settings]
+        if not owners:
+            names = ", ".join(m.name for m in models)
+            flag = "--every" if key == "every" else f"--setting {key}"
+            raise ParameterError(f"{flag}: none of the models {names} takes this setting")
+        for model in owners:
+            routed[model.name][key] = value
+    return routed
+
+
+def routed_starts(models: list[Any], texts: tuple[str, ...]) -> dict[str, Any]:
+    """``--start [MODEL=]S``: a start for one model, or (without MODEL=) for every model."""
+    from ..models import get_model
+
+    starts: dict[str, Any] = {}
+    for text in texts:
+        name, sep, value = text.partition("=")  # a start itself never holds "="
+        if sep:
+            model = get_model(name.strip())
+            if model.name not in {m.name for m in models}:
+                listed = ", ".join(m.name for m in models)
+                raise ParameterError(f"--start {shorten(text)}: {name.strip()} is not one of the models {listed}")
+            starts[model.name] = start_value(value)
+        else:
+            start = start_value(text)
+            starts.update({m.name: start for m in models})
+    return starts
+
+
 def _extra_keys(model: Any) -> tuple[str, ...]:
     """Keys a model takes besides its dimensional ones (rate-and-state's ``law``)."""
     return ("law",) if hasattr(model, "LAW_NAMES") else ()
@@ -74,8 +109,10 @@ def compare_models(options: dict[str, Any]) -> None:
     protocol = build_protocol(options["v0_text"], options["duration_text"], options["segment_texts"],
                               options["protocol_file"])  # fmt: skip
     rig, own_spring = build_rig(options["control"], options["stiffness_text"], models)
+    settings = routed_settings(models, options.get("setting_texts", ()), options.get("every_text"))
+    starts = routed_starts(models, options.get("start_texts", ()))
     for model in models:  # what a model cannot run is refused before any model runs
-        model.check(protocol, rig, {})
+        model.check(protocol, rig, settings[model.name])
     routed = routed_overrides(models, options["overrides"])
     for name, text in own_spring.items():
         routed[name]["k"] = text
@@ -85,11 +122,15 @@ def compare_models(options: dict[str, Any]) -> None:
         for model in models:
             try:
                 params = model_parameters(model, params_name, routed[model.name])
-                runs[model.name] = model.run(params, protocol, rig)
+                runs[model.name] = model.run(params, protocol, rig, start=starts.get(model.name),
+                                             **settings[model.name])  # fmt: skip
             except (ParameterError, ModelError) as exc:
                 raise type(exc)(f"model {model.name}: {exc}") from None
             bar.advance(note=model.name)
     summaries = {name: run_summary(run, protocol, rig) for name, run in runs.items()}
+    for model in models:  # models that start differently do not settle alike: each row says where it began
+        summaries[model.name]["start"] = model.describe_start(starts.get(model.name), protocol, settings[model.name])
+        summaries[model.name]["settings"] = settings[model.name]
     document = {
         "protocol": [{"velocity": s.velocity, "duration": s.duration} for s in protocol.segments],
         "rig": {"control": rig.control, "stiffness": rig.stiffness},
@@ -126,12 +167,13 @@ def comparison_table(summaries: dict[str, dict[str, Any]]) -> Any:
     from rich.table import Table
 
     table = Table(title="Same protocol and rig, each model", title_justify="left")
-    for heading in ("model", "regime", "period (s)", "peak", "trough", "mean", "unit"):
-        table.add_column(heading, justify="left" if heading in ("model", "regime") else "right")
+    for heading in ("model", "start", "regime", "period (s)", "peak", "trough", "mean", "unit"):
+        table.add_column(heading, justify="left" if heading in ("model", "start", "regime") else "right")
     for name, s in summaries.items():
         signal, unit = ("stress", "Pa") if "peak_stress" in s else ("friction", "μ")
-        table.add_row(name, s["regime"] + ("" if s["status"] == "ok" else " (FAILED)"), _number(s["period"]),
-                      *(_number(s[f"{w}_{signal}"]) for w in ("peak", "trough", "mean")), unit)  # fmt: skip
+        table.add_row(name, s.get("start", ""), s["regime"] + ("" if s["status"] == "ok" else " (FAILED)"),
+                      _number(s["period"]), *(_number(s[f"{w}_{signal}"]) for w in ("peak", "trough", "mean")),
+                      unit)  # fmt: skip
     return table
 
 

@@ -152,6 +152,11 @@ class FrictionModel(ABC):
         """Analytic boundaries between steady sliding and stick-slip in the (x, y) plane; none by default."""
         return []
 
+    def describe_start(self, start: Any, protocol: Protocol, settings: Mapping[str, Any] | None = None) -> str:
+        """In words, where a run of ``protocol`` from ``start`` begins (tables that set models side by side
+        say it, since models that start differently do not settle alike)."""
+        return "the model's own start" if start is None else f"start {start!r}"
+
     # ------------------------------------------------------------------ checks every implementation shares
     def check_available(self) -> None:
         """Refuse, in one line, a model whose modules this installation does not have."""

@@ -41,6 +41,11 @@ class QuasiStatic(BondModel):
         sim = simulate(params, velocity, duration, start_stress=start, jump_curve=settings.get("jump_curve", "aging"))
         return simulation_run(sim)
 
+    def describe_start(self, start: Any, protocol: Protocol, settings: Any = None) -> str:
+        if start is None:
+            return "first stick from σc (the cycle's own start)"
+        return f"first stick from {float(start):.6g} Pa"
+
     def stability_boundary(self, fixed: Any, x: str, y: str, frame: Any = None) -> list[Boundary]:
         """V0 = Vc: the critical velocity against the other axis (from the rows' own Vc)."""
         if frame is None or "pulling_velocity" not in (x, y) or "critical_velocity" not in frame:

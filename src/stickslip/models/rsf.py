@@ -69,6 +69,12 @@ class RSFModel(FrictionModel):
     def dimensions(self) -> dict[str, str]:
         return dict(self.KEYS)
 
+    def describe_start(self, start: Any, protocol: Protocol, settings: Any = None) -> str:
+        from ..display import velocity
+
+        shown = velocity(protocol.segments[0].velocity if start is None else float(start), 4)
+        return f"steady sliding at {shown}"
+
     def parameters(self, spec: Any = None, overrides: Mapping[str, Any] | None = None) -> Any:
         """:class:`stickslip.rsf.RSFParams` from ``spec`` (RSFParams, a mapping as in a TOML file, or None for
         the defaults) and ``overrides`` of :attr:`KEYS` and ``law`` (a name, or its index in :attr:`LAW_NAMES`)."""
