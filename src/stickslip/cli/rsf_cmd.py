@@ -54,6 +54,9 @@ def model_options(func: Callable[..., Any], stiffness: bool = True) -> Callable[
         click.option("--mass", default=None, help='Slider mass per area, e.g. "100 kg/m^2" (needs --normal-stress).'),
         click.option("--normal-stress", default=None, help='Normal stress, e.g. "30 MPa".'),
         click.option("--regularized", is_flag=True, default=None, help="Use the regularised (asinh) friction form."),
+        click.option("--cutoff-v1", default=None,
+                     help='Cut-off velocity form (QDYN): V1 of the direct effect, e.g. "1 mm/s"; needs --cutoff-v2.'),
+        click.option("--cutoff-v2", default=None, help='Cut-off velocity V2 of the evolution effect, e.g. "1 um/s".'),
     ]  # fmt: skip
     for option in reversed(options):
         func = option(func)
@@ -104,6 +107,11 @@ def build_params(options: dict[str, Any]) -> Any:
         mapping["mass"] = _positive(options["mass"], "mass_per_area", "--mass", allow_zero=True)
     if options.get("regularized"):
         mapping["regularized"] = True
+    if (options.get("cutoff_v1") is None) != (options.get("cutoff_v2") is None):
+        raise ParameterError("--cutoff-v1/--cutoff-v2: the cut-off velocity form needs both V1 and V2")
+    if options.get("cutoff_v1") is not None:
+        mapping["cutoff"] = (_positive(options["cutoff_v1"], "velocity", "--cutoff-v1"),
+                             _positive(options["cutoff_v2"], "velocity", "--cutoff-v2"))  # fmt: skip
     source = "options" if options.get("params_file") is None else f"--params {options['params_file']} (or options)"
     return RSFParams.from_dict(mapping, source=source)
 

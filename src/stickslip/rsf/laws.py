@@ -15,6 +15,13 @@ nagata     1 - V theta/Dc - (c/b) theta dmu/dt           aging - (c/b) dmu/dt
 (PRZ uses theta = (2 Dc/V0) e^psi, so that theta_ss = 2 Dc/V as in Perrin, Rice
 and Zheng 1995 and in rsfmodel.)  In steady state psi = -x for every law.
 
+The *cut-off velocity* friction form (QDYN's ``FRICTION_MODEL = 'cut-off
+velocity'``, after Okubo 1989 and Dieterich 1981) changes the friction, not the
+laws: ``mu = mu0 - a ln(V1/V + 1) + sum_i b_i ln(V2 theta_i/(s Dc_i) + 1)``
+(s = theta_scale, 1 for aging and slip), i.e. with ``l1 = ln(V1/V0)`` and
+``l2 = ln(V2/V0)``: ``mu = mu0 - a sp(l1 - x) + sum_i b_i sp(psi_i + l2)``
+where ``sp(z) = ln(1 + e^z)``.  :class:`CutoffForm` evaluates it.
+
 Adding a law touches one place: subclass :class:`StateLaw` (or write any object
 with the same attributes) and call :func:`register_law`; ``stickslip rsf
 simulate --law NAME`` and :func:`stickslip.rsf.simulate` then know it.  A law
@@ -39,7 +46,59 @@ def cexp(z: float) -> float:
     return math.exp(z if z < EXP_CAP else EXP_CAP)
 
 
-__all__ = ["EXP_CAP", "LAWS", "Aging", "Nagata", "Prz", "Slip", "StateLaw", "cexp", "get_law", "register_law"]
+__all__ = [
+    "EXP_CAP",
+    "LAWS",
+    "Aging",
+    "CutoffForm",
+    "Nagata",
+    "Prz",
+    "Slip",
+    "StateLaw",
+    "cexp",
+    "get_law",
+    "register_law",
+]
+
+
+def softplus(z: float) -> float:
+    """ln(1 + e^z) without overflow or loss of the small tail."""
+    return (z if z > 0 else 0.0) + math.log1p(math.exp(-abs(z)))
+
+
+def logistic(z: float) -> float:
+    """1/(1 + e^-z), the slope of :func:`softplus`, without overflow."""
+    if z >= 0:
+        return 1.0 / (1.0 + math.exp(-z))
+    e = math.exp(z)
+    return e / (1.0 + e)
+
+
+class CutoffForm:
+    """The cut-off velocity friction in the solver's variables (see the module notes and docs/rsf.md, Laws).
+
+    ``mu = mu0 - a sp(l1 - x) + sum_i b_i sp(psi_i + l2)``, so
+    ``dmu/dx = a L(l1 - x) = a V1/(V1 + V)`` and
+    ``dmu/dpsi_i = b_i L(psi_i + l2) = b_i V2 theta_i/(V2 theta_i + s Dc_i)``
+    (L the logistic function); their own derivatives, ``-a L(1 - L)`` and ``b_i L(1 - L)``, enter the Jacobian.
+    """
+
+    def __init__(self, v1: float, v2: float, v0: float) -> None:
+        self.l1 = math.log(v1) - math.log(v0)  # the ratios themselves may overflow
+        self.l2 = math.log(v2) - math.log(v0)
+
+    def friction(self, mu0: float, a: float, b: list[float], x: float, psi: list[float]) -> float:
+        return mu0 - a * softplus(self.l1 - x) + sum(bi * softplus(p + self.l2) for bi, p in zip(b, psi, strict=True))
+
+    def direct(self, a: float, x: float) -> tuple[float, float]:
+        """(dmu/dx, d2mu/dx2)."""
+        s = logistic(self.l1 - x)
+        return a * s, -a * s * (1.0 - s)
+
+    def evolution(self, b: float, psi: float) -> tuple[float, float]:
+        """(dmu/dpsi, d2mu/dpsi2) of one state term."""
+        s = logistic(psi + self.l2)
+        return b * s, b * s * (1.0 - s)
 
 
 class StateLaw:

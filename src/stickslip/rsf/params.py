@@ -3,7 +3,11 @@
 ``stiffness`` is friction per slip (1/m): a machine stiffness K in Pa/m with a
 normal stress sigma is ``K / sigma``.  ``eta`` is radiation damping in friction
 per velocity (s/m: the shear impedance over sigma).  ``mass`` is the slider's
-mass per unit area (kg/m^2) and needs ``normal_stress``.
+mass per unit area (kg/m^2) and needs ``normal_stress``.  ``cutoff = (V1, V2)``
+(m/s) selects the cut-off velocity form ``mu = mu0 - a ln(V1/V + 1) + sum b_i
+ln(V2 theta_i/Dc_i + 1)`` (QDYN's; see :mod:`stickslip.rsf.laws`), where mu0 is
+the friction with both logarithms' arguments at 1 and v_ref only scales the
+solver's variables.
 """
 
 from __future__ import annotations
@@ -71,6 +75,7 @@ class RSFParams:
     mass: float = 0.0
     normal_stress: float | None = None
     regularized: bool = False
+    cutoff: tuple[float, float] | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "a", _finite("a", self.a, 0.0))
@@ -98,6 +103,19 @@ class RSFParams:
         if not isinstance(self.regularized, (bool, np.bool_)):  # bool("false") is True: take no strings or numbers
             raise ParameterError(f"regularized: expected true or false, got {shorten(self.regularized)}")
         object.__setattr__(self, "regularized", bool(self.regularized))
+        if self.cutoff is not None:
+            object.__setattr__(self, "cutoff", _cutoff_pair(self.cutoff))
+            self._check_cutoff_combinations()
+
+    def _check_cutoff_combinations(self) -> None:
+        if self.regularized:
+            raise ParameterError("cutoff: the cut-off velocity form and the regularised form exclude each other")
+        for s in self.states:
+            if get_law(s.law).coupling(1.0, 1.0) != 0.0:
+                raise ParameterError(
+                    f"cutoff: the {s.law} law couples the state to dmu/dt of the classical form; expected a law"
+                    " without that coupling (aging, slip, prz) with the cut-off velocity form"
+                )
 
     @property
     def b(self) -> float:
@@ -109,10 +127,19 @@ class RSFParams:
         return self.states[0].dc
 
     def steady_friction(self, velocity: Any) -> Any:
-        """mu_ss(V) = mu0 + (a - b) ln(V/V0) (the regularised form differs only where V/V0 << e^(-mu/a))."""
+        """mu_ss(V) = mu0 + (a - b) ln(V/V0) (the regularised form differs only where V/V0 << e^(-mu/a)).
+
+        With ``cutoff = (V1, V2)``: mu0 - a ln(V1/V + 1) + b ln(V2/V + 1).
+        """
         import numpy as np
 
         v = np.asarray(velocity, dtype=float)
+        if self.cutoff is not None:  # theta_i = s Dc_i/V in steady state for every law: both terms are ln(Vc/V + 1)
+            v1, v2 = self.cutoff
+            lv = np.log(v)
+            return (
+                self.mu0 - self.a * np.logaddexp(0.0, math.log(v1) - lv) + self.b * np.logaddexp(0.0, math.log(v2) - lv)
+            )
         if not self.regularized:
             return self.mu0 + (self.a - self.b) * np.log(v / self.v_ref)
         return self.a * np.arcsinh(0.5 * v / self.v_ref * np.exp((self.mu0 - self.b * np.log(v / self.v_ref)) / self.a))
@@ -126,6 +153,10 @@ class RSFParams:
         out["states"] = [asdict(s) for s in self.states]
         if out["normal_stress"] is None:
             del out["normal_stress"]
+        if self.cutoff is None:
+            del out["cutoff"]
+        else:
+            out["cutoff"] = {"v1": self.cutoff[0], "v2": self.cutoff[1]}
         return out
 
     def to_toml(self) -> str:
@@ -143,7 +174,7 @@ class RSFParams:
     @classmethod
     def from_dict(cls, mapping: Mapping[str, Any], source: str = "parameters") -> RSFParams:
         """From plain values or strings with units (as written by :meth:`to_dict`); unknown keys are errors."""
-        known = {"a", "states", "mu0", "v_ref", "stiffness", "eta", "mass", "normal_stress", "regularized"}
+        known = {"a", "states", "mu0", "v_ref", "stiffness", "eta", "mass", "normal_stress", "regularized", "cutoff"}
         if not isinstance(mapping, Mapping):
             raise ParameterError(f"{source}: expected a mapping of parameters, got {shorten(mapping)}")
         unknown = sorted(set(mapping) - known)
@@ -156,6 +187,8 @@ class RSFParams:
             if key in mapping and not (key == "normal_stress" and mapping[key] is None):
                 value = mapping[key]
                 values[key] = to_si(value, dims[key], f"{source}: {key}") if key in dims else value
+        if mapping.get("cutoff") is not None:
+            values["cutoff"] = _cutoff_from(mapping["cutoff"], f"{source}: cutoff")
         sigma = values.get("normal_stress")
         for key, stress_dim in (("stiffness", "stress_per_length"), ("eta", "stress_per_velocity")):
             if key in mapping:
@@ -206,7 +239,29 @@ def _friction_units(value: Any, dimension: str, stress_dimension: str, sigma: fl
         return converted / sigma
 
 
+def _cutoff_pair(value: Any) -> tuple[float, float]:
+    """(V1, V2) in m/s, each positive and finite."""
+    if isinstance(value, (str, bytes, Mapping)) or not isinstance(value, (tuple, list, np.ndarray)) or len(value) != 2:
+        raise ParameterError(f"cutoff: expected two velocities (V1, V2) in m/s, got {shorten(value)}")
+    v1, v2 = (_finite(f"cutoff {name}", v, 0.0) for name, v in zip(("V1", "V2"), value, strict=True))
+    return v1, v2
+
+
+def _cutoff_from(value: Any, name: str) -> tuple[float, float]:
+    """(V1, V2) from a table {v1, v2} or a pair, each a number (m/s) or a string with its unit."""
+    if isinstance(value, Mapping):
+        keys = {str(k).lower(): v for k, v in value.items()}
+        if set(keys) != {"v1", "v2"}:
+            raise ParameterError(f"{name}: expected a table with v1 and v2 (velocities), got {shorten(value)}")
+        value = (keys["v1"], keys["v2"])
+    if isinstance(value, (str, bytes)) or not isinstance(value, (list, tuple)) or len(value) != 2:
+        raise ParameterError(f"{name}: expected v1 and v2 (velocities), got {shorten(value)}")
+    return to_si(value[0], "velocity", f"{name}.v1"), to_si(value[1], "velocity", f"{name}.v2")
+
+
 def _toml_value(value: Any) -> str:
+    if isinstance(value, Mapping):
+        return "{ " + ", ".join(f"{k} = {_toml_value(v)}" for k, v in value.items()) + " }"
     if isinstance(value, bool):
         return "true" if value else "false"
     if isinstance(value, str):
@@ -231,6 +286,7 @@ def rsf_params(
     mass: float = 0.0,
     normal_stress: float | None = None,
     regularized: bool = False,
+    cutoff: tuple[float, float] | None = None,
 ) -> RSFParams:
     """Convenience constructor for one or two state variables (SI values)."""
     states = [StateVariable(law, b, dc, c)]
@@ -238,4 +294,4 @@ def rsf_params(
         raise ParameterError("b2/dc2: a second state variable needs both b2 and dc2")
     if b2 is not None and dc2 is not None:
         states.append(StateVariable(law2 or law, b2, dc2, c))
-    return RSFParams(a, tuple(states), mu0, v_ref, stiffness, eta, mass, normal_stress, regularized)
+    return RSFParams(a, tuple(states), mu0, v_ref, stiffness, eta, mass, normal_stress, regularized, cutoff)

@@ -52,7 +52,7 @@ class Stability:
 
 
 def _closed_form_applies(p: RSFParams) -> bool:
-    return len(p.states) == 1 and p.states[0].law in _CLASSICAL and not p.regularized
+    return len(p.states) == 1 and p.states[0].law in _CLASSICAL and not p.regularized and p.cutoff is None
 
 
 def critical_stiffness(params: RSFParams, velocity: float | str) -> float:

@@ -10,7 +10,9 @@ and ``d psi_i/dt = g_i + h_i dmu/dt`` (h_i = 0 except for Nagata's law):
     dmu/dt = (A dx/dt + G) / (1 - H),    G = sum B_i g_i,  H = sum B_i h_i,
 
 where A = dmu/dx and B_i = dmu/dpsi_i (a and b_i for the classical form;
-state-dependent for the regularised asinh form).  With a mass m per area and
+state-dependent for the regularised asinh form; A = a V1/(V1 + V) and
+B_i = b_i/(1 + (V0/V2) e^-psi_i) for the cut-off velocity form, which takes no
+dmu/dt coupling, H = 0).  With a mass m per area and
 normal stress sigma, ``m dV/dt = sigma (s - mu - eta V)`` and ``ds/dt = k (V_lp - V)``.
 """
 
@@ -20,7 +22,7 @@ import math
 
 import numpy as np
 
-from .laws import EXP_CAP, get_law
+from .laws import EXP_CAP, CutoffForm, get_law
 from .laws import cexp as _exp
 from .params import RSFParams
 
@@ -47,13 +49,19 @@ class System:
         self.size = self.n + 1 + self.offset
         self.one_minus_h = 1.0 - sum(b * h for b, h in zip(self.b, self.h, strict=True))  # classical form
         self.has_jacobian = not self.regularized
+        self.cutoff = None if params.cutoff is None else CutoffForm(*params.cutoff, self.v0)
         self._terms = [(law.rate, b, dc) for law, b, dc in zip(self.laws, self.b, self.dc, strict=True)]
         self._coupled = any(h != 0.0 for h in self.h)
-        if self.has_jacobian and not (self._coupled or self.inertial):
+        if self.cutoff is not None:
+            if not self.inertial:
+                self.rhs = self._rhs_cutoff  # type: ignore[method-assign]
+        elif self.has_jacobian and not (self._coupled or self.inertial):
             self.rhs = self._rhs_classical  # type: ignore[method-assign]  # the common case, without generality's cost
 
     # ------------------------------------------------------------------ friction
     def friction(self, x: float, psi: list[float] | np.ndarray) -> float:
+        if self.cutoff is not None:
+            return self.cutoff.friction(self.mu0, self.a, self.b, x, [float(p) for p in psi])
         if not self.regularized:
             return self.mu0 + self.a * x + sum(b * p for b, p in zip(self.b, psi, strict=True))
         z = x + (self.mu0 + sum(b * p for b, p in zip(self.b, psi, strict=True))) / self.a
@@ -61,6 +69,10 @@ class System:
 
     def friction_many(self, x: np.ndarray, psi: np.ndarray) -> np.ndarray:
         """Vectorised :meth:`friction`; ``psi`` has shape (n, len(x))."""
+        if self.cutoff is not None:
+            c = self.cutoff
+            evolution = sum(b * np.logaddexp(0.0, row + c.l2) for b, row in zip(self.b, psi, strict=True))
+            return self.mu0 - self.a * np.logaddexp(0.0, c.l1 - np.asarray(x, dtype=float)) + evolution
         bpsi = sum(b * row for b, row in zip(self.b, psi, strict=True))  # tensordot is slow for these shapes
         if not self.regularized:
             return self.mu0 + self.a * x + bpsi
@@ -85,9 +97,14 @@ class System:
         g = []
         for law, p, dc in zip(self.laws, psi, self.dc, strict=True):
             g.append(law.rate(x, p, self.v0, dc)[0])
-        A, factor = self._slopes(x, psi)
-        G = factor * sum(b * gi for b, gi in zip(self.b, g, strict=True))
-        Q = 1.0 - factor * sum(b * h for b, h in zip(self.b, self.h, strict=True))
+        if self.cutoff is not None:  # H = 0 (no coupled law with this form)
+            A = self.cutoff.direct(self.a, x)[0]
+            G = sum(self.cutoff.evolution(b, p)[0] * gi for b, p, gi in zip(self.b, psi, g, strict=True))
+            Q = 1.0
+        else:
+            A, factor = self._slopes(x, psi)
+            G = factor * sum(b * gi for b, gi in zip(self.b, g, strict=True))
+            Q = 1.0 - factor * sum(b * h for b, h in zip(self.b, self.h, strict=True))
         if self.inertial:
             s = float(y[0])
             xdot = (s - self.friction(x, psi) - self.eta * v) / (self.inertia * v)
@@ -111,8 +128,25 @@ class System:
         out[0] = (self.k * (vlp - v) - G) / (self.a + self.eta * v)
         return out
 
+    def _rhs_cutoff(self, t: float, y: np.ndarray, vlp: float) -> list[float]:
+        """:meth:`rhs` for the cut-off velocity form without mass: dx/dt = (k (V_lp - V) - sum B_i g_i)/(A + eta V)."""
+        x, *psi = y.tolist()
+        v0, c = self.v0, self.cutoff
+        assert c is not None
+        out = [0.0]
+        G = 0.0
+        for (rate, b, dc), p in zip(self._terms, psi):  # noqa: B905  (lengths match by construction)
+            g = rate(x, p, v0, dc)[0]
+            out.append(g)
+            G += c.evolution(b, p)[0] * g
+        v = v0 * _exp(x)
+        out[0] = (self.k * (vlp - v) - G) / (c.direct(self.a, x)[0] + self.eta * v)
+        return out
+
     def jacobian(self, t: float, y: np.ndarray, vlp: float) -> np.ndarray:
-        """Analytic Jacobian of :meth:`rhs` (classical friction form)."""
+        """Analytic Jacobian of :meth:`rhs` (classical and cut-off friction forms)."""
+        if self.cutoff is not None:
+            return self._jacobian_cutoff(y, vlp)
         if self.inertial:
             return self._jacobian_inertial(y, vlp)
         x = float(y[0])
@@ -161,6 +195,38 @@ class System:
             jac[2 + i] = self.h[i] * dmu
             jac[2 + i, 1] += rates[i][1]
             jac[2 + i, 2 + i] += rates[i][2]
+        return jac
+
+    def _jacobian_cutoff(self, y: np.ndarray, vlp: float) -> np.ndarray:
+        """Jacobian with A(x) = dmu/dx and B_i(psi_i) = dmu/dpsi_i varying (docs/rsf.md, Laws); H = 0."""
+        c, o, n = self.cutoff, self.offset, self.n
+        assert c is not None
+        x = float(y[o])
+        psi = [float(p) for p in y[o + 1 :]]
+        v = self.v0 * _exp(x)
+        rates = [law.rate(x, p, self.v0, dc) for law, p, dc in zip(self.laws, psi, self.dc, strict=True)]
+        A, dA = c.direct(self.a, x)
+        weights = [c.evolution(b, p) for b, p in zip(self.b, psi, strict=True)]
+        jac = np.zeros((self.size, self.size))
+        for i in range(n):
+            jac[o + 1 + i, o] = rates[i][1]
+            jac[o + 1 + i, o + 1 + i] = rates[i][2]
+        if self.inertial:  # xdot = (s - mu - eta V)/(m' V)
+            mv = self.inertia * v
+            xdot = (float(y[0]) - self.friction(x, psi) - self.eta * v) / mv
+            jac[0, 1] = -self.k * v
+            jac[1, 0] = 1.0 / mv
+            jac[1, 1] = (-A - self.eta * v) / mv - xdot
+            for j in range(n):
+                jac[1, 2 + j] = -weights[j][0] / mv
+            return jac
+        G = sum(w[0] * r[0] for w, r in zip(weights, rates, strict=True))
+        D = A + self.eta * v
+        xdot = (self.k * (vlp - v) - G) / D
+        jac[0, 0] = (-self.k * v - sum(w[0] * r[1] for w, r in zip(weights, rates, strict=True))
+                     - xdot * (dA + self.eta * v)) / D  # fmt: skip
+        for j in range(n):
+            jac[0, 1 + j] = -(weights[j][1] * rates[j][0] + weights[j][0] * rates[j][2]) / D
         return jac
 
     # ------------------------------------------------------------------ states
