@@ -34,6 +34,7 @@ from .. import regimes
 from ..columns import with_units
 from ..errors import DataError, ParameterError
 from ..parameters import Parameters, load_parameters
+from ..reprs import compact_repr
 from .detect import MEDIAN_WIDTH, Coarse, coarse_segments, rise_start
 from .fits import QUADRATIC, Corner, Line, fit_corner, fit_line
 from .traces import Trace, check_trace
@@ -121,6 +122,8 @@ class CycleResult:
 @dataclass(frozen=True)
 class TraceAnalysis:
     """Result of :func:`analyze_trace`: the regime, the cycles and their summary."""
+
+    __repr__ = compact_repr  # counts, not hundreds of array elements
 
     time: np.ndarray
     stress: np.ndarray

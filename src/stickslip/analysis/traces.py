@@ -25,6 +25,7 @@ import numpy as np
 
 from ..columns import with_units
 from ..errors import DataError, ParameterError
+from ..reprs import compact_repr
 from ..tables import Table, read_table, read_text_cells
 from ..trace_columns import MODEL_COLUMNS
 
@@ -39,6 +40,8 @@ TRACE_DIMENSIONS = {"time": "time", "stress": "stress", "force": "force"}
 @dataclass(frozen=True)
 class Trace:
     """A stress record: ``time`` (s) and ``stress`` (Pa, NaN in gaps), with the file rows."""
+
+    __repr__ = compact_repr  # counts, not hundreds of array elements
 
     time: np.ndarray
     stress: np.ndarray

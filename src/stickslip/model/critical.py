@@ -21,12 +21,14 @@ import math
 from dataclasses import dataclass
 from functools import lru_cache
 from itertools import pairwise
+from typing import Any
 
 import numpy as np
 
 from ..errors import ModelError
 from ..numerics.roots import brentq  # scipy.optimize would add 0.3 s to start-up
 from ..parameters import BlockParameters, Parameters, StickParameters
+from ..reprs import compact_repr
 from .steady import ACCURATE_QUADRATURE, require_parameters, steady_state
 
 #: Velocity range searched for extrema, m/s, and the grid density per decade.
@@ -44,6 +46,8 @@ class Extremum:
 @dataclass(frozen=True)
 class CriticalPoint:
     """Vc and sigma_c of Eq 9 (None with a message when the curve has no minimum)."""
+
+    __repr__ = compact_repr  # counts, not hundreds of array elements
 
     velocity: float | None
     stress: float | None
@@ -64,6 +68,16 @@ class CriticalPoint:
             "turnover_stress": self.turnover_stress,
             "turnover_message": self.turnover_message,
         }
+
+    def to_frame(self) -> Any:
+        """One row: Vc [m/s], sigma_c [Pa], whether they exist, the turnover and the messages (units in
+        ``attrs["units"]``, as every result's frame)."""
+        import pandas as pd
+
+        from ..columns import with_units
+
+        frame = pd.DataFrame([self.as_dict()])
+        return with_units(frame, {"exists": None, "turnover_message": None})
 
 
 #: Relative accuracy of sigma and of V dsigma/dV with ACCURATE_QUADRATURE, with margin: slopes below this

@@ -38,6 +38,7 @@ from .. import regimes
 from ..columns import with_units
 from ..errors import ParameterError
 from ..parameters import Parameters
+from ..reprs import compact_repr
 from ..trace_columns import QUASI_STATIC
 from .jump import Jump, check_curve, jump_velocity, require_critical_point
 from .slip import SlipPhase, slip_phase
@@ -87,6 +88,8 @@ class Cycle:
 @dataclass(frozen=True)
 class Simulation:
     """A simulated trace (SI units) and its cycles; see :func:`simulate`."""
+
+    __repr__ = compact_repr  # counts, not hundreds of array elements
 
     time: np.ndarray
     stress: np.ndarray

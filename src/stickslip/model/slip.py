@@ -45,6 +45,7 @@ from scipy.special import exprel
 from ..columns import with_units
 from ..errors import ModelError, ParameterError
 from ..parameters import Parameters
+from ..reprs import compact_repr
 from .jump import (
     BELOW_VC,
     adaptive_chebyshev,
@@ -79,6 +80,8 @@ Curve = Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]
 @dataclass(frozen=True)
 class SlipTrajectory:
     """t, slider displacement and sigma as functions of x = ln V along one slip (Chebyshev series)."""
+
+    __repr__ = compact_repr  # counts, not hundreds of array elements
 
     stiffness: float
     pulling_velocity: float
@@ -231,6 +234,8 @@ def slip_trajectory(
 @dataclass(frozen=True)
 class SlipPhase:
     """One slip phase (Eq 10).  Arrays in SI units; time from the jump."""
+
+    __repr__ = compact_repr  # counts, not hundreds of array elements
 
     time: np.ndarray
     velocity: np.ndarray

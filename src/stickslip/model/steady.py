@@ -37,6 +37,7 @@ from ..columns import with_units
 from ..errors import ModelError, ParameterError
 from ..numerics.quadrature import panel_rule
 from ..parameters import BOLTZMANN, Parameters
+from ..reprs import compact_repr
 from ..units import shorten
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -104,6 +105,8 @@ _TINY = 1e-300
 @dataclass(frozen=True)
 class SteadyState:
     """Steady friction curve sigma(V) (Eqs 6-8); arrays have the shape of ``velocity``."""
+
+    __repr__ = compact_repr  # counts, not hundreds of array elements
 
     velocity: np.ndarray
     stress: np.ndarray

@@ -49,6 +49,7 @@ from ..columns import with_units
 from ..errors import ModelError, ParameterError
 from ..numerics.events import integrate_in_chunks
 from ..parameters import Parameters
+from ..reprs import compact_repr
 from .jump import require_critical_point
 from .steady import require_parameters
 
@@ -85,6 +86,8 @@ FLOOR_FRACTIONS = (0.5, 0.8, 0.9, 0.95, 0.99)
 @dataclass(frozen=True)
 class StickPhase:
     """One stick phase (Eqs 11-16).  Arrays in SI units; time from the instant of sticking."""
+
+    __repr__ = compact_repr  # counts, not hundreds of array elements
 
     time: np.ndarray
     stress: np.ndarray

@@ -20,6 +20,7 @@ import numpy as np
 
 from .. import regimes
 from ..errors import DataError, ParameterError
+from ..reprs import compact_repr
 
 if TYPE_CHECKING:  # pragma: no cover
     import pandas as pd
@@ -89,6 +90,8 @@ class Run:
     own scalar results (e.g. ``stick_time``), ``native`` the model's own result object (not compared, not
     written).  ``status`` is "ok" or "failed" (then ``message`` says why).
     """
+
+    __repr__ = compact_repr  # counts, not hundreds of array elements
 
     model: str
     time: np.ndarray

@@ -13,6 +13,7 @@ from .. import regimes
 from ..columns import with_units
 from ..errors import StickslipError
 from ..protocols import Protocol
+from ..reprs import compact_repr
 from .params import RSFParams
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -59,6 +60,8 @@ class Regime(regimes.Regime):
 class Solution:
     """The solver's own solution over one protocol piece: accepted steps and the interpolant between them."""
 
+    __repr__ = compact_repr  # counts, not hundreds of array elements
+
     start: float
     t: np.ndarray
     y: np.ndarray
@@ -68,6 +71,8 @@ class Solution:
 @dataclass(frozen=True)
 class RSFRun:
     """A spring-slider trace (SI units; friction dimensionless; ``state`` has one row per state variable)."""
+
+    __repr__ = compact_repr  # counts, not hundreds of array elements
 
     time: np.ndarray
     friction: np.ndarray
