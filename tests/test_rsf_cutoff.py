@@ -174,3 +174,10 @@ def test_command_line_cutoff(capsys, tmp_path):
     status, _, err = run_main(capsys, "rsf", "simulate", "--cutoff-v1", "1 mm/s", "--segment", "1 um/s:1 s")
     assert status == 2
     assert err.strip().splitlines()[-1].endswith("the cut-off velocity form needs both V1 and V2")
+
+
+def test_model_interface_overrides_keep_the_cutoff():
+    from stickslip.models import get_model
+
+    base = rsf_params(A, B, DC, cutoff=(1e-3, 1e-6))
+    assert get_model("rsf").parameters(base, {"a": 0.02}).cutoff == (1e-3, 1e-6)

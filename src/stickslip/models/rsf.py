@@ -113,6 +113,7 @@ class RSFModel(FrictionModel):
             stiffness=values["k"],
             eta=values["eta"],
             normal_stress=values.get("normal_stress"),
+            cutoff=base.cutoff,  # the friction form is not a key: an override keeps the one given
         )
 
     def _law_code(self, raw: Any) -> int:
