@@ -18,7 +18,7 @@ from scipy.integrate import solve_ivp
 from cli_helpers import run_main
 from stickslip import protocols
 from stickslip.errors import ParameterError
-from stickslip.rsf import RSFParams, critical_stiffness, rsf_params, simulate
+from stickslip.rsf import RSFParams, critical_stiffness, rsf_params, simulate, stability
 from stickslip.rsf.solver import evolve_state
 
 if sys.version_info >= (3, 11):
@@ -112,6 +112,10 @@ def test_critical_stiffness_is_the_classical_one_with_effective_a_and_b():
         a_eff, b_eff = A * v1 / (v1 + v), b * v2 / (v2 + v)
         assert b_eff > a_eff
         assert critical_stiffness(p, v) == pytest.approx((b_eff - a_eff) / DC, rel=1e-9)
+    # b > a, yet steady sliding at 10 um/s with V2 = 1 um/s is stable at every stiffness, and is said to be why
+    strong = stability(rsf_params(A, b, DC, cutoff=(1e-4, 1e-6)), 1e-5)
+    assert strong.critical_stiffness == 0.0
+    assert "b V2/(V2+V) <= a V1/(V1+V)" in strong.message
 
 
 def test_state_at_fixed_velocity_and_its_friction():

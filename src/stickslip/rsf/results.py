@@ -269,7 +269,8 @@ def _stability_note(system: System, velocity: float, kind: str) -> str:
         return ""
     k = system.params.stiffness
     if kc <= 0:
-        where = "steady sliding is linearly stable at every stiffness here (b <= a + eta V)"
+        rule = "b V2/(V2+V) <= a V1/(V1+V) + eta V" if system.params.cutoff else "b <= a + eta V"  # slopes at V
+        where = f"steady sliding is linearly stable at every stiffness here ({rule})"
         stable = True
     elif k > kc:
         where = f"k = {k:.4g} 1/m is above kc = {kc:.4g} 1/m: steady sliding is linearly stable"

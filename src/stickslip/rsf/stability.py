@@ -92,7 +92,8 @@ def stability(params: RSFParams, velocity: float | str) -> Stability:
     sigma = params.normal_stress
     method = "closed form" if _closed_form_applies(params) else "eigenvalues of the linearised equations"
     if kc == 0:
-        message = "steady sliding is stable at every stiffness (velocity strengthening: b <= a + eta V)"
+        rule = "b V2/(V2+V) <= a V1/(V1+V) + eta V" if params.cutoff else "b <= a + eta V"  # the slopes at V
+        message = f"steady sliding is stable at every stiffness (velocity strengthening: {rule})"
     elif stable:
         message = f"stable: k = {params.stiffness:.4g} 1/m is above k_c = {kc:.4g} 1/m; perturbations decay"
     else:
