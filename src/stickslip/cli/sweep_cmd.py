@@ -55,7 +55,12 @@ MODEL_NAMES = ("quasi-static", "transient", "rsf")  # the built-ins; any registe
     help="--model transient: add the paper's stick chains (Eqs 13-16); without them Eq 1 never lets a stuck block go.",
 )
 @click.option("-o", "--output", default=None, metavar="OUT", help="Output folder OUT.")
-@click.option("--workers", type=int, default=None, help="Local worker processes [default: one per core]; 0: no dask.")
+@click.option(
+    "--workers",
+    type=int,
+    default=None,
+    help="Local worker processes [default: one per core, or none when the sweep would take under 5 s in this process]; 0: no dask.",
+)
 @click.option("--scheduler", default=None, metavar="ADDRESS", help="Use a running cluster, e.g. tcp://HOST:8786.")
 @click.option("--batch-size", type=int, default=None, help="Points per task [default: up to 256, at least 64 tasks].")
 @click.option("--quiet", is_flag=True, help="No progress and no summary.")

@@ -18,7 +18,7 @@ from typing import Any
 from ..errors import DataError, ParameterError
 from ..parameters import Parameters
 from ..units import to_si
-from .engine import check_scheduler_address, compute, dask_client, default_batch_size, read_results
+from .engine import check_scheduler_address, compute, compute_while_cheap, dask_client, default_batch_size, read_results
 from .main_guard import unguarded_script_line
 from .models import ALIASES, MODELS, get_model
 from .progress import Silent, reporter
@@ -132,6 +132,8 @@ def run_sweep(
                 pass  # all done already: no cluster to start
             elif workers == 0 and scheduler is None:
                 compute(store, None, shown.advance)
+            elif workers is None and scheduler is None and compute_while_cheap(store, shown.advance):
+                pass  # a small sweep: done in this process before a cluster would have started
             else:
                 with dask_client(workers, scheduler) as client:
                     compute(store, client, shown.advance)
