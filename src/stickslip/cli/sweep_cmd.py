@@ -59,7 +59,8 @@ MODEL_NAMES = ("quasi-static", "transient", "rsf")  # the built-ins; any registe
     "--workers",
     type=int,
     default=None,
-    help="Local worker processes [default: one per core, or none when the sweep would take under 5 s in this process]; 0: no dask.",
+    help="Local worker processes [default: one per core, or none when the sweep would take under 5 s in this"
+    " process]; 0: no dask.",
 )
 @click.option("--scheduler", default=None, metavar="ADDRESS", help="Use a running cluster, e.g. tcp://HOST:8786.")
 @click.option("--batch-size", type=int, default=None, help="Points per task [default: up to 256, at least 64 tasks].")
