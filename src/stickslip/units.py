@@ -210,6 +210,8 @@ def _string_to_si(text: str, dimension: str, name: str) -> float:
         return number
     match = _NUMBER_THEN_UNIT.match(stripped)
     magnitude, unit = (float(match.group(1)), match.group(2).strip()) if match else (1.0, stripped)
+    if match is not None and unit.startswith("/"):  # "1.6e-3/um", as lab notes write a stiffness: per micrometre
+        unit = "1" + unit
     if not _readable_unit(unit):
         raise UnitError(
             f"{name}: cannot read {shorten(stripped)} as {_describe(dimension)}:"

@@ -8,18 +8,23 @@ with ``--params``.
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import json
 import math
 import sys
+import time
 from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import click
+import numpy as np
 
-from ..errors import DataError, ParameterError, StickslipError, UnitError
+from ..errors import DataError, ModelError, ParameterError, StickslipError, UnitError
 from ..fileio import atomic_path, atomic_write_text, protect_inputs, read_input_text, refuse_input_as_output
+from ..numerics.budget import PROGRESS_AFTER_SECONDS
 from ..units import quantity_noun, shorten
 from .common import json_text, quantity
 from .protocol_options import build_protocol as build_run_protocol
@@ -362,6 +367,65 @@ def stability_command(**options: Any) -> None:
         save_figure(stability_figure(params, low, high), options["plot_path"])
 
 
+#: The keys of ``--fix`` and ``--guess`` and their dimensions (a stiffness may also be Pa/m with --normal-stress).
+FIT_KEYS = {
+    "mu0": "dimensionless",
+    "a": "dimensionless",
+    "b": "dimensionless",
+    "dc": "length",
+    "b2": "dimensionless",
+    "dc2": "length",
+    "stiffness": "per_length",
+    "trend": "per_length",
+    "time_trend": "rate",
+}
+_POSITIVE_KEYS = ("a", "dc", "dc2", "stiffness")
+_SECOND_STATE_KEYS = ("b2", "dc2")
+#: Fewest rows a --window may hold (a record has at least 10).
+MIN_WINDOW_ROWS = 10
+#: Default of ``rsf fit --max-time``.
+MAX_TIME_DEFAULT = "5 min"
+#: Jacobians (each n + 1 model runs, n the free parameters) of one least-squares search: counted runs over n + 1
+#: were 6-12 on the step records of tests/test_rsf_fit_protocols.py that fit, 20-80 on ones that fail and restart.
+JACOBIANS_PER_SEARCH = 15
+#: At most this many times the typical cost: a troubled search restarts in Dc (3) and is polished (up to 3).
+RESTART_FACTOR = 7
+#: A model run this long is timed once (the first run's set-up, about a second, is then a small part of it).
+SLOW_RUN_SECONDS = 10.0
+#: More rows than this in the text report's history are summarised (a measured history has hundreds).
+SHOWN_SEGMENTS = 12
+
+
+@dataclass(frozen=True)
+class FitCost:
+    """The up-front estimate of an ``rsf fit``: one model run (measured) times the runs a fit typically takes."""
+
+    run_seconds: float
+    runs: int
+    free: int
+
+    @property
+    def seconds(self) -> float:
+        return self.run_seconds * self.runs
+
+    def text(self) -> str:
+        return (
+            f"about {_duration(self.seconds)} ({self.runs} model runs of {_duration(self.run_seconds)} each for"
+            f" {self.free} free parameters; up to {_duration(RESTART_FACTOR * self.seconds)} if the search restarts)"
+        )
+
+
+def _duration(seconds: float) -> str:
+    """A length of time as people read it: "0.76 s", "45 s", "17 min", "3.5 h"."""
+    if seconds < 1e-3:
+        return "under 1 ms"
+    for limit, scale, unit in ((120.0, 1.0, "s"), (7200.0, 60.0, "min"), (math.inf, 3600.0, "h")):
+        if seconds < limit:
+            value = seconds / scale
+            return f"{value:.2g} {unit}" if value < 100 else f"{value:.0f} {unit}"
+    return "an unbounded time"
+
+
 @rsf_group.command("fit")
 @click.argument("record_file", metavar="FILE", type=click.Path(dir_okay=False, path_type=Path))
 @click.option(
@@ -370,13 +434,28 @@ def stability_command(**options: Any) -> None:
     metavar="ROLE=HEADER,...",
     help='Map headers: time="Time(s)",displacement="Displ(microns)",friction=Friction.',
 )
-@click.option("--displacement-unit", default="m", show_default=True, help="Unit of the displacement column.")
+@click.option("--displacement-unit", default=None,
+              help="Unit of the displacement column [the unit its header names, e.g. (um), else m].")  # fmt: skip
 @click.option("--time-unit", default="s", show_default=True, help="Unit of the time column.")
-@click.option("--law", default="aging", show_default=True, help="State evolution law.")
-@click.option("--states", type=click.IntRange(1, 2), default=1, show_default=True, help="State variables.")
-@click.option("--stiffness", default=None, help='Fixed spring stiffness ("1e-3 1/um", or Pa/m with --normal-stress).')
+@click.option("--window", "window_text", default=None, metavar="T0:T1",
+              help='Fit only the rows from T0 to T1 in the file\'s own clock, e.g. "20100 s:21000 s" (an end may be '
+                   "left out).")  # fmt: skip
+@click.option("--law", default="aging", show_default=True,
+              help="State evolution law; one per state for mixed laws, e.g. aging,slip with --states 2.")  # fmt: skip
+@click.option("--states", type=click.IntRange(1, 2), default=None, help="State variables [1, or one per --law].")
+@click.option("--fix", "fix_items", multiple=True, metavar="KEY=VALUE",
+              help=f'Hold a parameter at a value, with its unit (repeatable): --fix "dc=20 um", '
+                   f'--fix "stiffness=1.6e-3/um", --fix mu0=0.6; keys {", ".join(FIT_KEYS)}.')  # fmt: skip
+@click.option("--free", "free_keys", multiple=True, metavar="KEY",
+              help="Also fit this parameter (repeatable): stiffness, trend (slip drift), time_trend.")  # fmt: skip
+@click.option("--guess", "guess_items", multiple=True, metavar="KEY=VALUE",
+              help='Start a fitted parameter here (repeatable), e.g. --guess "stiffness=2e-3/um".')  # fmt: skip
+@click.option("--stiffness", default=None,
+              help='Spring stiffness ("1e-3 1/um", or Pa/m with --normal-stress): held fixed, as --fix stiffness=K; '
+                   "with --fit-stiffness the free stiffness starts there, as --guess stiffness=K.")  # fmt: skip
 @click.option("--normal-stress", default=None, help="Normal stress, to read a stiffness in Pa/m.")
-@click.option("--fit-stiffness", is_flag=True, help="Fit the stiffness (the default when --stiffness is not given).")
+@click.option("--fit-stiffness", is_flag=True,
+              help="Fit the stiffness (the default without --stiffness), as --free stiffness.")  # fmt: skip
 @click.option(
     "--trend",
     type=click.Choice(["slip", "time", "both"]),
@@ -385,6 +464,11 @@ def stability_command(**options: Any) -> None:
     default=None,
     help="Fit a linear drift as well: in slip (--trend alone), in time, or both.",
 )
+@click.option("--step-weight", default=None, metavar="W",
+              help="Weight of the rows just after each velocity step, relative to the rest (> 0).")  # fmt: skip
+@click.option("--history", type=click.Choice(["segments", "measured"]), default="segments", show_default=True,
+              help="Load-point history: constant-velocity segments found in the displacement, or the measured "
+                   "displacement itself (smoothed), as lab codes drive the model.")  # fmt: skip
 @click.option(
     "--segment",
     multiple=True,
@@ -398,69 +482,374 @@ def stability_command(**options: Any) -> None:
     default=None,
     help="Load-point history as a protocol CSV (time,velocity or velocity,duration; SI), as for simulate.",
 )
+@click.option("--max-time", default=MAX_TIME_DEFAULT, show_default=True,
+              help="Refuse a fit estimated to take longer (one model run is timed before the fit starts).")  # fmt: skip
 @click.option("--mcmc", "mcmc_steps", type=click.IntRange(min=0), default=0, help="emcee steps for a posterior.")
 @click.option("--seed", type=int, default=None, help="Seed of the emcee walkers.")
-@click.option("--json", "as_json", is_flag=True, help="Print the report as JSON (SI units).")
+@click.option("--json", "as_json", is_flag=True, help="Print the report as JSON (SI units: Dc in m, stiffness in 1/m).")
 @click.option("-o", "--output", type=click.Path(dir_okay=False, path_type=Path), help="Write fitted parameters (TOML).")
 @click.option("--plot", "plot_path", type=click.Path(dir_okay=False, path_type=Path), help="Save data and fit.")
 def fit_command(**options: Any) -> None:
     """Fit rate-and-state friction to a lab record (time, load-point displacement, friction).
 
     The load point's velocity history is found from the displacement (or
-    given with --segment or --protocol); the slider starts in steady sliding.
+    given with --segment or --protocol, or the measured displacement itself
+    with --history measured); the slider starts in steady sliding.  Free:
+    mu0, a, b, Dc (b2, Dc2 with two states) and the stiffness unless held
+    (--stiffness or --fix); --fix holds any of them, --guess starts one.
     The report gives the history used, values in the record's units with
     standard errors and 95 % intervals, a - b with its own error, correlations,
-    reduced chi-square against the record's own noise, and warnings.  A fit
-    that cannot be trusted says why (status "failed", reason) and exits with
-    status 3; its parameters are not written to -o.
+    reduced chi-square against the record's own noise, and warnings; --json
+    gives it in SI units.  The cost is estimated before the fit (one model
+    run timed) and a fit estimated above --max-time is refused.  A fit that
+    cannot be trusted says why (status "failed", reason) and exits with
+    status 3; its parameters are not written to -o.  Bad input exits 2.
     """
-    from .. import protocols
     from ..rsf.data import parse_columns, read_record
     from ..rsf.fit import fit_record
 
     output, plot_path = options["output"], options["plot_path"]
     refuse_input_as_output([options["record_file"], options["protocol_file"]], [("-o", output), ("--plot", plot_path)])
-    record = read_record(options["record_file"], parse_columns(options["columns"]), options["displacement_unit"],
-                         options["time_unit"])  # fmt: skip
-    sigma = None
-    if options["normal_stress"] is not None:
-        sigma = _positive(options["normal_stress"], "stress", "--normal-stress")
-    stiffness = None
-    if options["stiffness"] is not None:
-        if options["fit_stiffness"]:
-            raise click.UsageError("--stiffness and --fit-stiffness: give one of them")
-        stiffness = _per_sigma(options["stiffness"], "per_length", "stress_per_length", sigma, "--stiffness")
-    protocol = None
-    if options["segment"] and options["protocol_file"] is not None:
-        raise click.UsageError("--segment and --protocol: give one of them")
-    if options["protocol_file"] is not None:
-        protocol = protocols.read_protocol(options["protocol_file"])
-    elif options["segment"]:
-        protocol = protocols.Protocol(tuple(protocols.parse_segment(s) for s in options["segment"]))
-    fit = fit_record(record, law=options["law"], states=options["states"], stiffness=stiffness,
-                     fit_stiffness=True if options["fit_stiffness"] else None, trend=options["trend"] or False,
-                     protocol=protocol, mcmc_steps=options["mcmc_steps"], seed=options["seed"])  # fmt: skip
+    window = _window(options["window_text"])  # the options first: a typing error is said before the record is read
+    max_time = _positive(options["max_time"], "time", "--max-time")
+    reading = {} if options["displacement_unit"] is None else {"displacement_unit": options["displacement_unit"]}
+    record = read_record(options["record_file"], parse_columns(options["columns"]), time_unit=options["time_unit"],
+                         **reading)  # fmt: skip
+    settings = _fit_settings(options, record, window)
+    cost = estimate_fit_cost(record, settings)
+    if cost.seconds > max_time:
+        raise ParameterError(
+            f"rsf fit: estimated {cost.text()}, above --max-time {_duration(max_time)}; allow it with --max-time "
+            f'"{_duration(2 * cost.seconds).replace("under ", "")}" or fit less: a --window, fixed parameters'
+        )
+    if cost.seconds > PROGRESS_AFTER_SECONDS:
+        click.echo(f"stickslip: rsf fit: {cost.text()}", err=True)
+    started = time.perf_counter()
+    try:
+        fit = fit_record(record, **settings)
+    except ModelError as exc:  # the search ran and ended where the model cannot be run: a failed fit, not bad input
+        click.echo(_one_line(f"stickslip: fit failed: {exc}"), err=True)
+        raise SystemExit(FIT_FAILED) from None
+    elapsed = time.perf_counter() - started
+    if options["history"] == "measured" and fit.protocol_source == "given":
+        fit = dataclasses.replace(fit, protocol_source="measured load-point displacement (smoothed)")
     report = fit.summary()
+    report["cost"] = {"seconds": elapsed, "estimated_seconds": cost.seconds, "model_run_seconds": cost.run_seconds,
+                      "estimated_model_runs": cost.runs}  # fmt: skip
     if output is not None and fit.status == "ok":
         write(output, fit.to_toml())
         write(sidecar(output), json_text({"parameters": fit.params.to_dict(), "fit": report}))
     if options["as_json"]:
         click.echo(json_text(report))
     else:
-        click.echo(_fit_text(fit))
+        click.echo(_fit_text(fit) + f"\n  time: {_duration(elapsed)} (estimated {_duration(cost.seconds)})")
     if plot_path is not None:
         from ..plots.rsf import fit_figure
 
         save_figure(fit_figure(fit), plot_path)
     if fit.status != "ok":
         unwritten = f" ({output} not written)" if output is not None else ""
-        click.echo(f"stickslip: fit failed: {fit.reason}{unwritten}", err=True)
+        click.echo(_one_line(f"stickslip: fit failed: {fit.reason}{unwritten}"), err=True)
         # SystemExit, not click's Exit: main() runs click with standalone_mode=False, which swallows Exit's code
         raise SystemExit(FIT_FAILED)
 
 
 #: exit status of a fit that ran but cannot be trusted (2 is bad input, 1 an internal error)
 FIT_FAILED = 3
+
+
+def _one_line(text: str) -> str:
+    return " ".join(text.split())
+
+
+def _window(text: str | None) -> tuple[float | None, float | None] | None:
+    """``--window T0:T1`` as (T0, T1) in seconds (None for an end left out); units required, as everywhere."""
+    if text is None:
+        return None
+    parts = text.split(":")
+    if len(parts) != 2 or not "".join(parts).strip():
+        raise ParameterError(
+            f"--window {shorten(text)}: expected START:END with units, e.g. --window '20100 s:21000 s'"
+            " (an end may be left out)"
+        )
+    ends = [None if not part.strip() else _window_end(part.strip()) for part in parts]
+    if ends[0] is not None and ends[1] is not None and not ends[0] < ends[1]:
+        raise ParameterError(f"--window {shorten(text)}: the start must come before the end")
+    return ends[0], ends[1]
+
+
+def _window_end(text: str) -> float:
+    from .common import require_unit
+
+    require_unit(text, "time", "--window ", typical=1e3)  # a bare 20100 is meant in seconds, not ms
+    return _quantity(text, "time", "--window")
+
+
+def _quantity(text: str, dimension: str, name: str) -> float:
+    from .common import quantity
+
+    return quantity(text, dimension, name)
+
+
+def _within_record(window: tuple[float | None, float | None], text: str, record: Any) -> tuple[float, float]:
+    """The window's ends on the record's own clock (its ends where left out); at least 10 rows inside."""
+    first, last = record.t0, record.t0 + float(record.time[-1])
+    lo = first if window[0] is None else window[0]
+    hi = last if window[1] is None else window[1]
+    clock = record.time + record.t0
+    inside = int(np.count_nonzero((clock >= lo) & (clock <= hi)))
+    if inside < MIN_WINDOW_ROWS:
+        raise ParameterError(
+            f"--window {shorten(text)}: {inside} rows of the record fall inside (it runs from {first:.6g} s to "
+            f"{last:.6g} s on its own clock); expected at least {MIN_WINDOW_ROWS}"
+        )
+    return lo, hi
+
+
+def _key_values(items: tuple[str, ...], flag: str, sigma: float | None) -> dict[str, float]:
+    """Repeated ``FLAG KEY=VALUE`` (the house parser, :func:`stickslip.cli.common.key_value`) as SI values."""
+    from .common import key_value
+
+    out: dict[str, float] = {}
+    for item in items:
+        key, value = key_value(item, flag, example=f"{flag} 'dc=20 um'")
+        key = key.lower()
+        if key not in FIT_KEYS:
+            raise ParameterError(f"{flag} {shorten(item)}: unknown parameter {key!r}; expected one of "
+                                 f"{', '.join(FIT_KEYS)}")  # fmt: skip
+        if not value:
+            raise ParameterError(f"{flag} {key}=: expected a value after '=', e.g. {flag} '{key}=...'")
+        if key in out:
+            raise ParameterError(f"{flag} {key}: given twice")
+        out[key] = _fit_value(key, value, flag, sigma)
+    return out
+
+
+def _fit_value(key: str, text: str, flag: str, sigma: float | None) -> float:
+    from .common import require_unit
+
+    dimension = FIT_KEYS[key]
+    require_unit(text, dimension, f"{flag} {key}=")
+    name = f"{flag} {key}"
+    if key == "stiffness":
+        return _per_sigma(text, "per_length", "stress_per_length", sigma, name)
+    if key in _POSITIVE_KEYS:
+        return _positive(text, dimension, name)
+    return _quantity(text, dimension, name)
+
+
+def _free_keys(items: tuple[str, ...]) -> set[str]:
+    keys = {item.strip().lower() for item in items}
+    unknown = sorted(keys - set(FIT_KEYS))
+    if unknown:
+        raise ParameterError(f"--free {shorten(unknown[0])}: unknown parameter; expected one of {', '.join(FIT_KEYS)}")
+    return keys
+
+
+def _laws(text: str, states: int | None) -> tuple[str | tuple[str, ...], int]:
+    """``--law aging`` or ``--law aging,slip`` (one per state) and the number of states."""
+    from ..rsf import get_law
+
+    names = [name.strip().lower() for name in text.split(",")]
+    if not all(names):
+        raise ParameterError(f"--law {shorten(text)}: expected law names separated by commas, e.g. aging,slip")
+    for name in names:
+        try:
+            get_law(name)
+        except ParameterError as exc:
+            raise ParameterError(f"--law {shorten(text)}: {exc}") from None
+    if len(names) > 2:
+        raise ParameterError(f"--law {shorten(text)}: {len(names)} laws, but a fit has at most 2 state variables")
+    if states is None:
+        states = len(names)
+    if len(names) > 1 and len(names) != states:
+        raise ParameterError(f"--law {shorten(text)} names {len(names)} laws for --states {states}: give one law "
+                             "for every state, or one per state")  # fmt: skip
+    return (names[0] if len(names) == 1 else tuple(names)), states
+
+
+def _stiffness_roles(
+    options: dict[str, Any], fixed: dict[str, float], guess: dict[str, float], free: set[str], sigma: float | None
+) -> None:
+    """Place --stiffness among the held (alone) or started (with --fit-stiffness) values."""
+    if options["fit_stiffness"]:
+        free.add("stiffness")
+    if options["stiffness"] is None:
+        return
+    k = _per_sigma(options["stiffness"], "per_length", "stress_per_length", sigma, "--stiffness")
+    for flag, given in (("--fix", fixed), ("--guess", guess)):
+        if "stiffness" in given:
+            raise ParameterError(f"--stiffness and {flag} stiffness=: give one of them")
+    (guess if "stiffness" in free else fixed)["stiffness"] = k
+
+
+def _trend_kinds(options: dict[str, Any], fixed: dict[str, float], guess: dict[str, float], free: set[str]) -> str:
+    """The drifts to fit as fit_record's word: '' (none), slip, time or both."""
+    kinds = {"slip": {"slip"}, "time": {"time"}, "both": {"slip", "time"}, None: set()}[options["trend"]]
+    for key, kind in (("trend", "slip"), ("time_trend", "time")):
+        if key in free or key in guess:
+            kinds.add(kind)
+        if key in fixed and kind in kinds:
+            also = "--trend" if key not in free and key not in guess else ("--free" if key in free else "--guess")
+            raise ParameterError(f"--fix {key} and {also}: the {kind} drift is either held or fitted")
+    return "both" if len(kinds) == 2 else next(iter(kinds), "")
+
+
+def _fit_settings(
+    options: dict[str, Any], record: Any, window: tuple[float | None, float | None] | None
+) -> dict[str, Any]:
+    """The keyword arguments of :func:`stickslip.rsf.fit.fit_record` the options ask for (every value SI)."""
+    sigma = None
+    if options["normal_stress"] is not None:
+        sigma = _positive(options["normal_stress"], "stress", "--normal-stress")
+    law, states = _laws(options["law"], options["states"])
+    fixed = _key_values(options["fix_items"], "--fix", sigma)
+    guess = _key_values(options["guess_items"], "--guess", sigma)
+    free = _free_keys(options["free_keys"])
+    _stiffness_roles(options, fixed, guess, free, sigma)
+    for key in sorted(set(fixed) & (set(guess) | free)):
+        named = key in options["free_keys"]
+        other = f"--guess {key}" if key in guess else f"--free {key}" if named else "--fit-stiffness"
+        raise ParameterError(f"--fix {key} and {other}: a parameter is either held or fitted")
+    if states == 1:
+        for flag, keys in (("--fix", fixed), ("--guess", guess), ("--free", free)):
+            for key in _SECOND_STATE_KEYS:
+                if key in keys:
+                    raise ParameterError(f"{flag} {key}: a second state variable needs --states 2")
+    settings: dict[str, Any] = {"law": law, "states": states, "trend": _trend_kinds(options, fixed, guess, free)
+                                or False, "protocol": _history(options, record),
+                                "mcmc_steps": options["mcmc_steps"], "seed": options["seed"]}  # fmt: skip
+    if "stiffness" in free or "stiffness" in guess:
+        settings["fit_stiffness"] = True
+    # only what was asked for goes in: fit_record's other arguments keep their defaults
+    if fixed:
+        settings["fixed"] = fixed
+    if guess:
+        settings["guess"] = guess
+    if window is not None:
+        settings["window"] = _within_record(window, options["window_text"], record)
+    if options["step_weight"] is not None:
+        settings["step_weight"] = _step_weight(options["step_weight"])
+    return settings
+
+
+def _step_weight(text: str) -> float:
+    from ..units import bare_number
+
+    weight = bare_number(text)
+    if weight is None or not (math.isfinite(weight) and weight > 0):
+        raise ParameterError(f"--step-weight {shorten(text)}: expected a positive number, e.g. --step-weight 5")
+    return weight
+
+
+def _history(options: dict[str, Any], record: Any) -> Any:
+    """The load-point history the options give (None: fit_record finds it from the displacement)."""
+    from .. import protocols
+
+    given = [flag for flag, value in (("--segment", options["segment"]), ("--protocol", options["protocol_file"]))
+             if value]  # fmt: skip
+    if len(given) == 2:
+        raise ParameterError("--segment and --protocol: give one of them")
+    if options["history"] == "measured":
+        if given:
+            raise ParameterError(f"--history measured and {given[0]}: the measured history is the record's own "
+                                 "displacement; give one of them")  # fmt: skip
+        from ..rsf.data import measured_history
+
+        return measured_history(record)
+    if options["protocol_file"] is not None:
+        return protocols.read_protocol(options["protocol_file"])
+    if options["segment"]:
+        return protocols.Protocol(tuple(protocols.parse_segment(s) for s in options["segment"]))
+    return None
+
+
+def estimate_fit_cost(record: Any, settings: dict[str, Any]) -> FitCost:
+    """One model run of the record's history at the fit's tolerance, timed, times the runs a fit typically takes:
+    (n + 1) per Jacobian x :data:`JACOBIANS_PER_SEARCH` per search (a two-state fit and a time drift add a first
+    search), plus walkers x steps of an emcee posterior."""
+    held = set(settings.get("fixed", {})) - {"trend", "time_trend"}  # a held drift is no fitted one either way
+    free = 5 + (2 if settings["states"] == 2 else 0) - len(held)  # mu0, a, b, Dc, k (b2, Dc2)
+    trend = settings["trend"] or ""
+    free += {"both": 2, "slip": 1, "time": 1}.get(trend, 0)
+    searches = 1 + (settings["states"] == 2) + (trend in ("time", "both"))
+    runs = searches * (free + 1) * JACOBIANS_PER_SEARCH
+    if settings["mcmc_steps"]:
+        runs += max(4 * free, 16) * settings["mcmc_steps"]
+    return FitCost(_timed_run(record, settings), runs, free)
+
+
+def _timed_run(record: Any, settings: dict[str, Any]) -> float:
+    """Seconds of one model run over the fitted rows at start-like values (the fastest of two or three)."""
+    from ..errors import StickslipError
+    from ..rsf import simulate
+    from ..rsf.fit import FIT_RTOL
+
+    time_, displacement = record.time, record.displacement
+    if "window" in settings:
+        lo, hi = settings["window"]
+        inside = (time_ + record.t0 >= lo) & (time_ + record.t0 <= hi)
+        time_, displacement = time_[inside], displacement[inside]
+    history = _cut(settings["protocol"], float(time_[0]), float(time_[-1])) if settings["protocol"] is not None \
+        else _found(time_, displacement)  # fmt: skip
+    if history is None or float(np.max(history.velocities)) <= 0:
+        return 0.0
+    params = _start_params(record, history, settings)
+    start = history.initial_velocity if history.initial_velocity > 0 else float(np.max(history.velocities))
+    times = np.clip(time_ - time_[0], 0.0, history.duration)
+    best, spent = math.inf, 0.0
+    for attempt in range(3):
+        began = time.perf_counter()
+        try:
+            simulate(params, history, start_velocity=start, times=times, rtol=FIT_RTOL, atol=FIT_RTOL * 1e-2,
+                     detect=False)  # fmt: skip
+        except StickslipError:  # a start that blows up still took its time
+            pass
+        took = time.perf_counter() - began
+        best, spent = min(best, took), spent + took
+        # the first run in a process carries a second of imports and caches: time a second one unless it was long
+        if (attempt >= 1 and spent > 0.2) or took > SLOW_RUN_SECONDS:
+            break
+    return best
+
+
+def _found(time_: np.ndarray, displacement: np.ndarray) -> Any:
+    """The history the fit will find (one straight line where the finder refuses: the fit says why)."""
+    from .. import protocols
+    from ..errors import DataError
+    from ..rsf.data import find_segments
+
+    try:
+        return find_segments(time_ - time_[0], displacement)
+    except DataError:
+        speed = float(displacement[-1] - displacement[0]) / max(float(time_[-1] - time_[0]), 1e-300)
+        return protocols.constant(abs(speed), float(time_[-1] - time_[0])) if speed else None
+
+
+def _cut(protocol: Any, start: float, end: float) -> Any:
+    """The part of ``protocol`` from ``start`` to ``end`` (s from its start), as a protocol of its own."""
+    from ..protocols import Protocol, Segment
+
+    kept = [Segment(v, min(t1, end) - max(t0, start)) for t0, t1, v in protocol.pieces()
+            if t1 > start and t0 < end and min(t1, end) - max(t0, start) > 0]  # fmt: skip
+    return Protocol(tuple(kept)) if kept else None
+
+
+def _start_params(record: Any, history: Any, settings: dict[str, Any]) -> Any:
+    """Values like the fit's starting ones (held and guessed values where given): the estimate's model."""
+    from ..rsf import RSFParams, StateVariable
+
+    given = {**settings.get("guess", {}), **settings.get("fixed", {})}
+    slip = max(float(np.ptp(record.displacement)), 1e-9)
+    dc = given.get("dc", min(max(slip / 100, 1e-7), 1e-3))
+    stiffness = given.get("stiffness", 0.02 / dc)
+    laws = settings["law"] if isinstance(settings["law"], tuple) else (settings["law"],) * settings["states"]
+    states = [StateVariable(laws[0], given.get("b", 0.015), dc)]
+    if settings["states"] == 2:
+        states.append(StateVariable(laws[1], given.get("b2", 0.002), given.get("dc2", 10 * dc)))
+    v_ref = history.initial_velocity if history.initial_velocity > 0 else float(np.max(history.velocities))
+    mu0 = given.get("mu0", float(np.median(record.friction[: max(5, len(record) // 50)])))
+    return RSFParams(a=given.get("a", 0.01), states=tuple(states), mu0=mu0, v_ref=v_ref, stiffness=stiffness)
 
 
 def _fit_text(fit: Any) -> str:
@@ -470,7 +859,12 @@ def _fit_text(fit: Any) -> str:
     lines = [f"rate-and-state fit of {fit.record.source} ({len(fit.record)} rows): {fit.status}"
              + (f": {fit.reason}" if fit.reason else "")]  # fmt: skip
     lines.append(f"  load point ({fit.protocol_source}):")
-    for row in fit.protocol_rows():
+    rows = fit.protocol_rows()
+    if len(rows) > SHOWN_SEGMENTS:  # a measured history: hundreds of short pieces
+        speeds = [row["velocity"] for row in rows]
+        lines.append(f"    {len(rows)} constant-velocity pieces over {sum(r['duration'] for r in rows):.6g} s,"
+                     f" {min(speeds):.6g} to {max(speeds):.6g} {unit}/s")  # fmt: skip
+    for row in rows if len(rows) <= SHOWN_SEGMENTS else []:
         lines.append(f"    from {row['start']:.6g} s: {row['velocity']:.6g} {unit}/s for {row['duration']:.6g} s")
     for name, p in {**fit.parameters, **fit.derived}.items():
         lines.append(f"  {name:10s} {p.text()}")
