@@ -124,7 +124,8 @@ def simulate_command(
         from ..plots.cycles import plot_simulation
 
         ax = plot_simulation(sim)
-        ax.legend(loc="upper right", frameon=False, fontsize=8)
+        # below the axes: any corner of the frame holds a stress peak or trough of some run
+        ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.14), ncol=3, frameon=False, fontsize=8)
         ax.set_title(f"V0 = {v0 * 1e6:.4g} µm/s, {params.name}: {sim.regime}", fontsize=11)
         save_figure(ax.figure, plot_path)
     if as_json:

@@ -236,8 +236,14 @@ def _save_curve_plot(
 
 @click.command("critical")
 @click.option("--json", "as_json", is_flag=True, help="Print JSON in SI units.")
+@click.option(
+    "--plot",
+    "plot_path",
+    type=click.Path(dir_okay=False, path_type=Path),
+    help="Also save the steady curves around Vc (a decade either side) with the critical point marked.",
+)
 @params_options
-def critical_command(as_json: bool, params_name: str, overrides: tuple[str, ...]) -> None:
+def critical_command(as_json: bool, plot_path: Path | None, params_name: str, overrides: tuple[str, ...]) -> None:
     """Vc and σc (Eq 9): the minimum of the aging curve.
 
     Also prints the maximum (turnover) of the no-aging curve.  When the
@@ -245,8 +251,14 @@ def critical_command(as_json: bool, params_name: str, overrides: tuple[str, ...]
     """
     from ..model.critical import critical_point
 
+    refuse_overwriting_inputs([], [("--plot", plot_path)], params_name)
     params = resolve_params(params_name, overrides)
     point = critical_point(params)
+    if plot_path is not None:
+        from ..plots.steady import figure_steady_curve
+
+        centre = point.velocity if point.exists else 1e-4  # no minimum: the paper's range of velocities
+        save_figure(figure_steady_curve(params, vmin=centre / 10, vmax=centre * 10), plot_path)
     if as_json:
         emit_json(point.as_dict())
         return

@@ -68,7 +68,8 @@ def plot_simulation(sim: Simulation, ax: Axes | None = None, phases: bool = True
     else:
         kwargs.setdefault("label", f"V0 = {_um(sim.pulling_velocity)}")
         ax.plot(sim.time, sim.stress, **kwargs)
-    ax.axhline(sim.critical_stress, color=CRITICAL_COLOR, linestyle="--", linewidth=0.8, alpha=0.6)
+    ax.axhline(sim.critical_stress, color=CRITICAL_COLOR, linestyle="--", linewidth=0.8, alpha=0.6,
+               label=f"σc = {sim.critical_stress:.4g} Pa")  # fmt: skip
     ax.set_xlabel(TIME_LABEL)
     ax.set_ylabel(STRESS_LABEL)
     ax.set_xlim(0.0, sim.duration)

@@ -17,7 +17,7 @@ def overlay_figure(runs: Mapping[str, Run], title: str = "") -> Figure:
     import numpy as np
     from matplotlib.figure import Figure
 
-    from .style import apply_style
+    from .style import apply_style, resolved_limits
 
     fig = Figure(figsize=(9, 6), layout="constrained")
     top, bottom = fig.subplots(2, 1, sharex=True, height_ratios=(2, 1))
@@ -40,6 +40,13 @@ def overlay_figure(runs: Mapping[str, Run], title: str = "") -> Figure:
     speeds = np.concatenate([np.asarray(r.slider_velocity, float) for r in runs.values()])
     if speeds.size and np.all(speeds[np.isfinite(speeds)] > 0):
         bottom.set_yscale("log")
+    else:
+        resolved_limits(bottom, *(np.asarray(r.slider_velocity, float) * 1e6 for r in runs.values()))
+    stresses = [r.stress for r in runs.values() if r.stress is not None]
+    if stresses:
+        resolved_limits(top, *stresses)
+    if right is not None:
+        resolved_limits(right, *(r.friction for r in runs.values() if r.stress is None))
     bottom.set_ylabel("slider velocity (µm/s)")
     bottom.set_xlabel("time (s)")
     for ax in (top, bottom):

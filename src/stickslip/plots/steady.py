@@ -48,11 +48,27 @@ def plot_steady(result: SteadyState, ax: Axes | None = None, **kwargs: Any) -> A
     if velocity.size == 1:
         kwargs.setdefault("marker", "o")
     ax.plot(velocity[order], stress[order], **kwargs)
+    _interesting_range(ax, stress[order])
     ax.set_xscale("log")
     ax.set_xlabel(VELOCITY_LABEL)
     ax.set_ylabel(STRESS_LABEL)
     apply_style(ax)
     return ax
+
+
+def _interesting_range(ax: Axes, stress: np.ndarray) -> None:
+    """With a minimum inside the grid, keep it in view: the aging curve climbs to tens of kPa far below Vc
+    (19 kPa at 10 µm/s for the paper's set) and would squash the minimum flat; the top is set by the branch
+    above the minimum (x 1.25, at least twice the minimum)."""
+    finite = stress[np.isfinite(stress)]
+    if finite.size < 3:
+        return
+    low = int(np.argmin(finite))
+    if not 0 < low < finite.size - 1:
+        return
+    top = 1.25 * max(float(np.max(finite[low:])), 2.0 * float(finite[low]))
+    if float(np.max(finite)) > top:
+        ax.set_ylim(min(0.0, float(finite[low])), top)
 
 
 def _data_arrays(data: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
@@ -143,6 +159,7 @@ def figure_steady_curve(
             tops.append(float(np.nanmax(s)))
     if critical.exists and vmin <= critical.velocity <= vmax:
         _mark_critical(ax, critical.velocity, critical.stress, grid, aging.stress)
+        _mark_maxima(ax, [e for e in critical.extrema if e.kind == "maximum" and vmin <= e.velocity <= vmax], grid)
         tops.append(critical.stress)
     # the aging curve climbs steeply below Vc (Fig 4); keep the interesting range in view
     top = 1.25 * max(tops)
@@ -183,6 +200,21 @@ def _mark_critical(ax: Axes, vc: float, sc: float, grid: np.ndarray, stress: np.
         ax.text(x / 2.0, 0.82, "velocity weakening\n(dσ/dV < 0)  ←", ha="right", **style)
     if np.count_nonzero(grid > vc) >= 2:
         ax.text(x * 1.5, 0.82, "→  velocity strengthening\n    (dσ/dV > 0)", ha="left", **style)
+
+
+def _mark_maxima(ax: Axes, maxima: list[Any], grid: np.ndarray) -> None:
+    """A maximum of the aging curve (the paper's set: 5.04 mm/s) ends the strengthening branch: above it the
+    curve weakens again, and the label says so rather than leave "strengthening" over the whole right side."""
+    from matplotlib.transforms import blended_transform_factory
+
+    where = blended_transform_factory(ax.transData, ax.transAxes)
+    box = {"boxstyle": "round,pad=0.25", "facecolor": "white", "edgecolor": "none", "alpha": 0.85}
+    for peak in maxima:
+        x = peak.velocity * UM_PER_S
+        ax.axvline(x, color=CRITICAL_COLOR, linestyle=":", linewidth=0.8, alpha=0.7)
+        if np.count_nonzero(grid > peak.velocity) >= 2:
+            ax.text(float(grid[-1]) * UM_PER_S, 0.55, f"weakening again\nabove {x / 1e3:.3g} mm/s  ",
+                    transform=where, fontsize=9, va="top", ha="right", bbox=box, zorder=7)  # fmt: skip
 
 
 def protocol_plot(protocol: Any, ax: Axes | None = None) -> Axes:

@@ -54,3 +54,27 @@ def legend_of_all_panels(fig: Figure, axes: Sequence[Axes] | None = None, **kwar
     if handles:
         options = {"loc": "upper right", "frameon": False, "fontsize": 8, "ncols": 4, **kwargs}
         panels[0].legend(list(handles.values()), list(handles), **options)
+
+
+#: The smallest span an axis shows, relative to the size of its values: round-off (1e-13 of a steady run's
+#: friction) must not be autoscaled into a spike; nothing in friction is resolved below a millionth.
+RESOLUTION = 1e-6
+
+
+def resolved_limits(ax: Axes, *series: Any, axis: str = "y", resolution: float = RESOLUTION) -> None:
+    """Keep a linear axis at least ``resolution`` x |values| wide (centred on the data) and without the
+    offset notation that writes round-off as ``1e-13+5.80439885e-1``."""
+    import numpy as np
+
+    values = np.concatenate([np.asarray(s, dtype=float).ravel() for s in series]) if series else np.array([])
+    values = values[np.isfinite(values)]
+    if values.size == 0:
+        return
+    lo, hi = float(values.min()), float(values.max())
+    size = max(abs(lo), abs(hi))
+    least = resolution * size if size > 0 else 1.0
+    if hi - lo < least:
+        middle = 0.5 * (lo + hi)
+        (ax.set_ylim if axis == "y" else ax.set_xlim)(middle - least, middle + least)
+    if (ax.get_yscale() if axis == "y" else ax.get_xscale()) == "linear":
+        ax.ticklabel_format(axis=axis, useOffset=False)

@@ -41,11 +41,13 @@ def plot_transient(result: TransientResult, ax: Axes | None = None, velocity: bo
 
 
 def _linear_threshold(v: np.ndarray) -> float:
-    """The symlog axis' linear range: below the slowest moving sample (so all motion is on the log part)."""
+    """The symlog axis' linear range: a power of ten at or below the slowest moving sample (so all motion is on
+    the log part, and 0 and the first decade's tick are a whole decade apart rather than printed over each
+    other)."""
     moving = np.abs(v[np.isfinite(v) & (v != 0)])
     if moving.size == 0:
         return 1.0
-    return float(max(moving.min(), 1e-6 * moving.max()))
+    return float(10.0 ** np.floor(np.log10(max(moving.min(), 1e-6 * moving.max()))))
 
 
 def figure_transient_runs(
