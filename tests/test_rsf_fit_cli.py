@@ -199,7 +199,8 @@ def test_a_search_that_ends_where_the_model_cannot_run_is_a_failed_fit_exit_3(
 
 
 def test_the_estimated_runs_bracket_the_runs_a_fit_makes(record_path, monkeypatch):
-    """Counted model runs of a real fit against the estimate: within its typical-to-worst range (not a timing)."""
+    """Counted model runs of a real fit against the estimated count (runs, not seconds: a count does not depend on
+    the machine's load)."""
     import stickslip.rsf.fit as fit_module
 
     record = read_record(record_path)
@@ -217,7 +218,7 @@ def test_the_estimated_runs_bracket_the_runs_a_fit_makes(record_path, monkeypatc
     monkeypatch.setattr(fit_module, "simulate", counting)
     fit = fit_module.fit_record(record, **settings)
     assert fit.status == "ok", fit.reason
-    assert cost.runs / 4 <= runs <= rsf_cmd.RESTART_FACTOR * cost.runs, (runs, cost.runs)
+    assert cost.runs / 2 <= runs <= 2 * cost.runs, (runs, cost.runs)  # a converged fit: no restarts
 
 
 # --- real fits: SI JSON, held and started stiffness, windows, exit 3 ------------------------------------------
