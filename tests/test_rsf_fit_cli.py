@@ -7,6 +7,8 @@ from __future__ import annotations
 import json
 import math
 import re
+import signal
+import time
 
 import numpy as np
 import pandas as pd
@@ -219,6 +221,19 @@ def test_the_estimated_runs_bracket_the_runs_a_fit_makes(record_path, monkeypatc
     fit = fit_module.fit_record(record, **settings)
     assert fit.status == "ok", fit.reason
     assert cost.runs / 2 <= runs <= 2 * cost.runs, (runs, cost.runs)  # a converged fit: no restarts
+
+
+def test_a_fit_still_running_at_max_time_is_stopped_exit_3(record_path, tmp_path, capsys, monkeypatch):
+    """The estimate can be wrong (the issue's fit ran 17 minutes): the real fit, estimated as instant, is stopped
+    at --max-time inside the optimiser and the integrator, and nothing is written."""
+    monkeypatch.setattr(rsf_cmd, "estimate_fit_cost", lambda record, settings: rsf_cmd.FitCost(1e-6, 90, 5))
+    output = tmp_path / "fit.toml"
+    began = time.perf_counter()
+    code, out, err = run_main(capsys, "rsf", "fit", str(record_path), "--max-time", "0.3 s", "-o", str(output))
+    assert time.perf_counter() - began < 3.0  # the whole fit takes longer than that here (about 1-4 s)
+    assert code == 3 and out == "" and not output.exists()
+    assert err.startswith("stickslip: fit failed: stopped at --max-time 0.3 s") and err.count("\n") == 1, err
+    assert signal.getitimer(signal.ITIMER_REAL) == (0.0, 0.0)  # the alarm is off again
 
 
 # --- real fits: SI JSON, held and started stiffness, windows, exit 3 ------------------------------------------

@@ -8,13 +8,16 @@ with ``--params``.
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import functools
 import json
 import math
+import signal
 import sys
+import threading
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -482,8 +485,12 @@ def _duration(seconds: float) -> str:
     default=None,
     help="Load-point history as a protocol CSV (time,velocity or velocity,duration; SI), as for simulate.",
 )
-@click.option("--max-time", default=MAX_TIME_DEFAULT, show_default=True,
-              help="Refuse a fit estimated to take longer (one model run is timed before the fit starts).")  # fmt: skip
+@click.option(
+    "--max-time",
+    default=MAX_TIME_DEFAULT,
+    show_default=True,
+    help="Refuse a fit estimated to take longer (a model run is timed first); stop one that runs on.",
+)
 @click.option("--mcmc", "mcmc_steps", type=click.IntRange(min=0), default=0, help="emcee steps for a posterior.")
 @click.option("--seed", type=int, default=None, help="Seed of the emcee walkers.")
 @click.option("--json", "as_json", is_flag=True, help="Print the report as JSON (SI units: Dc in m, stiffness in 1/m).")
@@ -501,7 +508,8 @@ def fit_command(**options: Any) -> None:
     standard errors and 95 % intervals, a - b with its own error, correlations,
     reduced chi-square against the record's own noise, and warnings; --json
     gives it in SI units.  The cost is estimated before the fit (one model
-    run timed) and a fit estimated above --max-time is refused.  A fit that
+    run timed): a fit estimated above --max-time is refused, and one still
+    running at --max-time is stopped (a failed fit).  A fit that
     cannot be trusted says why (status "failed", reason) and exits with
     status 3; its parameters are not written to -o.  Bad input exits 2.
     """
@@ -526,9 +534,15 @@ def fit_command(**options: Any) -> None:
         click.echo(f"stickslip: rsf fit: {cost.text()}", err=True)
     started = time.perf_counter()
     try:
-        fit = fit_record(record, **settings)
+        with _deadline(max_time):
+            fit = fit_record(record, **settings)
     except ModelError as exc:  # the search ran and ended where the model cannot be run: a failed fit, not bad input
         click.echo(_one_line(f"stickslip: fit failed: {exc}"), err=True)
+        raise SystemExit(FIT_FAILED) from None
+    except _OutOfTime:
+        click.echo(f"stickslip: fit failed: stopped at --max-time {_duration(max_time)} (estimated "
+                   f"{_duration(cost.seconds)}); nothing written; allow more with --max-time or fit less (a "
+                   "--window, fixed parameters)", err=True)  # fmt: skip
         raise SystemExit(FIT_FAILED) from None
     elapsed = time.perf_counter() - started
     if options["history"] == "measured" and fit.protocol_source == "given":
@@ -560,6 +574,31 @@ FIT_FAILED = 3
 
 def _one_line(text: str) -> str:
     return " ".join(text.split())
+
+
+class _OutOfTime(BaseException):
+    """Raised by the --max-time alarm inside a running fit: a BaseException, so no ``except Exception`` on the
+    way (the optimiser, the integrator's callbacks) can swallow it."""
+
+
+@contextlib.contextmanager
+def _deadline(seconds: float) -> Iterator[None]:
+    """Stop the block with :class:`_OutOfTime` after ``seconds`` (an estimate can be wrong: the issue's fit ran
+    17 minutes); a no-op off the main thread or without interval timers (Windows)."""
+    if threading.current_thread() is not threading.main_thread() or not hasattr(signal, "setitimer"):
+        yield
+        return
+
+    def ring(signum: int, frame: Any) -> None:
+        raise _OutOfTime
+
+    previous = signal.signal(signal.SIGALRM, ring)
+    signal.setitimer(signal.ITIMER_REAL, seconds)
+    try:
+        yield
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, previous)
 
 
 def _window(text: str | None) -> tuple[float | None, float | None] | None:
