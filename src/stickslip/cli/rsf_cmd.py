@@ -576,6 +576,10 @@ def _one_line(text: str) -> str:
     return " ".join(text.split())
 
 
+#: A --max-time beyond this (three years) sets no timer: the platform's timers overflow near 1e12 s.
+LONGEST_TIMER_SECONDS = 1e8
+
+
 class _OutOfTime(BaseException):
     """Raised by the --max-time alarm inside a running fit: a BaseException, so no ``except Exception`` on the
     way (the optimiser, the integrator's callbacks) can swallow it."""
@@ -585,7 +589,11 @@ class _OutOfTime(BaseException):
 def _deadline(seconds: float) -> Iterator[None]:
     """Stop the block with :class:`_OutOfTime` after ``seconds`` (an estimate can be wrong: the issue's fit ran
     17 minutes); a no-op off the main thread or without interval timers (Windows)."""
-    if threading.current_thread() is not threading.main_thread() or not hasattr(signal, "setitimer"):
+    if (
+        threading.current_thread() is not threading.main_thread()
+        or not hasattr(signal, "setitimer")
+        or seconds > LONGEST_TIMER_SECONDS
+    ):
         yield
         return
 
