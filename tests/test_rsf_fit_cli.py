@@ -247,10 +247,16 @@ def _text_value(text: str, name: str) -> tuple[float, str]:
 
 
 def test_json_is_si_and_the_text_is_in_the_records_unit(record_path, tmp_path, capsys):
-    """Issue 27 item 9: one fit, its text report (um) and its JSON (SI, the -o sidecar and --json alike)."""
+    """Issue 27 items 4 and 9: the unit named in a mapped header is used (it was read as metres), the text report
+    gives Dc in it (um) and the JSON in SI (the -o sidecar and --json hold the same report)."""
+    frame = pd.read_csv(record_path)
+    frame.columns = ["Time (s)", "LP Displacement (um)", "Friction"]
+    path = tmp_path / "lab.csv"
+    frame.to_csv(path, index=False)
     output = tmp_path / "fit.toml"
-    code, out, err = run_main(capsys, "rsf", "fit", str(record_path), "--fix", "stiffness=1.6e-3/um", "-o",
-                              str(output))  # fmt: skip
+    code, out, err = run_main(capsys, "rsf", "fit", str(path), "--columns",
+                              'time="Time (s)",displacement="LP Displacement (um)",friction=Friction', "--fix",
+                              "stiffness=1.6e-3/um", "-o", str(output))  # fmt: skip
     assert code == 0, err
     report = json.loads((tmp_path / "fit.params.json").read_text())["fit"]
     dc_text, unit = _text_value(out, "dc")
