@@ -905,6 +905,11 @@ def _fit_text(fit: Any) -> str:
     unit = shown_unit(fit.record.length_unit)
     lines = [f"rate-and-state fit of {fit.record.source} ({len(fit.record)} rows): {fit.status}"
              + (f": {fit.reason}" if fit.reason else "")]  # fmt: skip
+    laws = [state.law for state in fit.params.states]
+    if len(set(laws)) == 1:
+        lines.append(f"  state evolution: {laws[0]} law" + (f" ({len(laws)} state variables)" if len(laws) > 1 else ""))
+    else:
+        lines.append(f"  state evolution: {laws[0]} law (first state), {laws[1]} law (second)")
     lines.append(f"  load point ({fit.protocol_source}):")
     rows = fit.protocol_rows()
     if len(rows) > SHOWN_SEGMENTS:  # a measured history: hundreds of short pieces
