@@ -221,6 +221,14 @@ def test_headline_counts_every_row_once_by_class(report: Path, results: dict) ->
     assert f"{counts['input']} are the paper's own inputs" in lead and f"{counts['agrees']} agree" in lead
     assert f"{counts['erratum']} differ because of an error in the paper" in lead
     assert f"{counts['limitation']} are limitations of the model" in lead
+    # the README quotes the same counts (it said 11 errors and 3 limitations while the report said 8 and 6)
+    readme = (Path(__file__).resolve().parents[1] / "README.md").read_text(encoding="utf-8")
+    quoted = (f"{results['summary']['compared']} numbers stated in the paper are compared with the computation, each in"
+              " one class:"
+              f" {counts['input']} are the paper's inputs handed back (not counted as agreement), {counts['agrees']}"
+              f" agree within 2 %, {counts['scatter']} lie within the scatter the paper states or shows,"
+              f" {counts['erratum']} are paper errors and {counts['limitation']} model limitations")  # fmt: skip
+    assert quoted in readme
 
 
 def test_parameter_rows_handed_back_are_inputs_not_agreements(rows: dict) -> None:
