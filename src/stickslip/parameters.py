@@ -230,7 +230,10 @@ class Parameters:
                 raise ParameterError(f"overrides: expected 'section.key' names, got {shorten(key)}")
             dimension = key_dimension(key)
             values[key] = to_si(raw, dimension, key)
-        return _build(values, name=self.name, description=self.description, reference=self.reference)
+        try:
+            return _build(values, name=self.name, description=self.description, reference=self.reference)
+        except ParameterError as exc:
+            raise _as_written(exc, overrides) from None
 
     def rows(self) -> list[tuple[str, str, str, str]]:
         """(key, symbol, value with unit, meaning) for display."""
@@ -334,6 +337,16 @@ def _parse_toml(text: str, source: str) -> Parameters:
     except RecursionError:  # "a = [[[[..." a hundred thousand deep: tomllib recurses
         raise ParameterError(f"{source}: malformed TOML: nested too deeply to be a parameter file") from None
     return parameters_from_mapping(data, source)
+
+
+def _as_written(exc: ParameterError, overrides: Mapping[str, Any]) -> ParameterError:
+    """An override refused after its conversion to SI, named as the user wrote it ("got '-5 mm'", not "got
+    -0.005")."""
+    message = str(exc)
+    for key, raw in overrides.items():
+        if isinstance(raw, str) and message.startswith(f"{key}:") and ", got " in message:
+            return ParameterError(f"{message.rsplit(', got ', 1)[0]}, got {raw.strip()!r}")
+    return exc
 
 
 def load_parameters(

@@ -198,8 +198,12 @@ def parse_segment(text: str, name: str = "--segment") -> Segment:
     duration = to_si(duration_text.strip(), "time", f"{name} duration")
     try:
         return Segment(velocity, duration)
-    except ParameterError as exc:
-        raise ParameterError(f"{name} {text!r}: {exc}") from None
+    except ParameterError as exc:  # named as written ("got '-5 um/s'"), not in SI
+        message = str(exc)
+        written = velocity_text if message.startswith("segment velocity") else duration_text
+        if ", got " in message:
+            message = f"{message.rsplit(', got ', 1)[0]}, got {written.strip()!r}"
+        raise ParameterError(f"{name} {text!r}: {message}") from None
 
 
 def read_protocol(path: str | Path) -> Protocol:

@@ -334,4 +334,13 @@ def _check_corners(adapter: Any, spec: SweepSpec) -> None:
             try:
                 adapter.parameters({**first, key: end})
             except ParameterError as exc:
-                raise ParameterError(f"--vary {key}: the value {end:g} (SI) is refused: {exc}") from None
+                raise ParameterError(f"--vary {key}: the value {_shown(end, key, adapter)} is refused: {exc}") from None
+
+
+def _shown(value: float, key: str, adapter: Any) -> str:
+    """An SI value with its SI unit (from the model's dimensions), as refusals name it."""
+    from ..units import DIMENSIONS
+
+    dimension = adapter.dimensions().get(key, "") if hasattr(adapter, "dimensions") else ""
+    unit = DIMENSIONS.get(dimension, ("", ""))[1]
+    return f"{value:g} {unit}".strip()
