@@ -3,17 +3,18 @@
 A record has time, load-point displacement and friction.  Columns are found
 by name: the package's own trace CSV (``time``, ``load_point_displacement``,
 ``friction``), or any header mapped with ``columns={"time": "Time(s)",
-"displacement": "Displ(microns)", "friction": "Friction"}`` and a
-``displacement_unit`` such as ``"um"``.  A record without a displacement column
-but with the load point's velocity (``load_point_velocity``, ``velocity`` or a
-mapped ``velocity=...``, in displacement units per time unit) has it integrated
-(trapezoids) into the displacement.  Tab, comma, semicolon or whitespace
-separated; ``#`` comments are skipped.
+"displacement": "Displ(microns)", "friction": "Friction"}``.  A header that names
+its unit (``Displ(microns)``, ``LP Displacement (um)``, ``disp [µm]``, ``time_ms``)
+is read in it; else ``displacement_unit`` / ``time_unit``; else metres and seconds.
+A record without a displacement column but with the load point's velocity
+(``load_point_velocity``, ``velocity`` or a mapped ``velocity=...``) has it
+integrated into the displacement, each row's velocity holding from that row on.
+Tab, comma, semicolon or whitespace separated; ``#`` comments are skipped.
 
 The load point's velocity history comes from the displacement record:
-:func:`find_segments` splits it into straight pieces by the exact penalised
-least-squares segmentation (PELT with O(1) misfits from running sums), then
-merges neighbours whose velocities differ by less than ``min_change``.
+:func:`find_segments` finds its velocity levels (change points under a measured
+noise model, then a test of each change), or :func:`measured_history` follows the
+smoothed displacement itself with a few hundred short segments.
 """
 
 from __future__ import annotations
@@ -21,7 +22,7 @@ from __future__ import annotations
 import itertools
 import math
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -32,14 +33,14 @@ from ..errors import DataError, ParameterError
 from ..fileio import protect_inputs
 from ..protocols import Protocol, Segment
 
-__all__ = ["LabRecord", "find_segments", "parse_columns", "read_record"]
+__all__ = ["LabRecord", "find_segments", "measured_history", "parse_columns", "read_record"]
 
 ROLES = ("time", "displacement", "friction", "velocity")
 _DEFAULT_NAMES = {
     "time": ("time", "time(s)", "time_s", "t"),
-    "displacement": ("load_point_displacement", "displacement", "displ", "lp_disp", "displ(m)"),
+    "displacement": ("load_point_displacement", "displacement", "displ", "disp", "lp_disp", "lp displacement"),
     "friction": ("friction", "mu", "friction_coefficient"),
-    "velocity": ("load_point_velocity", "velocity", "lp_velocity", "lp_vel"),
+    "velocity": ("load_point_velocity", "velocity", "vel", "lp_velocity", "lp_vel"),
 }
 
 
@@ -109,33 +110,91 @@ def parse_columns(text: str | None) -> dict[str, str]:
 
 
 def read_record(
-    path: str | Path, columns: dict[str, str] | None = None, displacement_unit: str = "m", time_unit: str = "s"
+    path: str | Path,
+    columns: dict[str, str] | None = None,
+    displacement_unit: str | None = None,
+    time_unit: str | None = None,
 ) -> LabRecord:
-    """A :class:`LabRecord` from delimited text (see the module notes)."""
-    import pandas as pd
+    """A :class:`LabRecord` from delimited text (see the module notes).
 
-    from ..units import to_si
+    Each column's unit comes from its header (``Displ(microns)``, ``LP Displacement (um)``, ``disp [µm]``,
+    ``time_ms``), else from ``displacement_unit`` / ``time_unit``, else metres and seconds.  A header and an
+    option that name different units are refused (DataError), as is a load point moving faster than
+    :data:`FASTEST_LOAD_POINT` (a unit forgotten: the message names the likely one).
+    """
+    import pandas as pd
 
     path = Path(path)
     if not path.is_file():
         raise DataError(f"{path}: record not found")
     protect_inputs([path])  # in a command, no output may replace the record
-    d_scale = to_si(f"1 {displacement_unit}", "length", "--displacement-unit")
-    t_scale = to_si(f"1 {time_unit}", "time", "--time-unit")
-    try:
-        with open(path, encoding="utf-8", errors="replace") as handle:
-            head = "".join(line for _, line in zip(range(20), handle, strict=False) if not line.startswith("#"))
-        sep = "\t" if "\t" in head else ";" if head.count(";") > head.count(",") else "," if "," in head else r"\s+"
-        frame = pd.read_csv(path, sep=sep, comment="#", engine="c" if len(sep) == 1 else "python")
-    except (OSError, ValueError, pd.errors.ParserError) as exc:
-        raise DataError(f"{path}: cannot read as delimited text ({str(exc).splitlines()[0]})") from None
+    option = {
+        "time": _option_scale(time_unit, "time", "--time-unit"),
+        "length": _option_scale(displacement_unit, "length", "--displacement-unit"),
+    }
+    option["velocity"] = _velocity_option(option["length"], option["time"])
+    frame = _read_frame(path, pd)
     headers = {str(c).strip(): c for c in frame.columns}
     bracketed = {str(c): split_header(str(c)) for c in frame.columns}  # "time [s]" as this package writes it
     lower = {k.lower(): v for k, v in headers.items()}
     lower.update(
         {name.lower(): c for c, (name, unit) in bracketed.items() if unit is not None and name.lower() not in lower}
     )
-    chosen = {}
+    for header, column in headers.items():  # "Time (s)" is found as time
+        bare = re.sub(r"\s*[\(\[][^\(\)\[\]]*[\)\]]\s*$", "", header).strip().lower()
+        lower.setdefault(bare, column)
+    chosen = _choose_columns(path, columns, headers, lower)
+    data = {role: pd.to_numeric(frame[col], errors="coerce").to_numpy(dtype=float) for role, col in chosen.items()}
+    dimension = {"time": "time", "displacement": "length", "velocity": "velocity"}
+    units = {role: _header_unit(str(chosen[role]), dimension[role], path) for role in chosen if role in dimension}
+
+    def in_si(role: str) -> np.ndarray:
+        """A column in SI: by the unit its header names, else by the option, else SI."""
+        header, given = units.get(role), option[dimension[role]]
+        if header is not None and given is not None and not math.isclose(header[0], given[0], rel_tol=1e-9):
+            flag = "--time-unit" if role == "time" else "--displacement-unit"
+            raise DataError(
+                f"{path}: column {chosen[role]!r} is in {header[1]} but {flag} says {given[1]}; give one of them"
+            )
+        factor = header[0] if header is not None else given[0] if given is not None else 1.0
+        return data[role] * factor
+
+    time = in_si("time")
+    if "displacement" in data:
+        displacement = in_si("displacement")
+        written = units.get("displacement") or option["length"]
+        column = chosen["displacement"]
+    else:
+        displacement = _integrated(time, in_si("velocity"), path)
+        speed_unit = units.get("velocity")
+        written = _length_of(speed_unit) if speed_unit is not None else option["length"]
+        column = chosen["velocity"]
+    shown_unit = _plain_length(written[1]) if written is not None else "m"
+    record = LabRecord.from_arrays(time, displacement, data["friction"], str(path), shown_unit)
+    _refuse_implausible_speed(record, str(column), written)
+    return record
+
+
+#: a rock or gel friction rig's load point moves at nm/s to mm/s: faster than this (m/s) is a unit read wrong
+FASTEST_LOAD_POINT = 0.1
+_UNIT_WORDS = {"micron": "um", "microns": "um", "µm": "um", "μm": "um", "micrometre": "um", "micrometer": "um"}
+#: last words of a header taken as its unit (without brackets only these, so "friction_coefficient" names none)
+_TAIL_UNITS = {"m", "mm", "um", "µm", "μm", "nm", "micron", "microns", "s", "ms", "us", "µs", "min"}
+_TAIL_UNITS |= {"m/s", "mm/s", "um/s", "µm/s", "μm/s", "nm/s"}
+
+
+def _read_frame(path: Path, pd: Any) -> Any:
+    try:
+        with open(path, encoding="utf-8", errors="replace") as handle:
+            head = "".join(line for _, line in zip(range(20), handle, strict=False) if not line.startswith("#"))
+        sep = "\t" if "\t" in head else ";" if head.count(";") > head.count(",") else "," if "," in head else r"\s+"
+        return pd.read_csv(path, sep=sep, comment="#", engine="c" if len(sep) == 1 else "python")
+    except (OSError, ValueError, pd.errors.ParserError) as exc:
+        raise DataError(f"{path}: cannot read as delimited text ({str(exc).splitlines()[0]})") from None
+
+
+def _choose_columns(path: Path, columns: dict[str, str] | None, headers: dict, lower: dict) -> dict[str, Any]:
+    chosen: dict[str, Any] = {}
     for role in ROLES:
         if role == "velocity" and "displacement" in chosen:
             continue
@@ -159,62 +218,136 @@ def read_record(
                 "friction=...)"
             )
         chosen[role] = match
-    data = {role: pd.to_numeric(frame[col], errors="coerce").to_numpy(dtype=float) for role, col in chosen.items()}
-    unit_of_role = {role: bracketed[str(col)][1] for role, col in chosen.items()}
+    return chosen
 
-    def in_si(role: str, dimension: str, default: float) -> np.ndarray:
-        """A column in SI: by the unit in its header's brackets (the file's word), else by the option."""
-        unit = unit_of_role.get(role)
-        factor = to_si(f"1 {unit}", dimension, f"column {chosen[role]!r}") if unit else default
-        return data[role] * factor
 
-    time = in_si("time", "time", t_scale)
-    if "displacement" in data:
-        displacement = in_si("displacement", "length", d_scale)
-    else:
-        displacement = _integrated(time, in_si("velocity", "velocity", d_scale / t_scale), path)
-    shown_unit = unit_of_role.get("displacement") or displacement_unit.strip()
-    return LabRecord.from_arrays(time, displacement, data["friction"], str(path), shown_unit)
+def _option_scale(unit: str | None, dimension: str, flag: str) -> tuple[float, str] | None:
+    from ..units import to_si
+
+    if unit is None or not str(unit).strip():
+        return None
+    return to_si(f"1 {unit}", dimension, flag), str(unit).strip()
+
+
+def _velocity_option(length: tuple[float, str] | None, time: tuple[float, str] | None) -> tuple[float, str] | None:
+    """What the options say a velocity column is in (a length option alone: per second)."""
+    if length is None:
+        return None
+    per = time if time is not None else (1.0, "s")
+    return length[0] / per[0], f"{length[1]}/{per[1]}"
+
+
+def _header_unit(header: str, dimension: str, path: Path) -> tuple[float, str] | None:
+    """The SI factor and name of the unit a header names: in brackets at its end (``Displ(microns)``,
+    ``disp [µm]``, ``Vel (um/s)``) or as its last word (``time_ms``, ``LP displacement um``); None when it
+    names none.  A bracketed unit of another dimension is refused."""
+    from ..units import to_si
+
+    text = header.strip()
+    match = re.search(r"[\(\[]\s*([^\(\)\[\]]+?)\s*[\)\]]\s*$", text)
+    tail = re.search(r"[\s_]([A-Za-zµμ/]+)$", text)
+    word = match.group(1) if match else tail.group(1) if tail and tail.group(1).lower() in _TAIL_UNITS else None
+    if word is None:
+        return None
+    unit = _UNIT_WORDS.get(word.lower(), word)
+    try:
+        return to_si(f"1 {unit}", dimension, header), unit
+    except ParameterError:
+        pass
+    for other in ("length", "time", "velocity"):
+        try:
+            to_si(f"1 {unit}", other, header)
+        except ParameterError:
+            continue
+        raise DataError(f"{path}: column {header!r} is in {word}, a {other}; expected a {dimension}") from None
+    return None  # a word in brackets that is no unit ("Displ (LVDT 2)")
+
+
+def _length_of(velocity_unit: tuple[float, str]) -> tuple[float, str]:
+    """The length unit of a velocity unit (``um/s`` -> um); its factor is not needed, only its name."""
+    return 0.0, velocity_unit[1].split("/")[0].strip() or "m"
+
+
+def _plain_length(unit: str) -> str:
+    return _UNIT_WORDS.get(unit.lower(), unit)
+
+
+def _refuse_implausible_speed(record: LabRecord, column: str, written: tuple[float, str] | None) -> None:
+    """DataError when the load point moves faster than any friction rig's (a unit read wrong): the median speed
+    over ten stretches of the record, so a short fast stretch is allowed."""
+    t, d = record.time, record.displacement
+    edges = np.unique(np.linspace(0, t.size - 1, 11).astype(int))
+    speed = float(np.median(np.abs(np.diff(d[edges])) / np.diff(t[edges])))
+    if speed <= FASTEST_LOAD_POINT:
+        return
+    unit = written[1] if written is not None else "m"
+    factor = written[0] if written is not None and written[0] > 0 else 1.0
+    scales = {"mm": 1e-3, "um": 1e-6, "nm": 1e-9}
+    likely = min(scales, key=lambda u: abs(math.log10(speed / factor * scales[u]) + 5.0))  # nearest to 10 um/s
+    raise DataError(
+        f"{record.source}: the load point moves at {speed:.3g} m/s reading column {column!r} in {unit}, faster "
+        f"than any friction rig's; if it is in {likely} give --displacement-unit {likely} (or name the unit in "
+        f"its header, e.g. 'Displ ({likely})')"
+    )
 
 
 def _integrated(time: np.ndarray, velocity: np.ndarray, path: Path) -> np.ndarray:
-    """Displacement from the load point's velocity by trapezoids (in the record's units)."""
+    """Displacement from the load point's velocity column (in SI).
+
+    A rig writes the velocity it commands from that row on: row i's velocity holds on [t_i, t_(i+1)), so a step
+    whose first row is at t = 50.0 s starts at 50.0 s (trapezoids between rows put it half a row early).
+    """
     bad = ~np.isfinite(velocity)
     if bad.any():
         raise DataError(f"{path}: row {int(np.argmax(bad)) + 1}: velocity is not a finite number")
     if velocity.size < 2:
         return np.zeros_like(velocity)
-    steps = 0.5 * (velocity[1:] + velocity[:-1]) * np.diff(time)
-    return np.concatenate([[0.0], np.cumsum(steps)])
+    return np.concatenate([[0.0], np.cumsum(velocity[:-1] * np.diff(time))])
 
 
 def find_segments(
-    time: np.ndarray, displacement: np.ndarray, max_segments: int = 60, min_change: float = 0.2, min_points: int = 10
+    time: np.ndarray,
+    displacement: np.ndarray,
+    max_segments: int = 60,
+    min_change: float = 0.2,
+    min_points: int = 10,
+    min_duration: float | None = None,
 ) -> Protocol:
     """The load point's piecewise-constant velocity history from its displacement record.
 
-    The optimal segmentation of the displacement into straight pieces under a
-    penalty per piece (PELT, Killick et al. 2012, exact for an additive cost):
-    each piece costs its least-squares misfit plus ``4 sigma^2 ln n``, sigma the
-    displacement's white-noise level from second differences.  Neighbouring
-    pieces whose velocities differ by less than ``min_change`` (relative) are
-    merged; a change time is where the two fitted lines meet (the load point's
-    displacement is continuous).  Raises DataError when more than
-    ``max_segments`` pieces remain (the displacement is not piecewise linear).
+    The record is averaged in equal TIME bins (at most :data:`SEARCH_BINS`; a sampling rate that changes
+    mid-record changes only how many rows a bin holds) and each bin's noise is measured, not assumed
+    (:func:`_noise_model`: residuals of straight lines over a fixed time span, white and row-independent
+    parts, the quantisation step's q^2/12, and the lag-one correlation left between bins).  The optimal
+    segmentation into straight pieces under a penalty per piece (PELT, Killick et al. 2012) of
+    ``4 ln n`` times the correlation's variance inflation proposes the changes; the load point's
+    displacement is continuous, so a continuous broken line through them is then fitted and a change
+    is dropped, weakest first, while its change of slope is within ``z = sqrt(2 ln n) + 2`` standard
+    errors of none, the two velocities differ by less than ``min_change`` (relative), or a piece is shorter
+    than ``min_points`` rows or ``min_duration`` seconds (default: three bins).  Each remaining change is
+    then placed on the full record and dated where the two fitted lines meet.  Raises DataError when more
+    than ``max_segments`` pieces remain (the displacement is not piecewise linear).
     """
     t = np.asarray(time, dtype=float)
     d = np.asarray(displacement, dtype=float)
     n = t.size
     if n < 2 * min_points:
         return Protocol((Segment(max(_line(t, d)[0], 0.0), float(t[-1] - t[0])),), name="from displacement")
-    breaks = _merge(t, d, _segment(t, d, min_points), min_change)
-    if len(breaks) - 1 > max_segments:
+    bins = _bins(t, d)
+    proposed = _pelt(bins)
+    bins = replace(bins, inflation=_slope_inflation(bins.t, bins.d, bins.var, proposed))
+    shortest = 3.0 * bins.width if min_duration is None else float(min_duration)
+    hinges = _significant_hinges(bins, proposed, min_change, min_points, shortest)
+    if len(hinges) + 1 > max_segments:
         raise DataError(
-            f"load-point displacement: {len(breaks) - 1} straight pieces found, more than {max_segments}; "
+            f"load-point displacement: {len(hinges) + 1} straight pieces found, more than {max_segments}; "
             "expected piecewise-constant velocity (give the history with --segment or --protocol)"
         )
+    _refuse_curved(bins, hinges)
+    sums = _cumulative_sums(t, d)
+    breaks = _refine(sums, [0, *[int(bins.first[b]) for b in hinges], n], bins.first, hinges, min_points)
     lines = [_line(t[i0:i1], d[i0:i1]) for i0, i1 in itertools.pairwise(breaks)]
-    times = [0.0]
+    times = [float(t[0])]
     for j, i in enumerate(breaks[1:-1]):
         (s1, c1), (s2, c2) = lines[j], lines[j + 1]
         meet = (c2 - c1) / (s1 - s2) if s1 != s2 else math.nan
@@ -225,12 +358,165 @@ def find_segments(
     return Protocol(tuple(items), name="from displacement")
 
 
-def _noise(d: np.ndarray) -> float:
-    """White-noise level from second differences (1.4826 MAD: the kinks do not inflate it)."""
-    if d.size < 4:
+#: the change-point search runs on at most this many equal time bins (each change is then placed on the full record)
+SEARCH_BINS = 2000
+#: rows of bins in one local straight-line fit of the noise model
+_NOISE_WINDOW = 8
+
+
+@dataclass(frozen=True)
+class _Bins:
+    """The record averaged in equal time bins, in scaled units (time and displacement O(1), a line removed)."""
+
+    t: np.ndarray  # mean time of each bin (scaled)
+    d: np.ndarray  # mean displacement (scaled)
+    count: np.ndarray  # rows in each bin
+    first: np.ndarray  # first row of each bin
+    var: np.ndarray  # noise variance of each bin's mean (scaled)
+    inflation: tuple[np.ndarray, np.ndarray]  # stretch lengths (bins) and their slope-variance inflation
+    width: float  # the bins' width in seconds
+    time_scale: float  # seconds per scaled time unit
+    trend: float  # the slope of the line removed, in scaled units (added back to compare velocities)
+
+
+def _bins(t: np.ndarray, d: np.ndarray) -> _Bins:
+    n = t.size
+    span = float(t[-1] - t[0])
+    tc = (t - t[0]) / span
+    line = np.polyfit(tc, d, 1)
+    dc = d - np.polyval(line, tc)
+    scale = max(float(np.max(np.abs(dc))), 1e-300)
+    dc = dc / scale
+    if n <= SEARCH_BINS:
+        first = np.arange(n)
+        width = span / max(n - 1, 1)
+    else:
+        ids = np.minimum((tc * SEARCH_BINS).astype(np.int64), SEARCH_BINS - 1)
+        first = np.flatnonzero(np.concatenate([[True], np.diff(ids) > 0]))
+        width = span / SEARCH_BINS
+    count = np.diff(np.concatenate([first, [n]]))
+    bt = np.add.reduceat(tc, first) / count
+    bd = np.add.reduceat(dc, first) / count
+    var, inflation = _noise_model(bt, bd, count, _quantum(d) / scale)
+    return _Bins(bt, bd, count, first, var, inflation, width, span, float(line[0]) / scale)
+
+
+def _quantum(d: np.ndarray) -> float:
+    """The displacement's bit, where it is written in whole steps of one (0 when it is not)."""
+    steps = np.abs(np.diff(d))
+    steps = steps[steps > 0]
+    if steps.size < 10:
         return 0.0
-    second = np.diff(d, 2)
-    return float(1.4826 * np.median(np.abs(second - np.median(second))) / math.sqrt(6.0))
+    q = float(np.min(steps))
+    whole = np.abs(steps / q - np.round(steps / q)) < 0.02
+    return q if np.mean(whole) > 0.9 and np.max(steps) / q < 1e6 else 0.0
+
+
+def _window_residuals(bt: np.ndarray, bd: np.ndarray, width: int) -> tuple[np.ndarray, np.ndarray]:
+    """Residuals of straight lines fitted to consecutive groups of ``width`` bins (one row per group), and the
+    groups' first bins."""
+    m = bt.size // width
+    tt = bt[: m * width].reshape(m, width)
+    dd = bd[: m * width].reshape(m, width)
+    tt = tt - tt.mean(axis=1, keepdims=True)
+    dd = dd - dd.mean(axis=1, keepdims=True)
+    stt = np.sum(tt * tt, axis=1, keepdims=True)
+    slope = np.divide(np.sum(tt * dd, axis=1, keepdims=True), stt, out=np.zeros_like(stt), where=stt > 0)
+    return dd - slope * tt, np.arange(m) * width
+
+
+def _noise_model(
+    bt: np.ndarray, bd: np.ndarray, count: np.ndarray, q: float
+) -> tuple[np.ndarray, tuple[np.ndarray, np.ndarray]]:
+    """Each bin mean's noise variance, and how much more the velocities of neighbouring stretches differ than
+    that variance says (:func:`_slope_inflation`).
+
+    Straight lines over a fixed span of bins (a fixed time span: the bins are equal in time) leave the noise
+    whatever the sampling rate or the noise's colour; a window with a change in it is an outlier the medians
+    ignore.  The variance of a bin mean is modelled as ``white / rows + floor``: white noise averages down with
+    the rows a bin holds, correlated noise and the rig's wander do not; where the sampling rate changes the two
+    parts are told apart by the bins' row counts.  The quantisation step ``q`` adds at least ``q^2 / 12`` per row.
+    """
+    width = _NOISE_WINDOW if bt.size >= 4 * _NOISE_WINDOW else max(3, bt.size // 4)
+    residual, starts = _window_residuals(bt, bd, width)
+    per_window = np.sum(residual**2, axis=1) / (width - 2)
+    inverse = np.array([np.mean(1.0 / count[s : s + width]) for s in starts])
+    median_factor = _chi2_median_ratio(width - 2)
+    classes = np.round(np.log2(1.0 / inverse)).astype(int)
+    xs, vs = [], []
+    for c in np.unique(classes):
+        chosen = classes == c
+        if np.count_nonzero(chosen) >= 3 or np.unique(classes).size == 1:
+            xs.append(float(np.median(inverse[chosen])))
+            vs.append(float(np.median(per_window[chosen])) / median_factor)
+    white, floor = _two_part_variance(np.array(xs), np.array(vs))
+    # the floor sits above the cancellation error of the running sums (relative 1e-16 * n)
+    var = np.maximum(white / count + floor, (q * q / 12.0) / count + (3e-7) ** 2)
+    return var, _slope_inflation(bt, bd, var)
+
+
+def _two_part_variance(x: np.ndarray, v: np.ndarray) -> tuple[float, float]:
+    """``v = white * x + floor`` with both parts >= 0 (x the mean inverse row count of a class of bins)."""
+    if x.size == 0:
+        return 0.0, 0.0
+    if x.size == 1 or np.ptp(x) < 0.2 * np.max(x):
+        return 0.0, float(np.median(v))  # one sampling rate: the two parts cannot be told apart
+    a, b = np.polyfit(x, v, 1)
+    if a < 0:
+        return 0.0, float(np.mean(v))
+    if b < 0:
+        return float(np.sum(v * x) / np.sum(x * x)), 0.0
+    return float(a), float(b)
+
+
+def _chi2_median_ratio(dof: int) -> float:
+    """Median of chi^2_dof / dof (Wilson-Hilferty)."""
+    return (1.0 - 2.0 / (9.0 * dof)) ** 3
+
+
+def _slope_inflation(
+    bt: np.ndarray, bd: np.ndarray, var: np.ndarray, breaks: list[int] | None = None
+) -> tuple[np.ndarray, np.ndarray]:
+    """How much more the slopes of neighbouring stretches of the record differ than the bins' variances say.
+
+    Correlated noise, the rig's wander and slow drift make the velocity of one stretch differ from the next by
+    more than independent bins allow, and the more so the longer the stretches (red noise); the record itself
+    tells by how much.  Adjacent stretches of 8, 16, 32, ... bins are fitted with straight lines and the median
+    of (s1 - 2 s2 + s3)^2 / (var1 + 4 var2 + var3) over all triples (a steady acceleration does not enter; a
+    stretch holding one of the proposed ``breaks`` is left out, so the real changes do not) is compared with
+    chi^2_1's median, 0.455.  Returns the stretch lengths (bins) and the ratios, made non-decreasing and >= 1.
+    """
+    widths, ratios = [], []
+    width = _NOISE_WINDOW
+    marks = np.zeros(bt.size + 1)
+    marks[np.asarray(breaks or [], dtype=int)] = 1.0
+    crossed = np.concatenate([[0.0], np.cumsum(marks)])
+    while bt.size // width >= 13:
+        m = bt.size // width
+        tt, dd, ww = (v[: m * width].reshape(m, width) for v in (bt, bd, 1.0 / var))
+        sw = np.sum(ww, axis=1, keepdims=True)
+        tm = np.sum(ww * tt, axis=1, keepdims=True) / sw
+        dm = np.sum(ww * dd, axis=1, keepdims=True) / sw
+        stt = np.sum(ww * (tt - tm) ** 2, axis=1)
+        slope = np.sum(ww * (tt - tm) * (dd - dm), axis=1) / stt
+        starts = np.arange(m) * width
+        clean = crossed[starts + width] - crossed[starts + 1] == 0  # no break inside the stretch
+        usable = clean[2:] & clean[1:-1] & clean[:-2]
+        ratio = np.diff(slope, 2) ** 2 / (1.0 / stt[2:] + 4.0 / stt[1:-1] + 1.0 / stt[:-2])
+        if np.count_nonzero(usable) < 5:
+            break
+        widths.append(width)
+        ratios.append(float(np.median(ratio[usable])) / 0.455)
+        width *= 2
+    if not widths:
+        return np.array([float(_NOISE_WINDOW)]), np.array([1.0])
+    return np.array(widths, dtype=float), np.maximum.accumulate(np.maximum(ratios, 1.0))
+
+
+def _inflation_at(bins: _Bins, length: np.ndarray) -> np.ndarray:
+    """The slope-variance inflation for stretches of ``length`` bins (log-interpolated, held beyond the ends)."""
+    widths, ratios = bins.inflation
+    return np.interp(np.log(np.maximum(length, 1.0)), np.log(widths), ratios)
 
 
 def _line(t: np.ndarray, d: np.ndarray) -> tuple[float, float]:
@@ -238,17 +524,20 @@ def _line(t: np.ndarray, d: np.ndarray) -> tuple[float, float]:
     return float(slope), float(intercept)
 
 
-def _cumulative_sums(t: np.ndarray, d: np.ndarray) -> list[np.ndarray]:
-    """Running sums for O(1) straight-line misfits; t and d scaled to O(1) so the differences keep their digits."""
+def _cumulative_sums(t: np.ndarray, d: np.ndarray, weight: np.ndarray | None = None) -> list[np.ndarray]:
+    """Running (weighted) sums for O(1) straight-line misfits; t and d scaled to O(1) so the differences keep
+    their digits."""
     tc = (t - t.mean()) / max(float(np.ptp(t)), 1e-300)
     dc = d - np.polyval(np.polyfit(tc, d, 1), tc)
     dc = dc / max(float(np.max(np.abs(dc))), 1e-300)
-    return [np.concatenate([[0.0], np.cumsum(v)]) for v in (np.ones_like(tc), tc, dc, tc * tc, tc * dc, dc * dc)]
+    w = np.ones_like(tc) if weight is None else weight
+    return [np.concatenate([[0.0], np.cumsum(v)]) for v in (w, w * tc, w * dc, w * tc * tc, w * tc * dc, w * dc * dc)]
 
 
 def _misfit(sums: list[np.ndarray], lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
     """Least-squares misfit of a straight line through rows [lo, hi)."""
     c, st, sd, stt, std, sdd = (s[hi] - s[lo] for s in sums)
+    c = np.where(c > 0, c, 1.0)
     vt = stt - st * st / c
     cov = std - st * sd / c
     vd = sdd - sd * sd / c
@@ -256,77 +545,18 @@ def _misfit(sums: list[np.ndarray], lo: np.ndarray, hi: np.ndarray) -> np.ndarra
     return np.maximum(vd - slope * cov, 0.0)
 
 
-#: above this many rows the search runs on block means and each break is then placed on the full record
-SEARCH_ROWS = 2000
-
-
-def _segment(t: np.ndarray, d: np.ndarray, min_points: int) -> list[int]:
-    """PELT's breaks; on a long record found on block means (the pruning keeps every candidate inside a straight
-    piece, so the search grows as n^2 there), then each break moved to its best row between its neighbours."""
-    n = t.size
-    block = math.ceil(n / SEARCH_ROWS)
-    if block <= 1:
-        return _pelt(t, d, min_points)
-    rows = (n // block) * block
-    coarse_t = t[:rows].reshape(-1, block).mean(axis=1)
-    coarse_d = d[:rows].reshape(-1, block).mean(axis=1)
-    coarse = _pelt(coarse_t, coarse_d, max(3, math.ceil(min_points / block)))
-    breaks = [0, *[b * block for b in coarse[1:-1]], n]
-    sums = _cumulative_sums(t, d)
-    penalty = _penalty(sums, n)
-    breaks = _refine(sums, breaks, block, min_points)
-    # a block straddling a change looks like a short piece of its own: drop every break the full record's
-    # penalised misfit does not pay for (each drop re-placing the others)
-    improved = True
-    while improved and len(breaks) > 2:
-        improved = False
-        current = _objective(sums, breaks, penalty)
-        for k in range(1, len(breaks) - 1):
-            fewer = _refine(sums, breaks[:k] + breaks[k + 1 :], block, min_points)
-            if _objective(sums, fewer, penalty) < current:
-                breaks, improved = fewer, True
-                break
-    return breaks
-
-
-def _penalty(sums: list[np.ndarray], n: int) -> float:
-    """The cost of one more piece: 4 sigma^2 ln n in the running sums' scaled units."""
-    scaled = sums[2][1:] - sums[2][:-1]
-    # the floor sits above the cancellation error of the running sums (relative 1e-16 * n)
-    sigma = max(_noise(scaled), 3e-7)
-    return 4.0 * sigma**2 * math.log(n)
-
-
-def _objective(sums: list[np.ndarray], breaks: list[int], penalty: float) -> float:
-    lo, hi = np.array(breaks[:-1]), np.array(breaks[1:])
-    return float(np.sum(_misfit(sums, lo, hi))) + penalty * (len(breaks) - 1)
-
-
-def _refine(sums: list[np.ndarray], breaks: list[int], block: int, min_points: int) -> list[int]:
-    """Each interior break moved to its best row within two blocks, between its neighbours."""
-    breaks = list(breaks)
-    for k in range(1, len(breaks) - 1):
-        lo = max(breaks[k - 1] + min_points, breaks[k] - 2 * block)
-        hi = min(breaks[k + 1] - min_points, breaks[k] + 2 * block)
-        if hi <= lo:
-            continue
-        j = np.arange(lo, hi + 1)
-        cost = _misfit(sums, np.full_like(j, breaks[k - 1]), j) + _misfit(sums, j, np.full_like(j, breaks[k + 1]))
-        breaks[k] = int(j[np.argmin(cost)])
-    return breaks
-
-
-def _pelt(t: np.ndarray, d: np.ndarray, min_points: int) -> list[int]:
-    """Break indices ``[0, ..., n]`` minimising total misfit + penalty per piece (pruned exact search)."""
-    n = t.size
-    sums = _cumulative_sums(t, d)
-    penalty = _penalty(sums, n)
+def _pelt(bins: _Bins, min_bins: int = 3) -> list[int]:
+    """Interior break bins minimising the bins' weighted misfit + ``4 ln n`` x inflation per piece (PELT)."""
+    n = bins.t.size
+    weight = 1.0 / bins.var
+    sums = [np.concatenate([[0.0], np.cumsum(v)]) for v in _weighted_moments(bins.t, bins.d, weight)]
+    penalty = 4.0 * math.log(max(n, 3)) * float(bins.inflation[1][0])  # proposals: the shortest scale's
     best = np.full(n + 1, np.inf)
     best[0] = -penalty
     previous = np.zeros(n + 1, dtype=int)
     candidates = np.array([0], dtype=int)
-    for end in range(min_points, n + 1):
-        newest = end - min_points
+    for end in range(min_bins, n + 1):
+        newest = end - min_bins
         if newest > 0 and np.isfinite(best[newest]):
             candidates = np.append(candidates, newest)
         cost = best[candidates] + _misfit(sums, candidates, np.full_like(candidates, end)) + penalty
@@ -336,17 +566,203 @@ def _pelt(t: np.ndarray, d: np.ndarray, min_points: int) -> list[int]:
     breaks = [n]
     while breaks[-1] > 0:
         breaks.append(int(previous[breaks[-1]]))
-    return breaks[::-1]
+    return breaks[::-1][1:-1]
 
 
-def _merge(t: np.ndarray, d: np.ndarray, breaks: list[int], min_change: float) -> list[int]:
-    """Drop the break between the two most similar neighbouring velocities while they differ by < min_change."""
-    breaks = list(breaks)
-    while len(breaks) > 2:
-        slopes = [_line(t[a:b], d[a:b])[0] for a, b in itertools.pairwise(breaks)]
-        change = [abs(s1 - s2) / max(abs(s1), abs(s2), 1e-300) for s1, s2 in itertools.pairwise(slopes)]
-        j = int(np.argmin(change))
-        if change[j] >= min_change:
+def _weighted_moments(t: np.ndarray, d: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, ...]:
+    return w, w * t, w * d, w * t * t, w * t * d, w * d * d
+
+
+def _piece_test(bins: _Bins, sums: list[np.ndarray], hinges: list[int]) -> tuple[np.ndarray, np.ndarray]:
+    """Each piece's velocity (scaled units) and each change's t-value: the two pieces' slopes differ by how many
+    standard errors (from the noise model, its inflation at the shorter piece's length and any excess misfit).
+
+    The bin beside a change is left out of both pieces' lines (it may straddle the change), so a change's exact
+    time within its bins does not matter here.
+    """
+    edges = np.array([0, *hinges, bins.t.size])
+    lengths = np.diff(edges)
+    guard = (lengths >= 7).astype(int)
+    lo, hi = edges[:-1] + guard, edges[1:] - guard
+    c, st, sd, stt, std, _ = (s[hi] - s[lo] for s in sums)
+    vt = stt - st * st / c
+    slopes = (std - st * sd / c) / vt + bins.trend
+    excess = max(float(np.sum(_misfit(sums, edges[:-1], edges[1:]))) / max(bins.t.size - 2 * lengths.size, 1), 1.0)
+    shorter = np.minimum(lengths[1:], lengths[:-1])
+    var = (1.0 / vt[1:] + 1.0 / vt[:-1]) * excess * _inflation_at(bins, shorter)
+    return slopes, np.diff(slopes) / np.sqrt(var)
+
+
+def _significant_hinges(
+    bins: _Bins, hinges: list[int], min_change: float, min_points: int, min_duration: float
+) -> list[int]:
+    """Drop changes, weakest first, until each is significant, a real change of velocity and between pieces long
+    enough (see :func:`find_segments`)."""
+    hinges = list(hinges)
+    n = bins.t.size
+    z_crit = math.sqrt(2.0 * math.log(max(n, 3))) + 2.0
+    rows = np.concatenate([bins.first, [int(bins.first[-1] + bins.count[-1])]])
+    sums = [np.concatenate([[0.0], np.cumsum(v)]) for v in _weighted_moments(bins.t, bins.d, 1.0 / bins.var)]
+    while hinges:
+        slopes, tvalue = _piece_test(bins, sums, hinges)
+        strength = np.abs(tvalue)
+        change = np.abs(np.diff(slopes)) / np.maximum(np.maximum(np.abs(slopes[1:]), np.abs(slopes[:-1])), 1e-300)
+        weak = (strength < z_crit) | (change < min_change)
+        edges = [0, *hinges, n]
+        for j, (a, b) in enumerate(itertools.pairwise(edges)):
+            duration = (bins.t[b - 1] - bins.t[a]) * bins.time_scale + bins.width
+            if rows[b] - rows[a] < min_points or duration < min_duration:
+                neighbours = [k for k in (j - 1, j) if 0 <= k < len(hinges)]
+                weak[min(neighbours, key=lambda k: strength[k])] = True
+        if not weak.any():
             break
-        del breaks[j + 1]
+        candidates = np.flatnonzero(weak)
+        del hinges[int(candidates[np.argmin(strength[candidates])])]
+    return hinges
+
+
+#: the pieces may miss the record by at most this many times its noise at the longest scale (a smooth curve
+#: misses it by 1e5-1e7 times; the real sepiolite records by 0.5-0.9, synthetic quantised ones by about 1)
+CURVED = 100.0
+
+
+def _refuse_curved(bins: _Bins, hinges: list[int]) -> None:
+    """DataError when the straight pieces miss the binned record by far more than its noise: the load point's
+    velocity changes smoothly, not in steps."""
+    sums = [np.concatenate([[0.0], np.cumsum(v)]) for v in _weighted_moments(bins.t, bins.d, 1.0 / bins.var)]
+    edges = np.array([0, *hinges, bins.t.size])
+    dof = max(bins.t.size - 2 * (edges.size - 1), 1)
+    excess = float(np.sum(_misfit(sums, edges[:-1], edges[1:]))) / dof / float(bins.inflation[1][-1])
+    if excess > CURVED:
+        raise DataError(
+            f"load-point displacement: its {edges.size - 1} straight pieces miss it by {excess:.3g} times its noise; "
+            "expected piecewise-constant velocity (give the history with --segment or --protocol, or drive the "
+            "model with the measured displacement)"
+        )
+
+
+def _refine(
+    sums: list[np.ndarray], breaks: list[int], first: np.ndarray, hinges: list[int], min_points: int
+) -> list[int]:
+    """Each interior break moved to its best row within two bins, between its neighbours."""
+    breaks = list(breaks)
+    last = int(sums[0].size - 1)
+    for k in range(1, len(breaks) - 1):
+        h = hinges[k - 1]
+        lo = max(breaks[k - 1] + min_points, int(first[max(h - 2, 0)]))
+        hi = min(breaks[k + 1] - min_points, int(first[h + 2]) if h + 2 < first.size else last)
+        if hi <= lo:
+            continue
+        j = np.arange(lo, hi + 1)
+        cost = _misfit(sums, np.full_like(j, breaks[k - 1]), j) + _misfit(sums, j, np.full_like(j, breaks[k + 1]))
+        breaks[k] = int(j[np.argmin(cost)])
     return breaks
+
+
+#: the smoothing window makes a local line's velocity this precise (relative to the record's slower speeds)
+SMOOTH_PRECISION = 0.05
+
+
+def measured_history(record: LabRecord, smoothing: float | None = None) -> Protocol:
+    """The load point's history as measured: its smoothed displacement, followed by piecewise-constant velocities.
+
+    Lab codes (xlook, RSFit3000) drive the model with the measured load point; this does so with a history the
+    RSF solver integrates piece by piece.  The velocity levels' changes (:func:`find_segments`) are kept as
+    kinks; between them the displacement is smoothed by local straight lines over ``smoothing`` seconds (by
+    default the window over which the record's noise leaves a line's velocity 5 % uncertain at its slower
+    speeds), never across a change, so a step is not smeared while the rig's ramps and wander are followed.
+    The smoothed curve is then cut into straight pieces where it bends (Douglas-Peucker, to the noise of one
+    bin's mean), so a steady stretch costs one segment and a transient a few; the velocities are >= 0.
+    """
+    if smoothing is not None and not (
+        isinstance(smoothing, (int, float)) and math.isfinite(smoothing) and smoothing > 0
+    ):
+        raise ParameterError(f"smoothing: expected a positive time window in seconds, got {smoothing!r}")
+    t, d = record.time, record.displacement
+    levels = find_segments(t, d, max_segments=10_000)
+    bins = _bins(t, d)
+    scale = float(np.max(np.abs(d - np.polyval(np.polyfit(t, d, 1), t)))) or 1.0
+    noise = math.sqrt(float(np.median(bins.var)) * float(bins.inflation[1][0])) * scale  # one bin's mean (m)
+    window = float(smoothing) if smoothing is not None else _smoothing_window(t, d, noise, bins.width)
+    changes = levels.boundaries
+    grid_t, grid_d = _smoothed(t, d, changes, window)
+    keep = _bends(grid_t, grid_d, noise, np.searchsorted(grid_t, changes))
+    knots_t, knots_d = grid_t[keep], np.maximum.accumulate(grid_d[keep])
+    speeds = np.diff(knots_d) / np.diff(knots_t)
+    items = tuple(Segment(float(v), float(dt)) for v, dt in zip(speeds, np.diff(knots_t), strict=True))
+    return Protocol(items, name="measured load point")
+
+
+def _smoothing_window(t: np.ndarray, d: np.ndarray, noise: float, width: float) -> float:
+    """The window over which a line's slope through bins of ``noise`` is SMOOTH_PRECISION of the slower speeds:
+    slope variance 12 noise^2 width / T^3 (T / width bins of a line over T)."""
+    edges = np.unique(np.linspace(0, t.size - 1, 21).astype(int))
+    speeds = np.abs(np.diff(d[edges])) / np.diff(t[edges])
+    slow = float(np.percentile(speeds[speeds > 0], 10)) if np.any(speeds > 0) else 0.0
+    span = float(t[-1] - t[0])
+    if slow <= 0 or noise <= 0:
+        return 3.0 * width
+    window = (12.0 * noise**2 * width / (SMOOTH_PRECISION * slow) ** 2) ** (1.0 / 3.0)
+    return float(min(max(window, 3.0 * width), span / 20.0))
+
+
+def _smoothed(t: np.ndarray, d: np.ndarray, changes: np.ndarray, window: float) -> tuple[np.ndarray, np.ndarray]:
+    """Local straight lines over ``window`` (truncated at each change, >= 5 rows) on a grid of window / 4 that
+    holds every change; at a change the two sides' values are averaged (the load point is continuous)."""
+    grid_t, grid_d = [], []
+    for a, b in itertools.pairwise(changes):
+        i0, i1 = np.searchsorted(t, [a, b + 1e-12 * max(abs(b), 1.0)])
+        i1 = max(i1, i0 + 2)
+        rows_t, rows_d = t[i0:i1], d[i0:i1]
+        steps = max(math.ceil((b - a) / (0.25 * window)), 1)
+        g = np.linspace(a, b, steps + 1)
+        grid_t.append(g)
+        grid_d.append(_local_lines(rows_t, rows_d, g, window))
+    times = np.concatenate(grid_t)
+    values = np.concatenate(grid_d)
+    # the end of one piece and the start of the next are the same time: average them
+    same = np.flatnonzero(np.diff(times) <= 0)
+    values[same + 1] = 0.5 * (values[same] + values[same + 1])
+    keep = np.ones(times.size, dtype=bool)
+    keep[same] = False
+    return times[keep], values[keep]
+
+
+def _local_lines(t: np.ndarray, d: np.ndarray, g: np.ndarray, window: float) -> np.ndarray:
+    """A straight line through the rows within window / 2 of each grid time (at least 5 rows), at that time."""
+    if t.size < 3:
+        return np.interp(g, t, d)
+    t0 = float(t[0])
+    tc, dc = t - t0, d - d[0]
+    sums = [np.concatenate([[0.0], np.cumsum(v)]) for v in (np.ones_like(tc), tc, dc, tc * tc, tc * dc)]
+    lo = np.searchsorted(t, g - 0.5 * window)
+    hi = np.searchsorted(t, g + 0.5 * window, side="right")
+    short = hi - lo < 5
+    lo = np.where(short, np.clip(np.searchsorted(t, g) - 2, 0, max(t.size - 5, 0)), lo)
+    hi = np.where(short, np.minimum(lo + 5, t.size), hi)
+    c, st, sd, stt, std = (s[hi] - s[lo] for s in sums)
+    vt = stt - st * st / c
+    slope = np.divide(std - st * sd / c, vt, out=np.zeros_like(vt), where=vt > 0)
+    return d[0] + sd / c + slope * (g - t0 - st / c)
+
+
+def _bends(t: np.ndarray, d: np.ndarray, tolerance: float, fixed: np.ndarray) -> np.ndarray:
+    """Indices of the points a broken line needs to stay within ``tolerance`` of (t, d) (Douglas-Peucker), the
+    ``fixed`` ones always among them."""
+    keep = np.zeros(t.size, dtype=bool)
+    keep[np.clip(fixed, 0, t.size - 1)] = True
+    keep[[0, -1]] = True
+    stack = list(itertools.pairwise(np.flatnonzero(keep)))
+    while stack:
+        a, b = stack.pop()
+        if b - a < 2:
+            continue
+        inner = slice(a + 1, b)
+        line = d[a] + (d[b] - d[a]) * (t[inner] - t[a]) / (t[b] - t[a])
+        miss = np.abs(d[inner] - line)
+        k = int(np.argmax(miss))
+        if miss[k] > tolerance:
+            m = a + 1 + k
+            keep[m] = True
+            stack += [(a, m), (m, b)]
+    return np.flatnonzero(keep)
