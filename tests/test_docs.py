@@ -11,7 +11,9 @@ A page steers a block with HTML comments on the lines just before its fence (inv
 
 * ``<!-- test: skip REASON -->``: not run (the reason is required and kept in the test's output);
 * ``<!-- test: replace OLD -> NEW -->``: run with OLD replaced by NEW, for shorter runs (OLD must occur);
-* ``<!-- test: before COMMAND -->``: a shell line run first, to make the block's input files.
+* ``<!-- test: before COMMAND -->``: a shell line run first, to make the block's input files;
+* ``<!-- test: expect TEXT -->`` (repeatable): what the block's commands print must contain TEXT — a number
+  the page quotes beside the command comes from that command (a block with an ``expect`` runs unshortened).
 
 Inline code that starts with ``stickslip`` (synopses in tables and prose) is checked too: its command must exist
 and every ``--option`` in it must be one of that command's.  Every ``stickslip.module.name`` a page mentions must
@@ -37,7 +39,7 @@ PAGES = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
 RUNNABLE = {"bash", "console", "python"}
 SHOWN = {"text", "json", "toml", "csv"}
 FENCE = re.compile(r"^(?P<indent> {0,3})(?P<fence>`{3,}|~{3,})\s*(?P<lang>[^\s`]*)")
-MARKER = re.compile(r"^\s*<!--\s*test:\s*(?P<kind>skip|replace|before)\b\s*(?P<arg>.*?)\s*-->\s*$")
+MARKER = re.compile(r"^\s*<!--\s*test:\s*(?P<kind>skip|replace|before|expect)\b\s*(?P<arg>.*?)\s*-->\s*$")
 INLINE = re.compile(r"(?<!`)`(stickslip [^`]+)`(?!`)")
 TIMES: dict[str, float] = {}
 
@@ -118,21 +120,24 @@ def shell_lines(text: str, lang: str) -> list[str]:
     return [line for line in lines if line and not line.startswith("#")]
 
 
-def run_shell_line(line: str, where: str, capsys: pytest.CaptureFixture[str]) -> None:
+def run_shell_line(line: str, where: str, capsys: pytest.CaptureFixture[str]) -> str:
+    """Run one logical line (``&&`` chains too); returns what its stickslip commands printed."""
     words = shlex.split(line, comments=True)
     unsupported = {"|", ">", ">>", "<", ";", "||", "&"} & set(words)
     assert not unsupported, f"{where}: cannot run {line!r} (shell operator {unsupported}); mark the block"
     command: list[str] = []
+    printed = ""
     for word in [*words, "&&"]:
         if word != "&&":
             command.append(word)
             continue
         if command:
-            run_command(command, where, capsys)
+            printed += run_command(command, where, capsys)
         command = []
+    return printed
 
 
-def run_command(argv: list[str], where: str, capsys: pytest.CaptureFixture[str]) -> None:
+def run_command(argv: list[str], where: str, capsys: pytest.CaptureFixture[str]) -> str:
     program = Path(argv[0]).name
     if program == "stickslip":
         capsys.readouterr()
@@ -141,10 +146,12 @@ def run_command(argv: list[str], where: str, capsys: pytest.CaptureFixture[str])
         out, err = capsys.readouterr()
         status = exit_info.value.code or 0
         assert status == 0, f"{where}: `{shlex.join(argv)}` exited {status}:\n{err[-2000:]}\n{out[-1000:]}"
+        return out + err
     elif program in {"python", "python3"} and len(argv) == 3 and argv[1] == "-c":
         exec(compile(argv[2], where, "exec"), {"__name__": "__main__"})
     else:
         pytest.fail(f"{where}: no runner for `{shlex.join(argv)}`; mark the block (skip REASON) if it is not run")
+    return ""
 
 
 def run_block(block: Block, namespace: dict, capsys: pytest.CaptureFixture[str]) -> None:
@@ -156,8 +163,9 @@ def run_block(block: Block, namespace: dict, capsys: pytest.CaptureFixture[str])
         exec(compile(text, block.where, "exec"), namespace)
         capsys.readouterr()
     else:
-        for line in shell_lines(text, block.lang):
-            run_shell_line(line, block.where, capsys)
+        printed = "".join(run_shell_line(line, block.where, capsys) for line in shell_lines(text, block.lang))
+        missing = [arg for kind, arg in block.markers if kind == "expect" and arg not in printed]
+        assert not missing, f"{block.where}: the page quotes {missing} beside the command, which printed:\n{printed}"
 
 
 @pytest.mark.parametrize("page", PAGES, ids=_page_id)
@@ -169,6 +177,8 @@ def test_every_block_is_tagged_and_marked_with_reasons(page):
         reason = block.skip_reason()
         assert reason is None or len(reason) > 10, f"{block.where}: `test: skip` needs its reason"
         block.runnable_text()  # every replace marker applies
+        kinds = {kind for kind, _ in block.markers}
+        assert not {"expect", "replace"} <= kinds, f"{block.where}: a quoted number comes from the command as shown"
     assert not indented_commands(page), "commands in indented blocks are not tested; fence them:\n" + "\n".join(
         indented_commands(page)
     )
