@@ -390,7 +390,7 @@ MIN_WINDOW_ROWS = 10
 MAX_TIME_DEFAULT = "5 min"
 #: Jacobians (each n + 1 model runs, n the free parameters) of one least-squares search: counted runs over n + 1
 #: were 6-12 on the step records of tests/test_rsf_fit_protocols.py that fit, 20-80 on ones that fail and restart.
-JACOBIANS_PER_SEARCH = 15
+JACOBIANS_PER_SEARCH = 10
 #: At most this many times the typical cost: a troubled search restarts in Dc (3) and is polished (up to 3).
 RESTART_FACTOR = 7
 #: A model run this long is timed once (the first run's set-up, about a second, is then a small part of it).
@@ -439,7 +439,8 @@ def _duration(seconds: float) -> str:
 )
 @click.option("--displacement-unit", default=None,
               help="Unit of the displacement column [the unit its header names, e.g. (um), else m].")  # fmt: skip
-@click.option("--time-unit", default="s", show_default=True, help="Unit of the time column.")
+@click.option("--time-unit", default=None,
+              help="Unit of the time column [the unit its header names, e.g. (s), else s].")  # fmt: skip
 @click.option("--window", "window_text", default=None, metavar="T0:T1",
               help='Fit only the rows from T0 to T1 in the file\'s own clock, e.g. "20100 s:21000 s" (an end may be '
                    "left out).")  # fmt: skip
@@ -813,14 +814,15 @@ def _history(options: dict[str, Any], record: Any) -> Any:
 
 def estimate_fit_cost(record: Any, settings: dict[str, Any]) -> FitCost:
     """One model run of the record's history at the fit's tolerance, timed, times the runs a fit typically takes:
-    (n + 1) per Jacobian x :data:`JACOBIANS_PER_SEARCH` per search (three for a two-state fit), plus walkers x
-    steps of an emcee posterior.  Counted runs of fits that converged were 0.75-1.2 times this
-    (tests/test_rsf_fit_cli.py checks one)."""
+    (n + 1) per Jacobian x :data:`JACOBIANS_PER_SEARCH` per search, two searches (the fit and its comparison
+    with the drift term toggled) and two more for a second state, plus walkers x steps of an emcee posterior.
+    Counted runs were 0.6-1.2 times this on synthetic records and shipped records that fit at once, 3 times on
+    ones whose search restarts (docs/rsf.md; tests/test_rsf_fit_cli.py checks one)."""
     held = set(settings.get("fixed", {})) - {"trend", "time_trend"}  # a held drift is no fitted one either way
     free = 5 + (2 if settings["states"] == 2 else 0) - len(held)  # mu0, a, b, Dc, k (b2, Dc2)
     trend = settings["trend"] or ""
     free += {"both": 2, "slip": 1, "time": 1}.get(trend, 0)
-    searches = 1 + 2 * (settings["states"] == 2)  # the two-state search follows a one-state one and runs longer
+    searches = 2 + 2 * (settings["states"] == 2)  # the two-state search follows a one-state one and runs longer
     runs = searches * (free + 1) * JACOBIANS_PER_SEARCH
     if settings["mcmc_steps"]:
         runs += max(4 * free, 16) * settings["mcmc_steps"]
