@@ -328,7 +328,7 @@ def test_steady_state_plot_returns_axes_in_um_per_s():
 
 
 def test_figure_steady_curve_marks_vc_and_data():
-    from stickslip.plotting import figure_steady_curve
+    from stickslip.plots.steady import figure_steady_curve
 
     data = {"velocity": np.array([2e-4, 1e-3]), "stress": np.array([300.0, 650.0])}
     fig = figure_steady_curve(load_parameters(), vmin=20e-6, vmax=5e-3, data=data)

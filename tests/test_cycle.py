@@ -188,7 +188,7 @@ def test_frame_summary_and_plot(sim50):
 def test_figures(sim50, sim100, sim350, params):
     from matplotlib.figure import Figure
 
-    from stickslip.cycle_plots import figure_chain_fraction, figure_cycle_path, figure_cycles, figure_slip_velocity
+    from stickslip.plots.cycles import figure_chain_fraction, figure_cycle_path, figure_cycles, figure_slip_velocity
 
     sims = [sim50, sim100, sim350]
     data = [(sim50.time, sim50.stress + 1.0), None, None]

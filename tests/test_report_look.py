@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from matplotlib.colors import to_rgba
 
-from stickslip.cycle_plots import figure_cycles
+from stickslip.plots.cycles import figure_cycles
 from stickslip.model.cycle import simulate
 from stickslip.parameters import load_parameters
 from stickslip.plots.sweeps import plot_phase_diagram

@@ -1,7 +1,9 @@
-"""Old home of the stick-slip cycle figures, kept for code that imports them from here.
+"""Old home of the stick-slip cycle figures, deprecated: it warns on import.
 
 The drawing now lives in :mod:`stickslip.plots.cycles`.
 """
+
+import warnings
 
 from .plots.cycles import (
     figure_chain_fraction,
@@ -24,3 +26,9 @@ __all__ = [
     "plot_slip",
     "plot_stick",
 ]
+
+warnings.warn(
+    "stickslip.cycle_plots is deprecated; import from stickslip.plots.cycles",
+    DeprecationWarning,
+    stacklevel=2,
+)

@@ -1,7 +1,9 @@
-"""Old home of the steady-curve figures and the common style, kept for code that imports it from here.
+"""Old home of the steady-curve figures and the common style, deprecated: it warns on import.
 
 The drawing now lives in :mod:`stickslip.plots` (:mod:`~stickslip.plots.steady`, :mod:`~stickslip.plots.style`).
 """
+
+import warnings
 
 from .plots.steady import figure_steady_curve, plot_steady, protocol_plot
 from .plots.style import (
@@ -30,3 +32,9 @@ __all__ = [
     "plot_steady",
     "protocol_plot",
 ]
+
+warnings.warn(
+    "stickslip.plotting is deprecated; import from stickslip.plots.steady and stickslip.plots.style",
+    DeprecationWarning,
+    stacklevel=2,
+)

@@ -36,7 +36,7 @@ def saturating_figure(run: ModelRun) -> ReportFigure:
     from ..fitting.saturation_fit import fit_saturation
     from ..model.cycle import simulate
     from ..model.steady import steady_state
-    from ..plotting import apply_style
+    from ..plots.style import apply_style
 
     paper = run.params
     data = read_steady_data(synthetic_steady_path())

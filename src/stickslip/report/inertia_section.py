@@ -25,7 +25,7 @@ def inertia_figure(run: ModelRun) -> ReportFigure:
     import numpy as np
     from matplotlib.figure import Figure
 
-    from ..plotting import apply_style
+    from ..plots.style import apply_style
     from ..studies.inertia import gel_block_cases
     from ..transient.stability import critical_from_response, follow_root, interface_response
 
@@ -116,7 +116,7 @@ def inertia_run_figure(run: ModelRun) -> ReportFigure:
     from matplotlib.figure import Figure
     from scipy.signal import find_peaks
 
-    from ..plotting import apply_style
+    from ..plots.style import apply_style
     from ..protocols import constant
     from ..studies.inertia import gel_block_cases
     from ..transient import run_transient

@@ -22,7 +22,7 @@ STEPS = (("step up", (100e-6, 1000e-6), "C0"), ("step down", (1000e-6, 100e-6), 
 def rsf_reading_figure(run: ModelRun) -> ReportFigure:
     from matplotlib.figure import Figure
 
-    from ..plotting import apply_style
+    from ..plots.style import apply_style
     from ..studies.rsf_reading import bond_step, interval_table, read_step
 
     readings = []

@@ -28,7 +28,7 @@ def sensitivity_figure(run: ModelRun) -> ReportFigure:
     import numpy as np
     from matplotlib.figure import Figure
 
-    from ..plotting import apply_style
+    from ..plots.style import apply_style
     from ..studies.sensitivity import TOLERANCE, predictions, quasi_static_predictions, spreads, stored_region
 
     region = stored_region(run.params)
