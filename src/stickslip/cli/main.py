@@ -97,10 +97,32 @@ def _run(argv: list[str] | None) -> int:
             "a number left the floating-point range (about 1e-308 to 1e308) during the computation;"
             " check that the input values are physical"
         )
+    except OSError as exc:  # `stickslip critical --json > /dev/full`: the output could not be written
+        _silence_stdout()
+        return _fail(_os_error_text(exc))
     except MemoryError:
         return _fail("out of memory: the input or the requested size is too large for this machine")
     except Exception as exc:  # a bug: still one line, but say it is ours
         return _fail(f"internal error ({type(exc).__name__}): {exc}", status=1)
+    return 0
+
+
+def _os_error_text(exc: OSError) -> str:
+    """An I/O failure in words: what could not be read or written, and why (no errno numbers, no traceback)."""
+    reason = exc.strerror or str(exc) or type(exc).__name__
+    where = exc.filename if exc.filename is not None else "the output (standard output or a file)"
+    return f"cannot read or write {where}: {reason}"
+
+
+def _flush_stdout() -> int:
+    """Flush standard output now, so a full disk is reported in one line instead of at interpreter exit."""
+    try:
+        sys.stdout.flush()
+    except OSError as exc:
+        _silence_stdout()
+        return _fail(_os_error_text(exc))
+    except ValueError:  # closed stdout (tests)
+        pass
     return 0
 
 
@@ -124,6 +146,7 @@ def main(argv: list[str] | None = None) -> None:
     warnings.showwarning = collect  # numpy's "overflow encountered in exp" is not for the user's eyes
     try:
         status = _run(argv)
+        status = _flush_stdout() or status
     finally:
         warnings.showwarning = shown
     if status == 0 and caught:

@@ -31,7 +31,7 @@ def register_model(model: Any, *, replace: bool = False) -> FrictionModel:
     """Make ``model`` (a :class:`FrictionModel` instance, or a class to instantiate) available by its name and
     aliases; returns it.  A name already taken by another model is refused unless ``replace=True``."""
     if isinstance(model, type):
-        model = model()
+        model = _instance(model, "register_model")
     missing = [attr for attr in _REQUIRED if not hasattr(model, attr)]
     if missing:
         raise ParameterError(
@@ -124,6 +124,24 @@ def _entry_points() -> None:
         register_model(model)
 
 
+def _instance(target: Any, where: str) -> Any:
+    """A class instantiated (no arguments), anything else as is; an abstract class or one needing arguments refused."""
+    if not isinstance(target, type):
+        return target
+    import inspect
+
+    if inspect.isabstract(target):
+        missing = ", ".join(sorted(getattr(target, "__abstractmethods__", ())))
+        raise ParameterError(
+            f"{where}: {target.__name__} is an abstract class (it lacks {missing});"
+            " expected a concrete friction model, e.g. a subclass of stickslip.FrictionModel that defines them"
+        )
+    try:
+        return target()
+    except TypeError as exc:
+        raise ParameterError(f"{where}: {target.__name__} cannot be made without arguments ({exc})") from None
+
+
 def _imported(path: str) -> FrictionModel:
     """``module:attr`` (attr may be dotted): the model there, registered under its name."""
     module_name, _, attr = path.partition(":")
@@ -137,7 +155,7 @@ def _imported(path: str) -> FrictionModel:
         if not hasattr(target, part):
             raise ParameterError(f"--model {path!r}: module {module_name!r} has no attribute {attr!r}")
         target = getattr(target, part)
-    model = target() if isinstance(target, type) else target
+    model = _instance(target, f"--model {path!r}")
     if not all(hasattr(model, a) for a in _REQUIRED):
         raise ParameterError(f"--model {path!r}: {attr} is not a friction model (subclass stickslip.FrictionModel)")
     _builtins()

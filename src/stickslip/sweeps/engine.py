@@ -201,7 +201,15 @@ def read_results(folder: str | Path) -> Any:
         raise DataError(f"{folder}: no finished batch yet (no part-*.parquet); run or resume the sweep first")
     from ..columns import read_parquet
 
-    frame = read_parquet(folder)
+    try:
+        frame = read_parquet(folder)
+    except StickslipError:
+        raise
+    except (OSError, ValueError) as exc:  # pyarrow.ArrowInvalid (a ValueError) on a truncated or foreign chunk
+        raise DataError(
+            f"{folder}: a Parquet chunk cannot be read ({type(exc).__name__}: {exc}); run the same sweep command"
+            " again to check the chunks and recompute the damaged ones"
+        ) from None
     units = frame.attrs["units"]
     frame = frame.sort_values("point", kind="stable").reset_index(drop=True)
     frame.attrs["units"] = units  # the units each chunk's schema names (stickslip.columns)

@@ -144,6 +144,7 @@ def open_store(folder: str | Path, spec: SweepSpec, batch_size: int, overwrite: 
     if isinstance(batch_size, bool) or not isinstance(batch_size, int) or batch_size < 1:
         raise ParameterError(f"batch_size: expected a positive whole number of points, got {batch_size!r}")
     created = not os.path.lexists(folder) if str(folder).strip() else False
+    had_lock = os.path.lexists(Path(folder) / LOCK) if str(folder).strip() else True
     path = _folder(folder)
     lock = _lock_folder(path, folder)
     try:
@@ -154,6 +155,9 @@ def open_store(folder: str | Path, spec: SweepSpec, batch_size: int, overwrite: 
                 (path / LOCK).unlink()
                 (path / MANIFEST).unlink(missing_ok=True)
                 path.rmdir()
+        elif not had_lock:  # a refused command writes nothing: not even the lock file, in a folder of other files
+            with contextlib.suppress(OSError):
+                (path / LOCK).unlink()
         os.close(lock)
         raise
     store.lock = lock
@@ -285,6 +289,11 @@ def _check_chunks(store: SweepStore) -> None:
         match = _CHUNK.match(path.name)
         if not match:
             continue
+        if not path.is_file() or path.is_symlink():  # a folder or a link by a chunk's name is not ours to remove
+            raise DataError(
+                f"-o {store.folder}: {path.name} is not a regular file (a folder, link or device by a chunk's name);"
+                " remove or rename it, then run the same command again"
+            )
         batch = int(match.group(1))
         why = _chunk_problem(store, batch, path, ledger.get(batch))
         if why is None:
