@@ -756,7 +756,7 @@ def _fit_settings(
     free = _free_keys(options["free_keys"])
     _stiffness_roles(options, fixed, guess, free, sigma)
     for key in sorted(set(fixed) & (set(guess) | free)):
-        named = key in options["free_keys"]
+        named = key in _free_keys(options["free_keys"])  # (else the stiffness was freed by --fit-stiffness)
         other = f"--guess {key}" if key in guess else f"--free {key}" if named else "--fit-stiffness"
         raise ParameterError(f"--fix {key} and {other}: a parameter is either held or fitted")
     if states == 1:
