@@ -387,13 +387,15 @@ def _bins(t: np.ndarray, d: np.ndarray) -> _Bins:
     dc = d - np.polyval(line, tc)
     scale = max(float(np.max(np.abs(dc))), 1e-300)
     dc = dc / scale
-    if n <= SEARCH_BINS:
-        first = np.arange(n)
+    steps = np.diff(t)
+    if n <= SEARCH_BINS and np.max(steps) <= 1.5 * np.min(steps):
+        first = np.arange(n)  # evenly sampled: a row is a bin
         width = span / max(n - 1, 1)
-    else:
-        ids = np.minimum((tc * SEARCH_BINS).astype(np.int64), SEARCH_BINS - 1)
+    else:  # equal time bins: a changed sampling rate changes only how many rows a bin holds
+        bins = min(SEARCH_BINS, n)
+        ids = np.minimum((tc * bins).astype(np.int64), bins - 1)
         first = np.flatnonzero(np.concatenate([[True], np.diff(ids) > 0]))
-        width = span / SEARCH_BINS
+        width = span / bins
     count = np.diff(np.concatenate([first, [n]]))
     bt = np.add.reduceat(tc, first) / count
     bd = np.add.reduceat(dc, first) / count
