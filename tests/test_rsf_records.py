@@ -265,3 +265,24 @@ def test_the_measured_history_refuses_a_bad_window():
         with pytest.raises(ParameterError, match="smoothing"):
             measured_history(record, smoothing=bad)
     assert measured_history(record, smoothing=5.0).velocities == pytest.approx(1e-6, rel=1e-9)
+
+
+@pytest.mark.parametrize(
+    ("velocities", "durations", "sampling", "noise"),
+    [
+        ((10, 0, 10, 3), (20, 10, 30, 40), ((0, 0.01), (40, 0.1)), 0.2),  # slide-hold-slide, 100 Hz then 10 Hz
+        ((1, 1.3, 1), (100, 100, 100), ((0, 0.01),), 0.2),  # a 30 % step, 30,000 rows
+        ((1, 10, 1), (10, 10, 10), ((0, 0.1), (9, 0.001), (21, 0.1)), 1e-6),  # clean, 1 kHz around both steps
+    ],
+    ids=["slide-hold-slide", "30 % up and back", "clean at two rates"],
+)
+def test_other_shapes_with_bits_and_correlated_noise(velocities, durations, sampling, noise):
+    """A hold (velocity 0), a small step, and a noise-free record at two rates (where PELT's three-bin slivers
+    at a kink must not survive as levels): the truth's levels and change times."""
+    t = sample_times(sampling, float(sum(durations)))
+    bit = 0.1 if noise > 1e-3 else 1e-9
+    truth, d = load_point(velocities, durations, t, bit=bit, noise=noise, correlation_time=0.05, seed=1)
+    found = find_segments(t, d * UM)
+    assert len(found.segments) == len(velocities), found.describe()
+    assert found.velocities == pytest.approx(truth.velocities, rel=0.02, abs=0.02 * UM)
+    assert np.all(np.abs(found.boundaries[1:-1] - truth.boundaries[1:-1]) <= change_tolerance(truth, t, noise * UM))

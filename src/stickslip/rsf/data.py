@@ -324,7 +324,7 @@ def find_segments(
     displacement is continuous, so a continuous broken line through them is then fitted and a change
     is dropped, weakest first, while its change of slope is within ``z = sqrt(2 ln n) + 2`` standard
     errors of none, the two velocities differ by less than ``min_change`` (relative), or a piece is shorter
-    than ``min_points`` rows or ``min_duration`` seconds (default: three bins).  Each remaining change is
+    than ``min_points`` rows or ``min_duration`` seconds (default: five bins).  Each remaining change is
     then placed on the full record and dated where the two fitted lines meet.  Raises DataError when more
     than ``max_segments`` pieces remain (the displacement is not piecewise linear).
     """
@@ -336,7 +336,7 @@ def find_segments(
     bins = _bins(t, d)
     proposed = _pelt(bins)
     bins = replace(bins, inflation=_slope_inflation(bins.t, bins.d, bins.var, proposed))
-    shortest = 3.0 * bins.width if min_duration is None else float(min_duration)
+    shortest = 5.0 * bins.width if min_duration is None else float(min_duration)  # PELT leaves 3-bin slivers
     hinges = _significant_hinges(bins, proposed, min_change, min_points, shortest)
     if len(hinges) + 1 > max_segments:
         raise DataError(
@@ -584,7 +584,7 @@ def _piece_test(bins: _Bins, sums: list[np.ndarray], hinges: list[int]) -> tuple
     """
     edges = np.array([0, *hinges, bins.t.size])
     lengths = np.diff(edges)
-    guard = (lengths >= 7).astype(int)
+    guard = (lengths >= 4).astype(int)
     lo, hi = edges[:-1] + guard, edges[1:] - guard
     c, st, sd, stt, std, _ = (s[hi] - s[lo] for s in sums)
     vt = stt - st * st / c
