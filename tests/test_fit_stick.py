@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pytest
 
@@ -116,3 +118,60 @@ def test_stick_plot_has_model_line_error_bars_and_linear_axes():
     assert any(len(line.get_xdata()) > 50 for line in ax.get_lines())  # the fitted t_s(V0) curve
     assert any(c.has_yerr for c in ax.containers)
     assert ax.get_xlim()[0] == 0.0 and ax.get_ylim()[0] == 0.0
+
+
+def _table(velocity, stick_time) -> StickData:
+    velocity = np.asarray(velocity, dtype=float)
+    return StickData.from_arrays(velocity, np.asarray(stick_time, dtype=float), None, np.full(velocity.size, SIGMA_C))
+
+
+GARBAGE = {
+    # issue 29: each exited 0 and wrote -o, with 341 % relative noise and every parameter "not determined"
+    "random": ([20e-6, 30e-6, 50e-6, 70e-6, 100e-6, 150e-6], [14.1, 2.3, 27.0, 5.5, 21.9, 1.7]),
+    "increasing": ([20e-6, 30e-6, 50e-6, 70e-6, 100e-6, 150e-6], [3.0, 8.4, 13.8, 19.2, 24.6, 30.0]),
+    "same velocity": ([50e-6] * 5, [6.0, 22.0, 11.0, 29.0, 15.0]),
+    "tiny velocities": ([2e-11, 3e-11, 5e-11, 7e-11, 1e-10, 1.5e-10], [30.0, 24.6, 19.2, 13.8, 8.4, 3.0]),
+}
+
+
+@pytest.mark.parametrize("name", list(GARBAGE))
+def test_garbage_tables_fail(name):
+    fit = fit_stick(_table(*GARBAGE[name]))
+    assert fit.status == "failed" and not fit.success and fit.reason
+    assert fit.as_dict()["status"] == "failed" and fit.as_dict()["reason"] == fit.reason
+    assert all(e.interval is None for e in fit.estimates)
+    assert fit.report().startswith("# Stick-phase fit") and "**Fit failed:**" in fit.report()
+
+
+def test_good_tables_have_status_ok(synthetic_table):
+    """The exact table and Table 1 (its outlier row 11 kept or left out) are fits, with status ok."""
+    assert fit_stick(synthetic_table).status == "ok"
+    for rows in ([], [11]):
+        fit = fit_stick(datasets.table1_path(), exclude_rows=rows)
+        assert fit.status == "ok" and fit.reason == "" and fit.as_dict()["status"] == "ok"
+
+
+def test_a_misfit_larger_than_the_scatter_of_repeated_cycles_fails():
+    """Repeated cycles measure the noise without the model (here 1 %): stick times that rise with velocity,
+    which Eq 15 cannot follow, leave a misfit far above it."""
+    velocity = np.repeat([30e-6, 60e-6, 100e-6], 3)
+    times = np.repeat([6.0, 12.0, 24.0], 3) * (1 + 0.01 * np.tile([-1.0, 0.0, 1.0], 3))
+    fit = fit_stick(_table(velocity, times))
+    assert fit.status == "failed" and "model does not describe these stick times" in fit.reason
+
+
+def test_cli_fit_stick_fails_with_exit_3_and_no_output(tmp_path, capsys):
+    from cli_helpers import run_main
+
+    velocity, times = GARBAGE["random"]
+    path = tmp_path / "random.csv"
+    path.write_text(
+        "pulling_velocity,stick_time,start_stress [Pa]\n"
+        + "\n".join(f"{v},{t},{SIGMA_C}" for v, t in zip(velocity, times, strict=True))
+        + "\n"
+    )
+    toml = tmp_path / "out.toml"
+    code, out, err = run_main(capsys, "fit", "stick", str(path), "--json", "-o", str(toml))
+    assert code == 3 and not toml.exists()
+    assert "stickslip: fit failed:" in err and "not written" in err
+    assert json.loads(out)["status"] == "failed"

@@ -169,7 +169,7 @@ def steady_command(
         seed=seed,
     )
     posterior = None
-    if posterior_module is not None:
+    if posterior_module is not None and fit.success:  # a failed fit has no posterior worth sampling
         # a bar on a terminal only (never with --json); a chain that stopped at the cap unconverged is said on
         # stderr too (a length fixed by --steps is the user's choice: the report and the JSON say it)
         posterior = posterior_module.sample_posterior(
@@ -214,10 +214,7 @@ def steady_command(
         emit_json(result)
     else:
         click.echo(report)
-    if not fit.success:
-        unwritten = f" ({output} not written)" if output is not None else ""
-        click.echo(f"stickslip: fit failed: {fit.reason}{unwritten}", err=True)
-        raise SystemExit(3)  # as `rsf fit`: 3 is a fit that ran but cannot be trusted (2 is bad input)
+    _exit_if_failed(fit, output)
 
 
 def _bayes_module() -> Any:
@@ -282,7 +279,7 @@ def stick_command(
         include_steady=include_steady,
         level=level,
     )
-    if output is not None:
+    if output is not None and fit.success:
         fitted = _fitted_set(
             fit.parameters, f"stick fit of {table.name}", f"stickslip fit stick of {table}, from {params.name}"
         )
@@ -308,6 +305,16 @@ def stick_command(
         emit_json(fit.as_dict())
     else:
         click.echo(report)
+    _exit_if_failed(fit, output)
+
+
+def _exit_if_failed(fit: Any, output: Path | None) -> None:
+    """A fit that ran but cannot be trusted: its reason on stderr, -o left unwritten, exit status 3."""
+    if fit.success:
+        return
+    unwritten = f" ({output} not written)" if output is not None else ""
+    click.echo(f"stickslip: fit failed: {fit.reason}{unwritten}", err=True)
+    raise SystemExit(3)  # as `rsf fit`: 3 is a fit that ran but cannot be trusted (2 is bad input)
 
 
 def register(cli: click.Group) -> None:

@@ -178,6 +178,7 @@ def stick_report(fit: StickFit) -> str:
     lines = [
         "# Stick-phase fit (Eqs 13-16)",
         "",
+        *([f"**Fit failed:** {fit.reason}.", ""] if fit.status != "ok" else []),
         f"- data: `{data.source}`, {int(fit.used.sum())} of {len(data)} rows fitted",
         f"- noise: {fit.noise}",
         goodness_line(fit.chi_square, fit.dof, True),

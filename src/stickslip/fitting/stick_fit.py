@@ -23,6 +23,7 @@ estimated from the scatter.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
@@ -82,6 +83,12 @@ class StickFit:
     noise_scale: float
     level: float
     messages: tuple[str, ...]
+    status: str = "ok"  # "failed" when the fit cannot be trusted; ``reason`` says why
+    reason: str = ""
+
+    @property
+    def success(self) -> bool:
+        return self.status == "ok"
 
     @property
     def reduced_chi_square(self) -> None:
@@ -99,6 +106,8 @@ class StickFit:
 
     def as_dict(self) -> dict[str, Any]:
         return {
+            "status": self.status,
+            **({"reason": self.reason} if self.reason else {}),
             "parameters": {e.key: e.as_dict() for e in self.estimates},
             "chi_square": self.chi_square,
             "dof": self.dof,
@@ -416,6 +425,9 @@ def fit_stick(
     if dof <= 0:
         messages.append("no degrees of freedom left: the noise cannot be estimated and the errors are undefined")
     noise = f"relative (ln), estimated from the scatter: {100 * math.sqrt(scale2):.3g} %" if dof > 0 else "undefined"
+    problems = _stick_problems(data, used, rows, current, keys, fixed, dof, scale2, problems)
+    if problems:
+        estimates = [_unusable(e) for e in estimates]
     return StickFit(
         data=data,
         parameters=current,
@@ -437,7 +449,102 @@ def fit_stick(
         noise_scale=math.sqrt(scale2) if dof > 0 else float("nan"),
         level=level,
         messages=tuple(messages),
+        status="failed" if problems else "ok",
+        reason="; ".join(problems),
     )
+
+
+#: Largest rms of the ln-residuals a usable fit may leave: beyond it the model predicts the stick times only
+#: to within a factor e^0.5 = 1.65 (Table 1 is fitted to 1.7 %, stick times are measured to a few per cent).
+MAX_RELATIVE_NOISE = 0.5
+#: p of the F test of the stick fit's misfit against the scatter of repeated cycles at one velocity (the noise
+#: measured without the model).
+STICK_SIGNIFICANCE = 1e-3
+#: Pulling velocities closer than this (relative) are the same velocity (repeated cycles).
+SAME_VELOCITY = 1e-6
+
+
+def _unusable(estimate: Estimate) -> Estimate:
+    if estimate.fixed:
+        return estimate
+    return dataclasses.replace(estimate, stderr=None, interval=None, status="undetermined", note="the fit failed")
+
+
+def _groups(velocity: np.ndarray) -> list[np.ndarray]:
+    """Indices of the rows at each distinct pulling velocity."""
+    order = np.argsort(velocity)
+    groups: list[list[int]] = []
+    for k in order:
+        if groups and abs(velocity[k] - velocity[groups[-1][0]]) <= SAME_VELOCITY * velocity[groups[-1][0]]:
+            groups[-1].append(int(k))
+        else:
+            groups.append([int(k)])
+    return [np.array(g) for g in groups]
+
+
+def _stick_problems(
+    data: StickData,
+    used: np.ndarray,
+    rows: _Rows,
+    fitted: Parameters,
+    keys: Sequence[str],
+    fixed: Mapping[str, float],
+    dof: int,
+    scale2: float,
+    model_problems: Sequence[str],
+) -> list[str]:
+    """Why the stick fit cannot be trusted (empty when it can)."""
+    from scipy import stats
+
+    problems = [f"the fitted model does not reproduce every stick: {p}" for p in model_problems]
+    requested = [k for k in STICK_KEYS if k not in fixed]
+    if requested and not keys:
+        problems.append(
+            f"the stick times determine none of the free parameters ({', '.join(requested)}): each was fixed at its"
+            " input value"
+        )
+    groups = _groups(rows.velocity)
+    if len(groups) < 2:
+        problems.append(
+            f"every fitted row is at one pulling velocity ({human(float(rows.velocity[0]), 'velocity')}): the stick"
+            " times cannot show the velocity dependence Eq 15 describes"
+        )
+    if dof <= 0:
+        problems.append("no degrees of freedom are left: the noise and the errors cannot be estimated")
+        return problems
+    if math.sqrt(scale2) > MAX_RELATIVE_NOISE:
+        problems.append(
+            f"the model does not describe these stick times: the fit leaves an rms misfit of"
+            f" {100 * math.sqrt(scale2):.3g} % in ln (a factor {math.exp(math.sqrt(scale2)):.3g}), more than"
+            f" the {100 * MAX_RELATIVE_NOISE:g} % a usable fit may leave"
+        )
+    log_t = np.log(rows.stick_time)
+    r_t = np.log(_stick_times([fitted], rows)[0] / rows.stick_time)
+    n, p = log_t.size, len(keys)  # the stick times alone: with fitted peaks the test is conservative
+    if np.all(np.isfinite(r_t)) and n - p > 0 and len(groups) >= 2:
+        s_model = float(r_t @ r_t) / (n - p)
+        replicate = _replicate_scatter(log_t, groups)
+        if replicate is not None:
+            s_rep, dof_rep = replicate
+            p_misfit = float(stats.f.sf(s_model / s_rep, n - p, dof_rep)) if s_rep > 0 else 0.0
+            if p_misfit < STICK_SIGNIFICANCE:
+                worst = int(np.argmax(np.abs(r_t)))
+                problems.append(
+                    f"the model does not describe these stick times: rms misfit {100 * math.sqrt(s_model):.3g} %"
+                    f" against a scatter of {100 * math.sqrt(s_rep):.3g} % between repeated cycles at one velocity"
+                    f" (F test: p = {p_misfit:.2g}); the largest is a factor {math.exp(-r_t[worst]):.3g} at"
+                    f" {human(float(rows.velocity[worst]), 'velocity')}"
+                )
+    return problems
+
+
+def _replicate_scatter(log_t: np.ndarray, groups: Sequence[np.ndarray]) -> tuple[float, int] | None:
+    """Pooled variance of ln t_s within groups of repeated cycles and its degrees of freedom (None: no repeats)."""
+    dof = sum(g.size - 1 for g in groups)
+    if dof < 1:
+        return None
+    ss = sum(float(np.sum((log_t[g] - np.mean(log_t[g])) ** 2)) for g in groups)
+    return ss / dof, dof
 
 
 def _outliers(data: StickData, used: np.ndarray, model_t: np.ndarray) -> list[str]:

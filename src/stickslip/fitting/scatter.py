@@ -1,0 +1,176 @@
+"""The noise of a steady curve estimated without the model: the scatter between neighbouring points.
+
+A fit that ends far from the data and then estimates the noise from its own
+residuals will call any curve noisy, and then find "no velocity dependence"
+in a stress that varies by a factor of 3 (issue 27 item 8).  The tests of
+the steady fit therefore measure the noise without the model, from the
+pseudo-residuals of Gasser, Sroka and Jennen-Steinmetz (Biometrika 73, 625,
+1986): each interior point against the straight line through its two
+neighbours (in ln V),
+
+    d_i = y_i - (w_l y_{i-1} + w_r y_{i+1}),   var d_i = e_i^2 + w_l^2 e_{i-1}^2 + w_r^2 e_{i+1}^2  (times s^2),
+
+with y = ln(stress) and unit e when the noise is relative and unknown, or
+y = stress and e = stress_err when errors are stated (then s^2 ~ 1 if they
+are right).  The curve's own curvature adds to d_i, so the estimate errs
+on the large side: tests against it are conservative (slower to call a
+misfit, slower to call a velocity dependence).  The d_i are correlated
+(neighbours share points); s^2 = (1/m) sum d_i^2/var_i is the quadratic form
+e^T A e of the noise, whose Satterthwaite degrees of freedom are
+tr(A)^2 / tr(A^2) (Gaussian noise), about (n - 2)/1.9 for even spacing.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import stats
+
+#: Smallest relative scatter taken as real: the model itself is accurate to ~1e-9, and an exact power law has
+#: zero pseudo-residuals; below this the noise is "not measurable" and the floor is used.
+SCATTER_FLOOR = 1e-6
+#: p below this: a difference the noise does not explain (misfit, or a velocity dependence).
+SIGNIFICANCE = 1e-3
+
+
+@dataclass(frozen=True)
+class Scatter:
+    """Noise variance (``variance``, in units of the stated errors, or relative when none are stated) and its
+    effective degrees of freedom, from neighbouring points; ``relative`` says which."""
+
+    variance: float
+    dof: float
+    relative: bool
+    points: int
+
+    @property
+    def scale(self) -> float:
+        return math.sqrt(self.variance)
+
+    def describe(self) -> str:
+        size = f"{100 * self.scale:.3g} % of the stress" if self.relative else f"{self.scale:.3g} stated errors"
+        return (
+            f"{size} (scatter of each point about the line through its neighbours, ≈{self.dof:.3g} degrees of freedom)"
+        )
+
+
+def local_scatter(velocity: np.ndarray, stress: np.ndarray, stress_err: np.ndarray | None) -> Scatter:
+    """The scatter of the data about the line through each point's neighbours (module docstring)."""
+    order = np.argsort(velocity)
+    x = np.log(velocity[order])
+    relative = stress_err is None
+    y = np.log(stress[order]) if relative else stress[order] / 1.0
+    e = np.ones_like(y) if relative else stress_err[order]  # type: ignore[index]
+    n = x.size
+    if n < 3:
+        return Scatter(math.inf, 0.0, relative, n)
+    h_left, h_right = x[1:-1] - x[:-2], x[2:] - x[1:-1]
+    w_left, w_right = h_right / (h_left + h_right), h_left / (h_left + h_right)
+    # the pseudo-residuals as rows of D (d = D y), each scaled to unit variance under the noise model
+    d = np.zeros((n - 2, n))
+    rows = np.arange(n - 2)
+    d[rows, rows], d[rows, rows + 1], d[rows, rows + 2] = -w_left, 1.0, -w_right
+    sd = np.sqrt(e[1:-1] ** 2 + (w_left * e[:-2]) ** 2 + (w_right * e[2:]) ** 2)
+    d /= sd[:, None]
+    pseudo = d @ y
+    variance = float(pseudo @ pseudo) / (n - 2)
+    # Satterthwaite: s^2 = z^T A z / (n-2) with z = y/e standard noise, A = E D^T D E
+    a = (d * e[None, :]).T @ (d * e[None, :])
+    dof = float(np.trace(a) ** 2 / np.sum(a * a))
+    floor = SCATTER_FLOOR**2 if relative else (SCATTER_FLOOR * float(np.median(stress / e))) ** 2
+    return Scatter(max(variance, floor), dof, relative, n)
+
+
+@dataclass(frozen=True)
+class Dependence:
+    """Whether the stress varies with velocity by more than its noise."""
+
+    p_value: float
+    spread: float  # rms of ln(stress) about its mean (relative) or of (stress - mean)/error
+    significant: bool
+    text: str
+
+
+def velocity_dependence(stress: np.ndarray, stress_err: np.ndarray | None, scatter: Scatter) -> Dependence:
+    """Does the stress vary by more than its noise?  F test of the spread about a constant against the
+    scatter between neighbours; with stated errors also the chi-square of a constant, and the larger p of
+    the two (a dependence is claimed only when both noise estimates say so)."""
+    n = stress.size
+    if stress_err is None:
+        y = np.log(stress)
+        spread2 = float(np.var(y, ddof=1))
+    else:
+        w = 1.0 / stress_err**2
+        level = float(np.sum(w * stress) / np.sum(w))
+        spread2 = float(np.sum(w * (stress - level) ** 2)) / (n - 1)
+    if spread2 <= scatter.variance * 1e-12 or spread2 == 0.0:
+        p = 1.0
+    elif scatter.dof <= 0:
+        p = 1.0
+    else:
+        p = float(stats.f.sf(spread2 / scatter.variance, n - 1, scatter.dof))
+        if stress_err is not None:
+            p = max(p, float(stats.chi2.sf(spread2 * (n - 1), n - 1)))
+    spread = math.sqrt(spread2)
+    if stress_err is None:
+        size = f"{100 * (math.exp(spread) - 1):.3g} % (rms of ln σ about its mean)"
+        noise = f"{100 * scatter.scale:.3g} %"
+    else:
+        size = f"{spread:.3g} stated errors (rms about a constant)"
+        noise = f"{scatter.scale:.3g} stated errors"
+    text = (
+        f"the stress varies by {size}, against a scatter of {noise} between neighbouring points (F test: p = {p:.2g})"
+    )
+    return Dependence(p, spread, p <= SIGNIFICANCE, text)
+
+
+@dataclass(frozen=True)
+class Misfit:
+    """How far a fitted curve is from the data, against the model-independent noise."""
+
+    p_value: float
+    rms_relative: float  # rms of (data - model)/data
+    rms_pa: float
+    worst_pa: float  # data - model at the worst point
+    worst_velocity: float
+    worst_stress: float
+    significant: bool
+    ratio: float  # fit's residual variance / scatter variance
+    chi_square: float  # with the errors of the fit (stated, or the stress itself: relative)
+
+
+def misfit(
+    velocity: np.ndarray,
+    stress: np.ndarray,
+    stress_err: np.ndarray | None,
+    model: np.ndarray,
+    free: int,
+    scatter: Scatter,
+) -> Misfit:
+    """Is the fit's misfit larger than the noise?  F test of its residual variance against the scatter
+    between neighbours; with stated errors also the chi-square test, and the larger p of the two (a misfit is
+    claimed only when both say so: errors stated too small are not the model's fault)."""
+    n = stress.size
+    dof = max(n - free, 1)
+    error = stress if stress_err is None else stress_err
+    z = (stress - model) / error
+    chi = float(z @ z)
+    ratio = chi / dof / scatter.variance
+    p = float(stats.f.sf(ratio, dof, scatter.dof)) if scatter.dof > 0 else 1.0
+    if stress_err is not None:
+        p = max(p, float(stats.chi2.sf(chi, dof)))
+    diff = stress - model
+    k = int(np.argmax(np.abs(diff)))
+    return Misfit(
+        p_value=p,
+        rms_relative=float(np.sqrt(np.mean((diff / stress) ** 2))),
+        rms_pa=float(np.sqrt(np.mean(diff**2))),
+        worst_pa=float(diff[k]),
+        worst_velocity=float(velocity[k]),
+        worst_stress=float(stress[k]),
+        significant=p <= SIGNIFICANCE,
+        ratio=ratio,
+        chi_square=chi,
+    )
