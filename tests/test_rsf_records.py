@@ -286,3 +286,18 @@ def test_other_shapes_with_bits_and_correlated_noise(velocities, durations, samp
     assert len(found.segments) == len(velocities), found.describe()
     assert found.velocities == pytest.approx(truth.velocities, rel=0.02, abs=0.02 * UM)
     assert np.all(np.abs(found.boundaries[1:-1] - truth.boundaries[1:-1]) <= change_tolerance(truth, t, noise * UM))
+
+
+def test_the_measured_history_follows_a_smoothly_accelerating_load_point():
+    """A load point accelerating steadily (no levels: find_segments refuses it) is still followed, to within the
+    noise of the exact displacement."""
+    t = np.linspace(0.0, 100.0, 4000)
+    exact = 1e-8 * t**2
+    noise = 0.02 * UM
+    record = LabRecord.from_arrays(t, exact + noise * np.random.default_rng(3).standard_normal(t.size), 0.6 + 0 * t)
+    with pytest.raises(DataError, match="straight pieces"):
+        find_segments(record.time, record.displacement)
+    history = measured_history(record)
+    miss = history.displacement_at(t) - exact
+    assert np.max(np.abs(miss - miss.mean())) < 3 * noise
+    assert len(history.segments) < 100
