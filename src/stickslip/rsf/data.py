@@ -315,18 +315,22 @@ def find_segments(
 ) -> Protocol:
     """The load point's piecewise-constant velocity history from its displacement record.
 
-    The record is averaged in equal TIME bins (at most :data:`SEARCH_BINS`; a sampling rate that changes
-    mid-record changes only how many rows a bin holds) and each bin's noise is measured, not assumed
-    (:func:`_noise_model`: residuals of straight lines over a fixed time span, white and row-independent
-    parts, the quantisation step's q^2/12, and the lag-one correlation left between bins).  The optimal
-    segmentation into straight pieces under a penalty per piece (PELT, Killick et al. 2012) of
-    ``4 ln n`` times the correlation's variance inflation proposes the changes; the load point's
-    displacement is continuous, so a continuous broken line through them is then fitted and a change
-    is dropped, weakest first, while its change of slope is within ``z = sqrt(2 ln n) + 2`` standard
-    errors of none, the two velocities differ by less than ``min_change`` (relative), or a piece is shorter
-    than ``min_points`` rows or ``min_duration`` seconds (default: five bins).  Each remaining change is
-    then placed on the full record and dated where the two fitted lines meet.  Raises DataError when more
-    than ``max_segments`` pieces remain (the displacement is not piecewise linear).
+    1. The record is averaged in equal TIME bins (at most :data:`SEARCH_BINS`), so a sampling rate that changes
+       mid-record changes only how many rows a bin holds.
+    2. Each bin's noise is measured, not assumed (:func:`_noise_model`): residuals of straight lines over a
+       fixed span, white and row-independent parts, at least q^2/12 per row for a quantisation step q.
+    3. How much more neighbouring stretches' velocities differ than that noise says, stretch length by stretch
+       length (:func:`_slope_inflation`: correlated noise, wander, drift), is measured too.
+    4. PELT (Killick et al. 2012: the optimal segmentation into straight pieces under a penalty per piece,
+       here ``4 ln n`` times the short-scale inflation) proposes changes.
+    5. A change is dropped, weakest first, while the two pieces' velocities are within ``sqrt(2 ln n) + 2``
+       inflated standard errors of each other, differ by less than ``min_change`` (relative), or a piece is
+       shorter than ``min_points`` rows or ``min_duration`` seconds (default: five bins).
+    6. Each remaining change is placed on its best row of the full record and dated where the two fitted lines
+       meet (the load point's displacement is continuous).
+
+    Raises DataError when more than ``max_segments`` pieces remain or the pieces miss the record by more than
+    :data:`CURVED` times its noise (the displacement is not piecewise linear).
     """
     t = np.asarray(time, dtype=float)
     d = np.asarray(displacement, dtype=float)
@@ -526,14 +530,12 @@ def _line(t: np.ndarray, d: np.ndarray) -> tuple[float, float]:
     return float(slope), float(intercept)
 
 
-def _cumulative_sums(t: np.ndarray, d: np.ndarray, weight: np.ndarray | None = None) -> list[np.ndarray]:
-    """Running (weighted) sums for O(1) straight-line misfits; t and d scaled to O(1) so the differences keep
-    their digits."""
+def _cumulative_sums(t: np.ndarray, d: np.ndarray) -> list[np.ndarray]:
+    """Running sums for O(1) straight-line misfits; t and d scaled to O(1) so the differences keep their digits."""
     tc = (t - t.mean()) / max(float(np.ptp(t)), 1e-300)
     dc = d - np.polyval(np.polyfit(tc, d, 1), tc)
     dc = dc / max(float(np.max(np.abs(dc))), 1e-300)
-    w = np.ones_like(tc) if weight is None else weight
-    return [np.concatenate([[0.0], np.cumsum(v)]) for v in (w, w * tc, w * dc, w * tc * tc, w * tc * dc, w * dc * dc)]
+    return _running(np.ones_like(tc), tc, dc)
 
 
 def _misfit(sums: list[np.ndarray], lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
@@ -550,8 +552,7 @@ def _misfit(sums: list[np.ndarray], lo: np.ndarray, hi: np.ndarray) -> np.ndarra
 def _pelt(bins: _Bins, min_bins: int = 3) -> list[int]:
     """Interior break bins minimising the bins' weighted misfit + ``4 ln n`` x inflation per piece (PELT)."""
     n = bins.t.size
-    weight = 1.0 / bins.var
-    sums = [np.concatenate([[0.0], np.cumsum(v)]) for v in _weighted_moments(bins.t, bins.d, weight)]
+    sums = _running(1.0 / bins.var, bins.t, bins.d)
     penalty = 4.0 * math.log(max(n, 3)) * float(bins.inflation[1][0])  # proposals: the shortest scale's
     best = np.full(n + 1, np.inf)
     best[0] = -penalty
@@ -571,8 +572,9 @@ def _pelt(bins: _Bins, min_bins: int = 3) -> list[int]:
     return breaks[::-1][1:-1]
 
 
-def _weighted_moments(t: np.ndarray, d: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, ...]:
-    return w, w * t, w * d, w * t * t, w * t * d, w * d * d
+def _running(w: np.ndarray, t: np.ndarray, d: np.ndarray) -> list[np.ndarray]:
+    """Running weighted sums of 1, t, d, t^2, t d, d^2 (what :func:`_misfit` reads)."""
+    return [np.concatenate([[0.0], np.cumsum(v)]) for v in (w, w * t, w * d, w * t * t, w * t * d, w * d * d)]
 
 
 def _piece_test(bins: _Bins, sums: list[np.ndarray], hinges: list[int]) -> tuple[np.ndarray, np.ndarray]:
@@ -604,7 +606,7 @@ def _significant_hinges(
     n = bins.t.size
     z_crit = math.sqrt(2.0 * math.log(max(n, 3))) + 2.0
     rows = np.concatenate([bins.first, [int(bins.first[-1] + bins.count[-1])]])
-    sums = [np.concatenate([[0.0], np.cumsum(v)]) for v in _weighted_moments(bins.t, bins.d, 1.0 / bins.var)]
+    sums = _running(1.0 / bins.var, bins.t, bins.d)
     while hinges:
         slopes, tvalue = _piece_test(bins, sums, hinges)
         strength = np.abs(tvalue)
@@ -631,7 +633,7 @@ CURVED = 100.0
 def _refuse_curved(bins: _Bins, hinges: list[int]) -> None:
     """DataError when the straight pieces miss the binned record by far more than its noise: the load point's
     velocity changes smoothly, not in steps."""
-    sums = [np.concatenate([[0.0], np.cumsum(v)]) for v in _weighted_moments(bins.t, bins.d, 1.0 / bins.var)]
+    sums = _running(1.0 / bins.var, bins.t, bins.d)
     edges = np.array([0, *hinges, bins.t.size])
     dof = max(bins.t.size - 2 * (edges.size - 1), 1)
     excess = float(np.sum(_misfit(sums, edges[:-1], edges[1:]))) / dof / float(bins.inflation[1][-1])
