@@ -301,3 +301,15 @@ def test_the_measured_history_follows_a_smoothly_accelerating_load_point():
     miss = history.displacement_at(t) - exact
     assert np.max(np.abs(miss - miss.mean())) < 3 * noise
     assert len(history.segments) < 100
+
+
+def test_the_shipped_biaxial_record_is_read_as_it_comes():
+    """Only the displacement column named (``Time (s)`` and ``mu`` are found): micrometres from its header, four
+    levels at the truth it was made from."""
+    record = read_record(RECORDS / "biaxial_4level.txt", {"displacement": "LP Displacement (um)"})
+    assert record.length_unit == "um" and len(record) == 3986
+    truth, t, _ = four_level(1)
+    np.testing.assert_allclose(record.time, t, atol=5e-4)  # written to the millisecond
+    found = find_segments(record.time, record.displacement)
+    assert found.velocities == pytest.approx(truth.velocities, rel=0.015)
+    assert np.all(np.abs(found.boundaries[1:-1] - truth.boundaries[1:-1]) <= change_tolerance(truth, t, 0.15 * UM))
