@@ -84,6 +84,10 @@ class _Validated:
             value = float(raw)
             if math.isnan(value) or math.isinf(value):
                 raise ParameterError(f"{key}: expected a finite number, got {value}")
+            if 0 < abs(value) < sys.float_info.min:  # a denormal: every product with it loses its digits
+                raise ParameterError(
+                    f"{key}: {value:g} (SI) is below the smallest normal float, 2.2e-308; expected a physical value"
+                )
             if f.metadata["zero_allowed"]:
                 if value < 0:
                     raise ParameterError(f"{key}: expected a value >= 0, got {value:g}")
@@ -208,6 +212,15 @@ class Parameters:
     name: str = "custom"
     description: str = ""
     reference: str = ""
+
+    def __post_init__(self) -> None:
+        for section, cls in SECTIONS.items():  # Parameters(bonds=None) would fail later, far from its cause
+            given = getattr(self, section)
+            if not isinstance(given, cls):
+                raise ParameterError(f"Parameters({section}=...): expected a {cls.__name__}, got {shorten(given)}")
+        for meta in ("name", "description", "reference"):
+            if not isinstance(getattr(self, meta), str):
+                raise ParameterError(f"Parameters({meta}=...): expected a text, got {shorten(getattr(self, meta))}")
 
     def as_dict(self) -> dict[str, float]:
         """Flat mapping ``section.key -> SI float`` (an optional key left out is absent)."""

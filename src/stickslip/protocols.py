@@ -206,6 +206,28 @@ def parse_segment(text: str, name: str = "--segment") -> Segment:
         raise ParameterError(f"{name} {text!r}: {message}") from None
 
 
+def _refuse_duplicated_columns(text: str, path: Path) -> None:
+    """A header naming a column twice (``velocity,velocity,duration``) is ambiguous: which one is meant?
+
+    pandas would rename the second ``velocity.1`` and read the first silently; the data readers refuse it, so here too.
+    """
+    import csv
+
+    for line in text.splitlines():
+        if line.strip() and not line.lstrip().startswith("#"):
+            try:
+                dialect = csv.Sniffer().sniff(line, delimiters=",\t;")
+                names = next(csv.reader([line], dialect))
+            except csv.Error:
+                names = line.split(",")
+            seen: set[str] = set()
+            for name in (n.strip().lower() for n in names):
+                if name and name in seen:
+                    raise DataError(f"{path}: the column {name!r} appears twice in the header; keep one")
+                seen.add(name)
+            return
+
+
 def read_protocol(path: str | Path) -> Protocol:
     """A protocol from a CSV file.
 
@@ -237,6 +259,7 @@ def read_protocol(path: str | Path) -> Protocol:
     except (ValueError, csv.Error, pd.errors.ParserError) as exc:  # csv.Error: no delimiter could be found
         raise DataError(f"{path}: cannot read as CSV ({(str(exc).splitlines() or [''])[0]})") from None
     columns = {str(c).strip().lower(): c for c in frame.columns}
+    _refuse_duplicated_columns(text, path)
     if {"velocity", "duration"} <= set(columns):
         pairs = _numeric_rows(frame, path, [columns["velocity"], columns["duration"]])
         try:

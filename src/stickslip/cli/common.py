@@ -209,6 +209,11 @@ def quantity(text: str | float, dimension: str, name: str) -> float:
     value = to_si(text, dimension, name)
     if not math.isfinite(value):
         raise ParameterError(f"{name}: expected a finite value, got {shorten(text)}")
+    if 0 < abs(value) < sys.float_info.min:  # a denormal: no physical value, and any product with it loses its digits
+        raise ParameterError(
+            f"{name} {shorten(text)}: {value:g} (SI) is below the smallest normal float, 2.2e-308;"
+            " expected a physical value"
+        )
     return value
 
 

@@ -84,10 +84,9 @@ def routed_starts(models: list[Any], texts: tuple[str, ...]) -> dict[str, Any]:
             if model.name not in {m.name for m in models}:
                 listed = ", ".join(m.name for m in models)
                 raise ParameterError(f"--start {shorten(text)}: {name.strip()} is not one of the models {listed}")
-            starts[model.name] = start_value(value)
+            starts[model.name] = start_value(value, model)
         else:
-            start = start_value(text)
-            starts.update({m.name: start for m in models})
+            starts.update({m.name: start_value(text, m) for m in models})  # each model reads it in its dimension
     return starts
 
 

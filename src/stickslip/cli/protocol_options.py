@@ -86,7 +86,7 @@ def build_protocol(
     if (v0_text is None) != (duration_text is None):
         given, missing = ("--v0", "--duration") if duration_text is None else ("--duration", "--v0")
         raise ParameterError(f"{given} needs {missing}: the first segment is a velocity and a length of time")
-    segments = [parse_segment(text) for text in segment_texts]
+    segments = [parse_segment(checked_segment_text(text)) for text in segment_texts]
     if v0_text is not None and duration_text is not None:
         first = Segment(
             positive(v0_text, "velocity", "--v0", allow_zero=True), positive(duration_text, "time", "--duration")
@@ -97,6 +97,23 @@ def build_protocol(
     if fallback is not None:
         return fallback
     raise ParameterError('give the protocol: --v0 V --duration T, --segment "V:T" (repeatable) or --protocol FILE')
+
+
+def checked_segment_text(text: str, name: str = "--segment") -> str:
+    """``--segment "V:T"`` as typed, each of V and T with its unit (the API reads bare numbers as SI; a user who
+    types ``50:60`` does not mean 50 m/s); zero needs none.  Returned unchanged for :func:`parse_segment`."""
+    from ..units import bare_number
+
+    velocity_text, sep, duration_text = str(text).rpartition(":")
+    for part, what in ((velocity_text, "velocity"), (duration_text, "duration")):
+        number = bare_number(part) if sep else None
+        if number is not None and number != 0:
+            example = "1 mm/s:2 s"
+            raise UnitError(
+                f"{name} {text!r}: the {what} {part.strip()} needs a unit, e.g. {name} {example!r}"
+                " (bare numbers are refused on the command line)"
+            )
+    return text
 
 
 def refuse_unsupported(

@@ -76,23 +76,54 @@ def model_parameters(model: Any, params_name: str | None, overrides: dict[str, s
     return model.parameters(load_params_mapping(path), overrides)
 
 
-def start_value(text: str | None) -> Any:
-    """``--start``: a word ("empty", "steady") as it is, or a stress or velocity with its unit, in SI."""
-    from ..units import to_si
+def start_value(text: str | None, model: Any = None) -> Any:
+    """``--start``: a word ("empty", "steady") as it is, or a number with its unit, in SI.
+
+    A number must be of the dimension the model starts from (``model.start_dimension``: the quasi-static model's
+    is a stress, rate-and-state's a velocity; None: the model starts only from words), so ``--start '3 Pa'`` is
+    never read as 3 m/s.  Without a model (a start routed to several), a stress or a velocity.
+    """
+    from ..units import quantity_noun, to_si
 
     if text is None:
         return None
     if text.strip().isalpha():
         return text.strip()
-    for dimension, prefix in (("stress", "--start "), ("velocity", "--start ")):
+    if model is not None:
+        dimension = getattr(model, "start_dimension", None)
+        if dimension is None:
+            raise ParameterError(
+                f"--start {shorten(text)}: --model {model.name} starts from a word (transient: empty or steady),"
+                " not a number"
+            )
+        require_unit(text, dimension, "--start ")
         try:
-            require_unit(text, dimension, prefix)
-            return to_si(text, dimension, "--start")
+            value = to_si(text, dimension, "--start")
+        except UnitError:
+            raise ParameterError(
+                f"--start {shorten(text)}: --model {model.name} starts from {quantity_noun(dimension)};"
+                f" expected one with its unit, e.g. {_START_EXAMPLES.get(dimension, 'a value with its unit')}"
+            ) from None
+        return _finite_start(value, text)
+    for dimension in ("stress", "velocity"):
+        try:
+            require_unit(text, dimension, "--start ")
+            return _finite_start(to_si(text, dimension, "--start"), text)
         except UnitError:
             continue
     raise ParameterError(
         f"--start {shorten(text)}: expected a word (empty, steady) or a stress or velocity with its unit"
     )
+
+
+#: How a start of each dimension is written, in refusals.
+_START_EXAMPLES = {"stress": "--start '400 Pa'", "velocity": "--start '50 um/s'"}
+
+
+def _finite_start(value: float, text: str) -> float:
+    if not math.isfinite(value):
+        raise ParameterError(f"--start {shorten(text)}: expected a finite value")
+    return value
 
 
 def settings_of(texts: tuple[str, ...], every_text: str | None) -> dict[str, Any]:
@@ -135,13 +166,22 @@ def run_summary(run: Any, protocol: Any, rig: Any) -> dict[str, Any]:
         "periods_seen": r.periods,
         "amplitude_ratio": r.amplitude_ratio,
         "period": run.period,
-        f"peak_{signal}": run.peak,
-        f"trough_{signal}": run.trough,
-        f"mean_{signal}": run.mean,
+        f"peak_{signal}": _above_round_off(run.peak),
+        f"trough_{signal}": _above_round_off(run.trough),
+        f"mean_{signal}": _above_round_off(run.mean),
         f"final_{signal}": float(run.signal[-1]) if run.time.size else None,
         "end_time": float(run.time[-1]) if run.time.size else None,
         "summary": dict(run.summary),
     }
+
+
+#: A stress (Pa) or friction coefficient smaller than this is the solver's round-off, not a value (a block at rest
+#: reports a mean stress of -5.6e-17 Pa): it is shown as 0.
+ROUND_OFF = 1e-12
+
+
+def _above_round_off(value: float) -> float:
+    return 0.0 if value is not None and math.isfinite(value) and abs(value) < ROUND_OFF else value
 
 
 def summary_text(summary: dict[str, Any]) -> str:
@@ -236,7 +276,7 @@ def run_command(
     params = model_parameters(model, params_name, mapping)
     settings = settings_of(setting_texts, every_text)
     model.check(protocol, rig, settings)  # what the model cannot do, before any work
-    start = start_value(start_text)
+    start = start_value(start_text, model)
     with progress(model.name, total=protocol.duration, unit="s", enabled=False if as_json else None) as bar:
         if "progress" in model.capabilities.settings and "progress" not in settings:  # a bar on a terminal only
             settings["progress"] = lambda fraction: bar.update(fraction * protocol.duration)

@@ -50,6 +50,7 @@ def stability_command(
     for text in velocities:
         v = positive(text, "velocity", "--v0")
         kc = critical_stiffness_details(params, v, not no_aging, mass, damping)
+        _refuse_unbounded(kc, text, mass_text, damping_text, growth_at)
         row: dict[str, Any] = {
             "velocity": v,
             "mass": mass,
@@ -74,6 +75,25 @@ def stability_command(
                 f"  at K = {growth_at:g} x Kc: growth {row['growth_rate']:+.6g} 1/s,"
                 f" oscillating at {row['growth_frequency']:.6g} Hz"
             )
+
+
+def _refuse_unbounded(
+    kc: Any, v0_text: str, mass_text: str | None, damping_text: str | None, factor: float | None
+) -> None:
+    """A Kc (or F x Kc) beyond the floating-point range is no answer: refuse it, naming the inputs, never print inf."""
+    from ..errors import ParameterError
+
+    value = kc.value
+    if kc.mode != "oscillatory" or value is None:
+        return
+    given = ", ".join(f"{name} {text}" for name, text in (("--mass", mass_text), ("--damping", damping_text)) if text)
+    if not math.isfinite(value) or not math.isfinite(kc.rate):
+        raise ParameterError(
+            f"--v0 {v0_text}{', ' + given if given else ''}: Kc leaves the floating-point range (above 1e308 Pa/m);"
+            " expected a smaller block mass or damping"
+        )
+    if factor is not None and not math.isfinite(factor * value):
+        raise ParameterError(f"--growth-at {factor:g}: F x Kc = {factor:g} x {value:.4g} Pa/m is beyond 1e308 Pa/m")
 
 
 UNITS = {

@@ -42,7 +42,16 @@ COLUMNS = tuple((name, unit_of(name)) for name in ("velocity", "stress", "bonded
 
 def _velocity(text: str, name: str) -> float:
     """A positive, finite velocity from an option value with its unit (a bare number other than 0 is refused)."""
-    return positive(text, "velocity", name)
+    value = positive(text, "velocity", name)
+    if value > SPEED_OF_LIGHT:  # no sliding is faster; and far above it the curve's numbers leave the float range
+        raise ParameterError(
+            f"{name} {text!r}: expected a velocity below the speed of light (3e8 m/s), got {value:g} m/s"
+        )
+    return value
+
+
+#: The speed of light (m/s): no velocity of a sliding block is above it.
+SPEED_OF_LIGHT = 299_792_458.0
 
 
 def _velocities(
@@ -96,7 +105,16 @@ def _evaluate(params: Any, velocities: np.ndarray, aging: bool) -> dict[str, np.
     from ..model.steady import steady_state
 
     result = steady_state(params, velocities, aging=aging)
-    return {name: np.ravel(getattr(result, name)) for name, _ in COLUMNS}
+    columns = {name: np.ravel(getattr(result, name)) for name, _ in COLUMNS}
+    for name, values in columns.items():  # never print inf or nan: say where the numbers ran out
+        bad = ~np.isfinite(values)
+        if bad.any():
+            where = float(np.ravel(velocities)[np.argmax(bad)])
+            raise ParameterError(
+                f"the steady curve's {name} cannot be computed at V = {where:.4g} m/s with these parameters"
+                " (a number leaves the floating-point range); give a narrower --vmin/--vmax or --velocity"
+            )
+    return columns
 
 
 def _stream_csv(params: Any, velocities: np.ndarray, aging: bool, output: Path | None) -> None:

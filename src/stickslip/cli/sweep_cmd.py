@@ -130,6 +130,7 @@ def _run(
         raise ParameterError("--workers and --scheduler: give one (a running cluster has its own workers)")
     if batch_size is not None and batch_size < 1:
         raise ParameterError(f"--batch-size: expected a positive number of points, got {batch_size}")
+    require_unit(duration_text, "time", "--duration ")  # the API reads a bare number as seconds; a user types one
     spec = build_spec(
         list(vary),
         model=model,

@@ -113,6 +113,9 @@ class FrictionModel(ABC):
     description: str = ""
     capabilities: Capabilities = Capabilities()
     sweep_start: Any = None
+    #: the dimension of a numeric ``start`` (a :data:`stickslip.units.DIMENSIONS` name, e.g. "stress" or
+    #: "velocity"), so the command line reads ``--start`` in it and refuses another; None: words only
+    start_dimension: str | None = None
     #: modules the model needs (an install without them refuses the model in one line, see check_available)
     requires: tuple[str, ...] = ()
     #: the columns of a sweep row (name -> "str", "float" or "int"), read off the Run (:meth:`Run.row`)

@@ -29,6 +29,7 @@ class RSFModel(FrictionModel):
 
     name = "rsf"
     aliases = ("rate-and-state", "rate-state")
+    start_dimension = "velocity"
     description = "rate-and-state friction on a spring-slider (Dieterich-Ruina laws)"
     capabilities = Capabilities(
         controls=("spring",), protocols="any", damping=True, mass=True, settings=("every", "times", "rtol", "atol")
@@ -103,6 +104,7 @@ class RSFModel(FrictionModel):
             else:
                 expected = ", ".join((*self.KEYS, "law"))
                 raise ParameterError(f"--set {given}: unknown rate-and-state key; expected one of: {expected}")
+        _refuse_unphysical(values, overrides)
         return rsf_params(
             values["a"],
             values["b"],
@@ -238,3 +240,25 @@ def rsf_run(result: Any) -> Run:
         status="ok" if result.status == "ok" else "failed",
         native=result,
     )
+
+
+#: Largest a or |b| an override may give: the terms a ln(V/v_ref), b ln(...) are corrections to mu0 (of order 0.01);
+#: one of order 1 already makes friction negative within a decade of velocity.
+MAX_RATE_COEFFICIENT = 1.0
+
+
+def _refuse_unphysical(values: Mapping[str, float], overrides: Mapping[str, Any]) -> None:
+    """An override no friction can have: a negative mu0, a or |b| beyond :data:`MAX_RATE_COEFFICIENT`."""
+
+    def shown(key: str) -> str:
+        given = next((raw for name, raw in overrides.items() if ALIASES.get(name, name) == key), values[key])
+        return f"--set {key}={given}"
+
+    if values["mu0"] < 0:
+        raise ParameterError(f"{shown('mu0')}: expected a friction coefficient >= 0")
+    for key in ("a", "b"):
+        if abs(values[key]) > MAX_RATE_COEFFICIENT:
+            raise ParameterError(
+                f"{shown(key)}: expected |{key}| <= {MAX_RATE_COEFFICIENT:g} (a rate-and-state coefficient is a small"
+                " correction to mu0, typically 0.001 to 0.05)"
+            )

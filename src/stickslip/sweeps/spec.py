@@ -165,6 +165,8 @@ def parse_vary(
         return _value(text, dimension, where)
 
     match = _RANGE.match(body)
+    if match is not None and ("..." in body or match["hi"].strip().startswith(".")):
+        raise ParameterError(f"{where}: expected two dots between the ends (LO..HI), got three or more")
     if match is None:
         items = body.split(",")
         if len(items) > MAX_AXIS_VALUES:
