@@ -195,6 +195,30 @@ def same_file(a: str | Path, b: str | Path) -> bool:
     return (first.st_dev, first.st_ino) == (second.st_dev, second.st_ino)
 
 
+def refuse_shared_outputs(outputs: list[tuple[str, str | Path | None]]) -> None:
+    """Raise :class:`DataError` if two outputs name one file (``-o X --plot X``): the later would silently replace
+    the earlier.  Standard output (``-``) taken twice is refused too; two names of one file (a link) are one file."""
+    seen: list[tuple[str, str | Path]] = []
+    for option, out in outputs:
+        if out is None or not str(out).strip():
+            continue
+        for earlier, path in seen:
+            if _one_output(path, out):
+                where = "standard output" if str(out) == STDOUT else f"the file {out}"
+                raise DataError(f"{earlier} {path} and {option} {out}: both write {where}; give each its own name")
+        seen.append((option, out))
+
+
+def _one_output(a: str | Path, b: str | Path) -> bool:
+    if (str(a) == STDOUT) or (str(b) == STDOUT):
+        return str(a) == str(b)
+    if os.path.exists(a) and not _is_regular(a):  # /dev/null takes any number of outputs, and keeps none
+        return False
+    if same_file(a, b):
+        return True
+    return os.path.normcase(os.path.realpath(a)) == os.path.normcase(os.path.realpath(b))
+
+
 def refuse_input_as_output(inputs: list[str | Path | None], outputs: list[tuple[str, str | Path | None]]) -> None:
     """Raise :class:`DataError` if any output names the same file as an input; remember the inputs.
 
@@ -204,6 +228,7 @@ def refuse_input_as_output(inputs: list[str | Path | None], outputs: list[tuple[
     later that was not listed here (a side file) cannot replace them either.
     """
     protect_inputs(inputs)
+    refuse_shared_outputs(outputs)
     existing = [p for p in inputs if p is not None and str(p) != STDOUT and _is_regular(p)]
     for option, out in outputs:
         if out is None or str(out) == STDOUT:
