@@ -313,17 +313,31 @@ def _verdict(
     ratio = ratios[-1] if ratios else math.nan
     recent = ratios[-RATIOS_NEEDED:]
     if len(recent) == RATIOS_NEEDED and all(abs(r - 1) <= RATIO_TOLERANCE for r in recent):
-        evidence = f"{periods} period(s) of {period:.6g} s, amplitude ratio {ratio:.4g} per period"
+        evidence = f"{periods} period(s) of {_seconds(period)}, {_ratio(ratio)}"
         return Regime(STICK_SLIP, periods, ratio, period, peak, trough, f"stick-slip (limit cycle): {evidence}")
     if latest is not None and math.isfinite(latest):
         period = latest
-    evidence = f"{periods} period(s), the latest {period:.6g} s, amplitude ratio {ratio:.4g} per period"
+    latest_text = f"the latest {_seconds(period)}" if math.isfinite(period) else f"period {_seconds(period)}"
+    evidence = f"{periods} period(s), {latest_text}, {_ratio(ratio)}"
     if len(recent) == RATIOS_NEEDED:
         if all(r < 1 - RATIO_TOLERANCE for r in recent):
             return Regime(DECAYING, periods, ratio, period, peak, trough, f"decaying oscillation: {evidence}")
         if all(r > 1 + RATIO_TOLERANCE for r in recent):
             return Regime(GROWING, periods, ratio, period, peak, trough, f"growing oscillation: {evidence}")
     return Regime(UNDETERMINED, periods, ratio, period, peak, trough, f"undetermined: {evidence}")
+
+
+def _seconds(period: float) -> str:
+    """A period in words: its length, or that it is not known (NaN never reaches a user)."""
+    return f"{period:.6g} s" if math.isfinite(period) else "not known (fewer than two peaks)"
+
+
+def _ratio(ratio: float) -> str:
+    return (
+        f"amplitude ratio {ratio:.4g} per period"
+        if math.isfinite(ratio)
+        else "amplitude ratio not known (fewer than two swings)"
+    )
 
 
 def classify_cycles(peak_times: list[float], peaks: list[float], troughs: list[float]) -> Regime:

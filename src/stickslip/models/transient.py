@@ -115,6 +115,11 @@ def _first(result: Any, *names: str) -> Any:
 def _regime(result: Any, protocol: Protocol | None) -> regimes.Regime:
     """The solver's verdict, with the evidence of the one classifier: the slips' exact peaks and the sticks'
     troughs (cycles) in the last segment when it oscillates, the classifier on the solver's steps otherwise."""
+    found = getattr(result, "evidence", None)
+    if isinstance(found, regimes.Regime):  # the solver's own verdict: the same periods and extremes, in the same words
+        return regimes.Regime(
+            result.regime, found.periods, found.amplitude_ratio, found.period, found.peak, found.trough, result.message
+        )
     start = float(protocol.boundaries[-2]) if protocol is not None else float(result.time[0])
     whole = [c for c in result.cycles if c.period is not None and c.start_time >= start]
     time, stress = np.asarray(result.time, dtype=float), np.asarray(result.stress, dtype=float)

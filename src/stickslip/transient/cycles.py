@@ -112,6 +112,23 @@ def classify(
     stop: str | None,
     resolution: float | None = None,
 ) -> tuple[str, str]:
+    """(regime, message): :func:`judge` without its evidence."""
+    regime, message, _ = judge(time, stress, velocity, protocol, cycles, events, control, stop, resolution)
+    return regime, message
+
+
+def judge(
+    time: np.ndarray,
+    stress: np.ndarray,
+    velocity: np.ndarray,
+    protocol: Protocol,
+    cycles: tuple[Cycle, ...],
+    events: list,
+    control: str,
+    stop: str | None,
+    resolution: float | None = None,
+    lowest: np.ndarray | None = None,
+) -> tuple[str, str, regimes.Regime | None]:
     """(regime, message) of the last protocol segment, by :func:`stickslip.regimes.classify` on the stress.
 
     "stick-slip" (a limit cycle: the amplitude constant over the last periods), "steady" (stress and, under
@@ -122,17 +139,33 @@ def classify(
     repeats (a limit cycle) is judged only when its peak-to-trough stress is :data:`RESOLVED` times that
     tolerance of the stress or more: a smaller one is within what the steps may get wrong (a block with mass
     ringing against resting bonds at rtol 1e-4 swung by 2 x the tolerance, ~4 steps a period, and read as
-    growing, or as a limit cycle, while it decays).
+    growing, or as a limit cycle, while it decays).  The third item: the classifier's evidence (periods seen,
+    amplitude ratio, period, extremes), None when the run stopped.
     """
     if stop is not None:
-        return regimes.UNDETERMINED, stop
+        return regimes.UNDETERMINED, stop, None
     start = float(protocol.boundaries[-2])
     inside = time >= start
     scale = float(np.max(np.abs(stress[inside]))) if np.any(inside) else 0.0
     floor = SETTLED * max(scale, 1e-300)
-    found = _from_events(events, start, time, stress) or regimes.classify(
+    found = _from_events(events, start, time, stress, lowest) or regimes.classify(
         time, stress, floor=floor, start=start, unit="Pa"
     )
+    return (*_words(found, time, stress, velocity, protocol, cycles, control, resolution, scale), found)
+
+
+def _words(
+    found: regimes.Regime,
+    time: np.ndarray,
+    stress: np.ndarray,
+    velocity: np.ndarray,
+    protocol: Protocol,
+    cycles: tuple[Cycle, ...],
+    control: str,
+    resolution: float | None,
+    scale: float,
+) -> tuple[str, str]:
+    """(regime, message) of the run from the classifier's ``found`` and the slider's motion at the end."""
     stuck = stuck_mask(time, velocity, protocol)
     vp = protocol.segments[-1].velocity
     whole = [c for c in cycles if c.period is not None]
@@ -151,8 +184,8 @@ def classify(
         if whole:
             c = whole[-1]
             text += (
-                f"; {len(cycles)} slip(s), last: stick {c.stick_time:.4g} s up to σs = {c.peak_stress:.5g} Pa,"
-                f" jump to {c.jump_velocity * 1e6:.4g} µm/s, slip {c.slip_time:.4g} s"
+                f"; {len(cycles)} slip(s), the last whole cycle: stick {c.stick_time:.4g} s up to"
+                f" σs = {c.peak_stress:.5g} Pa, jump to {c.jump_velocity * 1e6:.4g} µm/s, slip {c.slip_time:.4g} s"
             )
         return regimes.STICK_SLIP, text
     if found.kind in (regimes.DECAYING, regimes.GROWING):
@@ -185,36 +218,117 @@ def classify(
     )
 
 
-def _from_events(events: list, start: float, time: np.ndarray, stress: np.ndarray) -> regimes.Regime | None:
-    """The regime from the stick chains' exact slips and sticks (time, stress), independent of ``every``.
+@dataclasses.dataclass(frozen=True)
+class _ChainCycle:
+    """One stick of the chains (from t_stick under sigma_stick) ended by a slip at t_slip under sigma_s; the
+    stick after it (time, stress), if the run reached one."""
 
-    Each slip (the chains collapse at sigma_s) and the stick that follows it (sigma where the slider stops) is
-    one period's peak and trough.  None when the run has no such cycles in its last segment, or when the last
-    of them ended more than two periods before the end (the run left stick-slip: the trace decides).  The
-    reported extremes are the events' or the trace's over the last period, whichever reaches further (both
-    are values of the solution; the slip's lowest stress can come just before the stick).
-    """
-    slips = [(t, s) for kind, t, s, _ in events if kind == "slip" and t >= start]
-    sticks = [(t, s) for kind, t, s, _ in events if kind == "stick" and t >= start]
-    times, peaks, troughs = [], [], []
-    for t_slip, sigma_s in slips:
-        after = [s for t, s in sticks if t > t_slip]
-        if not after:
-            break
-        times.append(t_slip)
-        peaks.append(sigma_s)
-        troughs.append(after[0])
-    if not times:
-        return None
-    found = regimes.classify_cycles(times, peaks, troughs)
-    last_event = max(t for _, t, _, _ in events)
-    if math.isfinite(found.period) and float(time[-1]) - last_event > 2 * found.period:
-        return None
-    last = time >= (times[-2] if len(times) >= 2 else times[-1])
-    if np.any(last):
-        found = dataclasses.replace(
-            found,
-            peak=max(found.peak, float(np.max(stress[last]))),
-            trough=min(found.trough, float(np.min(stress[last]))),
-        )
+    t_stick: float
+    sigma_stick: float
+    t_slip: float
+    sigma_s: float
+    after: tuple[float, float] | None
+
+    @property
+    def rise(self) -> float:
+        return self.sigma_s - self.sigma_stick
+
+
+def _chain_cycles(events: list, start: float) -> list[_ChainCycle]:
+    """The stick -> slip pairs of the chains with both events at or after ``start`` (the last protocol segment)."""
+    marks = [(kind, float(t), float(s)) for kind, t, s, _ in events if kind in ("stick", "slip") and t >= start]
+    found = []
+    for k, (kind, t, sigma) in enumerate(marks):
+        if kind != "slip" or k == 0 or marks[k - 1][0] != "stick":
+            continue
+        after = marks[k + 1][1:] if k + 1 < len(marks) and marks[k + 1][0] == "stick" else None
+        found.append(_ChainCycle(marks[k - 1][1], marks[k - 1][2], t, sigma, after))
     return found
+
+
+def _repeats(first: tuple[float, float], second: tuple[float, float], rise: float) -> bool:
+    """The cycle's state repeated: both stresses within RATIO_TOLERANCE of the stick's rise."""
+    return all(abs(b - a) <= regimes.RATIO_TOLERANCE * abs(rise) for a, b in zip(first, second, strict=True))
+
+
+def _from_events(
+    events: list, start: float, time: np.ndarray, stress: np.ndarray, lowest: np.ndarray | None = None
+) -> regimes.Regime | None:
+    """The regime from the stick chains' exact sticks and slips (time, stress), independent of ``every``.
+
+    With the chains a cycle has one number of state: a stick starts with fresh chains, so the stress it starts
+    under (and the puller's pace) fixes its slip's σs; a slip lands on the steady population of its jump, so σs
+    fixes the stick that follows.  A cycle whose state repeats the one before (the stick's start and σs within
+    RATIO_TOLERANCE of its rise), or a stick that starts where the one before started, therefore repeats for
+    ever: a limit cycle, shown by two slips (or by one slip and the stick after it).  Otherwise three or more
+    whole cycles are judged by their amplitudes (regimes.classify_cycles); fewer are undetermined, in words.
+    None when the last segment has no such cycle, or its last event is more than two periods before the end
+    (the run left stick-slip: the trace decides).  The reported extremes are the events' or the trace's over
+    the last period, whichever reaches further (the slip's lowest stress can come just before the stick);
+    ``lowest``: each row's lowest stress of the solver's steps since the row before (``every`` must not move
+    the trough).
+    """
+    cycles = _chain_cycles(events, start)
+    if not cycles:
+        return None
+    whole = [c for c in cycles if c.after is not None]
+    lengths = [c.after[0] - c.t_stick for c in whole if c.after is not None]
+    period = float(np.mean(lengths[-3:])) if lengths else math.nan
+    last_event = max(float(t) for _, t, _, _ in events)
+    if math.isfinite(period) and float(time[-1]) - last_event > 2 * period:
+        return None
+    found = _chain_verdict(cycles, whole, period)
+    recent = time >= (cycles[-2].t_slip if len(cycles) >= 2 else cycles[-1].t_stick)
+    inside = np.flatnonzero(recent)
+    if inside.size:
+        troughs = [found.trough, float(np.min(stress[inside]))]
+        if lowest is not None and inside.size > 1:  # the first row's steps began before the window: not counted
+            troughs.append(float(np.min(lowest[inside[1:]])))
+        found = dataclasses.replace(found, peak=max(found.peak, float(np.max(stress[inside]))), trough=min(troughs))
+    return found
+
+
+def _chain_verdict(cycles: list[_ChainCycle], whole: list[_ChainCycle], period: float) -> regimes.Regime:
+    """The verdict of the chains' cycles: a limit cycle as soon as one cycle repeats the one before."""
+    last = cycles[-1]
+    peak = last.sigma_s
+    trough = min(c.sigma_stick for c in cycles[-2:])
+    repeating = 0  # the trailing cycles that repeat the one before each: the periods that back the verdict
+    for prev, this in zip(reversed(cycles[:-1]), reversed(cycles[1:]), strict=True):
+        if not _repeats((prev.sigma_stick, prev.sigma_s), (this.sigma_stick, this.sigma_s), prev.rise):
+            break
+        repeating += 1
+    if repeating:
+        prev = cycles[-2]
+        ratio = last.rise / prev.rise
+        slips = [c.t_slip for c in cycles[-repeating - 1 :]]
+        length = float(np.mean(np.diff(slips[-4:])))
+        evidence = (
+            f"stick-slip (limit cycle): {repeating} period(s) of {length:.6g} s, {repeating + 1} slips whose cycles"
+            f" repeat (the last two: stick from {prev.sigma_stick:.6g} then {last.sigma_stick:.6g} Pa, σs ="
+            f" {prev.sigma_s:.6g} then {last.sigma_s:.6g} Pa, amplitude ratio {ratio:.4g}): with fresh chains at"
+            " each stick the cycle repeats from there"
+        )
+        return regimes.Regime(regimes.STICK_SLIP, repeating, ratio, length, peak, trough, evidence)
+    if last.after is not None and _repeats((last.sigma_stick,), (last.after[1],), last.rise):
+        length = last.after[0] - last.t_stick
+        evidence = (
+            f"stick-slip (limit cycle): 1 period of {length:.6g} s: the stick after the slip (σs = {last.sigma_s:.6g}"
+            f" Pa) starts under {last.after[1]:.6g} Pa, where the one before started ({last.sigma_stick:.6g} Pa),"
+            " and with fresh chains the cycle repeats from there"
+        )
+        return regimes.Regime(regimes.STICK_SLIP, 1, math.nan, length, peak, trough, evidence)
+    if len(whole) >= 3:
+        times = [c.t_slip for c in whole]
+        troughs = [c.after[1] for c in whole if c.after is not None]
+        return regimes.classify_cycles(times, [c.sigma_s for c in whole], troughs)
+    history = "; ".join(f"stick from {c.sigma_stick:.6g} Pa to σs = {c.sigma_s:.6g} Pa" for c in cycles[-3:])
+    if last.after is not None:
+        history += f"; the next stick from {last.after[1]:.6g} Pa"
+    why = "no cycle repeats the one before yet" if len(cycles) >= 2 or last.after is not None else "no stick after it"
+    evidence = (
+        f"undetermined: {len(cycles)} slip(s) ({history}), {why}: whether the run settles into a limit cycle needs"
+        " another slip"
+    )
+    ratio = last.rise / cycles[-2].rise if len(cycles) >= 2 and cycles[-2].rise > 0 else math.nan
+    return regimes.Regime(regimes.UNDETERMINED, len(whole), ratio, period, peak, trough, evidence)

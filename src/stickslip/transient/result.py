@@ -73,6 +73,8 @@ class TransientResult:
     #: the block's mass (kg/m^2) and viscous damping (Pa s/m); 0: the paper's massless block
     mass: float = 0.0
     damping: float = 0.0
+    #: the classifier's evidence for ``regime`` (periods seen, amplitude ratio, period, extremes; None if stopped)
+    evidence: Any = field(default=None, repr=False)
 
     @property
     def final_stress(self) -> float:

@@ -337,7 +337,9 @@ def run_transient(
                 chain_state = {"elapsed": 0.0, "fraction": 1.0}
                 events.append(("stick", state.t, k_block * (state.puller - state.x), state.v))
             if not all(math.isfinite(q) for q in (state.t, state.x, state.v, state.h)):
-                raise ModelError(_non_finite(state.t, out[:count], rows, float(np.max(protocol.velocities)), inertial))
+                raise ModelError(
+                    _non_finite(state.t, out[:count], rows, float(np.max(protocol.velocities)), inertial, state.h)
+                )
             if state.acc[4] > budget:
                 raise over_budget("transient", int(state.acc[4]), budget, state.t, duration)
             if progress is not None:
@@ -358,22 +360,45 @@ def run_transient(
 RUNAWAY = 1e6
 
 
-def _non_finite(t: float, block: np.ndarray, rows: list[np.ndarray], pace: float, inertial: bool = False) -> str:
-    """The failure in words: a runaway slip (the bonds gave way faster than an inertia-free block can follow)."""
+def _non_finite(
+    t: float, block: np.ndarray, rows: list[np.ndarray], pace: float, inertial: bool = False, step: float = math.nan
+) -> str:
+    """The failure in words: a runaway slip (the bonds gave way faster than an inertia-free block can follow).
+
+    ``block``: the kernel's rows of its last call; ``rows``: the trace so far, single rows or blocks of them
+    (time, sigma, N, V, X first in both); ``step``: the step size the kernel had come down to.  What decides is
+    the kernel's state (its step collapsed, or a recorded velocity past :data:`RUNAWAY` x ``pace``), so that
+    the sampling of the rows (``every``) does not change the verdict; the rows only add the last state known.
+    Never nan or inf in the words: what is not known is said so.
+    """
+    recent = [np.atleast_2d(np.asarray(r, dtype=float))[:, :5] for r in (*rows[-2:], block) if np.size(r)]
+    table = np.vstack(recent) if recent else np.empty((0, 5))
+    finite = table[np.all(np.isfinite(table[:, [0, 1, 3, 4]]), axis=1)] if table.size else table
+    when = f"t = {t:.6g} s" if math.isfinite(t) else "an unknown time"
+    if finite.size:
+        last = finite[np.argmax(finite[:, 0])]
+        when += f" (last finite state at t = {last[0]:.6g} s: σ = {last[1]:.6g} Pa, V = {show_velocity(last[3], 3)})"
     if inertial:
-        return f"transient solver failed at t = {t:.6g} s (non-finite state of the block with mass)"
-    finite = [r for r in (*rows[-1:], *np.atleast_2d(block)) if r.size and np.all(np.isfinite(r[[0, 1, 3, 4]]))]
-    fast = [r for r in finite if r[3] > RUNAWAY * max(pace, 1e-300)]
-    if fast:  # the first row past the bound: what followed is the runaway itself
-        t_run, sigma, v = float(fast[0][0]), float(fast[0][1]), float(fast[0][3])
-        return (
-            f"transient solver failed at t = {t_run:.6g} s: the slider ran away ({v:.3g} m/s under σ = {sigma:.6g}"
-            " Pa): the bonds gave way faster than a block without inertia can follow, and Eq 1 through the block"
-            " has no finite slip velocity from there (a steady start on the unstable branch below Vc does this, and"
-            " so can sliding faster than Δl_m/τ, where steady sliding through the block is oscillatory-unstable:"
-            " transient.critical_stiffness)"
-        )
-    return f"transient solver failed at t = {t:.6g} s (non-finite state)"
+        return f"transient solver failed at {when}: non-finite state of the block with mass"
+    fast = finite[finite[:, 3] > RUNAWAY * max(pace, 1e-300)] if finite.size else finite
+    collapsed = math.isfinite(step) and math.isfinite(t) and step < COLLAPSED * max(t, 1e-300)
+    if not (fast.size or collapsed):
+        return f"transient solver failed at {when}: non-finite state"
+    seen = ""
+    if fast.size:  # the first row past the bound: what followed is the runaway itself
+        seen = f", {fast[0][3]:.3g} m/s under σ = {fast[0][1]:.6g} Pa at t = {fast[0][0]:.6g} s"
+    elif collapsed:
+        seen = f", the step down to {step:.3g} s"
+    return (
+        f"transient solver failed at {when}: the slider ran away{seen}: the bonds gave way faster than a block"
+        " without inertia can follow, and Eq 1 through the block has no finite slip velocity from there (a steady"
+        " start on the unstable branch below Vc does this, and so can sliding faster than Δl_m/τ, where steady"
+        " sliding through the block is oscillatory-unstable: transient.critical_stiffness)"
+    )
+
+
+#: a step shorter than this fraction of the time reached has collapsed (the kernel's floor is 1e-15 of it)
+COLLAPSED = 1e-12
 
 
 def _chunk(state: _State, budget: int, reducer: _Reducer | None) -> int:
@@ -646,7 +671,7 @@ def _finish(
     mass: float = 0.0,
     damping: float = 0.0,
 ) -> TransientResult:
-    from .cycles import classify, detect_cycles
+    from .cycles import detect_cycles, judge
 
     table = np.vstack([np.atleast_2d(r) for r in rows])
     order = np.argsort(table[:, 0], kind="stable")
@@ -658,7 +683,9 @@ def _finish(
     bonded = bonded / n0
     bonded = np.where(np.isnan(bonded), 0.0, bonded)  # the bonds of Eq 1 are set aside while the chains hold
     cycles = detect_cycles(time, sigma, v, protocol, events)
-    regime, message = classify(time, sigma, v, protocol, cycles, events, control, stop, resolution=resolution)
+    regime, message, evidence = judge(
+        time, sigma, v, protocol, cycles, events, control, stop, resolution=resolution, lowest=table[:, 14]
+    )
     message = message + note
     saturating = params.aging.saturation_age is not None  # the extension lets go: its stuck is its own answer
     if regime == "stuck" and not cycles and not stick_population_used(events) and not saturating:
@@ -693,6 +720,7 @@ def _finish(
         lowest_stress=lowest,
         mass=mass,
         damping=damping,
+        evidence=evidence,
     )
 
 
