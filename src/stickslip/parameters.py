@@ -182,6 +182,18 @@ SECTIONS: dict[str, type] = {
 _META_KEYS = ("name", "description", "reference")
 
 
+def require_flag(value: Any, name: str) -> bool:
+    """``value`` as a bool; anything but True/False (numpy's included) is one ParameterError naming ``name``.
+
+    ``bool("false")`` is True: a truthy text, number or None is refused instead of silently read.
+    """
+    if isinstance(value, bool) or (
+        getattr(value, "dtype", None) is not None and value.dtype.kind == "b" and getattr(value, "ndim", 1) == 0
+    ):  # fmt: skip - numpy's bool, not imported here
+        return bool(value)
+    raise ParameterError(f"{name}: expected True or False, got {shorten(value)}")
+
+
 def parameter_keys() -> list[str]:
     """All canonical keys, ``section.key``."""
     return [f"{s}.{f.name}" for s, cls in SECTIONS.items() for f in fields(cls)]

@@ -110,13 +110,13 @@ class Protocol:
 
     def velocity_at(self, t: Any) -> np.ndarray:
         """Load-point velocity at times ``t`` (right-continuous; the last segment's beyond the end)."""
-        t = np.asarray(t, dtype=float)
+        t = _times(t, "velocity_at")
         index = np.clip(np.searchsorted(self.boundaries, t, side="right") - 1, 0, len(self.segments) - 1)
         return self.velocities[index]
 
     def displacement_at(self, t: Any) -> np.ndarray:
         """Load-point displacement since t = 0 (m): the exact integral of the velocity."""
-        t = np.asarray(t, dtype=float)
+        t = _times(t, "displacement_at")
         b = self.boundaries
         v = self.velocities
         start_disp = np.concatenate([[0.0], np.cumsum(v * np.diff(b))])
@@ -185,6 +185,19 @@ def slide_hold_slide(
         (Segment(slide_velocity, slide_time), Segment(hold_velocity, hold_time), Segment(slide_velocity, reslide)),
         name="slide-hold-slide",
     )
+
+
+def _times(t: Any, method: str) -> np.ndarray:
+    """Times (s) as floats, or one ParameterError naming the method: 'x' or NaN is no time."""
+    try:
+        times = np.asarray(t, dtype=float)
+    except (TypeError, ValueError):
+        raise ParameterError(
+            f"Protocol.{method}(t): expected a time in seconds or an array of them, got {t!r}"[:300]
+        ) from None
+    if np.isnan(times).any():
+        raise ParameterError(f"Protocol.{method}(t): expected times in seconds, got NaN")
+    return times
 
 
 def parse_segment(text: str, name: str = "--segment") -> Segment:

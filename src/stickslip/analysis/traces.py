@@ -72,6 +72,8 @@ def read_trace(path: str | Path, contact_area: float | None = None) -> Trace:
     time with different stresses are a jump and are kept); :class:`ParameterError` for a
     missing, superfluous or non-positive contact area.
     """
+    if not isinstance(path, (str, Path)) and not hasattr(path, "__fspath__"):
+        raise DataError(f"read_trace: expected a file name (str or Path), got {type(path).__name__}")
     table = read_table(
         path, TRACE_DIMENSIONS, required=["time"], allow_missing=["stress", "force"], ignore=MODEL_COLUMNS
     )

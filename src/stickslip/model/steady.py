@@ -36,7 +36,7 @@ import numpy as np
 from ..columns import with_units
 from ..errors import ModelError, ParameterError
 from ..numerics.quadrature import panel_rule
-from ..parameters import BOLTZMANN, Parameters
+from ..parameters import BOLTZMANN, Parameters, require_flag
 from ..reprs import compact_repr
 from ..units import shorten
 
@@ -630,6 +630,7 @@ def steady_state(
     of Eq 3 diverges, and the integral of Eq 8 diverges logarithmically.
     """
     require_parameters(params)
+    aging, distribution = require_flag(aging, "aging"), require_flag(distribution, "distribution")
     if not isinstance(quadrature, QuadratureSettings):
         raise ParameterError(f"quadrature: expected QuadratureSettings, got {type(quadrature).__name__}")
     v = _check_velocity(velocity)
@@ -679,6 +680,7 @@ def steady_stress_many(
     With ``paired=True`` set k is evaluated only at velocity[k] (shape
     (len(params_list),)).  Same accuracy as :func:`steady_state`.
     """
+    aging, paired = require_flag(aging, "aging"), require_flag(paired, "paired")
     v = np.ravel(_check_velocity(velocity))
     for k, p in enumerate(params_list):
         require_parameters(p, f"parameter set {k}")

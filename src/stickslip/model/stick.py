@@ -48,7 +48,7 @@ from scipy.optimize import brentq
 from ..columns import with_units
 from ..errors import ModelError, ParameterError
 from ..numerics.events import integrate_in_chunks
-from ..parameters import Parameters
+from ..parameters import Parameters, require_flag
 from ..reprs import compact_repr
 from .jump import require_critical_point
 from .steady import require_parameters
@@ -295,8 +295,11 @@ def stick_phase(
         sigma0 = float(cp.stress)
     else:
         sigma0 = check_stress(start_stress)
+    aging = require_flag(aging, "aging")
     if horizon is not None:
         horizon = _number(horizon, "horizon", "s")
+        if horizon < 0:  # 0 is allowed: the time-dependent model asks with what is left of a segment
+            raise ParameterError(f"horizon: expected a time >= 0 in s, got {horizon!r}")
     cap = math.inf
     if aging_cap is not None:
         cap = _number(aging_cap, "aging_cap", "aging times")

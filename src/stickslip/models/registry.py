@@ -16,6 +16,7 @@ from importlib import metadata
 from typing import Any
 
 from ..errors import ParameterError
+from ..parameters import require_flag
 from .base import FrictionModel
 
 __all__ = ["ENTRY_POINT_GROUP", "available_models", "get_model", "register_model"]
@@ -30,6 +31,7 @@ _REQUIRED = ("name", "dimensions", "parameters", "run")
 def register_model(model: Any, *, replace: bool = False) -> FrictionModel:
     """Make ``model`` (a :class:`FrictionModel` instance, or a class to instantiate) available by its name and
     aliases; returns it.  A name already taken by another model is refused unless ``replace=True``."""
+    replace = require_flag(replace, "register_model: replace")
     if isinstance(model, type):
         model = _instance(model, "register_model")
     missing = [attr for attr in _REQUIRED if not hasattr(model, attr)]

@@ -76,6 +76,31 @@ def _column(values: Any, name: str, size: int | None) -> np.ndarray:
     return array
 
 
+def _trace_arrays(time: Any, stress: Any, friction: Any) -> tuple[np.ndarray, np.ndarray]:
+    """``time`` and the classified signal as float arrays, checked before anything is computed from them:
+    one row per time, at least one row, times finite and never going back (a raw numpy error otherwise)."""
+    if stress is None and friction is None:
+        raise ParameterError("Run.from_trace: expected stress= or friction=, got neither")
+    try:
+        t = np.asarray(time, dtype=float)
+        signal = np.asarray(stress if stress is not None else friction, dtype=float)
+    except (TypeError, ValueError):
+        raise ParameterError("Run.from_trace: expected time and stress (or friction) as arrays of numbers") from None
+    name = "stress" if stress is not None else "friction"
+    if t.ndim != 1 or signal.ndim != 1:
+        raise ParameterError(f"Run.from_trace: expected one-dimensional time and {name}, got shapes {t.shape}, "
+                             f"{signal.shape}")  # fmt: skip
+    if t.size == 0:
+        raise ParameterError("Run.from_trace: time is empty; a run has at least one row")
+    if signal.size != t.size:
+        raise ParameterError(f"Run.from_trace: {signal.size} {name} values for {t.size} times; expected one per time")
+    if not np.all(np.isfinite(t)):
+        raise ParameterError(f"Run.from_trace: time holds a non-finite value at row {int(np.argmin(np.isfinite(t)))}")
+    if np.any(np.diff(t) < 0):
+        raise ParameterError(f"Run.from_trace: time goes back at row {int(np.argmax(np.diff(t) < 0)) + 1}")
+    return t, signal
+
+
 def _is_text(values: Any) -> bool:
     array = np.asarray(values)
     return array.dtype.kind in "OUS"
@@ -153,8 +178,7 @@ class Run:
         """A Run from the model's solution; without ``regime`` it is classified on the stress (or friction)
         by :func:`stickslip.regimes.classify`, with ``dense`` the solver's interpolant of that signal if there is
         one, over ``t >= start``, changes below ``floor`` (default 1e-9 of the signal's scale) counting as none."""
-        t = np.asarray(time, dtype=float)
-        signal = np.asarray(stress if stress is not None else friction, dtype=float)
+        t, signal = _trace_arrays(time, stress, friction)
         if regime is None:
             if floor is None:
                 scale = float(np.max(np.abs(signal[np.isfinite(signal)]), initial=0.0))

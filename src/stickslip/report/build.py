@@ -266,6 +266,31 @@ def _render_in_worker(index: int, folder: Path) -> tuple[RenderedFigure, list[Pa
     return _render(_SHARED_RUN, index, folder)
 
 
+#: prctl(2) option: the signal a process gets when its parent dies (linux/prctl.h).
+PR_SET_PDEATHSIG = 1
+
+
+def die_with_parent(parent: int) -> None:
+    """Worker initializer: end this process when ``parent`` dies, even by ``kill -9`` (no cleanup runs there).
+
+    A forked worker blocked on its task pipe would otherwise outlive a killed ``stickslip reproduce`` for as long
+    as the machine runs.  On Linux the kernel sends SIGKILL at the parent's death (PR_SET_PDEATHSIG); the parent
+    may already be gone before the call, so that is checked after it.  Elsewhere (no fork there) nothing is done.
+    """
+    if not sys.platform.startswith("linux"):
+        return
+    import ctypes
+    import signal
+
+    try:
+        libc = ctypes.CDLL(None, use_errno=True)
+        libc.prctl(PR_SET_PDEATHSIG, int(signal.SIGKILL), 0, 0, 0)
+    except (OSError, AttributeError):  # no prctl: the worker still ends when its task pipe closes normally
+        return
+    if os.getppid() != parent:  # the parent died between the fork and the prctl call
+        os._exit(1)
+
+
 def _figure_workers(workers: int | None) -> int:
     """Processes to draw the figures in: forked ones only where fork exists (they share the model run)."""
     if workers is not None:
@@ -293,7 +318,9 @@ def _rendered_figures(
     _SHARED_RUN = run
     try:
         context = multiprocessing.get_context("fork")
-        with ProcessPoolExecutor(max_workers=count, mp_context=context) as pool:
+        with ProcessPoolExecutor(
+            max_workers=count, mp_context=context, initializer=die_with_parent, initargs=(os.getpid(),)
+        ) as pool:
             futures = [pool.submit(_render_in_worker, i, folder) for i in range(len(FIGURE_BUILDERS))]
             for (description, _), future in zip(FIGURE_BUILDERS, futures, strict=True):
                 step(description)

@@ -163,22 +163,39 @@ class Nagata(Aging):
 LAWS: dict[str, StateLaw] = {}
 
 
-def register_law(law: StateLaw, name: str | None = None) -> StateLaw:
-    """Make ``law`` available under ``name`` (default ``law.name``); returns it."""
-    key = (name or law.name).strip().lower()
+def register_law(law: StateLaw, name: str | None = None, *, replace: bool = False) -> StateLaw:
+    """Make ``law`` available under ``name`` (default ``law.name``); returns it.
+
+    A name already taken by another law (a built-in such as ``aging`` included) is refused unless
+    ``replace=True``: silently swapping the aging law for the rest of the process would change every later run.
+    """
+    if name is not None and not isinstance(name, str):
+        raise ParameterError(f"register_law: expected name as a text, got {type(name).__name__}")
+    own = getattr(law, "name", None)
+    key = (name if name is not None else own if isinstance(own, str) else "").strip().lower()
     if not key:
-        raise ParameterError("register_law: expected a non-empty law name")
+        raise ParameterError("register_law: expected a non-empty law name (name=... or the law's .name)")
     for attr in ("rate", "coupling", "theta_scale"):
         if not hasattr(law, attr):
             raise ParameterError(f"register_law {key!r}: the law has no {attr!r} (see stickslip.rsf.laws.StateLaw)")
+    if not isinstance(replace, bool):
+        raise ParameterError(f"register_law: expected replace=True or False, got {replace!r}")
+    taken = LAWS.get(key)
+    if taken is not None and taken is not law and not replace:
+        raise ParameterError(
+            f"register_law {key!r}: the name is taken by the {type(taken).__name__} law; give another name,"
+            " or replace=True to replace it for the rest of this process"
+        )
     LAWS[key] = law
     return law
 
 
 def get_law(name: str | StateLaw) -> StateLaw:
-    """The law registered under ``name`` (a law object passes through)."""
+    """The law registered under ``name`` (a law object passes through; anything else is a ParameterError)."""
     if not isinstance(name, str):
-        return name
+        if all(hasattr(name, attr) for attr in ("rate", "coupling", "theta_scale")):
+            return name
+        raise ParameterError(f"law: expected a law name, one of {', '.join(sorted(LAWS))}; got {name!r}"[:300])
     try:
         return LAWS[name.strip().lower()]
     except KeyError:

@@ -16,7 +16,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import DataError, ParameterError
-from ..parameters import Parameters
+from ..parameters import Parameters, require_flag
 from ..units import to_si
 from .engine import check_scheduler_address, compute, compute_while_cheap, dask_client, default_batch_size, read_results
 from .main_guard import unguarded_script_line
@@ -80,6 +80,7 @@ def build_spec(
         given["pulling_velocity"] = pulling_velocity
     fixed, label = adapter.fixed_values(params, given)
     adapter.check_keys(tuple(a.key for a in axes), fixed)
+    stick_population = require_flag(stick_population, "stick_population")
     settings = _settings(adapter, _duration(duration), jump_curve=jump_curve, stick_population=stick_population)
     spec = SweepSpec(
         model=model,
@@ -122,6 +123,7 @@ def run_sweep(
     if scheduler is not None:
         check_scheduler_address(scheduler)
     workers = _workers_for_the_caller(workers, scheduler)
+    overwrite = require_flag(overwrite, "overwrite")
     store = open_store(output, spec, batch_size or default_batch_size(spec.size), overwrite=overwrite)
     shown = progress if progress is not None else Silent()
     try:
@@ -188,6 +190,7 @@ def sweep(
     """
     if output is not None and not str(output).strip():  # Path("") would be the current folder
         raise ParameterError("output: the folder name is empty; give a folder, or None for no folder")
+    quiet = require_flag(quiet, "quiet")
     spec = build_spec(vary, **specification)
     folder = Path(output) if output is not None else Path(tempfile.mkdtemp(prefix="stickslip-sweep-"))
     try:

@@ -44,6 +44,33 @@ class Axis:
     high: float | None = None
     log: bool = False
 
+    def __post_init__(self) -> None:
+        where = f"Axis({self.key!r})"
+        if not isinstance(self.key, str) or not self.key.strip():
+            raise ParameterError(f"Axis: expected key as a non-empty text, got {self.key!r}")
+        if not isinstance(self.log, (bool, np.bool_)):  # bool("false") is True: take no texts
+            raise ParameterError(f"{where}: expected log=True or False, got {self.log!r}")
+        if isinstance(self.values, (str, bytes)):
+            raise ParameterError(f"{where}: expected values as a sequence of numbers, got a text")
+        values = tuple(_finite(v, f"{where}: values") for v in self.values)
+        object.__setattr__(self, "values", values)
+        object.__setattr__(self, "log", bool(self.log))
+        if values:
+            if self.low is not None or self.high is not None:
+                raise ParameterError(f"{where}: give either values or low..high, not both")
+            ends = values
+        else:
+            if self.low is None or self.high is None:
+                raise ParameterError(f"{where}: expected values, or both low and high")
+            low, high = _finite(self.low, f"{where}: low"), _finite(self.high, f"{where}: high")
+            if low > high:
+                raise ParameterError(f"{where}: expected low <= high, got {low:g} > {high:g}")
+            object.__setattr__(self, "low", low)
+            object.__setattr__(self, "high", high)
+            ends = (low, high)
+        if self.log and min(ends) <= 0:
+            raise ParameterError(f"{where}: a log axis needs positive values, got {min(ends):g}")
+
     @property
     def is_range(self) -> bool:
         return not self.values
@@ -76,6 +103,30 @@ class SweepSpec:
     seed: int = 0
     settings: Mapping[str, Any] = field(default_factory=dict)  # model options: duration, jump curve, ...
     label: str = ""  # the parameter set's name, for titles
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.model, str) or not self.model.strip():
+            raise ParameterError(f"SweepSpec: expected model as a name, got {self.model!r}")
+        if not isinstance(self.fixed, Mapping) or not all(isinstance(k, str) for k in self.fixed):
+            raise ParameterError("SweepSpec: expected fixed as a mapping {key: SI value}")
+        object.__setattr__(self, "fixed", {k: _finite(v, f"SweepSpec: fixed[{k!r}]") for k, v in self.fixed.items()})
+        if isinstance(self.axes, Axis) or not all(isinstance(a, Axis) for a in self.axes):
+            raise ParameterError("SweepSpec: expected axes as a tuple of Axis")
+        axes = tuple(self.axes)
+        object.__setattr__(self, "axes", axes)
+        if self.design not in ("grid", "latin-hypercube"):
+            raise ParameterError(f"SweepSpec: expected design 'grid' or 'latin-hypercube', got {self.design!r}")
+        for name in ("samples", "seed"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 0:
+                raise ParameterError(f"SweepSpec: expected {name} as a whole number >= 0, got {value!r}")
+        samples = int(self.samples) if self.design == "latin-hypercube" else None
+        if check_design(axes, samples) != self.design:  # pragma: no cover - check_design refuses a mismatch first
+            raise ParameterError(f"SweepSpec: the axes do not make a {self.design} design")
+        if not isinstance(self.settings, Mapping):
+            raise ParameterError(f"SweepSpec: expected settings as a mapping, got {type(self.settings).__name__}")
+        if not isinstance(self.label, str):
+            raise ParameterError(f"SweepSpec: expected label as a text, got {self.label!r}")
 
     @property
     def keys(self) -> tuple[str, ...]:
@@ -185,6 +236,19 @@ def parse_vary(
     if count > 1 and low == high:
         raise ParameterError(f"{where}: {count} points between equal ends; give one value or two different ends")
     return Axis(key, values=tuple(float(v) for v in _spaced(low, high, count, log)), log=log)
+
+
+def _finite(value: Any, where: str) -> float:
+    """A finite float, or one ParameterError naming ``where`` (a text, None, NaN or inf is no value)."""
+    if isinstance(value, (bool, str, bytes)) or value is None:
+        raise ParameterError(f"{where}: expected a finite number (SI), got {value!r}"[:300])
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        raise ParameterError(f"{where}: expected a finite number (SI), got {value!r}"[:300]) from None
+    if not math.isfinite(number):
+        raise ParameterError(f"{where}: expected a finite number (SI), got {number}")
+    return number
 
 
 def _value(text: str, dimension: str, where: str) -> float:
