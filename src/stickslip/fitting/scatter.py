@@ -68,17 +68,16 @@ def local_scatter(velocity: np.ndarray, stress: np.ndarray, stress_err: np.ndarr
         return Scatter(math.inf, 0.0, relative, n)
     h_left, h_right = x[1:-1] - x[:-2], x[2:] - x[1:-1]
     w_left, w_right = h_right / (h_left + h_right), h_left / (h_left + h_right)
-    # the pseudo-residuals as rows of D (d = D y), each scaled to unit variance under the noise model
-    d = np.zeros((n - 2, n))
-    rows = np.arange(n - 2)
-    d[rows, rows], d[rows, rows + 1], d[rows, rows + 2] = -w_left, 1.0, -w_right
     sd = np.sqrt(e[1:-1] ** 2 + (w_left * e[:-2]) ** 2 + (w_right * e[2:]) ** 2)
-    d /= sd[:, None]
-    pseudo = d @ y
+    pseudo = (y[1:-1] - w_left * y[:-2] - w_right * y[2:]) / sd
     variance = float(pseudo @ pseudo) / (n - 2)
-    # Satterthwaite: s^2 = z^T A z / (n-2) with z = y/e standard noise, A = E D^T D E
-    a = (d * e[None, :]).T @ (d * e[None, :])
-    dof = float(np.trace(a) ** 2 / np.sum(a * a))
+    # Satterthwaite: pseudo = B z with z = y/e standard noise and B banded (row i: columns i, i+1, i+2);
+    # s^2 = z^T B^T B z/(n - 2), tr(B^T B) = n - 2 (unit rows), tr((B^T B)^2) = |B B^T|_F^2 from its 3 diagonals
+    c0, c1, c2 = -w_left * e[:-2] / sd, e[1:-1] / sd, -w_right * e[2:] / sd
+    off1 = c1[:-1] * c0[1:] + c2[:-1] * c1[1:]
+    off2 = c2[:-2] * c0[2:]
+    square_trace = float(np.sum((c0**2 + c1**2 + c2**2) ** 2) + 2 * off1 @ off1 + 2 * off2 @ off2)
+    dof = (n - 2) ** 2 / square_trace
     floor = SCATTER_FLOOR**2 if relative else (SCATTER_FLOOR * float(np.median(stress / e))) ** 2
     return Scatter(max(variance, floor), dof, relative, n)
 
