@@ -107,25 +107,27 @@ def test_cli_fit_json_and_toml(tmp_path, capsys):
 
 
 def test_real_sepiolite_velocity_step_is_described():
-    """docs/rsf.md: one state with a linear trend describes the record to within 3x its high-frequency noise."""
+    """docs/rsf.md: one state with a linear trend; the residuals (rms ~1.1e-3) exceed the steady sliding's noise
+    (~3.8e-4, model-independent) about 3x, so the fit warns of structure it does not describe, and the
+    intervals, from the residuals' own scatter and correlation (slow: about a hundred independent rows of
+    16,466), are wide accordingly."""
     cols = parse_columns('time="Time(s)",displacement="Displ(microns)",friction=Friction')
     rec = read_record(REAL_FILE, cols, displacement_unit="um")
     assert len(rec) == 16466
-    fit = fit_record(rec, trend=True)
+    fit = fit_record(rec, trend=True, drift_check=False)
     assert fit.success and fit.status == "ok"
     speeds = fit.protocol.velocities
     assert [speeds[0], speeds[-1]] == pytest.approx([0.2e-6, 2e-6], rel=0.01)
     assert sum(s.duration for s in fit.protocol.segments[1:-1]) < 5.0  # at most the servo's few-second ramp
-    assert fit.rms < 3 * fit.noise * math.sqrt(10)  # residual rms ~ 1.1e-3 against noise 3.4e-4 (drifts remain)
+    assert 2e-4 < fit.noise < 6e-4 and 2 < fit.rms / fit.noise < 5
     assert 0.5 < (fit.parameters["a"].value - fit.parameters["b"].value) * math.log(10) / 0.05 < 1.5
-    # chi-square_r ~ 10: the intervals assume the record's noise, so a warning offers them widened by sqrt(chi2_r)
     assert fit.reduced_chi_square > 2
-    assert any("reduced chi-square" in w and "scaled" in w for w in fit.warnings)
+    assert any("reduced chi-square" in w and "structure the model does not describe" in w for w in fit.warnings)
+    assert 20 < fit.effective_rows < 0.1 * len(rec)  # slowly correlated residuals count as few independent rows
     a = fit.parameters["a"]
-    widths = (a.scaled_interval[1] - a.scaled_interval[0]) / (a.interval[1] - a.interval[0])
-    assert widths == pytest.approx(math.sqrt(fit.reduced_chi_square), rel=1e-9)
+    assert a.scaled_interval is None and a.interval[0] < a.value < a.interval[1]
     report = fit.summary()
-    assert report["parameters"]["dc"]["unit"] == "um" and 1 < report["parameters"]["dc"]["value"] < 1000
+    assert report["parameters"]["dc"]["unit"] == "m" and 1e-6 < report["parameters"]["dc"]["value"] < 1e-3
 
 
 def test_optional_emcee_posterior():

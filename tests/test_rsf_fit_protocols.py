@@ -68,10 +68,10 @@ def test_the_issue_example_fits_from_displacement_and_a_wrong_history_fails_with
     assert code == 0, err
     report = json.loads(out)
     assert report["status"] == "ok"
-    assert [row["velocity"] for row in report["protocol"]] == pytest.approx([1, 10, 1], rel=1e-3)
-    assert report["protocol"][0]["unit"] == "um/s"
-    assert report["parameters"]["dc"]["unit"] == "um"
-    assert report["parameters"]["dc"]["value"] == pytest.approx(20.0, rel=0.05)
+    assert [row["velocity"] for row in report["protocol"]] == pytest.approx([1e-6, 1e-5, 1e-6], rel=1e-3)
+    assert report["protocol"][0]["unit"] == "m/s"  # the JSON is SI (issue 27, item 9)
+    assert report["parameters"]["dc"]["unit"] == "m"
+    assert report["parameters"]["dc"]["value"] == pytest.approx(20e-6, rel=0.05)
     assert report["derived"]["a-b"]["value"] == pytest.approx(-0.005, abs=5e-4)
     # the same record fitted with one segment (the old misreading): failed, with the reason, exit 3, nothing written
     history = tmp_path / "one.csv"

@@ -26,7 +26,7 @@ class Transient(BondModel):
     segment's velocity, or at the setting ``start_velocity``).  A spring rig's ``mass`` and ``damping`` give the
     block inertia (run_transient's ``mass``, ``damping``).  Settings: those of ``run_transient``
     (``stick_population``, ``aging``, ``start_velocity``, ``every``, ``rtol``, ``max_step``, ``max_steps``,
-    ``reduction``, ``snapshot_times``, ``progress``).
+    ``max_time``, ``reduction``, ``snapshot_times``, ``progress``).
     """
 
     name = "transient"
@@ -38,8 +38,8 @@ class Transient(BondModel):
         damping=True,
         mass=True,
         settings=(
-            "stick_population", "aging", "start_velocity", "every", "rtol", "max_step", "max_steps", "reduction",
-            "snapshot_times", "progress",
+            "stick_population", "aging", "start_velocity", "every", "rtol", "max_step", "max_steps", "max_time",
+            "reduction", "snapshot_times", "progress",
         ),
     )  # fmt: skip
     sweep_start = "steady"
