@@ -59,6 +59,16 @@ class Transient(BondModel):
         result = run_transient(params, protocol, control=control, start="empty" if start is None else start, **settings)
         return transient_run(result, protocol)
 
+    def describe_start(self, start: Any, protocol: Protocol, settings: Any = None) -> str:
+        from ..display import velocity
+
+        if start is None or start == "empty":
+            return "empty: no bonds, no stress"
+        if start == "steady":
+            at = (settings or {}).get("start_velocity") or protocol.segments[0].velocity
+            return f"steady population at {velocity(float(at), 4)}"
+        return f"start {start!r}"
+
     def stability_boundary(self, fixed: Any, x: str, y: str, frame: Any = None) -> list[Boundary]:
         """Kc(V0) of the linear stability of steady sliding, in the plane (V0, a stiffness key)."""
         from ..transient import critical_stiffness
