@@ -145,4 +145,5 @@ def test_joint_fit_of_data_without_velocity_dependence_fails_before_fitting(kind
     assert fit.status == "failed" and "no significant velocity dependence" in fit.reason
     assert fit.stages == () and fit.free_keys == ()
     assert "between neighbouring points" in fit.reason
+    assert "no model fitted" in fit.report()
     assert np.allclose(fit.curve(velocity[:3]), fit.model_stress[0])

@@ -73,7 +73,11 @@ def steady_report(fit: SteadyFit) -> str:
         f" {human(float(data.velocity.max()), 'velocity')}",
         f"- method: {fit.method}" + (f" (split at {human(fit.split, 'velocity')})" if fit.split else ""),
         f"- noise: {fit.noise}",
-        goodness_line(fit.chi_square, fit.dof, fit.noise_estimated),
+        (
+            "- no model fitted: the data were compared with a constant stress"
+            if fit.flat_level is not None
+            else goodness_line(fit.chi_square, fit.dof, fit.noise_estimated)
+        ),
         f"- intervals: {level}; parameters symmetric in ln (Wald); Vc and σc by {fit.interval_method}",
         "",
         "## Critical point (Eq 9)",
