@@ -20,6 +20,9 @@ STEADY_TOLERANCE = 1e-3
 SETTLED = 1e-5
 #: an oscillation's growth or decay is judged only above this many times the solver's tolerance, peak to trough
 RESOLVED = 10.0
+#: Eq 1 through the block: a slip is the slider outrunning the puller to this many times its pace, after a stick
+#: where it fell below 1/SLIP_FACTOR of it (the saturating set's stick creeps at 5-22 % of V0, its slip jumps to 14x)
+SLIP_FACTOR = 2.0
 
 
 def stuck_mask(time: np.ndarray, velocity: np.ndarray, protocol: Protocol) -> np.ndarray:
@@ -37,43 +40,146 @@ def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
 
 
 def detect_cycles(
-    time: np.ndarray, stress: np.ndarray, velocity: np.ndarray, protocol: Protocol, events: list
+    time: np.ndarray,
+    stress: np.ndarray,
+    velocity: np.ndarray,
+    protocol: Protocol,
+    events: list,
+    lowest: np.ndarray | None = None,
+    stiffness: float | None = None,
 ) -> tuple[Cycle, ...]:
     """A cycle is a stick that ended in a slip; its slip lasts until the next stick (None if the run ends first).
 
     With the stick chains the solver records each stick and slip as an event at its exact time and stress:
-    the cycles are read from those, whatever the sampling; otherwise from the trace.
+    the cycles are read from those, whatever the sampling; otherwise from the trace (:func:`_trace_cycles`).
     """
     from_events = _cycles_from_events(events)
     if from_events:
         return from_events
-    stuck = stuck_mask(time, velocity, protocol)
-    runs = _runs(stuck)
+    return _trace_cycles(time, stress, velocity, protocol, lowest, stiffness)
+
+
+def _pace(time: np.ndarray, protocol: Protocol) -> np.ndarray:
+    """The puller's velocity at each row (in a hold, vp = 0, the protocol's fastest: the sliding scale)."""
+    vp = protocol.velocity_at(np.minimum(time, np.nextafter(protocol.duration, 0.0)))
+    return np.where(vp > 0, vp, np.max(protocol.velocities))
+
+
+def _trace_cycles(
+    time: np.ndarray,
+    stress: np.ndarray,
+    velocity: np.ndarray,
+    protocol: Protocol,
+    lowest: np.ndarray | None,
+    stiffness: float | None,
+) -> tuple[Cycle, ...]:
+    """The cycles of Eq 1 through the block, read from the solution: a slip is a stretch where the slider outruns
+    the puller (the stress falls: dsigma/dt = K (Vp - V)) and reaches :data:`SLIP_FACTOR` x its pace, after a
+    stick where it fell to 1/SLIP_FACTOR of it.  The stick runs from the previous slip's end (V back below Vp:
+    the stress's trough) to the slip's onset (V up through Vp: its peak), whatever the slider creeps at in
+    between; a run that starts faster than the puller (a steady start above it) has no stick before that.
+
+    The trough is the lowest stress of the solver's steps (``lowest``), the peak the maximum of the cubic
+    through the two rows around the onset with their slopes K (Vp - V) (``stiffness``; without it, the rows'):
+    neither depends on the rows kept (``every``).  The jump velocity is the fastest row's.
+    """
+    n = time.size
+    if n < 3:
+        return ()
+    pace = _pace(time, protocol)
+    ahead = velocity > pace
+    runs = [(a, z) for a, z in _runs(ahead) if a > 0]  # a run from the first row is the start, not a slip
     cycles: list[Cycle] = []
-    for k, (a, z) in enumerate(runs):
-        if z + 1 >= time.size:
-            break  # still stuck at the end: no slip
-        nxt = runs[k + 1][0] if k + 1 < len(runs) else None
-        slip_end = nxt if nxt is not None else time.size - 1
-        jump = float(np.max(velocity[z + 1 : slip_end + 1])) if slip_end > z else float(velocity[z + 1])
-        vp = float(protocol.velocity_at(min(time[z + 1], np.nextafter(protocol.duration, 0.0))))
-        if jump <= vp:
-            continue  # the slider crept back up to the puller's pace without jumping: no slip
-        stick_time = float(time[z + 1] - time[a])
-        slip_time = float(time[nxt] - time[z + 1]) if nxt is not None else None
+    stick_from = _first_stick(ahead)
+    for a, z in runs:
+        if a <= stick_from:
+            continue
+        slow = float(np.min(velocity[stick_from:a] / pace[stick_from:a]))
+        jump = float(np.max(velocity[a : z + 1]))
+        end = z + 1 if z + 1 < n else None  # the row where the slider is back below the puller
+        if not (slow <= 1.0 / SLIP_FACTOR and jump >= SLIP_FACTOR * float(np.max(pace[a : z + 1]))):
+            if slow > 1.0 / SLIP_FACTOR and end is not None:
+                stick_from = end  # a swing while sliding: a stick, if any, starts after it
+            continue  # else a creep that briefly outran the puller without a jump: the stick goes on
+        t_peak, sigma_s = _extremum(time, stress, velocity, pace, a, stiffness, highest=True)
+        start_time, start_stress = float(time[stick_from]), float(stress[stick_from])
+        if stick_from > 0:  # the previous slip's end: the trough of the solution, not of the rows kept
+            start_time, start_stress = _extremum(time, stress, velocity, pace, stick_from, stiffness, highest=False)
+            if lowest is not None:  # the solver's own lowest: exact, where a cubic over long rows may undershoot
+                start_stress = _lowest(
+                    min(float(stress[stick_from - 1]), float(stress[stick_from])), lowest, stick_from
+                )
+        slip_time = None
+        if end is not None:
+            slip_time = _extremum(time, stress, velocity, pace, end, stiffness, highest=False)[0] - t_peak
+        stick_time = t_peak - start_time
         cycles.append(
             Cycle(
                 index=len(cycles),
-                start_time=float(time[a]),
-                start_stress=float(stress[a]),
-                peak_stress=float(np.max(stress[a : z + 2])),
+                start_time=start_time,
+                start_stress=start_stress,
+                peak_stress=sigma_s,
                 stick_time=stick_time,
                 jump_velocity=jump,
                 slip_time=slip_time,
                 period=None if slip_time is None else stick_time + slip_time,
             )
         )
+        if end is None:
+            break
+        stick_from = end
     return tuple(cycles)
+
+
+def _first_stick(ahead: np.ndarray) -> int:
+    """The row where the first stick starts: the first, or the first after a start faster than the puller."""
+    behind = np.flatnonzero(~ahead)
+    return int(behind[0]) if behind.size else ahead.size
+
+
+def _lowest(value: float, lowest: np.ndarray | None, row: int) -> float:
+    """The lower of ``value`` and the lowest stress of the solver's steps since the row before ``row``."""
+    if lowest is not None and math.isfinite(lowest[row]):
+        return min(value, float(lowest[row]))
+    return value
+
+
+def _extremum(
+    time: np.ndarray,
+    stress: np.ndarray,
+    velocity: np.ndarray,
+    pace: np.ndarray,
+    a: int,
+    stiffness: float | None,
+    highest: bool,
+) -> tuple[float, float]:
+    """(time, stress) of the turn where the slider's velocity crosses the puller's, between rows a - 1 and a:
+    the extremum of the cubic through both rows with their slopes dsigma/dt = K (Vp - V) (the rows' own
+    without the stiffness)."""
+    sign = 1.0 if highest else -1.0
+    t0, t1 = float(time[a - 1]), float(time[a])
+    s0, s1 = float(stress[a - 1]), float(stress[a])
+    best = (t0, s0) if sign * s0 >= sign * s1 else (t1, s1)
+    if stiffness is None or not t1 > t0:
+        return best
+    h = t1 - t0
+    d0 = stiffness * (float(pace[a - 1]) - float(velocity[a - 1])) * h  # the slopes over the unit interval
+    d1 = stiffness * (float(pace[a]) - float(velocity[a])) * h
+    # the Hermite cubic p(u) has p'(u) = A u^2 + B u + d0
+    big_a = 6 * s0 + 3 * d0 - 6 * s1 + 3 * d1
+    big_b = -6 * s0 - 4 * d0 + 6 * s1 - 2 * d1
+    roots = np.roots([big_a, big_b, d0]) if abs(big_a) + abs(big_b) > 0 else np.array([])
+    for root in roots:
+        if abs(root.imag) > 1e-12 or not 0.0 < root.real < 1.0:
+            continue
+        u = float(root.real)
+        value = (
+            (2 * u**3 - 3 * u**2 + 1) * s0 + (u**3 - 2 * u**2 + u) * d0 + (-2 * u**3 + 3 * u**2) * s1
+            + (u**3 - u**2) * d1
+        )  # fmt: skip
+        if sign * value > sign * best[1]:
+            best = (t0 + u * h, value)
+    return best
 
 
 def _cycles_from_events(events: list) -> tuple[Cycle, ...]:

@@ -682,7 +682,9 @@ def _finish(
     time, sigma, bonded, v, x, puller = (table[:, k] for k in range(6))
     bonded = bonded / n0
     bonded = np.where(np.isnan(bonded), 0.0, bonded)  # the bonds of Eq 1 are set aside while the chains hold
-    cycles = detect_cycles(time, sigma, v, protocol, events)
+    # the slopes K (Vp - V) of sigma place each peak between rows: a massless block's spring carries sigma
+    slope = k_block if control == "block" and mass == 0 else None
+    cycles = detect_cycles(time, sigma, v, protocol, events, lowest=table[:, 14], stiffness=slope)
     regime, message, evidence = judge(
         time, sigma, v, protocol, cycles, events, control, stop, resolution=resolution, lowest=table[:, 14]
     )
