@@ -187,9 +187,9 @@ def test_a_failure_with_nothing_finite_says_so_in_words():
 
 
 UNRESOLVED_JUMP = (
-    "the kernel accepts a step at its floor (1e-15 of the time reached) whatever its error: where the massless block"
-    " jumps, the steps collapse and go non-finite, or, landing elsewhere on a finer grid, one floor step carries"
-    " the jump (passing sigma = -2.4e29 Pa) and the run ends stuck; the kernel must reject or resolve it"
+    "the massless block jumps (520 Pa to ~0 within one step) and the kernel takes that step only at its floor (1e-15"
+    " of the time reached), accepted whatever its error: unsampled and every 1 ms it goes non-finite, every 0.1 ms"
+    " it lands and the run ends stuck (as issue 33's independent solver); the kernel must resolve the jump"
 )
 
 
