@@ -33,6 +33,42 @@ def _trace_csv(result: Any) -> str:
     return csv_text(result.to_frame())
 
 
+#: exit status of a run stopped at its budget (it ran, but did not reach the end): as a failed fit or run
+STOPPED = 3
+#: a protocol of more segments is described in one line by its count, length and range of velocities
+DESCRIBED_SEGMENTS = 6
+
+
+class StepCount(click.ParamType):
+    """A step budget: a positive whole number in any float spelling (3e6, 3000000, 3_000_000)."""
+
+    name = "steps"
+
+    def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> int:
+        from ..errors import ParameterError
+        from ..numerics.budget import parse_step_count
+
+        if isinstance(value, int) and not isinstance(value, bool):
+            return value
+        try:
+            return parse_step_count(value, "--max-steps")
+        except ParameterError as exc:
+            self.fail(str(exc).split(": ", 1)[1], param, ctx)
+
+
+def _describe(protocol: Any) -> str:
+    """The protocol in one line: each segment, or for many their count, length and velocities."""
+    from ..display import velocity
+
+    if len(protocol.segments) <= DESCRIBED_SEGMENTS:
+        return str(protocol.describe())
+    v = protocol.velocities
+    return (
+        f"{len(protocol.segments)} segments, {protocol.duration:g} s in all, at {velocity(float(v.min()), 4)}"
+        f" to {velocity(float(v.max()), 4)}"
+    )
+
+
 @click.command("transient")
 @protocol_options(stiffness_help='Spring stiffness K with --control spring, e.g. "400 kPa/m" [the block\'s, Eq 17].')
 @inertia_options
@@ -54,9 +90,17 @@ def _trace_csv(result: Any) -> str:
 )
 @click.option(
     "--max-steps",
-    type=click.IntRange(min=1),
+    type=StepCount(),
     default=None,
-    help="Step budget: runs estimated to need more are refused, runs that get there stop [3e6].",
+    help="Step budget (3e6, 3000000 or 3_000_000): a run stops when it gets there, and a run estimated at more"
+    " than 10x is refused [3e6].",
+)
+@click.option(
+    "--max-time",
+    "max_time_text",
+    metavar="T",
+    help='CPU time budget, e.g. "30 min": a run stops when it gets there, and a run estimated at more than 3x is'
+    " refused [10 min].",
 )
 @click.option("-o", "--output", type=click.Path(dir_okay=False, path_type=Path), help="Write the trace (CSV, SI).")
 @click.option("--plot", "plot_path", type=click.Path(dir_okay=False, path_type=Path), help="Save σ(t) and V(t) here.")
@@ -79,6 +123,7 @@ def transient_command(
     rtol: float,
     no_reduce: bool,
     max_steps: int | None,
+    max_time_text: str | None,
     output: Path | None,
     plot_path: Path | None,
     as_json: bool,
@@ -94,11 +139,15 @@ def transient_command(
     --v0 V --duration T, then any --segment "V:T"; or --protocol FILE.  The regime is "steady", "stick-slip", "stuck" or
     "undetermined" (still changing at the end of the run).
 
-    The work is estimated before the run starts; a run estimated to need more
-    than the step budget (--max-steps, default 3e6) is refused in one line.
+    The work is estimated first; a run estimated at more than 10x its step
+    budget (--max-steps, default 3e6) or 3x its CPU time budget (--max-time,
+    default 10 min) is refused in one line.  Any other run starts (with a
+    progress bar on a terminal when it is expected to take more than 2 s) and
+    stops only when it uses up a budget: then it says how far it got, writes
+    the trace up to there (-o, --plot) and exits with status 3.
     """
     from ..models import get_model
-    from ..numerics.budget import PROGRESS_AFTER_SECONDS
+    from ..numerics.budget import PROGRESS_AFTER_SECONDS, BudgetExhausted
     from ..progress import progress
     from ..transient.solver import estimate_cost
 
@@ -112,28 +161,58 @@ def transient_command(
     refuse_overwriting_inputs([protocol_file], [("-o", output), ("--plot", plot_path)], params_name)
     start_velocity = None if start_v_text is None else positive(start_v_text, "velocity", "--start-velocity")
     every = None if every_text is None else positive(every_text, "time", "--every")
+    max_time = None if max_time_text is None else positive(max_time_text, "time", "--max-time")
     params = resolve_params(params_name, overrides)
     settings = dict(start_velocity=start_velocity, aging=not no_aging, stick_population=stick_population, every=every,
-                    rtol=rtol, max_steps=max_steps, reduction="off" if no_reduce else "auto")  # fmt: skip
+                    rtol=rtol, max_steps=max_steps, max_time=max_time,
+                    reduction="off" if no_reduce else "auto")  # fmt: skip
     cost = estimate_cost(params, protocol, control=solver_control, start_velocity=start_velocity, rtol=rtol,
                          every=every, aging=not no_aging, reduction=settings["reduction"], mass=rig.mass or 0.0,
                          stiffness=rig.stiffness)  # fmt: skip
     shown = None if cost.seconds > PROGRESS_AFTER_SECONDS and not as_json else False  # None: on a terminal
+    stopped: BudgetExhausted | None = None
     with progress("transient", total=protocol.duration, unit="s", enabled=shown) as bar:
-        run = get_model("transient").run(params, protocol, rig, start=start,
-                                         progress=lambda f: bar.update(f * protocol.duration), **settings)  # fmt: skip
-    result = run.native  # the TransientResult: its trace columns, cycles and summary are printed below
+        try:
+            shown_progress = lambda f: bar.update(f * protocol.duration)  # noqa: E731
+            run = get_model("transient").run(params, protocol, rig, start=start, progress=shown_progress, **settings)
+            result = run.native  # the TransientResult: its trace columns, cycles and summary are printed below
+        except BudgetExhausted as exc:
+            if exc.partial is None:
+                raise
+            stopped, result = exc, exc.partial
+    _report(result, protocol, control, rig, start, output, plot_path, as_json, stopped)
+    if stopped is not None:
+        written = [str(path) for path in (output, plot_path) if path is not None]
+        kept = f"; the run up to there is in {' and '.join(written)}" if written else ""
+        click.echo(f"stickslip: error: {stopped}{kept}", err=True)
+        raise SystemExit(STOPPED)
+
+
+def _report(
+    result: Any,
+    protocol: Any,
+    control: str,
+    rig: Any,
+    start: str,
+    output: Path | None,
+    plot_path: Path | None,
+    as_json: bool,
+    stopped: Exception | None,
+) -> None:
+    """Write the trace and figure, print the summary (of the run up to its stop, if it stopped)."""
     if output is not None:
         write_text(output, _trace_csv(result))
     if plot_path is not None:
         ax = result.plot()
-        ax.set_title(f"{protocol.describe()}: {result.regime}", fontsize=9)
+        ax.set_title(f"{_describe(protocol)}: {result.regime}", fontsize=9)
         save_figure(ax.figure, plot_path)
     if as_json:
-        emit_json(result.summary())
+        summary = result.summary()
+        summary["status"] = "ok" if stopped is None else "stopped"
+        emit_json(summary)
         return
     block = f", block mass {rig.mass:g} kg/m², damping {rig.damping or 0:g} Pa·s/m" if rig.has_mass else ""
-    click.echo(f"{protocol.describe()} ({control} control{block}, {start} start)")
+    click.echo(f"{_describe(protocol)} ({control} control{block}, {start} start)")
     click.echo(f"  regime: {result.regime}")
     click.echo(f"  {result.message}")
     click.echo(

@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import bisect
 import math
+import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
@@ -12,7 +14,16 @@ import numpy as np
 from ..display import velocity as show_velocity
 from ..errors import ModelError, ParameterError
 from ..model.cycle import Cycle
-from ..numerics.budget import CostEstimate, check_max_steps, over_budget, require_within
+from ..numerics.budget import (
+    REFUSE_FACTOR,
+    TIME_REFUSE_FACTOR,
+    BudgetExhausted,
+    CostEstimate,
+    check_max_steps,
+    check_max_time,
+    over_budget,
+    require_within,
+)
 from ..parameters import Parameters
 from ..protocols import Protocol
 from ..units import checked_number
@@ -25,8 +36,13 @@ STARTS = ("empty", "steady")
 REDUCTIONS = ("auto", "off")
 #: the slider counts as stuck below this fraction of the puller velocity (cycle detection, stick chains)
 STICK_FRACTION = 0.01
+#: a protocol of more segments keeps snapshots only at its start, its end and the snapshot_times asked for
+SNAPSHOT_SEGMENTS = 100
 #: kernel calls return after this many steps (progress reports, buffer flushes)
 CHUNK = 20000
+#: and after about this much CPU (s): a time budget is checked between calls (a step over thousands of cohorts
+#: is slow; most runs take CHUNK steps in less)
+PACE_SECONDS = 10.0
 #: default relative tolerance of the local error (stress and bonded fraction)
 RTOL = 1e-4
 
@@ -94,6 +110,7 @@ def run_transient(
     reduction: str = "auto",
     mass: float | None = None,
     damping: float | None = None,
+    max_time: float | None = None,
 ) -> TransientResult:
     """Solve Eqs 1-5 (history form of Eq 3) through ``protocol``.
 
@@ -112,8 +129,9 @@ def run_transient(
     the solver itself; otherwise every accepted step is a row.  ``rtol`` is
     the local error tolerance (relative, in stress and bonded fraction).
     ``progress`` is called with the fraction done.  ``snapshot_times`` (s):
-    extra instants to keep the age/extension distribution at (the start, the
-    end of every protocol segment and the end are always kept).
+    extra instants to keep the age/extension distribution at (the start and
+    the end are always kept, and the end of every protocol segment when there
+    are at most :data:`SNAPSHOT_SEGMENTS`).
 
     A steady start below Vc through the block, at the first segment's
     velocity, would sit on the unstable branch of the steady curve: the run
@@ -137,9 +155,15 @@ def run_transient(
     then the interface's, sigma = sum w f; the block's spring carries
     K (P - X).  Such a run keeps the cohorts throughout (no reduction).
 
-    The work is estimated first (:func:`estimate_cost`); a run above
-    ``max_steps`` (default :data:`stickslip.numerics.budget.DEFAULT_MAX_STEPS`)
-    is refused before it starts, or stopped when it gets there.
+    The work is estimated first (:func:`estimate_cost`, within its stated
+    factor); a run estimated at more than ten times its budget of steps
+    (``max_steps``, default :data:`stickslip.numerics.budget.DEFAULT_MAX_STEPS`)
+    or three times its budget of CPU seconds (``max_time``, default
+    :data:`stickslip.numerics.budget.DEFAULT_MAX_SECONDS`; ``math.inf``: none)
+    is refused before it starts; any other runs, and stops when it uses up
+    either budget by raising :class:`stickslip.numerics.budget.BudgetExhausted`
+    (a ParameterError) whose ``partial`` is the result up to there (its message
+    says where it stopped).
     """
     if not isinstance(params, Parameters):
         raise ParameterError(f"params: expected stickslip Parameters, got {type(params).__name__}")
@@ -174,6 +198,8 @@ def run_transient(
     if start_velocity is not None:
         start_velocity = _finite(start_velocity, "start velocity")
     budget = check_max_steps(max_steps)
+    seconds = check_max_time(max_time)
+    cpu0 = time.process_time()
     _require_finite_chains(params, protocol, control, start, start_velocity, k_block)
     require_within(
         estimate_cost(params, protocol, control=control, start_velocity=start_velocity, rtol=rtol, every=every,
@@ -181,6 +207,9 @@ def run_transient(
                       stick_population=bool(stick_population)),
         budget,
         "transient",
+        max_time=seconds,
+        factor=REFUSE_FACTOR,
+        time_factor=TIME_REFUSE_FACTOR,
     )  # fmt: skip
     note = ""
     if start == "steady" and control == "block" and aging:
@@ -209,7 +238,10 @@ def run_transient(
     state.puller = state.x + (sigma0 + damping * state.v) / k_block if control == "block" else state.x
 
     times = _sample_grid(every, duration)
-    wanted = sorted(set([0.0, duration, *protocol.boundaries.tolist(), *np.atleast_1d(snapshot_times or []).tolist()]))
+    # a snapshot copies every cohort: at each segment end only for a protocol of a few segments (issue 29: 1e5
+    # segments of 1 ms held 8.4 GB of them)
+    ends = protocol.boundaries.tolist() if len(protocol.segments) <= SNAPSHOT_SEGMENTS else []
+    wanted = sorted(set([0.0, duration, *ends, *np.atleast_1d(snapshot_times or []).tolist()]))
     snapshots: list[Snapshot] = []
     rows: list[np.ndarray] = [_row(state, params, control, k_block, mass)]
     chain_rows: list[np.ndarray] = []
@@ -219,6 +251,7 @@ def run_transient(
     sample_index = 1 if times.size else 0  # t = 0 is already a row
     out = np.empty((CHUNK, 13))
     h_max = math.inf if max_step is None else float(max_step)
+    pace_steps = CHUNK  # steps per kernel call: about PACE_SECONDS of CPU, so that a time budget is kept
     snap_index = 0
     if chains_on:
         events.append(("stick", 0.0, sigma0, 0.0))
@@ -301,8 +334,8 @@ def run_transient(
                     reducer.loaded_steady(state)
                 continue
             # the solver stops at the next snapshot instant (a reduced stretch rebuilds its cohorts there)
-            upcoming = [w for w in wanted[snap_index:] if state.t + 1e-15 < w < t1]
-            t_stop = upcoming[0] if upcoming else t1
+            following = bisect.bisect_right(wanted, state.t + 1e-15, lo=snap_index)  # not a scan: 1e5 segments
+            t_stop = wanted[following] if following < len(wanted) and wanted[following] < t1 else t1
             if reducer is not None and state.acc[4] >= reducer.next_try:
                 glided, sample_index = reducer.attempt(state, t0, t_stop, vp, times, sample_index, rows)
                 if glided:
@@ -321,11 +354,13 @@ def run_transient(
             stick_v = STICK_FRACTION * pace if (stick_population and pace > 0) else 0.0
             puller0 = state.puller - vp * (state.t - t0)  # puller position at the start t0 of this piece
             lw_new, rate0, lc, aa, w1 = (np.empty(state.xb.size) for _ in range(5))
+            steps_before, cpu_before = int(state.acc[4]), time.process_time()
             status, t, x, v, h, n, sample_index, count = advance(
                 state.t, t_stop, state.x, state.v, state.h, puller0, vp, t0, 1 if control == "block" else 0,
                 state.n, state.xb, state.tb, state.lw, lw_new, rate0, lc, aa, w1, state.acc, p, float(rtol), h_max,
-                times, sample_index, out, CHUNK, stick_v, _chunk(state, budget, reducer),
+                times, sample_index, out, CHUNK, stick_v, _chunk(state, budget, reducer, pace_steps),
             )  # fmt: skip
+            pace_steps = _paced(pace_steps, int(state.acc[4]) - steps_before, time.process_time() - cpu_before)
             state.t, state.x, state.v, state.h, state.n = float(t), float(x), float(v), float(h), int(n)
             state.puller = puller0 + vp * (state.t - t0) if control == "block" else state.x
             if count:
@@ -340,8 +375,13 @@ def run_transient(
                 raise ModelError(
                     _non_finite(state.t, out[:count], rows, float(np.max(protocol.velocities)), inertial, state.h)
                 )
-            if state.acc[4] > budget:
-                raise over_budget("transient", int(state.acc[4]), budget, state.t, duration)
+            unfinished = state.t < duration - 1e-12 * max(duration, 1.0)  # a run that got to its end is whole
+            if unfinished and (state.acc[4] > budget or time.process_time() - cpu0 > seconds):
+                cpu = time.process_time() - cpu0
+                stopped = over_budget("transient", int(state.acc[4]), budget, state.t, duration,
+                                      cpu=cpu if cpu > seconds else None, max_time=seconds)  # fmt: skip
+                raise _with_partial(stopped, rows, chain_rows, events, snapshots, state, params, protocol, control,
+                                    k_block, note, float(rtol), mass, damping)  # fmt: skip
             if progress is not None:
                 progress(min(1.0, state.t / duration))
             while snap_index < len(wanted) and wanted[snap_index] <= state.t + 1e-15 and wanted[snap_index] < t1:
@@ -401,9 +441,40 @@ def _non_finite(
 COLLAPSED = 1e-12
 
 
-def _chunk(state: _State, budget: int, reducer: _Reducer | None) -> int:
-    """Steps the kernel may take in this call: the budget, and the next look for a quasi-steady stretch."""
-    steps = min(CHUNK, budget + 1 - int(state.acc[4]))
+def _paced(pace: int, steps: int, cpu: float) -> int:
+    """Steps per kernel call for about PACE_SECONDS of CPU (many cohorts make a step slow), within 64..CHUNK."""
+    if steps < 64 or cpu <= 0:
+        return pace
+    return int(min(CHUNK, max(64, steps * PACE_SECONDS / cpu)))
+
+
+def _with_partial(
+    stopped: BudgetExhausted,
+    rows: list[np.ndarray],
+    chain_rows: list[np.ndarray],
+    events: list[tuple[str, float, float, float]],
+    snapshots: list[Snapshot],
+    state: _State,
+    params: Parameters,
+    protocol: Protocol,
+    control: str,
+    k_block: float,
+    note: str,
+    rtol: float,
+    mass: float,
+    damping: float,
+) -> BudgetExhausted:
+    """The budget's error, carrying the run up to where it stopped (its message says so; regime undetermined)."""
+    snaps = [*snapshots, _snapshot(state)]
+    stopped.partial = _finish(rows, chain_rows, events, snaps, state, params, protocol, control, k_block,
+                              int(state.acc[4]), stop=str(stopped), note=note, resolution=rtol, mass=mass,
+                              damping=damping)  # fmt: skip
+    return stopped
+
+
+def _chunk(state: _State, budget: int, reducer: _Reducer | None, pace: int = CHUNK) -> int:
+    """Steps the kernel may take in this call: the budget, the pace, the next look for a quasi-steady stretch."""
+    steps = min(CHUNK, pace, budget + 1 - int(state.acc[4]))
     if reducer is not None:
         steps = min(steps, int(reducer.next_try - state.acc[4]) if reducer.next_try > state.acc[4] else steps)
     return max(1, steps)
@@ -432,6 +503,13 @@ class _Reducer:
         self.interval = self.FIRST_LOOK
         self.steady: dict[float, tuple[float, float, float]] = {}
         self.unbuildable = -math.inf  # the start of the protocol piece where a table could not be built
+        self.fold: float | None = None
+
+    def _fold(self) -> float:
+        """Vc, the fold of the steady curve (0: none; inf: not found), looked for once."""
+        if self.fold is None:
+            self.fold = _reduced_from(self.params, "block", self.aging) / FOLD_MARGIN
+        return self.fold
 
     def _steady_at(self, v: float) -> tuple[float, float, float]:
         """(S, N, S') of the steady solver at v, remembered for the run."""
@@ -544,6 +622,8 @@ class _Reducer:
         m = R.manifold_for(self.params, self.aging, lo, hi, 3.0 * hi, self.rtol, build=False)
         if m is None:  # worth building only where the state is near the steady curve's rising branch
             if self.unbuildable >= t0:
+                return None
+            if v < self._fold():  # the falling branch: no table (and no costly steady_state for each short piece)
                 return None
             ref = steady_state(self.params, v, self.aging)
             if not (float(ref.stress_slope) > 0 and abs(sigma - float(ref.stress)) <= 1e-2 * abs(sigma)):
@@ -815,9 +895,28 @@ def _steady_start_below_vc(
 RIGID = 1e6
 #: a steady start below Vc starts this fraction above Vc (the stable side; sigma within ~1e-6 of sigma_c)
 STABLE_SIDE = 1e-3
-#: rough CPU cost of one step (s) at ~100 cohorts, and what one protocol segment costs in steps
-STEP_SECONDS = 20e-6
+#: CPU of one step (s; 55-160 us measured on this 2-core machine), and what one protocol segment costs in steps
+STEP_SECONDS = 100e-6
 SEGMENT_STEPS = 10.0
+#: CPU of a segment's start through the block with the reduction (its look for a stretch; 19 ms measured for
+#: 1000 segments of 1 ms at 350/400 um/s), a tenth of that otherwise
+SEGMENT_SECONDS = 0.02
+#: CPU per step and cohort (s): a block stuck for good keeps every cohort it bears, its run costs ~ this x steps^2
+#: (1000 segments of 1 ms from rest: 3291 steps, 7 s; one segment: 2409 steps, 1.5-2 s)
+COHORT_SECONDS = 5e-7
+#: with the paper's attached chains a stuck block is their closed form: a stick-slip cycle costs the steps of its
+#: slip and re-stick, measured 3100-5550 from 30 to 120 um/s (gel, K = 3.06e5 Pa/m, rtol 1e-4)
+SLIP_STEPS = 4000.0
+#: and a stiffer block more, as sqrt(K / K_REFERENCE) (never fewer): K = 1e6 Pa/m, 100 um/s: 6557 steps for 2
+#: slips; 4e6 Pa/m, 104 um/s: 49 407 for 3 (and 296 127 for 14 in 30 s); K_REFERENCE is the gel's block, as a
+#: share of the bonds' own stiffness N0 M (2.51e-5)
+K_REFERENCE = 2.51e-5
+#: a slider sliding into a piece below the fold decelerates to its stick in about this many steps (1454-1491
+#: from a steady start, with the chains)
+STOP_STEPS = 1500.0
+#: the block's own motion is counted at no fewer steps than the cohorts' over this many bond times (for the gel,
+#: ~40: never binding; for a set whose births outpace any step, the cohorts' count)
+FORMING = 10.0
 #: through the block the slider slides only part of the time (a stuck block takes long steps): measured 0.04-0.4
 #: of the velocity-control estimate (350 um/s sliding steadily: 0.42; 350 -> 50 um/s with the chains: 0.04)
 BLOCK_SHARE = 0.4
@@ -864,38 +963,52 @@ def estimate_cost(
     mass: float = 0.0,
     stiffness: float | None = None,
 ) -> CostEstimate:
-    """The steps a run needs, from the time scales it must resolve (no step taken).
+    """The steps a run needs, and its CPU seconds, from the time scales and cycles it must resolve (no step taken).
 
     While sliding at V the cohorts' steps resolve the births (a few per
     tau/(1+u0)), the climb of the hazard (ln r grows at g = (lambda/kT) M V less
     the aging slope: a bond dies within ~1/g) and the FENE wall (V/dl_m);
     calibrated on the gel's set from 10 um/s to 1 m/s and the audit set of
-    issue 17 (within 0.4-5x of the cohorts' steps while sliding; a stuck block
-    takes far fewer, and through the block the estimate is scaled by
-    :data:`BLOCK_SHARE`).  Every protocol segment and every sampling instant
-    costs at least a step.
+    issue 17 (within 0.4-5x of the cohorts' steps while sliding; through the
+    block the estimate is scaled by :data:`BLOCK_SHARE`).  Every protocol
+    segment and every sampling instant costs at least a step.
 
     With ``reduction="auto"`` (and no ``max_step``) a piece the quasi-steady
     reduction can take (any sliding piece under velocity control; through the
     block, a puller faster than :data:`FOLD_MARGIN` x Vc, where steady sliding
     is stable) costs the cohorts' steps over :data:`SETTLE` bond memories
-    dl_m/Vp (the bonds born before the piece must be gone before a reduced
-    stretch starts) and :data:`REDUCED_STEPS` for the stretch, whatever its
-    length (calibrated from 20 um/s to 10 mm/s; the cohorts are counted through
-    the block above :data:`BLOCK_FASTEST` dl_m/tau, under velocity control above
-    100 dl_m/tau, a likely slip of units); a block
-    from rest (``start="empty"``) adds :data:`STUCK_STEPS` for its first stick
-    (none with ``stick_population``: the chains carry a stuck block).
-    Holds, a block below the fold (creep, stick, stick-slip) and
-    ``reduction="off"`` cost the cohorts' steps throughout.  Measured
-    (docs/transient.md section 9, tests/test_transient_budget.py): 0.2-15x the
-    steps taken where the reduction applies, 1.8-45x below the fold (stick-slip:
-    the cohorts' bound); a run that takes more than the budget after all is
+    dl_m/Vp and :data:`REDUCED_STEPS` for the stretch, whatever its length (the
+    cohorts are counted through the block above :data:`BLOCK_FASTEST` dl_m/tau,
+    under velocity control above 100 dl_m/tau, a likely slip of units).
+
+    Through the block (with aging, no mass) the block's own motion is counted,
+    not the cohorts' bound (issue 28: 70x too high for stick-slip):
+
+    * with ``stick_population`` a stuck block is the chains' closed form (no
+      step), and a piece below the fold costs :data:`SLIP_STEPS` per slip, the
+      slips counted from the quasi-static model's first stick and period
+      (:mod:`stickslip.model.cycle`, at the block's K; a slider that was
+      sliding first decelerates, :data:`STOP_STEPS`);
+    * without it (and with aging that never saturates) one population of Eq 1
+      never lets go: a block from rest is stuck for good, and a sliding block
+      that meets a piece below the fold stops and is stuck for good; the run
+      costs :data:`STUCK_STEPS` (and :data:`STOP_STEPS`), one step per later
+      segment, whatever its length.
+
+    Holds and pieces below the fold otherwise, ``reduction="off"`` and a
+    ``max_step`` cost the cohorts' steps throughout.  Measured over the box
+    (docs/transient.md section 2a, tests/test_transient_budget.py): steps
+    taken / estimated 0.2-3 for the block's own motion, 0.07-5 where the
+    reduction applies; a run that takes more than its budget after all is
     stopped with the reason.
 
     A block with ``mass`` (kg/m^2; ``stiffness`` K in Pa/m, default the set's block) is never reduced, and its
     ringing at f_b = sqrt((K + N0 M)/m)/(2 pi) costs :data:`RING_STEPS` per period over up to
     :data:`RING_WINDOW` of every piece: a light block rings fast, and against resting bonds for long.
+
+    ``seconds``: :data:`STEP_SECONDS` a step, :data:`SEGMENT_SECONDS` a segment (its set-up and look for a
+    quasi-steady stretch), and for a block stuck for good :data:`COHORT_SECONDS` x steps^2 (it keeps every
+    cohort it bears: 1e5 segments of 1 ms are ~1e5 steps but ~1.5 h of CPU).
     """
     _check_choice(reduction, REDUCTIONS, "reduction")
     if mass > 0:
@@ -905,7 +1018,12 @@ def estimate_cost(
     scale = (1e-4 / rtol) ** 0.25
     v_start = 0.0 if start_velocity is None else abs(start_velocity)
     reducing = reduction == "auto" and max_step is None
-    reduced_from: float | None = None  # the fold's velocity, found only when a piece would gain by the reduction
+    k_block = params.block.effective_stiffness if stiffness is None else float(stiffness)
+    # the block's own motion: stick-slip with the chains, or stuck for good under Eq 1 alone
+    motion = _BlockMotion(params, aging, k_block, bool(stick_population), start) if (
+        control == "block" and aging and mass == 0 and max_step is None
+    ) else None  # fmt: skip
+    fold: list[float] = []  # FOLD_MARGIN x Vc, looked for only when a piece needs it
     steps = 0.0
     fastest = 0.0
     reduced = 0
@@ -918,19 +1036,21 @@ def estimate_cost(
         rate = 4.0 * (1.0 + b.breakage_weight) / b.bond_time + 10.0 * climb + 100.0 * v / b.max_extension
         rate *= scale * (BLOCK_SHARE if control == "block" else 1.0)
         cohorts = rate * (t1 - t0)
+        if motion is not None and motion.counts():
+            piece = motion.piece(t1 - t0, vp, lambda v=vp: v < _fold(fold, params, control, aging))
+            if piece is not None:  # births a stuck block cannot resolve in STUCK_STEPS (a huge u0) are counted
+                steps += min(max(piece, rate * FORMING * b.bond_time) * scale, cohorts) + motion.segment_steps()
+                continue
         if reducing and 0 < vp <= (BLOCK_FASTEST if control == "block" else 100.0) * natural:
             settle = rate * SETTLE * b.max_extension / vp + REDUCED_STEPS
             if settle < min(cohorts, HOPELESS):  # beyond HOPELESS the fold is not worth finding
-                if reduced_from is None:
-                    reduced_from = _reduced_from(params, control, aging)
-                if vp >= reduced_from:
+                if vp >= _fold(fold, params, control, aging):
                     cohorts = settle
                     reduced += 1
         steps += cohorts + SEGMENT_STEPS
-    if control == "block" and start == "empty" and not stick_population and reduced:  # chains hold a stuck block
-        steps += STUCK_STEPS
+    if control == "block" and start == "empty" and not stick_population and reduced and motion is None:
+        steps += STUCK_STEPS  # a block from rest sticks first (the chains hold a stuck block)
     if control == "block" and mass > 0:
-        k_block = params.block.effective_stiffness if stiffness is None else stiffness
         ringing = math.sqrt((k_block + b.site_density * b.chain_stiffness) / mass) / (2.0 * math.pi)
         steps += RING_STEPS * ringing * sum(min(t1 - t0, RING_WINDOW) for t0, t1, _ in protocol.pieces())
     duration = protocol.duration
@@ -939,14 +1059,148 @@ def estimate_cost(
     if max_step is not None:
         steps = max(steps, duration / max_step)
     basis = f"{duration:.3g} s at up to {fastest:.3g} m/s, resolving τ = {b.bond_time:.3g} s"
+    if len(protocol.segments) > 1:
+        basis += f", {len(protocol.segments)} segments"
     if reduced:
-        basis += f", {reduced} of {len(protocol.segments)} segments quasi-steady"
+        basis += f", {reduced} quasi-steady"
+    if motion is not None:
+        basis += motion.describe()
     unit = ""
     if fastest > 100.0 * natural:
         unit = f"; {fastest:.3g} m/s is {fastest / natural:.2g} × the set's Δl_m/τ = {natural:.3g} m/s: check the unit"
     _require_resolvable(params, protocol, rtol, unit)
     basis += unit
-    return CostEstimate(steps, basis, steps * STEP_SECONDS)
+    stuck = 0.0 if motion is None else motion.stuck_steps
+    moving = len(protocol.segments) - (0 if motion is None else motion.stuck_segments)  # a stuck one looks for none
+    per_segment = SEGMENT_SECONDS if (reducing and control == "block") else 0.1 * SEGMENT_SECONDS
+    seconds = steps * STEP_SECONDS + moving * per_segment + COHORT_SECONDS * stuck * stuck
+    return CostEstimate(steps, basis, seconds)
+
+
+def _fold(found: list[float], params: Parameters, control: str, aging: bool) -> float:
+    """FOLD_MARGIN x Vc (:func:`_reduced_from`), found once per estimate."""
+    if not found:
+        found.append(_reduced_from(params, control, aging))
+    return found[0]
+
+
+class _BlockMotion:
+    """The block's own motion through the protocol, for :func:`estimate_cost`: stick-slip cycles of the quasi-static
+    model with the paper's attached chains, or a block stuck for good under Eq 1 alone (aging that never saturates)."""
+
+    def __init__(self, params: Parameters, aging: bool, k_block: float, chains: bool, start: str) -> None:
+        self.params, self.aging, self.k_block, self.chains = params, aging, k_block, chains
+        self.sliding = start == "steady"
+        self.stuck_for_good = False
+        self.stuck_steps = 0.0  # the steps of a block stuck for good: its cohorts, all kept
+        self.lump = 0.0  # its sticking, counted with the next piece
+        self.stuck_segments = 0
+        self.from_rest = start == "empty"  # the first stick starts at sigma = 0
+        self.clock = 0.0  # time since the slider last stopped (the chains' stick and the cycles after it)
+        self.slips = 0.0
+        self.clocks: dict[tuple[float, bool], tuple[float, float]] = {}
+        self.failed = False
+        b = params.bonds
+        self.stiffer = math.sqrt(max(1.0, k_block / (K_REFERENCE * b.site_density * b.chain_stiffness)))
+        if not chains and params.aging.saturation_age is None and start == "empty":
+            self._stick_for_good(stop=False)
+
+    def counts(self) -> bool:
+        """Whether this motion is counted (else the cohorts' estimate): with the chains, or stuck for good."""
+        return not self.failed and (self.chains or self.stuck_for_good or self.params.aging.saturation_age is None)
+
+    def _stick_for_good(self, stop: bool) -> None:
+        self.stuck_for_good = True
+        self.lump = STUCK_STEPS + (STOP_STEPS if stop else 0.0)
+        self.stuck_steps = self.lump
+
+    def segment_steps(self) -> float:
+        """A stuck block takes one step per segment (and keeps its cohort); a moving one more."""
+        if self.stuck_for_good:
+            self.stuck_steps += 1.0
+            self.stuck_segments += 1
+            return 1.0
+        return SEGMENT_STEPS
+
+    def piece(self, dt: float, vp: float, below: Callable[[], bool]) -> float | None:
+        """Steps of a piece of length dt at puller velocity vp (``below()``: below the fold, looked for only when
+        needed), or None: the cohorts' count."""
+        if self.stuck_for_good:
+            lump, self.lump = self.lump, 0.0
+            return lump
+        if not below():
+            self.sliding = self.sliding or not self.chains or vp > 0
+            self.clock, self.from_rest = 0.0, False
+            return None  # sliding: the cohorts' (or the reduction's) count
+        if not self.chains:  # a sliding block decelerates and sticks for good
+            self._stick_for_good(stop=self.sliding)
+            lump, self.lump = self.lump, 0.0
+            return lump
+        steps = 0.0
+        if self.sliding:  # it decelerates to a stick near sigma_c
+            steps += STOP_STEPS
+            self.sliding, self.clock = False, 0.0
+        if vp > 0:
+            try:
+                first, period = self._cycle(vp)
+            except (ModelError, ParameterError):
+                self.failed = True
+                return None
+            before = _slips(self.clock, first, period)
+            self.clock += dt
+            slips = _slips(self.clock, first, period) - before
+            self.slips += slips
+            steps += SLIP_STEPS * slips * self.stiffer
+        else:
+            self.clock += dt
+        return steps
+
+    def _cycle(self, vp: float) -> tuple[float, float]:
+        """(time to the first slip, period after it) of the quasi-static model at vp (inf: never), remembered by
+        velocity to 1 %."""
+        key = (float(f"{vp:.2g}"), self.from_rest)
+        if key not in self.clocks:
+            self.clocks[key] = _quasi_static_clock(self.params, key[0], self.aging, self.k_block, self.from_rest)
+        return self.clocks[key]
+
+    def describe(self) -> str:
+        if self.stuck_for_good:
+            return ", the block stuck for good under Eq 1 (no stick chains)"
+        if self.chains and self.slips > 0:
+            return f", about {self.slips:.3g} stick–slip cycles of the quasi-static model"
+        return ""
+
+
+def _slips(t: float, first: float, period: float) -> float:
+    """Slips within a time t stuck or cycling: the first at ``first``, then one per ``period``."""
+    if not t >= first:
+        return 0.0
+    return 1.0 + ((t - first) / period if math.isfinite(period) else 0.0)
+
+
+def _quasi_static_clock(
+    params: Parameters, vp: float, aging: bool, k_block: float, from_rest: bool
+) -> tuple[float, float]:
+    """(first stick's time, stick + slip period from sigma_c) of the quasi-static cycle (model.cycle) at K."""
+    from ..model.jump import jump_velocity
+    from ..model.slip import slip_phase
+    from ..model.stick import stick_phase
+
+    k_set = params.block.effective_stiffness
+    if not math.isclose(k_block, k_set, rel_tol=1e-9):
+        params = params.with_overrides({"block.shear_modulus": params.block.shear_modulus * k_block / k_set})
+    first = stick_phase(params, vp, 0.0 if from_rest else None, aging=aging)
+    again = first if not from_rest else stick_phase(params, vp, None, aging=aging)
+    t_first = first.stick_time if first.status == "slipped" and first.stick_time else math.inf
+    if again.status != "slipped" or not again.stick_time or again.peak_stress is None:
+        return t_first, math.inf
+    jump = jump_velocity(params, again.peak_stress, "aging" if aging else "no-aging")
+    if not jump.reachable or jump.velocity is None:
+        return t_first, math.inf  # the run stops at the collapse
+    slip = slip_phase(params, vp, jump.velocity)
+    if slip.ends == "steady":
+        return t_first, math.inf
+    return t_first, again.stick_time + slip.duration
 
 
 def _require_resolvable(params: Parameters, protocol: Protocol, rtol: float, unit: str) -> None:
