@@ -279,3 +279,15 @@ def test_a_swing_about_the_pullers_pace_while_sliding_is_no_cycle(amplitude):
     v = VP * (1.0 + np.where(ring > 0, amplitude, 0.45) * ring)  # forward swings to 1.5 or 4 VP, back to 0.55 VP
     sigma = 250.0 + K_BLOCK * np.r_[0.0, np.cumsum(0.5 * (2 * VP - v[1:] - v[:-1]) * np.diff(t))]
     assert detect_cycles(t, sigma, v, protocols.constant(VP, 20.0), [], stiffness=K_BLOCK) == ()
+
+
+def test_a_failed_run_exits_3_with_its_reason_in_one_line(capsys):
+    """A run that started and could not go on is a failed run (exit 3), not bad input (2), nor an internal error."""
+    code, _, err = run_main(
+        capsys, "transient", "--set", "bonds.activation_length=2 Å", "--start", "steady", "--start-velocity",
+        "4.2 mm/s", "--v0", "4.242 mm/s", "--duration", "10 ms", "--segment", "4.2 mm/s:10 ms", "--every", "1 ms",
+    )  # fmt: skip
+    assert code == 3, err
+    assert "the run failed" in err and "the slider ran away" in err and "internal error" not in err, err
+    assert len(err.strip().splitlines()) == 1
+    _no_nan(err)

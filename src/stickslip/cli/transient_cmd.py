@@ -149,7 +149,7 @@ def transient_command(
     from ..models import get_model
     from ..numerics.budget import PROGRESS_AFTER_SECONDS, BudgetExhausted
     from ..progress import progress
-    from ..transient.solver import estimate_cost
+    from ..transient.solver import SolverFailed, estimate_cost
 
     check_output("-o", output)
     check_output("--plot", plot_path, plot=True)
@@ -180,6 +180,9 @@ def transient_command(
             if exc.partial is None:
                 raise
             stopped, result = exc, exc.partial
+        except SolverFailed as exc:  # it ran and could not go on: a failed run (exit 3), not bad input
+            click.echo(f"stickslip: error: the run failed: {exc}", err=True)
+            raise SystemExit(STOPPED) from None
     _report(result, protocol, control, rig, start, output, plot_path, as_json, stopped)
     if stopped is not None:
         written = [str(path) for path in (output, plot_path) if path is not None]

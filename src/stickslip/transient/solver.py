@@ -372,7 +372,7 @@ def run_transient(
                 chain_state = {"elapsed": 0.0, "fraction": 1.0}
                 events.append(("stick", state.t, k_block * (state.puller - state.x), state.v))
             if not all(math.isfinite(q) for q in (state.t, state.x, state.v, state.h)):
-                raise ModelError(
+                raise SolverFailed(
                     _non_finite(state.t, out[:count], rows, float(np.max(protocol.velocities)), inertial, state.h)
                 )
             unfinished = state.t < duration - 1e-12 * max(duration, 1.0)  # a run that got to its end is whole
@@ -439,6 +439,10 @@ def _non_finite(
 
 #: a step shorter than this fraction of the time reached has collapsed (the kernel's floor is 1e-15 of it)
 COLLAPSED = 1e-12
+
+
+class SolverFailed(ModelError):
+    """The run started and could not go on (its state went non-finite): a failed run, not bad input."""
 
 
 def _paced(pace: int, steps: int, cpu: float) -> int:
