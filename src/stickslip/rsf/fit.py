@@ -323,7 +323,10 @@ def fit_record(
     start = _initial_guess(record, protocol, {**starts, **held}, held.get("stiffness"))
     labels = _sampling_classes(record.time)
     given = noise is not None
-    start["noise"] = float(noise) if given else _pre_fit_noise(record, protocol, start["dc"], labels)
+    if given:
+        start["noise"] = float(noise)
+    else:
+        start["noise"] = _pre_fit_noise(record, protocol, start["dc"], labels, start["noise"])
     setup = _Setup(record, protocol, laws, states, "stiffness" not in held, kinds, held, None, frozenset(starts))
     mismatch = _history_mismatch(record, protocol)
     result, residual = _best_search(setup, start, mismatch, "stiffness" in starts or "stiffness" in held)
@@ -652,10 +655,14 @@ def _clipped_sd(x: np.ndarray) -> float:
     return float(np.std(keep))
 
 
-def _pre_fit_noise(record: LabRecord, protocol: Protocol, dc: float, labels: np.ndarray) -> float:
-    """The noise the search scales its residuals by (its answer does not depend on it)."""
+def _pre_fit_noise(record: LabRecord, protocol: Protocol, dc: float, labels: np.ndarray, white: float) -> float:
+    """The noise the search scales its residuals by.  Its answer does not depend on it in principle, but its path
+    does (a search in a long valley ends elsewhere for a 1 % change), and the restarts for a troubled search
+    judge chi-square by it: the white-noise level ``white`` (second differences) where the steady sliding
+    agrees to within 2x, else the steady sliding's (correlated noise at 1 kHz: 5x above the white level)."""
     rows, _ = _quiet_noise(record, protocol, dc, labels)
-    return float(np.sqrt(np.mean(rows**2)))
+    quiet = float(np.sqrt(np.mean(rows**2)))
+    return quiet if quiet > 2.0 * white else white
 
 
 def _correlation_factor(resid: np.ndarray, labels: np.ndarray) -> np.ndarray:
