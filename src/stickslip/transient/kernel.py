@@ -41,6 +41,11 @@ import numpy as np
 LOG_RATE_CAP = 700.0
 #: cohorts lighter than this fraction of N0 are dropped (counted as broken)
 LIGHTEST = 1e-30
+#: with saturating aging (docs/transient.md section 2, *Housekeeping*): a cohort is dropped once it carries less than
+#: this share of rtol times the bonds alive and of the stress; saturated cohorts are merged while the spread of their
+#: log hazards (aging exponent, and the force's through the slider position) stays within this share of sqrt(rtol)
+LIGHT_SHARE = 1e-3
+SATURATED_SPREAD = 0.1
 
 # float parameter vector layout (see pack_parameters in model.py)
 (
@@ -57,7 +62,8 @@ LIGHTEST = 1e-30
     P_SATURATION,
     P_MASS,
     P_DAMPING,
-) = range(13)
+    P_MERGE_SATURATED,
+) = range(14)
 # integer status returned by advance()
 DONE, FULL, STEPS, STICK, FAILED = 0, 1, 2, 3, 4
 #: half-distance of the two Gauss-Legendre points from the middle of a step, as a fraction of the step
@@ -418,6 +424,47 @@ def _vacancy(u, q0, tau, h, l0, d0, l1, d1):  # type: ignore[no-untyped-def]
     f_u = tau * (lu - tau * dlu + tau * tau * ddlu - tau * tau * tau * 6.0 * e)
     f_0 = tau * (a - tau * b + tau * tau * 2.0 * c - tau * tau * tau * 6.0 * e)
     return q0 * dec + f_u - dec * f_0
+
+
+def _saturated_bins(n, nn, ss, s_floor, rtol, p):  # type: ignore[no-untyped-def]
+    """The housekeeping of saturating aging: (log weight floor, stress floor, bin width in log hazard).
+
+    A cohort past the saturation age that is lighter than LIGHT_SHARE rtol of the bonds alive and carries less
+    than that share of the stress, both shared among the n cohorts, is dropped (the absolute floor LIGHTEST N0 kept
+    cohorts dying at the resting hazard for ~1.7 s: 5e4 of them on a stuck block).  Shared among the cohorts, so
+    that all those dropped at once stay within the share, and so do, at a steady pace of drops, those that would
+    still be alive (the bonds missing are the drops' flux times their remaining life 1/r: LIGHT_SHARE rtol N over
+    the log of a cohort's weight ratio from birth to the floor).  Cohorts are merged within bins
+    (:func:`_same_bin`) of the returned width in log hazard.
+    """
+    share = LIGHT_SHARE * rtol / max(n, 1)
+    return math.log(max(share * nn, 1e-300)), share * max(abs(ss), s_floor), p[P_MERGE_SATURATED] * math.sqrt(rtol)
+
+
+def _negligible(lw, e, light_n, light_s, p):  # type: ignore[no-untyped-def]
+    """Lighter than the share of the bonds alive, and carrying less than the share of the stress."""
+    return lw < light_n and math.exp(lw) * abs(_chain_force(e, p[P_M], p[P_DLM])) < light_s
+
+
+def _same_bin(t, x, tb_i, tb_g, xb_i, xb_g, spread, p):  # type: ignore[no-untyped-def]
+    """Cohort i and the (merged) cohort g before it lie in one bin of width ``spread`` in both log-hazard terms.
+
+    The aging term: its distance from saturation, (t_s/tau_a) e^(-t_a/t_s), which only shrinks as both age.  The
+    force term: beta f'(e) x_b, f' at the larger extension of the two or at half the FENE length, whichever is
+    larger (the bonds break further out when the block slips; no merge within 1e-3 of the wall).  A merged cohort
+    (weight, mean position and mean age kept) then breaks as its parts to second order in the spread, ~spread^2/8
+    of its hazard, in any later history.  Bins, not neighbours' distances: a chain of merges cannot drift.
+    """
+    ts = p[P_SATURATION]
+    scale = ts * p[P_INV_TAU_A]
+    if np.floor(scale * math.exp(-(t - tb_i) / ts) / spread) != np.floor(scale * math.exp(-(t - tb_g) / ts) / spread):
+        return False
+    dlm = p[P_DLM]
+    e = max(abs(x - xb_i), abs(x - xb_g), 0.5 * dlm)
+    if e >= 0.999 * dlm:
+        return False
+    width = spread / (p[P_FORCE_SENS] * _chain_stiffness(e, p[P_M], dlm))
+    return np.floor(xb_i / width) == np.floor(xb_g / width)
 
 
 def advance(
@@ -873,15 +920,27 @@ def advance(
         age_gap = 1e-2 * math.sqrt(rtol)  # in units of the aging time: merged cohorts age alike in any future
         keep = 0
         floor = math.log(LIGHTEST * big)
+        # the housekeeping of saturating aging (below); off: the paper's, as for linear aging
+        saturated = saturating and aging_on and p[P_MERGE_SATURATED] > 0.0
+        light_n, light_s, spread = 0.0, 0.0, 1.0
+        if saturated:
+            light_n, light_s, spread = _saturated_bins(n, nn1, s1, s_floor, rtol, p)
         for i in range(n):
-            if lw[i] > floor:
+            # only cohorts past the saturation age: those linger at the resting hazard (the young are as before)
+            aged = saturated and t - tb[i] >= p[P_SATURATION]
+            if lw[i] > floor and not (aged and _negligible(lw[i], x - xb[i], light_n, light_s, p)):
                 if (
                     keep > 0
-                    and rate0[i] < quiet
-                    and rate0[keep - 1] < quiet
-                    and abs(xb[i] - xb[keep - 1]) < gap
-                    and abs(tb[i] - tb[keep - 1]) * p[P_INV_TAU_A] * p[P_AGING] < age_gap
                     and i < n - 1
+                    and (
+                        (
+                            rate0[i] < quiet
+                            and rate0[keep - 1] < quiet
+                            and abs(xb[i] - xb[keep - 1]) < gap
+                            and abs(tb[i] - tb[keep - 1]) * p[P_INV_TAU_A] * p[P_AGING] < age_gap
+                        )
+                        or (aged and _same_bin(t, x, tb[i], tb[keep - 1], xb[i], xb[keep - 1], spread, p))
+                    )
                 ):
                     wa = math.exp(lw[keep - 1])
                     wb = math.exp(lw[i])
@@ -966,6 +1025,8 @@ def compiled() -> dict[str, object]:
             "_log_rate",
             "_hermite",
             "_vacancy",
+            "_negligible",
+            "_same_bin",
         ):
             g[name] = _jit(g[name])
         for name in (
@@ -975,6 +1036,7 @@ def compiled() -> dict[str, object]:
             "_balance_from",
             "_balance_weights",
             "_inertial_step",
+            "_saturated_bins",
             "_sums",
             "_sums_keeping",
             "advance",

@@ -9,6 +9,8 @@ slider's travel since the bond formed, X(t) - X(t - t_a), not t_a V(t)
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 
 import numpy as np
@@ -27,7 +29,7 @@ def pack_parameters(
     """The float vector the kernel reads (layout: kernel.P_*); ``mass`` (kg/m^2) and ``damping`` (Pa s/m): the
     block's inertia and viscous damping (0: the paper's massless block)."""
     b, g = params.bonds, params.aging
-    p = np.zeros(13)
+    p = np.zeros(14)
     p[K.P_LOG_U0_TAU] = math.log(b.breakage_weight / b.bond_time)
     p[K.P_TAU] = b.bond_time
     p[K.P_FORCE_SENS] = b.force_sensitivity
@@ -41,7 +43,26 @@ def pack_parameters(
     p[K.P_SATURATION] = 0.0 if g.saturation_age is None else g.saturation_age  # 0: the paper's linear aging
     p[K.P_MASS] = mass
     p[K.P_DAMPING] = damping
+    p[K.P_MERGE_SATURATED] = _MERGE_SATURATED[0]
     return p
+
+
+#: the kernel's housekeeping of saturating aging (kernel._saturated_bins) on, or off (see :func:`plain_cohorts`)
+_MERGE_SATURATED = [K.SATURATED_SPREAD]
+
+
+@contextmanager
+def plain_cohorts() -> Iterator[None]:
+    """Within the block, saturating aging keeps every cohort until it weighs 1e-30 N0 and merges only quiet ones.
+
+    The reference for the kernel's merging of saturated cohorts and its relative drop (docs/transient.md
+    section 2, *Housekeeping*; ``benchmarks/bench_transient.py``, ``tests/test_transient_stuck.py``).
+    """
+    _MERGE_SATURATED[0] = 0.0
+    try:
+        yield
+    finally:
+        _MERGE_SATURATED[0] = K.SATURATED_SPREAD
 
 
 def aging_age(age: np.ndarray, params: Parameters) -> np.ndarray:
