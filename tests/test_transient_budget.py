@@ -434,7 +434,11 @@ def test_cli_a_run_that_stops_at_its_budget_writes_what_it_computed(capsys, tmp_
 
 
 def test_cli_max_time_is_a_time(capsys):
-    status, _, err = run_main(capsys, *CLI_BASE, "--max-time", "10")
+    short = ("transient", "--v0", "350 um/s", "--duration", "1 ms", "--start", "steady")
+    status, _, err = run_main(capsys, *short, "--max-time", "10")
     assert status == 2 and err.count("\n") == 1 and "--max-time" in err, err
-    status, out, err = run_main(capsys, *CLI_BASE, "--max-time", "1 min")
+    status, out, err = run_main(capsys, *short, "--max-time", "1 min")
     assert status == 0 and "regime" in out, err
+    status, _, err = run_main(capsys, "transient", "--v0", "100 um/s", "--duration", "300 s", "--stick-population",
+                              "--max-time", "1 s")  # fmt: skip
+    assert status == 2 and err.count("\n") == 1 and "more than 3 x the time budget of 1 s" in err, err

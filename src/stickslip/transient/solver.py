@@ -911,10 +911,9 @@ COHORT_SECONDS = 5e-7
 #: with the paper's attached chains a stuck block is their closed form: a stick-slip cycle costs the steps of its
 #: slip and re-stick, measured 3100-5550 from 30 to 120 um/s (gel, K = 3.06e5 Pa/m, rtol 1e-4)
 SLIP_STEPS = 4000.0
-#: and a stiffer block more, as sqrt(K / K_REFERENCE) (never fewer): K = 1e6 Pa/m, 100 um/s: 6557 steps for 2
-#: slips; 4e6 Pa/m, 104 um/s: 49 407 for 3 (and 296 127 for 14 in 30 s); K_REFERENCE is the gel's block, as a
-#: share of the bonds' own stiffness N0 M (2.51e-5)
-K_REFERENCE = 2.51e-5
+#: and a block stiffer than STIFF_BLOCK x the bonds' own stiffness N0 M (1.5e6 Pa/m for the gel) more, in
+#: proportion to K: measured per slip 2200-3300 steps at K = 1e6 Pa/m (30 and 100 um/s), 16 500-21 000 at 4e6
+STIFF_BLOCK = 1.23e-4
 #: a slider sliding into a piece below the fold decelerates to its stick in about this many steps (1454-1491
 #: from a steady start, with the chains)
 STOP_STEPS = 1500.0
@@ -1032,6 +1031,7 @@ def estimate_cost(
     fastest = 0.0
     reduced = 0
     natural = b.max_extension / b.bond_time
+    own = motion is not None and motion.counts()  # the block's own motion is counted (else the cohorts')
     for t0, t1, vp in protocol.pieces():
         v = max(abs(vp), v_start) if control == "block" else abs(vp)
         fastest = max(fastest, v)
@@ -1052,7 +1052,7 @@ def estimate_cost(
                     cohorts = settle
                     reduced += 1
         steps += cohorts + SEGMENT_STEPS
-    if control == "block" and start == "empty" and not stick_population and reduced and motion is None:
+    if control == "block" and start == "empty" and not stick_population and reduced and not own:
         steps += STUCK_STEPS  # a block from rest sticks first (the chains hold a stuck block)
     if control == "block" and mass > 0:
         ringing = math.sqrt((k_block + b.site_density * b.chain_stiffness) / mass) / (2.0 * math.pi)
@@ -1105,7 +1105,7 @@ class _BlockMotion:
         self.clocks: dict[tuple[float, bool], tuple[float, float]] = {}
         self.failed = False
         b = params.bonds
-        self.stiffer = math.sqrt(max(1.0, k_block / (K_REFERENCE * b.site_density * b.chain_stiffness)))
+        self.stiffer = max(1.0, k_block / (STIFF_BLOCK * b.site_density * b.chain_stiffness))
         if not chains and params.aging.saturation_age is None and start == "empty":
             self._stick_for_good(stop=False)
 
