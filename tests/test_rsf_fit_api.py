@@ -63,6 +63,8 @@ def test_fixed_values_are_held_and_the_rest_recovered():
         assert fit.parameters[key].fixed and fit.parameters[key].value == value
         assert fit.parameters[key].interval is None
     assert inside(fit, ("b", "dc"))
+    diff = fit.derived["a-b"]  # a held: a - b carries b's error alone
+    assert diff.stderr == pytest.approx(fit.parameters["b"].stderr, rel=1e-12)
     # a fixed a carries no error of its own: b's interval is narrower than with a free (a and b correlate)
     free = fit_record(synthetic(1), fixed={"stiffness": 3e3}, drift_check=False)
     held, loose = (f.parameters["b"].interval[1] - f.parameters["b"].interval[0] for f in (fit, free))

@@ -1267,11 +1267,13 @@ def _difference(result: Any, table: dict[str, FitParameter], widen: float | None
     """a - b with its standard error from the covariance (their correlation included)."""
     value = table["a"].value - table["b"].value
     covar, names = result.covar, list(result.var_names)
-    if covar is None or "a" not in names or "b" not in names:
+    free = [(names.index(k), sign) for k, sign in (("a", 1.0), ("b", -1.0)) if k in names]  # (a held: b's error)
+    if not free:
+        return FitParameter("a-b", value, None, None, fixed=True)
+    if covar is None:
         return FitParameter("a-b", value, None, None, constrained=False,
                             note="no covariance: the record cannot tell the parameters apart")  # fmt: skip
-    i, j = names.index("a"), names.index("b")
-    var = float(covar[i, i] + covar[j, j] - 2 * covar[i, j])
+    var = float(sum(si * sj * covar[i, j] for i, si in free for j, sj in free))
     if not (math.isfinite(var) and var >= 0):
         return FitParameter("a-b", value, None, None, constrained=False, note="covariance not positive")
     se = math.sqrt(var)
