@@ -13,6 +13,7 @@ from typing import Any
 
 import click
 
+from ..errors import ParameterError
 from .common import (
     InputFile,
     echo_err,
@@ -116,6 +117,7 @@ def analyze_command(
     for note in record.notes:
         echo_err(f"note: {note}")
     analysis = analyze_trace(record, None, v0, params)
+    _refuse_unbounded(analysis, v0_text)
     comparison = compare_with_model(analysis, params) if compare else None
     if output is not None:
         write_text(output, cycles_csv(analysis))
@@ -130,6 +132,19 @@ def analyze_command(
         from ..plots.traces import figure_analysis
 
         save_figure(figure_analysis(analysis, comparison), plot_path)
+
+
+def _refuse_unbounded(analysis: Any, v0_text: str) -> None:
+    """A per-cycle statistic beyond the floating-point range (the stiffness slope/V0 at --v0 '1e-300 um/s') is no
+    answer: refuse, naming --v0, rather than print inf."""
+    for name, stats in analysis.summary.items():
+        numbers = [v for v in (stats.get("mean"), stats.get("std")) if isinstance(v, float)] if isinstance(
+            stats, dict) else []  # fmt: skip
+        if any(not math.isfinite(v) for v in numbers):
+            raise ParameterError(
+                f"--v0 {v0_text}: the cycles' {name} leaves the floating-point range at this pulling velocity;"
+                " expected the velocity the record was measured at"
+            )
 
 
 def cycles_csv(analysis: Any) -> str:

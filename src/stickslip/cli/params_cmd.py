@@ -21,7 +21,14 @@ import click
 from ..display import symbol
 from ..parameters import BOLTZMANN, SECTIONS, Parameters, available_parameter_sets, load_parameters
 from ..units import DIMENSIONS
-from .common import params_options, refuse_overwriting_inputs, resolve_params, stdout_is_terminal, write_text
+from .common import (
+    check_output,
+    params_options,
+    refuse_overwriting_inputs,
+    resolve_params,
+    stdout_is_terminal,
+    write_text,
+)
 
 #: Width of tables written to files or pipes (a terminal uses its own width).
 PLAIN_WIDTH = 140
@@ -199,6 +206,7 @@ def export_command(
     """
     chosen = _chosen_set(ctx, name, params_name)
     refuse_overwriting_inputs([], [("-o", output)], chosen)
+    check_output("-o", output)  # -o '' (click reads it as the folder '.'): one line naming -o
     text = _with_override_note(resolve_params(chosen, overrides), overrides).to_toml()
     if output is None:
         click.echo(text, nl=False)
