@@ -19,7 +19,7 @@ from ..progress import progress
 from ..units import shorten
 from .common import check_output, check_unit, emit_json, key_value, refuse_overwriting_inputs, save_figure
 from .protocol_options import build_protocol, build_rig
-from .run_cmd import model_parameters, run_summary, settings_of, start_value
+from .run_cmd import in_run_words, model_parameters, run_summary, settings_of, start_value
 
 #: Exit status when a model's run failed (status "failed"); 2 is bad input.
 FAILED = 3
@@ -124,7 +124,8 @@ def compare_models(options: dict[str, Any]) -> None:
                 runs[model.name] = model.run(params, protocol, rig, start=starts.get(model.name),
                                              **settings[model.name])  # fmt: skip
             except (ParameterError, ModelError) as exc:
-                raise type(exc)(f"model {model.name}: {exc}") from None
+                said = in_run_words(str(exc), f"--start {model.name}=")
+                raise type(exc)(f"model {model.name}: {said}") from None
             bar.advance(note=model.name)
     summaries = {name: run_summary(run, protocol, rig) for name, run in runs.items()}
     for model in models:  # models that start differently do not settle alike: each row says where it began

@@ -14,7 +14,7 @@ from typing import Any
 
 import click
 
-from ..errors import ParameterError, UnitError
+from ..errors import ModelError, ParameterError, UnitError
 from ..progress import progress
 from ..units import shorten
 from .common import (
@@ -124,6 +124,11 @@ def _finite_start(value: float, text: str) -> float:
     if not math.isfinite(value):
         raise ParameterError(f"--start {shorten(text)}: expected a finite value")
     return value
+
+
+def in_run_words(message: str, start_option: str) -> str:
+    """A model's refusal in this command's words: ``rsf simulate``'s --start-velocity is --start here."""
+    return message.replace("give --start-velocity", f"give {start_option}'V um/s', the start's velocity")
 
 
 def settings_of(texts: tuple[str, ...], every_text: str | None) -> dict[str, Any]:
@@ -280,7 +285,10 @@ def run_command(
     with progress(model.name, total=protocol.duration, unit="s", enabled=False if as_json else None) as bar:
         if "progress" in model.capabilities.settings and "progress" not in settings:  # a bar on a terminal only
             settings["progress"] = lambda fraction: bar.update(fraction * protocol.duration)
-        run = model.run(params, protocol, rig, start=start, **settings)
+        try:
+            run = model.run(params, protocol, rig, start=start, **settings)
+        except (ParameterError, ModelError) as exc:
+            raise type(exc)(in_run_words(str(exc), "--start ")) from None
     summary = run_summary(run, protocol, rig)
     if output is not None:
         _write_run(run, output)
