@@ -470,6 +470,8 @@ def _duration(seconds: float) -> str:
 )
 @click.option("--step-weight", default=None, metavar="W",
               help="Weight of the rows just after each velocity step, relative to the rest (> 0).")  # fmt: skip
+@click.option("--cutoff-v1", default=None, help='Fit the cut-off velocity form (QDYN) with V1 held, e.g. "1 mm/s".')
+@click.option("--cutoff-v2", default=None, help='The cut-off form\'s V2 of the evolution effect, e.g. "1 um/s".')
 @click.option("--history", type=click.Choice(["segments", "measured"]), default="segments", show_default=True,
               help="Load-point history: constant-velocity segments found in the displacement, or the measured "
                    "displacement itself (smoothed), as lab codes drive the model.")  # fmt: skip
@@ -778,6 +780,11 @@ def _fit_settings(
         settings["window"] = _within_record(window, options["window_text"], record)
     if options["step_weight"] is not None:
         settings["step_weight"] = _step_weight(options["step_weight"])
+    if (options.get("cutoff_v1") is None) != (options.get("cutoff_v2") is None):
+        raise ParameterError("--cutoff-v1/--cutoff-v2: the cut-off velocity form needs both V1 and V2")
+    if options.get("cutoff_v1") is not None:
+        settings["cutoff"] = (_positive(options["cutoff_v1"], "velocity", "--cutoff-v1"),
+                              _positive(options["cutoff_v2"], "velocity", "--cutoff-v2"))  # fmt: skip
     return settings
 
 

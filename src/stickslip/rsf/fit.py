@@ -281,6 +281,7 @@ def fit_record(
     seed: int | None = None,
     noise: float | None = None,
     drift_check: bool | None = None,
+    cutoff: tuple[float, float] | None = None,
 ) -> RSFFit:
     """Fit rate-and-state friction to ``record`` (see the module notes).
 
@@ -297,12 +298,14 @@ def fit_record(
     known (a model's noise-free output fitted to a stated precision); by default it is estimated from the
     record (``noise_method`` says how).  ``drift_check`` (default: on unless ``noise`` is given) refits with the
     drift term toggled and reports when the conclusion depends on it (``drift_sensitivity``).
+    ``cutoff=(V1, V2)`` (m/s, held fixed) fits the cut-off velocity form of the friction law (docs/rsf.md, Laws).
     """
     if noise is not None and not (_real(noise) and math.isfinite(noise) and noise > 0):
         raise ParameterError(f"noise: expected a positive friction level, got {noise!r}")
     if states not in (1, 2):
         raise ParameterError(f"states: expected 1 or 2 state variables, got {states!r}")
     laws = _laws(law, states)
+    cutoff = _cutoff_checked(cutoff)
     kinds = _trend_kinds(trend)
     held = _named_values("fixed", fixed, states, strict=True)
     starts = _named_values("guess", guess, states, strict=False)
@@ -327,7 +330,8 @@ def fit_record(
         start["noise"] = float(noise)
     else:
         start["noise"] = _pre_fit_noise(record, protocol, start["dc"], labels, start["noise"])
-    setup = _Setup(record, protocol, laws, states, "stiffness" not in held, kinds, held, None, frozenset(starts))
+    setup = _Setup(record, protocol, laws, states, "stiffness" not in held, kinds, held, None, frozenset(starts),
+                   cutoff)  # fmt: skip
     mismatch = _history_mismatch(record, protocol)
     result, residual = _best_search(setup, start, mismatch, "stiffness" in starts or "stiffness" in held)
     if weight is not None:
@@ -399,6 +403,8 @@ class _Setup:
     weights: np.ndarray | None
     #: the names the caller gave starting values for (the staged search keeps them)
     guessed: frozenset[str] = frozenset()
+    #: the cut-off velocities (V1, V2) of the cut-off form, held fixed; None for the classical law
+    cutoff: tuple[float, float] | None = None
 
 
 #: the names ``fixed`` and ``guess`` take (SI values)
@@ -1080,7 +1086,14 @@ def _base(setup: _Setup, start: dict[str, float]) -> RSFParams:
     laws = setup.laws[: setup.states]
     states = tuple(StateVariable(law, start["b"], start["dc"]) for law in laws)
     return RSFParams(a=max(start["a"], 1e-12), states=states, mu0=start["mu0"], v_ref=setup.protocol.initial_velocity,
-                     stiffness=setup.fixed.get("stiffness", start["stiffness"]))  # fmt: skip
+                     stiffness=setup.fixed.get("stiffness", start["stiffness"]), cutoff=setup.cutoff)  # fmt: skip
+
+
+def _cutoff_checked(cutoff: Any) -> tuple[float, float] | None:
+    """The cut-off velocities as RSFParams checks them (positive, finite, m/s), or None."""
+    if cutoff is None:
+        return None
+    return RSFParams(a=0.01, states=(StateVariable("aging", 0.01, 1e-5),), cutoff=cutoff).cutoff
 
 
 #: lmfit's name of each public parameter (Dc and k in log space)
