@@ -192,8 +192,8 @@ def test_a_cutoff_record_is_fitted_with_the_cutoff_form_and_refused_by_the_class
     noise of 1e-5: fitted with the same cut-offs held, a, b and Dc come back within 3 standard errors of the truth
     (over 12 seeds their z-scores had rms 1.0-1.4) at chi-square_r near 1; the classical law cannot describe it
     (chi-square_r far above, so the fit fails)."""
-    from stickslip.rsf.fit import fit_record
     from stickslip.rsf.data import LabRecord
+    from stickslip.rsf.fit import fit_record
 
     truth = rsf_params(a=0.008, b=0.012, dc=20e-6, stiffness=2000.0, v_ref=1e-6, cutoff=(20e-6, 3e-6))
     history = protocols.velocity_steps([1e-6, 10e-6, 1e-6], [20.0, 20.0, 40.0])
