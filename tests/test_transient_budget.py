@@ -379,7 +379,7 @@ def test_the_estimate_counts_segments():
     many = estimate_cost(GEL, _many_segments(MANY), start="steady", control="velocity")
     assert many.steps >= one.steps + 10 * MANY and f"{MANY} segments" in many.basis
     stuck = [estimate_cost(GEL, _many_segments(n)) for n in (1000, 10000)]
-    assert stuck[1].steps > stuck[0].steps + 9000 and stuck[1].seconds > 10 * stuck[0].seconds
+    assert stuck[1].steps >= stuck[0].steps + 9000 and stuck[1].seconds > 10 * stuck[0].seconds
 
 
 def test_issue_29_a_protocol_of_1e5_short_segments_is_refused_in_one_line(capsys, tmp_path):

@@ -1042,8 +1042,10 @@ def estimate_cost(
         cohorts = rate * (t1 - t0)
         if motion is not None and motion.counts():
             piece = motion.piece(t1 - t0, vp, lambda v=vp: v < _fold(fold, params, control, aging))
-            if piece is not None:  # births a stuck block cannot resolve in STUCK_STEPS (a huge u0) are counted
-                steps += min(max(piece, rate * FORMING * b.bond_time) * scale, cohorts) + motion.segment_steps()
+            if piece is not None:  # births a block cannot resolve in STUCK_STEPS or a slip (a huge u0) are counted
+                floor = rate * FORMING * b.bond_time if piece > 0 else 0.0  # a piece held by the chains: no step
+                bound = math.inf if motion.stuck_for_good else cohorts  # the sticking is one lump, however short
+                steps += min(max(piece, floor) * scale, bound) + motion.segment_steps()
                 continue
         if reducing and 0 < vp <= (BLOCK_FASTEST if control == "block" else 100.0) * natural:
             settle = rate * SETTLE * b.max_extension / vp + REDUCED_STEPS
