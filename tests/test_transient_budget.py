@@ -442,3 +442,13 @@ def test_cli_max_time_is_a_time(capsys):
     status, _, err = run_main(capsys, "transient", "--v0", "100 um/s", "--duration", "300 s", "--stick-population",
                               "--max-time", "1 s")  # fmt: skip
     assert status == 2 and err.count("\n") == 1 and "more than 3 x the time budget of 1 s" in err, err
+
+
+def test_a_stopped_run_survives_pickling_and_rebuilding():
+    """A sweep's worker pickles the error; `run` rebuilds it from its words (it was an internal TypeError)."""
+    import pickle
+
+    stopped = BudgetExhausted("transient: stopped at the budget of 10 steps at t = 1 s of 2 s", 1.0)
+    again = pickle.loads(pickle.dumps(stopped))
+    assert isinstance(again, ParameterError) and again.reached == 1.0 and str(again) == str(stopped)
+    assert type(stopped)("words").reached is None

@@ -109,10 +109,13 @@ class BudgetExhausted(ParameterError):
     ``partial`` is what the solver computed up to there (a result whose message says where it stopped), or
     None where the solver cannot give it; ``reached`` is the time of the run reached (s)."""
 
-    def __init__(self, message: str, reached: float, partial: object = None) -> None:
+    def __init__(self, message: str, reached: float | None = None, partial: object = None) -> None:
         super().__init__(message)
-        self.reached = reached
+        self.reached = reached  # None: not known (an error rebuilt from its message alone)
         self.partial = partial
+
+    def __reduce__(self) -> tuple[object, ...]:  # pickled (a sweep's worker) with where it stopped
+        return (type(self), (str(self), self.reached, self.partial))
 
 
 def over_budget(
