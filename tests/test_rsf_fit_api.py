@@ -144,3 +144,24 @@ def test_summary_is_si_and_the_text_keeps_the_records_unit():
     assert report["units"]["length"] == "m" and report["units"]["record_length_unit"] == "um"
     assert "µm" in fit.parameters["dc"].text() and fit.protocol_rows()[0]["unit"] == "um/s"
     assert "steady sliding" in report["noise_method"] and report["effective_rows"] > 0
+
+
+def test_a_guessed_stiffness_below_the_starts_critical_one_still_fits():
+    """A free stiffness started at 1000 1/m with the default Dc start (1 % of the slip, 4.2 um here) and the
+    measured b - a = 0.005 starts past k_c = 1190 1/m: the search met a blow-up at once and failed.  The start's
+    Dc is raised until the spring is stable there, and the fit finds the record's own k = 1600 1/m."""
+    from stickslip import protocols
+    from stickslip.rsf import rsf_params, simulate
+    from stickslip.rsf.data import LabRecord
+    from stickslip.rsf.fit import fit_record
+
+    truth = rsf_params(a=0.005, b=0.01, dc=20e-6, stiffness=1600.0, v_ref=1e-6)
+    history = protocols.velocity_steps([1e-6, 10e-6], [20.0, 40.0])
+    times = np.linspace(0.0, 60.0, 1201)
+    rng = np.random.default_rng(1)
+    friction = simulate(truth, history, times=times).friction + rng.normal(0.0, 1e-5, times.size)
+    record = LabRecord.from_arrays(times, history.displacement_at(times), friction)
+    fit = fit_record(record, guess={"stiffness": 1000.0}, noise=1e-5)
+    assert fit.status == "ok", fit.reason
+    k = fit.parameters["stiffness"]
+    assert abs(k.value - 1600.0) < 3 * k.stderr

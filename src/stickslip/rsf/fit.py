@@ -323,7 +323,8 @@ def fit_record(
         protocol = find_segments(record.time, record.displacement)
     if protocol.initial_velocity <= 0:
         raise DataError("record: the load point does not move in the first segment; expected steady sliding first")
-    start = _initial_guess(record, protocol, {**starts, **held}, held.get("stiffness"))
+    start = _stable_start(_initial_guess(record, protocol, {**starts, **held}, held.get("stiffness")),
+                          "dc" in starts or "dc" in held)  # fmt: skip
     labels = _sampling_classes(record.time)
     given = noise is not None
     if given:
@@ -1087,6 +1088,22 @@ def _base(setup: _Setup, start: dict[str, float]) -> RSFParams:
     states = tuple(StateVariable(law, start["b"], start["dc"]) for law in laws)
     return RSFParams(a=max(start["a"], 1e-12), states=states, mu0=start["mu0"], v_ref=setup.protocol.initial_velocity,
                      stiffness=setup.fixed.get("stiffness", start["stiffness"]), cutoff=setup.cutoff)  # fmt: skip
+
+
+#: a start's spring must be this many times the critical stiffness (b - a)/Dc: a search that starts beyond the
+#: instability meets a blow-up at its first evaluation and cannot find its way back
+STABLE_MARGIN = 1.5
+
+
+def _stable_start(start: dict[str, float], dc_given: bool) -> dict[str, float]:
+    """The start with its Dc raised (when the caller gave none) until the spring is stable there: a held or
+    guessed stiffness of 1000 1/m with the default Dc (1 % of the slip) and a measured b - a of 0.005 started
+    past k_c = 1190 1/m, and the fit failed with a blow-up although the record's own parameters are stable."""
+    weakening = start["b"] - start["a"]
+    if dc_given or weakening <= 0 or start["stiffness"] >= STABLE_MARGIN * weakening / start["dc"]:
+        return start
+    stable_dc = STABLE_MARGIN * weakening / start["stiffness"]
+    return {**start, "dc": min(stable_dc, 0.5 * start["max_dc"])}
 
 
 def _cutoff_checked(cutoff: Any) -> tuple[float, float] | None:
