@@ -122,3 +122,23 @@ def test_what_a_model_cannot_run_is_one_line(argv, named, capsys):
     code, out, err = run_main(capsys, *argv)
     assert code == 2 and out == ""
     assert err.startswith("stickslip: error:") and err.count("\n") == 1 and named in err
+
+
+def test_a_run_that_stops_or_fails_on_its_way_exits_3(capsys, monkeypatch):
+    """A run stopped at its step budget, or whose state went non-finite, ran: exit 3 (a failed run), not the
+    exit 2 of bad input, with the place it stopped in one line."""
+    from cli_helpers import run_main
+
+    words = ["run", "--model", "transient", "--v0", "100 um/s", "--duration", "40 s", "--setting",
+             "stick_population=true"]  # fmt: skip
+    code, _, err = run_main(capsys, *words, "--setting", "max_steps=2000")
+    assert code == 3 and err.count("\n") == 1 and "stopped at the budget of 2000 steps at t = " in err, err
+    from stickslip.models.transient import Transient
+    from stickslip.transient.solver import SolverFailed
+
+    def non_finite(*args, **kwargs):
+        raise SolverFailed("transient: the state went non-finite at t = 3.07 ms")
+
+    monkeypatch.setattr(Transient, "run", non_finite)
+    code, _, err = run_main(capsys, *words)
+    assert code == 3 and "the run failed: transient: the state went non-finite" in err, err

@@ -25,3 +25,7 @@ class DataError(StickslipError, ValueError):
 
 class ModelError(StickslipError, ArithmeticError):
     """The model has no finite answer for these inputs (e.g. a divergent integral)."""
+
+
+class RunFailed(ModelError):
+    """A run started and could not go on (e.g. its state went non-finite): a failed run (exit 3), not bad input."""

@@ -14,7 +14,8 @@ from typing import Any
 
 import click
 
-from ..errors import ModelError, ParameterError, UnitError
+from ..errors import ModelError, ParameterError, RunFailed, UnitError
+from ..numerics.budget import BudgetExhausted
 from ..progress import progress
 from ..units import shorten
 from .common import (
@@ -287,6 +288,9 @@ def run_command(
             settings["progress"] = lambda fraction: bar.update(fraction * protocol.duration)
         try:
             run = model.run(params, protocol, rig, start=start, **settings)
+        except (RunFailed, BudgetExhausted) as exc:  # it ran and stopped: a failed run (exit 3), not bad input
+            click.echo(f"stickslip: the run failed: {exc}", err=True)
+            raise SystemExit(RUN_FAILED) from None
         except (ParameterError, ModelError) as exc:
             raise type(exc)(in_run_words(str(exc), "--start ")) from None
     summary = run_summary(run, protocol, rig)

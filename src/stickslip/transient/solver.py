@@ -12,7 +12,7 @@ from typing import Any
 import numpy as np
 
 from ..display import velocity as show_velocity
-from ..errors import ModelError, ParameterError
+from ..errors import ModelError, ParameterError, RunFailed
 from ..model.cycle import Cycle
 from ..numerics.budget import (
     REFUSE_FACTOR,
@@ -441,7 +441,7 @@ def _non_finite(
 COLLAPSED = 1e-12
 
 
-class SolverFailed(ModelError):
+class SolverFailed(RunFailed):
     """The run started and could not go on (its state went non-finite): a failed run, not bad input."""
 
 
