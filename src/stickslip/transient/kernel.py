@@ -46,6 +46,10 @@ LIGHTEST = 1e-30
 #: log hazards (aging exponent, and the force's through the slider position) stays within this share of sqrt(rtol)
 LIGHT_SHARE = 1e-3
 SATURATED_SPREAD = 0.1
+#: the force term's bin, in units of the aging term's: at the fold of a creeping block (11 um/s) neighbouring births
+#: differ by 1.3e-3 in log hazard through the force; 1 merged none of them (first slip from rest at 50 um/s in 60 s
+#: of CPU), 3 halves the cost with the slip equal to 1e-7, 10 broke a held population's closed form (5e-5)
+FORCE_SPREAD = 3.0
 
 # float parameter vector layout (see pack_parameters in model.py)
 (
@@ -451,7 +455,9 @@ def _same_bin(t, x, tb_i, tb_g, xb_i, xb_g, spread, p):  # type: ignore[no-untyp
 
     The aging term: its distance from saturation, (t_s/tau_a) e^(-t_a/t_s), which only shrinks as both age.  The
     force term: beta f'(e) x_b, f' at the larger extension of the two or at half the FENE length, whichever is
-    larger (the bonds break further out when the block slips; no merge within 1e-3 of the wall).  A merged cohort
+    larger (the bonds break further out when the block slips; no merge within 1e-3 of the wall), in bins
+    FORCE_SPREAD times wider (the FENE curvature bounds it: the merged cohort's force is its parts' to second
+    order in their spread of positions).  A merged cohort
     (weight, mean position and mean age kept) then breaks as its parts to second order in the spread, ~spread^2/8
     of its hazard, in any later history.  Bins, not neighbours' distances: a chain of merges cannot drift.
     """
@@ -463,7 +469,7 @@ def _same_bin(t, x, tb_i, tb_g, xb_i, xb_g, spread, p):  # type: ignore[no-untyp
     e = max(abs(x - xb_i), abs(x - xb_g), 0.5 * dlm)
     if e >= 0.999 * dlm:
         return False
-    width = spread / (p[P_FORCE_SENS] * _chain_stiffness(e, p[P_M], dlm))
+    width = FORCE_SPREAD * spread / (p[P_FORCE_SENS] * _chain_stiffness(e, p[P_M], dlm))
     return np.floor(xb_i / width) == np.floor(xb_g / width)
 
 
