@@ -155,6 +155,43 @@ def main() -> None:
         f"{p.block.effective_stiffness * 50e-6 * 25:.4g} Pa)"
     )
 
+    stuck_from_rest(quick)
+
+
+def first_slip(run, pace=50e-6):  # type: ignore[no-untyped-def]
+    """(time, stress) of the highest stress before the first jump (the slider past the puller's pace, after the
+    first second: from an empty surface the slider starts at the puller's pace)."""
+    jumped = np.flatnonzero((run.time > 1.0) & (run.slider_velocity > pace))
+    end = jumped[0] if jumped.size else run.time.size
+    i = int(np.argmax(run.stress[:end]))
+    return float(run.time[i]), float(run.stress[i])
+
+
+def stuck_from_rest(quick: bool) -> None:
+    """Issue 33: gelatin-glass-saturating at 50 um/s from rest, 45 s (a creep, the first slip at ~39 s, the slip,
+    the re-stick), with the kernel's merging of saturated cohorts and its relative drop beside the plain cohorts
+    (``plain_cohorts()``: every cohort kept until it weighs 1e-30 N0; ~5 min of CPU, skipped with --quick)."""
+    from stickslip.transient.model import plain_cohorts
+
+    sat = stickslip.load_parameters("gelatin-glass-saturating")
+    protocol = constant(50e-6, 45.0)
+    for label, plain in (("merged", False), ("plain cohorts", True)):
+        if plain and quick:
+            continue
+        start = time.process_time()
+        if plain:
+            with plain_cohorts():
+                run = run_transient(sat, protocol)
+        else:
+            run = run_transient(sat, protocol)
+        t_cpu = time.process_time() - start
+        when, peak = first_slip(run)
+        print(
+            f"gelatin-glass-saturating, 50 um/s from rest, 45 s, rtol 1e-4, {label}: cpu {t_cpu:.1f} s, "
+            f"{run.steps} steps, first slip at {when!r} s from {peak!r} Pa, final sigma {run.final_stress!r} Pa",
+            flush=True,
+        )
+
 
 if __name__ == "__main__":
     main()
