@@ -105,3 +105,18 @@ def test_a_held_creeping_population_follows_the_closed_form_survival() -> None:
     with plain_cohorts():
         plain = run_transient(SAT, constant(0.0, 0.1), snapshot_times=times, **kw)
     assert run.snapshots[-1].weight.size < plain.snapshots[-1].weight.size / 3
+
+
+def test_a_block_creeping_up_the_rising_branch_is_reduced() -> None:
+    """Below Vc the saturating set's N-shaped curve has a rising creep branch: the quasi-steady reduction takes it.
+
+    A steady start at 1 um/s on that branch, the puller at 50 um/s: 6513 steps reduced against 46 130 with the
+    cohorts throughout (final sigma equal to 5e-9); before, a shortcut that took every velocity below Vc for the
+    falling branch left the whole creep to the cohorts.  The slider ends on the steady curve to within the
+    population's lag (~0.025 s x dsigma/dt, 0.2 %)."""
+    from stickslip.model.steady import steady_state
+
+    run = run_transient(SAT, constant(50e-6, 2.0), start="steady", start_velocity=1e-6, rtol=RTOL)
+    assert run.steps < 10_000
+    on_curve = float(steady_state(SAT, float(run.slider_velocity[-1])).stress)
+    assert run.final_stress == pytest.approx(on_curve, rel=1e-2)

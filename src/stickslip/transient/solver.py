@@ -627,7 +627,9 @@ class _Reducer:
         if m is None:  # worth building only where the state is near the steady curve's rising branch
             if self.unbuildable >= t0:
                 return None
-            if v < self._fold():  # the falling branch: no table (and no costly steady_state for each short piece)
+            # below Vc the falling branch: no table (and no costly steady_state for each short piece); with saturating
+            # aging the curve is N-shaped and its creep branch, below the maximum, rises (a stuck block creeps up it)
+            if v < self._fold() and self.params.aging.saturation_age is None:
                 return None
             ref = steady_state(self.params, v, self.aging)
             if not (float(ref.stress_slope) > 0 and abs(sigma - float(ref.stress)) <= 1e-2 * abs(sigma)):
