@@ -167,3 +167,15 @@ def test_columns_of_the_curve_command_are_ignored_with_a_note(tmp_path):
     assert data.ignored_columns == ("bonded_fraction", "stress_slope")
     assert len(data.notes()) == 1 and "ignored" in data.notes()[0]
     assert np.allclose(data.stress, [250, 300, 400, 600]) and data.stress_err is None
+
+
+@pytest.mark.parametrize("mark", ["\t", ";"])
+def test_a_tab_or_semicolon_separated_table_reads_as_its_csv(tmp_path, mark):
+    """Issue 28 item 8: a tab-separated table was read as one garbled column; it reads as the same numbers."""
+    source = Path(datasets.data_path("synthetic_steady.csv"))
+    lines = source.read_text(encoding="utf-8").splitlines()
+    other = tmp_path / "steady.txt"
+    other.write_text("\n".join(x if x.startswith("#") else x.replace(",", mark) for x in lines) + "\n")
+    a, b = read_steady_data(source), read_steady_data(other)
+    assert np.array_equal(a.velocity, b.velocity) and np.array_equal(a.stress, b.stress)
+    assert np.array_equal(a.stress_err, b.stress_err)

@@ -116,6 +116,7 @@ def _text_columns(path: Path, header_row: int, width: int, positions: list[int])
         table = pacsv.read_csv(
             path,
             read_options=pacsv.ReadOptions(skip_rows=header_row, column_names=labels),
+            parse_options=pacsv.ParseOptions(delimiter=delimiter_of(path)),
             convert_options=pacsv.ConvertOptions(
                 include_columns=[labels[k] for k in positions],
                 column_types={labels[k]: pa.string() for k in positions},
@@ -135,11 +136,28 @@ def _header_position(header: list[str], name: str) -> int:
     raise KeyError(name)
 
 
+def delimiter_of(path: Path) -> str:
+    """The cell separator of a table: a tab or ';' when the header line has one and no comma, else ','
+    (spreadsheets and rigs write tab-separated tables; read as CSV their header was one garbled cell)."""
+    try:
+        with path.open(encoding="utf-8-sig", errors="replace") as handle:
+            for line in handle:
+                if line.strip() and not line.lstrip().startswith("#"):
+                    for mark in ("\t", ";"):
+                        if mark in line and "," not in line:
+                            return mark
+                    return ","
+    except OSError:
+        pass
+    return ","
+
+
 def _content_rows(path: Path, source: str) -> Iterator[tuple[int, list[str]]]:
     """(file row, cells) of every row that is not blank and not a '#' comment, streamed."""
+    delimiter = delimiter_of(path)
     try:
         with path.open(newline="", encoding="utf-8-sig") as handle:
-            for k, row in enumerate(csv.reader(handle), start=1):
+            for k, row in enumerate(csv.reader(handle, delimiter=delimiter), start=1):
                 if row and any(c.strip() for c in row) and not row[0].lstrip().startswith("#"):
                     yield k, row
     except FileNotFoundError:
@@ -235,7 +253,7 @@ def _read_columnar(
         table = pacsv.read_csv(
             path,
             read_options=pacsv.ReadOptions(skip_rows=header.row, column_names=header.names),
-            parse_options=pacsv.ParseOptions(ignore_empty_lines=True),
+            parse_options=pacsv.ParseOptions(ignore_empty_lines=True, delimiter=delimiter_of(path)),
             convert_options=pacsv.ConvertOptions(
                 include_columns=used,
                 column_types={n: pa.float64() for n in used},
