@@ -23,5 +23,6 @@ python3 -m venv "$venv"
 "$venv/bin/ruff" check src tests benchmarks scripts
 "$venv/bin/ruff" format --check src tests benchmarks scripts
 
-# run from the tests' view of an installed package (not the source tree)
-"$venv/bin/python" -m pytest "$@"
+# run from the tests' view of an installed package (not the source tree); one worker process per core
+# (pytest-xdist), each test file on one worker so its module fixtures are built once
+"$venv/bin/python" -m pytest -n "${STICKSLIP_TEST_WORKERS:-auto}" --dist loadfile "$@"
