@@ -142,3 +142,20 @@ def test_a_run_that_stops_or_fails_on_its_way_exits_3(capsys, monkeypatch):
     monkeypatch.setattr(Transient, "run", non_finite)
     code, _, err = run_main(capsys, *words)
     assert code == 3 and "the run failed: transient: the state went non-finite" in err, err
+
+
+def test_a_run_that_does_not_oscillate_reports_its_range_not_a_peak_and_trough(capsys):
+    """Issue 28 item 6: a stuck run's highest and lowest stress are a ramp's ends, not a cycle's peak and
+    trough; the text says so and the JSON says whether the numbers belong to an oscillation."""
+    import json
+
+    from cli_helpers import run_main
+
+    code, out, err = run_main(capsys, "run", "--model", "transient", "--v0", "50 um/s", "--duration", "1 s")
+    assert code == 0, err
+    assert "highest" in out and "lowest" in out and "(no oscillation)" in out and "peak" not in out.split("\n")[-2]
+    code, out, err = run_main(capsys, "run", "--model", "transient", "--v0", "50 um/s", "--duration", "1 s", "--json")
+    assert json.loads(out)["oscillates"] is False
+    code, out, err = run_main(capsys, "run", "--model", "quasi-static", "--v0", "50 um/s", "--duration", "50 s",
+                              "--json")  # fmt: skip
+    assert json.loads(out)["oscillates"] is True

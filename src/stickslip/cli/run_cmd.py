@@ -14,6 +14,7 @@ from typing import Any
 
 import click
 
+from .. import regimes
 from ..errors import ModelError, ParameterError, RunFailed, UnitError
 from ..numerics.budget import BudgetExhausted
 from ..progress import progress
@@ -157,6 +158,10 @@ def settings_of(texts: tuple[str, ...], every_text: str | None) -> dict[str, Any
     return settings
 
 
+#: the regimes whose peak and trough are those of an oscillation (the others: the run's highest and lowest)
+OSCILLATING = (regimes.STICK_SLIP, regimes.DECAYING, regimes.GROWING)
+
+
 def run_summary(run: Any, protocol: Any, rig: Any) -> dict[str, Any]:
     """What a run settled into, in SI: regime with its evidence, period, peak, trough, mean, the model's own numbers."""
     signal = "stress" if run.stress is not None else "friction"
@@ -168,6 +173,7 @@ def run_summary(run: Any, protocol: Any, rig: Any) -> dict[str, Any]:
         "protocol": [{"velocity": s.velocity, "duration": s.duration} for s in protocol.segments],
         "rig": {"control": rig.control, "stiffness": rig.stiffness},
         "regime": run.regime_name,
+        "oscillates": r.kind in OSCILLATING,
         "evidence": r.evidence,
         "periods_seen": r.periods,
         "amplitude_ratio": r.amplitude_ratio,
@@ -206,10 +212,15 @@ def summary_text(summary: dict[str, Any]) -> str:
     numbers = []
     if summary["period"] is not None and math.isfinite(summary["period"]):
         numbers.append(f"period {summary['period']:.6g} s")
-    for word in ("peak", "trough", "mean"):
+    # a run that settled without oscillating has a range and a mean, not the peak and trough of a cycle
+    words = ("peak", "trough", "mean") if summary.get("oscillates", True) else ("trough", "peak", "mean")
+    shown = {"peak": "highest", "trough": "lowest"} if not summary.get("oscillates", True) else {}
+    for word in words:
         value = summary[f"{word}_{signal}"]
         if value is not None and math.isfinite(value):
-            numbers.append(f"{word} {value:.6g}{unit}")
+            numbers.append(f"{shown.get(word, word)} {value:.6g}{unit}")
+    if not summary.get("oscillates", True) and numbers:
+        numbers[-1] += " over the run (no oscillation)"
     if numbers:
         lines.append("  " + ", ".join(numbers))
     return "\n".join(lines)
