@@ -153,7 +153,9 @@ def compare_command(**options: Any) -> None:
         from ..plots.compare import figure_bond_and_rsf
 
         save_figure(figure_bond_and_rsf(panels, pair, rsf, _how(rsf.status)), options["output"])
-        write(sidecar(options["output"]), json_text(summary) + "\n")
+        side = sidecar(options["output"])
+        if side is not None:
+            write(side, json_text(summary) + "\n")
     if failures:
         click.echo("stickslip: the rate-and-state side failed: " + failures[0], err=True)
         raise SystemExit(FAILED)

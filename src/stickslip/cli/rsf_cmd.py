@@ -244,8 +244,13 @@ def trace_csv(frame: Any) -> str:
     return csv_text(frame)
 
 
-def sidecar(path: Path) -> Path:
-    """Where the parameters of an output file go: ``NAME.params.json`` beside it."""
+def sidecar(path: Path | None) -> Path | None:
+    """Where the parameters of an output file go: ``NAME.params.json`` beside it; none beside standard output or
+    a special file (``-o /dev/null`` wrote ``/dev/null.params.json``)."""
+    if path is None or str(path) == "-":
+        return None
+    if path.exists() and not path.resolve().is_file():  # a device, a FIFO, a link to one: written as it is, alone
+        return None
     return path.with_name(path.stem + ".params.json")
 
 
@@ -305,7 +310,7 @@ def simulate_command(**options: Any) -> None:
         start = _positive(options["start_velocity"], "velocity", "--start-velocity")
     every = None if options["every"] is None else _positive(options["every"], "time", "--every")
     output, plot_path = options["output"], options["plot_path"]
-    side = sidecar(output) if output is not None and str(output) != "-" else None
+    side = sidecar(output)
     refuse_input_as_output(
         [options["protocol_file"], options["params_file"]],
         [("-o", output), ("-o (its NAME.params.json)", side), ("--plot", plot_path)],
@@ -555,7 +560,9 @@ def fit_command(**options: Any) -> None:
                       "estimated_model_runs": cost.runs}  # fmt: skip
     if output is not None and fit.status == "ok":
         write(output, fit.to_toml())
-        write(sidecar(output), json_text({"parameters": fit.params.to_dict(), "fit": report}))
+        side = sidecar(output)
+        if side is not None:
+            write(side, json_text({"parameters": fit.params.to_dict(), "fit": report}))
     if options["as_json"]:
         click.echo(json_text(report))
     else:

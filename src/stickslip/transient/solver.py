@@ -177,8 +177,7 @@ def run_transient(
             raise ParameterError(f"{name}: expected True or False, got {flag!r}")
     if not isinstance(protocol, Protocol):
         raise ParameterError(f"protocol: expected a stickslip.protocols.Protocol, got {type(protocol).__name__}")
-    if not (isinstance(rtol, (int, float)) and 1e-12 <= rtol <= 1e-1):
-        raise ParameterError(f"rtol: expected a number between 1e-12 and 0.1, got {rtol!r}")
+    check_rtol(rtol)
     if stick_population and control != "block":
         raise ParameterError("stick_population: the attached chains need block control (control='block')")
     mass, damping = _block_inertia(mass, damping, control, stick_population)
@@ -950,6 +949,12 @@ PRECISION = 1e-2
 CLOCK = 0.1
 
 
+def check_rtol(rtol: object) -> None:
+    """Refuse a tolerance outside 1e-12..0.1 (ParameterError, one line): 0 divided the cost estimate by zero."""
+    if isinstance(rtol, bool) or not (isinstance(rtol, (int, float)) and 1e-12 <= rtol <= 1e-1):
+        raise ParameterError(f"rtol: expected a number between 1e-12 and 0.1, got {rtol!r}")
+
+
 def estimate_cost(
     params: Parameters,
     protocol: Protocol,
@@ -1014,6 +1019,7 @@ def estimate_cost(
     quasi-steady stretch), and for a block stuck for good :data:`COHORT_SECONDS` x steps^2 (it keeps every
     cohort it bears: 1e5 segments of 1 ms are ~1e5 steps but ~1.5 h of CPU).
     """
+    check_rtol(rtol)
     _check_choice(reduction, REDUCTIONS, "reduction")
     if mass > 0:
         reduction = "off"
