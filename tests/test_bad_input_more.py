@@ -37,3 +37,16 @@ def test_rsf_simulate_into_a_fifo_writes_nothing_beside_it(tmp_path, capsys):
     assert code == 0, err
     assert got and got[0].startswith(b"time")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["pipe"]
+
+
+def test_rsf_fit_mcmc_without_emcee_is_refused_before_any_work(tmp_path, capsys, monkeypatch):
+    import importlib.util
+
+    trace = tmp_path / "t.csv"
+    code, _, err = run_main(capsys, "rsf", "simulate", "--segment", "1 um/s:10 s", "--segment", "10 um/s:10 s",
+                            "--every", "0.1 s", "-o", str(trace))  # fmt: skip
+    assert code == 0, err
+    real = importlib.util.find_spec
+    monkeypatch.setattr(importlib.util, "find_spec", lambda name, *a: None if name == "emcee" else real(name, *a))
+    code, _, err = run_main(capsys, "rsf", "fit", str(trace), "--mcmc", "20")
+    assert code == 2 and err.count("\n") == 1 and "pip install stickslip[bayes]" in err, err

@@ -532,6 +532,8 @@ def fit_command(**options: Any) -> None:
     record = read_record(options["record_file"], parse_columns(options["columns"]), time_unit=options["time_unit"],
                          **reading)  # fmt: skip
     settings = _fit_settings(options, record, window)
+    if settings["mcmc_steps"]:
+        _require_emcee()
     cost = estimate_fit_cost(record, settings)
     if cost.seconds > max_time:
         raise ParameterError(
@@ -793,6 +795,14 @@ def _fit_settings(
         settings["cutoff"] = (_positive(options["cutoff_v1"], "velocity", "--cutoff-v1"),
                               _positive(options["cutoff_v2"], "velocity", "--cutoff-v2"))  # fmt: skip
     return settings
+
+
+def _require_emcee() -> None:
+    """--mcmc needs emcee (the extra stickslip[bayes]): said in one line before any work, as fit steady --bayes."""
+    import importlib.util
+
+    if importlib.util.find_spec("emcee") is None:
+        raise ParameterError("--mcmc: the posterior needs emcee: pip install stickslip[bayes]")
 
 
 def _step_weight(text: str) -> float:
