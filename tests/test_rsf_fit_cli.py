@@ -229,10 +229,11 @@ def test_a_fit_still_running_at_max_time_is_stopped_exit_3(record_path, tmp_path
     monkeypatch.setattr(rsf_cmd, "estimate_fit_cost", lambda record, settings: rsf_cmd.FitCost(1e-6, 90, 5))
     output = tmp_path / "fit.toml"
     began = time.perf_counter()
-    code, out, err = run_main(capsys, "rsf", "fit", str(record_path), "--max-time", "0.3 s", "-o", str(output))
-    assert time.perf_counter() - began < 3.0  # the whole fit takes longer than that here (about 1-4 s)
+    # the whole fit takes 0.3 s warm on a quiet machine (1-4 s loaded): a limit well under it stops it wherever
+    code, out, err = run_main(capsys, "rsf", "fit", str(record_path), "--max-time", "0.03 s", "-o", str(output))
+    assert time.perf_counter() - began < 3.0
     assert code == 3 and out == "" and not output.exists()
-    assert err.startswith("stickslip: fit failed: stopped at --max-time 0.3 s") and err.count("\n") == 1, err
+    assert err.startswith("stickslip: fit failed: stopped at --max-time 0.03 s") and err.count("\n") == 1, err
     assert signal.getitimer(signal.ITIMER_REAL) == (0.0, 0.0)  # the alarm is off again
 
 
