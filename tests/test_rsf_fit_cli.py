@@ -328,3 +328,30 @@ def test_simulate_fit_simulate_chain(tmp_path, capsys):
     assert len(first) == len(again) == 481
     assert np.max(np.abs(again["friction [1]"] - first["friction [1]"])) < 1e-5  # of a 0.012 step
     assert math.isclose(first["friction [1]"].iloc[0], 0.6, abs_tol=1e-12)
+
+
+def test_a_fit_stopped_inside_the_optimiser_leaves_numpy_warnings_on(record_path, monkeypatch):
+    """lmfit's leastsq sets numpy's errors to 'ignore' and restores them only when it returns: a stop inside it (the
+    --max-time alarm, raised from the model run) left overflow warnings off for the rest of the process (found as a
+    later test of the CLI's warning summary failing on the same worker)."""
+    import numpy as np
+
+    from stickslip.rsf import fit as fit_module
+    from stickslip.rsf.data import read_record
+
+    class Stop(BaseException):
+        pass
+
+    real, calls = fit_module.simulate, []
+
+    def stopping(*args, **kwargs):
+        calls.append(1)
+        if len(calls) > 5:  # inside the optimiser's iterations
+            raise Stop
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(fit_module, "simulate", stopping)
+    before = np.geterr()
+    with pytest.raises(Stop):
+        fit_module.fit_record(read_record(record_path))
+    assert np.geterr() == before

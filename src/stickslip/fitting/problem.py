@@ -308,7 +308,7 @@ def minimize(space: Space, start: np.ndarray, block: Block, centre: np.ndarray |
     def gradient(p: lmfit.Parameters) -> np.ndarray:
         return jacobian(space, np.array([p[n].value for n in names]), block)
 
-    with lmfit_covariance_ignored():
+    with lmfit_covariance_ignored(), np.errstate():  # numpy's error state as it was, whatever lmfit does to it
         result = lmfit.minimize(
             objective,
             pars,

@@ -1161,9 +1161,12 @@ def _least_squares(setup: _Setup, start: dict[str, float]) -> Any:
         # MINPACK's forward-difference step sqrt(epsfcn) = 1e-5 (relative) sits well above the solver's
         # tolerance, so the Jacobians are not solver noise
         # scale_covar=False: the search's covariance assumes its noise scale; the reported one is set afterwards
-        result = lmfit.minimize(
-            residual, pars, method="leastsq", epsfcn=1e-10, max_nfev=METHOD_MAX_NFEV, scale_covar=False
-        )
+        # lmfit's leastsq turns numpy's warnings off and back on only when it returns: an exception through it
+        # (a stopped fit, ModelError) left them off for the rest of the process; errstate restores them always
+        with np.errstate():
+            result = lmfit.minimize(
+                residual, pars, method="leastsq", epsfcn=1e-10, max_nfev=METHOD_MAX_NFEV, scale_covar=False
+            )
     except (ValueError, ArithmeticError) as exc:
         raise ModelError(f"rate-and-state fit failed: {exc}") from None
     return result, residual
