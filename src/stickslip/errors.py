@@ -29,3 +29,11 @@ class ModelError(StickslipError, ArithmeticError):
 
 class RunFailed(ModelError):
     """A run started and could not go on (e.g. its state went non-finite): a failed run (exit 3), not bad input."""
+
+
+def as_written(message: str, written: str) -> str:
+    """A refusal that ends ", got <SI value>" ending instead with the value as the user wrote it ("got '-5 mm'",
+    not "got -0.005"); other messages unchanged."""
+    if ", got " not in message:
+        return message
+    return f"{message.rsplit(', got ', 1)[0]}, got {written.strip()!r}"

@@ -44,7 +44,7 @@ from importlib import resources
 from pathlib import Path
 from typing import Any
 
-from .errors import ParameterError
+from .errors import ParameterError, as_written
 from .fileio import protect_inputs, read_input_text
 from .units import format_quantity, format_si, shorten, to_si
 
@@ -370,7 +370,7 @@ def _as_written(exc: ParameterError, overrides: Mapping[str, Any]) -> ParameterE
     message = str(exc)
     for key, raw in overrides.items():
         if isinstance(raw, str) and message.startswith(f"{key}:") and ", got " in message:
-            return ParameterError(f"{message.rsplit(', got ', 1)[0]}, got {raw.strip()!r}")
+            return ParameterError(as_written(message, raw))
     return exc
 
 

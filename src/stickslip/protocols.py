@@ -25,7 +25,7 @@ import numpy as np
 
 from .columns import with_units
 from .display import velocity as velocity_text
-from .errors import DataError, ParameterError
+from .errors import DataError, ParameterError, as_written
 from .fileio import protect_inputs, read_input_text
 
 __all__ = [
@@ -214,9 +214,7 @@ def parse_segment(text: str, name: str = "--segment") -> Segment:
     except ParameterError as exc:  # named as written ("got '-5 um/s'"), not in SI
         message = str(exc)
         written = velocity_text if message.startswith("segment velocity") else duration_text
-        if ", got " in message:
-            message = f"{message.rsplit(', got ', 1)[0]}, got {written.strip()!r}"
-        raise ParameterError(f"{name} {text!r}: {message}") from None
+        raise ParameterError(f"{name} {text!r}: {as_written(message, written)}") from None
 
 
 def _refuse_duplicated_columns(text: str, path: Path) -> None:

@@ -1108,9 +1108,9 @@ def _stable_start(start: dict[str, float], dc_given: bool) -> dict[str, float]:
 
 def _cutoff_checked(cutoff: Any) -> tuple[float, float] | None:
     """The cut-off velocities as RSFParams checks them (positive, finite, m/s), or None."""
-    if cutoff is None:
-        return None
-    return RSFParams(a=0.01, states=(StateVariable("aging", 0.01, 1e-5),), cutoff=cutoff).cutoff
+    from .params import _cutoff_pair
+
+    return None if cutoff is None else _cutoff_pair(cutoff)
 
 
 #: lmfit's name of each public parameter (Dc and k in log space)

@@ -235,7 +235,8 @@ def judge(
     resolution: float | None = None,
     lowest: np.ndarray | None = None,
 ) -> tuple[str, str, regimes.Regime | None]:
-    """(regime, message) of the last protocol segment, by :func:`stickslip.regimes.classify` on the stress.
+    """(regime, message, evidence) of the last protocol segment, by :func:`stickslip.regimes.classify` on the
+    stress.
 
     "stick-slip" (a limit cycle: the amplitude constant over the last periods), "steady" (stress and, under
     block control, the slider's velocity settled), "decaying oscillation", "growing oscillation", "stuck"
