@@ -2,7 +2,7 @@
 
 Draws N random (parameter set, velocity, aging) points from tests/reference_steady.BOX with a fixed
 seed, half of them in issue 12's deep-dip/cliff corner, evaluates them with the production quadrature
-(stickslip.model.steady.steady_stress_many, paired, default settings) and with the independent
+(stickslip.quasistatic.steady.steady_stress_many, paired, default settings) and with the independent
 vectorised reference (tests/reference_steady.reference_many: Dormand-Prince 5(4) in an arc-length
 variable, no code shared), and prints the worst relative difference in sigma and where it is.
 
@@ -26,7 +26,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
 
 from reference_steady import box_cases, reference_many  # noqa: E402
 from stickslip import load_parameters  # noqa: E402
-from stickslip.model.steady import steady_stress_many  # noqa: E402
+from stickslip.quasistatic.steady import steady_stress_many  # noqa: E402
 
 
 def production(cases) -> np.ndarray:

@@ -2,7 +2,7 @@
 
 Targets: one whole cycle <= 20 ms, 100 cycles <= 1 s.
 
-* package: ``stickslip.model.cycle.simulate`` over one period and over 100 periods.  "cold" is the
+* package: ``stickslip.quasistatic.cycle.simulate`` over one period and over 100 periods.  "cold" is the
   first call for a parameter set (it includes the critical-point search and the steady-branch series,
   both cached per parameter set afterwards); "warm" is every later call.
 * reference: the plain approach — ``solve_ivp`` (LSODA) on Eq 15 in time until Nc/Nc0 = 0.2 (a
@@ -23,11 +23,11 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
-from stickslip.model import jump as jump_module
-from stickslip.model.critical import critical_point
-from stickslip.model.cycle import simulate
-from stickslip.model.steady import steady_state
 from stickslip.parameters import load_parameters
+from stickslip.quasistatic import jump as jump_module
+from stickslip.quasistatic.critical import critical_point
+from stickslip.quasistatic.cycle import simulate
+from stickslip.quasistatic.steady import steady_state
 from timing import best_of
 
 V0 = 50e-6

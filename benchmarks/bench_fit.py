@@ -36,9 +36,9 @@ from scipy.optimize import least_squares
 
 from stickslip.fitting import SteadyData, fit_steady
 from stickslip.fitting.bayes import sample_posterior
-from stickslip.model.critical import critical_point
-from stickslip.model.steady import steady_state
 from stickslip.parameters import load_parameters, replace
+from stickslip.quasistatic.critical import critical_point
+from stickslip.quasistatic.steady import steady_state
 from timing import best_of
 
 TRUE = load_parameters("gelatin-glass")
@@ -207,7 +207,7 @@ def bench_long_record(points: int = 100_000, reference_points: int = 10_000) -> 
 
 def bench_stick() -> None:
     from stickslip.fitting import datasets, fit_stick, stick_fit
-    from stickslip.model.stick import stick_phase
+    from stickslip.quasistatic.stick import stick_phase
 
     table = datasets.table1_path()
     fit_stick(table)  # warm-up

@@ -89,8 +89,8 @@ def child(task: str, *args: str) -> None:
             pd.read_csv(args[0], engine="pyarrow")
         elif task == "old-curve":
             from stickslip.cli.steady_cmd import COLUMNS
-            from stickslip.model.steady import steady_state
             from stickslip.parameters import load_parameters
+            from stickslip.quasistatic.steady import steady_state
 
             velocities = np.geomspace(10e-6, 10e-3, int(args[0]))
             result = steady_state(load_parameters(), velocities)

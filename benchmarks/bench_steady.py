@@ -6,7 +6,7 @@ that calls scipy.integrate.quad per velocity (the survival S(t_a) needs the
 cumulative hazard, itself a quad: a nested quad).  The plain one is timed on
 a subset of velocities spread over the same range and scaled to 1000.
 
-1000 velocities run the compiled march (stickslip.model.steady_kernel); the
+1000 velocities run the compiled march (stickslip.quasistatic.steady_kernel); the
 numpy march (what narrower calls use) is timed beside it in the same run, and
 the first call's cost (loading numba and its cached machine code, or
 compiling it when the cache is cold) is printed apart.
@@ -31,7 +31,7 @@ import numpy as np  # noqa: E402
 from scipy.integrate import quad  # noqa: E402
 
 from stickslip import load_parameters, steady_state  # noqa: E402
-from stickslip.model import steady  # noqa: E402
+from stickslip.quasistatic import steady  # noqa: E402
 
 VELOCITIES = np.geomspace(10e-6, 10e-3, 1000)
 PLAIN_SUBSET = 12

@@ -22,7 +22,7 @@ import time
 from pathlib import Path
 
 from stickslip import load_parameters, simulate
-from stickslip.model.jump import branch_interpolant, cached_critical_point
+from stickslip.quasistatic.jump import branch_interpolant, cached_critical_point
 from stickslip.sweeps import build_spec
 from stickslip.sweeps.engine import compute, dask_client, default_batch_size
 from stickslip.sweeps.store import open_store

@@ -18,8 +18,8 @@ from pathlib import Path
 
 import numpy as np
 
-from stickslip.model.steady import steady_state
 from stickslip.parameters import load_parameters
+from stickslip.quasistatic.steady import steady_state
 
 SEED = 20020
 POINTS = 24

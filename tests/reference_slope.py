@@ -1,6 +1,6 @@
 """An independent reference for the steady slope dsigma/dV, for the tests.
 
-It shares no code with ``stickslip.model.steady``: the same vectorised
+It shares no code with ``stickslip.quasistatic.steady``: the same vectorised
 Dormand-Prince 5(4) integration in an arc-length variable as
 ``reference_steady.reference_many`` (its DP tables and stepping rules), with
 the ln V derivatives carried as extra states of the ODE,

@@ -1,6 +1,6 @@
 """An independent, slow, high-accuracy evaluation of Eqs 6-8 for the tests.
 
-It shares no code with ``stickslip.model.steady`` beyond the parameter object.
+It shares no code with ``stickslip.quasistatic.steady`` beyond the parameter object.
 Instead of Gauss panels it integrates the ODE system
 
     dH/dx = e^L,   di/dx = e^-H,   dj/dx = e^-H x/(1-x^2)
@@ -136,7 +136,7 @@ def reference_curve(params, velocities, aging: bool = True) -> tuple[np.ndarray,
 # --------------------------------------------------------------------------- many points at once
 #
 # reference_many: the same integrals for thousands of (parameter set, velocity) points together, fast
-# enough for a random-set test of the whole box.  It shares no code with stickslip.model.steady (no
+# enough for a random-set test of the whole box.  It shares no code with stickslip.quasistatic.steady (no
 # panels, no Gauss rule, no width search, no tail bound) nor with reference_point above: one adaptive
 # Dormand-Prince 5(4) integration per point, all points stepping together in numpy arrays, each with
 # its own step, in an arc-length variable s with

@@ -16,8 +16,8 @@ from scipy.special import expi
 
 import stickslip
 from stickslip.errors import ParameterError, StickslipError
-from stickslip.model.steady import steady_state
 from stickslip.protocols import constant
+from stickslip.quasistatic.steady import steady_state
 from stickslip.transient import kernel as K
 from stickslip.transient import run_transient
 from stickslip.transient.model import chain_force, pack_parameters, steady_population
@@ -126,7 +126,7 @@ def test_steady_curve_with_saturation_against_an_ode(velocity: float) -> None:
 
 def test_a_batch_mixing_sets_with_and_without_saturation_matches_each_set() -> None:
     """steady_stress_many (fits, sweeps) in one march: the paper's lanes exactly as alone, the extension's too."""
-    from stickslip.model.steady import steady_stress_many
+    from stickslip.quasistatic.steady import steady_stress_many
 
     v = np.array([20e-6, 124e-6, 350e-6])
     both = steady_stress_many([GEL, SAT, GEL], v)

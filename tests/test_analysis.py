@@ -6,7 +6,7 @@ The truth of every synthetic record is known independently of the analysis:
   trapezoid written out here) from sigma_c to sigma_s, then a slip whose
   shape is an exponential with the model's end slopes K (V0 - Vs) and
   K (V0 - Vc) (docs/analysis.md), so corners, slopes and times are exact;
-* records sampled from the simulator (stickslip.model.cycle.simulate), whose
+* records sampled from the simulator (stickslip.quasistatic.cycle.simulate), whose
   cycles carry sigma_c, sigma_s, t_s and the slip time;
 * Table 1 of the paper (printed numbers).
 """
@@ -242,7 +242,7 @@ def test_table1_trace_built_by_hand(params, v0):
 # --------------------------------------------------------------------------- simulator records
 @pytest.fixture(scope="module")
 def simulations(params):
-    from stickslip.model.cycle import simulate
+    from stickslip.quasistatic.cycle import simulate
 
     return {v0: simulate(params, v0, duration) for v0, duration in ((50e-6, 120.0), (100e-6, 80.0), (350e-6, 60.0))}
 

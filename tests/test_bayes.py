@@ -13,9 +13,9 @@ from cli_helpers import run_main
 from stickslip.fitting import SteadyData, fit_steady
 from stickslip.fitting.bayes import CONVERGED_TIMES, MIN_STEPS, sample_posterior
 from stickslip.fitting.datasets import synthetic_steady_path
-from stickslip.model.steady import steady_state
 from stickslip.parameters import load_parameters
 from stickslip.progress import Silent, progress
+from stickslip.quasistatic.steady import steady_state
 
 pytest.importorskip("emcee")
 

@@ -152,8 +152,8 @@ def test_force_with_contact_area_gives_the_same_stress(capsys, record):
 
 
 def test_plot_and_compare(capsys, tmp_path, record):
-    from stickslip.model.cycle import simulate
     from stickslip.parameters import load_parameters
+    from stickslip.quasistatic.cycle import simulate
 
     sim = simulate(load_parameters("gelatin-glass"), V0, 90.0)
     rng = np.random.default_rng(8)

@@ -162,7 +162,7 @@ def test_a_record_near_the_float_limit_ends_in_at_most_one_line(capsys, tmp_path
 def test_numpy_warnings_reach_the_user_as_one_summary_line(capsys, monkeypatch):
     import numpy as np
 
-    import stickslip.model.critical as critical_module
+    import stickslip.quasistatic.critical as critical_module
 
     real = critical_module.critical_point
 

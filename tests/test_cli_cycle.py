@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from cli_helpers import run, run_main
-from stickslip.model.cycle import CYCLE_COLUMNS
+from stickslip.quasistatic.cycle import CYCLE_COLUMNS
 
 
 def test_simulate_json_at_50_um_per_s(runner):

@@ -21,8 +21,8 @@ import tomllib
 
 from cli_helpers import run, run_main
 from stickslip.cli.main import cli
-from stickslip.model.steady import steady_state
 from stickslip.parameters import load_parameters
+from stickslip.quasistatic.steady import steady_state
 from stickslip.tables import read_table
 from stickslip.units import DIMENSIONS
 

@@ -10,8 +10,8 @@ import pytest
 
 from cli_helpers import run_main
 from stickslip import protocols
-from stickslip.model.steady import steady_state
 from stickslip.parameters import load_parameters
+from stickslip.quasistatic.steady import steady_state
 from stickslip.rsf import RSFParams, StateVariable, simulate
 from stickslip.rsf import compare as cmp
 

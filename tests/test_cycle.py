@@ -13,11 +13,11 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from stickslip.errors import ParameterError
-from stickslip.model.cycle import CYCLE_COLUMNS, simulate
-from stickslip.model.slip import slip_phase
-from stickslip.model.steady import steady_state
-from stickslip.model.stick import stick_phase
 from stickslip.parameters import load_parameters
+from stickslip.quasistatic.cycle import CYCLE_COLUMNS, simulate
+from stickslip.quasistatic.slip import slip_phase
+from stickslip.quasistatic.steady import steady_state
+from stickslip.quasistatic.stick import stick_phase
 
 
 @pytest.fixture(scope="module")

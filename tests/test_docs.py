@@ -307,7 +307,7 @@ def test_the_harness_sees_markers_failures_and_unknown_names(tmp_path, capsys):
     with pytest.raises(AssertionError, match="shell operator"):
         run_shell_line("stickslip critical | head", "here", capsys)
     with pytest.raises(AttributeError):
-        _resolve("stickslip.model.no_such_function")
+        _resolve("stickslip.quasistatic.no_such_function")
     cycle = tmp_path / "cycle.md"
     cycle.write_text("Run `stickslip cycle --v0 V` or `stickslip rsf simulate --pull V`.\n")
     assert synopsis_problems(cycle) == [

@@ -329,15 +329,15 @@ def _rsf_run(**kwargs):
 
 
 def _steady(velocity):
-    from stickslip.model.steady import steady_state
     from stickslip.parameters import load_parameters
+    from stickslip.quasistatic.steady import steady_state
 
     return steady_state(load_parameters(), velocity)
 
 
 def _steady_quadrature(quadrature):
-    from stickslip.model.steady import steady_state
     from stickslip.parameters import load_parameters
+    from stickslip.quasistatic.steady import steady_state
 
     return steady_state(load_parameters(), 1e-4, quadrature=quadrature)
 

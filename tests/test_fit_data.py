@@ -10,8 +10,8 @@ import pytest
 
 from stickslip.errors import DataError
 from stickslip.fitting import SteadyData, StickData, datasets, read_steady_data, read_stick_data
-from stickslip.model.steady import steady_state
 from stickslip.parameters import load_parameters
+from stickslip.quasistatic.steady import steady_state
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -16,9 +16,9 @@ from stickslip.fitting import SteadyData, datasets, fit_steady, identify, read_s
 from stickslip.fitting.batch import stress_many
 from stickslip.fitting.critical_uncertainty import Profile, critical_gradient, critical_many
 from stickslip.fitting.problem import Block, Space
-from stickslip.model.critical import critical_point
-from stickslip.model.steady import steady_state
 from stickslip.parameters import load_parameters, replace
+from stickslip.quasistatic.critical import critical_point
+from stickslip.quasistatic.steady import steady_state
 
 TRUE = load_parameters("gelatin-glass")
 VC_TRUE, SC_TRUE = 124.097e-6, 257.359  # contracts.md: Vc = 124.097 um/s, sigma_c = 257.359 Pa

@@ -9,8 +9,8 @@ import pytest
 
 from cli_helpers import run_main
 from stickslip.fitting import SteadyData, fit_steady
-from stickslip.model.steady import steady_state
 from stickslip.parameters import load_parameters
+from stickslip.quasistatic.steady import steady_state
 
 TRUE = load_parameters("gelatin-glass")
 VELOCITY = np.geomspace(140e-6, 2000e-6, 24)

@@ -16,9 +16,9 @@ import pytest
 from cli_helpers import run_main
 from stickslip.fitting import SteadyData, fit_steady
 from stickslip.fitting.scatter import local_scatter, velocity_dependence
-from stickslip.model.critical import critical_point
-from stickslip.model.steady import steady_state
 from stickslip.parameters import load_parameters
+from stickslip.quasistatic.critical import critical_point
+from stickslip.quasistatic.steady import steady_state
 
 TRUE = load_parameters("gelatin-glass")
 WIDE = np.geomspace(10e-6, 2000e-6, 20)

@@ -10,9 +10,9 @@ import pytest
 from stickslip.errors import DataError, ParameterError
 from stickslip.fitting import StickData, datasets
 from stickslip.fitting.stick_fit import fit_stick
-from stickslip.model.critical import critical_point
-from stickslip.model.stick import stick_phase
 from stickslip.parameters import load_parameters
+from stickslip.quasistatic.critical import critical_point
+from stickslip.quasistatic.stick import stick_phase
 
 TRUE = load_parameters("gelatin-glass")
 SIGMA_C = critical_point(TRUE).stress

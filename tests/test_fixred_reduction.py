@@ -39,7 +39,7 @@ def _near_gel_cases(seed: int, count: int):
     steady start at the default (Vc's stable side) or at 0.5-1 of the puller's velocity."""
     import numpy as np
 
-    from stickslip.model.jump import cached_critical_point, steady_curve_key
+    from stickslip.quasistatic.jump import cached_critical_point, steady_curve_key
 
     keys = ("bonds.bond_time", "bonds.chain_stiffness", "bonds.activation_length", "bonds.max_extension",
             "aging.aging_time", "aging.aging_velocity", "bonds.site_density")  # fmt: skip

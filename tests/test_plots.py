@@ -86,7 +86,8 @@ def test_library_code_never_shows_a_window_nor_uses_pyplot() -> None:
 def test_results_load_neither_the_plots_nor_matplotlib_until_they_draw() -> None:
     code = (
         "import sys\n"
-        "import stickslip.model.cycle, stickslip.model.steady, stickslip.model.stick, stickslip.model.slip\n"
+        "import stickslip.quasistatic.cycle, stickslip.quasistatic.steady\n"
+        "import stickslip.quasistatic.stick, stickslip.quasistatic.slip\n"
         "import stickslip.transient.result, stickslip.rsf.results, stickslip.rsf.fit, stickslip.rsf.data\n"
         "import stickslip.analysis.cycles, stickslip.analysis.compare, stickslip.protocols, stickslip.sweeps\n"
         "import stickslip.fitting.steady_fit, stickslip.fitting.stick_fit, stickslip.fitting.bayes\n"

@@ -295,7 +295,7 @@ def test_differences_from_the_model_are_not_filed_as_paper_errors(rows: dict) ->
 
 
 def test_phase_diagram_caption_states_the_models_boundary_beside_the_grid(report: Path, results: dict, params):
-    from stickslip.model.stick import stick_phase
+    from stickslip.quasistatic.stick import stick_phase
 
     floor = results["model"]["lowest_velocity_with_a_jump"]
     critical = results["model"]["critical_point"]
@@ -441,9 +441,9 @@ def test_steady_numbers_match_the_paper(rows: dict) -> None:
 
 
 def test_stick_jump_and_slip_numbers_match_the_library(rows: dict, params) -> None:
-    from stickslip.model.cycle import simulate
-    from stickslip.model.jump import jump_velocity
-    from stickslip.model.stick import stick_phase
+    from stickslip.quasistatic.cycle import simulate
+    from stickslip.quasistatic.jump import jump_velocity
+    from stickslip.quasistatic.stick import stick_phase
 
     factor = math.log(5 / 3) / (5 / 3 - 1)
     for v0, velocity, slope in ((50, 50e-6, 16.5), (100, 100e-6, 33.5)):

@@ -9,10 +9,10 @@ import numpy as np
 import pytest
 from matplotlib.colors import to_rgba
 
-from stickslip.model.cycle import simulate
 from stickslip.parameters import load_parameters
 from stickslip.plots.cycles import figure_cycles
 from stickslip.plots.sweeps import plot_phase_diagram
+from stickslip.quasistatic.cycle import simulate
 from stickslip.report.computations import DURATIONS, ModelRun
 from stickslip.report.report_figures import chain_fraction_figure
 from stickslip.sweeps import build_spec, load_sweep, run_sweep

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import stickslip
-from stickslip.model.stick import stick_phase
+from stickslip.quasistatic.stick import stick_phase
 from stickslip.reprs import short_value
 
 P = stickslip.load_parameters("gelatin-glass")

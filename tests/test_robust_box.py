@@ -19,11 +19,11 @@ import pytest
 
 from reference_steady import box_cases, reference_many, reference_point
 from stickslip import ModelError, ParameterError, critical_point, load_parameters, steady_state
-from stickslip.model.cycle import simulate
-from stickslip.model.jump import jump_velocity
-from stickslip.model.slip import slip_phase
-from stickslip.model.steady import ACCURATE_QUADRATURE, steady_stress_many
-from stickslip.model.stick import stick_phase
+from stickslip.quasistatic.cycle import simulate
+from stickslip.quasistatic.jump import jump_velocity
+from stickslip.quasistatic.slip import slip_phase
+from stickslip.quasistatic.steady import ACCURATE_QUADRATURE, steady_stress_many
+from stickslip.quasistatic.stick import stick_phase
 
 GEL = load_parameters("gelatin-glass")
 SPEC = 1e-6  # the accuracy requirement (relative)

@@ -13,7 +13,7 @@ import math
 import pytest
 from scipy.optimize import brentq as scipy_brentq
 
-import stickslip.model.critical as critical_module
+import stickslip.quasistatic.critical as critical_module
 from stickslip.numerics.roots import MIN_RTOL, brentq
 
 CASES = [

@@ -72,7 +72,7 @@ def test_the_bond_models_steps_up_and_down_read_as_documented_and_need_two_slip_
     a - b equals the steady curve's log-slope between the two velocities (the steady solver, independent) to
     0.5 %; each step alone is described to within 10 % of its range at worst, but the step down relaxes over a
     slip 6x longer than the step up, their Dc intervals far apart: no one Dc describes both."""
-    from stickslip.model.steady import steady_state
+    from stickslip.quasistatic.steady import steady_state
 
     params = load_parameters("gelatin-glass")
     found = {}

@@ -19,8 +19,8 @@ from stickslip.analysis import analyze_trace, read_trace
 from stickslip.analysis.fits import QUADRATIC, STRAIGHT, Line, _HingeProfile, _sse_profile
 from stickslip.cli import steady_cmd
 from stickslip.errors import DataError
-from stickslip.model.steady import steady_state
 from stickslip.parameters import load_parameters
+from stickslip.quasistatic.steady import steady_state
 from stickslip.tables import _read_columnar, _read_header, _read_rows
 
 SLOPE, LOW, HIGH, SLIP, NOISE = 15.3, 257.4, 552.9, 3.8, 0.5  # Pa/s, Pa, Pa, s, Pa

@@ -19,9 +19,9 @@ import numpy as np
 import pytest
 
 from stickslip.errors import ModelError, ParameterError
-from stickslip.model.jump import branch_interpolant, jump_velocity
-from stickslip.model.slip import SETTLE_TOLERANCE, slip_phase, slip_trajectory, steady_curve
-from stickslip.model.steady import steady_state
+from stickslip.quasistatic.jump import branch_interpolant, jump_velocity
+from stickslip.quasistatic.slip import SETTLE_TOLERANCE, slip_phase, slip_trajectory, steady_curve
+from stickslip.quasistatic.steady import steady_state
 
 VC, SC, A, K = 124e-6, 257.0, 180.0, 3.0e5  # the analytic test curve and stiffness
 MP_DIGITS = 30

@@ -16,8 +16,8 @@ from scipy.interpolate import CubicSpline
 
 from reference_steady import reference_point
 from stickslip import ModelError, ParameterError, critical_point, load_parameters, steady_state
-from stickslip.model.steady import QuadratureSettings
 from stickslip.parameters import BOLTZMANN
+from stickslip.quasistatic.steady import QuadratureSettings
 
 GEL = load_parameters("gelatin-glass")
 SPEC = 1e-6  # the accuracy requirement (relative)

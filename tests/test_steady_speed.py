@@ -1,4 +1,4 @@
-"""Issue 21: the compiled steady-state march (stickslip.model.steady_kernel) over the parameter box.
+"""Issue 21: the compiled steady-state march (stickslip.quasistatic.steady_kernel) over the parameter box.
 
 Wide batches (steady.COMPILED_LANES velocities or more) are marched lane by lane in numba-compiled loops
 instead of numpy arrays.  Here the compiled march is forced on every call and checked against the
@@ -18,7 +18,7 @@ import pytest
 from reference_slope import reference_slope_many, slope_error
 from reference_steady import box_cases, reference_many
 from stickslip import ModelError, load_parameters, steady_state
-from stickslip.model import steady
+from stickslip.quasistatic import steady
 
 GEL = load_parameters("gelatin-glass")
 #: the issue's accuracy over the box (relative); reference_many itself is good to ~1e-9
@@ -129,7 +129,7 @@ def test_compiled_march_is_faster_than_the_numpy_one(monkeypatch):
 def test_compiled_exponential_is_within_an_ulp_of_numpy():
     """The march's vectorisable exp (Taylor on |r| <= ln2/2 times 2^n) against numpy's, over its whole range;
     below e^-708 (subnormal) it gives 0."""
-    from stickslip.model import steady_kernel
+    from stickslip.quasistatic import steady_kernel
 
     steady_kernel.compiled()
     rng = np.random.default_rng(2104)
@@ -182,7 +182,7 @@ def test_critical_point_is_computed_once_per_steady_curve(monkeypatch):
     """The report, the fits and the plots ask for the same critical point several times (~30 ms each): it is
     solved once per steady curve (bond and aging parameters), whatever the block, stick or name."""
     from stickslip import critical_point
-    from stickslip.model import critical
+    from stickslip.quasistatic import critical
 
     critical.cached_critical_point.cache_clear()
     solved = []

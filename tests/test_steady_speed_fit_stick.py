@@ -1,7 +1,7 @@
 """Issue 21: the stick fit after its speed-up (fitting/stick_batch.py) still lands on the least-squares optimum.
 
 The fit's stick times come from the batched Dormand-Prince march; here the optimum is checked with the
-independent single-phase solver (:func:`stickslip.model.stick.stick_phase`, scipy at rtol 1e-11): one
+independent single-phase solver (:func:`stickslip.quasistatic.stick.stick_phase`, scipy at rtol 1e-11): one
 Gauss-Newton step from the fitted values, with residuals and a central-difference Jacobian from
 stick_phase, must move the free ln-parameters by less than the fit's tolerance.
 """
@@ -15,7 +15,7 @@ import pytest
 
 from stickslip.fitting import datasets
 from stickslip.fitting.stick_fit import _params_for_rate, fit_stick
-from stickslip.model.stick import stick_phase
+from stickslip.quasistatic.stick import stick_phase
 
 STEP = 1e-3  # in ln-parameter
 

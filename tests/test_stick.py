@@ -20,10 +20,10 @@ from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 from scipy.special import exp1
 
-import stickslip.model.stick as stick_module
+import stickslip.quasistatic.stick as stick_module
 from stickslip.errors import ParameterError
-from stickslip.model.stick import never_slips, stick_phase, stuck_threshold
 from stickslip.parameters import load_parameters
+from stickslip.quasistatic.stick import never_slips, stick_phase, stuck_threshold
 
 
 def scaled_load(params, stress):

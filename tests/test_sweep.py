@@ -238,7 +238,7 @@ def test_a_sweep_of_another_stickslip_version_is_refused(tmp_path):
 
 
 def test_the_steady_curve_is_solved_once_for_every_block_and_stick(params):
-    from stickslip.model import jump
+    from stickslip.quasistatic import jump
 
     stickslip.simulate(params, 50e-6, 30.0)
     before = jump.cached_critical_point.cache_info().misses, jump.branch_interpolant.cache_info().misses

@@ -11,9 +11,9 @@ from tests.cli_helpers import run_main
 
 import stickslip
 from stickslip.errors import ModelError, ParameterError
-from stickslip.model.cycle import simulate
 from stickslip.numerics.budget import DEFAULT_MAX_STEPS, BudgetExhausted
 from stickslip.protocols import constant, segments
+from stickslip.quasistatic.cycle import simulate
 from stickslip.transient import critical_stiffness, run_transient
 from stickslip.transient.solver import estimate_cost
 

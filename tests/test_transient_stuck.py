@@ -114,7 +114,7 @@ def test_a_block_creeping_up_the_rising_branch_is_reduced() -> None:
     cohorts throughout (final sigma equal to 5e-9); before, a shortcut that took every velocity below Vc for the
     falling branch left the whole creep to the cohorts.  The slider ends on the steady curve to within the
     population's lag (~0.025 s x dsigma/dt, 0.2 %)."""
-    from stickslip.model.steady import steady_state
+    from stickslip.quasistatic.steady import steady_state
 
     run = run_transient(SAT, constant(50e-6, 2.0), start="steady", start_velocity=1e-6, rtol=RTOL)
     assert run.steps < 10_000

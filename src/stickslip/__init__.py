@@ -18,28 +18,28 @@ from typing import TYPE_CHECKING, Any
 from .errors import DataError, ModelError, ParameterError, StickslipError, UnitError
 
 if TYPE_CHECKING:
-    from .model.critical import CriticalPoint, critical_point
-    from .model.cycle import Simulation, simulate
-    from .model.jump import jump_velocity
-    from .model.slip import SlipPhase, slip_phase
-    from .model.steady import SteadyState, steady_state, steady_stress_many
-    from .model.stick import StickPhase, stick_phase
     from .models import FrictionModel, Rig, Run, available_models, get_model, register_model, run
     from .parameters import Parameters, available_parameter_sets, load_parameters
+    from .quasistatic.critical import CriticalPoint, critical_point
+    from .quasistatic.cycle import Simulation, simulate
+    from .quasistatic.jump import jump_velocity
+    from .quasistatic.slip import SlipPhase, slip_phase
+    from .quasistatic.steady import SteadyState, steady_state, steady_stress_many
+    from .quasistatic.stick import StickPhase, stick_phase
 
 _LAZY = {
-    "CriticalPoint": "stickslip.model.critical",
-    "critical_point": "stickslip.model.critical",
-    "Simulation": "stickslip.model.cycle",
-    "simulate": "stickslip.model.cycle",
-    "jump_velocity": "stickslip.model.jump",
-    "SlipPhase": "stickslip.model.slip",
-    "slip_phase": "stickslip.model.slip",
-    "SteadyState": "stickslip.model.steady",
-    "steady_state": "stickslip.model.steady",
-    "steady_stress_many": "stickslip.model.steady",
-    "StickPhase": "stickslip.model.stick",
-    "stick_phase": "stickslip.model.stick",
+    "CriticalPoint": "stickslip.quasistatic.critical",
+    "critical_point": "stickslip.quasistatic.critical",
+    "Simulation": "stickslip.quasistatic.cycle",
+    "simulate": "stickslip.quasistatic.cycle",
+    "jump_velocity": "stickslip.quasistatic.jump",
+    "SlipPhase": "stickslip.quasistatic.slip",
+    "slip_phase": "stickslip.quasistatic.slip",
+    "SteadyState": "stickslip.quasistatic.steady",
+    "steady_state": "stickslip.quasistatic.steady",
+    "steady_stress_many": "stickslip.quasistatic.steady",
+    "StickPhase": "stickslip.quasistatic.stick",
+    "stick_phase": "stickslip.quasistatic.stick",
     "Parameters": "stickslip.parameters",
     "available_parameter_sets": "stickslip.parameters",
     "load_parameters": "stickslip.parameters",
@@ -104,8 +104,8 @@ __version__ = "0.1.0"
 
 #: subpackages and modules reachable as ``stickslip.rsf`` etc. after a plain ``import stickslip``
 _SUBMODULES = frozenset(
-    {"analysis", "errors", "fileio", "fitting", "model", "models", "numerics", "parameters", "protocols", "report",
-     "rsf", "sweeps", "transient", "units"}
+    {"analysis", "errors", "fileio", "fitting", "models", "numerics", "parameters", "protocols", "quasistatic",
+     "report", "rsf", "sweeps", "transient", "units"}
 )  # fmt: skip
 
 

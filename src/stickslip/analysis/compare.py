@@ -28,7 +28,7 @@ if TYPE_CHECKING:  # pragma: no cover
     import pandas as pd
     from matplotlib.axes import Axes
 
-    from ..model.cycle import Simulation
+    from ..quasistatic.cycle import Simulation
 
 #: The shift is refined by least squares within this fraction of the aligned cycle.
 ALIGN_WINDOW = 0.05

@@ -12,7 +12,7 @@ by hinge fits against the adjacent slip branches (:mod:`.fits`).  Then
   by a small margin),
 * ``stiffness`` G_d/h         = slope / (V0 * geometric factor)  (Eq 17),
 * ``jump_velocity`` V_s       = where the steady curve carries sigma_s (Eq 8,
-  :func:`stickslip.model.jump.jump_velocity`),
+  :func:`stickslip.quasistatic.jump.jump_velocity`),
 * ``slip_time``               = next start corner - end corner,
 * ``period``                  = next start corner - start corner.
 
@@ -496,9 +496,9 @@ def _jump(params: Parameters, peak: float | None) -> tuple[float | None, str]:
     if peak is None:
         return None, ""
     try:
-        from ..model.jump import jump_velocity
+        from ..quasistatic.jump import jump_velocity
     except ImportError:
-        return None, "jump velocity not computed: the jump solver (stickslip.model.jump) is not available"
+        return None, "jump velocity not computed: the jump solver (stickslip.quasistatic.jump) is not available"
     if peak <= 0:
         return None, f"no jump velocity: peak stress {peak:.4g} Pa is not positive"
     result = jump_velocity(params, peak)

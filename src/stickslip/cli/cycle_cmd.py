@@ -105,8 +105,8 @@ def simulate_command(
     regime is "stick-slip", "steady" (V0 >= Vc: the slip settles at V0),
     "stuck" (a stick never ends) or "undetermined" (the model has no answer).
     """
-    from ..model.cycle import CYCLE_COLUMNS
     from ..models import get_model
+    from ..quasistatic.cycle import CYCLE_COLUMNS
 
     refuse_overwriting_inputs([protocol_file], [("-o", output), ("--plot", plot_path)], params_name)
     protocol = build_protocol(v0_text, duration_text, segment_texts, protocol_file)
@@ -207,7 +207,7 @@ def stick_command(
     Says so when the block stays stuck for ever (aging wins over loading)
     instead of inventing a stick time.
     """
-    from ..model.stick import stick_phase
+    from ..quasistatic.stick import stick_phase
 
     refuse_overwriting_inputs([], [("-o", output), ("--plot", plot_path)], params_name)
     v0 = _velocity(v0_text)
@@ -239,7 +239,7 @@ def stick_command(
 def _jump_after(params: Any, stick: Any) -> Any:
     """The jump that would follow the collapse (Eq 8), as ``simulate`` takes it; None when the block did not slip."""
     from ..errors import ModelError
-    from ..model.jump import jump_velocity
+    from ..quasistatic.jump import jump_velocity
 
     if stick.status != "slipped":
         return None

@@ -102,7 +102,7 @@ def _csv_rows(columns: dict[str, np.ndarray]) -> bytes:
 
 
 def _evaluate(params: Any, velocities: np.ndarray, aging: bool) -> dict[str, np.ndarray]:
-    from ..model.steady import steady_state
+    from ..quasistatic.steady import steady_state
 
     result = steady_state(params, velocities, aging=aging)
     columns = {name: np.ravel(getattr(result, name)) for name, _ in COLUMNS}
@@ -267,7 +267,7 @@ def critical_command(as_json: bool, plot_path: Path | None, params_name: str, ov
     Also prints the maximum (turnover) of the no-aging curve.  When the
     curve has no minimum the message says why, and the exit status is 0.
     """
-    from ..model.critical import critical_point
+    from ..quasistatic.critical import critical_point
 
     refuse_overwriting_inputs([], [("--plot", plot_path)], params_name)
     params = resolve_params(params_name, overrides)

@@ -1,6 +1,6 @@
 """The steady stress for many parameter sets at once (finite-difference Jacobians, MCMC walkers).
 
-:func:`stickslip.model.steady.steady_stress_many` evaluates all sets in one
+:func:`stickslip.quasistatic.steady.steady_stress_many` evaluates all sets in one
 quadrature march.  A set for which the model has no finite answer makes the
 batch fail; then each set is evaluated alone so that only its row is NaN.
 
@@ -20,8 +20,8 @@ from contextlib import contextmanager
 import numpy as np
 
 from ..errors import ModelError, ParameterError
-from ..model.steady import steady_state, steady_stress_many
 from ..parameters import Parameters
+from ..quasistatic.steady import steady_state, steady_stress_many
 
 
 @contextmanager

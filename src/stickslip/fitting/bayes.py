@@ -44,10 +44,10 @@ import numpy as np
 
 from ..columns import with_units
 from ..errors import ParameterError, StickslipError
-from ..model.steady import steady_state
 from ..parameters import Parameters, key_dimension
 from ..progress import Silent
 from ..progress import progress as progress_bar
+from ..quasistatic.steady import steady_state
 from . import identify
 from .batch import stress_many
 from .critical_uncertainty import critical_many

@@ -25,9 +25,9 @@ import numpy as np
 from scipy.optimize import brentq, least_squares
 
 from ..errors import ModelError, ParameterError
-from ..model.critical import critical_point
-from ..model.steady import steady_state
 from ..parameters import Parameters
+from ..quasistatic.critical import critical_point
+from ..quasistatic.steady import steady_state
 from .batch import overflow_is_failure, stress_many
 from .problem import FAILED_RESIDUAL, JACOBIAN_STEP, SEARCH_BOX, Block, Space
 

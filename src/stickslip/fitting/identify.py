@@ -1,6 +1,6 @@
 r"""What steady friction data can and cannot determine (docs/fitting.md).
 
-In the dimensionless form of Eqs 6-8 (see :mod:`stickslip.model.steady`)
+In the dimensionless form of Eqs 6-8 (see :mod:`stickslip.quasistatic.steady`)
 
     sigma(V) = S j / (V/c + i),   i, j functionals of  T = u0 c / V,  a,  alpha = (b/V) e^{-V/Va},
 

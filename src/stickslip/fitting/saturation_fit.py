@@ -18,9 +18,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ModelError
-from ..model.critical import Extremum, find_extrema
-from ..model.steady import steady_state
 from ..parameters import Parameters
+from ..quasistatic.critical import Extremum, find_extrema
+from ..quasistatic.steady import steady_state
 
 #: the fitted keys, as natural logarithms of their SI values
 KEYS = ("aging.aging_time", "aging.aging_velocity", "aging.saturation_age")

@@ -30,9 +30,9 @@ from scipy import stats
 
 from ..columns import with_units
 from ..errors import DataError, ModelError, ParameterError
-from ..model.critical import critical_point
-from ..model.steady import steady_state
 from ..parameters import Parameters, key_dimension, load_parameters
+from ..quasistatic.critical import critical_point
+from ..quasistatic.steady import steady_state
 from ..units import to_si
 from . import identify
 from .critical_uncertainty import Profile, critical_gradient, local_critical

@@ -1,6 +1,6 @@
 r"""Stick times of many stick phases at once (the stick fit's inner loop).
 
-Eq 15 for one stick phase, in the variables of :mod:`stickslip.model.stick`:
+Eq 15 for one stick phase, in the variables of :mod:`stickslip.quasistatic.stick`:
 n = Nc/Nc0, dn/dt = -r n exp((s0 + k t)/n - t/tau_a).  As there, the
 equation is integrated in the arc-length-like variable theta,
 
@@ -10,7 +10,7 @@ equation is integrated in the arc-length-like variable theta,
 collapse; past n = 0 the field is (0, -1), its limit, so no event location is
 needed: t_s is t' T once n < 0.
 
-:func:`stickslip.model.stick.stick_phase` solves one phase with scipy's
+:func:`stickslip.quasistatic.stick.stick_phase` solves one phase with scipy's
 adaptive Runge-Kutta at rtol 1e-11, with the stuck-for-ever proof and the
 full trajectory.  A fit needs only t_s, for every row and every perturbed
 parameter set of a Jacobian: here all of them advance together, each with
@@ -28,9 +28,9 @@ from scipy.special import expit
 #: Tolerances of the steps (t' and n are both O(1) per unit theta).
 RTOL = 1e-9
 ATOL = 1e-12
-#: Below this n the chains are gone (as in stickslip.model.stick).
+#: Below this n the chains are gone (as in stickslip.quasistatic.stick).
 N_GONE = 1e-200
-#: -ln of the shortest time scale used (1e-300 s), as in stickslip.model.stick.
+#: -ln of the shortest time scale used (1e-300 s), as in stickslip.quasistatic.stick.
 SHORTEST_LOG_TIME = 690.0
 #: Give up (NaN) after this many steps of the slowest phase.
 MAX_STEPS = 20000
@@ -68,7 +68,7 @@ def _field(constants: tuple[np.ndarray, ...], y: np.ndarray, out: np.ndarray) ->
     """(dt'/dtheta, dn/dtheta) at y = (t', n) (shape (2, phases)) into ``out``.
 
     Below N_GONE, n is taken as N_GONE: there w is astronomically large, so the field is (0, -1), the
-    collapse continued through n = 0 as in stickslip.model.stick.
+    collapse continued through n = 0 as in stickslip.quasistatic.stick.
     """
     log_rt, s0, k_t, aging_t = constants
     tau = y[0]

@@ -5,7 +5,7 @@ the model's critical stress where the cell is empty) and rises at the
 measured loading rate ``stick_slope`` when the table has it, else at
 K V0 with the block stiffness K of Eq 17.  The model's stick time t_s and
 peak stress sigma_s (Eq 16) come from
-:func:`stickslip.model.stick.stick_phase`.
+:func:`stickslip.quasistatic.stick.stick_phase`.
 
 Fitted: ``stick.attached_chains`` (Nc0), ``stick.break_rate`` (uc/tau) and
 ``stick.aging_time`` (tau_a of Eq 15), as ln-values.  In Eq 15 Nc0 appears
@@ -35,8 +35,8 @@ from scipy.special import stdtrit
 
 from ..columns import with_units
 from ..errors import DataError, ParameterError
-from ..model.critical import critical_point
 from ..parameters import Parameters, key_dimension, load_parameters, replace
+from ..quasistatic.critical import critical_point
 from ..units import to_si
 from . import identify
 from .data import StickData, read_stick_data
@@ -186,7 +186,7 @@ def _model(params: Parameters, rows: _Rows) -> tuple[np.ndarray, np.ndarray, lis
     problems = []
     if np.all(np.isfinite(times)):
         return times, rows.start + rows.rate * times, problems
-    from ..model.stick import stick_phase  # only here: it loads scipy.integrate (~30 ms of the command)
+    from ..quasistatic.stick import stick_phase  # only here: it loads scipy.integrate (~30 ms of the command)
 
     for k in np.nonzero(~np.isfinite(times))[0]:
         v, s0, rate = float(rows.velocity[k]), float(rows.start[k]), float(rows.rate[k])

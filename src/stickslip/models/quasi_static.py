@@ -34,7 +34,7 @@ class QuasiStatic(BondModel):
     def run(
         self, params: Parameters, protocol: Protocol, rig: Rig | None = None, *, start: Any = None, **settings: Any
     ) -> Run:
-        from ..model.cycle import simulate
+        from ..quasistatic.cycle import simulate
 
         rig = self.check(protocol, rig, settings)
         params = self.with_rig(_checked(params), rig)
@@ -63,7 +63,7 @@ class QuasiStatic(BondModel):
 
 
 def _checked(params: Any) -> Parameters:
-    from ..model.steady import require_parameters
+    from ..quasistatic.steady import require_parameters
 
     require_parameters(params)
     return params

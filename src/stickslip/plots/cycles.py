@@ -35,10 +35,10 @@ if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.axes import Axes
     from matplotlib.figure import Figure
 
-    from ..model.cycle import Simulation
-    from ..model.slip import SlipPhase
-    from ..model.stick import StickPhase
     from ..parameters import Parameters
+    from ..quasistatic.cycle import Simulation
+    from ..quasistatic.slip import SlipPhase
+    from ..quasistatic.stick import StickPhase
 
 STICK_COLOR = "#c0392b"
 SLIP_COLOR = AGING_COLOR
@@ -229,7 +229,7 @@ def figure_cycle_path(params: Parameters, simulation: Simulation, title: str | N
     constant stress, path 1 the slip down the aging curve, and the jump back
     to rest at sigma_c (path 2 schematically in the paper).
     """
-    from ..model.steady import steady_state
+    from ..quasistatic.steady import steady_state
 
     fig = _figure()
     ax = fig.add_subplot()

@@ -29,12 +29,12 @@ if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.axes import Axes
     from matplotlib.figure import Figure
 
-    from ..model.steady import SteadyState
     from ..parameters import Parameters
+    from ..quasistatic.steady import SteadyState
 
 
 def plot_steady(result: SteadyState, ax: Axes | None = None, **kwargs: Any) -> Axes:
-    """sigma against log V for one :class:`~stickslip.model.steady.SteadyState`; returns the Axes.
+    """sigma against log V for one :class:`~stickslip.quasistatic.steady.SteadyState`; returns the Axes.
 
     ``kwargs`` go to ``Axes.plot`` (``label`` defaults to "with aging" or
     "without aging").  Velocities are shown in um/s on a log axis.
@@ -126,8 +126,8 @@ def figure_steady_curve(
     """
     from matplotlib.figure import Figure
 
-    from ..model.critical import critical_point
-    from ..model.steady import steady_state
+    from ..quasistatic.critical import critical_point
+    from ..quasistatic.steady import steady_state
 
     if not (0 < vmin < vmax) or not np.isfinite(vmax):
         raise ValueError(f"figure_steady_curve: expected 0 < vmin < vmax, got vmin={vmin!r}, vmax={vmax!r}")

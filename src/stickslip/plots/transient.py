@@ -13,7 +13,7 @@ if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.axes import Axes
     from matplotlib.figure import Figure
 
-    from ..model.cycle import Simulation
+    from ..quasistatic.cycle import Simulation
     from ..transient.result import TransientResult
 
 

@@ -34,9 +34,9 @@ def saturating_figure(run: ModelRun) -> ReportFigure:
     from ..fitting.data import read_steady_data
     from ..fitting.datasets import synthetic_steady_path, table1
     from ..fitting.saturation_fit import fit_saturation
-    from ..model.cycle import simulate
-    from ..model.steady import steady_state
     from ..plots.style import apply_style
+    from ..quasistatic.cycle import simulate
+    from ..quasistatic.steady import steady_state
 
     paper = run.params
     data = read_steady_data(synthetic_steady_path())
@@ -93,7 +93,7 @@ def quasi_static_cycle(params, v0, peak, minimum, duration, points: int = 400): 
     Returns (time, stress, stick time, slip time, jump velocity)."""
     from scipy.optimize import brentq
 
-    from ..model.steady import steady_state
+    from ..quasistatic.steady import steady_state
 
     k = params.block.effective_stiffness
     jump = brentq(lambda v: float(steady_state(params, v).stress) - peak.stress, minimum.velocity * 1.0001, 1e-2)

@@ -16,13 +16,13 @@ import numpy as np
 
 from ..analysis import TraceAnalysis, analyze_trace
 from ..errors import ModelError
-from ..model.critical import CriticalPoint, critical_point
-from ..model.cycle import Simulation, simulate
-from ..model.jump import Jump, jump_velocity
-from ..model.slip import SlipPhase, slip_phase
-from ..model.steady import steady_state
-from ..model.stick import StickPhase, StuckThreshold, stick_phase, stuck_threshold
 from ..parameters import Parameters
+from ..quasistatic.critical import CriticalPoint, critical_point
+from ..quasistatic.cycle import Simulation, simulate
+from ..quasistatic.jump import Jump, jump_velocity
+from ..quasistatic.slip import SlipPhase, slip_phase
+from ..quasistatic.steady import steady_state
+from ..quasistatic.stick import StickPhase, StuckThreshold, stick_phase, stuck_threshold
 from .comparisons import Computed
 from .paper import (
     PULLING_VELOCITIES,

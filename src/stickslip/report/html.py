@@ -9,8 +9,8 @@ from importlib import resources
 from string import Template
 
 from ..analysis import TraceAnalysis
-from ..model.stick import StuckThreshold
 from ..parameters import Parameters
+from ..quasistatic.stick import StuckThreshold
 from .comparisons import CLASSES, TOLERANCE, Comparison, count_classes
 from .errata import Errata
 from .figures import Curve, ReportFigure, data_uri
@@ -285,7 +285,7 @@ def threshold_paragraph(
         f" no block stays stuck above Nc0 kT/(λ K τa) = {sigma_c.ceiling * 1e6:.2f} µm/s.{escape(gap)} "
         "Baumberger et al. drove the same gel from 10 µm/s to 2 mm/s and saw stick-slip below Vc, so this is a "
         "limitation of Eq 15 that conflicts with experiment, not a prediction (errata: “Where stick–slip "
-        "happens”; <code>stickslip.model.stick.stuck_threshold</code>).</p>"
+        "happens”; <code>stickslip.quasistatic.stick.stuck_threshold</code>).</p>"
     )
 
 

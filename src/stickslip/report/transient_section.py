@@ -87,7 +87,7 @@ def _hold_peak(params: Parameters, hold: float) -> float:
 
 
 def _caption(run: ModelRun, full: Run, alone: Run, quasi: Run, steps: Run, peaks: list[float]) -> str:
-    from ..model.steady import steady_state
+    from ..quasistatic.steady import steady_state
 
     sigma_c = run.critical.stress if run.critical is not None else float("nan")
     stuck = np.flatnonzero(alone.slider_velocity < 0.01 * STEP_DOWN[1])

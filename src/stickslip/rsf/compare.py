@@ -145,7 +145,7 @@ def bond_response(
         return BondTrace(np.asarray(run.time, float), np.asarray(run.stress, float), "time-dependent bond model",
                          "time-dependent bond model (stickslip.transient)")  # fmt: skip
     if control == "velocity":
-        from ..model.steady import steady_state
+        from ..quasistatic.steady import steady_state
 
         t = np.linspace(0, protocol.duration, 801) if times is None else np.asarray(times, float)
         v = protocol.velocity_at(t)
@@ -185,7 +185,7 @@ def _rig(control: str) -> Any:
 
 
 def _critical(params: Any) -> tuple[float, float]:
-    from ..model.critical import critical_point
+    from ..quasistatic.critical import critical_point
 
     cp = critical_point(params)
     if not cp.exists or cp.velocity is None or cp.stress is None:
@@ -201,7 +201,7 @@ def rsf_of_bond(
     ``duration`` is the time spent at each velocity; ``stiffness`` (1/m) that of the RSF rig that copies the
     slider (stiff: the bond model is under velocity control).
     """
-    from ..model.steady import steady_state
+    from ..quasistatic.steady import steady_state
 
     if model not in ("quasi-static", "transient"):
         raise ParameterError(f"bond model: expected 'quasi-static' or 'transient', got {model!r}")

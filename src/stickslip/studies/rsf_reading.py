@@ -211,7 +211,7 @@ def bond_step(
 ) -> StepRecord:  # fmt: skip
     """The time-dependent bond model's response to the slider velocities ``velocities`` (m/s), from steady
     sliding at the first: ``lead`` of slip at the first velocity, then ``window`` at each of the others."""
-    from ..model.critical import critical_point
+    from ..quasistatic.critical import critical_point
     from ..transient import run_transient
 
     _check_steps(velocities, window)

@@ -93,7 +93,7 @@ def steady_fit():  # type: ignore[no-untyped-def]
 
 def chi_square(data, params: Parameters, noise_scale: float = 1.0) -> float:  # type: ignore[no-untyped-def]
     """Chi-square of ``params`` on steady ``data`` (SteadyData), errors x ``noise_scale`` (stated errors: 1)."""
-    from ..model.steady import steady_state
+    from ..quasistatic.steady import steady_state
 
     model = np.array([float(steady_state(params, float(v)).stress) for v in data.velocity])
     err = (data.stress_err if data.stress_err is not None else data.stress) * noise_scale
@@ -181,8 +181,8 @@ def _value(params: Parameters, key: str) -> float:
 
 def quasi_static_predictions(params: Parameters) -> dict[str, float]:
     """Vc (m/s), sigma_c (Pa), and the first stick at 100 um/s from rest and from sigma_c (s, Pa)."""
-    from ..model.critical import critical_point
-    from ..model.stick import stick_phase
+    from ..quasistatic.critical import critical_point
+    from ..quasistatic.stick import stick_phase
 
     point = critical_point(params)
     rest = stick_phase(params, STICK_VELOCITY, start_stress=0.0)
@@ -201,7 +201,7 @@ def stability_predictions(params: Parameters, velocities: Sequence[float] = (100
     """Kc (Pa/m) of Eq 1 at each V0, and V* (m/s) where Kc(V0) equals the block's K (bisection in V0)."""
     from scipy.optimize import brentq
 
-    from ..model.critical import critical_point
+    from ..quasistatic.critical import critical_point
     from ..transient.stability import critical_stiffness
 
     out = {f"kc_{v * 1e6:g}_um_s": critical_stiffness(params, v) for v in velocities}

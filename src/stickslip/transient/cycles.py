@@ -9,8 +9,8 @@ import numpy as np
 
 from .. import regimes
 from ..display import velocity as show_velocity
-from ..model.cycle import Cycle
 from ..protocols import Protocol
+from ..quasistatic.cycle import Cycle
 
 #: the slider counts as stuck below this fraction of the puller velocity
 STUCK_FRACTION = 0.01

@@ -268,8 +268,8 @@ def stick_chains(
 
 
 def _fresh_chains(params: Parameters, aging: bool, stress0: float, loading_rate: float, span: float) -> StickChains:
-    """A stick from fresh chains at constant loading: the package's stick solver (model.stick, Eq 15)."""
-    from ..model.stick import stick_phase
+    """A stick from fresh chains at constant loading: the package's stick solver (quasistatic.stick, Eq 15)."""
+    from ..quasistatic.stick import stick_phase
 
     velocity = loading_rate / params.block.effective_stiffness
     stick = stick_phase(params, velocity, start_stress=stress0, aging=aging, horizon=span)

@@ -249,7 +249,7 @@ def _cells(v, p, cell_hazard):  # type: ignore[no-untyped-def]
 
 def build_manifold(params: Parameters, aging: bool, v_lo: float, v_hi: float, rtol: float) -> Manifold | None:
     """The interpolants over [v_lo, v_hi]; None when the steady stress cannot be tabulated to its share of rtol."""
-    from ..model.steady import steady_state
+    from ..quasistatic.steady import steady_state
 
     domain = [math.log(v_lo), math.log(v_hi)]
 
@@ -497,7 +497,7 @@ def manifold_for(
 
     ``build=False``: only one built before (None if there is none).
     """
-    from ..model.jump import steady_curve_key
+    from ..quasistatic.jump import steady_curve_key
 
     built = _BUILT.setdefault((steady_curve_key(params), aging), [])  # the block's stiffness plays no part
     for m, tol in built:

@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..columns import with_units
-from ..model.cycle import Cycle
+from ..quasistatic.cycle import Cycle
 from ..trace_columns import TRANSIENT
 
 if TYPE_CHECKING:  # pragma: no cover

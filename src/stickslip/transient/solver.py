@@ -13,7 +13,6 @@ import numpy as np
 
 from ..display import velocity as show_velocity
 from ..errors import ModelError, ParameterError, RunFailed
-from ..model.cycle import Cycle
 from ..numerics.budget import (
     REFUSE_FACTOR,
     TIME_REFUSE_FACTOR,
@@ -26,6 +25,7 @@ from ..numerics.budget import (
 )
 from ..parameters import Parameters
 from ..protocols import Protocol
+from ..quasistatic.cycle import Cycle
 from ..units import checked_number
 from . import kernel as K
 from .model import Population, pack_parameters, stick_chains
@@ -515,7 +515,7 @@ class _Reducer:
 
     def _steady_at(self, v: float) -> tuple[float, float, float]:
         """(S, N, S') of the steady solver at v, remembered for the run."""
-        from ..model.steady import steady_state
+        from ..quasistatic.steady import steady_state
 
         if v not in self.steady:
             ref = steady_state(self.params, v, self.aging)
@@ -594,7 +594,7 @@ class _Reducer:
         return True, glide.sample_index
 
     def _glide(self, state: _State, t0: float, t1: float, vp: float, times: np.ndarray, sample_index: int):  # type: ignore[no-untyped-def]
-        from ..model.steady import steady_state
+        from ..quasistatic.steady import steady_state
         from . import reduction as R
 
         b = self.params.bonds
@@ -648,7 +648,7 @@ _STEADY_COHORTS: dict[tuple[Parameters, float, bool], Population] = {}
 
 def _steady_cohorts(params: Parameters, velocity: float, aging: bool) -> Population:
     """steady_population, remembered (a steady run starts and ends on the same one)."""
-    from ..model.jump import steady_curve_key
+    from ..quasistatic.jump import steady_curve_key
 
     key = (steady_curve_key(params), float(velocity), bool(aging))
     if key not in _STEADY_COHORTS:
@@ -732,7 +732,7 @@ def _snapshot(state: _State) -> Snapshot:
 
 
 def _jump(params: Parameters, sigma: float, aging: bool) -> float | None:
-    from ..model.jump import jump_velocity
+    from ..quasistatic.jump import jump_velocity
 
     jump = jump_velocity(params, sigma, "aging" if aging else "no-aging")
     return jump.velocity if jump.reachable else None
@@ -870,7 +870,7 @@ def _steady_start_below_vc(
     params: Parameters, protocol: Protocol, start_velocity: float | None
 ) -> tuple[float | None, str]:
     """(start velocity, note): below Vc the default steady start moves to the stable side of the critical point."""
-    from ..model.jump import cached_critical_point, steady_curve_key
+    from ..quasistatic.jump import cached_critical_point, steady_curve_key
 
     v_start = protocol.initial_velocity if start_velocity is None else start_velocity
     if not v_start > 0:
@@ -996,7 +996,7 @@ def estimate_cost(
     * with ``stick_population`` a stuck block is the chains' closed form (no
       step), and a piece below the fold costs :data:`SLIP_STEPS` per slip, the
       slips counted from the quasi-static model's first stick and period
-      (:mod:`stickslip.model.cycle`, at the block's K; a slider that was
+      (:mod:`stickslip.quasistatic.cycle`, at the block's K; a slider that was
       sliding first decelerates, :data:`STOP_STEPS`);
     * without it (and with aging that never saturates) one population of Eq 1
       never lets go: a block from rest is stuck for good, and a sliding block
@@ -1195,10 +1195,10 @@ def _slips(t: float, first: float, period: float) -> float:
 def _quasi_static_clock(
     params: Parameters, vp: float, aging: bool, k_block: float, from_rest: bool
 ) -> tuple[float, float]:
-    """(first stick's time, stick + slip period from sigma_c) of the quasi-static cycle (model.cycle) at K."""
-    from ..model.jump import jump_velocity
-    from ..model.slip import slip_phase
-    from ..model.stick import stick_phase
+    """(first stick's time, stick + slip period from sigma_c) of the quasi-static cycle (quasistatic.cycle) at K."""
+    from ..quasistatic.jump import jump_velocity
+    from ..quasistatic.slip import slip_phase
+    from ..quasistatic.stick import stick_phase
 
     k_set = params.block.effective_stiffness
     if not math.isclose(k_block, k_set, rel_tol=1e-9):
@@ -1237,7 +1237,7 @@ def _reduced_from(params: Parameters, control: str, aging: bool) -> float:
     """The slowest puller velocity whose pieces the quasi-steady reduction takes (0: all; inf: none)."""
     if control != "block" or not aging:  # a rigid rig holds V; without aging the steady curve has no fold
         return 0.0
-    from ..model.jump import cached_critical_point, steady_curve_key
+    from ..quasistatic.jump import cached_critical_point, steady_curve_key
 
     try:
         cp = cached_critical_point(steady_curve_key(params))

@@ -7,7 +7,7 @@ gelatin-glass); the jump velocity of the stick-slip cycle is sought below
 that maximum.
 
 Method: dsigma/dV (computed analytically under the integral, see
-:mod:`stickslip.model.steady`) is sampled on a log grid of velocities; each
+:mod:`stickslip.quasistatic.steady`) is sampled on a log grid of velocities; each
 sign change clear of the quadrature noise is refined by Brent's method on
 log V (the same function, so the bracket's signs always hold) and kept only
 when the stress there is verified to be below (above) both ends of its

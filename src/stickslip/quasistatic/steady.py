@@ -485,7 +485,7 @@ def _march(s: _Scales, q: QuadratureSettings, keep_nodes: bool = False) -> _Inte
     raise ModelError(f"steady-state quadrature did not converge: more than {MAX_PANELS} panels needed")
 
 
-#: From this many lanes (velocities x parameter sets) on, the march runs compiled (stickslip.model.steady_kernel),
+#: From this many lanes (velocities x parameter sets) on, the march runs compiled (stickslip.quasistatic.steady_kernel),
 #: ~3x faster per lane.  Loading numba and its cached code costs ~0.2 s once per process (the numpy march of
 #: ~30k lanes), so narrow calls -- a command line's curve, the critical point's grid -- stay on numpy, and the
 #: wide ones that programs repeat (curves for plots and benchmarks, batched fits) run compiled.

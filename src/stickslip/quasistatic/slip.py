@@ -25,7 +25,7 @@ that pole is subtracted analytically, g0/(V0 - e^x) with g0 = g(ln V0), and
 the remainder -(g - g0)/(x - x0) / (V0 exprel(x - x0)) is smooth.  sigma and g
 are interpolated by a Chebyshev series in x and integrated exactly.  The
 curve itself comes from the aging branch series of
-:func:`stickslip.model.jump.branch_interpolant`, computed once per parameter
+:func:`stickslip.quasistatic.jump.branch_interpolant`, computed once per parameter
 set, so a slip phase costs no new steady-state quadrature.
 """
 

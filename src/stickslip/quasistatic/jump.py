@@ -17,7 +17,7 @@ stresses of that branch the jump is unreachable and the result says so.
 
 Numerics: the branch is interpolated once per parameter set by a Chebyshev
 series in ln V, converged to 1e-12 of the largest coefficient (one or two
-vectorised calls of :func:`stickslip.model.steady.steady_state`); Brent's
+vectorised calls of :func:`stickslip.quasistatic.steady.steady_state`); Brent's
 method finds the root of the series.
 """
 
@@ -140,7 +140,7 @@ def branch_maximum(params: Parameters, curve: str) -> tuple[float, float]:
 
 
 #: The aging branch's series reaches this far below Vc, so that the slip phase can subtract a pole at
-#: any V0 in [BELOW_VC * Vc, Vc) (see :mod:`stickslip.model.slip`).
+#: any V0 in [BELOW_VC * Vc, Vc) (see :mod:`stickslip.quasistatic.slip`).
 BELOW_VC = 0.5
 
 

@@ -1,4 +1,4 @@
-"""The steady-state march (:func:`stickslip.model.steady._march`) compiled by numba, one velocity at a time.
+"""The steady-state march (:func:`stickslip.quasistatic.steady._march`) compiled by numba, one velocity at a time.
 
 The numpy march advances all velocities together as arrays; on wide batches
 (a curve of 1000 velocities) its cost is that of ~40 array passes per panel
@@ -8,7 +8,7 @@ width search below is the numpy one's, lane by lane, test by test), the
 same nodes, the same sums, so the two agree to rounding (~1e-15; tested in
 tests/test_steady_speed.py).  Compiling takes ~2 s once; numba caches the
 machine code on disk, and loading numba and the cache costs ~0.2 s per
-process, so :mod:`stickslip.model.steady` uses this only for wide batches
+process, so :mod:`stickslip.quasistatic.steady` uses this only for wide batches
 (COMPILED_LANES velocities or more).
 """
 
