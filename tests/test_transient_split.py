@@ -1,0 +1,159 @@
+"""The cohort kernel and run_transient split into named steps (issue 30 item 4) give the same numbers, bit for bit.
+
+A regression test of a refactor: the reference arrays in ``tests/data/transient_split_reference.npz`` were written
+by ``python tests/test_transient_split.py --write`` from the code *before* the split (commit 6299fba), and every
+trace array of each case must equal them exactly (``np.array_equal``, nan where nan), as must the step counts, the
+regime and the message.  The numbers themselves are validated independently elsewhere (tests/test_transient*.py:
+closed forms, the steady solver, convergence orders); this file only pins that splitting ``kernel.advance`` and
+``solver.run_transient`` into functions changed no floating-point operation.
+
+Each case starts from cleared caches (the quasi-steady reduction's built manifolds, ``reduction._BUILT``, are
+reused within a process, and one built at a tighter rtol serves a looser one: the answer would depend on the
+order of the cases), so the cases are independent of the order they run in; the reference was written twice,
+once per case in a fresh process and once all in one process, and the two agreed bit for bit.
+"""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import stickslip
+from stickslip.protocols import Protocol, Segment, constant
+from stickslip.transient import reduction, run_transient, solver
+from stickslip.transient.result import TransientResult
+
+REFERENCE = Path(__file__).parent / "data" / "transient_split_reference.npz"
+
+
+def _gel() -> stickslip.Parameters:
+    return stickslip.load_parameters("gelatin-glass")
+
+
+def _from_rest() -> TransientResult:
+    """The massless block from rest under Eq 1 alone (stuck, creeping; every cohort kept)."""
+    return run_transient(_gel(), constant(100e-6, 0.02))
+
+
+def _from_rest_chains() -> TransientResult:
+    """The massless block from rest with the stick chains: stuck, the chains' collapse, the jump, the slip."""
+    return run_transient(_gel(), constant(1e-3, 8.0), stick_population=True, rtol=1e-3)
+
+
+def _steady_spring() -> TransientResult:
+    """A steady start through the spring, a step of the puller down (the paper's cycle's start), the plain cohorts."""
+    protocol = Protocol((Segment(350e-6, 0.02), Segment(100e-6, 0.02)))
+    return run_transient(_gel(), protocol, start="steady", rtol=1e-3, reduction="off")
+
+
+def _steady_reduced() -> TransientResult:
+    """The same through the quasi-steady reduction, sampled every 5 ms."""
+    protocol = Protocol((Segment(350e-6, 0.2), Segment(700e-6, 0.2)))
+    return run_transient(_gel(), protocol, start="steady", every=5e-3)
+
+
+def _velocity_step() -> TransientResult:
+    """Velocity control from empty, a step of the slider's velocity."""
+    protocol = Protocol((Segment(100e-6, 4e-3), Segment(300e-6, 4e-3)))
+    return run_transient(_gel(), protocol, control="velocity", rtol=1e-4, reduction="off")
+
+
+def _mass() -> TransientResult:
+    """A block with mass (and damping) from a steady start, a kick of the puller."""
+    protocol = Protocol((Segment(360e-6, 2e-3), Segment(350e-6, 2e-3)))
+    return run_transient(_gel(), protocol, start="steady", start_velocity=350e-6, mass=1.0, damping=10.0, rtol=1e-3)
+
+
+def _saturating() -> TransientResult:
+    """Saturating aging from rest: the merging of saturated cohorts and their relative drop."""
+    return run_transient(stickslip.load_parameters("gelatin-glass-saturating"), constant(50e-6, 0.06), rtol=1e-3)
+
+
+CASES: dict[str, Callable[[], TransientResult]] = {
+    "from_rest": _from_rest,
+    "from_rest_chains": _from_rest_chains,
+    "steady_spring": _steady_spring,
+    "steady_reduced": _steady_reduced,
+    "velocity_step": _velocity_step,
+    "mass": _mass,
+    "saturating": _saturating,
+}
+
+
+def _clear_caches() -> None:
+    reduction._BUILT.clear()
+    solver._STEADY_COHORTS.clear()
+
+
+def _arrays(run: TransientResult) -> dict[str, np.ndarray]:
+    """Every trace array of a run, its counts, its verdict and its last snapshot's sums (its cohorts, thousands from a
+    steady population, would make the file large; the sums of the weights, and of the weights times ages and
+    extensions, change with any of them)."""
+    out = {
+        name: np.asarray(getattr(run, name))
+        for name in ("time", "stress", "bonded_fraction", "slider_velocity", "slider_position", "puller_position")
+    }
+    for name in ("chain_fraction", "lowest_stress"):
+        if getattr(run, name) is not None:
+            out[name] = np.asarray(getattr(run, name))
+    for name in ("born", "broken", "work", "dissipation", "bond_energy", "block_energy", "stress_integral"):
+        value = getattr(run.bookkeeping, name)
+        if value is not None:
+            out["bookkeeping_" + name] = np.asarray(value)
+    out["counts"] = np.array([run.steps, run.rejected])
+    out["verdict"] = np.array([run.regime, run.message])
+    last = run.snapshots[-1]
+    w = np.asarray(last.weight)
+    out["snapshot"] = np.array([last.time, w.size, w.sum(), w @ np.asarray(last.age), w @ np.asarray(last.extension)])
+    return out
+
+
+def _case(name: str) -> dict[str, np.ndarray]:
+    _clear_caches()
+    return _arrays(CASES[name]())
+
+
+@pytest.fixture(scope="module")
+def reference() -> dict[str, np.ndarray]:
+    with np.load(REFERENCE) as data:
+        return {key: data[key] for key in data.files}
+
+
+@pytest.mark.parametrize("name", list(CASES))
+def test_the_split_changes_no_number(name: str, reference: dict[str, np.ndarray]) -> None:
+    got = _case(name)
+    keys = sorted(key.split("/", 1)[1] for key in reference if key.startswith(name + "/"))
+    assert keys == sorted(got), (keys, sorted(got))
+    for key in keys:
+        expected = reference[f"{name}/{key}"]
+        nan = expected.dtype.kind == "f"  # rows without chains (or before the first slip) hold nan in both
+        assert np.array_equal(got[key], expected, equal_nan=nan), f"{name}: {key} differs"
+
+
+def test_the_comparison_can_fail(reference: dict[str, np.ndarray]) -> None:
+    """A last bit changed anywhere in a trace is seen (the comparison is exact, not a tolerance)."""
+    stress = reference["velocity_step/stress"].copy()
+    stress[-1] = np.nextafter(stress[-1], np.inf)
+    assert not np.array_equal(stress, reference["velocity_step/stress"])
+
+
+def _write(names: list[str]) -> None:
+    """Write the reference of the named cases (all when none), merged into the file."""
+    stored: dict[str, np.ndarray] = {}
+    if REFERENCE.exists():
+        with np.load(REFERENCE) as data:
+            stored = {key: data[key] for key in data.files}
+    for name in names or list(CASES):
+        stored = {key: value for key, value in stored.items() if not key.startswith(name + "/")}
+        stored.update({f"{name}/{key}": value for key, value in _case(name).items()})
+    REFERENCE.parent.mkdir(exist_ok=True)
+    np.savez_compressed(REFERENCE, **stored)
+
+
+if __name__ == "__main__":
+    if sys.argv[1:2] == ["--write"]:
+        _write(sys.argv[2:])
