@@ -473,65 +473,593 @@ def _same_bin(t, x, tb_i, tb_g, xb_i, xb_g, spread, p):  # type: ignore[no-untyp
     return np.floor(xb_i / width) == np.floor(xb_g / width)
 
 
-def advance(
-    t,
-    t_end,
-    x,
-    v,
-    h,
-    puller0,
-    vp,
-    t0,
-    block,
-    n,
-    xb,
-    tb,
-    lw,
-    lw_new,
-    rate0,
-    lc,
-    aa,
-    w1,
-    acc,
-    p,
-    rtol,
-    h_max,
-    sample_times,
-    sample_index,
-    out,
-    out_max,
-    stick_velocity,
-    max_steps,
-):  # type: ignore[no-untyped-def]
-    """Integrate from t to t_end (one protocol piece).  Returns (status, t, x, v, h, n, sample_index, rows).
+def _step_length(t, t_end, h, h_max, sample_times, sample_index):  # type: ignore[no-untyped-def]
+    """(hh, landing): the step tried from t, the proposed h cut to h_max and to the piece's end, or landing exactly
+    on the next sample time; a sliver left before the end is taken with this step."""
+    hh = min(h, h_max, t_end - t)
+    landing = False
+    if sample_index < sample_times.shape[0] and t + hh >= sample_times[sample_index]:
+        hh = sample_times[sample_index] - t
+        landing = True
+    if t_end - t - hh <= 1e-12 * max(t_end, 1.0):
+        hh = t_end - t
+    if hh <= 0.0:
+        hh = t_end - t
+    return hh, landing
 
-    One step (docs/transient.md section 2): every cohort's log weight by the trapezoid rule of its hazard
-    along its characteristic; the step's births (the exact exponential of the vacancy's 1/tau relaxation)
-    lumped into one cohort at mid-step; under block control the slider then put where the bonds balance the
-    block (sigma = K (P - X) exactly) and its velocity taken as the stable root of g.  The local error
-    estimate is of third order in h, as the method's local error: the trapezoid's h^2/12 |r'(t1) - r'(t0)|
-    per cohort, the lumping of births (h r)^2/24 of their mass, and, under block control, the effect of
-    the predicted slider position and velocity on the hazards.
 
-    ``acc`` accumulates [born, broken, puller work, dissipation, steps, rejected, integral of sigma dt, lowest
-    sigma since the last row] (the integral by the same end-corrected trapezoid as the work).  Rows written
-    to ``out`` (time, sigma, N, V, X, P,
-    born, broken, work, dissipation, bond energy, integral of sigma dt, lowest stress of the steps since the
-    previous row: acc[7], reset there): every accepted step
-    when ``sample_times`` is empty, else only at those times (the steps land on them exactly).
-    ``t0``: the start of the protocol's piece (puller0 is the puller there; bonds born before it were born
-    at other steps).  ``block``: 1 for block control (vp is the puller's velocity), 0 for velocity control (v = vp).
-    """
-    big = p[P_N0]
-    beta = p[P_FORCE_SENS]
+def _predicted_path(x, v, v_prev, h_prev, hh, vp, block, inertial, accel_now, accel_prev):  # type: ignore[no-untyped-def]
+    """(v0, v1p, x1p, x_mid, jerk): the slider's velocity at the step's start, and its velocity and position at the
+    end and its position at mid-step: exact under velocity control, predicted through the block (the velocity
+    extrapolated from the last step), Taylor's cubic for a block with mass (its acceleration known, its jerk from
+    the last step)."""
+    jerk = 0.0
+    if block == 0:
+        v0 = vp
+        v1p = vp
+    elif inertial:
+        v0 = v
+        # the jerk from the last step, unless that step was much shorter (one landing on a sample time), where
+        # the difference quotient amplifies the acceleration's rounding
+        jerk = (accel_now - accel_prev) / h_prev if h_prev > 0.25 * hh else 0.0
+        v1p = v + hh * accel_now + 0.5 * hh * hh * jerk
+    else:
+        v0 = v
+        v1p = v + (v - v_prev) * (hh / h_prev) if h_prev > 0.0 else v
+        if v1p < 0.0:
+            v1p = 0.0
+    if inertial:
+        x1p = x + hh * (v0 + hh * (0.5 * accel_now + hh * jerk / 6.0))
+        x_mid = x + 0.5 * hh * (v0 + 0.5 * hh * (0.5 * accel_now + 0.5 * hh * jerk / 6.0))
+    else:
+        x1p = x + 0.5 * hh * (v0 + v1p)
+        x_mid = x + 0.5 * hh * v0 + 0.125 * hh * (v1p - v0)
+    return v0, v1p, x1p, x_mid, jerk
+
+
+def _cohort_gone(i, lw_new, rate0, w1, known):  # type: ignore[no-untyped-def]
+    """Cohort i is broken by the step's end (its chains at or past the FENE wall)."""
+    lw_new[i] = -np.inf
+    rate0[i] = np.inf
+    w1[i] = 0.0
+    known[0, i] = -1.0
+
+
+def _hazard_ends(i, t, t1, tb_i, e0, e1, f0, v0, v1p, slope0, slope1, accel, cache, cached, p):  # type: ignore[no-untyped-def]
+    """Cohort i's hazard at both ends of the step along its characteristic: (lr0, r0, lr1, r1, g0, g1, k0, f1, k1,
+    age1): ln r and r, d ln r/dt (through the force, the age, and the velocity's effect on aging), the chain
+    stiffness f' at both ends, the force at the end and the age the aging term sees there.  The start's values
+    are the last row's where ``cached`` (the same numbers)."""
     m = p[P_M]
     dlm = p[P_DLM]
+    beta = p[P_FORCE_SENS]
+    if p[P_SATURATION] > 0.0:  # the age the aging term sees, and its rate
+        age0, clock0 = _aging_clock(t - tb_i, p)
+        age1, clock1 = _aging_clock(t1 - tb_i, p)
+    else:
+        age0, clock0 = t - tb_i, 1.0
+        age1, clock1 = t1 - tb_i, 1.0
+    f1 = _chain_force(e1, m, dlm)
+    if cached:
+        lr0 = cache[4, i]
+        r0 = cache[5, i]
+    else:
+        lr0 = min(p[P_LOG_U0_TAU] + beta * abs(f0) - age0 * slope0, LOG_RATE_CAP)
+        r0 = math.exp(lr0)
+    lr1 = min(p[P_LOG_U0_TAU] + beta * abs(f1) - age1 * slope1, LOG_RATE_CAP)
+    r1 = math.exp(lr1)
+    k0 = cache[2, i] if cached else _chain_stiffness(e0, m, dlm)
+    k1 = _chain_stiffness(e1, m, dlm)
+    g0 = beta * (1.0 if f0 >= 0.0 else -1.0) * k0 * v0 - slope0 * clock0
+    g1 = beta * (1.0 if f1 >= 0.0 else -1.0) * k1 * v1p - slope1 * clock1
+    if p[P_AGING] > 0.0 and accel != 0.0:
+        g0 += age0 * slope0 * accel / p[P_VA] * (1.0 if v0 >= 0.0 else -1.0)
+        g1 += age1 * slope1 * accel / p[P_VA] * (1.0 if v1p >= 0.0 else -1.0)
+    return lr0, r0, lr1, r1, g0, g1, k0, f1, k1, age1
+
+
+def _cohort_weight(i, lw_i, w0, f0, hh, lr0, r0, lr1, r1, g0, g1, known):  # type: ignore[no-untyped-def]
+    """Cohort i's log weight at the step's end: (new, its weight, its error, the stress dying at a cliff, the
+    trapezoid of its hazard).  Marks in ``known`` whether exp(new) was taken exactly."""
+    trap = 0.5 * hh * (r0 + r1)
+    dying = 0.0
+    if abs(lr1 - lr0) > 1.0 and max(lr0, lr1) < LOG_RATE_CAP:
+        # the hazard changes by more than a factor e within the step (a young bond aging on a stuck
+        # block, or a rupture): the rule exact for ln r linear in time, where the trapezoid would kill
+        # the 2 % of young bonds that age into permanence; its error from the curvature of ln r
+        integral = hh * (r1 - r0) / (lr1 - lr0)
+        wn = w0 * math.exp(-integral)
+        known[0, i] = -1.0
+        new = lw_i - integral
+        delta = abs(g1 - g0) * hh / 8.0 * integral
+        dw = min(wn * math.expm1(min(delta, 50.0)), w0) + abs(wn - w0 * math.exp(-min(trap, 745.0))) * 1e-3
+        if g1 > 0.0:
+            # a cliff of the hazard (the force, or the FENE stiffening) steeper than the steps: bonds born
+            # over a step like this die as a block there, and the stress falls in steps; the Gauss births
+            # resolve it only for h g < 1, erring by ~(h g)^4/4320 of the stress that dies
+            # (the current step stands for the birth spacing of bonds born under the current drive only)
+            hg = hh * g1
+            dying = (w0 - wn) * abs(f0) * min(hg * hg * hg * hg / 4320.0, 1.0)
+    else:
+        corr = hh * hh / 12.0 * (r1 * g1 - r0 * g0)  # Euler-Maclaurin end correction: fourth order
+        limit = 0.5 * trap
+        corr = min(max(corr, -limit), limit)
+        new = lw_i - trap + corr
+        wn = math.exp(new)
+        known[0, i] = wn
+        dw = abs(wn - w0 * math.exp(-min(trap, 745.0)))  # against the plain trapezoid
+    return new, wn, dw, dying, trap
+
+
+def _cohort_dissipation(i, trap, hh, w0, wn, r0, r1, g0, g1, f0, f1, v0, v1p, e0, e1, e_mid, cache, cached, p):  # type: ignore[no-untyped-def]
+    """The energy cohort i's breakage dissipates over the step: r w u by the end-corrected trapezoid (fourth
+    order), or, a cohort breaking within the step, its lost mass at the mid-step energy."""
+    m = p[P_M]
+    dlm = p[P_DLM]
+    if trap < 0.5:
+        u0 = cache[3, i] if cached else _chain_energy(e0, m, dlm)
+        u1 = _chain_energy(e1, m, dlm)
+        phi0 = r0 * w0 * u0
+        phi1 = r1 * wn * u1
+        dphi0 = phi0 * (g0 - r0) + r0 * w0 * f0 * v0
+        dphi1 = phi1 * (g1 - r1) + r1 * wn * f1 * v1p
+        return 0.5 * hh * (phi0 + phi1) - hh * hh / 12.0 * (dphi1 - dphi0)
+    return (w0 - wn) * _chain_energy(e_mid, m, dlm)
+
+
+def _cohort_pass(  # type: ignore[no-untyped-def]
+    n, t, t1, t0, hh, x, x1p, x_mid, v0, v1p, slope0, slope1, accel, xb, tb, lw, lw_new, rate0, w1, known,
+    predicted, cache, cached, p,
+):  # fmt: skip
+    """One pass over the cohorts: each one's log weight at the step's end (``lw_new``, ``w1``; its hazard there in
+    ``rate0``, its force and stiffness at the predicted end in ``predicted``), and the sums over them:
+    (N and sigma at both ends, the breakage rate and its time derivative at both ends, bonds broken, energy
+    dissipated, sum r w f and the interface stiffness at both ends, the errors in stress and bonds, the step's
+    stress loss's sensitivity to the slider's position and to the aging slope, bonds freed by the FENE wall, the
+    stress dying at a hazard cliff of bonds born within and before this piece)."""
+    m = p[P_M]
+    dlm = p[P_DLM]
+    beta = p[P_FORCE_SENS]
+    nn0 = s0 = nn1 = s1 = 0.0
+    loss0 = loss1 = 0.0  # breakage rate (bonds per m^2 per s) at both ends of the step
+    dloss0 = dloss1 = 0.0  # and its time derivative
+    broken = dissip = 0.0
+    rate_s0 = rate_s1 = 0.0  # sum r w f: the stress lost to breakage per unit time, at both ends
+    kint0 = kint1 = 0.0  # sum w f': the interface stiffness, at both ends
+    err_s = err_n = 0.0
+    sens_x = 0.0  # sum w f r beta f': how the step's stress loss depends on the slider position
+    sens_a = 0.0  # sum w f r t_a: how it depends on the aging slope
+    walled = 0.0  # bonds freed by the FENE wall within the step (not part of the smooth breakage rate)
+    cliff = 0.0  # stress dying at a hazard cliff steeper than the step (see _cohort_weight)
+    cliff_old = 0.0  # the same for bonds born before this piece of the protocol
+    for i in range(n):
+        w0 = cache[0, i] if cached else math.exp(lw[i])
+        e0 = x - xb[i]
+        e1 = x1p - xb[i]
+        nn0 += w0
+        if e0 >= dlm or -e0 >= dlm:  # beyond the FENE wall already (cannot happen for a live cohort)
+            _cohort_gone(i, lw_new, rate0, w1, known)
+            broken += w0
+            continue
+        f0 = cache[1, i] if cached else _chain_force(e0, m, dlm)
+        s0 += w0 * f0
+        if e1 >= dlm or -e1 >= dlm:  # the chain reaches full extension within the step
+            _cohort_gone(i, lw_new, rate0, w1, known)
+            broken += w0
+            walled += w0
+            dissip += w0 * _chain_energy(e0, m, dlm)
+            err_s += w0 * abs(f0)
+            err_n += w0
+            continue
+        lr0, r0, lr1, r1, g0, g1, k0, f1, k1, age1 = _hazard_ends(
+            i, t, t1, tb[i], e0, e1, f0, v0, v1p, slope0, slope1, accel, cache, cached, p
+        )
+        predicted[0, i] = f1
+        predicted[1, i] = k1
+        new, wn, dw, dying, trap = _cohort_weight(i, lw[i], w0, f0, hh, lr0, r0, lr1, r1, g0, g1, known)
+        if tb[i] >= t0:
+            cliff += dying
+        else:
+            cliff_old += dying
+        err_s += abs(f1) * dw
+        err_n += dw
+        sens_x += wn * abs(f1) * r1 * beta * k1
+        sens_a += wn * abs(f1) * r1 * age1
+        loss0 += w0 * r0
+        loss1 += wn * r1
+        dloss0 += w0 * r0 * (g0 - r0)
+        dloss1 += wn * r1 * (g1 - r1)
+        broken += w0 - wn
+        dissip += _cohort_dissipation(
+            i, trap, hh, w0, wn, r0, r1, g0, g1, f0, f1, v0, v1p, e0, e1, x_mid - xb[i], cache, cached, p
+        )
+        rate_s0 += w0 * r0 * f0
+        rate_s1 += wn * r1 * f1
+        kint0 += w0 * k0
+        kint1 += wn * k1
+        nn1 += wn
+        s1 += wn * f1
+        lw_new[i] = new
+        w1[i] = wn
+        rate0[i] = r1  # kept for the merging of quiet cohorts after the step
+    return (
+        nn0, s0, nn1, s1, loss0, loss1, dloss0, dloss1, broken, dissip, rate_s0, rate_s1, kint0, kint1, err_s, err_n,
+        sens_x, sens_a, walled, cliff, cliff_old,
+    )  # fmt: skip
+
+
+def _gauss_birth(  # type: ignore[no-untyped-def]
+    k, n, t, hh, x, x1p, v0, v1p, accel, accel_now, jerk, slope1, q0, loss0, dloss0, l1, d1, inertial, xb, tb,
+    lw_new, w1, known, rate0, predicted, p,
+):  # fmt: skip
+    """The births of half the step (k = 0, 1) as one cohort, n + k, at its Gauss-Legendre point, the vacancy's
+    relaxation from q0 with the breakage rate's Hermite cubic (l1, d1 at the end): (born, alive at the step's end,
+    the energy of those that broke, the error of lumping them, their breakage rate at the end and its derivative,
+    their extension there)."""
+    m = p[P_M]
+    dlm = p[P_DLM]
+    tau = p[P_TAU]
+    r_birth = math.exp(p[P_LOG_U0_TAU])  # hazard at age 0, extension 0
+    u = hh * (0.5 - GAUSS if k == 0 else 0.5 + GAUSS)
+    q = _vacancy(u, q0, tau, hh, loss0, dloss0, l1, d1)
+    mass = 0.5 * hh * max(q, 0.0) / tau
+    d = hh - u  # its age at t1
+    if inertial:  # on the predicted cubic path
+        x_k = x + u * (v0 + u * (0.5 * accel_now + u * jerk / 6.0))
+    else:
+        x_k = x + u * v0 + 0.5 * (v1p - v0) * u * u / hh
+    e_k = x1p - x_k
+    predicted[0, n + k] = _chain_force(e_k, m, dlm)
+    predicted[1, n + k] = _chain_stiffness(e_k, m, dlm)
+    lr_end = min(_log_rate(e_k, d, slope1, p), LOG_RATE_CAP)
+    r_end = math.exp(lr_end)
+    g_end = p[P_FORCE_SENS] * _chain_stiffness(e_k, m, dlm) * v1p - slope1 * _aging_clock(d, p)[1]
+    g_start = p[P_FORCE_SENS] * m * (v0 + accel * u) - _aging_factor(v0 + accel * u, p)
+    trap = 0.5 * d * (r_birth + r_end)
+    lr_birth = p[P_LOG_U0_TAU]
+    if abs(lr_end - lr_birth) > 1.0 and lr_end < LOG_RATE_CAP:  # as for the cohorts (_cohort_weight)
+        alive = mass * math.exp(-d * (r_end - r_birth) / (lr_end - lr_birth))
+    else:
+        corr = d * d / 12.0 * (r_end * g_end - r_birth * g_start)
+        corr = min(max(corr, -0.5 * trap), 0.5 * trap)
+        alive = mass * math.exp(-trap + corr)
+    # births reaching the FENE wall within the step are gone by its end; their energy is taken at
+    # half the wall's extension (the step control keeps such losses small, below)
+    dissip = (mass - alive) * _chain_energy(0.5 * min(e_k, dlm), m, dlm)
+    # the error of lumping this half-step's births into one cohort: (h r)^2/24 of its mass for a
+    # gentle hazard; when the births die within the step, what a resolved step would keep alive at
+    # its end (the birth rate times the newborns' life 1/r, at most all of it): bonds living
+    # shorter than a step would otherwise vanish from the population without a word
+    z = max(r_birth * hh, trap)
+    lump = min(mass * min(1.0, z * z / 24.0), 2.0 * mass / (hh * r_birth))
+    xb[n + k] = x_k
+    tb[n + k] = t + u
+    lw_new[n + k] = math.log(alive) if alive > 0.0 else -np.inf
+    w1[n + k] = alive
+    known[0, n + k] = -1.0
+    rate0[n + k] = r_end
+    return mass, alive, dissip, lump, alive * r_end, alive * r_end * (g_end - r_end), e_k
+
+
+def _births(  # type: ignore[no-untyped-def]
+    n, t, hh, x, x1p, v0, v1p, accel, accel_now, jerk, slope1, nn0, nn1, loss0, dloss0, loss1, dloss1, inertial,
+    xb, tb, lw_new, w1, known, rate0, predicted, p,
+):  # fmt: skip
+    """Births over the step, as two cohorts at the Gauss-Legendre points (fourth order in h): the vacancy
+    Q = N0 - N relaxes at 1/tau and is refilled by breakage, a Hermite cubic over the step; the newborns' own
+    breakage joins it (fixed-point passes, for their mass and rate at t1).  Returns (born, alive at t1, their
+    breakage rate at t1, the energy of those that broke, the lumping error, the second's extension, the vacancy
+    at the start, the breakage rate's derivative at both ends with the newborns')."""
+    big = p[P_N0]
+    tau = p[P_TAU]
+    q0 = big - nn0
+    r_birth = math.exp(p[P_LOG_U0_TAU])  # hazard at age 0, extension 0
+    dloss0 += r_birth * q0 / tau
+    born = born_alive = newborn_loss = newborn_dloss = newborn_dissip = lump = 0.0
+    q_end = q0
+    e_nb = 0.0
+    d1 = 0.0
+    for _sweep in range(3):
+        l1 = loss1 + newborn_loss
+        d1 = dloss1 + newborn_dloss + r_birth * q_end / tau
+        born = born_alive = newborn_loss = newborn_dloss = newborn_dissip = lump = 0.0
+        for k in range(2):
+            mass, alive, dissip, lumped, loss_k, dloss_k, e_k = _gauss_birth(
+                k, n, t, hh, x, x1p, v0, v1p, accel, accel_now, jerk, slope1, q0, loss0, dloss0, l1, d1, inertial,
+                xb, tb, lw_new, w1, known, rate0, predicted, p,
+            )  # fmt: skip
+            born += mass
+            born_alive += alive
+            newborn_dissip += dissip
+            lump += lumped
+            newborn_loss += loss_k
+            newborn_dloss += dloss_k
+            if k == 1:
+                e_nb = e_k
+        q_end = max(big - nn1 - born_alive, 0.0)
+    return born, born_alive, newborn_loss, newborn_dissip, lump, e_nb, q0, dloss0, d1
+
+
+def _births_within_vacancy(  # type: ignore[no-untyped-def]
+    n, hh, q0, loss0, dloss0, loss1, newborn_loss, d1, walled, nn1, born, born_alive, newborn_dissip, err_n, w1,
+    lw_new, p,
+):  # fmt: skip
+    """The births must not overfill the vacancy the bonds left: (born, alive, their dissipation, err_n) rescaled.
+
+    Over a step much longer than tau the Gauss masses rest on the Hermite cubic of the breakage rate across the
+    whole step, which is poor where the hazard of young bonds falls at 1/tau_a (a stuck block: N/N0 came out
+    1.00005); there the vacancy at t1 is set by its own equation instead, N(t1) = N0 - Q(t1), Q relaxing over the
+    last few tau of the step, where the breakage rate is the exact one at t1 (sites freed by the FENE wall refill
+    from the next step on).  Over shorter steps the Gauss masses stand (where N << N0 they are far more accurate
+    than N0 - Q), but never above the vacancy."""
+    big = p[P_N0]
+    tau = p[P_TAU]
+    target = born_alive
+    if hh > 2.0 * tau:
+        q_h = max(_vacancy(hh, q0, tau, hh, loss0, dloss0, loss1 + newborn_loss, d1), 0.0) + walled
+        target = max(big - nn1 - q_h, 0.0)
+    target = min(target, max(big - nn1, 0.0))
+    if born_alive > 0.0 and target != born_alive:
+        scale = target / born_alive
+        err_n += abs(target - born_alive)
+        for k in range(2):
+            w1[n + k] *= scale
+            lw_new[n + k] = math.log(w1[n + k]) if w1[n + k] > 0.0 else -np.inf
+        born *= scale
+        born_alive = target
+        newborn_dissip *= scale
+    return born, born_alive, newborn_dissip, err_n
+
+
+def _birth_errors(err_s, err_n, lump, born, hh, x1p, x_mid, v1p, slope1, p):  # type: ignore[no-untyped-def]
+    """(err_s, err_n) with the births' errors: one lumped cohort's (a conservative estimate: the Gauss pair's is far
+    smaller), and the Gauss rule's at a hazard cliff.
+
+    Births lumped at two instants per step meet the hazard's cliff later (ln r climbing at g = beta M V minus the
+    aging slope): the Gauss rule over birth times then errs by ~(h g)^4/4320 of the stress the bonds carry there,
+    the whole stream born at this pace over their life a_cliff (bonds living ~40 us, dying within ~3 us, steps of
+    ~10 us left the stress 5e-3 off the steady curve with nothing in the estimate).  A quadrature error of the
+    population, not one that accumulates: it is compared, as a whole, with rtol times the stress."""
+    m = p[P_M]
+    dlm = p[P_DLM]
+    r_birth = math.exp(p[P_LOG_U0_TAU])
+    err_n += lump
+    err_s += lump * abs(_chain_force(min(x1p - x_mid, 0.5 * dlm), m, dlm))
+    g_cliff = p[P_FORCE_SENS] * m * abs(v1p) - slope1
+    if g_cliff > r_birth:
+        z4 = (hh * g_cliff) ** 4 / 4320.0
+        a_cliff = math.log1p(g_cliff / r_birth) / g_cliff  # age at which the cumulative hazard reaches 1
+        e_cliff = min(abs(v1p) * a_cliff, 0.5 * dlm)
+        carried = born * max(1.0, a_cliff / hh) * 0.5 * _chain_force(e_cliff, m, dlm)
+        err_s += min(z4, 1.0) * carried
+    return err_s, err_n
+
+
+def _slider_at_end(  # type: ignore[no-untyped-def]
+    n, t, t1, t0, hh, x, v0, x1p, v1p, slope1, s0, s1, e_nb, sens_x, sens_a, err_s, puller0, vp, block, inertial,
+    xb, tb, lw_new, w1, lc, aa, known, predicted, p,
+):  # fmt: skip
+    """The slider at the step's end and the stress there: (x1, v1, s1, err_s, the block's force at the start).
+
+    Velocity control: the slider where it was told, sigma with the newborns' force.  Through the massless block:
+    where the bonds balance the block exactly, then its velocity (the stable root of g).  With a mass: its travel
+    by the trapezoid rule against the end population.  err_s gains the error of the hazards having used the
+    predicted path."""
+    dlm = p[P_DLM]
+    x1 = x1p
+    v1 = v1p
+    spring0 = p[P_K] * (puller0 + vp * (t - t0) - x)  # the block's force (massless: sigma) at the step's start
+    if inertial:
+        # the hazards used the predicted path, and the rule's own error (Milne's: a sixth of the corrector's
+        # distance from the predictor, whose error is five times the trapezoid's) counts in the stress of the
+        # block's mode
+        force0 = spring0 - p[P_DAMPING] * v0 - s0
+        travel, s1, k_end = _inertial_step(
+            x1p - x, x, v0, force0, hh, puller0 + vp * (t1 - t0), n + 2, xb, w1, p, predicted
+        )
+        x1 = x + travel
+        v1 = 2.0 * travel / hh - v0
+        err_s += 0.5 * hh * (abs(x1 - x1p) * sens_x + abs(_aging_factor(v1, p) - slope1) * sens_a)
+        k_mode = p[P_K] + k_end
+        err_s += (math.sqrt(p[P_MASS] * k_mode) * abs(v1 - v1p) + k_mode * abs(x1 - x1p)) / 6.0
+        if not (hh * abs(v1 - v1p) <= dlm):
+            err_s = np.inf
+    elif block == 1:
+        x1 = _balance_from(x1p, puller0 + vp * (t1 - t0), n + 2, xb, w1, p, predicted, True)
+        v1 = _slider_velocity(v1p, vp, n + 2, xb, tb, lw_new, x1, t1, p, lc, aa, known)
+        err_s += 0.5 * hh * (abs(x1 - x1p) * sens_x + abs(_aging_factor(v1, p) - slope1) * sens_a)
+        s1 = p[P_K] * (puller0 + vp * (t1 - t0) - x1)
+        # that estimate is linear in the correction, and the hazard near the FENE wall is not: a cohort the
+        # predicted position left just short of the wall can sit on its cliff (ln r at the cap) at the
+        # balanced one, where g keeps no slow root and the slider's velocity comes out ~1e178 m/s (a creeping
+        # steady start, 40 s at 100 um/s, went non-finite so).  A step whose end velocity would carry the
+        # slider over a whole chain extension within the step does not follow the path it assumed: shorter.
+        if not (hh * abs(v1 - v1p) <= dlm):
+            err_s = np.inf
+    else:
+        s1 += w1[n] * _chain_force(x1p - xb[n], p[P_M], dlm) + w1[n + 1] * _chain_force(e_nb, p[P_M], dlm)
+    return x1, v1, s1, err_s, spring0
+
+
+def _step_error(err_s, err_n, cliff, cliff_old, s0, s1, s_floor, rtol, p):  # type: ignore[no-untyped-def]
+    """The step's error as a fraction of the tolerance (accepted at most 1).
+
+    Bonds born before this piece (a hold's, the steady start's) were lumped at steps unrelated to this one, which
+    cannot mend that: their cliff counts only where it makes the stress fall across the step, a maximum the trace
+    must resolve (the peak on re-sliding after a hold, old bonds dying at the FENE wall).  Counted always, the
+    steady start's oldest bonds reaching the wall one cohort after another while sigma is ~1e-3 of that peak held
+    the steps at ~0.1 us: 1 s hold then 5x the steps, 25x the CPU.  A rupture cascade is resolved in the trace:
+    the stress falls by at most MAX_DROP within one step (both ends can be exact while the peak between them is
+    lost)."""
+    s_ref = max(abs(s1), abs(s0), s_floor)
+    if abs(s1) < abs(s0):
+        cliff += cliff_old
+    err_s += cliff
+    err = max(err_s / (rtol * s_ref), err_n / (rtol * p[P_N0]))
+    return max(err, (max(abs(s0) - abs(s1), 0.0) / (MAX_DROP * s_ref)) ** 3)
+
+
+def _shorter_step(hh, err):  # type: ignore[no-untyped-def]
+    """The step to try after a rejected one of length hh (its error err, nan: a tenth)."""
+    factor = 0.9 * err ** (-1.0 / 3.0) if err == err else 0.1
+    return hh * max(0.1, min(0.7, factor))
+
+
+def _next_step(hh, err, h, h_max, landing):  # type: ignore[no-untyped-def]
+    """The step to try after an accepted one of length hh: grown or shrunk by its error (a step that landed on a
+    sample time keeps the step proposed before it)."""
+    factor = 0.9 * max(err, 1e-12) ** (-1.0 / 3.0)
+    return min(hh * min(4.0, max(0.2, factor)), h_max) if not landing else max(h, hh)
+
+
+def _book_step(  # type: ignore[no-untyped-def]
+    acc, n, t, t1, t0, hh, x1, v0, v1, s0, s1, spring0, kint0, kint1, rate_s0, rate_s1, born, born_alive, broken,
+    dissip, newborn_dissip, puller0, vp, block, inertial, xb, w1, rate0, p,
+):  # fmt: skip
+    """The accepted step's totals into ``acc`` (``n``: the cohorts with the two newborns, last): born, broken, the
+    puller's work and the integral of sigma (the end-corrected trapezoid, dsigma/dt = K (Vp - V) through the
+    massless block, else k_int V - sum r w f), dissipation, steps, the lowest stress."""
+    m = p[P_M]
+    dlm = p[P_DLM]
+    broken += born - born_alive
+    acc[0] += born
+    acc[1] += broken
+    if block == 1 and not inertial:
+        mean = 0.5 * (spring0 + s1) - hh / 12.0 * p[P_K] * (v0 - v1)  # over the step
+        acc[2] += mean * vp * hh
+        acc[6] += mean * hh
+    else:
+        for k in range(2):
+            e_k = x1 - xb[n - 2 + k]
+            kint1 += w1[n - 2 + k] * _chain_stiffness(e_k, m, dlm)
+            rate_s1 += w1[n - 2 + k] * rate0[n - 2 + k] * _chain_force(e_k, m, dlm)
+        ds0 = kint0 * v0 - rate_s0
+        ds1 = kint1 * v1 - rate_s1
+        mean = 0.5 * (s0 + s1) - hh / 12.0 * (ds1 - ds0)
+        acc[6] += mean * hh
+        if inertial:  # the puller works against the block's spring, not the interface
+            spring1 = p[P_K] * (puller0 + vp * (t1 - t0) - x1)
+            mean = 0.5 * (spring0 + spring1) - hh / 12.0 * p[P_K] * (v0 - v1)
+        acc[2] += mean * vp * hh
+    acc[3] += dissip + newborn_dissip
+    if inertial:  # the damping's share, eta V^2 over the step
+        acc[3] += 0.5 * hh * p[P_DAMPING] * (v0 * v0 + v1 * v1)
+    acc[4] += 1.0
+    acc[7] = min(acc[7], s1)  # the lowest stress of the accepted steps since the last row
+
+
+def _mergeable(i, g, n, t, x, quiet, gap, age_gap, aged, spread, xb, tb, rate0, p):  # type: ignore[no-untyped-def]
+    """Cohort i merges into the kept cohort g before it: both quiet (negligible breakage for the rest of the piece)
+    and born at nearly the same slider position and time, or (saturated aging) in one bin (:func:`_same_bin`).
+    The newest cohort (i = n - 1) is never merged."""
+    if g < 0 or i >= n - 1:
+        return False
+    return (
+        rate0[i] < quiet
+        and rate0[g] < quiet
+        and abs(xb[i] - xb[g]) < gap
+        and abs(tb[i] - tb[g]) * p[P_INV_TAU_A] * p[P_AGING] < age_gap
+    ) or (aged and _same_bin(t, x, tb[i], tb[g], xb[i], xb[g], spread, p))
+
+
+def _merge(g, i, xb, tb, lw, known, rate0):  # type: ignore[no-untyped-def]
+    """Cohort i into g: the weight, the mean extension and age kept, so it breaks as its parts would in any later
+    history (a hold followed by re-sliding, for one)."""
+    wa = math.exp(lw[g])
+    wb = math.exp(lw[i])
+    wt = wa + wb
+    xb[g] = (wa * xb[g] + wb * xb[i]) / wt
+    tb[g] = (wa * tb[g] + wb * tb[i]) / wt
+    lw[g] = math.log(wt)
+    known[0, g] = -1.0
+    known[1, g] = np.nan
+    rate0[g] = max(rate0[g], rate0[i])
+
+
+def _move(keep, i, xb, tb, lw, known, rate0):  # type: ignore[no-untyped-def]
+    xb[keep] = xb[i]
+    tb[keep] = tb[i]
+    lw[keep] = lw[i]
+    known[0, keep] = known[0, i]
+    known[1, keep] = known[1, i]
+    known[2, keep] = known[2, i]
+    rate0[keep] = rate0[i]
+
+
+def _housekeeping(n, t, t_end, x, nn1, s1, s_floor, rtol, xb, tb, lw, rate0, known, acc, p):  # type: ignore[no-untyped-def]
+    """Drop dead cohorts (their weight counts as broken, up to LIGHTEST * N0; with saturated aging, the negligible
+    ones of :func:`_saturated_bins`) and merge neighbours (:func:`_mergeable`).  Returns the cohorts kept."""
+    dlm = p[P_DLM]
+    quiet = 1e-3 * rtol / max(t_end - t, 1.0)
+    gap = 1e-4 * math.sqrt(rtol) * dlm
+    age_gap = 1e-2 * math.sqrt(rtol)  # in units of the aging time: merged cohorts age alike in any future
+    keep = 0
+    floor = math.log(LIGHTEST * p[P_N0])
+    # the housekeeping of saturating aging; off: the paper's, as for linear aging
+    saturated = p[P_SATURATION] > 0.0 and p[P_AGING] > 0.0 and p[P_MERGE_SATURATED] > 0.0
+    light_n, light_s, spread = 0.0, 0.0, 1.0
+    if saturated:
+        light_n, light_s, spread = _saturated_bins(n, nn1, s1, s_floor, rtol, p)
+    for i in range(n):
+        # only cohorts past the saturation age: those linger at the resting hazard (the young are as before)
+        aged = saturated and t - tb[i] >= p[P_SATURATION]
+        if lw[i] > floor and not (aged and _negligible(lw[i], x - xb[i], light_n, light_s, p)):
+            if _mergeable(i, keep - 1, n, t, x, quiet, gap, age_gap, aged, spread, xb, tb, rate0, p):
+                _merge(keep - 1, i, xb, tb, lw, known, rate0)
+                continue
+            _move(keep, i, xb, tb, lw, known, rate0)
+            keep += 1
+        elif lw[i] > -np.inf:
+            w = math.exp(lw[i])
+            acc[1] += w
+            acc[3] += w * _chain_energy(x - xb[i], p[P_M], dlm) if abs(x - xb[i]) < dlm else 0.0
+    return keep
+
+
+def _write_row(out, row, t, x, v, nn, ss, uu, puller0, vp, t0, block, acc):  # type: ignore[no-untyped-def]
+    """One row of the trace: (time, sigma, N, V, X, P, born, broken, work, dissipation, bond energy, integral of
+    sigma dt, lowest stress since the last row; that lowest then reset)."""
+    out[row, 0] = t
+    out[row, 1] = ss
+    out[row, 2] = nn
+    out[row, 3] = v
+    out[row, 4] = x
+    out[row, 5] = puller0 + vp * (t - t0) if block == 1 else x
+    out[row, 6] = acc[0]
+    out[row, 7] = acc[1]
+    out[row, 8] = acc[2]
+    out[row, 9] = acc[3]
+    out[row, 10] = uu
+    out[row, 11] = acc[6]
+    out[row, 12] = min(acc[7], ss)
+    acc[7] = np.inf
+
+
+def advance(  # type: ignore[no-untyped-def]
+    t, t_end, x, v, h, puller0, vp, t0, block, n, xb, tb, lw, lw_new, rate0, lc, aa, w1, acc, p, rtol, h_max,
+    sample_times, sample_index, out, out_max, stick_velocity, max_steps,
+):  # fmt: skip
+    """Integrate from t to t_end (one protocol piece).  Returns (status, t, x, v, h, n, sample_index, rows).
+
+    One step (docs/transient.md section 2): its length (:func:`_step_length`), the slider's path over it
+    (:func:`_predicted_path`), every cohort's log weight along its characteristic (:func:`_cohort_pass`), the
+    births at the Gauss points (:func:`_births`, :func:`_births_within_vacancy`, :func:`_birth_errors`), the slider
+    at the end (:func:`_slider_at_end`), the error (:func:`_step_error`); then rejected (:func:`_shorter_step`) or
+    accepted: its totals (:func:`_book_step`), the cohorts dropped and merged (:func:`_housekeeping`), the next
+    step (:func:`_next_step`) and a row (:func:`_write_row`).
+
+    ``acc`` accumulates [born, broken, puller work, dissipation, steps, rejected, integral of sigma dt, lowest
+    sigma since the last row].  Rows are written to ``out`` every accepted step when ``sample_times`` is empty,
+    else only at those times (the steps land on them exactly).  ``t0``: the start of the protocol's piece
+    (puller0 is the puller there; bonds born before it were born at other steps).  ``block``: 1 for block control
+    (vp is the puller's velocity), 0 for velocity control (v = vp).
+    """
     rows = 0
     steps = 0
     n_samples = sample_times.shape[0]
     v_prev = v
     h_prev = 0.0
-    s_floor = 1e-9 * m * big * dlm
+    s_floor = 1e-9 * p[P_M] * p[P_N0] * p[P_DLM]
     while sample_index < n_samples and sample_times[sample_index] <= t:  # grid points already passed
         sample_index += 1
     cache = np.empty((6, xb.shape[0]))  # the cohorts' values at the start of the step, when ``cached``
@@ -550,462 +1078,65 @@ def advance(
             return STEPS, t, x, v, h, n, sample_index, rows
         if n + 3 >= xb.shape[0]:
             return FULL, t, x, v, h, n, sample_index, rows
-        hh = min(h, h_max, t_end - t)
-        landing = False
-        if sample_index < n_samples and t + hh >= sample_times[sample_index]:
-            hh = sample_times[sample_index] - t
-            landing = True
-        if t_end - t - hh <= 1e-12 * max(t_end, 1.0):
-            hh = t_end - t
-        if hh <= 0.0:
-            hh = t_end - t
+        hh, landing = _step_length(t, t_end, h, h_max, sample_times, sample_index)
         t1 = t + hh
-        # ---- the slider's path over the step: exact (velocity control) or predicted (block control)
-        jerk = 0.0
-        if block == 0:
-            v0 = vp
-            v1p = vp
-        elif inertial:
-            v0 = v
-            # the jerk from the last step, unless that step was much shorter (one landing on a sample time), where
-            # the difference quotient amplifies the acceleration's rounding
-            jerk = (accel_now - accel_prev) / h_prev if h_prev > 0.25 * hh else 0.0
-            v1p = v + hh * accel_now + 0.5 * hh * hh * jerk
-        else:
-            v0 = v
-            v1p = v + (v - v_prev) * (hh / h_prev) if h_prev > 0.0 else v
-            if v1p < 0.0:
-                v1p = 0.0
-        if inertial:  # Taylor's cubic of the slider's path (its acceleration known, its jerk from the last step)
-            x1p = x + hh * (v0 + hh * (0.5 * accel_now + hh * jerk / 6.0))
-            x_mid = x + 0.5 * hh * (v0 + 0.5 * hh * (0.5 * accel_now + 0.5 * hh * jerk / 6.0))
-        else:
-            x1p = x + 0.5 * hh * (v0 + v1p)
-            x_mid = x + 0.5 * hh * v0 + 0.125 * hh * (v1p - v0)
+        v0, v1p, x1p, x_mid, jerk = _predicted_path(
+            x, v, v_prev, h_prev, hh, vp, block, inertial, accel_now, accel_prev
+        )
         slope0 = _aging_factor(v0, p)
         slope1 = _aging_factor(v1p, p)
         accel = (v1p - v0) / hh
-        aging_on = p[P_AGING] > 0.0
-        saturating = p[P_SATURATION] > 0.0
-        # ---- one pass over the cohorts: hazards at both ends, corrected trapezoid, error terms, sums
-        nn0 = 0.0
-        s0 = 0.0
-        nn1 = 0.0
-        s1 = 0.0
-        loss0 = 0.0  # breakage rate (bonds per m^2 per s) at both ends of the step
-        loss1 = 0.0
-        dloss0 = 0.0  # and its time derivative
-        dloss1 = 0.0
-        broken = 0.0
-        dissip = 0.0
-        rate_s0 = 0.0  # sum r w f: the stress lost to breakage per unit time, at both ends
-        rate_s1 = 0.0
-        kint0 = 0.0  # sum w f': the interface stiffness, at both ends
-        kint1 = 0.0
-        err_s = 0.0
-        err_n = 0.0
-        sens_x = 0.0  # sum w f r beta f': how the step's stress loss depends on the slider position
-        sens_a = 0.0  # sum w f r t_a: how it depends on the aging slope
-        walled = 0.0  # bonds freed by the FENE wall within the step (not part of the smooth breakage rate)
-        cliff = 0.0  # stress dying at a hazard cliff steeper than the step (see below)
-        cliff_old = 0.0  # the same for bonds born before this piece of the protocol
-        for i in range(n):
-            w0 = cache[0, i] if cached else math.exp(lw[i])
-            e0 = x - xb[i]
-            e1 = x1p - xb[i]
-            nn0 += w0
-            if e0 >= dlm or -e0 >= dlm:  # beyond the FENE wall already (cannot happen for a live cohort)
-                lw_new[i] = -np.inf
-                rate0[i] = np.inf
-                w1[i] = 0.0
-                known[0, i] = -1.0
-                broken += w0
-                continue
-            f0 = cache[1, i] if cached else _chain_force(e0, m, dlm)
-            s0 += w0 * f0
-            if e1 >= dlm or -e1 >= dlm:  # the chain reaches full extension within the step
-                lw_new[i] = -np.inf
-                rate0[i] = np.inf
-                w1[i] = 0.0
-                known[0, i] = -1.0
-                broken += w0
-                walled += w0
-                dissip += w0 * _chain_energy(e0, m, dlm)
-                err_s += w0 * abs(f0)
-                err_n += w0
-                continue
-            if saturating:  # the age the aging term sees, and its rate
-                age0, clock0 = _aging_clock(t - tb[i], p)
-                age1, clock1 = _aging_clock(t1 - tb[i], p)
-            else:
-                age0, clock0 = t - tb[i], 1.0
-                age1, clock1 = t1 - tb[i], 1.0
-            f1 = _chain_force(e1, m, dlm)
-            if cached:
-                lr0 = cache[4, i]
-                r0 = cache[5, i]
-            else:
-                lr0 = min(p[P_LOG_U0_TAU] + beta * abs(f0) - age0 * slope0, LOG_RATE_CAP)
-                r0 = math.exp(lr0)
-            lr1 = min(p[P_LOG_U0_TAU] + beta * abs(f1) - age1 * slope1, LOG_RATE_CAP)
-            r1 = math.exp(lr1)
-            # d ln r/dt along the characteristic at both ends (force, age, and the velocity's effect on aging)
-            k0 = cache[2, i] if cached else _chain_stiffness(e0, m, dlm)
-            k1 = _chain_stiffness(e1, m, dlm)
-            predicted[0, i] = f1
-            predicted[1, i] = k1
-            g0 = beta * (1.0 if f0 >= 0.0 else -1.0) * k0 * v0 - slope0 * clock0
-            g1 = beta * (1.0 if f1 >= 0.0 else -1.0) * k1 * v1p - slope1 * clock1
-            if aging_on and accel != 0.0:
-                g0 += age0 * slope0 * accel / p[P_VA] * (1.0 if v0 >= 0.0 else -1.0)
-                g1 += age1 * slope1 * accel / p[P_VA] * (1.0 if v1p >= 0.0 else -1.0)
-            trap = 0.5 * hh * (r0 + r1)
-            if abs(lr1 - lr0) > 1.0 and max(lr0, lr1) < LOG_RATE_CAP:
-                # the hazard changes by more than a factor e within the step (a young bond aging on a stuck
-                # block, or a rupture): the rule exact for ln r linear in time, where the trapezoid would kill
-                # the 2 % of young bonds that age into permanence; its error from the curvature of ln r
-                integral = hh * (r1 - r0) / (lr1 - lr0)
-                wn = w0 * math.exp(-integral)
-                known[0, i] = -1.0
-                new = lw[i] - integral
-                delta = abs(g1 - g0) * hh / 8.0 * integral
-                dw = min(wn * math.expm1(min(delta, 50.0)), w0) + abs(wn - w0 * math.exp(-min(trap, 745.0))) * 1e-3
-                if g1 > 0.0:
-                    # a cliff of the hazard (the force, or the FENE stiffening) steeper than the steps: bonds born
-                    # over a step like this die as a block there, and the stress falls in steps; the Gauss births
-                    # resolve it only for h g < 1, erring by ~(h g)^4/4320 of the stress that dies
-                    # (the current step stands for the birth spacing of bonds born under the current drive only)
-                    hg = hh * g1
-                    dying = (w0 - wn) * abs(f0) * min(hg * hg * hg * hg / 4320.0, 1.0)
-                    if tb[i] >= t0:
-                        cliff += dying
-                    else:
-                        cliff_old += dying
-            else:
-                corr = hh * hh / 12.0 * (r1 * g1 - r0 * g0)  # Euler-Maclaurin end correction: fourth order
-                limit = 0.5 * trap
-                corr = min(max(corr, -limit), limit)
-                new = lw[i] - trap + corr
-                wn = math.exp(new)
-                known[0, i] = wn
-                dw = abs(wn - w0 * math.exp(-min(trap, 745.0)))  # against the plain trapezoid
-            err_s += abs(f1) * dw
-            err_n += dw
-            sens_x += wn * abs(f1) * r1 * beta * k1
-            sens_a += wn * abs(f1) * r1 * age1
-            loss0 += w0 * r0
-            loss1 += wn * r1
-            dloss0 += w0 * r0 * (g0 - r0)
-            dloss1 += wn * r1 * (g1 - r1)
-            broken += w0 - wn
-            if trap < 0.5:  # dissipation r w u by the end-corrected trapezoid (fourth order)
-                u0 = cache[3, i] if cached else _chain_energy(e0, m, dlm)
-                u1 = _chain_energy(e1, m, dlm)
-                phi0 = r0 * w0 * u0
-                phi1 = r1 * wn * u1
-                dphi0 = phi0 * (g0 - r0) + r0 * w0 * f0 * v0
-                dphi1 = phi1 * (g1 - r1) + r1 * wn * f1 * v1p
-                dissip += 0.5 * hh * (phi0 + phi1) - hh * hh / 12.0 * (dphi1 - dphi0)
-            else:  # a cohort breaking within the step: its lost mass at the mid-step energy
-                dissip += (w0 - wn) * _chain_energy(x_mid - xb[i], m, dlm)
-            rate_s0 += w0 * r0 * f0
-            rate_s1 += wn * r1 * f1
-            kint0 += w0 * k0
-            kint1 += wn * k1
-            nn1 += wn
-            s1 += wn * f1
-            lw_new[i] = new
-            w1[i] = wn
-            rate0[i] = r1  # kept for the merging of quiet cohorts after the step
-        # ---- births over the step, as two cohorts at the Gauss-Legendre points (fourth order in h): the
-        # vacancy Q = N0 - N relaxes at 1/tau and is refilled by breakage, a Hermite cubic over the step;
-        # the newborns' own breakage joins it (fixed-point passes, for their mass and rate at t1)
-        q0 = big - nn0
-        tau = p[P_TAU]
-        r_birth = math.exp(p[P_LOG_U0_TAU])  # hazard at age 0, extension 0
-        dloss0 += r_birth * q0 / tau
-        born = 0.0
-        born_alive = 0.0
-        newborn_loss = 0.0
-        newborn_dloss = 0.0
-        newborn_dissip = 0.0
-        lump = 0.0
-        q_end = q0
-        e_nb = 0.0
-        for _sweep in range(3):
-            l1 = loss1 + newborn_loss
-            d1 = dloss1 + newborn_dloss + r_birth * q_end / tau
-            born = 0.0
-            born_alive = 0.0
-            newborn_loss = 0.0
-            newborn_dloss = 0.0
-            newborn_dissip = 0.0
-            lump = 0.0
-            for k in range(2):
-                u = hh * (0.5 - GAUSS if k == 0 else 0.5 + GAUSS)
-                q = _vacancy(u, q0, tau, hh, loss0, dloss0, l1, d1)
-                mass = 0.5 * hh * max(q, 0.0) / tau
-                d = hh - u  # its age at t1
-                if inertial:  # on the predicted cubic path
-                    x_k = x + u * (v0 + u * (0.5 * accel_now + u * jerk / 6.0))
-                else:
-                    x_k = x + u * v0 + 0.5 * (v1p - v0) * u * u / hh
-                e_k = x1p - x_k
-                predicted[0, n + k] = _chain_force(e_k, m, dlm)
-                predicted[1, n + k] = _chain_stiffness(e_k, m, dlm)
-                lr_end = min(_log_rate(e_k, d, slope1, p), LOG_RATE_CAP)
-                r_end = math.exp(lr_end)
-                g_end = beta * _chain_stiffness(e_k, m, dlm) * v1p - slope1 * _aging_clock(d, p)[1]
-                g_start = beta * m * (v0 + accel * u) - _aging_factor(v0 + accel * u, p)
-                trap = 0.5 * d * (r_birth + r_end)
-                lr_birth = p[P_LOG_U0_TAU]
-                if abs(lr_end - lr_birth) > 1.0 and lr_end < LOG_RATE_CAP:  # as for the cohorts above
-                    alive = mass * math.exp(-d * (r_end - r_birth) / (lr_end - lr_birth))
-                else:
-                    corr = d * d / 12.0 * (r_end * g_end - r_birth * g_start)
-                    corr = min(max(corr, -0.5 * trap), 0.5 * trap)
-                    alive = mass * math.exp(-trap + corr)
-                born += mass
-                born_alive += alive
-                # births reaching the FENE wall within the step are gone by its end; their energy is taken at
-                # half the wall's extension (the step control keeps such losses small, below)
-                newborn_dissip += (mass - alive) * _chain_energy(0.5 * min(e_k, dlm), m, dlm)
-                # the error of lumping this half-step's births into one cohort: (h r)^2/24 of its mass for a
-                # gentle hazard; when the births die within the step, what a resolved step would keep alive at
-                # its end (the birth rate times the newborns' life 1/r, at most all of it): bonds living
-                # shorter than a step would otherwise vanish from the population without a word
-                z = max(r_birth * hh, trap)
-                lump += min(mass * min(1.0, z * z / 24.0), 2.0 * mass / (hh * r_birth))
-                newborn_loss += alive * r_end
-                newborn_dloss += alive * r_end * (g_end - r_end)
-                xb[n + k] = x_k
-                tb[n + k] = t + u
-                lw_new[n + k] = math.log(alive) if alive > 0.0 else -np.inf
-                w1[n + k] = alive
-                known[0, n + k] = -1.0
-                rate0[n + k] = r_end
-                if k == 1:
-                    e_nb = e_k
-            q_end = max(big - nn1 - born_alive, 0.0)
-        # the births must not overfill the vacancy the bonds left.  Over a step much longer than tau the Gauss
-        # masses rest on the Hermite cubic of the breakage rate across the whole step, which is poor where
-        # the hazard of young bonds falls at 1/tau_a (a stuck block: N/N0 came out 1.00005); there the vacancy
-        # at t1 is set by its own equation instead, N(t1) = N0 - Q(t1), Q relaxing over the last few tau of
-        # the step, where the breakage rate is the exact one at t1 (sites freed by the FENE wall refill from
-        # the next step on).  Over shorter steps the Gauss masses stand (where N << N0 they are far more
-        # accurate than N0 - Q), but never above the vacancy.
-        target = born_alive
-        if hh > 2.0 * tau:
-            q_h = max(_vacancy(hh, q0, tau, hh, loss0, dloss0, loss1 + newborn_loss, d1), 0.0) + walled
-            target = max(big - nn1 - q_h, 0.0)
-        target = min(target, max(big - nn1, 0.0))
-        if born_alive > 0.0 and target != born_alive:
-            scale = target / born_alive
-            err_n += abs(target - born_alive)
-            for k in range(2):
-                w1[n + k] *= scale
-                lw_new[n + k] = math.log(w1[n + k]) if w1[n + k] > 0.0 else -np.inf
-            born *= scale
-            born_alive = target
-            newborn_dissip *= scale
-        # the error one lumped cohort would make (the Gauss pair's is far smaller): a conservative estimate
-        err_n += lump
-        err_s += lump * abs(_chain_force(min(x1p - x_mid, 0.5 * dlm), m, dlm))
-        # births lumped at two instants per step meet the hazard's cliff later (ln r climbing at g = beta M V
-        # minus the aging slope): the Gauss rule over birth times then errs by ~(h g)^4/4320 of the stress the
-        # bonds carry there, the whole stream born at this pace over their life a_cliff (bonds living ~40 us,
-        # dying within ~3 us, steps of ~10 us left the stress 5e-3 off the steady curve with nothing in the
-        # estimate).  A quadrature error of the population, not one that accumulates: it is compared, as a
-        # whole, with rtol times the stress.
-        g_cliff = beta * m * abs(v1p) - slope1
-        if g_cliff > r_birth:
-            z4 = (hh * g_cliff) ** 4 / 4320.0
-            a_cliff = math.log1p(g_cliff / r_birth) / g_cliff  # age at which the cumulative hazard reaches 1
-            e_cliff = min(abs(v1p) * a_cliff, 0.5 * dlm)
-            carried = born * max(1.0, a_cliff / hh) * 0.5 * _chain_force(e_cliff, m, dlm)
-            err_s += min(z4, 1.0) * carried
-        x1 = x1p
-        v1 = v1p
-        spring0 = p[P_K] * (puller0 + vp * (t - t0) - x)  # the block's force (massless: sigma) at the step's start
-        if inertial:
-            # the slider's travel by the trapezoid rule against the end population; the hazards used the predicted
-            # path, and the rule's own error (Milne's: a sixth of the corrector's distance from the predictor,
-            # whose error is five times the trapezoid's) counts in the stress of the block's mode
-            force0 = spring0 - p[P_DAMPING] * v0 - s0
-            travel, s1, k_end = _inertial_step(
-                x1p - x, x, v0, force0, hh, puller0 + vp * (t1 - t0), n + 2, xb, w1, p, predicted
-            )
-            x1 = x + travel
-            v1 = 2.0 * travel / hh - v0
-            err_s += 0.5 * hh * (abs(x1 - x1p) * sens_x + abs(_aging_factor(v1, p) - slope1) * sens_a)
-            k_mode = p[P_K] + k_end
-            err_s += (math.sqrt(p[P_MASS] * k_mode) * abs(v1 - v1p) + k_mode * abs(x1 - x1p)) / 6.0
-            if not (hh * abs(v1 - v1p) <= dlm):
-                err_s = np.inf
-        elif block == 1:
-            # the slider where the bonds balance the block exactly, then its velocity (the stable root of g)
-            x1 = _balance_from(x1p, puller0 + vp * (t1 - t0), n + 2, xb, w1, p, predicted, True)
-            v1 = _slider_velocity(v1p, vp, n + 2, xb, tb, lw_new, x1, t1, p, lc, aa, known)
-            # the hazards used the predicted slider position and velocity
-            err_s += 0.5 * hh * (abs(x1 - x1p) * sens_x + abs(_aging_factor(v1, p) - slope1) * sens_a)
-            s1 = p[P_K] * (puller0 + vp * (t1 - t0) - x1)
-            # that estimate is linear in the correction, and the hazard near the FENE wall is not: a cohort the
-            # predicted position left just short of the wall can sit on its cliff (ln r at the cap) at the
-            # balanced one, where g keeps no slow root and the slider's velocity comes out ~1e178 m/s (a creeping
-            # steady start, 40 s at 100 um/s, went non-finite so).  A step whose end velocity would carry the
-            # slider over a whole chain extension within the step does not follow the path it assumed: shorter.
-            if not (hh * abs(v1 - v1p) <= dlm):
-                err_s = np.inf
-        else:
-            s1 += w1[n] * _chain_force(x1p - xb[n], m, dlm) + w1[n + 1] * _chain_force(e_nb, m, dlm)
+        (
+            nn0, s0, nn1, s1, loss0, loss1, dloss0, dloss1, broken, dissip, rate_s0, rate_s1, kint0, kint1, err_s,
+            err_n, sens_x, sens_a, walled, cliff, cliff_old,
+        ) = _cohort_pass(
+            n, t, t1, t0, hh, x, x1p, x_mid, v0, v1p, slope0, slope1, accel, xb, tb, lw, lw_new, rate0, w1, known,
+            predicted, cache, cached, p,
+        )  # fmt: skip
+        born, born_alive, newborn_loss, newborn_dissip, lump, e_nb, q0, dloss0, d1 = _births(
+            n, t, hh, x, x1p, v0, v1p, accel, accel_now, jerk, slope1, nn0, nn1, loss0, dloss0, loss1, dloss1,
+            inertial, xb, tb, lw_new, w1, known, rate0, predicted, p,
+        )  # fmt: skip
+        born, born_alive, newborn_dissip, err_n = _births_within_vacancy(
+            n, hh, q0, loss0, dloss0, loss1, newborn_loss, d1, walled, nn1, born, born_alive, newborn_dissip, err_n,
+            w1, lw_new, p,
+        )  # fmt: skip
+        err_s, err_n = _birth_errors(err_s, err_n, lump, born, hh, x1p, x_mid, v1p, slope1, p)
+        x1, v1, s1, err_s, spring0 = _slider_at_end(
+            n, t, t1, t0, hh, x, v0, x1p, v1p, slope1, s0, s1, e_nb, sens_x, sens_a, err_s, puller0, vp, block,
+            inertial, xb, tb, lw_new, w1, lc, aa, known, predicted, p,
+        )  # fmt: skip
         nn1 += born_alive
-        s_ref = max(abs(s1), abs(s0), s_floor)
-        # bonds born before this piece (a hold's, the steady start's) were lumped at steps unrelated to this
-        # one, which cannot mend that: their cliff counts only where it makes the stress fall across the step,
-        # a maximum the trace must resolve (the peak on re-sliding after a hold, old bonds dying at the FENE
-        # wall).  Counted always, the steady start's oldest bonds reaching the wall one cohort after another
-        # while sigma is ~1e-3 of that peak held the steps at ~0.1 us: 1 s hold then 5x the steps, 25x the CPU
-        if abs(s1) < abs(s0):
-            cliff += cliff_old
-        err_s += cliff
-        err = max(err_s / (rtol * s_ref), err_n / (rtol * big))
-        # a rupture cascade is resolved in the trace: the stress falls by at most a fifth within one step
-        # (both ends can be exact while the peak between them is lost)
-        err = max(err, (max(abs(s0) - abs(s1), 0.0) / (MAX_DROP * s_ref)) ** 3)
+        err = _step_error(err_s, err_n, cliff, cliff_old, s0, s1, s_floor, rtol, p)
         if not (err <= 1.0) and hh > 1e-15 * max(t, p[P_TAU]):
             acc[5] += 1.0
-            factor = 0.9 * err ** (-1.0 / 3.0) if err == err else 0.1
-            h = hh * max(0.1, min(0.7, factor))
+            h = _shorter_step(hh, err)
             continue
-        # ---- accept
+        # ---- accepted
         cached = False
         for i in range(n + 2):
             lw[i] = lw_new[i]
         n += 2
-        broken += born - born_alive
-        acc[0] += born
-        acc[1] += broken
-        # puller work by the end-corrected trapezoid; dsigma/dt = K (Vp - V) (block) or k_int V - sum r w f
-        if block == 1 and not inertial:
-            mean = 0.5 * (spring0 + s1) - hh / 12.0 * p[P_K] * (v0 - v1)  # over the step
-            acc[2] += mean * vp * hh
-            acc[6] += mean * hh
-        else:
-            for k in range(2):
-                e_k = x1 - xb[n - 2 + k]
-                kint1 += w1[n - 2 + k] * _chain_stiffness(e_k, m, dlm)
-                rate_s1 += w1[n - 2 + k] * rate0[n - 2 + k] * _chain_force(e_k, m, dlm)
-            ds0 = kint0 * v0 - rate_s0
-            ds1 = kint1 * v1 - rate_s1
-            mean = 0.5 * (s0 + s1) - hh / 12.0 * (ds1 - ds0)
-            acc[6] += mean * hh
-            if inertial:  # the puller works against the block's spring, not the interface
-                spring1 = p[P_K] * (puller0 + vp * (t1 - t0) - x1)
-                mean = 0.5 * (spring0 + spring1) - hh / 12.0 * p[P_K] * (v0 - v1)
-            acc[2] += mean * vp * hh
-        acc[3] += dissip + newborn_dissip
-        if inertial:  # the damping's share, eta V^2 over the step
-            acc[3] += 0.5 * hh * p[P_DAMPING] * (v0 * v0 + v1 * v1)
-        acc[4] += 1.0
-        acc[7] = min(acc[7], s1)  # the lowest stress of the accepted steps since the last row
-        v_prev = v
-        h_prev = hh
-        t = t1
-        x = x1
-        v = v1
+        _book_step(
+            acc, n, t, t1, t0, hh, x1, v0, v1, s0, s1, spring0, kint0, kint1, rate_s0, rate_s1, born, born_alive,
+            broken, dissip, newborn_dissip, puller0, vp, block, inertial, xb, w1, rate0, p,
+        )  # fmt: skip
+        v_prev, h_prev, t, x, v = v, hh, t1, x1, v1
         if inertial:
             accel_prev = accel_now
             accel_now = (p[P_K] * (puller0 + vp * (t - t0) - x) - p[P_DAMPING] * v - s1) / p[P_MASS]
         steps += 1
-        # drop dead cohorts (their weight counts as broken already, up to LIGHTEST * N0), and merge
-        # neighbours that are quiet (negligible breakage for the rest of the piece) and born at nearly the
-        # same slider position and time: the merged cohort keeps the weight, the mean extension and age, so
-        # it breaks as its parts would in any later history (a hold followed by re-sliding, for one)
-        quiet = 1e-3 * rtol / max(t_end - t, 1.0)
-        gap = 1e-4 * math.sqrt(rtol) * dlm
-        age_gap = 1e-2 * math.sqrt(rtol)  # in units of the aging time: merged cohorts age alike in any future
-        keep = 0
-        floor = math.log(LIGHTEST * big)
-        # the housekeeping of saturating aging (below); off: the paper's, as for linear aging
-        saturated = saturating and aging_on and p[P_MERGE_SATURATED] > 0.0
-        light_n, light_s, spread = 0.0, 0.0, 1.0
-        if saturated:
-            light_n, light_s, spread = _saturated_bins(n, nn1, s1, s_floor, rtol, p)
-        for i in range(n):
-            # only cohorts past the saturation age: those linger at the resting hazard (the young are as before)
-            aged = saturated and t - tb[i] >= p[P_SATURATION]
-            if lw[i] > floor and not (aged and _negligible(lw[i], x - xb[i], light_n, light_s, p)):
-                if (
-                    keep > 0
-                    and i < n - 1
-                    and (
-                        (
-                            rate0[i] < quiet
-                            and rate0[keep - 1] < quiet
-                            and abs(xb[i] - xb[keep - 1]) < gap
-                            and abs(tb[i] - tb[keep - 1]) * p[P_INV_TAU_A] * p[P_AGING] < age_gap
-                        )
-                        or (aged and _same_bin(t, x, tb[i], tb[keep - 1], xb[i], xb[keep - 1], spread, p))
-                    )
-                ):
-                    wa = math.exp(lw[keep - 1])
-                    wb = math.exp(lw[i])
-                    wt = wa + wb
-                    xb[keep - 1] = (wa * xb[keep - 1] + wb * xb[i]) / wt
-                    tb[keep - 1] = (wa * tb[keep - 1] + wb * tb[i]) / wt
-                    lw[keep - 1] = math.log(wt)
-                    known[0, keep - 1] = -1.0
-                    known[1, keep - 1] = np.nan
-                    rate0[keep - 1] = max(rate0[keep - 1], rate0[i])
-                    continue
-                xb[keep] = xb[i]
-                tb[keep] = tb[i]
-                lw[keep] = lw[i]
-                known[0, keep] = known[0, i]
-                known[1, keep] = known[1, i]
-                known[2, keep] = known[2, i]
-                rate0[keep] = rate0[i]
-                keep += 1
-            elif lw[i] > -np.inf:
-                w = math.exp(lw[i])
-                acc[1] += w
-                acc[3] += w * _chain_energy(x - xb[i], m, dlm) if abs(x - xb[i]) < dlm else 0.0
-        n = keep
-        factor = 0.9 * max(err, 1e-12) ** (-1.0 / 3.0)
-        h = min(hh * min(4.0, max(0.2, factor)), h_max) if not landing else max(h, hh)
+        n = _housekeeping(n, t, t_end, x, nn1, s1, s_floor, rtol, xb, tb, lw, rate0, known, acc, p)
+        h = _next_step(hh, err, h, h_max, landing)
         record = n_samples == 0
         if landing:
             sample_index += 1
             record = True
         if record and rows < out_max:
             # the next step starts from this state: its opening values are kept (rejected steps keep them too)
-            nn, ss, uu, cached = _sums_keeping(
-                n,
-                xb,
-                tb,
-                lw,
-                x,
-                t,
-                _aging_factor(v if block == 1 else vp, p),
-                p,
-                cache,
-                known,
-                block == 1 and not inertial,
-            )
-            out[rows, 0] = t
-            out[rows, 1] = ss
-            out[rows, 2] = nn
-            out[rows, 3] = v
-            out[rows, 4] = x
-            out[rows, 5] = puller0 + vp * (t - t0) if block == 1 else x
-            out[rows, 6] = acc[0]
-            out[rows, 7] = acc[1]
-            out[rows, 8] = acc[2]
-            out[rows, 9] = acc[3]
-            out[rows, 10] = uu
-            out[rows, 11] = acc[6]
-            out[rows, 12] = min(acc[7], ss)
-            acc[7] = np.inf
+            slope = _aging_factor(v if block == 1 else vp, p)
+            nn, ss, uu, cached = _sums_keeping(n, xb, tb, lw, x, t, slope, p, cache, known, block == 1 and not inertial)
+            _write_row(out, rows, t, x, v, nn, ss, uu, puller0, vp, t0, block, acc)
             rows += 1
             if rows >= out_max:
                 return STEPS, t, x, v, h, n, sample_index, rows
@@ -1045,6 +1176,27 @@ def compiled() -> dict[str, object]:
             "_saturated_bins",
             "_sums",
             "_sums_keeping",
+            "_step_length",
+            "_predicted_path",
+            "_cohort_gone",
+            "_hazard_ends",
+            "_cohort_weight",
+            "_cohort_dissipation",
+            "_cohort_pass",
+            "_gauss_birth",
+            "_births",
+            "_births_within_vacancy",
+            "_birth_errors",
+            "_slider_at_end",
+            "_step_error",
+            "_shorter_step",
+            "_next_step",
+            "_book_step",
+            "_mergeable",
+            "_merge",
+            "_move",
+            "_housekeeping",
+            "_write_row",
             "advance",
         ):
             g[name] = _jit(g[name])
