@@ -50,3 +50,69 @@ def test_rsf_fit_mcmc_without_emcee_is_refused_before_any_work(tmp_path, capsys,
     monkeypatch.setattr(importlib.util, "find_spec", lambda name, *a: None if name == "emcee" else real(name, *a))
     code, _, err = run_main(capsys, "rsf", "fit", str(trace), "--mcmc", "20")
     assert code == 2 and err.count("\n") == 1 and "pip install stickslip[bayes]" in err, err
+
+
+def test_an_overflow_names_the_most_extreme_value_typed(capsys):
+    code, _, err = run_main(
+        capsys, "transient", "--v0", "50 um/s", "--duration", "1 s", "--mass", "1 kg/m^2", "--damping", "1e308 Pa s/m"
+    )
+    assert code == 2 and err.count("\n") == 1, err
+    assert "floating-point range" in err and "--damping '1e308 Pa s/m'" in err, err
+
+
+def test_most_extreme_input_ignores_ordinary_values():
+    from stickslip.cli.main import _most_extreme_input
+
+    assert _most_extreme_input(["transient", "--v0", "50 um/s", "--duration", "1 s"]) == ""
+    assert "--set 'bonds.bond_time=1e-320 s'" in _most_extreme_input(["run", "--set", "bonds.bond_time=1e-320 s"])
+    assert "--rtol '1e-40'" in _most_extreme_input(["transient", "--rtol=1e-40"])
+
+
+def test_rsf_simulate_with_an_unknown_figure_format_writes_nothing(tmp_path, capsys):
+    trace, figure = tmp_path / "t.csv", tmp_path / "x.json"
+    code, _, err = run_main(capsys, "rsf", "simulate", "--v0", "1 um/s", "--duration", "10 s", "-o", str(trace),
+                            "--plot", str(figure))  # fmt: skip
+    assert code == 2 and err.count("\n") == 1 and "--plot" in err and "unknown figure format .json" in err, err
+    assert sorted(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize(
+    "command",
+    [["rsf", "simulate", "--v0", "1 um/s", "--duration", "10 s"], ["rsf", "stability", "--velocity", "1 um/s"]],
+)
+def test_rsf_refuses_a_negative_reference_friction(capsys, command):
+    code, _, err = run_main(capsys, *command, "--mu0", "-1")
+    assert code == 2 and err.count("\n") == 1 and "mu0: expected a positive friction coefficient" in err, err
+
+
+def test_rsf_fit_refuses_bare_numbers_in_its_segments(capsys):
+    from stickslip.fitting.datasets import data_path
+
+    record = data_path("giacomel-sepiolite/velstep3_TR2_exp013_sepiolite.txt")
+    code, _, err = run_main(capsys, "rsf", "fit", str(record), "--segment", "10:10")
+    assert code == 2 and err.count("\n") == 1 and "--segment '10:10'" in err and "needs a unit" in err, err
+
+
+def test_api_refusals_are_typed_and_name_the_argument():
+    import stickslip
+    from stickslip.errors import DataError, ParameterError, UnitError
+    from stickslip.fitting import datasets, fit_steady
+    from stickslip.transient import critical_stiffness
+
+    with pytest.raises(ParameterError, match="params: expected a stickslip Parameters set"):
+        critical_stiffness(None, 50e-6)
+    with pytest.raises(DataError, match="data: expected SteadyData or the path"):
+        fit_steady(None)
+    with pytest.raises(UnitError, match=r"split: .* expected a velocity"):
+        fit_steady(datasets.synthetic_steady_path(), split="800 Pa")
+    with pytest.raises(stickslip.StickslipError):
+        fit_steady(datasets.synthetic_steady_path(), split="-1 um/s")
+
+
+def test_fit_steady_takes_its_split_with_a_unit():
+    from stickslip.fitting import datasets, fit_steady
+
+    path = datasets.synthetic_steady_path()
+    with_unit, in_si = fit_steady(path, split="800 um/s"), fit_steady(path, split=800e-6)
+    assert with_unit.split == pytest.approx(800e-6, rel=1e-12) and in_si.split == pytest.approx(800e-6, rel=1e-12)
+    assert with_unit.critical_velocity.value == pytest.approx(in_si.critical_velocity.value, rel=1e-6)

@@ -153,6 +153,10 @@ def check_unit(
     require_unit(value, dimension, f"--set {key}=", None if typical_of is None else typical_of(key))
 
 
+#: output options that name a figure (their suffix must be a format matplotlib writes)
+FIGURE_OPTIONS = frozenset({"--plot", "--corner"})
+
+
 def refuse_overwriting_inputs(
     inputs: Sequence[Path | str | None], outputs: Sequence[tuple[str, Path | None]], params_name: str | None = None
 ) -> None:
@@ -166,6 +170,9 @@ def refuse_overwriting_inputs(
     if params_name is not None:
         files.append(params_name)  # a built-in set name is no file, and is skipped
     refuse_input_as_output(files, list(outputs))
+    for option, path in outputs:  # an unknown figure format or a missing folder is said before anything is written
+        if path is not None and str(path) != "-":
+            check_output(option, Path(path), plot=option in FIGURE_OPTIONS)
 
 
 def require_unit(text: str, dimension: str, prefix: str, typical: float | None = None) -> None:

@@ -12,7 +12,9 @@ lmfit and rich are imported inside the functions that use them.
 
 from __future__ import annotations
 
+import math
 import os
+import re
 import sys
 import warnings
 from typing import Any
@@ -95,7 +97,7 @@ def _run(argv: list[str] | None) -> int:
     except (OverflowError, FloatingPointError):
         return _fail(
             "a number left the floating-point range (about 1e-308 to 1e308) during the computation;"
-            " check that the input values are physical"
+            f" check that the input values are physical{_most_extreme_input(argv)}"
         )
     except OSError as exc:  # `stickslip critical --json > /dev/full`: the output could not be written
         _silence_stdout()
@@ -105,6 +107,35 @@ def _run(argv: list[str] | None) -> int:
     except Exception as exc:  # a bug: still one line, but say it is ours
         return _fail(f"internal error ({type(exc).__name__}): {exc}", status=1)
     return 0
+
+
+#: a number as typed: the mantissa and an optional exponent
+_NUMBER = re.compile(r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?")
+
+
+def _most_extreme_input(argv: list[str] | None) -> str:
+    """``"; the most extreme value given was --damping '1e308 Pa s/m'"``: the typed value whose number is
+    farthest from 1 in orders of magnitude (10 or more), so an overflow names its likely cause; else ``""``."""
+    words = list(sys.argv[1:] if argv is None else argv)
+    best, where = 10.0, ""
+    option = ""
+    for word in words:
+        if word.startswith("--") and "=" not in word[2:]:
+            option = word
+            continue
+        name, _, value = word.partition("=") if word.startswith("--") else (option, "", word)
+        for text in _NUMBER.findall(value or word):
+            try:
+                number = abs(float(text))
+            except ValueError:  # pragma: no cover - the pattern only matches numbers
+                continue
+            if number == 0 or not math.isfinite(number):
+                continue
+            size = abs(math.log10(number))
+            if size >= best:
+                best, where = size, f"{name} {value or word!r}".strip()
+        option = ""
+    return f"; the most extreme value given was {where}" if where else ""
 
 
 def _os_error_text(exc: OSError) -> str:

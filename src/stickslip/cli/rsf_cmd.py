@@ -26,12 +26,12 @@ import click
 import numpy as np
 
 from ..errors import DataError, ModelError, ParameterError, StickslipError, UnitError
-from ..fileio import atomic_path, atomic_write_text, protect_inputs, read_input_text, refuse_input_as_output
+from ..fileio import atomic_path, atomic_write_text, protect_inputs, read_input_text
 from ..numerics.budget import PROGRESS_AFTER_SECONDS
 from ..units import quantity_noun, shorten
-from .common import json_text, quantity
+from .common import json_text, quantity, refuse_overwriting_inputs
 from .protocol_options import build_protocol as build_run_protocol
-from .protocol_options import protocol_options, refuse_unsupported
+from .protocol_options import checked_segment_text, protocol_options, refuse_unsupported
 
 LAW_NAMES = ("aging", "slip", "prz", "nagata")
 
@@ -311,7 +311,7 @@ def simulate_command(**options: Any) -> None:
     every = None if options["every"] is None else _positive(options["every"], "time", "--every")
     output, plot_path = options["output"], options["plot_path"]
     side = sidecar(output)
-    refuse_input_as_output(
+    refuse_overwriting_inputs(
         [options["protocol_file"], options["params_file"]],
         [("-o", output), ("-o (its NAME.params.json)", side), ("--plot", plot_path)],
     )
@@ -353,7 +353,7 @@ def stability_command(**options: Any) -> None:
     from ..rsf import stability
 
     params = build_params(options)
-    refuse_input_as_output([options.get("params_file")], [("--plot", options["plot_path"])])
+    refuse_overwriting_inputs([options.get("params_file")], [("--plot", options["plot_path"])])
     reports = [stability(params, _positive(v, "velocity", "--velocity")).as_dict() for v in options["velocities"]]
     if options["as_json"]:
         click.echo(json_text(reports if len(reports) > 1 else reports[0]))
@@ -525,7 +525,9 @@ def fit_command(**options: Any) -> None:
     from ..rsf.fit import fit_record
 
     output, plot_path = options["output"], options["plot_path"]
-    refuse_input_as_output([options["record_file"], options["protocol_file"]], [("-o", output), ("--plot", plot_path)])
+    refuse_overwriting_inputs(
+        [options["record_file"], options["protocol_file"]], [("-o", output), ("--plot", plot_path)]
+    )
     window = _window(options["window_text"])  # the options first: a typing error is said before the record is read
     max_time = _positive(options["max_time"], "time", "--max-time")
     reading = {} if options["displacement_unit"] is None else {"displacement_unit": options["displacement_unit"]}
@@ -832,7 +834,7 @@ def _history(options: dict[str, Any], record: Any) -> Any:
     if options["protocol_file"] is not None:
         return protocols.read_protocol(options["protocol_file"])
     if options["segment"]:
-        return protocols.Protocol(tuple(protocols.parse_segment(s) for s in options["segment"]))
+        return protocols.Protocol(tuple(protocols.parse_segment(checked_segment_text(s)) for s in options["segment"]))
     return None
 
 

@@ -33,7 +33,7 @@ from ..errors import DataError, ModelError, ParameterError
 from ..parameters import Parameters, key_dimension, load_parameters
 from ..quasistatic.critical import critical_point
 from ..quasistatic.steady import steady_state
-from ..units import to_si
+from ..units import shorten, to_si
 from . import identify
 from .critical_uncertainty import Profile, critical_gradient, local_critical
 from .data import SteadyData, read_steady_data
@@ -397,7 +397,7 @@ def fit_steady(
     data: SteadyData | str | Path,
     params: Parameters | str | None = None,
     method: str = "two-step",
-    split: float = DEFAULT_SPLIT,
+    split: float | str = DEFAULT_SPLIT,
     fix: Mapping[str, Any] | None = None,
     free: Sequence[str] | None = None,
     intervals: str | None = None,
@@ -414,6 +414,8 @@ def fit_steady(
     None picks the method whose coverage was checked for each fit method
     (docs/fitting.md): ``delta`` for two-step, ``profile`` for joint.
     """
+    if not isinstance(data, SteadyData | str | Path):
+        raise DataError(f"data: expected SteadyData or the path of a steady-sliding table, got {shorten(data)}")
     if not isinstance(data, SteadyData):
         data = read_steady_data(data)
     if method not in METHODS:
@@ -436,6 +438,7 @@ def fit_steady(
         )
     if not 0.0 < level < 1.0:
         raise ParameterError(f"level: expected a confidence level between 0 and 1, got {level!r}")
+    split = to_si(split, "velocity", "split")  # a number (m/s) or a string with its unit, "800 um/s"
     if not (math.isfinite(split) and split > 0):
         raise ParameterError(f"split: expected a positive velocity in m/s, got {split!r}")
     if intervals == "bootstrap" and bootstrap_samples < 20:

@@ -91,7 +91,10 @@ class RSFParams:
             if not isinstance(item, StateVariable):
                 raise ParameterError(f"states: expected StateVariable items, got {type(item).__name__}")
         object.__setattr__(self, "states", states)
-        object.__setattr__(self, "mu0", _finite("mu0", self.mu0))
+        mu0 = _finite("mu0", self.mu0)
+        if mu0 <= 0:  # the friction coefficient at V0 of a slider pressed on its track: below zero it would push
+            raise ParameterError(f"mu0: expected a positive friction coefficient (friction at V0), got {mu0:g}")
+        object.__setattr__(self, "mu0", mu0)
         object.__setattr__(self, "v_ref", _finite("v_ref", self.v_ref, 0.0))
         object.__setattr__(self, "stiffness", _finite("stiffness", self.stiffness, 0.0))
         object.__setattr__(self, "eta", _finite("eta", self.eta, 0.0, strict=False))

@@ -219,6 +219,9 @@ def critical_stiffness_details(
     params: Parameters, velocity: float, aging: bool = True, mass: float = 0.0, damping: float = 0.0
 ) -> CriticalStiffness:
     """Kc with the unstable mode (real runaway or oscillation) and its rate."""
+    from ..quasistatic.steady import require_parameters
+
+    require_parameters(params)
     mass, damping = _block_terms(mass, damping)
     tau = params.bonds.bond_time
 
