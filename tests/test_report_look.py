@@ -31,14 +31,20 @@ def simulations(params):
     return {v: simulate(params, v * 1e-6, DURATIONS[v], start_stress=0.0 if v == 350 else None) for v in (50, 100, 350)}
 
 
-def test_fig5_legend_names_every_phase_drawn_in_any_panel(simulations):
-    """Fig 5c's steady part is green in panel (c) only; the one legend (on panel a) must still name it."""
+def test_fig5_each_panel_legend_names_what_that_panel_draws(simulations):
+    """Fig 5c's steady part is green in panel (c) only: panel (c) names it, panel (a)'s legend does not (issue 32);
+    every phase drawn anywhere is named by some legend, each once."""
     fig = figure_cycles([simulations[v] for v in (50, 100, 350)])
-    drawn = {line.get_label() for ax in fig.axes for line in ax.get_lines() if not line.get_label().startswith("_")}
-    assert "steady" in drawn  # the 350 um/s run does settle (the model, not this test, says so)
-    legend = fig.axes[0].get_legend()
-    assert legend is not None
-    assert drawn <= {t.get_text() for t in legend.get_texts()}
+    named: list[str] = []
+    for ax in fig.axes:
+        drawn = {line.get_label() for line in ax.get_lines() if not line.get_label().startswith("_")}
+        legend = ax.get_legend()
+        shown = [t.get_text() for t in legend.get_texts()] if legend is not None else []
+        assert set(shown) <= drawn, f"{ax.get_title()}: legend names {set(shown) - drawn}, not drawn there"
+        assert drawn <= set(shown) | set(named)  # what an earlier legend did not name, this one does
+        named += shown
+    assert "steady" in named and "steady" not in [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
+    assert len(named) == len(set(named))
 
 
 def test_fig3_6_paper_triangles_take_the_colour_of_their_curve(params, simulations):

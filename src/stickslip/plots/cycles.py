@@ -19,15 +19,17 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..display import velocity as _velocity_text
+from .legends import legend_per_panel
 from .style import (
     AGING_COLOR,
     CRITICAL_COLOR,
     DATA_COLOR,
     NO_AGING_COLOR,
+    STRESS_LABEL,
     UM_PER_S,
     VELOCITY_LABEL,
     apply_style,
-    legend_of_all_panels,
+    legend_of_all_panels,  # noqa: F401  (re-exported by the deprecated stickslip.cycle_plots)
     new_axes,
 )
 
@@ -45,7 +47,6 @@ SLIP_COLOR = AGING_COLOR
 STEADY_COLOR = "#27ae60"
 PHASE_COLORS = {"stick": STICK_COLOR, "slip": SLIP_COLOR, "steady": STEADY_COLOR}
 TIME_LABEL = "time t (s)"
-STRESS_LABEL = "shear stress σ (Pa)"
 
 
 def _um(v: float) -> str:
@@ -83,8 +84,9 @@ def plot_stick(stick: StickPhase, ax: Axes | None = None, **kwargs: Any) -> Axes
     kwargs.setdefault("label", f"V0 = {_um(stick.pulling_velocity)}" + ("" if stick.aging else ", no aging"))
     kwargs.setdefault("linewidth", 1.8)
     line = ax.plot(stick.time, stick.chain_fraction, **kwargs)[0]
-    if stick.stick_time is not None:
-        ax.plot([stick.stick_time], [0.0], "o", color=line.get_color(), markersize=5)
+    if stick.stick_time is not None:  # gid: the name of its CSV in a report (it has no legend entry)
+        ax.plot([stick.stick_time], [0.0], "o", color=line.get_color(), markersize=5,
+                gid=f"stick time ts, {line.get_label()}")  # fmt: skip
     ax.set_xlabel("time since sticking t (s)")
     ax.set_ylabel("attached chains $N_c/N_{c0}$")
     ax.set_ylim(-0.03, 1.05)
@@ -136,7 +138,7 @@ def figure_cycles(
         ax.set_title(f"({chr(ord('a') + k)}) V0 = {_um(sim.pulling_velocity)}: {sim.regime}", fontsize=10, loc="left")
         if k < len(simulations) - 1:
             ax.set_xlabel("")
-    legend_of_all_panels(fig)
+    legend_per_panel(fig)
     if title:
         fig.suptitle(title, fontsize=11)
     return fig
@@ -244,7 +246,7 @@ def figure_cycle_path(params: Parameters, simulation: Simulation, title: str | N
     path_style = {"color": "#111111", "linewidth": 2.2}
     if stick is not None:
         top = stick.peak_stress if stick.peak_stress is not None else float(stick.stress[-1])
-        ax.plot([0.0, 0.0], [stick.start_stress, top], **path_style)
+        ax.plot([0.0, 0.0], [stick.start_stress, top], **path_style, gid="stick path")
         ax.annotate("stick", xy=(0.0, 0.5 * (stick.start_stress + top)), xytext=(6, 0), textcoords="offset points",
                     fontsize=9, va="center")  # fmt: skip
         if slip is not None:

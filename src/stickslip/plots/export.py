@@ -3,7 +3,8 @@
 The CSV files are read back from the matplotlib artists themselves, so they
 hold exactly what is drawn: every line and every set of points drawn in data
 coordinates (reference lines such as ``axvline`` and shaded spans are not
-curves and are skipped).  Columns are named after the axis labels.
+curves and are skipped).  Columns are named after the axis labels; files after
+the ``gid`` a figure gave the curve, else after its legend label.
 """
 
 from __future__ import annotations
@@ -107,8 +108,13 @@ def _axis_label(ax: Axes, which: str) -> str:
 SLUG_LENGTH = 40
 
 
+#: Letters of the labels spelled in ASCII for file names ("ρh" -> "rhoh", "1000 × ρh" -> "1000-x-rhoh").
+_ASCII = str.maketrans({"µ": "u", "σ": "sigma", "τ": "tau", "ρ": "rho", "η": "eta", "λ": "lambda", "Δ": "delta",
+                        "χ": "chi", "×": "x", "ₛ": "s", "₀": "0"})  # fmt: skip
+
+
 def _slug(text: str) -> str:
-    text = plain_label(text).lower().replace("µ", "u").replace("σ", "sigma").replace("τ", "tau")
+    text = plain_label(text).translate(_ASCII).lower()
     slug = re.sub(r"[^a-z0-9]+", "-", text).strip("-")
     if len(slug) > SLUG_LENGTH:
         slug = slug[: SLUG_LENGTH + 1].rsplit("-", 1)[0]
@@ -144,7 +150,7 @@ def extract_curves(figure: Figure, figure_id: str) -> list[Curve]:
         panel = chr(ord("a") + index) if len(panels) > 1 else ""
         x_name = _column(_axis_label(ax, "x"), "x")
         y_name = _column(_axis_label(ax, "y"), "y")
-        found: list[tuple[str, np.ndarray, np.ndarray]] = []
+        found: list[tuple[str, str | None, np.ndarray, np.ndarray]] = []
         labels, caps = _errorbar_parts(ax)
         for line in ax.get_lines():
             if not _in_data_coordinates(line, ax) or id(line) in caps:
@@ -152,14 +158,14 @@ def extract_curves(figure: Figure, figure_id: str) -> list[Curve]:
             x = np.asarray(line.get_xdata(), dtype=float).ravel()
             y = np.asarray(line.get_ydata(), dtype=float).ravel()
             if x.size and x.size == y.size:
-                found.append((labels.get(id(line), str(line.get_label())), x, y))
+                found.append((labels.get(id(line), str(line.get_label())), line.get_gid(), x, y))
         for collection in ax.collections:
             offsets = np.asarray(collection.get_offsets(), dtype=float)
             if offsets.ndim != 2 or offsets.shape[0] == 0 or collection.get_offset_transform() != ax.transData:
                 continue
-            found.append((str(collection.get_label()), offsets[:, 0], offsets[:, 1]))
-        for k, (label, x, y) in enumerate(found):
-            shown = "" if label.startswith("_") else plain_label(label)
+            found.append((str(collection.get_label()), collection.get_gid(), offsets[:, 0], offsets[:, 1]))
+        for k, (label, gid, x, y) in enumerate(found):
+            shown = _shown_name(label, gid)
             unnamed = f"{'point' if x.size == 1 else 'curve'}-{k + 1}"
             stem = "_".join(s for s in (figure_id, panel, _slug(shown) or unnamed) if s)
             name, n = stem, 2
@@ -168,6 +174,14 @@ def extract_curves(figure: Figure, figure_id: str) -> list[Curve]:
             used.add(name)
             curves.append(Curve(name, figure_id, panel, shown, x_name, y_name, x, y))
     return curves
+
+
+def _shown_name(label: str, gid: str | None) -> str:
+    """A curve's name: the one its figure gave it as ``gid`` (a marker the legend leaves out, one of several
+    lines drawn as one with one legend entry), else its legend label; empty when it has neither."""
+    if gid:
+        return plain_label(gid)
+    return "" if label.startswith("_") else plain_label(label)
 
 
 def _num(value: float) -> str:

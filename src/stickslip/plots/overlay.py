@@ -31,7 +31,7 @@ def overlay_figure(runs: Mapping[str, Run], title: str = "") -> Figure:
             right = top.twinx() if right is None else right
             right.plot(run.time, run.friction, color=color, lw=1.2, ls="--", label=label)
         bottom.plot(run.time, np.asarray(run.slider_velocity) * 1e6, color=color, lw=0.9)
-    top.set_ylabel("friction stress (Pa)")
+    top.set_ylabel("friction stress σ (Pa)")
     if right is not None:
         right.set_ylabel("friction coefficient μ (dashed)")
     handles = [h for ax in (top, right) if ax is not None for h in ax.get_legend_handles_labels()[0]]

@@ -17,7 +17,7 @@ def plot_run(run: Run, ax: Axes | None = None, *, velocity: bool = True) -> Axes
     ax = new_axes(ax, figsize=(7, 4))
     if run.stress is not None:
         ax.plot(run.time, run.stress, color="C0", lw=1.2, label="stress")
-        ax.set_ylabel("friction stress (Pa)")
+        ax.set_ylabel("friction stress σ (Pa)")
     else:
         ax.plot(run.time, run.friction, color="C0", lw=1.2, label="friction")
         ax.set_ylabel("friction coefficient")

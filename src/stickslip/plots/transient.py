@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .style import apply_style, new_axes
+from .style import STRESS_LABEL, apply_style, new_axes
 
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.axes import Axes
@@ -26,7 +26,7 @@ def plot_transient(result: TransientResult, ax: Axes | None = None, velocity: bo
     ax = new_axes(ax)
     ax.plot(result.time, result.stress, color=kwargs.pop("color", "C0"), label="σ (Pa)", **kwargs)
     ax.set_xlabel("time (s)")
-    ax.set_ylabel("stress σ (Pa)")
+    ax.set_ylabel(STRESS_LABEL)
     if velocity:
         twin = ax.twinx()
         v = np.asarray(result.slider_velocity, float) * 1e6
@@ -82,7 +82,7 @@ def figure_transient_runs(
         ax_cycle.plot(quasi.time + shift, quasi.stress, color="k", lw=0.8, ls="--", label="quasi-static, shifted")
     ax_cycle.set_xlim(0, duration)
     ax_cycle.set_xlabel("time (s)")
-    ax_cycle.set_ylabel("stress σ (Pa)")
+    ax_cycle.set_ylabel(STRESS_LABEL)
     ax_cycle.set_title(f"{high * 1e6:.0f} → {low * 1e6:.0f} µm/s through the block", fontsize=10)
     ax_cycle.legend(fontsize="small", loc="upper left")
 
@@ -92,13 +92,13 @@ def figure_transient_runs(
         near = slip <= 2.0
         ax_step.plot(slip[near], steps.stress[after][near], color=color, lw=1.2, label=label)
     ax_step.set_xlabel("slip since the step (µm)")
-    ax_step.set_ylabel("stress σ (Pa)")
+    ax_step.set_ylabel(STRESS_LABEL)
     ax_step.set_title(step_title, fontsize=9)
     ax_step.legend(fontsize="small")
 
     ax_hold.loglog(holds, peaks, "o-", color="C3", label="peak on re-sliding")
     ax_hold.set_xlabel("hold time (s)")
-    ax_hold.set_ylabel("peak stress (Pa)")
+    ax_hold.set_ylabel("peak friction stress (Pa)")
     ax_hold.set_title("slide-hold-slide at 100 µm/s", fontsize=9)
     for ax in (ax_cycle, ax_step, ax_hold):
         apply_style(ax)

@@ -34,7 +34,7 @@ def saturating_figure(run: ModelRun) -> ReportFigure:
     from ..fitting.data import read_steady_data
     from ..fitting.datasets import synthetic_steady_path, table1
     from ..fitting.saturation_fit import fit_saturation
-    from ..plots.style import apply_style
+    from ..plots.style import STRESS_LABEL, apply_style
     from ..quasistatic.cycle import simulate
     from ..quasistatic.steady import steady_state
 
@@ -68,7 +68,7 @@ def saturating_figure(run: ModelRun) -> ReportFigure:
     ax_curve.axhspan(542, 556, color="C2", alpha=0.2, lw=0, label="Table 1 σs (cycles from a slip)")
     ax_curve.set_ylim(0, 1200)
     ax_curve.set_xlabel("sliding velocity V (µm/s)")
-    ax_curve.set_ylabel("steady stress σ (Pa)")
+    ax_curve.set_ylabel(STRESS_LABEL)
     ax_curve.legend(fontsize="x-small", loc="upper right")
     ax_curve.set_title("one bond population with saturating aging", fontsize=10)
 
@@ -76,7 +76,7 @@ def saturating_figure(run: ModelRun) -> ReportFigure:
     ax_cycle.plot(two.time, two.stress, color="C0", lw=1.2, label="paper: bonds + stick chains")
     ax_cycle.set_xlim(0, CYCLE_TIME)
     ax_cycle.set_xlabel("time (s)")
-    ax_cycle.set_ylabel("stress σ (Pa)")
+    ax_cycle.set_ylabel(STRESS_LABEL)
     ax_cycle.set_title(f"stick-slip at {CYCLE_VELOCITY * UM:.0f} µm/s through the Eq 17 block", fontsize=10)
     ax_cycle.legend(fontsize="small", loc="lower right")
     for ax in (ax_curve, ax_cycle):
@@ -138,12 +138,12 @@ def _caption(fit, stick, slip, jump, two) -> str:  # type: ignore[no-untyped-def
         else "the paper's model gives no whole cycle in this window"
     )
     return (
-        "Extension (docs/extensions.md section 1), off by default: Eq 1's aging term −(t_a/τa)e^{−V/Va} with the "
-        "age replaced by t_s(1 − e^{−t_a/t_s}), a bond barrier that matures by first-order kinetics and stops "
-        "strengthening past t_s. One bond population then has an N-shaped steady curve: a maximum at low velocity "
-        "(creep gives way to slip: the static threshold σs), the minimum at Vc (re-stick), and the jump between "
-        "branches. Fitted to the steady data plus Table 1's σs and σc (95 % intervals): "
-        f"t_s = {show('aging.saturation_age', 1e3, 'ms')}, τa = {show('aging.aging_time', 1e3, 'ms')}, "
+        "Extension (docs/extensions.md section 1), off by default: Eq 1's aging term −(t_{a}/τa) e^{−V/Va} with the "
+        "age replaced by t_{s}(1 − e^{−t_{a}/t_{s}}), a bond barrier that matures by first-order kinetics and stops "
+        "strengthening past the saturation age t_{s}. One bond population then has an N-shaped steady curve: a "
+        "maximum at low velocity (creep gives way to slip: the static threshold σs), the minimum at Vc (re-stick), "
+        "and the jump between branches. Fitted to the steady data plus Table 1's σs and σc (95 % intervals): "
+        f"t_{{s}} = {show('aging.saturation_age', 1e3, 'ms')}, τa = {show('aging.aging_time', 1e3, 'ms')}, "
         f"Va = {show('aging.aging_velocity', 1e6, 'µm/s')}, χ² = {fit.chi_square:.1f} for {fit.dof} degrees of "
         f"freedom. Top: σs = {fit.peak.stress:.1f} Pa at {fit.peak.velocity * UM:.1f} µm/s, "
         f"σc = {fit.minimum.stress:.1f} Pa at Vc = {fit.minimum.velocity * UM:.1f} µm/s (paper: 124 µm/s); "

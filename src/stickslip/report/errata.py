@@ -14,6 +14,7 @@ from html import escape
 from importlib import resources
 
 from ..errors import DataError
+from .markup import inline_html
 
 _ENTRY = re.compile(r"^(E\d+)\b[\s.:—–-]*(.*)$")
 #: The one piece of raw HTML the errata may use: an empty anchor, ``<a id="e1"></a>``.
@@ -59,7 +60,7 @@ def render_errata(text: str, source: str = "errata.md") -> Errata:
     from markdown_it import MarkdownIt
 
     md = MarkdownIt("commonmark", {"html": True}).enable("table").disable("image")
-    tokens = md.parse(text)
+    tokens = _without_title(md.parse(text))
     entries: list[ErrataEntry] = []
     for k, token in enumerate(tokens):
         if token.type != "heading_open" or token.tag != "h2":
@@ -81,8 +82,17 @@ def render_errata(text: str, source: str = "errata.md") -> Errata:
             _neutralise(token, heading_ids)
         elif token.type == "inline" and token.children:
             _neutralise_inline(token.children, heading_ids)
+            _raise_superscripts(token.children)
     html = md.renderer.render(tokens, md.options, {}).replace("<p></p>\n", "")
     return Errata(source, tuple(entries), html)
+
+
+def _without_title(tokens: list) -> list:
+    """The tokens without the document's level-1 title: the report's section carries its own "Errata" heading,
+    and the title, moved one level down, would be a second one."""
+    if len(tokens) >= 3 and tokens[0].type == "heading_open" and tokens[0].tag == "h1":
+        return tokens[3:]
+    return tokens
 
 
 def _neutralise(token: object, heading_ids: set[str]) -> None:
@@ -94,6 +104,14 @@ def _neutralise(token: object, heading_ids: set[str]) -> None:
         token.content = "" if name in heading_ids else f'<a id="{name}"></a>\n'  # type: ignore[attr-defined]
     else:
         token.content = escape(content)  # type: ignore[attr-defined]
+
+
+def _raise_superscripts(children: list) -> None:
+    """``e^{−V/Va}`` in the errata's text (never in its code) as a superscript, not as raw TeX."""
+    for child in children:
+        if child.type == "text" and ("^" in child.content or "_{" in child.content):
+            child.type = "html_inline"
+            child.content = inline_html(child.content)
 
 
 def _neutralise_inline(children: list, heading_ids: set[str]) -> None:

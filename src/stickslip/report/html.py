@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from html import escape
@@ -15,6 +16,7 @@ from .comparisons import CLASSES, TOLERANCE, Comparison, count_classes
 from .errata import Errata
 from .figures import Curve, ReportFigure, data_uri
 from .formatting import DISPLAY_UNITS, format_parameter, format_percent, format_quantity
+from .markup import inline_html
 from .paper import TABLE1_COLUMNS, TABLE1_ROWS, PaperNumber
 
 #: Opening of a wide table's box: it scrolls sideways when the window is too narrow, and then says so
@@ -51,7 +53,7 @@ def figure_section(item: RenderedFigure) -> str:
         f"<h2>{escape(f.number)}: {escape(f.title)}</h2>\n"
         f"<figure>\n"
         f'<img src="{data_uri(item.png)}" alt="{escape(f.number)}: {escape(f.title)}">\n'
-        f"<figcaption>{escape(f.caption)}"
+        f"<figcaption>{inline_html(f.caption)}"
         f'<span class="files">Files: <a href="{escape(f.id)}.png">{escape(f.id)}.png</a>, '
         f'<a href="{escape(f.id)}.svg">{escape(f.id)}.svg</a>; curves: {csv_links}</span>'
         f"</figcaption>\n</figure>\n</section>"
@@ -198,11 +200,40 @@ def _note(text: str) -> str:
     return f'<br><span class="note">{escape(text)}</span>' if text else ""
 
 
+#: The paper's symbols where a parameter's own (ASCII, to be typed on a command line) differs; the two aging times
+#: the paper calls τa both get a label saying which one they are.
+PAPER_SYMBOLS = {
+    "bonds.site_density": "N_{0}",
+    "bonds.bond_time": "τ",
+    "bonds.breakage_weight": "u_{0}",
+    "bonds.activation_length": "λ",
+    "bonds.max_extension": "Δl_{m}",
+    "aging.aging_time": "τ_{a} of the bonds (Eqs 1, 6)",
+    "aging.aging_velocity": "V_{a}",
+    "aging.saturation_age": "t_{s}",
+    "stick.attached_chains": "N_{c0}",
+    "stick.break_rate": "u_{c}/τ",
+    "stick.aging_time": "τ_{a} of the stick chains (Eq 15)",
+    "block.shear_modulus": "G_{d}",
+}
+_GREEK = {"tau": "τ", "lambda": "λ", "eta": "η", "rho": "ρ", "sigma": "σ", "mu": "µ", "theta": "θ", "dl": "Δl"}
+_ASCII_GREEK = re.compile(r"\b(" + "|".join(_GREEK) + r")(?=\b|_)")
+
+
+def parameter_symbol(key: str, symbol: str) -> str:
+    """The symbol a reader of the paper knows (with subscript marks for :func:`inline_html`): the paper's where
+    known, else the parameter's own with its Greek letters and subscripts written out."""
+    if key in PAPER_SYMBOLS:
+        return PAPER_SYMBOLS[key]
+    written = _ASCII_GREEK.sub(lambda m: _GREEK[m.group(1)], symbol)
+    return re.sub(r"_([A-Za-z0-9]+)", r"_{\1}", written)
+
+
 def parameter_table(params: Parameters) -> str:
     out = ["<table>\n<thead><tr><th>Key</th><th>Symbol</th><th>Value</th><th>Meaning</th></tr></thead>\n<tbody>"]
     for key, symbol, value, dimension, meaning in parameter_rows(params):
         out.append(
-            f"<tr><td><code>{escape(key)}</code></td><td>{escape(symbol)}</td>"
+            f"<tr><td><code>{escape(key)}</code></td><td>{inline_html(parameter_symbol(key, symbol))}</td>"
             f'<td class="num">{escape(format_parameter(value, dimension))}</td><td>{escape(meaning)}</td></tr>'
         )
     out.append("</tbody>\n</table>")
@@ -233,13 +264,13 @@ def summary_sentence(rows: Sequence[Comparison]) -> str:
     """The headline: how many rows fall in each class."""
     counts = count_classes(list(rows))
     text = (
-        f"{len(rows)} numbers stated in the paper are compared with this package's computation: "
-        f"{counts['input']} are the paper's own inputs handed back (parameters and arithmetic on them, not counted "
-        f"as agreement); {counts['agrees']} agree within {100 * TOLERANCE:g} %; {counts['scatter']} lie within the "
-        f"scatter the paper states or shows; {counts['erratum']} differ because of an error in the paper (where "
-        f"the paper contradicts itself; each links its erratum); {counts['limitation']} are limitations of the "
-        "model (the model with the paper's stated inputs does not give them; each explained). A difference between "
-        "the model and a measurement is never counted as the paper's error."
+        f"Of the {len(rows)} numbers the paper states, {counts['agrees']} agree with this package's computation "
+        f"within {100 * TOLERANCE:g} % and {counts['scatter']} lie within the scatter the paper states or shows. "
+        f"{counts['erratum']} differ because of an error in the paper (where the paper contradicts itself; each "
+        f"links its erratum) and {counts['limitation']} are limitations of the model (the model with the paper's "
+        f"stated inputs does not give them; each explained). The other {counts['input']} are the paper's own inputs "
+        "handed back (parameters and arithmetic on them), not counted as agreement. A difference between the model "
+        "and a measurement is never counted as the paper's error."
     )
     return escape(text)
 
@@ -289,6 +320,18 @@ def threshold_paragraph(
     )
 
 
+def limitations_section(paragraphs: str) -> str:
+    """The model's limitations, after the figures: a reader meets what agrees first."""
+    if not paragraphs:
+        return ""
+    return (
+        '<section id="limitations">\n<h2>Limitations of the model</h2>\n'
+        "<p>Where the model, with the paper's inputs, cannot give what the experiment shows. The numbers it cannot"
+        " give are in the table below, class “model limitation”.</p>\n"
+        f"{paragraphs}\n</section>"
+    )
+
+
 def render_report(
     *,
     version: str,
@@ -308,6 +351,9 @@ def render_report(
         f'<li><a href="#{escape(f.figure.id)}">{escape(f.figure.number)}: {escape(f.figure.title)}</a></li>'
         for f in figures
     ]
+    limitation = threshold_paragraph(thresholds or {}, jump_floor, curve_maximum)
+    if limitation:
+        contents.append('<li><a href="#limitations">Limitations of the model</a></li>')
     contents += [
         '<li><a href="#comparisons">Every number the paper states</a></li>',
         '<li><a href="#parameters">Parameters used</a></li>',
@@ -323,7 +369,7 @@ def render_report(
         built=escape(built),
         elapsed=f"{elapsed:.1f}",
         summary=summary_sentence(comparisons),
-        limitation=threshold_paragraph(thresholds or {}, jump_floor, curve_maximum),
+        limitations=limitations_section(limitation),
         stiffness=stiffness_paragraph(comparisons),
         contents="\n".join(contents),
         figures="\n".join(figure_section(f) for f in figures),

@@ -55,23 +55,29 @@ def inertia_figure(run: ModelRun) -> ReportFigure:
     fig = Figure(figsize=(6.8, 4.2))
     ax_im, ax_re = fig.subplots(2, 1, sharex=True)
     hz = w / (2 * math.pi)
-    for (block, kc), color in zip(rows, ("k", "C0", "C3", "C1"), strict=True):
-        # the stiffness a root at i w needs, K = m w^2 - i eta w - Z(i w): a Hopf point where it is real
-        need = block.mass * w * w - 1j * block.damping * w - z
-        ax_im.plot(hz, need.imag, color=color, lw=1.2, label=block.label)
-        ax_re.plot(hz, need.real, color=color, lw=1.2, label=block.label)
-        ax_re.plot([kc.rate / (2 * math.pi)], [kc.value], "o", color=color, ms=4, label=f"Hopf point, {block.label}")
+    for ax in (ax_im, ax_re):  # scales first: which curves coincide is judged as the axes show them
+        ax.set_xscale("log")
+        ax.set_yscale("symlog", linthresh=1e6, linscale=0.4)
+    # the stiffness a root at i w needs, K = m w^2 - i eta w - Z(i w): a Hopf point where it is real
+    needs = [block.mass * w * w - 1j * block.damping * w - z for block, _ in rows]
+    labels = [shown_label(block.label) for block, _ in rows]
+    colors = ("k", "C0", "C3", "C1")
+    for ax, part in ((ax_im, np.imag), (ax_re, np.real)):
+        drawn = _draw_coinciding(ax, hz, [part(need) for need in needs], labels, colors)
+    for (_, kc), label, color in zip(rows, labels, drawn, strict=True):
+        # the Hopf points, on their line and in its colour, are named in the caption (dots); each keeps its name
+        # for its CSV
+        ax_re.plot([kc.rate / (2 * math.pi)], [kc.value], "o", color=color, ms=4, label="_hopf",
+                   gid=f"Hopf point, {label}")  # fmt: skip
     ax_im.axhline(0.0, color="0.5", lw=0.6)
-    ax_im.set_yscale("symlog", linthresh=1e6, linscale=0.4)
-    ax_re.set_yscale("symlog", linthresh=1e6, linscale=0.4)
     for ax in (ax_im, ax_re):  # decades only: the linear band around 0 would crowd its labels
         ax.set_yticks([-1e9, -1e7, 0.0, 1e7, 1e9] + ([] if ax is ax_im else [1e11]))
-    ax_re.set_xscale("log")
     ax_im.set_ylabel("Im (Pa/m)")
     ax_re.set_ylabel("Re (Pa/m)")
     ax_re.set_xlabel("frequency ω/2π (Hz)")
     ax_im.set_title(f"K = m ω² − iηω − Z(iω) puts a root at iω ({VELOCITY * 1e6:.0f} µm/s)", fontsize=9)
-    ax_im.legend(fontsize="x-small")
+    for ax in (ax_im, ax_re):  # lower left: no curve goes below zero at low frequency
+        ax.legend(fontsize="x-small", loc="lower left", frameon=False)
     for ax in (ax_im, ax_re):
         apply_style(ax)
     fig.tight_layout()
@@ -79,10 +85,41 @@ def inertia_figure(run: ModelRun) -> ReportFigure:
                         _caption(rows, root, massless, gel, heavy), fig)  # fmt: skip
 
 
+#: The blocks' labels (stickslip.studies.inertia) as a reader writes them.
+_SYMBOLS = (("rho h", "ρh"), (" x ", " × "), ("2 c_s", "2cₛ"))
+
+
+def shown_label(label: str) -> str:
+    """``"1000 x rho h"`` -> ``"1000 × ρh"``: the symbols, not their ASCII spelling."""
+    for ascii_text, symbol in _SYMBOLS:
+        label = label.replace(ascii_text, symbol)
+    return label
+
+
+def _draw_coinciding(ax, x, curves, labels, colors) -> list[str]:  # type: ignore[no-untyped-def]
+    """One visible line, with one legend entry, per group of curves that lie on top of one another on ``ax``.
+
+    Every curve is still drawn (its CSV holds it), in its group's colour; the legend names the group once.
+    Returns the colour each curve was drawn in.
+    """
+    from ..plots.legends import coinciding_groups
+
+    drawn = list(colors)
+    for group in coinciding_groups(ax, curves):
+        names = [labels[k] for k in group]
+        shown = names[0] if len(names) == 1 else ",\n".join(names) + ": one line (they coincide)"
+        for position, k in enumerate(group):
+            drawn[k] = colors[group[0]]
+            ax.plot(x, curves[k], color=drawn[k], lw=1.2, label=shown if position == 0 else "_same",
+                    gid=labels[k])  # fmt: skip
+    return drawn
+
+
 def _caption(rows, root, massless, gel, heavy) -> str:  # type: ignore[no-untyped-def]
     base = rows[0][1]
     parts = [
-        f"{block.label} (m = {block.mass:.3g} kg/m², η = {block.damping:.4g} Pa·s/m): Kc = {kc.value:.5g} Pa/m"
+        f"{shown_label(block.label)} (m = {block.mass:.3g} kg/m², η = {block.damping:.4g} Pa·s/m):"
+        f" Kc = {kc.value:.5g} Pa/m"
         f" ({100 * (kc.value / base.value - 1):+.2f} %), {kc.rate / (2 * math.pi):.4g} Hz"
         for block, kc in rows
     ]
@@ -128,7 +165,7 @@ def inertia_run_figure(run: ModelRun) -> ReportFigure:
     with_mass = run_transient(params, protocol, mass=gel.mass, damping=gel.damping, **common)
     runs = [
         ("massless block (the paper's)", run_transient(params, protocol, **common), "k"),
-        (gel.label, with_mass, "C0"),
+        (shown_label(gel.label), with_mass, "C0"),
     ]
     fig = Figure(figsize=(6.8, 3.4))
     ax = fig.subplots()
@@ -151,7 +188,8 @@ def inertia_run_figure(run: ModelRun) -> ReportFigure:
     caption = (
         f"The time-dependent model (Eq 1) from steady sliding at {DEPARTURE_VELOCITY * 1e6:.0f} µm/s, the unstable"
         f" branch, through the paper's block K = {massless.stiffness:.3g} Pa/m, without and with the block's mass"
-        f" and damping ({gel.label}: m = {gel.mass:.3g} kg/m², η = {gel.damping:.4g} Pa·s/m). The massless slider"
+        f" and damping ({shown_label(gel.label)}: m = {gel.mass:.3g} kg/m², η = {gel.damping:.4g} Pa·s/m)."
+        " The massless slider"
         f" leaves the branch in its first step, its velocity jumping to {massless.slider_velocity[1] * 1e6:.4g} µm/s"
         " (no time scale: there the massless model is ill posed), and creeps towards rest. With the mass the slider"
         " slides on until the unstable root (3.9e4 1/s by the linear analysis) has grown from round-off, decelerates,"

@@ -110,7 +110,7 @@ def cycles_figure(run: ModelRun) -> ReportFigure:
     s50, s100, s350 = sims
     first = s350.cycles[0]
     caption = (
-        "Shear stress against time at V0 = 50, 100 and 350 µm/s (Eqs 10-17). At 50 and 100 µm/s the run starts "
+        "Friction stress against time at V0 = 50, 100 and 350 µm/s (Eqs 10-17). At 50 and 100 µm/s the run starts "
         "with a stick at σc (dashed line); stick phases rise linearly (Eq 12) and end at σs (Eq 16); slip phases "
         f"follow the steady curve down to σc. At 50 µm/s the period is {s50.cycles[0].period:.1f} s "
         f"(stick {s50.cycles[0].stick_time:.1f} s); at 100 µm/s {s100.cycles[0].period:.1f} s "
@@ -125,8 +125,8 @@ def cycles_figure(run: ModelRun) -> ReportFigure:
 
 
 def _label_critical_stress_and_clear_peaks(fig: Figure, critical_stress: float) -> None:
-    """Name the dashed σc line in the legend, and leave room above the peaks so the legend covers no data."""
-    from ..plots.cycles import legend_of_all_panels
+    """Name the dashed σc line in the legend, and leave room above the peaks so the legends cover no data."""
+    from ..plots.legends import legend_per_panel
 
     for index, ax in enumerate(fig.axes):
         for line in ax.get_lines():
@@ -134,7 +134,7 @@ def _label_critical_stress_and_clear_peaks(fig: Figure, critical_stress: float) 
                 line.set_label(f"σc = {critical_stress:.1f} Pa" if index == 0 else "_σc")
         low, high = ax.get_ylim()
         ax.set_ylim(low, high + 0.25 * (high - low))
-    legend_of_all_panels(fig)
+    legend_per_panel(fig)
 
 
 def slip_velocity_figure(run: ModelRun) -> ReportFigure:

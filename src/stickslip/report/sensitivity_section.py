@@ -45,7 +45,8 @@ def sensitivity_figure(run: ModelRun) -> ReportFigure:
     ax_region.set_ylabel("Va (µm/s)")
     ax_region.set_yscale("log")
     ax_region.set_title("95 % region (Δχ² = 5.99)", fontsize=9)
-    ax_region.legend(fontsize="small")
+    # below the panel: inside, the ring's empty middle is where the best-fit star sits
+    ax_region.legend(fontsize="small", loc="upper center", bbox_to_anchor=(0.5, -0.3), ncols=2, frameon=False)
     for k, (key, (label, _, _)) in enumerate(SHOWN.items()):
         values = np.array([r[key] for r in rows])
         change = 100 * (values[1:] / values[0] - 1)
@@ -54,7 +55,7 @@ def sensitivity_figure(run: ModelRun) -> ReportFigure:
     ax_spread.axhline(0.0, color="k", lw=0.8)
     ax_spread.set_xticks(range(len(SHOWN)), [v[0] for v in SHOWN.values()], rotation=30, ha="right", fontsize=8)
     ax_spread.set_ylabel("change from the best fit (%)")
-    ax_spread.set_xlabel("prediction (#)")
+    ax_spread.set_xlabel("quasi-static prediction")
     ax_spread.set_title("quasi-static predictions over the region", fontsize=9)
     for ax in (ax_region, ax_spread):
         apply_style(ax)
@@ -80,7 +81,7 @@ def _caption(region, table) -> str:  # type: ignore[no-untyped-def]
     return (
         "The joint fit of Eqs 6-8 to the shipped steady curve (synthetic_steady.csv: the paper's parameters with 2 %"
         " noise, 140 µm/s to 2 mm/s) leaves τa and Va loosely determined. Left: the boundary of the region of"
-        f" (τa, Va) it allows at 95 % (profile χ², N0 and τ refitted at each point; λ, Δl_m, M, T, u0 held as the"
+        f" (τa, Va) it allows at 95 % (profile χ², N0 and τ refitted at each point; λ, Δl_{{m}}, M, T, u0 held as the"
         f" fit holds them): τa {min(ta):.3f}–{max(ta):.3f} ms, Va {min(va):.0f}–{max(va):.0f} µm/s. Right: each"
         " quasi-static prediction at the 8 boundary points against the best fit (grey band: a spread of"
         f" {100 * TOLERANCE:.0f} %, the line between robust and not). Over the region: " + "; ".join(parts) + "."
