@@ -13,7 +13,7 @@ from stickslip import protocols
 from stickslip.parameters import load_parameters
 from stickslip.quasistatic.steady import steady_state
 from stickslip.rsf import RSFParams, StateVariable, simulate
-from stickslip.rsf import compare as cmp
+from stickslip.studies import bond_rsf as cmp
 
 PARAMS = load_parameters("gelatin-glass")
 

@@ -13,6 +13,7 @@ import pytest
     [
         ("stickslip.plotting", "stickslip.plots.steady", "figure_steady_curve"),
         ("stickslip.cycle_plots", "stickslip.plots.cycles", "figure_cycles"),
+        ("stickslip.rsf.compare", "stickslip.studies.bond_rsf", "rsf_of_bond"),
     ],
 )
 def test_an_old_name_warns_and_gives_the_same_function(old, new, name):
@@ -27,7 +28,9 @@ def test_the_package_itself_imports_no_deprecated_name():
 
     code = (
         "import sys, stickslip, stickslip.report.build, stickslip.report.figures, stickslip.cli.main; "
-        "print(sorted(m for m in ('stickslip.plotting', 'stickslip.cycle_plots') if m in sys.modules))"
+        "import stickslip.studies.bond_rsf, stickslip.studies.rsf_reading, stickslip.cli.compare_cmd; "
+        "print(sorted(m for m in ('stickslip.plotting', 'stickslip.cycle_plots', 'stickslip.rsf.compare')"
+        " if m in sys.modules))"
     )
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert done.returncode == 0 and done.stdout.strip() == "[]", done.stdout + done.stderr[-2000:]

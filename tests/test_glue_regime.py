@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 
 from stickslip import protocols, regimes
+from stickslip.models import as_run
 from stickslip.rsf import RSFParams, StateVariable, simulate
 
 
@@ -29,7 +30,7 @@ def test_rsf_regime_is_the_classifiers_regime() -> None:
         "regime", "final_friction", "period", "peak_friction", "trough_friction", "growth", "periods", "status",
         "message",
     }  # fmt: skip
-    assert run.to_run().regime.kind == kind
+    assert as_run(run).regime.kind == kind
 
 
 def test_rsf_blow_up_and_unanalysed_runs_carry_a_classifier_kind() -> None:

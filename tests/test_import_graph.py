@@ -11,11 +11,17 @@ import order); and with every import counted, every loop through drawing code is
 ``plot()`` importing its drawing lazily from :mod:`stickslip.plots`, which may name the result back.  The second
 rule is the one the six cycles of issue 20 broke (results and their plot modules, spread over nine places,
 importing each other lazily and for typing); with runtime imports only, that code had no cycle either.
+
+The house's rules (issue 30 item 1, docs/architecture.md): the package's rooms (its top-level modules and
+subpackages) stand in :data:`LAYERS`, lowest first; no import of any kind runs up the layers but the designed
+lazy draws and the :data:`UPWARD` arrows named with their reason; the engines import nothing above them, with
+no exception at all; and with every import counted, the only loops are the designed lazy plot ones.
 """
 
 from __future__ import annotations
 
 import ast
+import functools
 from collections.abc import Callable, Iterable, Iterator
 from pathlib import Path
 
@@ -78,13 +84,19 @@ def _absolute(node: ast.ImportFrom, module: str, is_package: bool) -> str:
     return ".".join([*base, node.module] if node.module else base)
 
 
+@functools.lru_cache(maxsize=4096)
+def _statements(path: Path, mtime_ns: int) -> tuple[tuple[ast.Import | ast.ImportFrom, str], ...]:
+    """The import statements of a file, parsed once per version of it (the tests walk the package many times)."""
+    tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
+    return tuple(import_statements(tree.body))
+
+
 def imported_modules(
     module: str, path: Path, known: set[str], kinds: Iterable[str] = (RUNTIME,)
 ) -> Iterator[tuple[str, str]]:
     """(imported module, kind) for every import of ``module`` of one of ``kinds``, of any package."""
     wanted = set(kinds)
-    tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
-    for node, kind in import_statements(tree.body):
+    for node, kind in _statements(path, path.stat().st_mtime_ns):
         if kind not in wanted:
             continue
         if isinstance(node, ast.Import):
@@ -195,6 +207,99 @@ def matplotlib_importers(root: Path = SOURCE) -> list[str]:
     )
 
 
+#: The package's rooms, lowest layer first; a module may import its own layer and those below it.  The root
+#: (``stickslip/__init__.py``, the front door that re-exports) is in no layer: importing any module of the
+#: package runs it first, so an import of it (``__version__``) adds no dependency.
+LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
+    ("plumbing", ("errors", "units", "fileio", "tables", "numerics", "reprs", "display", "progress",
+                  "trace_columns", "regimes")),
+    ("definitions", ("parameters", "columns", "protocols")),
+    ("engines", ("quasistatic", "transient", "rsf")),
+    ("interface", ("models",)),
+    ("uses", ("analysis", "fitting", "studies", "sweeps")),
+    ("faces", ("plots", "report", "cli", "plotting", "cycle_plots", "__main__")),
+)  # fmt: skip
+ENGINES = "engines"
+#: Arrows that run up the layers, each with its reason (source module, target module).
+UPWARD: dict[tuple[str, str], str] = {
+    ("stickslip.columns", "stickslip.fitting.identify"): "the unit of a fit's combination key (stress_scale, ...)"
+    " is that combination's dimension; read lazily, only for a key no parameter has",
+}
+#: Alias modules kept for an old name: they warn on import and only re-export (tested below); they stand where
+#: the old name was, so the layer rules do not apply to them.
+DEPRECATED_ALIASES = frozenset({"stickslip.rsf.compare", "stickslip.plotting", "stickslip.cycle_plots"})
+
+
+def room(module: str) -> str:
+    """The top-level unit of the package a module belongs to (``stickslip.rsf.fit`` -> ``rsf``; the root: "")."""
+    parts = module.split(".")
+    return parts[1] if len(parts) > 1 else ""
+
+
+def layer_of(layers: tuple[tuple[str, tuple[str, ...]], ...] = LAYERS) -> dict[str, int]:
+    return {name: number for number, (_, rooms) in enumerate(layers) for name in rooms}
+
+
+def import_edges(root: Path = SOURCE) -> set[tuple[str, str, str]]:
+    """(source, target, kind) for every import of one package module by another, of every kind."""
+    modules = package_modules(root)
+    known = set(modules)
+    return {
+        (name, target, kind)
+        for name, path in modules.items()
+        for target, kind in imported_modules(name, path, known, EVERY_KIND)
+        if target in known and target != name
+    }
+
+
+def upward_arrows(
+    root: Path = SOURCE,
+    layers: tuple[tuple[str, tuple[str, ...]], ...] = LAYERS,
+    allowed: Iterable[tuple[str, str]] = (),
+    aliases: Iterable[str] = (),
+) -> list[tuple[str, str, str]]:
+    """Imports (of any kind) from a module to one of a higher layer, less the lazy draws, the ``allowed`` pairs
+    and imports by the ``aliases``; imports of or by the root are no arrows (see :data:`LAYERS`)."""
+    level, allowed, aliases = layer_of(layers), set(allowed), set(aliases)
+    return sorted(
+        (source, target, kind)
+        for source, target, kind in import_edges(root)
+        if room(source) and room(target) and level[room(target)] > level[room(source)]
+        and not is_lazy_draw(source, target, kind) and (source, target) not in allowed and source not in aliases
+    )  # fmt: skip
+
+
+def engine_breaches(
+    root: Path = SOURCE,
+    layers: tuple[tuple[str, tuple[str, ...]], ...] = LAYERS,
+    aliases: Iterable[str] = (),
+) -> list[tuple[str, str, str]]:
+    """Imports (runtime, lazy or typing) by an engine's module of a module above the engines, less the lazy draws."""
+    level = layer_of(layers)
+    engines = next(number for number, (name, _) in enumerate(layers) if name == ENGINES)
+    return [arrow for arrow in upward_arrows(root, layers, aliases=aliases) if level[room(arrow[0])] == engines]
+
+
+def unplaced_rooms(root: Path = SOURCE, layers: tuple[tuple[str, tuple[str, ...]], ...] = LAYERS) -> list[str]:
+    """Rooms of the package in no layer (a new room must be given one)."""
+    return sorted({room(name) for name in package_modules(root)} - set(layer_of(layers)) - {""})
+
+
+def unreached_modules(root: Path = SOURCE, entries: Iterable[str] = ()) -> list[str]:
+    """Modules no import of any kind reaches from ``entries`` (a module reached loads its parent packages too)."""
+    graph = import_graph(root, EVERY_KIND)
+    seen: set[str] = set()
+    pending = list(entries)
+    while pending:
+        module = pending.pop()
+        if module in seen or module not in graph:
+            continue
+        seen.add(module)
+        parent = module.rsplit(".", 1)[0]
+        pending.extend([*graph[module], *([parent] if parent != module else [])])
+    return sorted(set(graph) - seen)
+
+
 # --------------------------------------------------------------------------- the checker itself
 def _tree(tmp_path: Path, files: dict[str, str]) -> Path:
     root = tmp_path / PACKAGE
@@ -270,6 +375,79 @@ def test_checker_separates_runtime_lazy_and_typing_imports(tmp_path: Path) -> No
     }
 
 
+_HOUSE = (
+    ("plumbing", ("errors",)),
+    ("engines", ("engine",)),
+    ("interface", ("models",)),
+    ("faces", ("plots", "cli")),
+)
+
+
+def test_checker_finds_every_kind_of_arrow_up_from_an_engine_but_not_its_lazy_draw(tmp_path: Path) -> None:
+    root = _tree(
+        tmp_path,
+        {
+            "__init__.py": "from .models import run\n__version__ = '1'\n",
+            "errors.py": "def refuse():\n    from .engine import result\n",  # plumbing lazily up to an engine
+            "models.py": "from .engine.result import R\ndef run():\n    return R()\n",
+            "engine/__init__.py": "from .result import R\n",
+            "engine/result.py": "from typing import TYPE_CHECKING\nfrom .. import __version__\n"
+            "if TYPE_CHECKING:\n    from ..models import run\nclass R:\n    def to_run(self):\n"
+            "        from ..models import run\n    def plot(self):\n        from ..plots.draw import draw\n",
+            "engine/old.py": "from ..cli import main\n",
+            "plots/__init__.py": "",
+            "plots/draw.py": "from ..engine.result import R\ndef draw(r: R):\n    pass\n",
+            "cli.py": "from .models import run\ndef main():\n    pass\n",
+        },
+    )
+    breaches = engine_breaches(root, _HOUSE)
+    assert breaches == [
+        ("stickslip.engine.old", "stickslip.cli", RUNTIME),
+        ("stickslip.engine.result", "stickslip.models", LAZY),
+        ("stickslip.engine.result", "stickslip.models", TYPING),
+    ]  # the lazy draw into plots and the root's __version__ are no breach
+    assert engine_breaches(root, _HOUSE, aliases={"stickslip.engine.old"}) == breaches[1:]
+    up = upward_arrows(root, _HOUSE)
+    assert ("stickslip.errors", "stickslip.engine.result", LAZY) in up and len(up) == 4
+    assert upward_arrows(root, _HOUSE, allowed={("stickslip.errors", "stickslip.engine.result")}) == breaches
+    assert unplaced_rooms(root, _HOUSE) == []
+    assert unplaced_rooms(root, _HOUSE[1:]) == ["errors"]
+
+
+def test_checker_finds_loops_of_lazy_and_typing_imports_but_lets_the_designed_draw_be(tmp_path: Path) -> None:
+    root = _tree(
+        tmp_path,
+        {
+            "__init__.py": "",
+            "fit.py": "class Fit:\n    def report(self):\n        from .text import report\n"
+            "    def plot(self):\n        from .plots.fits import draw\n",
+            "text.py": "from typing import TYPE_CHECKING\nif TYPE_CHECKING:\n    from .fit import Fit\n",
+            "plots/__init__.py": "",
+            "plots/fits.py": "from ..fit import Fit\n",
+        },
+    )
+    assert cycles(import_graph(root)) == []  # no loop at import time
+    loops = cycles(import_graph(root, EVERY_KIND, keep_lazy_draws=False))
+    assert loops == [["stickslip.fit", "stickslip.text", "stickslip.fit"]]  # the report's loop, not the draw's
+    assert len(cycles(import_graph(root, EVERY_KIND))) == 1  # with the draw: one component of three modules
+
+
+def test_checker_finds_a_module_no_entry_reaches(tmp_path: Path) -> None:
+    root = _tree(
+        tmp_path,
+        {
+            "__init__.py": "",
+            "cli/__init__.py": "",
+            "cli/main.py": "def main():\n    from ..sub.used import f\n",
+            "sub/__init__.py": "",
+            "sub/used.py": "from typing import TYPE_CHECKING\nif TYPE_CHECKING:\n    from .typed import T\n",
+            "sub/typed.py": "T = int\n",
+            "sub/dead.py": "from .used import f\n",
+        },
+    )
+    assert unreached_modules(root, ["stickslip.cli.main"]) == ["stickslip.sub.dead"]
+
+
 # --------------------------------------------------------------------------- the package
 def _shown(found: list[list[str]]) -> str:
     return "\n".join(" -> ".join(cycle) for cycle in found)
@@ -296,3 +474,40 @@ def test_the_core_never_imports_matplotlib_at_import_time() -> None:
 @pytest.mark.parametrize("name", ["stickslip.plotting", "stickslip.sweeps.store"])
 def test_the_checker_sees_the_real_package(name: str) -> None:
     assert name in import_graph()
+
+
+def test_every_room_of_the_package_stands_in_a_layer() -> None:
+    assert not unplaced_rooms(), f"rooms in no layer of LAYERS: {unplaced_rooms()}"
+
+
+def test_no_engine_imports_anything_above_the_engines_by_any_kind_of_import() -> None:
+    found = engine_breaches(aliases=DEPRECATED_ALIASES)
+    assert not found, "engine modules importing the interface or above:\n" + "\n".join(map(str, found))
+
+
+def test_no_import_runs_up_the_layers_but_the_named_ones() -> None:
+    found = upward_arrows(allowed=UPWARD, aliases=DEPRECATED_ALIASES)
+    assert not found, "imports running up the layers:\n" + "\n".join(map(str, found))
+    every = {(source, target) for source, target, _ in import_edges()}
+    assert set(UPWARD) <= every, f"named arrows that no longer exist: {sorted(set(UPWARD) - every)}"
+
+
+def test_the_only_loops_of_any_kind_of_import_are_the_designed_lazy_draws() -> None:
+    found = cycles(import_graph(kinds=EVERY_KIND, keep_lazy_draws=False))
+    assert not found, "import loops (every import counted, less the lazy draws into stickslip.plots):\n" + _shown(found)
+
+
+@pytest.mark.parametrize("alias", sorted(DEPRECATED_ALIASES))
+def test_a_deprecated_alias_only_warns_and_re_exports(alias: str) -> None:
+    path = package_modules()[alias]
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    kinds = {type(node).__name__ for node in tree.body}
+    assert kinds <= {"Expr", "Import", "ImportFrom", "Assign"}, f"{alias} holds code: {kinds}"
+    assert "DeprecationWarning" in path.read_text(encoding="utf-8")
+
+
+def test_every_module_is_reached_from_the_command_line_or_the_public_api() -> None:
+    """A module no user path reaches (the ``stickslip`` command, ``python -m stickslip``, ``import stickslip``) is
+    dead or misplaced."""
+    found = set(unreached_modules(entries=["stickslip.cli.main", "stickslip.__main__", PACKAGE])) - DEPRECATED_ALIASES
+    assert not found, f"modules no user path reaches: {sorted(found)}"

@@ -10,7 +10,7 @@ import pytest
 import stickslip
 from stickslip import protocols
 from stickslip.errors import ModelError, ParameterError
-from stickslip.models import FrictionModel, Rig, Run, available_models, get_model, register_model
+from stickslip.models import FrictionModel, Rig, Run, as_run, available_models, get_model, register_model
 from stickslip.models.bond import with_stiffness
 
 
@@ -154,9 +154,9 @@ def test_the_old_results_convert_to_the_same_run():
     sim = stickslip.simulate(p, 50e-6, 60.0)
     direct = stickslip.run("quasi-static", p, protocols.constant(50e-6, 60.0))
     columns = get_model("quasi-static").sweep_columns
-    assert sim.to_run().row(columns) == direct.row(columns)
+    assert as_run(sim).row(columns) == direct.row(columns)
     rsf = stickslip.rsf.simulate(stickslip.rsf.rsf_params(0.005, 0.01, 10e-6), protocols.constant(1e-6, 20.0))
-    assert rsf.to_run().regime_name == rsf.regime.name
+    assert as_run(rsf).regime_name == rsf.regime.name
 
 
 def test_an_installed_package_registers_by_its_entry_point(monkeypatch):
@@ -234,8 +234,8 @@ def test_quasi_static_run_reports_the_repeating_cycle_when_started_off_sigma_c()
     from_c = stickslip.simulate(params, 50e-6, 120.0)
     from_300 = stickslip.simulate(params, 50e-6, 120.0, start_stress=300.0)
     assert from_300.cycles[0].period < 0.9 * from_c.cycles[0].period  # the first cycle is not the repeating one
-    assert from_300.to_run().period == pytest.approx(from_c.to_run().period, rel=1e-9)
-    assert from_300.to_run().peak == pytest.approx(from_c.to_run().peak, rel=1e-9)
+    assert as_run(from_300).period == pytest.approx(as_run(from_c).period, rel=1e-9)
+    assert as_run(from_300).peak == pytest.approx(as_run(from_c).peak, rel=1e-9)
 
 
 def test_a_sweep_point_of_plain_values_takes_the_cached_fast_path_with_or_without_an_extension_key():

@@ -11,9 +11,9 @@ from stickslip import protocols
 from stickslip.errors import DataError
 from stickslip.parameters import load_parameters
 from stickslip.rsf import RSFParams, simulate
-from stickslip.rsf.compare import BondTrace, fit_bond_step
 from stickslip.rsf.params import StateVariable
 from stickslip.studies import rsf_reading as reading
+from stickslip.studies.bond_rsf import BondTrace, fit_bond_step
 
 UM = 1e-6
 STEP = protocols.velocity_steps([200 * UM, 2000 * UM], [0.005, 0.005])

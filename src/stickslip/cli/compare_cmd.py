@@ -92,7 +92,7 @@ def compare_command(**options: Any) -> None:
     options["v0"] = options["v0_text"] or CLASSIC_V0
     options["duration"] = options["duration_text"] or CLASSIC_DURATION
     from .. import protocols
-    from ..rsf.compare import bond_response, rsf_of_bond, stick_slip_pair
+    from ..studies.bond_rsf import bond_response, rsf_of_bond, stick_slip_pair
 
     params = resolve_params(options["params_name"], options["overrides"])
     v0 = positive(options["v0"], "velocity", "--v0")
@@ -185,7 +185,7 @@ FAILED = 3
 def _rsf_panel(rsf: Any, protocol: Any, times: Any) -> tuple[Any, str | None]:
     """The RSF run of one panel and what is wrong with it (None when fine); not run when the fit failed."""
     from ..rsf import simulate
-    from ..rsf.compare import check_friction
+    from ..studies.bond_rsf import check_friction
 
     if not rsf.usable:
         return None, "not run: the RSF fit failed"
@@ -244,7 +244,7 @@ def _override(rsf: Any, options: dict[str, Any]) -> Any:
     a = quantity(given["rsf_a"], "dimensionless", "--a") if "rsf_a" in given else p.a
     b = quantity(given["rsf_b"], "dimensionless", "--b") if "rsf_b" in given else s.b
     dc = positive(given["rsf_dc"], "length", "--dc") if "rsf_dc" in given else s.dc
-    from ..rsf.compare import physical_problem
+    from ..studies.bond_rsf import physical_problem
 
     shown = ", ".join(f"{k[4:]} = {v}" for k, v in given.items())
     params = p.replace(a=a, states=(StateVariable(s.law, b, dc, s.c),))

@@ -208,9 +208,36 @@ class SteadyPosterior:
         }
 
     def report(self) -> str:
-        from .report import posterior_report
+        """A Markdown report of the posterior (the fit's report helpers, :mod:`stickslip.fitting.report`)."""
+        from .report import _g, _messages, _table, estimate_rows
 
-        return posterior_report(self)
+        rows = estimate_rows((*self.estimates, self.critical_velocity, self.critical_stress), with_key=False)
+        lines = [
+            "# Bayesian steady fit (emcee)",
+            "",
+            f"- data: `{self.data.source}`, {len(self.data)} points; noise: {self.noise}",
+            f"- sampler: {self.walkers} walkers × {self.steps} steps, first {self.burn} discarded, thinned by"
+            f" {self.thin}; {self.chain.shape[0]} samples; mean acceptance {self.acceptance:.2f}",
+            f"- autocorrelation time (steps): {', '.join(_g(t, 3) for t in self.autocorrelation)}",
+            f"- convergence: {self._convergence()}",
+            "",
+            "## Priors",
+            "",
+            *[f"- {p}" for p in self.priors],
+            "",
+            *_messages(self.messages),
+            "## Posterior (median and central 95 % credible interval)",
+            "",
+            *_table(["quantity", "median", "std. dev.", "95 % credible interval", "unit", "prior / note"], rows),
+            "",
+        ]
+        return "\n".join(lines)
+
+    def _convergence(self) -> str:
+        tau = float(max(self.autocorrelation))
+        times = f"{(self.steps - self.burn) / tau:.0f}" if 0 < tau < float("inf") else "no measurable number of"
+        verdict = "passed" if self.converged else "NOT CONVERGED"
+        return f"{verdict}: {times} autocorrelation times after burn-in (the check asks for {CONVERGED_TIMES})"
 
     def plot(self, ax: Axes | None = None) -> Axes:
         """The fit with the 95 % credible band of sigma(V)."""

@@ -1,18 +1,18 @@
-"""Markdown reports of the fits (also the plain-text output of ``stickslip fit``)."""
+"""Markdown reports of the fits (also the plain-text output of ``stickslip fit``).
+
+The fits' ``report()`` methods call down here; this module names none of their types (a ``SteadyFit``, a
+``StickFit``: ``Any`` below), so the fits and their reports form no import loop (tests/test_import_graph.py).
+The posterior's report is written in :mod:`stickslip.fitting.bayes` with the helpers of this module.
+"""
 
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import TYPE_CHECKING
+from typing import Any
 
 import numpy as np
 
 from .results import Estimate, display_unit, human
-
-if TYPE_CHECKING:  # pragma: no cover
-    from .bayes import SteadyPosterior
-    from .steady_fit import SteadyFit
-    from .stick_fit import StickFit
 
 
 def _table(header: Sequence[str], rows: Sequence[Sequence[str]]) -> list[str]:
@@ -62,7 +62,8 @@ def _correlation(keys: Sequence[str], matrix: np.ndarray) -> list[str]:
     return ["## Correlation of the fitted ln-parameters", "", *_table(header, rows), ""]
 
 
-def steady_report(fit: SteadyFit) -> str:
+def steady_report(fit: Any) -> str:
+    """The Markdown report of a :class:`stickslip.fitting.SteadyFit`."""
     level = f"{100 * fit.level:g} %"
     data = fit.data
     lines = [
@@ -131,7 +132,7 @@ def steady_report(fit: SteadyFit) -> str:
 RESIDUAL_ROWS = 60
 
 
-def _residual_table(fit: SteadyFit) -> list[str]:
+def _residual_table(fit: Any) -> list[str]:
     data = fit.data
     picks = np.arange(len(data))
     lines = ["## Residuals", ""]
@@ -161,7 +162,8 @@ def goodness_line(chi_square: float, dof: int, noise_estimated: bool) -> str:
     return f"- χ² = {_g(chi_square)}, degrees of freedom {dof}, reduced χ² = {_g(chi_square / dof if dof else None)}"
 
 
-def stick_report(fit: StickFit) -> str:
+def stick_report(fit: Any) -> str:
+    """The Markdown report of a :class:`stickslip.fitting.StickFit`."""
     level = f"{100 * fit.level:g} %"
     data = fit.data
     rows = []
@@ -200,41 +202,6 @@ def stick_report(fit: StickFit) -> str:
         "## Rows",
         "",
         *_table(["row", "V0 (µm/s)", "start σ (Pa)", "ts (s)", "fit ts (s)", "σs (Pa)", "fit σs (Pa)", "use"], rows),
-        "",
-    ]
-    return "\n".join(lines)
-
-
-def _convergence(post: SteadyPosterior) -> str:
-    from .bayes import CONVERGED_TIMES
-
-    tau = float(max(post.autocorrelation))
-    times = f"{(post.steps - post.burn) / tau:.0f}" if 0 < tau < float("inf") else "no measurable number of"
-    verdict = "passed" if post.converged else "NOT CONVERGED"
-    return f"{verdict}: {times} autocorrelation times after burn-in (the check asks for {CONVERGED_TIMES})"
-
-
-def posterior_report(post: SteadyPosterior) -> str:
-    lines = [
-        "# Bayesian steady fit (emcee)",
-        "",
-        f"- data: `{post.data.source}`, {len(post.data)} points; noise: {post.noise}",
-        f"- sampler: {post.walkers} walkers × {post.steps} steps, first {post.burn} discarded, thinned by {post.thin};"
-        f" {post.chain.shape[0]} samples; mean acceptance {post.acceptance:.2f}",
-        f"- autocorrelation time (steps): {', '.join(_g(t, 3) for t in post.autocorrelation)}",
-        f"- convergence: {_convergence(post)}",
-        "",
-        "## Priors",
-        "",
-        *[f"- {p}" for p in post.priors],
-        "",
-        *_messages(post.messages),
-        "## Posterior (median and central 95 % credible interval)",
-        "",
-        *_table(
-            ["quantity", "median", "std. dev.", "95 % credible interval", "unit", "prior / note"],
-            estimate_rows((*post.estimates, post.critical_velocity, post.critical_stress), with_key=False),
-        ),
         "",
     ]
     return "\n".join(lines)

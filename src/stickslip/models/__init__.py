@@ -8,6 +8,8 @@
 A model is a :class:`FrictionModel` (parameters, equations, its own solver); a protocol
 (:mod:`stickslip.protocols`) says what the load point does, a :class:`Rig` how it reaches the slider;
 every model returns a :class:`Run`.  :func:`register_model` adds a model from outside the package.
+:func:`as_run` turns an engine's own result (``stickslip.simulate``, ``run_transient``, ``rsf.simulate``) into
+its :class:`Run`: the engines do not know the interface that wraps them (docs/architecture.md).
 """
 
 from __future__ import annotations
@@ -27,6 +29,7 @@ __all__ = [
     "FrictionModel",
     "Rig",
     "Run",
+    "as_run",
     "available_models",
     "get_model",
     "register_model",
@@ -57,3 +60,34 @@ def run(
     if params is None or isinstance(params, (str, Path, Mapping)):
         params = found.parameters(params)
     return found.run(params, protocol, rig, start=start, **settings)
+
+
+def as_run(result: Any, protocol: Any = None) -> Run:
+    """An engine's own result as the interface's :class:`Run`, as its model's ``run`` would return it.
+
+    ``result``: a :class:`stickslip.Simulation` (``stickslip.simulate``), a
+    :class:`stickslip.transient.TransientResult` (``run_transient``; ``protocol``, the one it ran, judges its
+    last segment) or a :class:`stickslip.rsf.RSFRun` (``rsf.simulate``); a :class:`Run` is returned as it is.
+    """
+    from ..errors import ParameterError
+    from ..quasistatic.cycle import Simulation
+    from ..rsf.results import RSFRun
+    from ..transient.result import TransientResult
+
+    if isinstance(result, Run):
+        return result
+    if isinstance(result, Simulation):
+        from .quasi_static import simulation_run
+
+        return simulation_run(result)
+    if isinstance(result, TransientResult):
+        from .transient import transient_run
+
+        return transient_run(result, protocol)
+    if isinstance(result, RSFRun):
+        from .rsf import rsf_run
+
+        return rsf_run(result)
+    raise ParameterError(
+        f"result: expected a Simulation, TransientResult or RSFRun (an engine's result), got {type(result).__name__}"
+    )

@@ -140,12 +140,6 @@ class Simulation:
 
         return with_units(pd.DataFrame({name: getattr(self, name) for name in CYCLE_COLUMNS}))
 
-    def to_run(self) -> Any:
-        """This simulation as the interface's one result type, :class:`stickslip.models.Run`."""
-        from ..models.quasi_static import simulation_run
-
-        return simulation_run(self)
-
     def plot(self, ax: Axes | None = None, **kwargs: Any) -> Axes:
         """sigma(t) over the cycles (Fig 5a-c); returns the Axes."""
         from ..plots.cycles import plot_simulation

@@ -134,12 +134,6 @@ class RSFRun:
 
         return json.dumps(json_safe(self.metadata()), indent=2) + "\n"
 
-    def to_run(self) -> Any:
-        """This run as the interface's one result type, :class:`stickslip.models.Run`."""
-        from ..models.rsf import rsf_run
-
-        return rsf_run(self)
-
     def plot(self, ax: Axes | None = None, **kwargs: Any) -> Axes:
         from ..plots.rsf import plot_run
 

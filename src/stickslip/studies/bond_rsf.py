@@ -1,4 +1,7 @@
-"""The bond model and rate-and-state friction on the same experiments (``stickslip compare``).
+"""The bond model and rate-and-state friction on the same experiments (``stickslip compare``): a study.
+
+It lived in ``stickslip.rsf.compare`` (that name still imports, with a DeprecationWarning): it runs the bond
+model through the model interface, so it sits above the engines, not inside one (docs/architecture.md).
 
 The bond-model side is one small pluggable function, :func:`bond_response`: it
 uses the time-dependent bond model (``stickslip.transient.run_transient``) when
@@ -37,10 +40,12 @@ import numpy as np
 
 from ..errors import DataError, ModelError, ParameterError
 from ..protocols import Protocol
-from .params import RSFParams, StateVariable
-from .solver import simulate as rsf_simulate
+from ..rsf.params import RSFParams, StateVariable
+from ..rsf.solver import simulate as rsf_simulate
+from .rsf_reading import STEP_PRECISION, step_guess
 
 __all__ = [
+    "STEP_PRECISION",
     "BondRSF",
     "BondTrace",
     "bond_response",
@@ -239,33 +244,6 @@ def _fitted_rsf(
     return fit_bond_step(trace, protocol, sigma_c, slope)
 
 
-def step_guess(time: np.ndarray, friction: np.ndarray, protocol: Protocol) -> dict[str, float]:
-    """RSF starting values read off a velocity-step trace: the levels give a - b, the peak (the direct effect) a,
-    the slip over which the peak decays by e Dc, and the slip of the rise the rig stiffness."""
-    v0, v1 = protocol.segments[0].velocity, protocol.segments[1].velocity
-    change = protocol.boundaries[1]
-    before, after = time < change, time >= change
-    mu0 = float(np.median(friction[before][-max(before.sum() // 10, 1) :]))
-    tail = friction[after]
-    mu1 = float(np.median(tail[-max(tail.size // 10, 1) :]))
-    log_ratio = math.log(v1 / v0)
-    up = v1 > v0
-    k = int(np.argmax(tail) if up else np.argmin(tail))
-    peak, t_after = float(tail[k]), time[after]
-    overshoot = (peak - mu1) if up else (mu1 - peak)
-    a = (peak - mu0) / log_ratio if overshoot > 0 else 1.5 * (mu1 - mu0) / log_ratio
-    b = a - (mu1 - mu0) / log_ratio
-    excess = np.abs(tail[k:] - mu1)
-    decayed = np.nonzero(excess < excess[0] / math.e)[0]
-    dc = v1 * float(t_after[k + decayed[0]] - t_after[k]) if decayed.size and overshoot > 0 else 1e-6
-    rise = v1 * max(float(t_after[k] - change), 1e-12)
-    return {"mu0": mu0, "a": abs(a), "b": b, "dc": max(dc, 1e-9), "stiffness": max(abs(peak - mu0) / rise, 1.0)}
-
-
-#: The precision (fraction of the step's friction range) at which RSF is asked to describe the bond model's step.
-STEP_PRECISION = 0.01
-
-
 def fit_bond_step(trace: BondTrace, protocol: Protocol, sigma_c: float, slope: float) -> BondRSF:
     """RSF (aging law, one state) fitted to a bond-model trace of the velocity step ``protocol`` (given, not
     detected), with 95 % intervals (``extra["intervals"]``, SI).
@@ -275,8 +253,8 @@ def fit_bond_step(trace: BondTrace, protocol: Protocol, sigma_c: float, slope: f
     bond model's stress rises over the slip that stretches its bonds (a fraction of a micrometre), which a rigid
     RSF rig would make instantaneous.  docs/extensions.md section 3 reads the bond model's steps in full.
     """
-    from ..studies.rsf_reading import interval_table, step_record
-    from .fit import fit_record
+    from ..rsf.fit import fit_record
+    from .rsf_reading import interval_table, step_record
 
     v0, v1 = protocol.segments[0].velocity, protocol.segments[1].velocity
     step = f"{v0 * 1e6:.4g} -> {v1 * 1e6:.4g} um/s"

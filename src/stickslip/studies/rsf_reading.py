@@ -9,7 +9,7 @@ happened to step): the solver's accepted steps are interpolated by a cubic splin
 :func:`read_step` fits it with the package's own :func:`stickslip.rsf.fit.fit_record`, the protocol given, one
 or two state variables of the aging or slip law and the rig stiffness free (the bond model's stress rises over
 the slip that stretches its bonds; a rigid RSF rig would make that rise instantaneous).  A model's output has no
-noise: the fits are judged at a stated precision, :data:`stickslip.rsf.compare.STEP_PRECISION` of the record's
+noise: the fits are judged at a stated precision, :data:`STEP_PRECISION` of the record's
 friction range.  Which law describes the steps is read off the rms misfit against that precision, the structure
 of the residuals (lag-one autocorrelation near 1: a systematic misfit, not noise), the F test of two states
 against one, and whether the fitted values stay put when the step changes.
@@ -26,11 +26,11 @@ import numpy as np
 
 from ..errors import DataError, ModelError, ParameterError
 from ..protocols import Protocol, Segment, velocity_steps
-from ..rsf.compare import STEP_PRECISION
 
 __all__ = [
     "LEAD",
     "SLIP_SPACING",
+    "STEP_PRECISION",
     "TRACE_RTOL",
     "WINDOW",
     "Reading",
@@ -40,6 +40,7 @@ __all__ = [
     "interval_table",
     "read_step",
     "resample_in_slip",
+    "step_guess",
     "step_record",
 ]
 
@@ -52,6 +53,8 @@ SLIP_SPACING = 2e-9
 WINDOW = 5e-6
 #: slip kept before each change (m): the steady level the step leaves
 LEAD = 1e-6
+#: The precision (fraction of the step's friction range) at which RSF is asked to describe the bond model's step.
+STEP_PRECISION = 0.01
 
 
 @dataclass(frozen=True)
@@ -250,7 +253,7 @@ def read_step(
     """Fit RSF (``law``, one or two ``states``, rig stiffness free) to ``step`` at the stated precision.
 
     Without ``guess`` the search starts from the values read off each velocity change in turn
-    (:func:`stickslip.rsf.compare.step_guess`) and the lowest chi-square is kept: on a staircase the first
+    (:func:`step_guess`) and the lowest chi-square is kept: on a staircase the first
     change alone can start the search where it loses its way.
     """
     from ..rsf.fit import fit_record
@@ -270,10 +273,31 @@ def read_step(
     return Reading(law, states, best, precision, span)
 
 
+def step_guess(time: np.ndarray, friction: np.ndarray, protocol: Protocol) -> dict[str, float]:
+    """RSF starting values read off a velocity-step trace: the levels give a - b, the peak (the direct effect) a,
+    the slip over which the peak decays by e Dc, and the slip of the rise the rig stiffness."""
+    v0, v1 = protocol.segments[0].velocity, protocol.segments[1].velocity
+    change = protocol.boundaries[1]
+    before, after = time < change, time >= change
+    mu0 = float(np.median(friction[before][-max(before.sum() // 10, 1) :]))
+    tail = friction[after]
+    mu1 = float(np.median(tail[-max(tail.size // 10, 1) :]))
+    log_ratio = math.log(v1 / v0)
+    up = v1 > v0
+    k = int(np.argmax(tail) if up else np.argmin(tail))
+    peak, t_after = float(tail[k]), time[after]
+    overshoot = (peak - mu1) if up else (mu1 - peak)
+    a = (peak - mu0) / log_ratio if overshoot > 0 else 1.5 * (mu1 - mu0) / log_ratio
+    b = a - (mu1 - mu0) / log_ratio
+    excess = np.abs(tail[k:] - mu1)
+    decayed = np.nonzero(excess < excess[0] / math.e)[0]
+    dc = v1 * float(t_after[k + decayed[0]] - t_after[k]) if decayed.size and overshoot > 0 else 1e-6
+    rise = v1 * max(float(t_after[k] - change), 1e-12)
+    return {"mu0": mu0, "a": abs(a), "b": b, "dc": max(dc, 1e-9), "stiffness": max(abs(peak - mu0) / rise, 1.0)}
+
+
 def _guesses(step: StepRecord) -> list[dict[str, float]]:
     """Starting values read off each velocity change of ``step`` (mu0 is always the record's first level)."""
-    from ..rsf.compare import step_guess
-
     time, friction = step.record.time, step.record.friction
     edges, segments = step.protocol.boundaries, step.protocol.segments
     out = []

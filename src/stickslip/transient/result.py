@@ -119,12 +119,6 @@ class TransientResult:
             columns["held_by"] = self.held_by
         return with_units(pd.DataFrame(columns))
 
-    def to_run(self, protocol: Any = None) -> Any:
-        """This run as :class:`stickslip.models.Run` (``protocol``: the one it ran, to judge its last segment)."""
-        from ..models.transient import transient_run
-
-        return transient_run(self, protocol)
-
     def plot(self, ax: Axes | None = None, **kwargs: Any) -> Axes:
         """Stress against time (and the slider velocity on a twin axis); returns the Axes."""
         from ..plots.transient import plot_transient
