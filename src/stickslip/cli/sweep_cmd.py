@@ -156,6 +156,8 @@ def _run(
     if store.damaged:  # said even with --quiet: the folder was not as the last run left it
         echo_err(damage_note(store))
     summary = _summary(store.folder, spec.size)
+    if store.report is not None:  # workers and parallel efficiency (issue 31), also in OUT/_run.json
+        summary += f"; {store.report.words()}"
     if not quiet:
         echo_err(summary)
 

@@ -59,6 +59,23 @@ class Transient(BondModel):
         result = run_transient(params, protocol, control=control, start="empty" if start is None else start, **settings)
         return transient_run(result, protocol)
 
+    def estimate_seconds(
+        self, params: Parameters, protocol: Protocol, rig: Rig | None = None, *, start: Any = None, **settings: Any
+    ) -> float:
+        """The CPU seconds a run should take (``estimate_cost``, no step taken); a sweep runs its dearest first."""
+        from ..transient.solver import estimate_cost
+
+        rig = self.check(protocol, rig, settings)
+        taken = ("stick_population", "aging", "start_velocity", "every", "rtol", "max_step", "reduction")
+        options = {k: v for k, v in settings.items() if k in taken}
+        if rig.stiffness is not None:
+            options["stiffness"] = rig.stiffness
+        if rig.has_mass:
+            options["mass"] = rig.mass
+        control = "velocity" if rig.control == "velocity" else "block"
+        start = "empty" if start is None else start
+        return estimate_cost(params, protocol, control=control, start=start, **options).seconds
+
     def describe_start(self, start: Any, protocol: Protocol, settings: Any = None) -> str:
         from ..display import velocity
 

@@ -22,6 +22,7 @@ from .engine import check_scheduler_address, compute, compute_while_cheap, dask_
 from .main_guard import unguarded_script_line
 from .models import ALIASES, MODELS, get_model
 from .progress import Silent, reporter
+from .schedule import RunReport, check_schedule
 from .spec import Axis, SweepSpec, check_design, parse_vary
 from .store import SweepStore, checked_manifest, open_store, read_manifest
 
@@ -105,12 +106,15 @@ def run_sweep(
     overwrite: bool = False,
     progress: Silent | None = None,
     batch_size: int | None = None,
+    schedule: str = "cost",
 ) -> SweepStore:
     """Run (or resume) ``spec`` into the folder ``output``; ``workers=0`` runs in this process, without dask.
 
     One process writes a folder at a time (a second is refused with
     :class:`~stickslip.errors.DataError`).  Chunks found damaged on resume are
-    recomputed and named in the returned store's ``damaged``.
+    recomputed and named in the returned store's ``damaged``.  ``schedule``: "cost" (the dearest points first,
+    by the model's estimate, in shrinking tasks) or "given" (chunk by chunk in point order); the rows are the same.
+    The returned store's ``report`` (also ``OUT/_run.json``) gives the workers, wall time and parallel efficiency.
     """
     if not isinstance(spec, SweepSpec):
         raise ParameterError(f"spec: expected a SweepSpec (see build_spec), got {type(spec).__name__}")
@@ -124,8 +128,10 @@ def run_sweep(
         check_scheduler_address(scheduler)
     workers = _workers_for_the_caller(workers, scheduler)
     overwrite = require_flag(overwrite, "overwrite")
+    schedule = check_schedule(schedule)
     store = open_store(output, spec, batch_size or default_batch_size(spec.size), overwrite=overwrite)
     shown = progress if progress is not None else Silent()
+    report = RunReport(schedule)
     try:
         finished = store.finished()
         shown.start(spec.size, store.rows_done(finished))
@@ -137,13 +143,33 @@ def run_sweep(
             elif workers is None and scheduler is None and compute_while_cheap(store, shown.advance):
                 pass  # a small sweep: done in this process before a cluster would have started
             else:
-                with dask_client(workers, scheduler) as client:
-                    compute(store, client, shown.advance)
+                _on_cluster(store, workers, scheduler, shown, report)
         finally:
             shown.close()
+        report.in_process_points += store.points_written - report.points
+        report.in_process_seconds += store.point_seconds - report.point_seconds
+        store.write_report(report)
     finally:
         store.close()
     return store
+
+
+def _on_cluster(
+    store: SweepStore, workers: int | None, scheduler: str | None, shown: Silent, report: RunReport
+) -> None:
+    """Run the chunks still missing on a cluster, timing the cluster's part (for the parallel efficiency)."""
+    import time
+
+    asked = time.perf_counter()
+    points, seconds = store.points_written, store.point_seconds
+    with dask_client(workers, scheduler) as client:
+        began = time.perf_counter()
+        report.cluster_start = began - asked
+        report.workers = sum(client.nthreads().values()) or 1
+        compute(store, client, shown.advance, schedule=report.schedule)
+        report.wall = time.perf_counter() - began
+    report.points = store.points_written - points
+    report.point_seconds = store.point_seconds - seconds
 
 
 def _workers_for_the_caller(workers: int | None, scheduler: str | None) -> int | None:

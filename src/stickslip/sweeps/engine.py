@@ -5,6 +5,13 @@ thread) and submits the next one whenever one finishes, so neither the
 client, the scheduler nor any worker ever holds more than a window of
 results: a 10^7-point sweep needs no more memory than a 10^3-point one.
 Each finished batch goes straight to its Parquet chunk.
+
+The tasks are planned by cost (:mod:`stickslip.sweeps.schedule`): the points of
+the chunks still to run, a group of at most :data:`PLAN_POINTS` at a time, are
+submitted dearest first by the model's own estimate, in tasks that shrink toward
+the end; a chunk is written once all its points have come back, its rows in
+point order, so the files are those of the plain order (``schedule="given"``:
+one task per chunk, in point order).
 """
 
 from __future__ import annotations
@@ -12,13 +19,14 @@ from __future__ import annotations
 import contextlib
 import math
 import os
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from functools import lru_cache
 from pathlib import Path
 from typing import Any
 
 from ..errors import DataError, ParameterError, StickslipError
 from .models import get_model, key_units, result_columns, run_point
+from .schedule import check_schedule, plan_tasks, usable_costs
 from .spec import SweepSpec
 from .store import SweepStore, arrow_schema
 
@@ -28,6 +36,9 @@ MAX_BATCH = 256
 MIN_BATCHES = 64
 #: Batches in flight per worker thread: enough to hide the round trip, few enough to bound memory.
 WINDOW_PER_THREAD = 3
+#: Points planned at a time by cost: the client holds the rows of at most about this many points whose chunk is not
+#: yet complete, and estimates their costs (the time-dependent model's estimate takes a few ms a point) in one go.
+PLAN_POINTS = 4096
 
 
 def default_batch_size(points: int) -> int:
@@ -42,15 +53,20 @@ def _spec(text: str) -> SweepSpec:
 
 def run_batch(spec_json: str, start: int, stop: int) -> dict[str, list[Any]]:
     """The rows of points ``start .. stop-1``, as columns (runs on a worker)."""
+    return run_points(spec_json, range(start, stop))
+
+
+def run_points(spec_json: str, points: Sequence[int]) -> dict[str, list[Any]]:
+    """The rows of the points ``points`` (in that order), as columns (runs on a worker)."""
     spec = _spec(spec_json)
     model = get_model(spec.model)
-    varied = spec.points(start, stop)
-    columns: dict[str, list[Any]] = {"point": list(range(start, stop))}
+    varied = spec.points_at(list(points))
+    columns: dict[str, list[Any]] = {"point": [int(p) for p in points]}
     columns.update({key: values.tolist() for key, values in varied.items()})
     names = list(result_columns(model))
     for name in names:
         columns[name] = []
-    for k in range(stop - start):
+    for k in range(len(columns["point"])):
         values = {**spec.fixed, **{key: float(v[k]) for key, v in varied.items()}}
         row = run_point(model, values, spec.settings)
         for name in names:
@@ -147,49 +163,139 @@ def compute(
     store: SweepStore,
     client: Any | None,
     progress: Callable[[int], None],
+    schedule: str = "cost",
 ) -> int:
-    """Run every batch whose chunk is missing; ``progress(points)`` after each one.  Returns the batches run."""
+    """Run every batch whose chunk is missing; ``progress(points)`` as rows come back.  Returns the chunks written.
+
+    On a cluster, ``schedule="cost"`` submits the points dearest first in shrinking tasks, one task per worker
+    thread in flight, so that a free worker always takes the next (list scheduling, see
+    :mod:`stickslip.sweeps.schedule`); ``"given"`` submits one task per chunk in point order, a window of
+    :data:`WINDOW_PER_THREAD` per thread (the order before issue 31).  Either writes the same chunks.
+    """
+    schedule = check_schedule(schedule)
     spec_json = store.spec.to_json()
     done = store.finished()
     todo = (batch for batch in range(store.batches) if batch not in done)  # lazily: memory flat in the batches
-    ran = 0
     if client is None:  # in this process: for tiny sweeps and tests of the writer
+        ran = 0
         for batch in todo:
             start, stop = store.batch_range(batch)
             store.write(batch, to_table(store.spec, run_batch(spec_json, start, stop)))
             progress(stop - start)
             ran += 1
         return ran
+    threads = sum(client.nthreads().values()) or 1
+    if schedule == "given":
+        tasks: Iterator[Sequence[int]] = (range(*store.batch_range(batch)) for batch in todo)
+        return _run_window(store, client, tasks, WINDOW_PER_THREAD * threads, progress)
+    tasks = cost_ordered_tasks(store, todo, threads, store.spec.size - store.rows_done(done))
+    return _run_window(store, client, tasks, threads, progress)
+
+
+def cost_ordered_tasks(store: SweepStore, batches: Iterable[int], workers: int, points: int) -> Iterator[list[int]]:
+    """The ``points`` points of ``batches`` as tasks planned by cost, :data:`PLAN_POINTS` at a time (lazily)."""
+    model = get_model(store.spec.model)
+    later = points  # not yet planned
+    group: list[int] = []
+    for batch in batches:
+        group.extend(range(*store.batch_range(batch)))
+        if len(group) >= PLAN_POINTS:
+            later -= len(group)
+            yield from _planned(store, model, group, workers, max(later, 0))
+            group = []
+    if group:
+        yield from _planned(store, model, group, workers, 0)
+
+
+def _planned(store: SweepStore, model: Any, group: list[int], workers: int, later: int) -> Iterator[list[int]]:
+    """One group's tasks; the points after it (``later``) count at the group's mean cost, so that the tasks shrink
+    only toward the end of the sweep, not of each group."""
+    costs = usable_costs(point_costs(store.spec, model, group))
+    after = later * sum(costs) / len(costs)
+    for task in plan_tasks(costs, workers, store.batch_size, after=after):
+        yield [group[k] for k in task]
+
+
+def point_costs(spec: SweepSpec, model: Any, points: Sequence[int]) -> list[float | None]:
+    """The model's estimate of each point's CPU seconds (None for each when the model gives none)."""
+    if not model.estimates_cost:
+        return [None] * len(points)
+    varied = spec.points_at(list(points))
+    return [
+        model.cost({**spec.fixed, **{key: float(v[k]) for key, v in varied.items()}}, spec.settings)
+        for k in range(len(points))
+    ]
+
+
+def _run_window(
+    store: SweepStore, client: Any, tasks: Iterator[Sequence[int]], window: int, progress: Callable[[int], None]
+) -> int:
+    """Keep ``window`` tasks in flight; each result is filed under its chunk, written once whole."""
     from distributed import as_completed
 
-    threads = sum(client.nthreads().values()) or 1
-    pending = todo
+    spec_json = store.spec.to_json()
+    chunks = _Chunks(store)
 
-    def submit(batch: int) -> Any:
-        start, stop = store.batch_range(batch)
-        future = client.submit(run_batch, spec_json, start, stop, pure=False)
-        future.batch = batch  # type: ignore[attr-defined]
+    def submit(points: Sequence[int]) -> Any:
+        future = client.submit(run_points, spec_json, points, pure=False)
+        future.points = points  # type: ignore[attr-defined]
         return future
 
-    window = [submit(b) for _, b in zip(range(WINDOW_PER_THREAD * threads), pending, strict=False)]
-    finished = as_completed(window)
+    finished = as_completed([submit(t) for _, t in zip(range(window), tasks, strict=False)])
     for future in finished:
-        batch = future.batch
         try:
             columns = future.result()
         except Exception as exc:  # a worker died or the cluster went away: what is written stays written
             raise StickslipError(
-                f"batch {batch} failed on the cluster ({type(exc).__name__}: {exc}); run the same command again"
-                " to resume"
+                f"points {_shown_points(future.points)} failed on the cluster ({type(exc).__name__}: {exc});"
+                " run the same command again to resume"
             ) from None
-        store.write(batch, to_table(store.spec, columns))
-        future.release()
-        progress(len(columns["point"]))
-        ran += 1
-        following = next(pending, None)
-        if following is not None:
+        following = next(tasks, None)
+        if following is not None:  # before writing: the freed worker starts at once
             finished.add(submit(following))
-    return ran
+        future.release()
+        chunks.add(columns)
+        progress(len(columns["point"]))
+    if chunks.parts:  # pragma: no cover - every point of every chunk run was in some task
+        raise StickslipError(f"sweep: chunks {sorted(chunks.parts)[:3]} were left incomplete; run it again")
+    return chunks.written
+
+
+def _shown_points(points: Sequence[int]) -> str:
+    if isinstance(points, range) or list(points) == list(range(points[0], points[-1] + 1)):
+        return f"{points[0]}..{points[-1]}"
+    return ", ".join(map(str, points[:4])) + (f" and {len(points) - 4} more" if len(points) > 4 else "")
+
+
+class _Chunks:
+    """Rows back from tasks, held per chunk until the chunk's every point is there; then written in point order."""
+
+    def __init__(self, store: SweepStore) -> None:
+        self.store = store
+        self.parts: dict[int, list[dict[str, list[Any]]]] = {}
+        self.rows: dict[int, int] = {}
+        self.written = 0
+
+    def add(self, columns: dict[str, list[Any]]) -> None:
+        size = self.store.batch_size
+        by_batch: dict[int, list[int]] = {}
+        for row, point in enumerate(columns["point"]):
+            by_batch.setdefault(point // size, []).append(row)
+        for batch, rows in by_batch.items():
+            part = {name: [values[r] for r in rows] for name, values in columns.items()}
+            self.parts.setdefault(batch, []).append(part)
+            self.rows[batch] = self.rows.get(batch, 0) + len(rows)
+            start, stop = self.store.batch_range(batch)
+            if self.rows[batch] == stop - start:
+                self.store.write(batch, to_table(self.store.spec, self._whole(batch)))
+                self.written += 1
+
+    def _whole(self, batch: int) -> dict[str, list[Any]]:
+        parts = self.parts.pop(batch)
+        del self.rows[batch]
+        merged = {name: [value for part in parts for value in part[name]] for name in parts[0]}
+        order = sorted(range(len(merged["point"])), key=merged["point"].__getitem__)
+        return {name: [values[k] for k in order] for name, values in merged.items()}
 
 
 def read_results(folder: str | Path) -> Any:

@@ -10,6 +10,7 @@ boundaries are the model's ``stability_boundary``.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterator, Mapping
 from typing import Any
 
@@ -125,6 +126,27 @@ class SweepModel:
         protocol = constant(velocity, settings["duration"])
         taken = {k: v for k, v in settings.items() if self.takes(k)}
         return self.model.run(params, protocol, self.rig(), start=start, **taken).row(self.results)
+
+    @property
+    def estimates_cost(self) -> bool:
+        """Whether the model estimates a run's CPU seconds before running it (an ``estimate_seconds`` method)."""
+        return callable(getattr(self.model, "estimate_seconds", None))
+
+    def cost(self, values: Mapping[str, float], settings: Mapping[str, Any]) -> float | None:
+        """The model's estimate of one point's CPU seconds, for the schedule; None when it gives none or the point
+        cannot be estimated (its run will say why it fails)."""
+        from ..protocols import constant
+
+        if not self.estimates_cost:
+            return None
+        try:
+            params, velocity, start = self.point(values, settings["duration"])
+            taken = {k: v for k, v in settings.items() if self.takes(k)}
+            protocol = constant(velocity, settings["duration"])
+            seconds = float(self.model.estimate_seconds(params, protocol, self.rig(), start=start, **taken))
+        except Exception:  # an estimate only orders the points: a point refused here fails, with its reason, in run
+            return None
+        return seconds if math.isfinite(seconds) and seconds >= 0 else None
 
     def rig(self) -> Rig:
         """The model's own spring; a model that runs only under velocity control is driven directly."""

@@ -141,7 +141,14 @@ class SweepSpec:
 
     def points(self, start: int, stop: int) -> dict[str, np.ndarray]:
         """The varied values of points ``start .. stop-1`` (one array per key), computed from the spec alone."""
-        index = np.arange(start, min(stop, self.size), dtype=np.int64)
+        return self.points_at(np.arange(start, min(stop, self.size), dtype=np.int64))
+
+    def points_at(self, index: Any) -> dict[str, np.ndarray]:
+        """The varied values of the points ``index`` (any indices, in any order), elementwise as :meth:`points`:
+        a task of points that are not contiguous (the sweep's cost-ordered schedule) gets the same values."""
+        index = np.asarray(index, dtype=np.int64)
+        if index.size and (int(index.min()) < 0 or int(index.max()) >= self.size):
+            raise ParameterError(f"SweepSpec.points_at: indices must lie in 0..{self.size - 1}")
         if self.design == "latin-hypercube":
             return {
                 a.key: latin_hypercube(index, self.samples, self.seed, k, a.low, a.high, a.log)  # type: ignore[arg-type]

@@ -37,10 +37,11 @@ from .spec import SweepSpec
 MANIFEST = "_manifest.json"
 LEDGER = "_chunks.jsonl"
 LOCK = ".stickslip.lock"
+RUN = "_run.json"  # the latest run: workers, schedule, wall, point time, parallel efficiency
 FORMAT = "stickslip-sweep/1"
 _CHUNK = re.compile(r"^part-(\d{6,})\.parquet$")
-_TEMPORARY = re.compile(r"^\.(part-\d{6,}\.parquet|_manifest\.json|_chunks\.jsonl)\..*\.tmp$")
-_OWN = (MANIFEST, LEDGER, LOCK)
+_TEMPORARY = re.compile(r"^\.(part-\d{6,}\.parquet|_manifest\.json|_chunks\.jsonl|_run\.json)\..*\.tmp$")
+_OWN = (MANIFEST, LEDGER, LOCK, RUN)
 #: Bytes a row takes at least in its chunk: 8 per number that differs from row to row (floats do not compress).
 _BYTES_PER_NUMBER = 8
 #: Disk space a sweep leaves free, beyond its estimated size.
@@ -90,6 +91,9 @@ class SweepStore:
     done: set[int] = field(default_factory=set)  # batches whose chunk is whole and checked
     damaged: list[str] = field(default_factory=list)  # "part-000003.parquet (why)": removed, to recompute
     lock: int | None = None  # descriptor holding the folder's flock
+    points_written: int = 0  # rows written by this process, and the sum of their wall_time (the parallel efficiency)
+    point_seconds: float = 0.0
+    report: Any = None  # the run's stickslip.sweeps.schedule.RunReport, once run_sweep has run it
 
     @property
     def batches(self) -> int:
@@ -119,7 +123,14 @@ class SweepStore:
             entry = {"batch": batch, "start": start, "stop": stop, **_fingerprint(temp)}
             _append_line(self.folder / LEDGER, json.dumps(entry, sort_keys=True))  # before the rename: see module
         self.done.add(batch)
+        self.points_written += table.num_rows
+        self.point_seconds += sum(t for t in table.column("wall_time").to_pylist() if t is not None)
         return target
+
+    def write_report(self, report: Any) -> None:
+        """Keep the run's report (``RunReport.as_dict``) as ``_run.json``, atomically."""
+        self.report = report
+        atomic_write_text(self.folder / RUN, json.dumps(report.as_dict(), indent=2) + "\n")
 
     def close(self) -> None:
         """Release the folder's lock (also released by the kernel if the process dies)."""
@@ -191,7 +202,7 @@ def _open_locked(path: Path, folder: str | Path, spec: SweepSpec, batch_size: in
     store = SweepStore(path, spec, batch_size, __version__)
     _refuse_too_large(store, folder)
     for old in path.iterdir():
-        if _CHUNK.match(old.name) or old.name in (MANIFEST, LEDGER):
+        if _CHUNK.match(old.name) or old.name in (MANIFEST, LEDGER, RUN):
             old.unlink()
     atomic_write_text(path / MANIFEST, json.dumps(_manifest(store), indent=2) + "\n")
     return store
