@@ -54,6 +54,11 @@ def _messages(messages: Sequence[str]) -> list[str]:
     return ["## Notes", "", *[f"- {m}" for m in messages], ""]
 
 
+def _parameters(estimates: Sequence[Estimate], level: str) -> list[str]:
+    header = ["key", "symbol", "value", "std. error", f"{level} interval", "unit", "status"]
+    return ["## Parameters", "", *_table(header, estimate_rows(estimates)), ""]
+
+
 def _correlation(keys: Sequence[str], matrix: np.ndarray) -> list[str]:
     if not keys:
         return []
@@ -89,13 +94,7 @@ def steady_report(fit: Any) -> str:
         ),
         "",
         *_messages(fit.messages),
-        "## Parameters",
-        "",
-        *_table(
-            ["key", "symbol", "value", "std. error", f"{level} interval", "unit", "status"],
-            estimate_rows(fit.estimates),
-        ),
-        "",
+        *_parameters(fit.estimates, level),
         "## Identifiable combinations",
         "",
         "σ(V) depends on the parameters only through these (docs/fitting.md).",
@@ -191,13 +190,7 @@ def stick_report(fit: Any) -> str:
         f"- intervals: {level}, symmetric in ln (Wald)",
         "",
         *_messages(fit.messages),
-        "## Parameters",
-        "",
-        *_table(
-            ["key", "symbol", "value", "std. error", f"{level} interval", "unit", "status"],
-            estimate_rows(fit.estimates),
-        ),
-        "",
+        *_parameters(fit.estimates, level),
         *_correlation(fit.free_keys, fit.correlation),
         "## Rows",
         "",

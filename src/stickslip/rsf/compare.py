@@ -7,31 +7,8 @@ The comparison runs the bond model through the model interface, so it is a study
 
 import warnings
 
-from ..studies.bond_rsf import (
-    STEP_PRECISION,
-    BondRSF,
-    BondTrace,
-    bond_response,
-    check_friction,
-    fit_bond_step,
-    physical_problem,
-    rsf_of_bond,
-    step_guess,
-    stick_slip_pair,
-)
-
-__all__ = [
-    "STEP_PRECISION",
-    "BondRSF",
-    "BondTrace",
-    "bond_response",
-    "check_friction",
-    "fit_bond_step",
-    "physical_problem",
-    "rsf_of_bond",
-    "step_guess",
-    "stick_slip_pair",
-]
+from ..studies.bond_rsf import *  # noqa: F403  (every public name of the new home)
+from ..studies.bond_rsf import __all__  # noqa: F401
 
 warnings.warn(
     "stickslip.rsf.compare is deprecated; import from stickslip.studies.bond_rsf", DeprecationWarning, stacklevel=2
