@@ -12,8 +12,9 @@ A page steers a block with HTML comments on the lines just before its fence (inv
 * ``<!-- test: skip REASON -->``: not run (the reason is required and kept in the test's output);
 * ``<!-- test: replace OLD -> NEW -->``: run with OLD replaced by NEW, for shorter runs (OLD must occur);
 * ``<!-- test: before COMMAND -->``: a shell line run first, to make the block's input files;
-* ``<!-- test: expect TEXT -->`` (repeatable): what the block's commands print must contain TEXT — a number
-  the page quotes beside the command comes from that command (a block with an ``expect`` runs unshortened).
+* ``<!-- test: expect TEXT -->`` (repeatable): what the block's commands (or a ``python`` block's ``print``)
+  print must contain TEXT — a number the page quotes beside the command comes from that command (a block with
+  an ``expect`` runs unshortened).
 
 Inline code that starts with ``stickslip`` (synopses in tables and prose) is checked too: its command must exist
 and every ``--option`` in it must be one of that command's.  Every ``stickslip.module.name`` a page mentions must
@@ -40,6 +41,8 @@ RUNNABLE = {"bash", "console", "python"}
 SHOWN = {"text", "json", "toml", "csv"}
 FENCE = re.compile(r"^(?P<indent> {0,3})(?P<fence>`{3,}|~{3,})\s*(?P<lang>[^\s`]*)")
 MARKER = re.compile(r"^\s*<!--\s*test:\s*(?P<kind>skip|replace|before|expect)\b\s*(?P<arg>.*?)\s*-->\s*$")
+#: nan or inf as a number in an output (not "info", "infinite", "inflection")
+NON_FINITE = re.compile(r"(?<![A-Za-z])[-+]?(nan|inf|infinity)(?![A-Za-z])", re.IGNORECASE)
 INLINE = re.compile(r"(?<!`)`(stickslip [^`]+)`(?!`)")
 TIMES: dict[str, float] = {}
 
@@ -148,7 +151,10 @@ def run_command(argv: list[str], where: str, capsys: pytest.CaptureFixture[str])
         assert status == 0, f"{where}: `{shlex.join(argv)}` exited {status}:\n{err[-2000:]}\n{out[-1000:]}"
         return out + err
     elif program in {"python", "python3"} and len(argv) == 3 and argv[1] == "-c":
+        capsys.readouterr()
         exec(compile(argv[2], where, "exec"), {"__name__": "__main__"})
+        out, err = capsys.readouterr()
+        return out + err
     else:
         pytest.fail(f"{where}: no runner for `{shlex.join(argv)}`; mark the block (skip REASON) if it is not run")
     return ""
@@ -160,12 +166,16 @@ def run_block(block: Block, namespace: dict, capsys: pytest.CaptureFixture[str])
             run_shell_line(arg, f"{block.where} (before)", capsys)
     text = block.runnable_text()
     if block.lang == "python":
-        exec(compile(text, block.where, "exec"), namespace)
         capsys.readouterr()
+        exec(compile(text, block.where, "exec"), namespace)
+        out, err = capsys.readouterr()
+        printed = out + err
     else:
         printed = "".join(run_shell_line(line, block.where, capsys) for line in shell_lines(text, block.lang))
-        missing = [arg for kind, arg in block.markers if kind == "expect" and arg not in printed]
-        assert not missing, f"{block.where}: the page quotes {missing} beside the command, which printed:\n{printed}"
+        shown = NON_FINITE.search(printed)  # issue 28: no command prints nan or inf; it says what is unknown
+        assert shown is None, f"{block.where}: the output shows {shown.group(0)!r}:\n{printed[-2000:]}"
+    missing = [arg for kind, arg in block.markers if kind == "expect" and arg not in printed]
+    assert not missing, f"{block.where}: the page quotes {missing} beside the command, which printed:\n{printed}"
 
 
 @pytest.mark.parametrize("page", PAGES, ids=_page_id)
@@ -324,3 +334,17 @@ def test_shipped_third_party_data_keeps_its_licence_and_credit():
     assert "pgiacomel/steadystate" in (folder / "README.md").read_text()
     assert (folder / "velstep3_TR2_exp013_sepiolite.txt").stat().st_size > 700_000  # the data, not an LFS pointer
     assert '"data/*/*"' in (ROOT / "pyproject.toml").read_text()  # package data: the wheel ships the folder
+
+
+def test_expect_markers_check_python_prints_and_commands_never_print_nan(tmp_path, capsys):
+    page = tmp_path / "page.md"
+    page.write_text(
+        "<!-- test: expect 42 -->\n```python\nprint(6 * 7)\n```\n\n"
+        "<!-- test: expect 43 -->\n```python\nprint(6 * 7)\n```\n"
+    )
+    right, wrong = blocks(page)
+    run_block(right, {}, capsys)
+    with pytest.raises(AssertionError, match=r"quotes \['43'\]"):
+        run_block(wrong, {}, capsys)
+    assert NON_FINITE.search("period nan s") and NON_FINITE.search("Kc = -inf Pa/m") and NON_FINITE.search("NaN")
+    assert not NON_FINITE.search("info: infinite stiffness, an inflection, nanometre")
