@@ -76,8 +76,10 @@ def inertia_figure(run: ModelRun) -> ReportFigure:
     ax_re.set_ylabel("Re (Pa/m)")
     ax_re.set_xlabel("frequency ω/2π (Hz)")
     ax_im.set_title(f"K = m ω² − iηω − Z(iω) puts a root at iω ({VELOCITY * 1e6:.0f} µm/s)", fontsize=9)
-    for ax in (ax_im, ax_re):  # lower left: no curve goes below zero at low frequency
-        ax.legend(fontsize="x-small", loc="lower left", frameon=False)
+    # where no curve goes: below zero at low frequency (Im), above the heavy block's rise (Re)
+    ax_im.legend(fontsize="x-small", loc="lower left", frameon=False)
+    ax_re.set_ylim(top=1e13)  # room for that legend above the heavy block's line
+    ax_re.legend(fontsize="x-small", loc="upper left", frameon=False)
     for ax in (ax_im, ax_re):
         apply_style(ax)
     fig.tight_layout()
@@ -107,7 +109,7 @@ def _draw_coinciding(ax, x, curves, labels, colors) -> list[str]:  # type: ignor
     drawn = list(colors)
     for group in coinciding_groups(ax, curves):
         names = [labels[k] for k in group]
-        shown = names[0] if len(names) == 1 else ",\n".join(names) + ": one line (they coincide)"
+        shown = "\n= ".join(names)  # "a\n= b": a and b lie on one line
         for position, k in enumerate(group):
             drawn[k] = colors[group[0]]
             ax.plot(x, curves[k], color=drawn[k], lw=1.2, label=shown if position == 0 else "_same",
@@ -127,7 +129,8 @@ def _caption(rows, root, massless, gel, heavy) -> str:  # type: ignore[no-untype
         "Linear stability of steady sliding in the full model (Eq 1) through a block with mass m per unit area and"
         " viscous damping η: eigenvalues solve m s² + η s + K + Z(s) = 0 (docs/extensions.md section 4). A root"
         " crosses the imaginary axis at iω for the stiffness K = m ω² − iηω − Z(iω) where that is real: each"
-        " curve's imaginary part vanishes (top) at the Hopf frequency, where its real part is Kc (dots)."
+        " curve's imaginary part vanishes (top) at the Hopf frequency, where its real part is Kc (dots). Blocks whose"
+        " curves coincide share one line and one legend entry (“=”)."
         f" At {VELOCITY * 1e6:.0f} µm/s: " + "; ".join(parts) + "."
         f" With the gel block, at K = {FACTOR:g} Kc the Hopf eigenvalue grows at {root.real:+.4g} 1/s and"
         f" oscillates at {root.imag / (2 * math.pi):.4g} Hz (massless: {massless.real:+.4g} 1/s at"
