@@ -38,7 +38,7 @@ from stickslip.cli.main import cli, main
 ROOT = Path(__file__).resolve().parents[1]
 PAGES = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
 RUNNABLE = {"bash", "console", "python"}
-SHOWN = {"text", "json", "toml", "csv"}
+SHOWN = {"text", "json", "toml", "csv", "mermaid"}  # mermaid: the diagram of docs/architecture.md
 FENCE = re.compile(r"^(?P<indent> {0,3})(?P<fence>`{3,}|~{3,})\s*(?P<lang>[^\s`]*)")
 MARKER = re.compile(r"^\s*<!--\s*test:\s*(?P<kind>skip|replace|before|expect)\b\s*(?P<arg>.*?)\s*-->\s*$")
 #: nan or inf as a number in an output (not "info", "infinite", "inflection")
