@@ -45,6 +45,9 @@ NOT_A_LINK = re.compile(r"\]\(([^)\n]*\s[^)\n]*)\)")
 API_FUNCTION = re.compile(r"^<!-- api-function: (stickslip(?:\.\w+)+) -->$", re.MULTILINE)
 ROLE = re.compile(r":(?:class|func|meth|mod|data|attr|exc|obj):(<code>)")
 LOCAL_LINK = re.compile(r'\b(href|src)="(?![a-z]+:|#|/)')
+NOTEBOOK_MARKDOWN = re.compile(r'(<div class="jp-RenderedHTMLCommon jp-RenderedMarkdown[^>]*>)(.*?)(</div>)', re.DOTALL)
+CODE = re.compile(r"(<code\b.*?</code>|<pre\b.*?</pre>)", re.DOTALL)
+DOLLARS = re.compile(r"\$\$(.+?)\$\$|(?<![\\$\w])\$(?=\S)([^$\n]+?)(?<=\S)\$(?![\w$])", re.DOTALL)
 FIGURE = re.compile(r"<figure\b.*?</figure>", re.DOTALL)
 MATH = re.compile(r'<(span|div) class="arithmatex">(.*?)</\1>', re.DOTALL)
 
@@ -170,19 +173,31 @@ def _site_link(target: str, source: str, page_uri: str, files: Files) -> str:
 
 
 def on_page_content(html_text: str, page: Any, config: Any, files: Files) -> str:
-    """TeX marked by pymdownx.arithmatex (generic mode) as MathML; the docstrings' Sphinx roles as plain code."""
+    """TeX as MathML: marked by pymdownx.arithmatex (generic mode) in the pages, between dollars in the notebooks'
+    Markdown cells; and the docstrings' Sphinx roles as plain code."""
     html_text = ROLE.sub(r"\1", html_text)
-    if "arithmatex" not in html_text:
-        return html_text
+    html_text = NOTEBOOK_MARKDOWN.sub(lambda m: m.group(1) + _notebook_math(m.group(2)) + m.group(3), html_text)
+    return MATH.sub(_arithmatex, html_text)
+
+
+def _mathml(tex: str, block: bool) -> str:
     from latex2mathml.converter import convert
 
-    def mathml(match: re.Match[str]) -> str:
-        tex = html.unescape(match.group(2)).strip()
-        block = match.group(1) == "div"
-        for opening, closing in ((r"\[", r"\]"), (r"\(", r"\)")):
-            if tex.startswith(opening) and tex.endswith(closing):
-                tex = tex[len(opening) : -len(closing)].strip()
-        converted = convert(tex, display="block" if block else "inline")
-        return f'<{match.group(1)} class="math">{converted}</{match.group(1)}>'
+    tag = "div" if block else "span"
+    return f'<{tag} class="math">{convert(html.unescape(tex).strip(), display="block" if block else "inline")}</{tag}>'
 
-    return MATH.sub(mathml, html_text)
+
+def _arithmatex(match: re.Match[str]) -> str:
+    tex = html.unescape(match.group(2)).strip()
+    for opening, closing in ((r"\[", r"\]"), (r"\(", r"\)")):
+        if tex.startswith(opening) and tex.endswith(closing):
+            tex = tex[len(opening) : -len(closing)]
+    return _mathml(tex, match.group(1) == "div")
+
+
+def _notebook_math(cell: str) -> str:
+    # nbconvert leaves a Markdown cell's $...$ and $$...$$ for MathJax, which the offline site does not load
+    parts = CODE.split(cell)  # odd parts are <code>/<pre> elements: a dollar there is code, not TeX
+    for i in range(0, len(parts), 2):
+        parts[i] = DOLLARS.sub(lambda m: _mathml(m.group(1) or m.group(2), m.group(1) is not None), parts[i])
+    return "".join(parts)

@@ -118,3 +118,19 @@ def test_the_equations_page_numbers_eqs_1_to_17_once_each():
     text = (ROOT / "docs" / "equations.md").read_text(encoding="utf-8")
     numbers = [int(n) for n in re.findall(r"\\qquad \((\d+)\)\s*\$\$", text)]
     assert sorted(numbers) == list(range(1, 18))
+
+
+def test_notebook_markdown_math_becomes_mathml_and_code_and_prices_stay(hooks):
+    pytest.importorskip("latex2mathml")
+    cell = (
+        '<div class="jp-RenderedHTMLCommon jp-RenderedMarkdown jp-MarkdownOutput" data-mime-type="text/markdown">'
+        "<p>At $V_c$ the slope is zero: $$\\frac{d\\sigma}{dV} = 0$$ "
+        "(<code>echo $HOME $PATH</code>; it costs $5 and $6).</p></div>"
+        '<div class="jp-OutputArea-output"><pre>$x$ printed by a cell</pre></div>'
+    )
+    out = hooks.on_page_content(cell, None, None, None)
+    inline, block = re.findall(r"<math[^>]*>.*?</math>", out)
+    assert "<msub><mi>V</mi><mi>c</mi></msub>" in inline and 'display="inline"' in inline
+    assert "<mfrac>" in block and 'display="block"' in block
+    assert "<code>echo $HOME $PATH</code>" in out and "costs $5 and $6" in out
+    assert "<pre>$x$ printed by a cell</pre>" in out  # outputs are not Markdown
