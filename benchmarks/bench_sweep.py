@@ -1,15 +1,23 @@
-"""Sweep throughput: 10,000 quasi-static points on a local dask cluster, beside a plain loop of ``simulate`` calls.
+"""Sweep schedules and throughput: the cost-ordered schedule beside the plain order, on 1 and 2 workers.
 
-The grid is the report's phase diagram: V0 = 5 µm/s … 5 mm/s (log) by the
-block stiffness G/h × 0.1 … × 10 of gelatin-glass (log), 100 s per run.
+Default (issue 31): for each sweep, on a fresh LocalCluster of 1 and of 2 worker processes, the plain order
+(``schedule="given"``: one task per chunk, in point order, as before issue 31) and the cost order (the dearest
+points first by the model's estimate, in tasks that shrink toward the end), interleaved and repeated, so that
+whatever else loads the machine loads both alike.  Each run gives the wall time of the sweep (cluster start
+apart), the CPU of the workers and of this process, and the parallel efficiency (sum of the rows' point
+times / (workers x wall)).  The sweeps:
 
-* the plain reference: ``simulate`` called point after point in this process, on
-  an evenly spread subset of the same grid (per-point cost, best and median of 3);
-* the sweep: all points on a LocalCluster of 2 worker processes, chunks written
-  to Parquet; wall time, this process's CPU time and the workers' CPU time;
-* the speed-up from 1 to 2 workers on a smaller sweep (cluster start-up timed apart).
+* transient: the README's (V0, K) phase diagram with the stick chains, V0 20 µm/s–1 mm/s by K 40 kPa/m–4 MPa/m
+  (log), smaller by default (``--transient 10x5``, 10 s runs): the same shape of cost, a few stick–slip points at
+  the stiffest blocks, last in point order, among cheap steady ones (``--transient 20x10 --duration 30`` is the
+  README's own);
+* quasi-static: a V0 × stiffness grid of 100 s runs (``--quasi-static 1600`` points), cost uniform: the plan
+  keeps the chunks and shrinks only the last tasks.
 
-Run: ``PYTHONPATH=src python benchmarks/bench_sweep.py [--points 10000] [--small 2000]``.
+``--throughput``: the former benchmark, 10,000 quasi-static points on 2 workers beside a plain loop of
+``simulate`` calls, and the speed-up from 1 to 2 workers (``--points``, ``--small``, ``--speedup-only``).
+
+Run: ``PYTHONPATH=src python benchmarks/bench_sweep.py [--repeats 2] [--transient 10x5] [--quasi-static 1600]``.
 """
 
 from __future__ import annotations
@@ -87,15 +95,97 @@ def run(spec, workers: int) -> dict[str, float]:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--repeats", type=int, default=2, help="rounds of the schedule comparison")
+    parser.add_argument("--transient", default="10x5", help="V0 x K points of the transient sweep ('0': none)")
+    parser.add_argument("--duration", type=float, default=10.0, help="s per transient run")
+    parser.add_argument("--quasi-static", type=int, default=1600, help="points of the quasi-static sweep (0: none)")
+    parser.add_argument("--workers", default="1,2", help="worker counts, comma-separated")
+    parser.add_argument("--throughput", action="store_true", help="the former 10,000-point throughput benchmark")
     parser.add_argument("--points", type=int, default=10_000)
     parser.add_argument("--small", type=int, default=2_000, help="points of the 1-vs-2-worker comparison")
     parser.add_argument("--speedup-only", action="store_true", help="only the 1-vs-2-worker comparison")
     args = parser.parse_args()
-    spec = build_spec(grid(args.points))
-    small = build_spec(grid(args.small))
-    if not args.speedup_only:
-        big_sweep(spec)
-    speedup(small)
+    if args.throughput or args.speedup_only:
+        if not args.speedup_only:
+            big_sweep(build_spec(grid(args.points)))
+        speedup(build_spec(grid(args.small)))
+        return
+    sweeps = []
+    if args.transient != "0":
+        sweeps.append(("transient", transient_spec(args.transient, args.duration)))
+    if args.quasi_static:
+        sweeps.append(("quasi-static", build_spec(grid(args.quasi_static))))
+    counts = [int(w) for w in args.workers.split(",")]
+    for name, spec in sweeps:
+        compare_schedules(name, spec, counts, args.repeats)
+
+
+def transient_spec(shape: str, duration: float):
+    """The README's transient (V0, K) plane at ``shape`` = 'NxM' points (V0 fastest: the stiff blocks come last)."""
+    across, up = (int(n) for n in shape.lower().split("x"))
+    return build_spec(
+        [f"pulling_velocity=20 um/s..1 mm/s:{across}:log", f"block.stiffness=40 kPa/m..4 MPa/m:{up}:log"],
+        model="transient",
+        stick_population=True,
+        duration=duration,
+    )
+
+
+def scheduled_run(spec, workers: int, schedule: str) -> dict[str, float]:
+    """One sweep on a fresh LocalCluster of ``workers`` processes in ``schedule`` order; times in s."""
+    import logging
+
+    from distributed import Client, LocalCluster
+
+    from stickslip.sweeps import run_sweep
+
+    with tempfile.TemporaryDirectory() as folder:
+        began = time.perf_counter()
+        with LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None,
+                          scheduler_kwargs={"dashboard_address": "127.0.0.1:0"}, silence_logs=logging.ERROR
+                          ) as cluster, Client(cluster) as client:  # fmt: skip
+            started = time.perf_counter() - began
+            before, cpu = client.run(time.process_time), time.process_time()
+            store = run_sweep(spec, Path(folder) / "out", scheduler=cluster.scheduler_address, schedule=schedule)
+            client_cpu = time.process_time() - cpu
+            after = client.run(time.process_time)
+        report = store.report
+        return {
+            "start": started,
+            "wall": report.wall,
+            "worker_cpu": sum(after[w] - before[w] for w in after),
+            "client_cpu": client_cpu,
+            "point_seconds": report.point_seconds,
+            "efficiency": report.efficiency or 0.0,
+        }
+
+
+def compare_schedules(name: str, spec, counts: list[int], repeats: int) -> None:
+    """Both orders on each worker count, interleaved (the order of the two alternates between rounds)."""
+    print(f"{name} sweep: {spec.size} points, batches of {default_batch_size(spec.size)}; {repeats} rounds")
+    results: dict[tuple[int, str], list[dict[str, float]]] = {}
+    for round_ in range(repeats):
+        for workers in counts:
+            orders = ("given", "cost") if round_ % 2 == 0 else ("cost", "given")
+            for schedule in orders:
+                got = scheduled_run(spec, workers, schedule)
+                results.setdefault((workers, schedule), []).append(got)
+                print(
+                    f"  round {round_ + 1}, {workers} worker(s), {schedule:5s} order: wall {got['wall']:.1f} s"
+                    f" (+ {got['start']:.1f} s cluster start), CPU workers {got['worker_cpu']:.1f} s + client"
+                    f" {got['client_cpu']:.1f} s, point time {got['point_seconds']:.1f} s,"
+                    f" parallel efficiency {100 * got['efficiency']:.0f} %",
+                    flush=True,
+                )
+    for (workers, schedule), runs in sorted(results.items()):
+        walls = [r["wall"] for r in runs]
+        efficiency = [100 * r["efficiency"] for r in runs]
+        cpu = [r["worker_cpu"] + r["client_cpu"] for r in runs]
+        print(
+            f"{name}, {workers} worker(s), {schedule:5s} order: wall {min(walls):.1f}-{max(walls):.1f} s"
+            f" (median {statistics.median(walls):.1f}), CPU {min(cpu):.1f}-{max(cpu):.1f} s, parallel efficiency"
+            f" {min(efficiency):.0f}-{max(efficiency):.0f} %"
+        )
 
 
 def big_sweep(spec) -> None:

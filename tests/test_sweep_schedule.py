@@ -189,3 +189,28 @@ def test_cost_and_given_schedules_write_the_same_chunks_bit_for_bit(cluster, tmp
         assert saved["point_seconds"] == pytest.approx(sum(rows), rel=1e-6)
         assert saved["parallel_efficiency"] == pytest.approx(sum(rows) / (2 * saved["wall_seconds"]), rel=1e-4)
         assert 0 < saved["parallel_efficiency"] <= 1.05
+
+
+def test_a_sweep_is_planned_group_by_group_each_point_once(tmp_path, monkeypatch):
+    from stickslip.sweeps.store import open_store
+
+    monkeypatch.setattr(engine_module, "FIRST_PLAN_POINTS", 4)
+    monkeypatch.setattr(engine_module, "PLAN_POINTS", 8)
+    spec = build_spec(["pulling_velocity=30 um/s..3 mm/s:30:log"])
+    with open_store(tmp_path / "out", spec, batch_size=3) as store:
+        tasks = list(engine_module.cost_ordered_tasks(store, [0, 2, 3, 4, 5, 6, 7, 8, 9], workers=2, points=27))
+    points = [p for task in tasks for p in task]
+    assert sorted(points) == [p for p in range(30) if p not in (3, 4, 5)]  # chunk 1 was done: not run again
+    # groups of whole chunks (6, then 9, 9, 3 points), each in turn: a later group's points never come first
+    groups = [set(range(0, 3)) | set(range(6, 9)), set(range(9, 18)), set(range(18, 27)), set(range(27, 30))]
+    assert [next(k for k, g in enumerate(groups) if p in g) for p in points] == sorted(
+        next(k for k, g in enumerate(groups) if p in g) for p in points
+    )
+    # equal costs: a task is a chunk (3) until 1/(2 x 2 workers) of what is left in the whole sweep is less
+    left, in_group = 27, {0: 6, 1: 9, 2: 9, 3: 3}
+    for task in tasks:
+        group = next(k for k, g in enumerate(groups) if task[0] in g)
+        assert len(task) == min(3, max(1, left // 4), in_group[group])
+        left -= len(task)
+        in_group[group] -= len(task)
+    assert len(tasks[0]) == 3 and len(tasks[-1]) == 1

@@ -39,6 +39,8 @@ WINDOW_PER_THREAD = 3
 #: Points planned at a time by cost: the client holds the rows of at most about this many points whose chunk is not
 #: yet complete, and estimates their costs (the time-dependent model's estimate takes a few ms a point) in one go.
 PLAN_POINTS = 4096
+#: ... the first group fewer, since the workers wait while it is estimated (the later ones are planned meanwhile).
+FIRST_PLAN_POINTS = 512
 
 
 def default_batch_size(points: int) -> int:
@@ -168,9 +170,9 @@ def compute(
     """Run every batch whose chunk is missing; ``progress(points)`` as rows come back.  Returns the chunks written.
 
     On a cluster, ``schedule="cost"`` submits the points dearest first in shrinking tasks, one task per worker
-    thread in flight, so that a free worker always takes the next (list scheduling, see
-    :mod:`stickslip.sweeps.schedule`); ``"given"`` submits one task per chunk in point order, a window of
-    :data:`WINDOW_PER_THREAD` per thread (the order before issue 31).  Either writes the same chunks.
+    thread in flight when the model estimates costs, so that a free worker always takes the next (list
+    scheduling, see :mod:`stickslip.sweeps.schedule`); ``"given"`` submits one task per chunk in point order, a
+    window of :data:`WINDOW_PER_THREAD` per thread (the order before issue 31).  Either writes the same chunks.
     """
     schedule = check_schedule(schedule)
     spec_json = store.spec.to_json()
@@ -189,31 +191,52 @@ def compute(
         tasks: Iterator[Sequence[int]] = (range(*store.batch_range(batch)) for batch in todo)
         return _run_window(store, client, tasks, WINDOW_PER_THREAD * threads, progress)
     tasks = cost_ordered_tasks(store, todo, threads, store.spec.size - store.rows_done(done))
-    return _run_window(store, client, tasks, threads, progress)
+    # costs that differ: one task per thread, so each goes to the first worker free (a dear task queued behind
+    # another would wait while a worker idles); all alike: a window, so a queued task hides the round trip
+    window = threads if get_model(store.spec.model).estimates_cost else WINDOW_PER_THREAD * threads
+    return _run_window(store, client, tasks, window, progress)
 
 
 def cost_ordered_tasks(store: SweepStore, batches: Iterable[int], workers: int, points: int) -> Iterator[list[int]]:
-    """The ``points`` points of ``batches`` as tasks planned by cost, :data:`PLAN_POINTS` at a time (lazily)."""
+    """The ``points`` points of ``batches`` as tasks planned by cost, a group at a time (lazily).
+
+    The first group is :data:`FIRST_PLAN_POINTS` (the workers wait while it is estimated), the others
+    :data:`PLAN_POINTS`, each estimated and planned in a thread while the group before it runs.
+    """
+    from concurrent.futures import ThreadPoolExecutor
+
     model = get_model(store.spec.model)
-    later = points  # not yet planned
+    groups = _groups(store, iter(batches), points)
+    with ThreadPoolExecutor(max_workers=1, thread_name_prefix="stickslip-plan") as planner:
+        ahead = next(groups, None)
+        planning = None if ahead is None else planner.submit(_plan, store, model, *ahead, workers)
+        while planning is not None:
+            tasks = planning.result()
+            ahead = next(groups, None)
+            planning = None if ahead is None else planner.submit(_plan, store, model, *ahead, workers)
+            yield from tasks
+
+
+def _groups(store: SweepStore, batches: Iterator[int], points: int) -> Iterator[tuple[list[int], int]]:
+    """(the points of the next group of whole chunks, the points after it)."""
+    later, size = points, FIRST_PLAN_POINTS
     group: list[int] = []
     for batch in batches:
         group.extend(range(*store.batch_range(batch)))
-        if len(group) >= PLAN_POINTS:
-            later -= len(group)
-            yield from _planned(store, model, group, workers, max(later, 0))
-            group = []
+        if len(group) >= size:
+            later = max(later - len(group), 0)
+            yield group, later
+            group, size = [], PLAN_POINTS
     if group:
-        yield from _planned(store, model, group, workers, 0)
+        yield group, 0
 
 
-def _planned(store: SweepStore, model: Any, group: list[int], workers: int, later: int) -> Iterator[list[int]]:
+def _plan(store: SweepStore, model: Any, group: list[int], later: int, workers: int) -> list[list[int]]:
     """One group's tasks; the points after it (``later``) count at the group's mean cost, so that the tasks shrink
     only toward the end of the sweep, not of each group."""
     costs = usable_costs(point_costs(store.spec, model, group))
     after = later * sum(costs) / len(costs)
-    for task in plan_tasks(costs, workers, store.batch_size, after=after):
-        yield [group[k] for k in task]
+    return [[group[k] for k in task] for task in plan_tasks(costs, workers, store.batch_size, after=after)]
 
 
 def point_costs(spec: SweepSpec, model: Any, points: Sequence[int]) -> list[float | None]:
@@ -243,6 +266,9 @@ def _run_window(
 
     finished = as_completed([submit(t) for _, t in zip(range(window), tasks, strict=False)])
     for future in finished:
+        following = next(tasks, None)
+        if following is not None:  # before fetching and writing the rows: the freed worker starts at once
+            finished.add(submit(following))
         try:
             columns = future.result()
         except Exception as exc:  # a worker died or the cluster went away: what is written stays written
@@ -250,9 +276,6 @@ def _run_window(
                 f"points {_shown_points(future.points)} failed on the cluster ({type(exc).__name__}: {exc});"
                 " run the same command again to resume"
             ) from None
-        following = next(tasks, None)
-        if following is not None:  # before writing: the freed worker starts at once
-            finished.add(submit(following))
         future.release()
         chunks.add(columns)
         progress(len(columns["point"]))
