@@ -15,6 +15,7 @@ bad argument.
 from __future__ import annotations
 
 import argparse
+import re
 import sys
 import tempfile
 import time
@@ -24,6 +25,8 @@ EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 #: Seconds one cell may run before the notebook counts as failed (the slowest cell takes well under a minute).
 CELL_TIMEOUT = 300
 KERNEL = "python3"
+#: the terminal colours of IPython's tracebacks, which a CI log shows as raw escapes
+ANSI = re.compile(r"\x1b\[[0-9;]*m")
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -88,7 +91,7 @@ def _execute(source: Path, target: Path, timeout: int) -> tuple[float, str | Non
         try:
             client.execute()
         except (CellExecutionError, CellTimeoutError, DeadKernelError) as exc:
-            error = f"{source.name}: {type(exc).__name__}:\n{exc}"
+            error = f"{source.name}: {type(exc).__name__}:\n{ANSI.sub('', str(exc))}"
     seconds = time.perf_counter() - start
     _write(nb, target)
     return seconds, error
