@@ -326,6 +326,8 @@ def json_safe(obj: Any, digits: int | None = None) -> Any:
     """
     import numpy as np
 
+    from .regimes import Regime
+
     if isinstance(obj, dict):
         return {str(k): json_safe(v, digits) for k, v in obj.items()}
     if isinstance(obj, (list, tuple)):
@@ -341,6 +343,8 @@ def json_safe(obj: Any, digits: int | None = None) -> Any:
         return int(obj)
     if isinstance(obj, np.bool_):
         return bool(obj)
+    if isinstance(obj, Regime):  # a regime is written by its kind's name, as when it was a str
+        return obj.kind
     return obj
 
 

@@ -99,6 +99,25 @@ class Regime:
     trough: float
     evidence: str
 
+    def __str__(self) -> str:
+        """The kind: ``f"regime: {run.regime}"`` reads "regime: stick-slip"."""
+        return self.kind
+
+    def __eq__(self, other: object) -> bool:
+        # equal to its kind's name, so that ``sim.regime == "stick-slip"`` keeps working where a str was kept
+        if isinstance(other, str):
+            return self.kind == other
+        if isinstance(other, Regime):
+            return self._fields() == other._fields()
+        return NotImplemented
+
+    def __hash__(self) -> int:
+        # as its kind's, so that a Regime and the str it equals find the same dict entry
+        return hash(self.kind)
+
+    def _fields(self) -> tuple[object, ...]:
+        return (self.kind, self.periods, self.amplitude_ratio, self.period, self.peak, self.trough, self.evidence)
+
 
 def turning_points(values: np.ndarray, delta: float) -> tuple[np.ndarray, np.ndarray]:
     """(maxima, minima) indices, alternating, each extremum ``delta`` beyond its neighbours (hysteresis scan)."""

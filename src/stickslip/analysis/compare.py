@@ -131,7 +131,7 @@ def compare_with_model(
         shift=shift,
         model_time=model_time,
         model_stress=model_stress,
-        model_regime=sim.regime,
+        model_regime=sim.regime.kind,
         model_message=sim.message,
         rms_misfit=rms,
         points=int(np.count_nonzero(inside)),

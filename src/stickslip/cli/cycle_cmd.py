@@ -14,6 +14,7 @@ import click
 import numpy as np
 
 from .common import (
+    check_output,
     emit_json,
     params_options,
     positive,
@@ -75,7 +76,7 @@ def _fmt(value: float | None, scale: float = 1.0, digits: int = 5) -> str:
     help="Steady curve the stick-to-slip jump lands on (aging keeps the stress continuous; see docs/errata.md).",
 )
 @click.option(
-    "-o", "--output", type=click.Path(dir_okay=False, path_type=Path), help="Write the trace as CSV (SI units)."
+    "-o", "--output", type=click.Path(dir_okay=False, path_type=Path), help="Write the Run CSV (units in the header)."
 )
 @click.option("--plot", "plot_path", type=click.Path(dir_okay=False, path_type=Path), help="Save σ(t) (Fig 5) here.")
 @click.option("--json", "as_json", is_flag=True, help="Print the summary as JSON (SI units).")
@@ -97,6 +98,10 @@ def simulate_command(
 ) -> None:
     """Simulate stick-slip: stick -> jump -> slip -> jump -> ... for a pulling velocity and duration.
 
+    The spelling of `stickslip run --model quasi-static` (--start-stress is
+    its --start, --jump-curve its --setting jump_curve=...): the same Run CSV
+    (-o), the same summary and the cycles below it.
+
     The quasi-static model is a spring (the block, or --stiffness K) pulled at
     one constant velocity: --v0 V --duration T (or one --segment "V:T", or a
     one-segment --protocol file); other protocols and --control velocity are
@@ -106,67 +111,29 @@ def simulate_command(
     "stuck" (a stick never ends) or "undetermined" (the model has no answer).
     """
     from ..models import get_model
-    from ..quasistatic.cycle import CYCLE_COLUMNS
+    from .run_cmd import execute
 
     refuse_overwriting_inputs([protocol_file], [("-o", output), ("--plot", plot_path)], params_name)
+    check_output("-o", output)
+    check_output("--plot", plot_path, plot=True)
     protocol = build_protocol(v0_text, duration_text, segment_texts, protocol_file)
     refuse_unsupported("simulate (the quasi-static model)", protocol, control, controls=("spring",),
                        one_segment=True, instead="stickslip transient runs any protocol and rig")  # fmt: skip
-    v0 = protocol.segments[0].velocity
     rig, _ = build_rig(control, stiffness_text)
-    start = _stress(start_text)
     params = resolve_params(params_name, overrides)
-    run = get_model("quasi-static").run(params, protocol, rig, start=start, jump_curve=jump_curve)
-    sim = run.native  # the Simulation: its phases and cycles make the table below
-    if output is not None:
-        write_text(output, _csv({n: getattr(sim, n) for n in CYCLE_COLUMNS}))
-    if plot_path is not None:
-        from ..plots.cycles import plot_simulation
-
-        ax = plot_simulation(sim)
-        # below the axes: any corner of the frame holds a stress peak or trough of some run
-        ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.14), ncol=3, frameon=False, fontsize=8)
-        ax.set_title(f"V0 = {v0 * 1e6:.4g} µm/s, {params.name}: {sim.regime}", fontsize=11)
-        save_figure(ax.figure, plot_path)
-    if as_json:
-        emit_json(sim.summary())
-        return
-    print_rich(*_simulation_report(sim, params.name))
+    execute(get_model("quasi-static"), params, protocol, rig, start=_stress(start_text),
+            settings={"jump_curve": jump_curve}, output=output, plot_path=plot_path, as_json=as_json,
+            figure=lambda run: _figure(run.native, params.name), start_option="--start-stress ")  # fmt: skip
 
 
-def _simulation_report(sim: Any, name: str) -> list[Any]:
-    from rich.table import Table
+def _figure(sim: Any, name: str) -> Any:
+    """sigma(t) over the cycles (Fig 5), the legend below the axes: any corner holds a peak or trough of some run."""
+    from ..plots.cycles import plot_simulation
 
-    head = [
-        f"Stick-slip simulation, {name}: V0 = {sim.pulling_velocity * 1e6:.6g} µm/s for {sim.duration:.6g} s,"
-        f" starting stuck at {sim.start_stress:.6g} Pa (jump onto the {sim.jump_curve} curve)",
-        f"  Vc = {sim.critical_velocity * 1e6:.6g} µm/s, σc = {sim.critical_stress:.6g} Pa,"
-        f" K = {sim.stiffness / 1e3:.6g} kPa/m (Eq 17)",
-        f"  regime: {sim.regime}",
-        f"  {sim.message}",
-        f"  at t = {sim.time[-1]:.6g} s: σ = {sim.final_stress:.6g} Pa, V = {sim.final_velocity * 1e6:.6g} µm/s"
-        + ("" if sim.time[-1] >= sim.duration else " (the model stops here)"),
-    ]
-    out: list[Any] = ["\n".join(head)]
-    if sim.cycles:
-        table = Table(title="Cycles", title_justify="left")
-        for heading in ("#", "start (s)", "σ start (Pa)", "σs (Pa)", "ts (s)", "Vs (µm/s)", "slip (s)", "period (s)"):
-            table.add_column(heading, justify="right")
-        for c in sim.cycles:
-            table.add_row(
-                str(c.index + 1),
-                _fmt(c.start_time, digits=6),
-                _fmt(c.start_stress),
-                _fmt(c.peak_stress),
-                _fmt(c.stick_time),
-                _fmt(c.jump_velocity, 1e6),
-                _fmt(c.slip_time),
-                _fmt(c.period),
-            )
-        out.append(table)
-    else:
-        out.append("  no stick phase ended in a slip within the run")
-    return out
+    ax = plot_simulation(sim)
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.14), ncol=3, frameon=False, fontsize=8)
+    ax.set_title(f"V0 = {sim.pulling_velocity * 1e6:.4g} µm/s, {name}: {sim.regime}", fontsize=11)
+    return ax.figure
 
 
 # --------------------------------------------------------------------------- stick

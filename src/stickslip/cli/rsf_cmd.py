@@ -237,13 +237,6 @@ def _fallback_protocol(fallback: list[dict] | None) -> Any:
     return protocols.segments([(s["velocity"], s["duration"]) for s in fallback]) if fallback else None
 
 
-def trace_csv(frame: Any) -> str:
-    """The trace as CSV, units in the header brackets (:mod:`stickslip.columns`)."""
-    from ..columns import csv_text
-
-    return csv_text(frame)
-
-
 def sidecar(path: Path | None) -> Path | None:
     """Where the parameters of an output file go: ``NAME.params.json`` beside it; none beside standard output or
     a special file (``-o /dev/null`` wrote ``/dev/null.params.json``)."""
@@ -290,9 +283,11 @@ def simulate_command(**options: Any) -> None:
     The protocol in the words of every run command: --v0 V --duration T, then
     any --segment "V:T" (or --segment alone, or --protocol FILE); the rig is a
     spring (--stiffness), so --control velocity is refused.
-    The trace has columns time, friction, slider_velocity, state,
-    load_point_displacement, slider_displacement (SI).  With -o the
-    parameters go beside it in NAME.params.json.
+    The spelling of `stickslip run --model rsf` (the law options are its
+    --set keys, --start-velocity its --start): the same Run CSV (time,
+    friction, slider_velocity, slider_position, load_point_position, state;
+    on standard output without -o, the summary then on stderr) and the same
+    summary.  With -o the parameters go beside it in NAME.params.json.
     """
     from ..models import Rig, get_model
 
@@ -315,31 +310,19 @@ def simulate_command(**options: Any) -> None:
         [options["protocol_file"], options["params_file"]],
         [("-o", output), ("-o (its NAME.params.json)", side), ("--plot", plot_path)],
     )
-    run = get_model("rsf").run(params, protocol, Rig(), start=start, every=every).native  # the RSFRun
-    if output is not None:
-        write(output, trace_csv(run.to_frame()))
-        if side is not None:
-            write(side, run.metadata_json())
-    summary = run.summary()
-    if options["as_json"]:
-        click.echo(json_text(summary))
-    elif output is None:
-        click.echo(trace_csv(run.to_frame()), nl=False)
-    else:
-        click.echo(_summary_text(summary), err=True)
-    if plot_path is not None:
-        from ..plots.rsf import run_figure
+    from .run_cmd import execute
 
-        save_figure(run_figure(run), plot_path)
+    beside = None if side is None else lambda run: write(side, run.native.metadata_json())
+    execute(get_model("rsf"), params, protocol, Rig(), start=start, settings={} if every is None else {"every": every},
+            output=Path("-") if output is None and not options["as_json"] else output, plot_path=plot_path,
+            as_json=options["as_json"], figure=lambda run: _run_figure(run.native), beside=beside,
+            start_option="--start-velocity ")  # fmt: skip
 
 
-def _summary_text(summary: dict[str, Any]) -> str:
-    period = summary.get("period")
-    lines = [f"regime: {summary['regime']}", f"final friction: {summary['final_friction']:.6g}"]
-    if period is not None:
-        lines.append(f"period: {period:.6g} s")
-    lines.append(summary["message"])
-    return "\n".join(lines)
+def _run_figure(native: Any) -> Any:
+    from ..plots.rsf import run_figure
+
+    return run_figure(native)
 
 
 @rsf_group.command("stability")

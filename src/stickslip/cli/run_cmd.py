@@ -29,6 +29,7 @@ from .common import (
     set_values,
 )
 from .protocol_options import build_protocol, build_rig, inertia_options, protocol_options
+from .run_report import model_record, record_text
 
 #: Exit status of a run the model could not finish (status "failed"); 2 is bad input.
 RUN_FAILED = 3
@@ -171,7 +172,7 @@ def run_summary(run: Any, protocol: Any, rig: Any) -> dict[str, Any]:
         "status": run.status,
         "message": run.message,
         "protocol": [{"velocity": s.velocity, "duration": s.duration} for s in protocol.segments],
-        "rig": {"control": rig.control, "stiffness": rig.stiffness},
+        "rig": _rig_record(rig),
         "regime": run.regime_name,
         "oscillates": r.kind in OSCILLATING,
         "evidence": r.evidence,
@@ -187,6 +188,30 @@ def run_summary(run: Any, protocol: Any, rig: Any) -> dict[str, Any]:
     }
 
 
+def _rig_record(rig: Any) -> dict[str, Any]:
+    record = {"control": rig.control, "stiffness": rig.stiffness}
+    if rig.mass is not None:  # the block's inertia (transient --mass/--damping)
+        record.update(mass=rig.mass, damping=rig.damping)
+    return record
+
+
+#: a protocol of more segments is described in one line by its count, length and range of velocities
+DESCRIBED_SEGMENTS = 6
+
+
+def protocol_words(segments: list[dict[str, float]]) -> str:
+    """The protocol in one line: each segment, or for many their count, length and range of velocities."""
+    from ..display import velocity
+
+    if len(segments) <= DESCRIBED_SEGMENTS:
+        return ", then ".join(f"{velocity(s['velocity'], 4)} for {s['duration']:.6g} s" for s in segments)
+    speeds = [s["velocity"] for s in segments]
+    return (
+        f"{len(segments)} segments, {sum(s['duration'] for s in segments):.6g} s in all, at"
+        f" {velocity(min(speeds), 4)} to {velocity(max(speeds), 4)}"
+    )
+
+
 #: A stress (Pa) or friction coefficient smaller than this is the solver's round-off, not a value (a block at rest
 #: reports a mean stress of -5.6e-17 Pa): it is shown as 0.
 ROUND_OFF = 1e-12
@@ -196,17 +221,21 @@ def _above_round_off(value: float) -> float:
     return 0.0 if value is not None and math.isfinite(value) and abs(value) < ROUND_OFF else value
 
 
+#: how the summary's regime line marks a run that did not finish
+_STATUS_WORDS = {"ok": "", "stopped": " (of the run up to its stop: it used up its budget)"}
+
+
 def summary_text(summary: dict[str, Any]) -> str:
     """The summary for people: µm/s, Pa (or μ), s; the model's message in full."""
-    from ..display import velocity
-
-    protocol = ", then ".join(f"{velocity(s['velocity'], 4)} for {s['duration']:.6g} s" for s in summary["protocol"])
+    protocol = protocol_words(summary["protocol"])
     rig = summary["rig"]
     spring = "" if rig["stiffness"] is None else f", K = {rig['stiffness'] / 1e3:.6g} kPa/m"
+    if rig.get("mass") is not None:
+        spring += f", block mass {rig['mass']:g} kg/m², damping {rig.get('damping') or 0:g} Pa·s/m"
     signal, unit = ("stress", " Pa") if "peak_stress" in summary else ("friction", "")
     lines = [
         f"model {summary['model']}: {protocol} ({rig['control']} control{spring})",
-        f"  regime: {summary['regime']}" + ("" if summary["status"] == "ok" else " (the run FAILED)"),
+        f"  regime: {summary['regime']}" + _STATUS_WORDS.get(summary["status"], " (the run FAILED)"),
         f"  {summary['message'] or summary['evidence']}",
     ]
     numbers = []
@@ -294,28 +323,78 @@ def run_command(
     settings = settings_of(setting_texts, every_text)
     model.check(protocol, rig, settings)  # what the model cannot do, before any work
     start = start_value(start_text, model)
+    execute(model, params, protocol, rig, start=start, settings=settings, output=output, plot_path=plot_path,
+            as_json=as_json)  # fmt: skip
+
+
+def execute(
+    model: Any,
+    params: Any,
+    protocol: Any,
+    rig: Any,
+    *,
+    start: Any,
+    settings: dict[str, Any],
+    output: Path | None,
+    plot_path: Path | None,
+    as_json: bool,
+    figure: Any = None,
+    beside: Any = None,
+    start_option: str = "--start ",
+) -> Any:
+    """Run one model and report it: the one path of ``run`` and of its spellings ``simulate``, ``transient`` and
+    ``rsf simulate``.
+
+    ``-o`` writes the Run's CSV (of the run up to its stop, if a budget stopped it), ``--plot`` the figure
+    (``figure(run)``, default ``run.plot()``), then the summary: JSON, or the shared text with the model's own
+    record below it.  ``beside(run)`` writes what a spelling keeps beside the trace (``rsf simulate``'s
+    parameters).  A failed run, or one stopped by its budget, exits with status 3 after saying how far it got.
+    """
+    from ..models import as_run
+
+    model.check(protocol, rig, settings)
+    stopped: BudgetExhausted | None = None
     with progress(model.name, total=protocol.duration, unit="s", enabled=False if as_json else None) as bar:
         if "progress" in model.capabilities.settings and "progress" not in settings:  # a bar on a terminal only
             settings["progress"] = lambda fraction: bar.update(fraction * protocol.duration)
         try:
             run = model.run(params, protocol, rig, start=start, **settings)
-        except (RunFailed, BudgetExhausted) as exc:  # it ran and stopped: a failed run (exit 3), not bad input
+        except BudgetExhausted as exc:  # it ran and stopped at its budget: what it did is kept (exit 3)
+            if getattr(exc, "partial", None) is None:
+                click.echo(f"stickslip: the run failed: {exc}", err=True)
+                raise SystemExit(RUN_FAILED) from None
+            stopped, run = exc, as_run(exc.partial, protocol)
+        except RunFailed as exc:  # it ran and could not go on: a failed run (exit 3), not bad input
             click.echo(f"stickslip: the run failed: {exc}", err=True)
             raise SystemExit(RUN_FAILED) from None
         except (ParameterError, ModelError) as exc:
-            raise type(exc)(in_run_words(str(exc), "--start ")) from None
+            raise type(exc)(in_run_words(str(exc), start_option)) from None
     summary = run_summary(run, protocol, rig)
+    summary.update((key, value) for key, value in model_record(run).items() if key not in summary)
+    if stopped is not None:
+        summary["status"] = "stopped"
     if output is not None:
         _write_run(run, output)
+        if beside is not None:
+            beside(run)
     if plot_path is not None:
-        save_figure(run.plot().figure, plot_path)
+        save_figure(run.plot().figure if figure is None else figure(run), plot_path)
     if as_json:
         emit_json(summary)
     else:  # beside a trace on standard output (-o -), the summary goes to stderr
-        click.echo(summary_text(summary), err=output is not None and str(output) == "-")
+        record = record_text(run)
+        click.echo(
+            summary_text(summary) + ("\n" + record if record else ""), err=output is not None and str(output) == "-"
+        )
+    if stopped is not None:
+        written = [str(path) for path in (output, plot_path) if path is not None]
+        kept = f"; the run up to there is in {' and '.join(written)}" if written else ""
+        click.echo(f"stickslip: error: {stopped}{kept}", err=True)
+        raise SystemExit(RUN_FAILED)
     if run.status != "ok":
         click.echo(f"stickslip: the run failed: {run.message}", err=True)
         raise SystemExit(RUN_FAILED)
+    return run
 
 
 def _write_run(run: Any, output: Path) -> None:
@@ -329,4 +408,4 @@ def register(cli: click.Group) -> None:
     cli.add_command(run_command)
 
 
-__all__ = ["run_command", "run_summary", "summary_text"]
+__all__ = ["execute", "run_command", "run_summary", "summary_text"]

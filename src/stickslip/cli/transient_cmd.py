@@ -9,13 +9,10 @@ import click
 
 from .common import (
     check_output,
-    emit_json,
     params_options,
     positive,
     refuse_overwriting_inputs,
     resolve_params,
-    save_figure,
-    write_text,
 )
 from .protocol_options import (
     build_protocol,
@@ -26,15 +23,6 @@ from .protocol_options import (
     refuse_unsupported,
 )
 
-
-def _trace_csv(result: Any) -> str:
-    from ..columns import csv_text
-
-    return csv_text(result.to_frame())
-
-
-#: exit status of a run stopped at its budget (it ran, but did not reach the end): as a failed fit or run
-STOPPED = 3
 #: a protocol of more segments is described in one line by its count, length and range of velocities
 DESCRIBED_SEGMENTS = 6
 
@@ -132,6 +120,10 @@ def transient_command(
 ) -> None:
     """Solve the full time-dependent population balance (Eq 1, history form of Eq 3) through a protocol.
 
+    The spelling of `stickslip run --model transient` (its options are run's
+    --start and --setting KEY=VALUE): the same Run CSV (-o), the same summary
+    and the slip events below it.
+
     With --control spring (or block) the protocol is the puller's velocity and
     the block (Eq 17, or --stiffness K) couples it to the slider, without
     inertia unless --mass (and --damping) give the block's; with
@@ -147,17 +139,13 @@ def transient_command(
     the trace up to there (-o, --plot) and exits with status 3.
     """
     from ..models import get_model
-    from ..numerics.budget import PROGRESS_AFTER_SECONDS, BudgetExhausted
-    from ..progress import progress
-    from ..transient.solver import SolverFailed, estimate_cost
+    from .run_cmd import execute
 
     check_output("-o", output)
     check_output("--plot", plot_path, plot=True)
     protocol = build_protocol(v0_text, duration_text, segment_texts, protocol_file)
     refuse_unsupported("transient", protocol, control)
-    control = control_name(control)
-    solver_control = "block" if control == "spring" else control  # run_transient's name of the spring
-    rig, _ = build_rig(control, stiffness_text, mass_text=mass_text, damping_text=damping_text)
+    rig, _ = build_rig(control_name(control), stiffness_text, mass_text=mass_text, damping_text=damping_text)
     refuse_overwriting_inputs([protocol_file], [("-o", output), ("--plot", plot_path)], params_name)
     start_velocity = None if start_v_text is None else positive(start_v_text, "velocity", "--start-velocity")
     every = None if every_text is None else positive(every_text, "time", "--every")
@@ -166,69 +154,14 @@ def transient_command(
     settings = dict(start_velocity=start_velocity, aging=not no_aging, stick_population=stick_population, every=every,
                     rtol=rtol, max_steps=max_steps, max_time=max_time,
                     reduction="off" if no_reduce else "auto")  # fmt: skip
-    cost = estimate_cost(params, protocol, control=solver_control, start_velocity=start_velocity, rtol=rtol,
-                         every=every, aging=not no_aging, reduction=settings["reduction"], mass=rig.mass or 0.0,
-                         stiffness=rig.stiffness)  # fmt: skip
-    shown = None if cost.seconds > PROGRESS_AFTER_SECONDS and not as_json else False  # None: on a terminal
-    stopped: BudgetExhausted | None = None
-    with progress("transient", total=protocol.duration, unit="s", enabled=shown) as bar:
-        try:
-            shown_progress = lambda f: bar.update(f * protocol.duration)  # noqa: E731
-            run = get_model("transient").run(params, protocol, rig, start=start, progress=shown_progress, **settings)
-            result = run.native  # the TransientResult: its trace columns, cycles and summary are printed below
-        except BudgetExhausted as exc:
-            if exc.partial is None:
-                raise
-            stopped, result = exc, exc.partial
-        except SolverFailed as exc:  # it ran and could not go on: a failed run (exit 3), not bad input
-            click.echo(f"stickslip: error: the run failed: {exc}", err=True)
-            raise SystemExit(STOPPED) from None
-    _report(result, protocol, control, rig, start, output, plot_path, as_json, stopped)
-    if stopped is not None:
-        written = [str(path) for path in (output, plot_path) if path is not None]
-        kept = f"; the run up to there is in {' and '.join(written)}" if written else ""
-        click.echo(f"stickslip: error: {stopped}{kept}", err=True)
-        raise SystemExit(STOPPED)
+    execute(get_model("transient"), params, protocol, rig, start=start, settings=settings, output=output,
+            plot_path=plot_path, as_json=as_json, figure=lambda run: _figure(run.native, protocol))  # fmt: skip
 
 
-def _report(
-    result: Any,
-    protocol: Any,
-    control: str,
-    rig: Any,
-    start: str,
-    output: Path | None,
-    plot_path: Path | None,
-    as_json: bool,
-    stopped: Exception | None,
-) -> None:
-    """Write the trace and figure, print the summary (of the run up to its stop, if it stopped)."""
-    if output is not None:
-        write_text(output, _trace_csv(result))
-    if plot_path is not None:
-        ax = result.plot()
-        ax.set_title(f"{_describe(protocol)}: {result.regime}", fontsize=9)
-        save_figure(ax.figure, plot_path)
-    if as_json:
-        summary = result.summary()
-        summary["status"] = "ok" if stopped is None else "stopped"
-        emit_json(summary)
-        return
-    block = f", block mass {rig.mass:g} kg/m², damping {rig.damping or 0:g} Pa·s/m" if rig.has_mass else ""
-    click.echo(f"{_describe(protocol)} ({control} control{block}, {start} start)")
-    click.echo(f"  regime: {result.regime}")
-    click.echo(f"  {result.message}")
-    click.echo(
-        f"  at t = {result.time[-1]:.6g} s: σ = {result.final_stress:.6g} Pa,"
-        f" N/N0 = {result.final_bonded_fraction:.6g},"
-        f" V = {result.slider_velocity[-1] * 1e6:.6g} µm/s ({result.steps} steps)"
-    )
-    for c in result.cycles:
-        slip = "—" if c.slip_time is None else f"{c.slip_time:.4g} s"
-        click.echo(
-            f"  cycle {c.index + 1}: stick {c.stick_time:.4g} s, σs = {c.peak_stress:.5g} Pa,"
-            f" jump to {c.jump_velocity * 1e6:.4g} µm/s, slip {slip}"
-        )
+def _figure(result: Any, protocol: Any) -> Any:
+    ax = result.plot()
+    ax.set_title(f"{_describe(protocol)}: {result.regime}", fontsize=9)
+    return ax.figure
 
 
 def register(cli: click.Group) -> None:

@@ -72,17 +72,8 @@ def _checked(params: Any) -> Parameters:
 def simulation_run(sim: Any) -> Run:
     """The :class:`Run` of a :class:`stickslip.Simulation` (its phases give the regime and the cycle's numbers)."""
     summary = cycle_numbers(sim)
-    whole = [c for c in sim.cycles if c.period is not None]
     time, stress = sim.time, sim.stress
-    period = summary["period"]
-    if math.isfinite(period) and whole:  # the repeating cycle's extremes, from the trace of the last whole one
-        last = whole[-1]
-        inside = (time >= last.start_time) & (time <= last.start_time + period)
-        peak, trough = float(np.max(stress[inside])), float(np.min(stress[inside]))
-    else:
-        peak, trough = float(np.max(stress)), float(np.min(stress))
-    ratio = 1.0 if sim.regime == regimes.STICK_SLIP and len(whole) >= 2 else NAN
-    regime = regimes.Regime(sim.regime, len(whole), ratio, period, peak, trough, sim.message)
+    regime = sim.regime  # the engine's, with its evidence (the phases: every cycle after the first repeats)
     return Run(
         model=QuasiStatic.name,
         time=time,
@@ -104,7 +95,7 @@ def simulation_run(sim: Any) -> Run:
 def cycle_numbers(sim: Any) -> dict[str, Any]:
     """The repeating cycle's numbers (SI): period, stick time, sigma_s, Vs, the mean stress over the cycle."""
     row: dict[str, Any] = {
-        "regime": sim.regime,
+        "regime": sim.regime.kind,
         "period": NAN,
         "stick_time": NAN,
         "peak_stress": NAN,

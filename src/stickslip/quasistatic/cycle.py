@@ -99,7 +99,7 @@ class Simulation:
     block_shear: np.ndarray
     chain_fraction: np.ndarray
     phase: np.ndarray
-    regime: str
+    regime: regimes.Regime  # compares equal to its kind's name ("stick-slip"), as the str it once was
     cycles: tuple[Cycle, ...]
     final_stress: float  # at the end of the trace: ``duration``, or where the model stops ("undetermined")
     final_velocity: float
@@ -119,7 +119,7 @@ class Simulation:
     def summary(self) -> dict[str, Any]:
         """The JSON summary, SI units."""
         return {
-            "regime": self.regime,
+            "regime": self.regime.kind,
             "message": self.message,
             "final_stress": self.final_stress,
             "final_velocity": self.final_velocity,
@@ -345,7 +345,7 @@ def simulate(
     columns = trace.build()
     return Simulation(
         **columns,
-        regime=regime,
+        regime=_regime(regime, message, period, cycles, columns),
         cycles=tuple(cycles),
         final_stress=float(columns["stress"][-1]),
         final_velocity=float(columns["velocity"][-1]),
@@ -362,6 +362,23 @@ def simulate(
         jumps=phases.all("jump"),
         parameters=params,
     )
+
+
+def _regime(
+    kind: str, message: str, period: float | None, cycles: list[Cycle], columns: dict[str, np.ndarray]
+) -> regimes.Regime:
+    """The run's regime with its evidence: every cycle after the first is the same cycle (amplitude ratio 1), its
+    peak and trough those of the last whole cycle traced; without a repeating cycle, the run's extremes."""
+    whole = [c for c in cycles if c.period is not None]
+    time, stress = columns["time"], columns["stress"]
+    if period is not None and whole:
+        last = whole[-1]
+        inside = (time >= last.start_time) & (time <= last.start_time + period)
+        peak, trough = float(np.max(stress[inside])), float(np.min(stress[inside]))
+    else:
+        peak, trough = float(np.max(stress)), float(np.min(stress))
+    ratio = 1.0 if kind == regimes.STICK_SLIP and len(whole) >= 2 else math.nan
+    return regimes.Regime(kind, len(whole), ratio, math.nan if period is None else period, peak, trough, message)
 
 
 def _outlook(phases: _Phases, sigma0: float, sigma_c: float) -> tuple[str, str, float | None]:

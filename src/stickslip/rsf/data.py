@@ -1,8 +1,8 @@
 """Lab records for rate-and-state fits: delimited text as rigs write it, and the load-point history.
 
 A record has time, load-point displacement and friction.  Columns are found
-by name: the package's own trace CSV (``time``, ``load_point_displacement``,
-``friction``), or any header mapped with ``columns={"time": "Time(s)",
+by name: the package's own trace CSV (``time``, ``load_point_position`` of the Run CSV or the older
+``load_point_displacement``, ``friction``), or any header mapped with ``columns={"time": "Time(s)",
 "displacement": "Displ(microns)", "friction": "Friction"}``.  A header that names
 its unit (``Displ(microns)``, ``LP Displacement (um)``, ``disp [µm]``, ``time_ms``)
 is read in it; else ``displacement_unit`` / ``time_unit``; else metres and seconds.
@@ -38,7 +38,7 @@ __all__ = ["LabRecord", "find_segments", "measured_history", "parse_columns", "r
 ROLES = ("time", "displacement", "friction", "velocity")
 _DEFAULT_NAMES = {
     "time": ("time", "time(s)", "time_s", "t"),
-    "displacement": ("load_point_displacement", "displacement", "displ", "disp", "lp_disp", "lp displacement"),
+    "displacement": ("load_point_displacement", "load_point_position", "displacement", "displ", "disp", "lp_disp", "lp displacement"),
     "friction": ("friction", "mu", "friction_coefficient"),
     "velocity": ("load_point_velocity", "velocity", "vel", "lp_velocity", "lp_vel"),
 }

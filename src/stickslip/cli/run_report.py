@@ -1,0 +1,105 @@
+"""What a run prints below the shared summary: each model's own record (cycles, final state), text and JSON.
+
+``stickslip run --model NAME`` and its spellings (``simulate``, ``transient``, ``rsf simulate``) print one
+summary for every model (:func:`stickslip.cli.run_cmd.summary_text`); the model's own record follows it: the
+quasi-static model's critical point and its table of cycles, the transient model's final state and its cycles,
+rate-and-state's final friction.  In JSON the record's keys stand beside the summary's (the summary's win).
+"""
+
+from __future__ import annotations
+
+import io
+from typing import Any
+
+#: Width of the plain text a table is drawn in (as ``print_rich`` draws it to a pipe).
+PLAIN_WIDTH = 120
+
+
+def model_record(run: Any) -> dict[str, Any]:
+    """The engine's own summary (SI): ``simulate --json``'s cycles and critical point, ``transient --json``'s
+    final state and cycles, ``rsf simulate --json``'s friction numbers."""
+    summary = getattr(run.native, "summary", None)
+    record = dict(summary()) if callable(summary) else {}
+    record.pop("units", None)  # the JSON's units map is drawn for the whole document
+    return record
+
+
+def record_text(run: Any) -> str:
+    """The model's own record in words, below the shared summary ("" for a model without one)."""
+    native = run.native
+    kind = type(native).__name__
+    if kind == "Simulation":
+        return "\n".join(item if isinstance(item, str) else _plain(item) for item in _simulation_record(native))
+    if kind == "TransientResult":
+        return "\n".join(_transient_record(native))
+    if kind == "RSFRun":
+        return f"  at t = {native.time[-1]:.6g} s: μ = {float(native.friction[-1]):.6g}"
+    return ""
+
+
+def _plain(*renderables: Any) -> str:
+    """Rich renderables as plain text (a table in box characters, no colour), every line stripped."""
+    from rich.console import Console
+
+    buffer = io.StringIO()
+    console = Console(file=buffer, width=PLAIN_WIDTH, color_system=None, highlight=False, force_terminal=False)
+    for item in renderables:
+        console.print(item)
+    return "\n".join(line.rstrip() for line in buffer.getvalue().splitlines())
+
+
+def _fmt(value: float | None, scale: float = 1.0, digits: int = 5) -> str:
+    return "—" if value is None else f"{value * scale:.{digits}g}"
+
+
+def _simulation_record(sim: Any) -> list[Any]:
+    """The quasi-static run: its parameter set, start and critical point, where it ended, and its cycles."""
+    from rich.table import Table
+
+    name = sim.parameters.name if sim.parameters is not None else "parameters"
+    head = [
+        f"  {name}: starting stuck at {sim.start_stress:.6g} Pa (jump onto the {sim.jump_curve} curve);"
+        f" Vc = {sim.critical_velocity * 1e6:.6g} µm/s, σc = {sim.critical_stress:.6g} Pa,"
+        f" K = {sim.stiffness / 1e3:.6g} kPa/m (Eq 17)",
+        f"  at t = {sim.time[-1]:.6g} s: σ = {sim.final_stress:.6g} Pa, V = {sim.final_velocity * 1e6:.6g} µm/s"
+        + ("" if sim.time[-1] >= sim.duration else " (the model stops here)"),
+    ]
+    out: list[Any] = ["\n".join(head)]
+    if not sim.cycles:
+        out.append("  no stick phase ended in a slip within the run")
+        return out
+    table = Table(title="Cycles", title_justify="left")
+    for heading in ("#", "start (s)", "σ start (Pa)", "σs (Pa)", "ts (s)", "Vs (µm/s)", "slip (s)", "period (s)"):
+        table.add_column(heading, justify="right")
+    for c in sim.cycles:
+        table.add_row(
+            str(c.index + 1),
+            _fmt(c.start_time, digits=6),
+            _fmt(c.start_stress),
+            _fmt(c.peak_stress),
+            _fmt(c.stick_time),
+            _fmt(c.jump_velocity, 1e6),
+            _fmt(c.slip_time),
+            _fmt(c.period),
+        )
+    out.append(table)
+    return out
+
+
+def _transient_record(result: Any) -> list[str]:
+    """The transient run: where it ended (stress, bonded fraction, velocity, steps) and each stick-slip event."""
+    lines = [
+        f"  at t = {result.time[-1]:.6g} s: σ = {result.final_stress:.6g} Pa,"
+        f" N/N0 = {result.final_bonded_fraction:.6g},"
+        f" V = {result.slider_velocity[-1] * 1e6:.6g} µm/s ({result.steps} steps)"
+    ]
+    for c in result.cycles:
+        slip = "—" if c.slip_time is None else f"{c.slip_time:.4g} s"
+        lines.append(
+            f"  cycle {c.index + 1}: stick {c.stick_time:.4g} s, σs = {c.peak_stress:.5g} Pa,"
+            f" jump to {c.jump_velocity * 1e6:.4g} µm/s, slip {slip}"
+        )
+    return lines
+
+
+__all__ = ["model_record", "record_text"]
