@@ -101,10 +101,15 @@ def main() -> None:
     parser.add_argument("--quasi-static", type=int, default=1600, help="points of the quasi-static sweep (0: none)")
     parser.add_argument("--workers", default="1,2", help="worker counts, comma-separated")
     parser.add_argument("--throughput", action="store_true", help="the former 10,000-point throughput benchmark")
+    parser.add_argument("--predict", metavar="OUT", help="a finished sweep folder: makespans on --predict-workers")
+    parser.add_argument("--predict-workers", default="1,2,4,8,16")
     parser.add_argument("--points", type=int, default=10_000)
     parser.add_argument("--small", type=int, default=2_000, help="points of the 1-vs-2-worker comparison")
     parser.add_argument("--speedup-only", action="store_true", help="only the 1-vs-2-worker comparison")
     args = parser.parse_args()
+    if args.predict:
+        predict(Path(args.predict), [int(w) for w in args.predict_workers.split(",")])
+        return
     if args.throughput or args.speedup_only:
         if not args.speedup_only:
             big_sweep(build_spec(grid(args.points)))
@@ -118,6 +123,40 @@ def main() -> None:
     counts = [int(w) for w in args.workers.split(",")]
     for name, spec in sweeps:
         compare_schedules(name, spec, counts, args.repeats)
+
+
+def predict(folder: Path, counts: list[int]) -> None:
+    """Makespans of a finished sweep on more workers than this machine has, from its rows' measured point times.
+
+    List scheduling (each task to the worker free first) of the plain order's tasks (the chunks in point order)
+    and of the cost plan (ordered by the model's estimate, timed by the measured times), beside the bound
+    max(sum / workers, longest point): the longest point is the critical path no schedule shortens.
+    """
+    from stickslip.sweeps import load_sweep
+    from stickslip.sweeps.engine import point_costs
+    from stickslip.sweeps.models import get_model
+    from stickslip.sweeps.schedule import plan_tasks, predicted_makespan, usable_costs
+    from stickslip.sweeps.store import read_manifest
+
+    frame, spec = load_sweep(folder)
+    times = frame.sort_values("point")["wall_time"].tolist()
+    size = read_manifest(folder)["batch_size"]
+    began = time.process_time()
+    estimates = usable_costs(point_costs(spec, get_model(spec.model), range(spec.size)))
+    spent = time.process_time() - began
+    total = sum(times)
+    print(f"{folder}: {spec.size} points, chunks of {size}; point times: sum {total:.1f} s, longest {max(times):.1f} s;"
+          f" the estimates took {spent:.2f} s CPU")  # fmt: skip
+    for workers in counts:
+        given = predicted_makespan([sum(times[i : i + size]) for i in range(0, spec.size, size)], workers)
+        plan = plan_tasks(estimates, workers, size)
+        cost = predicted_makespan([sum(times[k] for k in task) for task in plan], workers)
+        bound = max(total / workers, max(times))
+        print(
+            f"  {workers:3d} workers: plain order {given:.0f} s (efficiency {total / (workers * given):.0%}),"
+            f" cost order {cost:.0f} s ({total / (workers * cost):.0%}); bound {bound:.0f} s"
+            f" ({total / (workers * bound):.0%})"
+        )
 
 
 def transient_spec(shape: str, duration: float):
@@ -160,9 +199,20 @@ def scheduled_run(spec, workers: int, schedule: str) -> dict[str, float]:
         }
 
 
+def warm_up(spec) -> None:
+    """One point of each chunk's kind in this process first: the compiled kernels are then on disk (numba's cache),
+    and every cluster run loads them alike instead of the first one compiling them."""
+    from stickslip.sweeps.engine import run_points
+
+    began = time.process_time()
+    run_points(spec.to_json(), [0, spec.size - 1])
+    print(f"  warm-up (2 points in this process, compiled kernels cached on disk): {time.process_time() - began:.1f} s")
+
+
 def compare_schedules(name: str, spec, counts: list[int], repeats: int) -> None:
     """Both orders on each worker count, interleaved (the order of the two alternates between rounds)."""
     print(f"{name} sweep: {spec.size} points, batches of {default_batch_size(spec.size)}; {repeats} rounds")
+    warm_up(spec)
     results: dict[tuple[int, str], list[dict[str, float]]] = {}
     for round_ in range(repeats):
         for workers in counts:
