@@ -83,7 +83,9 @@ def on_files(files: Files, config: Any) -> Files:
         files.append(File.generated(config, target, content=content))
     for path in _notebooks():
         # a File backed by a real folder (mkdocs-jupyter's wrapper loses a generated file's source path)
-        files.append(File(f"examples/{path.name}", str(path.parent.parent), config["site_dir"], False))
+        files.append(
+            File(f"examples/{path.name}", str(path.parent.parent), config["site_dir"], config["use_directory_urls"])
+        )
     files.append(File.generated(config, REPORT_PAGE, content=_report_page(files, config)))
     return files
 
