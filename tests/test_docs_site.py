@@ -134,3 +134,10 @@ def test_notebook_markdown_math_becomes_mathml_and_code_and_prices_stay(hooks):
     assert "<mfrac>" in block and 'display="block"' in block
     assert "<code>echo $HOME $PATH</code>" in out and "costs $5 and $6" in out
     assert "<pre>$x$ printed by a cell</pre>" in out  # outputs are not Markdown
+
+
+def test_the_pages_the_hook_makes_are_the_ones_the_navigation_expects(hooks):
+    made = {page for page in hooks.GENERATED.values() if page.endswith(".md")} | {hooks.REPORT_PAGE}
+    assert made == GENERATED_PAGES
+    for source in hooks.GENERATED:
+        assert (ROOT / source).is_file(), f"{source}: the hook makes a site page from it, but it is gone"
