@@ -35,7 +35,7 @@ def test_rsf_simulate_into_a_fifo_writes_nothing_beside_it(tmp_path, capsys):
     code, _, err = run_main(capsys, "rsf", "simulate", "--segment", "1 um/s:10 s", "-o", str(fifo))
     reader.join(timeout=60)
     assert code == 0, err
-    assert got and got[0].startswith(b"time")
+    assert got and got[0].startswith(b"# stickslip run") and b"\ntime [s]," in got[0]  # the Run CSV, whole
     assert sorted(p.name for p in tmp_path.iterdir()) == ["pipe"]
 
 

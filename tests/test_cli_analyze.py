@@ -239,7 +239,7 @@ def test_simulate_output_chains_into_analyze(capsys, tmp_path):
     assert code == 0, err
     notes = err.splitlines()
     assert notes[0] == (
-        "note: ignored column(s) velocity, slider_displacement, puller_displacement, block_shear, chain_fraction,"
+        "note: ignored column(s) slider_velocity, slider_position, load_point_position, block_shear, chain_fraction,"
         " phase: analyze reads time and stress only"
     )
     assert len(notes) == 2 and "repeat the time and stress of the row before" in notes[1]

@@ -23,9 +23,9 @@ def test_simulate_writes_trace_parameters_and_summary(tmp_path, capsys):
     summary = json.loads(out)
     assert set(summary) >= {"regime", "final_friction", "period", "peak_friction", "trough_friction", "message"}
     assert summary["final_friction"] == pytest.approx(0.6 - 0.005 * math.log(10), abs=2e-6)  # still ringing at 40 s
-    frame = pd.read_csv(trace)
-    assert list(frame.columns) == ["time [s]", "friction [1]", "slider_velocity [m/s]", "state [s]",
-                                   "load_point_displacement [m]", "slider_displacement [m]"]  # fmt: skip
+    frame = pd.read_csv(trace, skiprows=1)  # the Run CSV: its metadata line first
+    assert list(frame.columns) == ["time [s]", "friction [1]", "slider_velocity [m/s]", "slider_position [m]",
+                                   "load_point_position [m]", "state [s]"]  # fmt: skip
     frame.columns = [c.split(" [")[0] for c in frame.columns]
     # rsfmodel's published friction at t = 11 s (tests/test_rsf_rsfmodel.py has the full comparison)
     assert frame["friction"].iloc[11] == pytest.approx(0.60720485, abs=1e-7)
@@ -48,9 +48,9 @@ def test_simulate_blow_up_is_said_in_words(capsys):
     code, out, _ = run_main(capsys, "rsf", "simulate", "--law", "slip", "--a", "0.01", "--b", "0.015", "--dc", "10 um",
                             "--stiffness", "250 1/m", "--start-velocity", "1.1 um/s", "--segment", "1 um/s:300 s",
                             "--every", "0.5 s", "--json")  # fmt: skip
-    assert code == 0
+    assert code == 3  # as `run --model rsf`: a run that ran away is a failed run, its summary printed first
     summary = json.loads(out)
-    assert summary["regime"] == "blow-up" and "radiation damping" in summary["message"]
+    assert summary["status"] == "failed" and summary["regime"] == "blow-up" and "radiation damping" in summary["message"]
 
 
 def test_stability_json_matches_closed_form(capsys):

@@ -22,9 +22,9 @@ def test_velocity_step_trace_and_json(tmp_path):
     assert set(summary) >= {"regime", "final_stress", "final_bonded_fraction", "cycles", "message"}
     expected = float(stickslip.steady_state(stickslip.load_parameters("gelatin-glass"), 1e-3).stress)
     assert abs(summary["final_stress"] / expected - 1) < 1e-3
-    frame = pd.read_csv(trace)
-    assert list(frame.columns) == ["time [s]", "stress [Pa]", "bonded_fraction [1]", "slider_velocity [m/s]",
-                                   "slider_position [m]", "puller_position [m]"]  # fmt: skip
+    frame = pd.read_csv(trace, skiprows=1)  # the Run CSV: its metadata line first
+    assert list(frame.columns) == ["time [s]", "stress [Pa]", "slider_velocity [m/s]", "slider_position [m]",
+                                   "load_point_position [m]", "bonded_fraction [1]"]  # fmt: skip
     frame.columns = [c.split(" [")[0] for c in frame.columns]
     assert len(frame) == 15
 

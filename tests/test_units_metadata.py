@@ -174,7 +174,7 @@ def test_json_drops_float_noise(capsys):
 @pytest.mark.parametrize(
     ("argv", "header"),
     [
-        (("simulate", "--v0", "100 um/s", "--duration", "30 s"), "time [s],stress [Pa],velocity [m/s]"),
+        (("simulate", "--v0", "100 um/s", "--duration", "30 s"), "time [s],stress [Pa],slider_velocity [m/s]"),
         (("transient", "--v0", "350 um/s", "--duration", "2 ms", "--control", "velocity"), "time [s],stress [Pa]"),
         (
             (
@@ -192,7 +192,7 @@ def test_trace_csv_headers_name_units(capsys, tmp_path, argv, header):
     out = tmp_path / "trace.csv"
     code, _, err = run_main(capsys, *argv, "-o", str(out))
     assert code == 0, err
-    assert out.read_text().splitlines()[0].startswith(header)
+    assert out.read_text().splitlines()[1].startswith(header)  # below the Run CSV's metadata line
 
 
 def test_sweep_parquet_names_its_units_for_pandas_and_pyarrow(tmp_path):
@@ -263,7 +263,7 @@ def test_transient_trace_with_the_stick_chains_shows_what_holds_the_block(params
     code, _, err = run_main(capsys, "transient", "--v0", "100 um/s", "--duration", "12 s", "--start", "steady",
                             "--stick-population", "-o", str(trace))  # fmt: skip
     assert code == 0, err
-    assert trace.read_text().splitlines()[0].endswith(",chain_fraction [1],held_by")
+    assert trace.read_text().splitlines()[1].endswith(",chain_fraction [1],held_by")  # the Run CSV's header
     code, out, err = run_main(capsys, "analyze", str(trace), "--v0", "100 um/s", "--json")
     assert code == 0, err
     assert json.loads(out)["cycles"][0]["stick_time"] == pytest.approx(run.cycles[0].stick_time, abs=1e-2)

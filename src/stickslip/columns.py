@@ -163,6 +163,7 @@ UNITS: dict[str, str | None] = {
     "steps": None,
     "wall_time": _TIME,  # a sweep point's computing time
     "periods": None,  # how many periods the regime classifier saw
+    "periods_seen": None,  # the same, in a run's summary (run --json and its spellings)
     "amplitude_ratio": DIMENSIONLESS,
 }
 #: Keys whose numbers are in the unit of the key that holds them (``{"bonds.bond_time": {"value": ...}}``).
