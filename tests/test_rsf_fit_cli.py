@@ -324,7 +324,7 @@ def test_simulate_fit_simulate_chain(tmp_path, capsys):
     code, _, err = run_main(capsys, "rsf", "simulate", "--params", str(fitted), *segments, "--every", "0.25 s",
                             "-o", str(tmp_path / "again.csv"))  # fmt: skip
     assert code == 0, err
-    first, again = pd.read_csv(trace), pd.read_csv(tmp_path / "again.csv")
+    first, again = (pd.read_csv(path, skiprows=1) for path in (trace, tmp_path / "again.csv"))  # Run CSVs
     assert len(first) == len(again) == 481
     assert np.max(np.abs(again["friction [1]"] - first["friction [1]"])) < 1e-5  # of a 0.012 step
     assert math.isclose(first["friction [1]"].iloc[0], 0.6, abs_tol=1e-12)

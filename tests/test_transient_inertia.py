@@ -153,7 +153,7 @@ def test_cli_block_mass_writes_a_trace_analyze_reads(tmp_path):
     result = CliRunner().invoke(cli, args)
     assert result.exit_code == 0, result.output
     assert "block mass 10.5 kg/m², damping 1025 Pa·s/m" in result.output
-    header = out.read_text().splitlines()[0]
+    header = out.read_text().splitlines()[1]  # below the Run CSV's metadata line
     assert "slider_velocity" in header
     run = CliRunner().invoke(cli, ["run", "--model", "transient", "--v0", "350 um/s", "--duration", "3 ms",
                                    "--start", "steady", "--mass", "10.5 kg/m^2", "--json"])  # fmt: skip
