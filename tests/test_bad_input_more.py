@@ -116,3 +116,19 @@ def test_fit_steady_takes_its_split_with_a_unit():
     with_unit, in_si = fit_steady(path, split="800 um/s"), fit_steady(path, split=800e-6)
     assert with_unit.split == pytest.approx(800e-6, rel=1e-12) and in_si.split == pytest.approx(800e-6, rel=1e-12)
     assert with_unit.critical_velocity.value == pytest.approx(in_si.critical_velocity.value, rel=1e-6)
+
+
+def test_an_inertial_rsf_slider_that_stops_says_so_in_words():
+    """A slider with mass whose velocity underflows (it stops) has no state of rest in ln V: a ModelError that
+    says the slider stopped, not an internal ZeroDivisionError nor 'the inertia is too small to matter'."""
+    import stickslip
+    from stickslip import protocols
+    from stickslip.errors import ModelError
+    from stickslip.models import Rig
+
+    spec = {"mu0": 0.5, "v_ref": 1e-3, "a": 0.001, "b": 0.015, "dc": "10 um", "normal_stress": 1e3}
+    params = stickslip.get_model("rsf").parameters(None, spec)
+    rig = Rig(stiffness=1e4, damping=100.0, mass=1.0)
+    with pytest.raises(ModelError, match="the slider stopped") as info:
+        stickslip.run("rsf", params, protocols.constant(0.03, 2.0), rig, start=0.033)
+    assert "too small to matter" not in str(info.value)

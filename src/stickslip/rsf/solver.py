@@ -154,6 +154,13 @@ def _requested(run: RSFRun, grid: np.ndarray) -> RSFRun:
 
 def _out_of_range(system: System, t0: float, t1: float, exc: Exception) -> str:
     where = f"the rate-and-state equations left the floating-point range in the segment {t0:g} ... {t1:g} s ({exc})"
+    if system.inertial and isinstance(exc, ZeroDivisionError) and system.inertia > 1e-200:  # V underflowed
+        return (
+            f"the slider stopped in the segment {t0:g} ... {t1:g} s: its velocity fell below the floating-point"
+            " range, and a slider with mass, whose equations are written in ln V, has no state of rest (the model"
+            " has no answer after that): raise eta or a, or drop the mass (without it the slider creeps instead of"
+            " stopping)"
+        )
     if system.inertial:
         return (
             f"{where}: the slider's inertia m/σ = {system.inertia:.3g} s^2/m is too small to matter; drop the"
