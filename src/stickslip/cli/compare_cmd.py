@@ -25,6 +25,12 @@ from .common import json_text, params_options, positive, quantity, resolve_param
 from .protocol_options import protocol_options
 from .rsf_cmd import save_figure, sidecar, write
 
+#: The protocol sets of ``compare --models A,B --protocol-set NAME``: each runs its own protocols (options
+#: --v0/--v1/--step-time/--hold/--pull/--duration) on its models; bond-vs-rsf takes a bond model and rsf.
+PROTOCOL_SETS = {"bond-vs-rsf": ("quasi-static", "transient")}
+#: What plain ``stickslip compare`` runs (its older spelling, kept): the bond-vs-RSF set on these models.
+CLASSIC_MODELS = "quasi-static,rsf"
+
 #: The classic compare's --v0 and --duration when not given (with --models they are the protocol's first segment).
 CLASSIC_V0, CLASSIC_DURATION = "200 um/s", "120 s"
 
@@ -58,6 +64,15 @@ CLASSIC_V0, CLASSIC_DURATION = "200 um/s", "120 s"
     help="--models: a run setting (e.g. stick_population=true) for each model that takes it; repeatable.",
 )
 @click.option("--every", "every_text", default=None, metavar="DT", help="--models: sample each trace every DT.")
+@click.option(
+    "--protocol-set",
+    "protocol_set",
+    type=click.Choice(sorted(PROTOCOL_SETS)),
+    default=None,
+    help="Run --models (a bond model and rsf) on a set of protocols instead of one: bond-vs-rsf is the velocity"
+    " step, slide-hold-slide and stick-slip, rate-and-state fitted to the bond model's step (plain"
+    " `stickslip compare` runs it with --models quasi-static,rsf).",
+)
 @click.option("--v1", default="2 mm/s", show_default=True, help="Velocity after the step.")
 @click.option("--step-time", default="2 s", show_default=True, help="Duration of each velocity of the step.")
 @click.option("--hold", default="1 s", show_default=True, help="Hold time of the slide-hold-slide.")
@@ -76,18 +91,23 @@ CLASSIC_V0, CLASSIC_DURATION = "200 um/s", "120 s"
 @click.option("--json", "as_json", is_flag=True, help="Print the summary as JSON (SI units).")
 @click.option("-o", "--output", type=click.Path(dir_okay=False, path_type=Path), help="Save the figure here.")
 def compare_command(**options: Any) -> None:
-    """The bond model beside rate-and-state friction fitted to it: velocity step, slide-hold-slide, stick-slip.
+    """Models side by side on one protocol (--models A,B), or on a protocol set (--protocol-set).
 
-    Without --models: the classic comparison (--v0 is the velocity before the step [200 um/s], --duration that
-    of the stick-slip pair [120 s]).  With --models A,B: every model runs the protocol of --v0/--duration/
+    --models quasi-static,rsf --protocol-set bond-vs-rsf (plain `stickslip compare`, its older spelling, the
+    same run): the bond model beside rate-and-state fitted to it, on a velocity step, a slide-hold-slide and
+    stick-slip (--v0 is the velocity before the step [200 um/s], --duration that of the stick-slip pair
+    [120 s]; --models transient,rsf or --bond-model transient for the time-dependent bond model).
+
+    With --models A,B alone: every model runs the protocol of --v0/--duration/
     --segment/--protocol through the rig of --control/--stiffness; --set KEY=VALUE goes to each model that has
     the key (stickslip.models).  A run that failed makes the exit status 3.
     """
-    if options["models"] is not None:
+    if options["models"] is not None and options["protocol_set"] is None:
         from .compare_models import compare_models
 
         compare_models(options)
         return
+    options["bond_model"] = _bond_model_of(options)
     _refuse_model_options(options)
     options["v0"] = options["v0_text"] or CLASSIC_V0
     options["duration"] = options["duration_text"] or CLASSIC_DURATION
@@ -161,6 +181,30 @@ def compare_command(**options: Any) -> None:
         raise SystemExit(FAILED)
 
 
+def _bond_model_of(options: dict[str, Any]) -> str:
+    """The bond model of the bond-vs-rsf set: from --models (a bond model and rsf), else --bond-model.
+
+    Plain ``compare`` is ``compare --models quasi-static,rsf --protocol-set bond-vs-rsf`` (``--bond-model
+    transient``: ``--models transient,rsf``); the two spellings run the same code on the same options.
+    """
+    ctx = click.get_current_context()
+    if options["models"] is None:
+        return str(options["bond_model"])
+    names = [name.strip() for name in options["models"].split(",") if name.strip()]
+    bond = [name for name in names if name in PROTOCOL_SETS["bond-vs-rsf"]]
+    if len(names) != 2 or "rsf" not in names or len(bond) != 1:
+        raise ParameterError(
+            f"--models {options['models']}: --protocol-set bond-vs-rsf runs a bond model beside rate-and-state;"
+            " expected quasi-static,rsf or transient,rsf"
+        )
+    given = ctx.get_parameter_source("bond_model") not in (None, click.core.ParameterSource.DEFAULT)
+    if given and options["bond_model"] != bond[0]:
+        raise ParameterError(
+            f"--bond-model {options['bond_model']}: --models {options['models']} names the bond model already"
+        )
+    return bond[0]
+
+
 def _refuse_model_options(options: dict[str, Any]) -> None:
     """The protocol and rig words belong to --models; the classic comparison runs its own three experiments."""
     ctx = click.get_current_context()
@@ -171,8 +215,8 @@ def _refuse_model_options(options: dict[str, Any]) -> None:
         given.append("--control")
     if given:
         raise ParameterError(
-            f"{given[0]}: only with --models A,B; without it compare runs its own velocity step, slide-hold-slide"
-            " and stick-slip"
+            f"{given[0]}: only with --models A,B and no --protocol-set; the bond-vs-rsf set (plain compare) runs its"
+            " own velocity step, slide-hold-slide and stick-slip"
         )
 
 
