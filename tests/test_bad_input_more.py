@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import re
 from pathlib import Path
 
 import pytest
@@ -132,3 +133,33 @@ def test_an_inertial_rsf_slider_that_stops_says_so_in_words():
     with pytest.raises(ModelError, match="the slider stopped") as info:
         stickslip.run("rsf", params, protocols.constant(0.03, 2.0), rig, start=0.033)
     assert "too small to matter" not in str(info.value)
+
+
+@pytest.mark.parametrize(
+    ("words", "named"),
+    [
+        ({"progress": "notcallable"}, "progress: expected a function"),
+        ({"control": "velocity", "stiffness": 1e5}, "stiffness: 100000.0 given with control='velocity'"),
+        ({"snapshot_times": [-1.0]}, "snapshot_times: expected times within the run, 0 to 0.01 s, got -1.0"),
+        ({"snapshot_times": [float("nan")]}, "snapshot_times: expected times within the run"),
+        ({"snapshot_times": [0.5]}, "got 0.5"),
+        ({"snapshot_times": "soon"}, "snapshot_times: expected times in s"),
+    ],
+)
+def test_run_transient_refuses_its_words_before_a_step(words, named):
+    import stickslip
+    from stickslip import protocols
+    from stickslip.errors import ParameterError
+    from stickslip.transient import run_transient
+
+    with pytest.raises(ParameterError, match=re.escape(named)):
+        run_transient(stickslip.load_parameters(), protocols.constant(50e-6, 0.01), **words)
+
+
+def test_run_transient_keeps_a_snapshot_at_a_time_within_the_run():
+    import stickslip
+    from stickslip import protocols
+    from stickslip.transient import run_transient
+
+    result = run_transient(stickslip.load_parameters(), protocols.constant(50e-6, 0.01), snapshot_times=[0.005])
+    assert any(abs(s.time - 0.005) < 1e-12 for s in result.snapshots)

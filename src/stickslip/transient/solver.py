@@ -28,6 +28,7 @@ from ..protocols import Protocol
 from ..quasistatic.cycle import Cycle
 from ..units import checked_number
 from . import kernel as K
+from .arguments import check_progress, check_rig_words, check_snapshot_times
 from .model import Population, pack_parameters, stick_chains
 from .result import Bookkeeping, Snapshot, TransientResult
 
@@ -179,6 +180,8 @@ def run_transient(
     if not isinstance(protocol, Protocol):
         raise ParameterError(f"protocol: expected a stickslip.protocols.Protocol, got {type(protocol).__name__}")
     check_rtol(rtol)
+    progress = check_progress(progress)
+    check_rig_words(control, stiffness)
     if stick_population and control != "block":
         raise ParameterError("stick_population: the attached chains need block control (control='block')")
     mass, damping = _block_inertia(mass, damping, control, stick_population)
@@ -243,7 +246,7 @@ def run_transient(
     # a snapshot copies every cohort: at each segment end only for a protocol of a few segments (issue 29: 1e5
     # segments of 1 ms held 8.4 GB of them)
     ends = protocol.boundaries.tolist() if len(protocol.segments) <= SNAPSHOT_SEGMENTS else []
-    wanted = sorted(set([0.0, duration, *ends, *np.atleast_1d(snapshot_times or []).tolist()]))
+    wanted = sorted(set([0.0, duration, *ends, *check_snapshot_times(snapshot_times, duration)]))
     snapshots: list[Snapshot] = []
     rows: list[np.ndarray] = [_row(state, params, control, k_block, mass)]
     chain_rows: list[np.ndarray] = []
