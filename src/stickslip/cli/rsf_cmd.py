@@ -11,7 +11,6 @@ from __future__ import annotations
 import contextlib
 import dataclasses
 import functools
-import json
 import math
 import signal
 import sys
@@ -26,10 +25,11 @@ import click
 import numpy as np
 
 from ..errors import DataError, ModelError, ParameterError, StickslipError, UnitError
-from ..fileio import atomic_path, atomic_write_text, protect_inputs, read_input_text
+from ..fileio import atomic_path, atomic_write_text
 from ..numerics.budget import PROGRESS_AFTER_SECONDS
 from ..units import quantity_noun, shorten
 from .common import json_text, quantity, refuse_overwriting_inputs
+from .params_files import MAX_PARAMS_BYTES, load_params_file, load_params_mapping  # noqa: F401 (their old home)
 from .protocol_options import build_protocol as build_run_protocol
 from .protocol_options import checked_segment_text, protocol_options, refuse_unsupported
 
@@ -124,10 +124,6 @@ def build_params(options: dict[str, Any]) -> Any:
     return RSFParams.from_dict(mapping, source=source)
 
 
-#: Largest --params file read (one written by a run or fit is a few kB).
-MAX_PARAMS_BYTES = 1_000_000
-
-
 def _base_states(base: dict[str, Any], path: Path | None) -> list[dict[str, Any]]:
     """The state variables of a --params file (one aging state without one), each a table."""
     if "states" not in base:
@@ -138,43 +134,6 @@ def _base_states(base: dict[str, Any], path: Path | None) -> list[dict[str, Any]
             f"--params {path}: 'states' must be a non-empty list of tables with law, b, dc; got {shorten(states)}"
         )
     return [dict(s) for s in states]
-
-
-def load_params_mapping(path: Path) -> dict[str, Any]:
-    """The parameter mapping of a ``.params.json`` (trace or fit) or a ``.toml`` file."""
-    data = load_params_file(path)
-    mapping = data.get("parameters", data)
-    if not isinstance(mapping, dict):
-        raise DataError(f"--params {path}: 'parameters' must be a table of values, got {type(mapping).__name__}")
-    return dict(mapping)
-
-
-def load_params_file(path: Path) -> dict[str, Any]:
-    """The whole top-level table of a ``--params`` file; every problem with the file is one DataError line."""
-    path = Path(path)
-    text = _params_text(path)
-    protect_inputs([path])  # `rsf simulate --params run.params.json -o run.csv` must not rewrite it
-    try:
-        if path.suffix.lower() == ".toml":
-            try:
-                import tomllib
-            except ModuleNotFoundError:  # pragma: no cover - Python 3.10
-                import tomli as tomllib  # type: ignore[no-redef]
-            data = tomllib.loads(text)
-        else:
-            data = json.loads(text)
-    except ValueError as exc:  # JSONDecodeError and TOMLDecodeError are ValueErrors
-        kind = "TOML" if path.suffix.lower() == ".toml" else "JSON"
-        raise DataError(f"--params {path}: malformed {kind} ({(str(exc).splitlines() or [''])[0]})") from None
-    except RecursionError:  # "[[[[..." a hundred thousand deep: the parsers recurse
-        raise DataError(f"--params {path}: nested too deeply to be a parameter file") from None
-    if not isinstance(data, dict):
-        raise DataError(f"--params {path}: expected a table of parameters (a JSON object), got {type(data).__name__}")
-    return data
-
-
-def _params_text(path: Path) -> str:
-    return read_input_text(path, f"--params {path}", MAX_PARAMS_BYTES)
 
 
 def _run_meta(path: Path) -> tuple[list[dict[str, Any]] | None, float | None]:

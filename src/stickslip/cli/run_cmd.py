@@ -74,7 +74,7 @@ def model_parameters(model: Any, params_name: str | None, overrides: dict[str, s
         path = Path(params_name) if params_name is not None else None
         if path is None or path.suffix.lower() not in (".json", ".toml") or not path.is_file():
             raise
-    from .rsf_cmd import load_params_mapping  # a file of the mapping the model reads (rate-and-state's)
+    from .params_files import load_params_mapping  # a file of the mapping the model reads (rate-and-state's)
 
     return model.parameters(load_params_mapping(path), overrides)
 
