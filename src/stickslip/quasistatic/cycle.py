@@ -281,7 +281,8 @@ def simulate(
     steady curve on which the jump lands (``"aging"``, default, keeps the
     stress continuous; ``"no-aging"`` is the paper's Section 3 reading).
 
-    ``regime`` describes where the run is heading, whatever ``duration``:
+    ``regime`` (a :class:`stickslip.regimes.Regime`, the type of ``stickslip.run(...).regime``, equal to its
+    kind's name) describes where the run is heading, whatever ``duration``:
     ``"stick-slip"`` (cycles repeat), ``"steady"`` (the slip settles at V0 >=
     Vc), ``"stuck"`` (a stick never ends) or ``"undetermined"`` (the model has
     no answer: the jump stress is off the branch, a stick can neither be
