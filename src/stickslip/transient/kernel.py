@@ -79,12 +79,14 @@ GL4_X = np.array([-0.8611363115940526, -0.3399810435848563, 0.3399810435848563, 
 GL4_W = np.array([0.3478548451374538, 0.6521451548625461, 0.6521451548625461, 0.3478548451374538])
 
 
-def _jit(func):  # type: ignore[no-untyped-def]
+def _jit(func, inline: bool = False):  # type: ignore[no-untyped-def]
     from numba import njit
 
     # error_model="numpy": IEEE division (no zero-divisor test on every division; a zero divisor gives inf or nan,
     # which the solver reports as a non-finite state instead of a raw ZeroDivisionError)
-    return njit(cache=True, fastmath=False, nogil=True, error_model="numpy")(func)
+    return njit(cache=True, fastmath=False, nogil=True, error_model="numpy", inline="always" if inline else "never")(
+        func
+    )
 
 
 def _chain_force(e, m, dlm):  # type: ignore[no-untyped-def]
@@ -517,50 +519,20 @@ def _predicted_path(x, v, v_prev, h_prev, hh, vp, block, inertial, accel_now, ac
     return v0, v1p, x1p, x_mid, jerk
 
 
-def _cohort_gone(i, lw_new, rate0, w1, known):  # type: ignore[no-untyped-def]
-    """Cohort i is broken by the step's end (its chains at or past the FENE wall)."""
-    lw_new[i] = -np.inf
-    rate0[i] = np.inf
-    w1[i] = 0.0
-    known[0, i] = -1.0
-
-
-def _hazard_ends(i, t, t1, tb_i, e0, e1, f0, v0, v1p, slope0, slope1, accel, cache, cached, p):  # type: ignore[no-untyped-def]
-    """Cohort i's hazard at both ends of the step along its characteristic: (lr0, r0, lr1, r1, g0, g1, k0, f1, k1,
-    age1): ln r and r, d ln r/dt (through the force, the age, and the velocity's effect on aging), the chain
-    stiffness f' at both ends, the force at the end and the age the aging term sees there.  The start's values
-    are the last row's where ``cached`` (the same numbers)."""
-    m = p[P_M]
-    dlm = p[P_DLM]
-    beta = p[P_FORCE_SENS]
-    if p[P_SATURATION] > 0.0:  # the age the aging term sees, and its rate
-        age0, clock0 = _aging_clock(t - tb_i, p)
-        age1, clock1 = _aging_clock(t1 - tb_i, p)
-    else:
-        age0, clock0 = t - tb_i, 1.0
-        age1, clock1 = t1 - tb_i, 1.0
-    f1 = _chain_force(e1, m, dlm)
-    if cached:
-        lr0 = cache[4, i]
-        r0 = cache[5, i]
-    else:
-        lr0 = min(p[P_LOG_U0_TAU] + beta * abs(f0) - age0 * slope0, LOG_RATE_CAP)
-        r0 = math.exp(lr0)
-    lr1 = min(p[P_LOG_U0_TAU] + beta * abs(f1) - age1 * slope1, LOG_RATE_CAP)
-    r1 = math.exp(lr1)
-    k0 = cache[2, i] if cached else _chain_stiffness(e0, m, dlm)
-    k1 = _chain_stiffness(e1, m, dlm)
+def _hazard_slopes(f0, f1, k0, k1, v0, v1p, age0, age1, clock0, clock1, slope0, slope1, accel, beta, va, aging):  # type: ignore[no-untyped-def]
+    """(g0, g1): d ln r/dt along a cohort's characteristic at both ends of the step, through the force (its
+    stiffness k), the age the aging term sees (its clock rate), and the velocity's effect on aging."""
     g0 = beta * (1.0 if f0 >= 0.0 else -1.0) * k0 * v0 - slope0 * clock0
     g1 = beta * (1.0 if f1 >= 0.0 else -1.0) * k1 * v1p - slope1 * clock1
-    if p[P_AGING] > 0.0 and accel != 0.0:
-        g0 += age0 * slope0 * accel / p[P_VA] * (1.0 if v0 >= 0.0 else -1.0)
-        g1 += age1 * slope1 * accel / p[P_VA] * (1.0 if v1p >= 0.0 else -1.0)
-    return lr0, r0, lr1, r1, g0, g1, k0, f1, k1, age1
+    if aging and accel != 0.0:
+        g0 += age0 * slope0 * accel / va * (1.0 if v0 >= 0.0 else -1.0)
+        g1 += age1 * slope1 * accel / va * (1.0 if v1p >= 0.0 else -1.0)
+    return g0, g1
 
 
-def _cohort_weight(i, lw_i, w0, f0, hh, lr0, r0, lr1, r1, g0, g1, known):  # type: ignore[no-untyped-def]
-    """Cohort i's log weight at the step's end: (new, its weight, its error, the stress dying at a cliff, the
-    trapezoid of its hazard).  Marks in ``known`` whether exp(new) was taken exactly."""
+def _cohort_weight(lw_i, w0, f0, hh, lr0, r0, lr1, r1, g0, g1):  # type: ignore[no-untyped-def]
+    """A cohort's log weight at the step's end from its hazard at both ends: (new, its weight, its error, the
+    stress dying at a cliff, the trapezoid of the hazard, whether exp(new) was taken exactly)."""
     trap = 0.5 * hh * (r0 + r1)
     dying = 0.0
     if abs(lr1 - lr0) > 1.0 and max(lr0, lr1) < LOG_RATE_CAP:
@@ -569,7 +541,6 @@ def _cohort_weight(i, lw_i, w0, f0, hh, lr0, r0, lr1, r1, g0, g1, known):  # typ
         # the 2 % of young bonds that age into permanence; its error from the curvature of ln r
         integral = hh * (r1 - r0) / (lr1 - lr0)
         wn = w0 * math.exp(-integral)
-        known[0, i] = -1.0
         new = lw_i - integral
         delta = abs(g1 - g0) * hh / 8.0 * integral
         dw = min(wn * math.expm1(min(delta, 50.0)), w0) + abs(wn - w0 * math.exp(-min(trap, 745.0))) * 1e-3
@@ -580,24 +551,23 @@ def _cohort_weight(i, lw_i, w0, f0, hh, lr0, r0, lr1, r1, g0, g1, known):  # typ
             # (the current step stands for the birth spacing of bonds born under the current drive only)
             hg = hh * g1
             dying = (w0 - wn) * abs(f0) * min(hg * hg * hg * hg / 4320.0, 1.0)
-    else:
-        corr = hh * hh / 12.0 * (r1 * g1 - r0 * g0)  # Euler-Maclaurin end correction: fourth order
-        limit = 0.5 * trap
-        corr = min(max(corr, -limit), limit)
-        new = lw_i - trap + corr
-        wn = math.exp(new)
-        known[0, i] = wn
-        dw = abs(wn - w0 * math.exp(-min(trap, 745.0)))  # against the plain trapezoid
-    return new, wn, dw, dying, trap
+        return new, wn, dw, dying, trap, False
+    corr = hh * hh / 12.0 * (r1 * g1 - r0 * g0)  # Euler-Maclaurin end correction: fourth order
+    limit = 0.5 * trap
+    corr = min(max(corr, -limit), limit)
+    new = lw_i - trap + corr
+    wn = math.exp(new)
+    dw = abs(wn - w0 * math.exp(-min(trap, 745.0)))  # against the plain trapezoid
+    return new, wn, dw, dying, trap, True
 
 
-def _cohort_dissipation(i, trap, hh, w0, wn, r0, r1, g0, g1, f0, f1, v0, v1p, e0, e1, e_mid, cache, cached, p):  # type: ignore[no-untyped-def]
-    """The energy cohort i's breakage dissipates over the step: r w u by the end-corrected trapezoid (fourth
-    order), or, a cohort breaking within the step, its lost mass at the mid-step energy."""
-    m = p[P_M]
-    dlm = p[P_DLM]
+def _cohort_dissipation(trap, hh, w0, wn, r0, r1, g0, g1, f0, f1, v0, v1p, e0, e1, e_mid, u0, m, dlm):  # type: ignore[no-untyped-def]
+    """The energy a cohort's breakage dissipates over the step: r w u by the end-corrected trapezoid (fourth
+    order; u0 the energy at the start where known, else nan), or, a cohort breaking within the step, its lost
+    mass at the mid-step energy."""
     if trap < 0.5:
-        u0 = cache[3, i] if cached else _chain_energy(e0, m, dlm)
+        if u0 != u0:
+            u0 = _chain_energy(e0, m, dlm)
         u1 = _chain_energy(e1, m, dlm)
         phi0 = r0 * w0 * u0
         phi1 = r1 * wn * u1
@@ -620,6 +590,10 @@ def _cohort_pass(  # type: ignore[no-untyped-def]
     m = p[P_M]
     dlm = p[P_DLM]
     beta = p[P_FORCE_SENS]
+    log_u0_tau = p[P_LOG_U0_TAU]
+    va = p[P_VA]
+    saturating = p[P_SATURATION] > 0.0
+    aging_on = p[P_AGING] > 0.0
     nn0 = s0 = nn1 = s1 = 0.0
     loss0 = loss1 = 0.0  # breakage rate (bonds per m^2 per s) at both ends of the step
     dloss0 = dloss1 = 0.0  # and its time derivative
@@ -638,25 +612,49 @@ def _cohort_pass(  # type: ignore[no-untyped-def]
         e1 = x1p - xb[i]
         nn0 += w0
         if e0 >= dlm or -e0 >= dlm:  # beyond the FENE wall already (cannot happen for a live cohort)
-            _cohort_gone(i, lw_new, rate0, w1, known)
+            lw_new[i] = -np.inf
+            rate0[i] = np.inf
+            w1[i] = 0.0
+            known[0, i] = -1.0
             broken += w0
             continue
         f0 = cache[1, i] if cached else _chain_force(e0, m, dlm)
         s0 += w0 * f0
         if e1 >= dlm or -e1 >= dlm:  # the chain reaches full extension within the step
-            _cohort_gone(i, lw_new, rate0, w1, known)
+            lw_new[i] = -np.inf
+            rate0[i] = np.inf
+            w1[i] = 0.0
+            known[0, i] = -1.0
             broken += w0
             walled += w0
             dissip += w0 * _chain_energy(e0, m, dlm)
             err_s += w0 * abs(f0)
             err_n += w0
             continue
-        lr0, r0, lr1, r1, g0, g1, k0, f1, k1, age1 = _hazard_ends(
-            i, t, t1, tb[i], e0, e1, f0, v0, v1p, slope0, slope1, accel, cache, cached, p
-        )
+        if saturating:  # the age the aging term sees, and its rate
+            age0, clock0 = _aging_clock(t - tb[i], p)
+            age1, clock1 = _aging_clock(t1 - tb[i], p)
+        else:
+            age0, clock0 = t - tb[i], 1.0
+            age1, clock1 = t1 - tb[i], 1.0
+        f1 = _chain_force(e1, m, dlm)
+        if cached:  # the last row's values at the step's start (the same numbers)
+            lr0 = cache[4, i]
+            r0 = cache[5, i]
+            k0 = cache[2, i]
+        else:
+            lr0 = min(log_u0_tau + beta * abs(f0) - age0 * slope0, LOG_RATE_CAP)
+            r0 = math.exp(lr0)
+            k0 = _chain_stiffness(e0, m, dlm)
+        lr1 = min(log_u0_tau + beta * abs(f1) - age1 * slope1, LOG_RATE_CAP)
+        r1 = math.exp(lr1)
+        k1 = _chain_stiffness(e1, m, dlm)
         predicted[0, i] = f1
         predicted[1, i] = k1
-        new, wn, dw, dying, trap = _cohort_weight(i, lw[i], w0, f0, hh, lr0, r0, lr1, r1, g0, g1, known)
+        g0, g1 = _hazard_slopes(f0, f1, k0, k1, v0, v1p, age0, age1, clock0, clock1, slope0, slope1, accel, beta,
+                                va, aging_on)  # fmt: skip
+        new, wn, dw, dying, trap, exact = _cohort_weight(lw[i], w0, f0, hh, lr0, r0, lr1, r1, g0, g1)
+        known[0, i] = wn if exact else -1.0
         if tb[i] >= t0:
             cliff += dying
         else:
@@ -670,9 +668,9 @@ def _cohort_pass(  # type: ignore[no-untyped-def]
         dloss0 += w0 * r0 * (g0 - r0)
         dloss1 += wn * r1 * (g1 - r1)
         broken += w0 - wn
-        dissip += _cohort_dissipation(
-            i, trap, hh, w0, wn, r0, r1, g0, g1, f0, f1, v0, v1p, e0, e1, x_mid - xb[i], cache, cached, p
-        )
+        u0 = cache[3, i] if cached else np.nan
+        dissip += _cohort_dissipation(trap, hh, w0, wn, r0, r1, g0, g1, f0, f1, v0, v1p, e0, e1, x_mid - xb[i], u0, m,
+                                      dlm)  # fmt: skip
         rate_s0 += w0 * r0 * f0
         rate_s1 += wn * r1 * f1
         kint0 += w0 * k0
@@ -948,47 +946,21 @@ def _book_step(  # type: ignore[no-untyped-def]
     acc[7] = min(acc[7], s1)  # the lowest stress of the accepted steps since the last row
 
 
-def _mergeable(i, g, n, t, x, quiet, gap, age_gap, aged, spread, xb, tb, rate0, p):  # type: ignore[no-untyped-def]
-    """Cohort i merges into the kept cohort g before it: both quiet (negligible breakage for the rest of the piece)
-    and born at nearly the same slider position and time, or (saturated aging) in one bin (:func:`_same_bin`).
-    The newest cohort (i = n - 1) is never merged."""
-    if g < 0 or i >= n - 1:
-        return False
+def _quiet_neighbours(rate_i, rate_g, xb_i, xb_g, tb_i, tb_g, quiet, gap, age_gap, p):  # type: ignore[no-untyped-def]
+    """Two cohorts both quiet (negligible breakage for the rest of the piece) and born at nearly the same slider
+    position and time (in units of the aging time, none without aging)."""
     return (
-        rate0[i] < quiet
-        and rate0[g] < quiet
-        and abs(xb[i] - xb[g]) < gap
-        and abs(tb[i] - tb[g]) * p[P_INV_TAU_A] * p[P_AGING] < age_gap
-    ) or (aged and _same_bin(t, x, tb[i], tb[g], xb[i], xb[g], spread, p))
-
-
-def _merge(g, i, xb, tb, lw, known, rate0):  # type: ignore[no-untyped-def]
-    """Cohort i into g: the weight, the mean extension and age kept, so it breaks as its parts would in any later
-    history (a hold followed by re-sliding, for one)."""
-    wa = math.exp(lw[g])
-    wb = math.exp(lw[i])
-    wt = wa + wb
-    xb[g] = (wa * xb[g] + wb * xb[i]) / wt
-    tb[g] = (wa * tb[g] + wb * tb[i]) / wt
-    lw[g] = math.log(wt)
-    known[0, g] = -1.0
-    known[1, g] = np.nan
-    rate0[g] = max(rate0[g], rate0[i])
-
-
-def _move(keep, i, xb, tb, lw, known, rate0):  # type: ignore[no-untyped-def]
-    xb[keep] = xb[i]
-    tb[keep] = tb[i]
-    lw[keep] = lw[i]
-    known[0, keep] = known[0, i]
-    known[1, keep] = known[1, i]
-    known[2, keep] = known[2, i]
-    rate0[keep] = rate0[i]
+        rate_i < quiet
+        and rate_g < quiet
+        and abs(xb_i - xb_g) < gap
+        and abs(tb_i - tb_g) * p[P_INV_TAU_A] * p[P_AGING] < age_gap
+    )
 
 
 def _housekeeping(n, t, t_end, x, nn1, s1, s_floor, rtol, xb, tb, lw, rate0, known, acc, p):  # type: ignore[no-untyped-def]
     """Drop dead cohorts (their weight counts as broken, up to LIGHTEST * N0; with saturated aging, the negligible
-    ones of :func:`_saturated_bins`) and merge neighbours (:func:`_mergeable`).  Returns the cohorts kept."""
+    ones of :func:`_saturated_bins`) and merge neighbours that are quiet and born close (:func:`_quiet_neighbours`)
+    or, past the saturation age, in one bin (:func:`_same_bin`); never the newest.  Returns the cohorts kept."""
     dlm = p[P_DLM]
     quiet = 1e-3 * rtol / max(t_end - t, 1.0)
     gap = 1e-4 * math.sqrt(rtol) * dlm
@@ -1004,10 +976,34 @@ def _housekeeping(n, t, t_end, x, nn1, s1, s_floor, rtol, xb, tb, lw, rate0, kno
         # only cohorts past the saturation age: those linger at the resting hazard (the young are as before)
         aged = saturated and t - tb[i] >= p[P_SATURATION]
         if lw[i] > floor and not (aged and _negligible(lw[i], x - xb[i], light_n, light_s, p)):
-            if _mergeable(i, keep - 1, n, t, x, quiet, gap, age_gap, aged, spread, xb, tb, rate0, p):
-                _merge(keep - 1, i, xb, tb, lw, known, rate0)
+            g = keep - 1
+            if (
+                keep > 0
+                and i < n - 1
+                and (
+                    _quiet_neighbours(rate0[i], rate0[g], xb[i], xb[g], tb[i], tb[g], quiet, gap, age_gap, p)
+                    or (aged and _same_bin(t, x, tb[i], tb[g], xb[i], xb[g], spread, p))
+                )
+            ):
+                # merged: the weight, the mean extension and age kept, so it breaks as its parts would in any
+                # later history (a hold followed by re-sliding, for one)
+                wa = math.exp(lw[g])
+                wb = math.exp(lw[i])
+                wt = wa + wb
+                xb[g] = (wa * xb[g] + wb * xb[i]) / wt
+                tb[g] = (wa * tb[g] + wb * tb[i]) / wt
+                lw[g] = math.log(wt)
+                known[0, g] = -1.0
+                known[1, g] = np.nan
+                rate0[g] = max(rate0[g], rate0[i])
                 continue
-            _move(keep, i, xb, tb, lw, known, rate0)
+            xb[keep] = xb[i]
+            tb[keep] = tb[i]
+            lw[keep] = lw[i]
+            known[0, keep] = known[0, i]
+            known[1, keep] = known[1, i]
+            known[2, keep] = known[2, i]
+            rate0[keep] = rate0[i]
             keep += 1
         elif lw[i] > -np.inf:
             w = math.exp(lw[i])
@@ -1146,6 +1142,9 @@ def advance(  # type: ignore[no-untyped-def]
 
 
 _COMPILED: dict[str, object] = {}
+#: the steps of ``advance`` run once per cohort and step: inlined into their callers by numba (called as functions
+#: they left the kernel 1.5x slower, docs/transient.md section 2b)
+INLINED = ("_hazard_slopes", "_cohort_weight", "_cohort_dissipation", "_quiet_neighbours")
 
 
 def compiled() -> dict[str, object]:
@@ -1166,6 +1165,8 @@ def compiled() -> dict[str, object]:
             "_same_bin",
         ):
             g[name] = _jit(g[name])
+        for name in INLINED:
+            g[name] = _jit(g[name], inline=True)
         for name in (
             "_velocity_prepare",
             "_velocity_residual",
@@ -1176,14 +1177,10 @@ def compiled() -> dict[str, object]:
             "_saturated_bins",
             "_sums",
             "_sums_keeping",
+            "_gauss_birth",
             "_step_length",
             "_predicted_path",
-            "_cohort_gone",
-            "_hazard_ends",
-            "_cohort_weight",
-            "_cohort_dissipation",
             "_cohort_pass",
-            "_gauss_birth",
             "_births",
             "_births_within_vacancy",
             "_birth_errors",
@@ -1192,9 +1189,6 @@ def compiled() -> dict[str, object]:
             "_shorter_step",
             "_next_step",
             "_book_step",
-            "_mergeable",
-            "_merge",
-            "_move",
             "_housekeeping",
             "_write_row",
             "advance",
