@@ -69,6 +69,8 @@ RSF_NAMES = {STEADY: "steady sliding"}
 RATIO_TOLERANCE = 0.02
 #: a verdict on an oscillation needs this many consecutive period-to-period ratios that agree
 RATIOS_NEEDED = 2
+#: the most maxima one period of a limit cycle may have (a main peak and the ringing after a slip)
+MAX_MAXIMA_PER_PERIOD = 3
 #: a swing smaller than this fraction of the larger of its neighbours is a wiggle on a larger swing, not a period
 WIGGLE = 0.05
 #: more turning points than this and the scan keeps only swings of WIGGLE of the whole range (cost bound)
@@ -293,10 +295,19 @@ def classify(
     last_extremum = placed[-1][0] if placed else float(tw[0])
     quiet = float(tw[-1]) - last_extremum
     oscillating = periods >= 1 and not (math.isfinite(period) and quiet > 2 * period)
+    verdict = None
     if oscillating:
         last = [v for (tp, v) in placed if tp >= peaks[-2][0]] if len(peaks) >= 2 else [v for _, v in placed]
         peak, trough = max(last), min(last)
-        return _verdict(periods, ratios, period, peak, trough, latest)
+        verdict = _verdict(periods, ratios, period, peak, trough, latest)
+        if verdict.kind == STICK_SLIP:
+            return verdict
+    # a period of several maxima: judged on its own period (the gaps between single maxima are not one)
+    several = _repeating_with_several_maxima(placed, is_max) if periods >= 2 else None
+    if several is not None and not quiet > 2 * several.period:
+        return several
+    if verdict is not None:
+        return verdict
     # not (or no longer) oscillating: steady only when the tail has stopped changing
     tail_from = last_extremum if placed else float(tw[0])
     tau = min(relaxation if relaxation else math.inf, (float(tw[-1]) - tail_from) / 2.0, window / 2.0)
@@ -344,6 +355,30 @@ def _verdict(
         if all(r > 1 + RATIO_TOLERANCE for r in recent):
             return Regime(GROWING, periods, ratio, period, peak, trough, f"growing oscillation: {evidence}")
     return Regime(UNDETERMINED, periods, ratio, period, peak, trough, f"undetermined: {evidence}")
+
+
+def _repeating_with_several_maxima(placed: list[tuple[float, float]], is_max: list[bool]) -> Regime | None:
+    """A limit cycle with up to MAX_MAXIMA_PER_PERIOD maxima per period (a slip that rings, an inertial slider's
+    overshoot): every swing repeats the one m swings earlier, in size and in timing, over the last RATIOS_NEEDED
+    periods; then one period is m swings (the smallest such m).  None when no m fits."""
+    peaks = [placed[k] for k in range(len(placed)) if is_max[k]]
+    falls = [placed[k][1] - placed[k + 1][1] for k in range(len(placed) - 1) if is_max[k]]
+    times = [tp for tp, _ in peaks]
+    for m in range(2, MAX_MAXIMA_PER_PERIOD + 1):
+        needed = m * RATIOS_NEEDED
+        ratios = [falls[k + m] / falls[k] for k in range(len(falls) - m) if falls[k] > 0]
+        spans = [times[k + m] - times[k] for k in range(len(times) - m)]
+        if len(ratios) < needed or len(spans) < needed:
+            continue
+        recent, lasting = ratios[-needed:], spans[-needed:]
+        period = float(np.mean(lasting[-m:]))
+        if all(abs(r - 1) <= RATIO_TOLERANCE for r in recent) and np.ptp(lasting) <= RATIO_TOLERANCE * period:
+            periods = (len(peaks) - 1) // m
+            values = [v for (tp, v) in placed if tp >= peaks[-(m + 1)][0]]
+            evidence = f"{periods} period(s) of {_seconds(period)}, {_ratio(recent[-1])}, {m} maxima per period"
+            return Regime(STICK_SLIP, periods, recent[-1], period, max(values), min(values),
+                          f"stick-slip (limit cycle): {evidence}")  # fmt: skip
+    return None
 
 
 def _seconds(period: float) -> str:
