@@ -1142,9 +1142,28 @@ def advance(  # type: ignore[no-untyped-def]
 
 
 _COMPILED: dict[str, object] = {}
-#: the steps of ``advance`` run once per cohort and step: inlined into their callers by numba (called as functions
-#: they left the kernel 1.5x slower, docs/transient.md section 2b)
-INLINED = ("_hazard_slopes", "_cohort_weight", "_cohort_dissipation", "_quiet_neighbours")
+#: inlined into their callers by numba: the per-cohort steps (they take numbers, never arrays: helpers taking arrays
+#: once per cohort left the kernel 1.4x slower) and the steps ``advance`` takes once per step.  The two loops over
+#: the cohorts (_cohort_pass, _housekeeping) stay functions of their own: inlined, the kernel was 5-9 % slower.
+#: Measured against the kernel before the split in one process (docs/transient.md section 8).
+INLINED = (
+    "_hazard_slopes",
+    "_cohort_weight",
+    "_cohort_dissipation",
+    "_quiet_neighbours",
+    "_gauss_birth",
+    "_step_length",
+    "_predicted_path",
+    "_births",
+    "_births_within_vacancy",
+    "_birth_errors",
+    "_slider_at_end",
+    "_step_error",
+    "_shorter_step",
+    "_next_step",
+    "_book_step",
+    "_write_row",
+)
 
 
 def compiled() -> dict[str, object]:
@@ -1177,20 +1196,8 @@ def compiled() -> dict[str, object]:
             "_saturated_bins",
             "_sums",
             "_sums_keeping",
-            "_gauss_birth",
-            "_step_length",
-            "_predicted_path",
             "_cohort_pass",
-            "_births",
-            "_births_within_vacancy",
-            "_birth_errors",
-            "_slider_at_end",
-            "_step_error",
-            "_shorter_step",
-            "_next_step",
-            "_book_step",
             "_housekeeping",
-            "_write_row",
             "advance",
         ):
             g[name] = _jit(g[name])
