@@ -169,6 +169,40 @@ def run_transient(
     (a ParameterError) whose ``partial`` is the result up to there (its message
     says where it stopped).
     """
+    progress, mass, damping, k_block, start_velocity, budget, seconds = _checked_arguments(
+        params, protocol, control, start, reduction, aging, stick_population, rtol, progress, stiffness, mass, damping,
+        every, max_step, start_velocity, max_steps, max_time,
+    )  # fmt: skip
+    cpu0 = time.process_time()
+    _require_finite_chains(params, protocol, control, start, start_velocity, k_block)
+    require_within(
+        estimate_cost(params, protocol, control=control, start_velocity=start_velocity, rtol=rtol, every=every,
+                      max_step=max_step, aging=aging, reduction=reduction, start=start, mass=mass, stiffness=k_block,
+                      stick_population=bool(stick_population)),
+        budget,
+        "transient",
+        max_time=seconds,
+        factor=REFUSE_FACTOR,
+        time_factor=TIME_REFUSE_FACTOR,
+    )  # fmt: skip
+    note = ""
+    if start == "steady" and control == "block" and aging:
+        start_velocity, note = _steady_start_below_vc(params, protocol, start_velocity)
+    driver = _Driver(
+        params, protocol, control=control, k_block=k_block, aging=aging, stick_population=bool(stick_population),
+        rtol=float(rtol), mass=mass, damping=damping, budget=budget, seconds=seconds, cpu0=cpu0, note=note,
+        progress=progress,
+    )  # fmt: skip
+    driver.start(start, start_velocity, every, max_step, snapshot_times, reduction)
+    return driver.run()
+
+
+def _checked_arguments(  # type: ignore[no-untyped-def]
+    params, protocol, control, start, reduction, aging, stick_population, rtol, progress, stiffness, mass, damping,
+    every, max_step, start_velocity, max_steps, max_time,
+):  # fmt: skip
+    """run_transient's arguments checked (a ParameterError naming the first one wrong): (progress, mass, damping,
+    the block's stiffness, the start velocity, the budgets of steps and of CPU seconds)."""
     if not isinstance(params, Parameters):
         raise ParameterError(f"params: expected stickslip Parameters, got {type(params).__name__}")
     _check_choice(control, CONTROLS, "control")
@@ -185,7 +219,6 @@ def run_transient(
     if stick_population and control != "block":
         raise ParameterError("stick_population: the attached chains need block control (control='block')")
     mass, damping = _block_inertia(mass, damping, control, stick_population)
-    inertial = mass > 0
     k_block = params.block.effective_stiffness if stiffness is None else _finite(stiffness, "stiffness")
     if not (math.isfinite(k_block) and k_block > 0):
         raise ParameterError(f"stiffness: expected a positive finite value in Pa/m, got {stiffness!r}")
@@ -202,200 +235,238 @@ def run_transient(
         raise ParameterError(f"max_step: expected a positive time in s, got {max_step!r}")
     if start_velocity is not None:
         start_velocity = _finite(start_velocity, "start velocity")
-    budget = check_max_steps(max_steps)
-    seconds = check_max_time(max_time)
-    cpu0 = time.process_time()
-    _require_finite_chains(params, protocol, control, start, start_velocity, k_block)
-    require_within(
-        estimate_cost(params, protocol, control=control, start_velocity=start_velocity, rtol=rtol, every=every,
-                      max_step=max_step, aging=aging, reduction=reduction, start=start, mass=mass, stiffness=k_block,
-                      stick_population=bool(stick_population)),
-        budget,
-        "transient",
-        max_time=seconds,
-        factor=REFUSE_FACTOR,
-        time_factor=TIME_REFUSE_FACTOR,
-    )  # fmt: skip
-    note = ""
-    if start == "steady" and control == "block" and aging:
-        start_velocity, note = _steady_start_below_vc(params, protocol, start_velocity)
-    functions = K.compiled()
-    advance = functions["advance"]
-    slider_velocity = functions["_slider_velocity"]
-    p = pack_parameters(params, aging, k_block, mass, damping)
-    b = params.bonds
+    return progress, mass, damping, k_block, start_velocity, check_max_steps(max_steps), check_max_time(max_time)
 
-    state = _State(0.0, 0.0, 0.0, b.bond_time * 1e-3, 0.0, 0, np.empty(4096), np.empty(4096), np.empty(4096))
-    v_first = protocol.initial_velocity
-    if start == "steady":
-        v_start = v_first if start_velocity is None else float(start_velocity)
-        if not v_start > 0:
-            raise ParameterError(f"start velocity: a steady start needs a positive sliding velocity, got {v_start!r}")
-        pop = _steady_cohorts(params, v_start, aging)
-        state.load(pop)
-        state.v = v_start
-    elif start_velocity is not None:
-        raise ParameterError("start velocity: only used with start='steady'")
-    else:
-        state.v = v_first  # no bonds: the slider moves with the puller
-    sigma0 = float(np.exp(state.lw[: state.n]) @ _force(state.x - state.xb[: state.n], params)) if state.n else 0.0
-    # the block in balance with the bonds (and the damping, which a moving slider meets)
-    state.puller = state.x + (sigma0 + damping * state.v) / k_block if control == "block" else state.x
 
-    times = _sample_grid(every, duration)
-    # a snapshot copies every cohort: at each segment end only for a protocol of a few segments (issue 29: 1e5
-    # segments of 1 ms held 8.4 GB of them)
-    ends = protocol.boundaries.tolist() if len(protocol.segments) <= SNAPSHOT_SEGMENTS else []
-    wanted = sorted(set([0.0, duration, *ends, *check_snapshot_times(snapshot_times, duration)]))
-    snapshots: list[Snapshot] = []
-    rows: list[np.ndarray] = [_row(state, params, control, k_block, mass)]
-    chain_rows: list[np.ndarray] = []
-    chains_on = stick_population and start == "empty"
-    events: list[tuple[str, float, float, float]] = []  # (kind, time, stress, velocity)
-    chain_state = {"elapsed": 0.0, "fraction": 1.0}
-    sample_index = 1 if times.size else 0  # t = 0 is already a row
-    out = np.empty((CHUNK, 13))
-    h_max = math.inf if max_step is None else float(max_step)
-    snap_index = 0
-    if chains_on:
-        events.append(("stick", 0.0, sigma0, 0.0))
-    reducer = None
-    if reduction == "auto" and max_step is None and not inertial:  # a bound on the step: cohorts throughout
-        reducer = _Reducer(params, p, functions, control, k_block, float(rtol), aging)
-        reducer.disturbed(state.t)  # from empty, or a steady start: the cohorts first replace every bond
-    for t0, t1, vp in protocol.pieces():
-        while snap_index < len(wanted) and wanted[snap_index] <= t0 + 1e-15:
-            snapshots.append(_snapshot(state))
-            snap_index += 1
-        if control == "velocity":
-            if reducer is not None and vp != state.v:
-                reducer.disturbed(state.t)
-            state.v = vp
-        if reducer is not None:
-            reducer.next_try = state.acc[4]
-        while state.t < t1 - 1e-12 * max(t1, 1.0):
-            if chains_on:
-                # the stuck block: slider fixed, chains of Eq 15 carry sigma = K (P - X)
-                stress0 = k_block * (state.puller - state.x)
-                res = stick_chains(
-                    params, aging, stress0, k_block * vp, chain_state["elapsed"], chain_state["fraction"], t1 - state.t
+class _Driver:
+    """One run of :func:`run_transient` through its protocol, piece by piece: the stuck block under the attached
+    chains (:meth:`_stuck`, then the jump, :meth:`_jump_to_steady`), a quasi-steady stretch (:meth:`_glide`), or the
+    cohort kernel (:meth:`_cohorts`, its state checked by :meth:`_check`); snapshots kept on the way
+    (:meth:`_snapshots_through`)."""
+
+    def __init__(  # type: ignore[no-untyped-def]
+        self, params, protocol, *, control, k_block, aging, stick_population, rtol, mass, damping, budget, seconds,
+        cpu0, note, progress,
+    ) -> None:  # fmt: skip
+        self.params, self.protocol, self.control, self.k_block = params, protocol, control, k_block
+        self.aging, self.stick_population, self.rtol = aging, stick_population, rtol
+        self.mass, self.damping, self.inertial = mass, damping, mass > 0
+        self.budget, self.seconds, self.cpu0, self.note, self.progress = budget, seconds, cpu0, note, progress
+        self.duration = protocol.duration
+        self.functions = K.compiled()
+        self.p = pack_parameters(params, aging, k_block, mass, damping)
+        self.snapshots: list[Snapshot] = []
+        self.chain_rows: list[np.ndarray] = []
+        self.events: list[tuple[str, float, float, float]] = []  # (kind, time, stress, velocity)
+        self.chain_state = {"elapsed": 0.0, "fraction": 1.0}
+        self.snap_index = 0
+        self.out = np.empty((CHUNK, 13))
+
+    def start(
+        self, start: str, start_velocity: float | None, every: float | None, max_step: float | None,
+        snapshot_times: Any, reduction: str,
+    ) -> None:  # fmt: skip
+        """The state at t = 0 (empty, or the steady population with the block in balance), its row, the sampling
+        grid, the snapshot instants and the reduction."""
+        params, control, k_block = self.params, self.control, self.k_block
+        state = _State(0.0, 0.0, 0.0, params.bonds.bond_time * 1e-3, 0.0, 0, *(np.empty(4096) for _ in range(3)))
+        v_first = self.protocol.initial_velocity
+        if start == "steady":
+            v_start = v_first if start_velocity is None else float(start_velocity)
+            if not v_start > 0:
+                raise ParameterError(
+                    f"start velocity: a steady start needs a positive sliding velocity, got {v_start!r}"
                 )
-                t_new = state.t + res.duration
-                chain_rows.append(np.c_[state.t + res.times, res.fractions])
-                if times.size:  # the trace on the sampling grid: stress and positions are exact while stuck
-                    inside = (times > state.t) & (times <= t_new)
-                    for tt in times[inside]:
-                        ff = float(np.interp(tt - state.t, res.times, res.fractions))
-                        rows.append(_stuck_row(state, params, float(tt), vp, k_block, ff))
-                    # sigma rises while stuck: the stretch's lowest is its start, in its first row
-                    start_sigma = min(state.acc[7], k_block * (state.puller - state.x))
-                    state.acc[7] = np.inf if np.any(inside) else start_sigma
-                    sample_index = max(sample_index, int(np.searchsorted(times, t_new, side="right")))
-                else:
-                    for tt, ff in zip(res.times[1:], res.fractions[1:], strict=True):
-                        rows.append(_stuck_row(state, params, state.t + tt, vp, k_block, ff))
-                    state.acc[7] = np.inf if res.times.size > 1 else state.acc[7]
-                state.acc[6] += _stuck_impulse(state, vp, k_block, res.duration)
-                state.puller += vp * res.duration
-                state.t = t_new
-                chain_state["elapsed"] += res.duration
-                chain_state["fraction"] = res.fraction
-                if not res.collapsed:
+            state.load(_steady_cohorts(params, v_start, self.aging))
+            state.v = v_start
+        elif start_velocity is not None:
+            raise ParameterError("start velocity: only used with start='steady'")
+        else:
+            state.v = v_first  # no bonds: the slider moves with the puller
+        sigma0 = float(np.exp(state.lw[: state.n]) @ _force(state.x - state.xb[: state.n], params)) if state.n else 0.0
+        # the block in balance with the bonds (and the damping, which a moving slider meets)
+        state.puller = state.x + (sigma0 + self.damping * state.v) / k_block if control == "block" else state.x
+        self.state = state
+        self.times = _sample_grid(every, self.duration)
+        # a snapshot copies every cohort: at each segment end only for a protocol of a few segments (issue 29: 1e5
+        # segments of 1 ms held 8.4 GB of them)
+        ends = self.protocol.boundaries.tolist() if len(self.protocol.segments) <= SNAPSHOT_SEGMENTS else []
+        self.wanted = sorted(set([0.0, self.duration, *ends, *check_snapshot_times(snapshot_times, self.duration)]))
+        self.rows: list[np.ndarray] = [_row(state, params, control, k_block, self.mass)]
+        self.chains_on = self.stick_population and start == "empty"
+        self.sample_index = 1 if self.times.size else 0  # t = 0 is already a row
+        self.h_max = math.inf if max_step is None else float(max_step)
+        if self.chains_on:
+            self.events.append(("stick", 0.0, sigma0, 0.0))
+        self.reducer = None
+        if reduction == "auto" and max_step is None and not self.inertial:  # a bound on the step: cohorts throughout
+            self.reducer = _Reducer(params, self.p, self.functions, control, k_block, self.rtol, self.aging)
+            self.reducer.disturbed(state.t)  # from empty, or a steady start: the cohorts first replace every bond
+
+    def run(self) -> TransientResult:
+        """Every piece of the protocol, to its end (or to where the chains' jump has no landing point)."""
+        state = self.state
+        for t0, t1, vp in self.protocol.pieces():
+            while self.snap_index < len(self.wanted) and self.wanted[self.snap_index] <= t0 + 1e-15:
+                self._snapshot()
+            if self.control == "velocity":
+                if self.reducer is not None and vp != state.v:
+                    self.reducer.disturbed(state.t)
+                state.v = vp
+            if self.reducer is not None:
+                self.reducer.next_try = state.acc[4]
+            while state.t < t1 - 1e-12 * max(t1, 1.0):
+                if self.chains_on:
+                    stopped = self._stuck(t1, vp)
+                    if stopped is not None:
+                        return stopped
                     continue
-                sigma_s = k_block * (state.puller - state.x)
-                vs = _jump(params, sigma_s, aging)
-                if vs is None:
-                    events.append(("unreachable", state.t, sigma_s, 0.0))
-                    return _finish(
-                        rows,
-                        chain_rows,
-                        events,
-                        snapshots,
-                        state,
-                        params,
-                        protocol,
-                        control,
-                        k_block,
-                        int(state.acc[4]),
-                        note=note,
-                        stop=f"the chains collapse at σs = {sigma_s:.6g} Pa, beyond the"
-                        " steady curve's reach: the paper's jump has no landing point",
-                    )
-                events.append(("slip", state.t, sigma_s, vs))
-                pop = _steady_cohorts(params, vs, aging)
-                state.load(pop)
-                state.v = vs
-                state.h = b.bond_time * 1e-3
-                chains_on = False
-                # put the slider where the new bonds carry sigma_s
-                weights = np.exp(state.lw[: state.n])
-                state.x = functions["_balance_weights"](state.x, state.puller, state.n, state.xb, weights, p)
-                state.v = slider_velocity(
-                    vs, vp, state.n, state.xb, state.tb, state.lw, state.x, state.t, p, *_scratch(state)
-                )
-                rows.append(_row(state, params, control, k_block))
-                if reducer is not None:
-                    reducer.loaded_steady(state)
-                continue
-            # the solver stops at the next snapshot instant (a reduced stretch rebuilds its cohorts there)
-            following = bisect.bisect_right(wanted, state.t + 1e-15, lo=snap_index)  # not a scan: 1e5 segments
-            t_stop = wanted[following] if following < len(wanted) and wanted[following] < t1 else t1
-            if reducer is not None and state.acc[4] >= reducer.next_try:
-                glided, sample_index = reducer.attempt(state, t0, t_stop, vp, times, sample_index, rows)
-                if glided:
-                    while snap_index < len(wanted) and state.t + 1e-15 >= wanted[snap_index] < t1:
-                        snapshots.append(_snapshot(state))
-                        snap_index += 1
-                    if progress is not None:
-                        progress(min(1.0, state.t / duration))
+                # the solver stops at the next snapshot instant (a reduced stretch rebuilds its cohorts there)
+                following = bisect.bisect_right(self.wanted, state.t + 1e-15, lo=self.snap_index)  # 1e5 segments
+                wanted = self.wanted
+                t_stop = wanted[following] if following < len(wanted) and wanted[following] < t1 else t1
+                if self._glide(t0, t_stop, t1, vp):
                     continue
-            if control == "block" and not inertial:  # with a mass the velocity is a state of its own
-                state.v = slider_velocity(
-                    state.v, vp, state.n, state.xb, state.tb, state.lw, state.x, state.t, p, *_scratch(state)
-                )
-            # in a hold (vp = 0) the slider counts as stopped below 1 % of the protocol's sliding velocity
-            pace = vp if vp > 0 else float(np.max(protocol.velocities))
-            stick_v = STICK_FRACTION * pace if (stick_population and pace > 0) else 0.0
-            puller0 = state.puller - vp * (state.t - t0)  # puller position at the start t0 of this piece
-            lw_new, rate0, lc, aa, w1 = (np.empty(state.xb.size) for _ in range(5))
-            status, t, x, v, h, n, sample_index, count = advance(
-                state.t, t_stop, state.x, state.v, state.h, puller0, vp, t0, 1 if control == "block" else 0,
-                state.n, state.xb, state.tb, state.lw, lw_new, rate0, lc, aa, w1, state.acc, p, float(rtol), h_max,
-                times, sample_index, out, CHUNK, stick_v, _chunk(state, budget, reducer, _paced(state.n)),
-            )  # fmt: skip
-            state.t, state.x, state.v, state.h, state.n = float(t), float(x), float(v), float(h), int(n)
-            state.puller = puller0 + vp * (state.t - t0) if control == "block" else state.x
-            if count:
-                rows.extend(_kernel_rows(out[:count], k_block, control, mass))
-            if status == K.FULL:
-                state.grow()
-            elif status == K.STICK:
-                chains_on = True
-                chain_state = {"elapsed": 0.0, "fraction": 1.0}
-                events.append(("stick", state.t, k_block * (state.puller - state.x), state.v))
-            if not all(math.isfinite(q) for q in (state.t, state.x, state.v, state.h)):
-                raise SolverFailed(
-                    _non_finite(state.t, out[:count], rows, float(np.max(protocol.velocities)), inertial, state.h)
-                )
-            unfinished = state.t < duration - 1e-12 * max(duration, 1.0)  # a run that got to its end is whole
-            if unfinished and (state.acc[4] > budget or time.process_time() - cpu0 > seconds):
-                cpu = time.process_time() - cpu0
-                stopped = over_budget("transient", int(state.acc[4]), budget, state.t, duration,
-                                      cpu=cpu if cpu > seconds else None, max_time=seconds)  # fmt: skip
-                raise _with_partial(stopped, rows, chain_rows, events, snapshots, state, params, protocol, control,
-                                    k_block, note, float(rtol), mass, damping)  # fmt: skip
-            if progress is not None:
-                progress(min(1.0, state.t / duration))
-            while snap_index < len(wanted) and wanted[snap_index] <= state.t + 1e-15 and wanted[snap_index] < t1:
-                snapshots.append(_snapshot(state))
-                snap_index += 1
-    while snap_index < len(wanted):
-        snapshots.append(_snapshot(state))
-        snap_index += 1
-    return _finish(
-        rows, chain_rows, events, snapshots, state, params, protocol, control, k_block, int(state.acc[4]), note=note,
-        resolution=float(rtol), mass=mass, damping=damping,
-    )  # fmt: skip
+                self._cohorts(t0, t_stop, t1, vp)
+        while self.snap_index < len(self.wanted):
+            self._snapshot()
+        return self._finish(resolution=self.rtol, mass=self.mass, damping=self.damping)
+
+    def _snapshot(self) -> None:
+        self.snapshots.append(_snapshot(self.state))
+        self.snap_index += 1
+
+    def _snapshots_through(self, t1: float) -> None:
+        """The snapshot instants the run has reached within this piece (before its end t1)."""
+        while (
+            self.snap_index < len(self.wanted)
+            and self.wanted[self.snap_index] <= self.state.t + 1e-15
+            and self.wanted[self.snap_index] < t1
+        ):
+            self._snapshot()
+
+    def _report_progress(self) -> None:
+        if self.progress is not None:
+            self.progress(min(1.0, self.state.t / self.duration))
+
+    def _finish(self, **kwargs: Any) -> TransientResult:
+        return _finish(self.rows, self.chain_rows, self.events, self.snapshots, self.state, self.params, self.protocol,
+                       self.control, self.k_block, int(self.state.acc[4]), note=self.note, **kwargs)  # fmt: skip
+
+    def _stuck(self, t1: float, vp: float) -> TransientResult | None:
+        """The stuck block to the piece's end or the chains' collapse: the slider fixed, the chains of Eq 15 carry
+        sigma = K (P - X); at a collapse the jump (None), or the run's end where it has no landing point."""
+        state, k_block, times, rows, params = self.state, self.k_block, self.times, self.rows, self.params
+        stress0 = k_block * (state.puller - state.x)
+        chain = self.chain_state
+        res = stick_chains(params, self.aging, stress0, k_block * vp, chain["elapsed"], chain["fraction"], t1 - state.t)
+        t_new = state.t + res.duration
+        self.chain_rows.append(np.c_[state.t + res.times, res.fractions])
+        if times.size:  # the trace on the sampling grid: stress and positions are exact while stuck
+            inside = (times > state.t) & (times <= t_new)
+            for tt in times[inside]:
+                ff = float(np.interp(tt - state.t, res.times, res.fractions))
+                rows.append(_stuck_row(state, params, float(tt), vp, k_block, ff))
+            # sigma rises while stuck: the stretch's lowest is its start, in its first row
+            start_sigma = min(state.acc[7], k_block * (state.puller - state.x))
+            state.acc[7] = np.inf if np.any(inside) else start_sigma
+            self.sample_index = max(self.sample_index, int(np.searchsorted(times, t_new, side="right")))
+        else:
+            for tt, ff in zip(res.times[1:], res.fractions[1:], strict=True):
+                rows.append(_stuck_row(state, params, state.t + tt, vp, k_block, ff))
+            state.acc[7] = np.inf if res.times.size > 1 else state.acc[7]
+        state.acc[6] += _stuck_impulse(state, vp, k_block, res.duration)
+        state.puller += vp * res.duration
+        state.t = t_new
+        chain["elapsed"] += res.duration
+        chain["fraction"] = res.fraction
+        if not res.collapsed:
+            return None
+        sigma_s = k_block * (state.puller - state.x)
+        vs = _jump(params, sigma_s, self.aging)
+        if vs is None:
+            self.events.append(("unreachable", state.t, sigma_s, 0.0))
+            return self._finish(stop=f"the chains collapse at σs = {sigma_s:.6g} Pa, beyond the steady curve's"
+                                " reach: the paper's jump has no landing point")  # fmt: skip
+        self._jump_to_steady(sigma_s, vs, vp)
+        return None
+
+    def _jump_to_steady(self, sigma_s: float, vs: float, vp: float) -> None:
+        """The paper's jump: the steady population at vs, the slider where the new bonds carry sigma_s."""
+        state, p = self.state, self.p
+        self.events.append(("slip", state.t, sigma_s, vs))
+        state.load(_steady_cohorts(self.params, vs, self.aging))
+        state.v = vs
+        state.h = self.params.bonds.bond_time * 1e-3
+        self.chains_on = False
+        weights = np.exp(state.lw[: state.n])
+        state.x = self.functions["_balance_weights"](state.x, state.puller, state.n, state.xb, weights, p)
+        state.v = self.functions["_slider_velocity"](
+            vs, vp, state.n, state.xb, state.tb, state.lw, state.x, state.t, p, *_scratch(state)
+        )
+        self.rows.append(_row(state, self.params, self.control, self.k_block))
+        if self.reducer is not None:
+            self.reducer.loaded_steady(state)
+
+    def _glide(self, t0: float, t_stop: float, t1: float, vp: float) -> bool:
+        """A quasi-steady stretch where the reduction takes one (when it is time to look for one)."""
+        state, reducer = self.state, self.reducer
+        if reducer is None or state.acc[4] < reducer.next_try:
+            return False
+        glided, self.sample_index = reducer.attempt(state, t0, t_stop, vp, self.times, self.sample_index, self.rows)
+        if glided:
+            while self.snap_index < len(self.wanted) and state.t + 1e-15 >= self.wanted[self.snap_index] < t1:
+                self._snapshot()
+            self._report_progress()
+        return glided
+
+    def _cohorts(self, t0: float, t_stop: float, t1: float, vp: float) -> None:
+        """One call of the cohort kernel towards t_stop (it returns early on a full buffer, a stick, its pace)."""
+        state, p, control = self.state, self.p, self.control
+        if control == "block" and not self.inertial:  # with a mass the velocity is a state of its own
+            state.v = self.functions["_slider_velocity"](
+                state.v, vp, state.n, state.xb, state.tb, state.lw, state.x, state.t, p, *_scratch(state)
+            )
+        # in a hold (vp = 0) the slider counts as stopped below 1 % of the protocol's sliding velocity
+        pace = vp if vp > 0 else float(np.max(self.protocol.velocities))
+        stick_v = STICK_FRACTION * pace if (self.stick_population and pace > 0) else 0.0
+        puller0 = state.puller - vp * (state.t - t0)  # puller position at the start t0 of this piece
+        lw_new, rate0, lc, aa, w1 = (np.empty(state.xb.size) for _ in range(5))
+        status, t, x, v, h, n, self.sample_index, count = self.functions["advance"](
+            state.t, t_stop, state.x, state.v, state.h, puller0, vp, t0, 1 if control == "block" else 0,
+            state.n, state.xb, state.tb, state.lw, lw_new, rate0, lc, aa, w1, state.acc, p, self.rtol, self.h_max,
+            self.times, self.sample_index, self.out, CHUNK, stick_v,
+            _chunk(state, self.budget, self.reducer, _paced(state.n)),
+        )  # fmt: skip
+        state.t, state.x, state.v, state.h, state.n = float(t), float(x), float(v), float(h), int(n)
+        state.puller = puller0 + vp * (state.t - t0) if control == "block" else state.x
+        if count:
+            self.rows.extend(_kernel_rows(self.out[:count], self.k_block, control, self.mass))
+        if status == K.FULL:
+            state.grow()
+        elif status == K.STICK:
+            self.chains_on = True
+            self.chain_state = {"elapsed": 0.0, "fraction": 1.0}
+            self.events.append(("stick", state.t, self.k_block * (state.puller - state.x), state.v))
+        self._check(count)
+        self._report_progress()
+        self._snapshots_through(t1)
+
+    def _check(self, count: int) -> None:
+        """A state gone non-finite fails the run (SolverFailed, in words); a budget used up stops it
+        (BudgetExhausted, with the run so far)."""
+        state, duration = self.state, self.duration
+        if not all(math.isfinite(q) for q in (state.t, state.x, state.v, state.h)):
+            pace = float(np.max(self.protocol.velocities))
+            raise SolverFailed(_non_finite(state.t, self.out[:count], self.rows, pace, self.inertial, state.h))
+        unfinished = state.t < duration - 1e-12 * max(duration, 1.0)  # a run that got to its end is whole
+        if unfinished and (state.acc[4] > self.budget or time.process_time() - self.cpu0 > self.seconds):
+            cpu = time.process_time() - self.cpu0
+            stopped = over_budget("transient", int(state.acc[4]), self.budget, state.t, duration,
+                                  cpu=cpu if cpu > self.seconds else None, max_time=self.seconds)  # fmt: skip
+            raise _with_partial(stopped, self.rows, self.chain_rows, self.events, self.snapshots, state, self.params,
+                                self.protocol, self.control, self.k_block, self.note, self.rtol, self.mass,
+                                self.damping)  # fmt: skip
 
 
 #: a slider faster than this many times the protocol's fastest velocity has run away (no inertia holds it)
