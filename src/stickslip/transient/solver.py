@@ -1099,7 +1099,7 @@ def estimate_cost(
     if mass > 0:
         reduction = "off"
     _check_choice(start, STARTS, "start")
-    b, g = params.bonds, params.aging
+    b = params.bonds
     scale = (1e-4 / rtol) ** 0.25
     v_start = 0.0 if start_velocity is None else abs(start_velocity)
     reducing = reduction == "auto" and max_step is None
@@ -1108,34 +1108,9 @@ def estimate_cost(
     motion = _BlockMotion(params, aging, k_block, bool(stick_population), start) if (
         control == "block" and aging and mass == 0 and max_step is None
     ) else None  # fmt: skip
-    fold: list[float] = []  # FOLD_MARGIN x Vc, looked for only when a piece needs it
-    steps = 0.0
-    fastest = 0.0
-    reduced = 0
     natural = b.max_extension / b.bond_time
     own = motion is not None and motion.counts()  # the block's own motion is counted (else the cohorts')
-    for t0, t1, vp in protocol.pieces():
-        v = max(abs(vp), v_start) if control == "block" else abs(vp)
-        fastest = max(fastest, v)
-        slope = math.exp(-v / g.aging_velocity) / g.aging_time if aging else 0.0
-        climb = max(b.force_sensitivity * b.chain_stiffness * v - slope, 0.0)
-        rate = 4.0 * (1.0 + b.breakage_weight) / b.bond_time + 10.0 * climb + 100.0 * v / b.max_extension
-        rate *= scale * (BLOCK_SHARE if control == "block" else 1.0)
-        cohorts = rate * (t1 - t0)
-        if motion is not None and motion.counts():
-            piece = motion.piece(t1 - t0, vp, lambda v=vp: v < _fold(fold, params, control, aging))
-            if piece is not None:  # births a block cannot resolve in STUCK_STEPS or a slip (a huge u0) are counted
-                floor = rate * FORMING * b.bond_time if piece > 0 else 0.0  # a piece held by the chains: no step
-                bound = math.inf if motion.stuck_for_good else cohorts  # the sticking is one lump, however short
-                steps += min(max(piece, floor) * scale, bound) + motion.segment_steps()
-                continue
-        if reducing and 0 < vp <= (BLOCK_FASTEST if control == "block" else 100.0) * natural:
-            settle = rate * SETTLE * b.max_extension / vp + REDUCED_STEPS
-            if settle < min(cohorts, HOPELESS):  # beyond HOPELESS the fold is not worth finding
-                if vp >= _fold(fold, params, control, aging):
-                    cohorts = settle
-                    reduced += 1
-        steps += cohorts + SEGMENT_STEPS
+    steps, fastest, reduced = _pieces_steps(params, protocol, control, aging, v_start, scale, motion, reducing)
     if control == "block" and start == "empty" and not stick_population and reduced and not own:
         steps += STUCK_STEPS  # a block from rest sticks first (the chains hold a stuck block)
     if control == "block" and mass > 0:
@@ -1163,6 +1138,41 @@ def estimate_cost(
     per_segment = SEGMENT_SECONDS if (reducing and control == "block") else 0.1 * SEGMENT_SECONDS
     seconds = steps * STEP_SECONDS + moving * per_segment + COHORT_SECONDS * stuck * stuck
     return CostEstimate(steps, basis, seconds)
+
+
+def _pieces_steps(  # type: ignore[no-untyped-def]
+    params, protocol, control, aging, v_start, scale, motion, reducing
+) -> tuple[float, float, int]:
+    """:func:`estimate_cost`'s steps piece by piece: (steps, the fastest velocity, the pieces reduced)."""
+    b, g = params.bonds, params.aging
+    fold: list[float] = []  # FOLD_MARGIN x Vc, looked for only when a piece needs it
+    steps = 0.0
+    fastest = 0.0
+    reduced = 0
+    natural = b.max_extension / b.bond_time
+    for t0, t1, vp in protocol.pieces():
+        v = max(abs(vp), v_start) if control == "block" else abs(vp)
+        fastest = max(fastest, v)
+        slope = math.exp(-v / g.aging_velocity) / g.aging_time if aging else 0.0
+        climb = max(b.force_sensitivity * b.chain_stiffness * v - slope, 0.0)
+        rate = 4.0 * (1.0 + b.breakage_weight) / b.bond_time + 10.0 * climb + 100.0 * v / b.max_extension
+        rate *= scale * (BLOCK_SHARE if control == "block" else 1.0)
+        cohorts = rate * (t1 - t0)
+        if motion is not None and motion.counts():
+            piece = motion.piece(t1 - t0, vp, lambda v=vp: v < _fold(fold, params, control, aging))
+            if piece is not None:  # births a block cannot resolve in STUCK_STEPS or a slip (a huge u0) are counted
+                floor = rate * FORMING * b.bond_time if piece > 0 else 0.0  # a piece held by the chains: no step
+                bound = math.inf if motion.stuck_for_good else cohorts  # the sticking is one lump, however short
+                steps += min(max(piece, floor) * scale, bound) + motion.segment_steps()
+                continue
+        if reducing and 0 < vp <= (BLOCK_FASTEST if control == "block" else 100.0) * natural:
+            settle = rate * SETTLE * b.max_extension / vp + REDUCED_STEPS
+            if settle < min(cohorts, HOPELESS):  # beyond HOPELESS the fold is not worth finding
+                if vp >= _fold(fold, params, control, aging):
+                    cohorts = settle
+                    reduced += 1
+        steps += cohorts + SEGMENT_STEPS
+    return steps, fastest, reduced
 
 
 def _fold(found: list[float], params: Parameters, control: str, aging: bool) -> float:
