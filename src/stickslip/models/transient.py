@@ -159,7 +159,7 @@ def _regime(result: Any, protocol: Protocol | None) -> regimes.Regime:
         scale = float(np.max(np.abs(stress[inside]))) if np.any(inside) else 0.0
         found = regimes.classify(time, stress, floor=SETTLED * max(scale, 1e-300), start=start, unit="Pa")
     return regimes.Regime(
-        result.regime, found.periods, found.amplitude_ratio, found.period, found.peak, found.trough, result.message
+        str(result.regime), found.periods, found.amplitude_ratio, found.period, found.peak, found.trough, result.message
     )
 
 
@@ -169,7 +169,7 @@ def last_cycle_numbers(result: Any) -> dict[str, Any]:
     whole = [c for c in result.cycles if getattr(c, "period", None) is not None]
     time = np.asarray(result.time, dtype=float)
     row: dict[str, Any] = {
-        "regime": result.regime,
+        "regime": str(result.regime),  # a kind name (a Regime compares and prints as its kind)
         "period": NAN,
         "stick_time": NAN,
         "peak_stress": NAN,
