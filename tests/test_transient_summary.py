@@ -186,21 +186,14 @@ def test_a_failure_with_nothing_finite_says_so_in_words():
         _no_nan(text)
 
 
-UNRESOLVED_JUMP = (
-    "the massless block jumps (520 Pa to ~0 within one step) and the kernel takes that step only at its floor (1e-15"
-    " of the time reached), accepted whatever its error: unsampled and every 1 ms it goes non-finite, every 0.1 ms"
-    " it lands and the run ends stuck (as issue 33's independent solver); the kernel must resolve the jump"
-)
-
-
-@pytest.mark.parametrize(
-    "every", [None, 1e-3, pytest.param(1e-4, marks=pytest.mark.xfail(strict=True, reason=UNRESOLVED_JUMP))]
-)
+@pytest.mark.parametrize("every", [None, 1e-3, 1e-4])
 def test_a_runaway_fails_alike_whatever_the_sampling(every):
     """Issue 33.1's case: lambda = 2 A, a steady start at 4.2 mm/s (the falling branch) and a +1 % kick of the
     puller.  The slider accelerates and runs away (the massless block has no finite slip velocity) at ~3.07 ms;
     sampled every 1 ms the message was 'internal error (IndexError)'.  The verdict comes from the kernel's state
-    (its step collapsed), not the rows: unsampled and every 1 ms fail the same way at the same instant."""
+    (its step collapsed), not the rows: unsampled and every 1 ms fail the same way at the same instant.  Sampled every
+    0.1 ms the kernel accepted the step at its floor (1e-15 of the time reached) whatever its error, jumped 520 Pa to
+    ~0 and ended stuck: a step that fails at the floor is now refused, the run failed (kernel.FAILED)."""
     from stickslip.errors import ModelError
 
     params = stickslip.load_parameters("gelatin-glass").with_overrides({"bonds.activation_length": 2e-10})

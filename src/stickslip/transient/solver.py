@@ -448,15 +448,15 @@ class _Driver:
             self.chains_on = True
             self.chain_state = {"elapsed": 0.0, "fraction": 1.0}
             self.events.append(("stick", state.t, self.k_block * (state.puller - state.x), state.v))
-        self._check(count)
+        self._check(count, status == K.FAILED)
         self._report_progress()
         self._snapshots_through(t1)
 
-    def _check(self, count: int) -> None:
-        """A state gone non-finite fails the run (SolverFailed, in words); a budget used up stops it
-        (BudgetExhausted, with the run so far)."""
+    def _check(self, count: int, collapsed: bool = False) -> None:
+        """A state gone non-finite, or a step that collapsed to the kernel's floor and still failed, fails the run
+        (SolverFailed, in words); a budget used up stops it (BudgetExhausted, with the run so far)."""
         state, duration = self.state, self.duration
-        if not all(math.isfinite(q) for q in (state.t, state.x, state.v, state.h)):
+        if collapsed or not all(math.isfinite(q) for q in (state.t, state.x, state.v, state.h)):
             pace = float(np.max(self.protocol.velocities))
             raise SolverFailed(_non_finite(state.t, self.out[:count], self.rows, pace, self.inertial, state.h))
         unfinished = state.t < duration - 1e-12 * max(duration, 1.0)  # a run that got to its end is whole
@@ -491,10 +491,11 @@ def _non_finite(
     if finite.size:
         last = finite[np.argmax(finite[:, 0])]
         when += f" (last finite state at t = {last[0]:.6g} s: σ = {last[1]:.6g} Pa, V = {show_velocity(last[3], 3)})"
-    if inertial:
-        return f"transient solver failed at {when}: non-finite state of the block with mass"
-    fast = finite[finite[:, 3] > RUNAWAY * max(pace, 1e-300)] if finite.size else finite
     collapsed = math.isfinite(step) and math.isfinite(t) and step < COLLAPSED * max(t, 1e-300)
+    if inertial:
+        what = f"the step collapsed to {step:.3g} s" if collapsed else "non-finite state"
+        return f"transient solver failed at {when}: {what} of the block with mass"
+    fast = finite[finite[:, 3] > RUNAWAY * max(pace, 1e-300)] if finite.size else finite
     if not (fast.size or collapsed):
         return f"transient solver failed at {when}: non-finite state"
     seen = ""
