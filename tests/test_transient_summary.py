@@ -176,6 +176,18 @@ def test_the_failure_message_is_written_from_any_rows(shape):
     assert f"{2 * RUNAWAY * pace:.3g} m/s under σ = 519.6 Pa" in runaway, runaway
 
 
+def test_a_collapsed_step_of_the_block_with_mass_is_named():
+    """A step refused at the kernel's floor leaves a finite state: the message of a block with mass names the
+    collapsed step, not a non-finite state it did not reach."""
+    from stickslip.transient.solver import _non_finite
+
+    rows = _rows([1e-3, 2e-3], [500.0, 510.0], [1e-4, 2e-4], [1e-6, 2e-6])
+    text = _non_finite(2e-3, rows[:, :13], [rows], 1e-4, True, step=2e-18)
+    assert "the step collapsed to 2e-18 s of the block with mass" in text, text
+    assert "non-finite" not in text and "σ = 510 Pa" in text, text
+    _no_nan(text)
+
+
 def test_a_failure_with_nothing_finite_says_so_in_words():
     from stickslip.transient.solver import _non_finite
 
