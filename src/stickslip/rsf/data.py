@@ -38,7 +38,15 @@ __all__ = ["LabRecord", "find_segments", "measured_history", "parse_columns", "r
 ROLES = ("time", "displacement", "friction", "velocity")
 _DEFAULT_NAMES = {
     "time": ("time", "time(s)", "time_s", "t"),
-    "displacement": ("load_point_displacement", "load_point_position", "displacement", "displ", "disp", "lp_disp", "lp displacement"),
+    "displacement": (
+        "load_point_displacement",
+        "load_point_position",
+        "displacement",
+        "displ",
+        "disp",
+        "lp_disp",
+        "lp displacement",
+    ),
     "friction": ("friction", "mu", "friction_coefficient"),
     "velocity": ("load_point_velocity", "velocity", "vel", "lp_velocity", "lp_vel"),
 }
