@@ -317,6 +317,7 @@ def _rendered_figures(
     global _SHARED_RUN
     _SHARED_RUN = run
     try:
+        _load_before_fork(run)
         context = multiprocessing.get_context("fork")
         with ProcessPoolExecutor(
             max_workers=count, mp_context=context, initializer=die_with_parent, initargs=(os.getpid(),)
@@ -327,6 +328,25 @@ def _rendered_figures(
                 yield future.result()
     finally:
         _SHARED_RUN = None
+
+
+def _load_before_fork(run: ModelRun) -> None:
+    """Import, and load from numba's cache, what figures in both workers need, once here before the fork.
+
+    The forked workers share this process's memory, so what is loaded here is loaded for both; loaded in the
+    workers instead, it cost each of them the same CPU again: matplotlib (every figure, ~0.4 s), pandas (the phase
+    diagram's sweep and the rate-and-state fits, ~0.35 s), numba with the transient kernels (the time-dependent,
+    rate-and-state and inertia figures: ~0.6 s, most of it the compiled kernels read from the cache at the first
+    run).  The run below is a millisecond of sliding through the solver; its result is discarded.
+    """
+    import matplotlib.figure  # noqa: F401
+    import pandas  # noqa: F401
+
+    from ..protocols import constant
+    from ..transient import run_transient
+
+    velocity = 100e-6
+    run_transient(run.params, constant(velocity, 1e-3), control="velocity", start="steady", rtol=1e-3)
 
 
 def _write(action: Callable[[], Any]) -> Any:
