@@ -197,7 +197,7 @@ def _api(driver: Any, base: str) -> list[str]:
 
 
 def _notebooks(driver: Any, base: str, pages: list[str]) -> list[str]:
-    notebooks = [p for p in pages if p.startswith("examples/")]
+    notebooks = [p for p in pages if p.startswith("examples/") and p != "examples/index.html"]  # not the list
     if not notebooks:
         return ["no notebook pages under examples/"]
     problems = []

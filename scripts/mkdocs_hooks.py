@@ -37,6 +37,7 @@ GENERATED = {
     "src/stickslip/report/errata.md": "paper-errata.md",
     "LICENSE": "LICENSE.txt",
     "CITATION.cff": "CITATION.cff",
+    "examples/README.md": "examples/index.md",
 }
 REPORT_PAGE = "report-figures.md"
 LINK = re.compile(r"(\]\()([^)\s]+)(\))")
@@ -68,7 +69,7 @@ def on_config(config: Any) -> Any:
     """Lists the notebooks under "Examples" in the navigation (their names are known only at build time)."""
     pages = [f"examples/{path.name}" for path in _notebooks()]
     if pages and config.get("nav") is not None:
-        config["nav"].append({"Examples": pages})
+        config["nav"].append({"Examples": ["examples/index.md", *pages]})  # the folder's README, then each
     return config
 
 

@@ -82,6 +82,8 @@ class _Files:
         ("../src/stickslip/report/errata.md#e3", "docs/errata.md", "paper-errata.md#e3"),
         ("report.md#errata", "docs/errata.md", "report.md#errata"),
         ("../examples/01-x.ipynb", "docs/models.md", "examples/01-x.ipynb"),
+        ("examples/README.md", "README.md", "examples/index.md"),  # the notebooks' own README is a site page
+        ("01-x.ipynb", "examples/README.md", "01-x.ipynb"),  # ... whose links lead to the notebooks beside it
         ("https://distributed.dask.org", "README.md", "https://distributed.dask.org"),  # left alone
         ("#section", "docs/rsf.md", "#section"),
         ("../tests/test_docs.py", "docs/rsf.md", "../tests/test_docs.py"),  # not in the site: mkdocs reports it
@@ -138,6 +140,6 @@ def test_notebook_markdown_math_becomes_mathml_and_code_and_prices_stay(hooks):
 
 def test_the_pages_the_hook_makes_are_the_ones_the_navigation_expects(hooks):
     made = {page for page in hooks.GENERATED.values() if page.endswith(".md")} | {hooks.REPORT_PAGE}
-    assert made == GENERATED_PAGES
+    assert made == GENERATED_PAGES | {"examples/index.md"}  # the last listed by the hook, with the notebooks
     for source in hooks.GENERATED:
         assert (ROOT / source).is_file(), f"{source}: the hook makes a site page from it, but it is gone"
