@@ -5,10 +5,7 @@ by ``python tests/test_transient_split.py --write`` from the code *before* the s
 trace array of each case must equal them exactly (``np.array_equal``, nan where nan), as must the step counts, the
 regime and the message.  The numbers themselves are validated independently elsewhere (tests/test_transient*.py:
 closed forms, the steady solver, convergence orders); this file only pins that splitting ``kernel.advance`` and
-``solver.run_transient`` into functions changed no floating-point operation.  The ``saturating`` case was rewritten
-(``--write saturating``) when issue 33 item 3 changed its method on purpose (the births' lumping error of saturating
-aging: the Gauss pair's own, not one lumped cohort's); it agrees with the plain cohorts at rtol 1e-6 to 5e-8 of the
-peak stress and 3.3e-4 N0 (rtol 1e-3), tests/test_transient_stuck.py.
+``solver.run_transient`` into functions changed no floating-point operation.
 
 Each case starts from cleared caches (the quasi-steady reduction's built manifolds, ``reduction._BUILT``, are
 reused within a process, and one built at a tighter rtol serves a looser one: the answer would depend on the

@@ -686,18 +686,6 @@ def _cohort_pass(  # type: ignore[no-untyped-def]
     )  # fmt: skip
 
 
-def _lumped_share(z, p):  # type: ignore[no-untyped-def]
-    """The share of a half-step's births the lumping at one Gauss point misplaces, z = h r: one lumped cohort's
-    (h r)^2/24 (the paper's model: a conservative bound), or, with the housekeeping of saturating aging and a
-    resting hazard that is not nil (t_s/tau_a below the log-rate cap: a saturation age beyond every age of a run
-    is the paper's model, bit for bit), the Gauss pair's own error, (h r)^4/4320, for the whole stream born at
-    this pace over the newborns' life 1/r.  The bound halved the steps of a stuck saturating block (issue 33)."""
-    ts = p[P_SATURATION]
-    if p[P_MERGE_SATURATED] > 0.0 and p[P_AGING] > 0.0 and 0.0 < ts * p[P_INV_TAU_A] < LOG_RATE_CAP:
-        return z * z * z * z / 4320.0 * max(1.0, 1.0 / max(z, 1e-300))
-    return z * z / 24.0
-
-
 def _gauss_birth(  # type: ignore[no-untyped-def]
     k, n, t, hh, x, x1p, v0, v1p, accel, accel_now, jerk, slope1, q0, loss0, dloss0, l1, d1, inertial, xb, tb,
     lw_new, w1, known, rate0, predicted, p,
@@ -741,7 +729,7 @@ def _gauss_birth(  # type: ignore[no-untyped-def]
     # its end (the birth rate times the newborns' life 1/r, at most all of it): bonds living
     # shorter than a step would otherwise vanish from the population without a word
     z = max(r_birth * hh, trap)
-    lump = min(mass * min(1.0, _lumped_share(z, p)), 2.0 * mass / (hh * r_birth))
+    lump = min(mass * min(1.0, z * z / 24.0), 2.0 * mass / (hh * r_birth))
     xb[n + k] = x_k
     tb[n + k] = t + u
     lw_new[n + k] = math.log(alive) if alive > 0.0 else -np.inf
@@ -1199,7 +1187,6 @@ def compiled() -> dict[str, object]:
             "_vacancy",
             "_negligible",
             "_same_bin",
-            "_lumped_share",
         ):
             g[name] = _jit(g[name])
         for name in INLINED:
