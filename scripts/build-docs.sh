@@ -28,7 +28,7 @@ install() {
   python3 -m venv "$venv"
   "$venv/bin/python" -m pip install -q --upgrade pip
   # editable: the API pages are read from src/ anyway; scripts/check-wheel.sh checks the installed wheel
-  "$venv/bin/python" -m pip install -q -e ".[docs]"
+  "$venv/bin/python" -m pip install -q -e ".[docs]" "pytest>=7.4"
 }
 
 if [ "${STICKSLIP_DOCS_NO_INSTALL:-0}" = 1 ]; then
@@ -36,6 +36,9 @@ if [ "${STICKSLIP_DOCS_NO_INSTALL:-0}" = 1 ]; then
 else
   step "install" install
 fi
+# the tests the test command's environment skips without the docs extra (the hook's; the notebooks' schema): run here
+step "hook and notebook tests" "$venv/bin/python" -m pytest -q -p no:cacheprovider tests/test_docs_site.py \
+  tests/test_notebooks_static.py
 step "notebooks" "$venv/bin/python" scripts/run-notebooks.py --out "$work/examples"
 step "report" "$venv/bin/stickslip" reproduce -o "$work/report" --quiet
 export NO_MKDOCS_2_WARNING=1 STICKSLIP_DOCS_NOTEBOOKS="$work/examples" STICKSLIP_DOCS_REPORT="$work/report"
