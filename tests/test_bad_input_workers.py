@@ -1,8 +1,9 @@
-"""Issue 29: `kill -9` of `stickslip reproduce` must not leave its forked figure workers alive.
+"""Issue 29: `kill -9` of `stickslip reproduce` or `stickslip sweep` must not leave their worker processes alive.
 
-The parent here is a real process drawing slow figures in two forked workers (the report's own
+The report's parent here is a real process drawing slow figures in two forked workers (the report's own
 ``_rendered_figures``); it is killed with SIGKILL, which runs no cleanup at all, and every worker must be
 gone within seconds.  Before the fix the workers sat blocked on their task pipe for as long as the machine ran.
+The sweep is the real command on a two-worker dask cluster, killed the same way once its workers run.
 """
 
 from __future__ import annotations
@@ -90,3 +91,48 @@ def test_die_with_parent_ends_a_worker_whose_parent_is_already_gone() -> None:
             os._exit(0)
     _, status = os.waitpid(child, 0)
     assert os.WEXITSTATUS(status) == 1
+
+
+def _descendants(pid: int) -> list[int]:
+    """Every living process below ``pid`` (children, their children, ...), from /proc."""
+    parents: dict[int, int] = {}
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rsplit(")", 1)[1].split()
+        except (FileNotFoundError, ProcessLookupError, IndexError):
+            continue
+        if fields[0] not in ("Z", "X"):
+            parents[int(stat.parent.name)] = int(fields[1])
+    found, frontier = [], [pid]
+    while frontier:
+        children = [child for child, parent in parents.items() if parent in frontier]
+        found += children
+        frontier = children
+    return found
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads the process tree from /proc")
+def test_a_killed_sweep_leaves_no_dask_worker_behind(tmp_path: Path) -> None:
+    """`kill -9` of `stickslip sweep --workers 2`: its resource tracker and both dask worker processes go too."""
+    grid = ["--vary", "pulling_velocity=5 um/s..5 mm/s:40:log", "--vary", "block.stiffness=40 kPa/m..4 MPa/m:30:log"]
+    command = [sys.executable, "-m", "stickslip", "sweep", *grid, "-o", str(tmp_path / "out"), "--workers", "2"]
+    parent = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    try:
+        deadline = time.monotonic() + 120
+        while len(_descendants(parent.pid)) < 3 and time.monotonic() < deadline:
+            assert parent.poll() is None, "the sweep ended before its workers started"
+            time.sleep(0.1)
+        started = _descendants(parent.pid)
+        assert len(started) >= 3, f"expected a resource tracker and two workers, saw {started}"
+        os.kill(parent.pid, signal.SIGKILL)
+        parent.wait(timeout=10)
+        deadline = time.monotonic() + 30
+        while any(_alive(pid) for pid in started) and time.monotonic() < deadline:
+            time.sleep(0.1)
+        survivors = [pid for pid in started if _alive(pid)]
+    finally:
+        if parent.poll() is None:
+            parent.kill()
+    for pid in survivors:  # leave nothing behind even when the test fails
+        os.kill(pid, signal.SIGKILL)
+    assert not survivors, f"processes {survivors} outlived their killed sweep"
