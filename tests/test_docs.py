@@ -43,6 +43,17 @@ FENCE = re.compile(r"^(?P<indent> {0,3})(?P<fence>`{3,}|~{3,})\s*(?P<lang>[^\s`]
 MARKER = re.compile(r"^\s*<!--\s*test:\s*(?P<kind>skip|replace|before|expect)\b\s*(?P<arg>.*?)\s*-->\s*$")
 #: nan or inf as a number in an output (not "info", "infinite", "inflection")
 NON_FINITE = re.compile(r"(?<![A-Za-z])[-+]?(nan|inf|infinity)(?![A-Za-z])", re.IGNORECASE)
+#: a number printed with binary round-off showing (0.00035999999999999997, 10.000000000000002)
+FLOAT_NOISE = re.compile(r"(?<![\d.])\d+\.\d*?(?:0{9,}|9{9,})\d+(?:e[-+]?\d+)?")
+
+
+def float_noise(printed: str) -> list[str]:
+    """Numbers in what a command printed for a reader that show float round-off; a CSV line (a trace written to
+    standard output) keeps every digit on purpose, so that reading it back gives the same floats."""
+    text = "\n".join(line for line in printed.splitlines() if line.count(",") < 3)
+    return FLOAT_NOISE.findall(text)
+
+
 INLINE = re.compile(r"(?<!`)`(stickslip [^`]+)`(?!`)")
 TIMES: dict[str, float] = {}
 
@@ -174,6 +185,8 @@ def run_block(block: Block, namespace: dict, capsys: pytest.CaptureFixture[str])
         printed = "".join(run_shell_line(line, block.where, capsys) for line in shell_lines(text, block.lang))
         shown = NON_FINITE.search(printed)  # issue 28: no command prints nan or inf; it says what is unknown
         assert shown is None, f"{block.where}: the output shows {shown.group(0)!r}:\n{printed[-2000:]}"
+        noise = float_noise(printed)
+        assert not noise, f"{block.where}: the output shows binary float noise {noise[:3]}:\n{printed[-2000:]}"
     missing = [arg for kind, arg in block.markers if kind == "expect" and arg not in printed]
     assert not missing, f"{block.where}: the page quotes {missing} beside the command, which printed:\n{printed}"
 
@@ -348,3 +361,8 @@ def test_expect_markers_check_python_prints_and_commands_never_print_nan(tmp_pat
         run_block(wrong, {}, capsys)
     assert NON_FINITE.search("period nan s") and NON_FINITE.search("Kc = -inf Pa/m") and NON_FINITE.search("NaN")
     assert not NON_FINITE.search("info: infinite stiffness, an inflection, nanometre")
+    assert float_noise("mu0 0.00035999999999999997 and t = 10.000000000000002 s") == [
+        "0.00035999999999999997",
+        "10.000000000000002",
+    ]
+    assert float_noise("σ = 292.943 Pa, 1e-300, 100000 steps\n1.0,2.0000000000000004,3.0,4.0") == []
