@@ -47,6 +47,16 @@ def _alive(pid: int) -> bool:
     return state not in ("Z", "X")
 
 
+def _survivors_of_a_killed_parent(parent: subprocess.Popen, children: list[int], seconds: float) -> list[int]:
+    """SIGKILL ``parent`` (no cleanup runs), then the ``children`` still alive after ``seconds``."""
+    os.kill(parent.pid, signal.SIGKILL)
+    parent.wait(timeout=10)
+    deadline = time.monotonic() + seconds
+    while any(_alive(pid) for pid in children) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    return [pid for pid in children if _alive(pid)]
+
+
 def _pids(folder: Path, prefix: str) -> list[int]:
     return [int(p.name.split("-", 1)[1]) for p in folder.glob(f"{prefix}-*")]
 
@@ -65,12 +75,7 @@ def test_forked_figure_workers_die_with_a_killed_parent(tmp_path: Path) -> None:
         workers = _pids(tmp_path, "worker")
         assert len(workers) == 2, f"expected two forked workers drawing, saw {workers}"
         assert all(_alive(pid) for pid in workers)
-        os.kill(parent.pid, signal.SIGKILL)
-        parent.wait(timeout=10)
-        deadline = time.monotonic() + 10
-        while any(_alive(pid) for pid in workers) and time.monotonic() < deadline:
-            time.sleep(0.05)
-        survivors = [pid for pid in workers if _alive(pid)]
+        survivors = _survivors_of_a_killed_parent(parent, workers, 10)
     finally:
         if parent.poll() is None:
             parent.kill()
@@ -124,12 +129,7 @@ def test_a_killed_sweep_leaves_no_dask_worker_behind(tmp_path: Path) -> None:
             time.sleep(0.1)
         started = _descendants(parent.pid)
         assert len(started) >= 3, f"expected a resource tracker and two workers, saw {started}"
-        os.kill(parent.pid, signal.SIGKILL)
-        parent.wait(timeout=10)
-        deadline = time.monotonic() + 30
-        while any(_alive(pid) for pid in started) and time.monotonic() < deadline:
-            time.sleep(0.1)
-        survivors = [pid for pid in started if _alive(pid)]
+        survivors = _survivors_of_a_killed_parent(parent, started, 30)
     finally:
         if parent.poll() is None:
             parent.kill()
