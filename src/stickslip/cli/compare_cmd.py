@@ -21,15 +21,13 @@ import numpy as np
 from ..errors import ModelError, ParameterError
 from ..fileio import refuse_input_as_output
 from ..progress import progress
-from .common import json_text, params_options, positive, quantity, resolve_params
+from .common import json_text, params_options, positive, quantity, resolve_params, save_figure, write_text
 from .protocol_options import protocol_options
-from .rsf_cmd import save_figure, sidecar, write
+from .rsf_cmd import sidecar
 
 #: The protocol sets of ``compare --models A,B --protocol-set NAME``: each runs its own protocols (options
 #: --v0/--v1/--step-time/--hold/--pull/--duration) on its models; bond-vs-rsf takes a bond model and rsf.
 PROTOCOL_SETS = {"bond-vs-rsf": ("quasi-static", "transient")}
-#: What plain ``stickslip compare`` runs (its older spelling, kept): the bond-vs-RSF set on these models.
-CLASSIC_MODELS = "quasi-static,rsf"
 
 #: The classic compare's --v0 and --duration when not given (with --models they are the protocol's first segment).
 CLASSIC_V0, CLASSIC_DURATION = "200 um/s", "120 s"
@@ -175,7 +173,7 @@ def compare_command(**options: Any) -> None:
         save_figure(figure_bond_and_rsf(panels, pair, rsf, _how(rsf.status)), options["output"])
         side = sidecar(options["output"])
         if side is not None:
-            write(side, json_text(summary) + "\n")
+            write_text(side, json_text(summary) + "\n")
     if failures:
         click.echo("stickslip: the rate-and-state side failed: " + failures[0], err=True)
         raise SystemExit(FAILED)

@@ -14,7 +14,6 @@ import click
 import numpy as np
 
 from .common import (
-    check_output,
     emit_json,
     params_options,
     positive,
@@ -25,6 +24,7 @@ from .common import (
 )
 from .params_cmd import print_rich
 from .protocol_options import build_protocol, build_rig, protocol_options, refuse_unsupported
+from .run_cmd import execute, output_options
 
 #: Rows of the Nc/Nc0 table printed by ``stick`` (the whole curve is in --json and -o).
 STICK_TABLE_ROWS = 11
@@ -75,11 +75,7 @@ def _fmt(value: float | None, scale: float = 1.0, digits: int = 5) -> str:
     show_default=True,
     help="Steady curve the stick-to-slip jump lands on (aging keeps the stress continuous; see docs/errata.md).",
 )
-@click.option(
-    "-o", "--output", type=click.Path(dir_okay=False, path_type=Path), help="Write the Run CSV (units in the header)."
-)
-@click.option("--plot", "plot_path", type=click.Path(dir_okay=False, path_type=Path), help="Save σ(t) (Fig 5) here.")
-@click.option("--json", "as_json", is_flag=True, help="Print the summary as JSON (SI units).")
+@output_options
 @params_options
 def simulate_command(
     v0_text: str | None,
@@ -100,7 +96,7 @@ def simulate_command(
 
     The spelling of `stickslip run --model quasi-static` (--start-stress is
     its --start, --jump-curve its --setting jump_curve=...): the same Run CSV
-    (-o), the same summary and the cycles below it.
+    (-o), the same figure (--plot), the same summary and the cycles below it.
 
     The quasi-static model is a spring (the block, or --stiffness K) pulled at
     one constant velocity: --v0 V --duration T (or one --segment "V:T", or a
@@ -111,11 +107,8 @@ def simulate_command(
     "stuck" (a stick never ends) or "undetermined" (the model has no answer).
     """
     from ..models import get_model
-    from .run_cmd import execute
 
     refuse_overwriting_inputs([protocol_file], [("-o", output), ("--plot", plot_path)], params_name)
-    check_output("-o", output)
-    check_output("--plot", plot_path, plot=True)
     protocol = build_protocol(v0_text, duration_text, segment_texts, protocol_file)
     refuse_unsupported("simulate (the quasi-static model)", protocol, control, controls=("spring",),
                        one_segment=True, instead="stickslip transient runs any protocol and rig")  # fmt: skip
@@ -123,17 +116,7 @@ def simulate_command(
     params = resolve_params(params_name, overrides)
     execute(get_model("quasi-static"), params, protocol, rig, start=_stress(start_text),
             settings={"jump_curve": jump_curve}, output=output, plot_path=plot_path, as_json=as_json,
-            figure=lambda run: _figure(run.native, params.name), start_option="--start-stress ")  # fmt: skip
-
-
-def _figure(sim: Any, name: str) -> Any:
-    """sigma(t) over the cycles (Fig 5), the legend below the axes: any corner holds a peak or trough of some run."""
-    from ..plots.cycles import plot_simulation
-
-    ax = plot_simulation(sim)
-    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.14), ncol=3, frameon=False, fontsize=8)
-    ax.set_title(f"V0 = {sim.pulling_velocity * 1e6:.4g} µm/s, {name}: {sim.regime}", fontsize=11)
-    return ax.figure
+            start_option="--start-stress ")  # fmt: skip
 
 
 # --------------------------------------------------------------------------- stick

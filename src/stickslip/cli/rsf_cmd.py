@@ -24,14 +24,14 @@ from typing import Any
 import click
 import numpy as np
 
-from ..errors import DataError, ModelError, ParameterError, StickslipError, UnitError
-from ..fileio import atomic_path, atomic_write_text
+from ..errors import DataError, ModelError, ParameterError, UnitError
 from ..numerics.budget import PROGRESS_AFTER_SECONDS
 from ..units import quantity_noun, shorten
-from .common import json_text, quantity, refuse_overwriting_inputs
+from .common import json_text, positive, quantity, refuse_overwriting_inputs, save_figure, write_text
 from .params_files import MAX_PARAMS_BYTES, load_params_file, load_params_mapping  # noqa: F401 (their old home)
 from .protocol_options import build_protocol as build_run_protocol
 from .protocol_options import checked_segment_text, protocol_options, refuse_unsupported
+from .run_cmd import execute, output_options
 
 LAW_NAMES = ("aging", "slip", "prz", "nagata")
 
@@ -86,7 +86,7 @@ def build_params(options: dict[str, Any]) -> Any:
     if options.get("b") is not None:
         first["b"] = _number(options["b"], "--b")
     if options.get("dc") is not None:
-        first["dc"] = _positive(options["dc"], "length", "--dc")
+        first["dc"] = positive(options["dc"], "length", "--dc")
     if options.get("nagata_c") is not None:
         for s in states:
             s["c"] = _number(options["nagata_c"], "--c")
@@ -94,32 +94,32 @@ def build_params(options: dict[str, Any]) -> Any:
         raise ParameterError("--b2/--dc2: a second state variable needs both --b2 and --dc2")
     if options.get("b2") is not None:
         second = {"law": first.get("law", "aging"), "b": _number(options["b2"], "--b2"),
-                  "dc": _positive(options["dc2"], "length", "--dc2"), "c": first.get("c", 0.0)}  # fmt: skip
+                  "dc": positive(options["dc2"], "length", "--dc2"), "c": first.get("c", 0.0)}  # fmt: skip
         states = [first, second]
     mapping: dict[str, Any] = {k: v for k, v in base.items() if k != "states"}
     mapping["states"] = states
     sigma = base.get("normal_stress")
     if options.get("normal_stress") is not None:
-        sigma = mapping["normal_stress"] = _positive(options["normal_stress"], "stress", "--normal-stress")
+        sigma = mapping["normal_stress"] = positive(options["normal_stress"], "stress", "--normal-stress")
     if options.get("a") is not None:
         mapping["a"] = _number(options["a"], "--a")
     if options.get("mu0") is not None:
         mapping["mu0"] = _number(options["mu0"], "--mu0")
     if options.get("v_ref") is not None:
-        mapping["v_ref"] = _positive(options["v_ref"], "velocity", "--v-ref")
+        mapping["v_ref"] = positive(options["v_ref"], "velocity", "--v-ref")
     if options.get("stiffness") is not None:
         mapping["stiffness"] = _per_sigma(options["stiffness"], "per_length", "stress_per_length", sigma, "--stiffness")
     if options.get("eta") is not None:
         mapping["eta"] = _per_sigma(options["eta"], "slowness", "stress_per_velocity", sigma, "--eta", allow_zero=True)
     if options.get("mass") is not None:
-        mapping["mass"] = _positive(options["mass"], "mass_per_area", "--mass", allow_zero=True)
+        mapping["mass"] = positive(options["mass"], "mass_per_area", "--mass", allow_zero=True)
     if options.get("regularized"):
         mapping["regularized"] = True
     if (options.get("cutoff_v1") is None) != (options.get("cutoff_v2") is None):
         raise ParameterError("--cutoff-v1/--cutoff-v2: the cut-off velocity form needs both V1 and V2")
     if options.get("cutoff_v1") is not None:
-        mapping["cutoff"] = (_positive(options["cutoff_v1"], "velocity", "--cutoff-v1"),
-                             _positive(options["cutoff_v2"], "velocity", "--cutoff-v2"))  # fmt: skip
+        mapping["cutoff"] = (positive(options["cutoff_v1"], "velocity", "--cutoff-v1"),
+                             positive(options["cutoff_v2"], "velocity", "--cutoff-v2"))  # fmt: skip
     source = "options" if options.get("params_file") is None else f"--params {options['params_file']} (or options)"
     return RSFParams.from_dict(mapping, source=source)
 
@@ -156,12 +156,6 @@ def _number(text: str, name: str) -> float:
     return quantity(text, "dimensionless", name)
 
 
-def _positive(text: str, dimension: str, name: str, allow_zero: bool = False) -> float:
-    from .common import positive
-
-    return positive(text, dimension, name, allow_zero=allow_zero)
-
-
 def _per_sigma(
     text: str, dimension: str, stress_dimension: str, sigma: float | None, name: str, allow_zero: bool = False
 ) -> float:
@@ -170,10 +164,10 @@ def _per_sigma(
 
     require_unit(text, dimension, f"{name} ")  # a bare number: say it needs a unit, not that its unit is wrong
     try:
-        return _positive(text, dimension, name, allow_zero)
+        return positive(text, dimension, name, allow_zero)
     except UnitError:
         try:
-            value = _positive(text, stress_dimension, name, allow_zero)
+            value = positive(text, stress_dimension, name, allow_zero)
         except UnitError:
             raise UnitError(
                 f"{name}: {text!r} has the wrong dimension; expected {quantity_noun(dimension)} "
@@ -206,23 +200,6 @@ def sidecar(path: Path | None) -> Path | None:
     return path.with_name(path.stem + ".params.json")
 
 
-def save_figure(fig: Any, path: Path) -> None:
-    try:
-        with atomic_path(path) as temp:
-            fig.savefig(temp, dpi=120, bbox_inches="tight", format=path.suffix.lstrip(".") or "png")
-    except StickslipError:  # a refusal (an input named as output) is already one line
-        raise
-    except (OSError, ValueError) as exc:
-        raise click.FileError(str(path), hint=str(exc)) from None
-
-
-def write(path: Path, text: str) -> None:
-    try:
-        atomic_write_text(path, text)
-    except OSError as exc:
-        raise click.FileError(str(path), hint=str(exc.strerror or exc)) from None
-
-
 @click.group("rsf")
 def rsf_group() -> None:
     """Rate-and-state friction: spring-slider runs, fits to lab records, stability."""
@@ -233,9 +210,7 @@ def rsf_group() -> None:
 @protocol_options(stiffness_help=STIFFNESS_HELP)
 @click.option("--start-velocity", default=None, help="Steady sliding at this velocity at t = 0 [first segment's].")
 @click.option("--every", default=None, help='Sample the trace every DT (e.g. "0.1 s"); default: the solver\'s steps.')
-@click.option("-o", "--output", type=click.Path(dir_okay=False, path_type=Path), help="Write the trace CSV here.")
-@click.option("--json", "as_json", is_flag=True, help="Print the summary as JSON.")
-@click.option("--plot", "plot_path", type=click.Path(dir_okay=False, path_type=Path), help="Save a figure.")
+@output_options
 def simulate_command(**options: Any) -> None:
     """Run a loading protocol on the rate-and-state spring-slider.
 
@@ -245,8 +220,8 @@ def simulate_command(**options: Any) -> None:
     The spelling of `stickslip run --model rsf` (the law options are its
     --set keys, --start-velocity its --start): the same Run CSV (time,
     friction, slider_velocity, slider_position, load_point_position, state;
-    on standard output without -o, the summary then on stderr) and the same
-    summary.  With -o the parameters go beside it in NAME.params.json.
+    on standard output without -o, the summary then on stderr), the same
+    figure (--plot) and the same summary.  With -o the parameters go beside it in NAME.params.json.
     """
     from ..models import Rig, get_model
 
@@ -261,27 +236,18 @@ def simulate_command(**options: Any) -> None:
     refuse_unsupported("rsf simulate (the rate-and-state spring-slider)", protocol, options["control"],
                        controls=("spring",))  # fmt: skip
     if options["start_velocity"] is not None:
-        start = _positive(options["start_velocity"], "velocity", "--start-velocity")
-    every = None if options["every"] is None else _positive(options["every"], "time", "--every")
+        start = positive(options["start_velocity"], "velocity", "--start-velocity")
+    every = None if options["every"] is None else positive(options["every"], "time", "--every")
     output, plot_path = options["output"], options["plot_path"]
     side = sidecar(output)
     refuse_overwriting_inputs(
         [options["protocol_file"], options["params_file"]],
         [("-o", output), ("-o (its NAME.params.json)", side), ("--plot", plot_path)],
     )
-    from .run_cmd import execute
-
-    beside = None if side is None else lambda run: write(side, run.native.metadata_json())
+    beside = None if side is None else lambda run: write_text(side, run.native.metadata_json())
     execute(get_model("rsf"), params, protocol, Rig(), start=start, settings={} if every is None else {"every": every},
             output=Path("-") if output is None and not options["as_json"] else output, plot_path=plot_path,
-            as_json=options["as_json"], figure=lambda run: _run_figure(run.native), beside=beside,
-            start_option="--start-velocity ")  # fmt: skip
-
-
-def _run_figure(native: Any) -> Any:
-    from ..plots.rsf import run_figure
-
-    return run_figure(native)
+            as_json=options["as_json"], beside=beside, start_option="--start-velocity ")  # fmt: skip
 
 
 @rsf_group.command("stability")
@@ -296,7 +262,7 @@ def stability_command(**options: Any) -> None:
 
     params = build_params(options)
     refuse_overwriting_inputs([options.get("params_file")], [("--plot", options["plot_path"])])
-    reports = [stability(params, _positive(v, "velocity", "--velocity")).as_dict() for v in options["velocities"]]
+    reports = [stability(params, positive(v, "velocity", "--velocity")).as_dict() for v in options["velocities"]]
     if options["as_json"]:
         click.echo(json_text(reports if len(reports) > 1 else reports[0]))
     else:
@@ -471,7 +437,7 @@ def fit_command(**options: Any) -> None:
         [options["record_file"], options["protocol_file"]], [("-o", output), ("--plot", plot_path)]
     )
     window = _window(options["window_text"])  # the options first: a typing error is said before the record is read
-    max_time = _positive(options["max_time"], "time", "--max-time")
+    max_time = positive(options["max_time"], "time", "--max-time")
     reading = {} if options["displacement_unit"] is None else {"displacement_unit": options["displacement_unit"]}
     record = read_record(options["record_file"], parse_columns(options["columns"]), time_unit=options["time_unit"],
                          **reading)  # fmt: skip
@@ -505,10 +471,10 @@ def fit_command(**options: Any) -> None:
     report["cost"] = {"seconds": elapsed, "estimated_seconds": cost.seconds, "model_run_seconds": cost.run_seconds,
                       "estimated_model_runs": cost.runs}  # fmt: skip
     if output is not None and fit.status == "ok":
-        write(output, fit.to_toml())
+        write_text(output, fit.to_toml())
         side = sidecar(output)
         if side is not None:
-            write(side, json_text({"parameters": fit.params.to_dict(), "fit": report}))
+            write_text(side, json_text({"parameters": fit.params.to_dict(), "fit": report}))
     if options["as_json"]:
         click.echo(json_text(report))
     else:
@@ -585,13 +551,7 @@ def _window_end(text: str) -> float:
     from .common import require_unit
 
     require_unit(text, "time", "--window ", typical=1e3)  # a bare 20100 is meant in seconds, not ms
-    return _quantity(text, "time", "--window")
-
-
-def _quantity(text: str, dimension: str, name: str) -> float:
-    from .common import quantity
-
-    return quantity(text, dimension, name)
+    return quantity(text, "time", "--window")
 
 
 def _within_record(window: tuple[float | None, float | None], text: str, record: Any) -> tuple[float, float]:
@@ -637,8 +597,8 @@ def _fit_value(key: str, text: str, flag: str, sigma: float | None) -> float:
     if key == "stiffness":
         return _per_sigma(text, "per_length", "stress_per_length", sigma, name)
     if key in _POSITIVE_KEYS:
-        return _positive(text, dimension, name)
-    return _quantity(text, dimension, name)
+        return positive(text, dimension, name)
+    return quantity(text, dimension, name)
 
 
 def _free_keys(items: tuple[str, ...]) -> set[str]:
@@ -704,7 +664,7 @@ def _fit_settings(
     """The keyword arguments of :func:`stickslip.rsf.fit.fit_record` the options ask for (every value SI)."""
     sigma = None
     if options["normal_stress"] is not None:
-        sigma = _positive(options["normal_stress"], "stress", "--normal-stress")
+        sigma = positive(options["normal_stress"], "stress", "--normal-stress")
     law, states = _laws(options["law"], options["states"])
     fixed = _key_values(options["fix_items"], "--fix", sigma)
     guess = _key_values(options["guess_items"], "--guess", sigma)
@@ -736,8 +696,8 @@ def _fit_settings(
     if (options.get("cutoff_v1") is None) != (options.get("cutoff_v2") is None):
         raise ParameterError("--cutoff-v1/--cutoff-v2: the cut-off velocity form needs both V1 and V2")
     if options.get("cutoff_v1") is not None:
-        settings["cutoff"] = (_positive(options["cutoff_v1"], "velocity", "--cutoff-v1"),
-                              _positive(options["cutoff_v2"], "velocity", "--cutoff-v2"))  # fmt: skip
+        settings["cutoff"] = (positive(options["cutoff_v1"], "velocity", "--cutoff-v1"),
+                              positive(options["cutoff_v2"], "velocity", "--cutoff-v2"))  # fmt: skip
     return settings
 
 

@@ -20,7 +20,6 @@ from ..numerics.budget import BudgetExhausted
 from ..progress import progress
 from ..units import shorten
 from .common import (
-    check_output,
     emit_json,
     key_value,
     refuse_overwriting_inputs,
@@ -45,6 +44,20 @@ def model_spec_options(func: Any) -> Any:
                      help="The model's parameters: a built-in set or a file [the model's defaults]."),
         click.option("--set", "overrides", multiple=True, metavar="KEY=VALUE",
                      help="Override one of the model's parameter keys, with its unit; repeatable."),
+    ]  # fmt: skip
+    for option in reversed(options):
+        func = option(func)
+    return func
+
+
+def output_options(func: Any) -> Any:
+    """``-o``, ``--plot`` and ``--json``: what ``run`` and each of its spellings writes, in the same words."""
+    options = [
+        click.option("-o", "--output", type=click.Path(dir_okay=False, path_type=Path),
+                     help="Write the Run as CSV (units in the header; stickslip analyze reads it)."),
+        click.option("--plot", "plot_path", type=click.Path(dir_okay=False, path_type=Path),
+                     help="Save the run's figure."),
+        click.option("--json", "as_json", is_flag=True, help="Print the summary as JSON (SI units)."),
     ]  # fmt: skip
     for option in reversed(options):
         func = option(func)
@@ -275,14 +288,7 @@ def summary_text(summary: dict[str, Any]) -> str:
     metavar="KEY=VALUE",
     help="A model setting, e.g. jump_curve=no-aging, stick_population=true, rtol=1e-3; repeatable.",
 )
-@click.option(
-    "-o",
-    "--output",
-    type=click.Path(dir_okay=False, path_type=Path),
-    help="Write the Run as CSV (units in the header; stickslip analyze reads it).",
-)
-@click.option("--plot", "plot_path", type=click.Path(dir_okay=False, path_type=Path), help="Save the run's figure.")
-@click.option("--json", "as_json", is_flag=True, help="Print the summary as JSON (SI units).")
+@output_options
 @inertia_options
 def run_command(
     model_name: str,
@@ -311,8 +317,6 @@ def run_command(
     with status 3.
     """
     refuse_overwriting_inputs([protocol_file, params_name], [("-o", output), ("--plot", plot_path)])
-    check_output("-o", output)
-    check_output("--plot", plot_path, plot=True)
     model = load_model(model_name)
     protocol = build_protocol(v0_text, duration_text, segment_texts, protocol_file)
     mapping = model_overrides(model, overrides)
@@ -338,7 +342,6 @@ def execute(
     output: Path | None,
     plot_path: Path | None,
     as_json: bool,
-    figure: Any = None,
     beside: Any = None,
     start_option: str = "--start ",
 ) -> Any:
@@ -346,7 +349,7 @@ def execute(
     ``rsf simulate``.
 
     ``-o`` writes the Run's CSV (of the run up to its stop, if a budget stopped it), ``--plot`` the figure
-    (``figure(run)``, default ``run.plot()``), then the summary: JSON, or the shared text with the model's own
+    (``run.plot()``, whichever spelling ran it), then the summary: JSON, or the shared text with the model's own
     record below it.  ``beside(run)`` writes what a spelling keeps beside the trace (``rsf simulate``'s
     parameters).  A failed run, or one stopped by its budget, exits with status 3 after saying how far it got.
     """
@@ -378,7 +381,7 @@ def execute(
         if beside is not None:
             beside(run)
     if plot_path is not None:
-        save_figure(run.plot().figure if figure is None else figure(run), plot_path)
+        save_figure(run.plot().figure, plot_path)
     if as_json:
         emit_json(summary)
     else:  # beside a trace on standard output (-o -), the summary goes to stderr
@@ -408,4 +411,4 @@ def register(cli: click.Group) -> None:
     cli.add_command(run_command)
 
 
-__all__ = ["execute", "run_command", "run_summary", "summary_text"]
+__all__ = ["execute", "output_options", "run_command", "run_summary", "summary_text"]

@@ -7,13 +7,7 @@ from typing import Any
 
 import click
 
-from .common import (
-    check_output,
-    params_options,
-    positive,
-    refuse_overwriting_inputs,
-    resolve_params,
-)
+from .common import params_options, positive, refuse_overwriting_inputs, resolve_params
 from .protocol_options import (
     build_protocol,
     build_rig,
@@ -22,9 +16,7 @@ from .protocol_options import (
     protocol_options,
     refuse_unsupported,
 )
-
-#: a protocol of more segments is described in one line by its count, length and range of velocities
-DESCRIBED_SEGMENTS = 6
+from .run_cmd import execute, output_options
 
 
 class StepCount(click.ParamType):
@@ -42,19 +34,6 @@ class StepCount(click.ParamType):
             return parse_step_count(value, "--max-steps")
         except ParameterError as exc:
             self.fail(str(exc).split(": ", 1)[1], param, ctx)
-
-
-def _describe(protocol: Any) -> str:
-    """The protocol in one line: each segment, or for many their count, length and velocities."""
-    from ..display import velocity
-
-    if len(protocol.segments) <= DESCRIBED_SEGMENTS:
-        return str(protocol.describe())
-    v = protocol.velocities
-    return (
-        f"{len(protocol.segments)} segments, {protocol.duration:g} s in all, at {velocity(float(v.min()), 4)}"
-        f" to {velocity(float(v.max()), 4)}"
-    )
 
 
 @click.command("transient")
@@ -90,9 +69,7 @@ def _describe(protocol: Any) -> str:
     help='CPU time budget, e.g. "30 min": a run stops when it gets there, and a run estimated at more than 3x is'
     " refused [10 min].",
 )
-@click.option("-o", "--output", type=click.Path(dir_okay=False, path_type=Path), help="Write the trace (CSV, SI).")
-@click.option("--plot", "plot_path", type=click.Path(dir_okay=False, path_type=Path), help="Save σ(t) and V(t) here.")
-@click.option("--json", "as_json", is_flag=True, help="Print the summary as JSON (SI units).")
+@output_options
 @params_options
 def transient_command(
     v0_text: str | None,
@@ -121,8 +98,8 @@ def transient_command(
     """Solve the full time-dependent population balance (Eq 1, history form of Eq 3) through a protocol.
 
     The spelling of `stickslip run --model transient` (its options are run's
-    --start and --setting KEY=VALUE): the same Run CSV (-o), the same summary
-    and the slip events below it.
+    --start and --setting KEY=VALUE): the same Run CSV (-o), the same figure
+    (--plot), the same summary and the slip events below it.
 
     With --control spring (or block) the protocol is the puller's velocity and
     the block (Eq 17, or --stiffness K) couples it to the slider, without
@@ -139,14 +116,11 @@ def transient_command(
     the trace up to there (-o, --plot) and exits with status 3.
     """
     from ..models import get_model
-    from .run_cmd import execute
 
-    check_output("-o", output)
-    check_output("--plot", plot_path, plot=True)
+    refuse_overwriting_inputs([protocol_file], [("-o", output), ("--plot", plot_path)], params_name)
     protocol = build_protocol(v0_text, duration_text, segment_texts, protocol_file)
     refuse_unsupported("transient", protocol, control)
     rig, _ = build_rig(control_name(control), stiffness_text, mass_text=mass_text, damping_text=damping_text)
-    refuse_overwriting_inputs([protocol_file], [("-o", output), ("--plot", plot_path)], params_name)
     start_velocity = None if start_v_text is None else positive(start_v_text, "velocity", "--start-velocity")
     every = None if every_text is None else positive(every_text, "time", "--every")
     max_time = None if max_time_text is None else positive(max_time_text, "time", "--max-time")
@@ -155,13 +129,7 @@ def transient_command(
                     rtol=rtol, max_steps=max_steps, max_time=max_time,
                     reduction="off" if no_reduce else "auto")  # fmt: skip
     execute(get_model("transient"), params, protocol, rig, start=start, settings=settings, output=output,
-            plot_path=plot_path, as_json=as_json, figure=lambda run: _figure(run.native, protocol))  # fmt: skip
-
-
-def _figure(result: Any, protocol: Any) -> Any:
-    ax = result.plot()
-    ax.set_title(f"{_describe(protocol)}: {result.regime}", fontsize=9)
-    return ax.figure
+            plot_path=plot_path, as_json=as_json)  # fmt: skip
 
 
 def register(cli: click.Group) -> None:
