@@ -319,13 +319,3 @@ def _non_empty_lines(path: Path) -> np.ndarray:
             carry = data[ends[-1] + 1 :] if ends.size else data
     return np.concatenate(found) if found else np.empty(0, dtype=int)
 
-
-def require_positive(table: Table, name: str) -> None:
-    """DataError naming the first row where column ``name`` is <= 0."""
-    column = table[name]
-    bad = np.nonzero(column <= 0)[0]
-    if bad.size:
-        k = bad[0]
-        raise DataError(
-            f"{table.source}: row {table.rows[k]}, column {name!r}: expected a positive value, got {column[k]:g}"
-        )

@@ -75,11 +75,6 @@ def _velocities(
     return np.geomspace(lo, hi, count), lo, hi
 
 
-def curve_csv(columns: dict[str, np.ndarray]) -> str:
-    """CSV in SI with units in the header brackets (readable by :func:`stickslip.tables.read_table`)."""
-    return (_csv_header() + _csv_rows(columns)).decode("utf-8")
-
-
 def _csv_header() -> bytes:
     return (",".join(header_cell(name, unit) for name, unit in COLUMNS) + "\n").encode()
 

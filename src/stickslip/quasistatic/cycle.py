@@ -51,9 +51,6 @@ if TYPE_CHECKING:  # pragma: no cover
 
 #: Trace columns, in order (SI units: s, Pa, m/s, m, m, m, Nc/Nc0, phase name).
 CYCLE_COLUMNS = QUASI_STATIC
-#: The regimes of the quasi-static cycle, in the shared vocabulary of :mod:`stickslip.regimes`: here they follow
-#: exactly from the phases (every cycle after the first is the same cycle), not from a trace.
-REGIMES = (regimes.STICK_SLIP, regimes.STEADY, regimes.STUCK, regimes.UNDETERMINED)
 #: Long runs are thinned so that the trace stays below about this many rows (phase ends are always kept).
 MAX_ROWS = 1_000_000
 #: Runs of more cycles than this are refused (the trace would be mostly thinning).

@@ -26,7 +26,6 @@ from ..errors import ParameterError
 from ..units import to_si
 from .sampling import grid_values, latin_hypercube
 
-DESIGNS = ("grid", "latin-hypercube")
 #: Values of one grid axis at most: the manifest lists each of them.
 MAX_AXIS_VALUES = 1_000_000
 #: Points of a Latin hypercube at most (indices stay exact in float64 and int64); the disk refuses far fewer.
