@@ -220,11 +220,8 @@ LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("faces", ("plots", "report", "cli", "plotting", "cycle_plots", "__main__")),
 )  # fmt: skip
 ENGINES = "engines"
-#: Arrows that run up the layers, each with its reason (source module, target module).
-UPWARD: dict[tuple[str, str], str] = {
-    ("stickslip.columns", "stickslip.fitting.identify"): "the unit of a fit's combination key (stress_scale, ...)"
-    " is that combination's dimension; read lazily, only for a key no parameter has",
-}
+#: Arrows that run up the layers, each with its reason (source module, target module): none today.
+UPWARD: dict[tuple[str, str], str] = {}
 #: Alias modules kept for an old name: they warn on import and only re-export (tested below); they stand where
 #: the old name was, so the layer rules do not apply to them.
 DEPRECATED_ALIASES = frozenset({"stickslip.rsf.compare", "stickslip.plotting", "stickslip.cycle_plots"})

@@ -173,14 +173,12 @@ INHERITED = frozenset({"value", "stderr", "interval", "method_bias", "lower", "u
 def _parameter_unit(name: str) -> str | type[KeyError] | None:
     """The SI unit of a parameter key (``bonds.bond_time``) or of an RSF key, else KeyError (the class)."""
     from .errors import ParameterError
-    from .parameters import key_dimension
+    from .parameters import COMBINATIONS, key_dimension
     from .units import DIMENSIONS
 
     try:
         dimension = key_dimension(name)
     except ParameterError:
-        from .fitting.identify import COMBINATIONS
-
         dimension = next((c.dimension for c in COMBINATIONS if c.name == name), "")
         if not dimension:
             return KeyError

@@ -420,3 +420,54 @@ def replace(params: Parameters, **sections: Any) -> Parameters:
             raise ParameterError(f"unknown section {shorten(s)}")
         changes[s] = dataclasses.replace(getattr(params, s), **values)
     return dataclasses.replace(params, **changes)
+
+
+@dataclass(frozen=True)
+class Combination:
+    """A product of powers of parameters on which sigma(V) depends (the dimensionless form of Eqs 6-8).
+
+    Defined here, beside the keys, so that :mod:`stickslip.columns` knows the unit of a fit's combination key
+    (``stress_scale``, ...) without importing the fits above it; :mod:`stickslip.fitting.identify` uses them.
+    """
+
+    name: str
+    symbol: str
+    dimension: str
+    exponents: dict[str, int]
+    aging: bool = False
+
+    def value(self, params: Parameters) -> float:
+        values = params.as_dict()
+        out = 1.0
+        for key, power in self.exponents.items():
+            out *= values[key] ** power
+        if self.name == "fene_strength":
+            out /= BOLTZMANN
+        return out
+
+
+COMBINATIONS = (
+    Combination(
+        "stress_scale",
+        "M·N0·Δl_m",
+        "stress",
+        {"bonds.chain_stiffness": 1, "bonds.site_density": 1, "bonds.max_extension": 1},
+    ),
+    Combination("velocity_scale", "Δl_m/τ", "velocity", {"bonds.max_extension": 1, "bonds.bond_time": -1}),
+    Combination(
+        "fene_strength",
+        "a = λMΔl_m/kT",
+        "dimensionless",
+        {
+            "bonds.activation_length": 1,
+            "bonds.chain_stiffness": 1,
+            "bonds.max_extension": 1,
+            "bonds.temperature": -1,
+        },
+    ),
+    Combination("breakage_weight", "u0", "dimensionless", {"bonds.breakage_weight": 1}),
+    Combination(
+        "aging_velocity_scale", "Δl_m/τa", "velocity", {"bonds.max_extension": 1, "aging.aging_time": -1}, aging=True
+    ),
+    Combination("aging_velocity", "Va", "velocity", {"aging.aging_velocity": 1}, aging=True),
+)

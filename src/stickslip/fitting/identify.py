@@ -26,7 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..parameters import BOLTZMANN, Parameters
+from ..parameters import COMBINATIONS
 
 #: Every parameter the steady curve depends on, in a fixed order.
 STEADY_KEYS = (
@@ -84,53 +84,6 @@ SYMBOLS = {
     "stick.break_rate": "uc/τ",
     "stick.aging_time": "τa(stick)",
 }
-
-
-@dataclass(frozen=True)
-class Combination:
-    """A product of powers of parameters on which sigma(V) depends."""
-
-    name: str
-    symbol: str
-    dimension: str
-    exponents: dict[str, int]
-    aging: bool = False
-
-    def value(self, params: Parameters) -> float:
-        values = params.as_dict()
-        out = 1.0
-        for key, power in self.exponents.items():
-            out *= values[key] ** power
-        if self.name == "fene_strength":
-            out /= BOLTZMANN
-        return out
-
-
-COMBINATIONS = (
-    Combination(
-        "stress_scale",
-        "M·N0·Δl_m",
-        "stress",
-        {"bonds.chain_stiffness": 1, "bonds.site_density": 1, "bonds.max_extension": 1},
-    ),
-    Combination("velocity_scale", "Δl_m/τ", "velocity", {"bonds.max_extension": 1, "bonds.bond_time": -1}),
-    Combination(
-        "fene_strength",
-        "a = λMΔl_m/kT",
-        "dimensionless",
-        {
-            "bonds.activation_length": 1,
-            "bonds.chain_stiffness": 1,
-            "bonds.max_extension": 1,
-            "bonds.temperature": -1,
-        },
-    ),
-    Combination("breakage_weight", "u0", "dimensionless", {"bonds.breakage_weight": 1}),
-    Combination(
-        "aging_velocity_scale", "Δl_m/τa", "velocity", {"bonds.max_extension": 1, "aging.aging_time": -1}, aging=True
-    ),
-    Combination("aging_velocity", "Va", "velocity", {"aging.aging_velocity": 1}, aging=True),
-)
 
 
 def exponent_matrix(keys: Sequence[str], aging: bool = True) -> np.ndarray:
