@@ -28,7 +28,7 @@ from ..errors import DataError, ModelError, ParameterError, UnitError
 from ..numerics.budget import PROGRESS_AFTER_SECONDS
 from ..units import quantity_noun, shorten
 from .common import json_text, positive, quantity, refuse_overwriting_inputs, save_figure, write_text
-from .params_files import MAX_PARAMS_BYTES, load_params_file, load_params_mapping  # noqa: F401 (their old home)
+from .params_files import load_params_file, load_params_mapping
 from .protocol_options import build_protocol as build_run_protocol
 from .protocol_options import checked_segment_text, protocol_options, refuse_unsupported
 from .run_cmd import execute, output_options
@@ -761,20 +761,14 @@ def _timed_run(record: Any, settings: dict[str, Any]) -> float:
     """Seconds of one model run over the fitted rows at start-like values (the mean of the second and third)."""
     from ..errors import StickslipError
     from ..rsf import simulate
-    from ..rsf.fit import FIT_RTOL
+    from ..rsf.fit import FIT_RTOL, fitted_rows
 
-    time_, displacement = record.time, record.displacement
-    if "window" in settings:
-        lo, hi = settings["window"]
-        inside = (time_ + record.t0 >= lo) & (time_ + record.t0 <= hi)
-        time_, displacement = time_[inside], displacement[inside]
-    history = _cut(settings["protocol"], float(time_[0]), float(time_[-1])) if settings["protocol"] is not None \
-        else _found(time_, displacement)  # fmt: skip
-    if history is None or float(np.max(history.velocities)) <= 0:
+    rows, history = fitted_rows(record, settings["protocol"], settings.get("window"))  # refused as the fit would be
+    if float(np.max(history.velocities)) <= 0:
         return 0.0
-    params = _start_params(record, history, settings)
+    params = _start_params(rows, history, settings)
     start = history.initial_velocity if history.initial_velocity > 0 else float(np.max(history.velocities))
-    times = np.clip(time_ - time_[0], 0.0, history.duration)
+    times = np.clip(rows.time, 0.0, history.duration)
     took = []
     for _ in range(3):
         began = time.perf_counter()
@@ -788,28 +782,6 @@ def _timed_run(record: Any, settings: dict[str, Any]) -> float:
             return took[0]
     # the first run in a process imports the integrators (about a second): the mean of the other two
     return (took[1] + took[2]) / 2
-
-
-def _found(time_: np.ndarray, displacement: np.ndarray) -> Any:
-    """The history the fit will find (one straight line where the finder refuses: the fit says why)."""
-    from .. import protocols
-    from ..errors import DataError
-    from ..rsf.data import find_segments
-
-    try:
-        return find_segments(time_ - time_[0], displacement)
-    except DataError:
-        speed = float(displacement[-1] - displacement[0]) / max(float(time_[-1] - time_[0]), 1e-300)
-        return protocols.constant(abs(speed), float(time_[-1] - time_[0])) if speed else None
-
-
-def _cut(protocol: Any, start: float, end: float) -> Any:
-    """The part of ``protocol`` from ``start`` to ``end`` (s from its start), as a protocol of its own."""
-    from ..protocols import Protocol, Segment
-
-    kept = [Segment(v, min(t1, end) - max(t0, start)) for t0, t1, v in protocol.pieces()
-            if t1 > start and t0 < end and min(t1, end) - max(t0, start) > 0]  # fmt: skip
-    return Protocol(tuple(kept)) if kept else None
 
 
 def _start_params(record: Any, history: Any, settings: dict[str, Any]) -> Any:

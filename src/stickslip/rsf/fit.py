@@ -314,13 +314,8 @@ def fit_record(
     if twice:
         raise ParameterError(f"{twice[0]}: both fixed and guessed; expected one of them")
     weight = _step_weight(step_weight)
-    whole = record
-    record = _windowed(record, window)
     source = "given" if protocol is not None else "found from the load-point displacement"
-    if protocol is not None:
-        protocol = _covering(_shifted(protocol, record.t0 - whole.t0), record)
-    else:
-        protocol = find_segments(record.time, record.displacement)
+    record, protocol = fitted_rows(record, protocol, window)
     if protocol.initial_velocity <= 0:
         raise DataError("record: the load point does not move in the first segment; expected steady sliding first")
     start = _stable_start(_initial_guess(record, protocol, {**starts, **held}, held.get("stiffness")),
@@ -388,6 +383,18 @@ def fit_record(
         noise_method=level.method, effective_rows=level.n_eff, drift_sensitivity=sensitivity,
         window=None if window is None else (float(window[0]), float(window[1])), step_weight=weight,
     )  # fmt: skip
+
+
+def fitted_rows(record: LabRecord, protocol: Protocol | None = None, window: Any = None) -> tuple[LabRecord, Protocol]:
+    """The rows a fit uses (those of ``window``, on the record file's own clock) and their load-point history:
+    ``protocol`` from the window's first row to its last, or the history found from the displacement.
+
+    ``rsf fit`` times one model run over exactly these before it fits (its cost estimate).
+    """
+    rows = _windowed(record, window)
+    if protocol is None:
+        return rows, find_segments(rows.time, rows.displacement)
+    return rows, _covering(_shifted(protocol, rows.t0 - record.t0), rows)
 
 
 @dataclass(frozen=True)
