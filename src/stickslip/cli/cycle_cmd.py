@@ -6,7 +6,6 @@ header); people get um/s, Pa and s.
 
 from __future__ import annotations
 
-import io
 from pathlib import Path
 from typing import Any
 
@@ -38,22 +37,6 @@ def _stress(text: str | None) -> float | None:
     if text is None:
         return None
     return positive(text, "stress", "--start-stress", allow_zero=True)
-
-
-def _csv(columns: dict[str, Any]) -> str:
-    """CSV with units in the header brackets (``time [s],...``), numbers in SI with every digit."""
-    from ..columns import header_cell, unit_of
-
-    out = io.StringIO()
-    names = list(columns)
-    out.write(",".join(header_cell(n, unit_of(n)) for n in names) + "\n")
-    for row in zip(*(columns[n] for n in names), strict=True):
-        out.write(",".join(v if isinstance(v, str) else repr(float(v)) for v in row) + "\n")
-    return out.getvalue()
-
-
-def _fmt(value: float | None, scale: float = 1.0, digits: int = 5) -> str:
-    return "—" if value is None else f"{value * scale:.{digits}g}"
 
 
 # --------------------------------------------------------------------------- simulate
@@ -169,9 +152,10 @@ def stick_command(
         until = positive(until_text, "time", "--until")
     stick = stick_phase(params, v0, start_stress=start, aging=not no_aging, horizon=until)
     jump = _jump_after(params, stick)
-    columns = {"time": stick.time, "stress": stick.stress, "chain_fraction": stick.chain_fraction}
     if output is not None:
-        write_text(output, _csv(columns))
+        from ..columns import csv_text
+
+        write_text(output, csv_text(stick.to_frame()))
     if plot_path is not None:
         from ..plots.cycles import plot_stick
 
@@ -181,7 +165,8 @@ def stick_command(
         save_figure(ax.figure, plot_path)
     if as_json:
         extra = {"jump_velocity": jump.velocity, "jump_message": jump.message} if jump is not None else {}
-        emit_json({**stick.as_dict(), **extra, "curve": columns})
+        curve = {"time": stick.time, "stress": stick.stress, "chain_fraction": stick.chain_fraction}
+        emit_json({**stick.as_dict(), **extra, "curve": curve})
         return
     print_rich(*_stick_report(stick, params.name, jump))
 
