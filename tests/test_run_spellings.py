@@ -1,6 +1,7 @@
 """One run command (issue 30 item 3, issue 28 item 7): ``simulate``, ``transient`` and ``rsf simulate`` are
-spellings of ``run --model NAME``: the same Run CSV, the same summary; ``simulate().regime`` is a ``Regime``
-equal to its kind's name; plain ``compare`` is ``compare --models quasi-static,rsf --protocol-set bond-vs-rsf``.
+spellings of ``run --model NAME``: the same Run CSV, the same figure, the same summary; ``simulate().regime`` is a
+``Regime`` equal to its kind's name; plain ``compare`` is ``compare --models quasi-static,rsf --protocol-set
+bond-vs-rsf``.
 """
 
 from __future__ import annotations
@@ -54,8 +55,10 @@ def _ok(capsys, *argv: str) -> str:
 def test_each_spelling_writes_the_run_csv_of_run_model(capsys, tmp_path, model):
     spelling, run = SPELLINGS[model]
     mine, theirs = tmp_path / "spelling.csv", tmp_path / "run.csv"
-    _ok(capsys, *spelling, "-o", str(mine))
-    _ok(capsys, *run, "-o", str(theirs))
+    _ok(capsys, *spelling, "-o", str(mine), "--plot", str(tmp_path / "spelling.png"))
+    _ok(capsys, *run, "-o", str(theirs), "--plot", str(tmp_path / "run.png"))
+    # one --plot path (Run.plot()) for every spelling: the same picture, pixel for pixel
+    assert (tmp_path / "spelling.png").read_bytes() == (tmp_path / "run.png").read_bytes()
     header = mine.read_text().splitlines()[1]
     assert [cell.split(" [")[0] for cell in header.split(",")] == COLUMNS[model]
     assert mine.read_text() == theirs.read_text()  # metadata line, header and every digit
