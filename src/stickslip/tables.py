@@ -318,4 +318,3 @@ def _non_empty_lines(path: Path) -> np.ndarray:
             line += ends.size
             carry = data[ends[-1] + 1 :] if ends.size else data
     return np.concatenate(found) if found else np.empty(0, dtype=int)
-
