@@ -13,7 +13,7 @@ import base64
 import io
 import re
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -37,6 +37,77 @@ def svg_bytes(figure: Figure) -> bytes:
     buffer = io.BytesIO()
     figure.savefig(buffer, format="svg", bbox_inches="tight")
     return buffer.getvalue()
+
+
+def png_and_svg_bytes(figure: Figure, dpi: int = PNG_DPI) -> tuple[bytes, bytes]:
+    """The figure as PNG and as SVG, both cropped to what is drawn, from one layout and one raster draw.
+
+    ``savefig(bbox_inches="tight")`` lays the figure out and measures every text twice per file before it draws.
+    Here the figure is laid out and drawn once at ``dpi``; the tight box is measured on that same renderer (its
+    text sizes cached); the PNG is the raster cut to the box (the padding past the figure's edge in its face
+    colour, as ``savefig`` fills it), and the SVG is drawn into the same box with that layout kept.  Where an
+    artist reaches past the figure's edge the PNG is drawn again into the box, as ``savefig`` would.
+    """
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    dpi_before, engine, canvas_before = figure.dpi, figure.get_layout_engine(), figure.canvas
+    try:
+        figure.set_dpi(dpi)
+        canvas = FigureCanvasAgg(figure)
+        canvas.draw()  # the layout engine runs here, once
+        tight = figure.get_tightbbox(canvas.get_renderer())
+        box = tight.padded(_pad_inches())
+        figure.set_layout_engine(None)  # keep that layout for the SVG (savefig would lay it out again at 72 dpi)
+        png = io.BytesIO()
+        if _inside(tight, figure):
+            _write_png(png, _cut(np.asarray(canvas.buffer_rgba()), box, dpi, figure.get_facecolor()), dpi)
+        else:
+            figure.savefig(png, format="png", dpi=dpi, bbox_inches=box)
+        svg = io.BytesIO()
+        figure.savefig(svg, format="svg", bbox_inches=box)
+    finally:
+        figure.set_layout_engine(engine)
+        figure.set_dpi(dpi_before)
+        figure.set_canvas(canvas_before)
+    return png.getvalue(), svg.getvalue()
+
+
+def _pad_inches() -> float:
+    from matplotlib import rcParams
+
+    pad = rcParams["savefig.pad_inches"]
+    return float(pad) if isinstance(pad, int | float) else 0.1
+
+
+def _inside(box: Any, figure: Figure) -> bool:
+    """Whether ``box`` (inches) lies within the figure: then the raster of the figure holds all it shows."""
+    width, height = figure.get_size_inches()
+    return box.x0 >= 0.0 and box.y0 >= 0.0 and box.x1 <= width and box.y1 <= height
+
+
+def _cut(rgba: np.ndarray, box: Any, dpi: float, face: tuple[float, ...]) -> np.ndarray:
+    """The pixels of ``box`` (inches, origin bottom left) out of the raster of the whole figure; where the box
+    reaches past the raster (its padding), the figure's face colour."""
+    height, width = rgba.shape[:2]
+    # the size savefig gives (the Agg canvas truncates the box's size in pixels), within half a pixel of its place
+    left, top = round(box.x0 * dpi), height - round(box.y1 * dpi)
+    right, bottom = left + int(box.width * dpi), top + int(box.height * dpi)
+    out = np.empty((bottom - top, right - left, 4), dtype=np.uint8)
+    out[:] = np.round(np.asarray(face, dtype=float) * 255.0).astype(np.uint8)
+    rows, cols = slice(max(top, 0), min(bottom, height)), slice(max(left, 0), min(right, width))
+    out[rows.start - top : rows.stop - top, cols.start - left : cols.stop - left] = rgba[rows, cols]
+    return out
+
+
+def _write_png(buffer: io.BytesIO, rgba: np.ndarray, dpi: float) -> None:
+    """``rgba`` as PNG with the resolution and the Software entry that matplotlib's own PNG files carry."""
+    import matplotlib
+    from PIL import Image, PngImagePlugin
+
+    info = PngImagePlugin.PngInfo()
+    info.add_text("Software", f"Matplotlib version{matplotlib.__version__}, https://matplotlib.org/")
+    image = Image.frombuffer("RGBA", (rgba.shape[1], rgba.shape[0]), np.ascontiguousarray(rgba), "raw", "RGBA", 0, 1)
+    image.save(buffer, format="png", pnginfo=info, dpi=(dpi, dpi))
 
 
 _TEX = {

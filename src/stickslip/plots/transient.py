@@ -102,7 +102,7 @@ def figure_transient_runs(
     ax_hold.set_title("slide-hold-slide at 100 µm/s", fontsize=9)
     for ax in (ax_cycle, ax_step, ax_hold):
         apply_style(ax)
-    fig.tight_layout()
+    fig.set_layout_engine("tight")  # laid out when drawn, with the text sizes the drawing measures anyway
     return fig
 
 

@@ -81,7 +81,7 @@ def saturating_figure(run: ModelRun) -> ReportFigure:
     ax_cycle.legend(fontsize="small", loc="lower right")
     for ax in (ax_curve, ax_cycle):
         apply_style(ax)
-    fig.tight_layout()
+    fig.set_layout_engine("tight")  # laid out when drawn, with the text sizes the drawing measures anyway
     caption = _caption(fit, stick, slip, jump, two)
     return ReportFigure("extension_saturating_aging", "Extension", "One population that lets go", caption, fig)
 

@@ -11,7 +11,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from ..fileio import atomic_write_bytes
-from ..plots.export import PNG_DPI, Curve, data_uri, extract_curves, png_bytes, svg_bytes
+from ..plots.export import PNG_DPI, Curve, data_uri, extract_curves, png_and_svg_bytes, png_bytes, svg_bytes
 
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.figure import Figure
@@ -41,8 +41,8 @@ class ReportFigure:
 
 def save_figure_files(figure: ReportFigure, folder: Path) -> tuple[bytes, list[Path]]:
     """Write ``<id>.png`` and ``<id>.svg`` into ``folder``; returns the PNG bytes (for embedding) and the paths."""
-    png = figure.png()
+    png, svg = png_and_svg_bytes(figure.figure)  # one layout for both: half the cost of two savefig calls
     png_path, svg_path = folder / f"{figure.id}.png", folder / f"{figure.id}.svg"
     atomic_write_bytes(png_path, png)
-    atomic_write_bytes(svg_path, figure.svg())
+    atomic_write_bytes(svg_path, svg)
     return png, [png_path, svg_path]

@@ -82,7 +82,7 @@ def inertia_figure(run: ModelRun) -> ReportFigure:
     ax_re.legend(fontsize="x-small", loc="upper left", frameon=False)
     for ax in (ax_im, ax_re):
         apply_style(ax)
-    fig.tight_layout()
+    fig.set_layout_engine("tight")  # laid out when drawn, with the text sizes the drawing measures anyway
     return ReportFigure("inertia_hopf", "Extension", "Inertia and radiation damping at the Hopf point",
                         _caption(rows, root, massless, gel, heavy), fig)  # fmt: skip
 
@@ -182,7 +182,7 @@ def inertia_run_figure(run: ModelRun) -> ReportFigure:
     )
     ax.legend(fontsize="x-small")
     apply_style(ax)
-    fig.tight_layout()
+    fig.set_layout_engine("tight")  # laid out when drawn, with the text sizes the drawing measures anyway
     massless, massive = runs[0][1], runs[1][1]
     stopped = float(massive.time[np.argmax(massive.slider_velocity < STOPPED)])
     peaks, _ = find_peaks(massive.slider_velocity)

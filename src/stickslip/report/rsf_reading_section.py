@@ -42,7 +42,7 @@ def rsf_reading_figure(run: ModelRun) -> ReportFigure:
         ax.set_title(f"{velocities[0] * UM:.0f} → {velocities[1] * UM:.0f} µm/s", fontsize=9)
         apply_style(ax)
     axes[0].legend(fontsize="small")
-    fig.tight_layout()
+    fig.set_layout_engine("tight")  # laid out when drawn, with the text sizes the drawing measures anyway
     title = "A rate-and-state reading of the bond model"
     return ReportFigure("rsf_reading", "Extension", title, _caption(readings), fig)
 

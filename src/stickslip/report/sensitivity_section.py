@@ -59,7 +59,7 @@ def sensitivity_figure(run: ModelRun) -> ReportFigure:
     ax_spread.set_title("quasi-static predictions over the region", fontsize=9)
     for ax in (ax_region, ax_spread):
         apply_style(ax)
-    fig.tight_layout()
+    fig.set_layout_engine("tight")  # laid out when drawn, with the text sizes the drawing measures anyway
     return ReportFigure(
         "sensitivity_aging", "Extension", "What the predictions rest on: τa and Va", _caption(region, table), fig
     )
