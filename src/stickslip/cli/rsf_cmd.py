@@ -822,6 +822,7 @@ def _fit_text(fit: Any) -> str:
         lines.append(f"    from {row['start']:.6g} s: {row['velocity']:.6g} {unit}/s for {row['duration']:.6g} s")
     for name, p in {**fit.parameters, **fit.derived}.items():
         lines.append(f"  {name:10s} {p.text()}")
+    lines += [f"  {line}" for line in fit.change_lines()]  # (s from the fitted rows' first row)
     lines.append(f"  reduced chi-square {fit.reduced_chi_square:.4g} (noise {fit.noise:.3g}), rms {fit.rms:.4g}")
     lines += [f"  warning: {w}" for w in fit.warnings]
     return "\n".join(lines)

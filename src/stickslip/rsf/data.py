@@ -33,7 +33,9 @@ from ..errors import DataError, ParameterError
 from ..fileio import protect_inputs
 from ..protocols import Protocol, Segment
 
-__all__ = ["LabRecord", "find_segments", "measured_history", "parse_columns", "read_record"]
+__all__ = [
+    "LabRecord", "change_time_uncertainty", "find_segments", "measured_history", "parse_columns", "read_record",
+]  # fmt: skip
 
 ROLES = ("time", "displacement", "friction", "velocity")
 _DEFAULT_NAMES = {
@@ -368,6 +370,47 @@ def find_segments(
     times.append(float(t[-1]))
     items = [Segment(max(line[0], 0.0), b - a) for line, a, b in zip(lines, times[:-1], times[1:], strict=True)]
     return Protocol(tuple(items), name="from displacement")
+
+
+#: rows either side of a change whose scatter about the history gives the displacement's noise there
+CHANGE_ROWS = 50
+
+
+def change_time_uncertainty(time: np.ndarray, displacement: np.ndarray, protocol: Protocol) -> np.ndarray:
+    """Each interior change time's standard uncertainty (s), as the displacement dates it.
+
+    A change placed dt late moves every later displacement by dt * (v_after - v_before), so the change is dated
+    to the displacement's scatter s over the jump: sqrt(2) s / |jump| (two lines' ends, each known to about s:
+    correlated noise does not average down along a line), combined with the row spacing there over sqrt(12) (a
+    change falls between two rows).  s is the rows' scatter about the history within :data:`CHANGE_ROWS` rows
+    either side, each side about its own straight line.  A change with no jump gets 0 (it changes nothing).
+    """
+    t = np.asarray(time, dtype=float)
+    d = np.asarray(displacement, dtype=float)
+    edges, speeds = protocol.boundaries, protocol.velocities
+    off = d - protocol.displacement_at(t)
+    out = np.zeros(max(speeds.size - 1, 0))
+    for i in range(1, speeds.size):
+        jump = abs(float(speeds[i] - speeds[i - 1]))
+        k = int(np.clip(np.searchsorted(t, edges[i]), 1, t.size - 1))
+        sides = [slice(max(k - CHANGE_ROWS, 0), k), slice(k, min(k + CHANGE_ROWS, t.size))]
+        scatter = [_line_residuals(t[s], off[s]) for s in sides]
+        pooled = np.concatenate(scatter)
+        spread = float(np.sqrt(np.mean(pooled**2))) if pooled.size else 0.0
+        spacing = float(t[k] - t[k - 1])
+        out[i - 1] = math.hypot(math.sqrt(2.0) * spread / jump, spacing / math.sqrt(12.0)) if jump > 0 else 0.0
+    return out
+
+
+def _line_residuals(t: np.ndarray, d: np.ndarray) -> np.ndarray:
+    """Residuals of a straight line through (t, d), with its two degrees of freedom counted (none for < 3 rows)."""
+    if t.size < 3:
+        return np.zeros(0)
+    tt = t - t.mean()
+    stt = float(np.sum(tt * tt))
+    slope = float(np.sum(tt * (d - d.mean()))) / stt if stt > 0 else 0.0
+    r = d - d.mean() - slope * tt
+    return r * math.sqrt(t.size / (t.size - 2))
 
 
 #: the change-point search runs on at most this many equal time bins (each change is then placed on the full record)

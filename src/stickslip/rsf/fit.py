@@ -52,7 +52,7 @@ import numpy as np
 from ..columns import with_units
 from ..errors import DataError, ModelError, ParameterError
 from ..protocols import Protocol, Segment
-from .data import LabRecord, find_segments
+from .data import LabRecord, change_time_uncertainty, find_segments
 from .params import RSFParams, StateVariable
 from .solver import simulate
 
@@ -167,6 +167,8 @@ class RSFFit:
     drift_sensitivity: dict[str, Any] | None = None
     window: tuple[float, float] | None = None
     step_weight: float | None = None
+    #: the found history's change times (s from the fitted rows' first row): fitted where they matter, else held
+    change_times: tuple[FitParameter, ...] = ()
 
     @property
     def residuals(self) -> np.ndarray:
@@ -203,15 +205,34 @@ class RSFFit:
             "units": {
                 "time": "s", "length": "m", "velocity": "m/s", "dc": "m", "stiffness": "1/m", "trend": "1/m",
                 "time_trend": "1/s", "friction": "dimensionless", "record_length_unit": self.record.length_unit,
+                "change_times": "s from the fitted rows' first row (file_time: on the file's own clock)",
                 "note": "all values SI; the text report gives lengths in the record's unit",
             },
             "record": {"source": self.record.source, "rows": len(self.record), "t0": self.record.t0},
+            **({"change_times": self.change_rows()} if self.change_times else {}),
             **({"window": list(self.window)} if self.window else {}),
             **({"step_weight": self.step_weight} if self.step_weight is not None else {}),
             **({"drift_sensitivity": self.drift_sensitivity} if self.drift_sensitivity else {}),
             **({"posterior": self.posterior} if self.posterior else {}),
         }  # fmt: skip
         return out
+
+    def change_rows(self) -> list[dict[str, Any]]:
+        """The change times as JSON: s from the fitted rows' first row, and ``file_time`` on the file's clock."""
+        return [{"name": p.name, **p.as_dict(), "file_time": self.record.t0 + p.value} for p in self.change_times]
+
+    def change_lines(self) -> list[str]:
+        """One line per change time: fitted with its interval, or held and why (s from the fitted rows' first)."""
+        lines = []
+        for p in self.change_times:
+            if p.fixed or p.stderr is None or p.interval is None:
+                lines.append(f"{p.name:10s} {p.value:.6f} s ({'held: ' if p.fixed else ''}{p.note})")
+                continue
+            digits = min(max(1 - math.floor(math.log10(p.stderr)), 0), 12) if p.stderr > 0 else 6
+            lo, hi = p.interval
+            lines.append(f"{p.name:10s} {p.value:.{digits}f} ± {p.stderr:.2g} s   95 % [{lo:.{digits}f}, "
+                         f"{hi:.{digits}f}] ({p.note})")  # fmt: skip
+        return lines
 
     def to_toml(self) -> str:
         head = [
@@ -222,6 +243,7 @@ class RSFFit:
         ]
         for name, p in {**self.parameters, **self.derived}.items():
             head.append(f"# {name} = {p.text()}")
+        head += [f"# {line}" for line in self.change_lines()]
         head.append("# values below in SI units (m, 1/m)")
         return "\n".join(head) + "\n" + self.params.to_toml()
 
@@ -315,6 +337,7 @@ def fit_record(
         raise ParameterError(f"{twice[0]}: both fixed and guessed; expected one of them")
     weight = _step_weight(step_weight)
     source = "given" if protocol is not None else "found from the load-point displacement"
+    protocol_found = protocol is None
     record, protocol = fitted_rows(record, protocol, window)
     if protocol.initial_velocity <= 0:
         raise DataError("record: the load point does not move in the first segment; expected steady sliding first")
@@ -330,6 +353,14 @@ def fit_record(
                    cutoff)  # fmt: skip
     mismatch = _history_mismatch(record, protocol)
     result, residual = _best_search(setup, start, mismatch, "stiffness" in starts or "stiffness" in held)
+    seen: dict[int, dict[str, float]] = {}
+    if protocol_found and not mismatch and len(protocol.segments) > 1:
+        # the found change times are estimates: those that matter are fitted, so the intervals carry them
+        first = result.params.valuesdict()
+        changes, seen = _free_changes(setup, _base(setup, start), first, start["noise"])
+        if changes:
+            setup = replace(setup, changes=changes)
+            result, residual = _least_squares(setup, {**start, **_start_values(first)})
     if weight is not None:
         first = _start_values(result.params.valuesdict())
         setup = replace(setup, weights=_step_weights(record, protocol, first["dc"], weight))
@@ -344,6 +375,8 @@ def fit_record(
     units = _units(record.length_unit)
     widen = math.sqrt(level.redchi) if given and level.redchi > WARN_CHI2 else None
     table, corr, warns = _report(result, values, setup, start["stiffness"], widen, units)
+    change_times, change_warns = _change_report(setup, result, seen) if protocol_found else ((), [])
+    warns += change_warns
     derived = {"a-b": _difference(result, table, widen)}
     problems = _problems(result, record, resid, table, level, setup)
     if any(p.startswith(NO_RESPONSE_TEXT) for p in problems):  # then no interval of the friction law means anything
@@ -377,7 +410,8 @@ def fit_record(
     return RSFFit(
         params=_final_params(base, values), parameters=table, correlations=corr, reduced_chi_square=level.redchi,
         rms=float(np.sqrt(np.mean(resid**2))), noise=level.noise, trend=float(values.get("trend", 0.0)),
-        record=record, protocol=protocol, model_friction=model, warnings=tuple(warns), success=not problems,
+        record=record, protocol=_history(setup, values), model_friction=model, warnings=tuple(warns),
+        success=not problems, change_times=change_times,
         message=str(result.message), nfev=int(result.nfev), posterior=posterior,
         status="failed" if problems else "ok", reason="; ".join(problems), derived=derived, protocol_source=source,
         noise_method=level.method, effective_rows=level.n_eff, drift_sensitivity=sensitivity,
@@ -413,6 +447,8 @@ class _Setup:
     guessed: frozenset[str] = frozenset()
     #: the cut-off velocities (V1, V2) of the cut-off form, held fixed; None for the classical law
     cutoff: tuple[float, float] | None = None
+    #: change times of a found history fitted as nuisance parameters: (boundary index, its uncertainty in s)
+    changes: tuple[tuple[int, float], ...] = ()
 
 
 #: the names ``fixed`` and ``guess`` take (SI values)
@@ -549,11 +585,108 @@ def _best_search(setup: _Setup, start: dict[str, float], mismatch: str, stiffnes
 
 def _evaluated(setup: _Setup, base: RSFParams, values: dict[str, float]) -> np.ndarray:
     """The model at the best parameters; a ModelError saying exactly what happened where it cannot be had."""
-    model, why = _model_or_why(setup.record, setup.protocol, base, values)
+    model, why = _model_or_why(setup.record, _history(setup, values), base, values)
     if why:
-        shown = ", ".join(f"{_PUBLIC[k]} = {math.exp(v) if k.startswith('log_') else v:.4g}" for k, v in values.items())
+        shown = ", ".join(f"{_PUBLIC[k]} = {math.exp(v) if k.startswith('log_') else v:.4g}" for k, v in values.items()
+                          if k in _PUBLIC)  # fmt: skip
         raise ModelError(f"rate-and-state fit: the best parameters found ({shown}) cannot be evaluated: {why}")
     return model
+
+
+# --- the found history's change times as nuisance parameters ---------------------------------------------------
+
+#: a found change time is fitted when moving it by this many of its own uncertainties ...
+CHANGE_SHIFT = 3.0
+#: ... changes chi-square (at the search's noise) by more than this: held, it could bias the other parameters by
+#: up to sqrt(this) of their standard errors (the projection of the misfit onto them), here 0.3
+CHANGE_CHI2 = 0.1
+#: a fitted change time's parameter is offset + shift / its uncertainty: MINPACK's forward step (1e-5 relative)
+#: is then 0.01 uncertainty, a friction change well above the solver's tolerance (at 0 it would be 1e-5 of it)
+CHANGE_OFFSET = 1000.0
+#: the covariance's central difference for a change time, in its uncertainties
+CHANGE_STEP = 0.25
+#: a fitted change this many of its uncertainties from where the displacement dates it earns a warning
+CHANGE_FAR = 5.0
+
+
+def _history(setup: _Setup, values: dict[str, float]) -> Protocol:
+    """The load-point history at ``values``: the setup's, with each fitted change moved (kept in order)."""
+    if not setup.changes:
+        return setup.protocol
+    edges = setup.protocol.boundaries.copy()
+    for index, sigma in setup.changes:
+        edges[index] += (values.get(f"tc{index}", CHANGE_OFFSET) - CHANGE_OFFSET) * sigma
+    gap = 1e-9 * float(edges[-1])  # a search step that would swap two changes holds them apart
+    for j in range(1, edges.size - 1):
+        edges[j] = min(max(edges[j], edges[j - 1] + gap), edges[-1] - gap * (edges.size - 1 - j))
+    speeds = setup.protocol.velocities
+    return Protocol(tuple(Segment(v, float(e1 - e0)) for v, e0, e1 in zip(speeds, edges[:-1], edges[1:], strict=True)),
+                    name=setup.protocol.name)  # fmt: skip
+
+
+def _public(key: str) -> str:
+    """The reported name of a search parameter (a change time ``tcN`` is ``change_N``)."""
+    return _PUBLIC.get(key, f"change_{key[2:]}" if key.startswith("tc") else key)
+
+
+def _free_changes(setup: _Setup, base: RSFParams, values: dict[str, float], noise: float) -> tuple[
+        tuple[tuple[int, float], ...], dict[int, dict[str, float]]]:  # fmt: skip
+    """The found history's change times that matter at ``values``: each moved by CHANGE_SHIFT of its uncertainty
+    (from the displacement, :func:`change_time_uncertainty`) either way; free where chi-square at the search's
+    ``noise`` rises by more than CHANGE_CHI2.  Also, per change, its uncertainty and that rise (for the report)."""
+    record, protocol = setup.record, setup.protocol
+    sigmas = change_time_uncertainty(record.time, record.displacement, protocol)
+    model, why = _model_or_why(record, protocol, base, values)
+    free, seen = [], {}
+    for index, sigma in enumerate(sigmas, start=1):
+        rise = 0.0
+        if sigma > 0 and math.isfinite(sigma) and not why:
+            for sign in (1.0, -1.0):
+                moved = replace(setup, changes=((index, float(sigma)),))
+                there = {**values, f"tc{index}": CHANGE_OFFSET + sign * CHANGE_SHIFT}
+                shifted, _ = _model_or_why(record, _history(moved, there), base, there)
+                rise = max(rise, float(np.sum(((shifted - model) / noise) ** 2)))
+            rise = rise if math.isfinite(rise) else math.inf
+        seen[index] = {"uncertainty": float(sigma), "chi_square_change": rise}
+        if rise > CHANGE_CHI2:
+            free.append((index, float(sigma)))
+    return tuple(free), seen
+
+
+def _change_report(setup: _Setup, result: Any, seen: dict[int, dict[str, float]]) -> tuple[
+        tuple[FitParameter, ...], list[str]]:  # fmt: skip
+    """One FitParameter per change of the history (s, on the fitted rows' clock), and warnings for fitted changes
+    far from where the displacement dates them."""
+    protocol = setup.protocol
+    free = dict(setup.changes)
+    out, warns = [], []
+    for index in range(1, len(protocol.segments)):
+        found = float(protocol.boundaries[index])
+        info = seen.get(index)
+        name = f"change_{index}"
+        if index not in free or info is None:
+            why = ("given with the history" if info is None else
+                   f"held where the displacement dates it (± {info['uncertainty']:.3g} s): moving it by "
+                   f"{CHANGE_SHIFT:g} times that changes chi-square by {info['chi_square_change']:.2g} "
+                   f"(<= {CHANGE_CHI2:g})")  # fmt: skip
+            out.append(FitParameter(name, found, None, None, fixed=True, unit="s", note=why, si_unit="s"))
+            continue
+        sigma = free[index]
+        par = result.params[f"tc{index}"]
+        value = found + (par.value - CHANGE_OFFSET) * sigma
+        se = par.stderr * sigma if par.stderr is not None and math.isfinite(par.stderr) else None
+        interval = (value - Z95 * se, value + Z95 * se) if se is not None else None
+        note = (f"fitted; the displacement dates it at {found:.6g} ± {sigma:.3g} s" if se is not None else
+                "fitted, no standard error: the record cannot tell it apart from the others")  # fmt: skip
+        out.append(FitParameter(name, value, se, interval, unit="s", constrained=se is not None, note=note,
+                                si_unit="s"))  # fmt: skip
+        if abs(value - found) > CHANGE_FAR * sigma:
+            warns.append(
+                f"{name}: the friction places the velocity change at {value:.6g} s, {abs(value - found) / sigma:.3g} "
+                f"times its uncertainty from where the displacement dates it ({found:.6g} ± {sigma:.3g} s): check "
+                "the history (--segment, --protocol or --history measured)"
+            )
+    return tuple(out), warns
 
 
 # --- noise, its correlation and the intervals -------------------------------------------------------------------
@@ -788,8 +921,10 @@ def _jacobian(setup: _Setup, base: RSFParams, result: Any) -> np.ndarray | None:
         else:
             value = values[name]
             h = 1e-3 if name.startswith("log_") else 1e-3 * max(abs(value), 1e-3)
-            up, _ = _model_or_why(record, setup.protocol, base, {**values, name: value + h})
-            down, _ = _model_or_why(record, setup.protocol, base, {**values, name: value - h})
+            h = CHANGE_STEP if name.startswith("tc") else h
+            moved_up, moved_down = {**values, name: value + h}, {**values, name: value - h}
+            up, _ = _model_or_why(record, _history(setup, moved_up), base, moved_up)
+            down, _ = _model_or_why(record, _history(setup, moved_down), base, moved_down)
             if not (np.all(np.isfinite(up)) and np.all(np.isfinite(down))):
                 return None
             columns.append((up - down) / (2 * h))
@@ -1150,6 +1285,8 @@ def _least_squares(setup: _Setup, start: dict[str, float]) -> Any:
         pars.add("trend", value=start["trend"])
     if "time" in trend:
         pars.add("time_trend", value=start["time_trend"])
+    for index, _ in setup.changes:  # unbounded: _history keeps the changes in order
+        pars.add(f"tc{index}", value=start.get(f"tc{index}", CHANGE_OFFSET))
     for key, value in setup.fixed.items():  # held where the caller put it, whatever the bounds of a free one
         name = _INTERNAL[key]
         if key == "stiffness" or (key in ("b2", "dc2") and states != 2):
@@ -1160,7 +1297,8 @@ def _least_squares(setup: _Setup, start: dict[str, float]) -> Any:
     weights = 1.0 if setup.weights is None else np.sqrt(setup.weights)
 
     def residual(p: Any) -> np.ndarray:
-        model, _ = _model_or_why(record, setup.protocol, base, p.valuesdict())
+        values = p.valuesdict()
+        model, _ = _model_or_why(record, _history(setup, values), base, values)
         out = (model - record.friction) * weights / noise
         return np.where(np.isfinite(out), out, 1e6)
 
@@ -1255,7 +1393,7 @@ def _report(
     corr: dict[str, float] = {}
     for key, par in result.params.items():
         for other, value in (par.correl or {}).items():
-            pair = tuple(sorted((_PUBLIC[key], _PUBLIC[other])))
+            pair = tuple(sorted((_public(key), _public(other))))
             name = f"{pair[0]}-{pair[1]}"
             if name not in corr:
                 corr[name] = float(value)
@@ -1411,6 +1549,8 @@ def _posterior(residual: Any, result: Any, steps: int, seed: int | None) -> dict
     )  # fmt: skip
     out: dict[str, Any] = {"steps": int(steps), "walkers": walkers}
     for key in result.var_names:
+        if key not in _PUBLIC:  # (the change times' chains are nuisance)
+            continue
         chain = np.asarray(mc.flatchain[key])
         if key.startswith("log_"):
             chain = np.exp(chain)
