@@ -20,6 +20,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from session_cache import build_once
 from stickslip import critical_point, steady_state
 from stickslip.errors import DataError
 from stickslip.report import build as build_module
@@ -32,18 +33,21 @@ from stickslip.report.paper import PAPER_NUMBERS
 _BUILT: dict[str, object] = {}
 
 
+def _reproduce(folder: Path) -> dict:
+    started = time.perf_counter()
+    command = [sys.executable, "-m", "stickslip.cli.main", "reproduce", "-o", str(folder), "--quiet"]
+    done = subprocess.run(command, capture_output=True, text=True, timeout=300)
+    return {"args": command, "returncode": done.returncode, "stdout": done.stdout, "stderr": done.stderr,
+            "seconds": time.perf_counter() - started}  # fmt: skip
+
+
 def built_report(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """The report folder, built once per session by ``stickslip reproduce -o DIR --quiet``."""
+    """The report folder, built once per session by ``stickslip reproduce -o DIR --quiet``: once in all, not once
+    per xdist worker (tests/session_cache.py; the build is ~22 s of CPU, and its tests sit in three files)."""
     if "folder" not in _BUILT:
-        folder = tmp_path_factory.mktemp("reproduce") / "report"
-        started = time.perf_counter()
-        done = subprocess.run(
-            [sys.executable, "-m", "stickslip.cli.main", "reproduce", "-o", str(folder), "--quiet"],
-            capture_output=True,
-            text=True,
-            timeout=300,
-        )
-        _BUILT.update(folder=folder, process=done, seconds=time.perf_counter() - started)
+        folder, record = build_once(tmp_path_factory, "reproduce", lambda shared: _reproduce(shared / "report"))
+        done = subprocess.CompletedProcess(record["args"], record["returncode"], record["stdout"], record["stderr"])
+        _BUILT.update(folder=folder / "report", process=done, seconds=record["seconds"])
         assert done.returncode == 0, f"stickslip reproduce failed: {done.stderr}"
     return _BUILT["folder"]  # type: ignore[return-value]
 
