@@ -381,9 +381,10 @@ def change_time_uncertainty(time: np.ndarray, displacement: np.ndarray, protocol
 
     A change placed dt late moves every later displacement by dt * (v_after - v_before), so the change is dated
     to the displacement's scatter s over the jump: sqrt(2) s / |jump| (two lines' ends, each known to about s:
-    correlated noise does not average down along a line), combined with the row spacing there over sqrt(12) (a
-    change falls between two rows).  s is the rows' scatter about the history within :data:`CHANGE_ROWS` rows
-    either side, each side about its own straight line.  A change with no jump gets 0 (it changes nothing).
+    correlated noise does not average down along a line).  s is the rows' scatter about the history within
+    :data:`CHANGE_ROWS` rows either side, each side about its own straight line.  Where the change sits halfway
+    between two rows (:func:`find_segments` puts it there when the lines meet too far away) the row spacing over
+    sqrt(12) is added in quadrature.  A change with no jump gets 0 (it changes nothing).
     """
     t = np.asarray(time, dtype=float)
     d = np.asarray(displacement, dtype=float)
@@ -397,7 +398,8 @@ def change_time_uncertainty(time: np.ndarray, displacement: np.ndarray, protocol
         scatter = [_line_residuals(t[s], off[s]) for s in sides]
         pooled = np.concatenate(scatter)
         spread = float(np.sqrt(np.mean(pooled**2))) if pooled.size else 0.0
-        spacing = float(t[k] - t[k - 1])
+        halfway = abs(edges[i] - 0.5 * (t[k] + t[k - 1])) <= 1e-9 * max(abs(float(edges[i])), 1.0)
+        spacing = float(t[k] - t[k - 1]) if halfway else 0.0
         out[i - 1] = math.hypot(math.sqrt(2.0) * spread / jump, spacing / math.sqrt(12.0)) if jump > 0 else 0.0
     return out
 

@@ -228,7 +228,7 @@ class RSFFit:
             if p.fixed or p.stderr is None or p.interval is None:
                 lines.append(f"{p.name:10s} {p.value:.6f} s ({'held: ' if p.fixed else ''}{p.note})")
                 continue
-            digits = min(max(1 - math.floor(math.log10(p.stderr)), 0), 12) if p.stderr > 0 else 6
+            digits = _decimals(p.stderr)
             lo, hi = p.interval
             lines.append(f"{p.name:10s} {p.value:.{digits}f} ± {p.stderr:.2g} s   95 % [{lo:.{digits}f}, "
                          f"{hi:.{digits}f}] ({p.note})")  # fmt: skip
@@ -359,7 +359,7 @@ def fit_record(
         first = result.params.valuesdict()
         changes, seen = _free_changes(setup, _base(setup, start), first, start["noise"])
         if changes:
-            setup = replace(setup, changes=changes)
+            setup = replace(setup, changes=changes, change_noise=start["noise"])
             result, residual = _least_squares(setup, {**start, **_start_values(first)})
     if weight is not None:
         first = _start_values(result.params.valuesdict())
@@ -449,6 +449,8 @@ class _Setup:
     cutoff: tuple[float, float] | None = None
     #: change times of a found history fitted as nuisance parameters: (boundary index, its uncertainty in s)
     changes: tuple[tuple[int, float], ...] = ()
+    #: the friction noise the search scales its residuals by while the change times carry their prior
+    change_noise: float = 1.0
 
 
 #: the names ``fixed`` and ``guess`` take (SI values)
@@ -624,6 +626,13 @@ def _history(setup: _Setup, values: dict[str, float]) -> Protocol:
                     name=setup.protocol.name)  # fmt: skip
 
 
+def _decimals(uncertainty: float) -> int:
+    """Decimals that show a time to two significant digits of its uncertainty."""
+    if not (uncertainty > 0 and math.isfinite(uncertainty)):
+        return 6
+    return min(max(1 - math.floor(math.log10(uncertainty)), 0), 12)
+
+
 def _public(key: str) -> str:
     """The reported name of a search parameter (a change time ``tcN`` is ``change_N``)."""
     return _PUBLIC.get(key, f"change_{key[2:]}" if key.startswith("tc") else key)
@@ -666,7 +675,7 @@ def _change_report(setup: _Setup, result: Any, seen: dict[int, dict[str, float]]
         name = f"change_{index}"
         if index not in free or info is None:
             why = ("given with the history" if info is None else
-                   f"held where the displacement dates it (± {info['uncertainty']:.3g} s): moving it by "
+                   f"held where the displacement dates it (± {info['uncertainty']:.2g} s): moving it by "
                    f"{CHANGE_SHIFT:g} times that changes chi-square by {info['chi_square_change']:.2g} "
                    f"(<= {CHANGE_CHI2:g})")  # fmt: skip
             out.append(FitParameter(name, found, None, None, fixed=True, unit="s", note=why, si_unit="s"))
@@ -676,14 +685,15 @@ def _change_report(setup: _Setup, result: Any, seen: dict[int, dict[str, float]]
         value = found + (par.value - CHANGE_OFFSET) * sigma
         se = par.stderr * sigma if par.stderr is not None and math.isfinite(par.stderr) else None
         interval = (value - Z95 * se, value + Z95 * se) if se is not None else None
-        note = (f"fitted; the displacement dates it at {found:.6g} ± {sigma:.3g} s" if se is not None else
+        shown = f"{found:.{_decimals(sigma)}f} ± {sigma:.2g} s"
+        note = (f"fitted; the displacement dates it at {shown}, its prior" if se is not None else
                 "fitted, no standard error: the record cannot tell it apart from the others")  # fmt: skip
         out.append(FitParameter(name, value, se, interval, unit="s", constrained=se is not None, note=note,
                                 si_unit="s"))  # fmt: skip
         if abs(value - found) > CHANGE_FAR * sigma:
             warns.append(
                 f"{name}: the friction places the velocity change at {value:.6g} s, {abs(value - found) / sigma:.3g} "
-                f"times its uncertainty from where the displacement dates it ({found:.6g} ± {sigma:.3g} s): check "
+                f"times its uncertainty from where the displacement dates it ({shown}): check "
                 "the history (--segment, --protocol or --history measured)"
             )
     return tuple(out), warns
@@ -898,6 +908,13 @@ def _sandwich(setup: _Setup, base: RSFParams, result: Any, variance: np.ndarray)
     w = np.ones(len(setup.record)) if setup.weights is None else setup.weights
     bread = jac.T @ (w[:, None] * jac)
     meat = jac.T @ ((w**2 * variance)[:, None] * jac)
+    # the change times' priors (rows u_j of unit variance beside friction rows scaled by the search's noise n):
+    # n^2 in the bread, n^4 in the meat, in friction units
+    names = list(result.var_names)
+    for index, _ in setup.changes:
+        j = names.index(f"tc{index}")
+        bread[j, j] += setup.change_noise**2
+        meat[j, j] += setup.change_noise**4
     try:
         inverse = np.linalg.inv(bread)
     except np.linalg.LinAlgError:
@@ -1300,6 +1317,8 @@ def _least_squares(setup: _Setup, start: dict[str, float]) -> Any:
         values = p.valuesdict()
         model, _ = _model_or_why(record, _history(setup, values), base, values)
         out = (model - record.friction) * weights / noise
+        if setup.changes:  # each fitted change time's prior from the displacement: found +- its uncertainty
+            out = np.concatenate([out, [values[f"tc{i}"] - CHANGE_OFFSET for i, _ in setup.changes]])
         return np.where(np.isfinite(out), out, 1e6)
 
     try:
