@@ -357,9 +357,9 @@ def fit_record(
     if protocol_found and not mismatch and len(protocol.segments) > 1:
         # the found change times are estimates: those that matter are fitted, so the intervals carry them
         first = result.params.valuesdict()
-        changes, seen = _free_changes(setup, _base(setup, start), first, start["noise"])
+        changes, seen, weight = _free_changes(setup, _base(setup, start), first, start["noise"], labels)
         if changes:
-            setup = replace(setup, changes=changes, change_noise=start["noise"])
+            setup = replace(setup, changes=changes, change_noise=start["noise"], change_weight=weight)
             result, residual = _least_squares(setup, {**start, **_start_values(first)})
     if weight is not None:
         first = _start_values(result.params.valuesdict())
@@ -451,6 +451,9 @@ class _Setup:
     changes: tuple[tuple[int, float], ...] = ()
     #: the friction noise the search scales its residuals by while the change times carry their prior
     change_noise: float = 1.0
+    #: how much less each friction row tells than the search's chi-square says (the first fit's residual variance
+    #: over the search's noise squared, times rows per independent row): the priors are weighted up by it
+    change_weight: float = 1.0
 
 
 #: the names ``fixed`` and ``guess`` take (SI values)
@@ -638,14 +641,23 @@ def _public(key: str) -> str:
     return _PUBLIC.get(key, f"change_{key[2:]}" if key.startswith("tc") else key)
 
 
-def _free_changes(setup: _Setup, base: RSFParams, values: dict[str, float], noise: float) -> tuple[
-        tuple[tuple[int, float], ...], dict[int, dict[str, float]]]:  # fmt: skip
+def _free_changes(setup: _Setup, base: RSFParams, values: dict[str, float], noise: float, labels: np.ndarray) -> tuple[
+        tuple[tuple[int, float], ...], dict[int, dict[str, float]], float]:  # fmt: skip
     """The found history's change times that matter at ``values``: each moved by CHANGE_SHIFT of its uncertainty
     (from the displacement, :func:`change_time_uncertainty`) either way; free where chi-square at the search's
-    ``noise`` rises by more than CHANGE_CHI2.  Also, per change, its uncertainty and that rise (for the report)."""
+    ``noise`` rises by more than CHANGE_CHI2.  Also, per change, its uncertainty and that rise (for the report),
+    and the weight of the priors: the residuals' variance over ``noise`` squared times rows per independent row
+    (their correlation), so that the displacement's date is weighed against what the friction honestly tells
+    (a record described to its noise with independent residuals: 1; the sepiolite records: ~2000)."""
     record, protocol = setup.record, setup.protocol
     sigmas = change_time_uncertainty(record.time, record.displacement, protocol)
     model, why = _model_or_why(record, protocol, base, values)
+    weight = 1.0
+    if not why:
+        resid = record.friction - model
+        g = _correlation_factor(resid, labels)
+        weight = float(np.mean(resid**2)) / noise**2 * len(record) / float(np.sum(1.0 / g))
+        weight = weight if math.isfinite(weight) and weight > 0 else 1.0
     free, seen = [], {}
     for index, sigma in enumerate(sigmas, start=1):
         rise = 0.0
@@ -659,7 +671,7 @@ def _free_changes(setup: _Setup, base: RSFParams, values: dict[str, float], nois
         seen[index] = {"uncertainty": float(sigma), "chi_square_change": rise}
         if rise > CHANGE_CHI2:
             free.append((index, float(sigma)))
-    return tuple(free), seen
+    return tuple(free), seen, weight
 
 
 def _change_report(setup: _Setup, result: Any, seen: dict[int, dict[str, float]]) -> tuple[
@@ -908,13 +920,13 @@ def _sandwich(setup: _Setup, base: RSFParams, result: Any, variance: np.ndarray)
     w = np.ones(len(setup.record)) if setup.weights is None else setup.weights
     bread = jac.T @ (w[:, None] * jac)
     meat = jac.T @ ((w**2 * variance)[:, None] * jac)
-    # the change times' priors (rows u_j of unit variance beside friction rows scaled by the search's noise n):
-    # n^2 in the bread, n^4 in the meat, in friction units
+    # the change times' priors (rows sqrt(F) u_j, u_j of unit variance, beside friction rows scaled by the search's
+    # noise n): n^2 F in the bread, n^4 F^2 in the meat, in friction units
     names = list(result.var_names)
     for index, _ in setup.changes:
         j = names.index(f"tc{index}")
-        bread[j, j] += setup.change_noise**2
-        meat[j, j] += setup.change_noise**4
+        bread[j, j] += setup.change_noise**2 * setup.change_weight
+        meat[j, j] += setup.change_noise**4 * setup.change_weight**2
     try:
         inverse = np.linalg.inv(bread)
     except np.linalg.LinAlgError:
@@ -1318,7 +1330,8 @@ def _least_squares(setup: _Setup, start: dict[str, float]) -> Any:
         model, _ = _model_or_why(record, _history(setup, values), base, values)
         out = (model - record.friction) * weights / noise
         if setup.changes:  # each fitted change time's prior from the displacement: found +- its uncertainty
-            out = np.concatenate([out, [values[f"tc{i}"] - CHANGE_OFFSET for i, _ in setup.changes]])
+            prior = [values[f"tc{i}"] - CHANGE_OFFSET for i, _ in setup.changes]
+            out = np.concatenate([out, math.sqrt(setup.change_weight) * np.asarray(prior)])
         return np.where(np.isfinite(out), out, 1e6)
 
     try:
