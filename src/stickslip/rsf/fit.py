@@ -357,9 +357,9 @@ def fit_record(
     if protocol_found and not mismatch and len(protocol.segments) > 1:
         # the found change times are estimates: those that matter are fitted, so the intervals carry them
         first = result.params.valuesdict()
-        changes, seen, weight = _free_changes(setup, _base(setup, start), first, start["noise"], labels)
+        changes, seen, prior_weight = _free_changes(setup, _base(setup, start), first, start["noise"], labels)
         if changes:
-            setup = replace(setup, changes=changes, change_noise=start["noise"], change_weight=weight)
+            setup = replace(setup, changes=changes, change_noise=start["noise"], change_weight=prior_weight)
             result, residual = _least_squares(setup, {**start, **_start_values(first)})
     if weight is not None:
         first = _start_values(result.params.valuesdict())
