@@ -6,11 +6,12 @@ Each build runs as a fresh subprocess into a new temporary folder, ``--repeat`` 
 built in one process (``build_report(workers=1)``): the same files, no fork, so the difference between the two
 CPU columns is what the parallel drawing costs.  The target is <= 7 s CPU for ``stickslip reproduce``.
 
-    python benchmarks/bench_reproduce.py [--repeat N] [--compare OTHER_SRC]
+    python benchmarks/bench_reproduce.py [--repeat N] [--compare OTHER_SRC] [--only reproduce|one-process]
 
 The package is taken from this checkout's ``src/``.  ``--compare`` times a second copy of the package (e.g. an
 older commit unpacked with ``git archive COMMIT src | tar -x -C /tmp/old``, then ``--compare /tmp/old/src``) in
-the same run, build by build in turn, so that both see the same machine load.
+the same run, build by build in turn, so that both see the same machine load.  Issue 31's baseline is commit
+1e04c4c (15.0 s CPU quiet when the issue was filed; README's speed table has this round's figures beside it).
 """
 
 from __future__ import annotations
@@ -29,10 +30,10 @@ ROOT = Path(__file__).resolve().parent.parent
 REPRODUCE = [sys.executable, "-m", "stickslip.cli.main", "reproduce", "--quiet", "-o"]
 ONE_PROCESS = [sys.executable, "-c", "import sys; from stickslip.report import build_report; "
                "build_report(sys.argv[1], workers=1)"]  # fmt: skip
-CASES = (
-    ("stickslip reproduce (target <= 7 s CPU)", REPRODUCE),
-    ("build_report(workers=1) (reference)", ONE_PROCESS),
-)
+CASES = {
+    "reproduce": ("stickslip reproduce (target <= 7 s CPU)", REPRODUCE),
+    "one-process": ("build_report(workers=1) (reference)", ONE_PROCESS),
+}
 
 
 def run_once(command: list[str], env: dict[str, str]) -> tuple[float, float]:
@@ -53,13 +54,14 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=3, help="timed builds per case")
     parser.add_argument("--compare", type=Path, default=None, help="another src/ folder to time beside this one")
+    parser.add_argument("--only", choices=sorted(CASES), default=None, help="time this case alone")
     args = parser.parse_args()
     sources = {"": ROOT / "src"} if args.compare is None else {"this: ": ROOT / "src", "other: ": args.compare}
     envs = {label: {**os.environ, "PYTHONPATH": str(src)} for label, src in sources.items()}
     machine = f"Python {platform.python_version()} on {platform.machine()}, {os.cpu_count()} cores"
     print(f"{machine}; {args.repeat} builds each after a warm-up, wall and CPU (user + system, children included)")
     print(f"{'build':50s} {'best':>8s} {'median':>8s} {'cpu best':>9s} {'cpu med':>8s}")
-    for label, command in CASES:
+    for label, command in [CASES[args.only]] if args.only else CASES.values():
         for env in envs.values():
             run_once(command, env)  # warm the numba cache, the file cache and the bytecode
         times: dict[str, list[tuple[float, float]]] = {source: [] for source in envs}

@@ -5,9 +5,11 @@ the script prints the best and the median wall time and the child's CPU time
 (user + system), beside ``python -c pass`` (the interpreter alone) and
 ``python -c "import numpy"`` as the plain references.  The target is
 <= 0.4 s for ``stickslip --help``, ``stickslip critical`` and ``stickslip curve``
-with a few velocities, and <= 1 s for ``stickslip fit stick`` on Table 1 (issue 21).
+with a few velocities, and <= 1 s for ``stickslip fit stick`` on Table 1 (issue 21).  Issue 31: <= 0.8 s CPU
+for ``stickslip transient ... --stick-population`` with a short run, beside the import of the libraries such a
+run needs (numpy, scipy.integrate, numba), the floor of any command that runs it.
 
-    python benchmarks/bench_startup.py [--repeat N] [--compare OTHER_SRC]
+    python benchmarks/bench_startup.py [--repeat N] [--compare OTHER_SRC] [--only TEXT]
 
 The package is taken from this checkout's ``src/``.  ``--compare`` times a
 second copy of the package (e.g. an older commit unpacked with
@@ -29,6 +31,13 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 STICKSLIP = [sys.executable, "-m", "stickslip.cli.main"]
 TABLE1 = ROOT / "src" / "stickslip" / "data" / "table1.csv"
+TRANSIENT = [*STICKSLIP, "transient", "--start", "steady", "--stick-population"]
+#: a run short enough that the command is its start-up: Python, numpy, click, the package, scipy.integrate (the
+#: stick chains' initial state, Eq 15), numba and the compiled kernels loaded from numba's cache
+SHORT_RUN = ["--v0", "350 um/s", "--duration", "0.05 s"]
+#: issue 31's cycle (README speed table): 350 -> 100 um/s through the block, one stick-slip cycle
+ONE_CYCLE = ["--v0", "350 um/s", "--duration", "5 s", "--segment", "100 um/s:20 s"]
+LIBRARIES_LABEL = 'python -c "import numpy, scipy.integrate, numba" (reference: a transient run\'s libraries)'
 CASES = (
     ("python -c pass (reference)", [sys.executable, "-c", "pass"]),
     ('python -c "import numpy" (reference)', [sys.executable, "-c", "import numpy"]),
@@ -41,6 +50,10 @@ CASES = (
     ),
     ("stickslip params show", [*STICKSLIP, "params", "show"]),
     ("stickslip fit stick (Table 1; target <= 1 s)", [*STICKSLIP, "fit", "stick", str(TABLE1)]),
+    # issue 31: the time-dependent model's command with the stick chains; its floor is the libraries it runs on
+    (LIBRARIES_LABEL, [sys.executable, "-c", "import numpy, scipy.integrate, numba"]),
+    ("stickslip transient, 0.05 s, stick chains (target <= 0.8 s)", [*TRANSIENT, *SHORT_RUN]),
+    ("stickslip transient, one cycle, stick chains", [*TRANSIENT, *ONE_CYCLE]),
 )
 
 
@@ -61,6 +74,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=9, help="runs per command")
     parser.add_argument("--compare", type=Path, default=None, help="another src/ folder to time beside this one")
+    parser.add_argument("--only", default=None, help="time only the commands whose label contains TEXT")
     args = parser.parse_args()
     sources = {"": ROOT / "src"} if args.compare is None else {"this: ": ROOT / "src", "other: ": args.compare}
     envs = {label: {**os.environ, "PYTHONPATH": str(src)} for label, src in sources.items()}
@@ -68,6 +82,8 @@ def main() -> None:
     print(f"{machine}; {args.repeat} runs each, wall time and the child's CPU time (user + system)")
     print(f"{'command':50s} {'best':>8s} {'median':>8s} {'cpu best':>9s} {'cpu med':>8s}")
     for label, command in CASES:
+        if args.only is not None and args.only not in label:
+            continue
         for source, env in envs.items():
             if source and "reference" in label and source != next(iter(envs)):
                 continue  # the references do not depend on the package
