@@ -361,6 +361,13 @@ def fit_record(
         if changes:
             setup = replace(setup, changes=changes, change_noise=start["noise"], change_weight=prior_weight)
             result, residual = _least_squares(setup, {**start, **_start_values(first)})
+            # the first fit's residuals hold the misplaced changes' misfit too: weigh the priors again by this fit's
+            values = result.params.valuesdict()
+            model, why = _model_or_why(record, _history(setup, values), _base(setup, start), values)
+            again = prior_weight if why else _prior_weight(record.friction - model, start["noise"], labels)
+            if not 0.5 <= again / prior_weight <= 2.0:
+                setup = replace(setup, change_weight=again)
+                result, residual = _least_squares(setup, {**start, **_start_values(values)})
     if weight is not None:
         first = _start_values(result.params.valuesdict())
         setup = replace(setup, weights=_step_weights(record, protocol, first["dc"], weight))
@@ -629,6 +636,14 @@ def _history(setup: _Setup, values: dict[str, float]) -> Protocol:
                     name=setup.protocol.name)  # fmt: skip
 
 
+def _prior_weight(resid: np.ndarray, noise: float, labels: np.ndarray) -> float:
+    """How much less a friction row tells than the search's chi-square says: the residuals' variance over
+    ``noise`` squared, times rows per independent row (their correlation factor); 1 where it cannot be had."""
+    g = _correlation_factor(resid, labels)
+    weight = float(np.mean(resid**2)) / noise**2 * resid.size / float(np.sum(1.0 / g))
+    return weight if math.isfinite(weight) and weight > 0 else 1.0
+
+
 def _decimals(uncertainty: float) -> int:
     """Decimals that show a time to two significant digits of its uncertainty."""
     if not (uncertainty > 0 and math.isfinite(uncertainty)):
@@ -652,12 +667,7 @@ def _free_changes(setup: _Setup, base: RSFParams, values: dict[str, float], nois
     record, protocol = setup.record, setup.protocol
     sigmas = change_time_uncertainty(record.time, record.displacement, protocol)
     model, why = _model_or_why(record, protocol, base, values)
-    weight = 1.0
-    if not why:
-        resid = record.friction - model
-        g = _correlation_factor(resid, labels)
-        weight = float(np.mean(resid**2)) / noise**2 * len(record) / float(np.sum(1.0 / g))
-        weight = weight if math.isfinite(weight) and weight > 0 else 1.0
+    weight = 1.0 if why else _prior_weight(record.friction - model, noise, labels)
     free, seen = [], {}
     for index, sigma in enumerate(sigmas, start=1):
         rise = 0.0
