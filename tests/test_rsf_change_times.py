@@ -89,14 +89,14 @@ def test_the_change_times_are_reported_with_units(shipped):
 
 
 def test_change_time_uncertainty_scales_with_noise_over_the_jump():
-    """A clean step dated by its displacement: sqrt(2) x (row scatter) / jump, with the rows' spacing/sqrt(12)."""
+    """A clean step dated by its displacement: sqrt(2) x (row scatter) / jump (the lines meet between rows)."""
     t = np.arange(0.0, 20.0, 0.001)
     v1, v2, sigma = 10 * UM, 110 * UM, 0.2 * UM
     exact = np.where(t < 10.0, v1 * t, v1 * 10.0 + v2 * (t - 10.0))
     d = exact + sigma * np.random.default_rng(3).standard_normal(t.size)
     history = find_segments(t, d)
     (found,) = change_time_uncertainty(t, d, history)
-    expected = np.hypot(np.sqrt(2) * sigma / (v2 - v1), 0.001 / np.sqrt(12))
+    expected = np.sqrt(2) * sigma / (v2 - v1)
     assert found == pytest.approx(expected, rel=0.25)  # 100 rows' scatter: ~10 % sampling error
 
 
