@@ -24,5 +24,7 @@ python3 -m venv "$venv"
 "$venv/bin/ruff" format --check src tests benchmarks scripts
 
 # run from the tests' view of an installed package (not the source tree); one worker process per core
-# (pytest-xdist), each test file on one worker so its module fixtures are built once
-"$venv/bin/python" -m pytest -n "${STICKSLIP_TEST_WORKERS:-auto}" --dist loadfile "$@"
+# (pytest-xdist), each test file on one worker so its module fixtures are built once; the files in
+# tests/conftest.py's order, heaviest first, not xdist's (most tests first), so that no long file starts last
+# (docs/documentation.md, "The test command": the figures)
+"$venv/bin/python" -m pytest -n "${STICKSLIP_TEST_WORKERS:-auto}" --dist loadfile --no-loadscope-reorder "$@"

@@ -2,10 +2,47 @@
 
 from __future__ import annotations
 
+import os
+
 import pytest
 from click.testing import CliRunner
 
 from stickslip import critical_point, load_parameters
+
+#: The heaviest test files, heaviest first: CPU seconds of a whole-suite run on the 2-core machine (2026-11-28,
+#: numba's cache warm): 62, 45, 28, 26 (the report's build), 23, 19, 18, 18, 15, 14, 12, then 10 to 8.  Of 488 s.
+HEAVY_FIRST = (
+    "test_bayes.py",
+    "test_fit_steady.py",
+    "test_docs.py",
+    "test_report.py",
+    "test_rsf_fit_protocols.py",
+    "test_transient.py",
+    "test_transient_budget.py",
+    "test_transient_inertia.py",
+    "test_transient_box.py",
+    "test_fit_steady_global.py",
+    "test_rsf_two_state.py",
+    "test_regimes.py",
+    "test_inertia.py",
+    "test_fixred_reduction.py",
+    "test_cli_fit.py",
+    "test_rsf_fit.py",
+)
+
+
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    """Under xdist, the heaviest files first (largest job first: the last files to start are short ones).
+
+    scripts/run-tests.sh hands whole files to the workers (``--dist loadfile``) in this order
+    (``--no-loadscope-reorder``; xdist's own order, most tests first, put test_bayes.py, 62 s in 7 tests, near the
+    end, where one worker ran it while the other had nothing left).  The sort is stable: the other files keep
+    their order, and so do the tests in a file.  A run without workers keeps the plain order.
+    """
+    if not os.environ.get("PYTEST_XDIST_WORKER"):
+        return
+    rank = {name: place for place, name in enumerate(HEAVY_FIRST)}
+    items.sort(key=lambda item: rank.get(item.path.name, len(rank)))
 
 
 @pytest.fixture(scope="session")
