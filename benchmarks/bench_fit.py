@@ -116,6 +116,9 @@ def bench_bayes(walkers: int = 32, steps: int | None = None, reference_steps: in
     start = time.perf_counter()
     post = sample_posterior(fit, walkers=walkers, steps=steps, seed=1)
     ours = time.perf_counter() - start
+    numpy_batches = _with_numpy_batches(
+        lambda: _timed(lambda: sample_posterior(fit, walkers=walkers, steps=steps, seed=1))
+    )
     steps = post.steps
     keys = post.keys
     centre = np.array([math.log(fit.parameters.as_dict()[k]) for k in keys])
@@ -142,6 +145,10 @@ def bench_bayes(walkers: int = 32, steps: int | None = None, reference_steps: in
         f"  stickslip sample_posterior (independence proposal, batched walkers, Vc of 400 samples): {ours:6.1f} s;"
         f" tau up to {max(post.autocorrelation):.1f} steps, {converged} the 50-tau check"
     )
+    print(
+        f"  the same with the walkers' batches marched by numpy (the rule before BATCH_COMPILED_LANES):"
+        f" {numpy_batches[0]:6.1f} s"
+    )
     print(f"  plain loop, stretch move, one steady_state per walker ({reference_steps} steps, scaled):  {plain:6.1f} s")
     lo, hi = vc.interval
     print(f"  Vc posterior median {vc.value * 1e6:.2f} um/s, 95 % [{lo * 1e6:.2f}, {hi * 1e6:.2f}]")
@@ -167,6 +174,18 @@ def coverage(seeds: int) -> None:
             f"  {method:8s} {intervals:8s} Vc {100 * rate[0]:5.1f} %  sigma_c {100 * rate[1]:5.1f} %"
             f"   (binomial sd at 95 %: {100 * se:.1f} %; {per_fit:.2f} s per fit)"
         )
+
+
+def _with_numpy_batches(func):
+    """func() with steady_stress_many on the numpy march at every batch size (as before issue 31's round 4)."""
+    from stickslip.quasistatic import steady
+
+    saved = steady.BATCH_COMPILED_LANES
+    steady.BATCH_COMPILED_LANES = 10**12
+    try:
+        return func()
+    finally:
+        steady.BATCH_COMPILED_LANES = saved
 
 
 def _timed(func):  # (wall s, process s, result)

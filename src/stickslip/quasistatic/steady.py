@@ -382,7 +382,7 @@ class _Integrals:
     nodes: list[list[np.ndarray]] | None  # per velocity: panels of (x, S)
 
 
-def _march(s: _Scales, q: QuadratureSettings, keep_nodes: bool = False) -> _Integrals:
+def _march(s: _Scales, q: QuadratureSettings, keep_nodes: bool = False, compiled_from: int | None = None) -> _Integrals:
     """Integrate i, j and their ln V derivatives panel by panel from x = 0.
 
     All points advance together; each finishes when its cumulative hazard
@@ -391,7 +391,8 @@ def _march(s: _Scales, q: QuadratureSettings, keep_nodes: bool = False) -> _Inte
     written out and dropped, so a step costs what the remaining points cost.
     """
     # the compiled march ages linearly (the paper's Eq 1): the saturating-aging extension stays on numpy
-    if not keep_nodes and s.log_t.size >= COMPILED_LANES and s.sat is None:
+    lanes = COMPILED_LANES if compiled_from is None else compiled_from
+    if not keep_nodes and s.log_t.size >= lanes and s.sat is None:
         return _march_compiled(s, q)
     rule = panel_rule(q.order)
     # Node arrays are (K, n): the long axis innermost, so that per-point factors broadcast along rows cheaply
@@ -490,6 +491,11 @@ def _march(s: _Scales, q: QuadratureSettings, keep_nodes: bool = False) -> _Inte
 #: ~30k lanes), so narrow calls -- a command line's curve, the critical point's grid -- stay on numpy, and the
 #: wide ones that programs repeat (curves for plots and benchmarks, batched fits) run compiled.
 COMPILED_LANES = 1000
+#: The batched call (:func:`steady_stress_many`) runs compiled from this many lanes: its callers -- a fit's
+#: Jacobians, a sampler's walkers, a global search -- repeat it hundreds of times, and on a small batch the numpy
+#: march's per-call overhead dominates (16 sets x 2-20 velocities: 0.56-0.85 ms compiled against 4.9-6.8 ms numpy,
+#: 8-10x), so the one-off ~0.2 s load pays back within ~40 calls.
+BATCH_COMPILED_LANES = 16
 
 
 def _march_compiled(s: _Scales, q: QuadratureSettings) -> _Integrals:
@@ -699,6 +705,6 @@ def steady_stress_many(
         scale = np.repeat([_stress_scale(p) for p in params_list], v.size)
     joined = _join(parts)
     _check_scales(joined)
-    got = _march(joined, quadrature)
+    got = _march(joined, quadrature, compiled_from=min(COMPILED_LANES, BATCH_COMPILED_LANES))
     stress = scale * got.j / (joined.birth + got.i)
     return stress if paired else stress.reshape(len(params_list), v.size)
