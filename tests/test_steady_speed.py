@@ -193,3 +193,22 @@ def test_critical_point_is_computed_once_per_steady_curve(monkeypatch):
     assert again is first and len(solved) == 2  # the aging and the no-aging curve, once
     other = critical_point(GEL.with_overrides({"aging.aging_time": 20.0}))
     assert len(solved) == 4 and other.velocity != first.velocity
+
+
+def test_a_fits_small_batch_runs_compiled_and_agrees_with_the_numpy_march(monkeypatch):
+    """A fit's Jacobian or a sampler's walkers: 16 sets x 4 velocities through steady_stress_many (64 lanes, far
+    below COMPILED_LANES) take the compiled march, and give what the numpy march gives to its panel tolerance."""
+    from stickslip.quasistatic.steady import steady_stress_many
+
+    sets = [p for p, _, aging in box_cases(seed=2104, count=40, base=GEL, corner_share=0.0) if aging][:16]
+    velocity = np.array([20e-6, 124e-6, 350e-6, 2e-3])
+    calls = []
+    original = steady._march_compiled
+    monkeypatch.setattr(steady, "_march_compiled", lambda *a: calls.append(1) or original(*a))
+    fast = steady_stress_many(sets, velocity)
+    assert calls, "a batch of 64 lanes ran on numpy"
+    monkeypatch.setattr(steady, "BATCH_COMPILED_LANES", 10**12)
+    calls.clear()
+    plain = steady_stress_many(sets, velocity)
+    assert not calls
+    assert float(np.max(_rel(fast, plain))) <= 1e-10
