@@ -486,29 +486,46 @@ def _stress_integral(sol, m, vp, k_block, block, bounds, t, t_stop, times):  # t
     return np.interp(times, edges, total), float(total[-1])
 
 
-#: manifolds built so far, per (parameter set, aging): a sweep or a comparison reuses them
-_BUILT: dict[tuple[Parameters, bool], list[tuple[Manifold, float]]] = {}
+#: every table built in this process, one per exact request (steady curve, aging, range, rtol): a pure memo, so a
+#: table is the same whoever asked first and a run's answer never depends on what the process ran before (a run
+#: reuses only the tables it used itself: ``own`` in :func:`manifold_for`)
+_BUILT: dict[tuple, Manifold | None] = {}
+#: requests remembered at most (a sweep over many parameter sets forgets the oldest)
+BUILT_KEPT = 64
 
 
 def manifold_for(
-    params: Parameters, aging: bool, lo: float, hi: float, build_hi: float, rtol: float, build: bool = True
+    params: Parameters,
+    aging: bool,
+    lo: float,
+    hi: float,
+    build_hi: float,
+    rtol: float,
+    own: list[Manifold],
+    build: bool = True,
 ) -> Manifold | None:
-    """A manifold covering [lo, hi] at ``rtol``, built up to ``build_hi`` so that later stretches reuse it.
+    """A manifold covering [lo, hi] at ``rtol``: one of the run's ``own`` tables, or one built up to ``build_hi``
+    (and added to ``own``) so that the run's later stretches reuse it.
 
-    ``build=False``: only one built before (None if there is none).
+    ``build=False``: only one of the run's own (None if none covers).  A table built for the same request by an
+    earlier run in the process is taken from the memo; it is the table this run would build.
     """
     from ..quasistatic.jump import steady_curve_key
 
-    built = _BUILT.setdefault((steady_curve_key(params), aging), [])  # the block's stiffness plays no part
-    for m, tol in built:
-        if m.covers(lo, hi) and tol <= rtol:
+    for m in own:
+        if m.covers(lo, hi):
             return m
     if not build:
         return None
-    m = build_manifold(params, aging, lo, max(hi, build_hi), rtol)
+    key = (steady_curve_key(params), aging, lo, max(hi, build_hi), rtol)  # the block's stiffness plays no part
+    if key not in _BUILT:
+        _BUILT[key] = build_manifold(params, aging, lo, max(hi, build_hi), rtol)
+        for old in list(_BUILT)[:-BUILT_KEPT]:
+            del _BUILT[old]
+    m = _BUILT[key]
     if m is not None:
-        built.append((m, rtol))
-        del built[:-8]
+        own.append(m)
+        del own[:-8]
     return m
 
 

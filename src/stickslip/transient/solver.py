@@ -588,6 +588,7 @@ class _Reducer:
         self.interval = self.FIRST_LOOK
         self.steady: dict[float, tuple[float, float, float]] = {}
         self.unbuildable = -math.inf  # the start of the protocol piece where a table could not be built
+        self.tables: list[Any] = []  # the steady curve's tables this run has used (reduction.manifold_for)
         self.fold: float | None = None
 
     def _fold(self) -> float:
@@ -704,7 +705,7 @@ class _Reducer:
         # taken up again by a new table) and three times the fastest, for the jumps of later cycles
         lo = max(min(v, vp), v / 3.0) * 0.99
         hi = max(v, vp) * 1.01
-        m = R.manifold_for(self.params, self.aging, lo, hi, 3.0 * hi, self.rtol, build=False)
+        m = R.manifold_for(self.params, self.aging, lo, hi, 3.0 * hi, self.rtol, self.tables, build=False)
         if m is None:  # worth building only where the state is near the steady curve's rising branch
             if self.unbuildable >= t0:
                 return None
@@ -715,7 +716,7 @@ class _Reducer:
             ref = steady_state(self.params, v, self.aging)
             if not (float(ref.stress_slope) > 0 and abs(sigma - float(ref.stress)) <= 1e-2 * abs(sigma)):
                 return None
-            m = R.manifold_for(self.params, self.aging, lo, hi, 3.0 * hi, self.rtol)
+            m = R.manifold_for(self.params, self.aging, lo, hi, 3.0 * hi, self.rtol, self.tables)
             if m is None:  # the steady curve cannot be tabulated here to its share of rtol: cohorts for this piece
                 self.unbuildable = t0
                 return None
