@@ -139,7 +139,7 @@ def bench_bayes(walkers: int = 32, steps: int | None = None, reference_steps: in
     sampler.run_mcmc(p0, reference_steps)
     plain = (time.perf_counter() - start) * steps / reference_steps
     vc = post.critical_velocity
-    converged = "passes" if not post.messages else "FAILS"
+    converged = "passes" if post.converged else "FAILS"
     print(f"emcee, {walkers} walkers x {steps} steps (default: until converged), 20 points")
     print(
         f"  stickslip sample_posterior (independence proposal, batched walkers, Vc of 400 samples): {ours:6.1f} s;"
