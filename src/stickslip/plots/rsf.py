@@ -76,31 +76,6 @@ def plot_fit(fit: RSFFit, ax: Axes | None = None) -> Axes:
     return apply_style(ax)
 
 
-def run_figure(run: RSFRun) -> Figure:
-    """Friction, slip rate and state against time, and the phase plane, in one Figure."""
-    from matplotlib.figure import Figure
-
-    fig = Figure(figsize=(10, 7), layout="constrained")
-    (ax1, ax2), (ax3, ax4) = fig.subplots(2, 2)
-    plot_run(run, ax=ax1)
-    ax2.semilogy(run.time, run.slider_velocity * 1e6, color="#1f4e9c", lw=1.2, label="slider")
-    ax2.semilogy(run.time, np.maximum(run.load_point_velocity, 1e-30) * 1e6, color="#999999", lw=1, ls="--",
-                 label="load point")  # fmt: skip
-    ax2.set_xlabel("time (s)")
-    ax2.set_ylabel("velocity (µm/s)")
-    ax2.legend(fontsize=8, frameon=False)
-    apply_style(ax2)
-    for i, row in enumerate(run.state):
-        ax3.semilogy(run.time, row, lw=1.2, label=f"θ{i + 1}")
-    ax3.set_xlabel("time (s)")
-    ax3.set_ylabel("state θ (s)")
-    ax3.legend(fontsize=8, frameon=False)
-    apply_style(ax3)
-    phase_plot(run, ax=ax4)
-    fig.suptitle(run.summary()["message"], fontsize=9)
-    return fig
-
-
 def stability_figure(params: Any, v_low: float, v_high: float) -> Figure:
     """Critical stiffness against sliding velocity, with the spring's stiffness as a line."""
     from matplotlib.figure import Figure

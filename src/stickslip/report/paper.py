@@ -17,8 +17,6 @@ PULLING_VELOCITIES = (50e-6, 100e-6, 350e-6)
 
 #: The range of the steady-sliding data of Baumberger et al. (Fig 4), m/s.
 DATA_RANGE = (140e-6, 2000e-6)
-#: Split between the two steps of the steady fit (Section 3), m/s.
-FIT_SPLIT = 800e-6
 
 
 @dataclass(frozen=True)
