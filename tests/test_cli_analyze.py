@@ -328,3 +328,48 @@ def test_duplicated_rows_and_long_tables(capsys, tmp_path):
     text = _comparison_text(comparison).splitlines()
     assert sum(line.startswith("record cycle ") for line in text) == 8
     assert text[-1] == "(first 8 of 11 compared cycles; --json gives every one)"
+
+
+# ------------------------------------------------------------------ what `run -o` writes, `analyze` reads without --v0
+def _numbers_close(a, b, path=""):
+    """Equal structure and strings; numbers to 1e-9 relative or 1e-9 absolute (SI: Pa, s)."""
+    if isinstance(a, dict):
+        assert a.keys() == b.keys(), path
+        for k in a:
+            _numbers_close(a[k], b[k], f"{path}/{k}")
+    elif isinstance(a, list):
+        assert len(a) == len(b), path
+        for i, (u, v) in enumerate(zip(a, b, strict=True)):
+            _numbers_close(u, v, f"{path}[{i}]")
+    elif isinstance(a, float) or isinstance(b, float):
+        assert abs(a - b) <= 1e-9 * max(abs(a), abs(b)) + 1e-9, (path, a, b)
+    else:
+        assert a == b, (path, a, b)
+
+
+def test_a_run_trace_is_analysed_at_the_pulling_velocity_its_load_point_records(capsys, tmp_path):
+    trace = tmp_path / "run.csv"
+    code, _, err = run_main(capsys, "simulate", "--v0", "100 um/s", "--duration", "40 s", "-o", str(trace))
+    assert code == 0, err
+    code, inferred, err = run_main(capsys, "analyze", str(trace), "--json")
+    assert code == 0, err
+    assert "--v0 not given: the trace's load point moves at 100 µm/s throughout" in err, err
+    code, stated, err = run_main(capsys, "analyze", str(trace), "--json", "--v0", "100 um/s")
+    assert code == 0, err
+    # "100 um/s" converts to 9.999999999999999e-05 m/s, the load point's slope to 1e-4: the same analysis to round-off
+    _numbers_close(json.loads(inferred), json.loads(stated))
+    assert json.loads(inferred)["pulling_velocity"] == pytest.approx(1e-4, rel=1e-12)
+
+
+def test_without_v0_a_trace_with_no_one_pulling_velocity_is_refused_naming_v0(capsys, tmp_path):
+    two = tmp_path / "two.csv"
+    code, _, err = run_main(capsys, "run", "--model", "transient", "--v0", "350 um/s", "--duration", "0.05 s",
+                            "--start", "steady", "--segment", "100 um/s:0.05 s", "-o", str(two))  # fmt: skip
+    assert code == 0, err
+    code, _, err = run_main(capsys, "analyze", str(two))
+    assert code == 2 and "--v0: needed: its load point (load_point_position) does not move at one velocity" in err
+    plain = tmp_path / "plain.csv"
+    plain.write_text("time,stress\n0,1\n1,2\n2,1\n3,2\n")
+    code, _, err = run_main(capsys, "analyze", str(plain))
+    assert code == 2 and "--v0: needed: the trace has no load-point column" in err, err
+    assert len(err.strip().splitlines()) == 1

@@ -109,6 +109,33 @@ def read_trace(path: str | Path, contact_area: float | None = None) -> Trace:
     return replace(trace, notes=tuple(notes))
 
 
+#: the load-point columns of the package's own traces (Run CSV; old transient and rate-and-state traces)
+LOAD_POINT_COLUMNS = ("load_point_position", "puller_position", "load_point_displacement")
+
+
+def recorded_pulling_velocity(path: str | Path) -> tuple[float | None, str]:
+    """The pulling velocity (m/s) a package trace records, when its load point moves at one velocity throughout.
+
+    Returns (velocity, "") or (None, why not): a trace without a load-point column, or whose load point changes
+    velocity (a protocol of segments), has no one pulling velocity to analyse at.
+    """
+    for name in LOAD_POINT_COLUMNS:
+        others = [c for c in (*MODEL_COLUMNS, "stress", "force") if c != name]
+        try:
+            table = read_table(path, {"time": "time", name: "length"}, required=["time", name], ignore=others)
+        except DataError:
+            continue
+        t, x = table["time"], table[name]
+        if t.size < 2 or not (np.all(np.isfinite(t)) and np.all(np.isfinite(x))) or t[-1] <= t[0]:
+            return None, f"its {name} column does not give a velocity"
+        slope, offset = np.polyfit(t - t[0], x, 1)
+        wander = float(np.max(np.abs(x - (offset + slope * (t - t[0])))))
+        if not slope > 0 or wander > 1e-6 * abs(float(x[-1] - x[0])):
+            return None, f"its load point ({name}) does not move at one velocity throughout"
+        return float(slope), ""
+    return None, "the trace has no load-point column (" + ", ".join(LOAD_POINT_COLUMNS) + ")"
+
+
 def _merge_model_repeats(
     path: str | Path, table: Table, stress: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, str]:

@@ -65,7 +65,14 @@ TABLE_ROWS = (
 
 @click.command("analyze")
 @click.argument("trace", type=InputFile())
-@click.option("--v0", "v0_text", required=True, metavar="V", help='Pulling velocity with its unit, e.g. "50 um/s".')
+@click.option(
+    "--v0",
+    "v0_text",
+    default=None,
+    metavar="V",
+    help='Pulling velocity with its unit, e.g. "50 um/s"; without it, the one a stickslip trace records in its load'
+    " point (a run at one velocity).",
+)
 @click.option(
     "--contact-area",
     "area_text",
@@ -92,7 +99,7 @@ TABLE_ROWS = (
 )
 def analyze_command(
     trace: Path,
-    v0_text: str,
+    v0_text: str | None,
     area_text: str | None,
     params_name: str,
     overrides: tuple[str, ...],
@@ -110,6 +117,8 @@ def analyze_command(
     refuse_overwriting_inputs([trace], [("-o", output), ("--plot", plot_path)], params_name)
     from ..analysis import analyze_trace, compare_with_model, read_trace
 
+    if v0_text is None:
+        v0_text = _recorded_v0(trace)
     v0 = positive(v0_text, "velocity", "--v0")
     area = None if area_text is None else positive(area_text, "area", "--contact-area")
     params = resolve_params(params_name, overrides)
@@ -132,6 +141,18 @@ def analyze_command(
         from ..plots.traces import figure_analysis
 
         save_figure(figure_analysis(analysis, comparison), plot_path)
+
+
+def _recorded_v0(trace: Path) -> str:
+    """--v0 from the trace's own load point (what `run -o` and its spellings write), said on stderr."""
+    from ..analysis.traces import recorded_pulling_velocity
+    from ..display import velocity as show_velocity
+
+    v0, why = recorded_pulling_velocity(trace)
+    if v0 is None:
+        raise ParameterError(f"--v0: needed: {why}; give the pulling velocity with its unit, e.g. --v0 '50 um/s'")
+    echo_err(f"note: --v0 not given: the trace's load point moves at {show_velocity(v0, 6)} throughout")
+    return f"{v0:.12g} m/s"  # the load point is written to 17 digits; its slope is known to ~1e-12
 
 
 def _refuse_unbounded(analysis: Any, v0_text: str) -> None:
