@@ -20,11 +20,11 @@ import argparse
 import os
 import platform
 import statistics
-import subprocess
 import sys
 import tempfile
-import time
 from pathlib import Path
+
+from timing import child_run
 
 ROOT = Path(__file__).resolve().parent.parent
 REPRODUCE = [sys.executable, "-m", "stickslip.cli.main", "reproduce", "--quiet", "-o"]
@@ -39,15 +39,7 @@ CASES = {
 def run_once(command: list[str], env: dict[str, str]) -> tuple[float, float]:
     """(wall time, CPU time of the child and its children) of one build into a new folder; it must succeed."""
     with tempfile.TemporaryDirectory(prefix="bench-reproduce-") as folder:
-        before = os.times()
-        start = time.perf_counter()
-        done = subprocess.run([*command, str(Path(folder) / "report")], env=env, capture_output=True, check=False)
-        wall = time.perf_counter() - start
-        after = os.times()
-    if done.returncode != 0:
-        raise SystemExit(f"{' '.join(command)} failed: {done.stderr.decode(errors='replace')[-2000:]}")
-    cpu = (after.children_user - before.children_user) + (after.children_system - before.children_system)
-    return wall, cpu
+        return child_run([*command, str(Path(folder) / "report")], env)
 
 
 def main() -> None:

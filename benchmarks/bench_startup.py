@@ -23,10 +23,10 @@ import argparse
 import os
 import platform
 import statistics
-import subprocess
 import sys
-import time
 from pathlib import Path
+
+from timing import child_run
 
 ROOT = Path(__file__).resolve().parent.parent
 STICKSLIP = [sys.executable, "-m", "stickslip.cli.main"]
@@ -57,19 +57,6 @@ CASES = (
 )
 
 
-def run_once(command: list[str], env: dict[str, str]) -> tuple[float, float]:
-    """(wall time, child CPU time) of one run; the command must succeed."""
-    before = os.times()
-    start = time.perf_counter()
-    done = subprocess.run(command, env=env, capture_output=True, check=False)
-    wall = time.perf_counter() - start
-    after = os.times()
-    if done.returncode != 0:
-        raise SystemExit(f"{' '.join(command)} failed: {done.stderr.decode(errors='replace')}")
-    cpu = (after.children_user - before.children_user) + (after.children_system - before.children_system)
-    return wall, cpu
-
-
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=9, help="runs per command")
@@ -87,8 +74,8 @@ def main() -> None:
         for source, env in envs.items():
             if source and "reference" in label and source != next(iter(envs)):
                 continue  # the references do not depend on the package
-            run_once(command, env)  # warm the file cache and the bytecode
-            walls, cpus = zip(*(run_once(command, env) for _ in range(args.repeat)), strict=True)
+            child_run(command, env)  # warm the file cache and the bytecode
+            walls, cpus = zip(*(child_run(command, env) for _ in range(args.repeat)), strict=True)
             print(
                 f"{source + label:50s} {min(walls):7.3f}s {statistics.median(walls):7.3f}s"
                 f" {min(cpus):8.3f}s {statistics.median(cpus):7.3f}s"

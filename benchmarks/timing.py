@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import math
+import os
 import statistics
+import subprocess
 import time
 from collections.abc import Callable
 from typing import Any
@@ -28,3 +30,15 @@ def timed(func: Callable[[], Any], repeat: int) -> tuple[float, float, float, An
         walls.append(time.perf_counter() - wall)
         cpus.append(time.process_time() - cpu)
     return min(walls), statistics.median(walls), statistics.median(cpus), out
+
+
+def child_run(command: list[str], env: dict[str, str]) -> tuple[float, float]:
+    """(wall time, CPU time of the child and its children) of one run of ``command``; it must succeed."""
+    before = os.times()
+    start = time.perf_counter()
+    done = subprocess.run(command, env=env, capture_output=True, check=False)
+    wall = time.perf_counter() - start
+    after = os.times()
+    if done.returncode != 0:
+        raise SystemExit(f"{' '.join(command)} failed: {done.stderr.decode(errors='replace')[-2000:]}")
+    return wall, (after.children_user - before.children_user) + (after.children_system - before.children_system)
