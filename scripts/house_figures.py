@@ -11,9 +11,9 @@ imported).  Definitions:
 * a **loop** is a strongly connected component of the module graph with every kind of import; the designed
   one is a result's ``plot()`` importing its drawing from ``stickslip.plots`` lazily;
 * **floors**: the rooms' graph with every import but the designed lazy draws, the imports of the root package
-  (every module loads it first anyway: they are ``__version__``) and those of the deprecated aliases, each loop
-  of rooms squeezed to one room; the number of rooms on its longest chain.  **Arrows in room loops** are the
-  rooms' arrows inside such a loop (in any order of the rooms at least one per loop runs up);
+  (every module loads it first anyway: they are ``__version__``), each loop of rooms squeezed to one room; the
+  number of rooms on its longest chain.  **Arrows in room loops** are the rooms' arrows inside such a loop (in
+  any order of the rooms at least one per loop runs up);
 * **arrows up the layers**: module imports of any kind, less the lazy draws, from a room to one of a higher
   layer of ``LAYERS`` (tests/test_import_graph.py); counted with no exemption.
 """
@@ -110,11 +110,7 @@ def figures(root: Path = graph.SOURCE) -> dict[str, object]:
     undesigned = graph.import_graph(root, graph.EVERY_KIND, keep_lazy_draws=False)
     loops = graph.cycles(every)
     designed = [c for c in loops if c not in graph.cycles(undesigned)]
-    kept = {
-        source: {t for t in targets if graph.room(t)}
-        for source, targets in undesigned.items()
-        if source not in graph.DEPRECATED_ALIASES
-    }
+    kept = {source: {t for t in targets if graph.room(t)} for source, targets in undesigned.items()}
     chain, back = floors(rooms_graph(kept))
     lines = sum(len(p.read_text(encoding="utf-8").splitlines()) for p in root.rglob("*.py"))
     return {

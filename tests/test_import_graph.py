@@ -217,14 +217,11 @@ LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("engines", ("quasistatic", "transient", "rsf")),
     ("interface", ("models",)),
     ("uses", ("analysis", "fitting", "studies", "sweeps")),
-    ("faces", ("plots", "report", "cli", "plotting", "cycle_plots", "__main__")),
+    ("faces", ("plots", "report", "cli", "__main__")),
 )  # fmt: skip
 ENGINES = "engines"
 #: Arrows that run up the layers, each with its reason (source module, target module): none today.
 UPWARD: dict[tuple[str, str], str] = {}
-#: Alias modules kept for an old name: they warn on import and only re-export (tested below); they stand where
-#: the old name was, so the layer rules do not apply to them.
-DEPRECATED_ALIASES = frozenset({"stickslip.rsf.compare", "stickslip.plotting", "stickslip.cycle_plots"})
 
 
 def room(module: str) -> str:
@@ -468,7 +465,7 @@ def test_the_core_never_imports_matplotlib_at_import_time() -> None:
     assert not found, f"modules outside {', '.join(FACES)} import matplotlib at module level: {', '.join(found)}"
 
 
-@pytest.mark.parametrize("name", ["stickslip.plotting", "stickslip.sweeps.store"])
+@pytest.mark.parametrize("name", ["stickslip.plots.steady", "stickslip.sweeps.store"])
 def test_the_checker_sees_the_real_package(name: str) -> None:
     assert name in import_graph()
 
@@ -478,12 +475,12 @@ def test_every_room_of_the_package_stands_in_a_layer() -> None:
 
 
 def test_no_engine_imports_anything_above_the_engines_by_any_kind_of_import() -> None:
-    found = engine_breaches(aliases=DEPRECATED_ALIASES)
+    found = engine_breaches()
     assert not found, "engine modules importing the interface or above:\n" + "\n".join(map(str, found))
 
 
 def test_no_import_runs_up_the_layers_but_the_named_ones() -> None:
-    found = upward_arrows(allowed=UPWARD, aliases=DEPRECATED_ALIASES)
+    found = upward_arrows(allowed=UPWARD)
     assert not found, "imports running up the layers:\n" + "\n".join(map(str, found))
     every = {(source, target) for source, target, _ in import_edges()}
     assert set(UPWARD) <= every, f"named arrows that no longer exist: {sorted(set(UPWARD) - every)}"
@@ -494,17 +491,8 @@ def test_the_only_loops_of_any_kind_of_import_are_the_designed_lazy_draws() -> N
     assert not found, "import loops (every import counted, less the lazy draws into stickslip.plots):\n" + _shown(found)
 
 
-@pytest.mark.parametrize("alias", sorted(DEPRECATED_ALIASES))
-def test_a_deprecated_alias_only_warns_and_re_exports(alias: str) -> None:
-    path = package_modules()[alias]
-    tree = ast.parse(path.read_text(encoding="utf-8"))
-    kinds = {type(node).__name__ for node in tree.body}
-    assert kinds <= {"Expr", "Import", "ImportFrom", "Assign"}, f"{alias} holds code: {kinds}"
-    assert "DeprecationWarning" in path.read_text(encoding="utf-8")
-
-
 def test_every_module_is_reached_from_the_command_line_or_the_public_api() -> None:
     """A module no user path reaches (the ``stickslip`` command, ``python -m stickslip``, ``import stickslip``) is
     dead or misplaced."""
-    found = set(unreached_modules(entries=["stickslip.cli.main", "stickslip.__main__", PACKAGE])) - DEPRECATED_ALIASES
+    found = unreached_modules(entries=["stickslip.cli.main", "stickslip.__main__", PACKAGE])
     assert not found, f"modules no user path reaches: {sorted(found)}"

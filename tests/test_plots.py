@@ -100,16 +100,6 @@ def test_results_load_neither_the_plots_nor_matplotlib_until_they_draw() -> None
     assert out.stdout.strip() == "[]", out.stdout
 
 
-def test_old_module_paths_are_aliases_of_the_plots() -> None:
-    from stickslip import cycle_plots, plotting
-    from stickslip.plots import cycles, steady, style
-
-    assert plotting.figure_steady_curve is steady.figure_steady_curve
-    assert plotting.apply_style is style.apply_style and plotting.UM_PER_S == style.UM_PER_S
-    assert cycle_plots.figure_cycles is cycles.figure_cycles
-    assert set(cycle_plots.__all__) <= set(dir(cycles))
-
-
 def test_a_result_draws_through_the_plots_on_a_given_axes() -> None:
     from matplotlib.figure import Figure
 

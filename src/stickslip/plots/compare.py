@@ -26,9 +26,9 @@ def figure_bond_and_rsf(panels: Mapping[str, Any], pair: Mapping[str, Any], rsf:
     """The three panels of ``stickslip compare``, one row.
 
     ``panels``: name -> (bond response, RSF run or None, problem or None) of the velocity step and the
-    slide-hold-slide (:func:`stickslip.rsf.compare.bond_response`, :func:`stickslip.rsf.simulate`);
-    ``pair``: :func:`stickslip.rsf.compare.stick_slip_pair`; ``rsf``: the RSF standing for the bond model
-    (:func:`stickslip.rsf.compare.rsf_of_bond`); ``how``: how its a, b, Dc were found, in words.
+    slide-hold-slide (:func:`stickslip.studies.bond_rsf.bond_response`, :func:`stickslip.rsf.simulate`);
+    ``pair``: :func:`stickslip.studies.bond_rsf.stick_slip_pair`; ``rsf``: the RSF standing for the bond model
+    (:func:`stickslip.studies.bond_rsf.rsf_of_bond`); ``how``: how its a, b, Dc were found, in words.
     """
     from matplotlib.figure import Figure
 

@@ -29,7 +29,6 @@ from .style import (
     UM_PER_S,
     VELOCITY_LABEL,
     apply_style,
-    legend_of_all_panels,  # noqa: F401  (re-exported by the deprecated stickslip.cycle_plots)
     new_axes,
 )
 

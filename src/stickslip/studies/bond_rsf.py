@@ -1,7 +1,7 @@
 """The bond model and rate-and-state friction on the same experiments (``stickslip compare``): a study.
 
-It lived in ``stickslip.rsf.compare`` (that name still imports, with a DeprecationWarning): it runs the bond
-model through the model interface, so it sits above the engines, not inside one (docs/architecture.md).
+It runs the bond model through the model interface, so it sits above the engines, not inside one
+(docs/architecture.md).
 
 The bond-model side is one small pluggable function, :func:`bond_response`: it
 uses the time-dependent bond model (``stickslip.transient.run_transient``) when
