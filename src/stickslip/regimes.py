@@ -1,30 +1,9 @@
 """One regime classifier for every model: what a run settled into, read off its dense solution.
 
-The classifier sees a signal (stress or friction) at the solver's own steps,
-optionally with the solver's interpolant to place each extremum exactly, and
-answers with one of :data:`KINDS` and the evidence: how many oscillation
-periods it saw and how their amplitude changed from one period to the next.
-It never depends on how the output is sampled, and it says "undetermined"
-rather than guess when the run is too short to tell.
-
-Kinds (the names the CLI, JSON and sweep tables print):
-
-* ``steady``: the signal no longer changes (within ``floor``), and the
-  extrapolated remaining change of its exponential approach is within
-  ``floor`` too;
-* ``decaying oscillation``: the amplitude falls by more than
-  :data:`RATIO_TOLERANCE` per period over the last periods;
-* ``stick-slip``: a limit cycle, the amplitude constant within
-  :data:`RATIO_TOLERANCE` over the last periods;
-* ``growing oscillation``: the amplitude grows by more than
-  :data:`RATIO_TOLERANCE` per period over the last periods;
-* ``stuck``, ``blow-up``: decided by the model (the slider stopped; the slip
-  rate ran away), passed through;
-* ``undetermined``: none of the above can be shown from the run; the
-  evidence says what was seen (e.g. "2 periods, amplitude ratio 0.93").
-
-Rate-and-state keeps its historical name ``steady sliding`` for ``steady``
-(:data:`RSF_NAMES`).
+It sees a signal (stress or friction) at the solver's own steps, optionally with the solver's interpolant to
+place each extremum, and answers one of :data:`KINDS` with the evidence (periods seen, amplitude ratios); it never
+depends on the output sampling and says "undetermined" rather than guess.  The kinds and the rules:
+docs/regimes.md.  Rate-and-state keeps its name ``steady sliding`` for ``steady`` (:data:`RSF_NAMES`).
 """
 
 from __future__ import annotations

@@ -1,24 +1,9 @@
 """Per-cycle characteristics of a measured stick-slip record (the rows of Table 1).
 
-For each stick phase found by :mod:`.detect` the stress is fitted by a
-straight line (Eq 12: the block is stuck, dsigma/dt = K V0 with
-K = (G_d/h) ln(B/l)/(B/l - 1), Eq 17), and both ends of the line are located
-by hinge fits against the adjacent slip branches (:mod:`.fits`).  Then
-
-* ``critical_stress`` sigma_c = the line at the start corner (where the stick began),
-* ``peak_stress`` sigma_s     = the line at the end corner (Eq 16),
-* ``stick_time`` t_s          = end corner - start corner,
-* ``stick_slope`` and its standard error from the regression (corners excluded
-  by a small margin),
-* ``stiffness`` G_d/h         = slope / (V0 * geometric factor)  (Eq 17),
-* ``jump_velocity`` V_s       = where the steady curve carries sigma_s (Eq 8,
-  :func:`stickslip.quasistatic.jump.jump_velocity`),
-* ``slip_time``               = next start corner - end corner,
-* ``period``                  = next start corner - start corner.
-
-A cycle is one stick phase and the slip that follows; quantities that the
-record does not contain (a stick cut by its start, a slip cut by its end) are
-None and the cycle is ``complete=False``.
+Each stick phase found by :mod:`.detect` is fitted by a straight line (Eq 12) whose ends are located by hinge fits
+(:mod:`.fits`); the cycle's stresses, times, slope, stiffness and jump velocity are read off them
+(docs/analysis.md).  A cycle is one stick and the slip that follows; what the record does not contain is None and
+the cycle is ``complete=False``.
 """
 
 from __future__ import annotations

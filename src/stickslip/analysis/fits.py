@@ -1,18 +1,8 @@
 """Least-squares pieces of the trace analysis: the stick line and the corners.
 
-The stick phase of the model is a straight line (Eq 12, with the slope of
-Eq 17), and both ends of it are corners: the slope jumps from K (V0 - Vc) to
-K V0 where the block sticks and from K V0 to K (V0 - Vs) where it slips.  A
-corner is located by a *hinge fit*: the stick line (fixed, from the fit over
-the whole stick phase) on one side of the corner time tc, and a low-order
-polynomial joined continuously to it at tc on the other side,
-
-    sigma(t) = L(t)                                  on the stick side,
-    sigma(t) = L(tc) + c (t - tc) + d (t - tc)^2     on the slip side,
-
-with tc chosen to minimise the sum of squared residuals (for fixed tc the
-problem is linear in c, d).  The corner's stress is L(tc): the peak and the
-trough are read off the fitted line, never from a single noisy sample.
+A corner of the stick line (Eq 12, slope of Eq 17) is located by a *hinge fit*: the fixed stick line on one side
+of the corner time tc and a branch joined continuously to it on the other, tc minimising the sum of squares; the
+corner's stress is read off the fitted line, never from a single noisy sample (docs/analysis.md, "The corners").
 """
 
 from __future__ import annotations

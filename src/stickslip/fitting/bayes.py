@@ -1,37 +1,9 @@
-r"""Bayesian steady fit: posterior samples with emcee (optional extra ``stickslip[bayes]``).
+"""Bayesian steady fit: posterior samples with emcee (optional extra ``stickslip[bayes]``).
 
-The sampled parameters are the ln-values of the keys the least-squares fit
-determined (:class:`~stickslip.fitting.steady_fit.SteadyFit.free_keys`); keys
-it fixed stay fixed, for the reasons it gave.  Stated priors:
-
-* each sampled ln-parameter is uniform on [ln x0 - ln 1e4, ln x0 + ln 1e4]
-  around its start value x0 (log-uniform, the fit's search box);
-* with stated ``stress_err`` the likelihood is Gaussian with those errors;
-  without, each point has an error s * stress with an unknown relative noise
-  s under the Jeffreys prior 1/s, integrated out analytically:
-  p(data | theta) ~ chi2(theta)^(-n/2).
-
-Vc and sigma_c (Eq 9) are computed for a random subset of the posterior
-samples (local solver around the best-fit Vc), which gives their posteriors;
-the credible band of sigma(V) comes from the same kind of subset.
-
-Sampler.  Burn-in in three rounds.  The first: a mixture of two exact moves,
-half independence Metropolis-Hastings proposals (emcee's MHMove) from a
-multivariate t (10 degrees of freedom) centred on the maximum of the
-likelihood with its Gauss-Newton covariance (the Hastings factor included),
-half differential-evolution moves (DEMove).  After each round an independence
-proposal is fitted to the round's samples: a kernel density estimate mixed
-with a defensive t of heavier tails (:class:`_Fitted`); the last one is fixed
-for the main run (half that proposal, half DEMove), an exact chain, and the
-rounds are discarded.  The autocorrelation time is 4-6 steps on the shipped
-synthetic curve and 10-36 on a harder 20-point set, against 8-13 and 190-200
-for the mixture alone (which hit the 10000-step cap unconverged there).  By
-default the chain runs until it passes the convergence check -- at least 50
-integrated autocorrelation times after a burn-in of 5 of them -- and stops
-there, or at ``max_steps`` with a message that starts "NOT CONVERGED";
-``steps`` fixes the length (the mixture alone, no rounds).  A rich progress
-bar on standard error while it runs, on a terminal only
-(:mod:`stickslip.progress`).
+The ln-values of the keys the least-squares fit determined are sampled; the priors, the likelihood (with an
+unknown relative noise integrated out when no ``stress_err`` is given), the burn-in rounds with fitted
+independence proposals (:class:`_Fitted`), the convergence check and the posteriors of Vc and sigma_c:
+docs/fitting.md.
 """
 
 from __future__ import annotations

@@ -1,17 +1,9 @@
-r"""Uncertainty of the critical point (Vc, sigma_c of Eq 9) of a fitted curve.
+"""Uncertainty of the critical point (Vc, sigma_c of Eq 9) of a fitted curve.
 
-* ``delta``: first-order propagation.  Vc solves g(V, theta) = dsigma/dV = 0,
-  so by the implicit function theorem d ln Vc/d theta = -(dg/dtheta)/(dg/d ln V),
-  and because dsigma/dV = 0 there, d ln sigma_c/d theta = d ln sigma/d theta at
-  fixed V (envelope theorem).  Both are central differences of the model's
-  analytic slope and stress at Vc: 2p + 2 evaluations of one velocity.
-* ``profile``: the profile likelihood.  For a trial Vc = v the fit is redone
-  with the constraint dsigma/dV(v) = 0 (a heavily weighted extra residual);
-  the interval is where the constrained chi-square exceeds the best one by the
-  chi-square (or F) quantile.  For sigma_c the location v is an extra free
-  parameter with a second constraint sigma(v) = s.
-* ``bootstrap``: refits of data simulated from the fitted curve with the
-  fitted noise (see :mod:`stickslip.fitting.steady_fit`).
+Three methods: ``delta`` (first-order propagation through the implicit function and envelope theorems),
+``profile`` (the profile likelihood with the constraint dsigma/dV(v) = 0) and ``bootstrap`` (refits of data
+simulated from the fitted curve, :mod:`stickslip.fitting.steady_fit`); how each works and how it was checked:
+docs/fitting.md.
 """
 
 from __future__ import annotations

@@ -1,28 +1,9 @@
 """A global search for the steady fit: where a local least-squares fit ends far from the data.
 
-The least-squares steps start from the input parameters and can end in a
-local minimum far from the data (issue 27 item 8: 107 Pa where the data say
-488).  Before the fit calls the model unable to describe the data it scans
-the whole search box (a factor 1e4 either side of each start value, the box
-the least squares may use) of the free ln-parameters:
-
-* the stress scale is linear: sigma is proportional to N0, so where
-  ``bonds.site_density`` is free its best value for each trial is the
-  closed-form weighted least-squares factor and it is not scanned;
-* the other free keys (with the defaults one carrier each of Δl_m/τ,
-  a = λMΔl_m/kT, Δl_m/τa and Va: the identifiable combinations,
-  docs/fitting.md) are scanned by a scrambled Sobol sequence, 512 points per
-  dimension, with the 3^d corners, edge and face centres of the box (the
-  best fit of a curve the model cannot follow often lies on the box's edge,
-  where a limit such as a -> 0 or Va -> infinity is reached);
-* all trial sets go through the batched quadrature (``stress_many``), about
-  0.3 ms per set at 20 velocities.
-
-The 8 best distinct points of the scan are then polished together by a
-batched Levenberg-Marquardt (all starts and their Jacobians in one batch
-per iteration; the χ² landscape of a curve the model cannot follow has
-narrow valleys that a finer scan alone misses).  The best end is the start
-of the ordinary least-squares fit, which the caller runs.
+Before the fit calls the model unable to describe the data it scans the whole search box of the free
+ln-parameters (N0 profiled out in closed form; the others by a scrambled Sobol sequence with the box's corners,
+edge and face centres, through the batched quadrature), then polishes the 8 best distinct points by a batched
+Levenberg-Marquardt; the best end starts the ordinary fit, which the caller runs (docs/fitting.md).
 """
 
 from __future__ import annotations

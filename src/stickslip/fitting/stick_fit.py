@@ -1,24 +1,10 @@
-r"""Fit the stick-phase parameters (Eq 15) to measured stick times, like the paper's Table 1.
+"""Fit the stick-phase parameters (Eq 15) to measured stick times, like the paper's Table 1.
 
-Each row is one stick phase: the stress starts at ``start_stress`` (sigma_c;
-the model's critical stress where the cell is empty) and rises at the
-measured loading rate ``stick_slope`` when the table has it, else at
-K V0 with the block stiffness K of Eq 17.  The model's stick time t_s and
-peak stress sigma_s (Eq 16) come from
-:func:`stickslip.quasistatic.stick.stick_phase`.
-
-Fitted: ``stick.attached_chains`` (Nc0), ``stick.break_rate`` (uc/tau) and
-``stick.aging_time`` (tau_a of Eq 15), as ln-values.  In Eq 15 Nc0 appears
-only as (lambda/kT)/Nc0, so Nc0 is determined relative to the force
-sensitivity lambda/kT of the bonds, which is held.  With stick times at
-only two pulling velocities (Table 1) the three parameters are not all
-determined: the fit finds the undetermined direction from its covariance
-and fixes a parameter, with a message, as the steady fit does.
-
-Residuals are ln(model/measured) of t_s, and of sigma_s where given and the
-loading rate is not measured (with a measured rate sigma_s = sigma_c +
-rate * t_s repeats t_s and is only compared), with one relative noise level
-estimated from the scatter.
+Each row is one stick phase from ``start_stress`` (sigma_c where the cell is empty) at the measured loading rate
+``stick_slope``, else K V0 (Eq 17); the model's t_s and sigma_s come from
+:func:`stickslip.quasistatic.stick.stick_phase`.  Nc0, uc/tau and tau_a are fitted as ln-values on the residuals
+ln(model/measured); a direction the data do not determine is fixed with a message, as the steady fit does
+(docs/fitting.md).
 """
 
 from __future__ import annotations

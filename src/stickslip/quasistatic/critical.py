@@ -1,17 +1,8 @@
 """The critical point of the steady friction curve (Eq 9) and the no-aging turnover.
 
-Eq 9: dsigma/dV0 = 0 at V0 = Vc, the minimum of the aging curve separating the
-velocity-weakening left branch from the velocity-strengthening right branch.
-The no-aging curve has no such minimum but turns over at a few mm/s (for
-gelatin-glass); the jump velocity of the stick-slip cycle is sought below
-that maximum.
-
-Method: dsigma/dV (computed analytically under the integral, see
-:mod:`stickslip.quasistatic.steady`) is sampled on a log grid of velocities; each
-sign change clear of the quadrature noise is refined by Brent's method on
-log V (the same function, so the bracket's signs always hold) and kept only
-when the stress there is verified to be below (above) both ends of its
-bracket: a minimum of the converged curve, not of its noise.
+dsigma/dV (analytic, :mod:`stickslip.quasistatic.steady`) is sampled on a log grid; each sign change clear of the
+quadrature noise is refined by Brent's method on the same function and kept only when it is verified to be an
+extremum of the converged curve (docs/steady-state.md section 7).
 """
 
 from __future__ import annotations

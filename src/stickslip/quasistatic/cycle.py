@@ -1,28 +1,9 @@
-r"""Whole stick-slip cycles: stick (Eqs 11-17) -> jump (Eqs 8, 16) -> slip (Eq 10) -> jump back -> ...
+"""Whole stick-slip cycles: stick (Eqs 11-17) -> jump (Eqs 8, 16) -> slip (Eq 10) -> jump back -> ...
 
-The block starts stuck at sigma_c (or a given stress) with a fresh population
-of attached chains.  The puller loads it linearly (Eq 12, with the Eq 17
-stiffness K) until the chains collapse at t_s (Eq 15), at the stress sigma_s
-(Eq 16).  The velocity jumps to Vs on the steady curve (stress continuous),
-then relaxes along the aging curve by Eq 10:
-
-* V0 < Vc: down to Vc in finite time, where the block jumps back to rest at
-  sigma_c and the next stick begins with fresh chains;
-* V0 >= Vc: to V0, after which the block slides steadily at sigma(V0).
-
-Every stick after the first starts at sigma_c with Nc = Nc0, so every cycle
-after the first is the same cycle: each distinct phase is solved once and
-repeated with a time and displacement offset.  That is the physics of the
-model (the state at each re-stick is the same), not an approximation.
-
-Bookkeeping of the trace (positions measured from the slider's initial
-position): ``block_shear = sigma/K``, ``puller_displacement = sigma_0/K + V0 t``
-and ``slider_displacement = int V dt``, so that puller = slider + shear at
-all times.  With ``jump_curve="no-aging"`` the slip starts on the aging
-curve at the no-aging Vs, where the stress differs from sigma_s (for
-gelatin-glass it is ~18 Pa higher); the stress then jumps at the jump and
-the slider is displaced by (sigma_s - sigma(Vs))/K in no time, which keeps
-the bookkeeping exact and shows why the aging curve is the default.
+Every stick after the first starts at sigma_c with Nc = Nc0, so every cycle after the first is the same cycle:
+each distinct phase is solved once and repeated with a time and displacement offset (the model's physics, not an
+approximation).  The trace keeps puller = slider + shear at all times, across a no-aging jump too
+(``jump_curve="no-aging"``).  The cycle and its bookkeeping: docs/slip-phase.md.
 """
 
 from __future__ import annotations

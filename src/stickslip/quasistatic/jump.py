@@ -1,24 +1,9 @@
-r"""The jump from stick to slip: the velocity Vs at which the steady curve carries sigma_s (Eqs 8, 16).
+"""The jump from stick to slip: the velocity Vs at which the steady curve carries sigma_s (Eqs 8, 16).
 
-When the attached chains collapse (Eq 15) at the stress sigma_s of Eq 16,
-the block slips and its velocity jumps, in no time on the scale of the
-loading, to the velocity Vs at which steady sliding carries that stress.
-The block's shear cannot change instantly, so the stress is continuous
-through the jump: Vs is the root of
-
-    sigma(Vs) = sigma_s,      Vc < Vs < V_max,
-
-on the velocity-strengthening right branch of the steady curve (Eqs 6-8),
-between the critical velocity Vc of Eq 9 and the curve's maximum.  By
-default the curve is the aging curve, the one the slip phase then follows
-(Eq 10); the paper's Section 3 uses the no-aging form of Eq 8 instead
-(``curve="no-aging"``, see docs/errata.md).  When sigma_s lies outside the
-stresses of that branch the jump is unreachable and the result says so.
-
-Numerics: the branch is interpolated once per parameter set by a Chebyshev
-series in ln V, converged to 1e-12 of the largest coefficient (one or two
-vectorised calls of :func:`stickslip.quasistatic.steady.steady_state`); Brent's
-method finds the root of the series.
+The stress is continuous through the jump, so Vs is the root of sigma(Vs) = sigma_s on the right branch between
+Vc and the curve's maximum, of the aging curve by default (``curve="no-aging"``: the paper's Section 3); an
+unreachable jump is said in the result.  The branch is a Chebyshev series in ln V, computed once per parameter set
+(:func:`branch_interpolant`); Brent's method finds the root (docs/slip-phase.md).
 """
 
 from __future__ import annotations

@@ -1,32 +1,9 @@
-r"""The slip phase: quasi-static sliding down the steady curve (Eqs 5, 10, 17).
+"""The slip phase: quasi-static sliding down the steady curve (Eqs 5, 10, 17): dV/dt = -K (V - V0) / sigma'(V).
 
-After the jump the block slides on the right branch of the steady curve
-sigma(V) (Eqs 6-8 with aging), and the block's stress obeys Eq 5 with the
-stiffness K of Eq 17, dsigma/dt = K (V0 - V).  With sigma = sigma(V) this is
-Eq 10,
-
-    dV/dt = -K (V - V0) / sigma'(V).
-
-* V0 < Vc: V falls to the critical velocity Vc, where sigma'(Vc) = 0 and
-  dV/dt -> -infinity, in *finite* time; the block then sticks (the jump back
-  to rest) at sigma_c.
-* V0 >= Vc: V relaxes to V0, exponentially with time constant sigma'(V0)/K;
-  the slip phase ends (and steady sliding begins) when V is within
-  SETTLE_TOLERANCE of V0.
-
-Numerics (docs/slip-phase.md).  Time is regular as a function of V,
-
-    t(V) = (1/K) int_{Vs}^{V} sigma'(v)/(V0 - v) dv,
-
-and so is the slider displacement int V dt = (1/K) int v sigma'(v)/(V0 - v) dv.
-With x = ln v and g(x) = dsigma/dx = v sigma'(v) the integrand g/(V0 - e^x) is
-smooth, except for the pole at V0 when V0 lies on (or next to) the path;
-that pole is subtracted analytically, g0/(V0 - e^x) with g0 = g(ln V0), and
-the remainder -(g - g0)/(x - x0) / (V0 exprel(x - x0)) is smooth.  sigma and g
-are interpolated by a Chebyshev series in x and integrated exactly.  The
-curve itself comes from the aging branch series of
-:func:`stickslip.quasistatic.jump.branch_interpolant`, computed once per parameter
-set, so a slip phase costs no new steady-state quadrature.
+Below Vc the slip reaches Vc in finite time and the block sticks; above it V relaxes to V0 and the phase ends
+within ``SETTLE_TOLERANCE``.  Time and displacement are integrals over V (x = ln V, the pole at V0 subtracted,
+Chebyshev series of the aging branch from :func:`stickslip.quasistatic.jump.branch_interpolant`):
+docs/slip-phase.md.
 """
 
 from __future__ import annotations

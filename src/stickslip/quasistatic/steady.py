@@ -1,26 +1,8 @@
-r"""Steady sliding: the bond population at constant velocity (Eqs 6-8).
+"""Steady sliding: the bond population at constant velocity (Eqs 6-8).
 
-At steady sliding velocity V the age distribution of bonds obeys Eq 6,
-
-    dn/dt_a = -(u0/tau) exp( lambda/kT * M t_a V / (1 - (t_a V/dl_m)^2) - (t_a/tau_a) e^{-V/V_a} ) n,
-
-with the birth condition of Eq 7, n(0) = [N0 - N]/tau, and the stress of Eq 8.
-With the dimensionless age x = t_a V / dl_m in [0, 1) and
-
-    T = u0 dl_m / (V tau),   a = lambda M dl_m / kT,   alpha = dl_m/(V tau_a) e^{-V/V_a},
-
-the log-hazard is L(x) = ln T + a x/(1-x^2) - alpha x, the survival is
-S(x) = exp(-H(x)) with H(x) = int_0^x e^L, and (docs/steady-state.md)
-
-    N/N0  = i / (tau V/dl_m + i),           i = int_0^1 S dx,
-    sigma = M N0 dl_m j / (tau V/dl_m + i),  j = int_0^1 x S/(1-x^2) dx.
-
-L is convex in x, so the hazard e^L is largest at the ends of any interval;
-this lets the quadrature choose panels from explicit bounds (see
-:func:`_march`) and follow the survival wherever it falls off: at x ~ 1/T,
-at x ~ 1e-6 for very long chains, on a plateau left by aging, or at the FENE
-cliff close to x = 1.  dsigma/dV comes from differentiating under the
-integral (the same panels), not from finite differences.
+In the dimensionless age x = t_a V / dl_m the log-hazard is L(x) = ln T + a x/(1-x^2) - alpha x, and N/N0 and
+sigma are two integrals i, j of the survival (docs/steady-state.md).  L is convex, so the quadrature chooses its
+panels from explicit bounds (:func:`_march`); dsigma/dV is differentiated under the integral on the same panels.
 """
 
 from __future__ import annotations

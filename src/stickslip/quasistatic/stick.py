@@ -1,39 +1,10 @@
-r"""The stick phase: linear loading of the stuck block and the collapse of the attached chains (Eqs 11-17).
+"""The stick phase: linear loading of the stuck block and the collapse of the attached chains (Eqs 11-17).
 
-While the block is stuck its base does not move, so the stress rises
-linearly (Eqs 11-12, with the trapezoid factor of Eq 17):
-
-    sigma(t) = sigma_0 + K V0 t,      K = (G_d/h) ln(B/l)/(B/l - 1),
-
-and the attached chains, which share the load equally (Eq 14), break at the
-aged rate of Eq 15:
-
-    dNc/dt = -(uc/tau) exp( (lambda/kT) sigma(t)/Nc - t/tau_a ) Nc,   Nc(0) = Nc0.
-
-With n = Nc/Nc0, s(t) = (lambda/kT) sigma(t)/Nc0 and r = uc/tau this is
-dn/dt = -r n exp(s(t)/n - t/tau_a).  The collapse n -> 0 happens in finite
-time t_s (the stick time); the stress there is sigma_s of Eq 16.
-
-Numerics (docs/stick-phase.md).  The equation is explosive, not stiff:
-a time-stepper loses precision as n -> 0, while time as a function of n is
-regular there (dt/dn = -exp(-s/n + t/tau_a)/(r n) -> 0 with all its
-derivatives).  When aging wins, n levels off and t(n) is singular instead.
-Both are regular in the arc-length-like variable theta with
-
-    dt'/dtheta = 1/(1 + w),   dn/dtheta = -w/(1 + w),   w = r T n exp(s/n - t/tau_a),
-
-(t' = t/T, T a time scale): theta follows time while the chains hold and
-follows n while they collapse.  w is handled through its logarithm, so
-nothing overflows.  Whether the block stays stuck for ever is decided at
-checkpoints by an explicit bound on the remaining breakage
-(:func:`never_slips`); when neither the collapse nor the proof comes before a
-generous horizon the answer is "undetermined", never an invented number.
-
-Below a threshold pulling velocity (:func:`stuck_threshold`, 19.14 µm/s for
-``gelatin-glass`` from sigma_c) Eq 15 keeps the block stuck for ever: its
-aging term −t/τa grows without bound and outgrows the load.  That is a
-limitation of Eq 15, not a prediction: Baumberger et al. saw stick-slip of
-the same gel down to 10 µm/s (docs/stick-phase.md §5).
+With n = Nc/Nc0, s(t) = (lambda/kT) sigma(t)/Nc0 and r = uc/tau, Eq 15 is dn/dt = -r n exp(s(t)/n - t/tau_a).
+It is explosive, not stiff, so it is solved in an arc-length-like variable theta (``w`` handled through its
+logarithm), and whether the block never slips is proved at checkpoints (:func:`never_slips`), else the answer is
+"undetermined".  The derivation, the numerics and the threshold velocity (:func:`stuck_threshold`):
+docs/stick-phase.md.
 """
 
 from __future__ import annotations

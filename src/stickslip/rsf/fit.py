@@ -1,44 +1,8 @@
-r"""Fitting rate-and-state friction to a lab record (lmfit least squares, optional emcee posterior).
+"""Fitting rate-and-state friction to a lab record (lmfit least squares, optional emcee posterior).
 
-The model of a record: the spring-slider of :mod:`stickslip.rsf.solver`, driven by
-the load-point history found in the record (or given), in steady state at the
-first segment's velocity at the record's start, with ``V0`` = that velocity, so
-``mu0`` is the initial steady friction.  Free: ``mu0``, ``a``, ``b`` and ``Dc``
-(and ``b2``, ``Dc2`` with two states), optionally the stiffness and a linear
-trend ``mu += trend * (load-point displacement)`` (slow drifts common in rock
-and gouge records: wear, gouge growth), a trend in time ``mu += time_trend * t``
-(a load cell's thermal drift), or both (``trend="both"``).  ``Dc`` and ``k`` are fitted in log space (they span
-decades); their intervals are exp(log value +- 1.96 se), so asymmetric.
-
-The noise is estimated in two ways that do not depend on the sampling rate
-(``noise_method`` says which was used).  The fit is *judged* against the
-record's own noise, measured where the model has no say: the robust scatter of
-the steady sliding about straight lines over a fixed time window, per sampling
-rate, so the reduced chi-square says whether the model describes the data to
-within its noise (about 1) or leaves structure behind (much above 1).  The
-*intervals* come from the residuals themselves: the least-squares sandwich
-covariance with the residuals' variance and their autocorrelation per sampling
-rate (a correlated 1 kHz row counts as 1/g of an independent one; the effective
-number of independent rows is reported), so correlated and quantised noise at
-1 kHz neither shrinks them nor fails a good fit.  With a ``noise`` given the
-old white-noise treatment holds: intervals at that level, and a
-``scaled_interval`` (x sqrt(chi-square_r)) when chi-square_r > 2.  ``a - b``
-comes with its own standard error from the covariance (a and b are strongly
-correlated: their separate errors cannot give it).  A second fit with the slip
-drift toggled tells whether the conclusion depends on the drift term
-(``drift_sensitivity``).
-
-A fit is ``failed`` (never ``ok``) with a ``reason`` when the search did not
-converge; the covariance could not be estimated; chi-square_r is absurd
-(> :data:`ABSURD_CHI2`: the model or the load-point history does not describe
-the record); a, b and Dc did not move from starting values that do not fit; the history
-strays from the record's displacement by more than 10 % of its span; the
-friction shows no velocity dependence (an F test against constant friction,
-plus the trends when fitted); chi-square_r > 2 with a linear drift in slip and
-time explaining > 20 % of the residuals (a drift the model misses); or a, b or
-Dc is not constrained (at a bound of its range, no standard error, or known
-only to within a factor e).  Unconstrained parameters show no interval, with a
-note saying why.
+The model of a record (the spring-slider of :mod:`stickslip.rsf.solver` driven by the record's load-point
+history, steady at its first velocity, which is ``V0``), what is free, the two noise estimates, the intervals and
+when a fit is ``failed`` with a ``reason``: docs/rsf.md, "Fitting lab records".
 """
 
 from __future__ import annotations

@@ -1,33 +1,9 @@
-r"""State evolution laws of rate-and-state friction, all in one place.
+"""State evolution laws of rate-and-state friction, all in one place.
 
-Every law is written for the *state term* ``psi = ln(V0 theta / Dc)`` (the
-friction is ``mu = mu0 + a ln(V/V0) + sum_i b_i psi_i``), with ``x = ln(V/V0)``:
-
-=========  ==========================================  ===========================================
-law        d theta/dt                                   d psi/dt
-=========  ==========================================  ===========================================
-aging      1 - V theta/Dc                               (V0/Dc) (e^-psi - e^x)
-slip       -(V theta/Dc) ln(V theta/Dc)                 -(V0/Dc) e^x (x + psi)
-prz        1 - (V theta/(2 Dc))^2                        (V0/(2 Dc)) (e^-psi - e^(2x + psi))
-nagata     1 - V theta/Dc - (c/b) theta dmu/dt           aging - (c/b) dmu/dt
-=========  ==========================================  ===========================================
-
-(PRZ uses theta = (2 Dc/V0) e^psi, so that theta_ss = 2 Dc/V as in Perrin, Rice
-and Zheng 1995 and in rsfmodel.)  In steady state psi = -x for every law.
-
-The *cut-off velocity* friction form (QDYN's ``FRICTION_MODEL = 'cut-off
-velocity'``, after Okubo 1989 and Dieterich 1981) changes the friction, not the
-laws: ``mu = mu0 - a ln(V1/V + 1) + sum_i b_i ln(V2 theta_i/(s Dc_i) + 1)``
-(s = theta_scale, 1 for aging and slip), i.e. with ``l1 = ln(V1/V0)`` and
-``l2 = ln(V2/V0)``: ``mu = mu0 - a sp(l1 - x) + sum_i b_i sp(psi_i + l2)``
-where ``sp(z) = ln(1 + e^z)``.  :class:`CutoffForm` evaluates it.
-
-Adding a law touches one place: subclass :class:`StateLaw` (or write any object
-with the same attributes) and call :func:`register_law`; ``stickslip rsf
-simulate --law NAME`` and :func:`stickslip.rsf.simulate` then know it.  A law
-returns ``d psi/dt`` *without* the ``dmu/dt`` coupling and its two partial
-derivatives (used in the solver's analytic Jacobian); a law whose rate depends
-on ``dmu/dt`` linearly (as Nagata's) says so with :meth:`StateLaw.coupling`.
+Every law is written for the state term ``psi = ln(V0 theta / Dc)`` with ``x = ln(V/V0)`` and returns ``d psi/dt``
+*without* the ``dmu/dt`` coupling, with its two partial derivatives (the solver's analytic Jacobian); a law linear
+in ``dmu/dt`` (Nagata's) gives its coefficient by :meth:`StateLaw.coupling`.  :class:`CutoffForm` is the cut-off
+velocity friction.  The laws' table, the cut-off form and adding a law (:func:`register_law`): docs/rsf.md, "Laws".
 """
 
 from __future__ import annotations

@@ -1,20 +1,10 @@
 """The spring-slider driven by a loading protocol, integrated in log V and log theta.
 
-Each protocol segment is integrated on its own, with the segment's load-point
-velocity held fixed in the right-hand side, so the solver never steps across a
-velocity change: it stops exactly there and restarts from the state it reached.
-With ``every`` the trace is sampled on a uniform grid by the solver's own
-interpolant (ODEPACK LSODA through ``scipy.integrate.odeint``, analytic
-Jacobian); without it the trace holds the solver's own adaptive steps
-(``solve_ivp`` LSODA).  Both switch between non-stiff and stiff methods.
-The regime is read off the accepted steps of the last segment whatever the
-sampling (with a grid, that segment is integrated a second time for its
-steps), its extremes placed by the solver restarted from the step before.
-
-A quasi-static slider (no radiation damping, no mass) can reach infinite slip
-rate in finite time.  Such a run stops where the slip rate passes
-:data:`BLOW_UP_FACTOR` times the fastest driving velocity and says so in
-``status``/``message``; it never returns the solver's garbage.
+Each protocol segment is integrated on its own (the solver stops exactly at a velocity change and restarts from
+the state it reached), by LSODA with the analytic Jacobian: ``odeint`` on a uniform grid with ``every``, else
+``solve_ivp`` at its own steps.  The regime is read off the last segment's accepted steps whatever the sampling.
+A run whose slip rate passes :data:`BLOW_UP_FACTOR` times the fastest driving velocity stops and says so in
+``status``/``message`` (docs/rsf.md, "Spring–slider").
 """
 
 from __future__ import annotations

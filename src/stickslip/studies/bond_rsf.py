@@ -1,33 +1,10 @@
 """The bond model and rate-and-state friction on the same experiments (``stickslip compare``): a study.
 
-It runs the bond model through the model interface, so it sits above the engines, not inside one
-(docs/architecture.md).
-
-The bond-model side is one small pluggable function, :func:`bond_response`: it
-uses the time-dependent bond model (``stickslip.transient.run_transient``) when
-asked for and importable, and otherwise the quasi-static model:
-``steady_state`` under velocity control (its response to a velocity change is
-instantaneous: the steady curve has no state, so there is no transient to
-compare, and a hold has no steady value) and ``simulate`` (the jump cycle)
-under block control.  ``BondTrace.note`` says which was used, in words.
-
-Friction on both sides is stress over the critical stress sigma_c of the bond
-model (Eq 9), so the two share one axis.  ONE set of RSF parameters stands for
-the bond model in every panel (:func:`rsf_of_bond`), fitted to the velocity
-step the bond model actually makes:
-
-* the quasi-static model jumps at once to the new steady stress, so its step
-  is exactly a rate-only law: a = (mu1 - mu0)/ln(V1/V0), b = 0, and Dc has no
-  effect (it is not determined; it is set to the bond's dl_m and said so);
-* the time-dependent model's step is fitted by :func:`stickslip.rsf.fit.fit_record`
-  with the protocol given (the compare command knows it).
-
-Negative friction has no physical meaning, so a parameter set with a < 0,
-b < 0 or Dc <= 0 is reported as a **failed** fit (with the values the fit
-wanted), not used; and a panel in which the RSF friction goes below zero is
-reported as failed there (:func:`check_friction`).  We report rather than
-constrain: a fit pinned at b = 0 by a bound would not describe the step either,
-and the reason (e.g. "the step rises without a direct effect") is the finding.
+It runs the bond model through the model interface, so it sits above the engines (docs/architecture.md).
+:func:`bond_response` runs the time-dependent bond model when asked for, otherwise the quasi-static one
+(``BondTrace.note`` says which); friction on both sides is stress over sigma_c (Eq 9); one RSF set
+(:func:`rsf_of_bond`) stands for the bond model in every panel, and a set or panel with negative friction is
+reported as failed (:func:`check_friction`).  How and why: docs/rsf.md, "Side by side with the bond model".
 """
 
 from __future__ import annotations

@@ -1,18 +1,9 @@
-"""A rate-and-state reading of the bond model's velocity steps (issue 22 question 3; docs/extensions.md section 3).
+"""A rate-and-state reading of the bond model's velocity steps (docs/extensions.md section 3).
 
-The time-dependent bond model (:func:`stickslip.transient.run_transient`) is driven through velocity steps under
-velocity control from steady sliding.  Its stress over sigma_c is the friction of a record, sampled uniformly in
-slip (as a rig logging at a fixed rate per micrometre would, so the reading does not depend on where the solver
-happened to step): the solver's accepted steps are interpolated by a cubic spline within each segment, over
-``lead`` of slip before each change and ``window`` after it (the response is over within about Delta l_m).
-
-:func:`read_step` fits it with the package's own :func:`stickslip.rsf.fit.fit_record`, the protocol given, one
-or two state variables of the aging or slip law and the rig stiffness free (the bond model's stress rises over
-the slip that stretches its bonds; a rigid RSF rig would make that rise instantaneous).  A model's output has no
-noise: the fits are judged at a stated precision, :data:`STEP_PRECISION` of the record's
-friction range.  Which law describes the steps is read off the rms misfit against that precision, the structure
-of the residuals (lag-one autocorrelation near 1: a systematic misfit, not noise), the F test of two states
-against one, and whether the fitted values stay put when the step changes.
+The time-dependent bond model's stress over sigma_c through velocity steps, sampled uniformly in slip, is fitted
+by :func:`read_step` with :func:`stickslip.rsf.fit.fit_record` (one or two states, aging or slip law, the rig
+stiffness free) at a stated precision, :data:`STEP_PRECISION` of the record's friction range; the measures that
+say which law describes the steps are in the docs section.
 """
 
 from __future__ import annotations
