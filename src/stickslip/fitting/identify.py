@@ -1,22 +1,9 @@
-r"""What steady friction data can and cannot determine (docs/fitting.md).
+"""What steady friction data can and cannot determine (docs/fitting.md).
 
-In the dimensionless form of Eqs 6-8 (see :mod:`stickslip.quasistatic.steady`)
-
-    sigma(V) = S j / (V/c + i),   i, j functionals of  T = u0 c / V,  a,  alpha = (b/V) e^{-V/Va},
-
-with S = M N0 dl_m, c = dl_m/tau, a = lambda M dl_m/kT, b = dl_m/tau_a.  So
-sigma(V) depends on the nine bond and aging parameters only through six
-*combinations* (S, c, a, u0, b, Va): their logarithms are linear in the
-logarithms of the parameters, with the integer exponents of
-:data:`COMBINATIONS`.  A set of free parameters can be fitted only if the
-matrix of exponents restricted to them has full column rank; otherwise the
-fit would move along an exact degeneracy, such as dl_m, tau, tau_a -> s
-times, lambda M/kT and M N0 -> 1/s times.
-
-Beyond these exact degeneracies the data may leave a direction only weakly
-constrained (in the paper's velocity range the bonds break long before full
-extension, so the FENE strength ``a`` is barely seen): :func:`undetermined`
-finds such directions from the fit's covariance.
+sigma(V) depends on the nine bond and aging parameters only through six *combinations* (:data:`COMBINATIONS`,
+integer exponents of the parameters).  A set of free parameters can be fitted only if the matrix of exponents
+restricted to them has full column rank; beyond these exact degeneracies :func:`undetermined` finds the
+directions the fit's covariance leaves weakly constrained.
 """
 
 from __future__ import annotations

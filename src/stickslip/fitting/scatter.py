@@ -1,23 +1,8 @@
 """The noise of a steady curve estimated without the model: the scatter between neighbouring points.
 
-A fit that ends far from the data and then estimates the noise from its own
-residuals will call any curve noisy, and then find "no velocity dependence"
-in a stress that varies by a factor of 3 (issue 27 item 8).  The tests of
-the steady fit therefore measure the noise without the model, from the
-pseudo-residuals of Gasser, Sroka and Jennen-Steinmetz (Biometrika 73, 625,
-1986): each interior point against the straight line through its two
-neighbours (in ln V),
-
-    d_i = y_i - (w_l y_{i-1} + w_r y_{i+1}),   var d_i = e_i^2 + w_l^2 e_{i-1}^2 + w_r^2 e_{i+1}^2  (times s^2),
-
-with y = ln(stress) and unit e when the noise is relative and unknown, or
-y = stress and e = stress_err when errors are stated (then s^2 ~ 1 if they
-are right).  The curve's own curvature adds to d_i, so the estimate errs
-on the large side: tests against it are conservative (slower to call a
-misfit, slower to call a velocity dependence).  The d_i are correlated
-(neighbours share points); s^2 = (1/m) sum d_i^2/var_i is the quadratic form
-e^T A e of the noise, whose Satterthwaite degrees of freedom are
-tr(A)^2 / tr(A^2) (Gaussian noise), about (n - 2)/1.9 for even spacing.
+The pseudo-residuals of Gasser, Sroka and Jennen-Steinmetz (each interior point against the straight line
+through its two neighbours in ln V), with Satterthwaite degrees of freedom, so the steady fit's tests do not
+take the noise from a fit that may have ended far from the data (docs/fitting.md).
 """
 
 from __future__ import annotations

@@ -1,23 +1,9 @@
-r"""Stick times of many stick phases at once (the stick fit's inner loop).
+"""Stick times of many stick phases at once (the stick fit's inner loop).
 
-Eq 15 for one stick phase, in the variables of :mod:`stickslip.quasistatic.stick`:
-n = Nc/Nc0, dn/dt = -r n exp((s0 + k t)/n - t/tau_a).  As there, the
-equation is integrated in the arc-length-like variable theta,
-
-    dt'/dtheta = 1/(1 + w),   dn/dtheta = -w/(1 + w),   w = r T n exp((s0 + k t)/n - t/tau_a),
-
-(t' = t/T), which is regular both while the chains hold and through their
-collapse; past n = 0 the field is (0, -1), its limit, so no event location is
-needed: t_s is t' T once n < 0.
-
-:func:`stickslip.quasistatic.stick.stick_phase` solves one phase with scipy's
-adaptive Runge-Kutta at rtol 1e-11, with the stuck-for-ever proof and the
-full trajectory.  A fit needs only t_s, for every row and every perturbed
-parameter set of a Jacobian: here all of them advance together, each with
-its own step size, in a vectorised Dormand-Prince 5(4) pair (rtol 1e-9).
-Phases that have not slipped by their ``horizon`` get NaN (the fit treats
-them as "far too long"); nothing is claimed about them.  Tested against
-``stick_phase`` and the constant-load closed form t_s = E1(s0)/r.
+Eq 15 of every row and every perturbed parameter set of a Jacobian, in the arc-length-like variable of
+:mod:`stickslip.quasistatic.stick`, advances together in a vectorised Dormand-Prince 5(4) pair (rtol 1e-9), each
+phase with its own step; past n = 0 the field is (0, -1), so t_s needs no event location.  A phase that has not
+slipped by its ``horizon`` gets NaN (the fit reads "far too long"); nothing is claimed about it (docs/fitting.md).
 """
 
 from __future__ import annotations

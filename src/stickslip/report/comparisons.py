@@ -1,26 +1,8 @@
 """The comparison table: each number the paper states beside the value computed here, and what the difference is.
 
-relative_difference = (computed - paper) / |paper| (None where the paper's
-unit has another dimension: "units differ").  Every row is put in one class
-(:data:`CLASSES`), decided in this order:
-
-1. **input**: the computed value is the paper's own input handed back (a
-   parameter, or arithmetic on the paper's numbers such as 0.766 or
-   slope/(0.766 V0)) and matches it.  An echo that does not match is a
-   **paper error**: the paper's unit or arithmetic is wrong.
-2. **agrees**: |relative difference| <= :data:`TOLERANCE`.
-3. **scatter**: a measurement whose computed value lies inside the band the
-   paper states ("259 ± 5 Pa", "0.4 kPa") or shows (the cycles at the same
-   V0 that it calls the same, widened by the tolerance).
-4. otherwise **model limitation**: the model, with the paper's stated
-   inputs, does not give the number (the erratum entry says why, e.g. the
-   nominal stiffness below the measured one, or aging before shearing that the
-   model lacks); or **paper error**, but only where the paper contradicts
-   itself, which the row states (:data:`~.paper.PAPER_CONTRADICTIONS`).  The
-   size of a difference never makes it the paper's error: a difference between
-   the model and a measurement is the model's, not the paper's.
-
-Every row carries its reason in words (:func:`class_reason`).
+relative_difference = (computed - paper) / |paper| (None where the units differ).  Every row is put in one class
+of :data:`CLASSES` (input, agrees within :data:`TOLERANCE`, scatter, model limitation or paper error, decided in
+that order: docs/report.md, "Classes, and the headline") and carries its reason in words (:func:`class_reason`).
 """
 
 from __future__ import annotations

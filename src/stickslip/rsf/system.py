@@ -1,19 +1,8 @@
-r"""The spring-slider's equations in log variables: right-hand side and analytic Jacobian.
+"""The spring-slider's equations in log variables: right-hand side and analytic Jacobian.
 
-The unknowns are ``x = ln(V/V0)`` and the state terms ``psi_i = ln(V0 theta_i/Dc_i)``
-(plus ``s``, the spring's pull in friction units, when the slider has mass).
-Without inertia the spring balances friction plus radiation damping,
-``k (V_lp - V) = dmu/dt + eta dV/dt``; with ``mu = mu0 + a x + sum b_i psi_i``
-and ``d psi_i/dt = g_i + h_i dmu/dt`` (h_i = 0 except for Nagata's law):
-
-    dx/dt = ((1 - H) k (V_lp - V) - G) / (A + (1 - H) eta V),
-    dmu/dt = (A dx/dt + G) / (1 - H),    G = sum B_i g_i,  H = sum B_i h_i,
-
-where A = dmu/dx and B_i = dmu/dpsi_i (a and b_i for the classical form;
-state-dependent for the regularised asinh form; A = a V1/(V1 + V) and
-B_i = b_i/(1 + (V0/V2) e^-psi_i) for the cut-off velocity form, which takes no
-dmu/dt coupling, H = 0).  With a mass m per area and
-normal stress sigma, ``m dV/dt = sigma (s - mu - eta V)`` and ``ds/dt = k (V_lp - V)``.
+The unknowns are ``x = ln(V/V0)`` and the state terms ``psi_i = ln(V0 theta_i/Dc_i)`` (plus ``s``, the spring's
+pull in friction units, when the slider has mass); the equations, with A = dmu/dx, B_i = dmu/dpsi_i of each
+friction form and the ``dmu/dt`` coupling of Nagata's law: docs/rsf.md, "Spring–slider".
 """
 
 from __future__ import annotations

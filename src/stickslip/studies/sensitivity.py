@@ -1,20 +1,10 @@
-"""Issue 22 Q2: how much do the predictions rest on the aging parameters tau_a and V_a?
+"""How much do the predictions rest on the aging parameters tau_a and V_a? (docs/extensions.md section 2)
 
-The steady curve constrains tau_a and V_a only loosely (and together with N0 and tau).  This module takes
-the joint fit of Eqs 6-8 to the shipped steady curve (``synthetic_steady.csv``: the paper's parameters with
-2 % noise, the only steady curve the package ships), draws the boundary of the region of (tau_a, V_a) the
-data allow at 95 % (Delta chi^2 = 5.99 for two parameters, the other free parameters profiled out), and
-recomputes the predictions there:
-
-* quasi-static (cheap, in the report): Vc and sigma_c (Eq 9), the first stick at 100 um/s from rest and
-  from sigma_c through the paper's block (stick time and sigma_s, Eqs 11-17);
-* linear stability of Eq 1 (seconds each): Kc at V0 = 100 and 120 um/s and V*, the V0 where Kc = K;
-* slide-hold-slide through the block with the stick chains (minutes each): the peak on re-pulling.
-
-The profile is linearised (:func:`region_points` with ``refit=False``: the other free parameters follow
-their conditional mean given (tau_a, V_a) under the fit's covariance) or exact (``refit=True``: the steady
-fit rerun with tau_a and V_a fixed); :func:`chi_square` checks where each point really lies.
-docs/extensions.md section 2; ``scripts/sensitivity_table.py`` regenerates the slow numbers.
+The joint steady fit's 95 % region of (tau_a, V_a), with the predictions recomputed on its boundary.  The profile
+is linearised (:func:`region_points` with ``refit=False``: the other free parameters follow their conditional
+mean given (tau_a, V_a) under the fit's covariance) or exact (``refit=True``: the steady fit rerun with tau_a and
+V_a fixed); :func:`chi_square` checks where each point really lies.  ``scripts/sensitivity_table.py`` regenerates
+the slow numbers.
 """
 
 from __future__ import annotations

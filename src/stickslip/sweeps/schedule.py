@@ -1,19 +1,8 @@
 """When a sweep's points run: the dearest first, in tasks that shrink toward the end (guided self-scheduling).
 
-A worker that takes a long task last keeps every other worker idle until it
-ends; a sweep whose few expensive points (stick-slip cycles at a stiff block)
-sit anywhere in grid order ends on one of them.  The plan sorts the points by
-their estimated cost, longest first, and cuts the sorted list into tasks of at
-most ``1 / (factor x workers)`` of the work not yet planned: large tasks while
-much is left (few round trips), single points at the start (the dear ones) and
-ever smaller tasks at the end, so the workers finish together.  With factor
->= 2 and exact costs the plan run by list scheduling (each free worker takes
-the next task) ends within (4/3 - 1/(3 workers)) of the optimum, LPT's bound:
-a task of several points costs at most 1/(factor x workers) of what remains
-after it, so it cannot end past the mean load, and a single point is LPT's.
-
-Only *when* a point runs changes: every point is computed alone from the
-specification, and the rows are written chunk by chunk in point order.
+The points sorted by estimated cost, longest first, are cut into tasks of at most ``1 / (factor x workers)`` of
+the work not yet planned, so the workers finish together (within LPT's bound for factor >= 2: docs/sweep.md).
+Only *when* a point runs changes: every point is computed alone and the rows are written in point order.
 """
 
 from __future__ import annotations

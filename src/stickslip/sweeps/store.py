@@ -1,20 +1,8 @@
 """The output folder of a sweep: a manifest, one Parquet chunk per finished batch, a ledger of the chunks.
 
-``OUT/_manifest.json`` holds the specification, the package version and the
-batch size; ``OUT/part-000123.parquet`` holds batch 123; ``OUT/_chunks.jsonl``
-records, for every chunk written, its points, rows, size and SHA-256.  Each
-chunk appears under its name only when whole (written under a temporary
-``.part-...`` name, recorded in the ledger, then renamed), so resuming is "run
-the batches whose chunk is missing or fails its check": after ``kill -9`` at
-any moment nothing is lost, nothing is duplicated and nothing is
-half-written, and a chunk damaged afterwards (truncated, replaced, from
-another batch size) is found, removed, recomputed and reported.
-
-One process writes a folder at a time: it holds an exclusive ``flock`` on
-``OUT/.stickslip.lock`` (released by the kernel when the process ends, even
-by ``kill -9``), and a second writer is refused in one line.  Parquet readers
-skip names that start with ``_`` or ``.``, so ``pandas.read_parquet(OUT)``
-reads exactly the finished rows.
+A chunk appears under its name only when whole and is recorded with its SHA-256, so resuming runs the batches
+whose chunk is missing or fails its check; one process writes a folder at a time (``flock`` on
+``OUT/.stickslip.lock``).  The layout and what survives ``kill -9``: docs/sweep.md.
 """
 
 from __future__ import annotations
