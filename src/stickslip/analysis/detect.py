@@ -1,19 +1,8 @@
 """Coarse segmentation of a stress record into stick rises and slip drops.
 
-This step only has to find *where* the phases are, to a few samples; the
-numbers reported per cycle come from the fits of :mod:`.cycles`.
-
-1. The noise level is the robust (MAD) scatter of each sample about the
-   straight line through its two neighbours, scaled for white noise -- valid
-   for jittered sampling and blind to the linear stick phases.
-2. The record is resampled on a uniform grid (bridging NaN gaps) and
-   median-filtered, which keeps the drops sharp and removes spikes.
-3. Drop events are the peaks of that curve whose topographic prominence
-   exceeds :data:`PROMINENCE_SIGMAS` noise levels; between two peaks the
-   lowest point is the trough where the next stick began.
-4. After the last peak the record either rises again (a stick cut by the end
-   of the record), is still falling (a slip cut by the end), or has settled
-   into a flat stretch longer than the stick phases: steady sliding.
+This step only finds *where* the phases are, to a few samples (the numbers per cycle come from :mod:`.cycles`):
+a robust noise level, a median-filtered uniform resampling, drops as peaks of prominence above
+:data:`PROMINENCE_SIGMAS` noise levels, and what the record does after its last peak (docs/analysis.md).
 """
 
 from __future__ import annotations

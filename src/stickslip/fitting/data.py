@@ -1,19 +1,8 @@
 """Measurement files for fitting: steady friction curves and stick-phase tables.
 
-Both are CSV files with a header row; units go in brackets after the column
-name (``velocity [um/s]``), a bare name means SI, and lines starting with
-``#`` are comments.  Every problem is a :class:`~stickslip.errors.DataError`
-naming the file, the row (the header is row 1) and the column.
-
-Steady data (``stickslip fit steady``): ``velocity``, ``stress`` and an
-optional ``stress_err`` (one standard deviation); the other columns that
-``stickslip curve --format csv`` writes (``bonded_fraction``,
-``stress_slope``) are recognised and ignored, with a note, so that the
-curve command's output can be fitted as it is.  Stick data (``stickslip fit
-stick``): ``pulling_velocity``, ``stick_time`` and optional ``peak_stress``,
-``start_stress``; the other columns of the paper's Table 1 (``cycle``,
-``stick_slope``, ``stiffness``, ``jump_velocity``) are recognised and kept but
-not used by the fit.
+CSV with a header row, units in brackets after the column name (a bare name is SI), ``#`` comments; the columns
+of each kind, and those recognised and ignored: docs/fitting.md.  Every problem is a
+:class:`~stickslip.errors.DataError` naming the file, the row (the header is row 1) and the column.
 """
 
 from __future__ import annotations

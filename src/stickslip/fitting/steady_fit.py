@@ -1,19 +1,9 @@
 """Fit the steady friction curve (Eqs 6-8) to measured stress against velocity (paper, Section 3).
 
-Methods:
-
-* ``two-step`` (the paper's): above the split velocity (800 um/s) the aging
-  term is dropped and N0, tau and the force sensitivity are fitted (u0 = 1
-  and dl_m fixed); then below it tau_a and V_a are fitted with those held.
-  The covariance of step 2 includes the propagated uncertainty of step 1.
-* ``joint``: every free parameter at once on all points with aging, started
-  from the two-step result.
-
-What the data cannot determine is fixed, with a message, rather than fitted
-(:mod:`stickslip.fitting.identify`): exact degeneracies of sigma(V) before the
-fit, and directions with a standard deviation above a factor e after it.
-Vc and sigma_c (Eq 9) come with intervals by propagation (``delta``), by the
-profile likelihood (``profile``) or by a parametric bootstrap (``bootstrap``).
+Methods ``two-step`` (the paper's: no aging above the split velocity, then tau_a and V_a below it) and ``joint``
+(every free parameter at once, from the two-step result).  What the data cannot determine is fixed with a message
+(:mod:`stickslip.fitting.identify`); Vc and sigma_c (Eq 9) come with ``delta``, ``profile`` or ``bootstrap``
+intervals (docs/fitting.md).
 """
 
 from __future__ import annotations

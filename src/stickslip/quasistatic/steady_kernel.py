@@ -1,15 +1,8 @@
 """The steady-state march (:func:`stickslip.quasistatic.steady._march`) compiled by numba, one velocity at a time.
 
-The numpy march advances all velocities together as arrays; on wide batches
-(a curve of 1000 velocities) its cost is that of ~40 array passes per panel
-over (16, n) temporaries and of the width search's many small arrays.  Here
-each velocity is marched on its own in compiled loops: the same panels (the
-width search below is the numpy one's, lane by lane, test by test), the
-same nodes, the same sums, so the two agree to rounding (~1e-15; tested in
-tests/test_steady_speed.py).  Compiling takes ~2 s once; numba caches the
-machine code on disk, and loading numba and the cache costs ~0.2 s per
-process, so :mod:`stickslip.quasistatic.steady` uses this only for wide batches
-(COMPILED_LANES velocities or more).
+The same panels, nodes and sums as the numpy march, lane by lane, so the two agree to rounding (~1e-15;
+tests/test_steady_speed.py); :mod:`stickslip.quasistatic.steady` uses it for batches of ``COMPILED_LANES``
+velocities or more, where it pays for loading numba (docs/steady-state.md).
 """
 
 from __future__ import annotations

@@ -1,16 +1,8 @@
 """The report's section on the full time-dependent model (Eq 1), which the paper never solves.
 
-Three runs of the ``transient`` model with the paper's parameters, each
-beside what the paper's quasi-static picture predicts (docs/transient.md
-section 7 has the numbers at tighter tolerances); every run goes through the
-model interface (:func:`stickslip.models.get_model` ``.run`` with a ``Rig``),
-the figure's per-cycle numbers from each Run's ``native`` result:
-
-* a step down from steady sliding at 350 µm/s to 100 µm/s through the Eq 17
-  block, with Eq 1 alone and with the paper's stick chains, against
-  the ``quasi-static`` model;
-* velocity steps 100 → 1000 → 100 µm/s under velocity control;
-* slide–hold–slide: the peak on re-sliding against the hold time.
+Three runs of the ``transient`` model through the model interface, each beside what the paper's quasi-static
+picture predicts: a step down from steady sliding through the Eq 17 block, velocity steps under velocity control,
+and slide-hold-slide (docs/transient.md section 7).
 """
 
 from __future__ import annotations

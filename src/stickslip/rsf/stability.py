@@ -1,18 +1,8 @@
-r"""Linear stability of steady sliding: critical stiffness and the period at the Hopf point.
+"""Linear stability of steady sliding: critical stiffness and the period at the Hopf point.
 
-Perturbing steady sliding at V (L = Dc/V, M = m V/sigma, a' = a + eta V) for one
-state variable with the aging, slip or PRZ law (identical to first order) gives
-
-    M L lam^3 + (M + a' L) lam^2 + (k V L + a' - b) lam + k V = 0,
-
-whose Hopf point (docs/rsf.md) is
-
-    k_c = ((b - a')/Dc) (1 + m V^2/(sigma a' Dc)),   T = 2 pi (Dc/V) sqrt(a'/(b - a')),
-
-i.e. the familiar sigma (b - a)/Dc and 2 pi (Dc/V) sqrt(a/(b - a)) without damping
-and mass.  For several state variables or Nagata's law k_c is found numerically:
-the stiffness at which the largest real part of the Jacobian's eigenvalues at
-steady state crosses zero (bisection in log k).
+One aging, slip or PRZ state has the closed form k_c = ((b - a')/Dc) (1 + m V^2/(sigma a' Dc)) (a' = a + eta V);
+several states or Nagata's law: the stiffness at which the largest real part of the Jacobian's eigenvalues
+crosses zero (bisection in log k).  The derivation: docs/rsf.md, "Stability".
 """
 
 from __future__ import annotations

@@ -1,17 +1,8 @@
 """Running a sweep on dask.distributed: batches of points as tasks, chunks written as they finish.
 
-The client keeps a bounded window of batches in flight (a few per worker
-thread) and submits the next one whenever one finishes, so neither the
-client, the scheduler nor any worker ever holds more than a window of
-results: a 10^7-point sweep needs no more memory than a 10^3-point one.
-Each finished batch goes straight to its Parquet chunk.
-
-The tasks are planned by cost (:mod:`stickslip.sweeps.schedule`): the points of
-the chunks still to run, a group of at most :data:`PLAN_POINTS` at a time, are
-submitted dearest first by the model's own estimate, in tasks that shrink toward
-the end; a chunk is written once all its points have come back, its rows in
-point order, so the files are those of the plain order (``schedule="given"``:
-one task per chunk, in point order).
+A bounded window of batches is in flight, so no process holds more than a window of results; tasks are planned
+by cost (:mod:`stickslip.sweeps.schedule`, a group of at most :data:`PLAN_POINTS` at a time), and a chunk is
+written once all its points are back, its rows in point order (docs/sweep.md).
 """
 
 from __future__ import annotations
