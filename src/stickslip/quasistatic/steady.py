@@ -238,20 +238,11 @@ def _log_hazard_and_slope(x: np.ndarray, y: np.ndarray, s: _Scales) -> tuple[np.
 def _panel_width(x: np.ndarray, y: np.ndarray, s: _Scales, q: QuadratureSettings) -> tuple[np.ndarray, np.ndarray]:
     """(width of the next panel at left end x (y = 1 - x), lanes where the survival steps to 0 there).
 
-    A panel [x, x+w] is good when it is resolved (|L'| w <= q.log_hazard_step and
-    e^L w <= q.hazard_step) or negligible (e^L w <= q.negligible_hazard).  L is
-    convex, so |L'| and e^L are largest at an end of the panel and testing both
-    ends decides; both tests only get harder as w grows, so the good widths
-    form an interval (0, w*].  The width returned is good and within
-    WIDTH_RATIO of w* (or the widest allowed panel: q.widest_panel, and
-    q.end_ratio * y towards x = 1): a galloping search and bisection on ln w
-    run until the bracket is that tight, however many orders of magnitude it
-    spans (a deep aging dip followed by the FENE cliff puts w* hundreds of
-    e-folds below the widest panel; a fixed number of bisections there used to
-    stop the march in mid-dip, issue 12).  When not even STEP_ULPS ulps of the
-    position are good, the hazard explodes within them (FENE and aging terms
-    ~1e50 cancelling): the survival is a step there, exact to ~STEP_ULPS ulps
-    of x, and the lane is flagged.
+    A panel is good when resolved (|L'| w <= q.log_hazard_step and e^L w <= q.hazard_step) or negligible
+    (e^L w <= q.negligible_hazard); L is convex, so testing both ends decides, and the good widths form an interval
+    (0, w*].  The width returned is good and within WIDTH_RATIO of w* (or the widest allowed panel), by a galloping
+    search and bisection on ln w run until the bracket is that tight.  When not even STEP_ULPS ulps of the position
+    are good the survival is a step there and the lane is flagged (docs/steady-state.md, section 2).
     Everything is done on logarithms: no exponential can overflow.
     """
     log_widest = np.log(np.minimum(q.widest_panel, q.end_ratio * y))
@@ -548,14 +539,8 @@ def _tail_negligible(
 ) -> np.ndarray:
     """True where the survival S = e^-H left at x = 1 - y can add at most q.tail_tolerance to i and to j.
 
-    S never rises, so the rest of i is at most S y.  The rest of j is the
-    hard part: with aging H can level off (a plateau down to the FENE cliff)
-    while x S/(1 - x^2) grows towards x = 1, and when the survival fell
-    early (x ~ 1/T) j is tiny, so a plateau at S ~ 1e-17 can still carry
-    1e-3 of j.  Beyond 1 - y_c, y_c = a/(3(alpha + |ln T| + 50)), L >= 50
-    (there x/(1+x) >= 1/3) and the survival dies at once; before it,
-    int x/(1-x^2) <= ln(1/y_c)/2.  So the rest of j is at most
-    S (ln(1/y_c)/2 + 1).
+    The rest of i is at most S y and the rest of j at most S (ln(1/y_c)/2 + 1), y_c = a/(3(alpha + |ln T| + 50));
+    why (a plateau of the survival with aging can carry much of j): docs/steady-state.md, "Where the march stops".
     """
     y_c = np.minimum(y, np.maximum(s.a, _TINY) / (3.0 * (s.alpha + np.abs(s.log_t) + _CLIFF_LOG_HAZARD)))
     room_i = np.log(np.maximum(q.tail_tolerance * i, _TINY)) - np.log(y)

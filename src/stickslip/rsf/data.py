@@ -1,20 +1,9 @@
 """Lab records for rate-and-state fits: delimited text as rigs write it, and the load-point history.
 
-A record has time, load-point displacement and friction.  Columns are found
-by name: the package's own trace CSV (``time``, ``load_point_position`` of the Run CSV or the older
-``load_point_displacement``, ``friction``), or any header mapped with ``columns={"time": "Time(s)",
-"displacement": "Displ(microns)", "friction": "Friction"}``.  A header that names
-its unit (``Displ(microns)``, ``LP Displacement (um)``, ``disp [µm]``, ``time_ms``)
-is read in it; else ``displacement_unit`` / ``time_unit``; else metres and seconds.
-A record without a displacement column but with the load point's velocity
-(``load_point_velocity``, ``velocity`` or a mapped ``velocity=...``) has it
-integrated into the displacement, each row's velocity holding from that row on.
-Tab, comma, semicolon or whitespace separated; ``#`` comments are skipped.
-
-The load point's velocity history comes from the displacement record:
-:func:`find_segments` finds its velocity levels (change points under a measured
-noise model, then a test of each change), or :func:`measured_history` follows the
-smoothed displacement itself with a few hundred short segments.
+A record has time, load-point displacement (or the load point's velocity, integrated) and friction, its columns
+found by name or mapped with ``columns={...}``, each in the unit its header names, else ``displacement_unit`` /
+``time_unit``, else SI.  The history comes from the displacement: :func:`find_segments` (velocity levels) or
+:func:`measured_history` (the smoothed displacement).  How each works: docs/rsf.md, "Reading a record".
 """
 
 from __future__ import annotations
@@ -302,11 +291,7 @@ def _refuse_implausible_speed(record: LabRecord, column: str, written: tuple[flo
 
 
 def _integrated(time: np.ndarray, velocity: np.ndarray, path: Path) -> np.ndarray:
-    """Displacement from the load point's velocity column (in SI).
-
-    A rig writes the velocity it commands from that row on: row i's velocity holds on [t_i, t_(i+1)), so a step
-    whose first row is at t = 50.0 s starts at 50.0 s (trapezoids between rows put it half a row early).
-    """
+    """Displacement from the load point's velocity column (in SI): row i's velocity holds on [t_i, t_(i+1))."""
     bad = ~np.isfinite(velocity)
     if bad.any():
         raise DataError(f"{path}: row {int(np.argmax(bad)) + 1}: velocity is not a finite number")
@@ -325,19 +310,9 @@ def find_segments(
 ) -> Protocol:
     """The load point's piecewise-constant velocity history from its displacement record.
 
-    1. The record is averaged in equal TIME bins (at most :data:`SEARCH_BINS`), so a sampling rate that changes
-       mid-record changes only how many rows a bin holds.
-    2. Each bin's noise is measured, not assumed (:func:`_noise_model`): residuals of straight lines over a
-       fixed span, white and row-independent parts, at least q^2/12 per row for a quantisation step q.
-    3. How much more neighbouring stretches' velocities differ than that noise says, stretch length by stretch
-       length (:func:`_slope_inflation`: correlated noise, wander, drift), is measured too.
-    4. PELT (Killick et al. 2012: the optimal segmentation into straight pieces under a penalty per piece,
-       here ``4 ln n`` times the short-scale inflation) proposes changes.
-    5. A change is dropped, weakest first, while the two pieces' velocities are within ``sqrt(2 ln n) + 2``
-       inflated standard errors of each other, differ by less than ``min_change`` (relative), or a piece is
-       shorter than ``min_points`` rows or ``min_duration`` seconds (default: five bins).
-    6. Each remaining change is placed on its best row of the full record and dated where the two fitted lines
-       meet (the load point's displacement is continuous).
+    Equal time bins, a measured noise model (:func:`_noise_model`, :func:`_slope_inflation`), PELT proposing
+    changes and each change tested (``min_change``, ``min_points``, ``min_duration``), then placed and dated on the
+    full record: docs/rsf.md, "Velocity levels".
 
     Raises DataError when more than ``max_segments`` pieces remain or the pieces miss the record by more than
     :data:`CURVED` times its noise (the displacement is not piecewise linear).
@@ -379,12 +354,9 @@ CHANGE_ROWS = 50
 def change_time_uncertainty(time: np.ndarray, displacement: np.ndarray, protocol: Protocol) -> np.ndarray:
     """Each interior change time's standard uncertainty (s), as the displacement dates it.
 
-    A change placed dt late moves every later displacement by dt * (v_after - v_before), so the change is dated
-    to the displacement's scatter s over the jump: sqrt(2) s / |jump| (two lines' ends, each known to about s:
-    correlated noise does not average down along a line).  s is the rows' scatter about the history within
-    :data:`CHANGE_ROWS` rows either side, each side about its own straight line.  Where the change sits halfway
-    between two rows (:func:`find_segments` puts it there when the lines meet too far away) the row spacing over
-    sqrt(12) is added in quadrature.  A change with no jump gets 0 (it changes nothing).
+    sqrt(2) s / |jump|, s the rows' scatter about the history within :data:`CHANGE_ROWS` rows either side, with the
+    row spacing over sqrt(12) added where the change sits between two rows; a change with no jump gets 0
+    (docs/rsf.md, "the change times are fitted").
     """
     t = np.asarray(time, dtype=float)
     d = np.asarray(displacement, dtype=float)
@@ -490,11 +462,8 @@ def _noise_model(
     """Each bin mean's noise variance, and how much more the velocities of neighbouring stretches differ than
     that variance says (:func:`_slope_inflation`).
 
-    Straight lines over a fixed span of bins (a fixed time span: the bins are equal in time) leave the noise
-    whatever the sampling rate or the noise's colour; a window with a change in it is an outlier the medians
-    ignore.  The variance of a bin mean is modelled as ``white / rows + floor``: white noise averages down with
-    the rows a bin holds, correlated noise and the rig's wander do not; where the sampling rate changes the two
-    parts are told apart by the bins' row counts.  The quantisation step ``q`` adds at least ``q^2 / 12`` per row.
+    The variance of a bin mean is modelled as ``white / rows + floor`` from straight lines over a fixed span of
+    bins, at least ``q^2 / 12`` per row for a quantisation step ``q`` (docs/rsf.md, "Velocity levels", step 2).
     """
     width = _NOISE_WINDOW if bt.size >= 4 * _NOISE_WINDOW else max(3, bt.size // 4)
     residual, starts = _window_residuals(bt, bd, width)
@@ -538,12 +507,9 @@ def _slope_inflation(
 ) -> tuple[np.ndarray, np.ndarray]:
     """How much more the slopes of neighbouring stretches of the record differ than the bins' variances say.
 
-    Correlated noise, the rig's wander and slow drift make the velocity of one stretch differ from the next by
-    more than independent bins allow, and the more so the longer the stretches (red noise); the record itself
-    tells by how much.  Adjacent stretches of 8, 16, 32, ... bins are fitted with straight lines and the median
-    of (s1 - 2 s2 + s3)^2 / (var1 + 4 var2 + var3) over all triples (a steady acceleration does not enter; a
-    stretch holding one of the proposed ``breaks`` is left out, so the real changes do not) is compared with
-    chi^2_1's median, 0.455.  Returns the stretch lengths (bins) and the ratios, made non-decreasing and >= 1.
+    Stretches of 8, 16, 32, ... bins against chi^2_1's median (docs/rsf.md, "Velocity levels", step 3); a stretch
+    holding one of the proposed ``breaks`` is left out.  Returns the stretch lengths (bins) and the ratios, made
+    non-decreasing and >= 1.
     """
     widths, ratios = [], []
     width = _NOISE_WINDOW
@@ -723,13 +689,9 @@ SMOOTH_PRECISION = 0.05
 def measured_history(record: LabRecord, smoothing: float | None = None) -> Protocol:
     """The load point's history as measured: its smoothed displacement, followed by piecewise-constant velocities.
 
-    Lab codes (xlook, RSFit3000) drive the model with the measured load point; this does so with a history the
-    RSF solver integrates piece by piece.  The velocity levels' changes (:func:`find_segments`) are kept as
-    kinks; between them the displacement is smoothed by local straight lines over ``smoothing`` seconds (by
-    default the window over which the record's noise leaves a line's velocity 5 % uncertain at its slower
-    speeds), never across a change, so a step is not smeared while the rig's ramps and wander are followed.
-    The smoothed curve is then cut into straight pieces where it bends (Douglas-Peucker, to the noise of one
-    bin's mean), so a steady stretch costs one segment and a transient a few; the velocities are >= 0.
+    The levels' changes stay as kinks; between them the displacement is smoothed by local straight lines over
+    ``smoothing`` seconds (default from the record's noise), never across a change, and cut into straight pieces
+    where it bends; the velocities are >= 0 (docs/rsf.md, "The measured load point").
     """
     if smoothing is not None and not (
         isinstance(smoothing, (int, float)) and math.isfinite(smoothing) and smoothing > 0

@@ -739,11 +739,8 @@ def _quiet_noise(
 ) -> tuple[np.ndarray, str]:  # fmt: skip
     """Per-row friction noise from steady sliding alone (model-independent), per sampling rate.
 
-    The variogram of the steady sliding: half the variance (outliers beyond 4 sd cut) of friction differences
-    L rows apart, within one sampling rate and one segment of the history (each segment's mean difference, its
-    drift, taken off), for L = 1, 2, 4, ...  Noise correlated over tau rows (a sensor's low-pass at 1 kHz) makes
-    it grow until L is a few tau; then it levels off at the noise variance.  The first doubling that adds less
-    than PLATEAU - 1 gives the noise; a variogram that never levels off gives its last value (and says so).
+    The variogram's plateau (the first doubling of the lag that adds less than PLATEAU - 1; a variogram that never
+    levels off gives its last value, and says so): docs/rsf.md, "Noise, independent of the sampling rate".
     Returns (noise per row, how it was had).
     """
     t, f = record.time, record.friction
@@ -812,10 +809,8 @@ def _correlation_factor(resid: np.ndarray, labels: np.ndarray) -> np.ndarray:
     """Per row, g = 1 + 2 sum of the residuals' autocorrelations (rows of one sampling rate): each row counts as
     1/g independent rows.
 
-    The autocorrelation is read as white noise plus an exponentially correlated part, rho(k) = c phi^k, from the
-    lag-one and lag-two correlations (a sensor's low-pass plus quantisation), and checked by batch means over
-    CORRELATION_BLOCKS blocks: where these say more, beyond three of their standard errors (a slower correlation
-    than the two lags see), they are taken instead.
+    From the lag-one and lag-two correlations, checked by batch means over CORRELATION_BLOCKS blocks (docs/rsf.md,
+    "Noise, independent of the sampling rate").
     """
     out = np.ones(resid.size)
     for c in np.unique(labels):
@@ -858,9 +853,8 @@ def _uncertainty(
 ) -> _Level:
     """The fit's covariance (set on ``result``) and the noise it is judged by.
 
-    Given noise: white at that level.  Otherwise the covariance is the least-squares sandwich
-    B^-1 M B^-1 (B = J^T W J, M = sum_i w_i^2 s_i^2 g_i J_i J_i^T) with the residuals' own variance s^2 and
-    correlation factor g per sampling rate; chi-square is judged against the steady sliding's scatter.
+    Given noise: white at that level; otherwise the least-squares sandwich with the residuals' own variance and
+    correlation factor per sampling rate, chi-square judged against the steady sliding's scatter (docs/rsf.md).
     """
     record = setup.record
     resid = record.friction - model
