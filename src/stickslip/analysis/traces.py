@@ -1,16 +1,8 @@
 """Measured stress-time records: reading a CSV trace and checking it.
 
-A trace file has a ``time`` column and either ``stress`` or ``force`` (the
-latter divided by a contact area), units in header brackets as everywhere in
-stickslip (``time [s],stress [Pa]``; bare names are SI).  Empty or NaN stress
-cells are gaps and are kept as NaN; times must be present, finite and never go
-back.  Two rows at one instant with different stresses are a jump (a real
-discontinuity, as ``simulate`` writes at a slip) and both are kept; a row that
-repeats the time and stress of the one before is a duplicated row and refused,
-unless it differs in another column of a model trace (then it is read once).
-The other columns the package's own traces carry (:data:`MODEL_COLUMNS`) are
-ignored, with a note; any other column is an error.  Every problem is a typed
-error naming the file and row.
+A ``time`` column and ``stress`` or ``force`` (over a contact area), units in header brackets (bare names are SI);
+gaps, jumps at one instant, duplicated rows and the package's own trace columns (:data:`MODEL_COLUMNS`, ignored
+with a note) are handled as docs/analysis.md says.  Every problem is a typed error naming the file and row.
 """
 
 from __future__ import annotations

@@ -1,12 +1,7 @@
 """Plots of a sweep: the phase diagram of two varied keys, or the results against one, with the model's boundary.
 
-Phase diagram (two keys): regimes are discrete colours; numbers a colour scale
-(logarithmic where they span decades).  A full grid is drawn as cells, anything
-else (a Latin hypercube) as points.  Failed points are grey crosses.
-
-One key (:func:`figure_sweep_1d`): the chosen result columns against the key,
-one panel each, every point's marker in the colour of its regime, and the
-model's boundary on that key (V0 = Vc, k = kc) as a vertical line.
+Regimes in discrete colours, numbers on a colour scale, failed points as grey crosses; a full grid as cells,
+a Latin hypercube as points; one key (:func:`figure_sweep_1d`): a panel per result column (docs/sweep.md).
 """
 
 from __future__ import annotations

@@ -1,13 +1,8 @@
 """Points of a sweep computed one batch at a time from the specification alone.
 
-A worker asked for points ``i .. j`` computes exactly those: grid points by
-mixed-radix decomposition of the index, Latin-hypercube points by a keyed
-permutation of the strata (a Feistel network with cycle walking) and a
-counter-based hash for the position inside each stratum.  Nothing of size N
-is ever built, so 10^7 points cost a worker no more memory than 100.
-
-Everything is integer arithmetic on uint64 (which wraps by definition), so the
-samples are the same on every machine and numpy version.
+Grid points by mixed-radix decomposition of the index, Latin-hypercube points by a keyed Feistel permutation of
+the strata (with cycle walking) and a counter-based hash inside each stratum, all in uint64 integer arithmetic:
+nothing of size N is built, and the samples are the same on every machine and numpy version (docs/sweep.md).
 """
 
 from __future__ import annotations
