@@ -41,9 +41,11 @@ def stuck_runs():  # type: ignore[no-untyped-def]
 
 
 def test_the_merged_stuck_trace_is_the_plain_cohorts_trace(stuck_runs) -> None:  # type: ignore[no-untyped-def]
-    """Same rtol: the merging changes sigma by < 1e-3 rtol and N by < 0.1 rtol N0, with a third of the cohorts."""
+    """Same rtol: the merging and the births' own error bound (kernel._relaxed_births; the plain cohorts keep one
+    lumped cohort's) change sigma by < 1e-3 rtol and N by < 0.1 rtol N0 (measured 1.7e-4 and 1.4e-2 rtol), with
+    a third of the cohorts and fewer steps (566 against 1006)."""
     merged, plain, _tight = stuck_runs
-    assert merged.steps == plain.steps
+    assert merged.steps < 0.7 * plain.steps
     assert np.array_equal(merged.time, plain.time)
     scale = np.max(np.abs(plain.stress))
     assert np.max(np.abs(merged.stress - plain.stress)) <= 1e-3 * RTOL * scale

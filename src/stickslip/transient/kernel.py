@@ -46,10 +46,19 @@ LIGHTEST = 1e-30
 #: log hazards (aging exponent, and the force's through the slider position) stays within this share of sqrt(rtol)
 LIGHT_SHARE = 1e-3
 SATURATED_SPREAD = 0.1
+#: cohorts lighter than the mean are binned up to 2^LIGHT_LEVELS wider (:func:`_light_spread`)
+LIGHT_LEVELS = 5
 #: the force term's bin, in units of the aging term's: at the fold of a creeping block (11 um/s) neighbouring births
 #: differ by 1.3e-3 in log hazard through the force; 1 merged none of them (first slip from rest at 50 um/s in 60 s
 #: of CPU), 3 halves the cost with the slip equal to 1e-7, 10 broke a held population's closed form (5e-5)
 FORCE_SPREAD = 3.0
+
+#: saturating aging (:func:`_relaxed_births`): the births' fixed-point sweeps run until the newborns alive at the step's
+#: end move by less than this fraction of N0 (at most MAX_SWEEPS), and the Gauss pair's bias (h (r + 1/tau_a))^4/4320
+#: of the births counts BIRTH_BIAS times over (held to a tenth of the share)
+SWEEP_SETTLED = 1e-12
+MAX_SWEEPS = 20
+BIRTH_BIAS = 10.0
 
 # float parameter vector layout (see pack_parameters in model.py)
 (
@@ -391,6 +400,12 @@ def _inertial_step(d, x0, v0, force0, h, puller1, n, xb, w, p, at_x):  # type: i
     return d, s, k
 
 
+def _relaxed_births(p):  # type: ignore[no-untyped-def]
+    """Saturating aging with its housekeeping on: the births' error is the Gauss pair's own (docs/transient.md
+    section 8); otherwise (the paper's aging, :func:`model.plain_cohorts`) one lumped cohort's, as before."""
+    return p[P_SATURATION] > 0.0 and p[P_AGING] > 0.0 and p[P_MERGE_SATURATED] > 0.0
+
+
 def _hermite(theta, h, l0, d0, l1, d1):  # type: ignore[no-untyped-def]
     """The cubic with values l0, l1 and slopes d0, d1 at the ends of a step of length h, at theta = u/h."""
     t2 = theta * theta
@@ -473,6 +488,25 @@ def _same_bin(t, x, tb_i, tb_g, xb_i, xb_g, spread, p):  # type: ignore[no-untyp
         return False
     width = FORCE_SPREAD * spread / (p[P_FORCE_SENS] * _chain_stiffness(e, p[P_M], dlm))
     return np.floor(xb_i / width) == np.floor(xb_g / width)
+
+
+def _light_spread(spread, lw_i, lw_g, e_i, e_g, lw_mean, s_mean, p):  # type: ignore[no-untyped-def]
+    """The bin width for two cohorts: ``spread`` times 2^k, k the whole number of halvings in sqrt(w_mean/w) of the
+    heavier of the two, or in sqrt of the mean stress a cohort carries over theirs if that is smaller (0 for a
+    cohort at least as heavy or as loaded as the mean, at most LIGHT_LEVELS).
+
+    A merge moves the population by ~w spread^2/8 of its hazard, and its stress by as much through the FENE
+    curvature, so a cohort lighter than the mean by w_mean/w in both may be binned sqrt(w_mean/w) wider for the same
+    error as one of mean weight; the old, light cohorts of a creeping block (ages up to ~0.4 s at the resting hazard,
+    their birth positions spread by the creep) then share bins.  Both shares: in a hold the newborns at zero
+    extension make up N while the old cohorts carry the stress.  Widths are powers of two of ``spread``, so the bins
+    of each level nest in the next and a chain of merges cannot drift past the coarsest bin it was merged in."""
+    m = p[P_M]
+    dlm = p[P_DLM]
+    load = max(math.exp(lw_i) * abs(_chain_force(e_i, m, dlm)), math.exp(lw_g) * abs(_chain_force(e_g, m, dlm)))
+    ratio = min(math.exp(lw_mean - max(lw_i, lw_g)), s_mean / max(load, 1e-300))
+    k = math.floor(0.5 * math.log(max(ratio, 1.0)) / math.log(2.0))
+    return spread * 2.0 ** min(k, LIGHT_LEVELS)
 
 
 def _step_length(t, t_end, h, h_max, sample_times, sample_index):  # type: ignore[no-untyped-def]
@@ -729,7 +763,11 @@ def _gauss_birth(  # type: ignore[no-untyped-def]
     # its end (the birth rate times the newborns' life 1/r, at most all of it): bonds living
     # shorter than a step would otherwise vanish from the population without a word
     z = max(r_birth * hh, trap)
-    lump = min(mass * min(1.0, z * z / 24.0), 2.0 * mass / (hh * r_birth))
+    if _relaxed_births(p):  # the Gauss pair's own bias, held to a tenth of the share (docs/transient.md section 8)
+        z = max(hh * (r_birth + p[P_INV_TAU_A]), trap)
+        lump = min(mass * min(1.0, BIRTH_BIAS * z**4 / 4320.0), 2.0 * mass / (hh * r_birth))
+    else:
+        lump = min(mass * min(1.0, z * z / 24.0), 2.0 * mass / (hh * r_birth))
     xb[n + k] = x_k
     tb[n + k] = t + u
     lw_new[n + k] = math.log(alive) if alive > 0.0 else -np.inf
@@ -757,7 +795,10 @@ def _births(  # type: ignore[no-untyped-def]
     q_end = q0
     e_nb = 0.0
     d1 = 0.0
-    for _sweep in range(3):
+    relaxed = _relaxed_births(p)
+    last = -1.0
+    residual = 0.0
+    for _sweep in range(MAX_SWEEPS if relaxed else 3):
         l1 = loss1 + newborn_loss
         d1 = dloss1 + newborn_dloss + r_birth * q_end / tau
         born = born_alive = newborn_loss = newborn_dloss = newborn_dissip = lump = 0.0
@@ -775,7 +816,12 @@ def _births(  # type: ignore[no-untyped-def]
             if k == 1:
                 e_nb = e_k
         q_end = max(big - nn1 - born_alive, 0.0)
-    return born, born_alive, newborn_loss, newborn_dissip, lump, e_nb, q0, dloss0, d1
+        if relaxed:  # swept until the newborns' own breakage settles; what the last sweep moved counts as an error
+            residual = abs(born_alive - last) if last >= 0.0 else born_alive
+            if residual <= SWEEP_SETTLED * big:
+                break
+            last = born_alive
+    return born, born_alive, newborn_loss, newborn_dissip, lump + residual, e_nb, q0, dloss0, d1
 
 
 def _births_within_vacancy(  # type: ignore[no-untyped-def]
@@ -796,6 +842,9 @@ def _births_within_vacancy(  # type: ignore[no-untyped-def]
     if hh > 2.0 * tau:
         q_h = max(_vacancy(hh, q0, tau, hh, loss0, dloss0, loss1 + newborn_loss, d1), 0.0) + walled
         target = max(big - nn1 - q_h, 0.0)
+    elif _relaxed_births(p):  # the Gauss masses stand; their distance from the vacancy's own N counts as an error
+        q_h = max(_vacancy(hh, q0, tau, hh, loss0, dloss0, loss1 + newborn_loss, d1), 0.0) + walled
+        err_n += abs(max(big - nn1 - q_h, 0.0) - born_alive)
     target = min(target, max(big - nn1, 0.0))
     if born_alive > 0.0 and target != born_alive:
         scale = target / born_alive
@@ -970,19 +1019,25 @@ def _housekeeping(n, t, t_end, x, nn1, s1, s_floor, rtol, xb, tb, lw, rate0, kno
     # the housekeeping of saturating aging; off: the paper's, as for linear aging
     saturated = p[P_SATURATION] > 0.0 and p[P_AGING] > 0.0 and p[P_MERGE_SATURATED] > 0.0
     light_n, light_s, spread = 0.0, 0.0, 1.0
+    lw_mean = s_mean = 0.0
     if saturated:
         light_n, light_s, spread = _saturated_bins(n, nn1, s1, s_floor, rtol, p)
+        lw_mean = math.log(max(nn1, 1e-300) / max(n, 1))
+        s_mean = max(abs(s1), s_floor) / max(n, 1)
     for i in range(n):
         # only cohorts past the saturation age: those linger at the resting hazard (the young are as before)
         aged = saturated and t - tb[i] >= p[P_SATURATION]
         if lw[i] > floor and not (aged and _negligible(lw[i], x - xb[i], light_n, light_s, p)):
             g = keep - 1
+            width = spread
+            if aged and keep > 0:
+                width = _light_spread(spread, lw[i], lw[g], x - xb[i], x - xb[g], lw_mean, s_mean, p)
             if (
                 keep > 0
                 and i < n - 1
                 and (
                     _quiet_neighbours(rate0[i], rate0[g], xb[i], xb[g], tb[i], tb[g], quiet, gap, age_gap, p)
-                    or (aged and _same_bin(t, x, tb[i], tb[g], xb[i], xb[g], spread, p))
+                    or (aged and _same_bin(t, x, tb[i], tb[g], xb[i], xb[g], width, p))
                 )
             ):
                 # merged: the weight, the mean extension and age kept, so it breaks as its parts would in any
@@ -1177,6 +1232,7 @@ def compiled() -> dict[str, object]:
         g = globals()
         # compile helpers first so that the jitted callers bind to jitted callees
         for name in (
+            "_relaxed_births",
             "_chain_force",
             "_chain_stiffness",
             "_chain_energy",
@@ -1186,6 +1242,7 @@ def compiled() -> dict[str, object]:
             "_hermite",
             "_vacancy",
             "_negligible",
+            "_light_spread",
             "_same_bin",
         ):
             g[name] = _jit(g[name])

@@ -41,6 +41,10 @@ from .model import CELL_HAZARD, GAUSS, MAX_CELLS
 
 #: share of the local tolerance the reduction may change the stress by (entry and stay)
 THETA = 0.3
+#: through the block the neglected stress may reach NEGLECT_CAP times the share (the slider's velocity then errs by
+#: neglected/S_eff'), as long as the stress's drift it causes, the integral of K neglected/S_eff' dt, stays within the
+#: share (:func:`drift`; docs/transient.md section 9, *The block's drift*)
+NEGLECT_CAP = 10.0
 #: the neglected stress reported where the first-order manifold itself folds (Pa; ends a stretch)
 OFF_MANIFOLD = 1e300
 #: fewest trace rows a reduced stretch writes (besides the ODE's steps; a plot of the trace)
@@ -309,6 +313,38 @@ def effective(m: Manifold, v: float, vp: float, k_block: float) -> tuple[float, 
     return s_eff, a1, min(neglected, OFF_MANIFOLD)
 
 
+def drift(m: Manifold, v0: float, v: float, vp: float, k_block: float) -> float:
+    """How far (Pa) the neglected stress can have moved the block's stress from the truth over a stretch from v0 to v.
+
+    The neglected stress d is the error of sigma = S_eff(V) at a given V; through the block the true stress then leaves
+    the reduced one, e, as de/dt = -(K/S_eff')(e - d) (sigma' = K (Vp - V), V off by (e - d)/S_eff'), so |e| stays
+    below the integral of K |d|/S_eff' dt = the integral of |d|/|Vp - V| dV (dV/dt = K (Vp - V)/S_eff' on the
+    stretch, where V is monotone): a slider creeping far below the puller (S_eff'/K ~ 10^3 s from rest) or slowly
+    nearing the fold (~20 s) drifts far less than d itself.  Gauss-Legendre (16 points) in ln V.
+    """
+    if v == v0:
+        return 0.0
+    a, b = math.log(v0), math.log(v)
+    x = 0.5 * (a + b) + 0.5 * (b - a) * _GL16_X
+    u = np.exp(x)
+    sx = m.dstress(x)
+    s1 = sx / u
+    s2 = (m.d2stress(x) - sx) / (u * u)
+    c = m.lag(x)
+    c1 = m.dlag(x) / u
+    a0 = k_block * (vp - u) / s1
+    da0 = -k_block / s1 - k_block * (vp - u) * s2 / (s1 * s1)
+    ds_eff = s1 + c1 * a0 + c * da0
+    if not np.all(ds_eff > 0.0):
+        return OFF_MANIFOLD
+    a1 = k_block * (vp - u) / ds_eff
+    neglected = np.abs(c * (a1 - a0)) + np.abs(c * c / s1 * a1 * da0)
+    return float(abs(0.5 * (b - a) * np.sum(_GL16_W * neglected * u / np.abs(vp - u))))
+
+
+_GL16_X, _GL16_W = np.polynomial.legendre.leggauss(16)
+
+
 def _effective_stress(m: Manifold, v: np.ndarray, vp: float, k_block: float) -> np.ndarray:
     """S_eff at many velocities (the first element of :func:`effective`)."""
     x = np.log(v)
@@ -324,7 +360,7 @@ def entry_velocity(m: Manifold, sigma: float, v: float, vp: float, k_block: floa
     lo, hi = branch
     s_eff, a1, neglected = effective(m, v, vp, k_block)
     tol = THETA * rtol * abs(sigma)
-    if not (math.isfinite(a1) and abs(s_eff - sigma) <= tol and neglected <= 0.5 * tol):
+    if not (math.isfinite(a1) and abs(s_eff - sigma) <= tol and neglected <= 0.5 * NEGLECT_CAP * tol):
         return None
     for _ in range(30):  # Newton on S_eff(V) = sigma (S_eff' ~ S' > 0 on the stable branch)
         s_eff, _a, _n = effective(m, v, vp, k_block)
@@ -394,14 +430,19 @@ def glide(
 
     def off_manifold(_t: float, y: np.ndarray) -> float:
         s_eff, _a, neglected = effective(m, min(max(y[0], lo), hi), vp, k_block)
-        return neglected - tol * abs(s_eff)
+        return neglected - NEGLECT_CAP * tol * abs(s_eff)
+
+    def drifted(_t: float, y: np.ndarray) -> float:
+        vv = min(max(y[0], lo), hi)
+        return drift(m, v, vv, vp, k_block) - tol * abs(effective(m, vv, vp, k_block)[0])
 
     def off_table(_t: float, y: np.ndarray) -> float:
         return min(y[0] / lo - 1.0 - 1e-6, 1.0 - 1e-6 - y[0] / hi)
 
     off_manifold.terminal = True  # type: ignore[attr-defined]
     off_table.terminal = True  # type: ignore[attr-defined]
-    events = [off_manifold, off_table] if block else []
+    drifted.terminal = True  # type: ignore[attr-defined]
+    events = [off_manifold, off_table, drifted] if block else []
     y0 = np.array([v, 0.0, 0.0, 0.0])
     sol = solve_ivp(
         rhs, (t, t_end), y0, method="DOP853", rtol=1e-3 * rtol, atol=[1e-9 * v, 1e-12 * n0, 1e-30, 1e-30],

@@ -714,7 +714,7 @@ class _Reducer:
             if v < self._fold() and self.params.aging.saturation_age is None:
                 return None
             ref = steady_state(self.params, v, self.aging)
-            if not (float(ref.stress_slope) > 0 and abs(sigma - float(ref.stress)) <= 1e-2 * abs(sigma)):
+            if not (float(ref.stress_slope) > 0 and abs(sigma - float(ref.stress)) <= 0.1 * abs(sigma)):
                 return None
             m = R.manifold_for(self.params, self.aging, lo, hi, 3.0 * hi, self.rtol, self.tables)
             if m is None:  # the steady curve cannot be tabulated here to its share of rtol: cohorts for this piece
