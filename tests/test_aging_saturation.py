@@ -76,14 +76,17 @@ def _held_stress(t: float, velocity: float) -> float:
 
 
 def test_held_bonds_follow_the_closed_form_survival() -> None:
-    """The kernel integrates the saturated hazard along the characteristics: 5e-9 of the closed form at rtol 1e-4."""
+    """The kernel integrates the saturated hazard along the characteristics: at rtol 1e-4 within 2e-6 (0.02 rtol) of
+    the closed form while the held stress falls ~100-fold (measured 9.4e-8, 1.2e-7, 3.4e-7, 1.05e-6 at 1, 5, 20, 50
+    ms, 692 steps: the births' own error bound, docs/transient.md section 8; one lumped cohort's bound, 1239 steps:
+    6e-9, 5e-9, 2.1e-7, 6.8e-7)."""
     run = run_transient(
         SAT, constant(0.0, 0.05), control="velocity", start="steady", start_velocity=100e-6, rtol=1e-4, every=1e-3
     )
     for t in (1e-3, 5e-3, 2e-2, 5e-2):
         row = int(np.argmin(np.abs(run.time - t)))
         assert run.time[row] == pytest.approx(t, rel=1e-12)
-        assert run.stress[row] == pytest.approx(_held_stress(t, 100e-6), rel=1e-6)
+        assert run.stress[row] == pytest.approx(_held_stress(t, 100e-6), rel=2e-6)
     # the held stress decays towards zero: saturated bonds let go (linear aging keeps ~100 Pa for seconds)
     assert _held_stress(0.2, 100e-6) < 1e-2 * _held_stress(0.0, 100e-6)
 

@@ -59,6 +59,7 @@ FORCE_SPREAD = 3.0
 SWEEP_SETTLED = 1e-12
 MAX_SWEEPS = 20
 BIRTH_BIAS = 10.0
+SATURATED_BARRIER = 30.0
 
 # float parameter vector layout (see pack_parameters in model.py)
 (
@@ -402,8 +403,15 @@ def _inertial_step(d, x0, v0, force0, h, puller1, n, xb, w, p, at_x):  # type: i
 
 def _relaxed_births(p):  # type: ignore[no-untyped-def]
     """Saturating aging with its housekeeping on: the births' error is the Gauss pair's own (docs/transient.md
-    section 8); otherwise (the paper's aging, :func:`model.plain_cohorts`) one lumped cohort's, as before."""
-    return p[P_SATURATION] > 0.0 and p[P_AGING] > 0.0 and p[P_MERGE_SATURATED] > 0.0
+    section 8); otherwise (the paper's aging, :func:`model.plain_cohorts`) one lumped cohort's, as before.  Only
+    where the saturated barrier t_s/tau_a is at most SATURATED_BARRIER: beyond it a resting bond is as permanent as
+    under the paper's linear aging (a saturation age beyond every age of a run is the paper's model, bit for bit)."""
+    return (
+        p[P_SATURATION] > 0.0
+        and p[P_SATURATION] * p[P_INV_TAU_A] <= SATURATED_BARRIER
+        and p[P_AGING] > 0.0
+        and p[P_MERGE_SATURATED] > 0.0
+    )
 
 
 def _hermite(theta, h, l0, d0, l1, d1):  # type: ignore[no-untyped-def]
