@@ -1,6 +1,6 @@
 """The time-dependent model's summary: a verdict that agrees with the cycles it prints, never nan or inf in words
 (issue 28 item 2), cycles that end in slips, not at a creep threshold (issue 33 item 2), and a failure message
-that is written whatever the sampling (issue 33 item 1)."""
+that is written from any rows (issue 33 item 1; the jump that case needed: tests/test_transient_jump.py)."""
 
 from __future__ import annotations
 
@@ -202,27 +202,6 @@ def test_a_failure_with_nothing_finite_says_so_in_words():
         _no_nan(text)
 
 
-@pytest.mark.parametrize("every", [None, 1e-3, 1e-4])
-def test_a_runaway_fails_alike_whatever_the_sampling(every):
-    """Issue 33.1's case: lambda = 2 A, a steady start at 4.2 mm/s (the falling branch) and a +1 % kick of the
-    puller.  The slider accelerates and runs away (the massless block has no finite slip velocity) at ~3.07 ms;
-    sampled every 1 ms the message was 'internal error (IndexError)'.  The verdict comes from the kernel's state
-    (its step collapsed), not the rows: unsampled and every 1 ms fail the same way at the same instant.  Sampled every
-    0.1 ms the kernel accepted the step at its floor (1e-15 of the time reached) whatever its error, jumped 520 Pa to
-    ~0 and ended stuck: a step that fails at the floor is now refused, the run failed (kernel.FAILED).  An independent
-    solver of Eq 1 ends this case stuck, so the message claims no runaway: it says the outcome is not known."""
-    from stickslip.errors import ModelError
-
-    params = stickslip.load_parameters("gelatin-glass").with_overrides({"bonds.activation_length": 2e-10})
-    kick = protocols.segments([(4.242e-3, 0.01), (4.2e-3, 0.01)])
-    with pytest.raises(ModelError, match=r"what follows .*is not known") as failure:
-        run_transient(params, kick, start="steady", start_velocity=4.2e-3, every=every)
-    text = str(failure.value)
-    _no_nan(text)
-    at = float(re.search(r"failed at t = ([0-9.e-]+) s", text).group(1))
-    assert at == pytest.approx(3.0726e-3, rel=1e-3), text
-
-
 # --------------------------------------------------------------------------- issue 33.2: a stick ends in a slip
 VP, K_BLOCK, PERIOD, STICK = 50e-6, 3e5, 20.0, 16.0
 
@@ -289,16 +268,3 @@ def test_a_swing_about_the_pullers_pace_while_sliding_is_no_cycle(amplitude):
     v = VP * (1.0 + np.where(ring > 0, amplitude, 0.45) * ring)  # forward swings to 1.5 or 4 VP, back to 0.55 VP
     sigma = 250.0 + K_BLOCK * np.r_[0.0, np.cumsum(0.5 * (2 * VP - v[1:] - v[:-1]) * np.diff(t))]
     assert detect_cycles(t, sigma, v, protocols.constant(VP, 20.0), [], stiffness=K_BLOCK) == ()
-
-
-def test_a_failed_run_exits_3_with_its_reason_in_one_line(capsys):
-    """A run that started and could not go on is a failed run (exit 3), not bad input (2), nor an internal error."""
-    code, _, err = run_main(
-        capsys, "transient", "--set", "bonds.activation_length=2 Å", "--start", "steady", "--start-velocity",
-        "4.2 mm/s", "--v0", "4.242 mm/s", "--duration", "10 ms", "--segment", "4.2 mm/s:10 ms", "--every", "1 ms",
-    )  # fmt: skip
-    assert code == 3, err
-    assert "the run failed" in err and "the step down to" in err and "internal error" not in err, err
-    assert "what follows is not known" in err, err
-    assert len(err.strip().splitlines()) == 1
-    _no_nan(err)

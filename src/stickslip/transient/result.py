@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -75,6 +75,8 @@ class TransientResult:
     damping: float = 0.0
     #: the classifier's evidence for ``regime`` (periods seen, amplitude ratio, period, extremes; None if stopped)
     evidence: Any = field(default=None, repr=False)
+    #: the massless block's jumps through rupture cascades (transient.jump.Jump: instant, stresses, travel)
+    jumps: tuple[Any, ...] = field(default=(), repr=False)
 
     @property
     def final_stress(self) -> float:
@@ -97,7 +99,7 @@ class TransientResult:
             "steps": self.steps,
             "cycles": [c.as_dict() for c in self.cycles],
             "message": self.message,
-        }
+        } | ({"jumps": [asdict(j) for j in self.jumps]} if self.jumps else {})
 
     @property
     def held_by(self) -> np.ndarray:

@@ -6,7 +6,7 @@ import bisect
 import math
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -27,6 +27,7 @@ from ..parameters import Parameters
 from ..protocols import Protocol
 from ..quasistatic.cycle import Cycle
 from ..units import checked_number
+from . import jump
 from . import kernel as K
 from .arguments import check_progress, check_rig_words, check_snapshot_times
 from .model import Population, pack_parameters, stick_chains
@@ -258,6 +259,7 @@ class _Driver:
         self.snapshots: list[Snapshot] = []
         self.chain_rows: list[np.ndarray] = []
         self.events: list[tuple[str, float, float, float]] = []  # (kind, time, stress, velocity)
+        self.jumps: list[jump.Jump] = []  # the massless block's jumps through rupture cascades
         self.chain_state = {"elapsed": 0.0, "fraction": 1.0}
         self.snap_index = 0
         self.out = np.empty((CHUNK, 13))
@@ -350,8 +352,10 @@ class _Driver:
             self.progress(min(1.0, self.state.t / self.duration))
 
     def _finish(self, **kwargs: Any) -> TransientResult:
-        return _finish(self.rows, self.chain_rows, self.events, self.snapshots, self.state, self.params, self.protocol,
-                       self.control, self.k_block, int(self.state.acc[4]), note=self.note, **kwargs)  # fmt: skip
+        result = _finish(self.rows, self.chain_rows, self.events, self.snapshots, self.state, self.params,
+                         self.protocol, self.control, self.k_block, int(self.state.acc[4]),
+                         note=self.note + _jumps_note(self.jumps), **kwargs)  # fmt: skip
+        return replace(result, jumps=tuple(self.jumps)) if self.jumps else result
 
     def _stuck(self, t1: float, vp: float) -> TransientResult | None:
         """The stuck block to the piece's end or the chains' collapse: the slider fixed, the chains of Eq 15 carry
@@ -448,9 +452,31 @@ class _Driver:
             self.chains_on = True
             self.chain_state = {"elapsed": 0.0, "fraction": 1.0}
             self.events.append(("stick", state.t, self.k_block * (state.puller - state.x), state.v))
-        self._check(count, status == K.FAILED)
+        collapsed = status == K.FAILED and not self._jumped(vp)
+        self._check(count, collapsed)
         self._report_progress()
         self._snapshots_through(t1)
+
+    def _jumped(self, vp: float) -> bool:
+        """A collapsed step of the massless block in a rupture cascade: the jump (transient/jump.py), in no time;
+        False where the collapse is not one (the run then fails in words)."""
+        state, pace = self.state, float(np.max(self.protocol.velocities))
+        cascade = self.control == "block" and not self.inertial and math.isfinite(state.x)
+        if not (cascade and math.isfinite(state.v) and state.v > jump.ENTRY * pace):
+            return False
+        state.x, state.v, state.n, found, dissipated = jump.cascade(
+            state.t, state.x, state.v, state.puller, vp, pace, state.n, state.xb, state.tb, state.lw, self.p,
+            self.functions,
+        )  # fmt: skip
+        acc = state.acc
+        acc[1] += found.broken_share * self.params.bonds.site_density
+        acc[3] += dissipated
+        acc[7] = min(acc[7], found.stress_after)
+        state.h = self.params.bonds.bond_time * 1e-3
+        self.jumps.append(found)
+        if self.reducer is not None:
+            self.reducer.disturbed(state.t)
+        return True
 
     def _check(self, count: int, collapsed: bool = False) -> None:
         """A state gone non-finite, or a step that collapsed to the kernel's floor and still failed, fails the run
@@ -892,6 +918,14 @@ def _finish(
         damping=damping,
         evidence=evidence,
     )
+
+
+def _jumps_note(jumps: list[jump.Jump]) -> str:
+    """The jumps of the run in words (the first in full, and how many more)."""
+    if not jumps:
+        return ""
+    more = f"; {len(jumps) - 1} more jump(s) followed" if len(jumps) > 1 else ""
+    return f"; {jumps[0].describe()}{more}"
 
 
 def stick_population_used(events: list[tuple[str, float, float, float]]) -> bool:
