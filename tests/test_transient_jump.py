@@ -10,6 +10,7 @@ jump's balance."""
 
 from __future__ import annotations
 
+import json
 import math
 
 import numpy as np
@@ -136,12 +137,22 @@ def test_a_soft_spring_lets_every_bond_go():
     assert dissipated == pytest.approx(sigma**2 / (2 * stiffness) + chains, rel=1e-9)
 
 
+ISSUE_COMMAND = (
+    "transient", "--set", "bonds.activation_length=2 Å", "--start", "steady", "--start-velocity", "4.2 mm/s",
+    "--v0", "4.242 mm/s", "--duration", "10 ms", "--segment", "4.2 mm/s:10 ms", "--every", "1 ms",
+)  # fmt: skip
+
+
 def test_the_command_ends_stuck_and_names_the_jump(capsys):
     """The command of issue 33.1 (sampled every 1 ms) exits 0 with 'stuck' and the jump in words; before, it
-    failed (exit 3) or, sampled otherwise, jumped without a word."""
-    code, out, err = run_main(
-        capsys, "transient", "--set", "bonds.activation_length=2 Å", "--start", "steady", "--start-velocity",
-        "4.2 mm/s", "--v0", "4.242 mm/s", "--duration", "10 ms", "--segment", "4.2 mm/s:10 ms", "--every", "1 ms",
-    )  # fmt: skip
+    failed (exit 3) or, sampled otherwise, jumped without a word; its JSON lists the jump, each number's unit
+    named."""
+    code, out, err = run_main(capsys, *ISSUE_COMMAND)
     assert code == 0, err
     assert "stuck" in out and "jumped at t = 0.00307" in out and "every bond broke" in out, out
+    code, out, err = run_main(capsys, *ISSUE_COMMAND, "--json")
+    document = json.loads(out)
+    (found,) = document["jumps"]
+    assert found["stress_after"] == 0.0 and found["survivors"] == 0 and document["regime"] == "stuck"
+    units = document["units"]
+    assert (units["time"], units["stress_before"], units["travel"], units["broken_share"]) == ("s", "Pa", "m", "1")

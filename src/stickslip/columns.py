@@ -132,6 +132,13 @@ UNITS: dict[str, str | None] = {
     "reason": None,
     "cycles": None,  # a count (JSON: a list of cycles)
     "growth": DIMENSIONLESS,  # ratio of successive oscillation amplitudes
+    # the massless block's jumps (transient.jump.Jump)
+    "jumps": None,
+    "stress_before": _STRESS,
+    "stress_after": _STRESS,
+    "travel": _LENGTH,
+    "broken_share": DIMENSIONLESS,
+    "survivors": None,  # a count of cohorts
     "point": None,
     # sweep axes beyond the parameter keys
     "block.stiffness": "Pa/m",
