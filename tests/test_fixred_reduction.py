@@ -64,8 +64,9 @@ def _near_gel_cases(seed: int, count: int):
 def test_near_the_gel_below_vc_the_runs_finish_or_say_why():
     """Steady starts below and near Vc over a small random box around the gel, 40 s through the block: every run
     finishes with the same verdict with and without the reduction, or stops in words.  Where a start on the
-    unstable branch ruptures the interface faster than an inertia-free block can follow (set 4), the error
-    says so (it read "non-finite state")."""
+    unstable branch ruptures the interface faster than an inertia-free block can follow (set 4), the error said
+    so (it read "non-finite state" before); the block now jumps there (transient/jump.py) and sticks, with and
+    without the reduction alike."""
     from stickslip.errors import ModelError
     from stickslip.transient import run_transient
 
@@ -88,6 +89,9 @@ def test_near_the_gel_below_vc_the_runs_finish_or_say_why():
         if auto != "ran away":
             assert auto[1] == pytest.approx(off[1], rel=1e-3), (index, verdicts)  # the local tolerance
     assert cases[4] is not None
+    params, puller, start = cases[4]
+    jumped = run_transient(params, constant(puller, 40.0), start="steady", start_velocity=start, rtol=1e-3)
+    assert len(jumped.jumps) == 1 and jumped.jumps[0].survivors == 0 and jumped.regime == "stuck", jumped.message
 
 
 def test_fast_sliding_through_the_block_is_left_to_the_cohorts_and_a_runaway_says_so():
