@@ -509,10 +509,13 @@ def _light_spread(spread, lw_i, lw_g, e_i, e_g, lw_mean, s_mean, p):  # type: ig
     their birth positions spread by the creep) then share bins.  Both shares: in a hold the newborns at zero
     extension make up N while the old cohorts carry the stress.  Widths are powers of two of ``spread``, so the bins
     of each level nest in the next and a chain of merges cannot drift past the coarsest bin it was merged in."""
+    ratio = math.exp(lw_mean - max(lw_i, lw_g))
+    if ratio < 4.0:  # k = 0 whatever the stress share (the forces are not needed)
+        return spread
     m = p[P_M]
     dlm = p[P_DLM]
     load = max(math.exp(lw_i) * abs(_chain_force(e_i, m, dlm)), math.exp(lw_g) * abs(_chain_force(e_g, m, dlm)))
-    ratio = min(math.exp(lw_mean - max(lw_i, lw_g)), s_mean / max(load, 1e-300))
+    ratio = min(ratio, s_mean / max(load, 1e-300))
     k = math.floor(0.5 * math.log(max(ratio, 1.0)) / math.log(2.0))
     return spread * 2.0 ** min(k, LIGHT_LEVELS)
 
