@@ -9,9 +9,10 @@ slip (the highest stress before the slider first passes the puller's pace) and t
 1e-4 and at rtol 1e-3.
 
 Baseline, the method before issue 33 item 3's change (commit 3863829; the old method is gone from the code, so its
-figures are kept here): rtol 1e-4 28.0 s of CPU on this 2-core machine at load ~2.5 (29.0, 26.3 and 34.9 s in other
-processes under more load), 104 334 steps, 9 rejected, first slip at 38.93123993 s from 554.3530651 Pa, sigma(45 s)
-285.66116 Pa; rtol 1e-3 4.91 s, 37 677 steps, 11 rejected, first slip at 38.93092759 s from 554.3507673 Pa.
+figures are kept here): rtol 1e-4 28.0 s of CPU on this 2-core machine at load ~2.5 (22.1 s side by side with the
+new method's 5.7 s at load ~1.9; 29.0, 26.3 and 34.9 s in other processes under more load), 104 334 steps, 9
+rejected, first slip at 38.93123993 s from 554.3530651 Pa, sigma(45 s) 285.66116 Pa; rtol 1e-3 4.91 s, 37 677 steps,
+11 rejected, first slip at 38.93092759 s from 554.3507673 Pa.
 
 Now (saturating aging: the births' own error bound with converged sweeps, light saturated cohorts in wider nested
 bins, the reduction entered from rest at 0.32 s where the block is insensitive to its neglected term; docs/transient.md
