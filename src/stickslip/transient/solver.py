@@ -464,14 +464,19 @@ class _Driver:
         cascade = self.control == "block" and not self.inertial and math.isfinite(state.x)
         if not (cascade and math.isfinite(state.v) and state.v > jump.ENTRY * pace):
             return False
-        state.x, state.v, state.n, found, dissipated = jump.cascade(
+        cohorts = state.n
+        x, v, n, found, dissipated = jump.cascade(
             state.t, state.x, state.v, state.puller, vp, pace, state.n, state.xb, state.tb, state.lw, self.p,
             self.functions,
         )  # fmt: skip
+        if n == cohorts:  # no bond broke: not a cascade the jump can take (the kernel would fail there again)
+            return False
+        state.x, state.v, state.n = x, v, n
         acc = state.acc
         acc[1] += found.broken_share * self.params.bonds.site_density
         acc[3] += dissipated
         acc[7] = min(acc[7], found.stress_after)
+        acc[4] += 1.0  # a step, so that the step budget bounds a run that jumps again and again
         state.h = self.params.bonds.bond_time * 1e-3
         self.jumps.append(found)
         if self.reducer is not None:
