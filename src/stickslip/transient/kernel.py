@@ -46,8 +46,10 @@ LIGHTEST = 1e-30
 #: log hazards (aging exponent, and the force's through the slider position) stays within this share of sqrt(rtol)
 LIGHT_SHARE = 1e-3
 SATURATED_SPREAD = 0.1
-#: cohorts lighter than the mean are binned up to 2^LIGHT_LEVELS wider (:func:`_light_spread`)
+#: cohorts lighter than the mean are binned up to 2^LIGHT_LEVELS wider (:func:`_light_spread`), those within 4x of it
+#: not (compared in logs)
 LIGHT_LEVELS = 5
+LOG_FOUR = math.log(4.0)
 #: the force term's bin, in units of the aging term's: at the fold of a creeping block (11 um/s) neighbouring births
 #: differ by 1.3e-3 in log hazard through the force; 1 merged none of them (first slip from rest at 50 um/s in 60 s
 #: of CPU), 3 halves the cost with the slip equal to 1e-7, 10 broke a held population's closed form (5e-5)
@@ -60,6 +62,10 @@ SWEEP_SETTLED = 1e-12
 MAX_SWEEPS = 20
 BIRTH_BIAS = 10.0
 SATURATED_BARRIER = 30.0
+#: saturating aging's clock (:func:`_aging_clock`): below this decay e^(-t_a/t_s), 1 - decay is exact to an ulp
+CLOCK_PLAIN_DECAY = 0.5
+#: saturating aging: a cohort's error by the series of 1 - e^(-c) below this end correction c (:func:`_cohort_weight`)
+CORRECTION_SERIES = 1e-3
 
 # float parameter vector layout (see pack_parameters in model.py)
 (
@@ -122,10 +128,17 @@ def _aging_factor(v, p):  # type: ignore[no-untyped-def]
 
 def _aging_clock(age, p):  # type: ignore[no-untyped-def]
     """(A, dA/dt_a): the age the aging term sees and its rate.  A = t_a (the paper's Eq 1), or, with the
-    saturating-aging extension (p[P_SATURATION] = t_s > 0), A = t_s (1 - e^(-t_a/t_s)), dA/dt_a = e^(-t_a/t_s)."""
+    saturating-aging extension (p[P_SATURATION] = t_s > 0), A = t_s (1 - e^(-t_a/t_s)), dA/dt_a = e^(-t_a/t_s).
+
+    Past CLOCK_PLAIN_DECAY (t_a > t_s ln 2) 1 - e^(-t_a/t_s) is taken from the decay already computed: no
+    cancellation there (the difference is within an ulp of expm1's), and expm1, a library call, was 15 % of the
+    45 s from rest's CPU (four per cohort and step; docs/transient.md section 8).  Younger (and a saturation age
+    beyond every age of a run, the paper's model) keep expm1, where 1 - e^(-x) would lose digits."""
     ts = p[P_SATURATION]
     if ts > 0.0:
         decay = math.exp(-age / ts)
+        if decay < CLOCK_PLAIN_DECAY:
+            return ts * (1.0 - decay), decay
         return -ts * math.expm1(-age / ts), decay
     return age, 1.0
 
@@ -138,7 +151,7 @@ def _log_rate(e, age, slope, p):  # type: ignore[no-untyped-def]
     return p[P_LOG_U0_TAU] + p[P_FORCE_SENS] * abs(f) - _aging_clock(age, p)[0] * slope
 
 
-def _velocity_prepare(n, xb, tb, lw, x, t, p, lc, aa, known):  # type: ignore[no-untyped-def]
+def _velocity_prepare(n, xb, tb, lw, x, t, p, lc, aa, known, clock):  # type: ignore[no-untyped-def]
     """k_int; fills lc = ln(w f r) without the aging term and aa = A(t_a)/tau_a for the cohorts.
 
     ``known[0, i]``: exp(lw[i]) where the caller has it (bit for bit), negative where not; on return it holds
@@ -162,7 +175,9 @@ def _velocity_prepare(n, xb, tb, lw, x, t, p, lc, aa, known):  # type: ignore[no
         if p[P_AGING] == 0.0:
             aa[i] = 0.0
         elif p[P_SATURATION] > 0.0:
-            aa[i] = _aging_clock(t - tb[i], p)[0] * p[P_INV_TAU_A]
+            # ``clock``: A at t where the step's pass left it (the same number; nan or absent: computed)
+            age = clock[0, i] if i < clock.shape[1] and clock[0, i] == clock[0, i] else _aging_clock(t - tb[i], p)[0]
+            aa[i] = age * p[P_INV_TAU_A]
         else:  # the paper's linear aging, kept branch-free of the extension
             aa[i] = (t - tb[i]) * p[P_INV_TAU_A]
     return k_int
@@ -183,8 +198,13 @@ def _velocity_residual(v, vp, n, lc, aa, k_int, p):  # type: ignore[no-untyped-d
 
 
 def _slider_velocity(v_prev, vp, n, xb, tb, lw, x, t, p, lc, aa, known):  # type: ignore[no-untyped-def]
+    """The stable root of g nearest v_prev (block control): :func:`_slider_velocity_clocked` with no clock known."""
+    return _slider_velocity_clocked(v_prev, vp, n, xb, tb, lw, x, t, p, lc, aa, known, np.empty((2, 0)))
+
+
+def _slider_velocity_clocked(v_prev, vp, n, xb, tb, lw, x, t, p, lc, aa, known, clock):  # type: ignore[no-untyped-def]
     """The stable root of g nearest v_prev (block control): safeguarded Newton inside a bracket."""
-    k_int = _velocity_prepare(n, xb, tb, lw, x, t, p, lc, aa, known)
+    k_int = _velocity_prepare(n, xb, tb, lw, x, t, p, lc, aa, known, clock)
     g0, d0 = _velocity_residual(v_prev, vp, n, lc, aa, k_int, p)
     if p[P_AGING] == 0.0:  # g is linear in V
         return v_prev - g0 / d0
@@ -263,10 +283,11 @@ def _sums(n, xb, lw, x, p):  # type: ignore[no-untyped-def]
     return nn, s, k, u
 
 
-def _sums_keeping(n, xb, tb, lw, x, t, slope, p, cache, known, prepared):  # type: ignore[no-untyped-def]
+def _sums_keeping(n, xb, tb, lw, x, t, slope, p, cache, known, prepared, clock_end):  # type: ignore[no-untyped-def]
     """(N, sigma, bond energy) as _sums, keeping each cohort's weight, force, stiffness, energy and hazard at
     (x, t, slope) in ``cache``: exactly what the next step computes at its start (so it reuses them, bit for bit);
-    ``known`` as _velocity_prepare leaves it (its force and stiffness used where ``prepared``).
+    ``known`` as _velocity_prepare leaves it (its force and stiffness used where ``prepared``); ``clock_end``: the
+    saturating clock at t where the step's pass left it (nan where not: the newborns, merged cohorts).
     Returns ok = False (nothing kept) if a cohort is dead or beyond the FENE wall."""
     nn = 0.0
     s = 0.0
@@ -287,7 +308,14 @@ def _sums_keeping(n, xb, tb, lw, x, t, slope, p, cache, known, prepared):  # typ
         s += w * f
         u += w * energy
         if ok:
-            age = _aging_clock(t - tb[i], p)[0] if saturating else t - tb[i]
+            age = t - tb[i]
+            if saturating:  # kept for the next step's start (rows 6, 7: the same numbers it would compute)
+                if clock_end[0, i] == clock_end[0, i]:
+                    age, decay = clock_end[0, i], clock_end[1, i]
+                else:
+                    age, decay = _aging_clock(age, p)
+                cache[6, i] = age
+                cache[7, i] = decay
             lr = min(p[P_LOG_U0_TAU] + p[P_FORCE_SENS] * abs(f) - age * slope, LOG_RATE_CAP)
             cache[0, i] = w
             cache[1, i] = f
@@ -475,7 +503,7 @@ def _negligible(lw, e, light_n, light_s, p):  # type: ignore[no-untyped-def]
     return lw < light_n and math.exp(lw) * abs(_chain_force(e, p[P_M], p[P_DLM])) < light_s
 
 
-def _same_bin(t, x, tb_i, tb_g, xb_i, xb_g, spread, p):  # type: ignore[no-untyped-def]
+def _same_bin(x, decay_i, decay_g, xb_i, xb_g, spread, p):  # type: ignore[no-untyped-def]
     """Cohort i and the (merged) cohort g before it lie in one bin of width ``spread`` in both log-hazard terms.
 
     The aging term: its distance from saturation, (t_s/tau_a) e^(-t_a/t_s), which only shrinks as both age.  The
@@ -485,10 +513,11 @@ def _same_bin(t, x, tb_i, tb_g, xb_i, xb_g, spread, p):  # type: ignore[no-untyp
     order in their spread of positions).  A merged cohort
     (weight, mean position and mean age kept) then breaks as its parts to second order in the spread, ~spread^2/8
     of its hazard, in any later history.  Bins, not neighbours' distances: a chain of merges cannot drift.
+    ``decay_i``, ``decay_g``: e^(-t_a/t_s) of both (:func:`_saturation_decay`).
     """
     ts = p[P_SATURATION]
     scale = ts * p[P_INV_TAU_A]
-    if np.floor(scale * math.exp(-(t - tb_i) / ts) / spread) != np.floor(scale * math.exp(-(t - tb_g) / ts) / spread):
+    if np.floor(scale * decay_i / spread) != np.floor(scale * decay_g / spread):
         return False
     dlm = p[P_DLM]
     e = max(abs(x - xb_i), abs(x - xb_g), 0.5 * dlm)
@@ -496,6 +525,11 @@ def _same_bin(t, x, tb_i, tb_g, xb_i, xb_g, spread, p):  # type: ignore[no-untyp
         return False
     width = FORCE_SPREAD * spread / (p[P_FORCE_SENS] * _chain_stiffness(e, p[P_M], dlm))
     return np.floor(xb_i / width) == np.floor(xb_g / width)
+
+
+def _saturation_decay(t, tb, p):  # type: ignore[no-untyped-def]
+    """e^(-t_a/t_s) of a cohort born at tb, at t (:func:`_same_bin`)."""
+    return math.exp(-(t - tb) / p[P_SATURATION])
 
 
 def _light_spread(spread, lw_i, lw_g, e_i, e_g, lw_mean, s_mean, p):  # type: ignore[no-untyped-def]
@@ -509,9 +543,10 @@ def _light_spread(spread, lw_i, lw_g, e_i, e_g, lw_mean, s_mean, p):  # type: ig
     their birth positions spread by the creep) then share bins.  Both shares: in a hold the newborns at zero
     extension make up N while the old cohorts carry the stress.  Widths are powers of two of ``spread``, so the bins
     of each level nest in the next and a chain of merges cannot drift past the coarsest bin it was merged in."""
-    ratio = math.exp(lw_mean - max(lw_i, lw_g))
-    if ratio < 4.0:  # k = 0 whatever the stress share (the forces are not needed)
+    log_ratio = lw_mean - max(lw_i, lw_g)
+    if log_ratio < LOG_FOUR:  # k = 0 whatever the stress share (the forces and the exp are not needed)
         return spread
+    ratio = math.exp(log_ratio)
     m = p[P_M]
     dlm = p[P_DLM]
     load = max(math.exp(lw_i) * abs(_chain_force(e_i, m, dlm)), math.exp(lw_g) * abs(_chain_force(e_g, m, dlm)))
@@ -575,9 +610,13 @@ def _hazard_slopes(f0, f1, k0, k1, v0, v1p, age0, age1, clock0, clock1, slope0, 
     return g0, g1
 
 
-def _cohort_weight(lw_i, w0, f0, hh, lr0, r0, lr1, r1, g0, g1):  # type: ignore[no-untyped-def]
+def _cohort_weight(lw_i, w0, f0, hh, lr0, r0, lr1, r1, g0, g1, series):  # type: ignore[no-untyped-def]
     """A cohort's log weight at the step's end from its hazard at both ends: (new, its weight, its error, the
-    stress dying at a cliff, the trapezoid of the hazard, whether exp(new) was taken exactly)."""
+    stress dying at a cliff, the trapezoid of the hazard, whether exp(new) was taken exactly).
+
+    ``series`` (saturating aging): the error, the weight's distance from the plain trapezoid's, w |1 - e^(-c)| for
+    the end correction c, by its Taylor series where |c| < CORRECTION_SERIES (to ~1e-12 of itself) instead of a
+    second exp per cohort and step."""
     trap = 0.5 * hh * (r0 + r1)
     dying = 0.0
     if abs(lr1 - lr0) > 1.0 and max(lr0, lr1) < LOG_RATE_CAP:
@@ -602,7 +641,10 @@ def _cohort_weight(lw_i, w0, f0, hh, lr0, r0, lr1, r1, g0, g1):  # type: ignore[
     corr = min(max(corr, -limit), limit)
     new = lw_i - trap + corr
     wn = math.exp(new)
-    dw = abs(wn - w0 * math.exp(-min(trap, 745.0)))  # against the plain trapezoid
+    if series and abs(corr) < CORRECTION_SERIES:
+        dw = wn * abs(corr * (1.0 - corr * (0.5 - corr * (1.0 / 6.0 - corr / 24.0))))
+    else:
+        dw = abs(wn - w0 * math.exp(-min(trap, 745.0)))  # against the plain trapezoid
     return new, wn, dw, dying, trap, True
 
 
@@ -624,7 +666,7 @@ def _cohort_dissipation(trap, hh, w0, wn, r0, r1, g0, g1, f0, f1, v0, v1p, e0, e
 
 def _cohort_pass(  # type: ignore[no-untyped-def]
     n, t, t1, t0, hh, x, x1p, x_mid, v0, v1p, slope0, slope1, accel, xb, tb, lw, lw_new, rate0, w1, known,
-    predicted, cache, cached, p,
+    predicted, cache, cached, clock_end, p,
 ):  # fmt: skip
     """One pass over the cohorts: each one's log weight at the step's end (``lw_new``, ``w1``; its hazard there in
     ``rate0``, its force and stiffness at the predicted end in ``predicted``), and the sums over them:
@@ -676,9 +718,14 @@ def _cohort_pass(  # type: ignore[no-untyped-def]
             err_s += w0 * abs(f0)
             err_n += w0
             continue
-        if saturating:  # the age the aging term sees, and its rate
-            age0, clock0 = _aging_clock(t - tb[i], p)
+        if saturating:  # the age the aging term sees, and its rate (at the start as the last row kept it)
+            if cached:
+                age0, clock0 = cache[6, i], cache[7, i]
+            else:
+                age0, clock0 = _aging_clock(t - tb[i], p)
             age1, clock1 = _aging_clock(t1 - tb[i], p)
+            clock_end[0, i] = age1  # the same numbers the row at t1 needs (:func:`_sums_keeping`)
+            clock_end[1, i] = clock1
         else:
             age0, clock0 = t - tb[i], 1.0
             age1, clock1 = t1 - tb[i], 1.0
@@ -698,7 +745,7 @@ def _cohort_pass(  # type: ignore[no-untyped-def]
         predicted[1, i] = k1
         g0, g1 = _hazard_slopes(f0, f1, k0, k1, v0, v1p, age0, age1, clock0, clock1, slope0, slope1, accel, beta,
                                 va, aging_on)  # fmt: skip
-        new, wn, dw, dying, trap, exact = _cohort_weight(lw[i], w0, f0, hh, lr0, r0, lr1, r1, g0, g1)
+        new, wn, dw, dying, trap, exact = _cohort_weight(lw[i], w0, f0, hh, lr0, r0, lr1, r1, g0, g1, saturating)
         known[0, i] = wn if exact else -1.0
         if tb[i] >= t0:
             cliff += dying
@@ -895,7 +942,7 @@ def _birth_errors(err_s, err_n, lump, born, hh, x1p, x_mid, v1p, slope1, p):  # 
 
 def _slider_at_end(  # type: ignore[no-untyped-def]
     n, t, t1, t0, hh, x, v0, x1p, v1p, slope1, s0, s1, e_nb, sens_x, sens_a, err_s, puller0, vp, block, inertial,
-    xb, tb, lw_new, w1, lc, aa, known, predicted, p,
+    xb, tb, lw_new, w1, lc, aa, known, predicted, clock_end, p,
 ):  # fmt: skip
     """The slider at the step's end and the stress there: (x1, v1, s1, err_s, the block's force at the start).
 
@@ -924,7 +971,7 @@ def _slider_at_end(  # type: ignore[no-untyped-def]
             err_s = np.inf
     elif block == 1:
         x1 = _balance_from(x1p, puller0 + vp * (t1 - t0), n + 2, xb, w1, p, predicted, True)
-        v1 = _slider_velocity(v1p, vp, n + 2, xb, tb, lw_new, x1, t1, p, lc, aa, known)
+        v1 = _slider_velocity_clocked(v1p, vp, n + 2, xb, tb, lw_new, x1, t1, p, lc, aa, known, clock_end)
         err_s += 0.5 * hh * (abs(x1 - x1p) * sens_x + abs(_aging_factor(v1, p) - slope1) * sens_a)
         s1 = p[P_K] * (puller0 + vp * (t1 - t0) - x1)
         # that estimate is linear in the correction, and the hazard near the FENE wall is not: a cohort the
@@ -1017,7 +1064,7 @@ def _quiet_neighbours(rate_i, rate_g, xb_i, xb_g, tb_i, tb_g, quiet, gap, age_ga
     )
 
 
-def _housekeeping(n, t, t_end, x, nn1, s1, s_floor, rtol, xb, tb, lw, rate0, known, acc, p):  # type: ignore[no-untyped-def]
+def _housekeeping(n, t, t_end, x, nn1, s1, s_floor, rtol, xb, tb, lw, rate0, known, acc, clock_end, p):  # type: ignore[no-untyped-def]
     """Drop dead cohorts (their weight counts as broken, up to LIGHTEST * N0; with saturated aging, the negligible
     ones of :func:`_saturated_bins`) and merge neighbours that are quiet and born close (:func:`_quiet_neighbours`)
     or, past the saturation age, in one bin (:func:`_same_bin`); never the newest.  Returns the cohorts kept."""
@@ -1035,20 +1082,27 @@ def _housekeeping(n, t, t_end, x, nn1, s1, s_floor, rtol, xb, tb, lw, rate0, kno
         light_n, light_s, spread = _saturated_bins(n, nn1, s1, s_floor, rtol, p)
         lw_mean = math.log(max(nn1, 1e-300) / max(n, 1))
         s_mean = max(abs(s1), s_floor) / max(n, 1)
+    # e^(-t_a/t_s) of the last kept cohort g, while its birth time stands (an exp per cohort saved: the next
+    # cohort compares with it; the same numbers); negative: not known
+    decay_g = -1.0
     for i in range(n):
         # only cohorts past the saturation age: those linger at the resting hazard (the young are as before)
         aged = saturated and t - tb[i] >= p[P_SATURATION]
+        decay_i = -1.0
         if lw[i] > floor and not (aged and _negligible(lw[i], x - xb[i], light_n, light_s, p)):
             g = keep - 1
             width = spread
             if aged and keep > 0:
                 width = _light_spread(spread, lw[i], lw[g], x - xb[i], x - xb[g], lw_mean, s_mean, p)
+                decay_i = _saturation_decay(t, tb[i], p)
+                if decay_g < 0.0:
+                    decay_g = _saturation_decay(t, tb[g], p)
             if (
                 keep > 0
                 and i < n - 1
                 and (
                     _quiet_neighbours(rate0[i], rate0[g], xb[i], xb[g], tb[i], tb[g], quiet, gap, age_gap, p)
-                    or (aged and _same_bin(t, x, tb[i], tb[g], xb[i], xb[g], width, p))
+                    or (aged and _same_bin(x, decay_i, decay_g, xb[i], xb[g], width, p))
                 )
             ):
                 # merged: the weight, the mean extension and age kept, so it breaks as its parts would in any
@@ -1062,7 +1116,10 @@ def _housekeeping(n, t, t_end, x, nn1, s1, s_floor, rtol, xb, tb, lw, rate0, kno
                 known[0, g] = -1.0
                 known[1, g] = np.nan
                 rate0[g] = max(rate0[g], rate0[i])
+                decay_g = -1.0  # its birth time moved
+                clock_end[0, g] = np.nan
                 continue
+            decay_g = decay_i
             xb[keep] = xb[i]
             tb[keep] = tb[i]
             lw[keep] = lw[i]
@@ -1070,6 +1127,8 @@ def _housekeeping(n, t, t_end, x, nn1, s1, s_floor, rtol, xb, tb, lw, rate0, kno
             known[1, keep] = known[1, i]
             known[2, keep] = known[2, i]
             rate0[keep] = rate0[i]
+            clock_end[0, keep] = clock_end[0, i]
+            clock_end[1, keep] = clock_end[1, i]
             keep += 1
         elif lw[i] > -np.inf:
             w = math.exp(lw[i])
@@ -1124,7 +1183,9 @@ def advance(  # type: ignore[no-untyped-def]
     s_floor = 1e-9 * p[P_M] * p[P_N0] * p[P_DLM]
     while sample_index < n_samples and sample_times[sample_index] <= t:  # grid points already passed
         sample_index += 1
-    cache = np.empty((6, xb.shape[0]))  # the cohorts' values at the start of the step, when ``cached``
+    cache = np.empty((8, xb.shape[0]))  # the cohorts' values at the start of the step, when ``cached``
+    # saturating aging: each cohort's clock (A, dA/dt_a) at the step's end, from its pass; nan: not known
+    clock_end = np.full((2, xb.shape[0]), np.nan)
     # exp(lw_new) (then exp(lw)) where computed exactly so, else -1; force and stiffness at the step's end (block)
     known = np.full((3, xb.shape[0]), -1.0)
     predicted = np.empty((2, xb.shape[0]))  # force and stiffness at the step's predicted end x1p
@@ -1153,8 +1214,10 @@ def advance(  # type: ignore[no-untyped-def]
             err_n, sens_x, sens_a, walled, cliff, cliff_old,
         ) = _cohort_pass(
             n, t, t1, t0, hh, x, x1p, x_mid, v0, v1p, slope0, slope1, accel, xb, tb, lw, lw_new, rate0, w1, known,
-            predicted, cache, cached, p,
+            predicted, cache, cached, clock_end, p,
         )  # fmt: skip
+        clock_end[0, n] = np.nan  # the newborns' clock is not computed by the pass
+        clock_end[0, n + 1] = np.nan
         born, born_alive, newborn_loss, newborn_dissip, lump, e_nb, q0, dloss0, d1 = _births(
             n, t, hh, x, x1p, v0, v1p, accel, accel_now, jerk, slope1, nn0, nn1, loss0, dloss0, loss1, dloss1,
             inertial, xb, tb, lw_new, w1, known, rate0, predicted, p,
@@ -1166,7 +1229,7 @@ def advance(  # type: ignore[no-untyped-def]
         err_s, err_n = _birth_errors(err_s, err_n, lump, born, hh, x1p, x_mid, v1p, slope1, p)
         x1, v1, s1, err_s, spring0 = _slider_at_end(
             n, t, t1, t0, hh, x, v0, x1p, v1p, slope1, s0, s1, e_nb, sens_x, sens_a, err_s, puller0, vp, block,
-            inertial, xb, tb, lw_new, w1, lc, aa, known, predicted, p,
+            inertial, xb, tb, lw_new, w1, lc, aa, known, predicted, clock_end, p,
         )  # fmt: skip
         nn1 += born_alive
         err = _step_error(err_s, err_n, cliff, cliff_old, s0, s1, s_floor, rtol, p)
@@ -1193,7 +1256,7 @@ def advance(  # type: ignore[no-untyped-def]
             accel_prev = accel_now
             accel_now = (p[P_K] * (puller0 + vp * (t - t0) - x) - p[P_DAMPING] * v - s1) / p[P_MASS]
         steps += 1
-        n = _housekeeping(n, t, t_end, x, nn1, s1, s_floor, rtol, xb, tb, lw, rate0, known, acc, p)
+        n = _housekeeping(n, t, t_end, x, nn1, s1, s_floor, rtol, xb, tb, lw, rate0, known, acc, clock_end, p)
         h = _next_step(hh, err, h, h_max, landing)
         record = n_samples == 0
         if landing:
@@ -1202,7 +1265,9 @@ def advance(  # type: ignore[no-untyped-def]
         if record and rows < out_max:
             # the next step starts from this state: its opening values are kept (rejected steps keep them too)
             slope = _aging_factor(v if block == 1 else vp, p)
-            nn, ss, uu, cached = _sums_keeping(n, xb, tb, lw, x, t, slope, p, cache, known, block == 1 and not inertial)
+            nn, ss, uu, cached = _sums_keeping(
+                n, xb, tb, lw, x, t, slope, p, cache, known, block == 1 and not inertial, clock_end
+            )
             _write_row(out, rows, t, x, v, nn, ss, uu, puller0, vp, t0, block, acc)
             rows += 1
             if rows >= out_max:
@@ -1255,6 +1320,7 @@ def compiled() -> dict[str, object]:
             "_negligible",
             "_light_spread",
             "_same_bin",
+            "_saturation_decay",
         ):
             g[name] = _jit(g[name])
         for name in INLINED:
@@ -1262,6 +1328,7 @@ def compiled() -> dict[str, object]:
         for name in (
             "_velocity_prepare",
             "_velocity_residual",
+            "_slider_velocity_clocked",
             "_slider_velocity",
             "_balance_from",
             "_balance_weights",
