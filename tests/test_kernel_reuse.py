@@ -39,7 +39,8 @@ def test_row_sums_keep_exactly_what_the_next_step_computes():
     slope = math.exp(-v / p[K.P_VA]) * p[K.P_INV_TAU_A]
     cache = np.empty((6, n))
     unknown = np.full((3, n), -1.0)
-    nn, ss, uu, ok = functions["_sums_keeping"](n, xb, tb, lw, x, t, slope, p, cache, unknown, False)
+    no_clock = np.full((2, n), np.nan)  # the saturating clock at t, not known (the paper's aging has none)
+    nn, ss, uu, ok = functions["_sums_keeping"](n, xb, tb, lw, x, t, slope, p, cache, unknown, False, no_clock)
     assert ok
     direct_n, direct_sigma, _k, direct_energy = functions["_sums"](n, xb, lw, x, p)
     assert (nn, ss, uu) == (direct_n, direct_sigma, direct_energy)
@@ -57,9 +58,9 @@ def test_row_sums_keep_exactly_what_the_next_step_computes():
     # the slider balance's force and stiffness, when given, are the same numbers
     lc, aa = np.empty(n), np.empty(n)
     known = np.full((3, n), -1.0)
-    functions["_velocity_prepare"](n, xb, tb, lw, x, t, p, lc, aa, known)
+    functions["_velocity_prepare"](n, xb, tb, lw, x, t, p, lc, aa, known, no_clock)
     again = np.empty((6, n))
-    assert functions["_sums_keeping"](n, xb, tb, lw, x, t, slope, p, again, known, True) == (nn, ss, uu, True)
+    assert functions["_sums_keeping"](n, xb, tb, lw, x, t, slope, p, again, known, True, no_clock) == (nn, ss, uu, True)
     assert np.array_equal(again, cache)
 
 
@@ -70,7 +71,7 @@ def test_a_dead_cohort_keeps_nothing():
     lw[3] = -np.inf
     n = xb.size
     *_sums, ok = functions["_sums_keeping"](
-        n, xb, tb, lw, 0.0, 0.0, 0.0, p, np.empty((6, n)), np.full((3, n), -1.0), False
+        n, xb, tb, lw, 0.0, 0.0, 0.0, p, np.empty((6, n)), np.full((3, n), -1.0), False, np.full((2, n), np.nan)
     )
     assert not ok
 
