@@ -66,19 +66,16 @@ def _log_hazard(e: np.ndarray, age: np.ndarray, v: float, p: np.ndarray) -> np.n
     return p[K.P_LOG_U0_TAU] + p[K.P_FORCE_SENS] * np.abs(force) - clock * slope
 
 
-def _fast_root(x: float, xb: np.ndarray, lw: np.ndarray, vp: float, p: np.ndarray) -> float:
+def _fast_root(
+    x: float, t: float, n: int, xb: np.ndarray, tb: np.ndarray, lw: np.ndarray, vp: float, p: np.ndarray, prepare: Any
+) -> float:
     """The root of g with the aging term erased, (K Vp + sum w r f)/(K + k_int): g's largest root wherever it is
-    many V_a fast (the kernel's terms, each ln(w r f) capped as it caps them)."""
-    live = np.isfinite(lw)
-    e = x - xb[live]
-    y = e / p[K.P_DLM]
-    force = p[K.P_M] * e / (1.0 - y * y)
-    stiffness = p[K.P_M] * (1.0 + y * y) / (1.0 - y * y) ** 2
-    weights = np.exp(lw[live])
-    with np.errstate(divide="ignore"):
-        terms = lw[live] + np.log(force) + p[K.P_LOG_U0_TAU] + p[K.P_FORCE_SENS] * np.abs(force)
-    loss = float(np.sum(np.exp(np.minimum(terms, K.LOG_RATE_CAP))))
-    return (p[K.P_K] * vp + loss) / (p[K.P_K] + float(weights @ stiffness))
+    many V_a fast.  ``prepare``: the kernel's _velocity_prepare (k_int, and each cohort's ln(w f r) without the
+    aging term, capped below as the kernel's residual caps it)."""
+    lc, aa, known = np.empty(n), np.empty(n), np.full((3, n), -1.0)
+    k_int = prepare(n, xb, tb, lw, x, t, p, lc, aa, known, np.empty((2, 0)))
+    loss = float(np.sum(np.exp(np.minimum(lc, K.LOG_RATE_CAP))))
+    return (p[K.P_K] * vp + loss) / (p[K.P_K] + k_int)
 
 
 def cascade(
@@ -96,7 +93,7 @@ def cascade(
     lc, aa, known = np.empty(n), np.empty(n), np.empty((3, n))
     while alive.any():
         x = balance(x, puller, n, xb, weights, p)
-        v = _fast_root(x, xb[:n], live_lw, vp, p)
+        v = _fast_root(x, t, n, xb, tb, live_lw, vp, p, functions["_velocity_prepare"])
         if p[K.P_AGING] > 0.0 and v < FAST * p[K.P_VA]:  # where aging still counts, g's stable root below it
             known.fill(-1.0)
             v = velocity(v, vp, n, xb, tb, live_lw, x, t, p, lc, aa, known)
