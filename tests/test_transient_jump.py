@@ -156,3 +156,18 @@ def test_the_command_ends_stuck_and_names_the_jump(capsys):
     assert found["stress_after"] == 0.0 and found["survivors"] == 0 and document["regime"] == "stuck"
     units = document["units"]
     assert (units["time"], units["stress_before"], units["travel"], units["broken_share"]) == ("s", "Pa", "m", "1")
+
+
+def test_with_aging_a_slow_arrest_takes_the_kernels_root():
+    """Below 50 V_a the aging term counts and the velocity at a balance is the kernel's stable root of g: for
+    bonds born at this instant (age 0, so the aging term vanishes) it is the linear root of the case without
+    aging, to round-off; the arrest and the balance are the same."""
+    stiffness, pace = 1e11, 1e-5
+    outcomes = []
+    for aging in (False, True):
+        p, xb, tb, lw, x, puller = _two_cohorts(stiffness)
+        p = pack_parameters(PARAMS, aging, stiffness)
+        outcomes.append(jump.cascade(0.0, x, 1e3, puller, pace, pace, 2, xb, tb, lw, p, K.compiled()))
+    (x0, v0, n0, _, _), (x1, v1, n1, _, _) = outcomes
+    assert n0 == n1 == 1 and x1 == x0
+    assert v0 < jump.FAST * PARAMS.aging.aging_velocity and v1 == pytest.approx(v0, rel=1e-9)
