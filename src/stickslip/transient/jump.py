@@ -67,12 +67,14 @@ def _log_hazard(e: np.ndarray, age: np.ndarray, v: float, p: np.ndarray) -> np.n
 
 
 def _fast_root(
-    x: float, t: float, n: int, xb: np.ndarray, tb: np.ndarray, lw: np.ndarray, vp: float, p: np.ndarray, prepare: Any
-) -> float:
+    x: float, t: float, n: int, xb: np.ndarray, tb: np.ndarray, lw: np.ndarray, vp: float, p: np.ndarray, prepare: Any,
+    scratch: tuple[np.ndarray, np.ndarray, np.ndarray],
+) -> float:  # fmt: skip
     """The root of g with the aging term erased, (K Vp + sum w r f)/(K + k_int): g's largest root wherever it is
     many V_a fast.  ``prepare``: the kernel's _velocity_prepare (k_int, and each cohort's ln(w f r) without the
-    aging term, capped below as the kernel's residual caps it)."""
-    lc, aa, known = np.empty(n), np.empty(n), np.full((3, n), -1.0)
+    aging term, capped below as the kernel's residual caps it); ``scratch``: its work arrays (lc, aa, known)."""
+    lc, aa, known = scratch
+    known.fill(-1.0)
     k_int = prepare(n, xb, tb, lw, x, t, p, lc, aa, known, np.empty((2, 0)))
     loss = float(np.sum(np.exp(np.minimum(lc, K.LOG_RATE_CAP))))
     return (p[K.P_K] * vp + loss) / (p[K.P_K] + k_int)
@@ -93,7 +95,7 @@ def cascade(
     lc, aa, known = np.empty(n), np.empty(n), np.empty((3, n))
     while alive.any():
         x = balance(x, puller, n, xb, weights, p)
-        v = _fast_root(x, t, n, xb, tb, live_lw, vp, p, functions["_velocity_prepare"])
+        v = _fast_root(x, t, n, xb, tb, live_lw, vp, p, functions["_velocity_prepare"], (lc, aa, known))
         if p[K.P_AGING] > 0.0 and v < FAST * p[K.P_VA]:  # where aging still counts, g's stable root below it
             known.fill(-1.0)
             v = velocity(v, vp, n, xb, tb, live_lw, x, t, p, lc, aa, known)
