@@ -87,12 +87,6 @@ class SteadyData:
         rows = np.arange(1, columns["velocity"].size + 1)
         return _validated_steady(Table(source, columns, rows))
 
-    def subset(self, mask: np.ndarray) -> SteadyData:
-        err = None if self.stress_err is None else self.stress_err[mask]
-        return SteadyData(
-            self.velocity[mask], self.stress[mask], err, self.rows[mask], self.source, self.ignored_columns
-        )
-
     def to_frame(self) -> pd.DataFrame:
         import pandas as pd
 
@@ -144,20 +138,6 @@ class StickData:
         if len(set(sizes.values())) != 1:
             raise DataError(f"{source}: columns have different lengths {sizes}")
         return _validated_stick(Table(source, columns, np.arange(1, columns["stick_time"].size + 1)))
-
-    def subset(self, mask: np.ndarray) -> StickData:
-        def pick(a: np.ndarray | None) -> np.ndarray | None:
-            return None if a is None else a[mask]
-
-        return StickData(
-            self.pulling_velocity[mask],
-            self.stick_time[mask],
-            pick(self.peak_stress),
-            pick(self.start_stress),
-            self.rows[mask],
-            {k: v[mask] for k, v in self.extra.items()},
-            self.source,
-        )
 
     def to_frame(self) -> pd.DataFrame:
         import pandas as pd

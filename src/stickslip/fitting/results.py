@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from typing import Any
 
@@ -78,22 +77,3 @@ class Estimate:
         if self.bias is not None:
             out["method_bias"] = self.bias
         return out
-
-    def text(self) -> str:
-        """One line for reports: value ± stderr [interval] with units."""
-        if self.value is None:
-            return "—"
-        unit_value = format_si(self.value, self.dimension)
-        if self.fixed:
-            return f"{unit_value} (fixed)"
-        parts = [unit_value]
-        if self.stderr is not None and math.isfinite(self.stderr):
-            parts.append(f"± {self.stderr:.3g}")
-        if self.interval is not None:
-            lo, hi = self.interval
-            parts.append(f"[{_num(lo)}, {_num(hi)}]")
-        return " ".join(parts)
-
-
-def _num(x: float | None) -> str:
-    return "unbounded" if x is None else f"{x:.4g}"

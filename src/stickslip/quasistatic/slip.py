@@ -236,18 +236,6 @@ class SlipPhase:
         x = self.trajectory.log_velocity_at(min(max(t, 0.0), self.duration))
         return math.exp(x), float(self.trajectory.stress(x)), float(self.trajectory.slider_displacement(x))
 
-    def as_dict(self) -> dict[str, object]:
-        return {
-            "ends": self.ends,
-            "duration": self.duration,
-            "start_velocity": self.start_velocity,
-            "start_stress": self.start_stress,
-            "end_velocity": self.end_velocity,
-            "end_stress": self.end_stress,
-            "pulling_velocity": self.pulling_velocity,
-            "message": self.message,
-        }
-
     def to_frame(self) -> pd.DataFrame:
         """time [s], velocity [m/s], stress [Pa], slider_displacement [m]."""
         import pandas as pd
