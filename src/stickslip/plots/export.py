@@ -25,20 +25,6 @@ if TYPE_CHECKING:  # pragma: no cover
 PNG_DPI = 110
 
 
-def png_bytes(figure: Figure, dpi: int = PNG_DPI) -> bytes:
-    """The figure as PNG, cropped to what is drawn."""
-    buffer = io.BytesIO()
-    figure.savefig(buffer, format="png", dpi=dpi, bbox_inches="tight")
-    return buffer.getvalue()
-
-
-def svg_bytes(figure: Figure) -> bytes:
-    """The figure as SVG, cropped to what is drawn."""
-    buffer = io.BytesIO()
-    figure.savefig(buffer, format="svg", bbox_inches="tight")
-    return buffer.getvalue()
-
-
 def png_and_svg_bytes(figure: Figure, dpi: int = PNG_DPI) -> tuple[bytes, bytes]:
     """The figure as PNG and as SVG, both cropped to what is drawn, from one layout and one raster draw.
 

@@ -167,10 +167,6 @@ class BranchInterpolant:
             SLOPE_TOLERANCE * float(np.max(np.abs(self.g_series))),
         )
 
-    def covers(self, velocity: float) -> bool:
-        x = math.log(velocity)
-        return self.log_lo - 1e-12 <= x <= self.log_hi + 1e-12
-
 
 @lru_cache(maxsize=32)
 def branch_interpolant(params: Parameters, curve: str) -> BranchInterpolant:

@@ -164,10 +164,6 @@ class _Rates:
         """The aging exponent of Eq 15, t/tau_a, bounded by ``aging_cap``."""
         return min(t * self.inv_aging, self.aging_cap)
 
-    def log_rate(self, t: float, n: float) -> float:
-        """ln of the breakage rate per chain, ln(r) + s(t)/n - t/tau_a."""
-        return math.log(self.r) + (self.s0 + self.k * t) / n - self.aging(t)
-
     def time_scale(self) -> float:
         """T: the time in which the fresh load would break the chains, or the loading and aging times.
 

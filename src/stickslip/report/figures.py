@@ -11,7 +11,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from ..fileio import atomic_write_bytes
-from ..plots.export import PNG_DPI, Curve, data_uri, extract_curves, png_and_svg_bytes, png_bytes, svg_bytes
+from ..plots.export import PNG_DPI, Curve, data_uri, extract_curves, png_and_svg_bytes
 
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.figure import Figure
@@ -28,12 +28,6 @@ class ReportFigure:
     title: str
     caption: str  # plain text
     figure: Figure | None  # None once drawn and written (what the HTML and results.json need stays)
-
-    def png(self) -> bytes:
-        return png_bytes(self.figure)
-
-    def svg(self) -> bytes:
-        return svg_bytes(self.figure)
 
     def curves(self) -> list[Curve]:
         return extract_curves(self.figure, self.id)
