@@ -44,13 +44,30 @@ def _fix_values(items: tuple[str, ...]) -> dict[str, Any]:
     return out
 
 
-def _fitted_set(params: Parameters, name: str, description: str) -> Parameters:
+def _write_fitted(output: Path, params: Parameters, name: str, description: str, header: list[str]) -> None:
+    """The fitted set as TOML, its header lines as comments, the start set named as its reference."""
     reference = f"start values: {params.reference}" if params.reference else ""
-    return dataclasses.replace(params, name=name, description=description, reference=reference)
+    fitted = dataclasses.replace(params, name=name, description=description, reference=reference)
+    write_text(output, "\n".join(f"# {line}" for line in header) + "\n" + fitted.to_toml())
 
 
-def _toml_with_header(params: Parameters, header: list[str]) -> str:
-    return "\n".join(f"# {line}" for line in header) + "\n" + params.to_toml()
+def _fit_outputs(plot_help: str) -> Any:
+    """-o, --report, --plot and --json, as both fits take them."""
+    options = [
+        click.option("-o", "--output", type=click.Path(dir_okay=False, path_type=Path),
+                     help="Write the fitted parameters (TOML)."),
+        click.option("--report", "report_path", type=click.Path(dir_okay=False, path_type=Path),
+                     help="Write the report (Markdown)."),
+        click.option("--plot", "plot_path", type=click.Path(dir_okay=False, path_type=Path), help=plot_help),
+        click.option("--json", "as_json", is_flag=True, help="Print the results as JSON (SI units)."),
+    ]  # fmt: skip
+
+    def add(func: Any) -> Any:
+        for option in reversed(options):
+            func = option(func)
+        return func
+
+    return add
 
 
 def _figure_to(path: Path, make: Any) -> None:
@@ -91,16 +108,7 @@ def fit_group() -> None:
 @click.option("--samples", type=click.IntRange(min=20), default=200, show_default=True, help="Bootstrap refits.")
 @click.option("--level", type=click.FloatRange(0.5, 0.999), default=0.95, show_default=True, help="Confidence level.")
 @click.option("--seed", type=int, default=None, help="Random seed (bootstrap, Bayesian sampler).")
-@click.option(
-    "-o", "--output", type=click.Path(dir_okay=False, path_type=Path), help="Write the fitted parameters (TOML)."
-)
-@click.option(
-    "--report", "report_path", type=click.Path(dir_okay=False, path_type=Path), help="Write the report (Markdown)."
-)
-@click.option(
-    "--plot", "plot_path", type=click.Path(dir_okay=False, path_type=Path), help="Save the fit and residuals (PNG)."
-)
-@click.option("--json", "as_json", is_flag=True, help="Print the results as JSON (SI units).")
+@_fit_outputs("Save the fit and residuals (PNG).")
 @click.option("--bayes", is_flag=True, help="Also sample the posterior with emcee (needs stickslip[bayes]).")
 @click.option(
     "--walkers",
@@ -183,18 +191,14 @@ def steady_command(
         if steps is None and not posterior.converged:
             click.echo(f"stickslip: warning: Bayesian fit: {posterior.messages[0]}", err=True)
     if output is not None and fit.success:
-        fitted = _fitted_set(
-            fit.parameters,
-            f"fit of {data.name}",
-            f"stickslip fit steady --method {method} of {data}, start values from {params.name}",
-        )
         vc, sc = fit.critical_velocity, fit.critical_stress
         header = [f"Fitted by stickslip fit steady ({method}) to {data}; fitted keys: {', '.join(fit.free_keys)}."]
         if vc.value is not None and sc.value is not None:
             from ..fitting.results import human  # not at module level: it imports lmfit (start-up time)
 
             header.append(f"Vc = {human(vc.value, 'velocity')}, σc = {human(sc.value, 'stress')} (Eq 9).")
-        write_text(output, _toml_with_header(fitted, header))
+        description = f"stickslip fit steady --method {method} of {data}, start values from {params.name}"
+        _write_fitted(output, fit.parameters, f"fit of {data.name}", description, header)
     report = fit.report() if posterior is None else fit.report() + "\n" + posterior.report()
     if report_path is not None:
         write_text(report_path, report)
@@ -235,16 +239,7 @@ def _bayes_module() -> Any:
 @click.option("--exclude-row", "exclude_rows", multiple=True, type=int, metavar="N", help="Leave out file row N.")
 @click.option("--include-steady", is_flag=True, help="Keep rows whose pulling velocity is above Vc.")
 @click.option("--level", type=click.FloatRange(0.5, 0.999), default=0.95, show_default=True, help="Confidence level.")
-@click.option(
-    "-o", "--output", type=click.Path(dir_okay=False, path_type=Path), help="Write the fitted parameters (TOML)."
-)
-@click.option(
-    "--report", "report_path", type=click.Path(dir_okay=False, path_type=Path), help="Write the report (Markdown)."
-)
-@click.option(
-    "--plot", "plot_path", type=click.Path(dir_okay=False, path_type=Path), help="Save stick times, data and fit (PNG)."
-)
-@click.option("--json", "as_json", is_flag=True, help="Print the results as JSON (SI units).")
+@_fit_outputs("Save stick times, data and fit (PNG).")
 @params_options
 def stick_command(
     table: Path,
@@ -280,15 +275,9 @@ def stick_command(
         level=level,
     )
     if output is not None and fit.success:
-        fitted = _fitted_set(
-            fit.parameters, f"stick fit of {table.name}", f"stickslip fit stick of {table}, from {params.name}"
-        )
-        write_text(
-            output,
-            _toml_with_header(
-                fitted, [f"Fitted by stickslip fit stick to {table}; fitted keys: {', '.join(fit.free_keys)}."]
-            ),
-        )
+        header = [f"Fitted by stickslip fit stick to {table}; fitted keys: {', '.join(fit.free_keys)}."]
+        _write_fitted(output, fit.parameters, f"stick fit of {table.name}", f"stickslip fit stick of {table}, from "
+                      f"{params.name}", header)  # fmt: skip
     report = fit.report()
     if report_path is not None:
         write_text(report_path, report)
