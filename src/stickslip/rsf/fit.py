@@ -227,14 +227,7 @@ def _model_or_why(
     record: LabRecord, protocol: Protocol, base: RSFParams, values: dict[str, float]
 ) -> tuple[np.ndarray, str]:
     """The model friction at the record's rows, or NaN and what went wrong (never the caller's fault unsaid)."""
-    states = [StateVariable(base.states[0].law, values["b"], math.exp(values["log_dc"]), base.states[0].c)]
-    if "b2" in values:
-        law2 = base.states[1].law if len(base.states) > 1 else base.states[0].law
-        states.append(StateVariable(law2, values["b2"], math.exp(values["log_dc2"])))
-    params = base.replace(
-        a=values["a"], mu0=values["mu0"], states=tuple(states),
-        stiffness=math.exp(values["log_k"]) if "log_k" in values else base.stiffness,
-    )  # fmt: skip
+    params = _final_params(base, values)
     try:
         run = simulate(params, protocol, times=record.time, rtol=FIT_RTOL, atol=FIT_RTOL * 1e-2, detect=False)
     except (ModelError, ParameterError) as exc:
@@ -1318,6 +1311,7 @@ def _least_squares(setup: _Setup, start: dict[str, float]) -> Any:
 
 
 def _final_params(base: RSFParams, values: dict[str, float]) -> RSFParams:
+    """The rate-and-state parameters at the search's ``values`` (Dc and k in log space) on ``base``."""
     first = base.states[0]
     states = [StateVariable(first.law, values["b"], math.exp(values["log_dc"]), first.c)]
     if "b2" in values:
