@@ -460,14 +460,8 @@ def _march(s: _Scales, q: QuadratureSettings, keep_nodes: bool = False, compiled
 
 
 #: From this many lanes (velocities x parameter sets) on, the march runs compiled (stickslip.quasistatic.steady_kernel),
-#: ~3x faster per lane.  Loading numba and its cached code costs ~0.2 s once per process (the numpy march of
-#: ~30k lanes), so narrow calls -- a command line's curve, the critical point's grid -- stay on numpy, and the
-#: wide ones that programs repeat (curves for plots and benchmarks, batched fits) run compiled.
+#: and from BATCH_COMPILED_LANES in the batched call; why these: docs/steady-state.md, "Wide batches run compiled".
 COMPILED_LANES = 1000
-#: The batched call (:func:`steady_stress_many`) runs compiled from this many lanes: its callers -- a fit's
-#: Jacobians, a sampler's walkers, a global search -- repeat it hundreds of times, and on a small batch the numpy
-#: march's per-call overhead dominates (16 sets x 2-20 velocities: 0.56-0.85 ms compiled against 4.9-6.8 ms numpy,
-#: 8-10x), so the one-off ~0.2 s load pays back within ~40 calls.
 BATCH_COMPILED_LANES = 16
 
 
@@ -510,9 +504,7 @@ def _march_compiled(s: _Scales, q: QuadratureSettings) -> _Integrals:
     return _Integrals(out[0], out[1], out[2], out[3], None)
 
 
-#: OpenBLAS runs a matrix product of fewer than about this many multiply-adds on one thread; larger ones it
-#: spreads over every core, which for the march's small (K+1, K) @ (K, n) products only adds CPU time (and
-#: wall time when another process holds a core: 4 ms instead of 40 us measured at n = 4096 on 2 cores).
+#: OpenBLAS keeps a product of fewer multiply-adds than this on one thread (docs/steady-state.md, "One thread").
 ONE_THREAD_PRODUCT = 2**18
 
 
