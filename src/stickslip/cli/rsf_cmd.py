@@ -301,8 +301,7 @@ _SECOND_STATE_KEYS = ("b2", "dc2")
 MIN_WINDOW_ROWS = 10
 #: Default of ``rsf fit --max-time``.
 MAX_TIME_DEFAULT = "5 min"
-#: Jacobians (each n + 1 model runs, n the free parameters) of one least-squares search: counted runs over n + 1
-#: were 6-12 on the step records of tests/test_rsf_fit_protocols.py that fit, 20-80 on ones that fail and restart.
+#: Jacobians (each n + 1 model runs, n the free parameters) of one least-squares search (docs/rsf.md, "Cost estimate").
 JACOBIANS_PER_SEARCH = 10
 #: At most this many times the typical cost: a troubled search restarts in Dc (3) and is polished (up to 3).
 RESTART_FACTOR = 7
@@ -741,11 +740,8 @@ def _history(options: dict[str, Any], record: Any) -> Any:
 
 
 def estimate_fit_cost(record: Any, settings: dict[str, Any]) -> FitCost:
-    """One model run of the record's history at the fit's tolerance, timed, times the runs a fit typically takes:
-    (n + 1) per Jacobian x :data:`JACOBIANS_PER_SEARCH` per search, two searches (the fit and its comparison
-    with the drift term toggled) and two more for a second state, plus walkers x steps of an emcee posterior.
-    Counted runs were 0.6-1.2 times this on synthetic records and shipped records that fit at once, 3 times on
-    ones whose search restarts (docs/rsf.md; tests/test_rsf_fit_cli.py checks one)."""
+    """One model run of the record's history at the fit's tolerance, timed, times the runs a fit typically takes
+    (docs/rsf.md, "Cost estimate and --max-time"; tests/test_rsf_fit_cli.py checks one)."""
     held = set(settings.get("fixed", {})) - {"trend", "time_trend"}  # a held drift is no fitted one either way
     free = 5 + (2 if settings["states"] == 2 else 0) - len(held)  # mu0, a, b, Dc, k (b2, Dc2)
     trend = settings["trend"] or ""

@@ -615,12 +615,9 @@ def _public(key: str) -> str:
 
 def _free_changes(setup: _Setup, base: RSFParams, values: dict[str, float], noise: float, labels: np.ndarray) -> tuple[
         tuple[tuple[int, float], ...], dict[int, dict[str, float]], float]:  # fmt: skip
-    """The found history's change times that matter at ``values``: each moved by CHANGE_SHIFT of its uncertainty
-    (from the displacement, :func:`change_time_uncertainty`) either way; free where chi-square at the search's
-    ``noise`` rises by more than CHANGE_CHI2.  Also, per change, its uncertainty and that rise (for the report),
-    and the weight of the priors: the residuals' variance over ``noise`` squared times rows per independent row
-    (their correlation), so that the displacement's date is weighed against what the friction honestly tells
-    (a record described to its noise with independent residuals: 1; the sepiolite records: ~2000)."""
+    """The found history's change times that matter at ``values`` (free where moving one by CHANGE_SHIFT of its
+    uncertainty raises chi-square by more than CHANGE_CHI2), per change its uncertainty and that rise (for the
+    report), and the priors' weight (:func:`_prior_weight`): docs/rsf.md, "Which are fitted" and "Fitted"."""
     record, protocol = setup.record, setup.protocol
     sigmas = change_time_uncertainty(record.time, record.displacement, protocol)
     model, why = _model_or_why(record, protocol, base, values)
@@ -1064,10 +1061,7 @@ POLISH_ROUNDS = 3
 
 def _polish(setup: _Setup, start: dict[str, float], result: Any, residual: Any) -> Any:
     """Search again from two standard errors along the covariance's widest direction when chi-square is lower
-    there: MINPACK can stop short of the minimum in a long narrow valley, where its finite-difference Jacobian
-    no longer sees the slope along the valley (a and b correlated at 0.99 on the bond model's step: a 1e-16
-    change of the record left a 0.7 % off and chi-square 1.7 % above the minimum; a restart from the same
-    point stops at once).  A new search is kept only when it lowers chi-square."""
+    there, keeping a new search only when it lowers chi-square (docs/rsf.md, "Stopping short")."""
     for _ in range(POLISH_ROUNDS):
         lower = _downhill(result, residual)
         if lower is None:
