@@ -54,8 +54,6 @@ AGING_NEGLECT_WARNING = 0.5
 LARGEST_LOG_WIDTH = 700.0
 #: Above this many points the joint fit's automatic intervals are the delta method's, not the profile's.
 PROFILE_MAX_POINTS = 1000
-#: Give up the fix-and-refit loop after this many rounds (never reached: each round fixes one key).
-MAX_ROUNDS = 10
 
 
 @dataclass(frozen=True)
@@ -267,7 +265,7 @@ def _fit_block(
         if not bad:
             break
         _fix_undetermined(progress, keys, bad[0], name)
-    for _ in range(MAX_ROUNDS):
+    while True:  # each round that does not return fixes one key
         space = Space(progress.params, tuple(keys))
         theta0 = space.vector()
         centre = Space(progress.start, tuple(keys)).vector()
@@ -291,7 +289,6 @@ def _fit_block(
             )
             return keys, got.theta
         _fix_undetermined(progress, keys, bad[0], name)
-    raise RuntimeError("fix-and-refit loop did not terminate")  # pragma: no cover
 
 
 def _fix_undetermined(progress: _Progress, keys: list[str], direction: identify.Direction, name: str) -> None:

@@ -28,10 +28,6 @@ class PanelRule:
     weights: np.ndarray  # (K,)
     cumulative: np.ndarray  # (K+1, K): rows 0..K-1 integrate to the nodes, row K to +1
 
-    @property
-    def size(self) -> int:
-        return self.nodes.size
-
 
 @lru_cache(maxsize=8)
 def panel_rule(order: int) -> PanelRule:
