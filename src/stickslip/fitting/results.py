@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Any
 
@@ -77,3 +78,13 @@ class Estimate:
         if self.bias is not None:
             out["method_bias"] = self.bias
         return out
+
+
+#: ln-widths beyond this give an unbounded upper end (e^700 ~ 1e304: no number, only "unbounded").
+LARGEST_LOG_WIDTH = 700.0
+
+
+def log_interval(value: float, sd_log: float, q: float) -> tuple[float, float | None]:
+    """value e^(-q sd), value e^(q sd); the upper end is unbounded where that overflows (sd of hundreds)."""
+    width = q * sd_log
+    return value * math.exp(-width), (value * math.exp(width) if width < LARGEST_LOG_WIDTH else None)

@@ -39,6 +39,7 @@ from .problem import (
     residuals,
 )
 from .results import Estimate, display_unit, human
+from .results import log_interval as _log_interval
 from .scatter import Dependence, Misfit, Scatter, local_scatter, misfit, velocity_dependence
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -50,8 +51,6 @@ INTERVAL_METHODS = ("delta", "profile", "bootstrap")
 DEFAULT_SPLIT = 800e-6
 #: Above the split the two-step fit neglects aging; warn when that changes sigma by more than this many errors.
 AGING_NEGLECT_WARNING = 0.5
-#: ln-widths beyond this give an unbounded upper end (e^700 ~ 1e304: no number, only "unbounded").
-LARGEST_LOG_WIDTH = 700.0
 #: Above this many points the joint fit's automatic intervals are the delta method's, not the profile's.
 PROFILE_MAX_POINTS = 1000
 
@@ -372,12 +371,6 @@ def _inverse(matrix: np.ndarray) -> np.ndarray:
 def _quantile(level: float, dof: int, noise_known: bool) -> float:
     tail = 0.5 + level / 2.0
     return float(stats.norm.ppf(tail) if noise_known else stats.t.ppf(tail, max(dof, 1)))
-
-
-def _log_interval(value: float, sd_log: float, q: float) -> tuple[float, float | None]:
-    """value e^(-q sd), value e^(q sd); the upper end is unbounded where that overflows (sd of hundreds)."""
-    width = q * sd_log
-    return value * math.exp(-width), (value * math.exp(width) if width < LARGEST_LOG_WIDTH else None)
 
 
 def fit_steady(

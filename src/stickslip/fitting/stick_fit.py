@@ -27,7 +27,7 @@ from ..units import to_si
 from . import identify
 from .data import StickData, read_stick_data
 from .problem import JACOBIAN_STEP, SEARCH_BOX
-from .results import Estimate, human
+from .results import Estimate, human, log_interval
 from .stick_batch import stick_times
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -386,16 +386,7 @@ def fit_stick(
         dim = key_dimension(key)
         if key in keys:
             s = float(sd[keys.index(key)])
-            estimates.append(
-                Estimate(
-                    key,
-                    identify.SYMBOLS[key],
-                    dim,
-                    value,
-                    value * s,
-                    (value * math.exp(-q * s), value * math.exp(q * s)),
-                )
-            )
+            estimates.append(Estimate(key, identify.SYMBOLS[key], dim, value, value * s, log_interval(value, s, q)))
         else:
             reason = "fixed by request" if key in fixed else "not determined by the data; fixed at its input value"
             estimates.append(Estimate(key, identify.SYMBOLS[key], dim, value, status="fixed", note=reason))
