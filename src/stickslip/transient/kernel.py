@@ -64,6 +64,9 @@ BIRTH_BIAS = 10.0
 SATURATED_BARRIER = 30.0
 #: saturating aging's clock (:func:`_aging_clock`): below this decay e^(-t_a/t_s), 1 - decay is exact to an ulp
 CLOCK_PLAIN_DECAY = 0.5
+#: saturating aging: saturated cohorts are merged, and the negligible dropped, every MERGE_EVERY accepted steps (the
+#: bin tests were ~15 % of a step's CPU at the fold; in between at most 2 (MERGE_EVERY - 1) more cohorts are kept)
+MERGE_EVERY = 4
 #: saturating aging: a cohort's error by the series of 1 - e^(-c) below this end correction c (:func:`_cohort_weight`)
 CORRECTION_SERIES = 1e-3
 
@@ -184,17 +187,20 @@ def _velocity_prepare(n, xb, tb, lw, x, t, p, lc, aa, known, clock):  # type: ig
 
 
 def _velocity_residual(v, vp, n, lc, aa, k_int, p):  # type: ignore[no-untyped-def]
-    """(g(V), g'(V)) of the module docstring, from the prepared lc, aa."""
+    """(g(V), g'(V), g''(V)) of the module docstring, from the prepared lc, aa."""
     decay = math.exp(-abs(v) / p[P_VA]) if p[P_AGING] > 0.0 else 0.0
     loss = 0.0
     dloss = 0.0
+    ddloss = 0.0
     for i in range(n):
         if lc[i] == -np.inf:
             continue
         term = math.exp(min(lc[i] - aa[i] * decay, LOG_RATE_CAP))
+        rate = aa[i] * decay / p[P_VA]  # d(ln term)/dV
         loss += term
-        dloss += term * aa[i] * decay / p[P_VA]
-    return (k_int + p[P_K]) * v - p[P_K] * vp - loss, (k_int + p[P_K]) - dloss
+        dloss += term * rate
+        ddloss += term * rate * (rate - 1.0 / p[P_VA])
+    return (k_int + p[P_K]) * v - p[P_K] * vp - loss, (k_int + p[P_K]) - dloss, -ddloss
 
 
 def _slider_velocity(v_prev, vp, n, xb, tb, lw, x, t, p, lc, aa, known):  # type: ignore[no-untyped-def]
@@ -205,63 +211,36 @@ def _slider_velocity(v_prev, vp, n, xb, tb, lw, x, t, p, lc, aa, known):  # type
 def _slider_velocity_clocked(v_prev, vp, n, xb, tb, lw, x, t, p, lc, aa, known, clock):  # type: ignore[no-untyped-def]
     """The stable root of g nearest v_prev (block control): safeguarded Newton inside a bracket."""
     k_int = _velocity_prepare(n, xb, tb, lw, x, t, p, lc, aa, known, clock)
-    g0, d0 = _velocity_residual(v_prev, vp, n, lc, aa, k_int, p)
+    g0, d0, c0 = _velocity_residual(v_prev, vp, n, lc, aa, k_int, p)
     if p[P_AGING] == 0.0:  # g is linear in V
         return v_prev - g0 / d0
     if g0 == 0.0:
         return v_prev
-    # bracket the nearest crossing in the direction of the root (g(0) <= 0 always)
+    # Newton from v_prev inside a bracket [lo, hi] with g(lo) < 0 <= g(hi) (g(0) <= 0 always): each step from
+    # the last point evaluated, a bisection where Newton leaves the bracket, a growing leap while no g >= 0 is known
     scale = max(abs(v_prev), 1e-12)
-    # g and g' at the end of the bracket where Newton starts, already evaluated (the residual costs an exp per
-    # cohort; evaluating it again there would give the same numbers)
-    g_start, d_start = g0, d0
-    if g0 < 0.0:
-        lo, hi = v_prev, np.inf
-        if d0 > 0.0:
-            trial = v_prev - g0 / d0
-        else:
-            trial = v_prev + scale
-        for _ in range(400):
-            gt, dt = _velocity_residual(trial, vp, n, lc, aa, k_int, p)
-            if gt >= 0.0:
-                hi = trial
-                break
-            lo = trial
-            g_start, d_start = gt, dt
-            trial = lo + 2.0 * (lo - v_prev) + scale
-    else:
-        lo, hi = 0.0, v_prev
-        trial = v_prev - g0 / d0 if d0 > 0.0 else 0.5 * v_prev
-        if trial < 0.0:
-            trial = 0.0
-        for _ in range(400):
-            gt, dt = _velocity_residual(trial, vp, n, lc, aa, k_int, p)
-            if gt <= 0.0:
-                lo = trial
-                break
-            hi = trial
-            g_start, d_start = gt, dt
-            trial = 0.5 * trial if trial > 1e-300 else 0.0
-    if not hi < np.inf:
-        return lo
-    v = lo if g0 < 0.0 else hi
-    for iteration in range(100):
-        if iteration == 0:
-            g, d = g_start, d_start
-        else:
-            g, d = _velocity_residual(v, vp, n, lc, aa, k_int, p)
+    lo, hi = (v_prev, np.inf) if g0 < 0.0 else (0.0, v_prev)
+    v, g, d, c = v_prev, g0, d0, c0
+    for _ in range(500):
+        v_new = v - g / d if d > 0.0 else np.nan
+        newton = lo < v_new < hi
+        if not newton:
+            v_new = 0.5 * (lo + hi) if hi < np.inf else lo + 2.0 * (lo - v_prev) + scale
+        step = abs(v_new - v)
+        if step <= 1e-13 * max(abs(v_new), 1e-300) or (hi < np.inf and hi - lo <= 1e-14 * hi):
+            return v_new
+        # Newton's next correction would be ~|g''/(2 g')| step^2: within the tolerance, v_new is the root to it (one
+        # residual, an exp per cohort, saved on most steps)
+        if newton and abs(c) * step * step <= 2e-13 * d * max(abs(v_new), 1e-300):
+            return v_new
+        v = v_new
+        g, d, c = _velocity_residual(v, vp, n, lc, aa, k_int, p)
         if g == 0.0:
             return v
         if g < 0.0:
             lo = v
         else:
             hi = v
-        v_new = v - g / d if d > 0.0 else 0.5 * (lo + hi)
-        if not (lo < v_new < hi):
-            v_new = 0.5 * (lo + hi)
-        if abs(v_new - v) <= 1e-13 * max(abs(v_new), 1e-300) or hi - lo <= 1e-14 * hi:
-            return v_new
-        v = v_new
     return v
 
 
@@ -498,9 +477,17 @@ def _saturated_bins(n, nn, ss, s_floor, rtol, p):  # type: ignore[no-untyped-def
     return math.log(max(share * nn, 1e-300)), share * max(abs(ss), s_floor), p[P_MERGE_SATURATED] * math.sqrt(rtol)
 
 
-def _negligible(lw, e, light_n, light_s, p):  # type: ignore[no-untyped-def]
+def _negligible(lw, e, w_known, f_known, light_n, light_s, p):  # type: ignore[no-untyped-def]
     """Lighter than the share of the bonds alive, and carrying less than the share of the stress."""
-    return lw < light_n and math.exp(lw) * abs(_chain_force(e, p[P_M], p[P_DLM])) < light_s
+    return lw < light_n and _cohort_load(lw, e, w_known, f_known, p) < light_s
+
+
+def _cohort_load(lw, e, w_known, f_known, p):  # type: ignore[no-untyped-def]
+    """w |f(e)|, the stress a cohort carries: its weight and force where the step left them (``known``: the same
+    numbers; negative or nan where not), else computed."""
+    w = w_known if w_known >= 0.0 else math.exp(lw)
+    f = f_known if f_known == f_known else _chain_force(e, p[P_M], p[P_DLM])
+    return w * abs(f)
 
 
 def _same_bin(x, decay_i, decay_g, xb_i, xb_g, spread, p):  # type: ignore[no-untyped-def]
@@ -532,10 +519,11 @@ def _saturation_decay(t, tb, p):  # type: ignore[no-untyped-def]
     return math.exp(-(t - tb) / p[P_SATURATION])
 
 
-def _light_spread(spread, lw_i, lw_g, e_i, e_g, lw_mean, s_mean, p):  # type: ignore[no-untyped-def]
+def _light_spread(spread, log_ratio, load, s_mean):  # type: ignore[no-untyped-def]
     """The bin width for two cohorts: ``spread`` times 2^k, k the whole number of halvings in sqrt(w_mean/w) of the
-    heavier of the two, or in sqrt of the mean stress a cohort carries over theirs if that is smaller (0 for a
-    cohort at least as heavy or as loaded as the mean, at most LIGHT_LEVELS).
+    heavier of the two (``log_ratio``: ln(w_mean/w), at least LOG_FOUR: lighter ones share no wider bin), or in
+    sqrt of the mean stress a cohort carries over theirs (``load``, the larger) if that is smaller (at most
+    LIGHT_LEVELS).
 
     A merge moves the population by ~w spread^2/8 of its hazard, and its stress by as much through the FENE
     curvature, so a cohort lighter than the mean by w_mean/w in both may be binned sqrt(w_mean/w) wider for the same
@@ -543,14 +531,7 @@ def _light_spread(spread, lw_i, lw_g, e_i, e_g, lw_mean, s_mean, p):  # type: ig
     their birth positions spread by the creep) then share bins.  Both shares: in a hold the newborns at zero
     extension make up N while the old cohorts carry the stress.  Widths are powers of two of ``spread``, so the bins
     of each level nest in the next and a chain of merges cannot drift past the coarsest bin it was merged in."""
-    log_ratio = lw_mean - max(lw_i, lw_g)
-    if log_ratio < LOG_FOUR:  # k = 0 whatever the stress share (the forces and the exp are not needed)
-        return spread
-    ratio = math.exp(log_ratio)
-    m = p[P_M]
-    dlm = p[P_DLM]
-    load = max(math.exp(lw_i) * abs(_chain_force(e_i, m, dlm)), math.exp(lw_g) * abs(_chain_force(e_g, m, dlm)))
-    ratio = min(ratio, s_mean / max(load, 1e-300))
+    ratio = min(math.exp(log_ratio), s_mean / max(load, 1e-300))
     k = math.floor(0.5 * math.log(max(ratio, 1.0)) / math.log(2.0))
     return spread * 2.0 ** min(k, LIGHT_LEVELS)
 
@@ -681,6 +662,8 @@ def _cohort_pass(  # type: ignore[no-untyped-def]
     va = p[P_VA]
     saturating = p[P_SATURATION] > 0.0
     aging_on = p[P_AGING] > 0.0
+    ts = p[P_SATURATION]
+    step_decay = math.exp(-hh / ts) if saturating else 1.0
     nn0 = s0 = nn1 = s1 = 0.0
     loss0 = loss1 = 0.0  # breakage rate (bonds per m^2 per s) at both ends of the step
     dloss0 = dloss1 = 0.0  # and its time derivative
@@ -723,7 +706,13 @@ def _cohort_pass(  # type: ignore[no-untyped-def]
                 age0, clock0 = cache[6, i], cache[7, i]
             else:
                 age0, clock0 = _aging_clock(t - tb[i], p)
-            age1, clock1 = _aging_clock(t1 - tb[i], p)
+            if cached and clock0 < CLOCK_PLAIN_DECAY:
+                # e^(-t_a/t_s) carried over the step by one factor for all (an exp per cohort saved; ~2 ulp per
+                # step, ~1e-11 of the decay after 1e5 steps, itself < 1/2 here: no digit of the age that matters)
+                clock1 = clock0 * step_decay
+                age1 = ts * (1.0 - clock1)
+            else:
+                age1, clock1 = _aging_clock(t1 - tb[i], p)
             clock_end[0, i] = age1  # the same numbers the row at t1 needs (:func:`_sums_keeping`)
             clock_end[1, i] = clock1
         else:
@@ -1064,10 +1053,14 @@ def _quiet_neighbours(rate_i, rate_g, xb_i, xb_g, tb_i, tb_g, quiet, gap, age_ga
     )
 
 
-def _housekeeping(n, t, t_end, x, nn1, s1, s_floor, rtol, xb, tb, lw, rate0, known, acc, clock_end, p):  # type: ignore[no-untyped-def]
+def _housekeeping(
+    n, t, t_end, x, nn1, s1, s_floor, rtol, xb, tb, lw, rate0, known, prepared, merging, acc, clock_end, p
+):  # type: ignore[no-untyped-def]
     """Drop dead cohorts (their weight counts as broken, up to LIGHTEST * N0; with saturated aging, the negligible
     ones of :func:`_saturated_bins`) and merge neighbours that are quiet and born close (:func:`_quiet_neighbours`)
-    or, past the saturation age, in one bin (:func:`_same_bin`); never the newest.  Returns the cohorts kept."""
+    or, past the saturation age, in one bin (:func:`_same_bin`); never the newest.  ``known`` as the step left it:
+    each weight where exact, and each force at x where ``prepared`` (the massless block's balance): the same
+    numbers, not computed again.  Returns the cohorts kept."""
     dlm = p[P_DLM]
     quiet = 1e-3 * rtol / max(t_end - t, 1.0)
     gap = 1e-4 * math.sqrt(rtol) * dlm
@@ -1075,7 +1068,7 @@ def _housekeeping(n, t, t_end, x, nn1, s1, s_floor, rtol, xb, tb, lw, rate0, kno
     keep = 0
     floor = math.log(LIGHTEST * p[P_N0])
     # the housekeeping of saturating aging; off: the paper's, as for linear aging
-    saturated = p[P_SATURATION] > 0.0 and p[P_AGING] > 0.0 and p[P_MERGE_SATURATED] > 0.0
+    saturated = merging and p[P_SATURATION] > 0.0 and p[P_AGING] > 0.0 and p[P_MERGE_SATURATED] > 0.0
     light_n, light_s, spread = 0.0, 0.0, 1.0
     lw_mean = s_mean = 0.0
     if saturated:
@@ -1089,12 +1082,19 @@ def _housekeeping(n, t, t_end, x, nn1, s1, s_floor, rtol, xb, tb, lw, rate0, kno
         # only cohorts past the saturation age: those linger at the resting hazard (the young are as before)
         aged = saturated and t - tb[i] >= p[P_SATURATION]
         decay_i = -1.0
-        if lw[i] > floor and not (aged and _negligible(lw[i], x - xb[i], light_n, light_s, p)):
+        f_i = known[1, i] if prepared else np.nan
+        if lw[i] > floor and not (aged and _negligible(lw[i], x - xb[i], known[0, i], f_i, light_n, light_s, p)):
             g = keep - 1
             width = spread
+            if aged and keep > 0 and lw_mean - max(lw[i], lw[g]) >= LOG_FOUR:
+                load = max(
+                    _cohort_load(lw[i], x - xb[i], known[0, i], f_i, p),
+                    _cohort_load(lw[g], x - xb[g], known[0, g], known[1, g] if prepared else np.nan, p),
+                )
+                width = _light_spread(spread, lw_mean - max(lw[i], lw[g]), load, s_mean)
             if aged and keep > 0:
-                width = _light_spread(spread, lw[i], lw[g], x - xb[i], x - xb[g], lw_mean, s_mean, p)
-                decay_i = _saturation_decay(t, tb[i], p)
+                # the pass's clock at t where it left it (the same number), else computed
+                decay_i = clock_end[1, i] if clock_end[0, i] == clock_end[0, i] else _saturation_decay(t, tb[i], p)
                 if decay_g < 0.0:
                     decay_g = _saturation_decay(t, tb[g], p)
             if (
@@ -1256,7 +1256,10 @@ def advance(  # type: ignore[no-untyped-def]
             accel_prev = accel_now
             accel_now = (p[P_K] * (puller0 + vp * (t - t0) - x) - p[P_DAMPING] * v - s1) / p[P_MASS]
         steps += 1
-        n = _housekeeping(n, t, t_end, x, nn1, s1, s_floor, rtol, xb, tb, lw, rate0, known, acc, clock_end, p)
+        n = _housekeeping(
+            n, t, t_end, x, nn1, s1, s_floor, rtol, xb, tb, lw, rate0, known, block == 1 and not inertial,
+            steps % MERGE_EVERY == 0, acc, clock_end, p,
+        )  # fmt: skip
         h = _next_step(hh, err, h, h_max, landing)
         record = n_samples == 0
         if landing:
@@ -1317,6 +1320,7 @@ def compiled() -> dict[str, object]:
             "_log_rate",
             "_hermite",
             "_vacancy",
+            "_cohort_load",
             "_negligible",
             "_light_spread",
             "_same_bin",
