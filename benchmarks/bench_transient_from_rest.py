@@ -17,10 +17,11 @@ rejected, first slip at 38.93123993 s from 554.3530651 Pa, sigma(45 s) 285.66116
 Now (saturating aging: the births' own error bound with converged sweeps, light saturated cohorts in wider nested
 bins, the reduction entered from rest at 0.32 s where the block is insensitive to its neglected term, and the cohort
 step's work cut: the saturating clock without expm1 past t_s ln 2, its values at the step's end kept for the row and
-the next step; docs/transient.md section 8): printed beside the baseline.  The issue's target: <= 5 s of CPU at the
-default rtol with the answer kept; measured 4.41, 4.87, 5.91, 4.58, 4.82 s alternated with the commit before that
-change's 6.45, 7.25, 6.82, 7.24, 6.53 s (0.72; it took 5.69 s quiet: ~4.1 s), 25 587 steps, first slip at
-38.93119485 s from 554.3524791 Pa.
+the next step; then, commit 54dff9e, the slider's Newton iteration from its last point, stopped by its next
+correction's size (~1 residual a step instead of ~4), and saturated cohorts merged every fourth step;
+docs/transient.md section 8): printed beside the baseline.  The issue's target: <= 5 s of CPU at the default rtol
+with the answer kept; measured 3.80, 3.51, 3.47, 3.20, 3.79 s alternated with the commit before 54dff9e (5.64, 5.80,
+4.54, 4.43, 5.18 s), 25 555 steps, first slip at 38.93119532 s from 554.3524748 Pa.
 """
 
 from __future__ import annotations
