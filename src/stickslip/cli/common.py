@@ -84,6 +84,13 @@ def _meant_unit(number: float, dimension: str, typical: float | None) -> str:
     return min(candidates, key=lambda unit: abs(size + math.log10(unit[1]) - target))[0]
 
 
+def stacked(options: Sequence[Callable[[Any], Any]], func: Callable[..., Any]) -> Callable[..., Any]:
+    """``func`` with click ``options`` applied, the first listed shown first in ``--help``."""
+    for option in reversed(options):
+        func = option(func)
+    return func
+
+
 def params_options(func: Callable[..., Any]) -> Callable[..., Any]:
     """Add ``--params NAME|FILE`` and repeatable ``--set section.key=VALUE``."""
     func = click.option(

@@ -25,6 +25,7 @@ from .common import (
     require_unit,
     resolve_params,
     save_figure,
+    stacked,
     write_text,
 )
 
@@ -62,12 +63,7 @@ def _fit_outputs(plot_help: str) -> Any:
         click.option("--json", "as_json", is_flag=True, help="Print the results as JSON (SI units)."),
     ]  # fmt: skip
 
-    def add(func: Any) -> Any:
-        for option in reversed(options):
-            func = option(func)
-        return func
-
-    return add
+    return lambda func: stacked(options, func)
 
 
 def _figure_to(path: Path, make: Any) -> None:

@@ -26,7 +26,7 @@ from typing import Any
 import click
 
 from ..errors import ParameterError, UnitError
-from .common import positive, require_unit
+from .common import positive, require_unit, stacked
 
 #: Rigs every run command names the same way.
 CONTROLS = ("spring", "velocity")
@@ -57,9 +57,7 @@ def protocol_options(
                          help="spring: the protocol moves the load point, a spring drives the slider (block is"
                          " the older name); velocity: it moves the slider itself (a rigid rig)."),
         ]  # fmt: skip
-        for option in reversed(options):
-            func = option(func)
-        return func
+        return stacked(options, func)
 
     return decorate
 

@@ -27,7 +27,7 @@ import numpy as np
 from ..errors import DataError, ModelError, ParameterError, UnitError
 from ..numerics.budget import PROGRESS_AFTER_SECONDS
 from ..units import quantity_noun, shorten
-from .common import json_text, positive, quantity, refuse_overwriting_inputs, save_figure, write_text
+from .common import json_text, positive, quantity, refuse_overwriting_inputs, save_figure, stacked, write_text
 from .params_files import load_params_file, load_params_mapping
 from .protocol_options import build_protocol as build_run_protocol
 from .protocol_options import checked_segment_text, protocol_options, refuse_unsupported
@@ -66,9 +66,7 @@ def model_options(func: Callable[..., Any], stiffness: bool = True) -> Callable[
                      help='Cut-off velocity form (QDYN): V1 of the direct effect, e.g. "1 mm/s"; needs --cutoff-v2.'),
         click.option("--cutoff-v2", default=None, help='Cut-off velocity V2 of the evolution effect, e.g. "1 um/s".'),
     ]  # fmt: skip
-    for option in reversed(options):
-        func = option(func)
-    return func
+    return stacked(options, func)
 
 
 def build_params(options: dict[str, Any]) -> Any:

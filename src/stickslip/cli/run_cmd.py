@@ -26,6 +26,7 @@ from .common import (
     require_unit,
     save_figure,
     set_values,
+    stacked,
 )
 from .protocol_options import build_protocol, build_rig, inertia_options, protocol_options
 from .run_report import model_record, record_text
@@ -45,9 +46,7 @@ def model_spec_options(func: Any) -> Any:
         click.option("--set", "overrides", multiple=True, metavar="KEY=VALUE",
                      help="Override one of the model's parameter keys, with its unit; repeatable."),
     ]  # fmt: skip
-    for option in reversed(options):
-        func = option(func)
-    return func
+    return stacked(options, func)
 
 
 def output_options(func: Any) -> Any:
@@ -59,9 +58,7 @@ def output_options(func: Any) -> Any:
                      help="Save the run's figure."),
         click.option("--json", "as_json", is_flag=True, help="Print the summary as JSON (SI units)."),
     ]  # fmt: skip
-    for option in reversed(options):
-        func = option(func)
-    return func
+    return stacked(options, func)
 
 
 def load_model(model_name: str) -> Any:
