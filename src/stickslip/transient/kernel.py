@@ -1086,13 +1086,14 @@ def _housekeeping(
         if lw[i] > floor and not (aged and _negligible(lw[i], x - xb[i], known[0, i], f_i, light_n, light_s, p)):
             g = keep - 1
             width = spread
-            if aged and keep > 0 and lw_mean - max(lw[i], lw[g]) >= LOG_FOUR:
-                load = max(
-                    _cohort_load(lw[i], x - xb[i], known[0, i], f_i, p),
-                    _cohort_load(lw[g], x - xb[g], known[0, g], known[1, g] if prepared else np.nan, p),
-                )
-                width = _light_spread(spread, lw_mean - max(lw[i], lw[g]), load, s_mean)
             if aged and keep > 0:
+                log_ratio = lw_mean - max(lw[i], lw[g])
+                if log_ratio >= LOG_FOUR:  # lighter than a quarter of the mean: the loads decide a wider bin
+                    load = max(
+                        _cohort_load(lw[i], x - xb[i], known[0, i], f_i, p),
+                        _cohort_load(lw[g], x - xb[g], known[0, g], known[1, g] if prepared else np.nan, p),
+                    )
+                    width = _light_spread(spread, log_ratio, load, s_mean)
                 # the pass's clock at t where it left it (the same number), else computed
                 decay_i = clock_end[1, i] if clock_end[0, i] == clock_end[0, i] else _saturation_decay(t, tb[i], p)
                 if decay_g < 0.0:
