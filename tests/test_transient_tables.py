@@ -56,3 +56,25 @@ def test_the_memo_returns_the_table_a_run_would_build():
     fresh = reduction.build_manifold(gel, True, 300e-6, 2.4e-3, 1e-4)
     x = np.log(np.geomspace(300e-6, 2.4e-3, 7))
     assert np.array_equal(first.stress(x), fresh.stress(x)) and np.array_equal(first.lag(x), fresh.lag(x))
+
+
+def test_the_stacked_recurrence_gives_each_series_own_values_to_the_bit():
+    """Manifold.at evaluates the six series in one Clenshaw recurrence over their zero-padded coefficients (the
+    reduced ODE's right-hand side and event tests call it at every stage); against each numpy series' own call:
+    equal bit for bit (the padding adds exact zeros, the mapping is the series' own), so the runs' numbers did not
+    move.  The series have different degrees (the steady curve's and the lag's tables are refined separately),
+    and a repeated point returns the remembered values."""
+    gel = stickslip.load_parameters("gelatin-glass")
+    m = reduction.build_manifold(gel, True, 110e-6, 1.2e-3, 1e-4)
+    assert m is not None and m.stress.coef.size != m.lag.coef.size, "equal degrees: the padding is not exercised"
+    series = (m.stress, m.dstress, m.d2stress, m.lag, m.dlag, m.bonded)
+    for x in np.log(np.r_[110e-6, 1.2e-3, np.geomspace(111e-6, 1.19e-3, 37)]):
+        got = m.at(float(x))
+        want = np.array([float(s(float(x))) for s in series])
+        assert np.array_equal(got, want), x
+        assert m.at(float(x)) is got
+    s, slope, curv, c, dc = m.values(300e-6)
+    x = np.log(300e-6)
+    assert (s, c) == (float(m.stress(x)), float(m.lag(x)))
+    assert slope == float(m.dstress(x)) / 300e-6 and dc == float(m.dlag(x)) / 300e-6
+    assert curv == (float(m.d2stress(x)) - float(m.dstress(x))) / (300e-6 * 300e-6)

@@ -29,10 +29,11 @@ looked for while reduced (for the gel Kc = 0 from Vc to at least 1 mm/s).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.polynomial import chebyshev as cheb
+from numpy.polynomial import polyutils as pu
 
 from ..parameters import Parameters
 from . import kernel
@@ -71,6 +72,8 @@ class Manifold:
     lag: cheb.Chebyshev  # C(ln V), Pa s^2/m
     dlag: cheb.Chebyshev  # dC/dlnV
     energy: cheb.Chebyshev  # bond energy of the steady population (J/m^2)
+    _stacked: tuple[np.ndarray, np.floating, np.floating] | None = field(default=None, repr=False, compare=False)
+    _last: tuple[float, np.ndarray | None] = field(default=(math.nan, None), repr=False, compare=False)
 
     def covers(self, lo: float, hi: float) -> bool:
         return self.v_lo <= lo and hi <= self.v_hi
@@ -88,15 +91,33 @@ class Manifold:
         hi = min(self.v_hi, math.exp(above.min()) * (1 - 1e-3)) if above.size else self.v_hi
         return (lo, hi) if lo < v < hi else None
 
+    def at(self, x: float) -> np.ndarray:
+        """(S, dS/dlnV, d2S/dlnV2, C, dC/dlnV, N/N0) at ln V = x, in one Clenshaw recurrence over the six series'
+        coefficients stacked (zero-padded to one degree).  Each column sees the operations its own series' call
+        would do, so the values are the same to the bit; the reduced ODE asks for these at every stage and event
+        test, where one numpy call per series cost more than the recurrences (the last x is remembered: the right-
+        hand side and the event tests ask twice at one point)."""
+        last_x, last = self._last
+        if x == last_x and last is not None:
+            return last
+        if self._stacked is None:
+            series = (self.stress, self.dstress, self.d2stress, self.lag, self.dlag, self.bonded)
+            stack = np.zeros((max(s.coef.size for s in series), len(series)))
+            for k, s in enumerate(series):
+                stack[: s.coef.size, k] = s.coef
+            off, scl = pu.mapparms(self.stress.domain, self.stress.window)
+            self._stacked = (stack, off, scl)
+        stack, off, scl = self._stacked
+        out = cheb.chebval(off + scl * x, stack)
+        self._last = (x, out)
+        return out
+
     def values(self, v: float) -> tuple[float, float, float, float, float]:
         """(S, S', S'', C, C') at velocity v (SI)."""
-        x = math.log(v)
-        s = float(self.stress(x))
-        sx = float(self.dstress(x))
-        sxx = float(self.d2stress(x))
+        s, sx, sxx, c, cx, _n = (float(value) for value in self.at(math.log(v)))
         slope = sx / v
         curv = (sxx - sx) / (v * v)
-        return s, slope, curv, float(self.lag(x)), float(self.dlag(x)) / v
+        return s, slope, curv, c, cx / v
 
 
 def _lag(params: Parameters, velocity: float, aging: bool) -> tuple[float, float]:
@@ -409,8 +430,8 @@ def glide(
         if block:
             s_eff, a1, _n = effective(m, vv, vp, k_block)
         else:
-            s_eff, a1 = float(m.stress(math.log(vv))), 0.0
-        born = (n0 - n0 * float(m.bonded(math.log(vv)))) / tau
+            s_eff, a1 = float(m.at(math.log(vv))[0]), 0.0
+        born = (n0 - n0 * float(m.at(math.log(vv))[5])) / tau
         return np.array([a1, born, s_eff * vp, s_eff * vv])
 
     def off_manifold(_t: float, y: np.ndarray) -> float:
