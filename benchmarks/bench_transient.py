@@ -2,7 +2,8 @@
 
 Run as ``PYTHONPATH=src python benchmarks/bench_transient.py`` (``--reference`` adds the rtol 1e-5 cohort run of
 the cycle, 49 s of CPU, whose numbers tests/test_transient_speed.py compares with; ``--quick`` skips the plain
-cohort runs that take more than a few seconds).  CPU time (``time.process_time``) is printed with the ratio
+cohort runs that take more than a few seconds; ``--phases`` only counts where the cycle's steps go, issue 31).
+CPU time (``time.process_time``) is printed with the ratio
 to the plain solver's in the same process, and the accuracy reached: against the steady solver, or the
 cycle's stick time, peak, jump velocity and slip time against the tighter run.
 """
@@ -73,7 +74,39 @@ def cycle_numbers(run):  # type: ignore[no-untyped-def]
     return np.array([getattr(c, key) for key in CYCLE_KEYS])
 
 
+def cycle_phases() -> None:
+    """Issue 31: where the cycle's steps go (a trace row per step): gliding on the reduction, the stick on the
+    chains (Eqs 11-16), and the cohorts, these split by the slider's pace against the bonds' memory dl_m/V: slow
+    (V/|V'| above ten memories, where the population is quasi-steady but the reduction's closure has left it, near
+    the fold) or fast (the collapse to rest and the jump).  Measured: 8 224 steps; 8 048 of them in the two fold
+    passages (4 024 each, steps of 3.46e-5 s), and 7 169 of the 8 197 cohort steps quasi-steady in that sense
+    (docs/transient.md section 8)."""
+    p = stickslip.load_parameters("gelatin-glass")
+    run = run_transient(p, CYCLE, start="steady", stick_population=True)
+    t, v = run.time, run.slider_velocity
+    chains = run.to_frame()["held_by"].to_numpy() == "chains"
+    gap = np.diff(t, prepend=0.0)
+    cohorts = ~chains & (gap < 0.2 * p.bonds.bond_time)  # the cohorts' steps resolve tau; the glide's rows do not
+    memory = p.bonds.max_extension / np.maximum(np.abs(v), 1e-12)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        pace = np.abs(v / np.gradient(v, t))
+    slow = cohorts & (pace > 10 * memory)
+    print(f"cycle, rtol 1e-4: {run.steps} steps; trace rows: {np.count_nonzero(~chains & ~cohorts)} gliding or "
+          f"longer, {np.count_nonzero(chains)} on the stick chains, {np.count_nonzero(cohorts)} cohort steps, of them "
+          f"{np.count_nonzero(slow)} where V/|V'| > 10 dl_m/V (quasi-steady) and {np.count_nonzero(cohorts & ~slow)} "
+          "faster")  # fmt: skip
+    for start, end in ((8.5, 10.0), (23.5, 25.0)):
+        inside = cohorts & (t > start) & (t <= end)
+        if inside.any():
+            first, last, step = t[inside][0], t[inside][-1], np.median(gap[inside])
+            print(f"  the fold passage in {start:g}-{end:g} s: {np.count_nonzero(inside)} cohort steps from "
+                  f"{first:.4f} s to {last:.4f} s, median step {step:.3g} s")  # fmt: skip
+
+
 def main() -> None:
+    if "--phases" in sys.argv:
+        cycle_phases()
+        return
     quick = "--quick" in sys.argv
     p = stickslip.load_parameters("gelatin-glass")
     # compile / load the numba caches of the cohort kernel and of the reduction's tables, and find Vc once (a
