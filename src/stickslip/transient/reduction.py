@@ -427,11 +427,12 @@ def glide(
 
     def rhs(_t: float, y: np.ndarray) -> np.ndarray:
         vv = min(max(y[0], lo), hi)  # a trial stage may overshoot; the events end the stretch at the edges
+        table = m.at(math.log(vv))
         if block:
             s_eff, a1, _n = effective(m, vv, vp, k_block)
         else:
-            s_eff, a1 = float(m.at(math.log(vv))[0]), 0.0
-        born = (n0 - n0 * float(m.at(math.log(vv))[5])) / tau
+            s_eff, a1 = float(table[0]), 0.0
+        born = (n0 - n0 * float(table[5])) / tau
         return np.array([a1, born, s_eff * vp, s_eff * vv])
 
     def off_manifold(_t: float, y: np.ndarray) -> float:
