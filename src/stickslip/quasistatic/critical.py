@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from collections.abc import Iterator
 from dataclasses import dataclass
 from functools import lru_cache
 from itertools import pairwise
@@ -97,20 +98,31 @@ def _significant_signs(stress: np.ndarray, log_slope: np.ndarray) -> np.ndarray:
     return sign
 
 
-def _refine(params: Parameters, aging: bool, lo: float, hi: float) -> float:
-    """ln V of the zero of V dsigma/dV between ln V = lo and hi (Brent), or the better end if the signs disagree."""
+def _refine(params: Parameters, aging: bool, lo: float, hi: float) -> tuple[float, float]:
+    """(ln V, sigma) at the zero of V dsigma/dV between ln V = lo and hi (Brent), or at the better end if the signs
+    disagree.  Each point is evaluated once: Brent asks for the ends again, and the root it returns is one of its
+    points (a third of the scalar steady states of a search saved, the same numbers)."""
+    seen: dict[float, tuple[float, float]] = {}
+
+    def at(log_v: float) -> tuple[float, float]:
+        if log_v not in seen:
+            stress, log_slope = _curve(params, math.exp(log_v), aging)
+            seen[log_v] = (float(stress[0]), float(log_slope[0]))
+        return seen[log_v]
 
     def g(log_v: float) -> float:
-        return float(_curve(params, math.exp(log_v), aging)[1][0])
+        return at(log_v)[1]
 
     g_lo, g_hi = g(lo), g(hi)
     if g_lo == 0.0:
-        return lo
-    if g_hi == 0.0:
-        return hi
-    if g_lo * g_hi > 0.0:  # cannot happen with the grid's own values; never let brentq raise
-        return lo if abs(g_lo) < abs(g_hi) else hi
-    return float(brentq(g, lo, hi, xtol=1e-12, rtol=1e-13, maxiter=200))
+        root = lo
+    elif g_hi == 0.0:
+        root = hi
+    elif g_lo * g_hi > 0.0:  # cannot happen with the grid's own values; never let brentq raise
+        root = lo if abs(g_lo) < abs(g_hi) else hi
+    else:
+        root = float(brentq(g, lo, hi, xtol=1e-12, rtol=1e-13, maxiter=200))
+    return root, at(root)[0]
 
 
 def find_extrema(
@@ -124,6 +136,14 @@ def find_extrema(
     (maximum) both ends of its bracket by more than NOISE: a verified
     extremum of the converged curve, not a flicker of quadrature noise.
     """
+    return tuple(_extrema(params, aging, search_range, ("minimum", "maximum")))
+
+
+def _extrema(
+    params: Parameters, aging: bool, search_range: tuple[float, float], kinds: tuple[str, ...]
+) -> Iterator[Extremum]:
+    """The verified extrema of :func:`find_extrema` of the ``kinds`` asked for, lowest velocity first, each
+    refined only when asked for (a bracket refined costs ~10 scalar steady states, the grid one call)."""
     require_parameters(params)
     lo, hi = search_range
     n = int(np.ceil(np.log10(hi / lo) * POINTS_PER_DECADE)) + 1
@@ -132,16 +152,14 @@ def find_extrema(
     sign = _significant_signs(stress, log_slope)
     clear = np.nonzero(sign)[0]
     changes = [(a, b) for a, b in pairwise(clear) if sign[a] != sign[b]]
-    found = []
     for a, b in changes[:MAX_EXTREMA]:
-        log_v = _refine(params, aging, math.log(grid[a]), math.log(grid[b]))
-        v = math.exp(log_v)
-        s = float(_curve(params, v, aging)[0][0])
         kind = "minimum" if sign[a] < 0 else "maximum"
+        if kind not in kinds:
+            continue
+        log_v, s = _refine(params, aging, math.log(grid[a]), math.log(grid[b]))
         depth = (min(stress[a], stress[b]) - s) if kind == "minimum" else (s - max(stress[a], stress[b]))
         if depth > NOISE * abs(s):
-            found.append(Extremum(v, s, kind))
-    return tuple(found)
+            yield Extremum(math.exp(log_v), s, kind)
 
 
 def _no_minimum_message(params: Parameters, extrema: tuple[Extremum, ...]) -> str:
@@ -213,3 +231,16 @@ def cached_critical_point(params: Parameters) -> CriticalPoint:
             f"the no-aging curve rises over the whole range {SEARCH_RANGE[0]:g} to {SEARCH_RANGE[1]:g} m/s: no turnover"
         )
     return CriticalPoint(v, s, v is not None, message, tv, ts, turnover_message, extrema)
+
+
+def critical_minimum(params: Parameters) -> Extremum | None:
+    """Vc and sigma_c alone (Eq 9), as :func:`critical_point` finds them, or None where the aging curve has no
+    minimum: the same numbers at a quarter of the cost, for a study that needs nothing else of the point (the
+    curve's maximum and the no-aging turnover are neither refined nor searched)."""
+    require_parameters(params)
+    return _cached_minimum(steady_curve_key(params))
+
+
+@lru_cache(maxsize=32)
+def _cached_minimum(params: Parameters) -> Extremum | None:
+    return next(_extrema(params, True, SEARCH_RANGE, ("minimum",)), None)

@@ -171,15 +171,16 @@ def _value(params: Parameters, key: str) -> float:
 
 def quasi_static_predictions(params: Parameters) -> dict[str, float]:
     """Vc (m/s), sigma_c (Pa), and the first stick at 100 um/s from rest and from sigma_c (s, Pa)."""
-    from ..quasistatic.critical import critical_point
+    from ..quasistatic.critical import critical_minimum
     from ..quasistatic.stick import stick_phase
 
-    point = critical_point(params)
+    point = critical_minimum(params)  # Vc and sigma_c alone: the turnover and the curve's maximum are not shown
+    velocity, stress = (None, None) if point is None else (point.velocity, point.stress)
     rest = stick_phase(params, STICK_VELOCITY, start_stress=0.0)
-    cycle = stick_phase(params, STICK_VELOCITY, start_stress=point.stress)  # None (no minimum) raises, as it should
+    cycle = stick_phase(params, STICK_VELOCITY, start_stress=stress)  # None (no minimum) raises, as it should
     return {
-        "critical_velocity": _number(point.velocity),
-        "critical_stress": _number(point.stress),
+        "critical_velocity": _number(velocity),
+        "critical_stress": _number(stress),
         "stick_time_from_rest": _number(rest.stick_time),
         "peak_stress_from_rest": _number(rest.peak_stress),
         "stick_time_from_sigma_c": _number(cycle.stick_time),
