@@ -255,7 +255,8 @@ def _render(run: ModelRun, index: int, folder: Path) -> tuple[RenderedFigure, li
     png, paths = _write(lambda: save_figure_files(figure, folder))
     curves = tuple(figure.curves())
     csvs = [_write_text(folder / f"{curve.name}.csv", curve.to_csv()) for curve in curves]
-    figure.figure.clear()
+    # the Figure is dropped here (nothing else holds it) and the collector frees it: clearing it first, artist by
+    # artist, cost ~10 ms a figure
     return RenderedFigure(replace(figure, figure=None), png, curves), paths, csvs
 
 
