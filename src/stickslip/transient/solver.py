@@ -50,6 +50,9 @@ CHUNK = 20000
 COHORT_STEPS_PER_CALL = 10_000_000_000
 #: default relative tolerance of the local error (stress and bonded fraction)
 RTOL = 1e-4
+#: a limit cycle of the stick chains is repeated, not integrated again, once its state has settled (``_Repeater``;
+#: ``reduction="auto"`` and no ``every`` only); False integrates every cycle (the reference of the tests)
+REPEAT_CYCLES = True
 
 
 @dataclass
@@ -263,6 +266,7 @@ class _Driver:
         self.chain_state = {"elapsed": 0.0, "fraction": 1.0}
         self.snap_index = 0
         self.out = np.empty((CHUNK, 13))
+        self.repeater: _Repeater | None = None
 
     def start(
         self, start: str, start_velocity: float | None, every: float | None, max_step: float | None,
@@ -304,6 +308,8 @@ class _Driver:
         if reduction == "auto" and max_step is None and not self.inertial:  # a bound on the step: cohorts throughout
             self.reducer = _Reducer(params, self.p, self.functions, control, k_block, self.rtol, self.aging)
             self.reducer.disturbed(state.t)  # from empty, or a steady start: the cohorts first replace every bond
+            if REPEAT_CYCLES and self.stick_population and control == "block" and not self.times.size:
+                self.repeater = _Repeater(self)
 
     def run(self) -> TransientResult:
         """Every piece of the protocol, to its end (or to where the chains' jump has no landing point)."""
@@ -354,7 +360,8 @@ class _Driver:
     def _finish(self, **kwargs: Any) -> TransientResult:
         result = _finish(self.rows, self.chain_rows, self.events, self.snapshots, self.state, self.params,
                          self.protocol, self.control, self.k_block, int(self.state.acc[4]),
-                         note=self.note + _jumps_note(self.jumps), **kwargs)  # fmt: skip
+                         note=self.note + _jumps_note(self.jumps) + (self.repeater.note() if self.repeater else ""),
+                         **kwargs)  # fmt: skip
         return replace(result, jumps=tuple(self.jumps)) if self.jumps else result
 
     def _stuck(self, t1: float, vp: float) -> TransientResult | None:
@@ -452,6 +459,8 @@ class _Driver:
             self.chains_on = True
             self.chain_state = {"elapsed": 0.0, "fraction": 1.0}
             self.events.append(("stick", state.t, self.k_block * (state.puller - state.x), state.v))
+            if self.repeater is not None:
+                self.repeater.at_stick(t0, t1, vp)
         collapsed = status == K.FAILED and not self._jumped(vp)
         self._check(count, collapsed)
         self._report_progress()
@@ -498,6 +507,100 @@ class _Driver:
             raise _with_partial(stopped, self.rows, self.chain_rows, self.events, self.snapshots, state, self.params,
                                 self.protocol, self.control, self.k_block, self.note, self.rtol, self.mass,
                                 self.damping)  # fmt: skip
+
+
+class _Repeater:
+    """A limit cycle of the stick chains repeated rather than integrated again (docs/transient.md section 9).
+
+    With the chains a stick starts with fresh chains and the bonds of Eq 1 set aside, so the stress it starts under
+    is the whole state of the cycle (in the puller's frame, under a constant pace): a cycle that starts where the
+    one before started is the same cycle, shifted by its period in time and by Vp T in position.  Once the sticks'
+    stresses have settled to within rtol of the value they converge to (geometric convergence estimated from the
+    last two differences), the last cycle's rows, chain rows and events are copied forward, whole periods at a time,
+    with the running totals (bonds born and broken, work, dissipation, the stress integral) advanced by the cycle's
+    own increments; the last period or two before the piece's end are integrated again, so that the run ends on a
+    state of its own (its snapshot, the next piece).
+    """
+
+    #: the trace's running totals (bonds born and broken, work, dissipation, the stress integral): row column and
+    #: accumulator index
+    TOTALS = ((6, 0), (7, 1), (8, 2), (9, 3), (13, 6))
+
+    def __init__(self, driver: _Driver) -> None:
+        self.driver = driver
+        self.marks: list[tuple[float, float, int, int, int, int, np.ndarray, float]] = []
+        self.repeated = 0
+
+    def at_stick(self, t0: float, t1: float, vp: float) -> None:
+        """A stick has just begun: mark it, and copy the cycle forward if it has settled."""
+        d, state = self.driver, self.driver.state
+        sigma = d.k_block * (state.puller - state.x)
+        self.marks.append(
+            (state.t, sigma, len(d.rows), len(d.chain_rows), len(d.events), len(d.jumps), state.acc.copy(), t0)
+        )
+        del self.marks[:-3]
+        periods = self._periods(t1, vp)
+        if periods:
+            self._copy(periods, vp)
+
+    def _periods(self, t1: float, vp: float) -> int:
+        """Whole periods to copy: 0 where the sticks have not settled, or too little is left to gain.
+
+        Settled: the sticks' stress at the end of the copies is within rtol of where the integration would have
+        taken it, by the last difference carried over the copies (shrinking geometrically, as the last two
+        differences shrank, or not at all)."""
+        if len(self.marks) < 3 or vp <= 0:
+            return 0
+        (_, sa, *_, t0a), (tb, sb, *rest_b), (tc, sc, *rest_c) = self.marks
+        if not t0a == rest_b[-1] == rest_c[-1] or rest_b[3] != rest_c[3]:  # one piece; no cascade jump in the cycle
+            return 0
+        d, period = self.driver, tc - tb
+        following = bisect.bisect_right(d.wanted, tc + 1e-15)
+        end = min(t1, d.wanted[following]) if following < len(d.wanted) else t1
+        periods = max(0, math.floor((end - tc) / period) - 1) if period > 0 else 0
+        before, last = abs(sb - sa), abs(sc - sb)
+        ratio = last / before if before > 0 else (0.0 if last == 0 else math.inf)
+        carried = last * (min(periods, 1.0 / (1.0 - ratio)) if ratio < 1 else periods)
+        return periods if carried <= d.rtol * abs(sc) else 0
+
+    def _copy(self, periods: int, vp: float) -> None:
+        d, state = self.driver, self.driver.state
+        (tb, _, rows_b, chains_b, events_b, _, acc_b, _), (tc, _, rows_c, chains_c, events_c, _, acc_c, _) = self.marks[
+            -2:
+        ]
+        period, travel = tc - tb, vp * (tc - tb)
+        rows = np.vstack([np.atleast_2d(r) for r in d.rows[rows_b:rows_c]])
+        chains = [c.copy() for c in d.chain_rows[chains_b:chains_c]]
+        events = d.events[events_b:events_c]
+        gained = {index: acc_c[index] - acc_b[index] for _, index in self.TOTALS}  # acc[7], the lowest, may be inf
+        for j in range(1, periods + 1):
+            copied = rows.copy()
+            copied[:, 0] += j * period
+            copied[:, 4:6] += j * travel
+            for column, index in self.TOTALS:
+                copied[:, column] += j * gained[index]
+            d.rows.append(copied)
+            for c in chains:
+                shifted = c.copy()
+                shifted[:, 0] += j * period
+                d.chain_rows.append(shifted)
+            d.events.extend((kind, t + j * period, s, v) for kind, t, s, v in events)
+        state.t += periods * period
+        state.x += periods * travel
+        state.puller += periods * travel
+        for _, index in self.TOTALS:
+            state.acc[index] += periods * gained[index]
+        self.repeated += periods
+        self.marks.clear()  # the next settled cycle is judged afresh
+        d._report_progress()
+
+    def note(self) -> str:
+        if not self.repeated:
+            return ""
+        return (
+            f"; {self.repeated} period(s) of the limit cycle repeated, not integrated again: the sticks' stress had"
+            " settled within rtol (reduction='auto')"
+        )
 
 
 #: a slider faster than this many times the protocol's fastest velocity has run away (no inertia holds it)
@@ -1024,6 +1127,8 @@ RIGID = 1e6
 STABLE_SIDE = 1e-3
 #: CPU of one step (s; 55-160 us measured on this 2-core machine), and what one protocol segment costs in steps
 STEP_SECONDS = 100e-6
+#: CPU of a row copied from a repeated limit cycle (s; the rows are the run's steps, counted against max_steps)
+ROW_SECONDS = 1e-6
 SEGMENT_STEPS = 10.0
 #: CPU of a segment's start through the block with the reduction (its look for a stretch; 19 ms measured for
 #: 1000 segments of 1 ms at 350/400 um/s), a tenth of that otherwise
@@ -1037,6 +1142,9 @@ SLIP_STEPS = 4000.0
 #: and a block stiffer than STIFF_BLOCK x the bonds' own stiffness N0 M (1.5e6 Pa/m for the gel) more, in
 #: proportion to K: measured per slip 2200-3300 steps at K = 1e6 Pa/m (30 and 100 um/s), 16 500-21 000 at 4e6
 STIFF_BLOCK = 1.23e-4
+#: a piece whose limit cycle is repeated (_Repeater) integrates about this many slips: two to settle after its
+#: first, the one it is judged on, and the last period or two before its end
+REPEAT_SLIPS = 5.0
 #: a slider sliding into a piece below the fold decelerates to its stick in about this many steps (1454-1491
 #: from a steady start, with the chains)
 STOP_STEPS = 1500.0
@@ -1154,7 +1262,8 @@ def estimate_cost(
     reducing = reduction == "auto" and max_step is None
     k_block = params.block.effective_stiffness if stiffness is None else float(stiffness)
     # the block's own motion: stick-slip with the chains, or stuck for good under Eq 1 alone
-    motion = _BlockMotion(params, aging, k_block, bool(stick_population), start) if (
+    repeating = REPEAT_CYCLES and reducing and every is None
+    motion = _BlockMotion(params, aging, k_block, bool(stick_population), start, repeating) if (
         control == "block" and aging and mass == 0 and max_step is None
     ) else None  # fmt: skip
     natural = b.max_extension / b.bond_time
@@ -1185,7 +1294,9 @@ def estimate_cost(
     stuck = 0.0 if motion is None else motion.stuck_steps
     moving = len(protocol.segments) - (0 if motion is None else motion.stuck_segments)  # a stuck one looks for none
     per_segment = SEGMENT_SECONDS if (reducing and control == "block") else 0.1 * SEGMENT_SECONDS
-    seconds = steps * STEP_SECONDS + moving * per_segment + COHORT_SECONDS * stuck * stuck
+    copied = 0.0 if motion is None else min(motion.copied * scale, steps)  # rows of a repeated limit cycle
+    seconds = (steps - copied) * STEP_SECONDS + copied * ROW_SECONDS + moving * per_segment
+    seconds += COHORT_SECONDS * stuck * stuck
     return CostEstimate(steps, basis, seconds)
 
 
@@ -1235,8 +1346,13 @@ class _BlockMotion:
     """The block's own motion through the protocol, for :func:`estimate_cost`: stick-slip cycles of the quasi-static
     model with the paper's attached chains, or a block stuck for good under Eq 1 alone (aging that never saturates)."""
 
-    def __init__(self, params: Parameters, aging: bool, k_block: float, chains: bool, start: str) -> None:
+    def __init__(
+        self, params: Parameters, aging: bool, k_block: float, chains: bool, start: str, repeating: bool = False
+    ) -> None:
         self.params, self.aging, self.k_block, self.chains = params, aging, k_block, chains
+        self.repeating = repeating and chains  # a limit cycle repeated after a few (_Repeater)
+        self.repeated = 0.0  # slips repeated, not integrated
+        self.copied = 0.0  # their rows: counted as steps (the trace holds them), their CPU a copy's
         self.sliding = start == "steady"
         self.stuck_for_good = False
         self.stuck_steps = 0.0  # the steps of a block stuck for good: its cohorts, all kept
@@ -1298,6 +1414,9 @@ class _BlockMotion:
             slips = _slips(self.clock, first, period) - before
             self.slips += slips
             steps += SLIP_STEPS * slips * self.stiffer
+            if self.repeating and slips > REPEAT_SLIPS:
+                self.repeated += slips - REPEAT_SLIPS
+                self.copied += SLIP_STEPS * (slips - REPEAT_SLIPS) * self.stiffer
         else:
             self.clock += dt
         return steps
@@ -1314,7 +1433,8 @@ class _BlockMotion:
         if self.stuck_for_good:
             return ", the block stuck for good under Eq 1 (no stick chains)"
         if self.chains and self.slips > 0:
-            return f", about {self.slips:.3g} stick–slip cycles of the quasi-static model"
+            repeated = f", {self.repeated:.3g} of them repeated, not integrated" if self.repeated else ""
+            return f", about {self.slips:.3g} stick–slip cycles of the quasi-static model{repeated}"
         return ""
 
 
