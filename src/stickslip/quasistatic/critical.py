@@ -235,7 +235,7 @@ def cached_critical_point(params: Parameters) -> CriticalPoint:
 
 def critical_minimum(params: Parameters) -> Extremum | None:
     """Vc and sigma_c alone (Eq 9), as :func:`critical_point` finds them, or None where the aging curve has no
-    minimum: the same numbers at a quarter of the cost, for a study that needs nothing else of the point (the
+    minimum: the same numbers at about half the cost, for a study that needs nothing else of the point (the
     curve's maximum and the no-aging turnover are neither refined nor searched)."""
     require_parameters(params)
     return _cached_minimum(steady_curve_key(params))
