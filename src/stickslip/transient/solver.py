@@ -546,12 +546,12 @@ class _Repeater:
     def _periods(self, t1: float, vp: float) -> int:
         """Whole periods to copy: 0 where the sticks have not settled, or too little is left to gain.
 
-        Settled: the sticks' stress at the end of the copies is within rtol of where the integration would have
-        taken it, by the last difference carried over the copies (shrinking geometrically, as the last two
-        differences shrank, or not at all)."""
+        Settled, over the copies: the sticks' stress within rtol of where the integration would have taken it (the
+        last difference carried over the copies, shrinking geometrically as the last two differences shrank, or
+        not at all), and their clock within rtol of a period (the last two periods' difference, once per copy)."""
         if len(self.marks) < 3 or vp <= 0:
             return 0
-        (_, sa, *_, t0a), (tb, sb, *rest_b), (tc, sc, *rest_c) = self.marks
+        (ta, sa, *_, t0a), (tb, sb, *rest_b), (tc, sc, *rest_c) = self.marks
         if not t0a == rest_b[-1] == rest_c[-1] or rest_b[3] != rest_c[3]:  # one piece; no cascade jump in the cycle
             return 0
         d, period = self.driver, tc - tb
@@ -561,7 +561,8 @@ class _Repeater:
         before, last = abs(sb - sa), abs(sc - sb)
         ratio = last / before if before > 0 else (0.0 if last == 0 else math.inf)
         carried = last * (min(periods, 1.0 / (1.0 - ratio)) if ratio < 1 else periods)
-        return periods if carried <= d.rtol * abs(sc) else 0
+        drift = periods * abs(period - (tb - ta))
+        return periods if carried <= d.rtol * abs(sc) and drift <= d.rtol * period else 0
 
     def _copy(self, periods: int, vp: float) -> None:
         d, state = self.driver, self.driver.state
