@@ -2,7 +2,8 @@
 
 Run as ``PYTHONPATH=src python benchmarks/bench_transient.py`` (``--reference`` adds the rtol 1e-5 cohort run of
 the cycle, 49 s of CPU, whose numbers tests/test_transient_speed.py compares with; ``--quick`` skips the plain
-cohort runs that take more than a few seconds; ``--phases`` only counts where the cycle's steps go, issue 31).
+cohort runs that take more than a few seconds; ``--phases`` only counts where the cycle's steps go, issue 31;
+``--repeat`` only times long stick-slip runs, a settled limit cycle repeated beside every cycle integrated).
 CPU time (``time.process_time``) is printed with the ratio
 to the plain solver's in the same process, and the accuracy reached: against the steady solver, or the
 cycle's stick time, peak, jump velocity and slip time against the tighter run.
@@ -103,9 +104,53 @@ def cycle_phases() -> None:
                   f"{first:.4f} s to {last:.4f} s, median step {step:.3g} s")  # fmt: skip
 
 
+#: (label, parameter overrides, velocity m/s, duration s) of the --repeat runs
+REPEAT_RUNS = (
+    ("the paper's set, 100 um/s, 120 s", {}, 100e-6, 120.0),
+    ("the paper's set, 100 um/s, 1000 s", {}, 100e-6, 1000.0),
+    ("K = 4 MPa/m (the phase diagram's corner), 104 um/s, 30 s", {"block.height": 1e-3}, 104e-6, 30.0),
+)
+
+
+def repeated_cycles() -> None:
+    """Long stick-slip runs with a settled limit cycle repeated (the default) beside every cycle integrated
+    (``solver.REPEAT_CYCLES = False``, the plain reference), in turn in the same process; the cycles' largest
+    relative difference and the end stress's."""
+    from dataclasses import fields
+
+    from stickslip.transient import solver
+
+    p = stickslip.load_parameters("gelatin-glass")
+    run_transient(p, constant(100e-6, 1.0), stick_population=True)  # the numba caches
+    for label, overrides, velocity, duration in REPEAT_RUNS:
+        params = p.with_overrides(overrides) if overrides else p
+        runs = {}
+        for repeat in (True, False):
+            solver.REPEAT_CYCLES = repeat
+            runs[repeat] = cpu(lambda params=params, v=velocity, d=duration: run_transient(
+                params, constant(v, d), stick_population=True))  # fmt: skip
+        solver.REPEAT_CYCLES = True
+        (t_on, on), (t_off, off) = runs[True], runs[False]
+        worst = max(
+            abs(getattr(a, f.name) / getattr(b, f.name) - 1)
+            for a, b in zip(on.cycles, off.cycles, strict=True)
+            for f in fields(a)
+            if isinstance(getattr(a, f.name), float) and np.isfinite(getattr(b, f.name)) and getattr(b, f.name) != 0
+        )
+        print(
+            f"{label}: repeated {t_on:.2f} s CPU ({on.steps} steps), every cycle integrated {t_off:.2f} s "
+            f"({off.steps} steps): {t_off / t_on:.1f}x; {len(on.cycles)} cycles, largest relative difference "
+            f"{worst:.1e}; end stress {on.stress[-1]:.6f} against {off.stress[-1]:.6f} Pa",
+            flush=True,
+        )
+
+
 def main() -> None:
     if "--phases" in sys.argv:
         cycle_phases()
+        return
+    if "--repeat" in sys.argv:
+        repeated_cycles()
         return
     quick = "--quick" in sys.argv
     p = stickslip.load_parameters("gelatin-glass")
