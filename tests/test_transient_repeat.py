@@ -21,6 +21,8 @@ from stickslip.transient.solver import estimate_cost
 GEL = load_parameters()
 #: a block three times stiffer than the gel's: cycles of 5.8 s at 100 um/s, six slips in 40 s
 STIFF = GEL.with_overrides({"block.height": GEL.block.shear_modulus / 1.2e6})
+#: the runs' tolerance (1e-3: half the CPU of the default; the bounds below are fractions of it)
+RTOL = 1e-3
 
 
 def _both(params, protocol, **settings):
@@ -29,7 +31,7 @@ def _both(params, protocol, **settings):
         old = solver.REPEAT_CYCLES
         solver.REPEAT_CYCLES = repeat
         try:
-            runs[repeat] = run_transient(params, protocol, stick_population=True, **settings)
+            runs[repeat] = run_transient(params, protocol, stick_population=True, rtol=RTOL, **settings)
         finally:
             solver.REPEAT_CYCLES = old
     return runs[True], runs[False]
@@ -45,13 +47,13 @@ def test_repeated_cycles_agree_with_integrated_ones(stiff_runs):
     repeated, integrated = stiff_runs
     assert "period(s) of the limit cycle repeated" in repeated.message
     assert "repeated" not in integrated.message
-    assert repeated.steps < 0.8 * integrated.steps  # measured 13 245 against 19 812
+    assert repeated.steps < 0.8 * integrated.steps  # measured 4 092 against 6 090
     assert len(repeated.cycles) == len(integrated.cycles) >= 5
     for mine, theirs in zip(repeated.cycles, integrated.cycles, strict=True):
         for field in dataclasses.fields(mine):
             a, b = getattr(mine, field.name), getattr(theirs, field.name)
             if isinstance(a, float) and math.isfinite(b):
-                assert a == pytest.approx(b, rel=1e-6, abs=1e-9), field.name  # measured within 2.4e-8
+                assert a == pytest.approx(b, rel=1e-6, abs=1e-9), field.name  # measured within 5e-11
     assert repeated.regime == integrated.regime  # the last piece, 2 s at 80 um/s, is too short: undetermined
 
 
@@ -60,11 +62,11 @@ def test_the_run_ends_on_the_state_the_integration_reaches(stiff_runs):
     assert repeated.time[-1] == integrated.time[-1] == 42.0
     for name in ("stress", "slider_position", "puller_position", "bonded_fraction"):
         a, b = getattr(repeated, name)[-1], getattr(integrated, name)[-1]
-        assert a == pytest.approx(b, rel=1e-6, abs=1e-12), name
+        assert a == pytest.approx(b, rel=1e-6, abs=1e-12), name  # measured within 3e-10
     book_a, book_b = repeated.bookkeeping, integrated.bookkeeping
     for name in ("born", "broken", "work", "stress_integral"):
         a, b = getattr(book_a, name)[-1], getattr(book_b, name)[-1]
-        assert a == pytest.approx(b, rel=1e-6), name
+        assert a == pytest.approx(b, rel=1e-6), name  # measured within 4e-11
 
 
 def test_the_copies_are_the_trace_row_by_row(stiff_runs):
@@ -76,10 +78,10 @@ def test_the_copies_are_the_trace_row_by_row(stiff_runs):
     nearest -= np.abs(repeated.time[nearest - 1] - integrated.time) < np.abs(repeated.time[nearest] - integrated.time)
     matched = np.abs(repeated.time[nearest] - integrated.time) < 1e-6
     assert matched.mean() > 0.95
-    # measured: stress 7.1e-7 of the largest, position 1.4e-7, velocity 1.5e-6: a tenth of the rtol, 1e-4, is the bound
+    # measured: stress 1.2e-7 of the largest, position 4e-10, velocity 4.6e-6; the bound is a tenth of the rtol
     for name in ("stress", "slider_position", "slider_velocity"):
         a, b = getattr(repeated, name)[nearest[matched]], getattr(integrated, name)[matched]
-        assert np.max(np.abs(a - b)) <= 1e-5 * np.max(np.abs(b)), name
+        assert np.max(np.abs(a - b)) <= 0.1 * RTOL * np.max(np.abs(b)), name
 
 
 def test_no_repeat_on_a_sampling_grid_or_without_the_reduction():
@@ -88,7 +90,7 @@ def test_no_repeat_on_a_sampling_grid_or_without_the_reduction():
     for settings in (dict(every=0.5), dict(reduction="off")):
         estimate = estimate_cost(STIFF, protocol, stick_population=True, **settings)
         assert "repeated" not in estimate.basis
-    run = run_transient(STIFF, protocol, stick_population=True, every=0.5)
+    run = run_transient(STIFF, protocol, stick_population=True, every=0.5, rtol=RTOL)
     assert "repeated" not in run.message
     grid = np.arange(81) * 0.5
     assert np.all(np.min(np.abs(run.time[:, None] - grid[None, :]), axis=0) < 1e-12)  # every grid instant a row
