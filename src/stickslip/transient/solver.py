@@ -510,16 +510,15 @@ class _Driver:
 
 
 class _Repeater:
-    """A limit cycle of the stick chains repeated rather than integrated again (docs/transient.md section 9).
+    """A limit cycle of the stick chains repeated rather than integrated again (docs/transient.md section 10).
 
     With the chains a stick starts with fresh chains and the bonds of Eq 1 set aside, so the stress it starts under
     is the whole state of the cycle (in the puller's frame, under a constant pace): a cycle that starts where the
     one before started is the same cycle, shifted by its period in time and by Vp T in position.  Once the sticks'
-    stresses have settled to within rtol of the value they converge to (geometric convergence estimated from the
-    last two differences), the last cycle's rows, chain rows and events are copied forward, whole periods at a time,
-    with the running totals (bonds born and broken, work, dissipation, the stress integral) advanced by the cycle's
-    own increments; the last period or two before the piece's end are integrated again, so that the run ends on a
-    state of its own (its snapshot, the next piece).
+    stresses and the periods have settled (:meth:`_periods`), the last cycle's rows, chain rows and events are
+    copied forward, whole periods at a time, with the running totals (bonds born and broken, work, dissipation,
+    the stress integral) advanced by the cycle's own increments; the last period or two before the piece's end
+    are integrated again, so that the run ends on a state of its own (its snapshot, the next piece).
     """
 
     #: the trace's running totals (bonds born and broken, work, dissipation, the stress integral): row column and
