@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 from numpy.polynomial import chebyshev as cheb
@@ -72,6 +73,7 @@ class Manifold:
     lag: cheb.Chebyshev  # C(ln V), Pa s^2/m
     dlag: cheb.Chebyshev  # dC/dlnV
     energy: cheb.Chebyshev  # bond energy of the steady population (J/m^2)
+    bonded_lag: cheb.Chebyshev  # C_N/N0 (s^2/m): N/N0 = bonded + bonded_lag V' to first order
     _stacked: tuple[np.ndarray, np.floating, np.floating] | None = field(default=None, repr=False, compare=False)
     _last: tuple[float, np.ndarray | None] = field(default=(math.nan, None), repr=False, compare=False)
 
@@ -120,8 +122,9 @@ class Manifold:
         return s, slope, curv, c, cx / v
 
 
-def _lag(params: Parameters, velocity: float, aging: bool) -> tuple[float, float]:
-    """(C, bond energy) at ``velocity``: C = d/ds[Z(s)/s] at s = 0 by a Richardson central difference."""
+def _lag(params: Parameters, velocity: float, aging: bool) -> tuple[float, float, float]:
+    """(C, bond energy, C_N/N0) at ``velocity``: C = d/ds[Z(s)/s] at s = 0 by a Richardson central difference,
+    C_N the same of the bonded count's response (N = N_ss(V) + C_N V' to first order, as sigma = S(V) + C V')."""
     from .model import pack_parameters
     from .stability import _response_kernel
 
@@ -133,9 +136,10 @@ def _lag(params: Parameters, velocity: float, aging: bool) -> tuple[float, float
     s = np.array([-eps, eps, -2 * eps, 2 * eps], dtype=complex)
     z = _response_kernel()(s, a, w, width, f, fp, r, gv, b.force_sensitivity, birth_tau).real
     q = z / s.real
-    c1 = (q[1] - q[0]) / (2 * eps)
-    c2 = (q[3] - q[2]) / (4 * eps)
-    return (4 * c1 - c2) / 3, energy
+    c1 = (q[:, 1] - q[:, 0]) / (2 * eps)
+    c2 = (q[:, 3] - q[:, 2]) / (4 * eps)
+    lags = (4 * c1 - c2) / 3
+    return float(lags[0]), energy, float(lags[1]) / b.site_density
 
 
 #: the compiled steady cells (model.steady_population's, with its CELL_HAZARD, GAUSS and MAX_CELLS)
@@ -298,25 +302,30 @@ def build_manifold(params: Parameters, aging: bool, v_lo: float, v_hi: float, rt
     # the lag C varies over orders of magnitude towards the fold: its degree is raised until the fit holds at
     # the probes to LAG_SHARE of |C|, or of S' tau (a lag shorter than a bond's life changes nothing)
     lag_degree = LAG_DEGREE
-    probe_c, _u = _lags(params, aging, probe)
-    floor = np.abs(stress.deriv()(probe) / np.exp(probe)) * params.bonds.bond_time  # lags below a bond's life
+    probe_c, _u, probe_n = _lags(params, aging, probe)
+    tau = params.bonds.bond_time
+    floor = np.abs(stress.deriv()(probe) / np.exp(probe)) * tau  # lags below a bond's life
+    floor_n = np.abs(bonded.deriv()(probe) / np.exp(probe)) * tau
     while True:
         x_c = 0.5 * (domain[0] + domain[1]) + 0.5 * (domain[1] - domain[0]) * cheb.chebpts1(lag_degree + 1)
-        c_nodes, u_nodes = _lags(params, aging, x_c)
+        c_nodes, u_nodes, n_nodes = _lags(params, aging, x_c)
         lag = cheb.Chebyshev.fit(x_c, c_nodes, lag_degree, domain=domain)
-        if np.all(np.abs(lag(probe) - probe_c) <= LAG_SHARE * (np.abs(probe_c) + floor)):
+        bonded_lag = cheb.Chebyshev.fit(x_c, n_nodes, lag_degree, domain=domain)
+        if np.all(np.abs(lag(probe) - probe_c) <= LAG_SHARE * (np.abs(probe_c) + floor)) and np.all(
+            np.abs(bonded_lag(probe) - probe_n) <= LAG_SHARE * (np.abs(probe_n) + floor_n)
+        ):
             break
         if lag_degree >= MAX_DEGREE:
             return None
         lag_degree *= 2
     energy = cheb.Chebyshev.fit(x_c, u_nodes, lag_degree, domain=domain)
-    return Manifold(v_lo, v_hi, stress, stress.deriv(), stress.deriv(2), bonded, lag, lag.deriv(), energy)
+    return Manifold(v_lo, v_hi, stress, stress.deriv(), stress.deriv(2), bonded, lag, lag.deriv(), energy, bonded_lag)
 
 
-def _lags(params: Parameters, aging: bool, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """C and the steady bond energy at velocities e^x."""
-    pairs = [_lag(params, float(math.exp(xk)), aging) for xk in x]
-    return np.array([c for c, _u in pairs]), np.array([u for _c, u in pairs])
+def _lags(params: Parameters, aging: bool, x: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """C, the steady bond energy and C_N/N0 at velocities e^x."""
+    c, u, n = zip(*(_lag(params, float(math.exp(xk)), aging) for xk in x), strict=True)
+    return np.array(c), np.array(u), np.array(n)
 
 
 def effective(m: Manifold, v: float, vp: float, k_block: float) -> tuple[float, float, float]:
@@ -354,6 +363,15 @@ def _effective_stress(m: Manifold, v: np.ndarray, vp: float, k_block: float) -> 
     x = np.log(v)
     slope = m.dstress(x) / v
     return m.stress(x) + m.lag(x) * k_block * (vp - v) / slope
+
+
+def effective_bonded(m: Manifold, v: Any, vp: float, k_block: float, block: bool = True) -> Any:
+    """N/N0 on the first-order slow manifold (with its lag, as :func:`effective`'s stress) at one or many V; under
+    velocity control the steady N."""
+    x = np.log(v)
+    if not block:
+        return m.bonded(x)
+    return m.bonded(x) + m.bonded_lag(x) * k_block * (vp - v) / (m.dstress(x) / v)
 
 
 def entry_velocity(m: Manifold, sigma: float, v: float, vp: float, k_block: float, rtol: float) -> float | None:
@@ -475,7 +493,7 @@ def glide(
         sigma = m.stress(logv)
         pos = x + vp * (times - t)
         pull = pos
-    nn = n0 * m.bonded(logv)
+    nn = n0 * effective_bonded(m, vel, vp, k_block, block)
     uu = m.energy(logv)
     born = acc[0] + y[1]
     broken = acc[1] + y[1] - (nn - bonded)
@@ -492,7 +510,7 @@ def glide(
     sigma_end = effective(m, v_end, vp, k_block)[0] if block else float(m.stress(math.log(v_end)))
     acc[0] += end[1]
     acc[2] += end[2]
-    nn_end = n0 * float(m.bonded(math.log(v_end)))
+    nn_end = n0 * float(effective_bonded(m, v_end, vp, k_block, block))
     acc[1] += end[1] - (nn_end - bonded)
     u_end = float(m.energy(math.log(v_end)))
     acc[3] += end[3] - (u_end - energy)

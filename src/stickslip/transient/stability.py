@@ -74,7 +74,7 @@ def interface_response(
     a, w, width, f, fp, r, gv = _cells(params, float(velocity), aging, cell_hazard)
     birth = (b.site_density - w.sum()) / b.bond_time
     s = np.atleast_1d(np.asarray(s, dtype=complex))
-    z = _response_kernel()(s, a, w, width, f, fp, r, gv, b.force_sensitivity, birth * b.bond_time)
+    z = _response_kernel()(s, a, w, width, f, fp, r, gv, b.force_sensitivity, birth * b.bond_time)[0]
     return Response(float(velocity), s, z)
 
 
@@ -108,7 +108,9 @@ def _phi1(x):  # type: ignore[no-untyped-def]
 
 
 def _response_sum(s, a, w, width, f, fp, r, gv, c_f, birth_tau):  # type: ignore[no-untyped-def]
-    out = np.empty(s.size, dtype=np.complex128)
+    """Row 0: Z(s) of the module docstring; row 1: the bonded count's response dN/xi = -[sum W Phi] B0 tau /
+    (B0 tau + sum W e^{-sa}) (the births' share of the same closure; the quasi-steady reduction's lag of N)."""
+    out = np.empty((2, s.size), dtype=np.complex128)
     for j in range(s.size):
         sj = s[j]
         e_acc = 0.0 + 0.0j  # int_0^a q1 e^{-s(a-a')}, by recursion over the cells
@@ -137,7 +139,8 @@ def _response_sum(s, a, w, width, f, fp, r, gv, c_f, birth_tau):  # type: ignore
             sum_we += w[k] * ea
             sum_wphif += w[k] * phi * f[k]
             sum_inst += w[k] * fp[k] * (1.0 - ea)
-        out[j] = sum_wphi * sum_wfe / (birth_tau + sum_we) - sum_wphif + sum_inst
+        out[0, j] = sum_wphi * sum_wfe / (birth_tau + sum_we) - sum_wphif + sum_inst
+        out[1, j] = -sum_wphi * birth_tau / (birth_tau + sum_we)
     return out
 
 
