@@ -570,7 +570,7 @@ class _Repeater:
         ]
         period, travel = tc - tb, vp * (tc - tb)
         rows = np.vstack([np.atleast_2d(r) for r in d.rows[rows_b:rows_c]])
-        chains = [c.copy() for c in d.chain_rows[chains_b:chains_c]]
+        chains = d.chain_rows[chains_b:chains_c]  # each copy below is shifted from these
         events = d.events[events_b:events_c]
         gained = {index: acc_c[index] - acc_b[index] for _, index in self.TOTALS}  # acc[7], the lowest, may be inf
         for j in range(1, periods + 1):
