@@ -3,7 +3,8 @@
 Run as ``PYTHONPATH=src python benchmarks/bench_transient.py`` (``--reference`` adds the rtol 1e-5 cohort run of
 the cycle, 49 s of CPU, whose numbers tests/test_transient_speed.py compares with; ``--quick`` skips the plain
 cohort runs that take more than a few seconds; ``--phases`` only counts where the cycle's steps go, issue 31;
-``--repeat`` only times long stick-slip runs, a settled limit cycle repeated beside every cycle integrated).
+``--repeat`` only times long stick-slip runs, a settled limit cycle repeated beside every cycle integrated;
+``--births`` only times the cycle with the births spaced by their own error beside the lumped bound).
 CPU time (``time.process_time``) is printed with the ratio
 to the plain solver's in the same process, and the accuracy reached: against the steady solver, or the
 cycle's stick time, peak, jump velocity and slip time against the tighter run.
@@ -145,7 +146,43 @@ def repeated_cycles() -> None:
         )
 
 
+#: the stick chains' cycle against the plain cohorts at rtol 1e-5 (tests/test_transient_speed.py's reference)
+CYCLE_TIGHT = np.array([9.765432041866394, 556.4046077148165, 0.0007110383712498472, 5.590082951461191])
+
+
+def births_spacing(repeats: int = 5) -> None:
+    """Issue 31: the paper's cycle with the births spaced by their own Gauss error (the default with the stick
+    chains under a moving puller) beside the lumped bound (``solver.RELAXED_BIRTHS = False``: the code before,
+    with the stick landed), alternated in one process, best and median CPU of ``repeats`` each; and both against
+    the plain cohorts at rtol 1e-5 (docs/transient.md section 11)."""
+    from stickslip.transient import solver
+
+    p = stickslip.load_parameters("gelatin-glass")
+    run_transient(p, CYCLE, start="steady", stick_population=True)  # the numba caches and the tables
+    times: dict[bool, list[float]] = {True: [], False: []}
+    runs = {}
+    for _ in range(repeats):
+        for relaxed in (True, False):
+            solver.RELAXED_BIRTHS = relaxed
+            t_cpu, runs[relaxed] = cpu(lambda: run_transient(p, CYCLE, start="steady", stick_population=True))
+            times[relaxed].append(t_cpu)
+    solver.RELAXED_BIRTHS = True
+    for relaxed, label in ((True, "births by their Gauss error"), (False, "the lumped bound")):
+        run, t = runs[relaxed], sorted(times[relaxed])
+        error = np.abs(cycle_numbers(run) / CYCLE_TIGHT - 1)
+        print(
+            f"one cycle (350 -> 100 um/s, 25 s, stick chains, rtol 1e-4), {label}: best {t[0]:.3f} s CPU, median "
+            f"{t[len(t) // 2]:.3f} s, {run.steps} steps; against the rtol 1e-5 cohorts: "
+            + ", ".join(f"{k} {e:.1e}" for k, e in zip(CYCLE_KEYS, error, strict=True)),
+            flush=True,
+        )
+    print(f"speed-up: {sorted(times[False])[0] / sorted(times[True])[0]:.1f}x (best against best)")
+
+
 def main() -> None:
+    if "--births" in sys.argv:
+        births_spacing()
+        return
     if "--phases" in sys.argv:
         cycle_phases()
         return

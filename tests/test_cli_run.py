@@ -131,8 +131,8 @@ def test_a_run_that_stops_or_fails_on_its_way_exits_3(capsys, monkeypatch):
 
     words = ["run", "--model", "transient", "--v0", "100 um/s", "--duration", "40 s", "--setting",
              "stick_population=true"]  # fmt: skip
-    code, _, err = run_main(capsys, *words, "--setting", "max_steps=2000")
-    assert code == 3 and err.count("\n") == 1 and "stopped at the budget of 2000 steps at t = " in err, err
+    code, _, err = run_main(capsys, *words, "--setting", "max_steps=1000")
+    assert code == 3 and err.count("\n") == 1 and "stopped at the budget of 1000 steps at t = " in err, err
     from stickslip.models.transient import Transient
     from stickslip.transient.solver import SolverFailed
 

@@ -37,6 +37,12 @@ only ``bonded_fraction`` and ``bookkeeping_broken`` (births less the change of N
 for bit.  Against the plain cohorts at rtol 1e-5, N/N0 of ``steady_reduced`` (on its 5 ms grid) is within 2.6e-9
 instead of 6.2e-6, and of ``from_rest_chains`` (interpolated at its rows past 0.5 s) within 9.5e-7 instead of
 1.1e-6.
+
+``from_rest_chains`` was rewritten again when, with the stick chains under a moving puller, the births' spacing took
+their own Gauss error and a stick was landed on the slider's crossing of the stick velocity (issue 31;
+docs/transient.md section 11): the same 52 steps and verdict, the trace within 5.3e-8 (sigma), 2.6e-6 (N/N0, V) of
+the largest values of the previous one; against the plain cohorts at rtol 1e-5 (rows past 0.5 s) sigma within
+6.2e-8 (before 6.2e-8), N/N0 2.6e-6 (2.3e-6), V 2.4e-6 (2.1e-6) of their largest values.
 """
 
 from __future__ import annotations

@@ -86,11 +86,14 @@ CORRECTION_SERIES = 1e-3
     P_MASS,
     P_DAMPING,
     P_MERGE_SATURATED,
-) = range(14)
+    P_RELAXED_BIRTHS,
+) = range(15)
 # integer status returned by advance()
 DONE, FULL, STEPS, STICK, FAILED = 0, 1, 2, 3, 4
 #: half-distance of the two Gauss-Legendre points from the middle of a step, as a fraction of the step
 GAUSS = 0.5 / math.sqrt(3.0)
+#: a stick is taken within this share of rtol x sigma past the slider's crossing of the stick velocity
+STICK_LANDING = 0.01
 #: largest fraction by which the stress may fall within one step (the trace resolves ruptures)
 MAX_DROP = 0.2
 #: four-point Gauss-Legendre rule on [-1, 1]
@@ -409,11 +412,15 @@ def _inertial_step(d, x0, v0, force0, h, puller1, n, xb, w, p, at_x):  # type: i
 
 
 def _relaxed_births(p):  # type: ignore[no-untyped-def]
-    """Saturating aging with its housekeeping on: the births' error is the Gauss pair's own (docs/transient.md
-    section 8); otherwise (the paper's aging, :func:`model.plain_cohorts`) one lumped cohort's, as before.  Only
-    where the saturated barrier t_s/tau_a is at most SATURATED_BARRIER: beyond it a resting bond is as permanent as
-    under the paper's linear aging (a saturation age beyond every age of a run is the paper's model, bit for bit)."""
-    return (
+    """The births' error is the Gauss pair's own (docs/transient.md section 8) where no bond born sliding is held
+    and slid again (p[P_RELAXED_BIRTHS], set by the solver for the stick chains under a moving puller: every stop
+    is a stick, where the bonds of Eq 1 are set aside), and with saturating aging with its housekeeping on; otherwise
+    (the paper's aging, :func:`model.plain_cohorts`) one lumped cohort's, as before: their spacing is the quadrature
+    of a held population that a re-slide drives to the FENE wall (docs/transient.md section 10).  Saturating aging
+    only where the saturated barrier t_s/tau_a is at most SATURATED_BARRIER: beyond it a resting bond is as permanent
+    as under the paper's linear aging (a saturation age beyond every age of a run is the paper's model, bit for
+    bit)."""
+    return p[P_RELAXED_BIRTHS] > 0.0 or (
         p[P_SATURATION] > 0.0
         and p[P_SATURATION] * p[P_INV_TAU_A] <= SATURATED_BARRIER
         and p[P_AGING] > 0.0
@@ -993,6 +1000,20 @@ def _step_error(err_s, err_n, cliff, cliff_old, s0, s1, s_floor, rtol, p):  # ty
     return max(err, (max(abs(s0) - abs(s1), 0.0) / (MAX_DROP * s_ref)) ** 3)
 
 
+def _stick_landing(hh, v0, v1, stick_velocity, s1, vp, rtol, p):  # type: ignore[no-untyped-def]
+    """A step of length hh that took the slider below the stick velocity: the length that lands within
+    STICK_LANDING x rtol of the stress past the crossing (found by linear interpolation of the velocity), or hh
+    where it already does.  The chains take over at the step's end with the stress there, which moves at
+    K (Vp - V) after the crossing: a stick taken wherever the step happened to end put sigma_s ~K Vp h/2 off
+    (2e-6 of it for the gel, whatever rtol; docs/transient.md section 11)."""
+    rate = p[P_K] * max(abs(vp - v0), abs(vp - v1))  # |dsigma/dt| over the step (the massless block)
+    allowed = STICK_LANDING * rtol * max(abs(s1), 1e-300) / max(rate, 1e-300)
+    crossing = hh * (v0 - stick_velocity) / (v0 - v1)
+    if hh - crossing <= allowed:
+        return hh
+    return crossing + 0.5 * allowed
+
+
 def _shorter_step(hh, err):  # type: ignore[no-untyped-def]
     """The step to try after a rejected one of length hh (its error err, nan: a tenth)."""
     factor = 0.9 * err ** (-1.0 / 3.0) if err == err else 0.1
@@ -1243,6 +1264,12 @@ def advance(  # type: ignore[no-untyped-def]
             # than it can follow): accepted, it left the outcome to where the steps happened to land, a runaway
             # unsampled and a landing on a stuck block sampled every 0.1 ms (issue 33.1)
             return FAILED, t, x, v, hh, n, sample_index, rows
+        if stick_velocity > 0.0 and block == 1 and v1 < stick_velocity <= v:
+            landing_time = _stick_landing(hh, v, v1, stick_velocity, s1, vp, rtol, p)
+            if landing_time < hh:  # the step passed the stick by more than its stress may move: landed on it
+                acc[5] += 1.0
+                h = landing_time
+                continue
         # ---- accepted
         cached = False
         for i in range(n + 2):
@@ -1299,6 +1326,7 @@ INLINED = (
     "_birth_errors",
     "_slider_at_end",
     "_step_error",
+    "_stick_landing",
     "_shorter_step",
     "_next_step",
     "_book_step",
