@@ -416,7 +416,7 @@ def _relaxed_births(p):  # type: ignore[no-untyped-def]
     and slid again (p[P_RELAXED_BIRTHS], set by the solver for the stick chains under a moving puller: every stop
     is a stick, where the bonds of Eq 1 are set aside), and with saturating aging with its housekeeping on; otherwise
     (the paper's aging, :func:`model.plain_cohorts`) one lumped cohort's, as before: their spacing is the quadrature
-    of a held population that a re-slide drives to the FENE wall (docs/transient.md section 10).  Saturating aging
+    of a held population that a re-slide drives to the FENE wall (docs/transient.md section 11).  Saturating aging
     only where the saturated barrier t_s/tau_a is at most SATURATED_BARRIER: beyond it a resting bond is as permanent
     as under the paper's linear aging (a saturation age beyond every age of a run is the paper's model, bit for
     bit)."""
