@@ -117,8 +117,10 @@ def test_the_transient_model_estimates_a_stick_slip_point_dearer_than_a_steady_o
     spec = build_spec(["pulling_velocity=80 um/s,1 mm/s"], model="transient", stick_population=True,
                       overrides={"block.stiffness": "4 MPa/m"}, duration="30 s")  # fmt: skip
     below, above = (model.cost({**spec.fixed, "pulling_velocity": v}, spec.settings) for v in (80e-6, 1e-3))
-    # the README sweep's rows: 80-104 um/s at 4 MPa/m are stick-slip cycles (seconds), 1 mm/s steady (~0.02 s)
-    assert below > 20 * above > 0
+    # the README sweep's rows: 80-104 um/s at 4 MPa/m are stick-slip cycles, 1 mm/s slides after its first stick;
+    # estimated 0.83 s and 0.057 s, taken 0.79 s and 0.14 s of CPU (the stick chains' births spaced by their own
+    # error, docs/transient.md section 11; before, a stiff block's slips were counted in proportion to K: 20x)
+    assert below > 5 * above > 0
 
 
 def test_report_words_and_json_say_what_is_not_known():
