@@ -48,26 +48,23 @@ DIMENSIONS: dict[str, tuple[str, str]] = {
     "mass_per_area": ("[mass] / [length] ** 2", "kg/m^2"),
 }
 
+#: The base dimensions, in the order of the exponent vectors below.
+_BASE_DIMENSIONS = ("[mass]", "[length]", "[time]", "[temperature]")
+
+
+def _vector(dimensionality: str) -> tuple[int, int, int, int]:
+    """(mass, length, time, temperature) exponents of a pint dimensionality string of :data:`DIMENSIONS`."""
+    exponents = [0, 0, 0, 0]
+    for k, part in enumerate(dimensionality.split(" / ")):
+        for factor in part.split(" * "):
+            name, _, power = factor.partition(" ** ")
+            if name in _BASE_DIMENSIONS:
+                exponents[_BASE_DIMENSIONS.index(name)] += (1 if k == 0 else -1) * int(power or 1)
+    return exponents[0], exponents[1], exponents[2], exponents[3]
+
+
 #: Exponents of (mass, length, time, temperature) of each dimension.
-_DIMENSION_VECTORS: dict[str, tuple[int, int, int, int]] = {
-    "dimensionless": (0, 0, 0, 0),
-    "time": (0, 0, 1, 0),
-    "length": (0, 1, 0, 0),
-    "velocity": (0, 1, -1, 0),
-    "rate": (0, 0, -1, 0),
-    "per_area": (0, -2, 0, 0),
-    "stiffness": (1, 0, -2, 0),
-    "temperature": (0, 0, 0, 1),
-    "stress": (1, -1, -2, 0),
-    "stress_rate": (1, -1, -3, 0),
-    "stress_per_length": (1, -2, -2, 0),
-    "force": (1, 1, -2, 0),
-    "area": (0, 2, 0, 0),
-    "stress_per_velocity": (1, -2, -1, 0),
-    "per_length": (0, -1, 0, 0),
-    "slowness": (0, -1, 1, 0),
-    "mass_per_area": (1, -2, 0, 0),
-}
+_DIMENSION_VECTORS = {name: _vector(pint_text) for name, (pint_text, _) in DIMENSIONS.items()}
 
 #: Longest value string accepted (the longest sensible one is ~30 characters).
 MAX_VALUE_LENGTH = 200
@@ -110,8 +107,7 @@ def registry() -> Any:
     """The package's single pint registry (built lazily: importing pint is slow)."""
     import pint
 
-    ureg = pint.UnitRegistry(autoconvert_offset_to_baseunit=True)
-    return ureg
+    return pint.UnitRegistry(autoconvert_offset_to_baseunit=True)
 
 
 def shorten(value: Any, limit: int = ECHO_LENGTH) -> str:
@@ -281,19 +277,16 @@ def _fast_unit(unit: str) -> tuple[float, tuple[int, ...]] | None:
 
 def _dimension_text(vector: tuple[int, ...]) -> str:
     """pint's way of writing a dimension: ``[length] / [time] ** 2``."""
-    names = ("[mass]", "[length]", "[time]", "[temperature]")
-    up = [n + (f" ** {e}" if e != 1 else "") for n, e in zip(names, vector, strict=True) if e > 0]
-    down = [n + (f" ** {-e}" if e != -1 else "") for n, e in zip(names, vector, strict=True) if e < 0]
+    up = [n + (f" ** {e}" if e != 1 else "") for n, e in zip(_BASE_DIMENSIONS, vector, strict=True) if e > 0]
+    down = [n + (f" ** {-e}" if e != -1 else "") for n, e in zip(_BASE_DIMENSIONS, vector, strict=True) if e < 0]
     if not up and not down:
         return "dimensionless"
     return " / ".join([" * ".join(up) or "1", *down])
 
 
 def _table_unit(name: str) -> tuple[float, tuple[int, int, int, int]] | None:
-    if name in _UNITS:
-        return _UNITS[name]
-    if name in _PLAIN_UNITS:
-        return _PLAIN_UNITS[name]
+    if name in _UNITS or name in _PLAIN_UNITS:
+        return _UNITS.get(name) or _PLAIN_UNITS[name]
     prefix, base = name[:1], name[1:]
     if prefix in _PREFIXES and base in _UNITS:
         return _PREFIXES[prefix] * _UNITS[base][0], _UNITS[base][1]
@@ -322,34 +315,13 @@ def _quantity_to_si(quantity: Any, dimension: str, name: str, shown: Any) -> flo
     try:
         if dimension == "dimensionless":
             return float(quantity.to("dimensionless").magnitude)
-        return float(quantity.to_base_units().to(ureg.parse_units(_base_unit(dimension))).magnitude)
+        return float(quantity.to_base_units().to(ureg.parse_units(DIMENSIONS[dimension][1])).magnitude)
     except pint.DimensionalityError:
         raise UnitError(
             f"{name}: {shorten(shown)} has dimension {quantity.dimensionality}, expected {_describe(dimension)}"
         ) from None
     except (OverflowError, ZeroDivisionError, ValueError, TypeError):
         raise UnitError(f"{name}: cannot read {shorten(shown)} as {_describe(dimension)}") from None
-
-
-def _base_unit(dimension: str) -> str:
-    return {
-        "time": "s",
-        "length": "m",
-        "velocity": "m/s",
-        "rate": "1/s",
-        "per_area": "1/m**2",
-        "stiffness": "N/m",
-        "temperature": "K",
-        "stress": "Pa",
-        "stress_rate": "Pa/s",
-        "stress_per_length": "Pa/m",
-        "force": "N",
-        "area": "m**2",
-        "stress_per_velocity": "Pa*s/m",
-        "per_length": "1/m",
-        "slowness": "s/m",
-        "mass_per_area": "kg/m**2",
-    }[dimension]
 
 
 def format_si(value: float, dimension: str) -> str:
