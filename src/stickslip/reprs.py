@@ -42,3 +42,8 @@ def compact_repr(obj: Any) -> str:
             continue
         parts.append(f"{item.name}={short_value(getattr(obj, item.name))}")
     return f"{type(obj).__name__}({', '.join(parts)})"
+
+
+def field_values(obj: Any, names: str) -> dict[str, Any]:
+    """``{name: obj.name}`` for each of the space-separated ``names``, in order (a result's ``as_dict``)."""
+    return {name: getattr(obj, name) for name in names.split()}

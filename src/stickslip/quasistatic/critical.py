@@ -20,7 +20,7 @@ import numpy as np
 from ..errors import ModelError
 from ..numerics.roots import brentq  # scipy.optimize would add 0.3 s to start-up
 from ..parameters import BlockParameters, Parameters, StickParameters
-from ..reprs import compact_repr
+from ..reprs import compact_repr, field_values
 from .steady import ACCURATE_QUADRATURE, require_parameters, steady_state
 
 #: Velocity range searched for extrema, m/s, and the grid density per decade.
@@ -51,15 +51,8 @@ class CriticalPoint:
     extrema: tuple[Extremum, ...]
 
     def as_dict(self) -> dict[str, object]:
-        return {
-            "critical_velocity": self.velocity,
-            "critical_stress": self.stress,
-            "exists": self.exists,
-            "message": self.message,
-            "turnover_velocity": self.turnover_velocity,
-            "turnover_stress": self.turnover_stress,
-            "turnover_message": self.turnover_message,
-        }
+        turnover = field_values(self, "exists message turnover_velocity turnover_stress turnover_message")
+        return {"critical_velocity": self.velocity, "critical_stress": self.stress, **turnover}
 
     def to_frame(self) -> Any:
         """One row: Vc [m/s], sigma_c [Pa], whether they exist, the turnover and the messages (units in

@@ -19,7 +19,7 @@ from .. import regimes
 from ..columns import with_units
 from ..errors import ParameterError
 from ..parameters import Parameters
-from ..reprs import compact_repr
+from ..reprs import compact_repr, field_values
 from ..trace_columns import QUASI_STATIC
 from .jump import Jump, check_curve, jump_velocity, require_critical_point
 from .slip import SlipPhase, slip_phase
@@ -52,15 +52,7 @@ class Cycle:
     period: float | None = None
 
     def as_dict(self) -> dict[str, Any]:
-        return {
-            "start_time": self.start_time,
-            "start_stress": self.start_stress,
-            "peak_stress": self.peak_stress,
-            "stick_time": self.stick_time,
-            "jump_velocity": self.jump_velocity,
-            "slip_time": self.slip_time,
-            "period": self.period,
-        }
+        return field_values(self, "start_time start_stress peak_stress stick_time jump_velocity slip_time period")
 
 
 @dataclass(frozen=True)

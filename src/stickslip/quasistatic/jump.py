@@ -20,6 +20,7 @@ from scipy.optimize import brentq
 
 from ..errors import ModelError, ParameterError
 from ..parameters import Parameters
+from ..reprs import field_values
 from .critical import CriticalPoint, cached_critical_point, steady_curve_key
 from .steady import ACCURATE_QUADRATURE, require_parameters, steady_state
 
@@ -74,8 +75,7 @@ def adaptive_chebyshev(
     doubling samples only the new points.
     """
     n = start
-    u = chebyshev_points(n)
-    x = 0.5 * (lo + hi) + 0.5 * (hi - lo) * u
+    x = 0.5 * (lo + hi) + 0.5 * (hi - lo) * chebyshev_points(n)
     values = np.atleast_2d(sample(x))
     while True:
         coefficients = chebyshev_coefficients(values)
@@ -87,8 +87,7 @@ def adaptive_chebyshev(
                 f" {largest + 1} Chebyshev points"
             )
         n *= 2
-        u = chebyshev_points(n)
-        x = 0.5 * (lo + hi) + 0.5 * (hi - lo) * u
+        x = 0.5 * (lo + hi) + 0.5 * (hi - lo) * chebyshev_points(n)
         new = np.empty((values.shape[0], n + 1))
         new[:, ::2] = values
         new[:, 1::2] = np.atleast_2d(sample(x[1::2]))
@@ -214,13 +213,7 @@ class Jump:
     highest_stress: float  # the branch's maximum
 
     def as_dict(self) -> dict[str, object]:
-        return {
-            "stress": self.stress,
-            "jump_velocity": self.velocity,
-            "reachable": self.reachable,
-            "curve": self.curve,
-            "message": self.message,
-        }
+        return {"stress": self.stress, "jump_velocity": self.velocity, **field_values(self, "reachable curve message")}
 
 
 def check_curve(curve: str) -> str:

@@ -268,18 +268,14 @@ def _panel_width(x: np.ndarray, y: np.ndarray, s: _Scales, q: QuadratureSettings
     step = np.zeros(x.size, dtype=bool)
     # the widest panel can only be good where the left end allows it: test just those lanes
     searching = (log_widest > cap_resolved) & (log_widest > cap_negligible)
+    every = _Lanes(x, y, s, cap_resolved, cap_negligible, log_negligible)
     tried = np.nonzero(~searching)[0]
     if tried.size:
-        lanes = _Lanes(
-            x[tried], y[tried], _take(s, tried), cap_resolved[tried], cap_negligible[tried], log_negligible[tried]
-        )
-        searching[tried] = ~good(log_widest[tried], lanes)
+        searching[tried] = ~good(log_widest[tried], every.take(tried))
     open_ = np.nonzero(searching)[0]
     if open_.size == 0:
         return np.exp(log_w), step
-    lanes = _Lanes(
-        x[open_], y[open_], _take(s, open_), cap_resolved[open_], cap_negligible[open_], log_negligible[open_]
-    )
+    lanes = every.take(open_)
     # bracket [low, top]: top is not good; low is good once confirmed (before that it is the floor, STEP_ULPS
     # ulps of the position).  Gallop from the left end's cap (usually within a few times w*) with steps in ln w
     # that double, then bisect: a few tests per panel, and at most ~2 log2(745) however deep the dip.

@@ -20,7 +20,7 @@ from ..columns import with_units
 from ..errors import ModelError, ParameterError
 from ..numerics.events import integrate_in_chunks
 from ..parameters import Parameters, require_flag
-from ..reprs import compact_repr
+from ..reprs import compact_repr, field_values
 from .jump import require_critical_point
 from .steady import require_parameters
 
@@ -99,17 +99,8 @@ class StickPhase:
         return float(min(max(dense(theta)[1], 0.0), 1.0))
 
     def as_dict(self) -> dict[str, object]:
-        return {
-            "status": self.status,
-            "stuck": self.stuck,
-            "stick_time": self.stick_time,
-            "peak_stress": self.peak_stress,
-            "start_stress": self.start_stress,
-            "pulling_velocity": self.pulling_velocity,
-            "aging": self.aging,
-            "chain_floor": self.chain_floor,
-            "message": self.message,
-        }
+        names = "status stuck stick_time peak_stress start_stress pulling_velocity aging chain_floor message"
+        return field_values(self, names)
 
     def to_frame(self) -> pd.DataFrame:
         """time [s], stress [Pa], chain_fraction (Nc/Nc0)."""
@@ -139,6 +130,15 @@ def check_stress(value: Any, name: str = "start_stress") -> float:
     if s < 0:
         raise ParameterError(f"{name}: expected a stress >= 0 in Pa, got {s!r}")
     return s
+
+
+def _start_stress(params: Parameters, start_stress: Any) -> float:
+    """The stress a stick starts from: ``start_stress`` checked, or sigma_c of the critical point when None."""
+    if start_stress is not None:
+        return check_stress(start_stress)
+    cp = require_critical_point(params)
+    assert cp.stress is not None
+    return float(cp.stress)
 
 
 def _number(value: Any, name: str, unit: str) -> float:
@@ -256,12 +256,7 @@ def stick_phase(
     """
     require_parameters(params)
     v0 = check_velocity(pulling_velocity)
-    if start_stress is None:
-        cp = require_critical_point(params)
-        assert cp.stress is not None
-        sigma0 = float(cp.stress)
-    else:
-        sigma0 = check_stress(start_stress)
+    sigma0 = _start_stress(params, start_stress)
     aging = require_flag(aging, "aging")
     if horizon is not None:
         horizon = _number(horizon, "horizon", "s")
@@ -399,15 +394,7 @@ class StuckThreshold:
     message: str
 
     def as_dict(self) -> dict[str, object]:
-        return {
-            "velocity": self.velocity,
-            "lower": self.lower,
-            "upper": self.upper,
-            "ceiling": self.ceiling,
-            "start_stress": self.start_stress,
-            "aging": self.aging,
-            "message": self.message,
-        }
+        return field_values(self, "velocity lower upper ceiling start_stress aging message")
 
 
 def stuck_ceiling(params: Parameters) -> float:
@@ -428,12 +415,7 @@ def stuck_threshold(
     :func:`stuck_ceiling`; it is bracketed by bisection on the proven outcome
     of :func:`stick_phase`.  ``start_stress=None`` means sigma_c.
     """
-    if start_stress is None:
-        cp = require_critical_point(params)
-        assert cp.stress is not None
-        sigma0 = float(cp.stress)
-    else:
-        sigma0 = check_stress(start_stress)
+    sigma0 = _start_stress(params, start_stress)
     ceiling = stuck_ceiling(params)
 
     def result(velocity: float | None, lower: float, upper: float, message: str) -> StuckThreshold:
