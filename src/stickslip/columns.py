@@ -31,6 +31,7 @@ __all__ = [
     "INHERITED",
     "JSON_DIGITS",
     "UNITS",
+    "attribute_frame",
     "csv_text",
     "header_cell",
     "json_safe",
@@ -212,6 +213,14 @@ def with_units(frame: pd.DataFrame, extra: Mapping[str, str | None] | None = Non
     """``frame`` with ``attrs["units"]`` set for every column; returns the same frame."""
     frame.attrs["units"] = {str(c): unit_of(str(c), extra) for c in frame.columns}
     return frame
+
+
+def attribute_frame(obj: Any, names: str) -> pd.DataFrame:
+    """A frame of the space-separated ``names`` of ``obj``'s arrays (each flattened), with its units."""
+    import numpy as np
+    import pandas as pd
+
+    return with_units(pd.DataFrame({name: np.ravel(getattr(obj, name)) for name in names.split()}))
 
 
 def units_of_frame(frame: pd.DataFrame) -> dict[str, str | None]:

@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from .. import regimes
-from ..columns import with_units
+from ..columns import attribute_frame
 from ..errors import ParameterError
 from ..parameters import Parameters
 from ..reprs import compact_repr, field_values
@@ -106,9 +106,7 @@ class Simulation:
 
     def to_frame(self) -> pd.DataFrame:
         """The trace, one row per sample, columns :data:`CYCLE_COLUMNS` (SI units)."""
-        import pandas as pd
-
-        return with_units(pd.DataFrame({name: getattr(self, name) for name in CYCLE_COLUMNS}))
+        return attribute_frame(self, " ".join(CYCLE_COLUMNS))
 
     def plot(self, ax: Axes | None = None, **kwargs: Any) -> Axes:
         """sigma(t) over the cycles (Fig 5a-c); returns the Axes."""

@@ -19,7 +19,7 @@ from numpy.polynomial import chebyshev as cheb
 from scipy.optimize import brentq
 from scipy.special import exprel
 
-from ..columns import with_units
+from ..columns import attribute_frame
 from ..errors import ModelError, ParameterError
 from ..parameters import Parameters
 from ..reprs import compact_repr
@@ -238,18 +238,7 @@ class SlipPhase:
 
     def to_frame(self) -> pd.DataFrame:
         """time [s], velocity [m/s], stress [Pa], slider_displacement [m]."""
-        import pandas as pd
-
-        return with_units(
-            pd.DataFrame(
-                {
-                    "time": self.time,
-                    "velocity": self.velocity,
-                    "stress": self.stress,
-                    "slider_displacement": self.slider_displacement,
-                }
-            )
-        )
+        return attribute_frame(self, "time velocity stress slider_displacement")
 
     def plot(self, ax: Axes | None = None, **kwargs: Any) -> Axes:
         """V(t) during the slip (Fig 5d); returns the Axes."""

@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..columns import with_units
+from ..columns import attribute_frame
 from ..errors import ModelError, ParameterError
 from ..numerics.quadrature import panel_rule
 from ..parameters import BOLTZMANN, Parameters, require_flag
@@ -107,17 +107,7 @@ class SteadyState:
 
     def to_frame(self) -> pd.DataFrame:
         """One row per velocity, SI units."""
-        import pandas as pd
-
-        frame = pd.DataFrame(
-            {
-                "velocity": np.ravel(self.velocity),
-                "stress": np.ravel(self.stress),
-                "bonded_fraction": np.ravel(self.bonded_fraction),
-                "stress_slope": np.ravel(self.stress_slope),
-            }
-        )
-        return with_units(frame)
+        return attribute_frame(self, "velocity stress bonded_fraction stress_slope")
 
     def plot(self, ax: Axes | None = None, **kwargs: Any) -> Axes:
         """sigma against log V; returns the Axes (never shows the figure)."""

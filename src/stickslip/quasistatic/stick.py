@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from scipy.optimize import brentq
 
-from ..columns import with_units
+from ..columns import attribute_frame
 from ..errors import ModelError, ParameterError
 from ..numerics.events import integrate_in_chunks
 from ..parameters import Parameters, require_flag
@@ -104,11 +104,7 @@ class StickPhase:
 
     def to_frame(self) -> pd.DataFrame:
         """time [s], stress [Pa], chain_fraction (Nc/Nc0)."""
-        import pandas as pd
-
-        return with_units(
-            pd.DataFrame({"time": self.time, "stress": self.stress, "chain_fraction": self.chain_fraction})
-        )
+        return attribute_frame(self, "time stress chain_fraction")
 
     def plot(self, ax: Axes | None = None, **kwargs: Any) -> Axes:
         """Nc/Nc0 against time (Figs 3, 6); returns the Axes."""
