@@ -38,7 +38,7 @@ import dataclasses
 import math
 import os
 import sys
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field, fields
 from importlib import resources
 from pathlib import Path
@@ -234,14 +234,17 @@ class Parameters:
             if not isinstance(getattr(self, meta), str):
                 raise ParameterError(f"Parameters({meta}=...): expected a text, got {shorten(getattr(self, meta))}")
 
+    def _held(self) -> Iterator[tuple[str, Any, float]]:
+        """(``section.key``, its field, SI value) of each key, in order; an optional key left out is absent."""
+        for s, cls in SECTIONS.items():
+            for f in fields(cls):
+                value = getattr(getattr(self, s), f.name)
+                if value is not None:
+                    yield f"{s}.{f.name}", f, value
+
     def as_dict(self) -> dict[str, float]:
         """Flat mapping ``section.key -> SI float`` (an optional key left out is absent)."""
-        return {
-            f"{s}.{f.name}": getattr(getattr(self, s), f.name)
-            for s, cls in SECTIONS.items()
-            for f in fields(cls)
-            if getattr(getattr(self, s), f.name) is not None
-        }
+        return {key: value for key, _, value in self._held()}
 
     def with_overrides(self, overrides: Mapping[str, Any] | None) -> Parameters:
         """A new set with ``section.key`` values replaced (numbers in SI, or strings with units)."""
@@ -262,21 +265,10 @@ class Parameters:
 
     def rows(self) -> list[tuple[str, str, str, str]]:
         """(key, symbol, value with unit, meaning) for display."""
-        out = []
-        for s, cls in SECTIONS.items():
-            for f in fields(cls):
-                value = getattr(getattr(self, s), f.name)
-                if value is None:
-                    continue
-                out.append(
-                    (
-                        f"{s}.{f.name}",
-                        f.metadata["symbol"],
-                        format_si(value, f.metadata["dimension"]),
-                        f.metadata["doc"],
-                    )
-                )
-        return out
+        return [
+            (key, f.metadata["symbol"], format_si(value, f.metadata["dimension"]), f.metadata["doc"])
+            for key, f, value in self._held()
+        ]
 
     def to_toml(self) -> str:
         """An editable TOML file; values as a person writes them (``"360 um/s"``), and a reload gives the same set."""
@@ -285,15 +277,14 @@ class Parameters:
             lines.append(f"description = {_toml_str(self.description)}")
         if self.reference:
             lines.append(f"reference = {_toml_str(self.reference)}")
-        for s, cls in SECTIONS.items():
-            lines += ["", f"[{s}]"]
-            for f in fields(cls):
-                if getattr(getattr(self, s), f.name) is None:
-                    continue
-                dimension = f.metadata["dimension"]
-                text = format_quantity(getattr(getattr(self, s), f.name), dimension)
-                shown = text if dimension == "dimensionless" else _toml_str(text)
-                lines.append(f"{f.name} = {shown}  # {f.metadata['symbol']}: {f.metadata['doc']}")
+        for key, f, value in self._held():
+            header = f"[{key.partition('.')[0]}]"
+            if header not in lines:  # a section's first key (every section holds required keys)
+                lines += ["", header]
+            dimension = f.metadata["dimension"]
+            text = format_quantity(value, dimension)
+            shown = text if dimension == "dimensionless" else _toml_str(text)
+            lines.append(f"{f.name} = {shown}  # {f.metadata['symbol']}: {f.metadata['doc']}")
         return "\n".join(lines) + "\n"
 
 
