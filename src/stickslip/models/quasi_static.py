@@ -72,17 +72,15 @@ def _checked(params: Any) -> Parameters:
 def simulation_run(sim: Any) -> Run:
     """The :class:`Run` of a :class:`stickslip.Simulation` (its phases give the regime and the cycle's numbers)."""
     summary = cycle_numbers(sim)
-    time, stress = sim.time, sim.stress
-    regime = sim.regime  # the engine's, with its evidence (the phases: every cycle after the first repeats)
     return Run(
         model=QuasiStatic.name,
-        time=time,
-        stress=stress,
+        time=sim.time,
+        stress=sim.stress,
         friction=None,
         slider_velocity=sim.velocity,
         slider_position=sim.slider_displacement,
         load_point_position=sim.puller_displacement,
-        regime=regime,
+        regime=sim.regime,  # the engine's, with its evidence (the phases: every cycle after the first repeats)
         mean=summary["mean_stress"],
         states={"block_shear": sim.block_shear, "chain_fraction": sim.chain_fraction, "phase": sim.phase},
         state_units={"block_shear": "m", "chain_fraction": "1", "phase": None},

@@ -32,8 +32,7 @@ def register_model(model: Any, *, replace: bool = False) -> FrictionModel:
     """Make ``model`` (a :class:`FrictionModel` instance, or a class to instantiate) available by its name and
     aliases; returns it.  A name already taken by another model is refused unless ``replace=True``."""
     replace = require_flag(replace, "register_model: replace")
-    if isinstance(model, type):
-        model = _instance(model, "register_model")
+    model = _instance(model, "register_model")
     missing = [attr for attr in _REQUIRED if not hasattr(model, attr)]
     if missing:
         raise ParameterError(
@@ -89,11 +88,7 @@ def available_models() -> dict[str, FrictionModel]:
 
 
 def _lookup(key: str) -> FrictionModel | None:
-    if key in _MODELS:
-        return _MODELS[key]
-    if key in _ALIASES:
-        return _MODELS[_ALIASES[key]]
-    return None
+    return _MODELS.get(_ALIASES.get(key, key))
 
 
 def _builtins() -> None:

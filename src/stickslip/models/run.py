@@ -68,7 +68,8 @@ def window_mean(time: np.ndarray, values: np.ndarray, start: float) -> float:
 
 
 def _column(values: Any, name: str, size: int | None) -> np.ndarray:
-    array = np.asarray(values, dtype=float) if not _is_text(values) else np.asarray(values, dtype=object)
+    text = np.asarray(values).dtype.kind in "OUS"
+    array = np.asarray(values, dtype=object) if text else np.asarray(values, dtype=float)
     if array.ndim != 1:
         raise ParameterError(f"run column {name}: expected one value per time, got an array of shape {array.shape}")
     if size is not None and array.size != size:
@@ -99,11 +100,6 @@ def _trace_arrays(time: Any, stress: Any, friction: Any) -> tuple[np.ndarray, np
     if np.any(np.diff(t) < 0):
         raise ParameterError(f"Run.from_trace: time goes back at row {int(np.argmax(np.diff(t) < 0)) + 1}")
     return t, signal
-
-
-def _is_text(values: Any) -> bool:
-    array = np.asarray(values)
-    return array.dtype.kind in "OUS"
 
 
 @dataclass(frozen=True, eq=False)  # arrays: equality is not a truth value; compare columns instead
@@ -260,12 +256,7 @@ class Run:
 
         from ..columns import with_units
 
-        columns: dict[str, Any] = {"time": self.time}
-        for name in ("stress", "friction"):
-            if getattr(self, name) is not None:
-                columns[name] = getattr(self, name)
-        for name in ("slider_velocity", "slider_position", "load_point_position"):
-            columns[name] = getattr(self, name)
+        columns = {name: getattr(self, name) for name in BASE_COLUMNS if getattr(self, name) is not None}
         columns.update(self.states)
         return with_units(pd.DataFrame(columns), extra=self.units)
 
