@@ -40,5 +40,4 @@ def panel_rule(order: int) -> PanelRule:
     antiderivatives = legendre.legint(lagrange_coefficients, lbnd=-1.0, axis=0)
     at = np.append(nodes, 1.0)
     cumulative = legendre.legval(at, antiderivatives).T  # (K+1, K)
-    cumulative = np.ascontiguousarray(cumulative.T).T
     return PanelRule(nodes=nodes, weights=weights, cumulative=np.ascontiguousarray(cumulative))

@@ -108,8 +108,7 @@ class SweepStore:
         target = self.folder / chunk_name(batch)
         with atomic_path(target, clean=False) as temp:  # the folder was cleaned when opened, under its lock
             pq.write_table(table, temp)
-            entry = {"batch": batch, "start": start, "stop": stop, **_fingerprint(temp)}
-            _append_line(self.folder / LEDGER, json.dumps(entry, sort_keys=True))  # before the rename: see module
+            _record(self.folder, batch, start, stop, temp)  # before the rename: see the module's note
         self.done.add(batch)
         self.points_written += table.num_rows
         self.point_seconds += sum(t for t in table.column("wall_time").to_pylist() if t is not None)
@@ -246,11 +245,11 @@ def _refuse_too_large(store: SweepStore, folder: str | Path) -> None:
 
 
 def _size(count: float) -> str:
-    for unit in ("bytes", "kB", "MB", "GB", "TB", "PB"):
-        if count < 1000 or unit == "PB":
+    for unit in ("bytes", "kB", "MB", "GB", "TB"):
+        if count < 1000:
             return f"{count:.3g} {unit}"
         count /= 1000
-    return f"{count:.3g} PB"  # pragma: no cover
+    return f"{count:.3g} PB"
 
 
 def _fingerprint(path: Path) -> dict[str, Any]:
@@ -263,9 +262,11 @@ def _fingerprint(path: Path) -> dict[str, Any]:
     return {"bytes": size, "sha256": digest.hexdigest()}
 
 
-def _append_line(path: Path, line: str) -> None:
-    with open(path, "a", encoding="utf-8") as handle:
-        handle.write(line + "\n")
+def _record(folder: Path, batch: int, start: int, stop: int, chunk: Path) -> None:
+    """Append the chunk's ledger entry (its points and fingerprint), flushed to the disk."""
+    entry = {"batch": batch, "start": start, "stop": stop, **_fingerprint(chunk)}
+    with open(folder / LEDGER, "a", encoding="utf-8") as handle:
+        handle.write(json.dumps(entry, sort_keys=True) + "\n")
         handle.flush()
         os.fsync(handle.fileno())
 
@@ -313,8 +314,7 @@ def _chunk_problem(store: SweepStore, batch: int, path: Path, entry: dict[str, A
         return "its bytes differ from those written"
     why = _read_problem(store, path, start, stop)  # unrecorded (older folder, lost ledger) or recorded otherwise
     if why is None:
-        _append_line(store.folder / LEDGER, json.dumps({"batch": batch, "start": start, "stop": stop,
-                                                        **_fingerprint(path)}, sort_keys=True))  # fmt: skip
+        _record(store.folder, batch, start, stop, path)
     return why
 
 
