@@ -115,17 +115,11 @@ class StickPhase:
 
 def check_velocity(value: Any, name: str = "pulling_velocity") -> float:
     """A pulling velocity in m/s: finite and >= 0."""
-    v = _number(value, name, "m/s")
-    if v < 0:
-        raise ParameterError(f"{name}: expected a velocity >= 0 in m/s, got {v!r}")
-    return v
+    return _number(value, name, "m/s", "a velocity")
 
 
 def check_stress(value: Any, name: str = "start_stress") -> float:
-    s = _number(value, name, "Pa")
-    if s < 0:
-        raise ParameterError(f"{name}: expected a stress >= 0 in Pa, got {s!r}")
-    return s
+    return _number(value, name, "Pa", "a stress")
 
 
 def _start_stress(params: Parameters, start_stress: Any) -> float:
@@ -137,12 +131,15 @@ def _start_stress(params: Parameters, start_stress: Any) -> float:
     return float(cp.stress)
 
 
-def _number(value: Any, name: str, unit: str) -> float:
+def _number(value: Any, name: str, unit: str, at_least_zero: str = "") -> float:
+    """``value`` as a finite float; given ``at_least_zero`` (what it is, "a stress"), one >= 0."""
     if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
         raise ParameterError(f"{name}: expected a number in {unit}, got {value!r}")
     v = float(value)
     if not math.isfinite(v):
         raise ParameterError(f"{name}: expected a finite number in {unit}, got {v!r}")
+    if at_least_zero and v < 0:
+        raise ParameterError(f"{name}: expected {at_least_zero} >= 0 in {unit}, got {v!r}")
     return v
 
 

@@ -266,14 +266,10 @@ def _model_name(model: Any) -> str:
 
 def _whole(value: Any, name: str, minimum: int) -> int:
     """A whole number >= minimum (an integral float such as 3.0 too); anything else is one ParameterError."""
-    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+    whole = isinstance(value, numbers.Integral) or (isinstance(value, numbers.Real) and float(value).is_integer())
+    if isinstance(value, bool) or not whole:
         raise ParameterError(f"{name}: expected a whole number, got {value!r}")
-    if isinstance(value, numbers.Integral):
-        number = int(value)
-    elif float(value).is_integer():
-        number = int(value)
-    else:
-        raise ParameterError(f"{name}: expected a whole number, got {value!r}")
+    number = int(value)
     if number < minimum:
         raise ParameterError(f"{name}: expected a whole number >= {minimum}, got {number}")
     return number
