@@ -8,7 +8,6 @@ stresses in Pa; the objects passed in hold SI values.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -99,8 +98,6 @@ def _data_arrays(data: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
 
 
 def _has_key(data: Any, key: str) -> bool:
-    if isinstance(data, Mapping):
-        return key in data
     try:
         return key in data
     except TypeError:
