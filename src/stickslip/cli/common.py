@@ -13,6 +13,7 @@ bounded size: a FIFO or /dev/zero is refused instead of read for ever).
 
 from __future__ import annotations
 
+import io
 import math
 import stat
 import sys
@@ -34,52 +35,33 @@ from ..units import DIMENSIONS, bare_number, quantity_noun, shorten, to_si
 #: Largest data file (CSV) a command reads: a 10^7-sample record is about 0.4 GB.
 MAX_INPUT_BYTES = 2_000_000_000
 
-#: Units a bare number may have been meant in, per dimension: (unit, factor to SI).
-_CANDIDATE_UNITS: dict[str, tuple[tuple[str, float], ...]] = {
-    "time": (("s", 1.0), ("ms", 1e-3), ("us", 1e-6), ("ns", 1e-9), ("min", 60.0), ("h", 3600.0)),
-    "length": (("m", 1.0), ("mm", 1e-3), ("um", 1e-6), ("nm", 1e-9), ("angstrom", 1e-10)),
-    "velocity": (("m/s", 1.0), ("mm/s", 1e-3), ("um/s", 1e-6), ("nm/s", 1e-9)),
-    "rate": (("1/s", 1.0),),
-    "per_area": (("1/m^2", 1.0), ("1/um^2", 1e12)),
-    "stiffness": (("N/m", 1.0), ("mN/m", 1e-3)),
-    "temperature": (("K", 1.0),),
-    "stress": (("Pa", 1.0), ("kPa", 1e3), ("MPa", 1e6), ("GPa", 1e9)),
-    "stress_rate": (("Pa/s", 1.0), ("kPa/s", 1e3)),
-    "stress_per_length": (("Pa/m", 1.0), ("kPa/m", 1e3), ("MPa/m", 1e6)),
-    "force": (("N", 1.0), ("mN", 1e-3), ("uN", 1e-6)),
-    "area": (("m^2", 1.0), ("cm^2", 1e-4), ("mm^2", 1e-6)),
-    "stress_per_velocity": (("Pa s/m", 1.0), ("MPa s/m", 1e6)),
-    "per_length": (("1/m", 1.0), ("1/mm", 1e3), ("1/um", 1e6)),
-    "slowness": (("s/m", 1.0), ("s/mm", 1e3), ("s/um", 1e6)),
-    "mass_per_area": (("kg/m^2", 1.0), ("g/m^2", 1e-3)),
-}
-
-#: A typical size (SI) of an option's value, per dimension: a bare number is taken to be in the unit
-#: that puts it nearest this (pulling velocities of um/s to mm/s, stresses of kPa, times of seconds...).
-_TYPICAL_SI = {
-    "time": 10.0,
-    "length": 1e-5,
-    "velocity": 1e-4,
-    "rate": 1.0,
-    "per_area": 1e14,
-    "stiffness": 1e-4,
-    "temperature": 300.0,
-    "stress": 1e3,
-    "stress_rate": 1e2,
-    "stress_per_length": 1e5,
-    "force": 1.0,
-    "area": 1e-3,
-    "stress_per_velocity": 1e6,
-    "per_length": 1e3,
-    "slowness": 1.0,
-    "mass_per_area": 100.0,
+#: Per dimension: a typical size (SI) of an option's value, and the units a bare number may have been meant in,
+#: as (unit, factor to SI).  A bare number is taken to be in the unit that puts it nearest the typical size
+#: (pulling velocities of um/s to mm/s, stresses of kPa, times of seconds...).
+_MEANT_UNITS: dict[str, tuple[float, tuple[tuple[str, float], ...]]] = {
+    "time": (10.0, (("s", 1.0), ("ms", 1e-3), ("us", 1e-6), ("ns", 1e-9), ("min", 60.0), ("h", 3600.0))),
+    "length": (1e-5, (("m", 1.0), ("mm", 1e-3), ("um", 1e-6), ("nm", 1e-9), ("angstrom", 1e-10))),
+    "velocity": (1e-4, (("m/s", 1.0), ("mm/s", 1e-3), ("um/s", 1e-6), ("nm/s", 1e-9))),
+    "rate": (1.0, (("1/s", 1.0),)),
+    "per_area": (1e14, (("1/m^2", 1.0), ("1/um^2", 1e12))),
+    "stiffness": (1e-4, (("N/m", 1.0), ("mN/m", 1e-3))),
+    "temperature": (300.0, (("K", 1.0),)),
+    "stress": (1e3, (("Pa", 1.0), ("kPa", 1e3), ("MPa", 1e6), ("GPa", 1e9))),
+    "stress_rate": (1e2, (("Pa/s", 1.0), ("kPa/s", 1e3))),
+    "stress_per_length": (1e5, (("Pa/m", 1.0), ("kPa/m", 1e3), ("MPa/m", 1e6))),
+    "force": (1.0, (("N", 1.0), ("mN", 1e-3), ("uN", 1e-6))),
+    "area": (1e-3, (("m^2", 1.0), ("cm^2", 1e-4), ("mm^2", 1e-6))),
+    "stress_per_velocity": (1e6, (("Pa s/m", 1.0), ("MPa s/m", 1e6))),
+    "per_length": (1e3, (("1/m", 1.0), ("1/mm", 1e3), ("1/um", 1e6))),
+    "slowness": (1.0, (("s/m", 1.0), ("s/mm", 1e3), ("s/um", 1e6))),
+    "mass_per_area": (100.0, (("kg/m^2", 1.0), ("g/m^2", 1e-3))),
 }
 
 
 def _meant_unit(number: float, dimension: str, typical: float | None) -> str:
     """The unit that puts ``number`` nearest (in decades) to a typical value of its quantity."""
-    candidates = _CANDIDATE_UNITS.get(dimension, ((DIMENSIONS[dimension][1], 1.0),))
-    target = math.log10(typical if typical and typical > 0 else _TYPICAL_SI.get(dimension, 1.0))
+    typical_si, candidates = _MEANT_UNITS.get(dimension, (1.0, ((DIMENSIONS[dimension][1], 1.0),)))
+    target = math.log10(typical if typical and typical > 0 else typical_si)
     size = math.log10(abs(number))
     return min(candidates, key=lambda unit: abs(size + math.log10(unit[1]) - target))[0]
 
@@ -93,22 +75,13 @@ def stacked(options: Sequence[Callable[[Any], Any]], func: Callable[..., Any]) -
 
 def params_options(func: Callable[..., Any]) -> Callable[..., Any]:
     """Add ``--params NAME|FILE`` and repeatable ``--set section.key=VALUE``."""
-    func = click.option(
-        "--set",
-        "overrides",
-        multiple=True,
-        metavar="SECTION.KEY=VALUE",
-        help="Override one parameter, with its unit, e.g. bonds.bond_time='224 us'; repeatable.",
-    )(func)
-    func = click.option(
-        "--params",
-        "params_name",
-        default="gelatin-glass",
-        show_default=True,
-        metavar="NAME|FILE",
-        help="Built-in parameter set or TOML parameter file.",
-    )(func)
-    return func
+    options = [
+        click.option("--params", "params_name", default="gelatin-glass", show_default=True, metavar="NAME|FILE",
+                     help="Built-in parameter set or TOML parameter file."),
+        click.option("--set", "overrides", multiple=True, metavar="SECTION.KEY=VALUE",
+                     help="Override one parameter, with its unit, e.g. bonds.bond_time='224 us'; repeatable."),
+    ]  # fmt: skip
+    return stacked(options, func)
 
 
 def resolve_params(params_name: str, overrides: Sequence[str]) -> Parameters:
@@ -337,6 +310,17 @@ def check_output(option: str, path: Path | None, plot: bool = False) -> None:
                 f"{option} {shorten(text)}: unknown figure format .{suffix};"
                 f" expected one of {', '.join(sorted(formats))}"
             )
+
+
+def plain_text(renderables: Sequence[Any], width: int) -> str:
+    """Rich renderables as plain text ``width`` wide (a table in box characters, no colour), every line stripped."""
+    from rich.console import Console
+
+    buffer = io.StringIO()
+    console = Console(file=buffer, width=width, color_system=None, highlight=False, force_terminal=False)
+    for item in renderables:
+        console.print(item)
+    return "\n".join(line.rstrip() for line in buffer.getvalue().splitlines())
 
 
 def echo_err(message: str) -> None:

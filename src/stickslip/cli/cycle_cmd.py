@@ -22,8 +22,8 @@ from .common import (
     write_text,
 )
 from .params_cmd import print_rich
-from .protocol_options import build_protocol, build_rig, protocol_options, refuse_unsupported
-from .run_cmd import execute, output_options
+from .protocol_options import protocol_options
+from .run_cmd import output_options, run_spelling
 
 #: Rows of the Nc/Nc0 table printed by ``stick`` (the whole curve is in --json and -o).
 STICK_TABLE_ROWS = 11
@@ -60,21 +60,7 @@ def _stress(text: str | None) -> float | None:
 )
 @output_options
 @params_options
-def simulate_command(
-    v0_text: str | None,
-    duration_text: str | None,
-    segment_texts: tuple[str, ...],
-    protocol_file: Path | None,
-    stiffness_text: str | None,
-    control: str,
-    start_text: str | None,
-    jump_curve: str,
-    output: Path | None,
-    plot_path: Path | None,
-    as_json: bool,
-    params_name: str,
-    overrides: tuple[str, ...],
-) -> None:
+def simulate_command(**options: Any) -> None:
     """Simulate stick-slip: stick -> jump -> slip -> jump -> ... for a pulling velocity and duration.
 
     The spelling of `stickslip run --model quasi-static` (--start-stress is
@@ -89,17 +75,17 @@ def simulate_command(
     regime is "stick-slip", "steady" (V0 >= Vc: the slip settles at V0),
     "stuck" (a stick never ends) or "undetermined" (the model has no answer).
     """
-    from ..models import get_model
-
-    refuse_overwriting_inputs([protocol_file], [("-o", output), ("--plot", plot_path)], params_name)
-    protocol = build_protocol(v0_text, duration_text, segment_texts, protocol_file)
-    refuse_unsupported("simulate (the quasi-static model)", protocol, control, controls=("spring",),
-                       one_segment=True, instead="stickslip transient runs any protocol and rig")  # fmt: skip
-    rig, _ = build_rig(control, stiffness_text)
-    params = resolve_params(params_name, overrides)
-    execute(get_model("quasi-static"), params, protocol, rig, start=_stress(start_text),
-            settings={"jump_curve": jump_curve}, output=output, plot_path=plot_path, as_json=as_json,
-            start_option="--start-stress ")  # fmt: skip
+    run_spelling(
+        "quasi-static",
+        options,
+        "simulate (the quasi-static model)",
+        controls=("spring",),
+        one_segment=True,
+        instead="stickslip transient runs any protocol and rig",
+        settings=lambda: {"jump_curve": options["jump_curve"]},
+        start=lambda: _stress(options["start_text"]),
+        start_option="--start-stress ",
+    )
 
 
 # --------------------------------------------------------------------------- stick

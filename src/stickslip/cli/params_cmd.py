@@ -10,7 +10,6 @@ reload gives exactly the same set.  Both take ``--params`` and ``--set``.
 from __future__ import annotations
 
 import dataclasses
-import io
 import math
 from collections.abc import Sequence
 from pathlib import Path
@@ -24,6 +23,7 @@ from ..units import DIMENSIONS
 from .common import (
     check_output,
     params_options,
+    plain_text,
     refuse_overwriting_inputs,
     resolve_params,
     stdout_is_terminal,
@@ -90,11 +90,7 @@ def print_rich(*renderables: Any, output: Path | None = None) -> None:
         for item in renderables:
             console.print(item)
         return
-    buffer = io.StringIO()
-    console = Console(file=buffer, width=PLAIN_WIDTH, color_system=None, highlight=False, force_terminal=False)
-    for item in renderables:
-        console.print(item)
-    text = "\n".join(line.rstrip() for line in buffer.getvalue().splitlines()) + "\n"
+    text = plain_text(renderables, PLAIN_WIDTH) + "\n"
     if output is None:
         click.echo(text, nl=False)
     else:

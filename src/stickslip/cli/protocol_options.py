@@ -138,20 +138,13 @@ def refuse_unsupported(
 
 def inertia_options(func: Callable[..., Any]) -> Callable[..., Any]:
     """``--mass`` and ``--damping``: the block's inertia and viscous damping (a spring rig's; build_rig reads them)."""
-    func = click.option(
-        "--damping",
-        "damping_text",
-        default=None,
-        metavar="ETA",
-        help='Viscous (radiation) damping of the block, e.g. "1025 Pa s/m" (needs --mass).',
-    )(func)
-    return click.option(
-        "--mass",
-        "mass_text",
-        default=None,
-        metavar="M",
-        help='Block mass per area, e.g. "10.5 kg/m^2" [none: the paper\'s massless block].',
-    )(func)
+    options = [
+        click.option("--mass", "mass_text", default=None, metavar="M",
+                     help='Block mass per area, e.g. "10.5 kg/m^2" [none: the paper\'s massless block].'),
+        click.option("--damping", "damping_text", default=None, metavar="ETA",
+                     help='Viscous (radiation) damping of the block, e.g. "1025 Pa s/m" (needs --mass).'),
+    ]  # fmt: skip
+    return stacked(options, func)
 
 
 def build_rig(

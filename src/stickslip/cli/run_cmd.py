@@ -9,6 +9,7 @@ line; ``stickslip analyze`` reads it as a measured trace), ``--json`` its summar
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -28,7 +29,7 @@ from .common import (
     set_values,
     stacked,
 )
-from .protocol_options import build_protocol, build_rig, inertia_options, protocol_options
+from .protocol_options import build_protocol, build_rig, inertia_options, protocol_options, refuse_unsupported
 from .run_report import model_record, record_text
 
 #: Exit status of a run the model could not finish (status "failed"); 2 is bad input.
@@ -287,25 +288,7 @@ def summary_text(summary: dict[str, Any]) -> str:
 )
 @output_options
 @inertia_options
-def run_command(
-    model_name: str,
-    params_name: str | None,
-    overrides: tuple[str, ...],
-    v0_text: str | None,
-    duration_text: str | None,
-    segment_texts: tuple[str, ...],
-    protocol_file: Path | None,
-    stiffness_text: str | None,
-    control: str,
-    start_text: str | None,
-    every_text: str | None,
-    setting_texts: tuple[str, ...],
-    output: Path | None,
-    plot_path: Path | None,
-    as_json: bool,
-    mass_text: str | None,
-    damping_text: str | None,
-) -> None:
+def run_command(**options: Any) -> None:
     """Run any friction model on a protocol, through one interface, into one Run.
 
     The model refuses, in one line, what it cannot run (the quasi-static model:
@@ -313,19 +296,53 @@ def run_command(
     one classifier on the model's dense solution.  A run that failed exits
     with status 3.
     """
-    refuse_overwriting_inputs([protocol_file, params_name], [("-o", output), ("--plot", plot_path)])
-    model = load_model(model_name)
-    protocol = build_protocol(v0_text, duration_text, segment_texts, protocol_file)
-    mapping = model_overrides(model, overrides)
-    rig, own_spring = build_rig(control, stiffness_text, [model], mass_text, damping_text)
+    o = options
+    refuse_overwriting_inputs([o["protocol_file"], o["params_name"]], [("-o", o["output"]), ("--plot", o["plot_path"])])
+    model = load_model(o["model_name"])
+    protocol = build_protocol(o["v0_text"], o["duration_text"], o["segment_texts"], o["protocol_file"])
+    mapping = model_overrides(model, o["overrides"])
+    rig, own_spring = build_rig(o["control"], o["stiffness_text"], [model], o["mass_text"], o["damping_text"])
     if own_spring:  # a stiffness in the model's own unit sets its key k, as --set k=... would
         mapping["k"] = own_spring[model.name]
-    params = model_parameters(model, params_name, mapping)
-    settings = settings_of(setting_texts, every_text)
+    params = model_parameters(model, o["params_name"], mapping)
+    settings = settings_of(o["setting_texts"], o["every_text"])
     model.check(protocol, rig, settings)  # what the model cannot do, before any work
-    start = start_value(start_text, model)
-    execute(model, params, protocol, rig, start=start, settings=settings, output=output, plot_path=plot_path,
-            as_json=as_json)  # fmt: skip
+    start = start_value(o["start_text"], model)
+    execute(model, params, protocol, rig, start=start, settings=settings, output=o["output"],
+            plot_path=o["plot_path"], as_json=o["as_json"])  # fmt: skip
+
+
+def run_spelling(
+    model_name: str,
+    options: dict[str, Any],
+    command: str,
+    *,
+    settings: Callable[[], dict[str, Any]],
+    start: Callable[[], Any] = lambda: None,
+    start_option: str = "--start ",
+    **limits: Any,
+) -> None:
+    """The one body of ``simulate`` and ``transient``, spellings of ``run --model NAME`` for the bond models.
+
+    Their parameters from ``--params``/``--set``, the protocol and rig in the shared words (what the model cannot
+    run refused first, ``limits`` going to :func:`refuse_unsupported`), then :func:`execute`.  ``settings`` and
+    ``start`` read their options where each spelling always read them: before the parameters, and after.
+    """
+    from ..models import get_model
+    from .common import resolve_params
+
+    o = options
+    output, plot_path = o["output"], o["plot_path"]
+    refuse_overwriting_inputs([o["protocol_file"]], [("-o", output), ("--plot", plot_path)], o["params_name"])
+    protocol = build_protocol(o["v0_text"], o["duration_text"], o["segment_texts"], o["protocol_file"])
+    refuse_unsupported(command, protocol, o["control"], **limits)
+    rig, _ = build_rig(
+        o["control"], o["stiffness_text"], mass_text=o.get("mass_text"), damping_text=o.get("damping_text")
+    )
+    chosen = settings()
+    params = resolve_params(o["params_name"], o["overrides"])
+    execute(get_model(model_name), params, protocol, rig, start=start(), settings=chosen, output=output,
+            plot_path=plot_path, as_json=o["as_json"], start_option=start_option)  # fmt: skip
 
 
 def execute(
@@ -408,4 +425,4 @@ def register(cli: click.Group) -> None:
     cli.add_command(run_command)
 
 
-__all__ = ["execute", "output_options", "run_command", "run_summary", "summary_text"]
+__all__ = ["execute", "output_options", "run_command", "run_spelling", "run_summary", "summary_text"]

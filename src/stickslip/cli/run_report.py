@@ -8,8 +8,9 @@ rate-and-state's final friction.  In JSON the record's keys stand beside the sum
 
 from __future__ import annotations
 
-import io
 from typing import Any
+
+from .common import plain_text
 
 #: Width of the plain text a table is drawn in (as ``print_rich`` draws it to a pipe).
 PLAIN_WIDTH = 120
@@ -29,23 +30,14 @@ def record_text(run: Any) -> str:
     native = run.native
     kind = type(native).__name__
     if kind == "Simulation":
-        return "\n".join(item if isinstance(item, str) else _plain(item) for item in _simulation_record(native))
+        return "\n".join(
+            item if isinstance(item, str) else plain_text([item], PLAIN_WIDTH) for item in _simulation_record(native)
+        )
     if kind == "TransientResult":
         return "\n".join(_transient_record(native))
     if kind == "RSFRun":
         return f"  at t = {native.time[-1]:.6g} s: μ = {float(native.friction[-1]):.6g}"
     return ""
-
-
-def _plain(*renderables: Any) -> str:
-    """Rich renderables as plain text (a table in box characters, no colour), every line stripped."""
-    from rich.console import Console
-
-    buffer = io.StringIO()
-    console = Console(file=buffer, width=PLAIN_WIDTH, color_system=None, highlight=False, force_terminal=False)
-    for item in renderables:
-        console.print(item)
-    return "\n".join(line.rstrip() for line in buffer.getvalue().splitlines())
 
 
 def _fmt(value: float | None, scale: float = 1.0, digits: int = 5) -> str:

@@ -2,21 +2,13 @@
 
 from __future__ import annotations
 
-from pathlib import Path
 from typing import Any
 
 import click
 
-from .common import params_options, positive, refuse_overwriting_inputs, resolve_params
-from .protocol_options import (
-    build_protocol,
-    build_rig,
-    control_name,
-    inertia_options,
-    protocol_options,
-    refuse_unsupported,
-)
-from .run_cmd import execute, output_options
+from .common import params_options, positive
+from .protocol_options import inertia_options, protocol_options
+from .run_cmd import output_options, run_spelling
 
 
 class StepCount(click.ParamType):
@@ -71,30 +63,7 @@ class StepCount(click.ParamType):
 )
 @output_options
 @params_options
-def transient_command(
-    v0_text: str | None,
-    duration_text: str | None,
-    segment_texts: tuple[str, ...],
-    protocol_file: Path | None,
-    stiffness_text: str | None,
-    control: str,
-    mass_text: str | None,
-    damping_text: str | None,
-    start: str,
-    start_v_text: str | None,
-    no_aging: bool,
-    stick_population: bool,
-    every_text: str | None,
-    rtol: float,
-    no_reduce: bool,
-    max_steps: int | None,
-    max_time_text: str | None,
-    output: Path | None,
-    plot_path: Path | None,
-    as_json: bool,
-    params_name: str,
-    overrides: tuple[str, ...],
-) -> None:
+def transient_command(**options: Any) -> None:
     """Solve the full time-dependent population balance (Eq 1, history form of Eq 3) through a protocol.
 
     The spelling of `stickslip run --model transient` (its options are run's
@@ -115,21 +84,19 @@ def transient_command(
     stops only when it uses up a budget: then it says how far it got, writes
     the trace up to there (-o, --plot) and exits with status 3.
     """
-    from ..models import get_model
+    o = options
 
-    refuse_overwriting_inputs([protocol_file], [("-o", output), ("--plot", plot_path)], params_name)
-    protocol = build_protocol(v0_text, duration_text, segment_texts, protocol_file)
-    refuse_unsupported("transient", protocol, control)
-    rig, _ = build_rig(control_name(control), stiffness_text, mass_text=mass_text, damping_text=damping_text)
-    start_velocity = None if start_v_text is None else positive(start_v_text, "velocity", "--start-velocity")
-    every = None if every_text is None else positive(every_text, "time", "--every")
-    max_time = None if max_time_text is None else positive(max_time_text, "time", "--max-time")
-    params = resolve_params(params_name, overrides)
-    settings = dict(start_velocity=start_velocity, aging=not no_aging, stick_population=stick_population, every=every,
-                    rtol=rtol, max_steps=max_steps, max_time=max_time,
-                    reduction="off" if no_reduce else "auto")  # fmt: skip
-    execute(get_model("transient"), params, protocol, rig, start=start, settings=settings, output=output,
-            plot_path=plot_path, as_json=as_json)  # fmt: skip
+    def settings() -> dict[str, Any]:
+        start_velocity = (
+            None if o["start_v_text"] is None else positive(o["start_v_text"], "velocity", "--start-velocity")
+        )
+        every = None if o["every_text"] is None else positive(o["every_text"], "time", "--every")
+        max_time = None if o["max_time_text"] is None else positive(o["max_time_text"], "time", "--max-time")
+        return dict(start_velocity=start_velocity, aging=not o["no_aging"], stick_population=o["stick_population"],
+                    every=every, rtol=o["rtol"], max_steps=o["max_steps"], max_time=max_time,
+                    reduction="off" if o["no_reduce"] else "auto")  # fmt: skip
+
+    run_spelling("transient", options, "transient", settings=settings, start=lambda: o["start"])
 
 
 def register(cli: click.Group) -> None:

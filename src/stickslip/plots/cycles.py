@@ -29,6 +29,7 @@ from .style import (
     UM_PER_S,
     VELOCITY_LABEL,
     apply_style,
+    data_columns,
     new_axes,
 )
 
@@ -144,18 +145,8 @@ def figure_cycles(
 
 
 def _trace_arrays(item: Any) -> tuple[np.ndarray, np.ndarray]:
-    if isinstance(item, tuple) and len(item) == 2:
-        t, s = item
-    else:
-        try:
-            t, s = item["time"], item["stress"]
-        except (TypeError, KeyError, IndexError):
-            t, s = getattr(item, "time", None), getattr(item, "stress", None)
-            if t is None or s is None:
-                raise TypeError(
-                    "data: expected a (time, stress) pair, a mapping/table with 'time' and 'stress', or an object"
-                    f" with those attributes; got {type(item).__name__}"
-                ) from None
+    expected = "a (time, stress) pair, a mapping/table with 'time' and 'stress'"
+    t, s, _ = data_columns(item, ("time", "stress"), None, expected)
     return np.asarray(t, dtype=float).ravel(), np.asarray(s, dtype=float).ravel()
 
 

@@ -178,11 +178,6 @@ def _slug(text: str) -> str:
     return slug
 
 
-def _in_data_coordinates(artist: object, ax: Axes) -> bool:
-    transform = artist.get_transform()  # type: ignore[attr-defined]
-    return transform == ax.transData
-
-
 def _errorbar_parts(ax: Axes) -> tuple[dict[int, str], set[int]]:
     """Error bars: their data line carries the label of its container; the caps are not curves."""
     from matplotlib.container import ErrorbarContainer
@@ -210,7 +205,7 @@ def extract_curves(figure: Figure, figure_id: str) -> list[Curve]:
         found: list[tuple[str, str | None, np.ndarray, np.ndarray]] = []
         labels, caps = _errorbar_parts(ax)
         for line in ax.get_lines():
-            if not _in_data_coordinates(line, ax) or id(line) in caps:
+            if line.get_transform() != ax.transData or id(line) in caps:
                 continue
             x = np.asarray(line.get_xdata(), dtype=float).ravel()
             y = np.asarray(line.get_ydata(), dtype=float).ravel()

@@ -162,22 +162,18 @@ def corner_figure(posterior: SteadyPosterior) -> Figure:
     return fig
 
 
-class _CornerLogFilter:
-    """Keeps corner's messages (it logs to the root logger) off the user's terminal; they are about contour
-    drawing only."""
-
-    def filter(self, record: Any) -> bool:
-        return "corner" not in record.pathname
-
-
 @contextmanager
 def _corner_log_captured() -> Iterator[None]:
+    """Keep corner's messages (it logs to the root logger) off the user's terminal; they are about contour drawing
+    only."""
     import logging
 
+    def outside_corner(record: logging.LogRecord) -> bool:
+        return "corner" not in record.pathname
+
     root = logging.getLogger()
-    log_filter = _CornerLogFilter()
-    root.addFilter(log_filter)
+    root.addFilter(outside_corner)
     try:
         yield
     finally:
-        root.removeFilter(log_filter)
+        root.removeFilter(outside_corner)

@@ -8,7 +8,6 @@ stresses in Pa; the objects passed in hold SI values.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -22,6 +21,7 @@ from .style import (
     UM_PER_S,
     VELOCITY_LABEL,
     apply_style,
+    data_columns,
     new_axes,
 )
 
@@ -73,21 +73,8 @@ def _interesting_range(ax: Axes, stress: np.ndarray) -> None:
 
 def _data_arrays(data: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
     """(velocity, stress, stress error or None), SI, from a table, mapping, object or pair."""
-    if isinstance(data, tuple) and len(data) in (2, 3):
-        v, s = data[0], data[1]
-        err = data[2] if len(data) == 3 else None
-    else:
-        try:
-            v, s = data["velocity"], data["stress"]
-            err = data["stress_err"] if _has_key(data, "stress_err") else None
-        except (TypeError, KeyError, IndexError):
-            v, s = getattr(data, "velocity", None), getattr(data, "stress", None)
-            err = getattr(data, "stress_err", None)
-            if v is None or s is None:
-                raise TypeError(
-                    "data: expected (velocity, stress[, stress_err]) arrays, a mapping or table with "
-                    f"'velocity' and 'stress', or an object with those attributes; got {type(data).__name__}"
-                ) from None
+    expected = "(velocity, stress[, stress_err]) arrays, a mapping or table with 'velocity' and 'stress'"
+    v, s, err = data_columns(data, ("velocity", "stress"), "stress_err", expected)
     v, s = np.asarray(v, dtype=float).ravel(), np.asarray(s, dtype=float).ravel()
     if v.shape != s.shape:
         raise ValueError(f"data: velocity has {v.size} values but stress has {s.size}")
@@ -96,15 +83,6 @@ def _data_arrays(data: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
         if err.shape != v.shape or not np.any(np.isfinite(err)):
             err = None
     return v, s, err
-
-
-def _has_key(data: Any, key: str) -> bool:
-    if isinstance(data, Mapping):
-        return key in data
-    try:
-        return key in data
-    except TypeError:
-        return False
 
 
 def figure_steady_curve(

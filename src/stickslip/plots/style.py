@@ -43,6 +43,31 @@ def apply_style(ax: Axes) -> Axes:
     return ax
 
 
+def data_columns(data: Any, names: tuple[str, str], optional: str | None, expected: str) -> tuple[Any, Any, Any]:
+    """Measured data's two columns ``names`` and its ``optional`` one (None when absent): a tuple of them in that
+    order, a mapping or table with those items, or an object with those attributes (``expected`` names the first
+    two ways in the one-line refusal of anything else)."""
+    if isinstance(data, tuple) and len(data) in (2, 3 if optional else 2):
+        return data[0], data[1], data[2] if len(data) == 3 else None
+    try:
+        first, second = data[names[0]], data[names[1]]
+        return first, second, data[optional] if optional and _has_key(data, optional) else None
+    except (TypeError, KeyError, IndexError):
+        first, second = getattr(data, names[0], None), getattr(data, names[1], None)
+        if first is None or second is None:
+            raise TypeError(
+                f"data: expected {expected}, or an object with those attributes; got {type(data).__name__}"
+            ) from None
+        return first, second, getattr(data, optional, None) if optional else None
+
+
+def _has_key(data: Any, key: str) -> bool:
+    try:
+        return key in data
+    except TypeError:
+        return False
+
+
 def legend_of_all_panels(fig: Figure, axes: Sequence[Axes] | None = None, **kwargs: Any) -> None:
     """One legend, on the first panel, naming every line of every panel once (a phase that only a later panel
     shows, such as the steady part of Fig 5c, included).  ``axes``: the panels (default: all of ``fig``'s)."""

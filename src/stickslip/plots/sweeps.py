@@ -105,8 +105,8 @@ def plot_phase_diagram(
             raise ParameterError(
                 f"{option} {key}: not a varied key of this sweep; expected one of {', '.join(spec.keys)}"
             )
-    if color not in frame.columns or color in ("point", "status", "message"):
-        choices = [c for c in frame.columns if c not in ("point", "status", "message")]
+    if color not in frame.columns or color in NOT_RESULTS:
+        choices = [c for c in frame.columns if c not in NOT_RESULTS]
         raise ParameterError(f"--color {color}: not a column of this sweep; expected one of {', '.join(choices)}")
     model = get_model(spec.model)
     dimensions = model.dimensions()
@@ -128,20 +128,13 @@ def plot_phase_diagram(
         )  # fmt: skip
     for boundary in model.boundaries(spec, ok, x, y):
         bx, by = _scaled(boundary.x, dimensions[x]), _scaled(boundary.y, dimensions[y])
+        line = {"color": "black", "linewidth": 1.6, "linestyle": "--", "label": boundary.label}
         if np.all(np.isnan(by)):  # independent of the other axis: a line across the plot
-            ax.axvline(bx[0], color="black", linewidth=1.6, linestyle="--", label=boundary.label)
+            ax.axvline(bx[0], **line)
         elif np.all(np.isnan(bx)):
-            ax.axhline(by[0], color="black", linewidth=1.6, linestyle="--", label=boundary.label)
+            ax.axhline(by[0], **line)
         else:
-            ax.plot(
-                bx,
-                by,
-                color="black",
-                linewidth=1.6,
-                linestyle="--",
-                marker="" if len(bx) > 12 else ".",
-                label=boundary.label,
-            )
+            ax.plot(bx, by, marker="" if len(bx) > 12 else ".", **line)
     for setter, key, values in ((ax.set_xscale, x, xs), (ax.set_yscale, y, ys)):
         if _log_axis(spec, key, values):
             setter("log")

@@ -26,11 +26,11 @@ from ..quasistatic.stick import StickPhase, StuckThreshold, stick_phase, stuck_t
 from .comparisons import Computed
 from .paper import (
     PULLING_VELOCITIES,
+    SLIP_STRESSES,
     TABLE1_COLUMNS,
     TABLE1_FROM_REST,
     TABLE1_ROWS,
     TABLE1_SET_APART,
-    TEXT_NUMBERS,
     table1_value,
 )
 
@@ -46,10 +46,7 @@ _TABLE1_SLIP_STRESSES = {
     for column, value in zip(TABLE1_COLUMNS, next(r[4] for r in TABLE1_ROWS if r[0] == "slip_stress"), strict=True)
     if value is not None
 }
-_TEXT_SLIP_STRESSES = {
-    "jump_velocity_50": next(n.paper for n in TEXT_NUMBERS if n.key == "slip_stress_50"),
-    "jump_velocity_100": next(n.paper for n in TEXT_NUMBERS if n.key == "slip_stress_100"),
-}
+_TEXT_SLIP_STRESSES = {f"jump_velocity_{v0}": stress for v0, stress, _ in SLIP_STRESSES}
 
 Column = tuple[int, int]  # (V0 in um/s, cycle)
 
@@ -178,8 +175,7 @@ def _jump_floor(run: ModelRun) -> float | None:
 
 
 def _jumps(run: ModelRun) -> None:
-    stresses = {s for s in _TABLE1_SLIP_STRESSES.values() if s is not None}
-    stresses |= set(_TEXT_SLIP_STRESSES.values())
+    stresses = set(_TABLE1_SLIP_STRESSES.values()) | set(_TEXT_SLIP_STRESSES.values())
     stresses |= {s.peak_stress for s in run.sticks.values() if s.peak_stress is not None}
     for stress in sorted(stresses):
         run.jumps[stress] = jump_velocity(run.params, stress)

@@ -86,12 +86,13 @@ def _errata_link(row: Comparison, errata: Errata) -> str:
     return f'<a href="#{escape(anchor)}"{title}>{escape(row.errata)}</a>'
 
 
-def _alternative(row: Comparison, display: str, digits: int = 4) -> str:
+def _alternative(row: Comparison, display: str, digits: int = 4, label: str | None = None) -> str:
+    """The second value shown beside the computed one (``label`` instead of the row's own name for it)."""
     if row.alternative is None:
         return ""
     value = format_quantity(row.alternative, display, digits)
     return (
-        f'<br><span class="alt">{escape(row.alternative_label)}: {escape(value)}'
+        f'<br><span class="alt">{escape(label or row.alternative_label)}: {escape(value)}'
         f" ({escape(format_percent(row.alternative_difference))})</span>"
     )
 
@@ -142,12 +143,7 @@ def table1_matrix(rows: Sequence[Comparison]) -> str:
                 cells.append('<td class="num">--</td>')
                 continue
             css = "flagged" if row.flagged else "agrees"
-            nominal = ""
-            if row.alternative is not None:
-                nominal = (
-                    f'<br><span class="alt">nominal: {escape(format_quantity(row.alternative, display, digits=3))}'
-                    f" ({escape(format_percent(row.alternative_difference))})</span>"
-                )
+            nominal = _alternative(row, display, 3, "nominal")
             cells.append(
                 f'<td class="num {css}"><a href="#cmp-{escape(row.number.key)}">{escape(paper_text(row.number))}</a>'
                 f"<br>{escape(format_quantity(row.computed, display, digits=3))}<br>"

@@ -76,6 +76,8 @@ FIT = "Fitted slip-phase parameters (Section 3, Fig 4)"
 BLOCK = "Block stiffness and geometry (Eqs 5, 17)"
 STICK = "Stick phase (Eqs 15-16, Fig 6)"
 SLIP = "Jump and slip phase (Eqs 8, 10, Fig 5d)"
+#: The slip stresses the text quotes (V0 in µm/s, σs in Pa, where), and the jump velocity it reads off for each.
+SLIP_STRESSES = ((50, 554.0, "Table 1, cycle 1"), (100, 549.0, "Table 1, cycles 2 and 4"))
 
 TEXT_NUMBERS: tuple[PaperNumber, ...] = (
     _n("critical_velocity", "Critical velocity Vc", STEADY, "model", 125e-6, "m/s", "um/s", "125 µm.s⁻¹", "Section 3"),
@@ -185,150 +187,82 @@ TEXT_NUMBERS: tuple[PaperNumber, ...] = (
         "Section 3",
     ),
     _n("stick_aging_time", "Stick aging time τa (Eq 15)", STICK, "parameter", 10.0, "s", "s", "10 s", "Section 3"),
-    _n(
-        "stick_time_50",
-        "Stick time ts, V0 = 50 µm/s (paper's simulation)",
-        STICK,
-        "model",
-        18.3,
-        "s",
-        "s",
-        "18.3 s",
-        "Section 3, Fig 6",
+    *(
+        _n(
+            f"stick_time_{v0}",
+            f"Stick time ts, V0 = {v0} µm/s (paper's simulation)",
+            STICK,
+            "model",
+            ts,
+            "s",
+            "s",
+            printed,
+            "Section 3, Fig 6",
+        )
+        for v0, ts, printed in ((50, 18.3, "18.3 s"), (100, 9.3, "9.3 s (printed “for V0 = 50 µm.s⁻¹”)"))
     ),
-    _n(
-        "stick_time_100",
-        "Stick time ts, V0 = 100 µm/s (paper's simulation)",
-        STICK,
-        "model",
-        9.3,
-        "s",
-        "s",
-        "9.3 s (printed “for V0 = 50 µm.s⁻¹”)",
-        "Section 3, Fig 6",
+    *(
+        _n(
+            f"stick_time_{kind}_{v0}",
+            f"Stick time ts, V0 = {v0} µm/s (measured, {where} discussion)",
+            STICK,
+            "measured",
+            ts,
+            "s",
+            "s",
+            f"{ts:g} s",
+            source,
+        )
+        for kind, where, source, times in (
+            ("measured", "Fig 6", "Section 3, Fig 6", (18.1, 8.8)),
+            ("table", "Table 1", "Section 3, after Table 1", (18.9, 8.6)),
+        )
+        for v0, ts in zip((50, 100), times, strict=True)
     ),
-    _n(
-        "stick_time_measured_50",
-        "Stick time ts, V0 = 50 µm/s (measured, Fig 6 discussion)",
-        STICK,
-        "measured",
-        18.1,
-        "s",
-        "s",
-        "18.1 s",
-        "Section 3, Fig 6",
+    *(
+        _n(
+            f"slip_stress_{v0}",
+            f"Slip stress σs, V0 = {v0} µm/s (Eq 16)",
+            STICK,
+            "measured",
+            stress,
+            "Pa",
+            "Pa",
+            f"{stress:g} Pa",
+            source,
+        )
+        for v0, stress, source in SLIP_STRESSES
     ),
-    _n(
-        "stick_time_measured_100",
-        "Stick time ts, V0 = 100 µm/s (measured, Fig 6 discussion)",
-        STICK,
-        "measured",
-        8.8,
-        "s",
-        "s",
-        "8.8 s",
-        "Section 3, Fig 6",
+    *(
+        _n(
+            f"jump_velocity_{v0}",
+            f"Jump velocity Vs for σs = {stress:g} Pa, V0 = {v0} µm/s (Eq 8)",
+            SLIP,
+            "model",
+            702e-6,
+            "m/s",
+            "um/s",
+            "702 µm.s⁻¹",
+            source,
+        )
+        for v0, stress, source in SLIP_STRESSES
     ),
-    _n(
-        "stick_time_table_50",
-        "Stick time ts, V0 = 50 µm/s (measured, Table 1 discussion)",
-        STICK,
-        "measured",
-        18.9,
-        "s",
-        "s",
-        "18.9 s",
-        "Section 3, after Table 1",
-    ),
-    _n(
-        "stick_time_table_100",
-        "Stick time ts, V0 = 100 µm/s (measured, Table 1 discussion)",
-        STICK,
-        "measured",
-        8.6,
-        "s",
-        "s",
-        "8.6 s",
-        "Section 3, after Table 1",
-    ),
-    _n(
-        "slip_stress_50",
-        "Slip stress σs, V0 = 50 µm/s (Eq 16)",
-        STICK,
-        "measured",
-        554.0,
-        "Pa",
-        "Pa",
-        "554 Pa",
-        "Table 1, cycle 1",
-    ),
-    _n(
-        "slip_stress_100",
-        "Slip stress σs, V0 = 100 µm/s (Eq 16)",
-        STICK,
-        "measured",
-        549.0,
-        "Pa",
-        "Pa",
-        "549 Pa",
-        "Table 1, cycles 2 and 4",
-    ),
-    _n(
-        "jump_velocity_50",
-        "Jump velocity Vs for σs = 554 Pa, V0 = 50 µm/s (Eq 8)",
-        SLIP,
-        "model",
-        702e-6,
-        "m/s",
-        "um/s",
-        "702 µm.s⁻¹",
-        "Table 1, cycle 1",
-    ),
-    _n(
-        "jump_velocity_100",
-        "Jump velocity Vs for σs = 549 Pa, V0 = 100 µm/s (Eq 8)",
-        SLIP,
-        "model",
-        702e-6,
-        "m/s",
-        "um/s",
-        "702 µm.s⁻¹",
-        "Table 1, cycles 2 and 4",
-    ),
-    _n(
-        "slip_asymptote_50",
-        "Slip-phase asymptote, V0 = 50 µm/s",
-        SLIP,
-        "model",
-        125e-6,
-        "m/s",
-        "um/s",
-        "125 µm.s⁻¹",
-        "Section 3, Fig 5d",
-    ),
-    _n(
-        "slip_asymptote_100",
-        "Slip-phase asymptote, V0 = 100 µm/s",
-        SLIP,
-        "model",
-        125e-6,
-        "m/s",
-        "um/s",
-        "125 µm.s⁻¹",
-        "Section 3, Fig 5d",
-    ),
-    _n(
-        "slip_asymptote_350",
-        "Slip-phase asymptote, V0 = 350 µm/s",
-        SLIP,
-        "model",
-        350e-6,
-        "m/s",
-        "um/s",
-        "350 µm.s⁻¹",
-        "Section 3, Fig 5d",
+    *(
+        _n(
+            f"slip_asymptote_{v0}",
+            f"Slip-phase asymptote, V0 = {v0} µm/s",
+            SLIP,
+            "model",
+            v,
+            "m/s",
+            "um/s",
+            printed,
+            "Section 3, Fig 5d",
+        )
+        for v0, v, printed in ((50, 125e-6, "125 µm.s⁻¹"), (100, 125e-6, "125 µm.s⁻¹"), (350, 350e-6, "350 µm.s⁻¹"))
     ),
 )
+
 
 TABLE1 = "Table 1: stick-slip cycles of Baumberger et al. (measured)"
 
