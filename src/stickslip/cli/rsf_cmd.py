@@ -11,6 +11,7 @@ from __future__ import annotations
 import contextlib
 import dataclasses
 import functools
+import importlib.util
 import math
 import signal
 import sys
@@ -24,17 +25,14 @@ from typing import Any
 import click
 import numpy as np
 
-from ..errors import DataError, ModelError, ParameterError, UnitError
+from ..errors import DataError, ModelError, ParameterError, StickslipError, UnitError
 from ..numerics.budget import PROGRESS_AFTER_SECONDS
-from ..units import quantity_noun, shorten
+from ..units import bare_number, quantity_noun, shorten
 from .common import json_text, positive, quantity, refuse_overwriting_inputs, save_figure, stacked, write_text
 from .params_files import load_params_file, load_params_mapping
 from .protocol_options import build_protocol as build_run_protocol
 from .protocol_options import checked_segment_text, protocol_options, refuse_unsupported
 from .run_cmd import execute, output_options
-
-LAW_NAMES = ("aging", "slip", "prz", "nagata")
-
 
 #: Help of ``--stiffness`` on the rate-and-state commands.
 STIFFNESS_HELP = 'Spring stiffness: friction per slip ("1e-3 1/um") or Pa/m with --normal-stress.'
@@ -113,13 +111,20 @@ def build_params(options: dict[str, Any]) -> Any:
         mapping["mass"] = positive(options["mass"], "mass_per_area", "--mass", allow_zero=True)
     if options.get("regularized"):
         mapping["regularized"] = True
-    if (options.get("cutoff_v1") is None) != (options.get("cutoff_v2") is None):
-        raise ParameterError("--cutoff-v1/--cutoff-v2: the cut-off velocity form needs both V1 and V2")
-    if options.get("cutoff_v1") is not None:
-        mapping["cutoff"] = (positive(options["cutoff_v1"], "velocity", "--cutoff-v1"),
-                             positive(options["cutoff_v2"], "velocity", "--cutoff-v2"))  # fmt: skip
+    if (cutoff := _cutoff(options)) is not None:
+        mapping["cutoff"] = cutoff
     source = "options" if options.get("params_file") is None else f"--params {options['params_file']} (or options)"
     return RSFParams.from_dict(mapping, source=source)
+
+
+def _cutoff(options: dict[str, Any]) -> tuple[float, float] | None:
+    """``--cutoff-v1``/``--cutoff-v2`` in m/s (None without them; one alone is refused)."""
+    if (options.get("cutoff_v1") is None) != (options.get("cutoff_v2") is None):
+        raise ParameterError("--cutoff-v1/--cutoff-v2: the cut-off velocity form needs both V1 and V2")
+    if options.get("cutoff_v1") is None:
+        return None
+    return (positive(options["cutoff_v1"], "velocity", "--cutoff-v1"),
+            positive(options["cutoff_v2"], "velocity", "--cutoff-v2"))  # fmt: skip
 
 
 def _base_states(base: dict[str, Any], path: Path | None) -> list[dict[str, Any]]:
@@ -181,13 +186,6 @@ def _per_sigma(
         return converted
 
 
-def _fallback_protocol(fallback: list[dict] | None) -> Any:
-    """The protocol an earlier run's ``.params.json`` carries (None without one)."""
-    from .. import protocols
-
-    return protocols.segments([(s["velocity"], s["duration"]) for s in fallback]) if fallback else None
-
-
 def sidecar(path: Path | None) -> Path | None:
     """Where the parameters of an output file go: ``NAME.params.json`` beside it; none beside standard output or
     a special file (``-o /dev/null`` wrote ``/dev/null.params.json``)."""
@@ -222,15 +220,16 @@ def simulate_command(**options: Any) -> None:
     figure (--plot) and the same summary.  With -o the parameters go beside it in NAME.params.json.
     """
     from ..models import Rig, get_model
+    from ..protocols import segments
 
-    fallback = None
-    start = None
+    fallback, start = None, None
     if options["params_file"] is not None and options["params_file"].suffix.lower() == ".json":
         fallback, start = _run_meta(options["params_file"])
     options["stiffness"] = options.pop("stiffness_text")
     params = build_params(options)
+    earlier = segments([(s["velocity"], s["duration"]) for s in fallback]) if fallback else None  # the run's own
     protocol = build_run_protocol(options["v0_text"], options["duration_text"], options["segment_texts"],
-                                  options["protocol_file"], _fallback_protocol(fallback))  # fmt: skip
+                                  options["protocol_file"], earlier)  # fmt: skip
     refuse_unsupported("rsf simulate (the rate-and-state spring-slider)", protocol, options["control"],
                        controls=("spring",))  # fmt: skip
     if options["start_velocity"] is not None:
@@ -439,8 +438,8 @@ def fit_command(**options: Any) -> None:
     record = read_record(options["record_file"], parse_columns(options["columns"]), time_unit=options["time_unit"],
                          **reading)  # fmt: skip
     settings = _fit_settings(options, record, window)
-    if settings["mcmc_steps"]:
-        _require_emcee()
+    if settings["mcmc_steps"] and importlib.util.find_spec("emcee") is None:  # said before any work, as --bayes
+        raise ParameterError("--mcmc: the posterior needs emcee: pip install stickslip[bayes]")
     cost = estimate_fit_cost(record, settings)
     if cost.seconds > max_time:
         raise ParameterError(
@@ -690,25 +689,12 @@ def _fit_settings(
         settings["window"] = _within_record(window, options["window_text"], record)
     if options["step_weight"] is not None:
         settings["step_weight"] = _step_weight(options["step_weight"])
-    if (options.get("cutoff_v1") is None) != (options.get("cutoff_v2") is None):
-        raise ParameterError("--cutoff-v1/--cutoff-v2: the cut-off velocity form needs both V1 and V2")
-    if options.get("cutoff_v1") is not None:
-        settings["cutoff"] = (positive(options["cutoff_v1"], "velocity", "--cutoff-v1"),
-                              positive(options["cutoff_v2"], "velocity", "--cutoff-v2"))  # fmt: skip
+    if (cutoff := _cutoff(options)) is not None:
+        settings["cutoff"] = cutoff
     return settings
 
 
-def _require_emcee() -> None:
-    """--mcmc needs emcee (the extra stickslip[bayes]): said in one line before any work, as fit steady --bayes."""
-    import importlib.util
-
-    if importlib.util.find_spec("emcee") is None:
-        raise ParameterError("--mcmc: the posterior needs emcee: pip install stickslip[bayes]")
-
-
 def _step_weight(text: str) -> float:
-    from ..units import bare_number
-
     weight = bare_number(text)
     if weight is None or not (math.isfinite(weight) and weight > 0):
         raise ParameterError(f"--step-weight {shorten(text)}: expected a positive number, e.g. --step-weight 5")
@@ -753,7 +739,6 @@ def estimate_fit_cost(record: Any, settings: dict[str, Any]) -> FitCost:
 
 def _timed_run(record: Any, settings: dict[str, Any]) -> float:
     """Seconds of one model run over the fitted rows at start-like values (the mean of the second and third)."""
-    from ..errors import StickslipError
     from ..rsf import simulate
     from ..rsf.fit import FIT_RTOL, fitted_rows
 
