@@ -134,8 +134,6 @@ class RSFParams:
 
         With ``cutoff = (V1, V2)``: mu0 - a ln(V1/V + 1) + b ln(V2/V + 1).
         """
-        import numpy as np
-
         v = np.asarray(velocity, dtype=float)
         if self.cutoff is not None:  # theta_i = s Dc_i/V in steady state for every law: both terms are ln(Vc/V + 1)
             v1, v2 = self.cutoff
