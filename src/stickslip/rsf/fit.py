@@ -305,10 +305,7 @@ def fit_record(
                           "dc" in starts or "dc" in held)  # fmt: skip
     labels = _sampling_classes(record.time)
     given = noise is not None
-    if given:
-        start["noise"] = float(noise)
-    else:
-        start["noise"] = _pre_fit_noise(record, protocol, start["dc"], labels, start["noise"])
+    start["noise"] = float(noise) if given else _pre_fit_noise(record, protocol, start["dc"], labels, start["noise"])
     setup = _Setup(record, protocol, laws, states, "stiffness" not in held, kinds, held, None, frozenset(starts),
                    cutoff)  # fmt: skip
     mismatch = _history_mismatch(record, protocol)
