@@ -434,9 +434,8 @@ def fit_command(**options: Any) -> None:
     )
     window = _window(options["window_text"])  # the options first: a typing error is said before the record is read
     max_time = positive(options["max_time"], "time", "--max-time")
-    reading = {} if options["displacement_unit"] is None else {"displacement_unit": options["displacement_unit"]}
-    record = read_record(options["record_file"], parse_columns(options["columns"]), time_unit=options["time_unit"],
-                         **reading)  # fmt: skip
+    record = read_record(options["record_file"], parse_columns(options["columns"]), options["displacement_unit"],
+                         options["time_unit"])  # fmt: skip
     settings = _fit_settings(options, record, window)
     if settings["mcmc_steps"] and importlib.util.find_spec("emcee") is None:  # said before any work, as --bayes
         raise ParameterError("--mcmc: the posterior needs emcee: pip install stickslip[bayes]")

@@ -95,8 +95,7 @@ class RSFRun:
     def to_frame(self) -> Any:
         import pandas as pd
 
-        columns: dict[str, Any] = {"time": self.time, "friction": self.friction}
-        columns["slider_velocity"] = self.slider_velocity
+        columns = {"time": self.time, "friction": self.friction, "slider_velocity": self.slider_velocity}
         for i, row in enumerate(self.state):
             columns["state" if i == 0 else f"state{i + 1}"] = row
         columns["load_point_displacement"] = self.load_point_displacement
