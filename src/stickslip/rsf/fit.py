@@ -1146,11 +1146,7 @@ def _covering(protocol: Protocol, record: LabRecord) -> Protocol:
         raise DataError(
             f"protocol lasts {protocol.duration:g} s but the record {end:g} s; expected a history covering the record"
         )
-    kept = []
-    for t0, t1, v in protocol.pieces():
-        if t0 >= end:
-            break
-        kept.append(Segment(v, min(t1, end) - t0))
+    kept = [Segment(v, min(t1, end) - t0) for t0, t1, v in protocol.pieces() if t0 < end]
     return Protocol(tuple(kept), name=protocol.name)
 
 

@@ -162,13 +162,8 @@ def resample_in_slip(
 
 def _from(protocol: Protocol, start: float) -> Protocol:
     """``protocol`` seen from time ``start`` on (the part before it dropped)."""
-    segments, elapsed = [], 0.0
-    for segment in protocol.segments:
-        end = elapsed + segment.duration
-        if end > start:
-            segments.append(Segment(segment.velocity, end - max(start, elapsed)))
-        elapsed = end
-    return Protocol(tuple(segments), name=protocol.name)
+    kept = [Segment(v, t1 - max(start, t0)) for t0, t1, v in protocol.pieces() if t1 > start]
+    return Protocol(tuple(kept), name=protocol.name)
 
 
 def step_record(
