@@ -454,9 +454,8 @@ def _named_values(word: str, values: Any, states: int, strict: bool) -> dict[str
             raise ParameterError(f"{word}: {key} needs two state variables (states=2)")
         if not (_real(value) and math.isfinite(value)):
             raise ParameterError(f"{word}: {key} = {value!r}; expected a finite number (SI)")
-        if key in ("dc", "dc2", "stiffness") or (strict and key == "a"):
-            if not value > 0:
-                raise ParameterError(f"{word}: {key} = {value!r}; expected a positive value (SI)")
+        if (key in ("dc", "dc2", "stiffness") or (strict and key == "a")) and not value > 0:
+            raise ParameterError(f"{word}: {key} = {value!r}; expected a positive value (SI)")
         out[key] = float(value)
     return out
 
@@ -1118,10 +1117,8 @@ def _troubled(result: Any) -> bool:
     a local minimum) or leaves a, b or Dc unconstrained."""
     if not result.success or not result.errorbars or result.chisqr > WARN_CHI2 * max(result.nfree, 1):
         return True
-    for key in ("a", "b", "log_dc"):
+    for key in ("a", "b", "log_dc"):  # (a held one is not unconstrained)
         par = result.params[key]
-        if not par.vary:
-            continue
         se = par.stderr if par.stderr is not None and math.isfinite(par.stderr) else None
         if _unconstrained(key, par, se):
             return True

@@ -162,14 +162,9 @@ class RSFParams:
 
     def to_toml(self) -> str:
         lines = ["# rate-and-state parameters (SI: m, s, m/s; stiffness in 1/m; eta in s/m; mass in kg/m^2)"]
-        for key, value in self.to_dict().items():
-            if key != "states":
-                lines.append(f"{key} = {_toml_value(value)}")
+        lines += [f"{key} = {_toml_value(value)}" for key, value in self.to_dict().items() if key != "states"]
         for state in self.states:
-            lines.append("")
-            lines.append("[[states]]")
-            for key, value in asdict(state).items():
-                lines.append(f"{key} = {_toml_value(value)}")
+            lines += ["", "[[states]]", *(f"{key} = {_toml_value(value)}" for key, value in asdict(state).items())]
         return "\n".join(lines) + "\n"
 
     @classmethod
