@@ -71,9 +71,7 @@ def build_params(options: dict[str, Any]) -> Any:
     """RSFParams from the model options (on top of ``--params`` if given)."""
     from ..rsf import RSFParams
 
-    base: dict[str, Any] = {}
-    if options.get("params_file") is not None:
-        base = load_params_mapping(options["params_file"])
+    base = {} if options.get("params_file") is None else load_params_mapping(options["params_file"])
     states = _base_states(base, options.get("params_file"))
     first = states[0]
     if options.get("law") is not None:  # --law "" is an error (unknown law), not the default
@@ -92,8 +90,7 @@ def build_params(options: dict[str, Any]) -> Any:
         second = {"law": first.get("law", "aging"), "b": _number(options["b2"], "--b2"),
                   "dc": positive(options["dc2"], "length", "--dc2"), "c": first.get("c", 0.0)}  # fmt: skip
         states = [first, second]
-    mapping: dict[str, Any] = {k: v for k, v in base.items() if k != "states"}
-    mapping["states"] = states
+    mapping: dict[str, Any] = {**{k: v for k, v in base.items() if k != "states"}, "states": states}
     sigma = base.get("normal_stress")
     if options.get("normal_stress") is not None:
         sigma = mapping["normal_stress"] = positive(options["normal_stress"], "stress", "--normal-stress")
