@@ -1156,10 +1156,8 @@ def _initial_guess(
     # the solver reproduces friction to ~1e-9 (rtol 1e-8 in fits): a noise-free record is known no better
     noise = max(_noise(f), MODEL_PRECISION * max(1.0, float(np.median(np.abs(f)))))
     edges, speeds = protocol.boundaries, protocol.velocities
-    sliding_steps = [
-        i for i in range(1, speeds.size) if min(speeds[i], speeds[i - 1]) > 0 and speeds[i] != speeds[i - 1]
-    ]
-    step = sliding_steps[0] if sliding_steps else None
+    step = next((i for i in range(1, speeds.size) if min(speeds[i], speeds[i - 1]) > 0 and speeds[i] != speeds[i - 1]),
+                None)  # fmt: skip
     v1 = v2 = speeds[0]
     before = after = f[:0]
     if step is not None:
@@ -1286,8 +1284,7 @@ def _final_params(base: RSFParams, values: dict[str, float]) -> RSFParams:
     return base.replace(a=values["a"], mu0=values["mu0"], states=tuple(states), stiffness=k)
 
 
-_PUBLIC = {"mu0": "mu0", "a": "a", "b": "b", "log_dc": "dc", "b2": "b2", "log_dc2": "dc2", "log_k": "stiffness",
-           "trend": "trend", "time_trend": "time_trend"}  # fmt: skip
+_PUBLIC = {name: key for key, name in _INTERNAL.items()}
 
 
 def _trend_kinds(trend: bool | str | None) -> frozenset[str]:
