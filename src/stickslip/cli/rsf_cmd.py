@@ -741,8 +741,8 @@ def _timed_run(record: Any, settings: dict[str, Any]) -> float:
     rows, history = fitted_rows(record, settings["protocol"], settings.get("window"))  # refused as the fit would be
     if float(np.max(history.velocities)) <= 0:
         return 0.0
-    params = _start_params(rows, history, settings)
     start = history.initial_velocity if history.initial_velocity > 0 else float(np.max(history.velocities))
+    params = _start_params(rows, start, settings)
     times = np.clip(rows.time, 0.0, history.duration)
     took = []
     for _ in range(3):
@@ -759,7 +759,7 @@ def _timed_run(record: Any, settings: dict[str, Any]) -> float:
     return (took[1] + took[2]) / 2
 
 
-def _start_params(record: Any, history: Any, settings: dict[str, Any]) -> Any:
+def _start_params(record: Any, v_ref: float, settings: dict[str, Any]) -> Any:
     """Values like the fit's starting ones (held and guessed values where given): the estimate's model."""
     from ..rsf import RSFParams, StateVariable
 
@@ -771,7 +771,6 @@ def _start_params(record: Any, history: Any, settings: dict[str, Any]) -> Any:
     states = [StateVariable(laws[0], given.get("b", 0.015), dc)]
     if settings["states"] == 2:
         states.append(StateVariable(laws[1], given.get("b2", 0.002), given.get("dc2", 10 * dc)))
-    v_ref = history.initial_velocity if history.initial_velocity > 0 else float(np.max(history.velocities))
     mu0 = given.get("mu0", float(np.median(record.friction[: max(5, len(record) // 50)])))
     return RSFParams(a=given.get("a", 0.01), states=tuple(states), mu0=mu0, v_ref=v_ref, stiffness=stiffness)
 
