@@ -11,6 +11,7 @@ from __future__ import annotations
 import contextlib
 import dataclasses
 import functools
+import importlib.util
 import math
 import signal
 import sys
@@ -24,17 +25,14 @@ from typing import Any
 import click
 import numpy as np
 
-from ..errors import DataError, ModelError, ParameterError, UnitError
+from ..errors import DataError, ModelError, ParameterError, StickslipError, UnitError
 from ..numerics.budget import PROGRESS_AFTER_SECONDS
-from ..units import quantity_noun, shorten
+from ..units import bare_number, quantity_noun, shorten
 from .common import json_text, positive, quantity, refuse_overwriting_inputs, save_figure, stacked, write_text
 from .params_files import load_params_file, load_params_mapping
 from .protocol_options import build_protocol as build_run_protocol
 from .protocol_options import checked_segment_text, protocol_options, refuse_unsupported
 from .run_cmd import execute, output_options
-
-LAW_NAMES = ("aging", "slip", "prz", "nagata")
-
 
 #: Help of ``--stiffness`` on the rate-and-state commands.
 STIFFNESS_HELP = 'Spring stiffness: friction per slip ("1e-3 1/um") or Pa/m with --normal-stress.'
@@ -73,9 +71,7 @@ def build_params(options: dict[str, Any]) -> Any:
     """RSFParams from the model options (on top of ``--params`` if given)."""
     from ..rsf import RSFParams
 
-    base: dict[str, Any] = {}
-    if options.get("params_file") is not None:
-        base = load_params_mapping(options["params_file"])
+    base = {} if options.get("params_file") is None else load_params_mapping(options["params_file"])
     states = _base_states(base, options.get("params_file"))
     first = states[0]
     if options.get("law") is not None:  # --law "" is an error (unknown law), not the default
@@ -94,8 +90,7 @@ def build_params(options: dict[str, Any]) -> Any:
         second = {"law": first.get("law", "aging"), "b": _number(options["b2"], "--b2"),
                   "dc": positive(options["dc2"], "length", "--dc2"), "c": first.get("c", 0.0)}  # fmt: skip
         states = [first, second]
-    mapping: dict[str, Any] = {k: v for k, v in base.items() if k != "states"}
-    mapping["states"] = states
+    mapping: dict[str, Any] = {**{k: v for k, v in base.items() if k != "states"}, "states": states}
     sigma = base.get("normal_stress")
     if options.get("normal_stress") is not None:
         sigma = mapping["normal_stress"] = positive(options["normal_stress"], "stress", "--normal-stress")
@@ -113,13 +108,20 @@ def build_params(options: dict[str, Any]) -> Any:
         mapping["mass"] = positive(options["mass"], "mass_per_area", "--mass", allow_zero=True)
     if options.get("regularized"):
         mapping["regularized"] = True
-    if (options.get("cutoff_v1") is None) != (options.get("cutoff_v2") is None):
-        raise ParameterError("--cutoff-v1/--cutoff-v2: the cut-off velocity form needs both V1 and V2")
-    if options.get("cutoff_v1") is not None:
-        mapping["cutoff"] = (positive(options["cutoff_v1"], "velocity", "--cutoff-v1"),
-                             positive(options["cutoff_v2"], "velocity", "--cutoff-v2"))  # fmt: skip
+    if (cutoff := _cutoff(options)) is not None:
+        mapping["cutoff"] = cutoff
     source = "options" if options.get("params_file") is None else f"--params {options['params_file']} (or options)"
     return RSFParams.from_dict(mapping, source=source)
+
+
+def _cutoff(options: dict[str, Any]) -> tuple[float, float] | None:
+    """``--cutoff-v1``/``--cutoff-v2`` in m/s (None without them; one alone is refused)."""
+    if (options.get("cutoff_v1") is None) != (options.get("cutoff_v2") is None):
+        raise ParameterError("--cutoff-v1/--cutoff-v2: the cut-off velocity form needs both V1 and V2")
+    if options.get("cutoff_v1") is None:
+        return None
+    return (positive(options["cutoff_v1"], "velocity", "--cutoff-v1"),
+            positive(options["cutoff_v2"], "velocity", "--cutoff-v2"))  # fmt: skip
 
 
 def _base_states(base: dict[str, Any], path: Path | None) -> list[dict[str, Any]]:
@@ -181,13 +183,6 @@ def _per_sigma(
         return converted
 
 
-def _fallback_protocol(fallback: list[dict] | None) -> Any:
-    """The protocol an earlier run's ``.params.json`` carries (None without one)."""
-    from .. import protocols
-
-    return protocols.segments([(s["velocity"], s["duration"]) for s in fallback]) if fallback else None
-
-
 def sidecar(path: Path | None) -> Path | None:
     """Where the parameters of an output file go: ``NAME.params.json`` beside it; none beside standard output or
     a special file (``-o /dev/null`` wrote ``/dev/null.params.json``)."""
@@ -222,15 +217,16 @@ def simulate_command(**options: Any) -> None:
     figure (--plot) and the same summary.  With -o the parameters go beside it in NAME.params.json.
     """
     from ..models import Rig, get_model
+    from ..protocols import segments
 
-    fallback = None
-    start = None
+    fallback, start = None, None
     if options["params_file"] is not None and options["params_file"].suffix.lower() == ".json":
         fallback, start = _run_meta(options["params_file"])
     options["stiffness"] = options.pop("stiffness_text")
     params = build_params(options)
+    earlier = segments([(s["velocity"], s["duration"]) for s in fallback]) if fallback else None  # the run's own
     protocol = build_run_protocol(options["v0_text"], options["duration_text"], options["segment_texts"],
-                                  options["protocol_file"], _fallback_protocol(fallback))  # fmt: skip
+                                  options["protocol_file"], earlier)  # fmt: skip
     refuse_unsupported("rsf simulate (the rate-and-state spring-slider)", protocol, options["control"],
                        controls=("spring",))  # fmt: skip
     if options["start_velocity"] is not None:
@@ -435,12 +431,11 @@ def fit_command(**options: Any) -> None:
     )
     window = _window(options["window_text"])  # the options first: a typing error is said before the record is read
     max_time = positive(options["max_time"], "time", "--max-time")
-    reading = {} if options["displacement_unit"] is None else {"displacement_unit": options["displacement_unit"]}
-    record = read_record(options["record_file"], parse_columns(options["columns"]), time_unit=options["time_unit"],
-                         **reading)  # fmt: skip
+    record = read_record(options["record_file"], parse_columns(options["columns"]), options["displacement_unit"],
+                         options["time_unit"])  # fmt: skip
     settings = _fit_settings(options, record, window)
-    if settings["mcmc_steps"]:
-        _require_emcee()
+    if settings["mcmc_steps"] and importlib.util.find_spec("emcee") is None:  # said before any work, as --bayes
+        raise ParameterError("--mcmc: the posterior needs emcee: pip install stickslip[bayes]")
     cost = estimate_fit_cost(record, settings)
     if cost.seconds > max_time:
         raise ParameterError(
@@ -690,25 +685,12 @@ def _fit_settings(
         settings["window"] = _within_record(window, options["window_text"], record)
     if options["step_weight"] is not None:
         settings["step_weight"] = _step_weight(options["step_weight"])
-    if (options.get("cutoff_v1") is None) != (options.get("cutoff_v2") is None):
-        raise ParameterError("--cutoff-v1/--cutoff-v2: the cut-off velocity form needs both V1 and V2")
-    if options.get("cutoff_v1") is not None:
-        settings["cutoff"] = (positive(options["cutoff_v1"], "velocity", "--cutoff-v1"),
-                              positive(options["cutoff_v2"], "velocity", "--cutoff-v2"))  # fmt: skip
+    if (cutoff := _cutoff(options)) is not None:
+        settings["cutoff"] = cutoff
     return settings
 
 
-def _require_emcee() -> None:
-    """--mcmc needs emcee (the extra stickslip[bayes]): said in one line before any work, as fit steady --bayes."""
-    import importlib.util
-
-    if importlib.util.find_spec("emcee") is None:
-        raise ParameterError("--mcmc: the posterior needs emcee: pip install stickslip[bayes]")
-
-
 def _step_weight(text: str) -> float:
-    from ..units import bare_number
-
     weight = bare_number(text)
     if weight is None or not (math.isfinite(weight) and weight > 0):
         raise ParameterError(f"--step-weight {shorten(text)}: expected a positive number, e.g. --step-weight 5")
@@ -753,15 +735,14 @@ def estimate_fit_cost(record: Any, settings: dict[str, Any]) -> FitCost:
 
 def _timed_run(record: Any, settings: dict[str, Any]) -> float:
     """Seconds of one model run over the fitted rows at start-like values (the mean of the second and third)."""
-    from ..errors import StickslipError
     from ..rsf import simulate
     from ..rsf.fit import FIT_RTOL, fitted_rows
 
     rows, history = fitted_rows(record, settings["protocol"], settings.get("window"))  # refused as the fit would be
     if float(np.max(history.velocities)) <= 0:
         return 0.0
-    params = _start_params(rows, history, settings)
     start = history.initial_velocity if history.initial_velocity > 0 else float(np.max(history.velocities))
+    params = _start_params(rows, start, settings)
     times = np.clip(rows.time, 0.0, history.duration)
     took = []
     for _ in range(3):
@@ -778,7 +759,7 @@ def _timed_run(record: Any, settings: dict[str, Any]) -> float:
     return (took[1] + took[2]) / 2
 
 
-def _start_params(record: Any, history: Any, settings: dict[str, Any]) -> Any:
+def _start_params(record: Any, v_ref: float, settings: dict[str, Any]) -> Any:
     """Values like the fit's starting ones (held and guessed values where given): the estimate's model."""
     from ..rsf import RSFParams, StateVariable
 
@@ -790,7 +771,6 @@ def _start_params(record: Any, history: Any, settings: dict[str, Any]) -> Any:
     states = [StateVariable(laws[0], given.get("b", 0.015), dc)]
     if settings["states"] == 2:
         states.append(StateVariable(laws[1], given.get("b2", 0.002), given.get("dc2", 10 * dc)))
-    v_ref = history.initial_velocity if history.initial_velocity > 0 else float(np.max(history.velocities))
     mu0 = given.get("mu0", float(np.median(record.friction[: max(5, len(record) // 50)])))
     return RSFParams(a=given.get("a", 0.01), states=tuple(states), mu0=mu0, v_ref=v_ref, stiffness=stiffness)
 

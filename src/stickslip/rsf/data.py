@@ -205,11 +205,9 @@ def _choose_columns(path: Path, columns: dict[str, str] | None, headers: dict, l
             chosen[role] = headers[wanted]
             continue
         match = next((lower[n] for n in _DEFAULT_NAMES[role] if n in lower), None)
-        if match is None and role == "displacement" and not (columns and "velocity" in columns):
-            if any(n in lower for n in _DEFAULT_NAMES["velocity"]):
-                continue  # the velocity column gives it
-        if match is None and role == "displacement" and columns and "velocity" in columns:
-            continue
+        by_velocity = (columns and "velocity" in columns) or any(n in lower for n in _DEFAULT_NAMES["velocity"])
+        if match is None and role == "displacement" and by_velocity:
+            continue  # the velocity column gives it
         if match is None:
             found = ", ".join(headers) or "none"
             raise DataError(

@@ -16,8 +16,10 @@ import numpy as np
 from ..columns import with_units
 from ..errors import DataError, ModelError, ParameterError
 from ..protocols import Protocol, Segment
+from ..units import to_si
 from .data import LabRecord, change_time_uncertainty, find_segments
-from .params import RSFParams, StateVariable
+from .laws import get_law
+from .params import RSFParams, StateVariable, _cutoff_pair
 from .solver import simulate
 
 __all__ = ["FitParameter", "RSFFit", "fit_record"]
@@ -148,7 +150,7 @@ class RSFFit:
 
     def summary(self) -> dict[str, Any]:
         """The report as JSON: SI throughout (m, 1/m, m/s; ``units`` says so); the text keeps the record's unit."""
-        out = {
+        return {
             "status": self.status,
             **({"reason": self.reason} if self.reason else {}),
             "parameters": {k: v.as_dict() for k, v in self.parameters.items()},
@@ -179,7 +181,6 @@ class RSFFit:
             **({"drift_sensitivity": self.drift_sensitivity} if self.drift_sensitivity else {}),
             **({"posterior": self.posterior} if self.posterior else {}),
         }  # fmt: skip
-        return out
 
     def change_rows(self) -> list[dict[str, Any]]:
         """The change times as JSON: s from the fitted rows' first row, and ``file_time`` on the file's clock."""
@@ -284,7 +285,7 @@ def fit_record(
     if states not in (1, 2):
         raise ParameterError(f"states: expected 1 or 2 state variables, got {states!r}")
     laws = _laws(law, states)
-    cutoff = _cutoff_checked(cutoff)
+    cutoff = None if cutoff is None else _cutoff_pair(cutoff)  # as RSFParams checks it (positive, finite, m/s)
     kinds = _trend_kinds(trend)
     held = _named_values("fixed", fixed, states, strict=True)
     starts = _named_values("guess", guess, states, strict=False)
@@ -292,7 +293,9 @@ def fit_record(
     twice = sorted(set(held) & set(starts))
     if twice:
         raise ParameterError(f"{twice[0]}: both fixed and guessed; expected one of them")
-    weight = _step_weight(step_weight)
+    if step_weight is not None and not (_real(step_weight) and math.isfinite(step_weight) and step_weight > 0):
+        raise ParameterError(f"step_weight: expected a positive weight, got {step_weight!r}")
+    weight = None if step_weight is None else float(step_weight)
     source = "given" if protocol is not None else "found from the load-point displacement"
     protocol_found = protocol is None
     record, protocol = fitted_rows(record, protocol, window)
@@ -302,10 +305,7 @@ def fit_record(
                           "dc" in starts or "dc" in held)  # fmt: skip
     labels = _sampling_classes(record.time)
     given = noise is not None
-    if given:
-        start["noise"] = float(noise)
-    else:
-        start["noise"] = _pre_fit_noise(record, protocol, start["dc"], labels, start["noise"])
+    start["noise"] = float(noise) if given else _pre_fit_noise(record, protocol, start["dc"], labels, start["noise"])
     setup = _Setup(record, protocol, laws, states, "stiffness" not in held, kinds, held, None, frozenset(starts),
                    cutoff)  # fmt: skip
     mismatch = _history_mismatch(record, protocol)
@@ -422,7 +422,6 @@ class _Setup:
 
 #: the names ``fixed`` and ``guess`` take (SI values)
 FIXABLE = ("mu0", "a", "b", "dc", "b2", "dc2", "stiffness", "trend", "time_trend")
-_POSITIVE = ("a", "dc", "dc2", "stiffness")
 #: a step's weight covers the rows up to this many Dc / V after the velocity change
 STEP_RENEWALS = 3.0
 
@@ -433,8 +432,6 @@ def _real(value: Any) -> bool:
 
 def _laws(law: Any, states: int) -> tuple[str, ...]:
     """One law name per state variable (a single name serves them all)."""
-    from .laws import get_law
-
     names = (law,) * states if isinstance(law, str) else tuple(law) if isinstance(law, (tuple, list)) else None
     if names is None or len(names) != states or not all(isinstance(n, str) for n in names):
         raise ParameterError(f"law: expected a law name or {states} of them (one per state), got {law!r}")
@@ -457,9 +454,8 @@ def _named_values(word: str, values: Any, states: int, strict: bool) -> dict[str
             raise ParameterError(f"{word}: {key} needs two state variables (states=2)")
         if not (_real(value) and math.isfinite(value)):
             raise ParameterError(f"{word}: {key} = {value!r}; expected a finite number (SI)")
-        if key in ("dc", "dc2", "stiffness") or (strict and key == "a"):
-            if not value > 0:
-                raise ParameterError(f"{word}: {key} = {value!r}; expected a positive value (SI)")
+        if (key in ("dc", "dc2", "stiffness") or (strict and key == "a")) and not value > 0:
+            raise ParameterError(f"{word}: {key} = {value!r}; expected a positive value (SI)")
         out[key] = float(value)
     return out
 
@@ -480,14 +476,6 @@ def _stiffness_words(
         raise ParameterError("stiffness: given twice (as stiffness= and in fixed/guess); expected it once")
     return ({**held, "stiffness": float(stiffness)}, starts) if not fit_stiffness else (
         held, {**starts, "stiffness": float(stiffness)})  # fmt: skip
-
-
-def _step_weight(value: Any) -> float | None:
-    if value is None:
-        return None
-    if not (_real(value) and math.isfinite(value) and value > 0):
-        raise ParameterError(f"step_weight: expected a positive weight, got {value!r}")
-    return float(value)
 
 
 def _windowed(record: LabRecord, window: Any) -> LabRecord:
@@ -897,24 +885,21 @@ def _jacobian(setup: _Setup, base: RSFParams, result: Any) -> np.ndarray | None:
     """d model / d parameter at the fit: exact for the linear ones, central differences for the rest."""
     record = setup.record
     values = result.params.valuesdict()
+    linear = {"mu0": np.ones(len(record)), "trend": record.displacement, "time_trend": record.time}
     columns = []
     for name in result.var_names:
-        if name == "mu0":
-            columns.append(np.ones(len(record)))
-        elif name == "trend":
-            columns.append(record.displacement.copy())
-        elif name == "time_trend":
-            columns.append(record.time.copy())
-        else:
-            value = values[name]
-            h = 1e-3 if name.startswith("log_") else 1e-3 * max(abs(value), 1e-3)
-            h = CHANGE_STEP if name.startswith("tc") else h
-            moved_up, moved_down = {**values, name: value + h}, {**values, name: value - h}
-            up, _ = _model_or_why(record, _history(setup, moved_up), base, moved_up)
-            down, _ = _model_or_why(record, _history(setup, moved_down), base, moved_down)
-            if not (np.all(np.isfinite(up)) and np.all(np.isfinite(down))):
-                return None
-            columns.append((up - down) / (2 * h))
+        if name in linear:
+            columns.append(linear[name])
+            continue
+        value = values[name]
+        h = 1e-3 if name.startswith("log_") else 1e-3 * max(abs(value), 1e-3)
+        h = CHANGE_STEP if name.startswith("tc") else h
+        moved_up, moved_down = {**values, name: value + h}, {**values, name: value - h}
+        up, _ = _model_or_why(record, _history(setup, moved_up), base, moved_up)
+        down, _ = _model_or_why(record, _history(setup, moved_down), base, moved_down)
+        if not (np.all(np.isfinite(up)) and np.all(np.isfinite(down))):
+            return None
+        columns.append((up - down) / (2 * h))
     return np.column_stack(columns)
 
 
@@ -1132,10 +1117,8 @@ def _troubled(result: Any) -> bool:
     a local minimum) or leaves a, b or Dc unconstrained."""
     if not result.success or not result.errorbars or result.chisqr > WARN_CHI2 * max(result.nfree, 1):
         return True
-    for key in ("a", "b", "log_dc"):
+    for key in ("a", "b", "log_dc"):  # (a held one is not unconstrained)
         par = result.params[key]
-        if not par.vary:
-            continue
         se = par.stderr if par.stderr is not None and math.isfinite(par.stderr) else None
         if _unconstrained(key, par, se):
             return True
@@ -1160,11 +1143,7 @@ def _covering(protocol: Protocol, record: LabRecord) -> Protocol:
         raise DataError(
             f"protocol lasts {protocol.duration:g} s but the record {end:g} s; expected a history covering the record"
         )
-    kept = []
-    for t0, t1, v in protocol.pieces():
-        if t0 >= end:
-            break
-        kept.append(Segment(v, min(t1, end) - t0))
+    kept = [Segment(v, min(t1, end) - t0) for t0, t1, v in protocol.pieces() if t0 < end]
     return Protocol(tuple(kept), name=protocol.name)
 
 
@@ -1177,10 +1156,8 @@ def _initial_guess(
     # the solver reproduces friction to ~1e-9 (rtol 1e-8 in fits): a noise-free record is known no better
     noise = max(_noise(f), MODEL_PRECISION * max(1.0, float(np.median(np.abs(f)))))
     edges, speeds = protocol.boundaries, protocol.velocities
-    sliding_steps = [
-        i for i in range(1, speeds.size) if min(speeds[i], speeds[i - 1]) > 0 and speeds[i] != speeds[i - 1]
-    ]
-    step = sliding_steps[0] if sliding_steps else None
+    step = next((i for i in range(1, speeds.size) if min(speeds[i], speeds[i - 1]) > 0 and speeds[i] != speeds[i - 1]),
+                None)  # fmt: skip
     v1 = v2 = speeds[0]
     before = after = f[:0]
     if step is not None:
@@ -1230,13 +1207,6 @@ def _stable_start(start: dict[str, float], dc_given: bool) -> dict[str, float]:
         return start
     stable_dc = STABLE_MARGIN * weakening / start["stiffness"]
     return {**start, "dc": min(stable_dc, 0.5 * start["max_dc"])}
-
-
-def _cutoff_checked(cutoff: Any) -> tuple[float, float] | None:
-    """The cut-off velocities as RSFParams checks them (positive, finite, m/s), or None."""
-    from .params import _cutoff_pair
-
-    return None if cutoff is None else _cutoff_pair(cutoff)
 
 
 #: lmfit's name of each public parameter (Dc and k in log space)
@@ -1314,8 +1284,7 @@ def _final_params(base: RSFParams, values: dict[str, float]) -> RSFParams:
     return base.replace(a=values["a"], mu0=values["mu0"], states=tuple(states), stiffness=k)
 
 
-_PUBLIC = {"mu0": "mu0", "a": "a", "b": "b", "log_dc": "dc", "b2": "b2", "log_dc2": "dc2", "log_k": "stiffness",
-           "trend": "trend", "time_trend": "time_trend"}  # fmt: skip
+_PUBLIC = {name: key for key, name in _INTERNAL.items()}
 
 
 def _trend_kinds(trend: bool | str | None) -> frozenset[str]:
@@ -1332,8 +1301,6 @@ def _trend_kinds(trend: bool | str | None) -> frozenset[str]:
 
 def _length_scale(unit: str) -> float:
     """Metres per ``unit``."""
-    from ..units import to_si
-
     return to_si(f"1 {unit}", "length", "length unit")
 
 
@@ -1371,13 +1338,10 @@ def _report(
             warns.append(f"{public}: undetermined (standard error {se:.3g} exceeds the value {value:.3g})")
         table[public] = FitParameter(public, value, stderr, interval, unit=unit, scale=scale, constrained=not note,
                                      note=note, scaled_interval=scaled, si_unit=si)  # fmt: skip
-    if not setup.fit_stiffness:
-        unit, scale = units["stiffness"]
-        table["stiffness"] = FitParameter("stiffness", setup.fixed.get("stiffness", k_start), None, None, fixed=True,
-                                          unit=unit, scale=scale, si_unit="1/m")  # fmt: skip
-    if "trend" not in table:
-        unit, scale = units["trend"]
-        table["trend"] = FitParameter("trend", 0.0, None, None, fixed=True, unit=unit, scale=scale, si_unit="1/m")
+    for key, held in (("stiffness", setup.fixed.get("stiffness", k_start)), ("trend", 0.0)):
+        if key not in table:  # a stiffness not fitted is the base's own; no drift term is a drift of 0
+            unit, scale = units[key]
+            table[key] = FitParameter(key, held, None, None, fixed=True, unit=unit, scale=scale, si_unit="1/m")
     corr: dict[str, float] = {}
     for key, par in result.params.items():
         for other, value in (par.correl or {}).items():
@@ -1399,17 +1363,13 @@ def _interval(
     fitted: float, se: float | None, log: bool, widen: float | None
 ) -> tuple[float, float | None, tuple[float, float] | None, tuple[float, float] | None]:
     """Value, standard error, 95 % interval and the interval widened by ``widen`` (log-space ones asymmetric)."""
-    if log:
-        value = math.exp(fitted)
-        if se is None:
-            return value, None, None, None
-        pair = (_exp(fitted - Z95 * se), _exp(fitted + Z95 * se))
-        scaled = (_exp(fitted - Z95 * se * widen), _exp(fitted + Z95 * se * widen)) if widen else None
-        return value, value * se, pair, scaled
+    value = math.exp(fitted) if log else fitted
     if se is None:
-        return fitted, None, None, None
-    scaled = (fitted - Z95 * se * widen, fitted + Z95 * se * widen) if widen else None
-    return fitted, se, (fitted - Z95 * se, fitted + Z95 * se), scaled
+        return value, None, None, None
+    end = _exp if log else (lambda x: x)
+    pair = (end(fitted - Z95 * se), end(fitted + Z95 * se))
+    scaled = (end(fitted - Z95 * se * widen), end(fitted + Z95 * se * widen)) if widen else None
+    return value, value * se if log else se, pair, scaled
 
 
 def _unconstrained(key: str, par: Any, se: float | None) -> str:

@@ -134,8 +134,6 @@ class RSFParams:
 
         With ``cutoff = (V1, V2)``: mu0 - a ln(V1/V + 1) + b ln(V2/V + 1).
         """
-        import numpy as np
-
         v = np.asarray(velocity, dtype=float)
         if self.cutoff is not None:  # theta_i = s Dc_i/V in steady state for every law: both terms are ln(Vc/V + 1)
             v1, v2 = self.cutoff
@@ -164,14 +162,9 @@ class RSFParams:
 
     def to_toml(self) -> str:
         lines = ["# rate-and-state parameters (SI: m, s, m/s; stiffness in 1/m; eta in s/m; mass in kg/m^2)"]
-        for key, value in self.to_dict().items():
-            if key != "states":
-                lines.append(f"{key} = {_toml_value(value)}")
+        lines += [f"{key} = {_toml_value(value)}" for key, value in self.to_dict().items() if key != "states"]
         for state in self.states:
-            lines.append("")
-            lines.append("[[states]]")
-            for key, value in asdict(state).items():
-                lines.append(f"{key} = {_toml_value(value)}")
+            lines += ["", "[[states]]", *(f"{key} = {_toml_value(value)}" for key, value in asdict(state).items())]
         return "\n".join(lines) + "\n"
 
     @classmethod

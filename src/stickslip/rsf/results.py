@@ -95,8 +95,7 @@ class RSFRun:
     def to_frame(self) -> Any:
         import pandas as pd
 
-        columns: dict[str, Any] = {"time": self.time, "friction": self.friction}
-        columns["slider_velocity"] = self.slider_velocity
+        columns = {"time": self.time, "friction": self.friction, "slider_velocity": self.slider_velocity}
         for i, row in enumerate(self.state):
             columns["state" if i == 0 else f"state{i + 1}"] = row
         columns["load_point_displacement"] = self.load_point_displacement
@@ -167,17 +166,10 @@ def assemble_run(
     rtol: float = 1e-10,
 ) -> RSFRun:
     """Turn the solver's (t, y) into the physical trace."""
-    o = system.offset
-    x, psi = y[o], y[o + 1 :]
-    friction = system.friction_many(x, psi)
-    velocity = system.v0 * np.exp(np.minimum(x, 700.0))
+    _, friction, velocity = _physical(system, t, y)
     lp_disp = protocol.displacement_at(t)
-    k = system.k
-    if system.inertial:
-        spring = y[0]
-    else:
-        spring = friction + system.eta * velocity
-    slider = lp_disp - (spring - spring[0]) / k
+    spring = y[0] if system.inertial else friction + system.eta * velocity
+    slider = lp_disp - (spring - spring[0]) / system.k
     regime = (
         Regime(regimes.BLOW_UP, 0, math.nan, math.nan, float(np.max(friction)), float(np.min(friction)), "")
         if status != "ok"
@@ -189,7 +181,7 @@ def assemble_run(
         time=t,
         friction=friction,
         slider_velocity=velocity,
-        state=system.theta(psi),
+        state=system.theta(y[system.offset + 1 :]),
         load_point_displacement=lp_disp,
         slider_displacement=slider,
         load_point_velocity=protocol.velocity_at(t),

@@ -243,22 +243,12 @@ def _sampled_piece(
     system: System, y0: np.ndarray, t0: float, t1: float, vlp: float, inside: np.ndarray, x_cap: float,
     rtol: float, atol: float, watch: bool = False,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, float | None]:  # fmt: skip
-    from scipy.integrate import odeint
-
     if watch:
         return _dense_piece(system, y0, t0, t1, vlp, inside, x_cap, rtol, atol)
     t_eval = np.concatenate([[t0], inside, [] if inside.size and inside[-1] == t1 else [t1]])
-    jac = system.jacobian if system.has_jacobian else None
-    with warnings.catch_warnings():
-        # A failed odeint call (e.g. a blow-up) is detected below from its report and
-        # redone by the adaptive path, which locates the failure; its warning adds nothing.
-        warnings.simplefilter("ignore")
-        out, info = odeint(
-            system.rhs, y0, t_eval, args=(vlp,), Dfun=jac, rtol=rtol, atol=atol, tfirst=True, mxstep=200_000,
-            full_output=True,
-        )  # fmt: skip
-    x = out[:, system.offset]
-    if info.get("message") != "Integration successful." or not np.all(np.isfinite(out)) or np.max(x) > x_cap:
+    # a failed odeint call (e.g. a blow-up) is redone by the adaptive path, which locates the failure
+    out, ok = _odeint(system, y0, t_eval, vlp, rtol, atol)
+    if not ok or np.max(out[:, system.offset]) > x_cap:
         return _dense_piece(system, y0, t0, t1, vlp, inside, x_cap, rtol, atol)
     keep = slice(1, 1 + inside.size)
     return t_eval[keep], out[keep].T, out[-1], None
@@ -316,29 +306,47 @@ def _interpolant(system: System, vlp: float, t_steps: np.ndarray, y_steps: np.nd
 
     Cheaper than keeping scipy's interpolant for every step when only a few extremes and crossings are wanted.
     """
-    from scipy.integrate import odeint
-
-    jac = system.jacobian if system.has_jacobian else None
 
     def evaluate(times: np.ndarray) -> np.ndarray:
         # within the steps only: a tail reading before the segment's start (a segment shorter than the
         # relaxation time) is read at the start
         times = np.clip(np.asarray(times, dtype=float), t_steps[0], t_steps[-1])
         j = max(int(np.searchsorted(t_steps, times[0], side="right")) - 1, 0)
-        grid = np.r_[t_steps[j], times]
-        with warnings.catch_warnings():
-            # a failed restart is detected from odeint's report below (its warning adds nothing)
-            warnings.simplefilter("ignore")
-            out, info = odeint(
-                system.rhs, y_steps[:, j], grid, args=(vlp,), Dfun=jac, rtol=rtol, atol=atol, tfirst=True,
-                mxstep=200_000, full_output=True,
-            )  # fmt: skip
-        if info.get("message") != "Integration successful." or not np.all(np.isfinite(out)):
-            # the accepted steps themselves, linearly between them: coarser, never invented
+        out, ok = _odeint(system, y_steps[:, j], np.r_[t_steps[j], times], vlp, rtol, atol)
+        if not ok:  # the accepted steps themselves, linearly between them: coarser, never invented
             return np.array([np.interp(times, t_steps, row) for row in y_steps])
         return out[1:].T
 
     return evaluate
+
+
+def _odeint(
+    system: System, y0: np.ndarray, grid: np.ndarray, vlp: float, rtol: float, atol: float
+) -> tuple[np.ndarray, bool]:
+    """odeint (LSODA) at ``grid`` and whether it succeeded with finite values (its failure warning is silenced:
+    the caller reports or redoes a failed run)."""
+    from scipy.integrate import odeint
+
+    jac = system.jacobian if system.has_jacobian else None
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        out, info = odeint(
+            system.rhs, y0, grid, args=(vlp,), Dfun=jac, rtol=rtol, atol=atol, tfirst=True, mxstep=200_000,
+            full_output=True,
+        )  # fmt: skip
+    return out, info.get("message") == "Integration successful." and bool(np.all(np.isfinite(out)))
+
+
+def _solve(
+    system: System, y0: np.ndarray, t0: float, t1: float, vlp: float, rtol: float, atol: float, dense: bool,
+    method: str = "LSODA", events: Any = None,
+) -> Any:  # fmt: skip
+    """solve_ivp from ``t0`` to ``t1``, its evaluations counted (:func:`_counted`)."""
+    from scipy.integrate import solve_ivp
+
+    jac = system.jacobian if system.has_jacobian else None
+    return solve_ivp(_counted(system, t0, t1), (t0, t1), y0, method=method, args=(vlp,), jac=jac, rtol=rtol,
+                     atol=atol, events=events, dense_output=dense)  # fmt: skip
 
 
 def _adaptive_piece(
@@ -350,8 +358,6 @@ def _adaptive_piece(
     Without ``watch`` the steps are taken without the blow-up event (scipy checks events at a cost of about
     twice the integration); a run that fails or passes the cap is redone with it.
     """
-    from scipy.integrate import solve_ivp
-
     if not watch:
         try:
             fast = _quiet_solve(system, y0, t0, t1, vlp, rtol, atol, dense)
@@ -368,24 +374,17 @@ def _adaptive_piece(
 
     blow_up.terminal = True  # type: ignore[attr-defined]
     blow_up.direction = 1  # type: ignore[attr-defined]
-    jac = system.jacobian if system.has_jacobian else None
     try:
         with warnings.catch_warnings():
             # LSODA's own warning on a failure is replaced by the ModelError or blow-up report below
             warnings.simplefilter("ignore", UserWarning)
             try:
-                sol = solve_ivp(
-                    _counted(system, t0, t1), (t0, t1), y0, method="LSODA", args=(vlp,), jac=jac, rtol=rtol,
-                    atol=atol, events=blow_up, dense_output=dense,
-                )  # fmt: skip
+                sol = _solve(system, y0, t0, t1, vlp, rtol, atol, dense, events=blow_up)
             except ValueError:
                 # LSODA's interpolant can disagree in sign with its own step ends when the slip rate runs away,
                 # so scipy's event root-finder has no bracket; Radau's collocation polynomial passes through
                 # the step ends exactly, so the same event is bracketed there.
-                sol = solve_ivp(
-                    _counted(system, t0, t1), (t0, t1), y0, method="Radau", args=(vlp,), jac=jac, rtol=rtol,
-                    atol=atol, events=blow_up, dense_output=dense,
-                )  # fmt: skip
+                sol = _solve(system, y0, t0, t1, vlp, rtol, atol, dense, method="Radau", events=blow_up)
     except _Stalled as stalled:
         raise _stall_error(stalled, t0, t1) from None
     blown = float(sol.t_events[0][0]) if sol.t_events[0].size else None
@@ -441,16 +440,10 @@ def _quiet_solve(
     system: System, y0: np.ndarray, t0: float, t1: float, vlp: float, rtol: float, atol: float, dense: bool
 ) -> Any:
     """solve_ivp (LSODA) without events; None where it raises (the watched path then reports)."""
-    from scipy.integrate import solve_ivp
-
-    jac = system.jacobian if system.has_jacobian else None
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            return solve_ivp(
-                _counted(system, t0, t1), (t0, t1), y0, method="LSODA", args=(vlp,), jac=jac, rtol=rtol, atol=atol,
-                dense_output=dense,
-            )  # fmt: skip
+            return _solve(system, y0, t0, t1, vlp, rtol, atol, dense)
     except (ValueError, ArithmeticError):
         return None
 

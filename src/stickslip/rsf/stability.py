@@ -131,9 +131,8 @@ def jacobian_at(system: System, y: np.ndarray, load_velocity: float) -> np.ndarr
         up, down = y.copy(), y.copy()
         up[j] += h
         down[j] -= h
-        jac[:, j] = (np.array(system.rhs(0.0, up, load_velocity)) - np.array(system.rhs(0.0, down, load_velocity))) / (
-            2 * h
-        )
+        rise = np.array(system.rhs(0.0, up, load_velocity)) - np.array(system.rhs(0.0, down, load_velocity))
+        jac[:, j] = rise / (2 * h)
     return jac
 
 

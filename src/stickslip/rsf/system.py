@@ -83,9 +83,7 @@ class System:
         x = float(y[o])
         psi = [float(p) for p in y[o + 1 :]]
         v = self.v0 * _exp(x)
-        g = []
-        for law, p, dc in zip(self.laws, psi, self.dc, strict=True):
-            g.append(law.rate(x, p, self.v0, dc)[0])
+        g = [law.rate(x, p, self.v0, dc)[0] for law, p, dc in zip(self.laws, psi, self.dc, strict=True)]
         if self.cutoff is not None:  # H = 0 (no coupled law with this form)
             A = self.cutoff.direct(self.a, x)[0]
             G = sum(self.cutoff.evolution(b, p)[0] * gi for b, p, gi in zip(self.b, psi, g, strict=True))

@@ -16,10 +16,10 @@ from typing import Any
 import numpy as np
 
 from ..errors import DataError, ModelError, ParameterError
-from ..protocols import Protocol
+from ..protocols import Protocol, constant, velocity_steps
 from ..rsf.params import RSFParams, StateVariable
 from ..rsf.solver import simulate as rsf_simulate
-from .rsf_reading import STEP_PRECISION, step_guess
+from .rsf_reading import STEP_PRECISION, _critical, step_guess
 
 __all__ = [
     "STEP_PRECISION",
@@ -140,8 +140,6 @@ def bond_response(
                 "memory), so it shows no transient" + ("; during holds it has no steady value (blank)"
                                                          if not moving.all() else ""))  # fmt: skip
         return BondTrace(t, stress, "quasi-static bond model", note)
-    from ..protocols import constant
-
     if len(set(protocol.velocities.tolist())) != 1:
         raise ModelError(
             "the quasi-static bond model runs only constant pulling under block control; a changing protocol "
@@ -166,15 +164,6 @@ def _rig(control: str) -> Any:
     return Rig(control="velocity" if control == "velocity" else "spring")
 
 
-def _critical(params: Any) -> tuple[float, float]:
-    from ..quasistatic.critical import critical_point
-
-    cp = critical_point(params)
-    if not cp.exists or cp.velocity is None or cp.stress is None:
-        raise ModelError(f"the bond model has no critical point here ({cp.message}); nothing to normalise by")
-    return float(cp.velocity), float(cp.stress)
-
-
 def rsf_of_bond(
     params: Any, v0: float, v1: float, duration: float = 1.0, stiffness: float = 1e9, model: str = "quasi-static"
 ) -> BondRSF:
@@ -193,7 +182,8 @@ def rsf_of_bond(
     stress = np.ravel(steady.stress)
     slope = float(np.ravel(steady.stress_slope)[1] * vm / sigma_c)
     if model == "transient" and _transient() is not None:
-        return _fitted_rsf(params, v0, v1, duration, stiffness, slope, sigma_c)
+        protocol = velocity_steps([v0, v1], [duration, duration])
+        return fit_bond_step(bond_response(params, protocol, "velocity", model="transient"), protocol, sigma_c, slope)
     mu0, mu1 = float(stress[0] / sigma_c), float(stress[2] / sigma_c)
     a = (mu1 - mu0) / math.log(v1 / v0)
     dl_m = float(params.bonds.max_extension)
@@ -209,16 +199,6 @@ def rsf_of_bond(
             f"{mu1:.4g} (no transient, no state), which is exactly a = (μ1 − μ0)/ln(V1/V0) = {a:.4g}, b = 0; "
             f"Dc has no effect with b = 0 and is not determined (set to Δl_m = {dl_m * 1e6:.4g} µm)")  # fmt: skip
     return BondRSF(rsf, slope, vm, sigma_c, "fitted", note)
-
-
-def _fitted_rsf(
-    params: Any, v0: float, v1: float, duration: float, stiffness: float, slope: float, sigma_c: float
-) -> BondRSF:
-    from ..protocols import velocity_steps
-
-    protocol = velocity_steps([v0, v1], [duration, duration])
-    trace = bond_response(params, protocol, "velocity", model="transient")
-    return fit_bond_step(trace, protocol, sigma_c, slope)
 
 
 def fit_bond_step(trace: BondTrace, protocol: Protocol, sigma_c: float, slope: float) -> BondRSF:
@@ -280,8 +260,6 @@ def stick_slip_pair(params: Any, v0: float, duration: float, rsf: BondRSF, eta: 
     The RSF law is ``rsf``'s own (a, b, Dc, mu0 at its v_ref): only the rig (stiffness, radiation damping) is the
     bond model's block.  With a failed ``rsf`` the RSF side is not run (``"rsf": None``).
     """
-    from ..protocols import constant
-
     sim = _bond_model("quasi-static").run(params, constant(v0, duration), _rig("block"))  # a Run: the jump cycles
     k = float(params.block.effective_stiffness) / rsf.sigma_c  # Pa/m over sigma_c: friction per metre
     a = abs(rsf.params.a)

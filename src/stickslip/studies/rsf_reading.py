@@ -162,13 +162,8 @@ def resample_in_slip(
 
 def _from(protocol: Protocol, start: float) -> Protocol:
     """``protocol`` seen from time ``start`` on (the part before it dropped)."""
-    segments, elapsed = [], 0.0
-    for segment in protocol.segments:
-        end = elapsed + segment.duration
-        if end > start:
-            segments.append(Segment(segment.velocity, end - max(start, elapsed)))
-        elapsed = end
-    return Protocol(tuple(segments), name=protocol.name)
+    kept = [Segment(v, t1 - max(start, t0)) for t0, t1, v in protocol.pieces() if t1 > start]
+    return Protocol(tuple(kept), name=protocol.name)
 
 
 def step_record(
@@ -205,20 +200,27 @@ def bond_step(
 ) -> StepRecord:  # fmt: skip
     """The time-dependent bond model's response to the slider velocities ``velocities`` (m/s), from steady
     sliding at the first: ``lead`` of slip at the first velocity, then ``window`` at each of the others."""
-    from ..quasistatic.critical import critical_point
     from ..transient import run_transient
 
     _check_steps(velocities, window)
-    cp = critical_point(params)
-    if not cp.exists or cp.stress is None:
-        raise ModelError(f"the bond model has no critical point here ({cp.message}); nothing to normalise by")
+    sigma_c = _critical(params)[1]
     durations = [LEAD / velocities[0]] + [window / v for v in velocities[1:]]
     protocol = velocity_steps(velocities, durations)
     start = _time.process_time()
     run = run_transient(params, protocol, control="velocity", start="steady", rtol=rtol)
     cpu = _time.process_time() - start
     label = name or " -> ".join(f"{v * 1e6:.4g}" for v in velocities) + " µm/s"
-    return step_record(run.time, run.stress, protocol, float(cp.stress), label, cpu, window)
+    return step_record(run.time, run.stress, protocol, sigma_c, label, cpu, window)
+
+
+def _critical(params: Any) -> tuple[float, float]:
+    """Vc (m/s) and sigma_c (Pa) of the bond model, which its friction is normalised by."""
+    from ..quasistatic.critical import critical_point
+
+    cp = critical_point(params)
+    if not cp.exists or cp.velocity is None or cp.stress is None:
+        raise ModelError(f"the bond model has no critical point here ({cp.message}); nothing to normalise by")
+    return float(cp.velocity), float(cp.stress)
 
 
 def _check_steps(velocities: Any, window: float) -> None:

@@ -249,22 +249,14 @@ def spreads(rows: Sequence[dict[str, float]], tolerance: float = TOLERANCE) -> l
     out = []
     for key in rows[0]:
         values = np.array([r[key] for r in rows], dtype=float)
-        if np.isnan(values).any():
-            out.append(Spread(key, float(values[0]), math.nan, math.nan, tolerance))
-        else:
-            out.append(Spread(key, float(values[0]), float(values.min()), float(values.max()), tolerance))
+        low, high = (math.nan, math.nan) if np.isnan(values).any() else (float(values.min()), float(values.max()))
+        out.append(Spread(key, float(values[0]), low, high, tolerance))
     return out
 
 
 def predictions(points: Sequence[RegionPoint], *compute: Callable[[Parameters], dict[str, float]]) -> list[dict]:
     """The merged outputs of each ``compute`` at each point."""
-    rows = []
-    for p in points:
-        row: dict[str, float] = {}
-        for f in compute:
-            row.update(f(p.params))
-        rows.append(row)
-    return rows
+    return [{k: v for f in compute for k, v in f(p.params).items()} for p in points]
 
 
 def _number(x: float | None) -> float:
