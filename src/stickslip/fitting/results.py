@@ -80,6 +80,16 @@ class Estimate:
         return out
 
 
+#: (key, symbol, dimension) of the critical point's estimates, Vc and sigma_c (Eq 9).
+CRITICAL = (("critical_velocity", "Vc", "velocity"), ("critical_stress", "σc", "stress"))
+
+
+def undetermined_critical(note: str) -> tuple[Estimate, Estimate]:
+    """Vc and sigma_c, not determined; ``note`` says why."""
+    vc, sc = (Estimate(*names, None, status="undetermined", note=note) for names in CRITICAL)
+    return vc, sc
+
+
 #: ln-widths beyond this give an unbounded upper end (e^700 ~ 1e304: no number, only "unbounded").
 LARGEST_LOG_WIDTH = 700.0
 
