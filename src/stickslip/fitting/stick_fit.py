@@ -337,7 +337,8 @@ def fit_stick(
             raise ParameterError(f"{key} is given both to --fix and to --free")
     keys = [k for k in STICK_KEYS if k not in fixed]
     used, excluded, sigma_c, messages = _select_rows(data, base, exclude_rows, include_steady)
-    rows, fitted_peak = _rows(data, used, base, sigma_c, messages)
+    start, rate = _start_column(data, sigma_c), _rate_column(data, base)
+    rows, fitted_peak = _rows(data, used, start, rate, sigma_c, messages)
     n_obs = rows.stick_time.size + (0 if rows.peak is None else rows.peak.size)
     if rows.stick_time.size < 2:
         raise DataError(f"{data.source}: {rows.stick_time.size} usable row(s); need at least 2 stick phases to fit")
@@ -390,10 +391,7 @@ def fit_stick(
         else:
             reason = "fixed by request" if key in fixed else "not determined by the data; fixed at its input value"
             estimates.append(Estimate(key, identify.SYMBOLS[key], dim, value, status="fixed", note=reason))
-    full = _Rows(data.pulling_velocity, _start_column(data, sigma_c), _rate_column(data, base), data.stick_time, None)
-    times, peaks, problems = _model(
-        current, _Rows(*(a[used] for a in (full.velocity, full.start, full.rate, full.stick_time)), None)
-    )
+    times, peaks, problems = _model(current, rows)
     model_t = np.full(len(data), np.nan)
     model_s = np.full(len(data), np.nan)
     model_t[used], model_s[used] = times, peaks
@@ -415,8 +413,8 @@ def fit_stick(
         correlation=correlation,
         used=used,
         excluded=excluded,
-        start_stress=full.start,
-        loading_rate=full.rate,
+        start_stress=start,
+        loading_rate=rate,
         model_stick_time=model_t,
         model_peak_stress=model_s,
         fitted_peak_stress=fitted_peak,
@@ -605,15 +603,13 @@ def _rate_column(data: StickData, params: Parameters) -> np.ndarray:
 
 
 def _rows(
-    data: StickData, used: np.ndarray, params: Parameters, sigma_c: float | None, messages: list[str]
+    data: StickData, used: np.ndarray, start: np.ndarray, rate: np.ndarray, sigma_c: float | None, messages: list[str]
 ) -> tuple[_Rows, bool]:
-    start = _start_column(data, sigma_c)
     if data.start_stress is None or np.any(~np.isfinite(data.start_stress[used])):
         messages.append(
             f"rows without start_stress start at the critical stress σc = {human(sigma_c or 0.0, 'stress')} of the"
             " bond parameters"
         )
-    rate = _rate_column(data, params)
     measured = "stick_slope" in data.extra
     if measured:
         messages.append("loading rate of each stick phase from its measured stick_slope (instead of K·V0 of Eq 17)")
