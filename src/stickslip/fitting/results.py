@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 from typing import Any
@@ -78,6 +79,13 @@ class Estimate:
         if self.bias is not None:
             out["method_bias"] = self.bias
         return out
+
+
+def unusable(estimate: Estimate, why: str) -> Estimate:
+    """``estimate`` of a failed fit: undetermined, without error or interval (``why``); fixed ones stay."""
+    if estimate.fixed or estimate.interval is None:
+        return estimate
+    return dataclasses.replace(estimate, stderr=None, interval=None, status="undetermined", note=why)
 
 
 #: (key, symbol, dimension) of the critical point's estimates, Vc and sigma_c (Eq 9).

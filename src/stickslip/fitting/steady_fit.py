@@ -38,7 +38,7 @@ from .problem import (
     minimize,
     residuals,
 )
-from .results import CRITICAL, Estimate, display_unit, human, undetermined_critical
+from .results import CRITICAL, Estimate, display_unit, human, undetermined_critical, unusable
 from .results import log_interval as _log_interval
 from .scatter import Dependence, Misfit, Scatter, local_scatter, misfit, velocity_dependence
 
@@ -485,8 +485,8 @@ def fit_steady(
         _note_extrapolation(progress, vc, data)
     problems = _problems(progress, keys, fitted, base, covariance, chi_square, data) + misfits
     if misfits:
-        estimates = tuple(_undetermined(e, why) for e in estimates)
-        combos = tuple(_undetermined(e, why) for e in combos)
+        estimates = tuple(unusable(e, why) for e in estimates)
+        combos = tuple(unusable(e, why) for e in combos)
     return SteadyFit(
         data=data,
         parameters=fitted,
@@ -540,12 +540,6 @@ def _problems(
 def _unmoved(fitted: Parameters, base: Parameters, key: str) -> bool:
     now, start = fitted.as_dict()[key], base.as_dict()[key]
     return abs(now - start) <= 1e-9 * max(abs(start), 1e-300)
-
-
-def _undetermined(estimate: Estimate, why: str) -> Estimate:
-    if estimate.status in ("fixed",) or estimate.interval is None:
-        return estimate
-    return dataclasses.replace(estimate, stderr=None, interval=None, status="undetermined", note=why)
 
 
 #: A method's fit whose misfit the noise does not explain fails, when the model itself (its best fit on all
@@ -877,12 +871,7 @@ def _warn_aging_neglected(progress: _Progress, params: Parameters, hi: Block, no
 
 
 def _parameter_estimates(
-    fitted: Parameters,
-    keys: Sequence[str],
-    sd: np.ndarray,
-    q: float,
-    fixed: Mapping[str, float],
-    progress: _Progress,
+    fitted: Parameters, keys: Sequence[str], sd: np.ndarray, q: float, fixed: Mapping[str, float], progress: _Progress
 ) -> tuple[Estimate, ...]:
     values = fitted.as_dict()
     out = []

@@ -9,7 +9,6 @@ ln(model/measured); a direction the data do not determine is fixed with a messag
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
@@ -27,7 +26,7 @@ from ..units import to_si
 from . import identify
 from .data import StickData, read_stick_data
 from .problem import JACOBIAN_STEP, SEARCH_BOX
-from .results import Estimate, human, log_interval
+from .results import Estimate, human, log_interval, unusable
 from .stick_batch import stick_times
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -400,9 +399,9 @@ def fit_stick(
     if dof <= 0:
         messages.append("no degrees of freedom left: the noise cannot be estimated and the errors are undefined")
     noise = f"relative (ln), estimated from the scatter: {100 * math.sqrt(scale2):.3g} %" if dof > 0 else "undefined"
-    problems = _stick_problems(data, used, rows, current, keys, fixed, dof, scale2, problems)
+    problems = _stick_problems(rows, current, keys, fixed, dof, scale2, problems)
     if problems:
-        estimates = [_unusable(e) for e in estimates]
+        estimates = [unusable(e, "the fit failed") for e in estimates]
     return StickFit(
         data=data,
         parameters=current,
@@ -439,12 +438,6 @@ STICK_SIGNIFICANCE = 1e-3
 SAME_VELOCITY = 1e-6
 
 
-def _unusable(estimate: Estimate) -> Estimate:
-    if estimate.fixed:
-        return estimate
-    return dataclasses.replace(estimate, stderr=None, interval=None, status="undetermined", note="the fit failed")
-
-
 def _groups(velocity: np.ndarray) -> list[np.ndarray]:
     """Indices of the rows at each distinct pulling velocity."""
     order = np.argsort(velocity)
@@ -458,8 +451,6 @@ def _groups(velocity: np.ndarray) -> list[np.ndarray]:
 
 
 def _stick_problems(
-    data: StickData,
-    used: np.ndarray,
     rows: _Rows,
     fitted: Parameters,
     keys: Sequence[str],
