@@ -974,27 +974,19 @@ def _profile_estimates(
     cov = scale * cov if np.all(np.isfinite(cov)) else None
     guess_v = math.sqrt(max(float(grad_v @ cov @ grad_v), 1e-6)) if cov is not None else 0.1
     guess_s = math.sqrt(max(float(grad_s @ cov @ grad_s), 1e-6)) if cov is not None else 0.05
-    ends_v = [
-        profile.end(
-            profile.chi_square_at_velocity, math.log(vc), theta, best.chi_square, threshold, scale, guess_v, side
+    both_ends = [
+        [profile.end(chi_at, math.log(x), start, best.chi_square, threshold, scale, sd, side) for side in (-1, 1)]
+        for chi_at, x, start, sd in (
+            (profile.chi_square_at_velocity, vc, theta, guess_v),
+            (profile.chi_square_at_stress, sc, np.append(theta, math.log(vc)), guess_s),
         )
-        for side in (-1, 1)
-    ]
-    start_s = np.append(theta, math.log(vc))
-    ends_s = [
-        profile.end(
-            profile.chi_square_at_stress, math.log(sc), start_s, best.chi_square, threshold, scale, guess_s, side
-        )
-        for side in (-1, 1)
     ]
     note = "profile likelihood"
     if progress.undetermined:
         note += f", conditional on {', '.join(progress.undetermined)}"
     out = []
     q = _quantile(level, profile_dof, progress.noise_known)
-    for (name, symbol, dim), value, ends, sd in zip(
-        CRITICAL, (vc, sc), (ends_v, ends_s), (guess_v, guess_s), strict=True
-    ):
+    for (name, symbol, dim), value, ends, sd in zip(CRITICAL, (vc, sc), both_ends, (guess_v, guess_s), strict=True):
         interval = tuple(None if e.value is None else math.exp(e.value) for e in ends)
         lo, hi = interval
         extra = ""
