@@ -532,14 +532,11 @@ def _problems(
     if keys and not np.all(np.isfinite(covariance)):
         problems.append("the covariance could not be estimated: the data cannot tell the free parameters apart")
     stated_misfit = data.stress_err is not None and chi_square > 2.0 * max(len(data) - len(keys), 1)
-    if keys and all(_unmoved(fitted, base, k) for k in keys) and stated_misfit:  # a start that fits is no failure
+    now, start = fitted.as_dict(), base.as_dict()
+    unmoved = all(abs(now[k] - start[k]) <= 1e-9 * max(abs(start[k]), 1e-300) for k in keys)
+    if keys and unmoved and stated_misfit:  # a start that fits is no failure
         problems.append("the free parameters did not move from their start values, which do not fit the data")
     return problems
-
-
-def _unmoved(fitted: Parameters, base: Parameters, key: str) -> bool:
-    now, start = fitted.as_dict()[key], base.as_dict()[key]
-    return abs(now - start) <= 1e-9 * max(abs(start), 1e-300)
 
 
 #: A method's fit whose misfit the noise does not explain fails, when the model itself (its best fit on all
