@@ -165,13 +165,9 @@ def _refine_shift(analysis: TraceAnalysis, sim: Simulation, shift: float, aligne
 
 
 def _anchor(analysis: TraceAnalysis) -> tuple[float | None, int | None]:
-    for cycle in analysis.cycles:
-        if cycle.complete and cycle.start_time is not None:
-            return cycle.start_time, cycle.index
-    for cycle in analysis.cycles:
-        if cycle.start_time is not None:
-            return cycle.start_time, cycle.index
-    return None, None
+    started = [c for c in analysis.cycles if c.start_time is not None]
+    chosen = next((c for c in started if c.complete), started[0] if started else None)
+    return (None, None) if chosen is None else (chosen.start_time, chosen.index)
 
 
 def _model_values(sim: Simulation, k: int, params: Parameters) -> dict[str, float | None]:

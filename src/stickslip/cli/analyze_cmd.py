@@ -259,7 +259,7 @@ def _comparison_text(comparison: Any) -> str:
     for row in comparison.cycles[:TABLE_CYCLES]:
         diff = row["difference"]
         shown = [
-            f"{label} {_signed(diff[name], factor)}{unit}"
+            f"{label} {diff[name] * factor:+.4g}{unit}"
             for name, label, factor, unit in (
                 ("critical_stress", "Δσc", 1.0, " Pa"),
                 ("peak_stress", "Δσs", 1.0, " Pa"),
@@ -276,10 +276,6 @@ def _comparison_text(comparison: Any) -> str:
 
 def _number(value: float | None, factor: float, digits: int) -> str:
     return "--" if value is None else f"{value * factor:.{digits}g}"
-
-
-def _signed(value: float, factor: float) -> str:
-    return f"{value * factor:+.4g}"
 
 
 def register(cli: click.Group) -> None:

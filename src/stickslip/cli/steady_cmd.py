@@ -222,29 +222,16 @@ def curve_command(
         print_rich(*parts, output=output)
     if plot_path is not None:
         stress = _evaluate(params, values, aging)["stress"] if velocity else None  # marks only for --velocity
-        _save_curve_plot(params, values, stress, lo, hi, bool(velocity), no_aging, plot_path)
+        from ..plots.steady import figure_steady_curve
+        from ..plots.style import UM_PER_S
 
-
-def _save_curve_plot(
-    params: Any,
-    values: np.ndarray,
-    stress: np.ndarray | None,
-    lo: float,
-    hi: float,
-    mark: bool,
-    no_aging: bool,
-    path: Path,
-) -> None:
-    from ..plots.steady import figure_steady_curve
-    from ..plots.style import UM_PER_S
-
-    fig = figure_steady_curve(params, vmin=lo, vmax=hi)
-    if mark and stress is not None:  # the requested velocities, on the curve they were computed with
-        ax = fig.axes[0]
-        label = "requested (without aging)" if no_aging else "requested (with aging)"
-        ax.plot(values * UM_PER_S, stress, "s", markersize=6, color="#e67e22", label=label, zorder=8)
-        ax.legend(loc="lower right", frameon=False)
-    save_figure(fig, path)
+        fig = figure_steady_curve(params, vmin=lo, vmax=hi)
+        if stress is not None:  # the requested velocities, on the curve they were computed with
+            ax = fig.axes[0]
+            label = "requested (without aging)" if no_aging else "requested (with aging)"
+            ax.plot(values * UM_PER_S, stress, "s", markersize=6, color="#e67e22", label=label, zorder=8)
+            ax.legend(loc="lower right", frameon=False)
+        save_figure(fig, plot_path)
 
 
 @click.command("critical")

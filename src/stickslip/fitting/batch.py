@@ -43,16 +43,6 @@ def model_stress(params: Parameters, velocity: np.ndarray, aging: bool = True) -
     return stress
 
 
-def _loop(params_list: Sequence[Parameters], velocity: np.ndarray, aging: bool) -> np.ndarray:
-    out = np.full((len(params_list), velocity.size), np.nan)
-    for k, p in enumerate(params_list):
-        try:
-            out[k] = model_stress(p, velocity, aging=aging)
-        except (ModelError, ParameterError):
-            pass
-    return out
-
-
 def stress_many(params_list: Sequence[Parameters], velocity: np.ndarray, aging: bool = True) -> np.ndarray:
     """sigma(V) of Eqs 6-8, shape (len(params_list), len(velocity)); NaN rows where the model fails."""
     velocity = np.asarray(velocity, dtype=float).ravel()
@@ -63,4 +53,10 @@ def stress_many(params_list: Sequence[Parameters], velocity: np.ndarray, aging: 
             return out
     except (ModelError, ParameterError):
         pass
-    return _loop(params_list, velocity, aging)  # isolate the sets that fail
+    out = np.full((len(params_list), velocity.size), np.nan)
+    for k, p in enumerate(params_list):  # each alone: only the sets that fail are NaN
+        try:
+            out[k] = model_stress(p, velocity, aging=aging)
+        except (ModelError, ParameterError):
+            pass
+    return out

@@ -24,7 +24,7 @@ from . import identify
 from .batch import stress_many
 from .critical_uncertainty import critical_many
 from .problem import SEARCH_BOX, Space, jacobian, make_block, minimize
-from .results import Estimate, display_unit
+from .results import CRITICAL, Estimate, display_unit, undetermined_critical
 
 if TYPE_CHECKING:  # pragma: no cover
     import pandas as pd
@@ -380,11 +380,11 @@ def _fitted_moves(emcee: Any, samples: np.ndarray, fallback: Any) -> Any:
 def _moves(emcee: Any, centre: np.ndarray, covariance: np.ndarray) -> Any:
     """Half independence proposals, half differential-evolution moves (see the module docstring)."""
     evolution = emcee.moves.DEMove()
-    if not np.all(np.isfinite(covariance)):
-        return [(evolution, 0.8), (emcee.moves.DESnookerMove(), 0.2)]
     try:
-        proposal = _Independence(centre, covariance)
+        proposal = _Independence(centre, covariance) if np.all(np.isfinite(covariance)) else None
     except np.linalg.LinAlgError:
+        proposal = None
+    if proposal is None:
         return [(evolution, 0.8), (emcee.moves.DESnookerMove(), 0.2)]
     return [(emcee.moves.MHMove(proposal), INDEPENDENCE_WEIGHT), (evolution, 1.0 - INDEPENDENCE_WEIGHT)]
 
@@ -588,18 +588,8 @@ def _critical_summaries(
     if guess is None or len(found) < 10:
         note = "too few posterior samples have a minimum of σ(V)"
         messages.append(note)
-        empty = np.zeros((0, 2))
-        return (
-            Estimate("critical_velocity", "Vc", "velocity", None, status="undetermined", note=note),
-            Estimate("critical_stress", "σc", "stress", None, status="undetermined", note=note),
-            empty,
-        )
-    values = found
+        return (*undetermined_critical(note), np.zeros((0, 2)))
     note = f"posterior of {len(found)} random samples"
     if missing:
         note += f" ({missing} without a minimum left out)"
-    return (
-        _summary("critical_velocity", "Vc", "velocity", values[:, 0], note),
-        _summary("critical_stress", "σc", "stress", values[:, 1], note),
-        values,
-    )
+    return _summary(*CRITICAL[0], found[:, 0], note), _summary(*CRITICAL[1], found[:, 1], note), found

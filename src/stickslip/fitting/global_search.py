@@ -66,12 +66,6 @@ def _evaluate(space: Space, thetas: np.ndarray, block: Block, scale: bool) -> tu
     return chi, factor
 
 
-def _sobol(dimension: int, count: int, seed: int) -> np.ndarray:
-    from scipy.stats import qmc
-
-    return qmc.Sobol(dimension, scramble=True, seed=seed).random(count)
-
-
 def _corner_grid(dimension: int) -> np.ndarray:
     """The 3^d points with every coordinate at the box's lower end, middle or upper end (unit box)."""
     axes = np.meshgrid(*([np.array([0.0, 0.5, 1.0])] * dimension), indexing="ij")
@@ -144,8 +138,9 @@ def global_start(base: Parameters, centre: Parameters, keys: Sequence[str], bloc
     middle = Space(centre, scanned).vector()
     lower, upper = middle - SEARCH_BOX, middle + SEARCH_BOX
     if scanned:
-        count = POINTS_PER_DIMENSION * len(scanned)
-        unit = _sobol(len(scanned), count, seed)
+        from scipy.stats import qmc
+
+        unit = qmc.Sobol(len(scanned), scramble=True, seed=seed).random(POINTS_PER_DIMENSION * len(scanned))
         if len(scanned) <= CORNER_DIMENSIONS:  # the best fit of a curve the model cannot follow is often on the edge
             unit = np.concatenate([unit, _corner_grid(len(scanned))])
         thetas = lower + (upper - lower) * unit

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 from typing import Any
@@ -78,6 +79,23 @@ class Estimate:
         if self.bias is not None:
             out["method_bias"] = self.bias
         return out
+
+
+def unusable(estimate: Estimate, why: str) -> Estimate:
+    """``estimate`` of a failed fit: undetermined, without error or interval (``why``); fixed ones stay."""
+    if estimate.fixed or estimate.interval is None:
+        return estimate
+    return dataclasses.replace(estimate, stderr=None, interval=None, status="undetermined", note=why)
+
+
+#: (key, symbol, dimension) of the critical point's estimates, Vc and sigma_c (Eq 9).
+CRITICAL = (("critical_velocity", "Vc", "velocity"), ("critical_stress", "σc", "stress"))
+
+
+def undetermined_critical(note: str) -> tuple[Estimate, Estimate]:
+    """Vc and sigma_c, not determined; ``note`` says why."""
+    vc, sc = (Estimate(*names, None, status="undetermined", note=note) for names in CRITICAL)
+    return vc, sc
 
 
 #: ln-widths beyond this give an unbounded upper end (e^700 ~ 1e304: no number, only "unbounded").

@@ -38,7 +38,7 @@ from .problem import (
     minimize,
     residuals,
 )
-from .results import Estimate, display_unit, human
+from .results import CRITICAL, Estimate, display_unit, human, undetermined_critical, unusable
 from .results import log_interval as _log_interval
 from .scatter import Dependence, Misfit, Scatter, local_scatter, misfit, velocity_dependence
 
@@ -272,11 +272,8 @@ def _fit_block(
         progress.params = space.params(got.theta)
         dof = len(block) - len(keys)
         scale = 1.0 if progress.noise_known else math.sqrt(got.chi_square / dof)
-        if not keys:
-            progress.stages.append(Stage(name, (), len(block), got.chi_square, got.nfev, got.success, got.message))
-            return keys, got.theta
         jac = jacobian(Space(progress.params, tuple(keys)), got.theta, block)
-        bad = identify.undetermined(keys, jac, scale)
+        bad = identify.undetermined(keys, jac, scale) if keys else []
         if not bad:
             for key in got.at_edge:
                 progress.messages.append(
@@ -304,9 +301,14 @@ def _fix_undetermined(progress: _Progress, keys: list[str], direction: identify.
     )
 
 
-def _two_step(progress: _Progress, requested: Sequence[str], hi: Block, lo: Block, split: float) -> None:
+def _steps(requested: Sequence[str]) -> tuple[identify.Selection, list[str]]:
+    """The two-step method's keys: step 1's (no aging; those it can identify) and step 2's (aging)."""
     step1 = identify.select_identifiable([k for k in requested if k in identify.NO_AGING_KEYS], aging=False)
-    step2 = [k for k in requested if k in identify.AGING_KEYS]
+    return step1, [k for k in requested if k in identify.AGING_KEYS]
+
+
+def _two_step(progress: _Progress, requested: Sequence[str], hi: Block, lo: Block, split: float) -> None:
+    step1, step2 = _steps(requested)
     progress.messages.extend(step1.messages)
     v_split = human(split, "velocity")
     if len(hi) == 0 or len(lo) == 0:
@@ -324,26 +326,20 @@ def _joint_start(
     progress: _Progress, requested: Sequence[str], hi: Block, lo: Block, everything: Block, split: float
 ) -> None:
     """Start values for the joint fit: the two-step result when both velocity ranges can carry their step."""
-    n1 = len(identify.select_identifiable([k for k in requested if k in identify.NO_AGING_KEYS], aging=False).free)
-    n2 = len([k for k in requested if k in identify.AGING_KEYS])
-    if len(hi) > n1 and len(lo) > n2:
+    step1, step2 = _steps(requested)
+    if len(hi) > len(step1.free) and len(lo) > len(step2):
         _two_step(progress, requested, hi, lo, split)
     else:
         progress.params = _scaled_start(progress.params, everything, requested)
 
 
-def _free_after(progress: _Progress, requested: Sequence[str]) -> list[str]:
-    return [k for k in requested if k not in progress.undetermined]
-
-
-def _covariance_two_step(
-    params: Parameters, keys1: Sequence[str], keys2: Sequence[str], hi: Block, lo: Block, scale2: float
-) -> np.ndarray:
+def _covariance_two_step(params: Parameters, keys: Sequence[str], hi: Block, lo: Block, scale2: float) -> np.ndarray:
     """Covariance of the two-step estimator: step-1 uncertainty propagated through step 2 (docs/fitting.md)."""
+    keys1 = [k for k in keys if k in identify.NO_AGING_KEYS]
+    keys2 = [k for k in keys if k in identify.AGING_KEYS]
     p1, p2 = len(keys1), len(keys2)
     space1 = Space(params, tuple(keys1))
-    j11 = jacobian(space1, space1.vector(), hi)
-    c1 = scale2 * _inverse(j11.T @ j11)
+    c1 = scale2 * _gauss_newton(space1, space1.vector(), hi)
     if p2 == 0:
         return c1
     space2 = Space(params, tuple(keys2))
@@ -366,6 +362,12 @@ def _inverse(matrix: np.ndarray) -> np.ndarray:
     if values.min() <= values.max() * 1e-14:
         return np.full_like(matrix, np.inf)
     return (vectors / values) @ vectors.T
+
+
+def _gauss_newton(space: Space, theta: np.ndarray, block: Block) -> np.ndarray:
+    """(J^T J)^-1 of the weighted residuals at ``theta``: the covariance for unit noise."""
+    jac = jacobian(space, theta, block)
+    return _inverse(jac.T @ jac)
 
 
 def _quantile(level: float, dof: int, noise_known: bool) -> float:
@@ -430,38 +432,33 @@ def fit_steady(
     # the noise measured without the model: a fit far from the data must not set the yardstick it is judged by
     scatter = local_scatter(data.velocity, data.stress, data.stress_err)
     dependence = velocity_dependence(data.stress, data.stress_err, scatter)
+    check = _Check(
+        method, data, base, requested, explicit, fixed, split, scatter, intervals, level, bootstrap_samples, seed
+    )
     if not dependence.significant:  # nothing to fit: say so at once (a joint fit of noise ran 92 s before)
-        return _no_response_fit(data, base, method, split, intervals, level, requested, fixed, dependence, scatter)
+        return _no_response_fit(check, dependence)
     error, everything, hi, lo = _blocks(data, split, base)
-    progress, keys = _run_method(method, data, base, requested, explicit, fixed, (everything, hi, lo), split)
-    check = _Check(method, data, base, requested, explicit, fixed, split, scatter)
+    progress, keys = _run_method(check, (everything, hi, lo))
     progress, keys, adequacy = _adequate_or_searched(check, progress, keys, (everything, hi, lo))
     if not _interpolation_holds((everything, hi, lo), progress.params):
         # the curve changed shape on the way from the start: interpolate where the fit ended, and fit again
         restart = progress.params if adequacy.searched else None
         error, everything, hi, lo = _blocks(data, split, progress.params)
-        progress, keys = _run_method(
-            method, data, base, requested, explicit, fixed, (everything, hi, lo), split, start=restart
-        )
+        progress, keys = _run_method(check, (everything, hi, lo), start=restart)
         adequacy = _judge(check, progress, keys, everything, adequacy.searched)
     fitted = progress.params
     if auto_note:
         progress.messages.append(auto_note)
     full_r = residuals(Space(fitted, ()), np.zeros(0), everything)
     chi_square = everything.chi_square(full_r)
+    dof = len(data) - len(keys)
     if method == "joint":
-        dof = len(data) - len(keys)
         scale2 = 1.0 if noise_known else chi_square / dof
         space = Space(fitted, tuple(keys))
-        jac = jacobian(space, space.vector(), everything)
-        covariance = scale2 * _inverse(jac.T @ jac) if keys else np.zeros((0, 0))
+        covariance = scale2 * _gauss_newton(space, space.vector(), everything) if keys else np.zeros((0, 0))
     else:
-        keys1 = [k for k in keys if k in identify.NO_AGING_KEYS]
-        keys2 = [k for k in keys if k in identify.AGING_KEYS]
-        stage_chi = sum(s.chi_square for s in progress.stages)
-        dof = len(data) - len(keys)
-        scale2 = 1.0 if noise_known else stage_chi / dof
-        covariance = _covariance_two_step(fitted, keys1, keys2, hi, lo, scale2)
+        scale2 = 1.0 if noise_known else sum(s.chi_square for s in progress.stages) / dof
+        covariance = _covariance_two_step(fitted, keys, hi, lo, scale2)
         _warn_aging_neglected(progress, fitted, hi, math.sqrt(scale2))
     if dof <= 0:
         raise DataError(f"{data.source}: {len(data)} points for {len(keys)} free parameters; need more points")
@@ -469,8 +466,8 @@ def fit_steady(
     q = _quantile(level, dof, noise_known)
     sd = np.sqrt(np.clip(np.diag(covariance), 0.0, np.inf)) if keys else np.zeros(0)
     correlation = covariance / np.outer(sd, sd) if keys else np.zeros((0, 0))
-    estimates = _parameter_estimates(fitted, base, keys, sd, q, fixed, progress)
-    combos = _combination_estimates(fitted, keys, covariance, q, method)
+    estimates = _parameter_estimates(fitted, keys, sd, q, fixed, progress)
+    combos = _combination_estimates(fitted, keys, covariance, q)
     model = everything.model(fitted)
     noise = (
         "stated stress_err (chi-square not rescaled)"
@@ -479,21 +476,17 @@ def fit_steady(
     ) + f"; without the model, between neighbouring points: {scatter.describe()}"
     misfits = adequacy.problems()
     why = "the model does not describe the data (see the reason)"
-    vc = Estimate("critical_velocity", "Vc", "velocity", None, status="undetermined", note=why)
-    sc = Estimate("critical_stress", "σc", "stress", None, status="undetermined", note=why)
+    vc, sc = undetermined_critical(why)
     samples = None
     if not misfits:  # intervals (a profile or a bootstrap can take long) only for a curve the model describes
-        vc, sc, samples = _critical_estimates(
-            fitted, keys, covariance, q, intervals, level, dof, noise_known, everything, data, method, split,
-            fix, free, base, bootstrap_samples, seed, scale2, progress,
-        )  # fmt: skip
+        vc, sc, samples = _critical_estimates(check, fitted, keys, covariance, q, everything, scale2, progress)
         if method == "two-step" and vc.value is not None:
             vc, sc = _flag_split_bias(vc, sc, fitted, everything, keys, scale2, level, progress)
         _note_extrapolation(progress, vc, data)
     problems = _problems(progress, keys, fitted, base, covariance, chi_square, data) + misfits
     if misfits:
-        estimates = tuple(_undetermined(e, why) for e in estimates)
-        combos = tuple(_undetermined(e, why) for e in combos)
+        estimates = tuple(unusable(e, why) for e in estimates)
+        combos = tuple(unusable(e, why) for e in combos)
     return SteadyFit(
         data=data,
         parameters=fitted,
@@ -539,20 +532,11 @@ def _problems(
     if keys and not np.all(np.isfinite(covariance)):
         problems.append("the covariance could not be estimated: the data cannot tell the free parameters apart")
     stated_misfit = data.stress_err is not None and chi_square > 2.0 * max(len(data) - len(keys), 1)
-    if keys and all(_unmoved(fitted, base, k) for k in keys) and stated_misfit:  # a start that fits is no failure
+    now, start = fitted.as_dict(), base.as_dict()
+    unmoved = all(abs(now[k] - start[k]) <= 1e-9 * max(abs(start[k]), 1e-300) for k in keys)
+    if keys and unmoved and stated_misfit:  # a start that fits is no failure
         problems.append("the free parameters did not move from their start values, which do not fit the data")
     return problems
-
-
-def _unmoved(fitted: Parameters, base: Parameters, key: str) -> bool:
-    now, start = fitted.as_dict()[key], base.as_dict()[key]
-    return abs(now - start) <= 1e-9 * max(abs(start), 1e-300)
-
-
-def _undetermined(estimate: Estimate, why: str) -> Estimate:
-    if estimate.status in ("fixed",) or estimate.interval is None:
-        return estimate
-    return dataclasses.replace(estimate, stderr=None, interval=None, status="undetermined", note=why)
 
 
 #: A method's fit whose misfit the noise does not explain fails, when the model itself (its best fit on all
@@ -564,7 +548,7 @@ METHOD_TOLERANCE = 0.05
 
 @dataclass(frozen=True)
 class _Check:
-    """What the adequacy checks and the global search need to refit."""
+    """The fit's request: what the method, the adequacy checks, the global search and the intervals need."""
 
     method: str
     data: SteadyData
@@ -574,6 +558,10 @@ class _Check:
     fixed: Mapping[str, float]
     split: float
     scatter: Scatter
+    intervals: str
+    level: float
+    samples: int  # bootstrap refits
+    seed: int | None
 
 
 @dataclass(frozen=True)
@@ -664,8 +652,7 @@ def _adequate_or_searched(
     polished = _joint_refit(check, found.params, joint_keys, everything)
     polished_fit = _misfit_of(check, polished, everything, len(joint_keys))
     best_model = polished_fit if polished_fit.chi_square < first.model.chi_square else first.model
-    args = (check.data, check.base, check.requested, check.explicit, check.fixed, blocks, check.split)
-    again, again_keys = _run_method(check.method, *args, start=polished)
+    again, again_keys = _run_method(check, blocks, start=polished)
     again_fit = _misfit_of(check, again.params, everything, len(again_keys))
     if again_fit.chi_square < first.method_fit.chi_square:
         progress, keys, own = again, again_keys, again_fit
@@ -683,19 +670,9 @@ def _adequate_or_searched(
     return progress, keys, _Adequacy(best_model, own, check.method, found.evaluations, check.scatter)
 
 
-def _no_response_fit(
-    data: SteadyData,
-    base: Parameters,
-    method: str,
-    split: float,
-    intervals: str,
-    level: float,
-    requested: Sequence[str],
-    fixed: Mapping[str, float],
-    dependence: Dependence,
-    scatter: Scatter,
-) -> SteadyFit:
+def _no_response_fit(check: _Check, dependence: Dependence) -> SteadyFit:
     """The failed result for data whose stress does not vary by more than its noise: nothing is fitted."""
+    data, base = check.data, check.base
     why = "not fitted: the data show no velocity dependence"
     reason = f"{NO_RESPONSE_TEXT}: {dependence.text}; so Vc, σc and the parameters are not determined"
     error = data.stress_err if data.stress_err is not None else data.stress
@@ -708,10 +685,10 @@ def _no_response_fit(
     estimates = []
     for key in identify.STEADY_KEYS:
         symbol, dimension = identify.SYMBOLS[key], key_dimension(key)
-        if key in requested:
+        if key in check.requested:
             estimates.append(Estimate(key, symbol, dimension, values[key], status="undetermined", note=why))
         else:
-            note = "fixed by request" if key in fixed else "held at its input value"
+            note = "fixed by request" if key in check.fixed else "held at its input value"
             estimates.append(Estimate(key, symbol, dimension, values[key], status="fixed", note=note))
     combos = tuple(
         Estimate(c.name, c.symbol, c.dimension, c.value(base), status="undetermined", note=why)
@@ -719,13 +696,14 @@ def _no_response_fit(
     )
     noise = (
         "stated stress_err" if data.stress_err is not None else "relative"
-    ) + f"; between neighbouring points: {scatter.describe()}"
+    ) + f"; between neighbouring points: {check.scatter.describe()}"
+    vc, sc = undetermined_critical(why)
     return SteadyFit(
         data=data,
         parameters=base,
         start=base,
-        method=method,
-        split=split if method == "two-step" else None,
+        method=check.method,
+        split=check.split if check.method == "two-step" else None,
         estimates=tuple(estimates),
         combinations=combos,
         free_keys=(),
@@ -737,10 +715,10 @@ def _no_response_fit(
         noise_scale=noise_scale,
         model_stress=np.full(len(data), flat),
         residuals=(data.stress - flat) / (error * noise_scale),
-        critical_velocity=Estimate("critical_velocity", "Vc", "velocity", None, status="undetermined", note=why),
-        critical_stress=Estimate("critical_stress", "σc", "stress", None, status="undetermined", note=why),
-        interval_method=intervals,
-        level=level,
+        critical_velocity=vc,
+        critical_stress=sc,
+        interval_method=check.intervals,
+        level=check.level,
         stages=(),
         messages=(
             *data.notes(),
@@ -753,24 +731,17 @@ def _no_response_fit(
 
 
 def _run_method(
-    method: str,
-    data: SteadyData,
-    base: Parameters,
-    requested: Sequence[str],
-    explicit: Sequence[str],
-    fixed: Mapping[str, float],
-    blocks: tuple[Block, Block, Block],
-    split: float,
-    start: Parameters | None = None,
+    check: _Check, blocks: tuple[Block, Block, Block], start: Parameters | None = None
 ) -> tuple[_Progress, list[str]]:
-    """The least-squares steps of ``method`` from ``start`` (default ``base``, which also centres the search
+    """The least-squares steps of the method from ``start`` (default the base set, which also centres the search
     box and gives the values of what is fixed): the progress record and the fitted keys."""
     everything, hi, lo = blocks
-    progress = _Progress(start or base, base, tuple(explicit), data.stress_err is not None, [], [], [])
-    progress.messages.append(_structure_note(requested, fixed))
-    if method == "joint":
+    base, requested = check.base, check.requested
+    progress = _Progress(start or base, base, tuple(check.explicit), check.data.stress_err is not None, [], [], [])
+    progress.messages.append(_structure_note(requested, check.fixed))
+    if check.method == "joint":
         if start is None:
-            _joint_start(progress, requested, hi, lo, everything, split)
+            _joint_start(progress, requested, hi, lo, everything, check.split)
         # the two-step result is only the start: what the joint fit cannot determine is decided afresh
         progress.messages = progress.messages[:1]
         progress.stages = [dataclasses.replace(s, name=f"start, {s.name}") for s in progress.stages]
@@ -779,10 +750,9 @@ def _run_method(
         progress.messages.extend(selection.messages)
         keys, _ = _fit_block(progress, selection.free, everything, "the joint fit", precheck=True)
         return progress, keys
-    _two_step(progress, requested, hi, lo, split)
-    step_keys = _free_after(progress, requested)
-    keys = [k for k in step_keys if k in identify.NO_AGING_KEYS] + [k for k in step_keys if k in identify.AGING_KEYS]
-    return progress, [k for k in keys if _stage_has(progress.stages, k)]
+    _two_step(progress, requested, hi, lo, check.split)
+    kept = [k for k in requested if k not in progress.undetermined and any(k in s.keys for s in progress.stages)]
+    return progress, [k for k in kept if k in identify.NO_AGING_KEYS] + [k for k in kept if k in identify.AGING_KEYS]
 
 
 def _interpolation_holds(blocks: Sequence[Block], params: Parameters) -> bool:
@@ -820,8 +790,7 @@ def _flag_split_bias(
         located = local_critical(joint_space.base, float(vc.value))  # type: ignore[arg-type]
         if located is None:
             return vc, sc
-        jac = jacobian(joint_space, theta, everything)
-        covariance = scale2 * _inverse(jac.T @ jac)
+        covariance = scale2 * _gauss_newton(joint_space, theta, everything)
         gradients = critical_gradient(joint_space, theta, located[0])
     except (ModelError, ParameterError):  # pragma: no cover - the two-step optimum is a valid start
         return vc, sc
@@ -867,10 +836,6 @@ def _bracket(lo: float | None, hi: float | None, dimension: str) -> str:
     return f"[{end(lo)}, {end(hi)}]"
 
 
-def _stage_has(stages: Sequence[Stage], key: str) -> bool:
-    return any(key in s.keys for s in stages)
-
-
 def _structure_note(requested: Sequence[str], fixed: Mapping[str, float]) -> str:
     held = [k for k in identify.STEADY_KEYS if k not in requested]
     combos = ", ".join(identify.combination_names())
@@ -903,13 +868,7 @@ def _warn_aging_neglected(progress: _Progress, params: Parameters, hi: Block, no
 
 
 def _parameter_estimates(
-    fitted: Parameters,
-    base: Parameters,
-    keys: Sequence[str],
-    sd: np.ndarray,
-    q: float,
-    fixed: Mapping[str, float],
-    progress: _Progress,
+    fitted: Parameters, keys: Sequence[str], sd: np.ndarray, q: float, fixed: Mapping[str, float], progress: _Progress
 ) -> tuple[Estimate, ...]:
     values = fitted.as_dict()
     out = []
@@ -934,7 +893,7 @@ def _parameter_estimates(
 
 
 def _combination_estimates(
-    fitted: Parameters, keys: Sequence[str], covariance: np.ndarray, q: float, method: str
+    fitted: Parameters, keys: Sequence[str], covariance: np.ndarray, q: float
 ) -> tuple[Estimate, ...]:
     matrix = identify.exponent_matrix(keys) if keys else np.zeros((len(identify.COMBINATIONS), 0))
     cov = matrix @ covariance @ matrix.T if keys else np.zeros((len(identify.COMBINATIONS),) * 2)
@@ -961,23 +920,12 @@ def _note_extrapolation(progress: _Progress, vc: Estimate, data: SteadyData) -> 
 
 
 def _critical_estimates(
+    check: _Check,
     fitted: Parameters,
     keys: Sequence[str],
     covariance: np.ndarray,
     q: float,
-    intervals: str,
-    level: float,
-    dof: int,
-    noise_known: bool,
     everything: Block,
-    data: SteadyData,
-    method: str,
-    split: float,
-    fix: Mapping[str, Any] | None,
-    free: Sequence[str] | None,
-    base: Parameters,
-    bootstrap_samples: int,
-    seed: int | None,
     scale2: float,
     progress: _Progress,
 ) -> tuple[Estimate, Estimate, dict[str, np.ndarray] | None]:
@@ -985,45 +933,24 @@ def _critical_estimates(
     if not point.exists:
         message = f"the fitted curve has no minimum: {point.message}"
         progress.messages.append(message)
-        return (
-            Estimate("critical_velocity", "Vc", "velocity", None, status="undetermined", note=message),
-            Estimate("critical_stress", "σc", "stress", None, status="undetermined", note=message),
-            None,
-        )
+        return (*undetermined_critical(message), None)
     vc, sc = float(point.velocity), float(point.stress)
     space = Space(fitted, tuple(keys))
-    theta = space.vector()
-    if intervals == "delta" or not keys:
-        grad_v, grad_s = critical_gradient(space, theta, vc) if keys else (np.zeros(0), np.zeros(0))
-        sd_v = math.sqrt(max(float(grad_v @ covariance @ grad_v), 0.0)) if keys else 0.0
-        sd_s = math.sqrt(max(float(grad_s @ covariance @ grad_s), 0.0)) if keys else 0.0
+    if check.intervals == "delta" or not keys:
+        gradients = critical_gradient(space, space.vector(), vc) if keys else (np.zeros(0), np.zeros(0))
         note = "first-order propagation (delta method) of the parameter covariance, interval symmetric in ln"
-        return (
-            Estimate("critical_velocity", "Vc", "velocity", vc, vc * sd_v, _log_interval(vc, sd_v, q), "derived", note),
-            Estimate("critical_stress", "σc", "stress", sc, sc * sd_s, _log_interval(sc, sd_s, q), "derived", note),
-            None,
-        )
-    if intervals == "profile":
-        return (
-            *_profile_estimates(fitted, keys, covariance, vc, sc, level, dof, noise_known, everything, progress),
-            None,
-        )
-    return _bootstrap_estimates(
-        fitted, vc, sc, data, method, split, fix, free, base, bootstrap_samples, seed, scale2, level, progress
-    )
+        out = []
+        for names, value, grad in zip(CRITICAL, (vc, sc), gradients, strict=True):
+            sd = math.sqrt(max(float(grad @ covariance @ grad), 0.0))
+            out.append(Estimate(*names, value, value * sd, _log_interval(value, sd, q), "derived", note))
+        return out[0], out[1], None
+    if check.intervals == "profile":
+        return (*_profile_estimates(fitted, keys, vc, sc, check.level, everything, progress), None)
+    return _bootstrap_estimates(check, fitted, vc, sc, scale2, progress)
 
 
 def _profile_estimates(
-    fitted: Parameters,
-    keys: Sequence[str],
-    covariance: np.ndarray,
-    vc: float,
-    sc: float,
-    level: float,
-    dof: int,
-    noise_known: bool,
-    everything: Block,
-    progress: _Progress,
+    fitted: Parameters, keys: Sequence[str], vc: float, sc: float, level: float, everything: Block, progress: _Progress
 ) -> tuple[Estimate, Estimate]:
     """Profile-likelihood intervals of the joint fit over its free keys (fixed keys stay fixed)."""
     space = Space(fitted, tuple(keys))
@@ -1035,36 +962,28 @@ def _profile_estimates(
         vc, sc = located
     profile = Profile(space, everything, centre)
     profile_dof = max(len(everything) - len(keys), 1)
-    if noise_known:
+    if progress.noise_known:
         threshold, scale = float(stats.chi2.ppf(level, 1)), 1.0
     else:
         threshold, scale = float(stats.f.ppf(level, 1, profile_dof)), best.chi_square / profile_dof
     grad_v, grad_s = critical_gradient(space, theta, vc)
-    cov = _inverse_or_none(space, theta, everything, scale)
+    cov = _gauss_newton(space, theta, everything)
+    cov = scale * cov if np.all(np.isfinite(cov)) else None
     guess_v = math.sqrt(max(float(grad_v @ cov @ grad_v), 1e-6)) if cov is not None else 0.1
     guess_s = math.sqrt(max(float(grad_s @ cov @ grad_s), 1e-6)) if cov is not None else 0.05
-    ends_v = [
-        profile.end(
-            profile.chi_square_at_velocity, math.log(vc), theta, best.chi_square, threshold, scale, guess_v, side
+    both_ends = [
+        [profile.end(chi_at, math.log(x), start, best.chi_square, threshold, scale, sd, side) for side in (-1, 1)]
+        for chi_at, x, start, sd in (
+            (profile.chi_square_at_velocity, vc, theta, guess_v),
+            (profile.chi_square_at_stress, sc, np.append(theta, math.log(vc)), guess_s),
         )
-        for side in (-1, 1)
-    ]
-    start_s = np.append(theta, math.log(vc))
-    ends_s = [
-        profile.end(
-            profile.chi_square_at_stress, math.log(sc), start_s, best.chi_square, threshold, scale, guess_s, side
-        )
-        for side in (-1, 1)
     ]
     note = "profile likelihood"
     if progress.undetermined:
         note += f", conditional on {', '.join(progress.undetermined)}"
     out = []
-    q = _quantile(level, profile_dof, noise_known)
-    for name, symbol, dim, value, ends, sd in (
-        ("critical_velocity", "Vc", "velocity", vc, ends_v, guess_v),
-        ("critical_stress", "σc", "stress", sc, ends_s, guess_s),
-    ):
+    q = _quantile(level, profile_dof, progress.noise_known)
+    for (name, symbol, dim), value, ends, sd in zip(CRITICAL, (vc, sc), both_ends, (guess_v, guess_s), strict=True):
         interval = tuple(None if e.value is None else math.exp(e.value) for e in ends)
         lo, hi = interval
         extra = ""
@@ -1082,46 +1001,28 @@ def _profile_estimates(
     return out[0], out[1]
 
 
-def _inverse_or_none(space: Space, theta: np.ndarray, block: Block, scale: float) -> np.ndarray | None:
-    jac = jacobian(space, theta, block)
-    cov = _inverse(jac.T @ jac)
-    return None if not np.all(np.isfinite(cov)) else scale * cov
-
-
 def _bootstrap_estimates(
-    fitted: Parameters,
-    vc: float,
-    sc: float,
-    data: SteadyData,
-    method: str,
-    split: float,
-    fix: Mapping[str, Any] | None,
-    free: Sequence[str] | None,
-    base: Parameters,
-    samples: int,
-    seed: int | None,
-    scale2: float,
-    level: float,
-    progress: _Progress,
+    check: _Check, fitted: Parameters, vc: float, sc: float, scale2: float, progress: _Progress
 ) -> tuple[Estimate, Estimate, dict[str, np.ndarray]]:
     """Parametric bootstrap: refit curves simulated from the fit with its noise; percentile intervals."""
-    rng = np.random.default_rng(seed)
+    data, split = check.data, check.split
+    rng = np.random.default_rng(check.seed)
     model = steady_state(fitted, data.velocity).stress
     sigma = (data.stress_err if data.stress_err is not None else model) * math.sqrt(scale2)
-    held = dict(fix or {})
+    held = dict(check.fixed)
     for key in progress.undetermined:
-        held[key] = base.as_dict()[key]
+        held[key] = check.base.as_dict()[key]
     found_v, found_s, failed = [], [], 0
     _, everything, hi, lo = _blocks(data, split, fitted)
     high = data.velocity >= split
-    for _ in range(samples):
+    for _ in range(check.samples):
         fake = model + sigma * rng.standard_normal(model.size)
         if np.any(fake <= 0):
             failed += 1
             continue
         blocks = (everything.with_stress(fake), hi.with_stress(fake[high]), lo.with_stress(fake[~high]))
         try:
-            refit = _point_fit(blocks, fitted, method, held, free)
+            refit = _point_fit(blocks, fitted, check.method, held, check.explicit)
         except (DataError, ParameterError):
             failed += 1
             continue
@@ -1131,22 +1032,17 @@ def _bootstrap_estimates(
             continue
         found_v.append(located[0])
         found_s.append(located[1])
-    tail = (1 - level) / 2
+    tail = (1 - check.level) / 2
     note = f"parametric bootstrap, {len(found_v)} refits, percentile interval"
     if failed:
         note += f" ({failed} simulated data sets gave no fit or no minimum and were left out)"
     out = []
-    for name, symbol, dim, value, sample in (
-        ("critical_velocity", "Vc", "velocity", vc, np.array(found_v)),
-        ("critical_stress", "σc", "stress", sc, np.array(found_s)),
-    ):
+    for names, value, sample in zip(CRITICAL, (vc, sc), (np.array(found_v), np.array(found_s)), strict=True):
         if sample.size < 10:
-            out.append(Estimate(name, symbol, dim, value, None, None, "derived", note + ": too few to use"))
+            out.append(Estimate(*names, value, None, None, "derived", note + ": too few to use"))
             continue
         lo, hi = np.quantile(sample, [tail, 1 - tail])
-        out.append(
-            Estimate(name, symbol, dim, value, float(np.std(sample, ddof=1)), (float(lo), float(hi)), "derived", note)
-        )
+        out.append(Estimate(*names, value, float(np.std(sample, ddof=1)), (float(lo), float(hi)), "derived", note))
     return out[0], out[1], {"critical_velocity": np.array(found_v), "critical_stress": np.array(found_s)}
 
 
@@ -1154,20 +1050,19 @@ def _point_fit(
     blocks: tuple[Block, Block, Block],
     start: Parameters,
     method: str,
-    fix: Mapping[str, Any],
-    free: Sequence[str] | None,
+    held: Mapping[str, float],
+    explicit: Sequence[str],
 ) -> Parameters:
     """Best-fit parameters only (no covariance, no identifiability loop): the bootstrap's refit."""
-    params, fixed = _resolve_fix(start, fix)
-    _, requested = _requested([k for k in free or () if k not in fixed], fixed)
+    params = start.with_overrides(held) if held else start
+    _, requested = _requested([k for k in explicit if k not in held], held)
     everything, hi, lo = blocks
-    step1 = identify.select_identifiable([k for k in requested if k in identify.NO_AGING_KEYS], aging=False).free
-    step2 = [k for k in requested if k in identify.AGING_KEYS]
-    for keys, block in ((step1, hi), (step2, lo)):
+    step1, step2 = _steps(requested)
+    for keys, block in ((step1.free, hi), (step2, lo)):
         space = Space(params, tuple(keys))
         params = space.params(minimize(space, space.vector(), block).theta)
     if method == "joint":
-        keys = identify.select_identifiable([*step1, *step2], aging=True).free
+        keys = identify.select_identifiable([*step1.free, *step2], aging=True).free
         space = Space(params, tuple(keys))
         params = space.params(minimize(space, space.vector(), everything).theta)
     return params

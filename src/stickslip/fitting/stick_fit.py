@@ -9,7 +9,6 @@ ln(model/measured); a direction the data do not determine is fixed with a messag
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
@@ -27,7 +26,7 @@ from ..units import to_si
 from . import identify
 from .data import StickData, read_stick_data
 from .problem import JACOBIAN_STEP, SEARCH_BOX
-from .results import Estimate, human, log_interval
+from .results import Estimate, human, log_interval, unusable
 from .stick_batch import stick_times
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -337,7 +336,8 @@ def fit_stick(
             raise ParameterError(f"{key} is given both to --fix and to --free")
     keys = [k for k in STICK_KEYS if k not in fixed]
     used, excluded, sigma_c, messages = _select_rows(data, base, exclude_rows, include_steady)
-    rows, fitted_peak = _rows(data, used, base, sigma_c, messages)
+    start, rate = _start_column(data, sigma_c), _rate_column(data, base)
+    rows, fitted_peak = _rows(data, used, start, rate, sigma_c, messages)
     n_obs = rows.stick_time.size + (0 if rows.peak is None else rows.peak.size)
     if rows.stick_time.size < 2:
         raise DataError(f"{data.source}: {rows.stick_time.size} usable row(s); need at least 2 stick phases to fit")
@@ -390,10 +390,7 @@ def fit_stick(
         else:
             reason = "fixed by request" if key in fixed else "not determined by the data; fixed at its input value"
             estimates.append(Estimate(key, identify.SYMBOLS[key], dim, value, status="fixed", note=reason))
-    full = _Rows(data.pulling_velocity, _start_column(data, sigma_c), _rate_column(data, base), data.stick_time, None)
-    times, peaks, problems = _model(
-        current, _Rows(*(a[used] for a in (full.velocity, full.start, full.rate, full.stick_time)), None)
-    )
+    times, peaks, problems = _model(current, rows)
     model_t = np.full(len(data), np.nan)
     model_s = np.full(len(data), np.nan)
     model_t[used], model_s[used] = times, peaks
@@ -402,9 +399,9 @@ def fit_stick(
     if dof <= 0:
         messages.append("no degrees of freedom left: the noise cannot be estimated and the errors are undefined")
     noise = f"relative (ln), estimated from the scatter: {100 * math.sqrt(scale2):.3g} %" if dof > 0 else "undefined"
-    problems = _stick_problems(data, used, rows, current, keys, fixed, dof, scale2, problems)
+    problems = _stick_problems(rows, current, keys, fixed, dof, scale2, problems)
     if problems:
-        estimates = [_unusable(e) for e in estimates]
+        estimates = [unusable(e, "the fit failed") for e in estimates]
     return StickFit(
         data=data,
         parameters=current,
@@ -415,8 +412,8 @@ def fit_stick(
         correlation=correlation,
         used=used,
         excluded=excluded,
-        start_stress=full.start,
-        loading_rate=full.rate,
+        start_stress=start,
+        loading_rate=rate,
         model_stick_time=model_t,
         model_peak_stress=model_s,
         fitted_peak_stress=fitted_peak,
@@ -441,12 +438,6 @@ STICK_SIGNIFICANCE = 1e-3
 SAME_VELOCITY = 1e-6
 
 
-def _unusable(estimate: Estimate) -> Estimate:
-    if estimate.fixed:
-        return estimate
-    return dataclasses.replace(estimate, stderr=None, interval=None, status="undetermined", note="the fit failed")
-
-
 def _groups(velocity: np.ndarray) -> list[np.ndarray]:
     """Indices of the rows at each distinct pulling velocity."""
     order = np.argsort(velocity)
@@ -460,8 +451,6 @@ def _groups(velocity: np.ndarray) -> list[np.ndarray]:
 
 
 def _stick_problems(
-    data: StickData,
-    used: np.ndarray,
     rows: _Rows,
     fitted: Parameters,
     keys: Sequence[str],
@@ -605,15 +594,13 @@ def _rate_column(data: StickData, params: Parameters) -> np.ndarray:
 
 
 def _rows(
-    data: StickData, used: np.ndarray, params: Parameters, sigma_c: float | None, messages: list[str]
+    data: StickData, used: np.ndarray, start: np.ndarray, rate: np.ndarray, sigma_c: float | None, messages: list[str]
 ) -> tuple[_Rows, bool]:
-    start = _start_column(data, sigma_c)
     if data.start_stress is None or np.any(~np.isfinite(data.start_stress[used])):
         messages.append(
             f"rows without start_stress start at the critical stress σc = {human(sigma_c or 0.0, 'stress')} of the"
             " bond parameters"
         )
-    rate = _rate_column(data, params)
     measured = "stick_slope" in data.extra
     if measured:
         messages.append("loading rate of each stick phase from its measured stick_slope (instead of K·V0 of Eq 17)")
