@@ -175,3 +175,13 @@ def test_cli_fit_stick_fails_with_exit_3_and_no_output(tmp_path, capsys):
     assert code == 3 and not toml.exists()
     assert "stickslip: fit failed:" in err and "not written" in err
     assert json.loads(out)["status"] == "failed"
+
+
+def test_stick_fit_frame_of_the_shipped_table_names_every_unit():
+    """The shipped Table 1 carries extra columns (cycle, stick_slope, stiffness, jump_velocity): the fit's frame
+    keeps them with their SI units (read in kPa/m and um/s, held in Pa/m and m/s), a cycle number with none."""
+    frame = fit_stick(datasets.table1_path()).to_frame()
+    units = frame.attrs["units"]
+    assert units["stiffness"] == "Pa/m" and units["jump_velocity"] == "m/s" and units["stick_slope"] == "Pa/s"
+    assert units["cycle"] is None and units["model_stick_time"] == "s"
+    assert frame["stiffness"].iloc[0] == pytest.approx(431e3)  # 431 kPa/m in the file

@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..columns import with_units
+from ..columns import unit_of, with_units
 from ..errors import DataError
 from ..tables import Table, read_table
 
@@ -149,7 +149,16 @@ class StickData:
         if self.start_stress is not None:
             frame["start_stress"] = self.start_stress
         frame.update(self.extra)
-        return with_units(pd.DataFrame(frame), {name: None for name in self.extra})
+        # the extra columns are read in SI: the registry's unit where it knows the name (a cycle number has none)
+        return with_units(pd.DataFrame(frame), {name: None for name in self.extra if not _registered(name)})
+
+
+def _registered(name: str) -> bool:
+    try:
+        unit_of(name)
+    except KeyError:
+        return False
+    return True
 
 
 def read_steady_data(path: str | Path) -> SteadyData:

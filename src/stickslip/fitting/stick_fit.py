@@ -87,7 +87,7 @@ class StickFit:
         frame["loading_rate"] = self.loading_rate
         frame["model_stick_time"] = self.model_stick_time
         frame["model_peak_stress"] = self.model_peak_stress
-        return with_units(frame)
+        return with_units(frame, frame.attrs["units"])  # the table's own extra columns keep their units
 
     def as_dict(self) -> dict[str, Any]:
         return {
