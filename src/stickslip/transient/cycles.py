@@ -26,9 +26,7 @@ SLIP_FACTOR = 2.0
 
 
 def stuck_mask(time: np.ndarray, velocity: np.ndarray, protocol: Protocol) -> np.ndarray:
-    vp = protocol.velocity_at(np.minimum(time, np.nextafter(protocol.duration, 0.0)))
-    reference = np.maximum(vp, np.max(protocol.velocities))  # holds (vp = 0) keep the sliding scale
-    return velocity < STUCK_FRACTION * np.where(vp > 0, vp, reference)
+    return velocity < STUCK_FRACTION * _pace(time, protocol)
 
 
 def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
@@ -112,19 +110,7 @@ def _trace_cycles(
         slip_time = None
         if end is not None:
             slip_time = _extremum(time, stress, velocity, pace, end, stiffness, highest=False)[0] - t_peak
-        stick_time = t_peak - start_time
-        cycles.append(
-            Cycle(
-                index=len(cycles),
-                start_time=start_time,
-                start_stress=start_stress,
-                peak_stress=sigma_s,
-                stick_time=stick_time,
-                jump_velocity=jump,
-                slip_time=slip_time,
-                period=None if slip_time is None else stick_time + slip_time,
-            )
-        )
+        cycles.append(_cycle(len(cycles), start_time, start_stress, sigma_s, t_peak - start_time, jump, slip_time))
         if end is None:
             break
         stick_from = end
@@ -190,21 +176,15 @@ def _cycles_from_events(events: list) -> tuple[Cycle, ...]:
             continue
         _, t_stick, sigma_stick, _ = marks[k - 1]
         nxt = next((t for kind2, t, _, _ in marks[k + 1 :] if kind2 == "stick"), None)
-        stick_time = t_slip - t_stick
         slip_time = None if nxt is None else nxt - t_slip
-        cycles.append(
-            Cycle(
-                index=len(cycles),
-                start_time=t_stick,
-                start_stress=sigma_stick,
-                peak_stress=sigma_s,
-                stick_time=stick_time,
-                jump_velocity=v_jump,
-                slip_time=slip_time,
-                period=None if slip_time is None else stick_time + slip_time,
-            )
-        )
+        cycles.append(_cycle(len(cycles), t_stick, sigma_stick, sigma_s, t_slip - t_stick, v_jump, slip_time))
     return tuple(cycles)
+
+
+def _cycle(index: int, start: float, sigma: float, peak: float, stick: float, jump: float, slip: float | None) -> Cycle:
+    """A Cycle; its period stick + slip once the slip has ended."""
+    period = None if slip is None else stick + slip
+    return Cycle(index, start, sigma, peak, stick, jump, slip, period)
 
 
 def classify(
