@@ -88,7 +88,8 @@ def _trace_cycles(
     ahead = velocity > pace
     runs = [(a, z) for a, z in _runs(ahead) if a > 0]  # a run from the first row is the start, not a slip
     cycles: list[Cycle] = []
-    stick_from = _first_stick(ahead)
+    behind = np.flatnonzero(~ahead)  # the first stick starts at the first row, or after a start faster than the puller
+    stick_from = int(behind[0]) if behind.size else ahead.size
     for a, z in runs:
         if a <= stick_from:
             continue
@@ -104,9 +105,9 @@ def _trace_cycles(
         if stick_from > 0:  # the previous slip's end: the trough of the solution, not of the rows kept
             start_time, start_stress = _extremum(time, stress, velocity, pace, stick_from, stiffness, highest=False)
             if lowest is not None:  # the solver's own lowest: exact, where a cubic over long rows may undershoot
-                start_stress = _lowest(
-                    min(float(stress[stick_from - 1]), float(stress[stick_from])), lowest, stick_from
-                )
+                start_stress = min(float(stress[stick_from - 1]), float(stress[stick_from]))
+                if math.isfinite(lowest[stick_from]):  # the lowest of the solver's steps since the row before
+                    start_stress = min(start_stress, float(lowest[stick_from]))
         slip_time = None
         if end is not None:
             slip_time = _extremum(time, stress, velocity, pace, end, stiffness, highest=False)[0] - t_peak
@@ -115,19 +116,6 @@ def _trace_cycles(
             break
         stick_from = end
     return tuple(cycles)
-
-
-def _first_stick(ahead: np.ndarray) -> int:
-    """The row where the first stick starts: the first, or the first after a start faster than the puller."""
-    behind = np.flatnonzero(~ahead)
-    return int(behind[0]) if behind.size else ahead.size
-
-
-def _lowest(value: float, lowest: np.ndarray | None, row: int) -> float:
-    """The lower of ``value`` and the lowest stress of the solver's steps since the row before ``row``."""
-    if lowest is not None and math.isfinite(lowest[row]):
-        return min(value, float(lowest[row]))
-    return value
 
 
 def _extremum(
