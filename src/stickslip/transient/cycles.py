@@ -26,9 +26,7 @@ SLIP_FACTOR = 2.0
 
 
 def stuck_mask(time: np.ndarray, velocity: np.ndarray, protocol: Protocol) -> np.ndarray:
-    vp = protocol.velocity_at(np.minimum(time, np.nextafter(protocol.duration, 0.0)))
-    reference = np.maximum(vp, np.max(protocol.velocities))  # holds (vp = 0) keep the sliding scale
-    return velocity < STUCK_FRACTION * np.where(vp > 0, vp, reference)
+    return velocity < STUCK_FRACTION * _pace(time, protocol)
 
 
 def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
@@ -90,7 +88,8 @@ def _trace_cycles(
     ahead = velocity > pace
     runs = [(a, z) for a, z in _runs(ahead) if a > 0]  # a run from the first row is the start, not a slip
     cycles: list[Cycle] = []
-    stick_from = _first_stick(ahead)
+    behind = np.flatnonzero(~ahead)  # the first stick starts at the first row, or after a start faster than the puller
+    stick_from = int(behind[0]) if behind.size else ahead.size
     for a, z in runs:
         if a <= stick_from:
             continue
@@ -106,42 +105,17 @@ def _trace_cycles(
         if stick_from > 0:  # the previous slip's end: the trough of the solution, not of the rows kept
             start_time, start_stress = _extremum(time, stress, velocity, pace, stick_from, stiffness, highest=False)
             if lowest is not None:  # the solver's own lowest: exact, where a cubic over long rows may undershoot
-                start_stress = _lowest(
-                    min(float(stress[stick_from - 1]), float(stress[stick_from])), lowest, stick_from
-                )
+                start_stress = min(float(stress[stick_from - 1]), float(stress[stick_from]))
+                if math.isfinite(lowest[stick_from]):  # the lowest of the solver's steps since the row before
+                    start_stress = min(start_stress, float(lowest[stick_from]))
         slip_time = None
         if end is not None:
             slip_time = _extremum(time, stress, velocity, pace, end, stiffness, highest=False)[0] - t_peak
-        stick_time = t_peak - start_time
-        cycles.append(
-            Cycle(
-                index=len(cycles),
-                start_time=start_time,
-                start_stress=start_stress,
-                peak_stress=sigma_s,
-                stick_time=stick_time,
-                jump_velocity=jump,
-                slip_time=slip_time,
-                period=None if slip_time is None else stick_time + slip_time,
-            )
-        )
+        cycles.append(_cycle(len(cycles), start_time, start_stress, sigma_s, t_peak - start_time, jump, slip_time))
         if end is None:
             break
         stick_from = end
     return tuple(cycles)
-
-
-def _first_stick(ahead: np.ndarray) -> int:
-    """The row where the first stick starts: the first, or the first after a start faster than the puller."""
-    behind = np.flatnonzero(~ahead)
-    return int(behind[0]) if behind.size else ahead.size
-
-
-def _lowest(value: float, lowest: np.ndarray | None, row: int) -> float:
-    """The lower of ``value`` and the lowest stress of the solver's steps since the row before ``row``."""
-    if lowest is not None and math.isfinite(lowest[row]):
-        return min(value, float(lowest[row]))
-    return value
 
 
 def _extremum(
@@ -190,21 +164,15 @@ def _cycles_from_events(events: list) -> tuple[Cycle, ...]:
             continue
         _, t_stick, sigma_stick, _ = marks[k - 1]
         nxt = next((t for kind2, t, _, _ in marks[k + 1 :] if kind2 == "stick"), None)
-        stick_time = t_slip - t_stick
         slip_time = None if nxt is None else nxt - t_slip
-        cycles.append(
-            Cycle(
-                index=len(cycles),
-                start_time=t_stick,
-                start_stress=sigma_stick,
-                peak_stress=sigma_s,
-                stick_time=stick_time,
-                jump_velocity=v_jump,
-                slip_time=slip_time,
-                period=None if slip_time is None else stick_time + slip_time,
-            )
-        )
+        cycles.append(_cycle(len(cycles), t_stick, sigma_stick, sigma_s, t_slip - t_stick, v_jump, slip_time))
     return tuple(cycles)
+
+
+def _cycle(index: int, start: float, sigma: float, peak: float, stick: float, jump: float, slip: float | None) -> Cycle:
+    """A Cycle; its period stick + slip once the slip has ended."""
+    period = None if slip is None else stick + slip
+    return Cycle(index, start, sigma, peak, stick, jump, slip, period)
 
 
 def classify(

@@ -16,7 +16,6 @@ from ..errors import ModelError, ParameterError, RunFailed
 from ..numerics.budget import (
     REFUSE_FACTOR,
     TIME_REFUSE_FACTOR,
-    BudgetExhausted,
     CostEstimate,
     check_max_steps,
     check_max_time,
@@ -30,7 +29,7 @@ from ..units import checked_number
 from . import jump
 from . import kernel as K
 from .arguments import check_progress, check_rig_words, check_snapshot_times
-from .model import Population, pack_parameters, stick_chains
+from .model import Population, chain_force, pack_parameters, stick_chains
 from .result import Bookkeeping, Snapshot, TransientResult
 
 CONTROLS = ("block", "velocity")
@@ -294,7 +293,8 @@ class _Driver:
             raise ParameterError("start velocity: only used with start='steady'")
         else:
             state.v = v_first  # no bonds: the slider moves with the puller
-        sigma0 = float(np.exp(state.lw[: state.n]) @ _force(state.x - state.xb[: state.n], params)) if state.n else 0.0
+        pop = state.population()  # no cohort: sigma0 = 0
+        sigma0 = float(pop.weight @ chain_force(pop.extension, params))
         # the block in balance with the bonds (and the damping, which a moving slider meets)
         state.puller = state.x + (sigma0 + self.damping * state.v) / k_block if control == "block" else state.x
         self.state = state
@@ -343,7 +343,7 @@ class _Driver:
                 self._cohorts(t0, t_stop, t1, vp)
         while self.snap_index < len(self.wanted):
             self._snapshot()
-        return self._finish(resolution=self.rtol, mass=self.mass, damping=self.damping)
+        return self._finish()
 
     def _snapshot(self) -> None:
         self.snapshots.append(_snapshot(self.state))
@@ -362,11 +362,9 @@ class _Driver:
         if self.progress is not None:
             self.progress(min(1.0, self.state.t / self.duration))
 
-    def _finish(self, **kwargs: Any) -> TransientResult:
-        result = _finish(self.rows, self.chain_rows, self.events, self.snapshots, self.state, self.params,
-                         self.protocol, self.control, self.k_block, int(self.state.acc[4]),
-                         note=self.note + _jumps_note(self.jumps) + (self.repeater.note() if self.repeater else ""),
-                         **kwargs)  # fmt: skip
+    def _finish(self, stop: str | None = None) -> TransientResult:
+        note = self.note + _jumps_note(self.jumps) + (self.repeater.note() if self.repeater else "")
+        result = _finish(self, self.snapshots, stop, note)
         return replace(result, jumps=tuple(self.jumps)) if self.jumps else result
 
     def _stuck(self, t1: float, vp: float) -> TransientResult | None:
@@ -399,7 +397,10 @@ class _Driver:
         if not res.collapsed:
             return None
         sigma_s = k_block * (state.puller - state.x)
-        vs = _jump(params, sigma_s, self.aging)
+        from ..quasistatic.jump import jump_velocity
+
+        landing = jump_velocity(params, sigma_s, "aging" if self.aging else "no-aging")
+        vs = landing.velocity if landing.reachable else None
         if vs is None:
             self.events.append(("unreachable", state.t, sigma_s, 0.0))
             return self._finish(stop=f"the chains collapse at σs = {sigma_s:.6g} Pa, beyond the steady curve's"
@@ -431,8 +432,7 @@ class _Driver:
             return False
         glided, self.sample_index = reducer.attempt(state, t0, t_stop, vp, self.times, self.sample_index, self.rows)
         if glided:
-            while self.snap_index < len(self.wanted) and state.t + 1e-15 >= self.wanted[self.snap_index] < t1:
-                self._snapshot()
+            self._snapshots_through(t1)
             self._report_progress()
         return glided
 
@@ -509,9 +509,9 @@ class _Driver:
             cpu = time.process_time() - self.cpu0
             stopped = over_budget("transient", int(state.acc[4]), self.budget, state.t, duration,
                                   cpu=cpu if cpu > self.seconds else None, max_time=self.seconds)  # fmt: skip
-            raise _with_partial(stopped, self.rows, self.chain_rows, self.events, self.snapshots, state, self.params,
-                                self.protocol, self.control, self.k_block, self.note, self.rtol, self.mass,
-                                self.damping)  # fmt: skip
+            # the budget's error carries the run up to where it stopped (its message says so; regime undetermined)
+            stopped.partial = _finish(self, [*self.snapshots, _snapshot(state)], str(stopped), self.note)
+            raise stopped
 
 
 class _Repeater:
@@ -672,42 +672,12 @@ def _paced(cohorts: int) -> int:
     return int(min(CHUNK, max(64, COHORT_STEPS_PER_CALL // max(cohorts, 1))))
 
 
-def _with_partial(
-    stopped: BudgetExhausted,
-    rows: list[np.ndarray],
-    chain_rows: list[np.ndarray],
-    events: list[tuple[str, float, float, float]],
-    snapshots: list[Snapshot],
-    state: _State,
-    params: Parameters,
-    protocol: Protocol,
-    control: str,
-    k_block: float,
-    note: str,
-    rtol: float,
-    mass: float,
-    damping: float,
-) -> BudgetExhausted:
-    """The budget's error, carrying the run up to where it stopped (its message says so; regime undetermined)."""
-    snaps = [*snapshots, _snapshot(state)]
-    stopped.partial = _finish(rows, chain_rows, events, snaps, state, params, protocol, control, k_block,
-                              int(state.acc[4]), stop=str(stopped), note=note, resolution=rtol, mass=mass,
-                              damping=damping)  # fmt: skip
-    return stopped
-
-
 def _chunk(state: _State, budget: int, reducer: _Reducer | None, pace: int = CHUNK) -> int:
     """Steps the kernel may take in this call: the budget, the pace, the next look for a quasi-steady stretch."""
     steps = min(CHUNK, pace, budget + 1 - int(state.acc[4]))
     if reducer is not None:
         steps = min(steps, int(reducer.next_try - state.acc[4]) if reducer.next_try > state.acc[4] else steps)
     return max(1, steps)
-
-
-def reduction_share(rtol: float) -> float:
-    from .reduction import THETA
-
-    return THETA * rtol
 
 
 class _Reducer:
@@ -765,9 +735,11 @@ class _Reducer:
         if not old.any():
             self.disturbed_at = None
             return False
+        from .reduction import THETA
+
         w = np.exp(state.lw[:n])
-        f = np.abs(_force(state.x - state.xb[:n], self.params))
-        share = 1e-2 * reduction_share(self.rtol)
+        f = np.abs(chain_force(state.x - state.xb[:n], self.params))
+        share = 1e-2 * (THETA * self.rtol)
         if w[old].sum() <= share * w.sum() and (w * f)[old].sum() <= share * (w * f).sum():
             self.disturbed_at = None
             return False
@@ -888,12 +860,6 @@ def _steady_cohorts(params: Parameters, velocity: float, aging: bool) -> Populat
     return _STEADY_COHORTS[key]
 
 
-def _force(extension: np.ndarray, params: Parameters) -> np.ndarray:
-    from .model import chain_force
-
-    return chain_force(extension, params)
-
-
 def _scratch(state: _State) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Work arrays of kernel._slider_velocity (no weight known beforehand: the third, all -1)."""
     return np.empty(state.xb.size), np.empty(state.xb.size), np.full((3, state.xb.size), -1.0)
@@ -912,7 +878,7 @@ def _sample_grid(every: float | None, duration: float) -> np.ndarray:
 
 def _row(state: _State, params: Parameters, control: str, k_block: float, mass: float = 0.0) -> np.ndarray:
     pop = state.population()
-    f = _force(pop.extension, params)
+    f = chain_force(pop.extension, params)
     sigma = float(pop.weight @ f)
     block_energy = sigma * sigma / (2 * k_block) if control == "block" else 0.0
     if mass > 0:  # the spring's own stretch, and the moving block's kinetic energy
@@ -959,33 +925,12 @@ def _snapshot(state: _State) -> Snapshot:
     return Snapshot(state.t, pop.age.copy(), pop.extension.copy(), pop.weight.copy())
 
 
-def _jump(params: Parameters, sigma: float, aging: bool) -> float | None:
-    from ..quasistatic.jump import jump_velocity
-
-    jump = jump_velocity(params, sigma, "aging" if aging else "no-aging")
-    return jump.velocity if jump.reachable else None
-
-
-def _finish(
-    rows: list[np.ndarray],
-    chain_rows: list[np.ndarray],
-    events: list[tuple[str, float, float, float]],
-    snapshots: list[Snapshot],
-    state: _State,
-    params: Parameters,
-    protocol: Protocol,
-    control: str,
-    k_block: float,
-    steps: int,
-    stop: str | None = None,
-    note: str = "",
-    resolution: float | None = None,
-    mass: float = 0.0,
-    damping: float = 0.0,
-) -> TransientResult:
+def _finish(d: _Driver, snapshots: list[Snapshot], stop: str | None, note: str) -> TransientResult:
+    """The result of run ``d`` so far: its rows sorted by time, cycles and regime (``stop``: why it ended early)."""
     from .cycles import detect_cycles, judge
 
-    table = np.vstack([np.atleast_2d(r) for r in rows])
+    params, protocol, control, k_block, mass, events = d.params, d.protocol, d.control, d.k_block, d.mass, d.events
+    table = np.vstack([np.atleast_2d(r) for r in d.rows])
     order = np.argsort(table[:, 0], kind="stable")
     table = table[order]
     keep = np.r_[True, np.diff(table[:, 0]) > 0]
@@ -998,17 +943,17 @@ def _finish(
     slope = k_block if control == "block" and mass == 0 else None
     cycles = detect_cycles(time, sigma, v, protocol, events, lowest=table[:, 14], stiffness=slope)
     regime, message, evidence = judge(
-        time, sigma, v, protocol, cycles, events, control, stop, resolution=resolution, lowest=table[:, 14]
+        time, sigma, v, protocol, cycles, events, control, stop, resolution=d.rtol, lowest=table[:, 14]
     )
     message = message + note
     saturating = params.aging.saturation_age is not None  # the extension lets go: its stuck is its own answer
-    if regime == "stuck" and not cycles and not stick_population_used(events) and not saturating:
+    if regime == "stuck" and not cycles and not any(kind == "stick" for kind, *_ in events) and not saturating:
         message += (
             "; one population of Eq 1 never lets go: its aging term makes a resting bond unbreakable within"
             " milliseconds (docs/transient.md section 7); stick_population=True (--stick-population) adds the"
             " paper's attached chains, which give its stick-slip cycle"
         )
-    chain = table[:, 12] if chain_rows else None
+    chain = table[:, 12] if d.chain_rows else None
     book = Bookkeeping(
         born=table[:, 6], broken=table[:, 7], work=table[:, 8], dissipation=table[:, 9], bond_energy=table[:, 10],
         block_energy=table[:, 11], stress_integral=table[:, 13],
@@ -1029,11 +974,11 @@ def _finish(
         snapshots=tuple(snapshots),
         bookkeeping=book,
         chain_fraction=chain,
-        steps=steps,
-        rejected=int(state.acc[5]),
+        steps=int(d.state.acc[4]),
+        rejected=int(d.state.acc[5]),
         lowest_stress=lowest,
         mass=mass,
-        damping=damping,
+        damping=d.damping,
         evidence=evidence,
     )
 
@@ -1051,10 +996,6 @@ def _births_never_held(protocol: Protocol, stick_population: bool) -> bool:
     every stop of the slider is a stick, where those bonds are set aside (the chains hold it, and the slip after
     lands on the steady population of its jump).  A puller at rest lets the slider creep to a stop on them."""
     return stick_population and bool(np.all(protocol.velocities > 0))
-
-
-def stick_population_used(events: list[tuple[str, float, float, float]]) -> bool:
-    return any(kind == "stick" for kind, *_ in events)
 
 
 def _block_inertia(mass: Any, damping: Any, control: str, stick_population: bool) -> tuple[float, float]:

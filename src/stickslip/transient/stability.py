@@ -226,13 +226,8 @@ def critical_stiffness_details(
 
     require_parameters(params)
     mass, damping = _block_terms(mass, damping)
-    tau = params.bonds.bond_time
-
-    def response(s: np.ndarray) -> np.ndarray:
-        return interface_response(params, velocity, s, aging).z
-
     top = math.inf if mass == 0.0 and damping == 0.0 else resolved_frequency(params, velocity, aging)
-    return critical_from_response(response, SCAN / tau, mass, damping, top)
+    return critical_from_response(_response(params, velocity, aging), SCAN / params.bonds.bond_time, mass, damping, top)
 
 
 def critical_from_response(
@@ -332,11 +327,13 @@ def hopf_root(
     kc = critical_stiffness_details(params, velocity, aging, mass, damping)
     if kc.mode != "oscillatory":
         raise ModelError(f"no Hopf point at {velocity:.6g} m/s (mode {kc.mode!r}): {kc.message}")
+    z = _response(params, velocity, aging)
+    return follow_root(z, 1j * kc.rate, kc.value, factor * kc.value, mass, damping)
 
-    def response(s: np.ndarray) -> np.ndarray:
-        return interface_response(params, velocity, s, aging).z
 
-    return follow_root(response, 1j * kc.rate, kc.value, factor * kc.value, mass, damping)
+def _response(params: Parameters, velocity: float, aging: bool) -> Callable[[np.ndarray], np.ndarray]:
+    """Z(s) (Pa/m) of steady sliding at ``velocity``, as a function of s."""
+    return lambda s: interface_response(params, velocity, s, aging).z
 
 
 def real_growth_rates(
