@@ -88,3 +88,17 @@ def test_analyze_json_names_the_units_of_its_own_keys(tmp_path, capsys):
     for key in ("noise", "drop_threshold", "stress_std", "stress_sem", "mean_stress"):
         assert units[key] == "Pa", key
     assert units["steady_from"] == units["steady_to"] == "s"
+
+
+def test_fit_steady_on_a_flat_record_has_finite_residuals(tmp_path, capsys):
+    """A steady curve whose stresses are all equal (a logger at its resolution): the failed fit's residuals were
+    0/0 = NaN ("+nan" in the report's table, NaN in to_frame) because the noise scale from the scatter is 0."""
+    from stickslip.fitting import fit_steady
+
+    path = tmp_path / "flat.csv"
+    pd.DataFrame({"velocity [m/s]": np.geomspace(1e-4, 1e-2, 10), "stress [Pa]": 300.0}).to_csv(path, index=False)
+    fit = fit_steady(path)
+    assert fit.status == "failed" and np.all(np.isfinite(fit.residuals))
+    assert np.isfinite(fit.to_frame()["residual"]).all()
+    code, out, _ = run_main(capsys, "fit", "steady", str(path))
+    assert code == 3 and "nan" not in out.lower()
