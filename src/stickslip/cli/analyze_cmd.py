@@ -13,6 +13,7 @@ from typing import Any
 
 import click
 
+from ..columns import json_units
 from ..errors import ParameterError
 from .common import (
     InputFile,
@@ -46,6 +47,21 @@ CSV_COLUMNS = (
     ("period", "s"),
     ("stress_drop", "Pa"),
 )
+
+#: Units of the keys of ``--json`` that are particular to analyze (they win over the package's registry, where
+#: ``stress_slope`` is the steady curve's dsigma/dV: here it is the steady stretch's trend in time).
+JSON_UNITS = {
+    "noise": "Pa",
+    "drop_threshold": "Pa",
+    "stress_slope": "Pa/s",
+    "stress_std": "Pa",
+    "stress_sem": "Pa",
+    "steady_from": "s",
+    "steady_to": "s",
+    "shift": "s",
+    "rms_misfit": "Pa",
+    "model": None,  # the comparison's per-cycle table of the model's values, not a number
+}
 
 #: The printed table shows at most this many cycles (and the mean of all); -o and --json hold every one.
 TABLE_CYCLES = 8
@@ -134,6 +150,7 @@ def analyze_command(
         data = analysis.as_dict()
         if comparison is not None:
             data["comparison"] = comparison.as_dict()
+        data["units"] = json_units(data, JSON_UNITS)
         emit_json(data)
     else:
         print_rich(*_report(analysis, comparison))

@@ -798,8 +798,30 @@ def _fit_text(fit: Any) -> str:
         lines.append(f"  {name:10s} {p.text()}")
     lines += [f"  {line}" for line in fit.change_lines()]  # (s from the fitted rows' first row)
     lines.append(f"  reduced chi-square {fit.reduced_chi_square:.4g} (noise {fit.noise:.3g}), rms {fit.rms:.4g}")
+    lines += _posterior_lines(fit)
     lines += [f"  warning: {w}" for w in fit.warnings]
     return "\n".join(lines)
+
+
+def _posterior_lines(fit: Any) -> list[str]:
+    """The --mcmc posterior (medians and 2.5/97.5 % percentiles) in the record's units, as the values above."""
+    from ..display import unit as shown_unit
+
+    post = fit.posterior
+    if not post:
+        return []
+    lines = [f"  posterior (emcee, {post['steps']} steps x {post['walkers']} walkers): median, 95 % [2.5 %, 97.5 %]"]
+    for name, entry in post.items():
+        if not isinstance(entry, dict):
+            continue
+        shown = fit.parameters.get(name)
+        k = shown.scale if shown is not None else 1.0
+        unit = f" {shown_unit(shown.unit)}" if shown is not None and shown.unit else ""
+        lo, hi = entry["interval"]
+        lines.append(f"    {name:10s} {entry['median'] / k:.6g}{unit}   95 % [{lo / k:.6g}, {hi / k:.6g}]")
+    if post.get("warning"):
+        lines.append(f"  warning: posterior: {post['warning']}")
+    return lines
 
 
 def register(cli: click.Group) -> None:

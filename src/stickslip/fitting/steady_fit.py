@@ -714,7 +714,8 @@ def _no_response_fit(check: _Check, dependence: Dependence) -> SteadyFit:
         noise=noise,
         noise_scale=noise_scale,
         model_stress=np.full(len(data), flat),
-        residuals=(data.stress - flat) / (error * noise_scale),
+        # all equal (a flat record at its logger's resolution): chi-square and the noise scale are 0, the residuals 0
+        residuals=np.divide(data.stress - flat, error * noise_scale, out=np.zeros(len(data)), where=noise_scale > 0),
         critical_velocity=vc,
         critical_stress=sc,
         interval_method=check.intervals,

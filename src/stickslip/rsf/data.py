@@ -62,21 +62,29 @@ class LabRecord:
 
     @classmethod
     def from_arrays(
-        cls, time: Any, displacement: Any, friction: Any, source: str = "arrays", length_unit: str = "m"
+        cls,
+        time: Any,
+        displacement: Any,
+        friction: Any,
+        source: str = "arrays",
+        length_unit: str = "m",
+        rows: Any = None,
     ) -> LabRecord:
+        """``rows``: each sample's line in its file, for messages; else the samples are counted from 1."""
         t = np.asarray(time, dtype=float).ravel()
         d = np.asarray(displacement, dtype=float).ravel()
         f = np.asarray(friction, dtype=float).ravel()
         if not (t.size == d.size == f.size) or t.size < 10:
             raise DataError(f"{source}: expected time, displacement and friction of one length >= 10")
+        row = _row_names(rows, t.size)
         for name, col in (("time", t), ("displacement", d), ("friction", f)):
             bad = ~np.isfinite(col)
             if bad.any():
-                raise DataError(f"{source}: row {int(np.argmax(bad)) + 1}: {name} is not a finite number")
+                raise DataError(f"{source}: row {row[int(np.argmax(bad))]}: {name} is not a finite number")
         step = np.diff(t)
         if np.any(step <= 0):
-            row = int(np.argmax(step <= 0)) + 2
-            raise DataError(f"{source}: row {row}: time {t[row - 1]:g} s does not increase")
+            i = int(np.argmax(step <= 0)) + 1
+            raise DataError(f"{source}: row {row[i]}: time {t[i]:g} s does not increase")
         return cls(t - t[0], d - d[0], f, float(t[0]), source, length_unit)
 
     def to_frame(self) -> Any:
@@ -133,6 +141,7 @@ def read_record(
     }
     option["velocity"] = _velocity_option(option["length"], option["time"])
     frame = _read_frame(path, pd)
+    rows = _file_rows(path, len(frame))
     headers = {str(c).strip(): c for c in frame.columns}
     bracketed = {str(c): split_header(str(c)) for c in frame.columns}  # "time [s]" as this package writes it
     lower = {k.lower(): v for k, v in headers.items()}
@@ -164,12 +173,12 @@ def read_record(
         written = units.get("displacement") or option["length"]
         column = chosen["displacement"]
     else:
-        displacement = _integrated(time, in_si("velocity"), path)
+        displacement = _integrated(time, in_si("velocity"), path, rows)
         speed_unit = units.get("velocity")
         written = _length_of(speed_unit) if speed_unit is not None else option["length"]
         column = chosen["velocity"]
     shown_unit = _plain_length(written[1]) if written is not None else "m"
-    record = LabRecord.from_arrays(time, displacement, data["friction"], str(path), shown_unit)
+    record = LabRecord.from_arrays(time, displacement, data["friction"], str(path), shown_unit, rows)
     _refuse_implausible_speed(record, str(column), written)
     return record
 
@@ -180,6 +189,19 @@ _UNIT_WORDS = {"micron": "um", "microns": "um", "µm": "um", "μm": "um", "micro
 #: last words of a header taken as its unit (without brackets only these, so "friction_coefficient" names none)
 _TAIL_UNITS = {"m", "mm", "um", "µm", "μm", "nm", "micron", "microns", "s", "ms", "us", "µs", "min"}
 _TAIL_UNITS |= {"m/s", "mm/s", "um/s", "µm/s", "μm/s", "nm/s"}
+
+
+def _row_names(rows: Any, size: int) -> Any:
+    """Each sample's row for messages: ``rows`` when it names every sample, else 1, 2, ..."""
+    return rows if rows is not None and len(rows) == size else range(1, size + 1)
+
+
+def _file_rows(path: Path, samples: int) -> list[int] | None:
+    """The file line of each data row the reader kept (``#`` comments and blank lines skipped), as the package's
+    other readers number rows; None where that count does not match what the reader kept (a quoted line end)."""
+    with open(path, encoding="utf-8", errors="replace") as handle:
+        lines = [n for n, line in enumerate(handle, 1) if line.split("#", 1)[0].strip()]
+    return lines[1:] if len(lines) == samples + 1 else None
 
 
 def _read_frame(path: Path, pd: Any) -> Any:
@@ -288,11 +310,12 @@ def _refuse_implausible_speed(record: LabRecord, column: str, written: tuple[flo
     )
 
 
-def _integrated(time: np.ndarray, velocity: np.ndarray, path: Path) -> np.ndarray:
+def _integrated(time: np.ndarray, velocity: np.ndarray, path: Path, rows: Any = None) -> np.ndarray:
     """Displacement from the load point's velocity column (in SI): row i's velocity holds on [t_i, t_(i+1))."""
     bad = ~np.isfinite(velocity)
     if bad.any():
-        raise DataError(f"{path}: row {int(np.argmax(bad)) + 1}: velocity is not a finite number")
+        raise DataError(f"{path}: row {_row_names(rows, velocity.size)[int(np.argmax(bad))]}: velocity is not a "
+                        "finite number")  # fmt: skip
     if velocity.size < 2:
         return np.zeros_like(velocity)
     return np.concatenate([[0.0], np.cumsum(velocity[:-1] * np.diff(time))])

@@ -7,6 +7,8 @@ when a fit is ``failed`` with a ``reason``: docs/rsf.md, "Fitting lab records".
 
 from __future__ import annotations
 
+import contextlib
+import io
 import math
 from dataclasses import dataclass, field, replace
 from typing import Any
@@ -1491,11 +1493,15 @@ def _posterior(residual: Any, result: Any, steps: int, seed: int | None) -> dict
     import lmfit
 
     walkers = max(4 * result.nvarys, 16)
-    mc = lmfit.minimize(
-        residual, result.params, method="emcee", steps=int(steps), nwalkers=walkers, burn=int(steps) // 3,
-        is_weighted=True, progress=False, seed=seed,
-    )  # fmt: skip
+    said = io.StringIO()  # lmfit prints emcee's "chain is shorter than 50 autocorrelation times" on stdout
+    with contextlib.redirect_stdout(said):
+        mc = lmfit.minimize(
+            residual, result.params, method="emcee", steps=int(steps), nwalkers=walkers, burn=int(steps) // 3,
+            is_weighted=True, progress=False, seed=seed,
+        )  # fmt: skip
     out: dict[str, Any] = {"steps": int(steps), "walkers": walkers}
+    if said.getvalue().strip():
+        out["warning"] = " ".join(said.getvalue().split())
     for key in result.var_names:
         if key not in _PUBLIC:  # (the change times' chains are nuisance)
             continue

@@ -1,0 +1,104 @@
+"""Audit of records and fits as a user chains them: what broke on real-looking input, each with its fix."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from cli_helpers import run_main
+from stickslip import protocols
+from stickslip.rsf import rsf_params, simulate
+
+UM = 1e-6
+
+
+@pytest.fixture(scope="module")
+def step_record(tmp_path_factory):
+    """1 -> 10 um/s at 4 Hz (161 rows) with friction noise 1e-4, displacement in um."""
+    params = rsf_params(0.010, 0.015, 10 * UM, v_ref=UM, stiffness=1600.0, mu0=0.6)
+    t = np.arange(0.0, 40.0 + 1e-9, 0.25)
+    run = simulate(params, protocols.velocity_steps([1 * UM, 10 * UM], [20, 20]), times=t)
+    rng = np.random.default_rng(3)
+    frame = pd.DataFrame({
+        "time [s]": t,
+        "load_point_displacement [um]": run.load_point_displacement / UM,
+        "friction": run.friction + 1e-4 * rng.standard_normal(t.size),
+    })  # fmt: skip
+    path = tmp_path_factory.mktemp("audit-records") / "record.csv"
+    frame.to_csv(path, index=False)
+    return path
+
+
+def test_rsf_fit_mcmc_json_is_json_and_text_shows_the_posterior(step_record, capsys):
+    """--mcmc with a short chain: lmfit printed emcee's autocorrelation warning on stdout, before the JSON (which
+    then did not parse), and the text report never showed the posterior it had computed."""
+    args = ("rsf", "fit", str(step_record), "--stiffness", "1.6e-3 1/um", "--mcmc", "30", "--seed", "1")
+    code, out, _ = run_main(capsys, *args, "--json")
+    assert code == 0
+    report = json.loads(out)
+    post = report["posterior"]
+    assert {"a", "b", "dc", "mu0"} <= set(post) and "autocorrelation" in post["warning"]
+    code, out, _ = run_main(capsys, *args)
+    assert code == 0
+    assert "posterior (emcee, 30 steps" in out
+    line = next(x for x in out.splitlines() if x.strip().startswith("dc") and "95 %" in x and "±" not in x)
+    assert "µm" in line  # in the record's unit, as the values above it
+    assert "warning: posterior:" in out
+
+
+@pytest.mark.parametrize(
+    ("line", "column", "value", "said"),
+    [(11, 0, "0.001", "row 11: time 0.001 s does not increase"), (21, 1, "nan", "row 21: friction is not a finite")],
+)
+def test_rsf_fit_names_the_file_row_of_a_bad_sample(tmp_path, capsys, line, column, value, said):
+    """A bad row of a record was named by its index among the data rows (row 9 for line 11 of a Run CSV, whose
+    metadata and header lines come first), not by its line, as the package's other readers (analyze, fit steady,
+    protocols) name it."""
+    params = rsf_params(0.005, 0.01, 20 * UM, v_ref=UM, stiffness=1600.0)
+    run = simulate(params, protocols.velocity_steps([UM, 10 * UM], [5, 5]), every=0.05)
+    path = tmp_path / "trace.csv"
+    frame = run.to_frame()
+    text = "# a comment line\n" + frame.to_csv(index=False, header=[f"{c} [{frame.attrs['units'][c]}]" for c in frame])
+    lines = text.splitlines()
+    cells = lines[line - 1].split(",")
+    cells[column] = value
+    lines[line - 1] = ",".join(cells)
+    path.write_text("\n".join(lines) + "\n")
+    code, _, err = run_main(capsys, "rsf", "fit", str(path))
+    assert code == 2 and said in err, err
+
+
+def test_analyze_json_names_the_units_of_its_own_keys(tmp_path, capsys):
+    """The JSON of a steady record called the stress trend ``stress_slope`` "Pa s/m" (the registry's unit of the
+    steady curve's dsigma/dV) though it is a trend in time, Pa/s; noise, the drop threshold, the steady window and
+    the stress scatter had no unit at all."""
+    t = np.arange(0.0, 60.0, 0.01)
+    stress = 400.0 + 0.02 * t + np.random.default_rng(0).normal(0.0, 1.0, t.size)
+    path = tmp_path / "steady.csv"
+    pd.DataFrame({"time [s]": t, "stress [Pa]": stress}).to_csv(path, index=False)
+    code, out, _ = run_main(capsys, "analyze", str(path), "--v0", "350 um/s", "--json")
+    assert code == 0
+    report = json.loads(out)
+    assert report["summary"]["stress_slope"] == pytest.approx(0.02, abs=0.005)
+    units = report["units"]
+    assert units["stress_slope"] == "Pa/s"
+    for key in ("noise", "drop_threshold", "stress_std", "stress_sem", "mean_stress"):
+        assert units[key] == "Pa", key
+    assert units["steady_from"] == units["steady_to"] == "s"
+
+
+def test_fit_steady_on_a_flat_record_has_finite_residuals(tmp_path, capsys):
+    """A steady curve whose stresses are all equal (a logger at its resolution): the failed fit's residuals were
+    0/0 = NaN ("+nan" in the report's table, NaN in to_frame) because the noise scale from the scatter is 0."""
+    from stickslip.fitting import fit_steady
+
+    path = tmp_path / "flat.csv"
+    pd.DataFrame({"velocity [m/s]": np.geomspace(1e-4, 1e-2, 10), "stress [Pa]": 300.0}).to_csv(path, index=False)
+    fit = fit_steady(path)
+    assert fit.status == "failed" and np.all(np.isfinite(fit.residuals))
+    assert np.isfinite(fit.to_frame()["residual"]).all()
+    code, out, _ = run_main(capsys, "fit", "steady", str(path))
+    assert code == 3 and "nan" not in out.lower()
