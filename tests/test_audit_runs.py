@@ -3,9 +3,11 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 import stickslip
 from stickslip import protocols
+from stickslip.errors import DataError
 from stickslip.transient import run_transient
 
 P = stickslip.load_parameters("gelatin-glass")
@@ -17,3 +19,24 @@ def test_transient_result_prints_a_few_lines_not_its_arrays():
     assert text.startswith("TransientResult(") and len(text) < 1200, text
     assert f"<{result.time.size} values>" in text and "array(" not in text
     assert isinstance(result.time, np.ndarray) and result.time.size > 6
+
+
+def test_a_protocol_file_with_units_in_its_header_is_read_in_those_units(tmp_path):
+    """Every CSV the package writes names its units as ``name [unit]``; the protocol reader refused such a header."""
+    steps = tmp_path / "steps.csv"
+    steps.write_text("time [s],velocity [um/s]\n0,1\n10,0\n15,10\n20,0\n")
+    protocol = protocols.read_protocol(steps)
+    assert [s.velocity for s in protocol.segments] == pytest.approx([1e-6, 0.0, 1e-5], rel=1e-12)
+    assert protocol.duration == pytest.approx(20.0)
+    segments = tmp_path / "segments.csv"
+    segments.write_text("velocity [m/s];duration [min]\n1e-6;1\n1e-5;0.5\n")
+    protocol = protocols.read_protocol(segments)
+    assert [s.duration for s in protocol.segments] == pytest.approx([60.0, 30.0])
+    wrong = tmp_path / "wrong.csv"
+    wrong.write_text("time [s],velocity [Pa]\n0,1\n10,0\n")
+    with pytest.raises(DataError, match=r"wrong.csv: column 'velocity \[Pa\]'"):
+        protocols.read_protocol(wrong)
+    twice = tmp_path / "twice.csv"
+    twice.write_text("time,velocity [m/s],velocity\n0,1e-6,1e-6\n10,0,0\n")
+    with pytest.raises(DataError, match="appears twice"):
+        protocols.read_protocol(twice)
