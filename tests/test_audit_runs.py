@@ -40,3 +40,21 @@ def test_a_protocol_file_with_units_in_its_header_is_read_in_those_units(tmp_pat
     twice.write_text("time,velocity [m/s],velocity\n0,1e-6,1e-6\n10,0,0\n")
     with pytest.raises(DataError, match="appears twice"):
         protocols.read_protocol(twice)
+
+
+def test_a_bad_protocol_row_is_named_by_its_line_in_the_file(tmp_path):
+    """Comment and blank lines were not counted: the NaN on line 5 was reported on 'row 3', the header's line."""
+    commented = tmp_path / "commented.csv"
+    commented.write_text("# slide-hold-slide\n# by hand\ntime,velocity\n0,1e-6\n10,nan\n20,0\n")
+    with pytest.raises(
+        DataError, match=r"commented.csv: row 5: expected two finite numbers in SI units, got \[10.0, nan\]"
+    ):
+        protocols.read_protocol(commented)
+    blank = tmp_path / "blank.csv"
+    blank.write_text("time,velocity\n0,1e-6\n\n10,1e-5\n5,0\n")
+    with pytest.raises(DataError, match=r"blank.csv: row 5: time 5 s does not increase"):
+        protocols.read_protocol(blank)
+    negative = tmp_path / "negative.csv"
+    negative.write_text("velocity,duration\n# the hold\n1e-6,10\n-1e-6,5\n")
+    with pytest.raises(DataError, match=r"negative.csv: row 4: segment velocity"):
+        protocols.read_protocol(negative)

@@ -273,22 +273,25 @@ def read_protocol(path: str | Path) -> Protocol:
     # a header cell may carry its unit, as the package writes CSV headers: "time [s]", "velocity [um/s]"
     columns = {split_header(str(c))[0].lower(): c for c in frame.columns}
     _refuse_duplicated_columns(text, path)
+    lines = _data_lines(text, len(frame))
     if {"velocity", "duration"} <= set(columns):
-        pairs = _numeric_rows(frame, path, [columns["velocity"], columns["duration"]])
+        pairs = _numeric_rows(frame, path, [columns["velocity"], columns["duration"]], lines)
         try:
-            return Protocol(tuple(_checked_segment(v, d, path, i) for i, (v, d) in enumerate(pairs)), name=path.name)
+            return Protocol(
+                tuple(_checked_segment(v, d, path, lines[i]) for i, (v, d) in enumerate(pairs)), name=path.name
+            )
         except ParameterError as exc:
             raise DataError(str(exc)) from None
     if {"time", "velocity"} <= set(columns):
-        rows = _numeric_rows(frame, path, [columns["time"], columns["velocity"]])
+        rows = _numeric_rows(frame, path, [columns["time"], columns["velocity"]], lines)
         if len(rows) < 2:
             raise DataError(f"{path}: expected at least two rows (a start and an end time), got {len(rows)}")
         items = []
         for i in range(len(rows) - 1):
             (t0, v), (t1, _) = rows[i], rows[i + 1]
             if not t1 > t0:
-                raise DataError(f"{path}: row {i + 3}: time {t1:g} s does not increase (previous {t0:g} s)")
-            items.append(_checked_segment(v, t1 - t0, path, i))
+                raise DataError(f"{path}: row {lines[i + 1]}: time {t1:g} s does not increase (previous {t0:g} s)")
+            items.append(_checked_segment(v, t1 - t0, path, lines[i]))
         return Protocol(tuple(items), name=path.name)
     found = ", ".join(str(c) for c in frame.columns) or "none"
     raise DataError(f"{path}: expected columns time,velocity or velocity,duration (SI units); found {found}")
@@ -302,7 +305,14 @@ def _protocol_text(path: Path) -> str:
     return read_input_text(path, f"protocol file {path}", MAX_PROTOCOL_BYTES)
 
 
-def _numeric_rows(frame: Any, path: Path, cols: list[Any]) -> list[tuple[float, float]]:
+def _data_lines(text: str, count: int) -> list[int]:
+    """The file's line number of each of the ``count`` data rows: comment and blank lines are skipped by the
+    reader but counted by an editor, so an error names the line a user finds the value on."""
+    lines = [k for k, line in enumerate(text.split("\n"), start=1) if line.split("#", 1)[0].strip()][1:]
+    return lines if len(lines) == count else list(range(2, count + 2))
+
+
+def _numeric_rows(frame: Any, path: Path, cols: list[Any], lines: list[int]) -> list[tuple[float, float]]:
     import pandas as pd
 
     data = frame[cols].apply(pd.to_numeric, errors="coerce").to_numpy(dtype=float)
@@ -312,8 +322,8 @@ def _numeric_rows(frame: Any, path: Path, cols: list[Any]) -> list[tuple[float, 
     bad = ~np.isfinite(data).all(axis=1)
     if bad.any():
         row = int(np.argmax(bad))
-        raw = frame.iloc[row][cols].tolist()
-        raise DataError(f"{path}: row {row + 2}: expected two finite numbers in SI units, got {raw}")
+        raw = ", ".join(str(value) for value in frame.iloc[row][cols].tolist())
+        raise DataError(f"{path}: row {lines[row]}: expected two finite numbers in SI units, got [{raw}]")
     return [(float(a), float(b)) for a, b in data]
 
 
@@ -330,11 +340,11 @@ def _header_factor(column: Any, dimension: str, path: Path) -> float:
         raise DataError(f"{path}: {exc}") from None
 
 
-def _checked_segment(velocity: float, duration: float, path: Path, index: int) -> Segment:
+def _checked_segment(velocity: float, duration: float, path: Path, line: int) -> Segment:
     try:
         return Segment(velocity, duration)
     except ParameterError as exc:
-        raise DataError(f"{path}: row {index + 2}: {exc}") from None
+        raise DataError(f"{path}: row {line}: {exc}") from None
 
 
 def _as_segment(item: tuple[float, float] | Segment) -> Segment:
