@@ -2,10 +2,13 @@
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pytest
 
 import stickslip
+from cli_helpers import run_main
 from stickslip import protocols
 from stickslip.errors import DataError
 from stickslip.transient import run_transient
@@ -58,3 +61,22 @@ def test_a_bad_protocol_row_is_named_by_its_line_in_the_file(tmp_path):
     negative.write_text("velocity,duration\n# the hold\n1e-6,10\n-1e-6,5\n")
     with pytest.raises(DataError, match=r"negative.csv: row 4: segment velocity"):
         protocols.read_protocol(negative)
+
+
+def test_compare_protocol_set_json_names_the_unit_of_every_number(capsys):
+    """The stick-slip pair's spring is rate-and-state's k in 1/m; the units map said Pa/m, and left out sigma_c
+    and the panels' friction extremes."""
+    code, out, _ = run_main(capsys, "compare", "--duration", "30 s", "--json")
+    assert code == 0
+    document = json.loads(out)
+    units = document["units"]
+    assert units["stiffness"] == "1/m" and units["sigma_c"] == "Pa"
+
+    def numeric_keys(obj):
+        if isinstance(obj, dict):
+            for key, value in obj.items():
+                if isinstance(value, float):
+                    yield key
+                yield from numeric_keys(value)
+
+    assert sorted(set(numeric_keys(document)) - set(units)) == []
