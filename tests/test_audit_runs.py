@@ -80,3 +80,23 @@ def test_compare_protocol_set_json_names_the_unit_of_every_number(capsys):
                 yield from numeric_keys(value)
 
     assert sorted(set(numeric_keys(document)) - set(units)) == []
+
+
+def test_sweep_plot_refuses_one_key_on_both_axes(tmp_path, capsys):
+    """--x K --y K drew a 'phase diagram' of V0 against itself, with the Vc line across it."""
+    out = tmp_path / "sweep"
+    stickslip.sweep(["pulling_velocity=30 um/s,1 mm/s"], out, workers=0, duration=10.0)
+    code, _, err = run_main(
+        capsys,
+        "sweep",
+        "plot",
+        str(out),
+        "--x",
+        "pulling_velocity",
+        "--y",
+        "pulling_velocity",
+        "-o",
+        str(tmp_path / "p.png"),
+    )
+    assert code == 2 and "--y pulling_velocity: the same key as --x" in err
+    assert not (tmp_path / "p.png").exists()
