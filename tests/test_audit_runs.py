@@ -100,3 +100,26 @@ def test_sweep_plot_refuses_one_key_on_both_axes(tmp_path, capsys):
     )
     assert code == 2 and "--y pulling_velocity: the same key as --x" in err
     assert not (tmp_path / "p.png").exists()
+
+
+def test_a_plug_in_models_numeric_start_is_described_with_its_unit():
+    """compare --models printed a plug-in's --start "0.033 m/s" as 'start 0.033', no unit."""
+    from stickslip.models import Capabilities, FrictionModel
+
+    class Minimal(FrictionModel):
+        name = "minimal"
+        capabilities = Capabilities(controls=("spring",), protocols="constant")
+        start_dimension = "velocity"
+
+        def dimensions(self):
+            return {}
+
+        def parameters(self, spec=None, overrides=None):
+            return {}
+
+        def run(self, params, protocol, rig=None, *, start=None, **settings):
+            raise NotImplementedError
+
+    protocol = protocols.constant(0.03, 2.0)
+    assert Minimal().describe_start(0.033, protocol) == "start 0.033 m/s"
+    assert Minimal().describe_start(None, protocol) == "the model's own start"
