@@ -23,9 +23,9 @@ from typing import Any
 
 import numpy as np
 
-from .columns import with_units
+from .columns import split_header, with_units
 from .display import velocity as velocity_text
-from .errors import DataError, ParameterError, as_written
+from .errors import DataError, ParameterError, UnitError, as_written
 from .fileio import protect_inputs, read_input_text
 
 __all__ = [
@@ -232,7 +232,7 @@ def _refuse_duplicated_columns(text: str, path: Path) -> None:
             except csv.Error:
                 names = line.split(",")
             seen: set[str] = set()
-            for name in (n.strip().lower() for n in names):
+            for name in (split_header(n)[0].lower() for n in names):
                 if name and name in seen:
                     raise DataError(f"{path}: the column {name!r} appears twice in the header; keep one")
                 seen.add(name)
@@ -242,7 +242,8 @@ def _refuse_duplicated_columns(text: str, path: Path) -> None:
 def read_protocol(path: str | Path) -> Protocol:
     """A protocol from a CSV file.
 
-    Two layouts, told apart by the header (SI units, comma or tab separated):
+    Two layouts, told apart by the header (SI units, or the unit a header cell names as the package writes
+    them, ``time [ms]``; comma, tab or semicolon separated):
 
     * ``velocity,duration``: one segment per row;
     * ``time,velocity``: change points.  ``velocity`` holds from that row's
@@ -269,24 +270,28 @@ def read_protocol(path: str | Path) -> Protocol:
         frame = pd.read_csv(io.StringIO(text), sep=None, engine="python", comment="#", nrows=1_000_000)
     except (ValueError, csv.Error, pd.errors.ParserError) as exc:  # csv.Error: no delimiter could be found
         raise DataError(f"{path}: cannot read as CSV ({(str(exc).splitlines() or [''])[0]})") from None
-    columns = {str(c).strip().lower(): c for c in frame.columns}
+    # a header cell may carry its unit, as the package writes CSV headers: "time [s]", "velocity [um/s]"
+    columns = {split_header(str(c))[0].lower(): c for c in frame.columns}
     _refuse_duplicated_columns(text, path)
+    lines = _data_lines(text, len(frame))
     if {"velocity", "duration"} <= set(columns):
-        pairs = _numeric_rows(frame, path, [columns["velocity"], columns["duration"]])
+        pairs = _numeric_rows(frame, path, [columns["velocity"], columns["duration"]], lines)
         try:
-            return Protocol(tuple(_checked_segment(v, d, path, i) for i, (v, d) in enumerate(pairs)), name=path.name)
+            return Protocol(
+                tuple(_checked_segment(v, d, path, lines[i]) for i, (v, d) in enumerate(pairs)), name=path.name
+            )
         except ParameterError as exc:
             raise DataError(str(exc)) from None
     if {"time", "velocity"} <= set(columns):
-        rows = _numeric_rows(frame, path, [columns["time"], columns["velocity"]])
+        rows = _numeric_rows(frame, path, [columns["time"], columns["velocity"]], lines)
         if len(rows) < 2:
             raise DataError(f"{path}: expected at least two rows (a start and an end time), got {len(rows)}")
         items = []
         for i in range(len(rows) - 1):
             (t0, v), (t1, _) = rows[i], rows[i + 1]
             if not t1 > t0:
-                raise DataError(f"{path}: row {i + 3}: time {t1:g} s does not increase (previous {t0:g} s)")
-            items.append(_checked_segment(v, t1 - t0, path, i))
+                raise DataError(f"{path}: row {lines[i + 1]}: time {t1:g} s does not increase (previous {t0:g} s)")
+            items.append(_checked_segment(v, t1 - t0, path, lines[i]))
         return Protocol(tuple(items), name=path.name)
     found = ", ".join(str(c) for c in frame.columns) or "none"
     raise DataError(f"{path}: expected columns time,velocity or velocity,duration (SI units); found {found}")
@@ -300,23 +305,46 @@ def _protocol_text(path: Path) -> str:
     return read_input_text(path, f"protocol file {path}", MAX_PROTOCOL_BYTES)
 
 
-def _numeric_rows(frame: Any, path: Path, cols: list[Any]) -> list[tuple[float, float]]:
+def _data_lines(text: str, count: int) -> list[int]:
+    """The file's line number of each of the ``count`` data rows: comment and blank lines are skipped by the
+    reader but counted by an editor, so an error names the line a user finds the value on."""
+    lines = [k for k, line in enumerate(text.split("\n"), start=1) if line.split("#", 1)[0].strip()][1:]
+    return lines if len(lines) == count else list(range(2, count + 2))
+
+
+def _numeric_rows(frame: Any, path: Path, cols: list[Any], lines: list[int]) -> list[tuple[float, float]]:
     import pandas as pd
 
     data = frame[cols].apply(pd.to_numeric, errors="coerce").to_numpy(dtype=float)
+    data = data * [
+        _header_factor(c, "velocity" if split_header(str(c))[0].lower() == "velocity" else "time", path) for c in cols
+    ]
     bad = ~np.isfinite(data).all(axis=1)
     if bad.any():
         row = int(np.argmax(bad))
-        raw = frame.iloc[row][cols].tolist()
-        raise DataError(f"{path}: row {row + 2}: expected two finite numbers in SI units, got {raw}")
+        raw = ", ".join(str(value) for value in frame.iloc[row][cols].tolist())
+        raise DataError(f"{path}: row {lines[row]}: expected two finite numbers in SI units, got [{raw}]")
     return [(float(a), float(b)) for a, b in data]
 
 
-def _checked_segment(velocity: float, duration: float, path: Path, index: int) -> Segment:
+def _header_factor(column: Any, dimension: str, path: Path) -> float:
+    """The SI factor of a header cell's unit (``"time [ms]"``: 1e-3); a bare name is SI already."""
+    from .units import to_si
+
+    unit = split_header(str(column))[1]
+    if not unit:
+        return 1.0
+    try:
+        return to_si(f"1 {unit}", dimension, f"column {str(column).strip()!r}")
+    except UnitError as exc:
+        raise DataError(f"{path}: {exc}") from None
+
+
+def _checked_segment(velocity: float, duration: float, path: Path, line: int) -> Segment:
     try:
         return Segment(velocity, duration)
     except ParameterError as exc:
-        raise DataError(f"{path}: row {index + 2}: {exc}") from None
+        raise DataError(f"{path}: row {line}: {exc}") from None
 
 
 def _as_segment(item: tuple[float, float] | Segment) -> Segment:

@@ -18,10 +18,11 @@ from typing import Any
 import click
 import numpy as np
 
+from ..columns import json_units
 from ..errors import ModelError, ParameterError
 from ..fileio import refuse_input_as_output
 from ..progress import progress
-from .common import json_text, params_options, positive, quantity, resolve_params, save_figure, write_text
+from .common import json_safe, json_text, params_options, positive, quantity, resolve_params, save_figure, write_text
 from .protocol_options import protocol_options
 from .rsf_cmd import sidecar
 
@@ -31,6 +32,19 @@ PROTOCOL_SETS = {"bond-vs-rsf": ("quasi-static", "transient")}
 
 #: The classic compare's --v0 and --duration when not given (with --models they are the protocol's first segment).
 CLASSIC_V0, CLASSIC_DURATION = "200 um/s", "120 s"
+
+
+#: Units of the protocol set's JSON keys that the package's registry does not know or names otherwise.
+_SET_UNITS = {
+    "stiffness": "1/m",
+    "sigma_c": "Pa",
+    "rsf_a_minus_b": "1",
+    "bond_steady_slope": "1",
+    "bond_max": "1",
+    "bond_final": "1",
+    "rsf_max": "1",
+    "rsf_min": "1",
+}
 
 
 @click.command("compare")
@@ -163,6 +177,8 @@ def compare_command(**options: Any) -> None:
             "problem": pair["problem"],
         },
     }
+    # the units map: friction is stress over sigma_c; the stick-slip pair's spring is rate-and-state's k (1/m)
+    summary["units"] = json_units(json_safe(summary), _SET_UNITS)
     if options["as_json"]:
         click.echo(json_text(summary))
     else:

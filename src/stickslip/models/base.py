@@ -158,7 +158,14 @@ class FrictionModel(ABC):
     def describe_start(self, start: Any, protocol: Protocol, settings: Mapping[str, Any] | None = None) -> str:
         """In words, where a run of ``protocol`` from ``start`` begins (tables that set models side by side
         say it, since models that start differently do not settle alike)."""
-        return "the model's own start" if start is None else f"start {start!r}"
+        if start is None:
+            return "the model's own start"
+        from ..units import DIMENSIONS
+
+        unit = DIMENSIONS.get(self.start_dimension or "", ("", ""))[1]
+        if unit and isinstance(start, (int, float)) and not isinstance(start, bool):
+            return f"start {float(start):.6g} {unit}"  # a number is SI in the model's start_dimension
+        return f"start {start!r}"
 
     # ------------------------------------------------------------------ checks every implementation shares
     def check_available(self) -> None:

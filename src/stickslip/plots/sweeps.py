@@ -105,6 +105,9 @@ def plot_phase_diagram(
             raise ParameterError(
                 f"{option} {key}: not a varied key of this sweep; expected one of {', '.join(spec.keys)}"
             )
+    if y == x:
+        other = "leave --y out for a sweep of one key" if len(spec.keys) == 1 else "give another varied key"
+        raise ParameterError(f"--y {y}: the same key as --x; a phase diagram needs two keys ({other})")
     if color not in frame.columns or color in NOT_RESULTS:
         choices = [c for c in frame.columns if c not in NOT_RESULTS]
         raise ParameterError(f"--color {color}: not a column of this sweep; expected one of {', '.join(choices)}")

@@ -9,6 +9,7 @@ import numpy as np
 
 from ..columns import with_units
 from ..quasistatic.cycle import Cycle
+from ..reprs import compact_repr
 from ..trace_columns import TRANSIENT
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -51,6 +52,8 @@ class Bookkeeping:
 @dataclass(frozen=True)
 class TransientResult:
     """A run of the time-dependent population balance (Eqs 1-5); arrays in SI units."""
+
+    __repr__ = compact_repr  # counts, not hundreds of array elements
 
     time: np.ndarray
     stress: np.ndarray
