@@ -123,3 +123,17 @@ def test_a_plug_in_models_numeric_start_is_described_with_its_unit():
     protocol = protocols.constant(0.03, 2.0)
     assert Minimal().describe_start(0.033, protocol) == "start 0.033 m/s"
     assert Minimal().describe_start(None, protocol) == "the model's own start"
+
+
+@pytest.mark.parametrize(
+    ("model", "noun", "example"), [("quasi-static", "a stress", "400 Pa"), ("rsf", "a velocity", "50 um/s")]
+)
+def test_a_word_start_for_a_model_that_starts_from_a_number_names_the_option(capsys, model, noun, example):
+    """``--start steady`` for the quasi-static model said "start_stress: expected a number in Pa, got 'steady'",
+    naming the Python argument, where a transient-only word should be refused as ``--start`` is elsewhere."""
+    code, _, err = run_main(
+        capsys, "run", "--model", model, "--v0", "50 um/s", "--duration", "5 s", "--start", "steady"
+    )
+    assert code == 2
+    assert f"--start 'steady': --model {model} starts from {noun}, not a word" in err
+    assert f"--start '{example}'" in err and "start_stress" not in err and "start_velocity" not in err

@@ -102,6 +102,13 @@ def start_value(text: str | None, model: Any = None) -> Any:
     if text is None:
         return None
     if text.strip().isalpha():
+        words = getattr(model, "start_words", None)
+        if words is not None and text.strip() not in words:
+            dimension = getattr(model, "start_dimension", None)
+            raise ParameterError(
+                f"--start {shorten(text)}: --model {model.name} starts from {quantity_noun(dimension)}, not a word;"
+                f" expected one with its unit, e.g. {_START_EXAMPLES.get(dimension, 'a value with its unit')}"
+            )
         return text.strip()
     if model is not None:
         dimension = getattr(model, "start_dimension", None)

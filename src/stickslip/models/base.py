@@ -116,6 +116,8 @@ class FrictionModel(ABC):
     #: the dimension of a numeric ``start`` (a :data:`stickslip.units.DIMENSIONS` name, e.g. "stress" or
     #: "velocity"), so the command line reads ``--start`` in it and refuses another; None: words only
     start_dimension: str | None = None
+    #: the words ``start`` may be (transient: "empty", "steady"); None: any, the model's ``run`` judges them
+    start_words: tuple[str, ...] | None = None
     #: modules the model needs (an install without them refuses the model in one line, see check_available)
     requires: tuple[str, ...] = ()
     #: the columns of a sweep row (name -> "str", "float" or "int"), read off the Run (:meth:`Run.row`)

@@ -30,6 +30,7 @@ class QuasiStatic(BondModel):
     description = "bond model, quasi-static stick-jump-slip cycles (Eqs 6-17)"
     capabilities = Capabilities(controls=("spring",), protocols="constant", settings=("jump_curve",))
     start_dimension = "stress"
+    start_words = ()
 
     def run(
         self, params: Parameters, protocol: Protocol, rig: Rig | None = None, *, start: Any = None, **settings: Any

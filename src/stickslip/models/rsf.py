@@ -30,6 +30,7 @@ class RSFModel(FrictionModel):
     name = "rsf"
     aliases = ("rate-and-state", "rate-state")
     start_dimension = "velocity"
+    start_words = ()
     description = "rate-and-state friction on a spring-slider (Dieterich-Ruina laws)"
     capabilities = Capabilities(
         controls=("spring",), protocols="any", damping=True, mass=True, settings=("every", "times", "rtol", "atol")
