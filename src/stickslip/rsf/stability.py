@@ -167,8 +167,13 @@ def _numerical_critical(params: RSFParams, velocity: float) -> float:
         )
     if growth(lo) <= 0:
         return 0.0
-    if growth(hi) > 0:
-        return math.inf
+    while growth(hi) > 0:  # inertia raises k_c by 1 + m V^2/(sigma a' Dc), without bound: widen the bracket up
+        if hi > 1e300:
+            raise ModelError(
+                f"steady sliding at {velocity:.3g} m/s is unstable at every stiffness up to {hi:.3g} 1/m: no"
+                " critical stiffness can be represented (check mass, normal stress, a, b and Dc)"
+            )
+        lo, hi = hi, hi * 1e9
     for _ in range(200):
         mid = math.sqrt(lo) * math.sqrt(hi)
         if growth(mid) > 0:
