@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 import pytest
 
 from stickslip import rsf
@@ -34,3 +35,19 @@ def test_steady_state_refuses_a_pint_quantity_instead_of_dropping_its_unit() -> 
     params = load_parameters("gelatin-glass")
     with pytest.raises(ParameterError, match=r"velocity: .*units"):
         steady_state(params, pint.UnitRegistry().Quantity(1.0, "um/s"))
+
+
+def test_rsf_inertial_run_whose_regime_interpolant_probes_v_zero_finishes() -> None:
+    # The regime's dense interpolant restarts LSODA (odeint) from an accepted step; a trial step with
+    # V = v_ref e^x underflowing to 0 made dV/dt = (...)/(m V/sigma) a raw ZeroDivisionError out of simulate().
+    from stickslip import protocols
+
+    p = rsf.rsf_params(
+        4.418535456009215e-05, 0.0006029620679651103, 3.576722905439472e-05, stiffness=0.7853394924736056,
+        eta=1.3482482764787035e-06, mass=1.0177977091646792e-05, normal_stress=97802.63226493173,
+        v_ref=0.4079399015321571,
+    )  # fmt: skip
+    v, v2, duration = 1.769748365139191e-05, 0.0008936521280123709, 0.1545280135033514
+    run = rsf.simulate(p, protocols.velocity_steps([v, v2], [duration, duration]))
+    assert run.status == "ok"
+    assert np.all(np.isfinite(run.to_frame().select_dtypes("number").to_numpy()))

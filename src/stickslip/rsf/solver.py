@@ -328,12 +328,15 @@ def _odeint(
     from scipy.integrate import odeint
 
     jac = system.jacobian if system.has_jacobian else None
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        out, info = odeint(
-            system.rhs, y0, grid, args=(vlp,), Dfun=jac, rtol=rtol, atol=atol, tfirst=True, mxstep=200_000,
-            full_output=True,
-        )  # fmt: skip
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            out, info = odeint(
+                system.rhs, y0, grid, args=(vlp,), Dfun=jac, rtol=rtol, atol=atol, tfirst=True, mxstep=200_000,
+                full_output=True,
+            )  # fmt: skip
+    except (ZeroDivisionError, OverflowError):  # a trial step far out (m V / sigma underflowing to 0 in dV/dt)
+        return np.full((len(grid), len(y0)), np.nan), False
     return out, info.get("message") == "Integration successful." and bool(np.all(np.isfinite(out)))
 
 
