@@ -51,3 +51,26 @@ def test_rsf_inertial_run_whose_regime_interpolant_probes_v_zero_finishes() -> N
     run = rsf.simulate(p, protocols.velocity_steps([v, v2], [duration, duration]))
     assert run.status == "ok"
     assert np.all(np.isfinite(run.to_frame().select_dtypes("number").to_numpy()))
+
+
+def test_rsf_critical_stiffness_of_a_long_second_state_is_found() -> None:
+    # Dc2 / Dc = 1e10: the bisection's bracket started at 1e-9 (b - a)/min(Dc), above this k_c (~1.2e-3 1/m), and
+    # the result was 0 with "stable at every stiffness (velocity strengthening)"; the growth rate says otherwise.
+    from stickslip.rsf.stability import growth_rate
+
+    p = rsf.rsf_params(0.01, 0.002, 1e-9, b2=0.02, dc2=10.0)
+    kc = rsf.critical_stiffness(p, 1e-6)
+    assert 1e-3 < kc < 2e-3
+    assert growth_rate(p.replace(stiffness=0.9 * kc), 1e-6) > 0 > growth_rate(p.replace(stiffness=1.1 * kc), 1e-6)
+
+
+@pytest.mark.parametrize(
+    "mass, normal_stress", [(1e-300, 1e300), (1e300, 1.0)], ids=["inertia underflows", "k_c overflows"]
+)
+def test_rsf_stability_out_of_float_range_is_a_model_error(mass: float, normal_stress: float) -> None:
+    # was a raw ZeroDivisionError (m/sigma = 0 in dV/dt) and an infinite k_c
+    from stickslip.errors import ModelError
+
+    p = rsf.rsf_params(0.01, 0.02, 1e-5, mass=mass, normal_stress=normal_stress)
+    with pytest.raises(ModelError):
+        rsf.stability(p, 1000.0)

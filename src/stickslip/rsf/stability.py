@@ -54,7 +54,14 @@ def critical_stiffness(params: RSFParams, velocity: float | str) -> float:
         if s.b <= a_eff:
             return 0.0
         inertia = params.mass * velocity**2 / ((params.normal_stress or 1.0) * a_eff * s.dc) if params.mass else 0.0
-        return (s.b - a_eff) / s.dc * (1.0 + inertia)
+        kc = (s.b - a_eff) / s.dc * (1.0 + inertia)
+        if not math.isfinite(kc):
+            raise ModelError(
+                f"the critical stiffness at {velocity:.3g} m/s is beyond the floating-point range ((b - a')/Dc ="
+                f" {(s.b - a_eff) / s.dc:.3g} 1/m, inertia factor m V^2/(sigma a' Dc) = {inertia:.3g}): check the"
+                " mass, normal stress and Dc"
+            )
+        return kc
     return _numerical_critical(params, velocity)
 
 
@@ -145,7 +152,10 @@ def _eigenvalues(params: RSFParams, velocity: float) -> np.ndarray:
             " comparable size)"
         )
     system = System(params)
-    jac = jacobian_at(system, system.steady_y(velocity), velocity)
+    try:
+        jac = jacobian_at(system, system.steady_y(velocity), velocity)
+    except (ZeroDivisionError, OverflowError):  # e.g. m V / sigma underflowing to 0
+        jac = np.full((1, 1), np.nan)
     if not np.all(np.isfinite(jac)):
         raise ModelError(
             f"the linearised equations at {velocity:.3g} m/s overflow the floating-point range: these parameters"
@@ -166,7 +176,11 @@ def _numerical_critical(params: RSFParams, velocity: float) -> float:
             f" ({min(s.dc for s in params.states):.3g} m) and a, b"
         )
     if growth(lo) <= 0:
-        return 0.0
+        # a state with a far longer Dc has its k_c below this bracket: look down to its own scale
+        floor = max(abs(params.b - params.a), params.a) / max(s.dc for s in params.states) * 1e-9
+        if not (0 < floor < lo) or growth(floor) <= 0:
+            return 0.0
+        lo, hi = floor, lo
     while growth(hi) > 0:  # inertia raises k_c by 1 + m V^2/(sigma a' Dc), without bound: widen the bracket up
         if hi > 1e300:
             raise ModelError(
