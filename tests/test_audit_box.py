@@ -25,7 +25,7 @@ def test_rsf_numerical_critical_stiffness_with_large_inertia_is_finite() -> None
     assert not report.stable and math.isfinite(report.neutral_period)
 
 
-def test_steady_state_refuses_a_pint_quantity_instead_of_dropping_its_unit() -> None:
+def test_steady_state_reads_a_pint_quantity_in_its_unit() -> None:
     # np.asarray(1 um/s) is 1.0: the unit was dropped and the stress at 1 m/s (41 Pa) returned for 1 um/s.
     pint = pytest.importorskip("pint")
     from stickslip.errors import ParameterError
@@ -33,8 +33,13 @@ def test_steady_state_refuses_a_pint_quantity_instead_of_dropping_its_unit() -> 
     from stickslip.quasistatic.steady import steady_state
 
     params = load_parameters("gelatin-glass")
-    with pytest.raises(ParameterError, match=r"velocity: .*units"):
-        steady_state(params, pint.UnitRegistry().Quantity(1.0, "um/s"))
+    ureg = pint.UnitRegistry()  # a user's own registry, not the package's
+    one = steady_state(params, ureg.Quantity(1.0, "um/s")).stress  # (pint's factor may round differently)
+    assert one == pytest.approx(steady_state(params, 1e-6).stress, rel=1e-9)
+    both = steady_state(params, ureg.Quantity([1.0, 350.0], "um/s")).stress
+    assert both == pytest.approx(steady_state(params, [1e-6, 350e-6]).stress, rel=1e-9)
+    with pytest.raises(ParameterError, match=r"velocity: expected a velocity, got"):
+        steady_state(params, ureg.Quantity(1.0, "Pa"))
 
 
 def test_rsf_inertial_run_whose_regime_interpolant_probes_v_zero_finishes() -> None:

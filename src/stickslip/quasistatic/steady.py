@@ -535,11 +535,11 @@ def require_parameters(params: Any, name: str = "params") -> None:
 
 
 def _check_velocity(velocity: Any) -> np.ndarray:
-    if hasattr(velocity, "dimensionality") and hasattr(velocity, "magnitude"):  # np.asarray drops a pint unit
-        raise ParameterError(
-            f"velocity: expected numbers in m/s, got a quantity with units {shorten(velocity)}"
-            " (pass quantity.to('m/s').magnitude)"
-        )
+    if hasattr(velocity, "dimensionality") and hasattr(velocity, "magnitude"):  # np.asarray would drop the unit
+        try:
+            velocity = velocity.to("m/s").magnitude  # (in the quantity's own registry)
+        except Exception:  # pint's DimensionalityError, or a registry without m/s
+            raise ParameterError(f"velocity: expected a velocity, got {shorten(velocity)}") from None
     try:
         raw = np.asarray(velocity)
     except (TypeError, ValueError):  # ragged nested lists
