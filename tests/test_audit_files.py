@@ -66,3 +66,11 @@ def test_the_python_api_is_not_affected():
     before = sys.stdout
     assert claim_stdout(["-"]) is False
     assert sys.stdout is before
+
+
+def test_reproduce_refuses_dash_as_its_folder(tmp_path, capsys, monkeypatch):
+    """`reproduce -o -` (the README: `-o -` is standard output) silently made a folder named '-' of 93 files."""
+    monkeypatch.chdir(tmp_path)
+    status, _, err = run_main(capsys, "reproduce", "-o", "-", "--quiet")
+    assert status == 2 and err.strip().startswith("stickslip: error: output folder '-'"), err
+    assert len(err.strip().splitlines()) == 1 and list(tmp_path.iterdir()) == []
