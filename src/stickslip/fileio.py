@@ -10,7 +10,9 @@ What happens depends on what the name is:
 * a character device (``/dev/null``), a FIFO, a socket, or a name that leads
   through ``/proc/*/fd`` or ``/dev/fd`` (``/dev/stdout``): written as it is,
   appending, never replaced;
-* ``-``: standard output.
+* ``-``: standard output.  Then (and for a link to this process's own
+  standard output) everything else the command prints goes to standard
+  error (:func:`claim_stdout`), so ``--plot - > fig.png`` is a whole image.
 
 Temporary files are named ``.NAME.XXXXXXXX[.SUFFIX].tmp`` and locked
 (``flock``) while written; a killed write leaves one behind, and the next
@@ -44,6 +46,7 @@ __all__ = [
     "atomic_path",
     "atomic_write_bytes",
     "atomic_write_text",
+    "claim_stdout",
     "output_kind",
     "protect_inputs",
     "read_input_text",
@@ -62,6 +65,9 @@ _TEMP_TAIL = r"\.[a-z0-9_]{8}(?:\.[A-Za-z0-9_-]{1,16})?\.tmp"
 
 #: Key of the protected inputs in the click context of a command-line invocation.
 _META_KEY = "stickslip.fileio.inputs"
+
+#: Key of the real standard output once an output file has claimed it (see :func:`claim_stdout`).
+_STDOUT_KEY = "stickslip.fileio.stdout"
 
 
 # --------------------------------------------------------------------------- what an output name is
@@ -229,6 +235,7 @@ def refuse_input_as_output(inputs: list[str | Path | None], outputs: list[tuple[
     """
     protect_inputs(inputs)
     refuse_shared_outputs(outputs)
+    claim_stdout([out for _, out in outputs])
     existing = [p for p in inputs if p is not None and str(p) != STDOUT and _is_regular(p)]
     for option, out in outputs:
         if out is None or str(out) == STDOUT:
@@ -238,6 +245,52 @@ def refuse_input_as_output(inputs: list[str | Path | None], outputs: list[tuple[
                 raise DataError(
                     f"{option} {out}: that is the input file; refusing to overwrite it (choose another name)"
                 )
+
+
+# --------------------------------------------------------------------------- standard output taken by a file
+def claim_stdout(outputs: Iterable[str | Path | None]) -> bool:
+    """If one of the running command's outputs is standard output (``-``, or ``/dev/stdout``: a link to this
+    process's descriptor 1), send everything else it prints to standard error until the command ends.
+
+    ``stickslip curve --plot - > fig.png`` must give a whole PNG, not the table and then the image; a CSV on
+    ``-o -`` must not end in a summary.  Only inside a command-line invocation (the Python API prints nothing);
+    True if standard output was claimed.
+    """
+    meta = _invocation_meta()
+    if meta is None or _STDOUT_KEY in meta:
+        return meta is not None and _STDOUT_KEY in meta
+    if not any(out is not None and _is_stdout(out) for out in outputs):
+        return False
+    import click
+
+    real = sys.stdout
+    with contextlib.suppress(Exception):
+        real.flush()
+    meta[_STDOUT_KEY] = real
+    sys.stdout = sys.stderr
+
+    def restore() -> None:
+        if sys.stdout is sys.stderr:
+            sys.stdout = real
+        meta.pop(_STDOUT_KEY, None)
+
+    click.get_current_context().call_on_close(restore)
+    return True
+
+
+def _is_stdout(path: str | Path) -> bool:
+    if str(path) == STDOUT:
+        return True
+    try:
+        return _fd_link(path) == (os.getpid(), 1)
+    except (OSError, ValueError):
+        return False
+
+
+def _stdout() -> Any:
+    """The real standard output: the one an output file claimed, else ``sys.stdout``."""
+    meta = _invocation_meta()
+    return meta[_STDOUT_KEY] if meta and _STDOUT_KEY in meta else sys.stdout
 
 
 # --------------------------------------------------------------------------- writing
@@ -304,10 +357,11 @@ def atomic_open(path: str | Path, mode: str = "w", **kwargs: Any) -> Iterator[IO
 
 
 def _write_stdout(data: bytes) -> None:
-    sys.stdout.flush()
-    stream = getattr(sys.stdout, "buffer", None)
+    out = _stdout()
+    out.flush()
+    stream = getattr(out, "buffer", None)
     if stream is None:  # a text-only stand-in for stdout
-        sys.stdout.write(data.decode("utf-8", errors="replace"))
+        out.write(data.decode("utf-8", errors="replace"))
     else:
         stream.write(data)
         stream.flush()

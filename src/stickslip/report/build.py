@@ -71,6 +71,11 @@ def prepare_report_folder(where: str | Path) -> Path:
     """The output folder: new, empty, or holding an earlier stickslip report; anything else is refused."""
     if not str(where).strip():
         raise DataError("output folder: empty path; name a folder, e.g. stickslip-report")
+    if str(where).strip() == "-":  # elsewhere `-o -` is standard output; a report is a folder of files
+        raise DataError(
+            "output folder '-': a report is a folder of files, not standard output;"
+            " name a folder, e.g. stickslip-report"
+        )
     folder = Path(where)
     shown = shorten(str(folder), 240)
     if folder.exists() and not folder.is_dir():
