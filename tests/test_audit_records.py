@@ -102,3 +102,19 @@ def test_fit_steady_on_a_flat_record_has_finite_residuals(tmp_path, capsys):
     assert np.isfinite(fit.to_frame()["residual"]).all()
     code, out, _ = run_main(capsys, "fit", "steady", str(path))
     assert code == 3 and "nan" not in out.lower()
+
+
+def test_rsf_stability_json_names_rate_and_state_spring_in_its_unit(capsys):
+    """rsf stability --json said the spring was in Pa/m (the bond model's unit) while it holds friction per slip,
+    k = K/sigma in 1/m (3e9 Pa/m at 30 MPa: 100 1/m), and gave k_c in Pa/m no unit."""
+    code, out, _ = run_main(
+        capsys, "rsf", "stability", "--velocity", "1 um/s", "--a", "0.01", "--b", "0.02", "--dc", "10 um",
+        "--stiffness", "3e9 Pa/m", "--normal-stress", "30 MPa", "--json",
+    )  # fmt: skip
+    assert code == 0
+    document = json.loads(out)
+    assert document["stiffness"] == pytest.approx(100.0)
+    assert document["units"]["stiffness"] == "1/m" and document["units"]["critical_stiffness"] == "1/m"
+    assert document["units"]["critical_stiffness_pa"] == "Pa/m"
+    # k_c = sigma (b - a) / Dc in Pa/m, the closed form of the aging law's spring-slider (docs/rsf.md)
+    assert document["critical_stiffness_pa"] == pytest.approx(30e6 * 0.01 / 10e-6, rel=1e-9)

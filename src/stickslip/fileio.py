@@ -261,8 +261,7 @@ def claim_stdout(outputs: Iterable[str | Path | None]) -> bool:
         return meta is not None and _STDOUT_KEY in meta
     if not any(out is not None and _is_stdout(out) for out in outputs):
         return False
-    import click
-
+    click = sys.modules["click"]  # (loaded: the invocation's meta is its context's)
     real = sys.stdout
     with contextlib.suppress(Exception):
         real.flush()

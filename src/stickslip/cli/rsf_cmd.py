@@ -244,6 +244,10 @@ def simulate_command(**options: Any) -> None:
             as_json=options["as_json"], beside=beside, start_option="--start-velocity ")  # fmt: skip
 
 
+#: rate-and-state's spring is friction per slip (1/m), not the bond model's Pa/m; k_c in Pa/m with a normal stress
+_STABILITY_UNITS = {"stiffness": "1/m", "critical_stiffness_pa": "Pa/m"}
+
+
 @rsf_group.command("stability")
 @model_options
 @click.option("--velocity", "velocities", multiple=True, required=True, help='Sliding velocity, e.g. "1 um/s".')
@@ -258,7 +262,10 @@ def stability_command(**options: Any) -> None:
     refuse_overwriting_inputs([options.get("params_file")], [("--plot", options["plot_path"])])
     reports = [stability(params, positive(v, "velocity", "--velocity")).as_dict() for v in options["velocities"]]
     if options["as_json"]:
-        click.echo(json_text(reports if len(reports) > 1 else reports[0]))
+        from ..columns import json_safe, json_units
+
+        single = {**reports[0], "units": json_units(json_safe(reports[0]), _STABILITY_UNITS)}
+        click.echo(json_text(reports if len(reports) > 1 else single))
     else:
         for r in reports:
             period = r["neutral_period"]
