@@ -33,6 +33,7 @@ __all__ = [
     "UNITS",
     "attribute_frame",
     "csv_text",
+    "data_lines",
     "header_cell",
     "json_safe",
     "json_text",
@@ -237,6 +238,14 @@ def split_header(cell: str) -> tuple[str, str | None]:
         if name.strip():
             return name.strip(), unit.strip()
     return text, None
+
+
+def data_lines(lines: Iterable[str], count: int) -> list[int] | None:
+    """The 1-based file line of each of the ``count`` data rows after the header, blank lines and ``#`` comments
+    skipped as the readers skip them (an error names the line an editor shows); None where the numbers do not
+    match what the reader kept (a quoted line end)."""
+    numbers = [n for n, line in enumerate(lines, 1) if line.split("#", 1)[0].strip()][1:]
+    return numbers if len(numbers) == count else None
 
 
 def header_cell(name: str, unit: str | None) -> str:

@@ -23,7 +23,7 @@ from typing import Any
 
 import numpy as np
 
-from .columns import split_header, with_units
+from .columns import data_lines, split_header, with_units
 from .display import velocity as velocity_text
 from .errors import DataError, ParameterError, UnitError, as_written
 from .fileio import protect_inputs, read_input_text
@@ -273,7 +273,7 @@ def read_protocol(path: str | Path) -> Protocol:
     # a header cell may carry its unit, as the package writes CSV headers: "time [s]", "velocity [um/s]"
     columns = {split_header(str(c))[0].lower(): c for c in frame.columns}
     _refuse_duplicated_columns(text, path)
-    lines = _data_lines(text, len(frame))
+    lines = data_lines(text.split("\n"), len(frame)) or list(range(2, len(frame) + 2))
     if {"velocity", "duration"} <= set(columns):
         pairs = _numeric_rows(frame, path, [columns["velocity"], columns["duration"]], lines)
         try:
@@ -303,13 +303,6 @@ MAX_PROTOCOL_BYTES = 100_000_000
 
 def _protocol_text(path: Path) -> str:
     return read_input_text(path, f"protocol file {path}", MAX_PROTOCOL_BYTES)
-
-
-def _data_lines(text: str, count: int) -> list[int]:
-    """The file's line number of each of the ``count`` data rows: comment and blank lines are skipped by the
-    reader but counted by an editor, so an error names the line a user finds the value on."""
-    lines = [k for k, line in enumerate(text.split("\n"), start=1) if line.split("#", 1)[0].strip()][1:]
-    return lines if len(lines) == count else list(range(2, count + 2))
 
 
 def _numeric_rows(frame: Any, path: Path, cols: list[Any], lines: list[int]) -> list[tuple[float, float]]:

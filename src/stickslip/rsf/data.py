@@ -17,7 +17,7 @@ from typing import Any
 
 import numpy as np
 
-from ..columns import split_header, with_units
+from ..columns import data_lines, split_header, with_units
 from ..errors import DataError, ParameterError
 from ..fileio import protect_inputs
 from ..protocols import Protocol, Segment
@@ -141,7 +141,8 @@ def read_record(
     }
     option["velocity"] = _velocity_option(option["length"], option["time"])
     frame = _read_frame(path, pd)
-    rows = _file_rows(path, len(frame))
+    with open(path, encoding="utf-8", errors="replace") as handle:
+        rows = data_lines(handle, len(frame))
     headers = {str(c).strip(): c for c in frame.columns}
     bracketed = {str(c): split_header(str(c)) for c in frame.columns}  # "time [s]" as this package writes it
     lower = {k.lower(): v for k, v in headers.items()}
@@ -194,14 +195,6 @@ _TAIL_UNITS |= {"m/s", "mm/s", "um/s", "µm/s", "μm/s", "nm/s"}
 def _row_names(rows: Any, size: int) -> Any:
     """Each sample's row for messages: ``rows`` when it names every sample, else 1, 2, ..."""
     return rows if rows is not None and len(rows) == size else range(1, size + 1)
-
-
-def _file_rows(path: Path, samples: int) -> list[int] | None:
-    """The file line of each data row the reader kept (``#`` comments and blank lines skipped), as the package's
-    other readers number rows; None where that count does not match what the reader kept (a quoted line end)."""
-    with open(path, encoding="utf-8", errors="replace") as handle:
-        lines = [n for n, line in enumerate(handle, 1) if line.split("#", 1)[0].strip()]
-    return lines[1:] if len(lines) == samples + 1 else None
 
 
 def _read_frame(path: Path, pd: Any) -> Any:
