@@ -374,8 +374,10 @@ def execute(
     record below it.  ``beside(run)`` writes what a spelling keeps beside the trace (``rsf simulate``'s
     parameters).  A failed run, or one stopped by its budget, exits with status 3 after saying how far it got.
     """
+    from ..fileio import claim_stdout
     from ..models import as_run
 
+    claim_stdout([output, plot_path])  # (rsf simulate's trace goes to standard output without -o)
     model.check(protocol, rig, settings)
     stopped: BudgetExhausted | None = None
     with progress(model.name, total=protocol.duration, unit="s", enabled=False if as_json else None) as bar:
@@ -405,11 +407,9 @@ def execute(
         save_figure(run.plot().figure, plot_path)
     if as_json:
         emit_json(summary)
-    else:  # beside a trace on standard output (-o -), the summary goes to stderr
+    else:  # (beside a trace on standard output, claim_stdout above sends it to stderr)
         record = record_text(run)
-        click.echo(
-            summary_text(summary) + ("\n" + record if record else ""), err=output is not None and str(output) == "-"
-        )
+        click.echo(summary_text(summary) + ("\n" + record if record else ""))
     if stopped is not None:
         written = [str(path) for path in (output, plot_path) if path is not None]
         kept = f"; the run up to there is in {' and '.join(written)}" if written else ""
