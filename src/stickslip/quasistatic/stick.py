@@ -10,6 +10,7 @@ docs/stick-phase.md.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
@@ -18,7 +19,6 @@ from scipy.optimize import brentq
 
 from ..columns import attribute_frame
 from ..errors import ModelError, ParameterError
-from ..numerics.events import integrate_in_chunks
 from ..parameters import Parameters, require_flag
 from ..reprs import compact_repr, field_values
 from .jump import require_critical_point
@@ -52,6 +52,9 @@ MAX_AGING_CAP = 100.0
 THRESHOLD_RTOL = 1e-4
 #: Candidate floors, as fractions of the way from K V0 tau_a b/Nc0 to n, tried by the stuck proof.
 FLOOR_FRACTIONS = (0.5, 0.8, 0.9, 0.95, 0.99)
+#: How the theta integration is done: "steps" (scipy's DOP853 steps on Python floats, stickslip.numerics.dop853)
+#: or "solve_ivp" (the same method through scipy, ~6x dearer per call: the reference of benchmarks/bench_stick.py)
+SOLVER = "steps"
 
 
 @dataclass(frozen=True)
@@ -221,6 +224,88 @@ def _no_load_phase(
     )
 
 
+def _hold_function(rates: _Rates, scale: float, log_rt: float) -> Callable[[float, float], float]:
+    """dt'/dtheta = 1/(1 + w) at (t', n); dn/dtheta is that minus 1 (docs/stick-phase.md §3)."""
+    s0, k, inv_aging, cap = rates.s0, rates.k, rates.inv_aging, rates.aging_cap
+    log, exp = math.log, math.exp
+
+    def hold(tp: float, n: float) -> float:
+        if n <= N_GONE:  # the collapse, continued smoothly through n = 0
+            return 0.0
+        t = tp * scale
+        log_w = log_rt + log(n) + (s0 + k * t) / n - min(t * inv_aging, cap)
+        if log_w > 0.0:  # 1/(1 + w) without overflow
+            e = exp(-log_w)
+            return e / (1.0 + e)
+        return 1.0 / (1.0 + exp(log_w))
+
+    def hold_unbounded(tp: float, n: float) -> float:  # the same without the bound of aging (most calls)
+        if n <= N_GONE:
+            return 0.0
+        t = tp * scale
+        log_w = log_rt + log(n) + (s0 + k * t) / n - t * inv_aging
+        if log_w > 0.0:
+            e = exp(-log_w)
+            return e / (1.0 + e)
+        return 1.0 / (1.0 + exp(log_w))
+
+    return hold if math.isfinite(cap) else hold_unbounded
+
+
+def _solve_steps(
+    rates: _Rates,
+    scale: float,
+    log_rt: float,
+    checkpoints: list[float],
+    decide: Callable[[float, float, float], bool],
+    horizon: float | None,
+) -> tuple[str, Any, tuple[float, float]]:
+    """The theta integration on Python floats (:mod:`stickslip.numerics.dop853`: solve_ivp's DOP853, ~6x cheaper)."""
+    from ..numerics.dop853 import integrate
+
+    hold = _hold_function(rates, scale, log_rt)
+    result = integrate(hold, (0.0, 1.0), checkpoints, decide, rtol=RTOL, atol=ATOL)
+    if result.reason == "decided" and horizon is not None and horizon > result.y_end[0] * scale:
+        # the block is stuck: follow the (slow, t-like) decay on to the requested horizon
+        theta_h = result.s_end + (horizon / scale - result.y_end[0]) * 1.001 + 1.0
+        integrate(hold, result.y_end, [theta_h], lambda *_: False, RTOL, ATOL, result.s_end, result.steps)
+    return result.reason, result.steps, result.y_end
+
+
+def _solve_ivp(
+    rates: _Rates,
+    scale: float,
+    log_rt: float,
+    checkpoints: list[float],
+    decide: Callable[[float, float, float], bool],
+    horizon: float | None,
+) -> tuple[str, Any, tuple[float, float]]:
+    """The theta integration through solve_ivp (the reference of benchmarks/bench_stick.py and the tests)."""
+    from ..numerics.events import integrate_in_chunks
+
+    hold = _hold_function(rates, scale, log_rt)
+
+    def field_(_theta: float, y: np.ndarray) -> list[float]:
+        g = hold(y[0], y[1])
+        return [g, g - 1.0]
+
+    def collapse(_theta: float, y: np.ndarray) -> float:
+        return float(y[1])
+
+    def decide_(theta: float, y: np.ndarray) -> bool:
+        return decide(theta, float(y[0]), float(y[1]))
+
+    result = integrate_in_chunks(field_, [0.0, 1.0], collapse, checkpoints, decide_, rtol=RTOL, atol=ATOL)
+    dense = result.solution
+    if result.reason == "decided" and horizon is not None and horizon > float(result.y_end[0]) * scale:
+        theta_h = result.s_end + (horizon / scale - float(result.y_end[0])) * 1.001 + 1.0
+        integrate_in_chunks(
+            field_, result.y_end, collapse, [theta_h], lambda *_: False, rtol=RTOL, atol=ATOL,
+            start=result.s_end, chained=dense,
+        )  # fmt: skip
+    return result.reason, dense, (float(result.y_end[0]), float(result.y_end[1]))
+
+
 def stick_phase(
     params: Parameters,
     pulling_velocity: float,
@@ -280,31 +365,6 @@ def stick_phase(
     scale = rates.time_scale()
     log_rt = math.log(rates.r) + math.log(scale)
 
-    def field_(_theta: float, y: np.ndarray) -> list[float]:
-        tp, n = y[0], y[1]
-        if n <= N_GONE:  # the collapse, continued smoothly through n = 0
-            return [0.0, -1.0]
-        t = tp * scale
-        log_w = log_rt + math.log(n) + (rates.s0 + rates.k * t) / n - rates.aging(t)
-        # 1/(1 + w) without overflow
-        if log_w > 0.0:
-            e = math.exp(-log_w)
-            hold = e / (1.0 + e)
-        else:
-            hold = 1.0 / (1.0 + math.exp(log_w))
-        return [hold, hold - 1.0]
-
-    def collapse(_theta: float, y: np.ndarray) -> float:
-        return float(y[1])
-
-    floor: list[float] = []
-
-    def decide(_theta: float, y: np.ndarray) -> bool:
-        found = never_slips(rates, float(y[0]) * scale, float(y[1]))
-        if found is not None:
-            floor.append(found)
-        return found is not None
-
     if aging and not math.isfinite(rates.aging_cap):
         t_end = HORIZON_AGING_TIMES * params.stick.aging_time
         # checkpoints in theta; theta = t' + (1 - n) exactly, so theta >= t'
@@ -312,32 +372,33 @@ def stick_phase(
         checkpoints = [params.stick.aging_time * 2.0**j / scale + 1.0 for j in range(count)]
     else:
         checkpoints = [HORIZON_SCALED_TIME]
-    result = integrate_in_chunks(field_, [0.0, 1.0], collapse, checkpoints, decide, rtol=RTOL, atol=ATOL)
-    dense = result.solution
-    if result.reason == "decided" and horizon is not None and horizon > float(result.y_end[0]) * scale:
-        # the block is stuck: follow the (slow, t-like) decay on to the requested horizon
-        theta_h = result.s_end + (horizon / scale - float(result.y_end[0])) * 1.001 + 1.0
-        integrate_in_chunks(
-            field_, result.y_end, collapse, [theta_h], lambda *_: False, rtol=RTOL, atol=ATOL,
-            start=result.s_end, chained=dense,
-        )  # fmt: skip
+    floor: list[float] = []
+
+    def decide(_theta: float, tp: float, n: float) -> bool:
+        found = never_slips(rates, tp * scale, n)
+        if found is not None:
+            floor.append(found)
+        return found is not None
+
+    solve = _solve_steps if SOLVER == "steps" else _solve_ivp
+    reason, dense, y_end = solve(rates, scale, log_rt, checkpoints, decide, horizon)
     theta = np.linspace(dense.start, dense.end, SAMPLES)
     tp, n = dense(theta)
     time = np.maximum.accumulate(tp * scale)
     n = np.clip(n, 0.0, 1.0)
-    if result.reason == "event":
-        ts = float(result.y_end[0]) * scale
+    if reason == "event":
+        ts = y_end[0] * scale
         time = np.minimum(np.maximum.accumulate(time), ts)  # dense output may overshoot ts by rounding
         time[-1], n[-1] = ts, 0.0
         sigma_s = sigma0 + stiffness * v0 * ts
         status, stuck = "slipped", False
         message = f"the attached chains collapse at ts = {ts:.6g} s, σs = {sigma_s:.6g} Pa (Eqs 15-16): the block slips"
         stick_time, peak = ts, sigma_s
-    elif result.reason == "decided":
+    elif reason == "decided":
         status, stuck, stick_time, peak = "stuck", True, None, None
         message = (
             f"the block stays stuck: aging wins and Nc/Nc0 provably stays above {floor[0]:.4g} for all time"
-            f" (Eq 15; checked at t = {float(result.y_end[0]) * scale:.4g} s)"
+            f" (Eq 15; checked at t = {y_end[0] * scale:.4g} s)"
         )
         if v0 > 0.0:
             message += f"; {STUCK_LIMITATION}"
