@@ -20,6 +20,33 @@ from stickslip.quasistatic.steady import steady_state
 pytest.importorskip("emcee")
 
 
+#: _unbounded's notes by its inputs, for the tests of this file (see shared_unbounded)
+_UNBOUNDED: dict[tuple, list[str]] = {}
+
+
+@pytest.fixture(autouse=True)
+def shared_unbounded(monkeypatch):
+    """bayes._unbounded made once per log posterior and centre: the three tests on the hard fit (and the CLI's two
+    runs on one record) ask it the same (1-2 s each: eight refits at the prior's edges).  It is a function of the
+    data, the sampled keys, the box and the centre, all in the key, so each caller gets the notes it would
+    compute; the first caller computes them."""
+    from stickslip.fitting import bayes
+
+    compute = bayes._unbounded
+
+    def unbounded(log_post, centre):
+        block = log_post.block
+        data = block.residuals_of(np.zeros((1, block.eval_points.size)))  # the data over their errors
+        key = (log_post.space.keys, log_post.space.vector().tobytes(), log_post.lower.tobytes(),
+               log_post.upper.tobytes(), log_post.stated, centre.tobytes(), block.eval_points.tobytes(),
+               np.asarray(data).tobytes(), bayes.UNBOUNDED_DROP)  # fmt: skip
+        if key not in _UNBOUNDED:
+            _UNBOUNDED[key] = compute(log_post, centre)
+        return list(_UNBOUNDED[key])
+
+    monkeypatch.setattr(bayes, "_unbounded", unbounded)
+
+
 @pytest.fixture(scope="module")
 def hard_fit():
     """benchmarks/bench_fit.py's "harder 20-point set": gelatin-glass, 140-2000 µm/s, 2 % noise, seed 2 -- a
