@@ -4,7 +4,8 @@ Run as ``PYTHONPATH=src python benchmarks/bench_transient.py`` (``--reference`` 
 the cycle, 49 s of CPU, whose numbers tests/test_transient_speed.py compares with; ``--quick`` skips the plain
 cohort runs that take more than a few seconds; ``--phases`` only counts where the cycle's steps go, issue 31;
 ``--repeat`` only times long stick-slip runs, a settled limit cycle repeated beside every cycle integrated;
-``--births`` only times the cycle with the births spaced by their own error beside the lumped bound).
+``--births`` only times the cycle with the births spaced by their own error beside the lumped bound; ``--holds`` only
+times re-slides after holds with the steps landed short of the FENE wall beside the solver before).
 CPU time (``time.process_time``) is printed with the ratio
 to the plain solver's in the same process, and the accuracy reached: against the steady solver, or the
 cycle's stick time, peak, jump velocity and slip time against the tighter run.
@@ -179,7 +180,45 @@ def births_spacing(repeats: int = 5) -> None:
     print(f"speed-up: {sorted(times[False])[0] / sorted(times[True])[0]:.1f}x (best against best)")
 
 
+#: re-slide peaks after 1 s and 10 s holds (2 ms at 100 um/s, the hold, 15 ms at 100 um/s, velocity control) from
+#: the solver before the wall landing at rtol 1e-5 (8 750 and 11 147 steps): tests/test_transient_wall_landing.py
+HOLD_PEAKS = {0.1: 225907.003, 1.0: 3559901.17, 10.0: 39200921.6}
+
+
+def wall_landing(repeats: int = 3) -> None:
+    """Issue 31: re-sliding after a hold (the report's slide-hold-slide runs) with the steps ending short of a loaded
+    cohort's arrival at the FENE wall (the default) beside the solver before (``solver.WALL_LANDING = False``),
+    alternated in one process, best CPU of ``repeats`` each; the peak against the rtol 1e-5 reference."""
+    from stickslip.protocols import segments
+    from stickslip.transient import solver
+
+    p = stickslip.load_parameters("gelatin-glass")
+    run_transient(p, constant(100e-6, 1e-3), control="velocity")  # the numba caches
+    for rtol in (1e-3, 1e-4):
+        for hold, reference in HOLD_PEAKS.items():
+            protocol = segments([(100e-6, 0.002), (0.0, hold), (100e-6, 0.015)])
+            times: dict[bool, list[float]] = {True: [], False: []}
+            runs = {}
+            for _ in range(repeats):
+                for landing in (True, False):
+                    solver.WALL_LANDING = landing
+                    t_cpu, runs[landing] = cpu(lambda protocol=protocol, rtol=rtol: run_transient(
+                        p, protocol, control="velocity", start="steady", rtol=rtol))  # fmt: skip
+                    times[landing].append(t_cpu)
+            solver.WALL_LANDING = True
+            parts = []
+            for landing, label in ((True, "landed"), (False, "before")):
+                run = runs[landing]
+                peak = float(run.stress[run.time > 0.002 + hold].max())
+                parts.append(f"{label} {min(times[landing]):.2f} s CPU, {run.steps} steps + {run.rejected} rejected, "
+                             f"peak {peak / reference - 1:+.1e}")  # fmt: skip
+            print(f"re-slide after {hold:g} s, rtol {rtol:g}: " + "; ".join(parts), flush=True)
+
+
 def main() -> None:
+    if "--holds" in sys.argv:
+        wall_landing()
+        return
     if "--births" in sys.argv:
         births_spacing()
         return

@@ -43,6 +43,11 @@ their own Gauss error and a stick was landed on the slider's crossing of the sti
 docs/transient.md section 11): the same 52 steps and verdict, the trace within 5.3e-8 (sigma), 2.6e-6 (N/N0, V) of
 the largest values of the previous one; against the plain cohorts at rtol 1e-5 (rows past 0.5 s) sigma within
 6.2e-8 (before 6.2e-8), N/N0 2.6e-6 (2.3e-6), V 2.4e-6 (2.1e-6) of their largest values.
+
+``from_rest_chains`` was rewritten again when a step came to end short of a loaded cohort's arrival at the FENE wall
+(kernel.WALL_LANDING, issue 31; docs/transient.md section 12): the same 52 steps and verdict, sigma within 4.9e-14,
+N/N0 and V within 2.6e-6 and 2.3e-6 of the largest values of the previous trace; against the plain cohorts at rtol
+1e-5 (rows past 0.5 s) unchanged: sigma 6.2e-8, N/N0 2.6e-6, V 2.4e-6.  The other six cases are unchanged.
 """
 
 from __future__ import annotations

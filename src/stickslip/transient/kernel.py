@@ -87,7 +87,8 @@ CORRECTION_SERIES = 1e-3
     P_DAMPING,
     P_MERGE_SATURATED,
     P_RELAXED_BIRTHS,
-) = range(15)
+    P_WALL_LANDING,
+) = range(16)
 # integer status returned by advance()
 DONE, FULL, STEPS, STICK, FAILED = 0, 1, 2, 3, 4
 #: half-distance of the two Gauss-Legendre points from the middle of a step, as a fraction of the step
@@ -96,6 +97,11 @@ GAUSS = 0.5 / math.sqrt(3.0)
 STICK_LANDING = 0.01
 #: largest fraction by which the stress may fall within one step (the trace resolves ruptures)
 MAX_DROP = 0.2
+#: the step after an accepted one ends at this share of the time the nearest loaded cohort needs to reach the FENE
+#: wall at the slider's velocity (p[P_WALL_LANDING]; 0: no such bound, ``solver.WALL_LANDING = False``); loaded:
+#: carrying WALL_SHARE x rtol x |sigma| or more
+WALL_LANDING = 0.9
+WALL_SHARE = 0.1
 #: four-point Gauss-Legendre rule on [-1, 1]
 GL4_X = np.array([-0.8611363115940526, -0.3399810435848563, 0.3399810435848563, 0.8611363115940526])
 GL4_W = np.array([0.3478548451374538, 0.6521451548625461, 0.6521451548625461, 0.3478548451374538])
@@ -654,7 +660,7 @@ def _cohort_dissipation(trap, hh, w0, wn, r0, r1, g0, g1, f0, f1, v0, v1p, e0, e
 
 def _cohort_pass(  # type: ignore[no-untyped-def]
     n, t, t1, t0, hh, x, x1p, x_mid, v0, v1p, slope0, slope1, accel, xb, tb, lw, lw_new, rate0, w1, known,
-    predicted, cache, cached, clock_end, p,
+    predicted, cache, cached, clock_end, wall_load, p,
 ):  # fmt: skip
     """One pass over the cohorts: each one's log weight at the step's end (``lw_new``, ``w1``; its hazard there in
     ``rate0``, its force and stiffness at the predicted end in ``predicted``), and the sums over them:
@@ -683,6 +689,7 @@ def _cohort_pass(  # type: ignore[no-untyped-def]
     walled = 0.0  # bonds freed by the FENE wall within the step (not part of the smooth breakage rate)
     cliff = 0.0  # stress dying at a hazard cliff steeper than the step (see _cohort_weight)
     cliff_old = 0.0  # the same for bonds born before this piece of the protocol
+    wall_gap = np.inf  # the least extension left to the FENE wall of a cohort carrying wall_load or more towards it
     for i in range(n):
         w0 = cache[0, i] if cached else math.exp(lw[i])
         e0 = x - xb[i]
@@ -768,9 +775,11 @@ def _cohort_pass(  # type: ignore[no-untyped-def]
         lw_new[i] = new
         w1[i] = wn
         rate0[i] = r1  # kept for the merging of quiet cohorts after the step
+        if e1 * v1p > 0.0 and wn * abs(f1) >= wall_load:
+            wall_gap = min(wall_gap, dlm - abs(e1))
     return (
         nn0, s0, nn1, s1, loss0, loss1, dloss0, dloss1, broken, dissip, rate_s0, rate_s1, kint0, kint1, err_s, err_n,
-        sens_x, sens_a, walled, cliff, cliff_old,
+        sens_x, sens_a, walled, cliff, cliff_old, wall_gap,
     )  # fmt: skip
 
 
@@ -1203,6 +1212,7 @@ def advance(  # type: ignore[no-untyped-def]
     v_prev = v
     h_prev = 0.0
     s_floor = 1e-9 * p[P_M] * p[P_N0] * p[P_DLM]
+    wall_load = np.inf  # no landing before the first step's stress is known
     while sample_index < n_samples and sample_times[sample_index] <= t:  # grid points already passed
         sample_index += 1
     cache = np.empty((8, xb.shape[0]))  # the cohorts' values at the start of the step, when ``cached``
@@ -1233,10 +1243,10 @@ def advance(  # type: ignore[no-untyped-def]
         accel = (v1p - v0) / hh
         (
             nn0, s0, nn1, s1, loss0, loss1, dloss0, dloss1, broken, dissip, rate_s0, rate_s1, kint0, kint1, err_s,
-            err_n, sens_x, sens_a, walled, cliff, cliff_old,
+            err_n, sens_x, sens_a, walled, cliff, cliff_old, wall_gap,
         ) = _cohort_pass(
             n, t, t1, t0, hh, x, x1p, x_mid, v0, v1p, slope0, slope1, accel, xb, tb, lw, lw_new, rate0, w1, known,
-            predicted, cache, cached, clock_end, p,
+            predicted, cache, cached, clock_end, wall_load, p,
         )  # fmt: skip
         clock_end[0, n] = np.nan  # the newborns' clock is not computed by the pass
         clock_end[0, n + 1] = np.nan
@@ -1289,6 +1299,12 @@ def advance(  # type: ignore[no-untyped-def]
             steps % MERGE_EVERY == 0, acc, clock_end, p,
         )  # fmt: skip
         h = _next_step(hh, err, h, h_max, landing)
+        if p[P_WALL_LANDING] > 0.0 and abs(v1) > 0.0:
+            # the next step ends short of the next loaded cohort's arrival at the FENE wall (a chain reaching full
+            # extension within a step counts its whole stress as the step's error: such a step was rejected,
+            # three times on average, re-sliding after a hold, where aged bonds die at the wall one after another)
+            h = min(h, p[P_WALL_LANDING] * wall_gap / abs(v1))
+        wall_load = WALL_SHARE * rtol * max(abs(s1), s_floor)
         record = n_samples == 0
         if landing:
             sample_index += 1

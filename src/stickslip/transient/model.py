@@ -30,12 +30,14 @@ def pack_parameters(
     mass: float = 0.0,
     damping: float = 0.0,
     relaxed_births: bool = False,
+    wall_landing: bool = False,
 ) -> np.ndarray:
     """The float vector the kernel reads (layout: kernel.P_*); ``mass`` (kg/m^2) and ``damping`` (Pa s/m): the
     block's inertia and viscous damping (0: the paper's massless block); ``relaxed_births``: no bond born sliding
-    is held and slid again (kernel._relaxed_births)."""
+    is held and slid again (kernel._relaxed_births); ``wall_landing``: steps end short of a loaded cohort's arrival at
+    the FENE wall (kernel.WALL_LANDING)."""
     b, g = params.bonds, params.aging
-    p = np.zeros(15)
+    p = np.zeros(16)
     p[K.P_LOG_U0_TAU] = math.log(b.breakage_weight / b.bond_time)
     p[K.P_TAU] = b.bond_time
     p[K.P_FORCE_SENS] = b.force_sensitivity
@@ -51,6 +53,7 @@ def pack_parameters(
     p[K.P_DAMPING] = damping
     p[K.P_MERGE_SATURATED] = _MERGE_SATURATED[0]
     p[K.P_RELAXED_BIRTHS] = 1.0 if relaxed_births else 0.0
+    p[K.P_WALL_LANDING] = K.WALL_LANDING if wall_landing else 0.0
     return p
 
 

@@ -56,6 +56,9 @@ REPEAT_CYCLES = True
 #: lumped cohort's (kernel._relaxed_births, docs/transient.md section 11); False: the lumped bound throughout (the
 #: reference of the benchmark and the tests)
 RELAXED_BIRTHS = True
+#: steps end short of a loaded cohort's arrival at the FENE wall (kernel.WALL_LANDING; False: the reference, where such
+#: a step was rejected and retried, three times on average re-sliding after a hold; docs/transient.md section 12)
+WALL_LANDING = True
 
 
 @dataclass
@@ -262,7 +265,9 @@ class _Driver:
         self.duration = protocol.duration
         self.functions = K.compiled()
         relaxed = RELAXED_BIRTHS and _births_never_held(protocol, stick_population)
-        self.p = pack_parameters(params, aging, k_block, mass, damping, relaxed_births=relaxed)
+        self.p = pack_parameters(
+            params, aging, k_block, mass, damping, relaxed_births=relaxed, wall_landing=WALL_LANDING
+        )
         self.snapshots: list[Snapshot] = []
         self.chain_rows: list[np.ndarray] = []
         self.events: list[tuple[str, float, float, float]] = []  # (kind, time, stress, velocity)
