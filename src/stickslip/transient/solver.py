@@ -750,6 +750,20 @@ class _Reducer:
             return False
         return True
 
+    def _may_enter(self, s: float, slope: float, sigma: float, v: float, vp: float) -> bool:
+        """Whether the state can pass reduction.entry_velocity's first test, |S_eff(v) - sigma| <= THETA rtol |sigma|,
+        with the lag C computed at v alone (one steady population, ~1 ms) instead of a table (~30-70 ms): with the
+        table's own share of C (LAG_SHARE) and twice the tolerance to spare.  Near the fold a slider slowing past Vc
+        asked for tables down to a third of its velocity that no stretch then entered: 3 of the 5 tables of a stiff
+        block's first cycle, 0.2 s of its 0.7 s (docs/transient.md section 12)."""
+        from . import reduction as R
+
+        lag = R._lag(self.params, v, self.aging)[0]
+        accel = self.k_block * (vp - v) / slope
+        spare = 2.0 * R.THETA * self.rtol * abs(sigma)
+        spare += R.LAG_SHARE * (abs(lag) + slope * self.params.bonds.bond_time) * abs(accel)
+        return abs(s + lag * accel - sigma) <= spare
+
     def _miss(self, state: _State) -> None:
         self.next_try = state.acc[4] + self.interval
         self.interval = min(2 * self.interval, self.LAST_LOOK)
@@ -831,6 +845,8 @@ class _Reducer:
                 return None
             ref = steady_state(self.params, v, self.aging)
             if not (float(ref.stress_slope) > 0 and abs(sigma - float(ref.stress)) <= 0.1 * abs(sigma)):
+                return None
+            if not self._may_enter(float(ref.stress), float(ref.stress_slope), sigma, v, vp):
                 return None
             m = R.manifold_for(self.params, self.aging, lo, hi, 3.0 * hi, self.rtol, self.tables)
             if m is None:  # the steady curve cannot be tabulated here to its share of rtol: cohorts for this piece
