@@ -5,7 +5,8 @@ the cycle, 49 s of CPU, whose numbers tests/test_transient_speed.py compares wit
 cohort runs that take more than a few seconds; ``--phases`` only counts where the cycle's steps go, issue 31;
 ``--repeat`` only times long stick-slip runs, a settled limit cycle repeated beside every cycle integrated;
 ``--births`` only times the cycle with the births spaced by their own error beside the lumped bound; ``--holds`` only
-times re-slides after holds with the steps landed short of the FENE wall beside the solver before).
+times re-slides after holds with the steps landed short of the FENE wall beside the solver before; ``--against
+OTHER_SRC`` only times the cycle with this checkout and another copy of ``src/`` in alternate processes).
 CPU time (``time.process_time``) is printed with the ratio
 to the plain solver's in the same process, and the accuracy reached: against the steady solver, or the
 cycle's stick time, peak, jump velocity and slip time against the tighter run.
@@ -215,7 +216,51 @@ def wall_landing(repeats: int = 3) -> None:
             print(f"re-slide after {hold:g} s, rtol {rtol:g}: " + "; ".join(parts), flush=True)
 
 
+#: the child of ``--against``: the cycle in a warm process, best and median CPU of 7, its steps and numbers
+_CYCLE_CHILD = """
+import json, time, stickslip
+from stickslip.protocols import Protocol, Segment
+from stickslip.transient import run_transient
+cycle = Protocol((Segment(350e-6, 5.0), Segment(100e-6, 20.0)))
+p = stickslip.load_parameters("gelatin-glass")
+run_transient(p, cycle, start="steady", stick_population=True)
+times = []
+for _ in range(7):
+    start = time.process_time()
+    run = run_transient(p, cycle, start="steady", stick_population=True)
+    times.append(time.process_time() - start)
+c = run.cycles[0]
+times.sort()
+print(json.dumps([times[0], times[3], run.steps, [c.stick_time, c.peak_stress, c.jump_velocity, c.slip_time]]))
+"""
+
+
+def cycle_against(other: str, rounds: int = 3) -> None:
+    """Issue 31: the paper's cycle with this checkout's package and with another copy of ``src/`` (an older commit:
+    ``git archive COMMIT src | tar -x -C /tmp/old``, then ``--against /tmp/old/src``), each in its own process,
+    alternated ``rounds`` times so that both see the same machine; CPU best/median of 7 warm runs each."""
+    import json
+    import os
+    import subprocess
+    from pathlib import Path
+
+    sources = {"this": str(Path(__file__).resolve().parent.parent / "src"), "other": other}
+    for _ in range(rounds):
+        for label, src in sources.items():
+            env = {**os.environ, "PYTHONPATH": src}
+            out = subprocess.run([sys.executable, "-c", _CYCLE_CHILD], env=env, capture_output=True, text=True,
+                                 check=True).stdout  # fmt: skip
+            best, median, steps, numbers = json.loads(out.strip().splitlines()[-1])
+            error = np.abs(np.array(numbers) / CYCLE_TIGHT - 1)
+            against = ", ".join(f"{k} {e:.1e}" for k, e in zip(CYCLE_KEYS, error, strict=True))
+            print(f"{label} ({src}): one cycle best {best:.3f} s CPU, median {median:.3f} s, {steps} steps; against "
+                  f"the rtol 1e-5 cohorts: {against}", flush=True)  # fmt: skip
+
+
 def main() -> None:
+    if "--against" in sys.argv:
+        cycle_against(sys.argv[sys.argv.index("--against") + 1])
+        return
     if "--holds" in sys.argv:
         wall_landing()
         return
