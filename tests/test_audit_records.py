@@ -135,3 +135,29 @@ def test_rsf_stability_json_names_rate_and_state_spring_in_its_unit(capsys):
     assert document["units"]["critical_stiffness_pa"] == "Pa/m"
     # k_c = sigma (b - a) / Dc in Pa/m, the closed form of the aging law's spring-slider (docs/rsf.md)
     assert document["critical_stiffness_pa"] == pytest.approx(30e6 * 0.01 / 10e-6, rel=1e-9)
+
+
+def test_headers_with_units_in_parentheses_are_read_and_converted(tmp_path, capsys):
+    """``velocity (um/s),stress (Pa)`` (spreadsheets, lab software) was refused by fit steady and analyze ("cannot
+    read header"), while rsf fit read it; the same curve with ``[um/s]`` was read.  Both now give the same fit, and the
+    unit is converted (a curve in mm/s with the velocities a thousandth: the same fit)."""
+    from stickslip.fitting import fit_steady
+
+    shipped = pd.read_csv("src/stickslip/data/synthetic_steady.csv", comment="#")
+    v, s = shipped["velocity [um/s]"].to_numpy(), shipped["stress [Pa]"].to_numpy()
+    paths = {}
+    for name, header, scale in (("brackets", "velocity [um/s]", 1.0), ("parens", "velocity (um/s)", 1.0),
+                                ("mm", "velocity (mm/s)", 1e-3)):  # fmt: skip
+        paths[name] = tmp_path / f"{name}.csv"
+        pd.DataFrame({header: v * scale, "stress (Pa)": s}).to_csv(paths[name], index=False)
+    fits = {name: fit_steady(path) for name, path in paths.items()}
+    assert fits["brackets"].status == "ok"
+    for name in ("parens", "mm"):
+        assert fits[name].status == fits["brackets"].status
+        assert fits[name].critical_velocity.value == pytest.approx(fits["brackets"].critical_velocity.value, rel=1e-9)
+    trace = tmp_path / "trace.csv"
+    t = np.arange(0.0, 30.0, 0.01)
+    pd.DataFrame({"time (s)": t, "stress (kPa)": 0.4 + 1e-5 * t}).to_csv(trace, index=False)
+    code, out, _ = run_main(capsys, "analyze", str(trace), "--v0", "350 um/s", "--json")
+    assert code == 0
+    assert json.loads(out)["summary"]["stick_slope"]["mean"] == pytest.approx(0.01, rel=1e-6)  # 1e-5 kPa/s in Pa/s

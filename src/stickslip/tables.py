@@ -20,7 +20,9 @@ from .errors import DataError, UnitError
 from .fileio import protect_inputs
 from .units import to_si
 
-_HEADER = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*)\s*(?:\[(.*)\])?\s*$")
+#: a header cell: a name, and its unit in brackets (as the package writes it) or in parentheses (``velocity (um/s)``,
+#: as spreadsheets and lab software often write it; rsf fit's record reader takes both)
+_HEADER = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*)\s*(?:\[(.*)\]|\((.*)\))?\s*$")
 
 
 @dataclass(frozen=True)
@@ -182,9 +184,9 @@ def _read_header(
         if not match:
             raise DataError(
                 f"{source}: row {header_row}, column {position}: cannot read header {cell!r};"
-                " expected name or 'name [unit]'"
+                " expected name, 'name [unit]' or 'name (unit)'"
             )
-        name, unit = match.group(1), match.group(2)
+        name, unit = match.group(1), match.group(2) if match.group(2) is not None else match.group(3)
         if name not in dimensions and name not in ignore:
             raise DataError(f"{source}: unknown column {name!r}; expected {', '.join(dimensions)}")
         if name in names:
