@@ -45,6 +45,20 @@ def test_a_protocol_file_with_units_in_its_header_is_read_in_those_units(tmp_pat
         protocols.read_protocol(twice)
 
 
+def test_a_protocol_file_with_units_in_parentheses_is_read_in_those_units(tmp_path):
+    """``time (s),velocity (um/s)`` (spreadsheets, lab software) was refused: "expected columns time,velocity"."""
+    steps = tmp_path / "steps.csv"
+    steps.write_text("time (s),velocity (um/s)\n0,1\n10,0\n15,10\n20,0\n")
+    protocol = protocols.read_protocol(steps)
+    assert [s.velocity for s in protocol.segments] == pytest.approx([1e-6, 0.0, 1e-5], rel=1e-12)
+    assert protocol.duration == pytest.approx(20.0)
+    segments = tmp_path / "segments.csv"
+    segments.write_text("velocity (mm/s),duration (min)\n1e-3,1\n1e-2,0.5\n")
+    protocol = protocols.read_protocol(segments)
+    assert [s.velocity for s in protocol.segments] == pytest.approx([1e-6, 1e-5], rel=1e-12)
+    assert [s.duration for s in protocol.segments] == pytest.approx([60.0, 30.0])
+
+
 def test_a_bad_protocol_row_is_named_by_its_line_in_the_file(tmp_path):
     """Comment and blank lines were not counted: the NaN on line 5 was reported on 'row 3', the header's line."""
     commented = tmp_path / "commented.csv"

@@ -230,13 +230,16 @@ def units_of_frame(frame: pd.DataFrame) -> dict[str, str | None]:
     return {str(c): known[str(c)] if str(c) in known else unit_of(str(c)) for c in frame.columns}
 
 
-def split_header(cell: str) -> tuple[str, str | None]:
-    """``"name [unit]"`` -> (``"name"``, ``"unit"``); a header without brackets has no unit (None)."""
+def split_header(cell: str, parentheses: bool = False) -> tuple[str, str | None]:
+    """``"name [unit]"`` -> (``"name"``, ``"unit"``); a header without brackets has no unit (None).  With
+    ``parentheses`` ``"name (unit)"`` too (spreadsheets' and lab software's way; where a bracketed word may be no
+    unit, "Displ (LVDT 2)", the caller leaves it off)."""
     text = cell.strip()
-    if text.endswith("]") and "[" in text:
-        name, _, unit = text[:-1].rpartition("[")
-        if name.strip():
-            return name.strip(), unit.strip()
+    for opening, closing in (("[", "]"), ("(", ")")) if parentheses else (("[", "]"),):
+        if text.endswith(closing) and opening in text:
+            name, _, unit = text[:-1].rpartition(opening)
+            if name.strip():
+                return name.strip(), unit.strip()
     return text, None
 
 

@@ -232,7 +232,7 @@ def _refuse_duplicated_columns(text: str, path: Path) -> None:
             except csv.Error:
                 names = line.split(",")
             seen: set[str] = set()
-            for name in (split_header(n)[0].lower() for n in names):
+            for name in (split_header(n, parentheses=True)[0].lower() for n in names):
                 if name and name in seen:
                     raise DataError(f"{path}: the column {name!r} appears twice in the header; keep one")
                 seen.add(name)
@@ -271,7 +271,7 @@ def read_protocol(path: str | Path) -> Protocol:
     except (ValueError, csv.Error, pd.errors.ParserError) as exc:  # csv.Error: no delimiter could be found
         raise DataError(f"{path}: cannot read as CSV ({(str(exc).splitlines() or [''])[0]})") from None
     # a header cell may carry its unit, as the package writes CSV headers: "time [s]", "velocity [um/s]"
-    columns = {split_header(str(c))[0].lower(): c for c in frame.columns}
+    columns = {split_header(str(c), parentheses=True)[0].lower(): c for c in frame.columns}
     _refuse_duplicated_columns(text, path)
     lines = data_lines(text.split("\n"), len(frame)) or list(range(2, len(frame) + 2))
     if {"velocity", "duration"} <= set(columns):
@@ -310,7 +310,8 @@ def _numeric_rows(frame: Any, path: Path, cols: list[Any], lines: list[int]) -> 
 
     data = frame[cols].apply(pd.to_numeric, errors="coerce").to_numpy(dtype=float)
     data = data * [
-        _header_factor(c, "velocity" if split_header(str(c))[0].lower() == "velocity" else "time", path) for c in cols
+        _header_factor(c, "velocity" if split_header(str(c), True)[0].lower() == "velocity" else "time", path)
+        for c in cols
     ]
     bad = ~np.isfinite(data).all(axis=1)
     if bad.any():
@@ -324,7 +325,7 @@ def _header_factor(column: Any, dimension: str, path: Path) -> float:
     """The SI factor of a header cell's unit (``"time [ms]"``: 1e-3); a bare name is SI already."""
     from .units import to_si
 
-    unit = split_header(str(column))[1]
+    unit = split_header(str(column), parentheses=True)[1]
     if not unit:
         return 1.0
     try:
