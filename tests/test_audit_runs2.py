@@ -78,3 +78,10 @@ def test_rsf_summary_mean_is_over_the_run():
     assert not out["oscillates"]
     assert f"mean {out['run_mean_friction']:.6g} over the run" in text
     assert out["units"]["run_mean_friction"] == "1"
+
+
+def test_the_rigs_mass_and_damping_have_their_units_in_the_json():
+    out = as_json("run", "--model", "rsf", *RSF, "--set", "normal_stress=10 MPa", "--mass", "1e8 kg/m^2",
+                  "--damping", "1 MPa s/m")  # fmt: skip
+    assert out["rig"]["mass"] == 1e8 and out["rig"]["damping"] == 1e6
+    assert out["units"]["mass"] == "kg/m^2" and out["units"]["damping"] == "Pa s/m"

@@ -222,7 +222,13 @@ def run_mean(run: Any) -> float:
 
 
 #: Units of the summary's keys that the registry holds under another unit or not at all.
-SUMMARY_UNITS = {"run_mean_stress": "Pa", "run_mean_friction": "1", "stiffness_from": None}
+SUMMARY_UNITS = {
+    "run_mean_stress": "Pa",
+    "run_mean_friction": "1",
+    "stiffness_from": None,
+    "mass": "kg/m^2",  # the rig's block (--mass, --damping)
+    "damping": "Pa s/m",
+}
 
 
 def summary_units(summary: dict[str, Any], spring: tuple[float, str, str] | None) -> dict[str, str]:
