@@ -181,8 +181,13 @@ def settings_of(texts: tuple[str, ...], every_text: str | None) -> dict[str, Any
 OSCILLATING = (regimes.STICK_SLIP, regimes.DECAYING, regimes.GROWING)
 
 
-def run_summary(run: Any, protocol: Any, rig: Any) -> dict[str, Any]:
-    """What a run settled into, in SI: regime with its evidence, period, peak, trough, mean, the model's own numbers."""
+def run_summary(run: Any, protocol: Any, rig: Any, spring: tuple[float, str, str] | None = None) -> dict[str, Any]:
+    """What a run settled into, in SI: regime with its evidence, period, peak, trough, mean, the model's own numbers.
+
+    ``mean_*`` is the model's mean of what the run settled into (the repeating cycle's, the steady value; a sweep
+    row's ``mean_stress``), ``run_mean_*`` the mean of the solution over the run.  ``spring``: the stiffness the
+    run used, its unit and where it came from (``model.spring``); without it the rig's as given.
+    """
     signal = "stress" if run.stress is not None else "friction"
     r = run.regime
     return {
@@ -190,7 +195,7 @@ def run_summary(run: Any, protocol: Any, rig: Any) -> dict[str, Any]:
         "status": run.status,
         "message": run.message,
         "protocol": [{"velocity": s.velocity, "duration": s.duration} for s in protocol.segments],
-        "rig": _rig_record(rig),
+        "rig": _rig_record(rig, spring),
         "regime": run.regime_name,
         "oscillates": r.kind in OSCILLATING,
         "evidence": r.evidence,
@@ -200,14 +205,48 @@ def run_summary(run: Any, protocol: Any, rig: Any) -> dict[str, Any]:
         f"peak_{signal}": _above_round_off(run.peak),
         f"trough_{signal}": _above_round_off(run.trough),
         f"mean_{signal}": _above_round_off(run.mean),
+        f"run_mean_{signal}": _above_round_off(run_mean(run)),
         f"final_{signal}": float(run.signal[-1]) if run.time.size else None,
         "end_time": float(run.time[-1]) if run.time.size else None,
         "summary": dict(run.summary),
     }
 
 
-def _rig_record(rig: Any) -> dict[str, Any]:
-    record = {"control": rig.control, "stiffness": rig.stiffness}
+def run_mean(run: Any) -> float:
+    """The mean of the stress (or friction) over the whole run: the model's own (from its solution) where it gives
+    one in its summary, else the time average of the trace."""
+    from ..models.run import time_mean
+
+    own = run.summary.get(f"run_mean_{run.signal_name}")
+    return float(own) if own is not None else time_mean(run.time, run.signal)
+
+
+#: Units of the summary's keys that the registry holds under another unit or not at all.
+SUMMARY_UNITS = {
+    "run_mean_stress": "Pa",
+    "run_mean_friction": "1",
+    "stiffness_from": None,
+    "mass": "kg/m^2",  # the rig's block (--mass, --damping)
+    "damping": "Pa s/m",
+}
+
+
+def summary_units(summary: dict[str, Any], spring: tuple[float, str, str] | None) -> dict[str, str]:
+    """The JSON's ``units`` map: the registry's, the spring's stiffness in the model's unit (rate-and-state: 1/m)."""
+    from ..columns import json_units
+
+    extra = dict(SUMMARY_UNITS)
+    if spring is not None:
+        extra["stiffness"] = spring[1]
+    return json_units(summary, extra)
+
+
+def _rig_record(rig: Any, spring: tuple[float, str, str] | None = None) -> dict[str, Any]:
+    record: dict[str, Any] = {"control": rig.control, "stiffness": rig.stiffness}
+    if spring is not None:  # the stiffness used; "stiffness_from" unless it is the rig's as given
+        record["stiffness"] = spring[0]
+        if spring[2] != "rig" or spring[0] != rig.stiffness:
+            record["stiffness_from"] = spring[2]
     if rig.mass is not None:  # the block's inertia (transient --mass/--damping)
         record.update(mass=rig.mass, damping=rig.damping)
     return record
@@ -243,11 +282,17 @@ def _above_round_off(value: float) -> float:
 _STATUS_WORDS = {"ok": "", "stopped": " (of the run up to its stop: it used up its budget)"}
 
 
-def summary_text(summary: dict[str, Any]) -> str:
-    """The summary for people: µm/s, Pa (or μ), s; the model's message in full."""
+def summary_text(summary: dict[str, Any], units: dict[str, str] | None = None) -> str:
+    """The summary for people: µm/s, Pa (or μ), s; the model's message in full.  ``units``: the JSON's units map
+    (the spring's unit: Pa/m, or rate-and-state's 1/m)."""
     protocol = protocol_words(summary["protocol"])
     rig = summary["rig"]
-    spring = "" if rig["stiffness"] is None else f", K = {rig['stiffness'] / 1e3:.6g} kPa/m"
+    spring = ""
+    if rig["stiffness"] is not None:
+        per_slip = (units or {}).get("stiffness") == "1/m"  # rate-and-state's k, friction per slip
+        spring = f", k = {rig['stiffness']:.6g} 1/m" if per_slip else f", K = {rig['stiffness'] / 1e3:.6g} kPa/m"
+        if rig.get("stiffness_from") is not None:
+            spring += f" from the {rig['stiffness_from']}" + ("" if rig["stiffness_from"] != "rig" else "'s K")
     if rig.get("mass") is not None:
         spring += f", block mass {rig['mass']:g} kg/m², damping {rig.get('damping') or 0:g} Pa·s/m"
     signal, unit = ("stress", " Pa") if "peak_stress" in summary else ("friction", "")
@@ -257,17 +302,18 @@ def summary_text(summary: dict[str, Any]) -> str:
         f"  {summary['message'] or summary['evidence']}",
     ]
     numbers = []
+    # a cycle's peak, trough and mean once the run holds a whole one; else the run's range and its mean
+    cycle = summary.get("oscillates", True) and summary.get("periods_seen", 1) != 0
     if summary["period"] is not None and math.isfinite(summary["period"]):
-        numbers.append(f"period {summary['period']:.6g} s")
-    # a run that settled without oscillating has a range and a mean, not the peak and trough of a cycle
-    words = ("peak", "trough", "mean") if summary.get("oscillates", True) else ("trough", "peak", "mean")
-    shown = {"peak": "highest", "trough": "lowest"} if not summary.get("oscillates", True) else {}
+        numbers.append(f"period {summary['period']:.6g} s" + ("" if cycle else " (no whole cycle within the run)"))
+    words = ("peak", "trough", "mean") if cycle else ("trough", "peak", "run_mean")
+    shown = {} if cycle else {"peak": "highest", "trough": "lowest", "run_mean": "mean"}
     for word in words:
-        value = summary[f"{word}_{signal}"]
+        value = summary.get(f"{word}_{signal}")
         if value is not None and math.isfinite(value):
             numbers.append(f"{shown.get(word, word)} {value:.6g}{unit}")
-    if not summary.get("oscillates", True) and numbers:
-        numbers[-1] += " over the run (no oscillation)"
+    if not cycle and numbers:
+        numbers[-1] += " over the run" + ("" if summary.get("oscillates", True) else " (no oscillation)")
     if numbers:
         lines.append("  " + ", ".join(numbers))
     return "\n".join(lines)
@@ -378,7 +424,7 @@ def execute(
     from ..models import as_run
 
     claim_stdout([output, plot_path])  # (rsf simulate's trace goes to standard output without -o)
-    model.check(protocol, rig, settings)
+    checked = model.check(protocol, rig, settings)
     stopped: BudgetExhausted | None = None
     with progress(model.name, total=protocol.duration, unit="s", enabled=False if as_json else None) as bar:
         if "progress" in model.capabilities.settings and "progress" not in settings:  # a bar on a terminal only
@@ -395,8 +441,10 @@ def execute(
             raise SystemExit(RUN_FAILED) from None
         except (ParameterError, ModelError) as exc:
             raise type(exc)(in_run_words(str(exc), start_option)) from None
-    summary = run_summary(run, protocol, rig)
+    spring = model.spring(params, checked)
+    summary = run_summary(run, protocol, rig, spring)
     summary.update((key, value) for key, value in model_record(run).items() if key not in summary)
+    units = summary_units(summary, spring)
     if stopped is not None:
         summary["status"] = "stopped"
     if output is not None:
@@ -406,10 +454,10 @@ def execute(
     if plot_path is not None:
         save_figure(run.plot().figure, plot_path)
     if as_json:
-        emit_json(summary)
+        emit_json({**summary, "units": units})
     else:  # (beside a trace on standard output, claim_stdout above sends it to stderr)
         record = record_text(run)
-        click.echo(summary_text(summary) + ("\n" + record if record else ""))
+        click.echo(summary_text(summary, units) + ("\n" + record if record else ""))
     if stopped is not None:
         written = [str(path) for path in (output, plot_path) if path is not None]
         kept = f"; the run up to there is in {' and '.join(written)}" if written else ""

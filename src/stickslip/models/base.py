@@ -149,6 +149,14 @@ class FrictionModel(ABC):
                 out[key] = float(value)
         return out
 
+    def spring(self, params: Any, rig: Rig) -> tuple[float, str, str] | None:
+        """The spring a run of ``params`` through ``rig`` pulls through: (stiffness in SI, its unit, where it came
+        from: "rig" or "parameters"); None under velocity control, or where the model does not say (a model whose
+        own spring the rig leaves to it reports None unless it overrides this)."""
+        if rig.control != "spring" or rig.stiffness is None:
+            return None
+        return rig.stiffness, "Pa/m", "rig"
+
     def label(self, params: Any) -> str:
         """A short name of the parameter set (shown in sweep tables and figures)."""
         return str(getattr(params, "name", "") or self.name)

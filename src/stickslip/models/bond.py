@@ -77,6 +77,14 @@ class BondModel(FrictionModel):
             return params
         return with_stiffness(params, {"block.effective_stiffness": rig.stiffness})
 
+    def spring(self, params: Parameters, rig: Rig) -> tuple[float, str, str] | None:
+        """The rig's K (Pa/m) as given, else the block's own (Eq 17's K of the parameters); None without a spring."""
+        if rig.control != "spring":
+            return None
+        if rig.stiffness is not None:
+            return rig.stiffness, "Pa/m", "rig"
+        return float(params.block.effective_stiffness), "Pa/m", "parameters"
+
 
 def with_stiffness(params: Parameters, stiffness: Mapping[str, float]) -> Parameters:
     """``params`` with the block's height set by ``block.stiffness`` (G/h) or ``block.effective_stiffness`` (K)."""

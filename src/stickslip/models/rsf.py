@@ -157,6 +157,12 @@ class RSFModel(FrictionModel):
         result = simulate(params, protocol, start_velocity=start, **settings)
         return rsf_run(result)
 
+    def spring(self, params: Any, rig: Rig) -> tuple[float, str, str] | None:
+        """The spring the run uses, in friction per slip (1/m): the rig's K over the normal stress, else ``k``."""
+        if rig.control != "spring":
+            return None
+        return float(_with_rig(params, rig).stiffness), "1/m", "parameters" if rig.stiffness is None else "rig"
+
     def stability_boundary(self, fixed: Any, x: str, y: str | None, frame: Any = None) -> list[Boundary]:
         """k = kc from :func:`stickslip.rsf.critical_stiffness`, against the other axis when k is on one."""
         from ..rsf import critical_stiffness

@@ -165,7 +165,7 @@ def _regime(result: Any, protocol: Protocol | None) -> regimes.Regime:
 
 def last_cycle_numbers(result: Any) -> dict[str, Any]:
     """The last whole cycle's numbers (the run has settled onto its cycle by then, if ever) and the mean stress
-    over the whole cycles (over the run when there are none)."""
+    over the whole cycles (over the run when there are none); ``run_mean_stress`` over the run."""
     whole = [c for c in result.cycles if getattr(c, "period", None) is not None]
     time = np.asarray(result.time, dtype=float)
     row: dict[str, Any] = {
@@ -178,6 +178,7 @@ def last_cycle_numbers(result: Any) -> dict[str, Any]:
         "cycles": len(whole),
         "critical_velocity": NAN,
     }
+    row["run_mean_stress"] = row["mean_stress"]  # the mean over the run, whatever the cycles (run --json)
     if whole:
         last = whole[-1]
         row.update(

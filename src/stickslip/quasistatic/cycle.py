@@ -312,6 +312,13 @@ def simulate(
     elif regime == regimes.STUCK and cycles:
         message += f" (after {len(cycles)} slip(s))"
     columns = trace.build()
+    if regime == regimes.STEADY and _settle_time(phases, sigma0, sigma_c) > end:
+        # the regime is where the run is heading: say that it ends before it gets there
+        where = "stuck" if columns["phase"][-1] == "stick" else "slipping"
+        message += (
+            f"; the run ends at {end:.6g} s, still {where}, before it settles at t ="
+            f" {_settle_time(phases, sigma0, sigma_c):.6g} s"
+        )
     return Simulation(
         **columns,
         regime=_regime(regime, message, period, cycles, columns),
@@ -348,6 +355,19 @@ def _regime(
         peak, trough = float(np.max(stress)), float(np.min(stress))
     ratio = 1.0 if kind == regimes.STICK_SLIP and len(whole) >= 2 else math.nan
     return regimes.Regime(kind, len(whole), ratio, math.nan if period is None else period, peak, trough, message)
+
+
+def _settle_time(phases: _Phases, sigma0: float, sigma_c: float) -> float:
+    """When a run heading for steady sliding reaches it (the slip's end, within its tolerance of V0): the first
+    stick and slip, and the repeating cycle's stick and slip when the first slip ended in a stick."""
+    first = phases.cycle(sigma0)
+    assert first.slip is not None and first.stick.stick_time is not None
+    t = first.stick.stick_time + first.slip.duration
+    if first.slip.ends == "steady":
+        return t
+    repeat = phases.cycle(sigma_c)
+    assert repeat.slip is not None and repeat.stick.stick_time is not None
+    return t + repeat.stick.stick_time + repeat.slip.duration
 
 
 def _outlook(phases: _Phases, sigma0: float, sigma_c: float) -> tuple[str, str, float | None]:
