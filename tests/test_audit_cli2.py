@@ -64,3 +64,63 @@ def test_data_in_a_file_beside_a_figure_on_stdout_is_kept(capsys, tmp_path):
     )
     assert status == 0, err
     assert target.read_text().startswith("velocity [m/s],stress [Pa]")
+
+
+@pytest.fixture(scope="module")
+def cycles_tables(tmp_path_factory):
+    """`run -o trace.csv` at 50 and 100 um/s, each `analyze -o`: the cycles tables of two traces."""
+    from stickslip.cli.main import main
+
+    folder = tmp_path_factory.mktemp("chain")
+    tables = []
+    for v0, duration in (("50 um/s", "120 s"), ("100 um/s", "60 s")):
+        trace, cycles = folder / f"trace{v0[:3].strip()}.csv", folder / f"cycles{v0[:3].strip()}.csv"
+        for args in (
+            ["run", "--model", "quasi-static", "--v0", v0, "--duration", duration, "-o", str(trace)],
+            ["analyze", str(trace), "-o", str(cycles)],
+        ):
+            with pytest.raises(SystemExit) as exit_info:
+                main(args)
+            assert exit_info.value.code == 0
+        tables.append(cycles)
+    return tables
+
+
+def test_analyze_cycles_table_names_its_pulling_velocity(cycles_tables):
+    import pandas as pd
+
+    frame = pd.read_csv(cycles_tables[1])
+    assert list(frame["pulling_velocity [m/s]"].unique()) == [pytest.approx(100e-6, rel=1e-9)]
+
+
+def test_fit_stick_reads_the_cycles_of_analyze(capsys, cycles_tables, tmp_path):
+    """`analyze TRACE -o cycles.csv` then `fit stick cycles.csv`: unknown column 'complete' (exit 2) before."""
+    lines = cycles_tables[0].read_text().splitlines() + cycles_tables[1].read_text().splitlines()[1:]
+    both = tmp_path / "both.csv"
+    both.write_text("\n".join(lines) + "\n")
+    status, out, err = run_main(capsys, "fit", "stick", str(both), "--json")
+    assert status == 0, err
+    import json
+
+    result = json.loads(out)
+    assert result["status"] == "ok"
+    fitted = {key: e["value"] for key, e in result["parameters"].items()}
+    assert fitted["stick.attached_chains"] == pytest.approx(2.07e12, rel=1e-3)  # the run's own parameters
+    assert fitted["stick.aging_time"] == pytest.approx(10.0, rel=1e-3)
+    assert any("left out: cycles cut by the record's ends" in m for m in result["messages"])
+
+
+def test_fit_stick_of_one_trace_fails_for_its_one_velocity(capsys, cycles_tables):
+    status, _, err = run_main(capsys, "fit", "stick", str(cycles_tables[0]))
+    assert status == 3
+    assert "every fitted row is at one pulling velocity" in err
+
+
+def test_an_old_cycles_table_without_its_velocity_is_refused_in_one_line(capsys, cycles_tables, tmp_path):
+    import pandas as pd
+
+    old = tmp_path / "old.csv"
+    pd.read_csv(cycles_tables[0]).drop(columns="pulling_velocity [m/s]").to_csv(old, index=False)
+    status, out, err = run_main(capsys, "fit", "stick", str(old))
+    assert status == 2 and out == ""
+    assert err.count("\n") == 1 and "without a pulling_velocity column" in err
