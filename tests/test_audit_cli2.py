@@ -124,3 +124,11 @@ def test_an_old_cycles_table_without_its_velocity_is_refused_in_one_line(capsys,
     status, out, err = run_main(capsys, "fit", "stick", str(old))
     assert status == 2 and out == ""
     assert err.count("\n") == 1 and "without a pulling_velocity column" in err
+
+
+def test_exact_stick_times_flag_no_outlier_off_by_a_factor_1(cycles_tables):
+    """The cycles of a simulated trace agree to 1e-8: a row off by 1e-7 was called an outlier "off by a factor 1"."""
+    from stickslip.fitting.stick_fit import fit_stick
+
+    fit = fit_stick(cycles_tables[0])
+    assert not [m for m in fit.messages if "outlier" in m], fit.messages

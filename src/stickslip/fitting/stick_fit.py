@@ -573,6 +573,11 @@ def _replicate_scatter(log_t: np.ndarray, groups: Sequence[np.ndarray]) -> tuple
     return ss / dof, dof
 
 
+#: Least ln-misfit a row needs to be flagged as an outlier: on exact stick times (a simulated trace's cycles) the
+#: scatter is 1e-8 and a row off by 1e-7 is no outlier ("off by a factor 1"); stick times are measured to ~1 %.
+OUTLIER_FLOOR = 1e-3
+
+
 def _outliers(data: StickData, used: np.ndarray, model_t: np.ndarray) -> list[str]:
     """Rows whose stick time is off by more than 4 robust standard deviations of the others."""
     r = np.log(model_t[used] / data.stick_time[used])
@@ -581,7 +586,7 @@ def _outliers(data: StickData, used: np.ndarray, model_t: np.ndarray) -> list[st
     spread = 1.4826 * float(np.median(np.abs(r - np.median(r))))
     out = []
     for row, value in zip(data.rows[used], r, strict=True):
-        if spread > 0 and abs(value - np.median(r)) > 4 * spread:
+        if abs(value - np.median(r)) > max(4 * spread, OUTLIER_FLOOR):
             out.append(
                 f"row {row}: the model's stick time is off by a factor {math.exp(-value):.3g}, far outside the scatter"
                 f" of the other rows ({100 * spread:.2g} %): an outlier? (--exclude-row {row} leaves it out)"
