@@ -47,6 +47,7 @@ __all__ = [
     "atomic_write_bytes",
     "atomic_write_text",
     "claim_stdout",
+    "is_stdout",
     "output_kind",
     "protect_inputs",
     "read_input_text",
@@ -210,14 +211,14 @@ def refuse_shared_outputs(outputs: list[tuple[str, str | Path | None]]) -> None:
             continue
         for earlier, path in seen:
             if _one_output(path, out):
-                where = "standard output" if str(out) == STDOUT else f"the file {out}"
+                where = "standard output" if _is_stdout(out) else f"the file {out}"
                 raise DataError(f"{earlier} {path} and {option} {out}: both write {where}; give each its own name")
         seen.append((option, out))
 
 
 def _one_output(a: str | Path, b: str | Path) -> bool:
-    if (str(a) == STDOUT) or (str(b) == STDOUT):
-        return str(a) == str(b)
+    if _is_stdout(a) or _is_stdout(b):  # ``-`` and /dev/stdout are one output
+        return _is_stdout(a) and _is_stdout(b)
     if os.path.exists(a) and not _is_regular(a):  # /dev/null takes any number of outputs, and keeps none
         return False
     if same_file(a, b):
@@ -275,6 +276,12 @@ def claim_stdout(outputs: Iterable[str | Path | None]) -> bool:
 
     click.get_current_context().call_on_close(restore)
     return True
+
+
+def is_stdout(path: str | Path) -> bool:
+    """True if writing ``path`` writes this process's standard output: ``-``, or a link to descriptor 1
+    (``/dev/stdout``)."""
+    return _is_stdout(path)
 
 
 def _is_stdout(path: str | Path) -> bool:

@@ -30,6 +30,7 @@ from .params_cmd import print_rich
 
 #: Columns of ``-o cycles.csv``: (field, SI unit).  A model-derived field's column is named ``model_<field>``.
 CSV_COLUMNS = (
+    ("pulling_velocity", "m/s"),  # the trace's V0: cycles tables of several traces stack into one for `fit stick`
     ("cycle", ""),
     ("complete", ""),
     ("start_time", "s"),
@@ -192,6 +193,7 @@ def cycles_csv(analysis: Any) -> str:
     for cycle in analysis.cycles:
         data = cycle.as_dict()
         data["cycle"] = cycle.index
+        data["pulling_velocity"] = analysis.pulling_velocity
         data["complete"] = int(cycle.complete)
         out.write(",".join(_cell(data[name]) for name, _ in CSV_COLUMNS) + "\n")
     return out.getvalue()

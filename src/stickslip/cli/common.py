@@ -28,7 +28,7 @@ from ..columns import JSON_DIGITS as JSON_DIGITS  # re-exported: the JSON helper
 from ..columns import json_safe as json_safe
 from ..columns import json_text
 from ..errors import ParameterError, StickslipError, UnitError
-from ..fileio import atomic_path, atomic_write_text, protect_inputs, refuse_input_as_output
+from ..fileio import atomic_path, atomic_write_text, is_stdout, protect_inputs, refuse_input_as_output
 from ..parameters import Parameters, key_dimension, load_parameters
 from ..units import DIMENSIONS, bare_number, quantity_noun, shorten, to_si
 
@@ -138,21 +138,42 @@ FIGURE_OPTIONS = frozenset({"--plot", "--corner"})
 
 
 def refuse_overwriting_inputs(
-    inputs: Sequence[Path | str | None], outputs: Sequence[tuple[str, Path | None]], params_name: str | None = None
+    inputs: Sequence[Path | str | None],
+    outputs: Sequence[tuple[str, Path | None]],
+    params_name: str | None = None,
+    printed: str | None = None,
 ) -> None:
     """Refuse (DataError, one line) any output that names an input: a data file, or the --params TOML file.
 
     Call it before computing anything, so the user does not wait for a refusal.
     The inputs stay protected for the rest of the command (:func:`stickslip.fileio.protect_inputs`):
     a side file written later cannot replace them either.  An output ``-`` is standard output.
+    ``printed`` names the data the command prints on standard output when ``-o`` is not given (``"--format csv
+    (no -o)"``), if any: an output ``-`` beside it is refused too (:func:`refuse_printed_beside`).
     """
     files: list[str | Path | None] = list(inputs)
     if params_name is not None:
         files.append(params_name)  # a built-in set name is no file, and is skipped
+    refuse_printed_beside(printed, outputs)
     refuse_input_as_output(files, list(outputs))
     for option, path in outputs:  # an unknown figure format or a missing folder is said before anything is written
         if path is not None and str(path) != "-":
             check_output(option, Path(path), plot=option in FIGURE_OPTIONS)
+
+
+def refuse_printed_beside(printed: str | None, outputs: Sequence[tuple[str, Path | str | None]]) -> None:
+    """Refuse (ParameterError, one line naming both) an output on standard output (``-``, /dev/stdout) when the
+    command's data go there too for want of ``-o``: ``curve --format csv --plot -`` would put the CSV and the PNG in
+    one stream (the CSV was sent to stderr).  ``printed`` names those data; None when there are none: ``-o`` was
+    given, or the command prints only for people (a table, a summary, its ``--json`` summary), which then goes
+    to stderr (:func:`stickslip.fileio.claim_stdout`).  ``-o - --plot -`` is refused by the same rule."""
+    if printed is None:
+        return
+    for option, path in outputs:
+        if path is not None and str(path).strip() and is_stdout(path):
+            raise ParameterError(
+                f"{printed} and {option} {path}: both write standard output; give {option} a file name"
+            )
 
 
 def require_unit(text: str, dimension: str, prefix: str, typical: float | None = None) -> None:

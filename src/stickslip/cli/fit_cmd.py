@@ -254,7 +254,8 @@ def stick_command(
     """Fit Nc0, uc/τ and the stick aging time (Eq 15) to measured stick times in TABLE.
 
     Columns: pulling_velocity, stick_time, optional peak_stress, start_stress (and the
-    other columns of the paper's Table 1).  Bond parameters, block and start values
+    other columns of the paper's Table 1); or the cycles of 'stickslip analyze -o'
+    (of traces at two or more velocities, stacked).  Bond parameters, block and start values
     come from --params/--set: use the file written by 'stickslip fit steady -o'.
     """
     refuse_overwriting_inputs([table], [("-o", output), ("--report", report_path), ("--plot", plot_path)], params_name)

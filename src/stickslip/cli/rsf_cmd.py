@@ -234,9 +234,11 @@ def simulate_command(**options: Any) -> None:
     every = None if options["every"] is None else positive(options["every"], "time", "--every")
     output, plot_path = options["output"], options["plot_path"]
     side = sidecar(output)
+    printed = "the trace (standard output without -o)" if output is None and not options["as_json"] else None
     refuse_overwriting_inputs(
         [options["protocol_file"], options["params_file"]],
         [("-o", output), ("-o (its NAME.params.json)", side), ("--plot", plot_path)],
+        printed=printed,
     )
     beside = None if side is None else lambda run: write_text(side, run.native.metadata_json())
     execute(get_model("rsf"), params, protocol, Rig(), start=start, settings={} if every is None else {"every": every},

@@ -198,7 +198,8 @@ def curve_command(
     computed and written in chunks (any --points); the table shows at most
     100 rows, evenly spread; json holds at most 100,000 velocities.
     """
-    refuse_overwriting_inputs([], [("-o", output), ("--plot", plot_path)], params_name)
+    printed = f"--format {fmt} (no -o)" if output is None and fmt != "table" else None  # a table is for people
+    refuse_overwriting_inputs([], [("-o", output), ("--plot", plot_path)], params_name, printed)
     values, lo, hi = _velocities(velocity, vmin, vmax, points)
     params = resolve_params(params_name, overrides)
     aging = not no_aging
