@@ -224,6 +224,10 @@ class StickChains:
     collapsed: bool
     times: np.ndarray
     fractions: np.ndarray
+    #: fresh chains not collapsed within the stretch: when they would under the same loading (s from the stretch's
+    #: start; None: not known), or whether Eq 15 proves they never do
+    due: float | None = None
+    never: bool = False
 
 
 def stick_chains(
@@ -288,4 +292,5 @@ def _fresh_chains(params: Parameters, aging: bool, stress0: float, loading_rate:
     inside = stick.time < span
     times = np.r_[stick.time[inside], span]
     fractions = np.r_[stick.chain_fraction[inside], stick.chain_fraction_at(span)]
-    return StickChains(span, float(fractions[-1]), False, times, fractions)
+    due = stick.stick_time if stick.status == "slipped" else None
+    return StickChains(span, float(fractions[-1]), False, times, fractions, due, stick.status == "stuck")

@@ -273,6 +273,7 @@ class _Driver:
         self.events: list[tuple[str, float, float, float]] = []  # (kind, time, stress, velocity)
         self.jumps: list[jump.Jump] = []  # the massless block's jumps through rupture cascades
         self.chain_state = {"elapsed": 0.0, "fraction": 1.0}
+        self.chains_ahead: tuple[tuple[float, float] | None, bool] = (None, False)  # set by each stuck stretch
         self.snap_index = 0
         self.out = np.empty((CHUNK, 13))
         self.repeater: _Repeater | None = None
@@ -379,6 +380,9 @@ class _Driver:
         stress0 = k_block * (state.puller - state.x)
         chain = self.chain_state
         res = stick_chains(params, self.aging, stress0, k_block * vp, chain["elapsed"], chain["fraction"], t1 - state.t)
+        # what the chains would do under this loading past the stretch (the verdict of a run that ends stuck)
+        due = None if res.due is None else (state.t + res.due, stress0 + k_block * vp * res.due)
+        self.chains_ahead = (due, res.never)
         t_new = state.t + res.duration
         self.chain_rows.append(np.c_[state.t + res.times, res.fractions])
         if times.size:  # the trace on the sampling grid: stress and positions are exact while stuck
@@ -881,6 +885,24 @@ def _steady_cohorts(params: Parameters, velocity: float, aging: bool) -> Populat
     return _STEADY_COHORTS[key]
 
 
+def _chains_ahead(d: Any, regime: str, message: str, time: np.ndarray, sigma: np.ndarray) -> tuple[str, str]:
+    """A run that ends with the stick chains holding is stuck only if they would hold on: where Eq 15 has them
+    collapse later under the same loading it is undetermined, saying when; where it proves they never do, stuck
+    says so."""
+    if regime != "stuck" or not d.chains_on:
+        return regime, message
+    due, never = d.chains_ahead
+    if due is not None and due[0] > float(time[-1]):
+        return "undetermined", (
+            f"undetermined: stuck to the end of the run (t = {time[-1]:.6g} s, σ = {sigma[-1]:.6g} Pa), the stick"
+            f" chains holding; under this loading they collapse at t = {due[0]:.6g} s (σs = {due[1]:.6g} Pa, Eq 15),"
+            " after the run's end: run longer to see the slip"
+        )
+    if never:
+        return regime, message + "; Eq 15 proves the chains never collapse under this loading"
+    return regime, message
+
+
 def _scratch(state: _State) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Work arrays of kernel._slider_velocity (no weight known beforehand: the third, all -1)."""
     return np.empty(state.xb.size), np.empty(state.xb.size), np.full((3, state.xb.size), -1.0)
@@ -966,6 +988,7 @@ def _finish(d: _Driver, snapshots: list[Snapshot], stop: str | None, note: str) 
     regime, message, evidence = judge(
         time, sigma, v, protocol, cycles, events, control, stop, resolution=d.rtol, lowest=table[:, 14]
     )
+    regime, message = _chains_ahead(d, regime, message, time, sigma)
     message = message + note
     saturating = params.aging.saturation_age is not None  # the extension lets go: its stuck is its own answer
     if regime == "stuck" and not cycles and not any(kind == "stick" for kind, *_ in events) and not saturating:
