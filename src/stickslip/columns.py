@@ -22,6 +22,8 @@ from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from .tables import split_header as split_header  # the readers' header rule, one definition
+
 if TYPE_CHECKING:  # pragma: no cover
     import pandas as pd
     import pyarrow as pa
@@ -228,19 +230,6 @@ def units_of_frame(frame: pd.DataFrame) -> dict[str, str | None]:
     """The units of a frame's columns: its ``attrs["units"]``, else the registry."""
     known = frame.attrs.get("units") or {}
     return {str(c): known[str(c)] if str(c) in known else unit_of(str(c)) for c in frame.columns}
-
-
-def split_header(cell: str, parentheses: bool = False) -> tuple[str, str | None]:
-    """``"name [unit]"`` -> (``"name"``, ``"unit"``); a header without brackets has no unit (None).  With
-    ``parentheses`` ``"name (unit)"`` too (spreadsheets' and lab software's way; where a bracketed word may be no
-    unit, "Displ (LVDT 2)", the caller leaves it off)."""
-    text = cell.strip()
-    for opening, closing in (("[", "]"), ("(", ")")) if parentheses else (("[", "]"),):
-        if text.endswith(closing) and opening in text:
-            name, _, unit = text[:-1].rpartition(opening)
-            if name.strip():
-                return name.strip(), unit.strip()
-    return text, None
 
 
 def data_lines(lines: Iterable[str], count: int) -> list[int] | None:

@@ -211,14 +211,14 @@ def refuse_shared_outputs(outputs: list[tuple[str, str | Path | None]]) -> None:
             continue
         for earlier, path in seen:
             if _one_output(path, out):
-                where = "standard output" if _is_stdout(out) else f"the file {out}"
+                where = "standard output" if is_stdout(out) else f"the file {out}"
                 raise DataError(f"{earlier} {path} and {option} {out}: both write {where}; give each its own name")
         seen.append((option, out))
 
 
 def _one_output(a: str | Path, b: str | Path) -> bool:
-    if _is_stdout(a) or _is_stdout(b):  # ``-`` and /dev/stdout are one output
-        return _is_stdout(a) and _is_stdout(b)
+    if is_stdout(a) or is_stdout(b):  # ``-`` and /dev/stdout are one output
+        return is_stdout(a) and is_stdout(b)
     if os.path.exists(a) and not _is_regular(a):  # /dev/null takes any number of outputs, and keeps none
         return False
     if same_file(a, b):
@@ -260,7 +260,7 @@ def claim_stdout(outputs: Iterable[str | Path | None]) -> bool:
     meta = _invocation_meta()
     if meta is None or _STDOUT_KEY in meta:
         return meta is not None and _STDOUT_KEY in meta
-    if not any(out is not None and _is_stdout(out) for out in outputs):
+    if not any(out is not None and is_stdout(out) for out in outputs):
         return False
     click = sys.modules["click"]  # (loaded: the invocation's meta is its context's)
     real = sys.stdout
@@ -281,10 +281,6 @@ def claim_stdout(outputs: Iterable[str | Path | None]) -> bool:
 def is_stdout(path: str | Path) -> bool:
     """True if writing ``path`` writes this process's standard output: ``-``, or a link to descriptor 1
     (``/dev/stdout``)."""
-    return _is_stdout(path)
-
-
-def _is_stdout(path: str | Path) -> bool:
     if str(path) == STDOUT:
         return True
     try:

@@ -20,9 +20,29 @@ from .errors import DataError, UnitError
 from .fileio import protect_inputs
 from .units import to_si
 
-#: a header cell: a name, and its unit in brackets (as the package writes it) or in parentheses (``velocity (um/s)``,
-#: as spreadsheets and lab software often write it; rsf fit's record reader takes both)
-_HEADER = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*)\s*(?:\[(.*)\]|\((.*)\))?\s*$")
+
+def split_header(cell: str, parentheses: bool = False) -> tuple[str, str | None]:
+    """``"name [unit]"`` -> (``"name"``, ``"unit"``); a header without brackets has no unit (None).  With
+    ``parentheses`` ``"name (unit)"`` too (spreadsheets' and lab software's way; where a bracketed word may be no
+    unit, "Displ (LVDT 2)", the caller leaves it off)."""
+    text = cell.strip()
+    for opening, closing in (("[", "]"), ("(", ")")) if parentheses else (("[", "]"),):
+        if text.endswith(closing) and opening in text:
+            name, _, unit = text[:-1].rpartition(opening)
+            if name.strip():
+                return name.strip(), unit.strip()
+    return text, None
+
+
+#: a column name (its unit, in brackets or in parentheses, is split off by :func:`split_header`)
+_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
+
+
+def _header_cell(cell: str) -> tuple[str, str | None] | None:
+    """(name, unit or None) of a header cell, ``name [unit]`` as the package writes it or ``name (unit)`` as
+    spreadsheets and lab software do; None when the name is no identifier."""
+    name, unit = split_header(cell, parentheses=True)
+    return (name, unit) if _NAME.fullmatch(name) else None
 
 
 @dataclass(frozen=True)
@@ -132,8 +152,8 @@ def _text_columns(path: Path, header_row: int, width: int, positions: list[int])
 
 def _header_position(header: list[str], name: str) -> int:
     for k, cell in enumerate(header):
-        match = _HEADER.match(cell)
-        if match and match.group(1) == name:
+        found = _header_cell(cell)
+        if found and found[0] == name:
             return k
     raise KeyError(name)
 
@@ -180,13 +200,13 @@ def _read_header(
     names: list[str] = []
     factors: dict[str, float] = {}
     for position, cell in enumerate(header, start=1):
-        match = _HEADER.match(cell)
-        if not match:
+        found = _header_cell(cell)
+        if found is None:
             raise DataError(
                 f"{source}: row {header_row}, column {position}: cannot read header {cell!r};"
                 " expected name, 'name [unit]' or 'name (unit)'"
             )
-        name, unit = match.group(1), match.group(2) if match.group(2) is not None else match.group(3)
+        name, unit = found
         if name not in dimensions and name not in ignore:
             raise DataError(f"{source}: unknown column {name!r}; expected {', '.join(dimensions)}")
         if name in names:
