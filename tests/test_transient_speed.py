@@ -67,13 +67,22 @@ def test_block_deceleration_follows_the_cohorts(monkeypatch):
     assert auto.steps * 20 < off.steps
 
     original = R.Manifold.values
+    original_stack = R.Manifold.stacked
 
     def no_lag(self, v):  # type: ignore[no-untyped-def]
         s, s1, s2, _c, _c1 = original(self, v)
         return s, s1, s2, 0.0, 0.0
 
+    def no_lag_stack(self):  # type: ignore[no-untyped-def]
+        # the compiled glide reads the tables' stacked series (S, S', S'', C, C', N): C and C' zero
+        stack, off, scl = original_stack(self)
+        stack = stack.copy()
+        stack[:, 3:5] = 0.0
+        return stack, off, scl
+
     R._BUILT.clear()
     monkeypatch.setattr(R.Manifold, "values", no_lag)
+    monkeypatch.setattr(R.Manifold, "stacked", no_lag_stack)
     try:
         lagless = run_transient(GEL, protocol, **kw)
     finally:

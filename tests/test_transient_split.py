@@ -48,6 +48,15 @@ the largest values of the previous one; against the plain cohorts at rtol 1e-5 (
 (kernel.WALL_LANDING, issue 31; docs/transient.md section 12): the same 52 steps and verdict, sigma within 4.9e-14,
 N/N0 and V within 2.6e-6 and 2.3e-6 of the largest values of the previous trace; against the plain cohorts at rtol
 1e-5 (rows past 0.5 s) unchanged: sigma 6.2e-8, N/N0 2.6e-6, V 2.4e-6.  The other six cases are unchanged.
+
+The two cases through the reduction were rewritten again when its glide ODE took its first step on the velocity's
+own scale and ran compiled (``transient/glide.py``, issue 31; docs/transient.md section 13): scipy's heuristic had
+counted the quadratures' atol of 1e-30 and started at 10 ulp of t.  Fewer ODE steps (``from_rest_chains`` 38 against
+52, ``steady_reduced`` 67 against 81), hence other rows inside the glides, and the same verdicts.  ``steady_reduced``:
+every array within 3.1e-12 of its largest value at the same 5 ms rows (its ``lowest_stress``, the least stress of
+the ODE's own steps since the last row, moves by up to 1.3e-3 where a row holds no step now).
+``from_rest_chains``: the last row within 1.1e-9 (V) of the old one; against the plain cohorts at rtol 1e-5 (rows
+past 0.5 s) sigma within 6.4e-8 (before 6.2e-8), N/N0 2.6e-6 and V 2.4e-6 (unchanged).
 """
 
 from __future__ import annotations

@@ -37,6 +37,7 @@ from numpy.polynomial import chebyshev as cheb
 from numpy.polynomial import polyutils as pu
 
 from ..parameters import Parameters
+from . import glide as glide_ode
 from . import kernel
 from .kernel import P_AGING, P_DLM, P_FORCE_SENS, P_INV_TAU_A, P_LOG_U0_TAU, P_M, P_N0, P_TAU, P_VA
 from .model import CELL_HAZARD, GAUSS, MAX_CELLS
@@ -58,6 +59,8 @@ LAG_DEGREE = 16
 LAG_SHARE = 0.02
 #: the steady stress interpolant must agree with the steady solver to this share of rtol between its nodes
 TABLE_SHARE = 1e-3
+#: the glide's ODE: scipy's DOP853 compiled (``glide``), or "solve_ivp" (the same method through scipy; a reference)
+GLIDE_SOLVER = "compiled"
 
 
 @dataclass
@@ -102,6 +105,13 @@ class Manifold:
         last_x, last = self._last
         if x == last_x and last is not None:
             return last
+        stack, off, scl = self.stacked()
+        out = _clenshaw()(stack, float(off + scl * x))
+        self._last = (x, out)
+        return out
+
+    def stacked(self) -> tuple[np.ndarray, np.floating, np.floating]:
+        """The six series' coefficients stacked as columns (zero-padded), and the map of ln V onto [-1, 1]."""
         if self._stacked is None:
             series = (self.stress, self.dstress, self.d2stress, self.lag, self.dlag, self.bonded)
             stack = np.zeros((max(s.coef.size for s in series), len(series)))
@@ -109,10 +119,7 @@ class Manifold:
                 stack[: s.coef.size, k] = s.coef
             off, scl = pu.mapparms(self.stress.domain, self.stress.window)
             self._stacked = (stack, off, scl)
-        stack, off, scl = self._stacked
-        out = _clenshaw()(stack, float(off + scl * x))
-        self._last = (x, out)
-        return out
+        return self._stacked
 
     def values(self, v: float) -> tuple[float, float, float, float, float]:
         """(S, S', S'', C, C') at velocity v (SI)."""
@@ -465,8 +472,6 @@ def glide(
     ``acc`` (born, broken, work, dissipation, steps, rejected, integral of sigma dt) is updated in place; ``bonded`` and
     ``energy`` are the cohorts' N and bond energy at entry, so that the bookkeeping stays continuous.
     """
-    from scipy.integrate import solve_ivp
-
     b = params.bonds
     n0, tau = b.site_density, b.bond_time
     tol = THETA * rtol
@@ -494,10 +499,24 @@ def glide(
     off_table.terminal = True  # type: ignore[attr-defined]
     events = [off_manifold, off_table] if block else []
     y0 = np.array([v, 0.0, 0.0, 0.0])
-    sol = solve_ivp(
-        rhs, (t, t_end), y0, method="DOP853", rtol=1e-3 * rtol, atol=[1e-9 * v, 1e-12 * n0, 1e-30, 1e-30],
-        events=events, dense_output=True,
-    )  # fmt: skip
+    atol = np.array([1e-9 * v, 1e-12 * n0, 1e-30, 1e-30])
+    stack, off, scl = m.stacked()
+    reduced = dict(lo=lo, hi=hi, vp=vp, k_block=k_block, block=block, n0=n0, tau=tau, cap_off=OFF_MANIFOLD)
+    h_first = glide_ode.initial_step(stack, off, scl, **reduced, t0=t, t_end=t_end, v=v, rtol=1e-3 * rtol,
+                                     atol_v=atol[0])  # fmt: skip
+    sol: Any
+    if GLIDE_SOLVER == "solve_ivp":
+        from scipy.integrate import solve_ivp
+
+        sol = solve_ivp(
+            rhs, (t, t_end), y0, method="DOP853", rtol=1e-3 * rtol, atol=atol, events=events, dense_output=True,
+            first_step=h_first,
+        )  # fmt: skip
+    else:
+        sol = glide_ode.solve(
+            stack, off, scl, **reduced, tol=tol, cap=NEGLECT_CAP, t0=t, t_end=t_end, y0=y0, rtol=1e-3 * rtol,
+            atol=atol, h_first=h_first,
+        )  # fmt: skip
     if not (np.all(np.isfinite(sol.y[:, -1])) and sol.y[0, -1] > 0.0 and sol.t.size > 1):
         return None  # the stretch could not be followed (the caller leaves it to the cohorts)
     t_stop = float(sol.t[-1])
