@@ -169,14 +169,16 @@ def _steady_cells():  # type: ignore[no-untyped-def]
     return _CELLS[0]
 
 
-def steady_cohorts(params: Parameters, velocity: float, aging: bool):  # type: ignore[no-untyped-def]
+def steady_cohorts(  # type: ignore[no-untyped-def]
+    params: Parameters, velocity: float, aging: bool, cell_hazard: float = CELL_HAZARD, cells_least: float = 1000.0
+):
     """model.steady_population(params, velocity, aging) (the Gauss rule), compiled: the same cohorts, faster."""
     from .model import Population, pack_parameters, steady_population
 
     if not (velocity > 0 and math.isfinite(velocity)):
         return steady_population(params, velocity, aging)  # its error, in words
     _steady_cells()
-    age, weight = _CELLS[1](float(velocity), pack_parameters(params, aging, 1.0), CELL_HAZARD)
+    age, weight = _CELLS[1](float(velocity), pack_parameters(params, aging, 1.0), cell_hazard, cells_least)
     if age.size >= 2 * MAX_CELLS:
         return steady_population(params, velocity, aging)  # its error, in words
     return Population(extension=velocity * age, age=age, weight=weight)
@@ -222,11 +224,11 @@ def _log_rate(age, v, slope, p):  # type: ignore[no-untyped-def]
     return min(p[P_LOG_U0_TAU] + p[P_FORCE_SENS] * force - _aging_clock(age, p)[0] * slope, 700.0)
 
 
-def _march(v, p, cell_hazard):  # type: ignore[no-untyped-def]
+def _march(v, p, cell_hazard, cells_least=1000.0):  # type: ignore[no-untyped-def]
     """Cell edges in age and the cumulative hazard at them: model.steady_population's march, compiled."""
     slope = p[P_INV_TAU_A] * math.exp(-v / p[P_VA]) if p[P_AGING] > 0.0 else 0.0
     t_max = p[P_DLM] / v
-    widest = t_max / 1000.0
+    widest = t_max / cells_least
     edges = [0.0]
     cum = [0.0]
     a = 0.0
@@ -254,9 +256,9 @@ def _march(v, p, cell_hazard):  # type: ignore[no-untyped-def]
     return np.array(edges), np.array(cum), slope
 
 
-def _gauss(v, p, cell_hazard):  # type: ignore[no-untyped-def]
+def _gauss(v, p, cell_hazard, cells_least):  # type: ignore[no-untyped-def]
     """(age, weight) of model.steady_population(rule="gauss"): two cohorts per cell at its Gauss points."""
-    edges, cum, slope = _march(v, p, cell_hazard)
+    edges, cum, slope = _march(v, p, cell_hazard, cells_least)
     n = edges.size - 1
     age = np.empty(2 * n)
     weight = np.empty(2 * n)

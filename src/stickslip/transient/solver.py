@@ -421,7 +421,7 @@ class _Driver:
         """The paper's jump: the steady population at vs, the slider where the new bonds carry sigma_s."""
         state, p = self.state, self.p
         self.events.append(("slip", state.t, sigma_s, vs))
-        state.load(_steady_cohorts(self.params, vs, self.aging))
+        state.load(_steady_cohorts(self.params, vs, self.aging, *_rebuilt_cells(self.rtol)))
         state.v = vs
         state.h = self.params.bonds.bond_time * 1e-3
         self.chains_on = False
@@ -793,7 +793,7 @@ class _Reducer:
             state.x = x_entry + vp * (glide.t - t_entry)
             state.puller = state.x
         # the cohorts again, rebuilt from the steady population (balanced against the block)
-        state.load(_steady_cohorts(self.params, glide.v, self.aging))
+        state.load(_steady_cohorts(self.params, glide.v, self.aging, *_rebuilt_cells(self.rtol)))
         if self.block:
             weights = np.exp(state.lw[: state.n])
             state.x = self.functions["_balance_weights"](state.x, state.puller, state.n, state.xb, weights, self.p)
@@ -871,17 +871,42 @@ class _Reducer:
 _STEADY_COHORTS: dict[tuple[Parameters, float, bool], Population] = {}
 
 
-def _steady_cohorts(params: Parameters, velocity: float, aging: bool) -> Population:
+#: a steady population rebuilt within a run (a glide's end, the paper's jump) takes cells up to this many times
+#: coarser than the steady start's (model.CELL_HAZARD in hazard, dl_m/V / 1000 in age): see :func:`_rebuilt_cells`
+REBUILT_COARSEST = 10.0
+#: the relative error of a re-slide's peak after a hold of a rebuilt population, per squared coarsening (measured:
+#: tests/test_transient_speed.py's slide-hold-slide, coarsening 4, 6, 10: 2.5e-5, 7.0e-5, 1.9e-4)
+REBUILT_PEAK_ERROR = 1.9e-6
+
+
+def _rebuilt_cells(rtol: float) -> tuple[float, float]:
+    """(cell hazard, least cells over dl_m/V) of a steady population rebuilt within a run (docs/transient.md
+    section 13).  The steady start's resolution (CELL_HAZARD = 0.05, cells of dl_m/V / 1000 where the hazard is
+    low) is ~10x finer in age than the cohorts' own births at the steps of a fold passage: the ~2 800 cohorts rebuilt
+    at a glide's end, most living for tens of steps, were a third of the passage's CPU.  Coarser cells by a factor c
+    move what the rebuilt bonds do later at second order in the cells' width (each cohort carries its cell's bonds
+    to the FENE wall as one: the peak re-sliding after a hold moved by REBUILT_PEAK_ERROR c^2), so c is held where
+    that is the reduction's share of the tolerance, THETA rtol, and at most REBUILT_COARSEST."""
+    from .model import CELL_HAZARD
+    from .reduction import THETA
+
+    coarsening = min(max(math.sqrt(THETA * rtol / REBUILT_PEAK_ERROR), 1.0), REBUILT_COARSEST)
+    return CELL_HAZARD * coarsening, 1000.0 / coarsening
+
+
+def _steady_cohorts(
+    params: Parameters, velocity: float, aging: bool, cell_hazard: float = 0.05, cells_least: float = 1000.0
+) -> Population:
     """steady_population, remembered (a steady run starts and ends on the same one)."""
     from ..quasistatic.jump import steady_curve_key
 
-    key = (steady_curve_key(params), float(velocity), bool(aging))
+    key = (steady_curve_key(params), float(velocity), bool(aging), cell_hazard, cells_least)
     if key not in _STEADY_COHORTS:
         if len(_STEADY_COHORTS) > 16:
             _STEADY_COHORTS.clear()
         from .reduction import steady_cohorts
 
-        _STEADY_COHORTS[key] = steady_cohorts(params, velocity, aging)
+        _STEADY_COHORTS[key] = steady_cohorts(params, velocity, aging, cell_hazard, cells_least)
     return _STEADY_COHORTS[key]
 
 
