@@ -79,6 +79,7 @@ class Manifold:
     bonded_lag: cheb.Chebyshev  # C_N/N0 (s^2/m): N/N0 = bonded + bonded_lag V' to first order
     _stacked: tuple[np.ndarray, np.floating, np.floating] | None = field(default=None, repr=False, compare=False)
     _last: tuple[float, np.ndarray | None] = field(default=(math.nan, None), repr=False, compare=False)
+    _extrema: np.ndarray | None = field(default=None, repr=False, compare=False)  # real roots of S' in ln V
 
     def covers(self, lo: float, hi: float) -> bool:
         return self.v_lo <= lo and hi <= self.v_hi
@@ -88,8 +89,10 @@ class Manifold:
         x = math.log(v)
         if not (self.dstress(x) > 0 and self.v_lo < v < self.v_hi):
             return None
-        roots = self.dstress.roots()
-        roots = roots[np.abs(roots.imag) < 1e-12].real
+        if self._extrema is None:  # the table's own numbers: found once (an eigenvalue problem, ~0.1 ms a call)
+            roots = self.dstress.roots()
+            self._extrema = roots[np.abs(roots.imag) < 1e-12].real
+        roots = self._extrema
         below = roots[roots < x]
         above = roots[roots > x]
         lo = max(self.v_lo, math.exp(below.max()) * (1 + 1e-3)) if below.size else self.v_lo
