@@ -326,6 +326,28 @@ def test_the_light_commands_import_no_heavy_library():
         assert done.stdout.strip().splitlines()[-1] == "HEAVY []", (argv, done.stdout[-300:])
 
 
+#: what a short transient run must not load (issue 31: scipy.fft and scipy.optimize came in at import through
+#: stickslip.quasistatic.jump, ~0.35 s of its 1.5 s); scipy.linalg is numba's own (its BLAS check), not ours
+TRANSIENT_HEAVY = (*HEAVY, "scipy.fft", "scipy.interpolate", "scipy.sparse")
+
+
+def test_a_short_transient_run_imports_no_heavy_library():
+    code = (
+        "import sys\n"
+        "from stickslip.cli.main import cli\n"
+        "cli.main(sys.argv[1:], standalone_mode=False)\n"
+        f"print('HEAVY', [m for m in {TRANSIENT_HEAVY!r} if m in sys.modules])\n"
+    )
+    argv = ["transient", "--start", "steady", "--stick-population", "--v0", "350 um/s", "--duration", "0.05 s"]
+    env = {**os.environ, "PYTHONPATH": str(SRC)}
+    done = subprocess.run(  # a first run in a fresh checkout compiles the kernels into numba's cache (~20 s)
+        [sys.executable, "-c", code, *argv], capture_output=True, text=True, timeout=600, env=env, check=False
+    )
+    assert done.returncode == 0, done.stderr
+    assert "regime: steady" in done.stdout  # the run ran, not just its imports
+    assert done.stdout.strip().splitlines()[-1] == "HEAVY []", done.stdout[-300:]
+
+
 def test_outputs_get_the_usual_file_mode_not_a_private_one(tmp_path):
     umask = os.umask(0o022)
     os.umask(umask)

@@ -14,9 +14,7 @@ from dataclasses import dataclass
 from functools import lru_cache
 
 import numpy as np
-import scipy.fft
 from numpy.polynomial import chebyshev as cheb
-from scipy.optimize import brentq
 
 from ..errors import ModelError, ParameterError
 from ..parameters import Parameters
@@ -44,6 +42,8 @@ def chebyshev_points(n: int) -> np.ndarray:
 
 def chebyshev_coefficients(values: np.ndarray) -> np.ndarray:
     """Chebyshev coefficients of the interpolant through values at :func:`chebyshev_points` (last axis)."""
+    import scipy.fft  # here, not at import: it costs ~0.2 s of start-up, and the transient command never calls it
+
     n = values.shape[-1] - 1
     c = scipy.fft.dct(values, type=1, axis=-1) / n
     c[..., 0] /= 2.0
@@ -263,6 +263,8 @@ def jump_velocity(params: Parameters, stress: float, curve: str = "aging") -> Ju
     elif excess(branch.log_hi) <= 0.0:
         log_v = branch.log_hi
     else:
+        from scipy.optimize import brentq  # here: scipy.optimize costs ~0.15 s of start-up
+
         log_v = brentq(excess, branch.log_vc, branch.log_hi, xtol=1e-14, rtol=4 * np.finfo(float).eps)
     velocity = math.exp(log_v)
     return Jump(

@@ -16,8 +16,6 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.polynomial import Chebyshev
 from numpy.polynomial import chebyshev as cheb
-from scipy.optimize import brentq
-from scipy.special import exprel
 
 from ..columns import attribute_frame
 from ..errors import ModelError, ParameterError
@@ -119,6 +117,8 @@ class SlipTrajectory:
             return self.log_start
         if t >= self.duration:
             return self.log_end
+        from scipy.optimize import brentq  # here, not at import: it costs ~0.15 s of start-up
+
         return brentq(lambda x: float(self.time(x)) - t, self.log_end, self.log_start, xtol=1e-15, rtol=1e-15)
 
 
@@ -181,6 +181,8 @@ def slip_trajectory(
     stress_series = coefficients[0]
     integral_series = cheb.chebint(coefficients[1], lbnd=u_start) * half
     if subtract:
+        from scipy.special import exprel  # here, not at import: scipy.special costs ~0.1 s of start-up
+
         g_series = Chebyshev(coefficients[1])
         u0 = float(to_unit(x0, lo, hi))
         g0 = float(g_series(u0))

@@ -15,7 +15,6 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from scipy.optimize import brentq
 
 from ..columns import attribute_frame
 from ..errors import ModelError, ParameterError
@@ -98,6 +97,8 @@ class StickPhase:
         if self._dense is None or t >= self.end_time:
             return float(np.interp(t, self.time, self.chain_fraction))
         dense, scale = self._dense
+        from scipy.optimize import brentq  # here, not at import: it costs ~0.15 s of start-up
+
         theta = brentq(lambda s: float(dense(s)[0]) * scale - t, dense.start, dense.end, xtol=1e-14, rtol=1e-14)
         return float(min(max(dense(theta)[1], 0.0), 1.0))
 
