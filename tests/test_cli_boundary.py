@@ -14,6 +14,7 @@ import os
 import subprocess
 import sys
 import warnings
+from importlib import import_module
 from pathlib import Path
 
 import click
@@ -337,6 +338,7 @@ def test_a_short_transient_run_imports_no_heavy_library():
         "from stickslip.cli.main import cli\n"
         "cli.main(sys.argv[1:], standalone_mode=False)\n"
         f"print('HEAVY', [m for m in {TRANSIENT_HEAVY!r} if m in sys.modules])\n"
+        "print('COMMANDS', sorted(m for m in sys.modules if m.startswith('stickslip.cli.') and m.endswith('_cmd')))\n"
     )
     argv = ["transient", "--start", "steady", "--stick-population", "--v0", "350 um/s", "--duration", "0.05 s"]
     env = {**os.environ, "PYTHONPATH": str(SRC)}
@@ -345,7 +347,21 @@ def test_a_short_transient_run_imports_no_heavy_library():
     )
     assert done.returncode == 0, done.stderr
     assert "regime: steady" in done.stdout  # the run ran, not just its imports
-    assert done.stdout.strip().splitlines()[-1] == "HEAVY []", done.stdout[-300:]
+    *_, heavy, commands = done.stdout.strip().splitlines()
+    assert heavy == "HEAVY []", done.stdout[-300:]
+    # the command's own module and those it builds on (run's options and output), not every other command's
+    assert commands == "COMMANDS ['stickslip.cli.run_cmd', 'stickslip.cli.transient_cmd']", commands
+
+
+def test_every_command_is_registered_by_the_module_named_for_it():
+    from stickslip.cli.main import COMMAND_MODULES
+
+    modules = {path.stem for path in (SRC / "stickslip" / "cli").glob("*_cmd.py")}
+    assert set(COMMAND_MODULES.values()) == modules  # a new command module must be named there to be found
+    for module in modules:
+        group = click.Group()
+        import_module(f"stickslip.cli.{module}").register(group)
+        assert sorted(group.commands) == sorted(name for name, m in COMMAND_MODULES.items() if m == module), module
 
 
 def test_outputs_get_the_usual_file_mode_not_a_private_one(tmp_path):
