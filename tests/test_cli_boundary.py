@@ -328,15 +328,18 @@ def test_the_light_commands_import_no_heavy_library():
 
 
 #: what a short transient run must not load (issue 31: scipy.fft and scipy.optimize came in at import through
-#: stickslip.quasistatic.jump, ~0.35 s of its 1.5 s); scipy.linalg is numba's own (its BLAS check), not ours
-TRANSIENT_HEAVY = (*HEAVY, "scipy.fft", "scipy.interpolate", "scipy.sparse")
+#: stickslip.quasistatic.jump, scipy.linalg through numba's BLAS probe, stickslip.cli.numba_start)
+TRANSIENT_HEAVY = (*HEAVY, "scipy.fft", "scipy.linalg", "scipy.interpolate", "scipy.sparse")
 
 
 def test_a_short_transient_run_imports_no_heavy_library():
     code = (
         "import sys\n"
-        "from stickslip.cli.main import cli\n"
-        "cli.main(sys.argv[1:], standalone_mode=False)\n"
+        "from stickslip.cli.main import main\n"
+        "try:\n"
+        "    main(sys.argv[1:])\n"
+        "except SystemExit as stop:\n"
+        "    assert not stop.code, stop.code\n"
         f"print('HEAVY', [m for m in {TRANSIENT_HEAVY!r} if m in sys.modules])\n"
         "print('COMMANDS', sorted(m for m in sys.modules if m.startswith('stickslip.cli.') and m.endswith('_cmd')))\n"
     )
@@ -351,6 +354,31 @@ def test_a_short_transient_run_imports_no_heavy_library():
     assert heavy == "HEAVY []", done.stdout[-300:]
     # the command's own module and those it builds on (run's options and output), not every other command's
     assert commands == "COMMANDS ['stickslip.cli.run_cmd', 'stickslip.cli.transient_cmd']", commands
+
+
+def test_numba_without_its_blas_probe_still_compiles_linear_algebra():
+    """The command skips numba's BLAS probe (stickslip.cli.numba_start); np.dot, @ and np.linalg still compile
+    (they import scipy.linalg themselves) and agree with numpy's."""
+    code = (
+        "import sys\n"
+        "from stickslip.cli.numba_start import skip_blas_probe\n"
+        "skip_blas_probe()\n"
+        "import numba, numpy as np\n"
+        "from numba.core.registry import cpu_target\n"
+        "cpu_target.target_context.refresh()\n"
+        "import numba.np.arraymath\n"
+        "print('PROBE', numba.np.arraymath._HAVE_BLAS, 'scipy.linalg' in sys.modules)\n"
+        "f = numba.njit(lambda a, b: (np.dot(a, b), a @ b, np.linalg.solve(a, b)))\n"
+        "a, b = np.array([[2.0, 1.0], [1.0, 3.0]]), np.array([[1.0, -1.0], [0.5, 2.0]])\n"
+        "dot, at, solved = f(a, b)\n"
+        "print('SAME', np.array_equal(dot, np.dot(a, b)), np.array_equal(at, a @ b), np.allclose(a @ solved, b))\n"
+    )
+    env = {**os.environ, "PYTHONPATH": str(SRC)}
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300, env=env)
+    assert done.returncode == 0, done.stderr
+    probe, same = done.stdout.strip().splitlines()[-2:]
+    assert probe == "PROBE False False"  # the probe was skipped, and scipy.linalg not loaded for it
+    assert same == "SAME True True True"
 
 
 def test_every_command_is_registered_by_the_module_named_for_it():

@@ -25,6 +25,7 @@ import click
 
 from .. import __version__
 from ..errors import StickslipError
+from .numba_start import skip_blas_probe
 
 if TYPE_CHECKING:  # loaded by name (COMMAND_MODULES); named here for the type checker and the import graph
     from . import (  # noqa: F401
@@ -246,6 +247,7 @@ def _silence_stdout() -> None:
 
 def main(argv: list[str] | None = None) -> None:
     """Console entry point."""
+    skip_blas_probe()  # numba's, ~0.25 s of a transient run: see numba_start
     caught: list[tuple[type[Warning], str]] = []
 
     def collect(message: Any, category: type[Warning], *args: Any, **kwargs: Any) -> None:
