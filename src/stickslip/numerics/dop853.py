@@ -29,6 +29,7 @@ from operator import mul
 import numpy as np
 
 from ..errors import ModelError
+from .roots import brentq  # scipy's Brent bit for bit (tests/test_roots.py), without scipy.optimize
 
 _C = [
     0.0,
@@ -364,8 +365,6 @@ def _chunk(hold: Callable[[float, float], float], s0: float, tp: float, n: float
             rejected = True
         steps.add(s, h, (tp, n, tp_new, n_new), k)
         if n >= 0.0 and n_new <= 0.0:  # the collapse, located on the dense output as solve_ivp does
-            from scipy.optimize import brentq  # here, not at import: it costs ~0.15 s of start-up
-
             root = brentq(lambda theta: steps.at(theta)[1], s, s_new, xtol=4 * _EPS, rtol=4 * _EPS)
             steps.end = root
             tp_end, n_end = steps.at(root)

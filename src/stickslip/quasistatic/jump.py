@@ -17,6 +17,7 @@ import numpy as np
 from numpy.polynomial import chebyshev as cheb
 
 from ..errors import ModelError, ParameterError
+from ..numerics.roots import brentq  # scipy's Brent bit for bit (tests/test_roots.py), without scipy.optimize
 from ..parameters import Parameters
 from ..reprs import field_values
 from .critical import CriticalPoint, cached_critical_point, steady_curve_key
@@ -263,8 +264,6 @@ def jump_velocity(params: Parameters, stress: float, curve: str = "aging") -> Ju
     elif excess(branch.log_hi) <= 0.0:
         log_v = branch.log_hi
     else:
-        from scipy.optimize import brentq  # here: scipy.optimize costs ~0.15 s of start-up
-
         log_v = brentq(excess, branch.log_vc, branch.log_hi, xtol=1e-14, rtol=4 * np.finfo(float).eps)
     velocity = math.exp(log_v)
     return Jump(

@@ -19,6 +19,7 @@ from numpy.polynomial import chebyshev as cheb
 
 from ..columns import attribute_frame
 from ..errors import ModelError, ParameterError
+from ..numerics.roots import brentq  # scipy's Brent bit for bit (tests/test_roots.py), without scipy.optimize
 from ..parameters import Parameters
 from ..reprs import compact_repr
 from .jump import (
@@ -117,8 +118,6 @@ class SlipTrajectory:
             return self.log_start
         if t >= self.duration:
             return self.log_end
-        from scipy.optimize import brentq  # here, not at import: it costs ~0.15 s of start-up
-
         return brentq(lambda x: float(self.time(x)) - t, self.log_end, self.log_start, xtol=1e-15, rtol=1e-15)
 
 

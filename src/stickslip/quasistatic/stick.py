@@ -18,6 +18,7 @@ import numpy as np
 
 from ..columns import attribute_frame
 from ..errors import ModelError, ParameterError
+from ..numerics.roots import brentq  # scipy's Brent bit for bit (tests/test_roots.py), without scipy.optimize
 from ..parameters import Parameters, require_flag
 from ..reprs import compact_repr, field_values
 from .jump import require_critical_point
@@ -97,8 +98,6 @@ class StickPhase:
         if self._dense is None or t >= self.end_time:
             return float(np.interp(t, self.time, self.chain_fraction))
         dense, scale = self._dense
-        from scipy.optimize import brentq  # here, not at import: it costs ~0.15 s of start-up
-
         theta = brentq(lambda s: float(dense(s)[0]) * scale - t, dense.start, dense.end, xtol=1e-14, rtol=1e-14)
         return float(min(max(dense(theta)[1], 0.0), 1.0))
 
