@@ -356,17 +356,19 @@ def test_a_short_transient_run_imports_no_heavy_library():
     assert commands == "COMMANDS ['stickslip.cli.run_cmd', 'stickslip.cli.transient_cmd']", commands
 
 
-def test_the_quasi_static_cycle_loads_no_scipy_optimize():
-    """Stick (dop853's collapse), jump and slip find their roots with stickslip.numerics.roots.brentq, scipy's
-    Brent bit for bit (tests/test_roots.py): a transient run's cost estimate solves them, and scipy.optimize would
-    bring scipy.linalg, sparse and spatial with it (~0.2 s)."""
+def test_the_quasi_static_cycle_loads_no_scipy():
+    """Stick (dop853's collapse), jump and slip find their roots with stickslip.numerics.roots.brentq, and their
+    Chebyshev series with stickslip.numerics.transforms: scipy's numbers bit for bit (tests/test_roots.py,
+    tests/test_transforms.py).  A transient run's cost estimate and its jumps solve them; scipy.optimize would
+    bring scipy.linalg, sparse and spatial with it (~0.2 s), scipy.fft and scipy.special ~0.3 s."""
     code = (
         "import sys, stickslip\n"
         "params = stickslip.load_parameters()\n"
         "sim = stickslip.simulate(params, 50e-6, 60.0)\n"
         "stick = stickslip.stick_phase(params, 50e-6)\n"
         "print('RAN', sim.regime, len(sim.cycles), 0 < stick.chain_fraction_at(5.0) < 1)\n"
-        "print('LOADED', [m for m in ('scipy.optimize', 'scipy.integrate', 'scipy.linalg') if m in sys.modules])\n"
+        "heavy = ('scipy.optimize', 'scipy.integrate', 'scipy.linalg', 'scipy.fft', 'scipy.special')\n"
+        "print('LOADED', [m for m in heavy if m in sys.modules])\n"
     )
     env = {**os.environ, "PYTHONPATH": str(SRC)}
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300, env=env)

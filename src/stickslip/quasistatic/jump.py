@@ -18,6 +18,7 @@ from numpy.polynomial import chebyshev as cheb
 
 from ..errors import ModelError, ParameterError
 from ..numerics.roots import brentq  # scipy's Brent bit for bit (tests/test_roots.py), without scipy.optimize
+from ..numerics.transforms import dct1  # scipy.fft's, bit for bit, without its ~0.3 s import
 from ..parameters import Parameters
 from ..reprs import field_values
 from .critical import CriticalPoint, cached_critical_point, steady_curve_key
@@ -43,10 +44,8 @@ def chebyshev_points(n: int) -> np.ndarray:
 
 def chebyshev_coefficients(values: np.ndarray) -> np.ndarray:
     """Chebyshev coefficients of the interpolant through values at :func:`chebyshev_points` (last axis)."""
-    import scipy.fft  # here, not at import: it costs ~0.2 s of start-up, and the transient command never calls it
-
     n = values.shape[-1] - 1
-    c = scipy.fft.dct(values, type=1, axis=-1) / n
+    c = dct1(values) / n
     c[..., 0] /= 2.0
     c[..., -1] /= 2.0
     return c

@@ -20,6 +20,7 @@ from numpy.polynomial import chebyshev as cheb
 from ..columns import attribute_frame
 from ..errors import ModelError, ParameterError
 from ..numerics.roots import brentq  # scipy's Brent bit for bit (tests/test_roots.py), without scipy.optimize
+from ..numerics.transforms import exprel  # scipy.special's, bit for bit, without its import
 from ..parameters import Parameters
 from ..reprs import compact_repr
 from .jump import (
@@ -180,8 +181,6 @@ def slip_trajectory(
     stress_series = coefficients[0]
     integral_series = cheb.chebint(coefficients[1], lbnd=u_start) * half
     if subtract:
-        from scipy.special import exprel  # here, not at import: scipy.special costs ~0.1 s of start-up
-
         g_series = Chebyshev(coefficients[1])
         u0 = float(to_unit(x0, lo, hi))
         g0 = float(g_series(u0))
