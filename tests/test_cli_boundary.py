@@ -14,6 +14,7 @@ import os
 import subprocess
 import sys
 import warnings
+from importlib import import_module
 from pathlib import Path
 
 import click
@@ -324,6 +325,93 @@ def test_the_light_commands_import_no_heavy_library():
         )
         assert done.returncode == 0, done.stderr
         assert done.stdout.strip().splitlines()[-1] == "HEAVY []", (argv, done.stdout[-300:])
+
+
+#: what a short transient run must not load (issue 31: scipy.fft and scipy.optimize came in at import through
+#: stickslip.quasistatic.jump, scipy.linalg through numba's BLAS probe, stickslip.cli.numba_start)
+TRANSIENT_HEAVY = (*HEAVY, "scipy.fft", "scipy.linalg", "scipy.interpolate", "scipy.sparse")
+
+
+def test_a_short_transient_run_imports_no_heavy_library():
+    code = (
+        "import sys\n"
+        "from stickslip.cli.main import main\n"
+        "try:\n"
+        "    main(sys.argv[1:])\n"
+        "except SystemExit as stop:\n"
+        "    assert not stop.code, stop.code\n"
+        f"print('HEAVY', [m for m in {TRANSIENT_HEAVY!r} if m in sys.modules])\n"
+        "print('COMMANDS', sorted(m for m in sys.modules if m.startswith('stickslip.cli.') and m.endswith('_cmd')))\n"
+    )
+    argv = ["transient", "--start", "steady", "--stick-population", "--v0", "350 um/s", "--duration", "0.05 s"]
+    env = {**os.environ, "PYTHONPATH": str(SRC)}
+    done = subprocess.run(  # a first run in a fresh checkout compiles the kernels into numba's cache (~20 s)
+        [sys.executable, "-c", code, *argv], capture_output=True, text=True, timeout=600, env=env, check=False
+    )
+    assert done.returncode == 0, done.stderr
+    assert "regime: steady" in done.stdout  # the run ran, not just its imports
+    *_, heavy, commands = done.stdout.strip().splitlines()
+    assert heavy == "HEAVY []", done.stdout[-300:]
+    # the command's own module and those it builds on (run's options and output), not every other command's
+    assert commands == "COMMANDS ['stickslip.cli.run_cmd', 'stickslip.cli.transient_cmd']", commands
+
+
+def test_the_quasi_static_cycle_loads_no_scipy():
+    """Stick (dop853's collapse), jump and slip find their roots with stickslip.numerics.roots.brentq, and their
+    Chebyshev series with stickslip.numerics.transforms: scipy's numbers bit for bit (tests/test_roots.py,
+    tests/test_transforms.py).  A transient run's cost estimate and its jumps solve them; scipy.optimize would
+    bring scipy.linalg, sparse and spatial with it (~0.2 s), scipy.fft and scipy.special ~0.3 s."""
+    code = (
+        "import sys, stickslip\n"
+        "params = stickslip.load_parameters()\n"
+        "sim = stickslip.simulate(params, 50e-6, 60.0)\n"
+        "stick = stickslip.stick_phase(params, 50e-6)\n"
+        "print('RAN', sim.regime, len(sim.cycles), 0 < stick.chain_fraction_at(5.0) < 1)\n"
+        "heavy = ('scipy.optimize', 'scipy.integrate', 'scipy.linalg', 'scipy.fft', 'scipy.special')\n"
+        "print('LOADED', [m for m in heavy if m in sys.modules])\n"
+    )
+    env = {**os.environ, "PYTHONPATH": str(SRC)}
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300, env=env)
+    assert done.returncode == 0, done.stderr
+    ran, loaded = done.stdout.strip().splitlines()[-2:]
+    assert ran == "RAN stick-slip 2 True"  # stick, jump, slip and the chains' dense output were all solved
+    assert loaded == "LOADED []"
+
+
+def test_numba_without_its_blas_probe_still_compiles_linear_algebra():
+    """The command skips numba's BLAS probe (stickslip.cli.numba_start); np.dot, @ and np.linalg still compile
+    (they import scipy.linalg themselves) and agree with numpy's."""
+    code = (
+        "import sys\n"
+        "from stickslip.cli.numba_start import skip_blas_probe\n"
+        "skip_blas_probe()\n"
+        "import numba, numpy as np\n"
+        "from numba.core.registry import cpu_target\n"
+        "cpu_target.target_context.refresh()\n"
+        "import numba.np.arraymath\n"
+        "print('PROBE', numba.np.arraymath._HAVE_BLAS, 'scipy.linalg' in sys.modules)\n"
+        "f = numba.njit(lambda a, b: (np.dot(a, b), a @ b, np.linalg.solve(a, b)))\n"
+        "a, b = np.array([[2.0, 1.0], [1.0, 3.0]]), np.array([[1.0, -1.0], [0.5, 2.0]])\n"
+        "dot, at, solved = f(a, b)\n"
+        "print('SAME', np.array_equal(dot, np.dot(a, b)), np.array_equal(at, a @ b), np.allclose(a @ solved, b))\n"
+    )
+    env = {**os.environ, "PYTHONPATH": str(SRC)}
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300, env=env)
+    assert done.returncode == 0, done.stderr
+    probe, same = done.stdout.strip().splitlines()[-2:]
+    assert probe == "PROBE False False"  # the probe was skipped, and scipy.linalg not loaded for it
+    assert same == "SAME True True True"
+
+
+def test_every_command_is_registered_by_the_module_named_for_it():
+    from stickslip.cli.main import COMMAND_MODULES
+
+    modules = {path.stem for path in (SRC / "stickslip" / "cli").glob("*_cmd.py")}
+    assert set(COMMAND_MODULES.values()) == modules  # a new command module must be named there to be found
+    for module in modules:
+        group = click.Group()
+        import_module(f"stickslip.cli.{module}").register(group)
+        assert sorted(group.commands) == sorted(name for name, m in COMMAND_MODULES.items() if m == module), module
 
 
 def test_outputs_get_the_usual_file_mode_not_a_private_one(tmp_path):

@@ -56,7 +56,40 @@ def test_a_refinement_solves_each_point_once(monkeypatch):
         return real(params, velocity, aging)
 
     monkeypatch.setattr(critical, "_curve", counting)
+    _forget()
     extrema = critical.find_extrema(OTHERS[0], aging=True)
     assert len(extrema) == 2  # the minimum at Vc and the maximum at a few mm/s
     assert len(seen) == len(set(seen))  # Brent's ends and its root are not solved again
     assert len(seen) <= 2 * 12  # two refinements from brackets 1/16 decade wide to 1e-12 in ln V
+
+
+def _forget() -> None:
+    """Clear every remembered part of the search (the points, the minima, the grids and the refinements)."""
+    for cache in (critical.cached_critical_point, critical._cached_minimum, critical._grid_signs, critical._refine):
+        cache.cache_clear()
+
+
+def test_the_whole_point_after_vc_alone_solves_nothing_twice(monkeypatch):
+    """A transient run asks for Vc alone (critical_minimum), a jump later for the whole point: together they
+    solve the steady states of the whole point's search once, not the grid and the minimum's refinement twice."""
+    calls: list[float] = []
+    real = critical._curve
+
+    def counting(params, velocity, aging):
+        calls.append(np.size(velocity))
+        return real(params, velocity, aging)
+
+    monkeypatch.setattr(critical, "_curve", counting)
+    params = OTHERS[1]
+    _forget()
+    alone = critical_point(params)
+    whole = list(calls)
+    _forget()
+    calls.clear()
+    lean = critical_minimum(params)
+    first = list(calls)
+    assert critical_point(params) == alone
+    assert lean is not None and (lean.velocity, lean.stress) == (alone.velocity, alone.stress)
+    assert sorted(calls) == sorted(whole)  # the same steady states, each once
+    assert sum(n > 1 for n in first) == 1 and len(first) - 1 <= 12  # Vc alone: one grid, one refinement
+    assert sum(n > 1 for n in whole) == 2  # the whole point: the no-aging curve's grid too

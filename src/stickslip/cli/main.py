@@ -17,28 +17,18 @@ import os
 import re
 import sys
 import warnings
-from typing import Any
+from collections.abc import Iterator
+from importlib import import_module
+from typing import TYPE_CHECKING, Any
 
 import click
 
 from .. import __version__
 from ..errors import StickslipError
+from .numba_start import skip_blas_probe
 
-#: Longest error line printed (a message quoting a huge value is cut).
-MAX_MESSAGE_LENGTH = 600
-
-
-@click.group(context_settings={"help_option_names": ["-h", "--help"]})
-@click.version_option(version=__version__, prog_name="stickslip")
-def cli() -> None:
-    """Friction and stick-slip of soft solids: the bond-population model of Juvekar & Singh.
-
-    Values carry units: --v0 "50 um/s", --set bonds.bond_time="224 us".
-    """
-
-
-def _register() -> None:
-    from . import (
+if TYPE_CHECKING:  # loaded by name (COMMAND_MODULES); named here for the type checker and the import graph
+    from . import (  # noqa: F401
         analyze_cmd,
         compare_cmd,
         cycle_cmd,
@@ -53,12 +43,101 @@ def _register() -> None:
         transient_cmd,
     )
 
-    commands = (params_cmd, steady_cmd, cycle_cmd, transient_cmd, fit_cmd, analyze_cmd, reproduce_cmd)
-    for module in (*commands, run_cmd, rsf_cmd, compare_cmd, sweep_cmd, stability_cmd):
-        module.register(cli)
+#: Longest error line printed (a message quoting a huge value is cut).
+MAX_MESSAGE_LENGTH = 600
 
 
-_register()
+#: Each command's module (it registers the commands it defines): a command's module is imported only when that
+#: command runs, or when the help lists them all, so that ``stickslip transient`` does not load ``analyze``'s
+#: tables, ``rsf``'s options and the rest (issue 31: ~60 ms of its start-up).
+COMMAND_MODULES = {
+    "params": "params_cmd",
+    "curve": "steady_cmd",
+    "critical": "steady_cmd",
+    "simulate": "cycle_cmd",
+    "stick": "cycle_cmd",
+    "transient": "transient_cmd",
+    "fit": "fit_cmd",
+    "analyze": "analyze_cmd",
+    "reproduce": "reproduce_cmd",
+    "run": "run_cmd",
+    "rsf": "rsf_cmd",
+    "compare": "compare_cmd",
+    "sweep": "sweep_cmd",
+    "stability": "stability_cmd",
+}
+
+
+class _CommandTable(dict[str, click.Command]):
+    """The group's ``commands``, filled on demand: looking up a name imports the module of that command; looking at
+    them all (iterating, ``items()``, ``len()``: the help, click's "did you mean") imports every one."""
+
+    def __init__(self, group: click.Group) -> None:
+        super().__init__()
+        self._group = group
+
+    def _load(self, names: Any) -> None:
+        missing = [n for n in names if isinstance(n, str) and n in COMMAND_MODULES and not dict.__contains__(self, n)]
+        for module in dict.fromkeys(COMMAND_MODULES[name] for name in missing):
+            import_module(f"{__package__}.{module}").register(self._group)
+
+    def get(self, name: str, default: Any = None) -> Any:
+        self._load([name])
+        return super().get(name, default)
+
+    def __getitem__(self, name: str) -> click.Command:
+        self._load([name])
+        return super().__getitem__(name)
+
+    def __contains__(self, name: object) -> bool:
+        self._load([name])
+        return super().__contains__(name)
+
+    def __iter__(self) -> Iterator[str]:
+        self._load(COMMAND_MODULES)
+        return super().__iter__()
+
+    def __len__(self) -> int:
+        self._load(COMMAND_MODULES)
+        return super().__len__()
+
+    def __repr__(self) -> str:
+        self._load(COMMAND_MODULES)
+        return super().__repr__()
+
+    def keys(self) -> Any:
+        self._load(COMMAND_MODULES)
+        return super().keys()
+
+    def values(self) -> Any:
+        self._load(COMMAND_MODULES)
+        return super().values()
+
+    def items(self) -> Any:
+        self._load(COMMAND_MODULES)
+        return super().items()
+
+    def copy(self) -> dict[str, click.Command]:
+        return dict(self.items())
+
+
+class _Commands(click.Group):
+    """A group whose commands are imported on first use (:data:`COMMAND_MODULES`, :class:`_CommandTable`)."""
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        table = _CommandTable(self)
+        table.update(self.commands)
+        self.commands = table
+
+
+@click.group(cls=_Commands, context_settings={"help_option_names": ["-h", "--help"]})
+@click.version_option(version=__version__, prog_name="stickslip")
+def cli() -> None:
+    """Friction and stick-slip of soft solids: the bond-population model of Juvekar & Singh.
+
+    Values carry units: --v0 "50 um/s", --set bonds.bond_time="224 us".
+    """
 
 
 def _one_line(text: str) -> str:
@@ -168,6 +247,7 @@ def _silence_stdout() -> None:
 
 def main(argv: list[str] | None = None) -> None:
     """Console entry point."""
+    skip_blas_probe()  # numba's, ~0.25 s of a transient run: see numba_start
     caught: list[tuple[type[Warning], str]] = []
 
     def collect(message: Any, category: type[Warning], *args: Any, **kwargs: Any) -> None:

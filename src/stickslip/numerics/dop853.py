@@ -27,9 +27,9 @@ from dataclasses import dataclass
 from operator import mul
 
 import numpy as np
-from scipy.optimize import brentq
 
 from ..errors import ModelError
+from .roots import brentq  # scipy's Brent bit for bit (tests/test_roots.py), without scipy.optimize
 
 _C = [
     0.0,

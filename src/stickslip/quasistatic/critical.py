@@ -91,10 +91,13 @@ def _significant_signs(stress: np.ndarray, log_slope: np.ndarray) -> np.ndarray:
     return sign
 
 
+@lru_cache(maxsize=128)
 def _refine(params: Parameters, aging: bool, lo: float, hi: float) -> tuple[float, float]:
     """(ln V, sigma) at the zero of V dsigma/dV between ln V = lo and hi (Brent), or at the better end if the signs
     disagree.  Each point is evaluated once: Brent asks for the ends again, and the root it returns is one of its
-    points (a third of the scalar steady states of a search saved, the same numbers)."""
+    points (a third of the scalar steady states of a search saved, the same numbers).  Remembered, as
+    :func:`_grid_signs`: the whole point after Vc alone (:func:`critical_minimum`, what a transient run asks first)
+    refines the minimum once."""
     seen: dict[float, tuple[float, float]] = {}
 
     def at(log_v: float) -> tuple[float, float]:
@@ -138,11 +141,7 @@ def _extrema(
     """The verified extrema of :func:`find_extrema` of the ``kinds`` asked for, lowest velocity first, each
     refined only when asked for (a bracket refined costs ~10 scalar steady states, the grid one call)."""
     require_parameters(params)
-    lo, hi = search_range
-    n = int(np.ceil(np.log10(hi / lo) * POINTS_PER_DECADE)) + 1
-    grid = np.geomspace(lo, hi, n)
-    stress, log_slope = _curve(params, grid, aging)
-    sign = _significant_signs(stress, log_slope)
+    grid, stress, sign = _grid_signs(params, aging, *search_range)
     clear = np.nonzero(sign)[0]
     changes = [(a, b) for a, b in pairwise(clear) if sign[a] != sign[b]]
     for a, b in changes[:MAX_EXTREMA]:
@@ -153,6 +152,18 @@ def _extrema(
         depth = (min(stress[a], stress[b]) - s) if kind == "minimum" else (s - max(stress[a], stress[b]))
         if depth > NOISE * abs(s):
             yield Extremum(math.exp(log_v), s, kind)
+
+
+@lru_cache(maxsize=32)
+def _grid_signs(params: Parameters, aging: bool, lo: float, hi: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(grid, sigma, significant sign of the slope) of :func:`_extrema`'s search grid, read-only (remembered)."""
+    n = int(np.ceil(np.log10(hi / lo) * POINTS_PER_DECADE)) + 1
+    grid = np.geomspace(lo, hi, n)
+    stress, log_slope = _curve(params, grid, aging)
+    found = grid, stress, _significant_signs(stress, log_slope)
+    for array in found:
+        array.setflags(write=False)
+    return found
 
 
 def _no_minimum_message(params: Parameters, extrema: tuple[Extremum, ...]) -> str:

@@ -22,13 +22,15 @@ from ..parameters import Parameters
 from ..reprs import compact_repr, field_values
 from ..trace_columns import QUASI_STATIC
 from .jump import Jump, check_curve, jump_velocity, require_critical_point
-from .slip import SlipPhase, slip_phase
 from .steady import require_parameters
-from .stick import StickPhase, _number, check_stress, check_velocity, stick_phase
 
 if TYPE_CHECKING:  # pragma: no cover
     import pandas as pd
     from matplotlib.axes import Axes
+
+    # the phases are imported where they are solved: Cycle alone (what a transient run's result needs) loads neither
+    from .slip import SlipPhase
+    from .stick import StickPhase
 
 #: Trace columns, in order (SI units: s, Pa, m/s, m, m, m, Nc/Nc0, phase name).
 CYCLE_COLUMNS = QUASI_STATIC
@@ -207,6 +209,9 @@ class _Phases:
         return self.cycles[sigma]
 
     def _solve(self, sigma: float) -> _Cycle:
+        from .slip import slip_phase
+        from .stick import stick_phase
+
         stick = stick_phase(self.params, self.v0, sigma, horizon=self.horizon)
         if stick.status != "slipped":
             return _Cycle(stick, None, None, regimes.STUCK if stick.stuck else regimes.UNDETERMINED, stick.message)
@@ -257,6 +262,8 @@ def simulate(
     shown to end nor to last for ever, or the cycle degenerates); ``message``
     says which and why.  Runs longer than MAX_CYCLES periods are refused.
     """
+    from .stick import _number, check_stress, check_velocity
+
     require_parameters(params)
     v0 = check_velocity(pulling_velocity)
     end = _number(duration, "duration", "s")

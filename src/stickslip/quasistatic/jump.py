@@ -14,11 +14,11 @@ from dataclasses import dataclass
 from functools import lru_cache
 
 import numpy as np
-import scipy.fft
 from numpy.polynomial import chebyshev as cheb
-from scipy.optimize import brentq
 
 from ..errors import ModelError, ParameterError
+from ..numerics.roots import brentq  # scipy's Brent bit for bit (tests/test_roots.py), without scipy.optimize
+from ..numerics.transforms import dct1  # scipy.fft's, bit for bit, without its ~0.3 s import
 from ..parameters import Parameters
 from ..reprs import field_values
 from .critical import CriticalPoint, cached_critical_point, steady_curve_key
@@ -45,7 +45,7 @@ def chebyshev_points(n: int) -> np.ndarray:
 def chebyshev_coefficients(values: np.ndarray) -> np.ndarray:
     """Chebyshev coefficients of the interpolant through values at :func:`chebyshev_points` (last axis)."""
     n = values.shape[-1] - 1
-    c = scipy.fft.dct(values, type=1, axis=-1) / n
+    c = dct1(values) / n
     c[..., 0] /= 2.0
     c[..., -1] /= 2.0
     return c

@@ -16,11 +16,11 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.polynomial import Chebyshev
 from numpy.polynomial import chebyshev as cheb
-from scipy.optimize import brentq
-from scipy.special import exprel
 
 from ..columns import attribute_frame
 from ..errors import ModelError, ParameterError
+from ..numerics.roots import brentq  # scipy's Brent bit for bit (tests/test_roots.py), without scipy.optimize
+from ..numerics.transforms import exprel  # scipy.special's, bit for bit, without its import
 from ..parameters import Parameters
 from ..reprs import compact_repr
 from .jump import (

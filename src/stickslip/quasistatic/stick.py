@@ -15,10 +15,10 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from scipy.optimize import brentq
 
 from ..columns import attribute_frame
 from ..errors import ModelError, ParameterError
+from ..numerics.roots import brentq  # scipy's Brent bit for bit (tests/test_roots.py), without scipy.optimize
 from ..parameters import Parameters, require_flag
 from ..reprs import compact_repr, field_values
 from .jump import require_critical_point

@@ -1123,16 +1123,18 @@ def _steady_start_below_vc(
     params: Parameters, protocol: Protocol, start_velocity: float | None
 ) -> tuple[float | None, str]:
     """(start velocity, note): below Vc the default steady start moves to the stable side of the critical point."""
-    from ..quasistatic.jump import cached_critical_point, steady_curve_key
+    from ..quasistatic.critical import critical_minimum
 
     v_start = protocol.initial_velocity if start_velocity is None else start_velocity
     if not v_start > 0:
         return start_velocity, ""
     try:
-        cp = cached_critical_point(steady_curve_key(params))  # once per steady curve (the jump asks for it too)
+        # Vc and sigma_c alone, once per steady curve: half the search of the whole point (issue 31), which a
+        # jump later completes without solving them again (quasistatic.critical remembers the search's parts)
+        cp = critical_minimum(params)
     except (ModelError, ParameterError):
         return start_velocity, ""
-    if not cp.exists or cp.velocity is None or v_start >= cp.velocity:
+    if cp is None or v_start >= cp.velocity:
         return start_velocity, ""
     if start_velocity is not None:
         return start_velocity, (
@@ -1528,13 +1530,13 @@ def _reduced_from(params: Parameters, control: str, aging: bool) -> float:
     """The slowest puller velocity whose pieces the quasi-steady reduction takes (0: all; inf: none)."""
     if control != "block" or not aging:  # a rigid rig holds V; without aging the steady curve has no fold
         return 0.0
-    from ..quasistatic.jump import cached_critical_point, steady_curve_key
+    from ..quasistatic.critical import critical_minimum
 
     try:
-        cp = cached_critical_point(steady_curve_key(params))
+        cp = critical_minimum(params)  # Vc alone (as _steady_start_below_vc)
     except (ModelError, ParameterError):
         return math.inf  # no critical point to be found: count the cohorts throughout
-    if not cp.exists or cp.velocity is None:
+    if cp is None:
         return 0.0
     return FOLD_MARGIN * float(cp.velocity)
 
