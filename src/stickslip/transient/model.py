@@ -244,8 +244,6 @@ def stick_chains(
     ln(Nc/Nc0) is integrated (LSODA, rtol 1e-10) until the per-chain rate exceeds
     e^60 per second: the remaining chains then go in less than e^-60 s.
     """
-    from scipy.integrate import solve_ivp
-
     st = params.stick
     c = params.bonds.force_sensitivity / st.attached_chains
     inv_age = 1.0 / st.aging_time if aging else 0.0
@@ -268,6 +266,8 @@ def stick_chains(
         return StickChains(0.0, fraction, True, np.array([0.0]), np.array([fraction]))
     if elapsed == 0.0 and fraction == 1.0 and loading_rate > 0.0:
         return _fresh_chains(params, aging, stress0, loading_rate, span)
+    from scipy.integrate import solve_ivp  # here: fresh chains (the cycle's sticks) need no scipy.integrate (~0.4 s)
+
     try:
         sol = solve_ivp(rhs, (0.0, span), [y0], method="LSODA", rtol=1e-10, atol=1e-12, events=collapse)
     except ValueError:  # event bracketing lost in the explosive collapse: step without events
