@@ -332,7 +332,16 @@ def test_the_light_commands_import_no_heavy_library():
 TRANSIENT_HEAVY = (*HEAVY, "scipy.fft", "scipy.linalg", "scipy.interpolate", "scipy.sparse")
 
 
-def test_a_short_transient_run_imports_no_heavy_library():
+@pytest.mark.parametrize(
+    ("extra", "regime"),
+    [
+        (["--duration", "0.05 s"], "regime: steady"),
+        # the cycle: glides (transient/glide.py, compiled), fresh stick chains (Eq 15), the jump
+        (["--duration", "5 s", "--segment", "100 um/s:20 s"], "regime: stick-slip"),
+    ],
+    ids=["short", "one-cycle"],
+)
+def test_a_short_transient_run_imports_no_heavy_library(extra: list[str], regime: str) -> None:
     code = (
         "import sys\n"
         "from stickslip.cli.main import main\n"
@@ -343,13 +352,13 @@ def test_a_short_transient_run_imports_no_heavy_library():
         f"print('HEAVY', [m for m in {TRANSIENT_HEAVY!r} if m in sys.modules])\n"
         "print('COMMANDS', sorted(m for m in sys.modules if m.startswith('stickslip.cli.') and m.endswith('_cmd')))\n"
     )
-    argv = ["transient", "--start", "steady", "--stick-population", "--v0", "350 um/s", "--duration", "0.05 s"]
+    argv = ["transient", "--start", "steady", "--stick-population", "--v0", "350 um/s", *extra]
     env = {**os.environ, "PYTHONPATH": str(SRC)}
     done = subprocess.run(  # a first run in a fresh checkout compiles the kernels into numba's cache (~20 s)
         [sys.executable, "-c", code, *argv], capture_output=True, text=True, timeout=600, env=env, check=False
     )
     assert done.returncode == 0, done.stderr
-    assert "regime: steady" in done.stdout  # the run ran, not just its imports
+    assert regime in done.stdout  # the run ran, not just its imports
     *_, heavy, commands = done.stdout.strip().splitlines()
     assert heavy == "HEAVY []", done.stdout[-300:]
     # the command's own module and those it builds on (run's options and output), not every other command's
