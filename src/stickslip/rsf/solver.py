@@ -20,6 +20,7 @@ import numpy as np
 from ..errors import ModelError, ParameterError
 from ..protocols import Protocol
 from ..units import shorten, to_si
+from .laws import cexp as _exp
 from .params import RSFParams
 from .results import RSFRun, Solution, assemble_run
 from .stability import jacobian_at
@@ -81,14 +82,18 @@ def simulate(
             + (" (the first segment holds; give --start-velocity)" if start_velocity is None else "")
         )
     system = System(params)
+    # the solver also carries q = integral of mu dt (a last unknown that feeds nothing back): the run's mean
+    # friction is q(T)/T from the solver's own steps, whatever the output sampling
+    carried = WithIntegral(system)
     grid = _grid(protocol, every, times)
     v_cap = BLOW_UP_FACTOR * max(float(np.max(protocol.velocities)), v_start)
     x_cap = _blow_up_level(params, max(float(np.max(protocol.velocities)), v_start))
-    y = system.steady_y(v_start)
+    y = np.r_[system.steady_y(v_start), 0.0]
     # Where a quasi-static slider may run away, odeint could step over the run-away between samples:
     # sample from the adaptive solver's interpolant instead, which watches every step.
     watch = grid is not None and params.eta == 0 and params.mass == 0 and _unstable_somewhere(params, protocol)
     t_parts, y_parts = [np.array([0.0])], [y[:, None]]
+    integral, reached = 0.0, 0.0
     status, message = "ok", ""
     last: Solution | None = None
     last_piece = len(protocol.segments) - 1
@@ -96,25 +101,28 @@ def simulate(
         _check_clock(params, max(vlp, v_start if t0 == 0 else 0.0), t1)
         short = None
         try:
-            short = _short_piece(system, y, t0, t1, vlp, grid)
+            short = _short_piece(carried, y, t0, t1, vlp, grid)
             if short is not None:
                 t_out, y_out, y_end, blown = short
             elif grid is None:
-                t_out, y_out, y_end, blown, _ = _adaptive_piece(system, y, t0, t1, vlp, x_cap, rtol, atol)
+                t_out, y_out, y_end, blown, _ = _adaptive_piece(carried, y, t0, t1, vlp, x_cap, rtol, atol)
                 t_steps, y_steps = t_out, y_out
             else:
                 inside = grid[(grid > t0) & (grid <= t1)]
-                t_out, y_out, y_end, blown = _sampled_piece(system, y, t0, t1, vlp, inside, x_cap, rtol, atol, watch)
+                t_out, y_out, y_end, blown = _sampled_piece(carried, y, t0, t1, vlp, inside, x_cap, rtol, atol,
+                                                            watch)  # fmt: skip
                 if detect and index == last_piece and blown is None:
                     # the regime is read off every accepted step of the last segment, whatever the sampling
-                    t_steps, y_steps, _, _, _ = _adaptive_piece(system, y, t0, t1, vlp, x_cap, rtol, atol)
+                    t_steps, y_steps, _, _, _ = _adaptive_piece(system, y[:-1], t0, t1, vlp, x_cap, rtol, atol)
+                    y_steps = np.r_[y_steps, np.zeros((1, y_steps.shape[1]))]  # (q is not read there)
         except (ZeroDivisionError, OverflowError) as exc:  # e.g. m V / sigma underflowing to 0 in dV/dt
             raise ModelError(_out_of_range(system, t0, t1, exc)) from None
         if detect and index == last_piece and blown is None and short is None:  # a one-step piece has no steps
-            steps_t, steps_y = np.r_[t0, t_steps], np.c_[y, y_steps]
+            steps_t, steps_y = np.r_[t0, t_steps], np.c_[y, y_steps][:-1]
             last = Solution(t0, steps_t, steps_y, _interpolant(system, vlp, steps_t, steps_y, rtol, atol))
         t_parts.append(t_out)
         y_parts.append(y_out)
+        integral, reached = float(y_end[-1]), (t1 if blown is None else blown)
         if blown is not None:
             status = "blow-up"
             message = (
@@ -126,8 +134,64 @@ def simulate(
         y = y_end
     t_all = np.concatenate(t_parts)
     y_all = np.concatenate(y_parts, axis=1)
-    run = assemble_run(system, protocol, t_all, y_all, status, message, v_start, detect, last, rtol)
+    run = assemble_run(system, protocol, t_all, y_all[:-1], status, message, v_start, detect, last, rtol)
+    run = replace(run, run_mean_friction=integral / reached if reached > 0 else float(run.friction[-1]))
     return _requested(run, grid) if times is not None else run
+
+
+class WithIntegral:
+    """The equations of ``system`` with one more unknown last, q = integral of mu dt (dq/dt = mu), which no
+    other equation reads; every other attribute is the system's."""
+
+    def __init__(self, system: System) -> None:
+        self.system = system
+        self.size = system.size + 1
+        o = system.offset
+        self._x, self._psi = o, slice(o + 1, o + 1 + system.n)
+        # the common case (System._rhs_classical's equations, mu inline): the wrapper's cost is per evaluation
+        fast = system.rhs == system._rhs_classical
+        self.rhs = self._rhs_classical if fast else self._rhs
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self.system, name)
+
+    def _rhs(self, t: float, y: np.ndarray, vlp: float) -> list[float]:
+        inner = y[:-1]
+        return [*self.system.rhs(t, inner, vlp), self.system.friction(float(inner[self._x]), inner[self._psi])]
+
+    def _rhs_classical(self, t: float, y: np.ndarray, vlp: float) -> list[float]:
+        s = self.system
+        x, *psi = y.tolist()
+        psi.pop()  # q
+        v0 = s.v0
+        out = [0.0]
+        G = 0.0
+        mu = s.mu0 + s.a * x
+        for (rate, b, dc), p in zip(s._terms, psi):  # noqa: B905  (lengths match by construction)
+            g = rate(x, p, v0, dc)[0]
+            out.append(g)
+            G += b * g
+            mu += b * p
+        v = v0 * _exp(x)
+        out[0] = (s.k * (vlp - v) - G) / (s.a + s.eta * v)
+        out.append(mu)
+        return out
+
+    def jacobian(self, t: float, y: np.ndarray, vlp: float) -> np.ndarray:
+        """The system's Jacobian bordered by dmu/dy (analytic: the classical and cut-off forms have one)."""
+        s = self.system
+        inner = y[:-1]
+        jac = np.zeros((self.size, self.size))
+        jac[:-1, :-1] = s.jacobian(t, inner, vlp)
+        x = float(inner[self._x])
+        psi = inner[self._psi].tolist()
+        if s.cutoff is not None:
+            jac[-1, self._x] = s.cutoff.direct(s.a, x)[0]
+            jac[-1, self._psi] = [s.cutoff.evolution(b, p)[0] for b, p in zip(s.b, psi, strict=True)]
+        else:
+            jac[-1, self._x] = s.a
+            jac[-1, self._psi] = s.b
+        return jac
 
 
 def _requested(run: RSFRun, grid: np.ndarray) -> RSFRun:
