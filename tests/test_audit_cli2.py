@@ -132,3 +132,27 @@ def test_exact_stick_times_flag_no_outlier_off_by_a_factor_1(cycles_tables):
 
     fit = fit_stick(cycles_tables[0])
     assert not [m for m in fit.messages if "outlier" in m], fit.messages
+
+
+def test_the_python_reader_takes_the_cycles_table_as_fit_stick_does(cycles_tables, tmp_path):
+    """stickslip.read_stick_data refused the cycles table of analyze -o (unknown column 'complete') that `fit
+    stick` read: one reader serves both.  The chain run -> analyze -o -> read_stick_data -> fit_stick recovers the
+    run's own stick parameters (gelatin-glass: Nc0 = 2.07e12 /m^2, stick aging time 10 s)."""
+    import numpy as np
+
+    import stickslip
+    from stickslip.fitting.stick_fit import fit_stick
+
+    lines = cycles_tables[0].read_text().splitlines() + cycles_tables[1].read_text().splitlines()[1:]
+    both = tmp_path / "both.csv"
+    both.write_text("\n".join(lines) + "\n")
+    data = stickslip.read_stick_data(both)
+    assert sorted(set(data.pulling_velocity)) == [pytest.approx(50e-6, rel=1e-12), pytest.approx(100e-6, rel=1e-12)]
+    assert np.all(np.isfinite(data.stick_time)) and np.all(np.isfinite(data.start_stress))
+    assert any("left out: cycles cut by the record's ends" in note for note in data.notes())
+    fit = fit_stick(data)
+    assert fit.status == "ok"
+    fitted = {e.key: e.value for e in fit.estimates}
+    assert fitted["stick.attached_chains"] == pytest.approx(2.07e12, rel=1e-3)
+    assert fitted["stick.aging_time"] == pytest.approx(10.0, rel=1e-3)
+    assert any("critical_stress" in m for m in fit.messages)  # the reader's notes reach the fit's

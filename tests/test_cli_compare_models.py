@@ -156,3 +156,27 @@ def test_settings_and_starts_no_model_takes_are_refused_in_one_line(capsys, argv
 def test_the_classic_compare_refuses_the_run_words(capsys):
     code, _, err = run_main(capsys, "compare", "--setting", "stick_population=true")
     assert code == 2 and "--setting" in err and err.count("\n") == 1, err
+
+
+def test_each_model_names_the_spring_it_pulls_through_in_its_own_unit(capsys):
+    """compare --models --json gave rig.stiffness null for every model whose spring came from its parameters, and
+    one units map for all models, where the bond model's K is Pa/m and rate-and-state's k is 1/m.  Each model's rig
+    and units are checked against the parameters themselves and against its own `stickslip run --json`."""
+    from stickslip.models import get_model
+
+    words = ["--v0", "50 um/s", "--duration", "5 s"]
+    both = ok_json(capsys, "compare", "--models", "quasi-static,rsf", *words)
+    quasi, rsf = both["models"]["quasi-static"], both["models"]["rsf"]
+    own_k = load_parameters("gelatin-glass").block.effective_stiffness
+    assert quasi["rig"]["stiffness"] == pytest.approx(own_k, rel=1e-12) and quasi["units"]["stiffness"] == "Pa/m"
+    assert rsf["rig"]["stiffness"] == pytest.approx(get_model("rsf").parameters(None, {}).stiffness, rel=1e-12)
+    assert rsf["units"]["stiffness"] == "1/m" and rsf["rig"]["stiffness_from"] == "parameters"
+    for name, row in both["models"].items():
+        alone = ok_json(capsys, "run", "--model", name, *words)
+        assert row["rig"] == alone["rig"] and row["units"]["stiffness"] == alone["units"]["stiffness"]
+    # springs in two units: none at the top, which says where they are
+    assert both["rig"] == {"control": "spring", "stiffness": None, "stiffness_from": "each model"}
+    # one spring given to both bond models: it is the top-level one too
+    given = ok_json(capsys, "compare", "--models", "quasi-static,transient", *words, "--stiffness", "400 kPa/m")
+    assert given["rig"] == {"control": "spring", "stiffness": 4e5} and given["units"]["stiffness"] == "Pa/m"
+    assert all(row["rig"]["stiffness"] == 4e5 for row in given["models"].values())

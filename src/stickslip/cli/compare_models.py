@@ -14,12 +14,13 @@ from typing import Any
 
 import click
 
+from ..columns import json_units
 from ..errors import ModelError, ParameterError
 from ..progress import progress
 from ..units import shorten
 from .common import check_output, check_unit, emit_json, key_value, refuse_overwriting_inputs, save_figure
 from .protocol_options import build_protocol, build_rig
-from .run_cmd import in_run_words, model_parameters, run_summary, settings_of, start_value
+from .run_cmd import in_run_words, model_parameters, rig_record, run_summary, settings_of, start_value, summary_units
 
 #: Exit status when a model's run failed (status "failed"); 2 is bad input.
 FAILED = 3
@@ -110,12 +111,12 @@ def compare_models(options: dict[str, Any]) -> None:
     rig, own_spring = build_rig(options["control"], options["stiffness_text"], models)
     settings = routed_settings(models, options.get("setting_texts", ()), options.get("every_text"))
     starts = routed_starts(models, options.get("start_texts", ()))
-    for model in models:  # what a model cannot run is refused before any model runs
-        model.check(protocol, rig, settings[model.name])
+    # what a model cannot run is refused before any model runs; the checked rig is the one each spring is read from
+    checked = {model.name: model.check(protocol, rig, settings[model.name]) for model in models}
     routed = routed_overrides(models, options["overrides"])
     for name, text in own_spring.items():
         routed[name]["k"] = text
-    runs = {}
+    runs, springs = {}, {}
     # one stage per model: a bar on a terminal, nothing in a pipe or with --json
     with progress("compare", total=len(models), unit="models", enabled=False if options["as_json"] else None) as bar:
         for model in models:
@@ -123,20 +124,26 @@ def compare_models(options: dict[str, Any]) -> None:
                 params = model_parameters(model, params_name, routed[model.name])
                 runs[model.name] = model.run(params, protocol, rig, start=starts.get(model.name),
                                              **settings[model.name])  # fmt: skip
+                springs[model.name] = model.spring(params, checked[model.name])
             except (ParameterError, ModelError) as exc:
                 said = in_run_words(str(exc), f"--start {model.name}=")
                 raise type(exc)(f"model {model.name}: {said}") from None
             bar.advance(note=model.name)
-    summaries = {name: run_summary(run, protocol, rig) for name, run in runs.items()}
+    summaries = {name: run_summary(run, protocol, rig, springs[name]) for name, run in runs.items()}
     for model in models:  # models that start differently do not settle alike: each row says where it began
         summaries[model.name]["start"] = model.describe_start(starts.get(model.name), protocol, settings[model.name])
         summaries[model.name]["settings"] = settings[model.name]
+        # each model's own units map, as its `run --json` has: a spring is Pa/m in one model, 1/m in another
+        summaries[model.name]["units"] = summary_units(summaries[model.name], springs[model.name])
     document = {
         "protocol": [{"velocity": s.velocity, "duration": s.duration} for s in protocol.segments],
-        "rig": {"control": rig.control, "stiffness": rig.stiffness},
+        "rig": shared_rig(rig, list(springs.values())),
         "models": summaries,
         "status": "ok" if all(r.status == "ok" for r in runs.values()) else "failed",
     }
+    # the top-level map names the top-level numbers only: one map over every model would give one unit to a key
+    # that is Pa/m in one model and 1/m in another
+    document["units"] = json_units({k: v for k, v in document.items() if k != "models"})
     if options["as_json"]:
         emit_json(document)
     else:
@@ -151,6 +158,18 @@ def compare_models(options: dict[str, Any]) -> None:
     if failed:
         click.echo(f"stickslip: the run of {failed[0]} failed: {runs[failed[0]].message}", err=True)
         raise SystemExit(FAILED)
+
+
+def shared_rig(rig: Any, springs: list[tuple[float, str, str] | None]) -> dict[str, Any]:
+    """The top-level rig: the spring every model pulls through where they share one (value and unit), else the
+    rig as given; its stiffness null with ``stiffness_from`` "each model" where the models pull through springs
+    of their own (each in its ``rig``, in its unit)."""
+    if springs and all(s is not None and s[:2] == springs[0][:2] for s in springs):
+        return rig_record(rig, springs[0])
+    record = rig_record(rig)
+    if record["stiffness"] is None and any(s is not None for s in springs):
+        record["stiffness_from"] = "each model"
+    return record
 
 
 def _refuse_classic_options(ctx: click.Context) -> None:

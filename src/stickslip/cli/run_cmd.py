@@ -195,7 +195,7 @@ def run_summary(run: Any, protocol: Any, rig: Any, spring: tuple[float, str, str
         "status": run.status,
         "message": run.message,
         "protocol": [{"velocity": s.velocity, "duration": s.duration} for s in protocol.segments],
-        "rig": _rig_record(rig, spring),
+        "rig": rig_record(rig, spring),
         "regime": run.regime_name,
         "oscillates": r.kind in OSCILLATING,
         "evidence": r.evidence,
@@ -241,7 +241,9 @@ def summary_units(summary: dict[str, Any], spring: tuple[float, str, str] | None
     return json_units(summary, extra)
 
 
-def _rig_record(rig: Any, spring: tuple[float, str, str] | None = None) -> dict[str, Any]:
+def rig_record(rig: Any, spring: tuple[float, str, str] | None = None) -> dict[str, Any]:
+    """The summary's ``rig``: control, the stiffness of ``spring`` (``model.spring``; else the rig's as given) and,
+    where it is not the rig's as given, ``stiffness_from``; the block's mass and damping where it has them."""
     record: dict[str, Any] = {"control": rig.control, "stiffness": rig.stiffness}
     if spring is not None:  # the stiffness used; "stiffness_from" unless it is the rig's as given
         record["stiffness"] = spring[0]

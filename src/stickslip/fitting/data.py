@@ -54,6 +54,15 @@ STICK_COLUMNS = {
 STICK_OPTIONAL_CELLS = ("peak_stress", "start_stress", "cycle", "stick_slope", "stiffness", "jump_velocity")
 
 
+#: Columns of ``stickslip analyze -o`` (its cycles table) that a stick fit reads, and what it reads them as.
+CYCLES_COLUMNS = {"critical_stress": "start_stress"}
+#: Columns of that table the stick fit does not use (times within the record, errors, the slip, the model's Vs).
+CYCLES_IGNORED = (
+    "complete", "start_time", "peak_time", "end_time", "stick_slope_stderr", "stiffness_stderr",
+    "model_jump_velocity", "slip_time", "period", "stress_drop",
+)  # fmt: skip
+
+
 @dataclass(frozen=True)
 class SteadyData:
     """A measured steady friction curve, SI units, in file order."""
@@ -113,9 +122,14 @@ class StickData:
     rows: np.ndarray
     extra: dict[str, np.ndarray]
     source: str = "table"
+    read_notes: tuple[str, ...] = ()
 
     def __len__(self) -> int:
         return int(self.pulling_velocity.size)
+
+    def notes(self) -> list[str]:
+        """What the reader read otherwise than as written, or left out (a cycles table's rows), one line each."""
+        return list(self.read_notes)
 
     @classmethod
     def from_arrays(
@@ -178,11 +192,58 @@ def read_steady_data(path: str | Path) -> SteadyData:
 
 
 def read_stick_data(path: str | Path) -> StickData:
-    """Read and validate a stick table (pulling_velocity, stick_time, optional peak_stress, start_stress)."""
-    table = read_table(
-        path, STICK_COLUMNS, required=["pulling_velocity", "stick_time"], allow_missing=STICK_OPTIONAL_CELLS
-    )
+    """Read and validate a stick table: Table 1's columns (pulling_velocity, stick_time, optional peak_stress,
+    start_stress), or the cycles table of ``stickslip analyze -o`` (its ``critical_stress`` is the start stress;
+    cycles cut by the record's ends, without a stick time, are left out; :meth:`StickData.notes` says so).  The one
+    reader of ``fit stick`` and of the Python API."""
+    # Table 1's reader first: it reads the file once (a pipe too); a cycles table fails it at its header
+    try:
+        table = read_table(
+            path, STICK_COLUMNS, required=["pulling_velocity", "stick_time"], allow_missing=STICK_OPTIONAL_CELLS
+        )
+    except DataError:
+        names = _header_names(path)
+        if not {"critical_stress", "complete"} <= set(names):
+            raise
+        return _read_cycles_table(path, names)
     return _validated_stick(table)
+
+
+def _header_names(path: str | Path) -> list[str]:
+    """Column names of a CSV's header (its first line that is no comment); [] if it cannot be read."""
+    from ..columns import split_header
+
+    try:
+        with open(path, encoding="utf-8", errors="replace") as handle:
+            for line in handle:
+                if line.strip() and not line.lstrip().startswith("#"):
+                    return [split_header(cell, parentheses=True)[0] for cell in line.strip().split(",")]
+    except OSError:
+        pass
+    return []
+
+
+def _read_cycles_table(path: str | Path, names: Sequence[str]) -> StickData:
+    """The cycles table of ``stickslip analyze -o`` as stick data, with notes on what was read so."""
+    source = str(path)
+    if "pulling_velocity" not in names:
+        raise DataError(
+            f"{source}: a cycles table of stickslip analyze without a pulling_velocity column (written before it"
+            " had one): analyze the trace again, or add a column 'pulling_velocity [m/s]' holding its --v0"
+        )
+    dimensions = {n: d for n, d in STICK_COLUMNS.items() if n in names and n not in ("start_stress", "jump_velocity")}
+    dimensions["critical_stress"] = "stress"
+    allowed = tuple(n for n in dimensions if n != "pulling_velocity")
+    table = read_table(path, dimensions, required=["pulling_velocity", "stick_time"], allow_missing=allowed,
+                       ignore=CYCLES_IGNORED)  # fmt: skip
+    whole = np.isfinite(table["stick_time"])
+    columns = {CYCLES_COLUMNS.get(n, n): v[whole] for n, v in table.columns.items()}
+    notes = [f"{source}: the cycles table of stickslip analyze; its critical_stress (σc) is each row's start_stress"]
+    if not whole.all():
+        cut = ", ".join(str(r) for r in table.rows[~whole])
+        notes.append(f"{source}: row(s) {cut} left out: cycles cut by the record's ends (no stick time)")
+    data = _validated_stick(Table(source, columns, table.rows[whole]))
+    return dataclasses.replace(data, read_notes=tuple(notes))
 
 
 def _as_column(values: Any, name: str, source: str, allow_nan: bool = False) -> np.ndarray:

@@ -24,7 +24,7 @@ from ..parameters import Parameters, key_dimension, load_parameters, replace
 from ..quasistatic.critical import critical_point
 from ..units import to_si
 from . import identify
-from .data import STICK_COLUMNS, StickData, _validated_stick, read_stick_data
+from .data import StickData, read_stick_data
 from .problem import JACOBIAN_STEP, SEARCH_BOX
 from .results import Estimate, human, log_interval, unusable
 from .stick_batch import stick_times
@@ -305,63 +305,11 @@ def _select_rows(
     return used, excluded, (point.stress if point.exists else None), messages
 
 
-#: Columns of ``stickslip analyze -o`` (its cycles table) that a stick fit reads, and what it reads them as.
-CYCLES_COLUMNS = {"critical_stress": "start_stress"}
-#: Columns of that table the stick fit does not use (times within the record, errors, the slip, the model's Vs).
-CYCLES_IGNORED = (
-    "complete", "start_time", "peak_time", "end_time", "stick_slope_stderr", "stiffness_stderr",
-    "model_jump_velocity", "slip_time", "period", "stress_drop",
-)  # fmt: skip
-
-
 def read_stick_table(path: str | Path) -> tuple[StickData, list[str]]:
-    """A stick table: Table 1's columns (:func:`~stickslip.fitting.data.read_stick_data`), or the cycles table of
-    ``stickslip analyze -o`` (its ``critical_stress`` is the start stress; cycles cut by the record's ends, without
-    a stick time, are left out), with notes on what was read so."""
-    try:
-        return read_stick_data(path), []
-    except DataError:
-        names = _header_names(path)
-        if not {"critical_stress", "complete"} <= set(names):
-            raise
-    return _read_cycles_table(path, names)
-
-
-def _header_names(path: str | Path) -> list[str]:
-    """Column names of a CSV's header (its first line that is no comment); [] if it cannot be read."""
-    from ..columns import split_header
-
-    try:
-        with open(path, encoding="utf-8", errors="replace") as handle:
-            for line in handle:
-                if line.strip() and not line.lstrip().startswith("#"):
-                    return [split_header(cell, parentheses=True)[0] for cell in line.strip().split(",")]
-    except OSError:
-        pass
-    return []
-
-
-def _read_cycles_table(path: str | Path, names: Sequence[str]) -> tuple[StickData, list[str]]:
-    from ..tables import Table, read_table
-
-    source = str(path)
-    if "pulling_velocity" not in names:
-        raise DataError(
-            f"{source}: a cycles table of stickslip analyze without a pulling_velocity column (written before it"
-            " had one): analyze the trace again, or add a column 'pulling_velocity [m/s]' holding its --v0"
-        )
-    dimensions = {n: d for n, d in STICK_COLUMNS.items() if n in names and n not in ("start_stress", "jump_velocity")}
-    dimensions["critical_stress"] = "stress"
-    allowed = tuple(n for n in dimensions if n != "pulling_velocity")
-    table = read_table(path, dimensions, required=["pulling_velocity", "stick_time"], allow_missing=allowed,
-                       ignore=CYCLES_IGNORED)  # fmt: skip
-    whole = np.isfinite(table["stick_time"])
-    columns = {CYCLES_COLUMNS.get(n, n): v[whole] for n, v in table.columns.items()}
-    notes = [f"{source}: the cycles table of stickslip analyze; its critical_stress (σc) is each row's start_stress"]
-    if not whole.all():
-        cut = ", ".join(str(r) for r in table.rows[~whole])
-        notes.append(f"{source}: row(s) {cut} left out: cycles cut by the record's ends (no stick time)")
-    return _validated_stick(Table(source, columns, table.rows[whole])), notes
+    """A stick table (:func:`~stickslip.fitting.data.read_stick_data`: Table 1's columns or the cycles table of
+    ``stickslip analyze -o``) with the notes on what was read so."""
+    data = read_stick_data(path)
+    return data, data.notes()
 
 
 def fit_stick(
@@ -380,7 +328,8 @@ def fit_stick(
     stick keys at given values; ``free`` lists keys the user insists on
     fitting (they are fixed only if nothing else pins an undetermined direction).
     """
-    data, notes = (table, []) if isinstance(table, StickData) else read_stick_table(table)
+    data = table if isinstance(table, StickData) else read_stick_data(table)
+    notes = data.notes()
     if not 0.0 < level < 1.0:
         raise ParameterError(f"level: expected a confidence level between 0 and 1, got {level!r}")
     base = params if isinstance(params, Parameters) else load_parameters(params or "gelatin-glass")

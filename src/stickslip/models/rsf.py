@@ -229,6 +229,10 @@ def rsf_run(result: Any) -> Run:
         "growth": r.growth,
         "critical_stiffness": kc,
     }
+    if math.isfinite(result.run_mean_friction):  # the solver's own mean over the run, not the samples' (run_mean)
+        summary["run_mean_friction"] = result.run_mean_friction
+        if sigma is not None:  # a run in stress: its mean over the run in Pa (run --json's run_mean_stress)
+            summary["run_mean_stress"] = result.run_mean_friction * sigma
     states = {"state" if i == 0 else f"state{i + 1}": row for i, row in enumerate(result.state)}
     return Run(
         model=RSFModel.name,

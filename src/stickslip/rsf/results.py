@@ -87,6 +87,9 @@ class RSFRun:
     status: str
     message: str
     regime: Regime
+    #: the mean of mu over the run (to its end, or to a blow-up): the solver's integral of mu dt over its time,
+    #: whatever the output sampling (NaN where the run was not integrated so)
+    run_mean_friction: float = math.nan
 
     @property
     def final_friction(self) -> float:

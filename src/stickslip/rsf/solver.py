@@ -20,6 +20,7 @@ import numpy as np
 from ..errors import ModelError, ParameterError
 from ..protocols import Protocol
 from ..units import shorten, to_si
+from .laws import cexp as _exp
 from .params import RSFParams
 from .results import RSFRun, Solution, assemble_run
 from .stability import jacobian_at
@@ -38,10 +39,18 @@ MAX_CALLS = 1_000_000
 PROGRESS_CALLS = 20_000
 
 
+#: The absolute tolerance of the carried integral of mu dt: out of reach, so that it never limits a step.
+FREE_ATOL = 1e100
+#: Evaluations a piece may be projected to need (from its pace so far) before LSODA gives way to Radau.
+STIFF_PROJECTION = 1e8
+
+
 class _Stalled(Exception):
-    def __init__(self, time: float) -> None:
+    def __init__(self, time: float, projected: bool = False, state: np.ndarray | None = None) -> None:
         super().__init__(time)
         self.time = float(time)
+        self.state = None if state is None else np.array(state, dtype=float)  # (a trial state near the stall)
+        self.projected = projected  # not stuck: on its pace the piece would need over STIFF_PROJECTION evaluations
 
 
 ATOL = 1e-12
@@ -81,14 +90,22 @@ def simulate(
             + (" (the first segment holds; give --start-velocity)" if start_velocity is None else "")
         )
     system = System(params)
+    # the solver also carries q = integral of mu dt (a last unknown that feeds nothing back): the run's mean
+    # friction is q(T)/T from the solver's own steps, whatever the output sampling
+    carried = WithIntegral(system)
+    # q's own error never limits a step (its tolerance is out of reach): the steps, and so the trace, are those of
+    # the equations without it (a fit's search, which follows differences of 1e-12, takes the same path), and q is
+    # integrated on them by the same formulas
+    carried_atol = np.r_[np.full(system.size, atol), FREE_ATOL]
     grid = _grid(protocol, every, times)
     v_cap = BLOW_UP_FACTOR * max(float(np.max(protocol.velocities)), v_start)
     x_cap = _blow_up_level(params, max(float(np.max(protocol.velocities)), v_start))
-    y = system.steady_y(v_start)
+    y = np.r_[system.steady_y(v_start), 0.0]
     # Where a quasi-static slider may run away, odeint could step over the run-away between samples:
     # sample from the adaptive solver's interpolant instead, which watches every step.
     watch = grid is not None and params.eta == 0 and params.mass == 0 and _unstable_somewhere(params, protocol)
     t_parts, y_parts = [np.array([0.0])], [y[:, None]]
+    integral, reached = 0.0, 0.0
     status, message = "ok", ""
     last: Solution | None = None
     last_piece = len(protocol.segments) - 1
@@ -96,25 +113,28 @@ def simulate(
         _check_clock(params, max(vlp, v_start if t0 == 0 else 0.0), t1)
         short = None
         try:
-            short = _short_piece(system, y, t0, t1, vlp, grid)
+            short = _short_piece(carried, y, t0, t1, vlp, grid)
             if short is not None:
                 t_out, y_out, y_end, blown = short
             elif grid is None:
-                t_out, y_out, y_end, blown, _ = _adaptive_piece(system, y, t0, t1, vlp, x_cap, rtol, atol)
+                t_out, y_out, y_end, blown, _ = _adaptive_piece(carried, y, t0, t1, vlp, x_cap, rtol, carried_atol)
                 t_steps, y_steps = t_out, y_out
             else:
                 inside = grid[(grid > t0) & (grid <= t1)]
-                t_out, y_out, y_end, blown = _sampled_piece(system, y, t0, t1, vlp, inside, x_cap, rtol, atol, watch)
+                t_out, y_out, y_end, blown = _sampled_piece(carried, y, t0, t1, vlp, inside, x_cap, rtol, carried_atol,
+                                                            watch)  # fmt: skip
                 if detect and index == last_piece and blown is None:
                     # the regime is read off every accepted step of the last segment, whatever the sampling
-                    t_steps, y_steps, _, _, _ = _adaptive_piece(system, y, t0, t1, vlp, x_cap, rtol, atol)
+                    t_steps, y_steps, _, _, _ = _adaptive_piece(system, y[:-1], t0, t1, vlp, x_cap, rtol, atol)
+                    y_steps = np.r_[y_steps, np.zeros((1, y_steps.shape[1]))]  # (q is not read there)
         except (ZeroDivisionError, OverflowError) as exc:  # e.g. m V / sigma underflowing to 0 in dV/dt
             raise ModelError(_out_of_range(system, t0, t1, exc)) from None
         if detect and index == last_piece and blown is None and short is None:  # a one-step piece has no steps
-            steps_t, steps_y = np.r_[t0, t_steps], np.c_[y, y_steps]
+            steps_t, steps_y = np.r_[t0, t_steps], np.c_[y, y_steps][:-1]
             last = Solution(t0, steps_t, steps_y, _interpolant(system, vlp, steps_t, steps_y, rtol, atol))
         t_parts.append(t_out)
         y_parts.append(y_out)
+        integral, reached = float(y_end[-1]), (t1 if blown is None else blown)
         if blown is not None:
             status = "blow-up"
             message = (
@@ -126,8 +146,64 @@ def simulate(
         y = y_end
     t_all = np.concatenate(t_parts)
     y_all = np.concatenate(y_parts, axis=1)
-    run = assemble_run(system, protocol, t_all, y_all, status, message, v_start, detect, last, rtol)
+    run = assemble_run(system, protocol, t_all, y_all[:-1], status, message, v_start, detect, last, rtol)
+    run = replace(run, run_mean_friction=integral / reached if reached > 0 else float(run.friction[-1]))
     return _requested(run, grid) if times is not None else run
+
+
+class WithIntegral:
+    """The equations of ``system`` with one more unknown last, q = integral of mu dt (dq/dt = mu), which no
+    other equation reads; every other attribute is the system's."""
+
+    def __init__(self, system: System) -> None:
+        self.system = system
+        self.size = system.size + 1
+        o = system.offset
+        self._x, self._psi = o, slice(o + 1, o + 1 + system.n)
+        # the common case (System._rhs_classical's equations, mu inline): the wrapper's cost is per evaluation
+        fast = system.rhs == system._rhs_classical
+        self.rhs = self._rhs_classical if fast else self._rhs
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self.system, name)
+
+    def _rhs(self, t: float, y: np.ndarray, vlp: float) -> list[float]:
+        inner = y[:-1]
+        return [*self.system.rhs(t, inner, vlp), self.system.friction(float(inner[self._x]), inner[self._psi])]
+
+    def _rhs_classical(self, t: float, y: np.ndarray, vlp: float) -> list[float]:
+        s = self.system
+        x, *psi = y.tolist()
+        psi.pop()  # q
+        v0 = s.v0
+        out = [0.0]
+        G = 0.0
+        mu = s.mu0 + s.a * x
+        for (rate, b, dc), p in zip(s._terms, psi):  # noqa: B905  (lengths match by construction)
+            g = rate(x, p, v0, dc)[0]
+            out.append(g)
+            G += b * g
+            mu += b * p
+        v = v0 * _exp(x)
+        out[0] = (s.k * (vlp - v) - G) / (s.a + s.eta * v)
+        out.append(mu)
+        return out
+
+    def jacobian(self, t: float, y: np.ndarray, vlp: float) -> np.ndarray:
+        """The system's Jacobian bordered by dmu/dy (analytic: the classical and cut-off forms have one)."""
+        s = self.system
+        inner = y[:-1]
+        jac = np.zeros((self.size, self.size))
+        jac[:-1, :-1] = s.jacobian(t, inner, vlp)
+        x = float(inner[self._x])
+        psi = inner[self._psi].tolist()
+        if s.cutoff is not None:
+            jac[-1, self._x] = s.cutoff.direct(s.a, x)[0]
+            jac[-1, self._psi] = [s.cutoff.evolution(b, p)[0] for b, p in zip(s.b, psi, strict=True)]
+        else:
+            jac[-1, self._x] = s.a
+            jac[-1, self._psi] = s.b
+        return jac
 
 
 def _requested(run: RSFRun, grid: np.ndarray) -> RSFRun:
@@ -328,28 +404,51 @@ def _odeint(
     from scipy.integrate import odeint
 
     jac = system.jacobian if system.has_jacobian else None
-    try:
+    failed = np.full((len(grid), len(y0)), np.nan), False
+    if not system.implicit:
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                out, info = odeint(
+                    _counted(system, grid[0], grid[-1], limit=False), y0, grid, args=(vlp,), Dfun=jac, rtol=rtol,
+                    atol=atol, tfirst=True, mxstep=200_000, full_output=True,
+                )  # fmt: skip
+        except (ZeroDivisionError, OverflowError):  # a trial step far out (m V / sigma underflowing to 0 in dV/dt)
+            return failed
+        except _Stalled as stalled:
+            if not stalled.projected:
+                return failed
+            _take_implicit_steps(system)
+        else:
+            return out, info.get("message") == "Integration successful." and bool(np.all(np.isfinite(out)))
+    try:  # (odeint is LSODA only: the implicit steps at the same times)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            out, info = odeint(
-                system.rhs, y0, grid, args=(vlp,), Dfun=jac, rtol=rtol, atol=atol, tfirst=True, mxstep=200_000,
-                full_output=True,
-            )  # fmt: skip
-    except (ZeroDivisionError, OverflowError):  # a trial step far out (m V / sigma underflowing to 0 in dV/dt)
-        return np.full((len(grid), len(y0)), np.nan), False
-    return out, info.get("message") == "Integration successful." and bool(np.all(np.isfinite(out)))
+            sol = _solve(system, y0, grid[0], grid[-1], vlp, rtol, atol, False, t_eval=grid)
+    except (_Stalled, ValueError, ArithmeticError):
+        return failed
+    out = sol.y.T
+    return out, sol.status == 0 and out.shape[0] == len(grid) and bool(np.all(np.isfinite(out)))
+
+
+def _take_implicit_steps(system: System) -> None:
+    """From now on the run integrates ``system`` by Radau (implicit) instead of LSODA: LSODA was found keeping to
+    its explicit steps on a stiff problem (see :func:`_counted`), which it may do again on any piece."""
+    getattr(system, "system", system).implicit = True  # (the system itself, under a WithIntegral)
 
 
 def _solve(
     system: System, y0: np.ndarray, t0: float, t1: float, vlp: float, rtol: float, atol: float, dense: bool,
-    method: str = "LSODA", events: Any = None,
+    method: str = "LSODA", events: Any = None, t_eval: Any = None,
 ) -> Any:  # fmt: skip
     """solve_ivp from ``t0`` to ``t1``, its evaluations counted (:func:`_counted`)."""
     from scipy.integrate import solve_ivp
 
+    if method == "LSODA" and system.implicit:
+        method = "Radau"
     jac = system.jacobian if system.has_jacobian else None
     return solve_ivp(_counted(system, t0, t1), (t0, t1), y0, method=method, args=(vlp,), jac=jac, rtol=rtol,
-                     atol=atol, events=events, dense_output=dense)  # fmt: skip
+                     atol=atol, events=events, dense_output=dense, t_eval=t_eval)  # fmt: skip
 
 
 def _adaptive_piece(
@@ -365,7 +464,10 @@ def _adaptive_piece(
         try:
             fast = _quiet_solve(system, y0, t0, t1, vlp, rtol, atol, dense)
         except _Stalled as stalled:
-            raise _stall_error(stalled, t0, t1) from None
+            if not stalled.projected or system.implicit:
+                raise _stall_error(stalled, t0, t1, system) from None
+            fast = None
+            _take_implicit_steps(system)  # the watched path below, by Radau
         x = fast.y[system.offset] if fast is not None else None
         if fast is not None and fast.status == 0 and np.all(np.isfinite(fast.y)) and np.max(x) <= x_cap:
             return fast.t[1:], fast.y[:, 1:], fast.y[:, -1], None, fast.sol
@@ -388,22 +490,24 @@ def _adaptive_piece(
                 # so scipy's event root-finder has no bracket; Radau's collocation polynomial passes through
                 # the step ends exactly, so the same event is bracketed there.
                 sol = _solve(system, y0, t0, t1, vlp, rtol, atol, dense, method="Radau", events=blow_up)
+            except _Stalled as stalled:
+                if not stalled.projected or system.implicit:
+                    raise
+                _take_implicit_steps(system)
+                sol = _solve(system, y0, t0, t1, vlp, rtol, atol, dense, events=blow_up)
     except _Stalled as stalled:
-        raise _stall_error(stalled, t0, t1) from None
+        raise _stall_error(stalled, t0, t1, system) from None
     blown = float(sol.t_events[0][0]) if sol.t_events[0].size else None
     if blown is None and sol.status != 0:
         t_fail = float(sol.t[-1])
         x_fail = float(sol.y[o, -1])
         if x_fail > 0.5 * x_cap:  # the solver gave up while the slip rate ran away: a blow-up
             blown = t_fail
+        elif not system.implicit:  # LSODA gave up (a stiff slider with mass far below V0): implicit steps may not
+            _take_implicit_steps(system)
+            return _adaptive_piece(system, y0, t0, t1, vlp, x_cap, rtol, atol, dense, watch=True)
         elif system.inertial:
-            v = system.v0 * math.exp(min(x_fail, EXP_CAP))
-            tau = system.inertia * v / system.a
-            raise ModelError(
-                f"rate-and-state solver failed at t = {t_fail:.6g} s: the slider's inertial time mV/(σa) = "
-                f"{tau:.3g} s is too short beside the run ({t1 - t0:.3g} s); inertia this small does not matter, "
-                "drop the mass (the quasi-static slider is its limit; use eta for fast slip)"
-            )
+            raise _inertia_error(system, t_fail, x_fail, t0, t1, "failed")
         else:
             raise ModelError(
                 f"rate-and-state solver failed at t = {t_fail:.6g} s ({sol.message}): the equations cannot be"
@@ -412,26 +516,47 @@ def _adaptive_piece(
     return sol.t[1:], sol.y[:, 1:], sol.y[:, -1], blown, sol.sol
 
 
-def _counted(system: System, t0: float, t1: float) -> Callable[[float, np.ndarray, float], Any]:
-    """The right-hand side, raising _Stalled after MAX_CALLS evaluations or as soon as the clock stops moving."""
+def _counted(system: System, t0: float, t1: float, limit: bool = True) -> Callable[[float, np.ndarray, float], Any]:
+    """The right-hand side, raising _Stalled after MAX_CALLS evaluations or as soon as the clock stops moving, and
+    (``projected``) where its pace projects more than STIFF_PROJECTION evaluations for the piece.  ``limit=False``
+    (a sampled trace, which may need more than MAX_CALLS in all): the projection only."""
     calls = [0]
     checkpoint = [t0]
 
     def rhs(t: float, y: np.ndarray, vlp: float) -> Any:
         calls[0] += 1
-        if calls[0] > MAX_CALLS:
-            raise _Stalled(t)
+        if limit and calls[0] > MAX_CALLS:
+            raise _Stalled(t, state=y)
         if calls[0] % PROGRESS_CALLS == 0:
             # a clock that has not moved in PROGRESS_CALLS evaluations is stuck for good: say so now
-            if t - checkpoint[0] <= 1e-12 * max(abs(t), t1 - t0):
-                raise _Stalled(t)
+            if limit and t - checkpoint[0] <= 1e-12 * max(abs(t), t1 - t0):
+                raise _Stalled(t, state=y)
+            # LSODA can stay with its explicit (Adams) steps on a stiff problem, each held to the fastest time
+            # scale (a slider with mass far below V0: m V/(sigma a) = 1e-12 s, 3e-10 s steps): on its pace
+            # it would run for hours; the caller redoes the piece by implicit steps (_take_implicit_steps)
+            if calls[0] * (t1 - t0) > STIFF_PROJECTION * (t - t0):
+                raise _Stalled(t, projected=True, state=y)
             checkpoint[0] = t
         return system.rhs(t, y, vlp)
 
     return rhs
 
 
-def _stall_error(stalled: _Stalled, t0: float, t1: float) -> ModelError:
+def _inertia_error(system: System, t_fail: float, x_fail: float, t0: float, t1: float, what: str) -> ModelError:
+    v = system.v0 * math.exp(min(x_fail, EXP_CAP))
+    tau = system.inertia * v / system.a
+    return ModelError(
+        f"rate-and-state solver {what} at t = {t_fail:.6g} s: the slider's inertial time mV/(σa) = "
+        f"{tau:.3g} s is too short beside the run ({t1 - t0:.3g} s); inertia this small does not matter, "
+        "drop the mass (the quasi-static slider is its limit; use eta for fast slip)"
+    )
+
+
+def _stall_error(stalled: _Stalled, t0: float, t1: float, system: System | None = None) -> ModelError:
+    """The stall in words; with a slider with mass, its inertial time where it stalled (the stiffness that
+    neither LSODA nor Radau's implicit steps could follow)."""
+    if system is not None and system.inertial and stalled.state is not None:
+        return _inertia_error(system, stalled.time, float(stalled.state[system.offset]), t0, t1, "stalled")
     return ModelError(
         f"rate-and-state solver stalled at t = {stalled.time:.6g} s (in the segment "
         f"{t0:g} ... {t1:g} s): the equations are too stiff here (e.g. the regularised form far below V0 "

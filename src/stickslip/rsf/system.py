@@ -38,6 +38,8 @@ class System:
         self.size = self.n + 1 + self.offset
         self.one_minus_h = 1.0 - sum(b * h for b, h in zip(self.b, self.h, strict=True))  # classical form
         self.has_jacobian = not self.regularized
+        #: integrate by Radau, not LSODA (set by the solver once LSODA kept to explicit steps on a stiff problem)
+        self.implicit = False
         self.cutoff = None if params.cutoff is None else CutoffForm(*params.cutoff, self.v0)
         self._terms = [(law.rate, b, dc) for law, b, dc in zip(self.laws, self.b, self.dc, strict=True)]
         self._coupled = any(h != 0.0 for h in self.h)

@@ -73,8 +73,7 @@ def hopf_row(
     def response(s: np.ndarray) -> np.ndarray:
         return interface_response(params, velocity, s, True, cell_hazard).z
 
-    massless = block.mass == 0.0 and block.damping == 0.0
-    top = math.inf if massless else resolved_frequency(params, velocity)
+    top = resolved_frequency(params, velocity, True, cell_hazard)  # (with or without a mass: see its notes)
     kc = critical_from_response(response, SCAN / params.bonds.bond_time, block.mass, block.damping, top)
     if kc.mode != "oscillatory":
         return HopfRow(velocity, block, kc.value, math.nan, math.nan, math.nan, kc.mode)
