@@ -109,8 +109,9 @@ def simulate(
     status, message = "ok", ""
     last: Solution | None = None
     last_piece = len(protocol.segments) - 1
+    for t0, t1, vlp in protocol.pieces():  # every piece's clock before any is integrated (a long hold would
+        _check_clock(params, max(vlp, v_start if t0 == 0 else 0.0), t1)  # stall before the slide after it)
     for index, (t0, t1, vlp) in enumerate(protocol.pieces()):
-        _check_clock(params, max(vlp, v_start if t0 == 0 else 0.0), t1)
         short = None
         try:
             short = _short_piece(carried, y, t0, t1, vlp, grid)
@@ -503,7 +504,10 @@ def _adaptive_piece(
         x_fail = float(sol.y[o, -1])
         if x_fail > 0.5 * x_cap:  # the solver gave up while the slip rate ran away: a blow-up
             blown = t_fail
-        elif not system.implicit:  # LSODA gave up (a stiff slider with mass far below V0): implicit steps may not
+        elif system.inertial and not system.implicit:
+            # LSODA gave up on a slider with mass far below V0 (stiff: its inertial time m V/(sigma a)), where
+            # implicit steps go on; a massless run that LSODA cannot follow is refused as before (b = 1e300: Radau
+            # "integrated" it through overflows)
             _take_implicit_steps(system)
             return _adaptive_piece(system, y0, t0, t1, vlp, x_cap, rtol, atol, dense, watch=True)
         elif system.inertial:

@@ -411,6 +411,35 @@ class Solution:
         return y[0] if scalar else y.T
 
 
+def stacked_chebval(stack, x):  # type: ignore[no-untyped-def]
+    """numpy's ``chebval(x, stack)`` for a scalar x and stacked columns: the same Clenshaw recurrence, the same
+    operations in the same order (so the same bits), compiled: numpy's call costs ~40 us, and the paper's cycle
+    makes ~900 of them (a sixth of its CPU)."""
+    size = stack.shape[0]
+    if size == 1:
+        return stack[0].copy()
+    c0 = stack[size - 2].copy()
+    c1 = stack[size - 1].copy()
+    if size == 2:
+        return c0 + c1 * x
+    x2 = 2 * x
+    for i in range(3, size + 1):
+        tmp = c0
+        c0 = stack[size - i] - c1
+        c1 = tmp + c1 * x2
+    return c0 + c1 * x
+
+
+#: the compiled :func:`stacked_chebval`
+_CLENSHAW: list = []
+
+
+def clenshaw():  # type: ignore[no-untyped-def]
+    if not _CLENSHAW:
+        _CLENSHAW.append(kernel._jit(stacked_chebval))
+    return _CLENSHAW[0]
+
+
 #: the compiled functions (compiled on first use, cached on disk)
 _COMPILED: dict[str, object] = {}
 _chebval = None
@@ -418,10 +447,8 @@ _chebval = None
 
 def _compiled():  # type: ignore[no-untyped-def]
     if not _COMPILED:
-        from . import reduction
-
         g = globals()
-        g["_chebval"] = reduction._clenshaw()
+        g["_chebval"] = clenshaw()
         for name in ("_table", "_effective", "_rhs", "_event", "_dense_v", "_squares", "_norm", "_grown"):
             g[name] = kernel._jit(g[name], inline=True)
         for name in ("_event_root", "first_step", "integrate"):

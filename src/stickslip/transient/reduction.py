@@ -187,33 +187,8 @@ def steady_cohorts(  # type: ignore[no-untyped-def]
     return Population(extension=velocity * age, age=age, weight=weight)
 
 
-def _stacked_chebval(stack, x):  # type: ignore[no-untyped-def]
-    """numpy's ``chebval(x, stack)`` for a scalar x and stacked columns: the same Clenshaw recurrence, the same
-    operations in the same order (so the same bits), compiled: numpy's call costs ~40 us, and the paper's cycle
-    makes ~900 of them (a sixth of its CPU)."""
-    size = stack.shape[0]
-    if size == 1:
-        return stack[0].copy()
-    c0 = stack[size - 2].copy()
-    c1 = stack[size - 1].copy()
-    if size == 2:
-        return c0 + c1 * x
-    x2 = 2 * x
-    for i in range(3, size + 1):
-        tmp = c0
-        c0 = stack[size - i] - c1
-        c1 = tmp + c1 * x2
-    return c0 + c1 * x
-
-
-#: the compiled :func:`_stacked_chebval`
-_CLENSHAW: list = []
-
-
-def _clenshaw():  # type: ignore[no-untyped-def]
-    if not _CLENSHAW:
-        _CLENSHAW.append(kernel._jit(_stacked_chebval))
-    return _CLENSHAW[0]
+#: the stacked Clenshaw recurrence, compiled (glide.py, beside the glide's ODE that evaluates it at every stage)
+_stacked_chebval, _clenshaw = glide_ode.stacked_chebval, glide_ode.clenshaw
 
 
 # the chain's force, stiffness and energy are the kernel's (Eq 3), one definition

@@ -58,10 +58,8 @@ def _stiffness(extension: np.ndarray, params: Parameters) -> np.ndarray:
     return b.chain_stiffness * (1.0 + y * y) / (d * d)
 
 
-def interface_response(
-    params: Parameters, velocity: float, s: np.ndarray, aging: bool = True, cell_hazard: float = CELL_HAZARD
-) -> Response:
-    """Z(s) of the module docstring at the complex rates ``s`` (1/s); ``cell_hazard`` sets the age grid."""
+def _check_velocity(params: Parameters, velocity: float) -> None:
+    """A positive, finite sliding velocity below FASTEST x the set's dl_m/tau, else a ParameterError."""
     if not (isinstance(velocity, (int, float)) and math.isfinite(velocity) and velocity > 0):
         raise ParameterError(f"velocity: expected a positive sliding velocity in m/s, got {velocity!r}")
     b = params.bonds
@@ -71,6 +69,14 @@ def interface_response(
             f"velocity: {velocity:.3g} m/s is beyond {FASTEST:.0e} × the set's Δl_m/τ ({fastest:.3g} m/s): chains"
             " would reach full extension in a negligible fraction of a bond's life; check the unit"
         )
+
+
+def interface_response(
+    params: Parameters, velocity: float, s: np.ndarray, aging: bool = True, cell_hazard: float = CELL_HAZARD
+) -> Response:
+    """Z(s) of the module docstring at the complex rates ``s`` (1/s); ``cell_hazard`` sets the age grid."""
+    _check_velocity(params, velocity)
+    b = params.bonds
     a, w, width, f, fp, r, gv = _cells(params, float(velocity), aging, cell_hazard)
     birth = (b.site_density - w.sum()) / b.bond_time
     s = np.atleast_1d(np.asarray(s, dtype=complex))
@@ -231,6 +237,7 @@ def critical_stiffness_details(
     # crossings above the resolved frequency are the age grid's, not Z's, with or without a mass: a massless
     # block's scan of a short-lived bond (box draw tau = 64 ns) found 129 of them, each bisected (18 s), and
     # took the largest, Kc = 1.3e15 Pa/m at 6e11 Hz, which moved to 9e7 Hz on a grid twice as fine
+    _check_velocity(params, velocity)  # before the resolved frequency's cells: a typed error, not an overflow
     top = resolved_frequency(params, velocity, aging)
     return critical_from_response(_response(params, velocity, aging), SCAN / params.bonds.bond_time, mass, damping, top)
 
