@@ -379,10 +379,7 @@ def test_the_quasi_static_cycle_loads_no_scipy():
         "heavy = ('scipy.optimize', 'scipy.integrate', 'scipy.linalg', 'scipy.fft', 'scipy.special')\n"
         "print('LOADED', [m for m in heavy if m in sys.modules])\n"
     )
-    env = {**os.environ, "PYTHONPATH": str(SRC)}
-    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300, env=env)
-    assert done.returncode == 0, done.stderr
-    ran, loaded = done.stdout.strip().splitlines()[-2:]
+    ran, loaded = _last_two_lines(code)
     assert ran == "RAN stick-slip 2 True"  # stick, jump, slip and the chains' dense output were all solved
     assert loaded == "LOADED []"
 
@@ -404,10 +401,7 @@ def test_numba_without_its_blas_probe_still_compiles_linear_algebra():
         "dot, at, solved = f(a, b)\n"
         "print('SAME', np.array_equal(dot, np.dot(a, b)), np.array_equal(at, a @ b), np.allclose(a @ solved, b))\n"
     )
-    env = {**os.environ, "PYTHONPATH": str(SRC)}
-    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300, env=env)
-    assert done.returncode == 0, done.stderr
-    probe, same = done.stdout.strip().splitlines()[-2:]
+    probe, same = _last_two_lines(code)
     assert probe == "PROBE False False"  # the probe was skipped, and scipy.linalg not loaded for it
     assert same == "SAME True True True"
 
@@ -433,3 +427,11 @@ def test_outputs_get_the_usual_file_mode_not_a_private_one(tmp_path):
     kept.chmod(0o640)
     common.write_text(kept, "new\n")
     assert kept.stat().st_mode & 0o777 == 0o640 and kept.read_text(encoding="utf-8") == "new\n"
+
+
+def _last_two_lines(code: str) -> list[str]:
+    """The last two lines a fresh interpreter prints running ``code`` (this checkout's package first)."""
+    env = {**os.environ, "PYTHONPATH": str(SRC)}
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300, env=env)
+    assert done.returncode == 0, done.stderr
+    return done.stdout.strip().splitlines()[-2:]

@@ -151,6 +151,16 @@ def _event_root(which, f, y_old, t_old, h, ta, tb, stack, off, scl, lo, hi, vp, 
     return xcur
 
 
+def _stage(k, a, s, y, h, n, stage):  # type: ignore[no-untyped-def]
+    """The state where stage s is evaluated, y + h sum_j a[s, j] k_j over the stages before it, into ``stage``
+    (scipy's ``np.dot(K[:s].T, a[:s]) * h``)."""
+    for i in range(n):
+        acc = 0.0
+        for j in range(s):
+            acc += k[j, i] * a[s, j]
+        stage[i] = y[i] + acc * h
+
+
 def _squares(x, n):  # type: ignore[no-untyped-def]
     total = 0.0
     for i in range(n):
@@ -272,11 +282,7 @@ def integrate(  # type: ignore[no-untyped-def]
             for i in range(n):
                 k[0, i] = f[i]
             for s in range(1, N_STAGES):
-                for i in range(n):
-                    acc = 0.0
-                    for j in range(s):
-                        acc += k[j, i] * a[s, j]
-                    stage[i] = y[i] + acc * h
+                _stage(k, a, s, y, h, n, stage)
                 _rhs(stack, off, scl, stage[0], lo, hi, vp, k_block, block, n0, tau, cap_off, k[s])
             for i in range(n):
                 acc = 0.0
@@ -323,11 +329,7 @@ def integrate(  # type: ignore[no-untyped-def]
             seg_y = _grown(seg_y, cap_steps)
             seg_f = _grown(seg_f, cap_steps)
         for s in range(N_STAGES + 1, N_STAGES_EXTENDED):
-            for i in range(n):
-                acc = 0.0
-                for j in range(s):
-                    acc += k[j, i] * a[s, j]
-                stage[i] = y[i] + acc * h
+            _stage(k, a, s, y, h, n, stage)
             _rhs(stack, off, scl, stage[0], lo, hi, vp, k_block, block, n0, tau, cap_off, k[s])
         for i in range(n):
             delta = y_new[i] - y[i]
@@ -449,7 +451,7 @@ def _compiled():  # type: ignore[no-untyped-def]
     if not _COMPILED:
         g = globals()
         g["_chebval"] = clenshaw()
-        for name in ("_table", "_effective", "_rhs", "_event", "_dense_v", "_squares", "_norm", "_grown"):
+        for name in ("_table", "_effective", "_rhs", "_event", "_dense_v", "_stage", "_squares", "_norm", "_grown"):
             g[name] = kernel._jit(g[name], inline=True)
         for name in ("_event_root", "first_step", "integrate"):
             g[name] = kernel._jit(g[name])
