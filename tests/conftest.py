@@ -36,6 +36,8 @@ HEAVY_FIRST = (
     "test_steady_slope.py",
     "test_sweep_cluster.py",
     "test_transient_summary.py",
+    "test_critical_aliasing.py",
+    "test_cli_boundary.py",
 )
 
 
