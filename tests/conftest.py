@@ -37,7 +37,6 @@ HEAVY_FIRST = (
     "test_sweep_cluster.py",
     "test_transient_summary.py",
     "test_critical_aliasing.py",
-    "test_cli_boundary.py",
 )
 
 

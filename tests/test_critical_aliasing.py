@@ -4,7 +4,7 @@ A box draw of last session's audit (seed 2026, draw 10: a bond time of 64 ns at 
 critical_stiffness_details: its scan of Z(i w) had 132 sign changes of Im Z, 123 of them above the resolved
 frequency where the cohort sums alias, each bisected 30 times, and it returned the largest, Kc = 1.3e15 Pa/m at
 6e11 Hz, which moved to 9e7 Hz on an age grid twice as fine: the grid's, not Z's.  The check here is against
-that finer grid: near the returned frequency (within 10 %) it must cross at the same w and K.  (Z varies by 2 %
+that finer grid: near the returned frequency (within 2 %) it must cross at the same w and K.  (Z varies by 2 %
 over 1e-7 of w there, a near-pole of its closure: the crossings are compared, not Z at one w.)
 """
 
@@ -44,7 +44,7 @@ def test_an_aliased_crossing_is_not_kc_and_costs_no_bisection():
     kc = critical_stiffness_details(params, VELOCITY)
     spent = time.process_time() - start
     assert kc.mode == "oscillatory"
-    near = np.geomspace(kc.rate / 1.1, kc.rate * 1.1, 41)
+    near = np.geomspace(kc.rate / 1.02, kc.rate * 1.02, 9)  # (the finer grid costs ~0.1 s a rate)
     fine = critical_from_response(lambda s: interface_response(params, VELOCITY, s, cell_hazard=0.001).z, near)
     assert fine.mode == "oscillatory" and fine.rate == pytest.approx(kc.rate, rel=1e-5)
     assert fine.value == pytest.approx(kc.value, rel=3e-3)  # (the two grids' Kc differ by 1.2e-3)
