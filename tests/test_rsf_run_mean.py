@@ -8,6 +8,7 @@ from __future__ import annotations
 import json
 import math
 
+import numpy as np
 import pytest
 
 from cli_helpers import run_main
@@ -49,3 +50,16 @@ def test_steady_sliding_has_the_closed_form_mean():
     run = simulate(params, constant(50e-6, 7.0), every=0.3)
     expected = params.mu0 + (params.a - params.states[0].b) * math.log(50e-6 / params.v_ref)
     assert run.run_mean_friction == pytest.approx(expected, rel=1e-12)
+
+
+def test_a_fit_run_without_the_integral_has_the_same_trace_and_no_mean() -> None:
+    """``mean=False`` (what a fit asks: it reads the trace only) leaves the integral of mu dt out and changes no
+    number of the trace: q's tolerance is out of reach, so it never chose a step (a fit's search follows
+    differences of 1e-12)."""
+    protocol = segments([(1e-6, 20.0), (10e-6, 20.0), (3e-6, 20.0)])
+    times = np.linspace(0.0, 60.0, 601)
+    carried = simulate(_params(), protocol, times=times, detect=False)
+    plain = simulate(_params(), protocol, times=times, detect=False, mean=False)
+    assert np.array_equal(carried.friction, plain.friction)
+    assert np.array_equal(carried.slider_velocity, plain.slider_velocity)
+    assert math.isfinite(carried.run_mean_friction) and math.isnan(plain.run_mean_friction)

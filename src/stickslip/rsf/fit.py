@@ -232,7 +232,9 @@ def _model_or_why(
     """The model friction at the record's rows, or NaN and what went wrong (never the caller's fault unsaid)."""
     params = _final_params(base, values)
     try:
-        run = simulate(params, protocol, times=record.time, rtol=FIT_RTOL, atol=FIT_RTOL * 1e-2, detect=False)
+        run = simulate(
+            params, protocol, times=record.time, rtol=FIT_RTOL, atol=FIT_RTOL * 1e-2, detect=False, mean=False
+        )
     except (ModelError, ParameterError) as exc:
         return np.full(record.time.size, np.nan), f"the solver refused the run: {exc}"
     if run.status != "ok":

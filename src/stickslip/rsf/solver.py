@@ -66,6 +66,7 @@ def simulate(
     rtol: float = RTOL,
     atol: float = ATOL,
     detect: bool = True,
+    mean: bool = True,
 ) -> RSFRun:
     """Run ``protocol`` on the spring-slider, starting in steady sliding at ``start_velocity``.
 
@@ -74,7 +75,8 @@ def simulate(
     within the protocol) samples it at given times instead; neither changes
     the regime or the summary, which come from the solver's accepted steps.
     ``detect=False`` skips the regime detection (for fits, which call this
-    hundreds of times).
+    hundreds of times); ``mean=False`` does not carry the integral of mu dt
+    (``run_mean_friction`` is then nan), the same trace: a fit reads neither.
     """
     if not isinstance(params, RSFParams):
         raise ParameterError(f"params: expected RSFParams, got {type(params).__name__}")
@@ -92,15 +94,16 @@ def simulate(
     system = System(params)
     # the solver also carries q = integral of mu dt (a last unknown that feeds nothing back): the run's mean
     # friction is q(T)/T from the solver's own steps, whatever the output sampling
-    carried = WithIntegral(system)
+    carried: Any = WithIntegral(system) if mean else system
+    inner = slice(None, -1) if mean else slice(None)  # the system's own unknowns (less q where it is carried)
     # q's own error never limits a step (its tolerance is out of reach): the steps, and so the trace, are those of
     # the equations without it (a fit's search, which follows differences of 1e-12, takes the same path), and q is
     # integrated on them by the same formulas
-    carried_atol = np.r_[np.full(system.size, atol), FREE_ATOL]
+    carried_atol = np.r_[np.full(system.size, atol), FREE_ATOL] if mean else atol
     grid = _grid(protocol, every, times)
     v_cap = BLOW_UP_FACTOR * max(float(np.max(protocol.velocities)), v_start)
     x_cap = _blow_up_level(params, max(float(np.max(protocol.velocities)), v_start))
-    y = np.r_[system.steady_y(v_start), 0.0]
+    y = np.r_[system.steady_y(v_start), 0.0] if mean else np.asarray(system.steady_y(v_start), float)
     # Where a quasi-static slider may run away, odeint could step over the run-away between samples:
     # sample from the adaptive solver's interpolant instead, which watches every step.
     watch = grid is not None and params.eta == 0 and params.mass == 0 and _unstable_somewhere(params, protocol)
@@ -126,16 +129,17 @@ def simulate(
                                                             watch)  # fmt: skip
                 if detect and index == last_piece and blown is None:
                     # the regime is read off every accepted step of the last segment, whatever the sampling
-                    t_steps, y_steps, _, _, _ = _adaptive_piece(system, y[:-1], t0, t1, vlp, x_cap, rtol, atol)
-                    y_steps = np.r_[y_steps, np.zeros((1, y_steps.shape[1]))]  # (q is not read there)
+                    t_steps, y_steps, _, _, _ = _adaptive_piece(system, y[inner], t0, t1, vlp, x_cap, rtol, atol)
+                    if mean:
+                        y_steps = np.r_[y_steps, np.zeros((1, y_steps.shape[1]))]  # (q is not read there)
         except (ZeroDivisionError, OverflowError) as exc:  # e.g. m V / sigma underflowing to 0 in dV/dt
             raise ModelError(_out_of_range(system, t0, t1, exc)) from None
         if detect and index == last_piece and blown is None and short is None:  # a one-step piece has no steps
-            steps_t, steps_y = np.r_[t0, t_steps], np.c_[y, y_steps][:-1]
+            steps_t, steps_y = np.r_[t0, t_steps], np.c_[y, y_steps][inner]
             last = Solution(t0, steps_t, steps_y, _interpolant(system, vlp, steps_t, steps_y, rtol, atol))
         t_parts.append(t_out)
         y_parts.append(y_out)
-        integral, reached = float(y_end[-1]), (t1 if blown is None else blown)
+        integral, reached = (float(y_end[-1]) if mean else math.nan), (t1 if blown is None else blown)
         if blown is not None:
             status = "blow-up"
             message = (
@@ -147,8 +151,9 @@ def simulate(
         y = y_end
     t_all = np.concatenate(t_parts)
     y_all = np.concatenate(y_parts, axis=1)
-    run = assemble_run(system, protocol, t_all, y_all[:-1], status, message, v_start, detect, last, rtol)
-    run = replace(run, run_mean_friction=integral / reached if reached > 0 else float(run.friction[-1]))
+    run = assemble_run(system, protocol, t_all, y_all[inner], status, message, v_start, detect, last, rtol)
+    if mean:
+        run = replace(run, run_mean_friction=integral / reached if reached > 0 else float(run.friction[-1]))
     return _requested(run, grid) if times is not None else run
 
 
