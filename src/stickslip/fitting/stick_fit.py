@@ -305,13 +305,6 @@ def _select_rows(
     return used, excluded, (point.stress if point.exists else None), messages
 
 
-def read_stick_table(path: str | Path) -> tuple[StickData, list[str]]:
-    """A stick table (:func:`~stickslip.fitting.data.read_stick_data`: Table 1's columns or the cycles table of
-    ``stickslip analyze -o``) with the notes on what was read so."""
-    data = read_stick_data(path)
-    return data, data.notes()
-
-
 def fit_stick(
     table: StickData | str | Path,
     params: Parameters | str | None = None,
