@@ -16,6 +16,7 @@ two agree to rounding, not to the bit (tests/test_transient_glide.py compares th
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import numpy as np
 
@@ -79,15 +80,20 @@ def _event(which, stack, off, scl, y0, lo, hi, vp, k_block, tol, cap, cap_off): 
         return min(y0 / lo - 1.0 - 1e-6, 1.0 - 1e-6 - y0 / hi)
     vv = min(max(y0, lo), hi)
     s_eff, _a, neglected, slope = _effective(stack, off, scl, vv, vp, k_block, cap_off)
-    allowed = tol * max(abs(s_eff), min(abs(slope * (vp - vv)), cap * abs(s_eff)))
-    return neglected - allowed
+    return neglected - _allowance(slope, vv, vp, s_eff, tol, cap)
 
 
-def _dense_v(f, y_old, x):  # type: ignore[no-untyped-def]
-    """The velocity (component 0) of a step's dense output at the fraction x (scipy's Dop853DenseOutput)."""
+def _allowance(slope, v, vp, sigma, tol, cap):  # type: ignore[no-untyped-def]
+    """The neglected stress a stretch may carry at v: tol |sigma|, or tol S'|Vp - V| up to cap times more
+    (reduction.allowed_neglect, which says why)."""
+    return tol * max(abs(sigma), min(abs(slope * (vp - v)), cap * abs(sigma)))
+
+
+def _dense_at(f, y_old, x, component):  # type: ignore[no-untyped-def]
+    """One component of a step's dense output at the fraction x (scipy's Dop853DenseOutput)."""
     y = 0.0
     for i in range(POWERS):
-        y += f[POWERS - 1 - i, 0]
+        y += f[POWERS - 1 - i, component]
         if i % 2 == 0:
             y *= x
         else:
@@ -99,9 +105,9 @@ def _event_root(which, f, y_old, t_old, h, ta, tb, stack, off, scl, lo, hi, vp, 
     """The event's root in [ta, tb] on the step's dense output: scipy's brentq (xtol = rtol = 4 eps)."""
     eps4 = 4.0 * 2.220446049250313e-16
     xpre, xcur = ta, tb
-    fpre = _event(which, stack, off, scl, _dense_v(f, y_old, (xpre - t_old) / h), lo, hi, vp, k_block, tol, cap,
+    fpre = _event(which, stack, off, scl, _dense_at(f, y_old, (xpre - t_old) / h, 0), lo, hi, vp, k_block, tol, cap,
                   cap_off)  # fmt: skip
-    fcur = _event(which, stack, off, scl, _dense_v(f, y_old, (xcur - t_old) / h), lo, hi, vp, k_block, tol, cap,
+    fcur = _event(which, stack, off, scl, _dense_at(f, y_old, (xcur - t_old) / h, 0), lo, hi, vp, k_block, tol, cap,
                   cap_off)  # fmt: skip
     if fpre == 0.0:
         return xpre
@@ -146,7 +152,7 @@ def _event_root(which, f, y_old, t_old, h, ta, tb, stack, off, scl, lo, hi, vp, 
             xcur += scur
         else:
             xcur += delta if sbis > 0.0 else -delta
-        fcur = _event(which, stack, off, scl, _dense_v(f, y_old, (xcur - t_old) / h), lo, hi, vp, k_block, tol,
+        fcur = _event(which, stack, off, scl, _dense_at(f, y_old, (xcur - t_old) / h, 0), lo, hi, vp, k_block, tol,
                       cap, cap_off)  # fmt: skip
     return xcur
 
@@ -168,9 +174,34 @@ def _squares(x, n):  # type: ignore[no-untyped-def]
     return total
 
 
-def _norm(x, n):  # type: ignore[no-untyped-def]
-    """scipy's RMS norm."""
-    return math.sqrt(_squares(x, n)) / math.sqrt(n)
+def _scaled_norm(x, y, atol, rtol, m):  # type: ignore[no-untyped-def]
+    """scipy's RMS norm of x / (atol + rtol |y|) over the first m components (one: the plain ratio)."""
+    if m == 1:
+        return abs(x[0]) / (atol[0] + abs(y[0]) * rtol)
+    total = 0.0
+    for i in range(m):
+        ratio = x[i] / (atol[i] + abs(y[i]) * rtol)
+        total += ratio * ratio
+    return math.sqrt(total) / math.sqrt(m)
+
+
+def _select_initial_step(  # type: ignore[no-untyped-def]
+    stack, off, scl, lo, hi, vp, k_block, block, n0, tau, cap_off, t0, t_end, y, f, rtol, atol, m
+):  # fmt: skip
+    """scipy's select_initial_step (order 7, Hairer et al. II.4), its norms over the first m components."""
+    interval = abs(t_end - t0)
+    d0 = _scaled_norm(y, y, atol, rtol, m)
+    d1 = _scaled_norm(f, y, atol, rtol, m)
+    h0 = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
+    h0 = min(h0, interval)
+    f1 = np.empty(y.shape[0])
+    _rhs(stack, off, scl, y[0] + h0 * f[0], lo, hi, vp, k_block, block, n0, tau, cap_off, f1)  # (V alone matters)
+    d2 = _scaled_norm(f1 - f, y, atol, rtol, m) / h0
+    if d1 <= 1e-15 and d2 <= 1e-15:
+        h1 = max(1e-6, h0 * 1e-3)
+    else:
+        h1 = (0.01 / max(d1, d2)) ** (1.0 / 8.0)
+    return min(100.0 * h0, h1, interval)
 
 
 def first_step(stack, off, scl, lo, hi, vp, k_block, block, n0, tau, cap_off, t0, t_end, v, rtol, atol_v):  # type: ignore[no-untyped-def]
@@ -180,24 +211,14 @@ def first_step(stack, off, scl, lo, hi, vp, k_block, block, n0, tau, cap_off, t0
     counted, they made the heuristic's first step 10 ulp of t, and the solver then spent ~14 of a glide's ~22
     steps growing it tenfold per step to the velocity's own scale.  Where the velocity does not change (velocity
     control), the quadratures are linear in time and the whole stretch is one exact step."""
+    y = np.zeros(4)
+    y[0] = v
     f = np.empty(4)
     _rhs(stack, off, scl, v, lo, hi, vp, k_block, block, n0, tau, cap_off, f)
-    interval = abs(t_end - t0)
     if f[0] == 0.0:
-        return interval
-    scale = atol_v + abs(v) * rtol
-    d0 = abs(v) / scale
-    d1 = abs(f[0]) / scale
-    h0 = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
-    h0 = min(h0, interval)
-    f1 = np.empty(4)
-    _rhs(stack, off, scl, v + h0 * f[0], lo, hi, vp, k_block, block, n0, tau, cap_off, f1)
-    d2 = abs(f1[0] - f[0]) / scale / h0
-    if d1 <= 1e-15 and d2 <= 1e-15:
-        h1 = max(1e-6, h0 * 1e-3)
-    else:
-        h1 = (0.01 / max(d1, d2)) ** (1.0 / 8.0)
-    return min(100.0 * h0, h1, interval)
+        return abs(t_end - t0)
+    return _select_initial_step(stack, off, scl, lo, hi, vp, k_block, block, n0, tau, cap_off, t0, t_end, y, f, rtol,
+                                np.full(4, atol_v), 1)  # fmt: skip
 
 
 def integrate(  # type: ignore[no-untyped-def]
@@ -222,33 +243,11 @@ def integrate(  # type: ignore[no-untyped-def]
     _rhs(stack, off, scl, y[0], lo, hi, vp, k_block, block, n0, tau, cap_off, f)
     ts[0] = t0
     ys[0] = y
-    # scipy's select_initial_step (order 7)
-    scale = np.empty(n)
-    tmp = np.empty(n)
-    for i in range(n):
-        scale[i] = atol[i] + abs(y[i]) * rtol
-    for i in range(n):
-        tmp[i] = y[i] / scale[i]
-    d0 = _norm(tmp, n)
-    for i in range(n):
-        tmp[i] = f[i] / scale[i]
-    d1 = _norm(tmp, n)
-    h0 = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
-    interval = abs(t_end - t0)
-    h0 = min(h0, interval)
-    y1 = np.empty(n)
-    for i in range(n):
-        y1[i] = y[i] + h0 * f[i]
-    f1 = np.empty(n)
-    _rhs(stack, off, scl, y1[0], lo, hi, vp, k_block, block, n0, tau, cap_off, f1)
-    for i in range(n):
-        tmp[i] = (f1[i] - f[i]) / scale[i]
-    d2 = _norm(tmp, n) / h0
-    if d1 <= 1e-15 and d2 <= 1e-15:
-        h1 = max(1e-6, h0 * 1e-3)
+    if h_first > 0.0:
+        h_abs = h_first
     else:
-        h1 = (0.01 / max(d1, d2)) ** (1.0 / 8.0)
-    h_abs = min(100.0 * h0, h1, interval) if h_first <= 0.0 else h_first
+        h_abs = _select_initial_step(stack, off, scl, lo, hi, vp, k_block, block, n0, tau, cap_off, t0, t_end, y, f,
+                                     rtol, atol, n)  # fmt: skip
     n_events = 2 if block else 0
     g = np.empty(2)
     for which in range(n_events):
@@ -358,14 +357,7 @@ def integrate(  # type: ignore[no-untyped-def]
         if root < np.inf:
             x = (root - t) / h
             for i in range(n):
-                yi = 0.0
-                for p in range(POWERS):
-                    yi += seg_f[steps - 1, POWERS - 1 - p, i]
-                    if p % 2 == 0:
-                        yi *= x
-                    else:
-                        yi *= 1.0 - x
-                ys[steps, i] = yi + seg_y[steps - 1, i]
+                ys[steps, i] = _dense_at(seg_f[steps - 1], seg_y[steps - 1, i], x, i)
             ts[steps] = root
             status = EVENT
             break
@@ -451,9 +443,10 @@ def _compiled():  # type: ignore[no-untyped-def]
     if not _COMPILED:
         g = globals()
         g["_chebval"] = clenshaw()
-        for name in ("_table", "_effective", "_rhs", "_event", "_dense_v", "_stage", "_squares", "_norm", "_grown"):
+        for name in ("_table", "_effective", "_rhs", "_event", "_allowance", "_dense_at", "_stage", "_squares",
+                     "_scaled_norm", "_grown"):  # fmt: skip
             g[name] = kernel._jit(g[name], inline=True)
-        for name in ("_event_root", "first_step", "integrate"):
+        for name in ("_event_root", "_select_initial_step", "first_step", "integrate"):
             g[name] = kernel._jit(g[name])
             _COMPILED[name] = g[name]
     return _COMPILED
@@ -487,6 +480,43 @@ def solve(
         np.asarray(y0, float), rtol, np.asarray(atol, float), h_first, _A, _B, _C, _E3, _E5, _D,
     )  # fmt: skip
     return Solution(*result)
+
+
+def effective(
+    stack: np.ndarray, off: float, scl: float, v: float, vp: float, k_block: float, cap_off: float
+) -> tuple[float, float, float, float]:
+    """(S_eff, dV/dt, neglected stress, S') at v on the tables' stacked series (reduction.effective's numbers)."""
+    _compiled()
+    return _effective(stack, off, scl, v, vp, k_block, cap_off)
+
+
+def allowance(slope: float, v: float, vp: float, sigma: float, tol: float, cap: float) -> float:
+    """The neglected stress a stretch may carry at v (reduction.allowed_neglect)."""
+    _compiled()
+    return _allowance(slope, v, vp, sigma, tol, cap)
+
+
+def reference_field(
+    stack: np.ndarray, off: float, scl: float, *, lo: float, hi: float, vp: float, k_block: float, block: bool,
+    n0: float, tau: float, cap_off: float, tol: float, cap: float,
+) -> tuple[Callable[[float, np.ndarray], np.ndarray], list[Callable[[float, np.ndarray], float]]]:  # fmt: skip
+    """The glide's right-hand side and its terminal events (off the manifold, off the table; block only) as
+    ``solve_ivp`` takes them: the reference that steps the same field by scipy."""
+    _compiled()
+
+    def rhs(_t: float, y: np.ndarray) -> np.ndarray:
+        out = np.empty(4)
+        _rhs(stack, off, scl, y[0], lo, hi, vp, k_block, block, n0, tau, cap_off, out)
+        return out
+
+    def event(which: int) -> Callable[[float, np.ndarray], float]:
+        def crossing(_t: float, y: np.ndarray) -> float:
+            return _event(which, stack, off, scl, y[0], lo, hi, vp, k_block, tol, cap, cap_off)
+
+        crossing.terminal = True  # type: ignore[attr-defined]
+        return crossing
+
+    return rhs, ([event(0), event(1)] if block else [])
 
 
 def initial_step(

@@ -346,16 +346,10 @@ def _lags(params: Parameters, aging: bool, x: np.ndarray) -> tuple[np.ndarray, n
 
 def effective(m: Manifold, v: float, vp: float, k_block: float) -> tuple[float, float, float]:
     """(S_eff(V), dV/dt, neglected stress) on the first-order slow manifold through the block."""
-    s, s1, s2, c, c1 = m.values(v)
-    a0 = k_block * (vp - v) / s1
-    da0 = -k_block / s1 - k_block * (vp - v) * s2 / (s1 * s1)
-    s_eff = s + c * a0
-    ds_eff = s1 + c1 * a0 + c * da0
-    if not ds_eff > 0.0:  # past the first-order manifold's own fold: nothing quasi-steady is left here
-        return s_eff, 0.0, OFF_MANIFOLD
-    a1 = k_block * (vp - v) / ds_eff
-    neglected = abs(c * (a1 - a0)) + abs(c * c / s1 * a1 * da0)
-    return s_eff, a1, min(neglected, OFF_MANIFOLD)
+    # one source with the glide's compiled field (glide._effective): past the first-order manifold's own fold
+    # (S_eff' <= 0) nothing quasi-steady is left, and the neglected stress reads OFF_MANIFOLD
+    s_eff, a1, neglected, _slope = glide_ode.effective(*m.stacked(), v, vp, k_block, OFF_MANIFOLD)
+    return s_eff, a1, neglected
 
 
 def allowed_neglect(m: Manifold, v: float, vp: float, sigma: float, tol: float) -> float:
@@ -370,8 +364,7 @@ def allowed_neglect(m: Manifold, v: float, vp: float, sigma: float, tol: float) 
     V0/100: with the velocity's error alone bounded, at NEGLECT_CAP tol |sigma|, the paper's cycle at rtol 1e-3 began
     its stick 4e-3 late).  The cap bounds the velocity's error on the creep branch, d/(S' V) ~ d/|sigma| there.
     """
-    slope = m.values(v)[1]
-    return tol * max(abs(sigma), min(abs(slope * (vp - v)), NEGLECT_CAP * abs(sigma)))
+    return glide_ode.allowance(m.values(v)[1], v, vp, sigma, tol, NEGLECT_CAP)
 
 
 def _effective_stress(m: Manifold, v: np.ndarray, vp: float, k_block: float) -> np.ndarray:
@@ -456,28 +449,6 @@ def glide(
     n0, tau = b.site_density, b.bond_time
     tol = THETA * rtol
     lo, hi = m.rising(v) or (m.v_lo, m.v_hi)
-
-    def rhs(_t: float, y: np.ndarray) -> np.ndarray:
-        vv = min(max(y[0], lo), hi)  # a trial stage may overshoot; the events end the stretch at the edges
-        table = m.at(math.log(vv))
-        if block:
-            s_eff, a1, _n = effective(m, vv, vp, k_block)
-        else:
-            s_eff, a1 = float(table[0]), 0.0
-        born = (n0 - n0 * float(table[5])) / tau
-        return np.array([a1, born, s_eff * vp, s_eff * vv])
-
-    def off_manifold(_t: float, y: np.ndarray) -> float:
-        vv = min(max(y[0], lo), hi)
-        s_eff, _a, neglected = effective(m, vv, vp, k_block)
-        return neglected - allowed_neglect(m, vv, vp, s_eff, tol)
-
-    def off_table(_t: float, y: np.ndarray) -> float:
-        return min(y[0] / lo - 1.0 - 1e-6, 1.0 - 1e-6 - y[0] / hi)
-
-    off_manifold.terminal = True  # type: ignore[attr-defined]
-    off_table.terminal = True  # type: ignore[attr-defined]
-    events = [off_manifold, off_table] if block else []
     y0 = np.array([v, 0.0, 0.0, 0.0])
     atol = np.array([1e-9 * v, 1e-12 * n0, 1e-30, 1e-30])
     stack, off, scl = m.stacked()
@@ -488,6 +459,7 @@ def glide(
     if GLIDE_SOLVER == "solve_ivp":
         from scipy.integrate import solve_ivp
 
+        rhs, events = glide_ode.reference_field(stack, off, scl, **reduced, tol=tol, cap=NEGLECT_CAP)
         sol = solve_ivp(
             rhs, (t, t_end), y0, method="DOP853", rtol=1e-3 * rtol, atol=atol, events=events, dense_output=True,
             first_step=h_first,
