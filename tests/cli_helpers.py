@@ -21,3 +21,11 @@ def run_main(capsys: pytest.CaptureFixture[str], *args: str) -> tuple[int, str, 
         main(list(args))
     out, err = capsys.readouterr()
     return int(exit_info.value.code), out, err
+
+
+def run_main_bytes(capsysbinary: pytest.CaptureFixture[bytes], *args: str) -> tuple[int, bytes, str]:
+    """``main()`` in-process with standard output as bytes (a PNG there must not break the capture)."""
+    with pytest.raises(SystemExit) as exit_info:
+        main(list(args))
+    out, err = capsysbinary.readouterr()
+    return int(exit_info.value.code), out, err.decode()

@@ -12,19 +12,9 @@ from __future__ import annotations
 
 import pytest
 
-from cli_helpers import run_main
+from cli_helpers import run_main, run_main_bytes
 
 TABLE1 = "src/stickslip/data/table1.csv"
-
-
-def run_bytes(capsysbinary: pytest.CaptureFixture[bytes], *args: str) -> tuple[int, bytes, str]:
-    """``main()`` in-process with standard output as bytes (a PNG there must not break the capture)."""
-    from stickslip.cli.main import main
-
-    with pytest.raises(SystemExit) as exit_info:
-        main(list(args))
-    out, err = capsysbinary.readouterr()
-    return int(exit_info.value.code), out, err.decode()
 
 
 @pytest.mark.parametrize(
@@ -39,7 +29,7 @@ def run_bytes(capsysbinary: pytest.CaptureFixture[bytes], *args: str) -> tuple[i
 )
 def test_data_on_stdout_for_want_of_o_beside_an_output_on_stdout_is_refused(capsysbinary, args, named):
     """`stickslip curve --format csv --plot -` sent the CSV to stderr and the PNG to stdout."""
-    status, out, err = run_bytes(capsysbinary, *args)
+    status, out, err = run_main_bytes(capsysbinary, *args)
     assert status == 2, err
     assert out == b""
     line = err.strip()
@@ -49,7 +39,7 @@ def test_data_on_stdout_for_want_of_o_beside_an_output_on_stdout_is_refused(caps
 
 
 def test_dev_stdout_and_dash_are_one_output(capsysbinary):
-    status, out, err = run_bytes(
+    status, out, err = run_main_bytes(
         capsysbinary, "curve", "--velocity", "100 um/s", "--format", "csv", "-o", "-", "--plot", "/dev/stdout"
     )
     assert status == 2 and out == b""

@@ -6,18 +6,9 @@ import sys
 
 import pytest
 
-from cli_helpers import run_main
+from cli_helpers import run_main, run_main_bytes
 
 PNG_END = b"IEND\xaeB`\x82"
-
-
-def _stdout_bytes(capsysbinary: pytest.CaptureFixture[bytes], *args: str) -> tuple[int, bytes, str]:
-    with pytest.raises(SystemExit) as exit_info:
-        from stickslip.cli.main import main
-
-        main(list(args))
-    out, err = capsysbinary.readouterr()
-    return int(exit_info.value.code), out, err.decode()
 
 
 @pytest.mark.parametrize(
@@ -32,7 +23,7 @@ def _stdout_bytes(capsysbinary: pytest.CaptureFixture[bytes], *args: str) -> tup
 )
 def test_a_figure_on_standard_output_is_the_whole_output(capsysbinary, args):
     """`stickslip curve --plot - > fig.png` gave the table and then the PNG: an image no viewer opens."""
-    status, out, err = _stdout_bytes(capsysbinary, *args)
+    status, out, err = run_main_bytes(capsysbinary, *args)
     assert status == 0, err
     assert out.startswith(b"\x89PNG\r\n\x1a\n") and out.endswith(PNG_END), out[:80]
     assert err.strip(), "the text the command prints goes to stderr instead"
