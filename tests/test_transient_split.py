@@ -1,11 +1,18 @@
-"""The cohort kernel and run_transient split into named steps (issue 30 item 4) give the same numbers, bit for bit.
+"""The cohort kernel and run_transient split into named steps (issue 30 item 4) give the same numbers.
 
 A regression test of a refactor: the reference arrays in ``tests/data/transient_split_reference.npz`` were written
-by ``python tests/test_transient_split.py --write`` from the code *before* the split (commit 6299fba), and every
-trace array of each case must equal them exactly (``np.array_equal``, nan where nan), as must the step counts, the
-regime and the message.  The numbers themselves are validated independently elsewhere (tests/test_transient*.py:
-closed forms, the steady solver, convergence orders); this file only pins that splitting ``kernel.advance`` and
-``solver.run_transient`` into functions changed no floating-point operation.
+by ``python tests/test_transient_split.py --write`` from the code *before* the split (commit 6299fba).  Every trace
+array of each case must equal them within ``SAME`` (1e-6) of the array's largest value (nan where nan), the step
+count within ``SAME_STEPS``, the regime and the message exactly.  The numbers themselves are validated
+independently elsewhere (tests/test_transient*.py: closed forms, the steady solver, convergence orders); this file
+pins that the kernel's and the solver's outcome does not move when their code is rearranged.
+
+Until 2026-11-29 the comparison was bit for bit, which held on the machines that wrote the reference and failed on
+a fresh one (AMD EPYC, AVX2 without AVX-512): numba compiles the kernel for the host's CPU, and the last bits of
+the adaptive steps differ between CPUs.  Measured there against the stored arrays: the same step counts and verdicts,
+every array within 4.0e-8 of its largest value (``from_rest_chains``: its slider position and running totals after
+the jump; ``steady_reduced`` 8.8e-14; the other cases 1.3e-18 or equal).  ``SAME`` is 25 times that, and below the
+smallest change of method this file was rewritten for that moved the stress or N (2.6e-6, the births' spacing).
 
 Each case starts from cleared caches (the quasi-steady reduction's built manifolds, ``reduction._BUILT``, are
 reused within a process, and one built at a tighter rtol serves a looser one: the answer would depend on the
@@ -172,22 +179,51 @@ def reference() -> dict[str, np.ndarray]:
         return {key: data[key] for key in data.files}
 
 
+#: an array agrees when within this share of its largest value (the module docstring: 25x the spread between CPUs)
+SAME = 1e-6
+#: and a step count within this share (no case moved by a step between CPUs; an accepted step's error near 1 could)
+SAME_STEPS = 0.02
+
+
+def _same(got: np.ndarray, expected: np.ndarray) -> bool:
+    """Equal where not floats (counts within SAME_STEPS, verdict strings exactly); floats of one shape within SAME of
+    the largest expected value, nan where nan."""
+    if expected.dtype.kind != "f":
+        if expected.dtype.kind in "iu" and got.dtype.kind in "iu" and got.shape == expected.shape:
+            return bool(np.all(np.abs(got - expected) <= SAME_STEPS * np.abs(expected) + 1))
+        return bool(np.array_equal(got, expected))
+    if got.shape != expected.shape or not np.array_equal(np.isnan(got), np.isnan(expected)):
+        return False
+    finite = np.isfinite(expected)
+    if not np.array_equal(got[~finite], expected[~finite], equal_nan=True):
+        return False
+    scale = float(np.max(np.abs(expected[finite]), initial=0.0))
+    return bool(np.all(np.abs(got[finite] - expected[finite]) <= SAME * scale))
+
+
 @pytest.mark.parametrize("name", list(CASES))
 def test_the_split_changes_no_number(name: str, reference: dict[str, np.ndarray]) -> None:
     got = _case(name)
     keys = sorted(key.split("/", 1)[1] for key in reference if key.startswith(name + "/"))
     assert keys == sorted(got), (keys, sorted(got))
     for key in keys:
-        expected = reference[f"{name}/{key}"]
-        nan = expected.dtype.kind == "f"  # rows without chains (or before the first slip) hold nan in both
-        assert np.array_equal(got[key], expected, equal_nan=nan), f"{name}: {key} differs"
+        assert _same(got[key], reference[f"{name}/{key}"]), f"{name}: {key} differs"
 
 
 def test_the_comparison_can_fail(reference: dict[str, np.ndarray]) -> None:
-    """A last bit changed anywhere in a trace is seen (the comparison is exact, not a tolerance)."""
-    stress = reference["velocity_step/stress"].copy()
-    stress[-1] = np.nextafter(stress[-1], np.inf)
-    assert not np.array_equal(stress, reference["velocity_step/stress"])
+    """A change of 2 SAME of the largest value at one row is seen, as is one more nan, a row less, a step count 5 %
+    off; one of SAME / 2 is not."""
+    stress = reference["velocity_step/stress"]
+    scale = float(np.max(np.abs(stress)))
+    for moved, seen in ((2 * SAME, True), (0.5 * SAME, False)):
+        changed = stress.copy()
+        changed[len(changed) // 2] += moved * scale
+        assert _same(changed, stress) is not seen
+    holed = stress.copy()
+    holed[-1] = np.nan
+    assert not _same(holed, stress) and not _same(stress[:-1], stress)
+    counts = reference["velocity_step/counts"]
+    assert not _same(np.rint(counts * 1.05).astype(counts.dtype) + 1, counts) and _same(counts.copy(), counts)
 
 
 def _write(names: list[str]) -> None:
