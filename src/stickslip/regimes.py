@@ -373,6 +373,14 @@ def _ratio(ratio: float) -> str:
     )
 
 
+def settled_window_start(begin: float, end: float, period: float) -> float:
+    """Where a run over [begin, end] is averaged for what it settled into: the last whole periods within its second
+    half, or that half if it does not oscillate (``models.run.settled_mean``; rate-and-state's from its integral)."""
+    half = 0.5 * (end - begin)
+    span = float(np.floor(half / period) * period) if np.isfinite(period) and period > 0 else 0.0
+    return end - (span if span > 0 else half)
+
+
 def classify_cycles(peak_times: list[float], peaks: list[float], troughs: list[float]) -> Regime:
     """Classify from exact cycles instead of a trace: the time and stress of each peak, and the trough after it.
 

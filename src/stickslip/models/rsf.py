@@ -217,7 +217,9 @@ def rsf_run(result: Any) -> Run:
         kind, r.periods, r.growth, r.period, r.peak_friction * scale, r.trough_friction * scale,
         r.evidence or result.summary()["message"],
     )  # fmt: skip
-    mean = settled_mean(result.time, result.friction, r.period)
+    # the solver's integral over the settled window where it was carried; the rows' otherwise (a fit's runs)
+    settled = result.settled_mean_friction
+    mean = settled if math.isfinite(settled) else settled_mean(result.time, result.friction, r.period)
     velocity = protocol.segments[-1].velocity  # the last segment's, whose regime is reported
     kc = critical_stiffness(params, velocity) if velocity > 0 else NAN
     summary = {

@@ -52,10 +52,7 @@ def time_mean(time: np.ndarray, values: np.ndarray) -> float:
 
 def settled_mean(time: np.ndarray, values: np.ndarray, period: float) -> float:
     """Mean over the last whole periods within the run's second half (over that half if it does not oscillate)."""
-    end = float(time[-1])
-    half = 0.5 * (end - float(time[0]))
-    span = float(np.floor(half / period) * period) if np.isfinite(period) and period > 0 else 0.0
-    return window_mean(time, values, end - (span if span > 0 else half))
+    return window_mean(time, values, regimes.settled_window_start(float(time[0]), float(time[-1]), period))
 
 
 def window_mean(time: np.ndarray, values: np.ndarray, start: float) -> float:

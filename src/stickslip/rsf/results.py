@@ -90,6 +90,10 @@ class RSFRun:
     #: the mean of mu over the run (to its end, or to a blow-up): the solver's integral of mu dt over its time,
     #: whatever the output sampling (NaN where the run was not integrated so)
     run_mean_friction: float = math.nan
+    #: the mean of mu over the settled window (:func:`stickslip.models.run.settled_mean`'s: the last whole periods
+    #: within the run's second half, else that half) from the same integral, whatever the sampling (NaN where not
+    #: integrated so)
+    settled_mean_friction: float = math.nan
 
     @property
     def final_friction(self) -> float:

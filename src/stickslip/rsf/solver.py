@@ -17,6 +17,7 @@ from typing import Any
 
 import numpy as np
 
+from .. import regimes
 from ..errors import ModelError, ParameterError
 from ..protocols import Protocol
 from ..units import shorten, to_si
@@ -108,6 +109,7 @@ def simulate(
     # sample from the adaptive solver's interpolant instead, which watches every step.
     watch = grid is not None and params.eta == 0 and params.mass == 0 and _unstable_somewhere(params, protocol)
     t_parts, y_parts = [np.array([0.0])], [y[:, None]]
+    piece_starts: list[tuple[float, np.ndarray, float]] = []  # (t0, the state there, vlp) of each piece integrated
     integral, reached = 0.0, 0.0
     status, message = "ok", ""
     last: Solution | None = None
@@ -115,6 +117,7 @@ def simulate(
     for t0, t1, vlp in protocol.pieces():  # every piece's clock before any is integrated (a long hold would
         _check_clock(params, max(vlp, v_start if t0 == 0 else 0.0), t1)  # stall before the slide after it)
     for index, (t0, t1, vlp) in enumerate(protocol.pieces()):
+        piece_starts.append((t0, y, vlp))
         short = None
         try:
             short = _short_piece(carried, y, t0, t1, vlp, grid)
@@ -153,8 +156,38 @@ def simulate(
     y_all = np.concatenate(y_parts, axis=1)
     run = assemble_run(system, protocol, t_all, y_all[inner], status, message, v_start, detect, last, rtol)
     if mean:
-        run = replace(run, run_mean_friction=integral / reached if reached > 0 else float(run.friction[-1]))
+        run = replace(
+            run, run_mean_friction=integral / reached if reached > 0 else float(run.friction[-1]),
+            settled_mean_friction=_settled_mean(carried, t_all, y_all, piece_starts, integral, reached,
+                                                run.regime.period, rtol, carried_atol),
+        )  # fmt: skip
     return _requested(run, grid) if times is not None else run
+
+
+def _settled_mean(
+    carried: WithIntegral, t_rows: np.ndarray, y_rows: np.ndarray, starts: list[tuple[float, np.ndarray, float]],
+    integral: float, end: float, period: float, rtol: float, atol: Any,
+) -> float:  # fmt: skip
+    """The mean of mu over :func:`stickslip.models.run.settled_mean`'s window of [0, end] from the carried integral
+    q: q(end) less q at the window's start, which the solver reaches from the last row or piece start before it
+    (each holds the solver's own q; none is interpolated), so that the mean does not depend on the sampling.  NaN
+    where that short integration fails (the caller then takes the rows')."""
+    if not end > 0:
+        return math.nan
+    start = regimes.settled_window_start(0.0, end, period)
+    k = max(int(np.searchsorted(t_rows, start, side="right")) - 1, 0)
+    j = max(int(np.searchsorted([s[0] for s in starts], start, side="right")) - 1, 0)
+    t_anchor, y_anchor = float(t_rows[k]), y_rows[:, k]
+    if starts[j][0] > t_anchor:  # a piece began after the last row: its start is nearer, and on the same velocity
+        t_anchor, y_anchor = starts[j][0], starts[j][1]
+    if t_anchor == start:
+        q = float(y_anchor[-1])
+    else:
+        out, ok = _odeint(carried, np.asarray(y_anchor, float), np.array([t_anchor, start]), starts[j][2], rtol, atol)
+        if not ok:
+            return math.nan
+        q = float(out[-1, -1])
+    return (integral - q) / (end - start)
 
 
 class WithIntegral:
