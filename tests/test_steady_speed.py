@@ -17,7 +17,7 @@ import pytest
 
 from reference_slope import reference_slope_many, slope_error
 from reference_steady import box_cases, reference_many
-from stickslip import ModelError, load_parameters, steady_state
+from stickslip import ModelError, ParameterError, load_parameters, steady_state
 from stickslip.quasistatic import steady
 
 GEL = load_parameters("gelatin-glass")
@@ -211,3 +211,32 @@ def test_a_fits_small_batch_runs_compiled_and_agrees_with_the_numpy_march(monkey
     plain = steady_stress_many(sets, velocity)
     assert not calls
     assert float(np.max(_rel(fast, plain))) <= 1e-10
+
+
+def test_a_fits_narrow_calls_run_compiled_and_agree_with_steady_state(monkeypatch):
+    """A fit's residuals (model_stress at its data's few velocities) and its critical point's searches repeat
+    narrow calls: they take the compiled march at any width, and give steady_state's numpy march to rounding."""
+    from stickslip.fitting.batch import model_stress
+    from stickslip.fitting.critical_uncertainty import local_critical
+
+    velocity = np.array([20e-6, 124e-6, 350e-6])
+    plain = steady_state(GEL, velocity)
+    calls = []
+    original = steady._march_compiled
+    monkeypatch.setattr(steady, "_march_compiled", lambda *a: calls.append(1) or original(*a))
+    fast = model_stress(GEL, velocity)
+    assert calls, "a fit's narrow call ran on numpy"
+    assert float(np.max(_rel(fast, plain.stress))) <= 1e-10
+    calls.clear()
+    vc, sc = local_critical(GEL, 124e-6)
+    assert calls
+    monkeypatch.setattr(steady, "_march_compiled", original)
+    slope = steady_state(GEL, [vc * 0.999, vc * 1.001]).stress_slope
+    assert slope[0] < 0.0 < slope[1]  # a minimum of the numpy march's curve lies between
+    assert sc == pytest.approx(float(steady_state(GEL, vc).stress), rel=1e-10)
+
+
+@pytest.mark.parametrize("bad", [0, -3, 2.5, True, "16"])
+def test_compiled_from_must_be_a_positive_whole_number(bad):
+    with pytest.raises(ParameterError, match="compiled_from"):
+        steady_state(GEL, 1e-4, compiled_from=bad)

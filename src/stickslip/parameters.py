@@ -35,6 +35,7 @@ block.base_length         l        trapezoid length on the contact side (Eq 17)
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 import os
 import sys
@@ -68,15 +69,24 @@ def _optional(f: Any) -> bool:
     return bool(f.metadata.get("optional", False))
 
 
+@functools.cache
+def _fields_of(cls: type) -> tuple[Any, ...]:
+    return fields(cls)
+
+
 class _Validated:
     """Mixin: every field must be a finite float, positive (or >= 0 where allowed)."""
 
     _section = ""
 
     def __post_init__(self) -> None:
-        for f in fields(self):  # type: ignore[arg-type]
-            key = f"{self._section}.{f.name}"
+        for f in _fields_of(type(self)):
             raw = getattr(self, f.name)
+            # the common case, a float already finite, normal and of the allowed sign, needs no conversion (a
+            # sampler's walkers make ~10^5 sets; the checks below, key text included, cost most of a set's making)
+            if type(raw) is float and sys.float_info.min <= raw < math.inf:
+                continue
+            key = f"{self._section}.{f.name}"
             if raw is None and _optional(f):
                 continue
             if isinstance(raw, bool) or not isinstance(raw, (int, float)):

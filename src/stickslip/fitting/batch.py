@@ -21,7 +21,7 @@ import numpy as np
 
 from ..errors import ModelError, ParameterError
 from ..parameters import Parameters
-from ..quasistatic.steady import steady_state, steady_stress_many
+from ..quasistatic.steady import steady_stress_many
 
 
 @contextmanager
@@ -35,9 +35,14 @@ def overflow_is_failure() -> Iterator[None]:
 
 
 def model_stress(params: Parameters, velocity: np.ndarray, aging: bool = True) -> np.ndarray:
-    """sigma(V) of Eqs 6-8; ModelError where the model's arithmetic overflows or the answer is not finite."""
+    """sigma(V) of Eqs 6-8; ModelError where the model's arithmetic overflows or the answer is not finite.
+
+    A fit or a search calls this hundreds of times, and its Jacobians have loaded numba already: it runs the
+    compiled march at any width (docs/steady-state.md, "Wide batches run compiled").
+    """
+    shape = np.shape(velocity)
     with overflow_is_failure():
-        stress = steady_state(params, velocity, aging=aging).stress
+        stress = steady_stress_many([params], velocity, aging=aging, compiled_from=1)[0].reshape(shape)
     if not np.all(np.isfinite(stress)):
         raise ModelError("the steady model has no finite answer for these parameters")
     return stress

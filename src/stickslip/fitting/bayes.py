@@ -322,11 +322,12 @@ class _Kernels:
         self.norm = -math.log(count) - 0.5 * dim * math.log(2 * math.pi) - float(np.sum(np.log(np.diag(self.chol))))
 
     def log_density(self, x: np.ndarray) -> np.ndarray:
-        from scipy.special import logsumexp
-
         z = np.linalg.solve(self.chol, x.T).T  # (points, dim)
         squared = np.sum((z[:, None, :] - self.white[None, :, :]) ** 2, axis=2)
-        return logsumexp(-0.5 * squared, axis=1) + self.norm
+        # log-sum-exp of -squared/2 over the kernels, each row shifted by its nearest kernel (every term finite;
+        # scipy's logsumexp, which also handles infinities and signs, took half the proposal's time)
+        nearest = squared.min(axis=1)
+        return -0.5 * nearest + np.log(np.sum(np.exp(-0.5 * (squared - nearest[:, None])), axis=1)) + self.norm
 
     def draw(self, count: int, random: np.random.RandomState) -> np.ndarray:
         centres = self.samples[random.randint(self.samples.shape[0], size=count)]

@@ -40,6 +40,12 @@ PROFILE_TOLERANCE = 0.02
 PROFILE_REACH = math.log(100.0)
 
 
+def _steady(params: Parameters, velocity: Any, aging: bool = True) -> Any:
+    """steady_state on the compiled march at any width: locating Vc repeats narrow calls (the fit's Jacobians
+    have loaded numba already)."""
+    return steady_state(params, velocity, aging=aging, compiled_from=1)
+
+
 def local_critical(params: Parameters, guess: float) -> tuple[float, float] | None:
     """(Vc, sigma_c) near ``guess``: a slope sign change on a log grid refined by Brent's method.
 
@@ -48,7 +54,7 @@ def local_critical(params: Parameters, guess: float) -> tuple[float, float] | No
     """
     grid = guess * np.exp(np.linspace(-LOCAL_BRACKET, LOCAL_BRACKET, 13))
     try:
-        slope = steady_state(params, grid).stress_slope
+        slope = _steady(params, grid).stress_slope
     except (ModelError, ParameterError):
         return None
     ups = np.nonzero((slope[:-1] < 0) & (slope[1:] >= 0))[0]
@@ -58,11 +64,11 @@ def local_critical(params: Parameters, guess: float) -> tuple[float, float] | No
     k = ups[np.argmin(np.abs(np.log(grid[ups] / guess)))]
 
     def g(log_v: float) -> float:
-        return float(steady_state(params, math.exp(log_v)).stress_slope)
+        return float(_steady(params, math.exp(log_v)).stress_slope)
 
     log_v = brentq(g, math.log(grid[k]), math.log(grid[k + 1]), xtol=1e-10)
     v = math.exp(log_v)
-    return v, float(steady_state(params, v).stress)
+    return v, float(_steady(params, v).stress)
 
 
 def critical_many(params_list: list[Parameters], guess: float) -> np.ndarray:
@@ -92,12 +98,12 @@ def critical_many(params_list: list[Parameters], guess: float) -> np.ndarray:
         log_v = grid_ln[k] + 0.5 * h * (row[k - 1] - row[k + 1]) / curvature
         try:
             for _ in range(NEWTON_STEPS):
-                trio = steady_state(params, np.exp(log_v + np.array([-NEWTON_DELTA, 0.0, NEWTON_DELTA])))
+                trio = _steady(params, np.exp(log_v + np.array([-NEWTON_DELTA, 0.0, NEWTON_DELTA])))
                 g = trio.stress_slope * trio.velocity  # dsigma/d ln V
                 step = g[1] * 2 * NEWTON_DELTA / (g[2] - g[0])
                 log_v -= float(np.clip(step, -h, h))
             v = math.exp(log_v)
-            out[n] = (v, float(steady_state(params, v).stress))
+            out[n] = (v, float(_steady(params, v).stress))
         except (ModelError, ParameterError):
             continue
     return out
@@ -107,15 +113,15 @@ def critical_gradient(space: Space, theta: np.ndarray, vc: float) -> tuple[np.nd
     """(d ln Vc/d theta, d ln sigma_c/d theta) by the implicit function theorem (module docstring)."""
     h = JACOBIAN_STEP
     params = space.params(theta)
-    around = steady_state(params, np.array([vc * math.exp(-h), vc * math.exp(h)]))
+    around = _steady(params, np.array([vc * math.exp(-h), vc * math.exp(h)]))
     curvature = (around.stress_slope[1] - around.stress_slope[0]) / (2 * h)  # d slope/d ln V
     grad_v = np.empty(theta.size)
     grad_s = np.empty(theta.size)
     for k in range(theta.size):
         step = np.zeros_like(theta)
         step[k] = h
-        up = steady_state(space.params(theta + step), vc)
-        down = steady_state(space.params(theta - step), vc)
+        up = _steady(space.params(theta + step), vc)
+        down = _steady(space.params(theta - step), vc)
         grad_v[k] = -(float(up.stress_slope) - float(down.stress_slope)) / (2 * h) / curvature
         grad_s[k] = (math.log(float(up.stress)) - math.log(float(down.stress))) / (2 * h)
     return grad_v, grad_s
@@ -151,7 +157,7 @@ class Profile:
     def _state(self, theta: np.ndarray, v: float) -> tuple[np.ndarray, float, float] | None:
         try:
             with overflow_is_failure():
-                state = steady_state(self.space.params(theta), np.append(self.block.eval_points, v), aging=True)
+                state = _steady(self.space.params(theta), np.append(self.block.eval_points, v), aging=True)
         except (ModelError, ParameterError):
             return None
         stress = float(state.stress[-1])
@@ -202,7 +208,7 @@ class Profile:
             if log_s is not None:
                 out[n + 1, k] = CONSTRAINT_WEIGHT * (math.log(stress[up, n + 1] / stress[down, n + 1])) / (2 * h)
         if with_v:
-            trio = steady_state(self.space.params(theta), v * np.exp([-h, h]))
+            trio = _steady(self.space.params(theta), v * np.exp([-h, h]))
             slopes = trio.stress_slope * trio.velocity / trio.stress
             out[n, -1] = CONSTRAINT_WEIGHT * (slopes[1] - slopes[0]) / (2 * h)
             if log_s is not None:

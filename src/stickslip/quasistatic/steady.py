@@ -566,12 +566,23 @@ def _stress_scale(params: Parameters) -> float:
     return b.chain_stiffness * b.site_density * b.max_extension
 
 
+def _lanes(compiled_from: Any, default: int) -> int:
+    """The width from which the march runs compiled: ``compiled_from`` (a positive integer) or ``default``."""
+    if compiled_from is None:
+        return default
+    if isinstance(compiled_from, bool) or not isinstance(compiled_from, int | np.integer) or compiled_from < 1:
+        raise ParameterError(f"compiled_from: expected a positive whole number of lanes, got {compiled_from!r}")
+    return int(compiled_from)
+
+
 def steady_state(
     params: Parameters,
     velocity: Any,
     aging: bool = True,
     distribution: bool = False,
     quadrature: QuadratureSettings = DEFAULT_QUADRATURE,
+    *,
+    compiled_from: int | None = None,
 ) -> SteadyState:
     """The steady friction stress, bonded fraction and dsigma/dV at each sliding velocity (Eqs 6-8).
 
@@ -579,7 +590,9 @@ def steady_state(
     ParameterError, not 1 m/s or its real part); ``aging=False`` drops the aging
     term of Eq 6 (the paper's no-aging curve).  With ``distribution=True`` the
     age distribution n(t_a) of Eqs 6-7 is kept at the quadrature nodes.
-    ``quadrature`` sets the panel rule (see :class:`QuadratureSettings`).
+    ``quadrature`` sets the panel rule (see :class:`QuadratureSettings`).  The march runs compiled from
+    ``compiled_from`` velocities on (default COMPILED_LANES; a caller that repeats narrow calls, such as a fit,
+    passes 1).
 
     Raises :class:`ModelError` when the stress is infinite: with a zero
     activation length bonds survive to full extension, where the FENE force
@@ -594,7 +607,7 @@ def steady_state(
     flat = np.ravel(v)
     s = _scales(params, flat, aging)
     _check_scales(s)
-    got = _march(s, quadrature, keep_nodes=distribution)
+    got = _march(s, quadrature, keep_nodes=distribution, compiled_from=_lanes(compiled_from, COMPILED_LANES))
     denom = s.birth + got.i
     scale = _stress_scale(params)
     stress = scale * got.j / denom
@@ -628,13 +641,16 @@ def steady_stress_many(
     aging: bool = True,
     quadrature: QuadratureSettings = DEFAULT_QUADRATURE,
     paired: bool = False,
+    *,
+    compiled_from: int | None = None,
 ) -> np.ndarray:
     """sigma(V) (Eqs 6-8) for many parameter sets at once: shape (len(params_list), len(velocity)).
 
     One quadrature march serves every (set, velocity) pair, so the per-call
     cost is paid once: this is what fitting Jacobians and MCMC walkers need.
     With ``paired=True`` set k is evaluated only at velocity[k] (shape
-    (len(params_list),)).  Same accuracy as :func:`steady_state`.
+    (len(params_list),)).  Same accuracy as :func:`steady_state`.  The march runs compiled from
+    ``compiled_from`` lanes (sets x velocities) on (default BATCH_COMPILED_LANES, at most COMPILED_LANES).
     """
     aging, paired = require_flag(aging, "aging"), require_flag(paired, "paired")
     v = np.ravel(_check_velocity(velocity))
@@ -655,6 +671,6 @@ def steady_stress_many(
         scale = np.repeat([_stress_scale(p) for p in params_list], v.size)
     joined = _join(parts)
     _check_scales(joined)
-    got = _march(joined, quadrature, compiled_from=min(COMPILED_LANES, BATCH_COMPILED_LANES))
+    got = _march(joined, quadrature, compiled_from=min(COMPILED_LANES, _lanes(compiled_from, BATCH_COMPILED_LANES)))
     stress = scale * got.j / (joined.birth + got.i)
     return stress if paired else stress.reshape(len(params_list), v.size)

@@ -242,7 +242,8 @@ def integrate(  # type: ignore[no-untyped-def]
     f = np.empty(n)
     _rhs(stack, off, scl, y[0], lo, hi, vp, k_block, block, n0, tau, cap_off, f)
     ts[0] = t0
-    ys[0] = y
+    for i in range(n):  # element by element: a row assigned from an array compiles numba's shape-error message, ~7 s
+        ys[0, i] = y[i]
     if h_first > 0.0:
         h_abs = h_first
     else:
@@ -365,14 +366,18 @@ def integrate(  # type: ignore[no-untyped-def]
         for i in range(n):
             y[i] = y_new[i]
             f[i] = f_new[i]
+            ys[steps, i] = y[i]
         ts[steps] = t
-        ys[steps] = y
     return status, ts[: steps + 1], ys[: steps + 1], seg_t[:steps], seg_h[:steps], seg_y[:steps], seg_f[:steps]
 
 
 def _grown(x, size):  # type: ignore[no-untyped-def]
     out = np.empty((size,) + x.shape[1:])  # noqa: RUF005 (numba: tuple concatenation, not unpacking)
-    out[: x.shape[0]] = x
+    # element by element (both C-contiguous): a slice assigned from an array compiles numba's shape-mismatch
+    # message, string formatting included, ~7 s of a cold first run
+    src, dst = x.reshape(x.size), out.reshape(out.size)
+    for i in range(x.size):
+        dst[i] = src[i]
     return out
 
 
