@@ -229,3 +229,20 @@ def test_blow_up_under_a_soft_spring_with_the_slip_law_is_a_status_not_a_scipy_e
     )
     assert run.status == "blow-up"
     assert np.all(np.isfinite(run.friction)) and run.time[-1] < 50.0
+
+
+@pytest.mark.parametrize("law", ["aging", "slip", "prz"])
+def test_the_one_state_equations_are_the_general_ones_bit_for_bit(law):
+    """A single state takes its own right-hand side (its numbers bound as locals); it must give what the general
+    classical form and the fully general one give, exactly, and a System must still pickle."""
+    import pickle
+
+    p = RSFParams(a=0.011, states=(StateVariable(law, 0.015, DC),), v_ref=V0, stiffness=800.0, eta=3.0)
+    s = System(p)
+    assert s.rhs.__name__ == "rhs" and s.classical
+    rng = np.random.default_rng(5)
+    for y in rng.uniform(-8.0, 8.0, (200, 2)):
+        one = s.rhs(0.0, y, 3e-6)
+        assert one == s._rhs_classical(0.0, y, 3e-6) == System.rhs(s, 0.0, y, 3e-6)
+    again = pickle.loads(pickle.dumps(s))
+    assert again.rhs(0.0, np.array([0.3, -0.4]), 3e-6) == s.rhs(0.0, np.array([0.3, -0.4]), 3e-6)

@@ -200,8 +200,7 @@ class WithIntegral:
         o = system.offset
         self._x, self._psi = o, slice(o + 1, o + 1 + system.n)
         # the common case (System._rhs_classical's equations, mu inline): the wrapper's cost is per evaluation
-        fast = system.rhs == system._rhs_classical
-        self.rhs = self._rhs_classical if fast else self._rhs
+        self.rhs = self._rhs_classical if system.classical else self._rhs
 
     def __getattr__(self, name: str) -> Any:
         return getattr(self.system, name)

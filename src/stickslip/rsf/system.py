@@ -8,6 +8,8 @@ friction form and the ``dmu/dt`` coupling of Nagata's law: docs/rsf.md, "Springâ
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 
@@ -43,11 +45,25 @@ class System:
         self.cutoff = None if params.cutoff is None else CutoffForm(*params.cutoff, self.v0)
         self._terms = [(law.rate, b, dc) for law, b, dc in zip(self.laws, self.b, self.dc, strict=True)]
         self._coupled = any(h != 0.0 for h in self.h)
+        #: the classical form without mass or dmu/dt coupling (the common case, without generality's cost)
+        self.classical = self.cutoff is None and self.has_jacobian and not (self._coupled or self.inertial)
+        self._choose_rhs()
+
+    def _choose_rhs(self) -> None:
         if self.cutoff is not None:
             if not self.inertial:
                 self.rhs = self._rhs_cutoff  # type: ignore[method-assign]
-        elif self.has_jacobian and not (self._coupled or self.inertial):
-            self.rhs = self._rhs_classical  # type: ignore[method-assign]  # the common case, without generality's cost
+        elif self.classical:
+            # one state: its numbers bound in a closure (a fit's millions of evaluations: ~1/3 less per run, the
+            # same arithmetic in the same order as _rhs_classical)
+            self.rhs = _one_state_rhs(self) if self.n == 1 else self._rhs_classical  # type: ignore[method-assign]
+
+    def __getstate__(self) -> dict[str, Any]:
+        return {k: v for k, v in self.__dict__.items() if k != "rhs"}  # a closure does not pickle: rebuilt
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        self.__dict__.update(state)
+        self._choose_rhs()
 
     # ------------------------------------------------------------------ friction
     def friction(self, x: float, psi: list[float] | np.ndarray) -> float:
@@ -243,3 +259,17 @@ def _half_exp_ratio(z: float) -> float:
     """w / sqrt(1 + w^2) with w = e^z/2, for z <= 0."""
     w = 0.5 * math.exp(z)
     return w / math.sqrt(1.0 + w * w)
+
+
+def _one_state_rhs(system: System) -> Callable[[float, np.ndarray, float], list[float]]:
+    """:meth:`System._rhs_classical` for one state variable, its numbers bound as locals."""
+    ((rate, b, dc),) = system._terms
+    v0, k, a, eta = system.v0, system.k, system.a, system.eta
+
+    def rhs(t: float, y: np.ndarray, vlp: float) -> list[float]:
+        x, p = y.tolist()
+        g = rate(x, p, v0, dc)[0]
+        v = v0 * _exp(x)
+        return [(k * (vlp - v) - (0.0 + b * g)) / (a + eta * v), g]
+
+    return rhs
