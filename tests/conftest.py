@@ -9,34 +9,41 @@ from click.testing import CliRunner
 
 from stickslip import critical_point, load_parameters
 
-#: The heaviest test files, heaviest first: seconds of a whole-suite run on the 2-core machine (2026-11-29, one
-#: process, ``--durations=0`` summed per file, numba's cache warm; the files issue 31 shortened as measured after
-#: it): 21.9, 21.7, 20.3, 20, 20, 19.0 (the report's build), 18.8, 14.6, 14.0, 11.8, 9.7, 9.5, 7.5, 7.1, 6.8, 6.1,
-#: 6 (and numba's compilation when it runs first), 5.9, 5.4, 5.3, 5.1, 5.1, then 5 and less.  Of 426 s.
+#: The heaviest test files, heaviest first, and the first ones arranged for a cold numba cache (a fresh clone, as CI
+#: runs): test_docs.py starts alone on one worker and its README page compiles the transient kernels (~50 s of its
+#: ~100 s cold), while the other worker runs the rate-and-state and steady fits, which need none of them (~105 s);
+#: the next transient files then load the kernels from the cache instead of compiling them a second time on the
+#: other core (two workers compiling side by side cost the suite ~45 s of wall time).  Seconds per file, summed
+#: from ``--durations=0`` of a cold whole-suite run on the 2-core AMD EPYC machine (2026-11-29): 103.6 (docs; 36 warm),
+#: 34.2, 30.1, 23.5, 19.9, 64.7 (transient_inertia; 28 warm), 28.0, 26.4 (the report's build), 20.8, 17.4, 15.1,
+#: 13.3, 13.0, 12.4, 10.9, 10.6, then 10 and less.  Of 690 s.
 HEAVY_FIRST = (
+    "test_docs.py",
     "test_rsf_fit_protocols.py",
     "test_fit_steady.py",
-    "test_transient_inertia.py",
-    "test_docs.py",
-    "test_bayes.py",
-    "test_report.py",
-    "test_transient.py",
-    "test_transient_box.py",
-    "test_transient_budget.py",
     "test_rsf_two_state.py",
-    "test_regimes.py",
-    "test_inertia.py",
-    "test_rsf_fit.py",
-    "test_cli_fit.py",
-    "test_transient_speed.py",
-    "test_robust_box.py",
-    "test_aging_saturation.py",
-    "test_fit_steady_global.py",
-    "test_rsf_fit_cli.py",
-    "test_steady_slope.py",
-    "test_sweep_cluster.py",
-    "test_transient_summary.py",
+    "test_bayes.py",
+    "test_transient_inertia.py",
+    "test_transient.py",
+    "test_report.py",
+    "test_transient_box.py",
     "test_critical_aliasing.py",
+    "test_rsf_fit.py",
+    "test_transient_budget.py",
+    "test_rsf_fit_cli.py",
+    "test_inertia.py",
+    "test_robust_box.py",
+    "test_cli_boundary.py",
+    "test_fixred_reduction.py",
+    "test_regimes.py",
+    "test_transient_speed.py",
+    "test_plots.py",
+    "test_fit_stick.py",
+    "test_fit_steady_global.py",
+    "test_cli_fit.py",
+    "test_steady_slope.py",
+    "test_aging_saturation.py",
+    "test_sweep_cluster.py",
 )
 
 

@@ -448,8 +448,9 @@ def _compiled():  # type: ignore[no-untyped-def]
     if not _COMPILED:
         g = globals()
         g["_chebval"] = clenshaw()
-        for name in ("_table", "_effective", "_rhs", "_event", "_allowance", "_dense_at", "_stage", "_squares",
-                     "_scaled_norm", "_grown"):  # fmt: skip
+        for name in ("_table", "_effective", "_allowance", "_event", "_rhs", "_grown"):
+            g[name] = kernel._jit(g[name])
+        for name in ("_dense_at", "_stage", "_squares", "_scaled_norm"):
             g[name] = kernel._jit(g[name], inline=True)
         for name in ("_event_root", "_select_initial_step", "first_step", "integrate"):
             g[name] = kernel._jit(g[name])
