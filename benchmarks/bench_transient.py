@@ -21,7 +21,7 @@ import numpy as np
 
 import stickslip
 from stickslip.protocols import Protocol, Segment, constant
-from stickslip.transient import reduction, run_transient
+from stickslip.transient import cells, reduction, run_transient
 from stickslip.transient.solver import estimate_cost
 from timing import timed
 
@@ -279,7 +279,7 @@ def main() -> None:
     # steady start through the block asks for it, ~0.07 s per parameter set)
     run_transient(p, constant(350e-6, 1e-3), control="velocity")
     run_transient(p, constant(350e-6, 1e-3), start="steady")
-    reduction.steady_cohorts(p, 350e-6, True)
+    cells.steady_cohorts(p, 350e-6, True)
     reduction._lag(p, 350e-6, True)
 
     v = 350e-6

@@ -208,8 +208,8 @@ def test_the_quasi_steady_reduction_carries_the_saturating_clock():
     """Reduced and plain cohort runs agree with saturation set: the reduction's steady cells and lag see A(t_a)."""
     from stickslip.protocols import segments
     from stickslip.transient import run_transient
+    from stickslip.transient.cells import steady_cohorts
     from stickslip.transient.model import steady_population
-    from stickslip.transient.reduction import steady_cohorts
 
     p = stickslip.load_parameters("gelatin-glass").with_overrides({"aging.saturation_age": 3e-3})
     for v in (20e-6, 350e-6, 2e-3):  # the compiled steady cells are model.steady_population's, saturation and all

@@ -14,8 +14,8 @@ import numpy as np
 
 import stickslip
 from stickslip.transient import kernel as K
+from stickslip.transient.cells import steady_cohorts
 from stickslip.transient.model import pack_parameters
-from stickslip.transient.reduction import steady_cohorts
 
 GEL = stickslip.load_parameters("gelatin-glass")
 

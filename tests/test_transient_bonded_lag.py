@@ -13,7 +13,7 @@ import pytest
 import stickslip
 from stickslip.protocols import Protocol, Segment
 from stickslip.quasistatic.steady import steady_state
-from stickslip.transient import reduction, run_transient
+from stickslip.transient import cells, reduction, run_transient
 from stickslip.transient.model import pack_parameters
 from stickslip.transient.stability import _response_kernel
 
@@ -25,7 +25,7 @@ def test_the_bonded_response_has_the_steady_slope_as_its_quasi_static_limit(velo
     """Z_N(s)/s at s -> 0 is dN_ss/dV (central difference of the steady solver's N, h = 1e-4 V)."""
     b = GEL.bonds
     p = pack_parameters(GEL, True, 1.0)
-    a, w, width, f, fp, r, gv, _energy = reduction._steady_cells()(velocity, p, reduction.CELL_HAZARD)
+    a, w, width, f, fp, r, gv, _energy = cells._steady_cells()(velocity, p, cells.CELL_HAZARD)
     eps = 1e-4 * velocity / b.max_extension
     s = np.array([eps, -eps], dtype=complex)
     z = _response_kernel()(s, a, w, width, f, fp, r, gv, b.force_sensitivity, b.site_density - w.sum()).real

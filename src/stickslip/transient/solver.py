@@ -904,7 +904,7 @@ def _steady_cohorts(
     if key not in _STEADY_COHORTS:
         if len(_STEADY_COHORTS) > 16:
             _STEADY_COHORTS.clear()
-        from .reduction import steady_cohorts
+        from .cells import steady_cohorts
 
         _STEADY_COHORTS[key] = steady_cohorts(params, velocity, aging, cell_hazard, cells_least)
     return _STEADY_COHORTS[key]

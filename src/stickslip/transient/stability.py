@@ -90,15 +90,15 @@ def _cells(
 ) -> tuple[np.ndarray, ...]:
     """Steady cohorts at ``velocity`` with force, stiffness, hazard and aging sensitivity (cached).
 
-    The reduction's compiled march of the same cells (``reduction._cells``: ~1 s less per velocity than the
+    The compiled march of the same cells (``cells._cells``, the reduction's too: ~1 s less per velocity than the
     Python march of :func:`_cells_plain`, which agrees to rounding, tests/test_stability_response_sum.py); the
     Python march where the velocity or the cell count is out of range, for its error in words."""
-    from . import reduction
+    from .cells import _steady_cells
     from .model import MAX_CELLS, pack_parameters
 
     if velocity > 0 and math.isfinite(velocity):
         packed = pack_parameters(params, aging, 1.0)
-        a, w, width, f, fp, r, gv, _ = reduction._steady_cells()(float(velocity), packed, float(cell_hazard))
+        a, w, width, f, fp, r, gv, _ = _steady_cells()(float(velocity), packed, float(cell_hazard))
         if a.size < MAX_CELLS:
             return a, w, width, f, fp, r, gv
     return _cells_plain(params, velocity, aging, cell_hazard)
