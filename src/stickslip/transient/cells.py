@@ -122,7 +122,7 @@ def _gauss(v, p, cell_hazard, cells_least):  # type: ignore[no-untyped-def]
 
 def _cells(v, p, cell_hazard):  # type: ignore[no-untyped-def]
     dlm, m = p[P_DLM], p[P_M]
-    edges, cum, slope = _march(v, p, cell_hazard)
+    edges, cum, slope = _march(v, p, cell_hazard, 1000.0)
     n = len(edges) - 1
     mid = np.empty(n)
     width = np.empty(n)

@@ -217,8 +217,9 @@ def first_step(stack, off, scl, lo, hi, vp, k_block, block, n0, tau, cap_off, t0
     _rhs(stack, off, scl, v, lo, hi, vp, k_block, block, n0, tau, cap_off, f)
     if f[0] == 0.0:
         return abs(t_end - t0)
+    # np.int64(1), not 1: numba compiles a function once per literal argument (here 1, and 4 from integrate)
     return _select_initial_step(stack, off, scl, lo, hi, vp, k_block, block, n0, tau, cap_off, t0, t_end, y, f, rtol,
-                                np.full(4, atol_v), 1)  # fmt: skip
+                                np.full(4, atol_v), np.int64(1))  # fmt: skip
 
 
 def integrate(  # type: ignore[no-untyped-def]
@@ -248,7 +249,7 @@ def integrate(  # type: ignore[no-untyped-def]
         h_abs = h_first
     else:
         h_abs = _select_initial_step(stack, off, scl, lo, hi, vp, k_block, block, n0, tau, cap_off, t0, t_end, y, f,
-                                     rtol, atol, n)  # fmt: skip
+                                     rtol, atol, np.int64(n))  # fmt: skip
     n_events = 2 if block else 0
     g = np.empty(2)
     for which in range(n_events):

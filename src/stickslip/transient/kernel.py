@@ -316,11 +316,13 @@ def _sums_keeping(n, xb, tb, lw, x, t, slope, p, cache, known, prepared, clock_e
 
 def _balance_weights(x, puller, n, xb, w, p):  # type: ignore[no-untyped-def]
     """X with sum w f(X - x_b) = K (puller - X), weights given (not logs): Newton inside the FENE bracket."""
-    return _balance_from(x, puller, n, xb, w, p, np.empty((2, 0)), False)
+    return _balance_from(x, puller, n, xb, w, p, np.empty((2, 0)))
 
 
-def _balance_from(x, puller, n, xb, w, p, at_x, given):  # type: ignore[no-untyped-def]
-    """_balance_weights, with the chains' force and stiffness at the starting x in ``at_x`` where ``given``."""
+def _balance_from(x, puller, n, xb, w, p, at_x):  # type: ignore[no-untyped-def]
+    """_balance_weights, with the chains' force and stiffness at the starting x in ``at_x`` where it has columns."""
+    # from the array, not a literal True/False at the call: numba compiles a function once per literal argument
+    given = at_x.shape[1] > 0
     lo = -np.inf
     hi = np.inf
     for i in range(n):  # the FENE wall of the oldest live chain
@@ -975,7 +977,7 @@ def _slider_at_end(  # type: ignore[no-untyped-def]
         if not (hh * abs(v1 - v1p) <= dlm):
             err_s = np.inf
     elif block == 1:
-        x1 = _balance_from(x1p, puller0 + vp * (t1 - t0), n + 2, xb, w1, p, predicted, True)
+        x1 = _balance_from(x1p, puller0 + vp * (t1 - t0), n + 2, xb, w1, p, predicted)
         v1 = _slider_velocity_clocked(v1p, vp, n + 2, xb, tb, lw_new, x1, t1, p, lc, aa, known, clock_end)
         err_s += 0.5 * hh * (abs(x1 - x1p) * sens_x + abs(_aging_factor(v1, p) - slope1) * sens_a)
         s1 = p[P_K] * (puller0 + vp * (t1 - t0) - x1)
@@ -1221,7 +1223,8 @@ def advance(  # type: ignore[no-untyped-def]
     # exp(lw_new) (then exp(lw)) where computed exactly so, else -1; force and stiffness at the step's end (block)
     known = np.full((3, xb.shape[0]), -1.0)
     predicted = np.empty((2, xb.shape[0]))  # force and stiffness at the step's predicted end x1p
-    cached = False
+    # False, typed bool: a literal False here made numba compile _cohort_pass a second time (~2.5 s on a fresh cache)
+    cached = xb.shape[0] < 0
     # the block with a mass: the slider's acceleration now and at the previous step's start (for the predictor)
     inertial = block == 1 and p[P_MASS] > 0.0
     accel_now = 0.0
