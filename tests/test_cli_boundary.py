@@ -20,12 +20,16 @@ from pathlib import Path
 import click
 import pytest
 
+import stickslip
 from cli_helpers import run_main
 from stickslip.cli import common
 from stickslip.errors import DataError
 from stickslip.report.build import MARKER, prepare_report_folder
 
-SRC = Path(__file__).resolve().parent.parent / "src"
+#: the folder holding the package these tests import (installed, under scripts/run-tests.sh): the subprocesses run
+#: the same code, and load the kernels from its numba cache.  The checkout's src/ had a cache of its own, so on a
+#: fresh clone the two transient runs below compiled the kernels a second time (~45 s of CI's test time).
+SRC = Path(stickslip.__file__).resolve().parents[1]
 
 
 def _subprocess(*args: str, timeout: float = 60) -> subprocess.CompletedProcess[str]:

@@ -24,7 +24,7 @@ from stickslip.sweeps import build_spec, load_sweep, run_sweep
 from stickslip.sweeps.store import MANIFEST
 
 VARY = "pulling_velocity=30 um/s..110 um/s:24"
-SRC = str(Path(__file__).resolve().parents[1] / "src")
+SRC = str(Path(stickslip.__file__).resolve().parents[1])  # the package these tests import (installed, in CI)
 
 
 @pytest.fixture(scope="module")
