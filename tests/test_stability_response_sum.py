@@ -80,3 +80,50 @@ def test_the_response_from_the_compiled_cells_is_the_python_marchs() -> None:
         birth_tau = (b.site_density - cells[1].sum()) / b.bond_time * b.bond_time
         responses.append(stability._response_kernel()(rates, *cells, b.force_sensitivity, birth_tau)[0])
     assert np.all(np.abs(responses[0] - responses[1]) <= 1e-10 * np.abs(responses[1]))
+
+
+def _counting(monkeypatch: pytest.MonkeyPatch) -> list[np.ndarray]:
+    """Every array of rates ``interface_response`` is asked for, in order (the real function still answers)."""
+    asked: list[np.ndarray] = []
+    real = stability.interface_response
+
+    def counted(params, velocity, s, aging=True, cell_hazard=stability.CELL_HAZARD):  # type: ignore[no-untyped-def]
+        asked.append(np.atleast_1d(np.asarray(s, dtype=complex)).copy())
+        return real(params, velocity, s, aging, cell_hazard)
+
+    monkeypatch.setattr(stability, "interface_response", counted)
+    return asked
+
+
+def test_kc_from_the_memo_is_kc_from_fresh_responses_and_a_second_mass_pays_only_its_bisection(monkeypatch):
+    """Kc's scan of Z is the same for any block mass: a process evaluates each rate once (stability._response).
+
+    Against critical_from_response on a plain response (every rate computed afresh): the same Kc, mode and rate
+    to the bit, massless and with a mass; the memo's values equal fresh ones to the bit; a second Kc at the same
+    velocity asks only for its bisection's rates (30 per crossing), and the imaginary scan stops at the resolved
+    frequency (a crossing above it is ignored, so Z there was never needed)."""
+    params = stickslip.load_parameters("gelatin-glass").with_overrides({"bonds.bond_time": 0.3e-3})  # a fresh memo
+    velocity = 120e-6
+    stability._memo.cache_clear()
+    asked = _counting(monkeypatch)
+    first = stability.critical_stiffness_details(params, velocity, True, 0.0, 0.0)
+    evaluated_first = sum(a.size for a in asked)
+    top = stability.resolved_frequency(params, velocity, True)
+    scan = stability.SCAN / params.bonds.bond_time
+    assert first.mode == "oscillatory" and first.value > 0
+    imaginary = np.concatenate([a for a in asked if np.all(a.real == 0.0)])
+    assert np.max(imaginary.imag) <= max(top, first.rate * 1.0001) and imaginary.size < scan.size + 40
+    asked.clear()
+    # a mass alone leaves Im D(i w) and so the bisection's rates as they were; a damping moves them
+    heavy = stability.critical_stiffness_details(params, velocity, True, 50.0, 1e4)
+    assert 0 < sum(a.size for a in asked) <= 30 * 4, [a.size for a in asked]
+    assert evaluated_first > 500
+
+    def plain(s: np.ndarray) -> np.ndarray:
+        return stability.interface_response(params, velocity, s, True).z
+
+    for got, mass, damping in ((first, 0.0, 0.0), (heavy, 50.0, 1e4)):
+        want = stability.critical_from_response(plain, scan, mass, damping, top)
+        assert (got.value, got.mode, got.rate) == (want.value, want.mode, want.rate), (got, want)
+    rates = np.concatenate([scan[::37], 1j * scan[::41], [3.0 + 4.0j]])
+    assert np.array_equal(stability._response(params, velocity, True)(rates), plain(rates))

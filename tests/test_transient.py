@@ -150,10 +150,12 @@ def test_critical_stiffness_is_zero_above_vc_and_checked_by_direct_runs(params):
     kc = critical_stiffness(params, v0)
     assert 1e7 < kc < 1e9
     amplitudes = []
+    # at the default rtol 1e-4: the late/early amplitude ratios 11.21 and 0.0483 (rtol 1e-5: 11.19 and 0.0483, at
+    # four times the cost)
     for factor in (0.7, 1.4):
         run = run_transient(
             params, segments([(v0 * 1.001, 0.002), (v0, 0.25)]), start="steady", start_velocity=v0,
-            stiffness=factor * kc, rtol=1e-5,
+            stiffness=factor * kc,
         )  # fmt: skip
         v = run.slider_velocity
         early = np.ptp(v[(run.time > 0.01) & (run.time < 0.06)])

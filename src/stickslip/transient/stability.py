@@ -288,7 +288,8 @@ def critical_from_response(
         d = _block_polynomial(1j * w, 0.0, mass, damping) + response(1j * w)  # D(i w) at K = 0
         return d.imag, -d.real  # (Im D(i w), K that puts a root at i w)
 
-    im_d, k_at = crossing_terms(rates)
+    # a crossing above the resolved frequency is ignored, so Z is not evaluated there (half the scan at 120 um/s)
+    im_d, k_at = crossing_terms(rates[rates <= top])
     k_osc, w_osc = 0.0, 0.0
     crossing = np.flatnonzero(np.sign(im_d[1:]) != np.sign(im_d[:-1]))
     for k in crossing:
@@ -369,8 +370,28 @@ def hopf_root(
 
 
 def _response(params: Parameters, velocity: float, aging: bool) -> Callable[[np.ndarray], np.ndarray]:
-    """Z(s) (Pa/m) of steady sliding at ``velocity``, as a function of s."""
-    return lambda s: interface_response(params, velocity, s, aging).z
+    """Z(s) (Pa/m) of steady sliding at ``velocity``, as a function of s; each s evaluated once per process.
+
+    Kc's scan is the same ~800 rates for any block mass or damping (~1 s at 120 um/s): a second Kc at that
+    velocity (another mass, the Hopf root's own Kc) pays only its bisection.  Each Z(s) is computed apart from the
+    others (the kernel's outer loop), so a value from the memo is the one a fresh call gives, to the bit.
+    """
+    memo = _memo(params, float(velocity), bool(aging))
+
+    def z(s: np.ndarray) -> np.ndarray:
+        wanted = np.atleast_1d(np.asarray(s, dtype=complex)).tolist()
+        missing = [x for x in dict.fromkeys(wanted) if x not in memo]
+        if missing:
+            values = interface_response(params, velocity, np.array(missing), aging).z.tolist()
+            memo.update(zip(missing, values, strict=True))
+        return np.array([memo[x] for x in wanted], dtype=complex)
+
+    return z
+
+
+@lru_cache(maxsize=32)
+def _memo(params: Parameters, velocity: float, aging: bool) -> dict[complex, complex]:
+    return {}
 
 
 def real_growth_rates(
