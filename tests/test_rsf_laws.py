@@ -14,6 +14,7 @@ from stickslip.rsf import (
     StateLaw,
     StateVariable,
     critical_stiffness,
+    laws,
     neutral_period,
     register_law,
     rsf_params,
@@ -241,8 +242,14 @@ def test_the_one_state_equations_are_the_general_ones_bit_for_bit(law):
     s = System(p)
     assert s.rhs.__name__ == "rhs" and s.classical
     rng = np.random.default_rng(5)
-    for y in rng.uniform(-8.0, 8.0, (200, 2)):
+    # and about the exponentials' cap (EXP_CAP = 700: the laws' state_rate caps as cexp does)
+    edges = np.array([[750.0, -750.0], [-750.0, 750.0], [699.9, -0.5], [0.5, -700.1], [-360.0, 1400.0]])
+    for y in np.vstack([rng.uniform(-8.0, 8.0, (200, 2)), edges]):
         one = s.rhs(0.0, y, 3e-6)
         assert one == s._rhs_classical(0.0, y, 3e-6) == System.rhs(s, 0.0, y, 3e-6)
     again = pickle.loads(pickle.dumps(s))
     assert again.rhs(0.0, np.array([0.3, -0.4]), 3e-6) == s.rhs(0.0, np.array([0.3, -0.4]), 3e-6)
+    # a law that writes only rate() (a user's) gets state_rate from it
+    plain = type("Plain", (type(s.laws[0]),), {"state_rate": laws.StateLaw.state_rate})()
+    g, fast = plain.state_rate(V0, DC), s.laws[0].state_rate(V0, DC)
+    assert all(g(x, p) == fast(x, p) == s.laws[0].rate(x, p, V0, DC)[0] for x, p in rng.uniform(-8.0, 8.0, (50, 2)))

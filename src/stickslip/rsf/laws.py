@@ -9,6 +9,7 @@ velocity friction.  The laws' table, the cut-off form and adding a law (:func:`r
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from typing import ClassVar
 
 from ..errors import ParameterError
@@ -82,7 +83,9 @@ class StateLaw:
 
     ``theta_scale``: theta = theta_scale (Dc/V0) e^psi.  ``rate`` returns
     ``(g, dg/dx, dg/dpsi)`` where ``g`` is d psi/dt without the dmu/dt term.
-    ``coupling(b, c)`` is the coefficient h of ``d psi/dt = g + h dmu/dt``.
+    ``coupling(b, c)`` is the coefficient h of ``d psi/dt = g + h dmu/dt``.  ``state_rate(v0, dc)`` is ``g`` alone
+    as a function of ``(x, psi)``, for the solver's right-hand side (a law need not write it: the default takes
+    ``rate``'s first value; the built-in laws write it out, the same arithmetic in the same order).
     """
 
     name: ClassVar[str] = "law"
@@ -91,6 +94,10 @@ class StateLaw:
 
     def rate(self, x: float, psi: float, v0: float, dc: float) -> tuple[float, float, float]:
         raise NotImplementedError
+
+    def state_rate(self, v0: float, dc: float) -> Callable[[float, float], float]:
+        rate = self.rate
+        return lambda x, psi: rate(x, psi, v0, dc)[0]
 
     def coupling(self, b: float, c: float) -> float:
         return 0.0
@@ -105,6 +112,15 @@ class Aging(StateLaw):
         ev, ep = cexp(x), cexp(-psi)
         return r * (ep - ev), -r * ev, -r * ep
 
+    def state_rate(self, v0: float, dc: float) -> Callable[[float, float], float]:
+        r, exp, cap = v0 / dc, math.exp, EXP_CAP
+
+        def g(x: float, psi: float) -> float:
+            z = -psi
+            return r * (exp(z if z < cap else cap) - exp(x if x < cap else cap))
+
+        return g
+
 
 class Slip(StateLaw):
     name = "slip"
@@ -114,6 +130,14 @@ class Slip(StateLaw):
         w = v0 * cexp(x) / dc
         s = x + psi
         return -w * s, -w * (s + 1.0), -w
+
+    def state_rate(self, v0: float, dc: float) -> Callable[[float, float], float]:
+        exp, cap = math.exp, EXP_CAP
+
+        def g(x: float, psi: float) -> float:
+            return -(v0 * exp(x if x < cap else cap) / dc) * (x + psi)
+
+        return g
 
 
 class Prz(StateLaw):
@@ -125,6 +149,15 @@ class Prz(StateLaw):
         r = v0 / (2.0 * dc)
         ep, eq = cexp(-psi), cexp(2.0 * x + psi)
         return r * (ep - eq), -2.0 * r * eq, -r * (ep + eq)
+
+    def state_rate(self, v0: float, dc: float) -> Callable[[float, float], float]:
+        r, exp, cap = v0 / (2.0 * dc), math.exp, EXP_CAP
+
+        def g(x: float, psi: float) -> float:
+            z, u = -psi, 2.0 * x + psi
+            return r * (exp(z if z < cap else cap) - exp(u if u < cap else cap))
+
+        return g
 
 
 class Nagata(Aging):

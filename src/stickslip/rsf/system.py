@@ -263,12 +263,13 @@ def _half_exp_ratio(z: float) -> float:
 
 def _one_state_rhs(system: System) -> Callable[[float, np.ndarray, float], list[float]]:
     """:meth:`System._rhs_classical` for one state variable, its numbers bound as locals."""
-    ((rate, b, dc),) = system._terms
+    ((_, b, dc),) = system._terms
     v0, k, a, eta = system.v0, system.k, system.a, system.eta
+    rate = system.laws[0].state_rate(v0, dc)  # g alone (the built-in laws: no tuple, no call per exponential)
 
     def rhs(t: float, y: np.ndarray, vlp: float) -> list[float]:
         x, p = y.tolist()
-        g = rate(x, p, v0, dc)[0]
+        g = rate(x, p)
         v = v0 * _exp(x)
         return [(k * (vlp - v) - (0.0 + b * g)) / (a + eta * v), g]
 
