@@ -354,6 +354,12 @@ def _balance_from(x, puller, n, xb, w, p, at_x):  # type: ignore[no-untyped-def]
         else:
             lo = max(lo, x)
         x_new = x - g / k
+        if abs(x_new - x) <= 1e-15 * max(abs(x), p[P_DLM]) and lo <= x_new <= hi:
+            # Newton's own correction is within the tolerance: converged.  Tested after the bracket's fallback
+            # instead, a correction below an ulp of x (x_new == x, the bracket's edge) was taken for a step out of
+            # the bracket and bisected some 16 more passes over the cohorts down to the tolerance, to a root no
+            # closer (the paper's cycle: 1 400 of its 3 000 balances; docs/transient.md section 14)
+            return x_new
         if not (lo < x_new < hi):  # FENE walls: stay inside the bracket
             x_new = 0.5 * (lo + hi) if (lo > -np.inf and hi < np.inf) else x - 0.5 * g / k
         if abs(x_new - x) <= 1e-15 * max(abs(x), p[P_DLM]):
@@ -410,10 +416,15 @@ def _inertial_step(d, x0, v0, force0, h, puller1, n, xb, w, p, at_x):  # type: i
         else:
             lo = max(lo, d)
         d_new = d - g / slope
+        # v1 = 2 d/h - v0 to ~1e-15 of the slider's pace (a step landing on a sample can be ~1e-20 s long); Newton's
+        # own correction is judged before the bracket's fallback, which bisected a correction below an ulp of d
+        # (as in _balance_from)
+        settled = 1e-15 * (abs(d) + h * abs(v0))
+        if abs(d_new - d) <= settled:
+            break
         if not (lo < d_new < hi):
             d_new = 0.5 * (lo + hi) if (lo > -np.inf and hi < np.inf) else d - 0.5 * g / slope
-        # v1 = 2 d/h - v0 to ~1e-15 of the slider's pace (a step landing on a sample can be ~1e-20 s long)
-        if abs(d_new - d) <= 1e-15 * (abs(d) + h * abs(v0)) or d_new == d:
+        if abs(d_new - d) <= settled or d_new == d:
             break
         d = d_new
     return d, s, k
