@@ -465,14 +465,34 @@ def _vacancy(u, q0, tau, h, l0, d0, l1, d1):  # type: ignore[no-untyped-def]
     Exact for the cubic: Gauss-Legendre (4 points, degree 7) when u < tau, where the exponential kernel is
     smooth on [0, u]; the closed form by parts (no cancellation once u >= tau) otherwise.
     """
+    dec, c0, c1, c2, c3 = _vacancy_kernel(u, tau)
+    return _vacancy_from(u, q0, tau, h, l0, d0, l1, d1, dec, c0, c1, c2, c3)
+
+
+def _vacancy_kernel(u, tau):  # type: ignore[no-untyped-def]
+    """The exponentials of :func:`_vacancy` at u, which do not depend on the breakage rate: e^(-u/tau) and, for
+    u < tau, the kernel e^(-(u - s)/tau) at the four Gauss points s (the births' sweeps take them once a step)."""
     if u <= 0.0:
-        return q0
+        return 1.0, 0.0, 0.0, 0.0, 0.0
     dec = math.exp(-u / tau)
     if u < tau:
-        total = 0.0
-        for j in range(4):
-            s = 0.5 * u * (1.0 + GL4_X[j])
-            total += GL4_W[j] * _hermite(s / h, h, l0, d0, l1, d1) * math.exp(-(u - s) / tau)
+        c0 = math.exp(-(u - 0.5 * u * (1.0 + GL4_X[0])) / tau)
+        c1 = math.exp(-(u - 0.5 * u * (1.0 + GL4_X[1])) / tau)
+        c2 = math.exp(-(u - 0.5 * u * (1.0 + GL4_X[2])) / tau)
+        c3 = math.exp(-(u - 0.5 * u * (1.0 + GL4_X[3])) / tau)
+        return dec, c0, c1, c2, c3
+    return dec, 0.0, 0.0, 0.0, 0.0
+
+
+def _vacancy_from(u, q0, tau, h, l0, d0, l1, d1, dec, c0, c1, c2, c3):  # type: ignore[no-untyped-def]
+    """:func:`_vacancy` with its exponentials from :func:`_vacancy_kernel` (the same numbers)."""
+    if u <= 0.0:
+        return q0
+    if u < tau:
+        total = GL4_W[0] * _hermite(0.5 * u * (1.0 + GL4_X[0]) / h, h, l0, d0, l1, d1) * c0
+        total += GL4_W[1] * _hermite(0.5 * u * (1.0 + GL4_X[1]) / h, h, l0, d0, l1, d1) * c1
+        total += GL4_W[2] * _hermite(0.5 * u * (1.0 + GL4_X[2]) / h, h, l0, d0, l1, d1) * c2
+        total += GL4_W[3] * _hermite(0.5 * u * (1.0 + GL4_X[3]) / h, h, l0, d0, l1, d1) * c3
         return q0 * dec + 0.5 * u * total
     # L = a + b s + c s^2 + e s^3, and the integral of L(s) e^{-(u-s)/tau} over [0, u] is F(u) - e^{-u/tau} F(0)
     # with F = tau (L - tau dL + tau^2 d2L - tau^3 d3L)
@@ -796,21 +816,21 @@ def _cohort_pass(  # type: ignore[no-untyped-def]
     )  # fmt: skip
 
 
-def _gauss_birth(  # type: ignore[no-untyped-def]
-    k, n, t, hh, x, x1p, v0, v1p, accel, accel_now, jerk, slope1, q0, loss0, dloss0, l1, d1, inertial, xb, tb,
-    lw_new, w1, known, rate0, predicted, p,
+def _birth_point(  # type: ignore[no-untyped-def]
+    k, n, t, hh, x, x1p, v0, v1p, accel, accel_now, jerk, slope1, r_birth, inertial, xb, tb, known, rate0, predicted, p
 ):  # fmt: skip
-    """The births of half the step (k = 0, 1) as one cohort, n + k, at its Gauss-Legendre point, the vacancy's
-    relaxation from q0 with the breakage rate's Hermite cubic (l1, d1 at the end): (born, alive at the step's end,
-    the energy of those that broke, the error of lumping them, their breakage rate at the end and its derivative,
-    their extension there)."""
+    """The births of half the step (k = 0, 1), lumped at its Gauss-Legendre point as cohort n + k: what does not
+    depend on how many are born (their place, force, hazard, survival to the step's end), computed once a step.
+    Returns (the Gauss point u within the step, the share of them alive at the step's end, the energy each one
+    that breaks dissipates, the lumping error per bond born, their hazard at the end and its log's rate there,
+    their extension there, the vacancy's exponentials at u).
+
+    The births' mass comes from the vacancy, which the newborns' own breakage refills: :func:`_births` sweeps
+    that (:func:`_birth_mass`) without computing these again (two exponentials, a log and the chains' force,
+    stiffness and energy per point and sweep; ~9 sweeps a step in the stick chains' cycle)."""
     m = p[P_M]
     dlm = p[P_DLM]
-    tau = p[P_TAU]
-    r_birth = math.exp(p[P_LOG_U0_TAU])  # hazard at age 0, extension 0
     u = hh * (0.5 - GAUSS if k == 0 else 0.5 + GAUSS)
-    q = _vacancy(u, q0, tau, hh, loss0, dloss0, l1, d1)
-    mass = 0.5 * hh * max(q, 0.0) / tau
     d = hh - u  # its age at t1
     if inertial:  # on the predicted cubic path
         x_k = x + u * (v0 + u * (0.5 * accel_now + u * jerk / 6.0))
@@ -826,31 +846,45 @@ def _gauss_birth(  # type: ignore[no-untyped-def]
     trap = 0.5 * d * (r_birth + r_end)
     lr_birth = p[P_LOG_U0_TAU]
     if abs(lr_end - lr_birth) > 1.0 and lr_end < LOG_RATE_CAP:  # as for the cohorts (_cohort_weight)
-        alive = mass * math.exp(-d * (r_end - r_birth) / (lr_end - lr_birth))
+        survival = math.exp(-d * (r_end - r_birth) / (lr_end - lr_birth))
     else:
         corr = d * d / 12.0 * (r_end * g_end - r_birth * g_start)
         corr = min(max(corr, -0.5 * trap), 0.5 * trap)
-        alive = mass * math.exp(-trap + corr)
+        survival = math.exp(-trap + corr)
     # births reaching the FENE wall within the step are gone by its end; their energy is taken at
     # half the wall's extension (the step control keeps such losses small, below)
-    dissip = (mass - alive) * _chain_energy(0.5 * min(e_k, dlm), m, dlm)
+    energy = _chain_energy(0.5 * min(e_k, dlm), m, dlm)
     # the error of lumping this half-step's births into one cohort: (h r)^2/24 of its mass for a
     # gentle hazard; when the births die within the step, what a resolved step would keep alive at
-    # its end (the birth rate times the newborns' life 1/r, at most all of it): bonds living
-    # shorter than a step would otherwise vanish from the population without a word
+    # its end (the birth rate times the newborns' life 1/r, at most all of it; :func:`_birth_mass`): bonds
+    # living shorter than a step would otherwise vanish from the population without a word
     z = max(r_birth * hh, trap)
     if _relaxed_births(p):  # the Gauss pair's own bias, held to a tenth of the share (docs/transient.md section 8)
         z = max(hh * (r_birth + p[P_INV_TAU_A]), trap)
-        lump = min(mass * min(1.0, BIRTH_BIAS * z**4 / 4320.0), 2.0 * mass / (hh * r_birth))
+        lumping = min(1.0, BIRTH_BIAS * z**4 / 4320.0)
     else:
-        lump = min(mass * min(1.0, z * z / 24.0), 2.0 * mass / (hh * r_birth))
+        lumping = min(1.0, z * z / 24.0)
     xb[n + k] = x_k
     tb[n + k] = t + u
-    lw_new[n + k] = math.log(alive) if alive > 0.0 else -np.inf
-    w1[n + k] = alive
     known[0, n + k] = -1.0
     rate0[n + k] = r_end
-    return mass, alive, dissip, lump, alive * r_end, alive * r_end * (g_end - r_end), e_k
+    dec, c0, c1, c2, c3 = _vacancy_kernel(u, p[P_TAU])
+    return u, survival, energy, lumping, r_end, g_end, e_k, dec, c0, c1, c2, c3
+
+
+def _birth_mass(  # type: ignore[no-untyped-def]
+    u, q0, hh, loss0, dloss0, l1, d1, r_birth, survival, energy, lumping, r_end, g_end, dec, c0, c1, c2, c3, p
+):  # fmt: skip
+    """The births of half the step at its Gauss point (:func:`_birth_point`), from the vacancy's relaxation from
+    q0 with the breakage rate's Hermite cubic (l1, d1 at the end): (born, alive at the step's end, the energy of
+    those that broke, the error of lumping them, their breakage rate at the end and its derivative)."""
+    tau = p[P_TAU]
+    q = _vacancy_from(u, q0, tau, hh, loss0, dloss0, l1, d1, dec, c0, c1, c2, c3)
+    mass = 0.5 * hh * max(q, 0.0) / tau
+    alive = mass * survival
+    dissip = (mass - alive) * energy
+    lump = min(mass * lumping, 2.0 * mass / (hh * r_birth))
+    return mass, alive, dissip, lump, alive * r_end, alive * r_end * (g_end - r_end)
 
 
 def _births(  # type: ignore[no-untyped-def]
@@ -867,9 +901,17 @@ def _births(  # type: ignore[no-untyped-def]
     q0 = big - nn0
     r_birth = math.exp(p[P_LOG_U0_TAU])  # hazard at age 0, extension 0
     dloss0 += r_birth * q0 / tau
+    u_a, surv_a, energy_a, lumping_a, r_a, g_a, _e_a, dec_a, a0, a1, a2, a3 = _birth_point(
+        0, n, t, hh, x, x1p, v0, v1p, accel, accel_now, jerk, slope1, r_birth, inertial, xb, tb, known, rate0,
+        predicted, p,
+    )  # fmt: skip
+    u_b, surv_b, energy_b, lumping_b, r_b, g_b, e_nb, dec_b, b0, b1, b2, b3 = _birth_point(
+        1, n, t, hh, x, x1p, v0, v1p, accel, accel_now, jerk, slope1, r_birth, inertial, xb, tb, known, rate0,
+        predicted, p,
+    )  # fmt: skip
     born = born_alive = newborn_loss = newborn_dloss = newborn_dissip = lump = 0.0
+    alive_a = alive_b = 0.0
     q_end = q0
-    e_nb = 0.0
     d1 = 0.0
     relaxed = _relaxed_births(p)
     last = -1.0
@@ -877,26 +919,36 @@ def _births(  # type: ignore[no-untyped-def]
     for _sweep in range(MAX_SWEEPS if relaxed else 3):
         l1 = loss1 + newborn_loss
         d1 = dloss1 + newborn_dloss + r_birth * q_end / tau
-        born = born_alive = newborn_loss = newborn_dloss = newborn_dissip = lump = 0.0
-        for k in range(2):
-            mass, alive, dissip, lumped, loss_k, dloss_k, e_k = _gauss_birth(
-                k, n, t, hh, x, x1p, v0, v1p, accel, accel_now, jerk, slope1, q0, loss0, dloss0, l1, d1, inertial,
-                xb, tb, lw_new, w1, known, rate0, predicted, p,
-            )  # fmt: skip
-            born += mass
-            born_alive += alive
-            newborn_dissip += dissip
-            lump += lumped
-            newborn_loss += loss_k
-            newborn_dloss += dloss_k
-            if k == 1:
-                e_nb = e_k
+        mass, alive_a, dissip, lumped, loss_k, dloss_k = _birth_mass(
+            u_a, q0, hh, loss0, dloss0, l1, d1, r_birth, surv_a, energy_a, lumping_a, r_a, g_a, dec_a, a0, a1, a2,
+            a3, p,
+        )  # fmt: skip
+        born = mass
+        born_alive = alive_a
+        newborn_dissip = dissip
+        lump = lumped
+        newborn_loss = loss_k
+        newborn_dloss = dloss_k
+        mass, alive_b, dissip, lumped, loss_k, dloss_k = _birth_mass(
+            u_b, q0, hh, loss0, dloss0, l1, d1, r_birth, surv_b, energy_b, lumping_b, r_b, g_b, dec_b, b0, b1, b2,
+            b3, p,
+        )  # fmt: skip
+        born += mass
+        born_alive += alive_b
+        newborn_dissip += dissip
+        lump += lumped
+        newborn_loss += loss_k
+        newborn_dloss += dloss_k
         q_end = max(big - nn1 - born_alive, 0.0)
         if relaxed:  # swept until the newborns' own breakage settles; what the last sweep moved counts as an error
             residual = abs(born_alive - last) if last >= 0.0 else born_alive
             if residual <= SWEEP_SETTLED * big:
                 break
             last = born_alive
+    lw_new[n] = math.log(alive_a) if alive_a > 0.0 else -np.inf
+    w1[n] = alive_a
+    lw_new[n + 1] = math.log(alive_b) if alive_b > 0.0 else -np.inf
+    w1[n + 1] = alive_b
     return born, born_alive, newborn_loss, newborn_dissip, lump + residual, e_nb, q0, dloss0, d1
 
 
@@ -1348,7 +1400,8 @@ INLINED = (
     "_cohort_weight",
     "_cohort_dissipation",
     "_quiet_neighbours",
-    "_gauss_birth",
+    "_birth_point",
+    "_birth_mass",
     "_step_length",
     "_predicted_path",
     "_births",
@@ -1378,6 +1431,8 @@ def compiled() -> dict[str, object]:
             "_aging_clock",
             "_log_rate",
             "_hermite",
+            "_vacancy_kernel",
+            "_vacancy_from",
             "_vacancy",
             "_cohort_load",
             "_negligible",

@@ -717,10 +717,8 @@ class _Reducer:
 
     def _steady_at(self, v: float) -> tuple[float, float, float]:
         """(S, N, S') of the steady solver at v, remembered for the run."""
-        from ..quasistatic.steady import steady_state
-
         if v not in self.steady:
-            ref = steady_state(self.params, v, self.aging)
+            ref = _steady_state(self.params, v, self.aging)
             n0 = self.params.bonds.site_density
             self.steady[v] = (float(ref.stress), float(ref.bonded_fraction) * n0, float(ref.stress_slope))
         return self.steady[v]
@@ -812,7 +810,6 @@ class _Reducer:
         return True, glide.sample_index
 
     def _glide(self, state: _State, t0: float, t1: float, vp: float, times: np.ndarray, sample_index: int):  # type: ignore[no-untyped-def]
-        from ..quasistatic.steady import steady_state
         from . import reduction as R
 
         b = self.params.bonds
@@ -847,7 +844,7 @@ class _Reducer:
             # aging the curve is N-shaped and its creep branch, below the maximum, rises (a stuck block creeps up it)
             if v < self._fold() and self.params.aging.saturation_age is None:
                 return None
-            ref = steady_state(self.params, v, self.aging)
+            ref = _steady_state(self.params, v, self.aging)
             if not (float(ref.stress_slope) > 0 and abs(sigma - float(ref.stress)) <= 0.1 * abs(sigma)):
                 return None
             if not self._may_enter(float(ref.stress), float(ref.stress_slope), sigma, v, vp):
@@ -866,6 +863,16 @@ class _Reducer:
             return None
         return R.glide(m, self.params, v=v_entry, x=state.x, puller=state.puller, vp=vp, rtol=self.rtol, bonded=nn,
                        energy=uu, **common)  # fmt: skip
+
+
+def _steady_state(params: Parameters, velocity: float, aging: bool) -> Any:
+    """The steady solver at one velocity, its march compiled: the reduction's checks ask for S, N and S' at the
+    puller's and the slider's velocity ~4 times a stick-slip cycle, 2.3-3.3 ms each through numpy's march against
+    0.1-0.6 ms compiled (its load from numba's cache, ~25 ms, once per process; the two agree to ~1e-12,
+    docs/transient.md section 14)."""
+    from ..quasistatic.steady import steady_state
+
+    return steady_state(params, velocity, aging, compiled_from=1)
 
 
 _STEADY_COHORTS: dict[tuple[Parameters, float, bool], Population] = {}
