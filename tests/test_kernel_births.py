@@ -33,9 +33,10 @@ def test_the_vacancy_is_the_integral_of_its_ode(h, share):
     u = share * h
     q0, l0, l1 = 3.1e13, 4.0e16, 2.5e16
     d0, d1 = -1.0e16 / h, 3.0e15 / h
-    want = q0 * math.exp(-u / TAU) + quad(
-        lambda s: _hermite(s, h, l0, d0, l1, d1) * math.exp(-(u - s) / TAU), 0.0, u, epsabs=0.0, epsrel=1e-13
-    )[0]
+    want = (
+        q0 * math.exp(-u / TAU)
+        + quad(lambda s: _hermite(s, h, l0, d0, l1, d1) * math.exp(-(u - s) / TAU), 0.0, u, epsabs=0.0, epsrel=1e-13)[0]
+    )
     got = K._vacancy(u, q0, TAU, h, l0, d0, l1, d1)
     assert got == pytest.approx(want, rel=1e-9, abs=1e-9 * q0)
     # the sweeps' split: the same number, its exponentials taken apart
