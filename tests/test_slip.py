@@ -20,7 +20,7 @@ import pytest
 
 from stickslip.errors import ModelError, ParameterError
 from stickslip.quasistatic.jump import branch_interpolant, jump_velocity
-from stickslip.quasistatic.slip import SETTLE_TOLERANCE, slip_phase, slip_trajectory, steady_curve
+from stickslip.quasistatic.slip import SETTLE_TOLERANCE, slip_duration, slip_phase, slip_trajectory, steady_curve
 from stickslip.quasistatic.steady import steady_state
 
 VC, SC, A, K = 124e-6, 257.0, 180.0, 3.0e5  # the analytic test curve and stiffness
@@ -247,3 +247,10 @@ def test_a_slip_of_a_few_parts_per_million_next_to_vc(params, critical):
     direct = slip_trajectory(steady_curve(params), k_eff, 1e-7, vs, critical.velocity, noise=noise)
     assert slip.ends == "stick" and slip.duration > 0
     assert slip.duration == pytest.approx(direct.duration, rel=1e-6)
+
+
+@pytest.mark.parametrize(("pull", "start"), [(1e-4, 711e-6), (300e-6, 700e-6), (50e-6, 800e-6)])
+def test_slip_duration_is_the_slip_phases_own(params, pull, start):
+    """The cost estimate's shortcut (docs/transient.md section 14): how the slip ends and when, as slip_phase."""
+    full = slip_phase(params, pull, start)
+    assert slip_duration(params, pull, start) == (full.ends, full.duration)

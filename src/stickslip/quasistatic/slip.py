@@ -272,33 +272,11 @@ def slip_phase(params: Parameters, pulling_velocity: float, start_velocity: floa
     cp = require_critical_point(params)
     assert cp.velocity is not None and cp.stress is not None
     vc = cp.velocity
-    v_max, _ = branch_maximum(params, "aging")
-    if v0 >= v_max:
-        raise ModelError(
-            f"pulling velocity {v0:.6g} m/s is at or above the maximum of the steady curve ({v_max:.6g} m/s):"
-            " sliding there is velocity-weakening again and Eq 10 has no quasi-static solution"
-        )
-    if not vc * (1 - 1e-12) <= vs <= v_max * (1 + 1e-12):
-        raise ParameterError(
-            f"start_velocity: expected a velocity on the right branch, {vc:.6g} to {v_max:.6g} m/s, got {vs!r}"
-        )
     stiffness = params.block.effective_stiffness
-    gap = None
-    if v0 < vc:
-        ends, v_end = "stick", vc
-    else:
-        ends = "steady"
-        gap = math.copysign(SETTLE_TOLERANCE, vs - v0)
-        v_end = v0 * (1.0 + gap)
-        if abs(vs - v0) <= SETTLE_TOLERANCE * v0:
-            v_end, gap = vs, None
-    curve = branch_interpolant(steady_curve_key(params), "aging")  # spectrally accurate, solved once per curve
-    if abs(math.log(vs / v_end)) < 1e-14:
-        sigma = float(curve(np.array([vs]))[0][0])
+    ends, v_end, trajectory = _trajectory(params, v0, vs, vc)
+    if trajectory is None:
+        sigma = float(branch_interpolant(steady_curve_key(params), "aging")(np.array([vs]))[0][0])
         return _empty_slip(v0, vs, sigma, stiffness, ends)
-    trajectory = slip_trajectory(
-        curve, stiffness, v0, vs, v_end, end_gap=gap, noise=curve.noise, lowest=math.exp(curve.log_lo) * (1 + 1e-12)
-    )
     xs, xe = trajectory.log_start, trajectory.log_end
     x = _output_points(trajectory)
     time = trajectory.time(x)
@@ -335,6 +313,49 @@ def slip_phase(params: Parameters, pulling_velocity: float, start_velocity: floa
         message=message,
         trajectory=trajectory,
     )
+
+
+def slip_duration(params: Parameters, pulling_velocity: float, start_velocity: float) -> tuple[str, float]:
+    """(how the slip ends, its duration in s) of :func:`slip_phase`, the same numbers, without its output points (a
+    time-dependent run's cost estimate asks for these two alone: half of slip_phase's CPU is its output)."""
+    v0 = check_velocity(pulling_velocity)
+    vs = check_velocity(start_velocity, "start_velocity")
+    cp = require_critical_point(params)
+    assert cp.velocity is not None
+    ends, _v_end, trajectory = _trajectory(params, v0, vs, cp.velocity)
+    return ends, 0.0 if trajectory is None else trajectory.duration
+
+
+def _trajectory(params: Parameters, v0: float, vs: float, vc: float) -> tuple[str, float, SlipTrajectory | None]:
+    """(how the slip ends, the velocity where it ends, its trajectory; None where the jump lands there) of Eq 10
+    on the aging curve from vs, the puller at v0 (both checked against the curve's right branch)."""
+    v_max, _ = branch_maximum(params, "aging")
+    if v0 >= v_max:
+        raise ModelError(
+            f"pulling velocity {v0:.6g} m/s is at or above the maximum of the steady curve ({v_max:.6g} m/s):"
+            " sliding there is velocity-weakening again and Eq 10 has no quasi-static solution"
+        )
+    if not vc * (1 - 1e-12) <= vs <= v_max * (1 + 1e-12):
+        raise ParameterError(
+            f"start_velocity: expected a velocity on the right branch, {vc:.6g} to {v_max:.6g} m/s, got {vs!r}"
+        )
+    gap = None
+    if v0 < vc:
+        ends, v_end = "stick", vc
+    else:
+        ends = "steady"
+        gap = math.copysign(SETTLE_TOLERANCE, vs - v0)
+        v_end = v0 * (1.0 + gap)
+        if abs(vs - v0) <= SETTLE_TOLERANCE * v0:
+            v_end, gap = vs, None
+    curve = branch_interpolant(steady_curve_key(params), "aging")  # spectrally accurate, solved once per curve
+    if abs(math.log(vs / v_end)) < 1e-14:
+        return ends, v_end, None
+    trajectory = slip_trajectory(
+        curve, params.block.effective_stiffness, v0, vs, v_end, end_gap=gap, noise=curve.noise,
+        lowest=math.exp(curve.log_lo) * (1 + 1e-12),
+    )  # fmt: skip
+    return ends, v_end, trajectory
 
 
 def _empty_slip(v0: float, v: float, sigma: float, stiffness: float, ends: str) -> SlipPhase:

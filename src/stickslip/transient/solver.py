@@ -1497,7 +1497,7 @@ def _quasi_static_clock(
 ) -> tuple[float, float]:
     """(first stick's time, stick + slip period from sigma_c) of the quasi-static cycle (quasistatic.cycle) at K."""
     from ..quasistatic.jump import jump_velocity
-    from ..quasistatic.slip import slip_phase
+    from ..quasistatic.slip import slip_duration
     from ..quasistatic.stick import stick_phase
 
     k_set = params.block.effective_stiffness
@@ -1511,10 +1511,10 @@ def _quasi_static_clock(
     jump = jump_velocity(params, again.peak_stress, "aging" if aging else "no-aging")
     if not jump.reachable or jump.velocity is None:
         return t_first, math.inf  # the run stops at the collapse
-    slip = slip_phase(params, vp, jump.velocity)
-    if slip.ends == "steady":
+    ends, duration = slip_duration(params, vp, jump.velocity)
+    if ends == "steady":
         return t_first, math.inf
-    return t_first, again.stick_time + slip.duration
+    return t_first, again.stick_time + duration
 
 
 def _require_resolvable(params: Parameters, protocol: Protocol, rtol: float, unit: str) -> None:
