@@ -354,7 +354,8 @@ def _balance_from(x, puller, n, xb, w, p, at_x):  # type: ignore[no-untyped-def]
         else:
             lo = max(lo, x)
         x_new = x - g / k
-        if abs(x_new - x) <= 1e-15 * max(abs(x), p[P_DLM]) and lo <= x_new <= hi:
+        settled = 1e-15 * max(abs(x), p[P_DLM])
+        if abs(x_new - x) <= settled and lo <= x_new <= hi:
             # Newton's own correction is within the tolerance: converged.  Tested after the bracket's fallback
             # instead, a correction below an ulp of x (x_new == x, the bracket's edge) was taken for a step out of
             # the bracket and bisected some 16 more passes over the cohorts down to the tolerance, to a root no
@@ -362,7 +363,7 @@ def _balance_from(x, puller, n, xb, w, p, at_x):  # type: ignore[no-untyped-def]
             return x_new
         if not (lo < x_new < hi):  # FENE walls: stay inside the bracket
             x_new = 0.5 * (lo + hi) if (lo > -np.inf and hi < np.inf) else x - 0.5 * g / k
-        if abs(x_new - x) <= 1e-15 * max(abs(x), p[P_DLM]):
+        if abs(x_new - x) <= settled:
             return x_new
         x = x_new
     return x
