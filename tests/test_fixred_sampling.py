@@ -84,3 +84,34 @@ def test_transient_trough_does_not_depend_on_the_sampling(sampled_runs):
         assert run.regime.trough == pytest.approx(ref.regime.trough, rel=1e-5)
         assert run.regime.peak == pytest.approx(ref.regime.peak, rel=1e-5)
         assert run.regime.amplitude_ratio == pytest.approx(ref.regime.amplitude_ratio, rel=1e-5)
+
+
+@pytest.mark.parametrize("every", [None, 0.05])
+def test_stuck_rows_are_the_held_block_in_closed_form(every):
+    """The rows of a stick held by the chains (written as one array per stretch): sigma = K (P - X) with the slider
+    fixed, the block's energy sigma^2/2K, and the integral of sigma dt growing by the exact integral of a linear
+    sigma; on the sampling grid where one is asked for."""
+    import stickslip
+    from stickslip.protocols import Protocol, Segment
+
+    gel = stickslip.load_parameters("gelatin-glass")
+    cycle = Protocol((Segment(350e-6, 5.0), Segment(100e-6, 20.0)))
+    run = stickslip.transient.run_transient(gel, cycle, start="steady", stick_population=True, every=every)
+    held = run.to_frame()["held_by"].to_numpy() == "chains"
+    assert held.sum() >= 50
+    k = run.stiffness
+    t, sigma = run.time[held], run.stress[held]
+    x, puller = run.slider_position[held], run.puller_position[held]
+    same = np.diff(t) < 1.0  # consecutive rows of one stretch (the two sticks are ~15 s apart)
+    assert np.all(run.slider_velocity[held] == 0.0) and np.all(np.diff(x)[same] == 0.0)
+    assert np.max(np.abs(sigma - k * (puller - x))) <= 1e-12 * np.max(sigma)
+    assert np.allclose(run.bookkeeping.block_energy[held], sigma**2 / (2 * k), rtol=1e-14, atol=0.0)
+    assert np.all(np.diff(run.chain_fraction[held])[same] <= 0.0)
+    if every is not None:
+        assert np.allclose(t / every, np.round(t / every), rtol=0.0, atol=1e-9)
+    # consecutive rows of one stretch: the stress rises at K Vp, its integral by the trapezoid (exact for a line)
+    integral = run.bookkeeping.stress_integral[held]
+    rise = np.diff(sigma)[same] - k * 100e-6 * np.diff(t)[same]
+    assert np.max(np.abs(rise)) <= 1e-12 * np.max(sigma)
+    step = (np.diff(t) * 0.5 * (sigma[1:] + sigma[:-1]))[same]
+    assert np.max(np.abs(np.diff(integral)[same] - step)) <= 1e-12 * np.max(integral)

@@ -57,7 +57,8 @@ def test_row_sums_keep_exactly_what_the_next_step_computes():
     assert np.array_equal(cache[5], [math.exp(q) for q in log_rate])
     # the slider balance's force and stiffness, when given, are the same numbers
     lc, aa = np.empty(n), np.empty(n)
-    known = np.full((3, n), -1.0)
+    known = np.full((4, n), -1.0)
+    known[3] = np.nan  # no bond energy carried from a step's pass (kernel._energy_at_end): computed
     functions["_velocity_prepare"](n, xb, tb, lw, x, t, p, lc, aa, known, no_clock)
     again = np.empty((6, n))
     assert functions["_sums_keeping"](n, xb, tb, lw, x, t, slope, p, again, known, True, no_clock) == (nn, ss, uu, True)
@@ -87,3 +88,45 @@ def test_slider_velocity_does_not_depend_on_the_weights_given():
     given[0] = [math.exp(q) for q in lw]
     assert functions["_slider_velocity"](*args, given) == blind
     assert 0.0 < blind < 1e-2
+
+
+def test_the_balanced_ends_energy_from_the_predicted_ends_is_the_direct_one_to_rounding():
+    """kernel._energy_at_end: u(x1) from u(x1p) by the end-corrected trapezoid of the force, against the direct
+    -m dl_m^2/2 ln(1 - y^2) (math.log1p), for shifts up to ENERGY_SHIFT dl_m over a steady population (its
+    extensions from 2e-4 to 0.87 dl_m); a longer shift, a cohort without the pass's energy or force: nan."""
+    K.compiled()
+    p = pack_parameters(GEL, True, GEL.block.effective_stiffness)
+    xb, _tb, _lw = _population()
+    n = xb.size
+    m, dlm = p[K.P_M], p[K.P_DLM]
+    x1p = 0.0
+    e1p = x1p - xb
+    assert np.max(np.abs(e1p)) / dlm > 0.85
+
+    def force(e):
+        return m * e / (1.0 - (e / dlm) ** 2)
+
+    def stiffness(e):
+        y = e / dlm
+        return m * (1.0 + y * y) / (1.0 - y * y) ** 2
+
+    def energy(e):
+        return np.array([-0.5 * m * dlm * dlm * math.log1p(-((q / dlm) ** 2)) for q in e])
+
+    predicted = np.vstack([force(e1p), stiffness(e1p), energy(e1p)])
+    predicted[2, 3] = np.nan  # a cohort the pass left without its energy
+    for share in (-1.0, -1e-3, 1e-2, 0.3, 1.0):
+        shift = share * K.ENERGY_SHIFT * dlm
+        e1 = e1p + shift
+        known = np.vstack([np.ones(n), force(e1), stiffness(e1), np.zeros(n)])
+        known[1, 5] = np.nan  # a cohort without the balance's force
+        K._energy_at_end(n, shift, predicted, known, dlm)  # compiled by K.compiled(), as the kernel calls it
+        direct = energy(e1)
+        ok = np.ones(n, dtype=bool)
+        ok[[3, 5]] = False
+        assert np.all(np.isnan(known[3, ~ok]))
+        worst = np.max(np.abs(known[3, ok] - direct[ok]) / direct[ok])
+        assert worst <= 1e-14
+    beyond = np.vstack([np.ones(n), force(e1p), stiffness(e1p), np.zeros(n)])
+    K._energy_at_end(n, 1.5 * K.ENERGY_SHIFT * dlm, predicted, beyond, dlm)
+    assert np.all(np.isnan(beyond[3]))

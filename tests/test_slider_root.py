@@ -73,14 +73,13 @@ def test_the_residuals_curvature_is_the_derivative_of_its_slope() -> None:
     p = pack_parameters(GEL, True, GEL.block.effective_stiffness)
     xb, tb, lw = _population(128e-6)
     n = xb.size
-    lc, aa = np.empty(n), np.empty(n)
-    k_int = functions["_velocity_prepare"](n, xb, tb, lw, 1e-9, 0.0, p, lc, aa, np.full((3, n), -1.0),
-                                           np.empty((2, 0)))  # fmt: skip
+    lc, aa, known = np.empty(n), np.empty(n), np.full((3, n), -1.0)
+    k_int = functions["_velocity_prepare"](n, xb, tb, lw, 1e-9, 0.0, p, lc, aa, known, np.empty((2, 0)))
     for v in (3e-5, 1.28e-4, 5e-4):
-        g, _slope, curvature = functions["_velocity_residual"](v, PACE, n, lc, aa, k_int, p)
+        g, _slope, curvature = functions["_velocity_residual"](v, PACE, n, lc, aa, known, k_int, p)
         dv = 1e-4 * v
         assert g == pytest.approx(_g(np.array([v]), 1e-9, xb, tb, lw, p)[0], rel=1e-9, abs=1e-9 * p[K.P_K] * PACE)
-        slopes = [functions["_velocity_residual"](v + s * dv, PACE, n, lc, aa, k_int, p)[1] for s in (-1, 1)]
+        slopes = [functions["_velocity_residual"](v + s * dv, PACE, n, lc, aa, known, k_int, p)[1] for s in (-1, 1)]
         difference = (slopes[1] - slopes[0]) / (2 * dv)  # central: error ~ dv^2 g''''/6
         assert curvature == pytest.approx(difference, rel=1e-5)
         assert math.isfinite(curvature) and curvature != 0.0

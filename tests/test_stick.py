@@ -23,7 +23,7 @@ from scipy.special import exp1
 import stickslip.quasistatic.stick as stick_module
 from stickslip.errors import ParameterError
 from stickslip.parameters import load_parameters
-from stickslip.quasistatic.stick import never_slips, stick_phase, stuck_threshold
+from stickslip.quasistatic.stick import never_slips, stick_phase, stick_time, stuck_threshold
 
 
 def scaled_load(params, stress):
@@ -52,6 +52,25 @@ def test_constant_load_closed_form_over_loads(params, stress):
     stick = stick_phase(params, 0.0, start_stress=stress, aging=False)
     s0 = scaled_load(params, stress)
     assert stick.stick_time == pytest.approx(exp1(s0) / params.stick.break_rate, rel=1e-8)
+
+
+@pytest.mark.parametrize("stress", [5.0, 100.0, 2000.0])
+def test_stick_time_alone_matches_the_closed_form_and_the_phase(params, stress):
+    """The cost estimate's shortcut (docs/transient.md section 14): t_s and sigma_s without the trace, against
+    E1(s0)/r at a constant load and against stick_phase's own ends while pulled."""
+    ts, peak = stick_time(params, 0.0, start_stress=stress, aging=False)
+    assert ts == pytest.approx(exp1(scaled_load(params, stress)) / params.stick.break_rate, rel=1e-8)
+    assert peak == stress
+    for velocity, start in ((100e-6, None), (350e-6, 0.0), (50e-6, stress)):
+        phase = stick_phase(params, velocity, start_stress=start)
+        assert phase.status == "slipped"
+        assert stick_time(params, velocity, start_stress=start) == (phase.stick_time, phase.peak_stress)
+
+
+def test_stick_time_alone_is_none_where_the_block_does_not_slip(params, sigma_c):
+    assert stick_phase(params, 0.0).status == "stuck"  # aging wins at sigma_c (the closed form's test below)
+    assert stick_time(params, 0.0) is None
+    assert stick_time(params, 0.0, start_stress=0.0) is None  # nothing loads the block
 
 
 def test_constant_load_with_aging_that_slips(params, sigma_c):

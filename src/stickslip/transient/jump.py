@@ -71,12 +71,16 @@ def _fast_root(
     scratch: tuple[np.ndarray, np.ndarray, np.ndarray],
 ) -> float:  # fmt: skip
     """The root of g with the aging term erased, (K Vp + sum w r f)/(K + k_int): g's largest root wherever it is
-    many V_a fast.  ``prepare``: the kernel's _velocity_prepare (k_int, and each cohort's ln(w f r) without the
-    aging term, capped below as the kernel's residual caps it); ``scratch``: its work arrays (lc, aa, known)."""
+    many V_a fast.  ``prepare``: the kernel's _velocity_prepare (k_int, each cohort's ln(w r) without the aging
+    term, capped below as the kernel's residual caps it, and its force f in known[1]); ``scratch``: its work arrays
+    (lc, aa, known)."""
     lc, aa, known = scratch
     known.fill(-1.0)
     k_int = prepare(n, xb, tb, lw, x, t, p, lc, aa, known, np.empty((2, 0)))
-    loss = float(np.sum(np.exp(np.minimum(lc, K.LOG_RATE_CAP))))
+    live = lc[:n] > -np.inf
+    with np.errstate(over="ignore"):  # a cohort at the FENE wall: its w f r capped as the kernel caps it
+        terms = np.minimum(known[1, :n][live] * np.exp(np.minimum(lc[:n][live], K.LOG_RATE_CAP)), K.MAX_RATE)
+    loss = float(np.sum(terms))
     return (p[K.P_K] * vp + loss) / (p[K.P_K] + k_int)
 
 

@@ -39,6 +39,7 @@ import numpy as np
 
 #: log of the largest hazard used (exp(700) ~ 1e304 per second); beyond it a cohort is gone in any step
 LOG_RATE_CAP = 700.0
+MAX_RATE = math.exp(LOG_RATE_CAP)  # the same cap on a cohort's w f r in the slider's residual
 #: cohorts lighter than this fraction of N0 are dropped (counted as broken)
 LIGHTEST = 1e-30
 #: with saturating aging (docs/transient.md section 2, *Housekeeping*): a cohort is dropped once it carries less than
@@ -67,7 +68,7 @@ CLOCK_PLAIN_DECAY = 0.5
 #: saturating aging: saturated cohorts are merged, and the negligible dropped, every MERGE_EVERY accepted steps (the
 #: bin tests were ~15 % of a step's CPU at the fold; in between at most 2 (MERGE_EVERY - 1) more cohorts are kept)
 MERGE_EVERY = 4
-#: saturating aging: a cohort's error by the series of 1 - e^(-c) below this end correction c (:func:`_cohort_weight`)
+#: a cohort's error by the series of 1 - e^(-c) below this end correction c (:func:`_cohort_weight`)
 CORRECTION_SERIES = 1e-3
 
 # float parameter vector layout (see pack_parameters in model.py)
@@ -102,6 +103,9 @@ MAX_DROP = 0.2
 #: carrying WALL_SHARE x rtol x |sigma| or more
 WALL_LANDING = 0.9
 WALL_SHARE = 0.1
+#: the balanced end's bond energies follow from the predicted end's while the two lie within this share of dl_m
+#: (:func:`_energy_at_end`: the rule's error, ~(shift/dl_m)^5 of the energy, is then below rounding)
+ENERGY_SHIFT = 1e-4
 #: four-point Gauss-Legendre rule on [-1, 1]
 GL4_X = np.array([-0.8611363115940526, -0.3399810435848563, 0.3399810435848563, 0.8611363115940526])
 GL4_W = np.array([0.3478548451374538, 0.6521451548625461, 0.6521451548625461, 0.3478548451374538])
@@ -164,7 +168,7 @@ def _log_rate(e, age, slope, p):  # type: ignore[no-untyped-def]
 
 
 def _velocity_prepare(n, xb, tb, lw, x, t, p, lc, aa, known, clock):  # type: ignore[no-untyped-def]
-    """k_int; fills lc = ln(w f r) without the aging term and aa = A(t_a)/tau_a for the cohorts.
+    """k_int; fills lc = ln(w r) without the aging term (w f r = f e^lc, f in known[1]) and aa = A(t_a)/tau_a for the
 
     ``known[0, i]``: exp(lw[i]) where the caller has it (bit for bit), negative where not; on return it holds
     exp(lw[i]), and known[1, i], known[2, i] the chain force and stiffness at x (nan for a dead cohort)."""
@@ -183,7 +187,7 @@ def _velocity_prepare(n, xb, tb, lw, x, t, p, lc, aa, known, clock):  # type: ig
         known[0, i] = w
         known[1, i] = f
         known[2, i] = stiffness
-        lc[i] = lw[i] + math.log(f) + p[P_LOG_U0_TAU] + p[P_FORCE_SENS] * f if f > 0.0 else -np.inf
+        lc[i] = lw[i] + p[P_LOG_U0_TAU] + p[P_FORCE_SENS] * f if f > 0.0 else -np.inf  # ln(w r) unaged
         if p[P_AGING] == 0.0:
             aa[i] = 0.0
         elif p[P_SATURATION] > 0.0:
@@ -195,8 +199,8 @@ def _velocity_prepare(n, xb, tb, lw, x, t, p, lc, aa, known, clock):  # type: ig
     return k_int
 
 
-def _velocity_residual(v, vp, n, lc, aa, k_int, p):  # type: ignore[no-untyped-def]
-    """(g(V), g'(V), g''(V)) of the module docstring, from the prepared lc, aa."""
+def _velocity_residual(v, vp, n, lc, aa, known, k_int, p):  # type: ignore[no-untyped-def]
+    """(g(V), g'(V), g''(V)) of the module docstring, from the prepared lc, aa and the forces in known[1]."""
     decay = math.exp(-abs(v) / p[P_VA]) if p[P_AGING] > 0.0 else 0.0
     loss = 0.0
     dloss = 0.0
@@ -204,7 +208,8 @@ def _velocity_residual(v, vp, n, lc, aa, k_int, p):  # type: ignore[no-untyped-d
     for i in range(n):
         if lc[i] == -np.inf:
             continue
-        term = math.exp(min(lc[i] - aa[i] * decay, LOG_RATE_CAP))
+        # w f r, the force a factor (no log per cohort), capped as the hazards are (a cohort at the FENE wall)
+        term = min(known[1, i] * math.exp(min(lc[i] - aa[i] * decay, LOG_RATE_CAP)), MAX_RATE)
         rate = aa[i] * decay / p[P_VA]  # d(ln term)/dV
         loss += term
         dloss += term * rate
@@ -220,7 +225,7 @@ def _slider_velocity(v_prev, vp, n, xb, tb, lw, x, t, p, lc, aa, known):  # type
 def _slider_velocity_clocked(v_prev, vp, n, xb, tb, lw, x, t, p, lc, aa, known, clock):  # type: ignore[no-untyped-def]
     """The stable root of g nearest v_prev (block control): safeguarded Newton inside a bracket."""
     k_int = _velocity_prepare(n, xb, tb, lw, x, t, p, lc, aa, known, clock)
-    g0, d0, c0 = _velocity_residual(v_prev, vp, n, lc, aa, k_int, p)
+    g0, d0, c0 = _velocity_residual(v_prev, vp, n, lc, aa, known, k_int, p)
     if p[P_AGING] == 0.0:  # g is linear in V
         return v_prev - g0 / d0
     if g0 == 0.0:
@@ -243,7 +248,7 @@ def _slider_velocity_clocked(v_prev, vp, n, xb, tb, lw, x, t, p, lc, aa, known, 
         if newton and abs(c) * step * step <= 2e-13 * d * max(abs(v_new), 1e-300):
             return v_new
         v = v_new
-        g, d, c = _velocity_residual(v, vp, n, lc, aa, k_int, p)
+        g, d, c = _velocity_residual(v, vp, n, lc, aa, known, k_int, p)
         if g == 0.0:
             return v
         if g < 0.0:
@@ -274,7 +279,8 @@ def _sums(n, xb, lw, x, p):  # type: ignore[no-untyped-def]
 def _sums_keeping(n, xb, tb, lw, x, t, slope, p, cache, known, prepared, clock_end):  # type: ignore[no-untyped-def]
     """(N, sigma, bond energy) as _sums, keeping each cohort's weight, force, stiffness, energy and hazard at
     (x, t, slope) in ``cache``: exactly what the next step computes at its start (so it reuses them, bit for bit);
-    ``known`` as _velocity_prepare leaves it (its force and stiffness used where ``prepared``); ``clock_end``: the
+    ``known`` as _velocity_prepare leaves it (its force and stiffness used where ``prepared``, and then its row 3, the
+    bond energy :func:`_energy_at_end` derived, where not nan); ``clock_end``: the
     saturating clock at t where the step's pass left it (nan where not: the newborns, merged cohorts).
     Returns ok = False (nothing kept) if a cohort is dead or beyond the FENE wall."""
     nn = 0.0
@@ -291,7 +297,7 @@ def _sums_keeping(n, xb, tb, lw, x, t, slope, p, cache, known, prepared, clock_e
                 continue
         have = prepared and known[1, i] == known[1, i]
         f = known[1, i] if have else _chain_force(e, p[P_M], p[P_DLM])
-        energy = _chain_energy(e, p[P_M], p[P_DLM])
+        energy = known[3, i] if prepared and known[3, i] == known[3, i] else _chain_energy(e, p[P_M], p[P_DLM])
         nn += w
         s += w * f
         u += w * energy
@@ -638,13 +644,13 @@ def _hazard_slopes(f0, f1, k0, k1, v0, v1p, age0, age1, clock0, clock1, slope0, 
     return g0, g1
 
 
-def _cohort_weight(lw_i, w0, f0, hh, lr0, r0, lr1, r1, g0, g1, series):  # type: ignore[no-untyped-def]
+def _cohort_weight(lw_i, w0, f0, hh, lr0, r0, lr1, r1, g0, g1):  # type: ignore[no-untyped-def]
     """A cohort's log weight at the step's end from its hazard at both ends: (new, its weight, its error, the
     stress dying at a cliff, the trapezoid of the hazard, whether exp(new) was taken exactly).
 
-    ``series`` (saturating aging): the error, the weight's distance from the plain trapezoid's, w |1 - e^(-c)| for
-    the end correction c, by its Taylor series where |c| < CORRECTION_SERIES (to ~1e-12 of itself) instead of a
-    second exp per cohort and step."""
+    The error, the weight's distance from the plain trapezoid's, w |1 - e^(-c)| for the end correction c, is taken
+    by its Taylor series where |c| < CORRECTION_SERIES (to ~1e-12 of itself) instead of a second exp per cohort and
+    step (a tenth of the paper's cycle; docs/transient.md section 14)."""
     trap = 0.5 * hh * (r0 + r1)
     dying = 0.0
     if abs(lr1 - lr0) > 1.0 and max(lr0, lr1) < LOG_RATE_CAP:
@@ -669,21 +675,20 @@ def _cohort_weight(lw_i, w0, f0, hh, lr0, r0, lr1, r1, g0, g1, series):  # type:
     corr = min(max(corr, -limit), limit)
     new = lw_i - trap + corr
     wn = math.exp(new)
-    if series and abs(corr) < CORRECTION_SERIES:
+    if abs(corr) < CORRECTION_SERIES:
         dw = wn * abs(corr * (1.0 - corr * (0.5 - corr * (1.0 / 6.0 - corr / 24.0))))
     else:
         dw = abs(wn - w0 * math.exp(-min(trap, 745.0)))  # against the plain trapezoid
     return new, wn, dw, dying, trap, True
 
 
-def _cohort_dissipation(trap, hh, w0, wn, r0, r1, g0, g1, f0, f1, v0, v1p, e0, e1, e_mid, u0, m, dlm):  # type: ignore[no-untyped-def]
+def _cohort_dissipation(trap, hh, w0, wn, r0, r1, g0, g1, f0, f1, v0, v1p, e0, u1, e_mid, u0, m, dlm):  # type: ignore[no-untyped-def]
     """The energy a cohort's breakage dissipates over the step: r w u by the end-corrected trapezoid (fourth
-    order; u0 the energy at the start where known, else nan), or, a cohort breaking within the step, its lost
-    mass at the mid-step energy."""
+    order; u0 the energy at the start where known, else nan; u1 the energy at the step's predicted end), or, a
+    cohort breaking within the step, its lost mass at the mid-step energy."""
     if trap < 0.5:
         if u0 != u0:
             u0 = _chain_energy(e0, m, dlm)
-        u1 = _chain_energy(e1, m, dlm)
         phi0 = r0 * w0 * u0
         phi1 = r1 * wn * u1
         dphi0 = phi0 * (g0 - r0) + r0 * w0 * f0 * v0
@@ -734,6 +739,7 @@ def _cohort_pass(  # type: ignore[no-untyped-def]
             rate0[i] = np.inf
             w1[i] = 0.0
             known[0, i] = -1.0
+            predicted[2, i] = np.nan
             broken += w0
             continue
         f0 = cache[1, i] if cached else _chain_force(e0, m, dlm)
@@ -743,6 +749,7 @@ def _cohort_pass(  # type: ignore[no-untyped-def]
             rate0[i] = np.inf
             w1[i] = 0.0
             known[0, i] = -1.0
+            predicted[2, i] = np.nan
             broken += w0
             walled += w0
             dissip += w0 * _chain_energy(e0, m, dlm)
@@ -782,7 +789,7 @@ def _cohort_pass(  # type: ignore[no-untyped-def]
         predicted[1, i] = k1
         g0, g1 = _hazard_slopes(f0, f1, k0, k1, v0, v1p, age0, age1, clock0, clock1, slope0, slope1, accel, beta,
                                 va, aging_on)  # fmt: skip
-        new, wn, dw, dying, trap, exact = _cohort_weight(lw[i], w0, f0, hh, lr0, r0, lr1, r1, g0, g1, saturating)
+        new, wn, dw, dying, trap, exact = _cohort_weight(lw[i], w0, f0, hh, lr0, r0, lr1, r1, g0, g1)
         known[0, i] = wn if exact else -1.0
         if tb[i] >= t0:
             cliff += dying
@@ -798,7 +805,9 @@ def _cohort_pass(  # type: ignore[no-untyped-def]
         dloss1 += wn * r1 * (g1 - r1)
         broken += w0 - wn
         u0 = cache[3, i] if cached else np.nan
-        dissip += _cohort_dissipation(trap, hh, w0, wn, r0, r1, g0, g1, f0, f1, v0, v1p, e0, e1, x_mid - xb[i], u0, m,
+        u1 = _chain_energy(e1, m, dlm) if trap < 0.5 else np.nan
+        predicted[2, i] = u1  # the energy at x1p: the balanced end's follows from it (:func:`_energy_at_end`)
+        dissip += _cohort_dissipation(trap, hh, w0, wn, r0, r1, g0, g1, f0, f1, v0, v1p, e0, u1, x_mid - xb[i], u0, m,
                                       dlm)  # fmt: skip
         rate_s0 += w0 * r0 * f0
         rate_s1 += wn * r1 * f1
@@ -840,6 +849,7 @@ def _birth_point(  # type: ignore[no-untyped-def]
     e_k = x1p - x_k
     predicted[0, n + k] = _chain_force(e_k, m, dlm)
     predicted[1, n + k] = _chain_stiffness(e_k, m, dlm)
+    predicted[2, n + k] = np.nan  # their energy at x1p is not computed (:func:`_energy_at_end`)
     lr_end = min(_log_rate(e_k, d, slope1, p), LOG_RATE_CAP)
     r_end = math.exp(lr_end)
     g_end = p[P_FORCE_SENS] * _chain_stiffness(e_k, m, dlm) * v1p - slope1 * _aging_clock(d, p)[1]
@@ -1011,6 +1021,22 @@ def _birth_errors(err_s, err_n, lump, born, hh, x1p, x_mid, v1p, slope1, p):  # 
     return err_s, err_n
 
 
+def _energy_at_end(n, shift, predicted, known, dlm):  # type: ignore[no-untyped-def]
+    """known[3]: each cohort's bond energy at the balanced end x1 = x1p + shift, from the pass's at x1p
+    (predicted[2]) and the force and stiffness at both ends (predicted[:2], known[1:3]): u(x1p) + shift (f(x1p) +
+    f(x1))/2 - shift^2 (k(x1) - k(x1p))/12, the integral of f by the end-corrected trapezoid, whose error (shift^5
+    times the fourth derivative of f over 720) is below rounding for |shift| <= ENERGY_SHIFT dl_m: a log1p per
+    cohort and step saved; nan where not known, or the shift is longer."""
+    near = abs(shift) <= ENERGY_SHIFT * dlm
+    for i in range(n):
+        u = predicted[2, i]
+        if near and u == u and known[1, i] == known[1, i]:
+            half_sum = 0.5 * (predicted[0, i] + known[1, i])
+            known[3, i] = u + shift * (half_sum - shift * (known[2, i] - predicted[1, i]) / 12.0)
+        else:
+            known[3, i] = np.nan
+
+
 def _slider_at_end(  # type: ignore[no-untyped-def]
     n, t, t1, t0, hh, x, v0, x1p, v1p, slope1, s0, s1, e_nb, sens_x, sens_a, err_s, puller0, vp, block, inertial,
     xb, tb, lw_new, w1, lc, aa, known, predicted, clock_end, p,
@@ -1043,6 +1069,7 @@ def _slider_at_end(  # type: ignore[no-untyped-def]
     elif block == 1:
         x1 = _balance_from(x1p, puller0 + vp * (t1 - t0), n + 2, xb, w1, p, predicted)
         v1 = _slider_velocity_clocked(v1p, vp, n + 2, xb, tb, lw_new, x1, t1, p, lc, aa, known, clock_end)
+        _energy_at_end(n + 2, x1 - x1p, predicted, known, dlm)
         err_s += 0.5 * hh * (abs(x1 - x1p) * sens_x + abs(_aging_factor(v1, p) - slope1) * sens_a)
         s1 = p[P_K] * (puller0 + vp * (t1 - t0) - x1)
         # that estimate is linear in the correction, and the hazard near the FENE wall is not: a cohort the
@@ -1212,6 +1239,7 @@ def _housekeeping(
                 lw[g] = math.log(wt)
                 known[0, g] = -1.0
                 known[1, g] = np.nan
+                known[3, g] = np.nan
                 rate0[g] = max(rate0[g], rate0[i])
                 decay_g = -1.0  # its birth time moved
                 clock_end[0, g] = np.nan
@@ -1223,6 +1251,7 @@ def _housekeeping(
             known[0, keep] = known[0, i]
             known[1, keep] = known[1, i]
             known[2, keep] = known[2, i]
+            known[3, keep] = known[3, i]
             rate0[keep] = rate0[i]
             clock_end[0, keep] = clock_end[0, i]
             clock_end[1, keep] = clock_end[1, i]
@@ -1285,8 +1314,9 @@ def advance(  # type: ignore[no-untyped-def]
     # saturating aging: each cohort's clock (A, dA/dt_a) at the step's end, from its pass; nan: not known
     clock_end = np.full((2, xb.shape[0]), np.nan)
     # exp(lw_new) (then exp(lw)) where computed exactly so, else -1; force and stiffness at the step's end (block)
-    known = np.full((3, xb.shape[0]), -1.0)
-    predicted = np.empty((2, xb.shape[0]))  # force and stiffness at the step's predicted end x1p
+    known = np.full((4, xb.shape[0]), -1.0)
+    known[3] = np.nan  # and the bond energy at the step's end where derived from the pass's (:func:`_energy_at_end`)
+    predicted = np.empty((3, xb.shape[0]))  # force, stiffness and bond energy at the step's predicted end x1p
     # False, typed bool: a literal False here made numba compile _cohort_pass a second time (~2.5 s on a fresh cache)
     cached = xb.shape[0] < 0
     # the block with a mass: the slider's acceleration now and at the previous step's start (for the predictor)
@@ -1440,6 +1470,7 @@ def compiled() -> dict[str, object]:
             "_light_spread",
             "_same_bin",
             "_saturation_decay",
+            "_energy_at_end",
         ):
             g[name] = _jit(g[name])
         for name in INLINED:
