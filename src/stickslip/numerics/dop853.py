@@ -234,6 +234,34 @@ class Steps:
         self.coefficients[i] = found
         return found
 
+    def _fill_coefficients(self, indices: list[int]) -> None:
+        """:meth:`_coefficients` of many steps at once: the sums as matrix products over the steps (the stick
+        phase's 400-point trace asked for ~45 steps' one by one, half of a stick phase's time; the same numbers to
+        rounding, the order of the sums aside).  The extra stages' field values are still taken one by one."""
+        if not indices:
+            return
+        h = np.array([self.widths[i] for i in indices])
+        states = np.array([self.states[i] for i in indices])
+        tp, n = states[:, 0], states[:, 1]
+        k = np.array([self.stages[i] for i in indices])  # (m, 13)
+        k_n = k - 1.0
+        hold = self.hold
+        for row in _ROWS[13:]:
+            weights = np.array(row)
+            at_tp = tp + (k @ weights) * h
+            at_n = n + (k_n @ weights) * h
+            g = np.array([hold(a, b) for a, b in zip(at_tp.tolist(), at_n.tolist(), strict=True)])
+            k = np.column_stack([k, g])
+            k_n = np.column_stack([k_n, g - 1.0])
+        d = np.array(_D)  # (4, 16)
+        d_tp, d_n = states[:, 2] - tp, states[:, 3] - n
+        f_tp = np.column_stack([d_tp, h * k[:, 0] - d_tp, 2 * d_tp - h * (k[:, 12] + k[:, 0]), h[:, None] * (k @ d.T)])
+        f_n = np.column_stack(
+            [d_n, h * k_n[:, 0] - d_n, 2 * d_n - h * (k_n[:, 12] + k_n[:, 0]), h[:, None] * (k_n @ d.T)]
+        )
+        for j, i in enumerate(indices):
+            self.coefficients[i] = (f_tp[j].tolist(), f_n[j].tolist())
+
     def _index(self, theta: float) -> int:
         # the step holding theta (the earlier one at a break point, as scipy's OdeSolution)
         lo, hi = 0, len(self.starts) - 1
@@ -268,6 +296,7 @@ class Steps:
         starts = np.asarray(self.starts)
         which = np.clip(np.searchsorted(starts, values, side="left") - 1, 0, len(self.starts) - 1)
         used = np.unique(which)
+        self._fill_coefficients([i for i in used.tolist() if self.coefficients[i] is None])
         table = np.zeros((len(self.starts), 2, 7))
         origin = np.zeros((len(self.starts), 2))
         for i in used.tolist():

@@ -124,6 +124,13 @@ class Manifold:
             self._stacked = (stack, off, scl)
         return self._stacked
 
+    def many(self, x: np.ndarray) -> np.ndarray:
+        """The six series of :meth:`at` at many ln V (shape (6, len(x))): one recurrence over the stacked columns
+        (numpy's Clenshaw with two-dimensional coefficients), each value the same to the bit as its own series'
+        call (the zero padding above a series' degree leaves its recurrence unchanged)."""
+        stack, off, scl = self.stacked()
+        return cheb.chebval(off + np.asarray(x) * scl, stack)
+
     def values(self, v: float) -> tuple[float, float, float, float, float]:
         """(S, S', S'', C, C') at velocity v (SI)."""
         s, sx, sxx, c, cx, _n = (float(value) for value in self.at(math.log(v)))
@@ -234,9 +241,9 @@ def allowed_neglect(m: Manifold, v: float, vp: float, sigma: float, tol: float) 
 
 def _effective_stress(m: Manifold, v: np.ndarray, vp: float, k_block: float) -> np.ndarray:
     """S_eff at many velocities (the first element of :func:`effective`)."""
-    x = np.log(v)
-    slope = m.dstress(x) / v
-    return m.stress(x) + m.lag(x) * k_block * (vp - v) / slope
+    stress, dstress, _d2, lag, _dlag, _n = m.many(np.log(v))
+    slope = dstress / v
+    return stress + lag * k_block * (vp - v) / slope
 
 
 def effective_bonded(m: Manifold, v: Any, vp: float, k_block: float, block: bool = True) -> Any:
@@ -245,7 +252,8 @@ def effective_bonded(m: Manifold, v: Any, vp: float, k_block: float, block: bool
     x = np.log(v)
     if not block:
         return m.bonded(x)
-    return m.bonded(x) + m.bonded_lag(x) * k_block * (vp - v) / (m.dstress(x) / v)
+    _s, dstress, _d2, _lag, _dlag, bonded = m.many(x)
+    return bonded + m.bonded_lag(x) * k_block * (vp - v) / (dstress / v)
 
 
 def entry_velocity(m: Manifold, sigma: float, v: float, vp: float, k_block: float, rtol: float) -> float | None:
