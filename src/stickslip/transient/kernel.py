@@ -169,6 +169,7 @@ def _log_rate(e, age, slope, p):  # type: ignore[no-untyped-def]
 
 def _velocity_prepare(n, xb, tb, lw, x, t, p, lc, aa, known, clock):  # type: ignore[no-untyped-def]
     """k_int; fills lc = ln(w r) without the aging term (w f r = f e^lc, f in known[1]) and aa = A(t_a)/tau_a for the
+    cohorts.
 
     ``known[0, i]``: exp(lw[i]) where the caller has it (bit for bit), negative where not; on return it holds
     exp(lw[i]), and known[1, i], known[2, i] the chain force and stiffness at x (nan for a dead cohort)."""
@@ -650,7 +651,7 @@ def _cohort_weight(lw_i, w0, f0, hh, lr0, r0, lr1, r1, g0, g1):  # type: ignore[
 
     The error, the weight's distance from the plain trapezoid's, w |1 - e^(-c)| for the end correction c, is taken
     by its Taylor series where |c| < CORRECTION_SERIES (to ~1e-12 of itself) instead of a second exp per cohort and
-    step (a tenth of the paper's cycle; docs/transient.md section 14)."""
+    step (docs/transient.md section 15)."""
     trap = 0.5 * hh * (r0 + r1)
     dying = 0.0
     if abs(lr1 - lr0) > 1.0 and max(lr0, lr1) < LOG_RATE_CAP:
