@@ -212,32 +212,16 @@ class Steps:
 
     def _coefficients(self, i: int) -> tuple[list[float], list[float]]:
         """The 7 interpolation coefficients of step ``i`` for t' and n (scipy's Dop853DenseOutput.F)."""
+        if self.coefficients[i] is None:
+            self._fill_coefficients([i])
         found = self.coefficients[i]
-        if found is not None:
-            return found
-        h = self.widths[i]
-        tp, n, tp_new, n_new = self.states[i]
-        k = list(self.stages[i])
-        k_n = [g - 1.0 for g in k]
-        hold = self.hold
-        for row in _ROWS[13:]:
-            g = hold(tp + sum(map(mul, k, row)) * h, n + sum(map(mul, k_n, row)) * h)
-            k.append(g)
-            k_n.append(g - 1.0)
-        d_tp, d_n = tp_new - tp, n_new - n
-        f_tp = [d_tp, h * k[0] - d_tp, 2 * d_tp - h * (k[12] + k[0])]
-        f_n = [d_n, h * k_n[0] - d_n, 2 * d_n - h * (k_n[12] + k_n[0])]
-        for row in _D:
-            f_tp.append(h * sum(map(mul, k, row)))
-            f_n.append(h * sum(map(mul, k_n, row)))
-        found = (f_tp, f_n)
-        self.coefficients[i] = found
+        assert found is not None
         return found
 
     def _fill_coefficients(self, indices: list[int]) -> None:
-        """:meth:`_coefficients` of many steps at once: the sums as matrix products over the steps (the stick
-        phase's 400-point trace asked for ~45 steps' one by one, half of a stick phase's time; the same numbers to
-        rounding, the order of the sums aside).  The extra stages' field values are still taken one by one."""
+        """The interpolation coefficients (:meth:`_coefficients`) of many steps at once: the sums as matrix products
+        over the steps (the stick phase's 400-point trace asked for ~45 steps' one by one, each sum in Python: half
+        of a stick phase's time).  The extra stages' field values are taken one by one."""
         if not indices:
             return
         h = np.array([self.widths[i] for i in indices])
