@@ -126,15 +126,17 @@ def simulate(
             elif grid is None:
                 t_out, y_out, y_end, blown, _ = _adaptive_piece(carried, y, t0, t1, vlp, x_cap, rtol, carried_atol)
                 t_steps, y_steps = t_out, y_out
+                if detect and index == last_piece and blown is None and mean and system.implicit:
+                    # Radau's error norm is a mean over all the unknowns, q's included: its steps with q are not
+                    # those of the equations alone, which a sampled run reads the regime off (below)
+                    t_steps, y_steps = _regime_steps(system, y[inner], t0, t1, vlp, x_cap, rtol, atol, mean)
             else:
                 inside = grid[(grid > t0) & (grid <= t1)]
                 t_out, y_out, y_end, blown = _sampled_piece(carried, y, t0, t1, vlp, inside, x_cap, rtol, carried_atol,
                                                             watch)  # fmt: skip
                 if detect and index == last_piece and blown is None:
                     # the regime is read off every accepted step of the last segment, whatever the sampling
-                    t_steps, y_steps, _, _, _ = _adaptive_piece(system, y[inner], t0, t1, vlp, x_cap, rtol, atol)
-                    if mean:
-                        y_steps = np.r_[y_steps, np.zeros((1, y_steps.shape[1]))]  # (q is not read there)
+                    t_steps, y_steps = _regime_steps(system, y[inner], t0, t1, vlp, x_cap, rtol, atol, mean)
         except (ZeroDivisionError, OverflowError) as exc:  # e.g. m V / sigma underflowing to 0 in dV/dt
             raise ModelError(_out_of_range(system, t0, t1, exc)) from None
         if detect and index == last_piece and blown is None and short is None:  # a one-step piece has no steps
@@ -413,6 +415,18 @@ def _unstable_somewhere(params: RSFParams, protocol: Protocol) -> bool:
 
     speeds = {float(v) for v in protocol.velocities if v > 0}
     return any(growth_rate(params, v) > 0 for v in speeds)
+
+
+def _regime_steps(
+    system: System, y0: np.ndarray, t0: float, t1: float, vlp: float, x_cap: float, rtol: float, atol: float,
+    mean: bool,
+) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+    """The accepted steps of the equations alone (without q) over a piece, and the states there (with a zero row for
+    q where the run carries it: it is not read there)."""
+    t_steps, y_steps, _, _, _ = _adaptive_piece(system, y0, t0, t1, vlp, x_cap, rtol, atol)
+    if mean:
+        y_steps = np.r_[y_steps, np.zeros((1, y_steps.shape[1]))]
+    return t_steps, y_steps
 
 
 def _interpolant(system: System, vlp: float, t_steps: np.ndarray, y_steps: np.ndarray, rtol: float, atol: float) -> Any:
