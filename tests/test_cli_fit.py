@@ -97,6 +97,24 @@ def test_bad_options_exit_2(capsys, argv, expected):
     assert code == 2 and expected in err and err.count("\n") == 1
 
 
+@pytest.mark.parametrize(
+    ("argv", "named"),
+    [
+        (["--fix", "bonds.site_density=1e300 1/m^2"], "bonds.site_density = 1e+300 (SI) held fixed"),  # was exit 1
+        (["--set", "bonds.site_density=1e300 1/m^2"], "squares overflow"),  # named bonds.site_density ... got 0
+        (["--set", "bonds.site_density=1e-300 1/m^2"], "squares vanish"),  # ... got inf
+        (["--fix", "bonds.bond_time=1e-300 s"], "bonds.bond_time = 1e-300 (SI) held fixed"),  # site_density, nan
+    ],
+)
+def test_start_values_outside_the_box_are_refused_naming_what_was_given(capsys, argv, named):
+    """A fuzz of the command line (2026-11-29): such values overflowed in the search (an internal error, exit 1)
+    or rescaled N0 to 0, inf or nan and were reported against bonds.site_density, which the user had not given."""
+    code, out, err = run(capsys, "fit", "steady", SYNTHETIC, *argv)
+    assert code == 2 and out == "" and err.count("\n") == 1, err
+    assert named in err and "the fit cannot start there" in err, err
+    assert "nan" not in err and "inf" not in err.replace("1e+300", ""), err
+
+
 def test_bayes_option(tmp_path, capsys):
     corner_png = tmp_path / "corner.png"
     code, out, err = run(

@@ -217,6 +217,36 @@ def _blocks(data: SteadyData, split: float, params: Parameters) -> tuple[np.ndar
     return error, everything, hi_block, lo_block
 
 
+def _require_finite_start(block: Block, params: Parameters, fixed: Mapping[str, float]) -> None:
+    """ParameterError unless the start values give a finite, non-zero steady stress at the data's velocities: a
+    value far outside the physical box (N0 = 1e300 m^-2, tau = 1e-300 s) overflowed in the fit's search, or
+    rescaled N0 to 0 or inf, and was then reported as an internal error or against a key the user never gave."""
+    try:
+        # an overflow here gives inf and an underflow 0, both refused just below: silenced because it is checked
+        with np.errstate(over="ignore", under="ignore", invalid="ignore"):
+            model = np.asarray(block.model(params), dtype=float)
+            level = float(np.sum(model * model)) if model.size else math.nan
+    except (ModelError, ParameterError, ArithmeticError) as exc:
+        model, level, why = np.array([math.nan]), math.nan, str(exc)
+    else:
+        why = ""
+    if np.all(np.isfinite(model)) and math.isfinite(level) and level > 0.0:
+        return
+    given = ", ".join(f"{key} = {value:.6g} (SI)" for key, value in fixed.items())
+    where = f" with {given} held fixed" if given else ""
+    if why:
+        shown = why
+    elif np.any(np.isfinite(model)):
+        largest = float(np.nanmax(np.abs(model)))
+        shown = f"at most {largest:.3g} Pa, whose squares {'overflow' if largest > 1.0 else 'vanish'}"
+    else:
+        shown = "not a finite number"
+    raise ParameterError(
+        f"the start values{where} give a steady stress at the data's velocities of {shown}: the fit cannot start"
+        " there; check the values given with --fix and --set, and the parameter set"
+    )
+
+
 def _scaled_start(params: Parameters, block: Block, free: Sequence[str]) -> Parameters:
     """Rescale N0 so that the start curve matches the data's level (sigma is proportional to N0)."""
     if "bonds.site_density" not in free:
@@ -438,6 +468,7 @@ def fit_steady(
     if not dependence.significant:  # nothing to fit: say so at once (a joint fit of noise ran 92 s before)
         return _no_response_fit(check, dependence)
     error, everything, hi, lo = _blocks(data, split, base)
+    _require_finite_start(everything, base, fixed)
     progress, keys = _run_method(check, (everything, hi, lo))
     progress, keys, adequacy = _adequate_or_searched(check, progress, keys, (everything, hi, lo))
     if not _interpolation_holds((everything, hi, lo), progress.params):
