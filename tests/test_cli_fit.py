@@ -80,6 +80,28 @@ def test_bad_files_exit_2_with_one_line(tmp_path, capsys, content, expected):
     assert expected in err and "Traceback" not in err
 
 
+STICK_HEADER = "pulling_velocity [um/s],stick_time [s],peak_stress [Pa],stick_slope [Pa/s],stiffness [kPa/m]\n"
+
+
+@pytest.mark.parametrize(
+    ("row", "expected"),
+    [
+        # a fuzz of the command line (2026-11-29): 1e300 Pa/s held the stick fit's integration for minutes
+        ("50,17.8,552,1e300,437", "row 3, column 'stick_slope': 1e+300 Pa/s is outside the range of a stick phase's"),
+        ("50,1e20,552,16.3,437", "row 3, column 'stick_time': 1e+20 s is outside the range of a stick time"),
+        ("50,17.8,1e15,16.3,437", "row 3, column 'peak_stress': 1e+15 Pa is outside the range of a friction stress"),
+        ("50,17.8,552,16.3,1e300", "row 3, column 'stiffness': 1e+303 Pa/m is outside the range of a block's"),
+        ("1e20,17.8,552,16.3,437", "row 3, column 'pulling_velocity': 1e+14 m/s is outside the range"),
+    ],
+)
+def test_stick_values_outside_their_physical_range_are_refused_at_once(tmp_path, capsys, row, expected):
+    path = tmp_path / "stick.csv"
+    path.write_text(STICK_HEADER + "50,18.3,554,16.5,431\n" + row + "\n100,18.2,658,35.0,457\n")
+    code, out, err = run(capsys, "fit", "stick", str(path))
+    assert code == 2 and out == "" and err.count("\n") == 1, err
+    assert expected in err and "check the units in the header" in err, err
+
+
 @pytest.mark.parametrize(
     ("argv", "expected"),
     [

@@ -40,6 +40,12 @@ STEADY_IGNORED_COLUMNS = {"bonded_fraction": "dimensionless", "stress_slope": "s
 STRESS_RANGE = (1e-9, 1e12)
 #: The range of sliding velocities, m/s (the upper end is the speed of light).
 VELOCITY_RANGE = (1e-15, 3e8)
+#: The ranges of a stick phase's other columns: its duration (s; 1e12 s is ~30 000 years), its loading rate (Pa/s;
+#: 1e15 Pa/s passes STRESS_RANGE's top within a millisecond) and the block's stiffness (Pa/m).  Beyond them the
+#: numbers are unit mistakes; a stick_slope of 1e300 Pa/s held the stick fit's integration for minutes.
+STICK_TIME_RANGE = (1e-12, 1e12)
+STRESS_RATE_RANGE = (1e-15, 1e15)
+STIFFNESS_RANGE = (1e-9, 1e18)
 STICK_COLUMNS = {
     "pulling_velocity": "velocity",
     "stick_time": "time",
@@ -318,6 +324,16 @@ def _validated_stick(table: Table) -> StickData:
         table,
         ["pulling_velocity", "stick_time", "peak_stress", "start_stress", "stick_slope", "stiffness", "jump_velocity"],
     )
+    for name, bounds, unit, what in (
+        ("pulling_velocity", VELOCITY_RANGE, "m/s", "a pulling velocity"),
+        ("jump_velocity", VELOCITY_RANGE, "m/s", "a sliding velocity"),
+        ("stick_time", STICK_TIME_RANGE, "s", "a stick time"),
+        ("peak_stress", STRESS_RANGE, "Pa", "a friction stress"),
+        ("start_stress", STRESS_RANGE, "Pa", "a friction stress"),
+        ("stick_slope", STRESS_RATE_RANGE, "Pa/s", "a stick phase's loading rate"),
+        ("stiffness", STIFFNESS_RANGE, "Pa/m", "a block's stiffness"),
+    ):
+        _require_range(table, name, bounds, unit, what)
     peak = table["peak_stress"] if "peak_stress" in table else None
     start = table["start_stress"] if "start_stress" in table else None
     if peak is not None and start is not None:
