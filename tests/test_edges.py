@@ -508,3 +508,23 @@ def test_a_json_parameter_file_of_an_earlier_run_is_read_back(tmp_path, capsys):
     status, out, err = run_main(capsys, "rsf", "simulate", "--params", str(tmp_path / "run.params.json"), "--json")
     assert status == 0, err
     assert json.loads(out)["status"] == "ok"
+
+
+def test_a_stuck_block_loaded_for_1e300_s_reports_its_mean_stress_without_overflow(capsys):
+    """A fuzz of the command line (2026-11-29): the block stays stuck at 1 um/s (Eq 15's aging wins) and its stress
+    rises as sigma_c + K V t, to 3e299 Pa after 1e300 s: the model's answer. Its time mean overflowed (dt x sigma),
+    the run said "floating-point trouble" and wrote mean_stress null. The mean of the ramp is sigma_c + K V T / 2."""
+    from stickslip import critical_point, load_parameters
+    from stickslip.models.run import time_mean
+
+    params = load_parameters("gelatin-glass")
+    code, out, err = run_main(capsys, "simulate", "--v0", "1 um/s", "--duration", "1e300 s", "--json")
+    assert code == 0 and err == "", err
+    summary = json.loads(out)
+    assert summary["regime"] == "stuck"
+    ramp = critical_point(params).stress + params.block.effective_stiffness * 1e-6 * 1e300 / 2.0
+    assert summary["mean_stress"] == pytest.approx(ramp, rel=1e-9)
+    # the rule itself, at both ends of the range: a line's mean is the mean of its ends
+    for span, top in ((1e300, 1e299), (1e-300, 1e-290), (1.0, 1e308)):
+        t = np.linspace(0.0, span, 7)
+        assert time_mean(t, top * (t / span)) == pytest.approx(top / 2.0, rel=1e-14)
