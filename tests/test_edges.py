@@ -268,6 +268,14 @@ CASES: list[tuple[list[str], int, str]] = [
     (["simulate", "--v0", "50", "--duration", "10 s"], 2, '--v0 "50 um/s" (or "50 m/s" if you mean SI)'),
     (["simulate", "--v0", "1e300 m/s", "--duration", "10 s"], 2, "below what the stick model resolves"),
     (["simulate", "--v0", "50 um/s", "--duration", "1e300 s"], 2, "give a shorter duration"),
+    # --- stability with the block's mass (a fuzz, 2026-11-29: these printed a number beside an overflow warning)
+    (["stability", "--v0", "120 um/s", "--mass", "1e300 kg/m^2"], 2, "mass 1e+300 kg/m^2 and damping 0 Pa s/m leaves"),
+    (
+        ["stability", "--v0", "120 um/s", "--mass", "10 kg/m^2", "--damping", "1e300 Pa*s/m"],
+        2,
+        "damping 1e+300 Pa s/m leaves the floating-point range",
+    ),
+    (["stability", "--v0", "120 um/s", "--growth-at", "1e300"], 2, "expected a factor nearer 1"),  # was s = nan+nanj
     (["simulate", "--v0", "50 um/s", "--duration", "0"], 2, "--duration: expected a positive value"),
     # --- analyze and fit stick: input files
     (["analyze", "--v0", "50 um/s", "empty.csv"], 2, "empty.csv: empty file"),

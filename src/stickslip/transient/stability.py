@@ -264,7 +264,18 @@ def critical_stiffness_details(
     # took the largest, Kc = 1.3e15 Pa/m at 6e11 Hz, which moved to 9e7 Hz on a grid twice as fine
     _check_velocity(params, velocity)  # before the resolved frequency's cells: a typed error, not an overflow
     top = resolved_frequency(params, velocity, aging)
-    return critical_from_response(_response(params, velocity, aging), SCAN / params.bonds.bond_time, mass, damping, top)
+    try:
+        # raised, not warned: a mass of 1e300 kg/m^2 overflowed m w^2 over the scan and printed a Kc of 4e304 Pa/m
+        # beside a warning, a damping of 1e300 Pa s/m "stable for every stiffness" from infinite Im D
+        with np.errstate(over="raise", invalid="raise"):
+            return critical_from_response(
+                _response(params, velocity, aging), SCAN / params.bonds.bond_time, mass, damping, top
+            )
+    except FloatingPointError:
+        raise ModelError(
+            f"Kc at {velocity:.6g} m/s through a block of mass {mass:.6g} kg/m^2 and damping {damping:.6g} Pa s/m"
+            " leaves the floating-point range: expected a smaller block mass or damping"
+        ) from None
 
 
 def critical_from_response(
@@ -366,7 +377,17 @@ def hopf_root(
     if kc.mode != "oscillatory":
         raise ModelError(f"no Hopf point at {velocity:.6g} m/s (mode {kc.mode!r}): {kc.message}")
     z = _response(params, velocity, aging)
-    return follow_root(z, 1j * kc.rate, kc.value, factor * kc.value, mass, damping)
+    try:
+        with np.errstate(over="raise", invalid="raise"):  # raised, as in critical_stiffness_details
+            root = follow_root(z, 1j * kc.rate, kc.value, factor * kc.value, mass, damping)
+    except FloatingPointError:
+        root = complex(math.nan, math.nan)
+    if not (math.isfinite(root.real) and math.isfinite(root.imag)):
+        raise ModelError(
+            f"the Hopf root followed to K = {factor:g} x Kc = {factor * kc.value:.6g} Pa/m leaves the floating-point"
+            " range: expected a factor nearer 1"
+        )
+    return root
 
 
 def _response(params: Parameters, velocity: float, aging: bool) -> Callable[[np.ndarray], np.ndarray]:
