@@ -84,6 +84,19 @@ def test_bad_sweeps_fail_in_one_line_and_leave_no_folder(tmp_path, capsys, monke
     assert list(tmp_path.iterdir()) == []
 
 
+def test_a_sweep_whose_every_point_failed_exits_2_with_the_first_reason(tmp_path, capsys):
+    """A fuzz of the command line (2026-11-29): a duration no point can trace (1e300 s) left every row an error and
+    the command said "sweep: 3 points (3 failed)" with exit 0; one point failing among others is still a row."""
+    out = tmp_path / "out"
+    argv = ["--workers", "0", "--quiet", "--vary", "bonds.bond_time=100 us..500 us:3", "--v0", "50 um/s", "-o"]
+    status, _, err = run_main(capsys, "sweep", *argv, str(out), "--duration", "1e300 s")
+    line = _one_error_line(status, err)
+    assert "every point of the sweep failed (3 of 3;" in line and "give a shorter duration" in line
+    assert (pd.read_parquet(out)["status"] == "error").all()  # each reason kept in its row
+    status, _, err = run_main(capsys, "sweep", *argv, str(tmp_path / "fine"), "--duration", "30 s")
+    assert status == 0 and err == "", err
+
+
 def test_a_sweep_too_large_for_the_disk_is_refused_before_any_work(tmp_path, monkeypatch):
     usage = SimpleNamespace(total=10**12, used=10**12 - 10**9, free=10**9)
     monkeypatch.setattr("stickslip.sweeps.store.shutil.disk_usage", lambda path: usage)
