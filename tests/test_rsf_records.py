@@ -6,6 +6,7 @@ own rows, and the measured load point as the model's history.  The records are m
 from __future__ import annotations
 
 import math
+import re
 import time
 from pathlib import Path
 
@@ -193,6 +194,37 @@ def test_a_bracketed_unit_of_another_kind_is_refused(tmp_path):
     path = write(tmp_path / "rig.txt", "Time(s)\tDispl (mm/s)", t, t)
     with pytest.raises(DataError, match="is in mm/s, a velocity; expected a length"):
         read_record(path, {"time": "Time(s)", "displacement": "Displ (mm/s)", "friction": "Friction"})
+
+
+@pytest.mark.parametrize(
+    ("time_header", "friction_header", "refused"),
+    [
+        # a fuzz of the command line (2026-11-29): each was read as seconds or as mu, the fit said "ok"
+        ("time [kg]", "Friction", "column 'time [kg]' is in kg, not a time"),
+        ("time [xyz]", "Friction", "column 'time [xyz]': unknown unit 'xyz'; expected a time"),
+        ("Time (V)", "Friction", "column 'Time (V)' is in V, not a time"),
+        ("Time(s)", "friction [Pa]", "column 'friction [Pa]' is in Pa, a stress; expected the friction coefficient"),
+    ],
+)
+def test_a_header_unit_that_is_not_the_columns_kind_is_refused(tmp_path, time_header, friction_header, refused):
+    t = np.arange(0.0, 50.0)
+    rows = "".join(f"{a:.6g}\t{2e-6 * a:.9g}\t0.6\n" for a in t)
+    path = tmp_path / "rig.txt"
+    path.write_text(f"{time_header}\tDispl(m)\t{friction_header}\n" + rows)
+    with pytest.raises(DataError, match=re.escape(refused)) as caught:
+        read_record(path, {"time": time_header, "displacement": "Displ(m)", "friction": friction_header})
+    assert "\n" not in str(caught.value)
+
+
+def test_labels_in_round_brackets_and_pure_numbers_are_no_units(tmp_path):
+    """What a header may carry that names no unit: a label in round brackets, [1] or [-] on the friction."""
+    t = np.arange(0.0, 50.0)
+    for displ, friction in (("Displ (LVDT 2)", "friction [1]"), ("Displ (LVDT 2)", "friction [-]")):
+        rows = "".join(f"{a:.6g}\t{2e-6 * a:.9g}\t0.6\n" for a in t)
+        path = tmp_path / "rig.txt"
+        path.write_text(f"Time(s)\t{displ}\t{friction}\n" + rows)
+        record = read_record(path, {"time": "Time(s)", "displacement": displ, "friction": friction})
+        assert record.displacement[-1] == pytest.approx(98e-6) and record.friction[0] == 0.6
 
 
 # --- a velocity column ------------------------------------------------------------------------------------------

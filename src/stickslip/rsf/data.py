@@ -156,6 +156,8 @@ def read_record(
     data = {role: pd.to_numeric(frame[col], errors="coerce").to_numpy(dtype=float) for role, col in chosen.items()}
     dimension = {"time": "time", "displacement": "length", "velocity": "velocity"}
     units = {role: _header_unit(str(chosen[role]), dimension[role], path) for role in chosen if role in dimension}
+    if "friction" in chosen:
+        _header_unit(str(chosen["friction"]), "dimensionless", path)  # mu: a stress column is refused
 
     def in_si(role: str) -> np.ndarray:
         """A column in SI: by the unit its header names, else by the option, else SI."""
@@ -262,17 +264,35 @@ def _header_unit(header: str, dimension: str, path: Path) -> tuple[float, str] |
     if word is None:
         return None
     unit = _UNIT_WORDS.get(word.lower(), word)
+    if dimension == "dimensionless" and unit in ("1", "-"):  # a pure number, as this package writes one
+        return 1.0, unit
     try:
         return to_si(f"1 {unit}", dimension, header), unit
     except ParameterError:
         pass
-    for other in ("length", "time", "velocity"):
+    expected = "the friction coefficient (dimensionless)" if dimension == "dimensionless" else f"a {dimension}"
+    for other in ("length", "time", "velocity", "stress"):
         try:
             to_si(f"1 {unit}", other, header)
         except ParameterError:
             continue
-        raise DataError(f"{path}: column {header!r} is in {word}, a {other}; expected a {dimension}") from None
-    return None  # a word in brackets that is no unit ("Displ (LVDT 2)")
+        raise DataError(f"{path}: column {header!r} is in {word}, a {other}; expected {expected}") from None
+    if _known_unit(unit):  # a unit of any other kind ("time [kg]", "Displ (V)"): never read as a bare number
+        raise DataError(f"{path}: column {header!r} is in {word}, not {expected}; give the column in such a unit")
+    if match is not None and match.group(0).lstrip().startswith("["):  # this package's own way to write a unit
+        raise DataError(f"{path}: column {header!r}: unknown unit {word!r}; expected {expected}")
+    return None  # a word in round brackets that is no unit ("Displ (LVDT 2)")
+
+
+def _known_unit(unit: str) -> bool:
+    """Whether pint reads ``unit`` as a unit (of any dimension)."""
+    from ..units import registry
+
+    try:
+        registry().parse_units(unit)
+    except Exception:  # pint raises many things on garbage; all mean "no unit"
+        return False
+    return True
 
 
 def _length_of(velocity_unit: tuple[float, str]) -> tuple[float, str]:
