@@ -57,6 +57,8 @@ def _write_fixtures(folder: Path) -> None:
         "good.json": '{"parameters": {"a": 0.01}, "protocol": [{"velocity": 1e-6, "duration": 1.0}]}',
         "deep.json": "[" * 100_000 + "]" * 100_000,  # the parsers recurse: a RecursionError, not a message
         "deep.toml": "a = " + "[" * 100_000 + "]" * 100_000 + "\n",
+        "empty.toml": "",
+        "emptytable.json": '{"parameters": {}}',
     }
     for name, text in texts.items():
         (folder / name).write_text(text, encoding="utf-8")
@@ -117,6 +119,9 @@ CASES: list[tuple[list[str], int, str]] = [
     (["rsf", "simulate", "--params", "statesnull.json", *SEG], 2, "'states' must be a non-empty list"),
     (["rsf", "simulate", "--params", "statesx.json", *SEG], 2, "'states' must be a non-empty list"),
     (["rsf", "simulate", "--params", "states1.json", *SEG], 2, "'states' must be a non-empty list"),
+    # read as the defaults before (a fuzz, 2026-11-29); the bond model's commands refuse an empty file too
+    (["rsf", "simulate", "--params", "empty.toml", *SEG], 2, "--params empty.toml: holds no parameters"),
+    (["rsf", "simulate", "--params", "emptytable.json", *SEG], 2, "--params emptytable.json: holds no parameters"),
     (["rsf", "simulate", "--params", "protoabc.json"], 2, "'protocol' must be a list of"),
     (["rsf", "simulate", "--params", "protobad.json"], 2, "'protocol' must be a list of"),
     (["rsf", "simulate", "--params", "paramslist.json", *SEG], 2, "'parameters' must be a table of values"),

@@ -20,6 +20,11 @@ def load_params_mapping(path: Path) -> dict[str, Any]:
     mapping = data.get("parameters", data)
     if not isinstance(mapping, dict):
         raise DataError(f"--params {path}: 'parameters' must be a table of values, got {type(mapping).__name__}")
+    if not mapping:  # an empty file read as the defaults hid a file that was never written (the bond model refuses)
+        raise DataError(
+            f"--params {path}: holds no parameters (empty); give at least one, e.g. a = 0.005, or leave --params out"
+            " for the defaults"
+        )
     return dict(mapping)
 
 
