@@ -52,6 +52,23 @@ def test_a_protocol_header_of_the_wrong_unit_or_twice_is_refused(tmp_path):
         protocols.read_protocol(twice)
 
 
+def test_a_protocol_header_of_both_layouts_or_one_column_is_refused_naming_its_columns(tmp_path):
+    """A fuzz of the command line (2026-11-29): time,velocity,duration was read as segments, its times ignored;
+    a lone 'time' column was split on its 't' by pandas' sniffer ('found Unnamed: 0, ime')."""
+    both = tmp_path / "both.csv"
+    both.write_text("time,velocity,duration\n0,1e-6,10\n10,2e-6,10\n")
+    with pytest.raises(DataError, match="the header has both time and duration"):
+        protocols.read_protocol(both)
+    lone = tmp_path / "lone.csv"
+    lone.write_text("time\n0\n10\n")
+    with pytest.raises(DataError, match=r"found time$"):
+        protocols.read_protocol(lone)
+    for sep in (";", "\t"):  # the other separators still read
+        other = tmp_path / "other.csv"
+        other.write_text(f"time{sep}velocity\n0{sep}1e-6\n10{sep}2e-6\n")
+        assert protocols.read_protocol(other).segments[0].velocity == pytest.approx(1e-6)
+
+
 def test_a_bad_protocol_row_is_named_by_its_line_in_the_file(tmp_path):
     """Comment and blank lines were not counted: the NaN on line 5 was reported on 'row 3', the header's line."""
     commented = tmp_path / "commented.csv"

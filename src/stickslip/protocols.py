@@ -267,12 +267,20 @@ def read_protocol(path: str | Path) -> Protocol:
     if not text.strip():
         raise DataError(f"{path}: empty file, expected a CSV with columns time,velocity or velocity,duration")
     try:
-        frame = pd.read_csv(io.StringIO(text), sep=None, engine="python", comment="#", nrows=1_000_000)
+        # the separator from the header (pandas' sniffer took the "t" of a lone "time" column for one)
+        header = next((line for line in text.splitlines() if line.strip() and not line.lstrip().startswith("#")), "")
+        sep = "\t" if "\t" in header else ";" if header.count(";") > header.count(",") else ","
+        frame = pd.read_csv(io.StringIO(text), sep=sep, comment="#", nrows=1_000_000)
     except (ValueError, csv.Error, pd.errors.ParserError) as exc:  # csv.Error: no delimiter could be found
         raise DataError(f"{path}: cannot read as CSV ({(str(exc).splitlines() or [''])[0]})") from None
     # a header cell may carry its unit, as the package writes CSV headers: "time [s]", "velocity [um/s]"
     columns = {split_header(str(c), parentheses=True)[0].lower(): c for c in frame.columns}
     _refuse_duplicated_columns(text, path)
+    if {"time", "duration"} <= set(columns):  # which layout is meant? (read as segments, the times were ignored)
+        raise DataError(
+            f"{path}: the header has both time and duration; give time,velocity (change points) or velocity,duration"
+            " (segments)"
+        )
     lines = data_lines(text.split("\n"), len(frame)) or list(range(2, len(frame) + 2))
     if {"velocity", "duration"} <= set(columns):
         pairs = _numeric_rows(frame, path, [columns["velocity"], columns["duration"]], lines)
