@@ -122,6 +122,17 @@ def test_plot_into_the_sweep_folder_is_refused_and_the_folder_untouched(referenc
     assert sorted(p.name for p in folder.iterdir()) == before
 
 
+def test_plot_into_a_missing_folder_or_an_unknown_format_is_refused_before_drawing(reference, tmp_path, capsys):
+    """A fuzz of the command line (2026-11-29): the missing folder came back as an errno with the temporary name."""
+    plot = ["sweep", "plot", str(reference[0]), "--y", "block.height", "-o"]
+    status, _, err = run_main(capsys, *plot, str(tmp_path / "typo" / "x.png"))
+    line = _one_error_line(status, err)
+    assert "does not exist" in line and ".tmp" not in line and "Errno" not in line
+    status, _, err = run_main(capsys, *plot, str(tmp_path / "x.xyz"))
+    assert "unknown figure format .xyz" in _one_error_line(status, err)
+    assert list(tmp_path.iterdir()) == []
+
+
 @pytest.mark.parametrize(
     ("edit", "expected"),
     [

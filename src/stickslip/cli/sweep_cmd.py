@@ -9,7 +9,7 @@ from typing import Any
 import click
 
 from ..errors import DataError, ParameterError, StickslipError
-from .common import echo_err, require_unit, set_values
+from .common import check_output, echo_err, require_unit, set_values
 
 MODEL_NAMES = ("quasi-static", "transient", "rsf")  # the built-ins; any registered model or module:attr is taken
 
@@ -218,6 +218,8 @@ def plot_command(folder: Path, x: str, y: str | None, color: str, output: Path |
 
     target = output if output is not None else folder.parent / f"{folder.name}-{color}.png"
     _refuse_inside(folder, target)
+    if str(target) != "-":
+        check_output("-o", target, plot=True)  # before the work, in one line (it was an errno and a temporary name)
     frame, spec = load_sweep(folder)
     ax = plot_phase_diagram(frame, spec, x=x, y=y, color=color)
     try:

@@ -124,7 +124,15 @@ class RSFModel(FrictionModel):
             return int(raw)
         name = str(raw).strip().lower()
         if name not in self.LAW_NAMES:
-            raise ParameterError(f"--set law={raw}: expected one of {', '.join(self.LAW_NAMES)}")
+            from ..rsf.laws import LAWS
+
+            others = sorted(set(LAWS) - set(self.LAW_NAMES))
+            beyond = (
+                f" ({', '.join(others)}: a further constant or state, through stickslip rsf simulate --law)"
+                if others
+                else ""
+            )
+            raise ParameterError(f"--set law={raw}: expected one of {', '.join(self.LAW_NAMES)}{beyond}")
         return self.LAW_NAMES.index(name)
 
     def values(self, params: Any) -> dict[str, float]:
