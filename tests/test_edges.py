@@ -99,6 +99,8 @@ CASES: list[tuple[list[str], int, str]] = [
     (["rsf", "simulate", "--protocol", "blank.csv"], 2, "blank.csv: empty file"),
     (["rsf", "simulate", "--protocol", "bin.csv"], 2, "protocol file bin.csv: not a text (UTF-8) file"),
     (["rsf", "simulate", "--protocol", "fifo"], 2, "fifo: not a regular file"),
+    (["rsf", "fit", "zero"], 2, "zero: not a regular file"),  # "record not found" before (a fuzz, 2026-11-29)
+    (["rsf", "fit", "fifo"], 2, "fifo: not a regular file"),
     (["rsf", "simulate", "--protocol", "zero"], 2, "zero: not a regular file"),
     (["rsf", "simulate", "--protocol", "dir"], 2, "is a directory"),
     (["rsf", "simulate", "--protocol", "missing.csv"], 2, "protocol file missing.csv: file not found"),

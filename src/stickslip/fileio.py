@@ -127,13 +127,11 @@ def _invocation_meta() -> dict[str, Any] | None:
     return None if ctx is None else ctx.meta
 
 
-def read_input_text(path: str | Path, subject: str, max_bytes: int, error: type[Exception] = DataError) -> str:
-    """The text of an input file, checked before it is read: a regular file (a FIFO would block, /dev/zero never
-    end) of at most ``max_bytes``, UTF-8 (a byte-order mark is fine).  Every problem is one ``error`` line that
-    starts with ``subject`` (``"--params run.json"``, ``"protocol file p.csv"``)."""
-    path = Path(path)
+def require_input_file(path: str | Path, subject: str, error: type[Exception] = DataError) -> os.stat_result:
+    """The stat of an input file that is a regular file (a FIFO would block, /dev/zero never end, /dev/null is
+    empty); every other case is one ``error`` line that starts with ``subject``."""
     try:
-        info = path.stat()
+        info = Path(path).stat()
     except FileNotFoundError:
         raise error(f"{subject}: file not found") from None
     except (OSError, ValueError) as exc:  # ValueError: a NUL in the name
@@ -142,6 +140,15 @@ def read_input_text(path: str | Path, subject: str, max_bytes: int, error: type[
         raise error(f"{subject}: is a folder, not a file")
     if not stat.S_ISREG(info.st_mode):
         raise error(f"{subject}: not a regular file (save a pipe or device to a file first)")
+    return info
+
+
+def read_input_text(path: str | Path, subject: str, max_bytes: int, error: type[Exception] = DataError) -> str:
+    """The text of an input file, checked before it is read (:func:`require_input_file`), of at most
+    ``max_bytes``, UTF-8 (a byte-order mark is fine).  Every problem is one ``error`` line that starts with
+    ``subject`` (``"--params run.json"``, ``"protocol file p.csv"``)."""
+    path = Path(path)
+    info = require_input_file(path, subject, error)
     if info.st_size > max_bytes:
         raise error(f"{subject}: {info.st_size} bytes; at most {max_bytes} bytes are read")
     try:

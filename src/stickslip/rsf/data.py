@@ -19,7 +19,7 @@ import numpy as np
 
 from ..columns import data_lines, split_header, with_units
 from ..errors import DataError, ParameterError
-from ..fileio import protect_inputs
+from ..fileio import protect_inputs, require_input_file
 from ..protocols import Protocol, Segment
 
 __all__ = [
@@ -132,8 +132,7 @@ def read_record(
     import pandas as pd
 
     path = Path(path)
-    if not path.is_file():
-        raise DataError(f"{path}: record not found")
+    require_input_file(path, str(path))  # not found, a folder, a device or pipe: each in its own words
     protect_inputs([path])  # in a command, no output may replace the record
     option = {
         "time": _option_scale(time_unit, "time", "--time-unit"),
