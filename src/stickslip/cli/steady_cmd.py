@@ -115,6 +115,10 @@ def _evaluate(params: Any, velocities: np.ndarray, aging: bool) -> dict[str, np.
 def _stream_csv(params: Any, velocities: np.ndarray, aging: bool, output: Path | None) -> None:
     """Evaluate and write CHUNK velocities at a time: memory stays flat whatever --points is."""
 
+    # both ends first: a velocity outside what the model integrates fails there, before a header is written
+    # to standard output with nothing after it
+    _evaluate(params, velocities[[0, -1]], aging)
+
     def write_all(write: Any) -> None:
         write(_csv_header())
         for start in range(0, velocities.size, CHUNK):
