@@ -278,7 +278,9 @@ def test_a_transient_sweep_does_not_store_lambda_zero_as_ok(capsys, tmp_path):
     status, _, err = run_main(capsys, "sweep", "--model", "transient", "--v0", "350 um/s", "--vary",
                               "bonds.activation_length=0 m", "--duration", "0.1 s", "--workers", "0", "--quiet",
                               "-o", str(out))  # fmt: skip
-    assert status == 0, err
+    # its only point failed, so the sweep did (exit 2 since 2026-11-29: a sweep whose every point failed said "1
+    # failed" with exit 0); the row keeps the reason
+    assert status == 2 and "every point of the sweep failed (1 of 1;" in err and "activation_length" in err, err
     row = pd.read_parquet(out).iloc[0]
     assert row["status"] != "ok" and "activation_length" in row["message"]
 
