@@ -202,7 +202,7 @@ def test_a_bracketed_unit_of_another_kind_is_refused(tmp_path):
         # a fuzz of the command line (2026-11-29): each was read as seconds or as mu, the fit said "ok"
         ("time [kg]", "Friction", "column 'time [kg]' is in kg, not a time"),
         ("time [xyz]", "Friction", "column 'time [xyz]': unknown unit 'xyz'; expected a time"),
-        ("Time (V)", "Friction", "column 'Time (V)' is in V, not a time"),
+        ("time [V]", "Friction", "column 'time [V]' is in V, not a time"),
         ("Time(s)", "friction [Pa]", "column 'friction [Pa]' is in Pa, a stress; expected the friction coefficient"),
     ],
 )
@@ -217,9 +217,14 @@ def test_a_header_unit_that_is_not_the_columns_kind_is_refused(tmp_path, time_he
 
 
 def test_labels_in_round_brackets_and_pure_numbers_are_no_units(tmp_path):
-    """What a header may carry that names no unit: a label in round brackets, [1] or [-] on the friction."""
+    """What a header may carry that names no unit: a label in round brackets (even one that pint reads as a unit of
+    no kind a record has: A, mu), [1] or [-] on the friction."""
     t = np.arange(0.0, 50.0)
-    for displ, friction in (("Displ (LVDT 2)", "friction [1]"), ("Displ (LVDT 2)", "friction [-]")):
+    for displ, friction in (
+        ("Displ (LVDT 2)", "friction [1]"),
+        ("Displ (A)", "friction [-]"),
+        ("Displ", "Friction (mu)"),
+    ):
         rows = "".join(f"{a:.6g}\t{2e-6 * a:.9g}\t0.6\n" for a in t)
         path = tmp_path / "rig.txt"
         path.write_text(f"Time(s)\t{displ}\t{friction}\n" + rows)

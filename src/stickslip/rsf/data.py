@@ -276,11 +276,12 @@ def _header_unit(header: str, dimension: str, path: Path) -> tuple[float, str] |
         except ParameterError:
             continue
         raise DataError(f"{path}: column {header!r} is in {word}, a {other}; expected {expected}") from None
-    if _known_unit(unit):  # a unit of any other kind ("time [kg]", "Displ (V)"): never read as a bare number
-        raise DataError(f"{path}: column {header!r} is in {word}, not {expected}; give the column in such a unit")
     if match is not None and match.group(0).lstrip().startswith("["):  # this package's own way to write a unit
+        if _known_unit(unit):  # of any other kind ("time [kg]"): never read as a bare number
+            raise DataError(f"{path}: column {header!r} is in {word}, not {expected}; give the column in such a unit")
         raise DataError(f"{path}: column {header!r}: unknown unit {word!r}; expected {expected}")
-    return None  # a word in round brackets that is no unit ("Displ (LVDT 2)")
+    return None  # a word in round brackets that names no length, time, speed or stress: a label ("Displ (LVDT 2)",
+    # "Displ (A)" for channel A, "Friction (mu)")
 
 
 def _known_unit(unit: str) -> bool:
