@@ -1505,8 +1505,8 @@ def _quasi_static_clock(
     """(first stick's time, stick + slip period from sigma_c) of the quasi-static cycle (quasistatic.cycle) at K.
 
     Remembered by its arguments (a frozen parameter set; ~5 ms, as much as the cohorts' steps of a tenth of the
-    paper's cycle): runs of one set at one puller velocity ask again (the report's holds, a sweep over a protocol's
-    keys, a repeated run)."""
+    paper's cycle): runs of one set at one puller velocity ask again (a repeated run, a sweep over a protocol's
+    keys)."""
     from ..quasistatic.jump import jump_velocity
     from ..quasistatic.slip import slip_duration
     from ..quasistatic.stick import stick_time
