@@ -253,3 +253,25 @@ def test_the_one_state_equations_are_the_general_ones_bit_for_bit(law):
     plain = type("Plain", (type(s.laws[0]),), {"state_rate": laws.StateLaw.state_rate})()
     g, fast = plain.state_rate(V0, DC), s.laws[0].state_rate(V0, DC)
     assert all(g(x, p) == fast(x, p) == s.laws[0].rate(x, p, V0, DC)[0] for x, p in rng.uniform(-8.0, 8.0, (50, 2)))
+
+
+@pytest.mark.parametrize("names", [("aging", "slip"), ("prz", "aging"), ("slip", "prz", "aging")])
+def test_several_states_take_the_general_equations_bit_for_bit(names):
+    """Two states (unrolled) and three (a loop) take their own right-hand side, each law's g alone, with the numbers
+    bound as locals; it must give what the general classical form and the fully general one give, exactly, also
+    at the exponentials' cap, and a System must still pickle."""
+    import pickle
+
+    states = tuple(StateVariable(law, 0.006 + 0.002 * k, DC * (1 + 5 * k)) for k, law in enumerate(names))
+    s = System(RSFParams(a=0.011, states=states, v_ref=V0, stiffness=800.0, eta=3.0))
+    assert s.classical and s.rhs.__name__ == ("two" if len(names) == 2 else "rhs")
+    assert not hasattr(s.rhs, "__self__")  # a closure, not the method _rhs_classical
+    rng = np.random.default_rng(11)
+    size = len(names) + 1
+    edges = np.array([[750.0] + [-750.0] * (size - 1), [-750.0] + [750.0] * (size - 1), [699.9] + [-0.5] * (size - 1)])
+    for y in np.vstack([rng.uniform(-8.0, 8.0, (200, size)), edges]):
+        fast = s.rhs(0.0, y, 3e-6)
+        assert fast == s._rhs_classical(0.0, y, 3e-6) == System.rhs(s, 0.0, y, 3e-6)
+    again = pickle.loads(pickle.dumps(s))
+    y = rng.uniform(-1.0, 1.0, size)
+    assert again.rhs(0.0, y, 3e-6) == s.rhs(0.0, y, 3e-6)
