@@ -275,3 +275,22 @@ def test_several_states_take_the_general_equations_bit_for_bit(names):
     again = pickle.loads(pickle.dumps(s))
     y = rng.uniform(-1.0, 1.0, size)
     assert again.rhs(0.0, y, 3e-6) == s.rhs(0.0, y, 3e-6)
+
+
+@pytest.mark.parametrize("names", [("aging",), ("slip", "prz")])
+def test_the_carried_integral_of_friction_takes_the_same_equations(names):
+    """The classical form with the integral of mu carried (the run's mean friction) has its own right-hand side;
+    its rates are the system's bit for bit, and its dmu/dt the friction (to rounding: the sum is associated
+    differently)."""
+    from stickslip.rsf.solver import WithIntegral
+
+    states = tuple(StateVariable(law, 0.006 + 0.002 * k, DC * (1 + 5 * k)) for k, law in enumerate(names))
+    s = System(RSFParams(a=0.011, states=states, v_ref=V0, stiffness=800.0, eta=3.0))
+    carried = WithIntegral(s)
+    assert not hasattr(carried.rhs, "__self__")  # the closure, not the general method
+    rng = np.random.default_rng(13)
+    size = len(names) + 2
+    for y in np.vstack([rng.uniform(-8.0, 8.0, (200, size)), [[750.0] + [-750.0] * (size - 1)]]):
+        fast, general = carried.rhs(0.0, y, 3e-6), carried._rhs(0.0, y, 3e-6)
+        assert fast[:-1] == general[:-1]
+        assert fast[-1] == pytest.approx(general[-1], rel=1e-14, abs=1e-12)

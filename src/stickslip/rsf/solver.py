@@ -21,7 +21,6 @@ from .. import regimes
 from ..errors import ModelError, ParameterError
 from ..protocols import Protocol
 from ..units import shorten, to_si
-from .laws import cexp as _exp
 from .params import RSFParams
 from .results import RSFRun, Solution, assemble_run
 from .stability import jacobian_at
@@ -202,7 +201,7 @@ class WithIntegral:
         o = system.offset
         self._x, self._psi = o, slice(o + 1, o + 1 + system.n)
         # the common case (System._rhs_classical's equations, mu inline): the wrapper's cost is per evaluation
-        self.rhs = self._rhs_classical if system.classical else self._rhs
+        self.rhs = _classical_with_integral(system) if system.classical else self._rhs
 
     def __getattr__(self, name: str) -> Any:
         return getattr(self.system, name)
@@ -210,24 +209,6 @@ class WithIntegral:
     def _rhs(self, t: float, y: np.ndarray, vlp: float) -> list[float]:
         inner = y[:-1]
         return [*self.system.rhs(t, inner, vlp), self.system.friction(float(inner[self._x]), inner[self._psi])]
-
-    def _rhs_classical(self, t: float, y: np.ndarray, vlp: float) -> list[float]:
-        s = self.system
-        x, *psi = y.tolist()
-        psi.pop()  # q
-        v0 = s.v0
-        out = [0.0]
-        G = 0.0
-        mu = s.mu0 + s.a * x
-        for (rate, b, dc), p in zip(s._terms, psi):  # noqa: B905  (lengths match by construction)
-            g = rate(x, p, v0, dc)[0]
-            out.append(g)
-            G += b * g
-            mu += b * p
-        v = v0 * _exp(x)
-        out[0] = (s.k * (vlp - v) - G) / (s.a + s.eta * v)
-        out.append(mu)
-        return out
 
     def jacobian(self, t: float, y: np.ndarray, vlp: float) -> np.ndarray:
         """The system's Jacobian bordered by dmu/dy (analytic: the classical and cut-off forms have one)."""
@@ -244,6 +225,31 @@ class WithIntegral:
             jac[-1, self._x] = s.a
             jac[-1, self._psi] = s.b
         return jac
+
+
+def _classical_with_integral(system: System) -> Callable[[float, np.ndarray, float], list[float]]:
+    """:class:`WithIntegral`'s right-hand side for the classical form: System._rhs_classical's equations with mu
+    inline, each law's state rate alone and the numbers bound as locals (the same arithmetic in the same order)."""
+    v0, k, a, eta, mu0, exp, cap = system.v0, system.k, system.a, system.eta, system.mu0, math.exp, EXP_CAP
+    terms = [(law.state_rate(v0, dc), b) for law, b, dc in zip(system.laws, system.b, system.dc, strict=True)]
+
+    def rhs(t: float, y: np.ndarray, vlp: float) -> list[float]:
+        x, *psi = y.tolist()
+        psi.pop()  # q
+        out = [0.0]
+        G = 0.0
+        mu = mu0 + a * x
+        for (rate, b), p in zip(terms, psi):  # noqa: B905  (lengths match by construction)
+            g = rate(x, p)
+            out.append(g)
+            G += b * g
+            mu += b * p
+        v = v0 * exp(x if x < cap else cap)
+        out[0] = (k * (vlp - v) - G) / (a + eta * v)
+        out.append(mu)
+        return out
+
+    return rhs
 
 
 def _requested(run: RSFRun, grid: np.ndarray) -> RSFRun:
