@@ -58,3 +58,29 @@ def test_exprel_is_its_definition():
     assert exprel(1e-9) == pytest.approx(1 + 0.5e-9, rel=1e-15)
     assert exprel(1.0) == pytest.approx(math.e - 1, rel=1e-15)
     assert exprel(-30.0) == pytest.approx((math.exp(-30.0) - 1) / -30.0, rel=1e-15)
+
+
+@pytest.mark.parametrize("n", [1, 2, 3, 4, 17, 48, 65, 200])
+def test_chebval_at_one_point_is_numpys(n):
+    """numerics.chebyshev.chebval is numpy's chebval bit for bit: Clenshaw's recurrence on Python floats for one
+    point (a float, a numpy float, a 0-d array), numpy's own for arrays; a numpy float either way, so that a
+    division by zero downstream is inf with a warning as before."""
+    from numpy.polynomial import chebyshev as cheb
+
+    from stickslip.numerics.chebyshev import chebval
+
+    rng = np.random.default_rng(n)
+    for _ in range(300):
+        c = rng.standard_normal(n) * 10.0 ** rng.uniform(-6, 6)
+        x = float(rng.uniform(-1.2, 1.2))
+        for point in (x, np.float64(x), np.asarray(x)):
+            got, want = chebval(point, c), cheb.chebval(point, c)
+            assert got == want and type(got) is type(want), (n, point)
+        many = rng.uniform(-1.0, 1.0, 5)
+        assert np.array_equal(chebval(many, c), cheb.chebval(many, c))
+    with np.errstate(all="ignore"):
+        for point in (math.inf, -math.inf, math.nan, 0.0, -0.0, 1e308):
+            got, want = chebval(point, c), cheb.chebval(point, c)
+            assert got == want or (math.isnan(got) and math.isnan(want)), (n, point, got, want)
+    with pytest.warns(RuntimeWarning):
+        assert chebval(0.5, np.array([1.0, 2.0, 3.0])) / np.float64(0.0) == math.inf

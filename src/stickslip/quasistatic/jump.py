@@ -14,9 +14,9 @@ from dataclasses import dataclass
 from functools import lru_cache
 
 import numpy as np
-from numpy.polynomial import chebyshev as cheb
 
 from ..errors import ModelError, ParameterError
+from ..numerics.chebyshev import chebval  # numpy's, bit for bit, on floats for one point
 from ..numerics.roots import brentq  # scipy's Brent bit for bit (tests/test_roots.py), without scipy.optimize
 from ..numerics.transforms import dct1  # scipy.fft's, bit for bit, without its ~0.3 s import
 from ..parameters import Parameters
@@ -148,11 +148,11 @@ class BranchInterpolant:
         return to_unit(np.log(velocity), self.log_lo, self.log_hi)
 
     def stress(self, velocity: np.ndarray | float) -> np.ndarray:
-        return cheb.chebval(self._u(velocity), self.stress_series)
+        return chebval(self._u(velocity), self.stress_series)
 
     def slope(self, velocity: np.ndarray | float) -> np.ndarray:
         """dsigma/dV."""
-        return cheb.chebval(self._u(velocity), self.g_series) / np.asarray(velocity, dtype=float)
+        return chebval(self._u(velocity), self.g_series) / np.asarray(velocity, dtype=float)
 
     def __call__(self, velocity: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(sigma, dsigma/dV): the curve in the form the slip phase takes."""

@@ -19,6 +19,7 @@ from numpy.polynomial import chebyshev as cheb
 
 from ..columns import attribute_frame
 from ..errors import ModelError, ParameterError
+from ..numerics.chebyshev import chebval  # numpy's, bit for bit, on floats for one point
 from ..numerics.roots import brentq  # scipy's Brent bit for bit (tests/test_roots.py), without scipy.optimize
 from ..numerics.transforms import exprel  # scipy.special's, bit for bit, without its import
 from ..parameters import Parameters
@@ -84,7 +85,7 @@ class SlipTrajectory:
 
     def _time(self, x: np.ndarray, offset: np.ndarray | float) -> np.ndarray:
         # offset = x - x0, passed separately so that the end V0 (1 +- gap) keeps its digits
-        smooth = cheb.chebval(self._u(x), self.time_series)
+        smooth = chebval(self._u(x), self.time_series)
         if self.pole_weight != 0.0:
             smooth = smooth + self.pole_weight * (
                 (x - self.log_start)
@@ -94,14 +95,14 @@ class SlipTrajectory:
         return smooth / self.stiffness
 
     def stress(self, x: np.ndarray | float) -> np.ndarray:
-        return cheb.chebval(self._u(np.asarray(x, dtype=float)), self.stress_series)
+        return chebval(self._u(np.asarray(x, dtype=float)), self.stress_series)
 
     def slider_displacement(self, x: np.ndarray | float) -> np.ndarray:
         """int V dt since the jump = V0 t - (sigma(x) - sigma(xs))/K, with the sigma difference from int sigma'."""
         return self._slider(np.asarray(x, dtype=float), self.time(x))
 
     def _slider(self, x: np.ndarray, t: np.ndarray | float) -> np.ndarray:
-        integral = cheb.chebval(self._u(x), self.integral_series)
+        integral = chebval(self._u(x), self.integral_series)
         return self.pulling_velocity * t - integral / self.stiffness
 
     @property
@@ -185,7 +186,7 @@ def slip_trajectory(
         u0 = float(to_unit(x0, lo, hi))
         g0 = float(g_series(u0))
         divided = ((g_series - g0) // Chebyshev([-u0, 1.0])).coef / half  # (g - g0)/(x - x0)
-        h = -cheb.chebval(to_unit(x, lo, hi), divided) / (v0 * exprel(x - x0))
+        h = -chebval(to_unit(x, lo, hi), divided) / (v0 * exprel(x - x0))
         time_series = cheb.chebint(chebyshev_coefficients(h), lbnd=u_start) * half
         pole_weight = g0 / v0
     else:
