@@ -289,6 +289,8 @@ CASES: list[tuple[list[str], int, str]] = [
         "damping 1e+300 Pa s/m leaves the floating-point range",
     ),
     (["stability", "--v0", "120 um/s", "--growth-at", "1e300"], 2, "expected a factor nearer 1"),  # was s = nan+nanj
+    # Z(s) overflowed in the compiled sums: every step of the scan was a sign change of Im D, each bisected (26 s)
+    (["stability", "--v0", "50 um/s", "--set", "bonds.site_density=1e300 1/m^2"], 2, "Z(s) leaves the floating-point"),
     (["simulate", "--v0", "50 um/s", "--duration", "0"], 2, "--duration: expected a positive value"),
     # --- analyze and fit stick: input files
     (["analyze", "--v0", "50 um/s", "empty.csv"], 2, "empty.csv: empty file"),
