@@ -120,7 +120,11 @@ class System:
         return [xdot, *(gi + hi * mudot for gi, hi in zip(g, self.h, strict=True))]
 
     def _rhs_classical(self, t: float, y: np.ndarray, vlp: float) -> list[float]:
-        """:meth:`rhs` for the classical form without mass or dmu/dt coupling (same equations, fewer steps)."""
+        """:meth:`rhs` for the classical form without mass or dmu/dt coupling (same equations, fewer steps).
+
+        No run calls it since every number of states has a bound closure (:func:`_one_state_rhs`,
+        :func:`_states_rhs`); it stays as their plain reference, which tests/test_rsf_laws.py holds them to, bit for
+        bit."""
         x, *psi = y.tolist()
         v0 = self.v0
         out = [0.0]
