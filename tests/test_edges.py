@@ -292,6 +292,30 @@ CASES: list[tuple[list[str], int, str]] = [
     # Z(s) overflowed in the compiled sums: every step of the scan was a sign change of Im D, each bisected (26 s)
     (["stability", "--v0", "50 um/s", "--set", "bonds.site_density=1e300 1/m^2"], 2, "Z(s) leaves the floating-point"),
     (["simulate", "--v0", "50 um/s", "--duration", "0"], 2, "--duration: expected a positive value"),
+    # --- the time-dependent block with mass (a fuzz, 2026-11-29: 1e300 kg/m^2 exited 3, "the step collapsed"; a
+    # damping of 1e20 Pa s/m never finished 0.01 s)
+    (
+        ["transient", "--v0", "50 um/s", "--duration", "0.1 s", "--mass", "1e300 kg/m^2"],
+        2,
+        "mass: 1e+300 kg/m^2 is out of range; expected at most 1e+30 kg/m^2",
+    ),
+    (
+        ["transient", "--v0", "50 um/s", "--duration", "0.01 s", "--mass", "10 kg/m^2", "--damping", "1e20 Pa*s/m"],
+        2,
+        "damping: 1e+20 Pa s/m is out of range; expected at most 1e+12 Pa s/m",
+    ),
+    # N0 = 1e308 stopped with "non-finite state" (exit 3); 1e30 gave a stuck block's sigma 2.6e-2 off K V0 t
+    (
+        ["transient", "--v0", "50 um/s", "--duration", "0.1 s", "--set", "bonds.site_density=1e30 1/m^2"],
+        2,
+        "block stiffness 3.06e+05 Pa/m is less than 1e-16 x the bonds' own (N0 M = 1e+26 Pa/m)",
+    ),
+    (
+        ["transient", "--v0", "50 um/s", "--duration", "0.1 s", "--control", "velocity", "--set",
+         "bonds.site_density=1e308 1/m^2"],
+        2,
+        "stress scale N0 M dl_m = 1.07e+298 Pa leaves the floating-point range",
+    ),  # fmt: skip
     # --- analyze and fit stick: input files
     (["analyze", "--v0", "50 um/s", "empty.csv"], 2, "empty.csv: empty file"),
     (["analyze", "--v0", "50 um/s", "blank.csv"], 2, "blank.csv: empty file"),

@@ -232,6 +232,29 @@ def test_labels_in_round_brackets_and_pure_numbers_are_no_units(tmp_path):
         assert record.displacement[-1] == pytest.approx(98e-6) and record.friction[0] == 0.6
 
 
+def test_a_blank_separated_record_keeps_bracketed_units_with_their_names(tmp_path):
+    """Columns separated by blanks: "time [s]" and "disp (um)" are one column each (a fuzz of the command line,
+    2026-11-29, read a lone "time [s]" as two columns named "time" and "[s]"), after a comment line; a header whose
+    names do not match the rows' width is refused in one line."""
+    t = np.arange(0.0, 50.0)
+    rows = "".join(f"{a:.6g}  {2.0 * a:.9g}   0.6\n" for a in t)
+    path = tmp_path / "rig.txt"
+    path.write_text("# rig 3\n  time [s]   disp (um)  mu\n" + rows)
+    record = read_record(path, {"time": "time [s]", "displacement": "disp (um)", "friction": "mu"})
+    assert record.displacement[-1] == pytest.approx(98e-6) and record.time[-1] == 49.0
+    assert rsf_data.whitespace_headers("t [ms] Displ(microns) LP disp [um] mu") == [
+        "t [ms]", "Displ(microns)", "LP", "disp [um]", "mu",
+    ]  # fmt: skip
+    lone = tmp_path / "lone.txt"
+    lone.write_text("time [s]\n0\n1\n")
+    with pytest.raises(DataError, match=r"no displacement column; found time \[s\] \(map") as caught:
+        read_record(lone)
+    assert "\n" not in str(caught.value)
+    (tmp_path / "wide.txt").write_text("time disp\n0 1 0.6\n1 2 0.6\n")
+    with pytest.raises(DataError, match=r"header names 2 column\(s\) \(time, disp\) but the rows have 3"):
+        read_record(tmp_path / "wide.txt")
+
+
 # --- a velocity column ------------------------------------------------------------------------------------------
 
 

@@ -201,11 +201,44 @@ def _row_names(rows: Any, size: int) -> Any:
 def _read_frame(path: Path, pd: Any) -> Any:
     try:
         with open(path, encoding="utf-8", errors="replace") as handle:
-            head = "".join(line for _, line in zip(range(20), handle, strict=False) if not line.startswith("#"))
+            lines = [line for _, line in zip(range(20), handle, strict=False) if not line.startswith("#")]
+        head = "".join(lines)
         sep = "\t" if "\t" in head else ";" if head.count(";") > head.count(",") else "," if "," in head else r"\s+"
-        return pd.read_csv(path, sep=sep, comment="#", engine="c" if len(sep) == 1 else "python")
+        if sep != r"\s+":
+            return pd.read_csv(path, sep=sep, comment="#", engine="c")
+        return _read_whitespace_frame(path, pd, lines)
     except (OSError, ValueError, pd.errors.ParserError) as exc:
         raise DataError(f"{path}: cannot read as delimited text ({str(exc).splitlines()[0]})") from None
+
+
+def whitespace_headers(line: str) -> list[str]:
+    """A whitespace-separated header's names, a bracketed unit kept with its name: ``time [s]`` is one column."""
+    return re.findall(r"[^\s\[\(]+(?:\s*[\[\(][^\]\)]*[\]\)])?|[\[\(][^\]\)]*[\]\)]", line)
+
+
+def _read_whitespace_frame(path: Path, pd: Any, lines: list[str]) -> Any:
+    """Columns split at blanks; the header's names by :func:`whitespace_headers` ("time [s]" is not two columns)."""
+    header = next((line for line in lines if line.strip()), "")
+    names = whitespace_headers(header)
+    frame = pd.read_csv(
+        path, sep=r"\s+", comment="#", engine="python", header=None, skiprows=_lines_through(path, header)
+    )
+    if frame.shape[1] != len(names):
+        raise DataError(
+            f"{path}: the header names {len(names)} column(s) ({', '.join(names) or 'none'}) but the rows have"
+            f" {frame.shape[1]}; separate the columns with commas or tabs"
+        )
+    frame.columns = names
+    return frame
+
+
+def _lines_through(path: Path, header: str) -> int:
+    """How many of the file's lines, comments and blanks included, end with ``header``."""
+    with open(path, encoding="utf-8", errors="replace") as handle:
+        for number, line in enumerate(handle, start=1):
+            if line == header:
+                return number
+    return 0
 
 
 def _choose_columns(path: Path, columns: dict[str, str] | None, headers: dict, lower: dict) -> dict[str, Any]:

@@ -239,6 +239,18 @@ def _checked_arguments(  # type: ignore[no-untyped-def]
             f"block stiffness {k_block:.3g} Pa/m is more than {RIGID:.0e} x the bonds' own (N0 M = {rigid / RIGID:.3g}"
             " Pa/m): the block is rigid, the slider follows the puller (use control='velocity', --control velocity)"
         )
+    if control == "block" and k_block < PINNED * rigid / RIGID:
+        raise ParameterError(
+            f"block stiffness {k_block:.3g} Pa/m is less than {PINNED:.0e} x the bonds' own (N0 M = {rigid / RIGID:.3g}"
+            " Pa/m): the chains' stretch is below the float resolution of the slider's travel, and sigma loses its"
+            " digits; expected a stiffer block or a smaller bonds.site_density or bonds.chain_stiffness"
+        )
+    scale = params.bonds.site_density * params.bonds.chain_stiffness * params.bonds.max_extension
+    if not scale <= MOST_STRESS:
+        raise ParameterError(
+            f"the bonds' stress scale N0 M dl_m = {scale:.3g} Pa leaves the floating-point range of the cohorts' sums;"
+            f" expected at most {MOST_STRESS:.0e} Pa (a smaller bonds.site_density, chain_stiffness or max_extension)"
+        )
     duration = protocol.duration
     if every is not None and not (isinstance(every, (int, float)) and math.isfinite(every) and 0 < every <= duration):
         raise ParameterError(f"every: expected a positive time no longer than the run ({duration:g} s), got {every!r}")
@@ -1080,6 +1092,21 @@ def _births_never_held(protocol: Protocol, stick_population: bool) -> bool:
     return stick_population and bool(np.all(protocol.velocities > 0))
 
 
+#: the softest block against the bonds' N0 M: at the paper's set the stuck block's sigma = K V0 t was off by 1.1e-6
+#: at K = 3e-15 N0 M, 3.7e-6 at 3e-17, 2.6e-4 at 3e-19 and 2.6e-2 at 3e-21 (the chains' stretch lost in the slider's
+#: travel): refused below 1e-16
+PINNED = 1e-16
+#: the largest stress scale N0 M dl_m (Pa) the kernel's sums hold: the paper's set ran under velocity control to
+#: N0 = 1e300 (scale 1e290 Pa), and at 1e308 stopped with "non-finite state" (exit 3); a gel's is ~1e4 Pa
+MOST_STRESS = 1e295
+#: the largest block mass (kg/m^2): a fuzz's 1e300 overflowed the trapezoid's Newton slope 2 m/h (exit 3, "the step
+#: collapsed"); 1e12 already runs almost as an infinite mass (at 50 um/s its velocity 5e-5 below V0 after 1 s)
+MAX_MASS = 1e30
+#: the largest damping (Pa s/m): where eta V0 dwarfs sigma by ~1e12 the force balance K (P - X) - eta V - sigma has no
+#: digits left for sigma; 1e20 at 50 um/s never finished 0.01 s, 1e16 ran it in 1.5 s
+MAX_DAMPING = 1e12
+
+
 def _block_inertia(mass: Any, damping: Any, control: str, stick_population: bool) -> tuple[float, float]:
     """(m, eta) of the block, checked: non-negative and finite; a damping only with a mass; neither under
     velocity control, nor with the paper's attached chains (whose jump the mass would resolve instead)."""
@@ -1087,6 +1114,12 @@ def _block_inertia(mass: Any, damping: Any, control: str, stick_population: bool
         0.0 if value is None else checked_number(name, _finite(value, name), unit)
         for value, name, unit in ((mass, "mass", "kg/m^2"), (damping, "damping", "Pa s/m"))
     )
+    for value, name, unit, limit, why in (
+        (m, "mass", "kg/m^2", MAX_MASS, "from 1e12 kg/m^2 on the block already keeps its velocity over a run"),
+        (eta, "damping", "Pa s/m", MAX_DAMPING, "a rock's radiation damping G/(2 c_s) is ~5e6 Pa s/m"),
+    ):
+        if value > limit:
+            raise ParameterError(f"{name}: {value:g} {unit} is out of range; expected at most {limit:g} {unit} ({why})")
     if (m > 0 or eta > 0) and control != "block":
         raise ParameterError("mass/damping: a rigid rig (control='velocity') has no block; use control='block'")
     if eta > 0 and m == 0:
