@@ -311,11 +311,20 @@ CASES: list[tuple[list[str], int, str]] = [
         "block stiffness 3.06e+05 Pa/m is less than 1e-16 x the bonds' own (N0 M = 1e+26 Pa/m)",
     ),
     (
-        ["transient", "--v0", "50 um/s", "--duration", "0.1 s", "--control", "velocity", "--set",
-         "bonds.site_density=1e308 1/m^2"],
+        [
+            "transient",
+            "--v0",
+            "50 um/s",
+            "--duration",
+            "0.1 s",
+            "--control",
+            "velocity",
+            "--set",
+            "bonds.site_density=1e308 1/m^2",
+        ],
         2,
         "stress scale N0 M dl_m = 1.07e+298 Pa leaves the floating-point range",
-    ),  # fmt: skip
+    ),
     # --- analyze and fit stick: input files
     (["analyze", "--v0", "50 um/s", "empty.csv"], 2, "empty.csv: empty file"),
     (["analyze", "--v0", "50 um/s", "blank.csv"], 2, "blank.csv: empty file"),
