@@ -246,10 +246,11 @@ def _checked_arguments(  # type: ignore[no-untyped-def]
             " digits; expected a stiffer block or a smaller bonds.site_density or bonds.chain_stiffness"
         )
     scale = params.bonds.site_density * params.bonds.chain_stiffness * params.bonds.max_extension
-    if not scale <= MOST_STRESS:
+    if not LEAST_STRESS <= scale <= MOST_STRESS:
         raise ParameterError(
             f"the bonds' stress scale N0 M dl_m = {scale:.3g} Pa leaves the floating-point range of the cohorts' sums;"
-            f" expected at most {MOST_STRESS:.0e} Pa (a smaller bonds.site_density, chain_stiffness or max_extension)"
+            f" expected {LEAST_STRESS:.0e} to {MOST_STRESS:.0e} Pa (set bonds.site_density, chain_stiffness or"
+            " max_extension within it)"
         )
     duration = protocol.duration
     if every is not None and not (isinstance(every, (int, float)) and math.isfinite(every) and 0 < every <= duration):
@@ -1099,6 +1100,12 @@ PINNED = 1e-16
 #: the largest stress scale N0 M dl_m (Pa) the kernel's sums hold: the paper's set ran under velocity control to
 #: N0 = 1e300 (scale 1e290 Pa), and at 1e308 stopped with "non-finite state" (exit 3); a gel's is ~1e4 Pa
 MOST_STRESS = 1e295
+#: the smallest: at N0 = 1e-300 m^-2 (scale 1e-310 Pa) sigma went subnormal and the step collapsed; 1e-192 Pa ran
+LEAST_STRESS = 1e-250
+#: the weakest FENE strength a = lambda M dl_m / kT the cohorts follow to the FENE wall: the paper's set at 50 um/s
+#: under velocity control crossed it at a = 1.05e-9 (slowly: 12 256 steps in 15 s of CPU for 0.023 s) and the step
+#: collapsed there at 1.05e-11 (exit 3); the README's box starts at 2.5e-6
+WEAKEST_FENE = 1e-6
 #: the largest block mass (kg/m^2): a fuzz's 1e300 overflowed the trapezoid's Newton slope 2 m/h (exit 3, "the step
 #: collapsed"); 1e12 already runs almost as an infinite mass (at 50 um/s its velocity 5e-5 below V0 after 1 s)
 MAX_MASS = 1e30
@@ -1152,17 +1159,26 @@ def _travel(protocol: Protocol) -> float:
 def _require_finite_chains(
     params: Parameters, protocol: Protocol, control: str, start: str, start_velocity: float | None, k_block: float
 ) -> None:
-    """With lambda = 0 a sliding chain is only stopped by the FENE wall, where Eq 3's force is infinite."""
+    """With lambda = 0 a sliding chain is only stopped by the FENE wall, where Eq 3's force is infinite; with a FENE
+    strength a = lambda M dl_m / kT below :data:`WEAKEST_FENE` the cohorts cannot follow it there."""
     b = params.bonds
-    if b.activation_length != 0.0:
+    strength = b.stretch_sensitivity * b.max_extension
+    if strength >= WEAKEST_FENE:
         return
     reach = _travel(protocol)
-    if start == "steady" or reach >= b.max_extension:
+    if not (start == "steady" or reach >= b.max_extension):
+        return
+    travel = "" if start == "steady" else f" (the slider may travel {reach:.3g} m, Δl_m is {b.max_extension:.3g} m)"
+    if b.activation_length == 0.0:
         raise ModelError(
             "bonds.activation_length = 0: sliding bonds survive to full extension, where the FENE force (Eq 3) is"
-            " infinite, so the stress diverges (as in the steady solver); use a positive activation length"
-            + ("" if start == "steady" else f" (the slider may travel {reach:.3g} m, Δl_m is {b.max_extension:.3g} m)")
+            " infinite, so the stress diverges (as in the steady solver); use a positive activation length" + travel
         )
+    raise ModelError(
+        f"the bonds' FENE strength a = λ M Δl_m/kT = {strength:.3g} is below {WEAKEST_FENE:g}: the chain force hardly"
+        " speeds a sliding bond's breaking, so bonds reach full extension, where the time-dependent model cannot"
+        " follow them; expected a larger bonds.activation_length, chain_stiffness or max_extension" + travel
+    )
 
 
 def _steady_start_below_vc(
