@@ -201,12 +201,13 @@ def _row_names(rows: Any, size: int) -> Any:
 def _read_frame(path: Path, pd: Any) -> Any:
     try:
         with open(path, encoding="utf-8", errors="replace") as handle:
-            lines = [line for _, line in zip(range(20), handle, strict=False) if not line.startswith("#")]
-        head = "".join(lines)
+            # the first 20 lines, each with its place in the file (comments counted), comments left out
+            numbered = [(i, line) for i, line in zip(range(20), handle, strict=False) if not line.startswith("#")]
+        head = "".join(line for _, line in numbered)
         sep = "\t" if "\t" in head else ";" if head.count(";") > head.count(",") else "," if "," in head else r"\s+"
         if sep != r"\s+":
             return pd.read_csv(path, sep=sep, comment="#", engine="c")
-        return _read_whitespace_frame(path, pd, lines)
+        return _read_whitespace_frame(path, pd, numbered)
     except (OSError, ValueError, pd.errors.ParserError) as exc:
         raise DataError(f"{path}: cannot read as delimited text ({str(exc).splitlines()[0]})") from None
 
@@ -216,13 +217,11 @@ def whitespace_headers(line: str) -> list[str]:
     return re.findall(r"[^\s\[\(]+(?:\s*[\[\(][^\]\)]*[\]\)])?|[\[\(][^\]\)]*[\]\)]", line)
 
 
-def _read_whitespace_frame(path: Path, pd: Any, lines: list[str]) -> Any:
+def _read_whitespace_frame(path: Path, pd: Any, numbered: list[tuple[int, str]]) -> Any:
     """Columns split at blanks; the header's names by :func:`whitespace_headers` ("time [s]" is not two columns)."""
-    header = next((line for line in lines if line.strip()), "")
+    place, header = next(((i, line) for i, line in numbered if line.strip()), (-1, ""))
     names = whitespace_headers(header)
-    frame = pd.read_csv(
-        path, sep=r"\s+", comment="#", engine="python", header=None, skiprows=_lines_through(path, header)
-    )
+    frame = pd.read_csv(path, sep=r"\s+", comment="#", engine="python", header=None, skiprows=place + 1)
     if frame.shape[1] != len(names):
         raise DataError(
             f"{path}: the header names {len(names)} column(s) ({', '.join(names) or 'none'}) but the rows have"
@@ -230,15 +229,6 @@ def _read_whitespace_frame(path: Path, pd: Any, lines: list[str]) -> Any:
         )
     frame.columns = names
     return frame
-
-
-def _lines_through(path: Path, header: str) -> int:
-    """How many of the file's lines, comments and blanks included, end with ``header``."""
-    with open(path, encoding="utf-8", errors="replace") as handle:
-        for number, line in enumerate(handle, start=1):
-            if line == header:
-                return number
-    return 0
 
 
 def _choose_columns(path: Path, columns: dict[str, str] | None, headers: dict, lower: dict) -> dict[str, Any]:
