@@ -277,6 +277,27 @@ def test_several_states_take_the_general_equations_bit_for_bit(names):
     assert again.rhs(0.0, y, 3e-6) == s.rhs(0.0, y, 3e-6)
 
 
+@pytest.mark.parametrize("names", [("aging",), ("slip",), ("prz",), ("aging", "slip"), ("slip", "prz", "aging")])
+def test_the_bound_jacobian_is_the_general_one_bit_for_bit(names):
+    """The classical form's Jacobian with its numbers bound (a closure) gives the general method's matrix byte for
+    byte, at random states and at the exponentials' cap, and the closure is rebuilt after pickling."""
+    import pickle
+
+    states = tuple(StateVariable(law, 0.006 + 0.002 * k, DC * (1 + 5 * k)) for k, law in enumerate(names))
+    s = System(RSFParams(a=0.011, states=states, v_ref=V0, stiffness=800.0, eta=3.0))
+    assert s.classical and s.jacobian.__name__ == "jacobian" and not hasattr(s.jacobian, "__self__")
+    rng = np.random.default_rng(13)
+    size = len(names) + 1
+    edges = np.array([[750.0] + [-750.0] * (size - 1), [-750.0] + [750.0] * (size - 1), [699.9] + [-0.5] * (size - 1)])
+    for y in np.vstack([rng.uniform(-8.0, 8.0, (200, size)), edges]):
+        fast, general = s.jacobian(0.0, y, 3e-6), System.jacobian(s, 0.0, y, 3e-6)
+        assert fast.shape == general.shape == (size, size) and fast.dtype == general.dtype
+        assert fast.tobytes() == general.tobytes(), (y, fast, general)
+    again = pickle.loads(pickle.dumps(s))
+    y = rng.uniform(-1.0, 1.0, size)
+    assert again.jacobian(0.0, y, 3e-6).tobytes() == s.jacobian(0.0, y, 3e-6).tobytes()
+
+
 @pytest.mark.parametrize("names", [("aging",), ("slip", "prz")])
 def test_the_carried_integral_of_friction_takes_the_same_equations(names):
     """The classical form with the integral of mu carried (the run's mean friction) has its own right-hand side;

@@ -57,9 +57,12 @@ class System:
             # its numbers bound in a closure (a fit's millions of evaluations: ~1/3 less per run, the same
             # arithmetic in the same order as _rhs_classical)
             self.rhs = _one_state_rhs(self) if self.n == 1 else _states_rhs(self)  # type: ignore[method-assign]
+            # LSODA asks for it once per ~36 right-hand sides, at ~15x a right-hand side's cost in the general form
+            self.jacobian = _classical_jacobian(self)  # type: ignore[method-assign]
 
     def __getstate__(self) -> dict[str, Any]:
-        return {k: v for k, v in self.__dict__.items() if k != "rhs"}  # a closure does not pickle: rebuilt
+        # a closure does not pickle: rebuilt
+        return {k: v for k, v in self.__dict__.items() if k not in ("rhs", "jacobian")}
 
     def __setstate__(self, state: dict[str, Any]) -> None:
         self.__dict__.update(state)
@@ -311,3 +314,35 @@ def _one_state_rhs(system: System) -> Callable[[float, np.ndarray, float], list[
         return [(k * (vlp - v) - (0.0 + b * g)) / (a + eta * v), g]
 
     return rhs
+
+
+def _classical_jacobian(system: System) -> Callable[[float, np.ndarray, float], np.ndarray]:
+    """:meth:`System.jacobian` for the classical form without mass or dmu/dt coupling (``system.classical``), its
+    numbers bound as locals: the same arithmetic in the same order (Q = 1 - sum b h and the h terms kept, so that a
+    non-finite entry stays what the general form gives; tests/test_rsf_laws.py holds the two equal, bit for bit)."""
+    v0, k, a, eta, Q, n = system.v0, system.k, system.a, system.eta, system.one_minus_h, system.n
+    terms = [(law.rate, b, dc, h) for law, b, dc, h in zip(system.laws, system.b, system.dc, system.h, strict=True)]
+    exp, cap = math.exp, EXP_CAP
+
+    def jacobian(t: float, y: np.ndarray, vlp: float) -> np.ndarray:
+        x, *psi = y.tolist()
+        v = v0 * exp(x if x < cap else cap)
+        rates = [rate(x, p, v0, dc) for (rate, _, dc, _), p in zip(terms, psi)]  # noqa: B905  (lengths match)
+        G = 0
+        S = 0
+        for (_, b, _, _), r in zip(terms, rates):  # noqa: B905
+            G += b * r[0]
+            S += b * r[1]
+        D = a + Q * eta * v
+        xdot = (Q * k * (vlp - v) - G) / D
+        dxx = (-Q * k * v - S - xdot * Q * eta * v) / D
+        top = [dxx, *(-b * r[2] / D for (_, b, _, _), r in zip(terms, rates))]  # noqa: B905
+        dmu_dx = (a * dxx + S) / Q
+        dmu = [(a * top[j + 1] + terms[j][1] * rates[j][2]) / Q for j in range(n)]
+        rows = [top]
+        for i in range(n):
+            h, r = terms[i][3], rates[i]
+            rows.append([r[1] + h * dmu_dx, *((r[2] if i == j else 0.0) + h * dmu[j] for j in range(n))])
+        return np.array(rows)
+
+    return jacobian
