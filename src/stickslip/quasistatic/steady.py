@@ -187,15 +187,26 @@ def _ln_v_moment(x: np.ndarray, s: _Scales) -> np.ndarray:
 LARGEST_RATE = 1e200
 
 
+def check_steady_range(params: Parameters, velocity: Any, aging: bool = True) -> None:
+    """The ModelError :func:`steady_state` raises where the dimensionless groups at ``velocity`` (m/s, > 0) leave
+    floating point, without integrating anything (the time-dependent model checks its protocol's velocities with it
+    before it starts: its steady start, its reduction and its cost estimate use the steady model)."""
+    _check_scales(_scales(params, np.atleast_1d(np.asarray(velocity, dtype=float)), aging))
+
+
 def _check_scales(s: _Scales) -> None:
     """A one-line ModelError where the dimensionless groups leave floating point (far outside any physical box)."""
-    groups = (("FENE strength a = λMΔl_m/kT", s.a), ("aging rate Δl_m/(V τa) e^(−V/Va)", s.alpha))
-    for name, values in groups:
+    groups = (
+        ("FENE strength a = λMΔl_m/kT", s.a, "bonds.activation_length, chain_stiffness, max_extension, temperature"),
+        ("aging rate Δl_m/(V τa) e^(−V/Va)", s.alpha, "aging.aging_time, aging.aging_velocity, bonds.max_extension,"
+         " the velocity"),
+    )  # fmt: skip
+    for name, values, keys in groups:
         bad = ~(np.abs(values) <= LARGEST_RATE)
         if np.any(bad):
             raise ModelError(
                 f"the {name} is {float(values[bad][0]):.3g}, beyond {LARGEST_RATE:g}: these parameters are outside"
-                " what the steady model can integrate in floating point"
+                f" what the steady model can integrate in floating point (set by {keys})"
             )
     bad = ~(np.isfinite(s.log_t) & np.isfinite(s.birth))
     if np.any(bad):

@@ -186,6 +186,7 @@ def run_transient(
     )  # fmt: skip
     cpu0 = time.process_time()
     _require_finite_chains(params, protocol, control, start, start_velocity, k_block)
+    _require_steady_range(params, protocol, aging, start_velocity)
     require_within(
         estimate_cost(params, protocol, control=control, start_velocity=start_velocity, rtol=rtol, every=every,
                       max_step=max_step, aging=aging, reduction=reduction, start=start, mass=mass, stiffness=k_block,
@@ -1179,6 +1180,20 @@ def _require_finite_chains(
         " speeds a sliding bond's breaking, so bonds reach full extension, where the time-dependent model cannot"
         " follow them; expected a larger bonds.activation_length, chain_stiffness or max_extension" + travel
     )
+
+
+def _require_steady_range(params: Parameters, protocol: Protocol, aging: bool, start_velocity: float | None) -> None:
+    """The steady model's floating-point range (its FENE strength and aging rate below 1e200) at every velocity the
+    run is driven at: the steady start, the reduction and the cost estimate use that model, and outside it a run
+    was refused part-way, failed at its first step (a steady start: "non-finite state"), or, with a block mass,
+    rang against bonds that never break until its time budget ran out (aging.aging_time = 1e-300 s)."""
+    from ..quasistatic.steady import check_steady_range
+
+    driven = [abs(float(v)) for v in protocol.velocities if v != 0.0]
+    if start_velocity:
+        driven.append(abs(start_velocity))
+    if driven:
+        check_steady_range(params, driven, aging)
 
 
 def _steady_start_below_vc(
