@@ -55,15 +55,17 @@ def pytest_collection(session: pytest.Session) -> Generator[None, object, object
 
     Collecting imports every test module through pytest's assert rewriting, which builds and drops millions of
     syntax-tree nodes while the heap already holds numpy, scipy, pandas and matplotlib: each full collection the
-    allocations trigger walks that whole heap.  Paused, collecting took 9.4 s of CPU in each worker instead of
-    15.2 s (the rewriting itself 3.5 s instead of 8.3 s; 2026-11-30, the 2-core AMD EPYC machine).  Pausing it for
+    allocations trigger walks that whole heap.  Paused, collecting took 8.6-9.4 s of CPU in each worker instead of
+    15.2-16.1 s (the rewriting itself 3.5 s instead of 8.3 s; 2026-11-30, the 2-core AMD EPYC machine).  Pausing it for
     the whole run saved nothing measurable (tests/test_rsf_fit_protocols.py with tests/test_transient.py), so the
     tests run with it as a user's program does."""
+    enabled = gc.isenabled()
     gc.disable()
     try:
         return (yield)
     finally:
-        gc.enable()
+        if enabled:
+            gc.enable()
 
 
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
