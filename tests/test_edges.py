@@ -91,7 +91,8 @@ def _alarm(signum: int, frame: object) -> None:
 SEG = ["--segment", "1 um/s:10 s"]
 STEP = ["--segment", "1 um/s:10 s", "--segment", "10 um/s:10 s"]
 V = ["--velocity", "1 um/s"]
-VELOCITY_RUN = ["transient", "--v0", "50 um/s", "--duration", "0.05 s", "--control", "velocity"]
+BLOCK_RUN = ["transient", "--v0", "50 um/s", "--duration", "0.05 s"]
+VELOCITY_RUN = [*BLOCK_RUN, "--control", "velocity"]
 
 # (argv, exit status, fragment of stderr when 2 / of stdout when 0)
 CASES: list[tuple[list[str], int, str]] = [
@@ -339,8 +340,8 @@ CASES: list[tuple[list[str], int, str]] = [
             " steady model can integrate in floating point (set by aging.aging_time,",
         )
         for run in (
-            ["transient", "--v0", "50 um/s", "--duration", "0.05 s", "--mass", "1 kg/m^2"],
-            ["transient", "--v0", "50 um/s", "--duration", "0.05 s"],
+            [*BLOCK_RUN, "--mass", "1 kg/m^2"],
+            BLOCK_RUN,
             VELOCITY_RUN,
             [*VELOCITY_RUN, "--start", "steady"],
         )
