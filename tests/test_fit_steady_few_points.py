@@ -102,3 +102,24 @@ def test_cli_fits_the_curve_command_s_own_ten_points(tmp_path, capsys) -> None: 
     code, out, err = run_main(capsys, "fit", "steady", str(path))
     assert code == 0, err
     assert "no significant velocity dependence" not in out + err
+
+
+def test_a_failed_profile_falls_back_to_the_delta_method_itself(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The tester's curve12: the fallback said "delta-method interval" but gave the search's floor, σc's standard
+    error exactly 1e-3 σc, against 3.1e-11 Pa from the delta method on these exact data."""
+    from stickslip.fitting import critical_uncertainty
+
+    velocity = np.geomspace(10e-6, 10e-3, 12)
+    data = SteadyData.from_arrays(velocity, steady_state(TRUE, velocity).stress, None)
+    delta = fit_steady(data, method="joint", intervals="delta")
+    monkeypatch.setattr(
+        critical_uncertainty.Profile, "end", lambda *a, **k: critical_uncertainty.ProfileEnd(None, 1, False)
+    )
+    fallen = fit_steady(data, method="joint", intervals="profile")
+    for got, want in (
+        (fallen.critical_velocity, delta.critical_velocity),
+        (fallen.critical_stress, delta.critical_stress),
+    ):
+        assert "the profile search failed, so the delta-method interval is given instead" in got.note
+        assert got.stderr < 1e-6 * got.value  # not the search's floor, 1e-3 of the value
+        assert got.stderr == pytest.approx(want.stderr, rel=0.6)  # the same method, its covariance refitted

@@ -1046,8 +1046,11 @@ def _profile_estimates(
     grad_v, grad_s = critical_gradient(space, theta, vc)
     cov = _gauss_newton(space, theta, everything)
     cov = scale * cov if np.all(np.isfinite(cov)) else None
-    guess_v = math.sqrt(max(float(grad_v @ cov @ grad_v), 1e-6)) if cov is not None else 0.1
-    guess_s = math.sqrt(max(float(grad_s @ cov @ grad_s), 1e-6)) if cov is not None else 0.05
+    # the delta method's sd (in ln) is the fallback's interval; the search's first step is never below 1e-3
+    delta_v = math.sqrt(max(float(grad_v @ cov @ grad_v), 0.0)) if cov is not None else None
+    delta_s = math.sqrt(max(float(grad_s @ cov @ grad_s), 0.0)) if cov is not None else None
+    guess_v = max(delta_v, 1e-3) if delta_v is not None else 0.1
+    guess_s = max(delta_s, 1e-3) if delta_s is not None else 0.05
     both_ends = [
         [profile.end(chi_at, math.log(x), start, best.chi_square, threshold, scale, sd, side) for side in (-1, 1)]
         for chi_at, x, start, sd in (
@@ -1060,14 +1063,19 @@ def _profile_estimates(
         note += f", conditional on {', '.join(progress.undetermined)}"
     out = []
     q = _quantile(level, profile_dof, progress.noise_known)
-    for (name, symbol, dim), value, ends, sd in zip(CRITICAL, (vc, sc), both_ends, (guess_v, guess_s), strict=True):
+    for (name, symbol, dim), value, ends, sd in zip(CRITICAL, (vc, sc), both_ends, (delta_v, delta_s), strict=True):
         interval = tuple(None if e.value is None else math.exp(e.value) for e in ends)
         lo, hi = interval
         extra = ""
         if (lo is not None and lo >= value) or (hi is not None and hi <= value) or not all(e.converged for e in ends):
-            interval = _log_interval(value, sd, q)
-            extra = "; the profile search failed, so the delta-method interval is given instead"
-            progress.messages.append(f"warning: profile-likelihood interval of {symbol} failed; delta method used")
+            if sd is None:
+                interval = (None, None)
+                extra = "; the profile search failed and the covariance is not finite: no interval"
+                progress.messages.append(f"warning: profile-likelihood interval of {symbol} failed; no interval")
+            else:
+                interval = _log_interval(value, sd, q)
+                extra = "; the profile search failed, so the delta-method interval is given instead"
+                progress.messages.append(f"warning: profile-likelihood interval of {symbol} failed; delta method used")
         else:
             unbounded = [where for where, e in zip(("below", "above"), ends, strict=True) if e.value is None]
             if unbounded:
