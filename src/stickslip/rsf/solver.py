@@ -19,6 +19,7 @@ import numpy as np
 
 from .. import regimes
 from ..errors import ModelError, ParameterError
+from ..numerics.grid import sample_grid
 from ..protocols import Protocol
 from ..units import shorten, to_si
 from .params import RSFParams
@@ -71,7 +72,8 @@ def simulate(
     """Run ``protocol`` on the spring-slider, starting in steady sliding at ``start_velocity``.
 
     ``start_velocity`` defaults to the first segment's velocity; ``every``
-    samples the trace every ``every`` seconds from t = 0; ``times`` (sorted,
+    samples the trace every ``every`` seconds from t = 0, and at the run's end
+    (the protocol's, or a blow-up's); ``times`` (sorted,
     within the protocol) samples it at given times instead; neither changes
     the regime or the summary, which come from the solver's accepted steps.
     ``detect=False`` skips the regime detection (for fits, which call this
@@ -141,6 +143,10 @@ def simulate(
         if detect and index == last_piece and blown is None and short is None:  # a one-step piece has no steps
             steps_t, steps_y = np.r_[t0, t_steps], np.c_[y, y_steps][inner]
             last = Solution(t0, steps_t, steps_y, _interpolant(system, vlp, steps_t, steps_y, rtol, atol))
+        if blown is not None and every is not None and not (t_out.size and t_out[-1] >= blown):
+            # a sampled trace ends where the run stopped, as the solver's own steps do: its last row, the final
+            # value and end time a summary reads, must not depend on --every
+            t_out, y_out = np.r_[t_out, blown], np.c_[y_out, y_end]
         t_parts.append(t_out)
         y_parts.append(y_out)
         integral, reached = (float(y_end[-1]) if mean else math.nan), (t1 if blown is None else blown)
@@ -341,7 +347,10 @@ def _grid(protocol: Protocol, every: float | None, times: Any) -> np.ndarray | N
             raise ParameterError(
                 f"every: {every:g} s gives {count:.3g} samples over {end:g} s; expected at most {MAX_SAMPLES:.0e}"
             )
-        return np.arange(math.floor(count)) * every
+        grid = sample_grid(every, end)
+        if grid[-1] < end:  # (a multiple within rounding of the end, or every beyond it): the end's row is at the end
+            grid = np.append(grid[:-1] if grid.size > 1 else grid, end)
+        return grid
     if times is None:
         return None
     try:
@@ -525,10 +534,15 @@ def _adaptive_piece(
         try:
             fast = _quiet_solve(system, y0, t0, t1, vlp, rtol, atol, dense)
         except _Stalled as stalled:
-            if not stalled.projected or system.implicit:
+            # a quasi-static slider whose slip rate runs away stalls the unwatched solver once past the cap (its
+            # clock stops as V grows without bound): that is the blow-up, which the watched path below locates
+            # and reports, as a sampled run does, not a stiffness to loosen
+            running_away = stalled.state is not None and float(stalled.state[system.offset]) > 0.5 * x_cap
+            if not running_away and (not stalled.projected or system.implicit):
                 raise _stall_error(stalled, t0, t1, system) from None
             fast = None
-            _take_implicit_steps(system)  # the watched path below, by Radau
+            if not running_away:
+                _take_implicit_steps(system)  # the watched path below, by Radau
         x = fast.y[system.offset] if fast is not None else None
         if fast is not None and fast.status == 0 and np.all(np.isfinite(fast.y)) and np.max(x) <= x_cap:
             return fast.t[1:], fast.y[:, 1:], fast.y[:, -1], None, fast.sol
@@ -621,10 +635,16 @@ def _stall_error(stalled: _Stalled, t0: float, t1: float, system: System | None 
     neither LSODA nor Radau's implicit steps could follow)."""
     if system is not None and system.inertial and stalled.state is not None:
         return _inertia_error(system, stalled.time, float(stalled.state[system.offset]), t0, t1, "stalled")
+    if system is not None and not system.regularized:  # the classical form is already in use: no advice to take it
+        remedy = "(e.g. a very stiff spring or a tiny a); loosen the spring or check the magnitudes of a, b and Dc"
+    else:
+        remedy = (
+            "(e.g. the regularised form far below V0 under a very stiff spring); loosen the spring or use the"
+            " classical form"
+        )
     return ModelError(
         f"rate-and-state solver stalled at t = {stalled.time:.6g} s (in the segment "
-        f"{t0:g} ... {t1:g} s): the equations are too stiff here (e.g. the regularised form far below V0 "
-        "under a very stiff spring); loosen the spring or use the classical form"
+        f"{t0:g} ... {t1:g} s): the equations are too stiff here {remedy}"
     )
 
 

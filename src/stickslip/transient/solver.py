@@ -23,6 +23,7 @@ from ..numerics.budget import (
     over_budget,
     require_within,
 )
+from ..numerics.grid import sample_grid as _sample_grid
 from ..parameters import Parameters
 from ..protocols import Protocol
 from ..quasistatic.cycle import Cycle
@@ -952,17 +953,6 @@ def _chains_ahead(d: Any, regime: str, message: str, time: np.ndarray, sigma: np
 def _scratch(state: _State) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Work arrays of kernel._slider_velocity (no weight known beforehand: the third, all -1)."""
     return np.empty(state.xb.size), np.empty(state.xb.size), np.full((3, state.xb.size), -1.0)
-
-
-def _sample_grid(every: float | None, duration: float) -> np.ndarray:
-    if every is None:
-        return np.empty(0)
-    count = math.floor(duration / every + 1e-9)
-    grid = every * np.arange(count + 1)
-    grid = grid[grid <= duration]  # every * count may round past the end, which no step reaches
-    if duration - grid[-1] > 1e-9 * every:
-        grid = np.append(grid, duration)
-    return grid
 
 
 def _row(state: _State, params: Parameters, control: str, k_block: float, mass: float = 0.0) -> np.ndarray:
