@@ -20,10 +20,12 @@ import numpy as np
 from ..columns import data_lines, split_header, with_units
 from ..errors import DataError, ParameterError
 from ..fileio import protect_inputs, require_input_file
+from ..numerics.quantisation import quantum
 from ..protocols import Protocol, Segment
 
 __all__ = [
-    "LabRecord", "change_time_uncertainty", "find_segments", "measured_history", "parse_columns", "read_record",
+    "LabRecord", "change_time_uncertainty", "find_segments", "forward", "measured_history", "parse_columns",
+    "read_record",
 ]  # fmt: skip
 
 ROLES = ("time", "displacement", "friction", "velocity")
@@ -152,7 +154,7 @@ def read_record(
         bare = re.sub(r"\s*[\(\[][^\(\)\[\]]*[\)\]]\s*$", "", header).strip().lower()
         lower.setdefault(bare, column)
     chosen = _choose_columns(path, columns, headers, lower)
-    data = {role: pd.to_numeric(frame[col], errors="coerce").to_numpy(dtype=float) for role, col in chosen.items()}
+    data = {role: _numbers(frame[col], path, rows, pd) for role, col in chosen.items()}
     dimension = {"time": "time", "displacement": "length", "velocity": "velocity"}
     units = {role: _header_unit(str(chosen[role]), dimension[role], path) for role in chosen if role in dimension}
     if "friction" in chosen:
@@ -193,6 +195,22 @@ _TAIL_UNITS = {"m", "mm", "um", "µm", "μm", "nm", "micron", "microns", "s", "m
 _TAIL_UNITS |= {"m/s", "mm/s", "um/s", "µm/s", "μm/s", "nm/s"}
 
 
+def _numbers(column: Any, path: Path, rows: Any, pd: Any) -> np.ndarray:
+    """A column as floats; DataError naming the first cell that is text (not a blank or NaN, which
+    :meth:`LabRecord.from_arrays` reports), with the hint a decimal comma needs."""
+    values = pd.to_numeric(column, errors="coerce").to_numpy(dtype=float)
+    cells = column.to_numpy()
+    text = np.isnan(values) & pd.notna(column).to_numpy()
+    text &= np.array([str(c).strip().lower() not in ("", "nan") for c in cells])
+    if text.any():
+        i = int(np.argmax(text))
+        cell = str(cells[i])
+        hint = "; a decimal comma? expected numbers with a decimal point (0.5, not 0,5)" if "," in cell else ""
+        raise DataError(f"{path}: row {_row_names(rows, values.size)[i]}, column {str(column.name)!r}: {cell!r} is "
+                        f"not a number{hint}")  # fmt: skip
+    return values
+
+
 def _row_names(rows: Any, size: int) -> Any:
     """Each sample's row for messages: ``rows`` when it names every sample, else 1, 2, ..."""
     return rows if rows is not None and len(rows) == size else range(1, size + 1)
@@ -204,7 +222,10 @@ def _read_frame(path: Path, pd: Any) -> Any:
             # the first 20 lines, each with its place in the file (comments counted), comments left out
             numbered = [(i, line) for i, line in zip(range(20), handle, strict=False) if not line.startswith("#")]
         head = "".join(line for _, line in numbered)
-        sep = "\t" if "\t" in head else ";" if head.count(";") > head.count(",") else "," if "," in head else r"\s+"
+        header = next((line for _, line in numbered if line.strip()), "")
+        # a header split by semicolons names the delimiter: its rows' decimal commas outnumber the semicolons
+        semicolons = header.count(";") > header.count(",") or head.count(";") > head.count(",")
+        sep = "\t" if "\t" in head else ";" if semicolons else "," if "," in head else r"\s+"
         if sep != r"\s+":
             return pd.read_csv(path, sep=sep, comment="#", engine="c")
         return _read_whitespace_frame(path, pd, numbered)
@@ -364,6 +385,7 @@ def find_segments(
     min_change: float = 0.2,
     min_points: int = 10,
     min_duration: float | None = None,
+    t0: float = 0.0,
 ) -> Protocol:
     """The load point's piecewise-constant velocity history from its displacement record.
 
@@ -372,7 +394,8 @@ def find_segments(
     full record: docs/rsf.md, "Velocity levels".
 
     Raises DataError when more than ``max_segments`` pieces remain or the pieces miss the record by more than
-    :data:`CURVED` times its noise (the displacement is not piecewise linear).
+    :data:`CURVED` times its noise (the displacement is not piecewise linear; a jump, a re-zeroed transducer, is
+    named with its time: ``t0`` plus the record's time, as in the record's file).
     """
     t = np.asarray(time, dtype=float)
     d = np.asarray(displacement, dtype=float)
@@ -389,19 +412,69 @@ def find_segments(
             f"load-point displacement: {len(hinges) + 1} straight pieces found, more than {max_segments}; "
             "expected piecewise-constant velocity (give the history with --segment or --protocol)"
         )
-    _refuse_curved(bins, hinges)
-    sums = _cumulative_sums(t, d)
-    breaks = _refine(sums, [0, *[int(bins.first[b]) for b in hinges], n], bins.first, hinges, min_points)
+    _refuse_curved(bins, hinges, t, d, t0)
+    breaks = _refine(t, d, [0, *[int(bins.first[b]) for b in hinges], n], bins.first, hinges, min_points)
     lines = [_line(t[i0:i1], d[i0:i1]) for i0, i1 in itertools.pairwise(breaks)]
     times = [float(t[0])]
     for j, i in enumerate(breaks[1:-1]):
         (s1, c1), (s2, c2) = lines[j], lines[j + 1]
         meet = (c2 - c1) / (s1 - s2) if s1 != s2 else math.nan
-        lo, hi = t[max(i - 2, 0)], t[min(i + 1, n - 1)]
+        # the lines of two whole pieces date a change better than the best row, which quantisation moves by a
+        # few rows at 1 kHz; so their meeting is kept within a bin (the search's resolution) of that row, and
+        # only a meeting farther off (nearly parallel lines) falls back to the rows' midpoint
+        lo = min(t[max(i - 2, 0)], t[i - 1] - bins.width)
+        hi = max(t[min(i + 1, n - 1)], t[i] + bins.width)
         times.append(meet if lo <= meet <= hi else 0.5 * (t[i - 1] + t[i]))
     times.append(float(t[-1]))
     items = [Segment(max(line[0], 0.0), b - a) for line, a, b in zip(lines, times[:-1], times[1:], strict=True)]
     return Protocol(tuple(items), name="from displacement")
+
+
+def forward(record: LabRecord) -> tuple[LabRecord, bool]:
+    """The record with its load point moving forward, and whether its displacement was negated to make it so.
+
+    Rate and state sees the speed only: a transducer that counts the other way, or a velocity column written
+    negative, is the same experiment, so a displacement that ends below its start is taken by its magnitude.
+    (Whether it reverses mid-way is :func:`refuse_reversal`'s question.)
+    """
+    d = record.displacement
+    if d[-1] - d[0] >= 0:
+        return record, False
+    return replace(record, displacement=-d), True
+
+
+#: a piece moves when its speed is at least this share of the fastest piece's (below: a hold with drift)
+MOVING_SHARE = 0.02
+
+
+def refuse_reversal(record: LabRecord, protocol: Protocol) -> None:
+    """DataError when the load point moves both ways: a piece of ``protocol`` (found from ``record``) whose own
+    line runs backwards at a speed that is motion, not a hold's drift or noise, while another runs forwards.
+
+    :func:`find_segments` gives a backward piece velocity 0, which would fit the record as a hold.
+    """
+    t, d = record.time, record.displacement
+    pieces = []
+    for a, b, _ in protocol.pieces():
+        i0, i1 = np.searchsorted(t, [a, b], side="left")
+        i0, i1 = i0 + 2, i1 - 2  # rows beside a change may lie on the other piece's line
+        if i1 - i0 < 5:
+            continue
+        slope, intercept = _line(t[i0:i1], d[i0:i1])
+        scatter = float(np.std(d[i0:i1] - slope * t[i0:i1] - intercept))
+        travel = abs(slope) * float(t[i1 - 1] - t[i0])
+        pieces.append((float(t[i0]), slope, travel > 10.0 * scatter))
+    fastest = max((abs(v) for _, v, _ in pieces), default=0.0)
+    moving = [(start, v) for start, v, clear in pieces if clear and abs(v) >= MOVING_SHARE * fastest > 0]
+    backwards = [(start, v) for start, v in moving if v < 0]
+    if backwards and len(backwards) < len(moving):
+        start, v = backwards[0]
+        ahead = next(u for _, u in moving if u > 0)
+        raise DataError(
+            f"{record.source}: the load point reverses: it moves at {ahead:.3g} m/s and, from t = "
+            f"{record.t0 + start:.6g} s, at {v:.3g} m/s; expected it to move one way (fit each direction's rows "
+            "with --window)"
+        )
 
 
 #: rows either side of a change whose scatter about the history gives the displacement's noise there
@@ -485,19 +558,8 @@ def _bins(t: np.ndarray, d: np.ndarray) -> _Bins:
     count = np.diff(np.concatenate([first, [n]]))
     bt = np.add.reduceat(tc, first) / count
     bd = np.add.reduceat(dc, first) / count
-    var, inflation = _noise_model(bt, bd, count, _quantum(d) / scale)
+    var, inflation = _noise_model(bt, bd, count, quantum(d) / scale)
     return _Bins(bt, bd, count, first, var, inflation, width, span, float(line[0]) / scale)
-
-
-def _quantum(d: np.ndarray) -> float:
-    """The displacement's bit, where it is written in whole steps of one (0 when it is not)."""
-    steps = np.abs(np.diff(d))
-    steps = steps[steps > 0]
-    if steps.size < 10:
-        return 0.0
-    q = float(np.min(steps))
-    whole = np.abs(steps / q - np.round(steps / q)) < 0.02
-    return q if np.mean(whole) > 0.9 and np.max(steps) / q < 1e6 else 0.0
 
 
 def _window_residuals(bt: np.ndarray, bd: np.ndarray, width: int) -> tuple[np.ndarray, np.ndarray]:
@@ -606,14 +668,6 @@ def _line(t: np.ndarray, d: np.ndarray) -> tuple[float, float]:
     return float(slope), float(intercept)
 
 
-def _cumulative_sums(t: np.ndarray, d: np.ndarray) -> list[np.ndarray]:
-    """Running sums for O(1) straight-line misfits; t and d scaled to O(1) so the differences keep their digits."""
-    tc = (t - t.mean()) / max(float(np.ptp(t)), 1e-300)
-    dc = d - np.polyval(np.polyfit(tc, d, 1), tc)
-    dc = dc / max(float(np.max(np.abs(dc))), 1e-300)
-    return _running(np.ones_like(tc), tc, dc)
-
-
 def _misfit(sums: list[np.ndarray], lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
     """Least-squares misfit of a straight line through rows [lo, hi)."""
     c, st, sd, stt, std, sdd = (s[hi] - s[lo] for s in sums)
@@ -706,14 +760,27 @@ def _significant_hinges(
 CURVED = 100.0
 
 
-def _refuse_curved(bins: _Bins, hinges: list[int]) -> None:
+def _refuse_curved(bins: _Bins, hinges: list[int], t: np.ndarray, d: np.ndarray, t0: float) -> None:
     """DataError when the straight pieces miss the binned record by far more than its noise: the load point's
-    velocity changes smoothly, not in steps."""
+    velocity changes smoothly, not in steps, or its displacement jumps (:func:`_jump`, then named)."""
     sums = _running(1.0 / bins.var, bins.t, bins.d)
     edges = np.array([0, *hinges, bins.t.size])
-    dof = max(bins.t.size - 2 * (edges.size - 1), 1)
-    excess = float(np.sum(_misfit(sums, edges[:-1], edges[1:]))) / dof / float(bins.inflation[1][-1])
+    # the bin beside a change may straddle it: its mean lies off both lines by up to |dv| width / 8, which is
+    # no curvature but, against bin means precise to a nanometre (exact or finely sampled quantised records),
+    # hundreds of times the noise; so it is left out, as in _piece_test
+    guard = (np.diff(edges) >= 4).astype(int)
+    lo, hi = edges[:-1] + guard, edges[1:] - guard
+    dof = max(int(np.sum(hi - lo)) - 2 * (edges.size - 1), 1)
+    excess = float(np.sum(_misfit(sums, lo, hi))) / dof / float(bins.inflation[1][-1])
     if excess > CURVED:
+        i = _jump(t, d)
+        if i is not None:
+            size = 1e6 * abs(d[i] - d[i - 1])  # its sign is that of a record the fit may have turned forward
+            raise DataError(
+                f"load-point displacement: it jumps by {size:.4g} µm between t = {t0 + t[i - 1]:.6g} and "
+                f"{t0 + t[i]:.6g} s (a transducer re-zeroed?); expected a continuous load point (undo the offset, "
+                "or fit the rows on one side of it with --window)"
+            )
         raise DataError(
             f"load-point displacement: its {edges.size - 1} straight pieces miss it by {excess:.3g} times its noise; "
             "expected piecewise-constant velocity (give the history with --segment or --protocol, or drive the "
@@ -721,22 +788,64 @@ def _refuse_curved(bins: _Bins, hinges: list[int]) -> None:
         )
 
 
+#: a row-to-row step this many times larger than the record's other large steps is a jump, not motion
+JUMP_FACTOR = 20.0
+
+
+def _jump(t: np.ndarray, d: np.ndarray) -> int | None:
+    """The row at which the displacement jumps (the largest row-to-row step, when it is JUMP_FACTOR times the
+    99.9th percentile of the others' |speed| times its own time step), or None.
+
+    By speed, not by step, so a pause in sampling is no jump; the percentile lets the fastest 0.1 % of rows
+    (a short fast segment) move without being one.
+    """
+    if t.size < 20:
+        return None
+    dt = np.diff(t)
+    speed = np.abs(np.diff(d)) / dt
+    i = int(np.argmax(speed))
+    others = np.delete(speed, i)
+    usual = float(np.percentile(others, 99.9))
+    if speed[i] > JUMP_FACTOR * usual and speed[i] > 0:
+        return i + 1
+    return None
+
+
 def _refine(
-    sums: list[np.ndarray], breaks: list[int], first: np.ndarray, hinges: list[int], min_points: int
+    t: np.ndarray, d: np.ndarray, breaks: list[int], first: np.ndarray, hinges: list[int], min_points: int
 ) -> list[int]:
     """Each interior break moved to its best row within two bins, between its neighbours."""
     breaks = list(breaks)
-    last = int(sums[0].size - 1)
+    n = t.size
     for k in range(1, len(breaks) - 1):
         h = hinges[k - 1]
         lo = max(breaks[k - 1] + min_points, int(first[max(h - 2, 0)]))
-        hi = min(breaks[k + 1] - min_points, int(first[h + 2]) if h + 2 < first.size else last)
+        hi = min(breaks[k + 1] - min_points, int(first[h + 2]) if h + 2 < first.size else n)
         if hi <= lo:
             continue
+        a, b = breaks[k - 1], breaks[k + 1]
         j = np.arange(lo, hi + 1)
-        cost = _misfit(sums, np.full_like(j, breaks[k - 1]), j) + _misfit(sums, j, np.full_like(j, breaks[k + 1]))
+        none = np.zeros_like(j)
+        left = _residual_sums(t[a:hi], d[a:hi], lo - a)
+        right = _residual_sums(t[lo:b][::-1], d[lo:b][::-1], b - hi)  # reversed: rows [j, b) come first
+        cost = _misfit(left, none, j - a) + _misfit(right, none, b - j)
         breaks[k] = int(j[np.argmin(cost)])
     return breaks
+
+
+def _residual_sums(t: np.ndarray, d: np.ndarray, clean: int) -> list[np.ndarray]:
+    """Running sums (:func:`_running`) of the rows' offsets from the line through their first ``clean`` rows.
+
+    One row more or less on a piece of 1e5 rows changes its misfit by 1e-9 of the misfit of the raw displacement
+    about one line: sums over the whole record lose that to cancellation (a 1 kHz change was placed 2 rows late),
+    sums of offsets from the piece's own line keep it.
+    """
+    fit = slice(0, clean if clean >= 3 else t.size)
+    t0 = float(t[min(clean, t.size - 1)])
+    span = max(float(np.ptp(t)), 1e-300)
+    tc = (t - t0) / span
+    e = d - np.polyval(np.polyfit(tc[fit], d[fit], 1), tc)
+    return _running(np.ones_like(tc), tc, e)
 
 
 #: the smoothing window makes a local line's velocity this precise (relative to the record's slower speeds)
@@ -754,6 +863,7 @@ def measured_history(record: LabRecord, smoothing: float | None = None) -> Proto
         isinstance(smoothing, (int, float)) and math.isfinite(smoothing) and smoothing > 0
     ):
         raise ParameterError(f"smoothing: expected a positive time window in seconds, got {smoothing!r}")
+    record, _ = forward(record)
     t, d = record.time, record.displacement
     try:
         changes = find_segments(t, d, max_segments=10_000).boundaries

@@ -19,7 +19,7 @@ from ..columns import with_units
 from ..errors import DataError, ModelError, ParameterError
 from ..protocols import Protocol, Segment
 from ..units import to_si
-from .data import LabRecord, change_time_uncertainty, find_segments
+from .data import LabRecord, change_time_uncertainty, find_segments, forward, refuse_reversal
 from .laws import get_law
 from .params import RSFParams, StateVariable, _cutoff_pair
 from .solver import simulate
@@ -302,7 +302,7 @@ def fit_record(
     weight = None if step_weight is None else float(step_weight)
     source = "given" if protocol is not None else "found from the load-point displacement"
     protocol_found = protocol is None
-    record, protocol = fitted_rows(record, protocol, window)
+    record, protocol, backwards = _fitted_rows(record, protocol, window)
     if protocol.initial_velocity <= 0:
         raise DataError("record: the load point does not move in the first segment; expected steady sliding first")
     start = _stable_start(_initial_guess(record, protocol, {**starts, **held}, held.get("stiffness")),
@@ -345,6 +345,9 @@ def fit_record(
     table, corr, warns = _report(result, values, setup, start["stiffness"], widen, units)
     change_times, change_warns = _change_report(setup, result, seen) if protocol_found else ((), [])
     warns += change_warns
+    if backwards:
+        warns.insert(0, "the load-point displacement decreases (the load point moves in the negative direction): "
+                        "it was taken by its magnitude, as friction depends on the speed only")  # fmt: skip
     derived = {"a-b": _difference(result, table, widen)}
     problems = _problems(result, record, resid, table, level, setup)
     if any(p.startswith(NO_RESPONSE_TEXT) for p in problems):  # then no interval of the friction law means anything
@@ -393,10 +396,18 @@ def fitted_rows(record: LabRecord, protocol: Protocol | None = None, window: Any
 
     ``rsf fit`` times one model run over exactly these before it fits (its cost estimate).
     """
-    rows = _windowed(record, window)
+    rows, history, _ = _fitted_rows(record, protocol, window)
+    return rows, history
+
+
+def _fitted_rows(record: LabRecord, protocol: Protocol | None, window: Any) -> tuple[LabRecord, Protocol, bool]:
+    """:func:`fitted_rows`, and whether the displacement decreases (then it is taken by its magnitude)."""
+    rows, backwards = forward(_windowed(record, window))
     if protocol is None:
-        return rows, find_segments(rows.time, rows.displacement)
-    return rows, _covering(_shifted(protocol, rows.t0 - record.t0), rows)
+        found = find_segments(rows.time, rows.displacement, t0=rows.t0)
+        refuse_reversal(rows, found)
+        return rows, found, backwards
+    return rows, _covering(_shifted(protocol, rows.t0 - record.t0), rows), backwards
 
 
 @dataclass(frozen=True)
