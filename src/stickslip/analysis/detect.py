@@ -7,11 +7,14 @@ a robust noise level, a median-filtered uniform resampling, drops as peaks of pr
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 from scipy.ndimage import median_filter, uniform_filter1d
 from scipy.signal import find_peaks
+
+from ..numerics.quantisation import quantum
 
 #: A drop counts as a slip when it exceeds this many noise standard deviations.
 PROMINENCE_SIGMAS = 10.0
@@ -27,6 +30,10 @@ STEADY_AVERAGE = 25
 SETTLED_FRACTION = 0.25
 #: MAD -> standard deviation for Gaussian noise.
 MAD_SCALE = 1.482602218505602
+#: The trimmed RMS keeps this fraction of the smallest absolute deviations ...
+TRIM_FRACTION = 0.5
+#: ... whose RMS is this many standard deviations for Gaussian noise: sqrt(1 - 2 z phi(z) / 0.5), z = 0.6745.
+TRIM_SCALE = 0.377594
 
 
 @dataclass(frozen=True)
@@ -56,13 +63,82 @@ class Coarse:
 
 
 def noise_level(time: np.ndarray, stress: np.ndarray) -> float:
-    """Robust standard deviation of white noise on a piecewise-smooth record (finite samples only)."""
-    t, x = time, stress
-    if t.size < 3:
+    """Robust standard deviation of the noise on a piecewise-smooth record (finite samples only).
+
+    White noise is read off each sample against the line through its two neighbours; correlated noise by
+    widening that triple (:func:`_correlated_level`) until the estimate stops growing; and a record written in
+    whole ADC steps q never gets less than the steps' own q/sqrt(12) (docs/analysis.md, "Noise level").
+    """
+    if time.size < 3:
         return 0.0
+    level = _correlated_level(time, stress, _lag_level(time, stress, 1))
+    return max(level, _quantisation_level(stress))
+
+
+#: The noise estimate widens its triples (lag 1, 2, 4, ... samples) while the estimate's variance still grows by
+#: more than this factor (plus sampling scatter, :data:`GROWTH_SCATTER` / sqrt(independent triples)) ...
+NOISE_GROWTH = 1.3
+GROWTH_SCATTER = 6.0
+#: ... up to lags of this fraction of the record (in samples and in time): the stick lines, not the slips'
+#: curvature, must hold the median of the residuals.
+MAX_LAG_FRACTION = 0.01
+#: Triples per lag beyond which the estimate takes every n-th one (the median needs no more).
+LAG_TRIPLES = 1_000_000
+#: The quantisation step is read off at most this many samples from the start of the record.
+QUANTUM_SAMPLES = 1_000_000
+
+
+def _correlated_level(time: np.ndarray, stress: np.ndarray, white: float) -> float:
+    """The noise's whole standard deviation where successive samples are correlated.
+
+    For stationary noise of autocovariance g(k), the residual about the line through samples k apart has
+    variance 1.5 g(0) - 2 g(k) + 0.5 g(2k): g(0) (1 - 4 phi/3 + phi^2/3) at k = 1 for AR(1) noise, 7 % of it at
+    phi = 0.9, all of it once k outlasts the correlation.  Straight stick lines add nothing at any k, so the
+    noise is the level at the first lag k = 1, 2, 4, ... beyond which the next two doublings add no more than
+    their scatter: ``white`` (the MAD at k = 1) when that is k = 1, as for white noise.  Growth that never
+    levels off within :data:`MAX_LAG_FRACTION` of the record is the signal's curvature, not noise: ``white``.
+    The ladder compares trimmed RMS values, not MADs: on a quantised record the residuals take a few discrete
+    values, and a median can stay on one of them while the spread grows.
+    """
+    n = time.size
+    longest = max(MAX_LAG_FRACTION * n, 5.0)
+    horizon = time[0] + MAX_LAG_FRACTION * float(time[-1] - time[0])
+    levels: list[float] = []
+    lag = 1
+    while 2 * lag + 1 <= min(longest, n) and (lag == 1 or time[2 * lag] <= horizon):
+        levels.append(_lag_level(time, stress, lag, trimmed=True))
+        lag *= 2
+    for i in range(len(levels) - 1):
+        ahead = levels[i + 1 : i + 3]
+        growth = NOISE_GROWTH + GROWTH_SCATTER / math.sqrt(max(n / 2.0 ** (i + len(ahead)), 1.0))
+        if all(level**2 <= growth * levels[i] ** 2 for level in ahead):
+            return white if i == 0 else max(levels[i : i + 3])
+    return white
+
+
+def _quantisation_level(stress: np.ndarray) -> float:
+    """q / sqrt(12) for a record written in whole steps q (an ADC's bit), else 0: the least noise it can have.
+
+    Below that the record is a staircase whose treads are exact straight lines, so neighbouring samples show no
+    noise at all when the stress rises by less than q between samples (1 kHz) and some at 100 Hz."""
+    return quantum(stress[:QUANTUM_SAMPLES]) / math.sqrt(12.0)
+
+
+def _lag_level(time: np.ndarray, stress: np.ndarray, lag: int, trimmed: bool = False) -> float:
+    """Robust standard deviation of the residual of each sample about the line through the samples ``lag``
+    before and after it, scaled to the noise of one sample as if it were white: the MAD, or with ``trimmed``
+    the RMS of the :data:`TRIM_FRACTION` smallest deviations from the median."""
+    stride = max(1, (time.size - 2 * lag) // LAG_TRIPLES)
+    middle = slice(lag, time.size - lag, stride)
+    t_mid, x_mid = time[middle], stress[middle]
+    if lag == 1 and stride == 1:
+        t_prev, x_prev, t_next, x_next = time[:-2], stress[:-2], time[2:], stress[2:]
+    else:
+        before = slice(0, time.size - 2 * lag, stride)
+        after = slice(2 * lag, time.size, stride)
+        t_prev, x_prev, t_next, x_next = time[before], stress[before], time[after], stress[after]
     # in place where possible: a 10^7-sample record makes each temporary 80 MB
-    left, w_prev = t[1:-1] - t[:-2], t[2:] - t[1:-1]
-    x_prev, x_mid, x_next = x[:-2], x[1:-1], x[2:]
+    left, w_prev = t_mid - t_prev, t_next - t_mid
     span = left + w_prev
     spaced = span > 0  # three samples at one instant (a jump written as a run of rows) define no line
     if not np.all(spaced):
@@ -81,7 +157,12 @@ def noise_level(time: np.ndarray, stress: np.ndarray) -> float:
     residual /= np.sqrt(norm, out=norm)
     centre = np.median(residual)
     residual -= centre
-    return float(MAD_SCALE * np.median(np.abs(residual, out=residual), overwrite_input=True))
+    deviation = np.abs(residual, out=residual)
+    if not trimmed:
+        return float(MAD_SCALE * np.median(deviation, overwrite_input=True))
+    kept = max(1, int(TRIM_FRACTION * deviation.size))
+    smallest = np.partition(deviation, kept - 1)[:kept]
+    return float(math.sqrt(float(np.mean(np.square(smallest)))) / TRIM_SCALE)
 
 
 def sampling_step(time: np.ndarray) -> float:
