@@ -87,6 +87,8 @@ def simulation_run(sim: Any) -> Run:
         state_units={"block_shear": "m", "chain_fraction": "1", "phase": None},
         summary=summary,
         message=sim.message,
+        # a run the model stopped short of its duration without an answer failed (exit 3), as other models' do
+        status=getattr(sim, "status", "ok"),
         native=sim,
     )
 

@@ -13,6 +13,7 @@ show seconds, Pa and um/s.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
 
@@ -69,8 +70,9 @@ def plot_simulation(sim: Simulation, ax: Axes | None = None, phases: bool = True
     else:
         kwargs.setdefault("label", f"V0 = {_um(sim.pulling_velocity)}")
         ax.plot(sim.time, sim.stress, **kwargs)
-    ax.axhline(sim.critical_stress, color=CRITICAL_COLOR, linestyle="--", linewidth=0.8, alpha=0.6,
-               label=f"σc = {sim.critical_stress:.4g} Pa")  # fmt: skip
+    if math.isfinite(sim.critical_stress):  # a curve without Vc (steady sliding only) has no σc to mark
+        ax.axhline(sim.critical_stress, color=CRITICAL_COLOR, linestyle="--", linewidth=0.8, alpha=0.6,
+                   label=f"σc = {sim.critical_stress:.4g} Pa")  # fmt: skip
     ax.set_xlabel(TIME_LABEL)
     ax.set_ylabel(STRESS_LABEL)
     ax.set_xlim(0.0, sim.duration)

@@ -17,12 +17,13 @@ import numpy as np
 
 from .. import regimes
 from ..columns import attribute_frame
-from ..errors import ParameterError
+from ..errors import ModelError, ParameterError
 from ..parameters import Parameters
 from ..reprs import compact_repr, field_values
 from ..trace_columns import QUASI_STATIC
-from .jump import Jump, check_curve, jump_velocity, require_critical_point
-from .steady import require_parameters
+from .critical import CriticalPoint, cached_critical_point, steady_curve_key
+from .jump import Jump, check_curve, jump_velocity
+from .steady import ACCURATE_QUADRATURE, require_parameters, steady_state
 
 if TYPE_CHECKING:  # pragma: no cover
     import pandas as pd
@@ -87,11 +88,14 @@ class Simulation:
     slip_phases: tuple[SlipPhase, ...] = field(default=(), repr=False)
     jumps: tuple[Jump, ...] = field(default=(), repr=False)
     parameters: Parameters | None = field(default=None, repr=False, compare=False)
+    #: "ok", or "failed" when the model stopped before ``duration`` without an answer (``message`` says where)
+    status: str = "ok"
 
     def summary(self) -> dict[str, Any]:
         """The JSON summary, SI units."""
         return {
             "regime": self.regime.kind,
+            "status": self.status,
             "message": self.message,
             "final_stress": self.final_stress,
             "final_velocity": self.final_velocity,
@@ -115,6 +119,13 @@ class Simulation:
         from ..plots.cycles import plot_simulation
 
         return plot_simulation(self, ax=ax, **kwargs)
+
+
+@dataclass(frozen=True)
+class SteadySliding(Simulation):
+    """A run on a steady curve that rises at every velocity: no Vc, so no stick and no cycle, only steady sliding
+    at V0 (``critical_velocity`` and ``critical_stress`` are NaN).  Its own type, so that what describes a
+    cycle's start and critical point (the command line's record) is not printed; the figure draws no σc."""
 
 
 @dataclass
@@ -270,7 +281,9 @@ def simulate(
     if end <= 0:
         raise ParameterError(f"duration: expected a positive time in s, got {end!r}")
     check_curve(jump_curve)
-    cp = require_critical_point(params)
+    cp = cached_critical_point(steady_curve_key(params))
+    if not cp.exists:
+        return _without_critical_point(params, cp, v0, end, start_stress, jump_curve)
     assert cp.velocity is not None and cp.stress is not None
     sigma_c = float(cp.stress)
     sigma0 = sigma_c if start_stress is None else check_stress(start_stress)
@@ -320,11 +333,22 @@ def simulate(
         message += f" (after {len(cycles)} slip(s))"
     columns = trace.build()
     if regime == regimes.STEADY and _settle_time(phases, sigma0, sigma_c) > end:
-        # the regime is where the run is heading: say that it ends before it gets there
+        # steady sliding is where the run is heading, not what it reached: undetermined, as a run of the
+        # time-dependent model that has not settled; its numbers are the run's own (never σ(V0))
         where = "stuck" if columns["phase"][-1] == "stick" else "slipping"
+        message = (
+            f"undetermined: the run ends at {end:.6g} s, still {where} (σ = {columns['stress'][-1]:.6g} Pa,"
+            f" V = {columns['velocity'][-1] * 1e6:.6g} µm/s), before it settles; it would settle to steady"
+            f" sliding at t = {_settle_time(phases, sigma0, sigma_c):.6g} s: the slip {message}"
+        )
+        regime = regimes.UNDETERMINED
+    status = "ok"
+    if regime == regimes.UNDETERMINED and columns["time"][-1] < end:
+        # the model has no next phase: what was asked for beyond here is not computed, so the run failed
+        status = "failed"
         message += (
-            f"; the run ends at {end:.6g} s, still {where}, before it settles at t ="
-            f" {_settle_time(phases, sigma0, sigma_c):.6g} s"
+            f"; the model stops at t = {columns['time'][-1]:.6g} s of the {end:.6g} s asked for:"
+            " what follows is not known"
         )
     return Simulation(
         **columns,
@@ -343,6 +367,56 @@ def simulate(
         stick_phases=phases.all("stick"),
         slip_phases=phases.all("slip"),
         jumps=phases.all("jump"),
+        parameters=params,
+        status=status,
+    )
+
+
+def _without_critical_point(
+    params: Parameters, cp: CriticalPoint, v0: float, end: float, start_stress: float | None, jump_curve: str
+) -> Simulation:
+    """The run where the aging curve has no minimum: steady sliding at V0 where the curve rises there (the
+    physics' answer: there is no Vc, so no stick at σc to start from and no stick-slip); elsewhere no answer."""
+    if v0 > 0.0:
+        state = steady_state(params, v0, aging=True, quadrature=ACCURATE_QUADRATURE)
+        sigma, rising = float(state.stress), float(state.stress_slope) > 0.0
+    else:  # the puller stands still: nothing loads the block
+        sigma, rising = 0.0, True
+    if not rising:  # velocity-weakening at V0 with no minimum: neither steady sliding nor a cycle to follow
+        raise ModelError(f"no stick-slip cycle: {cp.message}")
+    if start_stress is not None:
+        # a stick from a given stress ends in a jump onto the curve's right branch, which starts at Vc
+        raise ModelError(
+            f"start stress: the steady curve has no Vc ({cp.message}), so a stick from {float(start_stress):.6g} Pa"
+            " has no branch to jump onto; leave the start stress out for steady sliding at V0"
+        )
+    stiffness = params.block.effective_stiffness
+    trace = _Trace(sigma, stiffness, v0, end)
+    _add_steady(trace, 0.0, sigma, 0.0)
+    columns = trace.build()
+    if v0 > 0.0:
+        kind = regimes.STEADY
+        message = (
+            f"steady sliding at V0 = {v0 * 1e6:.6g} µm/s from the start, σ = σ(V0) = {sigma:.6g} Pa: the steady"
+            f" curve has no Vc, so no stick at σc to start from and no stick-slip ({cp.message})"
+        )
+    else:
+        kind = regimes.STUCK
+        message = f"the puller stands still and the block stays at rest, unloaded (σ = 0 Pa): {cp.message}"
+    return SteadySliding(
+        **columns,
+        regime=regimes.Regime(kind, 0, math.nan, math.nan, sigma, sigma, message),
+        cycles=(),
+        final_stress=sigma,
+        final_velocity=v0,
+        message=message,
+        pulling_velocity=v0,
+        duration=end,
+        start_stress=sigma,
+        jump_curve=jump_curve,
+        critical_velocity=math.nan,
+        critical_stress=math.nan,
+        stiffness=stiffness,
         parameters=params,
     )
 
