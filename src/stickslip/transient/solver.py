@@ -1268,6 +1268,13 @@ FOLD_MARGIN = 1.02
 BLOCK_FASTEST = 1.0
 #: a block from rest first sticks under Eq 1 alone, in slowly lengthening steps (1712 steps for 0.1 s, 2413 for 100 s)
 STUCK_STEPS = 2500.0
+#: a resting bond's hazard falls with its age at 1/tau_a (Eq 1 at V = 0), so a newborn ages into permanence with
+#: probability exp(-u0 tau_a/tau) and a vacancy fills over tau exp(u0 tau_a/tau); for ln(1/rtol) such times the
+#: births and deaths churn at steps of about CHURN_STEP tau (the gel, u0 tau_a/tau = 4.0: filled in 12 ms, ~1 000
+#: of its 2 409 steps from rest; tau = 150 us, 6.0: 12 256 steps in the first 0.5 s; 10 us, 90: never filled, 94 176
+#: steps in 0.14 s), and a block stuck for good takes CHURN_SHARE times the churn's steps (2 409 against ~1 020)
+CHURN_STEP = 0.5
+CHURN_SHARE = 2.4
 #: steps no budget allows even with the reduction (the fold's velocity is not looked for then)
 HOPELESS = 1e9
 #: a block with mass rings at f_b = sqrt((K + N0 M)/m)/(2 pi) after each change of the protocol (and lightly damped
@@ -1364,7 +1371,8 @@ def estimate_cost(
     repeating = REPEAT_CYCLES and reducing and every is None
     # SLIP_STEPS were measured with the reduction: without it a slip costs more than the births' share saves
     relaxed = RELAXED_BIRTHS and reducing and _births_never_held(protocol, bool(stick_population))
-    motion = _BlockMotion(params, aging, k_block, bool(stick_population), start, repeating, relaxed) if (
+    churn = _churn(params, protocol.duration, rtol)
+    motion = _BlockMotion(params, aging, k_block, bool(stick_population), start, repeating, relaxed, churn) if (
         control == "block" and aging and mass == 0 and max_step is None
     ) else None  # fmt: skip
     natural = b.max_extension / b.bond_time
@@ -1443,6 +1451,28 @@ def _fold(found: list[float], params: Parameters, control: str, aging: bool) -> 
     return found[0]
 
 
+@dataclass(frozen=True)
+class _Churn:
+    """The resting bonds' churn on a block that sticks under Eq 1 alone (:data:`CHURN_STEP`): its steps within the
+    run, the probability that a newborn ages into permanence, and whether every cohort born is kept (its permanent
+    weight above the kernel's LIGHTEST: then each step works through all of them)."""
+
+    steps: float
+    permanence: float
+    lifetime: float  # u0 tau_a/tau, a resting newborn's integrated hazard
+    kept: bool
+    holds: bool  # the vacancy fills within the run: the block can stick for good
+
+
+def _churn(params: Parameters, duration: float, rtol: float) -> _Churn:
+    b, g = params.bonds, params.aging
+    lifetime = b.breakage_weight * g.aging_time / b.bond_time
+    filled = math.log(1.0 / rtol) * b.bond_time * math.exp(min(lifetime, 700.0))
+    steps = min(duration, filled) / (CHURN_STEP * b.bond_time)
+    kept = lifetime < -math.log(K.LIGHTEST)
+    return _Churn(steps, math.exp(-min(lifetime, 745.0)), lifetime, kept, filled <= duration)
+
+
 class _BlockMotion:
     """The block's own motion through the protocol, for :func:`estimate_cost`: stick-slip cycles of the quasi-static
     model with the paper's attached chains, or a block stuck for good under Eq 1 alone (aging that never saturates)."""
@@ -1456,8 +1486,10 @@ class _BlockMotion:
         start: str,
         repeating: bool = False,
         relaxed: bool = False,
+        churn: _Churn | None = None,
     ) -> None:
         self.params, self.aging, self.k_block, self.chains = params, aging, k_block, chains
+        self.churn = churn if churn is not None else _Churn(0.0, 1.0, 0.0, True, True)
         self.repeating = repeating and chains  # a limit cycle repeated after a few (_Repeater)
         self.share = RELAXED_SHARE if relaxed else 1.0  # the births' spacing by their Gauss error
         self.repeated = 0.0  # slips repeated, not integrated
@@ -1472,17 +1504,23 @@ class _BlockMotion:
         self.slips = 0.0
         self.clocks: dict[tuple[float, bool], tuple[float, float]] = {}
         self.failed = False
-        if not chains and params.aging.saturation_age is None and start == "empty":
+        if not chains and params.aging.saturation_age is None and start == "empty" and self.churn.holds:
             self._stick_for_good(stop=False)
 
     def counts(self) -> bool:
-        """Whether this motion is counted (else the cohorts' estimate): with the chains, or stuck for good."""
-        return not self.failed and (self.chains or self.stuck_for_good or self.params.aging.saturation_age is None)
+        """Whether this motion is counted (else the cohorts' estimate): with the chains, or stuck for good (where
+        resting bonds age into permanence within the run: else they churn, and the block creeps or slides)."""
+        forever = self.params.aging.saturation_age is None
+        return not self.failed and (self.chains or self.stuck_for_good or forever)
 
     def _stick_for_good(self, stop: bool) -> None:
         self.stuck_for_good = True
-        self.lump = STUCK_STEPS + (STOP_STEPS if stop else 0.0)
-        self.stuck_steps = self.lump
+        self.lump = max(STUCK_STEPS, CHURN_SHARE * self.churn.steps) + (STOP_STEPS if stop else 0.0)
+        # cohorts too light to keep die as they are born: then the steps cost what sliding ones do
+        self.stuck_steps = self.lump if self.churn.kept else 0.0
+
+    def _churning(self) -> bool:
+        return self.stuck_for_good and CHURN_SHARE * self.churn.steps > STUCK_STEPS
 
     def segment_steps(self) -> float:
         """A stuck block takes one step per segment (and keeps its cohort); a moving one more."""
@@ -1498,6 +1536,10 @@ class _BlockMotion:
         if self.stuck_for_good:
             lump, self.lump = self.lump, 0.0
             return lump
+        if not self.chains and not self.churn.holds and self.params.aging.saturation_age is None:
+            # resting bonds never fill the vacancies within the run: the births and deaths churn at steps of ~tau
+            # throughout, whether the block creeps or slides (tau = 10 us: 657 719 steps for 1 s, 1 ns: ~1e10)
+            return dt / (CHURN_STEP * self.params.bonds.bond_time)
         if not below():
             self.sliding = self.sliding or not self.chains or vp > 0
             self.clock, self.from_rest = 0.0, False
@@ -1537,8 +1579,20 @@ class _BlockMotion:
         return self.clocks[key]
 
     def describe(self) -> str:
+        if self._churning():
+            c = self.churn
+            return (
+                f", the block stuck for good under Eq 1 (no stick chains) once resting bonds, which age into"
+                f" permanence with probability e^(-u0 τa/τ) = {c.permanence:.3g}, fill its vacancies: until then their"
+                f" births and deaths churn at steps of ~τ/2 ({c.steps:.3g} such steps)"
+            )
         if self.stuck_for_good:
             return ", the block stuck for good under Eq 1 (no stick chains)"
+        if not self.chains and not self.churn.holds and self.params.aging.saturation_age is None:
+            return (
+                f", resting bonds that age into permanence with probability e^(-u0 τa/τ) = {self.churn.permanence:.3g}"
+                " (never filling the vacancies within the run): their births and deaths churn at steps of ~τ/2"
+            )
         if self.chains and self.slips > 0:
             repeated = f", {self.repeated:.3g} of them repeated, not integrated" if self.repeated else ""
             return f", about {self.slips:.3g} stick–slip cycles of the quasi-static model{repeated}"
