@@ -81,31 +81,26 @@ def test_the_written_figure_has_matplotlibs_labels_without_mathtext(monkeypatch:
     assert powers <= set(expected) and not any("mathdefault" in text for text in written)
 
 
+def _formatters(fig) -> list[tuple[object, ...]]:  # type: ignore[no-untyped-def]
+    return [
+        (
+            type(axis.get_major_formatter()),
+            type(axis.get_minor_formatter()),
+            axis.isDefault_majfmt,
+            axis.isDefault_minfmt,
+        )
+        for ax in fig.axes
+        for axis in (ax.xaxis, ax.yaxis)
+    ]
+
+
 def test_the_figure_keeps_its_formatters() -> None:
     from matplotlib.ticker import LogFormatterSciNotation
 
     fig = _figure()
-    before = [
-        (
-            type(axis.get_major_formatter()),
-            type(axis.get_minor_formatter()),
-            axis.isDefault_majfmt,
-            axis.isDefault_minfmt,
-        )
-        for ax in fig.axes
-        for axis in (ax.xaxis, ax.yaxis)
-    ]
+    before = _formatters(fig)
     png_and_svg_bytes(fig)
-    after = [
-        (
-            type(axis.get_major_formatter()),
-            type(axis.get_minor_formatter()),
-            axis.isDefault_majfmt,
-            axis.isDefault_minfmt,
-        )
-        for ax in fig.axes
-        for axis in (ax.xaxis, ax.yaxis)
-    ]
+    after = _formatters(fig)
     assert after == before and before[0][0] is LogFormatterSciNotation
     assert _tick_labels(fig)[0][0].startswith("$")  # matplotlib's own labels again when drawn afterwards
 
