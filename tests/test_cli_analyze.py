@@ -107,7 +107,9 @@ def test_cycles_csv_reads_back_with_units(capsys, record, tmp_path):
     assert code == 0
     header = target.read_text(encoding="utf-8").splitlines()[0]
     assert "critical_stress [Pa]" in header and "stiffness [Pa/m]" in header and "model_jump_velocity [m/s]" in header
+    assert "cycle [1]" in header and "complete [1]" in header  # pure numbers carry [1]
     dimensions = {"s": "time", "Pa": "stress", "Pa/s": "stress_rate", "Pa/m": "stress_per_length", "m/s": "velocity"}
+    dimensions["1"] = "dimensionless"
     columns = {}
     for cell in header.split(","):
         name, _, unit = cell.partition(" [")

@@ -91,7 +91,7 @@ def test_a_model_from_outside_the_package_runs_by_its_import_path(viscous, capsy
 REFUSALS = [
     ([*QS, "--control", "velocity"], "velocity"),
     ([*QS, "--segment", "1 mm/s:1 s"], "one constant pulling velocity"),
-    ([*QS, "--every", "1 s"], "unknown setting 'every'"),
+    ([*QS, "--every", "1 s"], "the quasi-static model takes no --every"),
     ([*QS, "--set", "bonds.bond_time=224"], "needs a unit"),
     (["run", "--model", "no-such-model", "--v0", "1 um/s", "--duration", "1 s"], "--model 'no-such-model'"),
     (["run", "--model", "rsf", "--v0", "1 um/s", "--duration", "1 s", "--control", "velocity"], "velocity"),

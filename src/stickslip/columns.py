@@ -319,11 +319,29 @@ def _keys(obj: Any) -> Iterable[str]:
             yield from _keys(item)
 
 
+def _word_keys(obj: Any) -> set[str]:
+    """The keys of ``obj`` (nested) whose every value is a string: a word has no unit ("model": "transient")."""
+    seen: dict[str, bool] = {}
+
+    def visit(item: Any) -> None:
+        if isinstance(item, Mapping):
+            for key, value in item.items():
+                seen[str(key)] = seen.get(str(key), True) and isinstance(value, str)
+                visit(value)
+        elif isinstance(item, (list, tuple)):
+            for each in item:
+                visit(each)
+
+    visit(obj)
+    return {key for key, word in seen.items() if word}
+
+
 def json_units(document: Mapping[str, Any], extra: Mapping[str, str | None] | None = None) -> dict[str, str]:
     """The ``units`` map of a JSON document: every key it contains that has a unit (SI)."""
     units: dict[str, str] = {}
+    words = _word_keys(document)
     for key in _keys(document):
-        if key in units or key == JSON_KEY:
+        if key in units or key == JSON_KEY or key in words:
             continue
         try:
             unit = unit_of(key, extra)

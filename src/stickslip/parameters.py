@@ -313,6 +313,7 @@ def parameters_from_mapping(data: Mapping[str, Any], source: str = "parameters")
     """Build a set from a nested mapping as read from TOML (values with units)."""
     meta: dict[str, str] = {}
     values: dict[str, float] = {}
+    written: dict[str, Any] = {}  # each key's value as the file writes it
     for top, content in data.items():
         if top in _META_KEYS:
             if not isinstance(content, str):
@@ -328,11 +329,32 @@ def parameters_from_mapping(data: Mapping[str, Any], source: str = "parameters")
             raise ParameterError(f"{source}: [{top}] must be a table of key = value")
         for name, raw in content.items():
             key = f"{top}.{name}"
-            values[key] = to_si(raw, key_dimension(key), f"{source}: {key}")
+            try:
+                dimension = key_dimension(key)
+            except ParameterError as exc:  # an unknown key: named with the file it is in
+                raise ParameterError(f"{source}: {exc}") from None
+            values[key] = to_si(raw, dimension, f"{source}: {key}")
+            written[key] = raw
     missing = [k for k in parameter_keys() if k not in values and k not in optional_keys()]
     if missing:
         raise ParameterError(f"{source}: missing parameter(s) {', '.join(missing)}")
-    return _build(values, **meta)
+    try:
+        return _build(values, **meta)
+    except ParameterError as exc:  # a value out of range: named with its file, as written and in SI
+        raise ParameterError(f"{source}: {_written_and_si(str(exc), written, values)}") from None
+
+
+def _written_and_si(message: str, written: Mapping[str, Any], values: Mapping[str, float]) -> str:
+    """A refusal ``"key: expected ..., got <SI number>"`` ending instead with the value as written and its SI value
+    with unit ("got -300 degC = -26.85 K"); other messages unchanged."""
+    key = message.partition(":")[0]
+    raw = written.get(key)
+    if ", got " not in message or key not in values or raw is None:
+        return message
+    si = format_si(values[key], key_dimension(key))
+    text = raw.strip() if isinstance(raw, str) else None  # a bare number is SI: shown with its unit
+    shown = si if text is None or text == si else f"{text} = {si}"
+    return f"{message.rsplit(', got ', 1)[0]}, got {shown}"
 
 
 def available_parameter_sets() -> list[str]:

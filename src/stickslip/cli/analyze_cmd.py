@@ -31,8 +31,8 @@ from .params_cmd import print_rich
 #: Columns of ``-o cycles.csv``: (field, SI unit).  A model-derived field's column is named ``model_<field>``.
 CSV_COLUMNS = (
     ("pulling_velocity", "m/s"),  # the trace's V0: cycles tables of several traces stack into one for `fit stick`
-    ("cycle", ""),
-    ("complete", ""),
+    ("cycle", "1"),  # pure numbers carry [1], as every CSV of the package writes them
+    ("complete", "1"),
     ("start_time", "s"),
     ("peak_time", "s"),
     ("end_time", "s"),

@@ -13,8 +13,10 @@ bounded size: a FIFO or /dev/zero is refused instead of read for ever).
 
 from __future__ import annotations
 
+import errno
 import io
 import math
+import os
 import stat
 import sys
 import tempfile
@@ -248,7 +250,19 @@ def write_text(path: Path, text: str) -> None:
     try:
         atomic_write_text(path, text)
     except OSError as exc:
-        raise click.FileError(shorten(str(path)), hint=str(exc.strerror or exc)) from None
+        raise write_failed(path, exc) from None
+
+
+def write_failed(path: Path | str, exc: OSError) -> click.ClickException:
+    """One line for an output that could not be written: the file, and what failed (a full device while writing,
+    a missing folder, a refusal of the system), never click's "Could not open file" for a failed write."""
+    shown = shorten(str(path))
+    if exc.errno == errno.ENOSPC:
+        return click.ClickException(f"{shown}: no space left on the device while writing it")
+    if exc.errno == errno.ENOENT:
+        folder = Path(os.path.realpath(path)).parent
+        return click.ClickException(f"{shown}: cannot be written: the folder {shorten(str(folder))} does not exist")
+    return click.ClickException(f"{shown}: cannot be written ({exc.strerror or exc})")
 
 
 def save_figure(fig: Any, path: Path) -> None:
@@ -261,8 +275,9 @@ def save_figure(fig: Any, path: Path) -> None:
     except StickslipError:
         raise
     except (OSError, ValueError) as exc:
-        hint = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
-        raise click.FileError(shorten(str(path)), hint=hint) from None
+        if isinstance(exc, OSError):
+            raise write_failed(path, exc) from None
+        raise click.ClickException(f"{shorten(str(path))}: cannot be written ({exc})") from None
 
 
 class InputFile(click.ParamType):
@@ -306,6 +321,12 @@ def check_output(option: str, path: Path | None, plot: bool = False) -> None:
     folder = path.parent if str(path.parent) else Path(".")
     if not folder.is_dir():
         raise ParameterError(f"{option} {shorten(text)}: the folder {shorten(str(folder))} does not exist")
+    if path.is_symlink() and not path.exists():  # a dangling link: the file is made where it points
+        target = Path(os.path.realpath(path))
+        if not target.parent.is_dir():
+            raise ParameterError(
+                f"{option} {shorten(text)}: a link into the folder {shorten(str(target.parent))}, which does not exist"
+            )
     try:
         info = path.stat()
     except OSError:

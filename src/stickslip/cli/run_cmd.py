@@ -28,6 +28,7 @@ from .common import (
     save_figure,
     set_values,
     stacked,
+    write_failed,
 )
 from .protocol_options import build_protocol, build_rig, inertia_options, protocol_options, refuse_unsupported
 from .run_report import model_record, record_text
@@ -82,8 +83,12 @@ def model_parameters(model: Any, params_name: str | None, overrides: dict[str, s
     try:
         return model.parameters(params_name, overrides)
     except ParameterError:
+        from ..models.bond import BondModel
+
         path = Path(params_name) if params_name is not None else None
         if path is None or path.suffix.lower() not in (".json", ".toml") or not path.is_file():
+            raise
+        if isinstance(model, BondModel):  # it read the file itself: its refusal names the file and the key
             raise
     from .params_files import load_params_mapping  # a file of the mapping the model reads (rate-and-state's)
 
@@ -175,6 +180,34 @@ def settings_of(texts: tuple[str, ...], every_text: str | None) -> dict[str, Any
     if every_text is not None:
         settings["every"] = positive(every_text, "time", "--every")
     return settings
+
+
+#: Why a model that takes no ``every`` setting has no --every (its trace is sampled its own way).
+NO_EVERY = {"quasi-static": "its trace is its phases, thinned"}
+
+#: Models that sample no further than the end of the run (rate-and-state reads an --every beyond it at the end).
+EVERY_WITHIN_RUN = ("transient",)
+
+
+def refuse_every(model: Any, protocol: Any, every_text: str | None) -> None:
+    """Refuse, in one line naming --every as written, an --every the model cannot take: a model without the
+    setting, or a step longer than the run for a model that samples within it."""
+    from ..units import format_si
+    from .common import positive
+
+    if every_text is None:
+        return
+    if "every" not in model.capabilities.settings:
+        why = NO_EVERY.get(model.name, "it samples its trace itself")
+        raise ParameterError(
+            f"--every {shorten(every_text)}: the {model.name} model takes no --every ({why}); leave it out"
+        )
+    every = positive(every_text, "time", "--every")
+    if model.name in EVERY_WITHIN_RUN and every > protocol.duration:
+        raise ParameterError(
+            f"--every: got {every_text.strip()} ({format_si(every, 'time')}), longer than the run"
+            f" ({format_si(protocol.duration, 'time')}); expected a step no longer than the run"
+        )
 
 
 #: the regimes whose peak and trough are those of an oscillation (the others: the run's highest and lowest)
@@ -360,6 +393,7 @@ def run_command(**options: Any) -> None:
     if own_spring:  # a stiffness in the model's own unit sets its key k, as --set k=... would
         mapping["k"] = own_spring[model.name]
     params = model_parameters(model, o["params_name"], mapping)
+    refuse_every(model, protocol, o["every_text"])
     settings = settings_of(o["setting_texts"], o["every_text"])
     model.check(protocol, rig, settings)  # what the model cannot do, before any work
     start = start_value(o["start_text"], model)
@@ -394,6 +428,7 @@ def run_spelling(
     rig, _ = build_rig(
         o["control"], o["stiffness_text"], mass_text=o.get("mass_text"), damping_text=o.get("damping_text")
     )
+    refuse_every(get_model(model_name), protocol, o.get("every_text"))
     chosen = settings()
     params = resolve_params(o["params_name"], o["overrides"])
     execute(get_model(model_name), params, protocol, rig, start=start(), settings=chosen, output=output,
@@ -475,7 +510,7 @@ def _write_run(run: Any, output: Path) -> None:
     try:
         run.to_csv(output)
     except OSError as exc:
-        raise click.FileError(shorten(str(output)), hint=str(exc.strerror or exc)) from None
+        raise write_failed(output, exc) from None
 
 
 def register(cli: click.Group) -> None:

@@ -22,6 +22,7 @@ from .common import (
     refuse_overwriting_inputs,
     resolve_params,
     save_figure,
+    write_failed,
 )
 from .params_cmd import human, print_rich
 
@@ -133,7 +134,7 @@ def _stream_csv(params: Any, velocities: np.ndarray, aging: bool, output: Path |
         with atomic_open(output, "wb") as handle:
             write_all(handle.write)
     except OSError as exc:
-        raise click.FileError(str(output), hint=str(exc.strerror or exc)) from None
+        raise write_failed(output, exc) from None
 
 
 def _table_picks(count: int) -> np.ndarray:
