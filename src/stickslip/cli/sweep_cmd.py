@@ -204,24 +204,41 @@ def _summary(folder: Path, total: int) -> str:
     "--color", "color", default="regime", show_default=True, help="Column shown in colour (regime: discrete)."
 )
 @click.option(
+    "--at",
+    "at",
+    multiple=True,
+    metavar="KEY=VALUE",
+    help="Only the points at this value of a varied key (with a unit, or SI); repeatable. Without it, a sweep of"
+    " more keys than --x and --y draws a panel per value of the others (up to 6).",
+)
+@click.option(
     "-o",
     "--output",
     type=click.Path(dir_okay=False, path_type=Path),
     default=None,
     help="Image [default: OUT-COLOR.png].",
 )
-def plot_command(folder: Path, x: str, y: str | None, color: str, output: Path | None) -> None:
+def plot_command(folder: Path, x: str, y: str | None, color: str, at: tuple[str, ...], output: Path | None) -> None:
     """Draw the phase diagram of the sweep in OUT, with the model's analytic stability boundary."""
     from ..fileio import atomic_path
-    from ..plots.sweeps import plot_phase_diagram
+    from ..plots.sweeps import keys_not_plotted, plot_phase_diagram, select_rows
     from ..sweeps import load_sweep
+
+    picked: dict[str, str] = {}
+    for item in at:
+        key, sep, value = item.partition("=")
+        if not sep or not key.strip() or not value.strip():
+            raise ParameterError(f"--at {item}: expected KEY=VALUE, e.g. --at 'pulling_velocity=1 mm/s'")
+        picked[key.strip()] = value.strip()
 
     target = output if output is not None else folder.parent / f"{folder.name}-{color}.png"
     _refuse_inside(folder, target)
     if str(target) != "-":
         check_output("-o", target, plot=True)  # before the work, in one line (it was an errno and a temporary name)
     frame, spec = load_sweep(folder)
-    ax = plot_phase_diagram(frame, spec, x=x, y=y, color=color)
+    ax = plot_phase_diagram(frame, spec, x=x, y=y, color=color, at=picked)
+    # the keys not on the axes, said here too: whoever reads only this line must know the panels' split
+    note = keys_not_plotted(select_rows(frame, spec, picked), spec, x, y) if y is not None else ""
     try:
         with atomic_path(target) as temp:
             ax.figure.savefig(temp, format=target.suffix.lstrip(".") or "png", dpi=120, bbox_inches="tight")
@@ -230,7 +247,7 @@ def plot_command(folder: Path, x: str, y: str | None, color: str, output: Path |
     except (OSError, ValueError) as exc:
         raise click.FileError(str(target), hint=str(exc)) from None
     if str(target) != "-":  # the image itself went to standard output
-        click.echo(f"phase diagram: {target}")
+        click.echo(f"phase diagram: {target}{f' ({note})' if note else ''}")
 
 
 def _refuse_inside(folder: Path, target: Path) -> None:

@@ -6,7 +6,7 @@ a Latin hypercube as points; one key (:func:`figure_sweep_1d`): a panel per resu
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -87,9 +87,21 @@ DECADES = 30.0
 
 
 def plot_phase_diagram(
-    frame: Any, spec: Any, x: str, y: str | None = None, color: str = "regime", ax: Axes | None = None
+    frame: Any,
+    spec: Any,
+    x: str,
+    y: str | None = None,
+    color: str = "regime",
+    ax: Axes | None = None,
+    at: Mapping[str, Any] | None = None,
 ) -> Axes:
     """The phase diagram of a sweep's rows ``frame`` (see :func:`stickslip.sweeps.load_sweep`); returns the Axes.
+
+    ``at`` (key -> value, a number in SI or a string with a unit) keeps the rows at those values of varied keys.
+    A sweep that varies other keys than ``x`` and ``y`` draws one panel per combination of their values (up to
+    :data:`MAX_PANELS`; returns the first panel, its ``.figure`` the whole figure): drawn in one panel, points
+    at the same (x, y) would cover each other.  More combinations are refused unless ``at`` picks values, or
+    unless no two points share an (x, y) (a Latin hypercube: one panel, its title naming the keys not shown).
 
     With ``y`` None (a sweep of one key) it draws :func:`figure_sweep_1d` instead, ``color`` naming the result
     column(s) to show (comma-separated; ``regime``: the default columns), and returns the first panel (its
@@ -99,7 +111,7 @@ def plot_phase_diagram(
         if ax is not None:
             raise ParameterError("plot_phase_diagram: a 1-D plot (y=None) draws its own figure; give no ax")
         columns = None if color == "regime" else [c.strip() for c in color.split(",") if c.strip()]
-        return figure_sweep_1d(frame, spec, x, columns).axes[0]
+        return figure_sweep_1d(select_rows(frame, spec, at), spec, x, columns).axes[0]
     for option, key in (("--x", x), ("--y", y)):
         if key not in spec.keys:
             raise ParameterError(
@@ -111,23 +123,211 @@ def plot_phase_diagram(
     if color not in frame.columns or color in NOT_RESULTS:
         choices = [c for c in frame.columns if c not in NOT_RESULTS]
         raise ParameterError(f"--color {color}: not a column of this sweep; expected one of {', '.join(choices)}")
+    frame = select_rows(frame, spec, at)
     model = get_model(spec.model)
     dimensions = model.dimensions()
-    ax = apply_style(new_axes(ax, figsize=(6.8, 4.8)))
+    others = other_keys(frame, spec, x, y)
+    groups = _panel_groups(frame, others, x, y, ax)
+    ok = frame[frame["status"] == "ok"]
+    numbers = not (color == "regime" or ok[color].dtype == object or str(ok[color].dtype) in ("str", "string"))
+    all_xs, all_ys = (_scaled(frame[k].to_numpy(dtype=float), dimensions[k]) for k in (x, y))
+    logs = (_log_axis(spec, x, all_xs), _log_axis(spec, y, all_ys))
+    if len(groups) == 1:
+        axes = [apply_style(new_axes(ax, figsize=(6.8, 4.8)))]
+    else:
+        from matplotlib.figure import Figure
+
+        ncols = min(len(groups), PANEL_COLUMNS)
+        nrows = -(-len(groups) // ncols)
+        fig = Figure(figsize=(1.4 + 4.0 * ncols, 0.8 + 3.4 * nrows), layout="constrained")
+        grid = fig.subplots(nrows, ncols, sharex=True, sharey=True, squeeze=False)
+        axes = [apply_style(a) for a in grid.ravel()[: len(groups)]]
+        for spare in grid.ravel()[len(groups) :]:
+            spare.set_visible(False)
+    # one colour per regime and one colour scale for every panel: the same colour means the same in each
+    labels = ok[color].astype(str).to_numpy() if not numbers else None
+    palette = _regime_colors(labels) if labels is not None else None
+    norm = _norm(ok[color].to_numpy(dtype=float)) if numbers else None
+    mappable = None
+    failures = f"failed ({int((frame['status'] != 'ok').sum())})"  # one legend entry for every panel's crosses
+    for panel, (values, rows) in zip(axes, groups, strict=True):
+        drawn = _draw_panel(panel, rows, spec, model, dimensions, (x, y), color, logs, palette, norm, failures)
+        mappable = drawn if mappable is None else mappable
+        if values:
+            panel.set_title(_values_text(values, dimensions), fontsize=9)
+    if mappable is not None:
+        unit = RESULT_UNITS.get(color, "")
+        label = f"{color} ({unit}); blank: none" if unit else f"{color}; blank: none"
+        axes[0].figure.colorbar(mappable, ax=axes, label=label)
+    for panel in axes:
+        for setter, on in ((panel.set_xscale, logs[0]), (panel.set_yscale, logs[1])):
+            if on:
+                setter("log")
+    ncols = _ncols(axes) if len(axes) > 1 else 1
+    for i, panel in enumerate(axes):
+        if i + ncols >= len(axes):  # nothing below it (a spare cell of the last row is hidden): it names x
+            panel.set_xlabel(_label(x, dimensions[x]))
+            panel.xaxis.set_tick_params(labelbottom=True)
+        if i % ncols == 0:
+            panel.set_ylabel(_label(y, dimensions[y]))
+    title = f"{spec.label or spec.model}: {color} ({spec.model} model, {len(frame)} points)"
+    picked = {k: float(frame[k].iloc[0]) for k in (at or {}) if len(frame)}
+    if picked:
+        title += f" at {_values_text(picked, dimensions)}"
+    note = keys_not_plotted(frame, spec, x, y)
+    if note:  # a projection, or panels: the title says over which keys
+        title += f";\n{note}"
+    if len(groups) == 1:
+        axes[0].set_title(title, fontsize=10)
+    else:
+        axes[0].figure.suptitle(title, fontsize=10)
+    legend_of_all_panels(axes[0].figure, axes, loc="best", fontsize=8, framealpha=0.85, ncols=1, frameon=True)
+    return axes[0]
+
+
+#: The most panels a phase diagram draws for the values of the keys it does not plot (else: pick with ``at``).
+MAX_PANELS = 6
+#: Panels per row of the figure.
+PANEL_COLUMNS = 3
+
+
+def _ncols(axes: Sequence[Axes]) -> int:
+    """The number of columns of the panels' grid."""
+    return axes[0].get_subplotspec().get_gridspec().ncols
+
+
+def other_keys(frame: Any, spec: Any, x: str, y: str) -> dict[str, list[float]]:
+    """The varied keys other than ``x`` and ``y`` that take more than one value in ``frame``: key -> values (SI)."""
+    others: dict[str, list[float]] = {}
+    for key in spec.keys:
+        if key not in (x, y) and key in frame.columns:
+            values = sorted(set(frame[key].dropna().astype(float).tolist()))
+            if len(values) > 1:
+                others[key] = values
+    return others
+
+
+def keys_not_plotted(frame: Any, spec: Any, x: str, y: str) -> str:
+    """What the phase diagram of ``frame`` does with the varied keys not on its axes, in words ("" if none):
+    ``a panel per value of mu0 (0.4, 0.55)``, or ``not shown on the axes: mu0 (40 values, 0.4 to 0.55)`` where
+    no two points share an (x, y)."""
+    others = other_keys(frame, spec, x, y)
+    if not others:
+        return ""
+    dimensions = get_model(spec.model).dimensions()
+    parts = []
+    for key, values in others.items():
+        unit = DISPLAY.get(dimensions[key], (1.0, DIMENSIONS[dimensions[key]][1]))[1]
+        shown = _scaled(np.asarray(values), dimensions[key])
+        text = ", ".join(f"{v:.4g}" for v in shown)
+        if len(values) > MAX_PANELS:
+            text = f"{len(values)} values, {shown[0]:.4g} to {shown[-1]:.4g}"
+        parts.append(f"{key} ({text}{' ' + unit if unit else ''})")
+    listed = "; ".join(parts)
+    if frame.duplicated(subset=[x, y]).any():
+        return f"a panel per value of {listed}"
+    return f"not shown on the axes: {listed}"
+
+
+def select_rows(frame: Any, spec: Any, at: Mapping[str, Any] | None) -> Any:
+    """The rows at ``at``'s values of varied keys (``--at KEY=VALUE``; a value in SI or with a unit)."""
+    if not at:
+        return frame
+    from ..units import to_si
+
+    dimensions = get_model(spec.model).dimensions()
+    for key, raw in at.items():
+        if key not in spec.keys:
+            raise ParameterError(f"--at {key}: not a varied key of this sweep; expected one of {', '.join(spec.keys)}")
+        value = to_si(raw, dimensions[key], f"--at {key}")
+        column = frame[key].to_numpy(dtype=float)
+        match = np.isclose(column, value, rtol=1e-9, atol=0.0)
+        if not match.any():
+            held = ", ".join(f"{v:g}" for v in sorted(set(column.tolist())))
+            raise ParameterError(f"--at {key}={raw}: no point of the sweep has that value; it has {held} (SI)")
+        frame = frame[match]
+    return frame
+
+
+def _panel_groups(
+    frame: Any, others: Mapping[str, list[float]], x: str, y: str, ax: Axes | None
+) -> list[tuple[dict[str, float], Any]]:
+    """(values of the keys not plotted, their rows) for each panel; one panel, values {}, when they need none."""
+    if not others:
+        return [({}, frame)]
+    keys = list(others)
+    groups = [(dict(zip(keys, values, strict=True)), rows) for values, rows in frame.groupby(keys, sort=True)]
+    groups = [({k: float(v) for k, v in values.items()}, rows) for values, rows in groups]
+    if len(groups) == 1:
+        return [({}, frame)]
+    shared = frame.duplicated(subset=[x, y]).any()
+    if not shared:  # every point has its own (x, y): nothing is covered, one panel shows all
+        return [({}, frame)]
+    pick = f"pick values with --at KEY=VALUE (e.g. --at {keys[0]}={others[keys[0]][0]:g})"
+    if ax is not None:
+        raise ParameterError(
+            f"plot_phase_diagram: the sweep also varies {', '.join(keys)}, whose points share (x, y); a panel per"
+            f" value needs a figure of its own: give no ax, or {pick}"
+        )
+    if len(groups) > MAX_PANELS:
+        raise ParameterError(
+            f"the sweep also varies {', '.join(keys)} ({len(groups)} combinations of values, more than"
+            f" {MAX_PANELS} panels), whose points would cover each other at the same ({x}, {y}); {pick}"
+        )
+    return groups
+
+
+def _values_text(values: Mapping[str, float], dimensions: Mapping[str, str]) -> str:
+    """``mu0 = 0.4, pulling_velocity = 300 µm/s``: values in their display units."""
+    parts = []
+    for key, value in values.items():
+        dimension = dimensions[key]
+        unit = DISPLAY.get(dimension, (1.0, DIMENSIONS[dimension][1]))[1]
+        shown = _scaled(np.array([value]), dimension)[0]
+        parts.append(f"{key} = {shown:.4g}{' ' + unit if unit else ''}")
+    return ", ".join(parts)
+
+
+def _norm(values: np.ndarray) -> Any:
+    from matplotlib.colors import LogNorm, Normalize
+
+    finite = values[np.isfinite(values)]
+    if not finite.size:
+        return Normalize()
+    low, high = float(finite.min()), float(finite.max())
+    return LogNorm(low, high) if _spans_decades(finite) else Normalize(low, high)
+
+
+def _draw_panel(
+    ax: Axes,
+    frame: Any,
+    spec: Any,
+    model: Any,
+    dimensions: Mapping[str, str],
+    keys: tuple[str, str],
+    color: str,
+    logs: tuple[bool, bool],
+    palette: list[tuple[str, str]] | None,
+    norm: Any,
+    failures: str,
+) -> Any:
+    """One panel: the rows' points or cells, failed points, the model's boundary; returns the colour scale's
+    mappable (None for categories)."""
+    x, y = keys
     ok = frame[frame["status"] == "ok"]
     xs, ys = (_scaled(ok[k].to_numpy(dtype=float), dimensions[k]) for k in (x, y))
     cells = _is_full_grid(xs, ys)
-    logs = (_log_axis(spec, x, xs), _log_axis(spec, y, ys))
-    if color == "regime" or ok[color].dtype == object or str(ok[color].dtype) in ("str", "string"):
-        _draw_categories(ax, xs, ys, ok[color].astype(str).to_numpy(), cells, logs)
+    mappable = None
+    if palette is not None:
+        _draw_categories(ax, xs, ys, ok[color].astype(str).to_numpy(), cells, logs, palette)
     else:
-        _draw_numbers(ax, xs, ys, ok[color].to_numpy(dtype=float), color, cells, logs)
+        mappable = _draw_numbers(ax, xs, ys, ok[color].to_numpy(dtype=float), cells, logs, norm)
     failed = frame[frame["status"] != "ok"]
     if len(failed):
         ax.scatter(
             _scaled(failed[x].to_numpy(dtype=float), dimensions[x]),
             _scaled(failed[y].to_numpy(dtype=float), dimensions[y]),
-            marker="x", color="#555555", s=18, label=f"failed ({len(failed)})",
+            marker="x", color="#555555", s=18, label=failures,
         )  # fmt: skip
     for boundary in model.boundaries(spec, ok, x, y):
         bx, by = _scaled(boundary.x, dimensions[x]), _scaled(boundary.y, dimensions[y])
@@ -138,14 +338,7 @@ def plot_phase_diagram(
             ax.axhline(by[0], **line)
         else:
             ax.plot(bx, by, marker="" if len(bx) > 12 else ".", **line)
-    for setter, key, values in ((ax.set_xscale, x, xs), (ax.set_yscale, y, ys)):
-        if _log_axis(spec, key, values):
-            setter("log")
-    ax.set_xlabel(_label(x, dimensions[x]))
-    ax.set_ylabel(_label(y, dimensions[y]))
-    ax.set_title(f"{spec.label or spec.model}: {color} ({spec.model} model, {len(frame)} points)", fontsize=10)
-    ax.legend(loc="best", fontsize=8, framealpha=0.85)
-    return ax
+    return mappable
 
 
 def _scaled(values: np.ndarray, dimension: str) -> np.ndarray:
@@ -216,37 +409,40 @@ def _cells(
 
 
 def _draw_categories(
-    ax: Axes, xs: np.ndarray, ys: np.ndarray, labels: np.ndarray, cells: bool, logs: tuple[bool, bool]
+    ax: Axes,
+    xs: np.ndarray,
+    ys: np.ndarray,
+    labels: np.ndarray,
+    cells: bool,
+    logs: tuple[bool, bool],
+    palette: list[tuple[str, str]],
 ) -> None:
     from matplotlib.colors import ListedColormap
 
-    names, colors = (list(column) for column in zip(*_regime_colors(labels), strict=True))
+    names, colors = (list(column) for column in zip(*palette, strict=True))
+    present = set(labels.tolist())
     codes = np.array([names.index(label) for label in labels], dtype=float)
     if cells:
         ex, ey, grid = _cells(xs, ys, codes, logs)
         ax.pcolormesh(ex, ey, np.ma.masked_invalid(grid), cmap=ListedColormap(colors), vmin=-0.5, vmax=len(names) - 0.5)
         for n, c in zip(names, colors, strict=True):  # legend entries for the cells
-            ax.scatter([], [], marker="s", color=c, label=n)
+            if n in present:
+                ax.scatter([], [], marker="s", color=c, label=n)
         return
     for name, c in zip(names, colors, strict=True):
         mask = labels == name
-        ax.scatter(xs[mask], ys[mask], s=14, color=c, label=name, edgecolors="none")
+        if mask.any():
+            ax.scatter(xs[mask], ys[mask], s=14, color=c, label=name, edgecolors="none")
 
 
 def _draw_numbers(
-    ax: Axes, xs: np.ndarray, ys: np.ndarray, values: np.ndarray, name: str, cells: bool, logs: tuple[bool, bool]
-) -> None:
-    from matplotlib.colors import LogNorm, Normalize
-
-    finite = values[np.isfinite(values)]
-    norm: Any = LogNorm() if _spans_decades(finite) else Normalize()
+    ax: Axes, xs: np.ndarray, ys: np.ndarray, values: np.ndarray, cells: bool, logs: tuple[bool, bool], norm: Any
+) -> Any:
+    """Numbers on the colour scale ``norm`` (shared by every panel); returns the mappable for the colour bar."""
     if cells:
         ex, ey, grid = _cells(xs, ys, values, logs)
-        mappable = ax.pcolormesh(ex, ey, np.ma.masked_invalid(grid), cmap="viridis", norm=norm)
-    else:
-        mappable = ax.scatter(xs, ys, c=values, s=14, cmap="viridis", norm=norm, plotnonfinite=False)
-    unit = RESULT_UNITS.get(name, "")
-    ax.figure.colorbar(mappable, ax=ax, label=f"{name} ({unit}); blank: none" if unit else f"{name}; blank: none")
+        return ax.pcolormesh(ex, ey, np.ma.masked_invalid(grid), cmap="viridis", norm=norm)
+    return ax.scatter(xs, ys, c=values, s=14, cmap="viridis", norm=norm, plotnonfinite=False)
 
 
 # --------------------------------------------------------------------------- one key
