@@ -92,6 +92,11 @@ CORRECTION_SERIES = 1e-3
 ) = range(16)
 # integer status returned by advance()
 DONE, FULL, STEPS, STICK, FAILED = 0, 1, 2, 3, 4
+#: advance's running totals at the start of a run (its docstring names them): the extremes since the last row
+#: start empty
+ACC_START = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, math.inf, -math.inf, math.nan, math.nan, -math.inf)
+#: the columns of advance's rows (:func:`_write_row`)
+ROW_COLUMNS = 17
 #: half-distance of the two Gauss-Legendre points from the middle of a step, as a fraction of the step
 GAUSS = 0.5 / math.sqrt(3.0)
 #: a stick is taken within this share of rtol x sigma past the slider's crossing of the stick velocity
@@ -1136,7 +1141,8 @@ def _book_step(  # type: ignore[no-untyped-def]
 ):  # fmt: skip
     """The accepted step's totals into ``acc`` (``n``: the cohorts with the two newborns, last): born, broken, the
     puller's work and the integral of sigma (the end-corrected trapezoid, dsigma/dt = K (Vp - V) through the
-    massless block, else k_int V - sum r w f), dissipation, steps, the lowest stress."""
+    massless block, else k_int V - sum r w f), dissipation, steps, the lowest and highest stress (and when), the
+    fastest slider."""
     m = p[P_M]
     dlm = p[P_DLM]
     broken += born - born_alive
@@ -1163,7 +1169,15 @@ def _book_step(  # type: ignore[no-untyped-def]
     if inertial:  # the damping's share, eta V^2 over the step
         acc[3] += 0.5 * hh * p[P_DAMPING] * (v0 * v0 + v1 * v1)
     acc[4] += 1.0
-    acc[7] = min(acc[7], s1)  # the lowest stress of the accepted steps since the last row
+    # the extremes of the accepted steps since the last row, with their times: a summary read from sampled rows
+    # (--every) takes them from here, not from the rows kept
+    if s1 < acc[7]:
+        acc[9] = t1
+    acc[7] = min(acc[7], s1)
+    if s1 > acc[8]:
+        acc[8] = s1
+        acc[10] = t1
+    acc[11] = max(acc[11], v1)
 
 
 def _quiet_neighbours(rate_i, rate_g, xb_i, xb_g, tb_i, tb_g, quiet, gap, age_gap, p):  # type: ignore[no-untyped-def]
@@ -1266,7 +1280,8 @@ def _housekeeping(
 
 def _write_row(out, row, t, x, v, nn, ss, uu, puller0, vp, t0, block, acc):  # type: ignore[no-untyped-def]
     """One row of the trace: (time, sigma, N, V, X, P, born, broken, work, dissipation, bond energy, integral of
-    sigma dt, lowest stress since the last row; that lowest then reset)."""
+    sigma dt, lowest and highest stress since the last row, their times, the fastest slider since the last row;
+    those extremes then reset).  An extreme's time is the row's own unless a step before it went beyond the row."""
     out[row, 0] = t
     out[row, 1] = ss
     out[row, 2] = nn
@@ -1280,7 +1295,15 @@ def _write_row(out, row, t, x, v, nn, ss, uu, puller0, vp, t0, block, acc):  # t
     out[row, 10] = uu
     out[row, 11] = acc[6]
     out[row, 12] = min(acc[7], ss)
+    out[row, 13] = max(acc[8], ss)
+    out[row, 14] = acc[9] if acc[7] < ss else t
+    out[row, 15] = acc[10] if acc[8] > ss else t
+    out[row, 16] = max(acc[11], v)
     acc[7] = np.inf
+    acc[8] = -np.inf
+    acc[9] = np.nan
+    acc[10] = np.nan
+    acc[11] = -np.inf
 
 
 def advance(  # type: ignore[no-untyped-def]
@@ -1297,10 +1320,11 @@ def advance(  # type: ignore[no-untyped-def]
     step (:func:`_next_step`) and a row (:func:`_write_row`).
 
     ``acc`` accumulates [born, broken, puller work, dissipation, steps, rejected, integral of sigma dt, lowest
-    sigma since the last row].  Rows are written to ``out`` every accepted step when ``sample_times`` is empty,
-    else only at those times (the steps land on them exactly).  ``t0``: the start of the protocol's piece
-    (puller0 is the puller there; bonds born before it were born at other steps).  ``block``: 1 for block control
-    (vp is the puller's velocity), 0 for velocity control (v = vp).
+    and highest sigma since the last row, the times of those two, the fastest V since the last row]
+    (:data:`ACC_START`).  Rows (:data:`ROW_COLUMNS`) are written to ``out`` every accepted step when
+    ``sample_times`` is empty, else only at those times (the steps land on them exactly).  ``t0``: the start of
+    the protocol's piece (puller0 is the puller there; bonds born before it were born at other steps).  ``block``:
+    1 for block control (vp is the puller's velocity), 0 for velocity control (v = vp).
     """
     rows = 0
     steps = 0

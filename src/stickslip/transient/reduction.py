@@ -347,7 +347,7 @@ def glide(
     t_stop = float(sol.t[-1])
     done = sol.status == 0 and t_stop >= t_end
     # rows at the ODE's own steps, and at least ROWS over the stretch (a plot of the trace); the summaries come
-    # from the solution (the integral of sigma dt, the lowest stress of the steps), not from the rows
+    # from the solution (the integral of sigma dt, the extremes of the steps), not from the rows
     times = np.unique(np.r_[sol.t, np.linspace(t, t_stop, ROWS)])
     if sample_times.size:
         inside = (sample_times > t) & (sample_times <= t_stop + 1e-12 * max(t_stop, 1.0))
@@ -373,11 +373,12 @@ def glide(
     work = acc[2] + y[2]
     dissipation = acc[3] + y[3] - (uu - energy)
     impulse, impulse_end = _stress_integral(sol, m, vp, k_block, block, (lo, hi), t, t_stop, times)
-    inner = sol.t[(sol.t > t) & (sol.t <= t_stop)]
-    v_inner = np.clip(sol.y[0][(sol.t > t) & (sol.t <= t_stop)], lo, hi)
+    stepped = (sol.t > t) & (sol.t <= t_stop)
+    inner = sol.t[stepped]
+    v_inner = np.clip(sol.y[0][stepped], lo, hi)
     sigma_inner = _effective_stress(m, v_inner, vp, k_block) if block else m.stress(np.log(v_inner))
-    lowest = _lowest_per_row(sigma, times, inner, sigma_inner, acc)
-    rows = np.c_[times, sigma, nn, vel, pos, pull, born, broken, work, dissipation, uu, acc[6] + impulse, lowest]
+    extremes = _extremes_per_row(sigma, vel, times, inner, sigma_inner, sol.y[0][stepped], acc)
+    rows = np.c_[times, sigma, nn, vel, pos, pull, born, broken, work, dissipation, uu, acc[6] + impulse, extremes]
     end = sol.sol(t_stop)
     v_end = float(end[0])
     sigma_end = effective(m, v_end, vp, k_block)[0] if block else float(m.stress(math.log(v_end)))
@@ -392,20 +393,38 @@ def glide(
     return Glide(t_stop, v_end, sigma_end, rows, done, sample_index, nn_end, u_end)
 
 
-def _lowest_per_row(sigma, times, inner, sigma_inner, acc):  # type: ignore[no-untyped-def]
-    """The lowest stress of the ODE's accepted steps closed by each row (the solver's own states, not the rows);
-    the steps after the last row are left in acc[7] for the next row."""
-    lowest = np.array(sigma, dtype=float)
+def _extremes_per_row(sigma, vel, times, inner, sigma_inner, v_inner, acc):  # type: ignore[no-untyped-def]
+    """The extremes of the ODE's accepted steps closed by each row (the solver's own states, not the rows), as
+    kernel._write_row writes them: columns lowest, highest stress, their times (the row's own unless a step went
+    beyond it), fastest V; the steps after the last row are left in acc[7:12] for the next row."""
     closing = np.searchsorted(times, inner, side="left")
     ahead = closing < times.size
+    lowest = np.array(sigma, dtype=float)
     np.minimum.at(lowest, closing[ahead], sigma_inner[ahead])
-    rest = float(np.min(sigma_inner[~ahead], initial=np.inf))
+    highest = np.array(sigma, dtype=float)
+    np.maximum.at(highest, closing[ahead], sigma_inner[ahead])
+    fastest = np.array(vel, dtype=float)
+    np.maximum.at(fastest, closing[ahead], v_inner[ahead])
+    t_low, t_high = np.array(times, dtype=float), np.array(times, dtype=float)
+    # each extreme's step (the earliest on a tie), where it is beyond the row's own stress
     if times.size:
-        lowest[0] = min(lowest[0], acc[7])
-        acc[7] = rest
-    else:
-        acc[7] = min(acc[7], rest)
-    return lowest
+        row = np.minimum(closing, times.size - 1)
+        for value, when, sign in ((lowest, t_low, -1.0), (highest, t_high, 1.0)):
+            beyond = ahead & (sigma_inner == value[row]) & (sign * sigma_inner > sign * np.asarray(sigma)[row])
+            found, first = np.unique(closing[beyond], return_index=True)
+            when[found] = inner[beyond][first]
+        carried = [acc[7] < lowest[0], acc[8] > highest[0]]
+        lowest[0], highest[0], fastest[0] = min(lowest[0], acc[7]), max(highest[0], acc[8]), max(fastest[0], acc[11])
+        t_low[0] = acc[9] if carried[0] else t_low[0]
+        t_high[0] = acc[10] if carried[1] else t_high[0]
+        acc[7:12] = (np.inf, -np.inf, np.nan, np.nan, -np.inf)
+    for k in np.flatnonzero(~ahead):  # the steps after the last row: the next row's
+        if sigma_inner[k] < acc[7]:
+            acc[7], acc[9] = sigma_inner[k], inner[k]
+        if sigma_inner[k] > acc[8]:
+            acc[8], acc[10] = sigma_inner[k], inner[k]
+        acc[11] = max(acc[11], v_inner[k])
+    return np.c_[lowest, highest, t_low, t_high, fastest]
 
 
 def _stress_integral(sol, m, vp, k_block, block, bounds, t, t_stop, times):  # type: ignore[no-untyped-def]
@@ -518,7 +537,9 @@ def steady_glide(
     rows = np.c_[
         times, stress, n_ss * one, velocity, pos, pull, acc[0] + birth * dt, acc[1] + birth * dt - (n_ss - bonded),
         acc[2] + work, acc[3] + dissipation, energy * one, acc[6] + impulse,
-        _lowest_per_row(stress, times, np.r_[times, t_end], np.r_[stress, end[0]], acc),
+        _extremes_per_row(
+            stress, velocity, times, np.r_[times, t_end], np.r_[stress, end[0]], np.r_[velocity, end[1]], acc
+        ),
     ]  # fmt: skip
     acc[0] += birth * (t_end - t)
     acc[1] += birth * (t_end - t) - (n_ss - bonded)

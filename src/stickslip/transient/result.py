@@ -73,6 +73,13 @@ class TransientResult:
     rejected: int = 0
     #: the lowest stress of the solver's accepted states since the previous row (Pa): troughs from the solution
     lowest_stress: np.ndarray | None = field(default=None, repr=False)
+    #: the highest stress of those states (Pa), the times of the lowest and the highest (s; the row's own unless a
+    #: state between the rows went beyond it) and the fastest slider among them (m/s): a summary read from rows
+    #: sampled by ``every`` takes its extremes from these, not from the rows kept
+    highest_stress: np.ndarray | None = field(default=None, repr=False)
+    lowest_time: np.ndarray | None = field(default=None, repr=False)
+    highest_time: np.ndarray | None = field(default=None, repr=False)
+    fastest_velocity: np.ndarray | None = field(default=None, repr=False)
     #: the block's mass (kg/m^2) and viscous damping (Pa s/m); 0: the paper's massless block
     mass: float = 0.0
     damping: float = 0.0

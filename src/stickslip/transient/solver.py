@@ -74,8 +74,8 @@ class _State:
     xb: np.ndarray
     tb: np.ndarray
     lw: np.ndarray
-    # kernel.advance's running totals: ..., the integral of sigma dt, the lowest sigma since the last row
-    acc: np.ndarray = field(default_factory=lambda: np.r_[np.zeros(7), np.inf])
+    # kernel.advance's running totals: ..., the integral of sigma dt, the extremes since the last row (K.ACC_START)
+    acc: np.ndarray = field(default_factory=lambda: np.array(K.ACC_START))
 
     def grow(self) -> None:
         size = 2 * self.xb.size
@@ -291,7 +291,7 @@ class _Driver:
         self.chain_state = {"elapsed": 0.0, "fraction": 1.0}
         self.chains_ahead: tuple[tuple[float, float] | None, bool] = (None, False)  # set by each stuck stretch
         self.snap_index = 0
-        self.out = np.empty((CHUNK, 13))
+        self.out = np.empty((CHUNK, K.ROW_COLUMNS))
         self.repeater: _Repeater | None = None
 
     def start(
@@ -406,13 +406,19 @@ class _Driver:
             grid = times[inside]
             if grid.size:
                 rows.append(_stuck_rows(state, vp, k_block, grid, np.interp(grid - state.t, res.times, res.fractions)))
-            # sigma rises while stuck: the stretch's lowest is its start, in its first row
-            start_sigma = min(state.acc[7], k_block * (state.puller - state.x))
-            state.acc[7] = np.inf if grid.size else start_sigma
+            # sigma rises while stuck: the stretch's lowest is its start, in its first row, and its highest its end,
+            # left for the next row where no grid point closes the stretch (the chains' collapse: the slip's σs)
+            if not grid.size:
+                _extremes_at(state.acc, state.t, k_block * (state.puller - state.x))
+            else:
+                _extremes_reset(state.acc)
+            end_sigma = k_block * (state.puller + vp * res.duration - state.x)
+            if not (grid.size and grid[-1] >= t_new) and end_sigma > state.acc[8]:
+                state.acc[8], state.acc[10] = end_sigma, t_new
             self.sample_index = max(self.sample_index, int(np.searchsorted(times, t_new, side="right")))
         elif res.times.size > 1:
             rows.append(_stuck_rows(state, vp, k_block, state.t + res.times[1:], res.fractions[1:]))
-            state.acc[7] = np.inf
+            _extremes_reset(state.acc)
         state.acc[6] += _stuck_impulse(state, vp, k_block, res.duration)
         state.puller += vp * res.duration
         state.t = t_new
@@ -513,7 +519,7 @@ class _Driver:
         acc = state.acc
         acc[1] += found.broken_share * self.params.bonds.site_density
         acc[3] += dissipated
-        acc[7] = min(acc[7], found.stress_after)
+        _extremes_at(acc, state.t, found.stress_after)
         acc[4] += 1.0  # a step, so that the step budget bounds a run that jumps again and again
         state.h = self.params.bonds.bond_time * 1e-3
         self.jumps.append(found)
@@ -604,7 +610,7 @@ class _Repeater:
         gained = {index: acc_c[index] - acc_b[index] for _, index in self.TOTALS}  # acc[7], the lowest, may be inf
         for j in range(1, periods + 1):
             copied = rows.copy()
-            copied[:, 0] += j * period
+            copied[:, [0, 16, 17]] += j * period  # the time, and those of the row's extremes
             copied[:, 4:6] += j * travel
             for column, index in self.TOTALS:
                 copied[:, column] += j * gained[index]
@@ -966,12 +972,37 @@ def _row(state: _State, params: Parameters, control: str, k_block: float, mass: 
     y = pop.extension / b.max_extension
     energy = float(pop.weight @ (-0.5 * b.chain_stiffness * b.max_extension**2 * np.log1p(-y * y)))
     acc = state.acc
-    lowest = min(acc[7], sigma)
-    acc[7] = np.inf  # this row closes the stretch of steps it summarises
+    extremes = _closing_extremes(acc, state.t, sigma, state.v)
+    _extremes_reset(acc)  # this row closes the stretch of steps it summarises
     return np.array(
         [state.t, sigma, pop.bonded, state.v, state.x, state.puller, acc[0], acc[1], acc[2], acc[3], energy,
-         block_energy, np.nan, acc[6], lowest]
+         block_energy, np.nan, acc[6], *extremes]
     )  # fmt: skip
+
+
+def _closing_extremes(acc: np.ndarray, t: float, sigma: float, v: float) -> tuple[float, float, float, float, float]:
+    """(lowest, highest stress, lowest's time, highest's time, fastest V) of a row at (t, sigma, v) closing the
+    steps in ``acc`` (as kernel._write_row: the row's own time unless a step went beyond the row)."""
+    return (
+        min(acc[7], sigma),
+        max(acc[8], sigma),
+        acc[9] if acc[7] < sigma else t,
+        acc[10] if acc[8] > sigma else t,
+        max(acc[11], v),
+    )
+
+
+def _extremes_reset(acc: np.ndarray) -> None:
+    """No step since the last row (kernel.ACC_START's extremes)."""
+    acc[7:12] = K.ACC_START[7:12]
+
+
+def _extremes_at(acc: np.ndarray, t: float, sigma: float) -> None:
+    """A state at (t, sigma) between rows into the extremes since the last row (the earlier time on a tie)."""
+    if sigma < acc[7]:
+        acc[7], acc[9] = sigma, t
+    if sigma > acc[8]:
+        acc[8], acc[10] = sigma, t
 
 
 def _stuck_rows(state: _State, vp: float, k_block: float, t: np.ndarray, fraction: np.ndarray) -> np.ndarray:
@@ -982,11 +1013,18 @@ def _stuck_rows(state: _State, vp: float, k_block: float, t: np.ndarray, fractio
     puller = state.puller + vp * dt
     sigma = k_block * (puller - state.x)
     acc = state.acc
-    rows = np.full((t.size, 15), np.nan)
+    rows = np.full((t.size, 19), np.nan)
     rows[:, 0], rows[:, 1], rows[:, 3], rows[:, 4], rows[:, 5] = t, sigma, 0.0, state.x, puller
     rows[:, 6], rows[:, 7], rows[:, 11], rows[:, 12] = acc[0], acc[1], sigma * sigma / (2 * k_block), fraction
     rows[:, 13] = acc[6] + _stuck_impulse(state, vp, k_block, dt)
-    rows[:, 14] = np.minimum(min(acc[7], k_block * (state.puller - state.x)), sigma)
+    start = k_block * (state.puller - state.x)
+    rows[:, 14] = np.minimum(min(acc[7], start), sigma)
+    # each row's highest is its own stress (sigma rises), the first's also the steps before the stretch
+    rows[:, 15], rows[:, 17], rows[:, 18] = sigma, t, 0.0
+    if acc[8] > sigma[0]:
+        rows[0, 15], rows[0, 17] = acc[8], acc[10]
+    rows[0, 18] = max(acc[11], 0.0)
+    rows[:, 16] = np.where(rows[:, 14] < sigma, acc[9] if acc[7] < start else state.t, t)
     return rows
 
 
@@ -1000,8 +1038,8 @@ def _kernel_rows(block: np.ndarray, k_block: float, control: str, mass: float = 
     block_energy = sigma**2 / (2 * k_block) if control == "block" else np.zeros_like(sigma)
     if mass > 0:  # sigma is the interface's: the spring's stretch P - X, and the kinetic energy
         block_energy = 0.5 * k_block * (block[:, 5] - block[:, 4]) ** 2 + 0.5 * mass * block[:, 3] ** 2
-    full = np.empty((sigma.size, 15))  # (np.c_ took ~80 us a call, ~2 ms of the paper's cycle)
-    full[:, :11], full[:, 11], full[:, 12], full[:, 13:] = block[:, :11], block_energy, np.nan, block[:, 11:13]
+    full = np.empty((sigma.size, 19))  # (np.c_ took ~80 us a call, ~2 ms of the paper's cycle)
+    full[:, :11], full[:, 11], full[:, 12], full[:, 13:] = block[:, :11], block_energy, np.nan, block[:, 11:]
     return [full]
 
 
@@ -1012,7 +1050,7 @@ def _snapshot(state: _State) -> Snapshot:
 
 def _finish(d: _Driver, snapshots: list[Snapshot], stop: str | None, note: str) -> TransientResult:
     """The result of run ``d`` so far: its rows sorted by time, cycles and regime (``stop``: why it ended early)."""
-    from .cycles import detect_cycles, judge
+    from .cycles import Between, detect_cycles, judge
 
     params, protocol, control, k_block, mass, events = d.params, d.protocol, d.control, d.k_block, d.mass, d.events
     table = np.vstack([np.atleast_2d(r) for r in d.rows])
@@ -1026,10 +1064,14 @@ def _finish(d: _Driver, snapshots: list[Snapshot], stop: str | None, note: str) 
     bonded = np.where(np.isnan(bonded), 0.0, bonded)  # the bonds of Eq 1 are set aside while the chains hold
     # the slopes K (Vp - V) of sigma place each peak between rows: a massless block's spring carries sigma
     slope = k_block if control == "block" and mass == 0 else None
-    cycles = detect_cycles(time, sigma, v, protocol, events, lowest=table[:, 14], stiffness=slope)
+    # each row's extremes of the solver's steps since the row before (lowest, highest, their times, fastest V):
+    # the summary's, whatever rows ``every`` kept
+    between = Between(*(table[:, k] for k in range(14, 19)))
+    cycles = detect_cycles(time, sigma, v, protocol, events, lowest=table[:, 14], stiffness=slope, between=between)
     regime, message, evidence = judge(
-        time, sigma, v, protocol, cycles, events, control, stop, resolution=d.rtol, lowest=table[:, 14]
-    )
+        time, sigma, v, protocol, cycles, events, control, stop, resolution=d.rtol, lowest=table[:, 14],
+        between=between,
+    )  # fmt: skip
     regime, message = _chains_ahead(d, regime, message, time, sigma)
     message = message + note
     saturating = params.aging.saturation_age is not None  # the extension lets go: its stuck is its own answer
@@ -1063,6 +1105,10 @@ def _finish(d: _Driver, snapshots: list[Snapshot], stop: str | None, note: str) 
         steps=int(d.state.acc[4]),
         rejected=int(d.state.acc[5]),
         lowest_stress=lowest,
+        highest_stress=table[:, 15],
+        lowest_time=table[:, 16],
+        highest_time=table[:, 17],
+        fastest_velocity=table[:, 18],
         mass=mass,
         damping=d.damping,
         evidence=evidence,
