@@ -93,3 +93,14 @@ def test_run_json_gives_no_unit_for_a_word(capsys):
     document = json.loads(out)
     assert document["model"] == "quasi-static" and "model" not in document["units"]
     assert document["units"]["mean_stress"] == "Pa"
+
+
+def test_a_hold_under_velocity_control_is_held_by_the_protocol_not_the_chains(capsys):  # type: ignore[no-untyped-def]
+    """A slide-hold without the stick chains said "the stick chains hold it" and advised adding them."""
+    code, out, err = run_main(
+        capsys, "transient", "--control", "velocity", "--start", "steady", "--v0", "100 um/s", "--duration", "5 ms",
+        "--segment", "0:0.1 s",
+    )  # fmt: skip
+    assert code == 0, err
+    assert "held at rest by the protocol" in out
+    assert "stick chains" not in out

@@ -299,7 +299,8 @@ def judge(
         found = _solution_extremes(
             regimes.classify(time, stress, floor=floor, start=start, unit="Pa"), time, stress, between, start
         )
-    return (*_words(found, time, stress, velocity, protocol, cycles, control, resolution, scale), found)
+    chains = any(kind == "stick" for kind, *_ in events)
+    return (*_words(found, time, stress, velocity, protocol, cycles, control, resolution, scale, chains), found)
 
 
 def _solution_extremes(
@@ -341,8 +342,10 @@ def _words(
     control: str,
     resolution: float | None,
     scale: float,
+    chains: bool = False,
 ) -> tuple[str, str]:
-    """(regime, message) of the run from the classifier's ``found`` and the slider's motion at the end."""
+    """(regime, message) of the run from the classifier's ``found`` and the slider's motion at the end
+    (``chains``: the stick chains took the load in this run)."""
     stuck = stuck_mask(time, velocity, protocol)
     vp = protocol.segments[-1].velocity
     whole = [c for c in cycles if c.period is not None]
@@ -369,11 +372,12 @@ def _words(
         return found.kind, found.evidence
     if stuck[-1] and found.periods == 0 and time.size > 1:
         slipped = f" after {len(cycles)} slip(s)" if cycles else ""
-        motion = (
-            "is at rest (the stick chains hold it)"
-            if velocity[-1] == 0.0
-            else f"creeps at {velocity[-1] * 1e9:.3g} nm/s"
-        )
+        if velocity[-1] != 0.0:
+            motion = f"creeps at {velocity[-1] * 1e9:.3g} nm/s"
+        elif control == "velocity":
+            motion = "is held at rest by the protocol (V = 0 under velocity control)"
+        else:
+            motion = f"is at rest (the {'stick chains' if chains else 'bonds of Eq 1'} hold it)"
         return (
             regimes.STUCK,
             f"stuck{slipped}: at t = {time[-1]:.6g} s the slider {motion} under σ = {stress[-1]:.6g} Pa",

@@ -1075,7 +1075,13 @@ def _finish(d: _Driver, snapshots: list[Snapshot], stop: str | None, note: str) 
     regime, message = _chains_ahead(d, regime, message, time, sigma)
     message = message + note
     saturating = params.aging.saturation_age is not None  # the extension lets go: its stuck is its own answer
-    if regime == "stuck" and not cycles and not any(kind == "stick" for kind, *_ in events) and not saturating:
+    held = control == "velocity"  # a rig holds the slider: the chains would change nothing there
+    if (
+        regime == "stuck"
+        and not cycles
+        and not any(kind == "stick" for kind, *_ in events)
+        and not (saturating or held)
+    ):
         message += (
             "; one population of Eq 1 never lets go: its aging term makes a resting bond unbreakable within"
             " milliseconds (docs/transient.md section 7); stick_population=True (--stick-population) adds the"
