@@ -29,7 +29,7 @@ SHORT = constant(350e-6, 0.01)
         (lambda: run_transient(GEL, SHORT, stick_population="yes"), ParameterError, "stick_population"),
         (lambda: run_transient(GEL, SHORT, max_step=0), ParameterError, "max_step"),
         (lambda: run_transient(GEL, SHORT, max_step=1e-300), ParameterError, "budget"),
-        (lambda: run_transient(GEL, SHORT, every=1e-300), ParameterError, "budget"),
+        (lambda: run_transient(GEL, SHORT, every=1e-300), ParameterError, "rows over"),  # more rows than memory holds
         (lambda: run_transient(GEL, SHORT, max_steps=0), ParameterError, "max_steps"),
         (lambda: run_transient(GEL, SHORT, start="steady", start_velocity=float("nan")), ParameterError, "finite"),
         # 11 days of stick-slip (65 000 cycles of the quasi-static model, ~2.6e8 steps); a block stuck for good takes
@@ -225,7 +225,7 @@ CLI_BASE = ("transient", "--v0", "50 um/s", "--duration", "1 s")
         ((*CLI_BASE, "--set", "bonds.bond_time=1e-300 s"), "precision"),
         ((*CLI_BASE, "--set", "bonds.activation_length=0", "--start", "steady"), "activation_length"),
         (("transient", "--v0", "350 um/s", "--duration", "1 s", "--set", "bonds.activation_length=0"), "diverges"),
-        ((*CLI_BASE, "--every", "1e-300 s"), "budget"),
+        ((*CLI_BASE, "--every", "1e-300 s"), "rows over"),
         ((*CLI_BASE, "--max-steps", "10"), "budget of 10 steps"),
         ((*CLI_BASE, "-o", "/nonexistent/x.csv"), "does not exist"),
         ((*CLI_BASE, "-o", ""), "file name"),

@@ -257,6 +257,11 @@ def _checked_arguments(  # type: ignore[no-untyped-def]
     duration = protocol.duration
     if every is not None and not (isinstance(every, (int, float)) and math.isfinite(every) and 0 < every <= duration):
         raise ParameterError(f"every: expected a positive time no longer than the run ({duration:g} s), got {every!r}")
+    if every is not None and duration / every > MAX_SAMPLES:
+        raise ParameterError(
+            f"every: {every:g} s gives {duration / every:.3g} rows over {duration:g} s; expected at most"
+            f" {MAX_SAMPLES:.0e} (each row holds ~{SAMPLE_BYTES} bytes until the trace is written: sample less often)"
+        )
     if max_step is not None and not (isinstance(max_step, (int, float)) and math.isfinite(max_step) and max_step > 0):
         raise ParameterError(f"max_step: expected a positive time in s, got {max_step!r}")
     if start_velocity is not None:
@@ -1277,6 +1282,13 @@ STABLE_SIDE = 1e-3
 STEP_SECONDS = 100e-6
 #: CPU of a row copied from a repeated limit cycle (s; the rows are the run's steps, counted against max_steps)
 ROW_SECONDS = 1e-6
+#: CPU of a sampled row (``every``), written out (s): 100 um/s for 60 s with the chains every 200 us, 3e5 rows,
+#: cost 3.3 s more than unsampled (11 us a row), and ~870 bytes a row; every 20 us (3e6 rows) was estimated at 5 min
+#: (a step's CPU a row) and took 39 s, 2.7 GB
+SAMPLE_SECONDS = 1.1e-5
+SAMPLE_BYTES = 870
+#: the most rows ``every`` may ask for: ~4 GB held until the trace is written
+MAX_SAMPLES = 5_000_000
 SEGMENT_STEPS = 10.0
 #: CPU of a segment's start through the block with the reduction (its look for a stretch; 19 ms measured for
 #: 1000 segments of 1 ms at 350/400 um/s), a tenth of that otherwise
@@ -1436,8 +1448,8 @@ def estimate_cost(
         ringing = math.sqrt((k_block + b.site_density * b.chain_stiffness) / mass) / (2.0 * math.pi)
         steps += RING_STEPS * ringing * sum(min(t1 - t0, RING_WINDOW) for t0, t1, _ in protocol.pieces())
     duration = protocol.duration
-    if every is not None:
-        steps += duration / every
+    samples = 0.0 if every is None else duration / every
+    steps += samples  # a sampling instant may cost a step where the cohorts run (they land on it)
     if max_step is not None:
         steps = max(steps, duration / max_step)
     basis = f"{duration:.3g} s at up to {fastest:.3g} m/s, resolving τ = {b.bond_time:.3g} s"
@@ -1456,7 +1468,8 @@ def estimate_cost(
     moving = len(protocol.segments) - (0 if motion is None else motion.stuck_segments)  # a stuck one looks for none
     per_segment = SEGMENT_SECONDS if (reducing and control == "block") else 0.1 * SEGMENT_SECONDS
     copied = 0.0 if motion is None else min(motion.copied * scale, steps)  # rows of a repeated limit cycle
-    seconds = (steps - copied) * STEP_SECONDS + copied * ROW_SECONDS + moving * per_segment
+    seconds = (steps - copied - samples) * STEP_SECONDS + copied * ROW_SECONDS + samples * SAMPLE_SECONDS
+    seconds += moving * per_segment
     seconds += COHORT_SECONDS * stuck * stuck
     return CostEstimate(steps, basis, seconds)
 
