@@ -232,7 +232,8 @@ class Run:
             "trough_friction": self.trough if self.stress is None else NAN,
             "mean_friction": self.mean if self.stress is None else NAN,
             "growth": self.regime.amplitude_ratio,
-            "cycles": self.regime.periods,
+            # a run that settled (or never moved) had no stick-slip cycles, whatever oscillation decayed on the way
+            "cycles": 0 if self.regime.kind in (regimes.STEADY, regimes.STUCK) else self.regime.periods,
         }
         row: dict[str, Any] = {}
         for name, kind in columns.items():

@@ -19,7 +19,6 @@ from ..models import FrictionModel, Rig, available_models
 from ..models import get_model as find_model
 from ..models.base import Boundary
 from ..models.rsf import ALIASES as RSF_ALIASES
-from ..regimes import STEADY, STUCK
 
 __all__ = [
     "ALIASES",
@@ -38,8 +37,6 @@ PROTOCOL_KEYS = {"pulling_velocity": "velocity"}
 #: Other spellings accepted for keys (the issue's symbols): rate-and-state's own, and V0 for the protocol's.
 ALIASES = {**RSF_ALIASES, "V0": "pulling_velocity"}
 NAN = float("nan")
-#: Regimes with no stick-slip cycles, whatever oscillation the classifier saw decay on the way.
-NO_CYCLES = (STEADY, STUCK)
 
 
 class SweepModel:
@@ -128,13 +125,7 @@ class SweepModel:
         params, velocity, start = self.point(values, settings["duration"])
         protocol = constant(velocity, settings["duration"])
         taken = {k: v for k, v in settings.items() if self.takes(k)}
-        run = self.model.run(params, protocol, self.rig(), start=start, **taken)
-        row = run.row(self.results)
-        if "cycles" in row and "cycles" not in run.summary and run.regime.kind in NO_CYCLES:
-            # the Run's generic count is the periods the classifier saw, which for a run that settled (or never
-            # moved) are the decay's, not stick-slip cycles: the bond models report 0 there, and so must any model
-            row["cycles"] = 0
-        return row
+        return self.model.run(params, protocol, self.rig(), start=start, **taken).row(self.results)
 
     @property
     def estimates_cost(self) -> bool:
