@@ -155,17 +155,23 @@ def _regime(result: Any, protocol: Protocol | None) -> regimes.Regime:
         troughs = [c.start_stress for c in whole[1:]] + [_last_trough(result, whole[-1].start_time)]
         found = regimes.classify_cycles([c.start_time + c.stick_time for c in whole], peaks, troughs)
     else:
-        from ..transient.cycles import Between, _solution_extremes, with_extremes
-
         names = ("lowest_stress", "highest_stress", "lowest_time", "highest_time", "fastest_velocity")
         columns = [getattr(result, name, None) for name in names]
-        # the states between the rows (sampled by ``every``): the tolerance and the extremes are the solution's
-        between = Between(*columns) if all(c is not None for c in columns) else None
-        t_all, s_all = with_extremes(time, stress, between)
-        inside = t_all >= start
-        scale = float(np.max(np.abs(s_all[inside]))) if np.any(inside) else 0.0
-        found = regimes.classify(time, stress, floor=SETTLED * max(scale, 1e-300), start=start, unit="Pa")
-        found = _solution_extremes(found, time, stress, between, start)
+        if all(c is not None for c in columns):
+            # the solver's own result: the states between its rows (sampled by ``every``) give the tolerance and
+            # the extremes (a stand-in solver's result has no such columns, and its package no cycles module)
+            from ..transient.cycles import Between, solution_extremes, with_extremes
+
+            between = Between(*columns)
+            t_all, s_all = with_extremes(time, stress, between)
+            inside = t_all >= start
+            scale = float(np.max(np.abs(s_all[inside]))) if np.any(inside) else 0.0
+            found = regimes.classify(time, stress, floor=SETTLED * max(scale, 1e-300), start=start, unit="Pa")
+            found = solution_extremes(found, time, stress, between, start)
+        else:
+            inside = time >= start
+            scale = float(np.max(np.abs(stress[inside]))) if np.any(inside) else 0.0
+            found = regimes.classify(time, stress, floor=SETTLED * max(scale, 1e-300), start=start, unit="Pa")
     return regimes.Regime(
         str(result.regime), found.periods, found.amplitude_ratio, found.period, found.peak, found.trough, result.message
     )

@@ -296,14 +296,14 @@ def judge(
     floor = SETTLED * max(scale, 1e-300)
     found = _from_events(events, start, time, stress, lowest)
     if found is None:
-        found = _solution_extremes(
+        found = solution_extremes(
             regimes.classify(time, stress, floor=floor, start=start, unit="Pa"), time, stress, between, start
         )
     chains = any(kind == "stick" for kind, *_ in events)
     return (*_words(found, time, stress, velocity, protocol, cycles, control, resolution, scale, chains), found)
 
 
-def _solution_extremes(
+def solution_extremes(
     found: regimes.Regime, time: np.ndarray, stress: np.ndarray, between: Between | None, start: float
 ) -> regimes.Regime:
     """The classifier's verdict on the rows, with the extremes of the solution: over the window (t >= start) when
