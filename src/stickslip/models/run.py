@@ -244,6 +244,7 @@ class Run:
             else:
                 row[name] = None if kind == "str" else 0 if kind == "int" else NAN
         row["message"] = self.message or self.regime.evidence
+        row["status"] = self.status  # a run the model could not finish is "failed", its numbers what it computed
         return row
 
     # ---------------------------------------------------------------- tables and files

@@ -189,13 +189,16 @@ def result_columns(model: SweepModel) -> dict[str, str]:
 
 
 def run_point(model: SweepModel, values: Mapping[str, float], settings: Mapping[str, Any]) -> dict[str, Any]:
-    """One point as a row; a failure is a row with status "error" and the one-line reason, never an exception."""
+    """One point as a row; a failure is a row with status "error" and the one-line reason, never an exception.
+
+    A run the model could not finish (status "failed") keeps what it computed, and its message says where it
+    stopped."""
     import time
 
     start = time.perf_counter()
     try:
         row = model.run(values, settings)
-        row["status"] = "ok"
+        row["status"] = row.get("status") or "ok"
     except Exception as exc:  # any failure of one point is that point's result; the sweep goes on
         row = {name: (None if kind == "str" else 0 if kind == "int" else NAN) for name, kind in model.results.items()}
         kind = "" if isinstance(exc, StickslipError) else f"{type(exc).__name__}: "

@@ -344,7 +344,8 @@ def _manifest(store: SweepStore) -> dict[str, Any]:
         "points": store.spec.size,
         "batch_size": store.batch_size,
         "batches": store.batches,
-        "columns": "point, the varied keys (SI), then the model's results; status is 'ok' or 'error'",
+        "columns": "point, the varied keys (SI), then the model's results; status is 'ok', 'failed' (the model"
+        " stopped short; what it computed) or 'error' (no result)",
         "specification": json.loads(store.spec.to_json()),
     }
 
