@@ -171,3 +171,19 @@ def test_with_aging_a_slow_arrest_takes_the_kernels_root():
     (x0, v0, n0, _, _), (x1, v1, n1, _, _) = outcomes
     assert n0 == n1 == 1 and x1 == x0
     assert v0 < jump.FAST * PARAMS.aging.aging_velocity and v1 == pytest.approx(v0, rel=1e-9)
+
+
+def test_a_cycle_through_a_cascade_has_no_finite_jump_velocity(capsys):
+    """At 1 m/s through the paper's massless block every bond breaks at once at each slip, the spring relaxing in
+    no time: the cycle's jump velocity is not the runaway velocity that set the cascade off (it read 1.6e14 µm/s,
+    the last step before the collapse), but none: inf in the API, null in JSON, "a jump in no time" in words."""
+    code, out, err = run_main(capsys, "transient", "--v0", "1 m/s", "--duration", "5 ms", "--json")
+    assert code == 0, err
+    summary = json.loads(out)
+    assert len(summary["jumps"]) == 1 and summary["jumps"][0]["stress_after"] == 0.0
+    (cycle,) = summary["cycles"]
+    assert cycle["jump_velocity"] is None
+    assert cycle["start_time"] + cycle["stick_time"] == pytest.approx(summary["jumps"][0]["time"], rel=1e-4)
+    code, out, err = run_main(capsys, "transient", "--v0", "1 m/s", "--duration", "5 ms")
+    assert "cycle 1: stick 0.003648 s, σs = 1116.4 Pa, a jump in no time" in out
+    assert "µm/s, slip" not in out.split("cycle 1:")[1]

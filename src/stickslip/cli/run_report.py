@@ -80,6 +80,8 @@ def _simulation_record(sim: Any) -> list[Any]:
 
 def _transient_record(result: Any) -> list[str]:
     """The transient run: where it ended (stress, bonded fraction, velocity, steps) and each stick-slip event."""
+    from ..transient.cycles import describe_jump
+
     lines = [
         f"  at t = {result.time[-1]:.6g} s: σ = {result.final_stress:.6g} Pa,"
         f" N/N0 = {result.final_bonded_fraction:.6g},"
@@ -89,7 +91,7 @@ def _transient_record(result: Any) -> list[str]:
         slip = "—" if c.slip_time is None else f"{c.slip_time:.4g} s"
         lines.append(
             f"  cycle {c.index + 1}: stick {c.stick_time:.4g} s, σs = {c.peak_stress:.5g} Pa,"
-            f" jump to {c.jump_velocity * 1e6:.4g} µm/s, slip {slip}"
+            f" {describe_jump(c.jump_velocity)}, slip {slip}"
         )
     return lines
 

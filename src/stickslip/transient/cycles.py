@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from collections.abc import Sequence
 
 import numpy as np
 
@@ -87,16 +88,25 @@ def detect_cycles(
     lowest: np.ndarray | None = None,
     stiffness: float | None = None,
     between: Between | None = None,
+    jumps: Sequence[float] = (),
 ) -> tuple[Cycle, ...]:
     """A cycle is a stick that ended in a slip; its slip lasts until the next stick (None if the run ends first).
 
     With the stick chains the solver records each stick and slip as an event at its exact time and stress:
     the cycles are read from those, whatever the sampling; otherwise from the trace (:func:`_trace_cycles`).
+    ``jumps``: the instants of the massless block's jumps through rupture cascades (transient/jump.py); a slip
+    that holds one has no finite jump velocity (``inf``: the cascade takes no time, see :func:`describe_jump`).
     """
     from_events = _cycles_from_events(events)
     if from_events:
         return from_events
-    return _trace_cycles(time, stress, velocity, protocol, lowest, stiffness, between)
+    return _trace_cycles(time, stress, velocity, protocol, lowest, stiffness, between, jumps)
+
+
+def describe_jump(velocity: float) -> str:
+    """The jump of a cycle in words: "jump to 711 µm/s", or, for the massless block's jump through a rupture
+    cascade (an infinite jump velocity), "a jump in no time" (the slider's travel is in the run's message)."""
+    return f"jump to {velocity * 1e6:.4g} µm/s" if math.isfinite(velocity) else "a jump in no time"
 
 
 def _pace(time: np.ndarray, protocol: Protocol) -> np.ndarray:
@@ -113,6 +123,7 @@ def _trace_cycles(
     lowest: np.ndarray | None,
     stiffness: float | None,
     between: Between | None = None,
+    jumps: Sequence[float] = (),
 ) -> tuple[Cycle, ...]:
     """The cycles of Eq 1 through the block, read from the solution: a slip is a stretch where the slider outruns
     the puller (the stress falls: dsigma/dt = K (Vp - V)) and reaches :data:`SLIP_FACTOR` x its pace, after a
@@ -123,7 +134,9 @@ def _trace_cycles(
     The trough is the lowest stress of the solver's steps (``lowest``), the peak the maximum of the cubic
     through the two rows around the onset with their slopes K (Vp - V) (``stiffness``; without it, the rows'),
     or, where rows sampled by ``every`` skip the solver's states, the highest of those (``between``, with the
-    lowest's and highest's times): neither depends on the rows kept.  The jump velocity is the fastest state's.
+    lowest's and highest's times): neither depends on the rows kept.  The jump velocity is the fastest state's,
+    or ``inf`` where the slip holds one of ``jumps`` (the massless block's cascade: the runaway that set it off
+    is not a velocity the slider reaches).
     """
     n = time.size
     if n < 3:
@@ -142,6 +155,8 @@ def _trace_cycles(
         if between is not None:  # the states between the rows, to the one back below the puller
             jump = max(jump, float(np.max(between.fastest[a : z + 2])))
         end = z + 1 if z + 1 < n else None  # the row where the slider is back below the puller
+        if any(time[a - 1] <= instant <= time[n - 1 if end is None else end] for instant in jumps):
+            jump = math.inf
         if not (slow <= 1.0 / SLIP_FACTOR and jump >= SLIP_FACTOR * float(np.max(pace[a : z + 1]))):
             if slow > 1.0 / SLIP_FACTOR and end is not None:
                 stick_from = end  # a swing while sliding: a stick, if any, starts after it
@@ -365,7 +380,7 @@ def _words(
             c = whole[-1]
             text += (
                 f"; {len(cycles)} slip(s), the last whole cycle: stick {c.stick_time:.4g} s up to"
-                f" σs = {c.peak_stress:.5g} Pa, jump to {c.jump_velocity * 1e6:.4g} µm/s, slip {c.slip_time:.4g} s"
+                f" σs = {c.peak_stress:.5g} Pa, {describe_jump(c.jump_velocity)}, slip {c.slip_time:.4g} s"
             )
         return regimes.STICK_SLIP, text
     if found.kind in (regimes.DECAYING, regimes.GROWING):

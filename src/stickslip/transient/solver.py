@@ -1072,7 +1072,10 @@ def _finish(d: _Driver, snapshots: list[Snapshot], stop: str | None, note: str) 
     # each row's extremes of the solver's steps since the row before (lowest, highest, their times, fastest V):
     # the summary's, whatever rows ``every`` kept
     between = Between(*(table[:, k] for k in range(14, 19)))
-    cycles = detect_cycles(time, sigma, v, protocol, events, lowest=table[:, 14], stiffness=slope, between=between)
+    cycles = detect_cycles(
+        time, sigma, v, protocol, events, lowest=table[:, 14], stiffness=slope, between=between,
+        jumps=[j.time for j in d.jumps],
+    )  # fmt: skip
     regime, message, evidence = judge(
         time, sigma, v, protocol, cycles, events, control, stop, resolution=d.rtol, lowest=table[:, 14],
         between=between,
