@@ -401,6 +401,11 @@ def test_bad_arrays_are_rejected(params):
         analyze_trace(t, np.r_[x[:-1], np.inf], 50e-6, params)
     with pytest.raises(DataError, match="negative over most of the record"):
         analyze_trace(t, -300.0 + np.sin(t), 50e-6, params)
+    # a unit read wrong, as `fit steady` refuses it (outside 1e-9 ... 1e12 Pa): analysed as stick-slip before
+    with pytest.raises(DataError, match=r"sample 0: stress 4e\+14 Pa is beyond the range of a friction stress"):
+        analyze_trace(t, 4e14 + 1e14 * np.sin(t), 50e-6, params)
+    with pytest.raises(DataError, match=r"every stress is below 1e-09 Pa .* \(largest 4\.9999\d*e-10 Pa\)"):
+        analyze_trace(t, 4e-10 + 1e-10 * np.sin(t), 50e-6, params)
     for v0 in (0.0, -1e-6, math.nan, "fast"):
         with pytest.raises(ParameterError, match="pulling_velocity"):
             analyze_trace(t, x, v0, params)

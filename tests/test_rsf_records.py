@@ -267,6 +267,8 @@ def test_a_velocity_column_steps_at_the_row_that_carries_the_new_velocity():
     found = find_segments(record.time, record.displacement)
     assert found.boundaries == pytest.approx(truth.boundaries, abs=1e-6)
     assert record.length_unit == "um"
+    assert record.displacement_from == "velocity"
+    assert read_record(RECORDS / "biaxial_4level.txt").displacement_from == "displacement"
 
 
 def test_a_fit_of_a_velocity_column_record_covers_dc_and_k():
@@ -276,6 +278,7 @@ def test_a_fit_of_a_velocity_column_record_covers_dc_and_k():
 
     fit = fit_record(read_record(RECORDS / "velocity_column.txt"))
     assert fit.status == "ok"
+    assert fit.protocol_source == "found from the load-point velocity"  # it read "... displacement"
     truth = TRUTH_VELOCITY["params"]
     for key, value in (("a", truth["a"]), ("b", truth["b"]), ("dc", truth["dc"] * UM),
                        ("stiffness", truth["stiffness"] / UM)):  # fmt: skip

@@ -195,6 +195,7 @@ def check_trace(
                 f"{source}: {where} {labels[bad[0]]}: {name} {values[bad[0]]:g} {unit} is beyond"
                 f" {MAX_MAGNITUDE:g} {unit} in magnitude; not a measured record"
             )
+    _require_friction_stress(s, labels, where, source)
     back = np.flatnonzero(t[1:] < t[:-1])
     if back.size:
         k = back[0] + 1
@@ -217,6 +218,27 @@ def check_trace(
     if t[-1] == t[0]:
         raise DataError(f"{source}: every sample is at time {t[0]:g} s; a record must span some time")
     return Trace(time=t, stress=s, rows=np.asarray(labels), source=source)
+
+
+def _require_friction_stress(s: np.ndarray, labels: np.ndarray, where: str, source: str) -> None:
+    """A stress beyond the range of a friction stress that ``fit steady`` checks, or a record whose every stress
+    is below its floor, is a unit read wrong (MPa written as Pa, a force without its area): refused in one line."""
+    from ..fitting.data import STRESS_RANGE
+
+    low, high = STRESS_RANGE
+    beyond = np.flatnonzero(np.abs(s) > high)
+    if beyond.size:
+        k = beyond[0]
+        raise DataError(
+            f"{source}: {where} {labels[k]}: stress {s[k]:g} Pa is beyond the range of a friction stress"
+            f" ({high:g} Pa); check the units in the header"
+        )
+    largest = float(np.nanmax(np.abs(s))) if np.isfinite(s).any() else math.nan
+    if 0.0 < largest < low:
+        raise DataError(
+            f"{source}: every stress is below {low:g} Pa in magnitude (largest {largest:g} Pa), under the range of"
+            " a friction stress; check the units in the header"
+        )
 
 
 def _as_vector(values: Any, name: str, source: str) -> np.ndarray:

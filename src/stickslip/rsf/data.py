@@ -50,6 +50,7 @@ class LabRecord:
     """Time (s, from the record's start), load-point displacement (m), friction; ``t0`` is the original start.
 
     ``length_unit`` is the unit the record's displacement was written in: reports give lengths in it.
+    ``displacement_from``: "displacement", or "velocity" where it was integrated from a velocity column.
     """
 
     time: np.ndarray
@@ -58,6 +59,7 @@ class LabRecord:
     t0: float = 0.0
     source: str = "record"
     length_unit: str = "m"
+    displacement_from: str = "displacement"
 
     def __len__(self) -> int:
         return int(self.time.size)
@@ -184,7 +186,7 @@ def read_record(
     shown_unit = _plain_length(written[1]) if written is not None else "m"
     record = LabRecord.from_arrays(time, displacement, data["friction"], str(path), shown_unit, rows)
     _refuse_implausible_speed(record, str(column), written)
-    return record
+    return record if "displacement" in data else replace(record, displacement_from="velocity")
 
 
 #: a rock or gel friction rig's load point moves at nm/s to mm/s: faster than this (m/s) is a unit read wrong

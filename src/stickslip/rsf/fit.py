@@ -300,7 +300,7 @@ def fit_record(
     if step_weight is not None and not (_real(step_weight) and math.isfinite(step_weight) and step_weight > 0):
         raise ParameterError(f"step_weight: expected a positive weight, got {step_weight!r}")
     weight = None if step_weight is None else float(step_weight)
-    source = "given" if protocol is not None else "found from the load-point displacement"
+    source = "given" if protocol is not None else f"found from the load-point {record.displacement_from}"
     protocol_found = protocol is None
     record, protocol, backwards = _fitted_rows(record, protocol, window)
     if protocol.initial_velocity <= 0:
@@ -510,8 +510,9 @@ def _windowed(record: LabRecord, window: Any) -> LabRecord:
             f"{clock[-1]:g} s); expected at least 10"
         )
     source = f"{record.source} [{lo:g} ... {hi:g} s]"
-    return LabRecord.from_arrays(clock[inside], record.displacement[inside], record.friction[inside], source=source,
+    kept = LabRecord.from_arrays(clock[inside], record.displacement[inside], record.friction[inside], source=source,
                                  length_unit=record.length_unit)  # fmt: skip
+    return replace(kept, displacement_from=record.displacement_from)
 
 
 def _shifted(protocol: Protocol, offset: float) -> Protocol:
