@@ -371,7 +371,7 @@ def test_without_v0_a_trace_with_no_one_pulling_velocity_is_refused_naming_v0(ca
     code, _, err = run_main(capsys, "analyze", str(two))
     assert code == 2 and "--v0: needed: its load point (load_point_position) does not move at one velocity" in err
     plain = tmp_path / "plain.csv"
-    plain.write_text("time,stress\n0,1\n1,2\n2,1\n3,2\n")
+    plain.write_text("time,stress\n" + "".join(f"{k},{1 + k % 2}\n" for k in range(30)))  # a trace, no load point
     code, _, err = run_main(capsys, "analyze", str(plain))
     assert code == 2 and "--v0: needed: the trace has no load-point column" in err, err
     assert len(err.strip().splitlines()) == 1

@@ -308,19 +308,26 @@ def test_a_fit_that_cannot_be_trusted_exits_3_in_one_line(record_path, tmp_path,
 # --- one command writes what the next reads ---------------------------------------------------------------------
 
 
-def test_simulate_fit_simulate_chain(tmp_path, capsys):
+@pytest.mark.parametrize("name", ["fit.toml", "fit.json"])
+def test_simulate_fit_simulate_chain(tmp_path, capsys, name):
     """rsf simulate -o trace.csv; rsf fit trace.csv -o fit.toml; rsf simulate --params fit.toml: the rerun gives
-    the first run's friction (the fit of a noise-free trace recovers the truth)."""
+    the first run's friction (the fit of a noise-free trace recovers the truth).  ``-o fit.json`` is JSON, as its
+    name says (it held TOML, which ``--params fit.json`` refused as malformed JSON), with no sidecar."""
     segments = [arg for v, t in STEPS for arg in ("--segment", f"{v}:{t}")]
     trace = tmp_path / "trace.csv"
     model = ["--a", str(TRUE["a"]), "--b", str(TRUE["b"]), "--dc", "10 um", "--v-ref", "1 um/s", "--stiffness",
              "1.6e-3/um"]  # fmt: skip
     code, _, err = run_main(capsys, "rsf", "simulate", *model, *segments, "--every", "0.25 s", "-o", str(trace))
     assert code == 0, err
-    fitted = tmp_path / "fit.toml"
+    fitted = tmp_path / name
     code, out, err = run_main(capsys, "rsf", "fit", str(trace), "-o", str(fitted), "--json")
     assert code == 0, err
     assert json.loads(out)["parameters"]["dc"]["value"] == pytest.approx(TRUE["dc"], rel=1e-3)
+    if name.endswith(".json"):
+        assert json.loads(fitted.read_text())["parameters"]["states"][0]["dc"] == pytest.approx(TRUE["dc"], rel=1e-3)
+        assert not (tmp_path / "fit.params.json").exists()
+    else:
+        assert (tmp_path / "fit.params.json").exists()
     code, _, err = run_main(capsys, "rsf", "simulate", "--params", str(fitted), *segments, "--every", "0.25 s",
                             "-o", str(tmp_path / "again.csv"))  # fmt: skip
     assert code == 0, err

@@ -7,6 +7,8 @@ paper's symbols (σs, τa, Δl_m) and µm/s.  What a user types stays ASCII
 
 from __future__ import annotations
 
+import math
+
 #: ASCII symbols of the parameter tables (``stickslip.parameters``) as the paper writes them.
 SYMBOLS = {
     "tau": "τ",
@@ -35,5 +37,9 @@ def unit(name: str) -> str:
 
 
 def velocity(value: float, digits: int = 6) -> str:
-    """A velocity (SI) in µm/s, the unit of every velocity the package prints: ``velocity(7.02e-4) == "702 µm/s"``."""
-    return f"{value * 1e6:.{digits}g} µm/s"
+    """A velocity (SI) in µm/s, the unit of every velocity the package prints: ``velocity(7.02e-4) == "702 µm/s"``;
+    a whole number of µm/s is written out up to 1 km/s (``velocity(0.1, 4) == "100000 µm/s"``, not "1e+05")."""
+    shown = value * 1e6
+    if math.isfinite(shown) and 10.0**digits <= abs(shown) < 1e15:
+        digits = int(math.log10(abs(shown))) + 1
+    return f"{shown:.{digits}g} µm/s"

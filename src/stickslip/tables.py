@@ -197,6 +197,11 @@ def _read_header(
     if first is None:
         raise DataError(f"{source}: empty file, expected a header row with columns {', '.join(required)}")
     header_row, header = first
+    if header[0].lstrip().startswith(("{", "[")):  # `curve --format json`, `--json` output: not a table
+        raise DataError(
+            f"{source}: row {header_row} starts with {header[0].lstrip()[0]!r}: a JSON file, not a CSV table;"
+            f" expected a header row with columns {', '.join(required)} (write the table as CSV, e.g. --format csv)"
+        )
     names: list[str] = []
     factors: dict[str, float] = {}
     for position, cell in enumerate(header, start=1):

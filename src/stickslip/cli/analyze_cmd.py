@@ -133,15 +133,19 @@ def analyze_command(
     """
     refuse_overwriting_inputs([trace], [("-o", output), ("--plot", plot_path)], params_name)
     from ..analysis import analyze_trace, compare_with_model, read_trace
+    from ..models.run import recorded_status
 
+    area = None if area_text is None else positive(area_text, "area", "--contact-area")
+    record = read_trace(trace, contact_area=area)  # first: a file that is no trace says so before --v0 is asked
     if v0_text is None:
         v0_text = _recorded_v0(trace)
     v0 = positive(v0_text, "velocity", "--v0")
-    area = None if area_text is None else positive(area_text, "area", "--contact-area")
     params = resolve_params(params_name, overrides)
-    record = read_trace(trace, contact_area=area)
     for note in record.notes:
         echo_err(f"note: {note}")
+    status, why = recorded_status(trace)
+    if status != "ok":  # a run cut short is still a record, but not of the run asked for
+        echo_err(f"note: {trace} is a run that {'stopped' if status == 'stopped' else 'failed'} before its end: {why}")
     analysis = analyze_trace(record, None, v0, params)
     _refuse_unbounded(analysis, v0_text)
     comparison = compare_with_model(analysis, params) if compare else None

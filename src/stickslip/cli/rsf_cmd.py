@@ -111,7 +111,17 @@ def build_params(options: dict[str, Any]) -> Any:
     if (cutoff := _cutoff(options)) is not None:
         mapping["cutoff"] = cutoff
     source = "options" if options.get("params_file") is None else f"--params {options['params_file']} (or options)"
-    return RSFParams.from_dict(mapping, source=source)
+    try:
+        return RSFParams.from_dict(mapping, source=source)
+    except ParameterError as exc:  # name the option the user typed, where the value came from one
+        key, sep, rest = str(exc).partition(": ")
+        given = key in _OPTION_OF and options.get(key) is not None
+        raise ParameterError(f"{_OPTION_OF[key]}: {rest}" if sep and given else str(exc)) from None
+
+
+#: the option of each top-level parameter an option sets (for messages)
+_OPTION_OF = {"a": "--a", "mu0": "--mu0", "v_ref": "--v-ref", "stiffness": "--stiffness", "eta": "--eta",
+              "mass": "--mass", "normal_stress": "--normal-stress"}  # fmt: skip
 
 
 def _cutoff(options: dict[str, Any]) -> tuple[float, float] | None:
@@ -412,7 +422,12 @@ def _duration(seconds: float) -> str:
 @click.option("--mcmc", "mcmc_steps", type=click.IntRange(min=0), default=0, help="emcee steps for a posterior.")
 @click.option("--seed", type=int, default=None, help="Seed of the emcee walkers.")
 @click.option("--json", "as_json", is_flag=True, help="Print the report as JSON (SI units: Dc in m, stiffness in 1/m).")
-@click.option("-o", "--output", type=click.Path(dir_okay=False, path_type=Path), help="Write fitted parameters (TOML).")
+@click.option(
+    "-o",
+    "--output",
+    type=click.Path(dir_okay=False, path_type=Path),
+    help="Write fitted parameters: TOML (with NAME.params.json beside it), or JSON for a NAME.json.",
+)
 @click.option("--plot", "plot_path", type=click.Path(dir_okay=False, path_type=Path), help="Save data and fit.")
 def fit_command(**options: Any) -> None:
     """Fit rate-and-state friction to a lab record (time, load-point displacement, friction).
@@ -435,8 +450,10 @@ def fit_command(**options: Any) -> None:
     from ..rsf.fit import fit_record
 
     output, plot_path = options["output"], options["plot_path"]
+    side = None if output is None or output.suffix.lower() == ".json" else sidecar(output)
     refuse_overwriting_inputs(
-        [options["record_file"], options["protocol_file"]], [("-o", output), ("--plot", plot_path)]
+        [options["record_file"], options["protocol_file"]],
+        [("-o", output), ("-o (its NAME.params.json)", side), ("--plot", plot_path)],
     )
     window = _window(options["window_text"])  # the options first: a typing error is said before the record is read
     max_time = positive(options["max_time"], "time", "--max-time")
@@ -472,10 +489,13 @@ def fit_command(**options: Any) -> None:
     report["cost"] = {"seconds": elapsed, "estimated_seconds": cost.seconds, "model_run_seconds": cost.run_seconds,
                       "estimated_model_runs": cost.runs}  # fmt: skip
     if output is not None and fit.status == "ok":
-        write_text(output, fit.to_toml())
-        side = sidecar(output)
-        if side is not None:
-            write_text(side, json_text({"parameters": fit.params.to_dict(), "fit": report}))
+        as_parameters = json_text({"parameters": fit.params.to_dict(), "fit": report})
+        if output.suffix.lower() == ".json":  # what its name says: the JSON `--params` reads (no TOML inside)
+            write_text(output, as_parameters)
+        else:
+            write_text(output, fit.to_toml())
+            if side is not None:
+                write_text(side, as_parameters)
     if options["as_json"]:
         click.echo(json_text(report))
     else:

@@ -8,6 +8,7 @@ line; ``stickslip analyze`` reads it as a measured trace), ``--json`` its summar
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Callable
 from pathlib import Path
@@ -484,6 +485,7 @@ def execute(
     units = summary_units(summary, spring)
     if stopped is not None:
         summary["status"] = "stopped"
+        run = dataclasses.replace(run, status="stopped")  # the file written says so too, as the summary does
     if output is not None:
         _write_run(run, output)
         if beside is not None:

@@ -39,6 +39,28 @@ BASE_COLUMNS: dict[str, str | None] = {
 }
 #: The first line of a Run CSV: a comment the trace readers skip, holding what the columns cannot.
 CSV_MARK = "# stickslip run "
+#: a run's status: finished, failed (the model could not go on), stopped (at its budget: the run up to there)
+STATUSES = ("ok", "failed", "stopped")
+
+
+def recorded_status(path: str | Path) -> tuple[str, str]:
+    """(status, message) a run trace written by :meth:`Run.to_csv` records in its first line; ("ok", "") for any
+    other file, and for one that is not a regular file (a FIFO is read once, by the reader of its rows)."""
+    path = Path(path)
+    if not path.is_file():
+        return "ok", ""
+    with open(path, encoding="utf-8", errors="replace") as handle:
+        first = handle.readline(1 << 20)
+    if not first.startswith(CSV_MARK):
+        return "ok", ""
+    try:
+        meta = json.loads(first[len(CSV_MARK) :])
+    except ValueError:
+        return "ok", ""
+    status = meta.get("status", "ok") if isinstance(meta, dict) else "ok"
+    return (str(status), str(meta.get("message", ""))) if status != "ok" else ("ok", "")
+
+
 NAN = float("nan")
 
 
@@ -109,7 +131,8 @@ class Run:
     ``period``, ``peak``, ``trough`` come from ``regime`` (the settled cycle's, or the window's extremes when
     it does not oscillate); ``mean`` is the model's mean over the settled cycle.  ``summary`` holds the model's
     own scalar results (e.g. ``stick_time``), ``native`` the model's own result object (not compared, not
-    written).  ``status`` is "ok" or "failed" (then ``message`` says why).
+    written).  ``status`` is "ok", "failed" (the model could not go on) or "stopped" (at its step or CPU budget:
+    the run up to there); ``message`` says why.
     """
 
     __repr__ = compact_repr  # counts, not hundreds of array elements
@@ -148,8 +171,8 @@ class Run:
         object.__setattr__(self, "state_units", {k: self.state_units.get(k) for k in states})
         if not isinstance(self.regime, regimes.Regime):
             raise ParameterError(f"run regime: expected a stickslip.regimes.Regime, got {type(self.regime).__name__}")
-        if self.status not in ("ok", "failed"):
-            raise ParameterError(f"run status: expected 'ok' or 'failed', got {self.status!r}")
+        if self.status not in STATUSES:
+            raise ParameterError(f"run status: expected one of {', '.join(map(repr, STATUSES))}, got {self.status!r}")
 
     # ---------------------------------------------------------------- building
     @classmethod

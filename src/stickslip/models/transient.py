@@ -131,6 +131,7 @@ def transient_run(result: Any, protocol: Protocol | None = None) -> Run:
         state_units=units,
         summary=summary,
         message=result.message,
+        status=getattr(result, "status", "ok"),  # (a stand-in solver's result may have none)
         native=result,
     )
 

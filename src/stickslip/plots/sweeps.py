@@ -457,6 +457,8 @@ def figure_sweep_1d(frame: Any, spec: Any, x: str, columns: Sequence[str] | None
     """
     from matplotlib.figure import Figure
 
+    if x not in spec.keys:  # named first: a mistyped --x is the mistake, not the --y left out
+        raise ParameterError(f"--x {x}: not a varied key of this sweep; expected one of {', '.join(spec.keys)}")
     if len(spec.keys) != 1:
         raise ParameterError(
             f"--y: this sweep varies {', '.join(spec.keys)}; give --y KEY (a plot without --y needs a sweep of one key)"

@@ -22,7 +22,7 @@ from ..parameters import Parameters
 from ..reprs import compact_repr, field_values
 from ..trace_columns import QUASI_STATIC
 from .critical import CriticalPoint, cached_critical_point, steady_curve_key
-from .jump import Jump, check_curve, jump_velocity
+from .jump import Jump, branch_maximum, check_curve, jump_velocity
 from .steady import ACCURATE_QUADRATURE, require_parameters, steady_state
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -236,6 +236,15 @@ class _Phases:
         jump = jump_velocity(self.params, stick.peak_stress, self.curve)
         if not jump.reachable or jump.velocity is None:
             message = f"the chains collapse at σs = {stick.peak_stress:.6g} Pa, but {jump.message}"
+            return _Cycle(stick, jump, None, regimes.UNDETERMINED, message)
+        v_max, _ = branch_maximum(self.params, "aging")
+        if self.v0 >= v_max:  # the slip after the jump has nothing to relax to (slip_phase refuses it)
+            message = (
+                f"the chains collapse at σs = {stick.peak_stress:.6g} Pa and the block jumps to"
+                f" {jump.velocity * 1e6:.6g} µm/s, but the pulling velocity {self.v0 * 1e6:.6g} µm/s is at or above"
+                f" the maximum of the steady curve ({v_max * 1e6:.6g} µm/s): sliding there is velocity-weakening"
+                " again and the slip (Eq 10) has no quasi-static solution"
+            )
             return _Cycle(stick, jump, None, regimes.UNDETERMINED, message)
         slip = slip_phase(self.params, self.v0, jump.velocity)
         if slip.ends == "stick" and slip.duration == 0.0:

@@ -78,8 +78,13 @@ class LabRecord:
         t = np.asarray(time, dtype=float).ravel()
         d = np.asarray(displacement, dtype=float).ravel()
         f = np.asarray(friction, dtype=float).ravel()
-        if not (t.size == d.size == f.size) or t.size < 10:
-            raise DataError(f"{source}: expected time, displacement and friction of one length >= 10")
+        if not (t.size == d.size == f.size):
+            raise DataError(
+                f"{source}: time, displacement and friction have {t.size}, {d.size} and {f.size} values; expected"
+                " one length"
+            )
+        if t.size < 10:
+            raise DataError(f"{source}: {t.size} data row(s); expected at least 10 to fit a record")
         row = _row_names(rows, t.size)
         for name, col in (("time", t), ("displacement", d), ("friction", f)):
             bad = ~np.isfinite(col)
@@ -203,7 +208,7 @@ def _numbers(column: Any, path: Path, rows: Any, pd: Any) -> np.ndarray:
     values = pd.to_numeric(column, errors="coerce").to_numpy(dtype=float)
     cells = column.to_numpy()
     text = np.isnan(values) & pd.notna(column).to_numpy()
-    text &= np.array([str(c).strip().lower() not in ("", "nan") for c in cells])
+    text &= np.array([str(c).strip().lower() not in ("", "nan") for c in cells], dtype=bool)  # bool: no rows too
     if text.any():
         i = int(np.argmax(text))
         cell = str(cells[i])

@@ -388,7 +388,9 @@ def _words(
     if stuck[-1] and found.periods == 0 and time.size > 1:
         slipped = f" after {len(cycles)} slip(s)" if cycles else ""
         if velocity[-1] != 0.0:
-            motion = f"creeps at {velocity[-1] * 1e9:.3g} nm/s"
+            slow = abs(velocity[-1]) < 1e-6  # nm/s for a creep, µm/s (as the end's V is written) from 1 µm/s up
+            creep = f"{velocity[-1] * 1e9:.3g} nm/s" if slow else show_velocity(velocity[-1], 3)
+            motion = f"creeps at {creep}"
         elif control == "velocity":
             motion = "is held at rest by the protocol (V = 0 under velocity control)"
         else:

@@ -87,6 +87,8 @@ class TransientResult:
     evidence: Any = field(default=None, repr=False)
     #: the massless block's jumps through rupture cascades (transient.jump.Jump: instant, stresses, travel)
     jumps: tuple[Any, ...] = field(default=(), repr=False)
+    #: "ok", or "failed" where the model cannot continue before the protocol's end (``message`` says where)
+    status: str = "ok"
 
     @property
     def final_stress(self) -> float:
@@ -109,6 +111,7 @@ class TransientResult:
             "steps": self.steps,
             "cycles": [c.as_dict() for c in self.cycles],
             "message": self.message,
+            "status": self.status,
         } | ({"jumps": [asdict(j) for j in self.jumps]} if self.jumps else {})
 
     @property

@@ -439,7 +439,9 @@ class _Driver:
         if vs is None:
             self.events.append(("unreachable", state.t, sigma_s, 0.0))
             return self._finish(stop=f"the chains collapse at σs = {sigma_s:.6g} Pa, beyond the steady curve's"
-                                " reach: the paper's jump has no landing point")  # fmt: skip
+                                " reach: the paper's jump has no landing point; the model stops at t ="
+                                f" {state.t:.6g} s of the {self.duration:.6g} s asked for: what follows is not"
+                                " known")  # fmt: skip
         self._jump_to_steady(sigma_s, vs, vp)
         return None
 
@@ -1126,6 +1128,7 @@ def _finish(d: _Driver, snapshots: list[Snapshot], stop: str | None, note: str) 
         mass=mass,
         damping=d.damping,
         evidence=evidence,
+        status="ok" if stop is None else "failed",  # the model could not go on to the protocol's end
     )
 
 

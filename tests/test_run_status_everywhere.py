@@ -1,0 +1,97 @@
+"""A run's status is the same wherever it is read (a tester's findings, 2026-11-30): a run stopped at its budget
+says "stopped" in the file it writes, not only in its summary; a run the model cannot continue is "failed" (exit 3)
+in every model, with what it computed; and files of the wrong kind are named as such in one line."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from cli_helpers import run_main
+from stickslip import load_parameters, simulate
+from stickslip.display import velocity
+from stickslip.models.run import Run, recorded_status
+
+
+def test_a_run_stopped_at_its_budget_says_so_in_its_file_and_analyze_notes_it(tmp_path, capsys):
+    """The CSV's first line said status "ok" while the summary said "stopped" (exit 3); `analyze` then read it
+    as a whole record without a word."""
+    trace = tmp_path / "budget.csv"
+    args = ["--v0", "100 um/s", "--duration", "10 s", "--no-reduce", "--max-steps", "300", "-o", str(trace)]
+    code, _, err = run_main(capsys, "transient", *args)
+    assert code == 3 and "budget of 300 steps" in err
+    assert recorded_status(trace)[0] == "stopped"
+    assert Run.read(trace).status == "stopped"
+    code, _, err = run_main(capsys, "analyze", str(trace))
+    assert code == 0, err
+    assert f"note: {trace} is a run that stopped before its end: transient: stopped at the budget" in err
+
+
+def test_the_stick_chains_without_a_landing_point_fail_the_transient_run(capsys):
+    """At 0.1 m/s the chains collapse at 1024.5 Pa, above the aging curve's right branch (up to 982.4 Pa): the
+    transient run ended at 0.033 s of 0.1 s with status ok and exit 0; the quasi-static model failed there."""
+    code, out, err = run_main(capsys, "transient", "--v0", "0.1 m/s", "--duration", "0.1 s", "--stick-population",
+                              "--json")  # fmt: skip
+    assert code == 3
+    summary = json.loads(out)
+    assert summary["status"] == "failed" and summary["regime"] == "undetermined"
+    assert summary["end_time"] == pytest.approx(0.0334275, rel=1e-5)
+    assert "the model stops at t = 0.0334275 s of the 0.1 s asked for" in summary["message"]
+    assert "the run failed" in err
+    quasi = simulate(load_parameters("gelatin-glass"), 0.1, 0.1)
+    assert quasi.status == "failed"  # the same verdict as the quasi-static model's
+
+
+@pytest.mark.parametrize("v0", [6e-3, 13.8e-3])
+def test_above_the_curve_s_maximum_the_quasi_static_run_fails_as_beyond_it(v0):
+    """Above the aging curve's maximum (5.0385 mm/s) the slip after the jump has nothing to relax to.  At 6 and
+    13.8 mm/s the jump lands (σs 810 Pa is on the branch) and Eq 10 raised a ModelError (exit 2, an error row in a
+    sweep), while at 0.1 m/s, whose σs is off the branch, the run failed with what it computed (exit 3): now both
+    fail after the stick, and say why."""
+    sim = simulate(load_parameters("gelatin-glass"), v0, 10.0)
+    assert sim.status == "failed" and sim.regime == "undetermined"
+    assert "at or above the maximum of the steady curve (5038.5 µm/s)" in sim.message
+    assert "the model stops at t =" in sim.message
+    assert sim.time[-1] < 1.0 and sim.stress[-1] > 257.36  # the stick it computed, up to σs
+
+
+def test_fast_velocities_are_written_out_not_in_exponent_form():
+    assert velocity(0.1, 4) == "100000 µm/s" and velocity(1.0, 4) == "1000000 µm/s"
+    assert velocity(7.02e-4) == "702 µm/s" and velocity(123.4567e-6, 4) == "123.5 µm/s"
+
+
+def test_json_given_to_a_table_reader_is_named_as_json(tmp_path, capsys):
+    """`curve --format json` fed to `fit steady` said "cannot read header '{'"; `analyze` asked for --v0 first."""
+    curve = tmp_path / "c.json"
+    code, _, err = run_main(capsys, "curve", "--points", "10", "--format", "json", "-o", str(curve))
+    assert code == 0, err
+    for command in (["fit", "steady"], ["analyze"]):
+        code, _, err = run_main(capsys, *command, str(curve))
+        assert code == 2
+        assert "row 1 starts with '{': a JSON file, not a CSV table" in err, command
+
+
+def test_a_header_only_record_is_bad_input_for_rsf_fit(tmp_path, capsys):
+    """An internal error (TypeError from numpy, exit 1) before."""
+    path = tmp_path / "header.csv"
+    path.write_text("time [s],friction [1],load_point_position [m]\n")
+    code, _, err = run_main(capsys, "rsf", "fit", str(path))
+    assert code == 2 and err.strip() == f"stickslip: error: {path}: 0 data row(s); expected at least 10 to fit a record"
+
+
+def test_an_option_s_bad_value_names_the_option(capsys):
+    code, _, err = run_main(capsys, "rsf", "simulate", "--a", "0", "--v0", "1 um/s", "--duration", "1 s")
+    assert code == 2 and err.strip() == "stickslip: error: --a: expected a value > 0, got 0"
+
+
+def test_sweep_plot_names_a_mistyped_x_before_asking_for_y(tmp_path, capsys):
+    """Without --y on a sweep of two keys, a mistyped --x was answered "--y: this sweep varies ...; give --y KEY"."""
+    out = tmp_path / "sweep"
+    code, _, err = run_main(capsys, "sweep", "--vary", "pulling_velocity=50 um/s,80 um/s", "--vary",
+                            "block.stiffness=300 kPa/m,600 kPa/m", "--duration", "5 s", "--workers", "0",
+                            "--quiet", "-o", str(out))  # fmt: skip
+    assert code == 0, err
+    code, _, err = run_main(capsys, "sweep", "plot", str(out), "--x", "foo", "-o", str(tmp_path / "p.png"))
+    assert code == 2
+    assert "--x foo: not a varied key of this sweep; expected one of pulling_velocity, block.stiffness" in err
