@@ -245,9 +245,27 @@ def _silence_stdout() -> None:
         pass
 
 
+def _notice_first_compiles() -> None:
+    """On a terminal, one line before a model's kernels are compiled for this machine (the first run after an
+    install waits ~45 s for the time-dependent model's; numerics/first_compile.py).  Not in a pipe or a capture:
+    there, as for the progress bars, standard error carries only what the command itself reports."""
+    from ..numerics.first_compile import on_first_compile
+    from ..progress import on_terminal
+
+    if on_terminal():
+        on_first_compile(
+            lambda what: click.echo(
+                f"stickslip: compiling {what} for this machine, once after an install (up to a minute; later runs"
+                " load them from numba's cache)",
+                err=True,
+            )
+        )
+
+
 def main(argv: list[str] | None = None) -> None:
     """Console entry point."""
     skip_blas_probe()  # numba's, ~0.25 s of a transient run: see numba_start
+    _notice_first_compiles()
     caught: list[tuple[type[Warning], str]] = []
 
     def collect(message: Any, category: type[Warning], *args: Any, **kwargs: Any) -> None:

@@ -11,6 +11,8 @@ import math
 
 import numpy as np
 
+from ..numerics.first_compile import announce_if_uncached
+
 #: status of a lane after the march
 MARCHED, TOO_MANY_PANELS = 0, 1
 
@@ -268,4 +270,5 @@ def compiled():  # type: ignore[no-untyped-def]
         for name in ("_exp_into", "_log_hazard", "_good", "_width"):  # callees first, so that the callers bind to them
             g[name] = njit(cache=True, nogil=True, fastmath=_FAST)(g[name])
         _COMPILED.append(njit(cache=True, nogil=True, fastmath=_FAST)(march))
+        announce_if_uncached(_COMPILED[0], "the steady curve's kernel")
     return _COMPILED[0]

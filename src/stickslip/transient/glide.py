@@ -21,6 +21,7 @@ from collections.abc import Callable
 import numpy as np
 
 from ..numerics import dop853 as _tableau
+from ..numerics.first_compile import announce_if_uncached
 from . import kernel
 
 #: the tableau (scipy's ``dop853_coefficients``): 12 stages, 3 more for the dense output, 7 interpolant powers
@@ -456,6 +457,7 @@ def _compiled():  # type: ignore[no-untyped-def]
         for name in ("_event_root", "_select_initial_step", "first_step", "integrate"):
             g[name] = kernel._jit(g[name])
             _COMPILED[name] = g[name]
+        announce_if_uncached(_COMPILED["integrate"], kernel.TRANSIENT_KERNELS)
     return _COMPILED
 
 

@@ -37,6 +37,8 @@ import math
 
 import numpy as np
 
+from ..numerics.first_compile import announce_if_uncached
+
 #: log of the largest hazard used (exp(700) ~ 1e304 per second); beyond it a cohort is gone in any step
 LOG_RATE_CAP = 700.0
 MAX_RATE = math.exp(LOG_RATE_CAP)  # the same cap on a cohort's w f r in the slider's residual
@@ -1473,6 +1475,10 @@ INLINED = (
 )
 
 
+#: the words of the first-compile notice (numerics/first_compile.py) for the time-dependent model's kernels
+TRANSIENT_KERNELS = "the time-dependent model's kernels"
+
+
 def compiled() -> dict[str, object]:
     """The numba-compiled kernel functions (compiled on first use, cached on disk)."""
     if not _COMPILED:
@@ -1517,4 +1523,5 @@ def compiled() -> dict[str, object]:
         ):
             g[name] = _jit(g[name])
             _COMPILED[name] = g[name]
+        announce_if_uncached(_COMPILED["advance"], TRANSIENT_KERNELS)
     return _COMPILED
