@@ -87,27 +87,112 @@ class Transient(BondModel):
         return f"start {start!r}"
 
     def stability_boundary(self, fixed: Any, x: str, y: str, frame: Any = None) -> list[Boundary]:
-        """Kc(V0) of the linear stability of steady sliding, in the plane (V0, a stiffness key)."""
-        from ..transient import critical_stiffness
+        """Kc(V0) of the linear stability of steady sliding, in the plane (V0, a stiffness key).
 
+        Kc at BOUNDARY_VELOCITIES log-spaced velocities over the rows' V0 and, where the steady curve's minimum Vc
+        (Eq 9) lies among them, at Vc (1 - 10^-j), j = 1..6: Kc falls to 0 at Vc (dsigma/dV = 0, the Hopf
+        frequency to 0), about linearly in Vc - V0, so these carry the curve down through the decades of
+        stiffness a sweep spans (the log grid alone jumps from ~1e9 Pa/m to 0 between two velocities).  Taken
+        from the fastest down, and no slower once Kc is BEYOND_ROWS times the rows' stiffest (Kc grows as V0
+        falls below Vc: the slower ones, the dearest, would be drawn outside the plot).  Each Kc by
+        :func:`_critical_stiffness_for_plot`; a velocity where Kc is not defined is skipped.  The curve drawn
+        between them is :func:`_boundary_curve`'s."""
         stiffness_axes = ("block.height", *STIFFNESS_KEYS)
         if frame is None or "pulling_velocity" not in (x, y) or not ({x, y} & set(stiffness_axes)):
             return []
+        from ..errors import ModelError, ParameterError
+        from ..quasistatic.critical import critical_point
+
         other = y if x == "pulling_velocity" else x
         params = self.parameters(None, {k: v for k, v in fixed.items() if k != "pulling_velocity"})
         lo, hi = float(frame["pulling_velocity"].min()), float(frame["pulling_velocity"].max())
-        velocity = np.geomspace(max(lo, 1e-12), max(hi, 2e-12), 80)
-        kc = np.array([critical_stiffness(params, v) for v in velocity], dtype=float)
+        lo, hi = max(lo, 1e-12), max(hi, 2e-12)
+        velocity = np.geomspace(lo, hi, BOUNDARY_VELOCITIES)
+        vc = critical_point(params).velocity
+        vc = vc if vc is not None and lo < vc <= hi else None
+        if vc is not None:
+            velocity = np.union1d(velocity, vc * (1.0 - np.logspace(-1, -6, 6)))
+        stiffest = _stiffest_rows(other, params, frame)
+        kc = np.full(velocity.size, NAN)
+        for k in range(velocity.size - 1, -1, -1):
+            try:
+                kc[k] = _critical_stiffness_for_plot(params, float(velocity[k]))
+            except (ModelError, ParameterError):  # beyond the steady population's range: no boundary there
+                continue
+            if kc[k] > BEYOND_ROWS * stiffest:
+                break
         good = np.isfinite(kc) & (kc > 0)
-        along = self.stiffness_of(other, params, kc[good])
-        curve = (velocity[good], along) if x == "pulling_velocity" else (along, velocity[good])
+        v, k_eff = _boundary_curve(velocity[good], kc[good], vc)
+        along = self.stiffness_of(other, params, k_eff)
+        curve = (v, along) if x == "pulling_velocity" else (along, v)
         return [Boundary(curve[0], curve[1], "K = Kc(V0), linear stability")]
+
+
+#: velocities of a sweep plot's boundary Kc(V0), log-spaced over the rows' (each Kc ~0.3-1 s; 80 took 4 min)
+BOUNDARY_VELOCITIES = 10
+#: no slower velocity once Kc exceeds the rows' stiffest by this factor (its point is drawn, beyond the axis)
+BEYOND_ROWS = 10.0
+#: Kc for a plot scans every PLOT_SCAN_STRIDE-th rate of critical_stiffness's scan
+PLOT_SCAN_STRIDE = 8
+#: points drawn between two computed ones
+BOUNDARY_FILL = 24
+
+
+def _stiffest_rows(key: str, params: Parameters, frame: Any) -> float:
+    """The rows' largest effective stiffness K (Pa/m) on axis ``key`` (block.height: the lowest block's)."""
+    values = np.asarray(frame[key], dtype=float) if key in frame else np.array([], dtype=float)
+    values = values[np.isfinite(values) & (values > 0)]
+    if not values.size:
+        return math.inf
+    block = params.block
+    if key == "block.height":
+        return float(block.shear_modulus * block.geometric_factor / values.min())
+    return float(values.max() * (block.geometric_factor if key == "block.stiffness" else 1.0))
+
+
+def _boundary_curve(velocity: np.ndarray, kc: np.ndarray, vc: float | None) -> tuple[np.ndarray, np.ndarray]:
+    """The curve Kc(V0) through the computed points, BOUNDARY_FILL points between each two: log Kc linear in
+    log(Vc - V0) below Vc (Kc ~ Vc - V0 there), in log V0 elsewhere.  Against a direct critical_stiffness at
+    the midpoints (gelatin-glass, 20 um/s - 1 mm/s): within 4.5 % where the points are furthest apart
+    (112-123 um/s), 0.07-0.4 % nearer Vc; a line in log V0 was 40 % off there."""
+    if velocity.size < 2:
+        return velocity, kc
+    below = vc is not None and bool(np.all(velocity < vc))
+    u = np.log(vc - velocity) if below else np.log(velocity)
+    fill = np.linspace(0.0, 1.0, BOUNDARY_FILL + 1)[:-1]
+    drawn = np.r_[(u[:-1, None] + (u[1:] - u[:-1])[:, None] * fill).ravel(), u[-1]]
+    along = np.exp(np.interp(drawn, u, np.log(kc)) if u[0] < u[-1] else np.interp(-drawn, -u, np.log(kc)))
+    return (vc - np.exp(drawn) if below else np.exp(drawn)), along
+
+
+def _critical_stiffness_for_plot(params: Parameters, velocity: float) -> float:
+    """Kc (Pa/m) of :func:`stickslip.transient.critical_stiffness` on a scan of every PLOT_SCAN_STRIDE-th rate of
+    its own, its crossings bisected as there: ~5x cheaper, for a curve drawn over a sweep's plot.
+
+    The oscillatory Kc is the bisection's, whatever the bracket: the same to ~1e-9; the real mode's minimum of
+    -Z(s) is read on the coarser scan, ~3e-6 below (gelatin-glass, 20-130 um/s).  Z at these rates is memoised by
+    the stability module, so a direct critical_stiffness at the same velocity pays only for the other rates."""
+    from ..transient import critical_stiffness
+
+    if getattr(critical_stiffness, "__module__", None) != "stickslip.transient.stability":  # a stand-in package's
+        return float(critical_stiffness(params, velocity))
+    from ..transient import stability
+
+    stability._check_velocity(params, velocity)  # before the cells: a typed error, as critical_stiffness's
+    top = stability.resolved_frequency(params, velocity)
+    rates = stability.SCAN[::PLOT_SCAN_STRIDE] / params.bonds.bond_time
+    with np.errstate(over="raise", invalid="raise"):
+        try:
+            found = stability.critical_from_response(stability._finite_response(params, velocity, True), rates, top=top)
+        except FloatingPointError:
+            return NAN
+    return found.value
 
 
 def transient_run(result: Any, protocol: Protocol | None = None) -> Run:
     """The :class:`Run` of a :class:`stickslip.transient.TransientResult` (regime from its slip events, in the
     protocol's last segment; over the whole run without the protocol)."""
-    summary = last_cycle_numbers(result)
+    summary = last_cycle_numbers(result, protocol)
     states: dict[str, Any] = {}
     units: dict[str, str | None] = {}
     if getattr(result, "bonded_fraction", None) is not None:
@@ -178,9 +263,10 @@ def _regime(result: Any, protocol: Protocol | None) -> regimes.Regime:
     )
 
 
-def last_cycle_numbers(result: Any) -> dict[str, Any]:
+def last_cycle_numbers(result: Any, protocol: Protocol | None = None) -> dict[str, Any]:
     """The last whole cycle's numbers (the run has settled onto its cycle by then, if ever) and the mean stress
-    over the whole cycles (over the run when there are none); ``run_mean_stress`` over the run."""
+    over the whole cycles (over the run when there are none); ``run_mean_stress`` over the run.  ``protocol``: the
+    run's, for the puller's exact travel into a stick that no cycle of the result starts (the run ended in it)."""
     whole = [c for c in result.cycles if getattr(c, "period", None) is not None]
     time = np.asarray(result.time, dtype=float)
     row: dict[str, Any] = {
@@ -202,11 +288,13 @@ def last_cycle_numbers(result: Any) -> dict[str, Any]:
         )  # fmt: skip
         end = last.start_time + last.period
         following = [c.start_stress for c in result.cycles if c.index == last.index + 1]
-        row["mean_stress"] = _mean_stress(result, whole[0].start_time, end, whole[0].start_stress, *following[:1])
+        row["mean_stress"] = _mean_stress(
+            result, whole[0].start_time, end, whole[0].start_stress, *following[:1], protocol=protocol
+        )
     return row
 
 
-def _mean_stress(result: Any, start: float, end: float, *exact: float) -> float:
+def _mean_stress(result: Any, start: float, end: float, *exact: float, protocol: Protocol | None = None) -> float:
     """Mean stress over [start, end] from the integral of sigma dt the solver keeps (not from the rows written:
     ``every`` must not change it); ``exact``: sigma at start (and end) where known (a stick event)."""
     time, stress = np.asarray(result.time, dtype=float), np.asarray(result.stress, dtype=float)
@@ -215,18 +303,50 @@ def _mean_stress(result: Any, start: float, end: float, *exact: float) -> float:
     if integral is None or not end > start or not np.all(np.isfinite(integral)):  # a stand-in's trace
         inside = (time >= start) & (time <= end)
         return time_mean(time[inside], stress[inside]) if np.count_nonzero(inside) > 1 else time_mean(time, stress)
-    chains = getattr(result, "chain_fraction", None)
-    stuck = np.isfinite(chains) if chains is not None else np.zeros(time.size, dtype=bool)
-    at = [_integral_at(time, stress, integral, stuck, t, *exact[k : k + 1]) for k, t in enumerate((start, end))]
+    held = _HeldBlock(result, protocol) if getattr(result, "chain_fraction", None) is not None else None
+    at = [_integral_at(time, stress, integral, t, *exact[k : k + 1], held=held) for k, t in enumerate((start, end))]
     return (at[1] - at[0]) / (end - start)
 
 
+class _HeldBlock:
+    """The stress of a block the stick chains hold, sigma = K (P - X) with the slider fixed: from a row of the stick
+    back to its start, K times the puller's travel between (the protocol's, exact; the rows' puller positions,
+    linear between them, without it)."""
+
+    def __init__(self, result: Any, protocol: Protocol | None) -> None:
+        self.stuck = np.isfinite(np.asarray(result.chain_fraction, dtype=float))  # the rows the chains hold
+        self.stiffness = float(result.stiffness)
+        self.protocol = protocol
+        self.time = np.asarray(result.time, dtype=float)
+        self.puller = np.asarray(_first(result, "puller_position", "puller_displacement"), dtype=float)
+
+    def stress_before(self, k: int, stress: float, t: float) -> float:
+        """sigma at t, given sigma at row k of the same stick (t <= time[k])."""
+        if self.protocol is not None:
+            travel = float(self.protocol.displacement_at(self.time[k]) - self.protocol.displacement_at(t))
+        else:
+            travel = float(self.puller[k] - np.interp(t, self.time, self.puller))
+        return stress - self.stiffness * travel
+
+
 def _integral_at(
-    time: np.ndarray, stress: np.ndarray, integral: np.ndarray, stuck: np.ndarray, t: float, *sigma: float
+    time: np.ndarray,
+    stress: np.ndarray,
+    integral: np.ndarray,
+    t: float,
+    *sigma: float,
+    held: _HeldBlock | None = None,
 ) -> float:
-    """The integral at t between rows: back from the next row by the trapezoid, with sigma(t) given, or on the
-    line through the next two rows where the chains hold the block (sigma = K (P - X) is linear there: exact),
-    else interpolated."""
+    """The integral at t between rows: back from the next row by the trapezoid, with sigma(t) given, or from the
+    held block (``held``) where the chains hold it at the next row, else interpolated.
+
+    With the stick chains every cycle's ends are stick events, and the first row at or after one lies in its stick
+    (a row is written at each slip, at its exact time): sigma = K (P - X) is linear from t to that row, so the
+    trapezoid is exact once sigma(t) is.  Where no cycle gives sigma(t) (the stick the run ended in), the held
+    block gives it from the row's stress and the puller's travel since t (the line through the next two rows, used
+    before, read the sliding row before the stick when ``every`` left the stick one row: 3 s and 7 s rows moved the
+    paper's mean from empty by 5.9e-4 and 2.5e-3).
+    """
     k = int(np.searchsorted(time, t, side="left"))
     if k >= time.size:
         return float(integral[-1])
@@ -234,8 +354,8 @@ def _integral_at(
         return float(integral[k])
     if sigma:
         here = sigma[0]
-    elif k + 1 < time.size and stuck[k] and stuck[k + 1]:
-        here = float(stress[k] + (stress[k + 1] - stress[k]) * (t - time[k]) / (time[k + 1] - time[k]))
+    elif held is not None and held.stuck[k]:
+        here = held.stress_before(k, float(stress[k]), t)
     else:
         here = float(np.interp(t, time, stress))
     return float(integral[k] - 0.5 * (here + stress[k]) * (time[k] - t))
