@@ -118,4 +118,3 @@ def test_the_mean_is_the_settled_cycle_s_not_the_start_up_s(runs):
     every_cycle = _end_corrected_trapezoid(native.time[i : j + 1], native.stress[i : j + 1], slope)
     every_cycle /= native.time[j] - native.time[i]
     assert abs(every_cycle / quasi.summary["mean_stress"] - 1.0) > 0.05  # 356.0 against 383.7 Pa: what it read
-
