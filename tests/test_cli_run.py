@@ -93,7 +93,7 @@ REFUSALS = [
     ([*QS, "--segment", "1 mm/s:1 s"], "one constant pulling velocity"),
     ([*QS, "--every", "1 s"], "the quasi-static model takes no --every"),
     ([*QS, "--set", "bonds.bond_time=224"], "needs a unit"),
-    (["run", "--model", "no-such-model", "--v0", "1 um/s", "--duration", "1 s"], "--model 'no-such-model'"),
+    (["run", "--model", "no-such-model", "--v0", "1 um/s", "--duration", "1 s"], "model 'no-such-model': expected"),
     (["run", "--model", "rsf", "--v0", "1 um/s", "--duration", "1 s", "--control", "velocity"], "velocity"),
     (
         [

@@ -57,9 +57,14 @@ def test_f_test_finds_the_second_state_only_where_there_is_one():
     assert one_fit.lag_one > 0.5 and abs(two_fit.lag_one) < 0.2  # ... correlated residuals; two states: noise
     value, p = f_test(one_fit, two_fit)
     assert p < 1e-10 and value > 50
+    assert two_fit.fit.status == "ok", two_fit.fit.reason
     one = record("aging", ((0.01, 20 * UM),), seed=5)
-    _, p_one = f_test(reading(one, 1), reading(one, 2))
+    one_state, spare = reading(one, 1), reading(one, 2)
+    _, p_one = f_test(one_state, spare)
     assert p_one > 1e-3  # no second state to find: the two extra parameters buy nothing beyond chance
+    # and the two-state fit says so itself (it was "ok", b and b2 each undetermined in a ridge of b + b2)
+    assert one_state.fit.status == "ok" and spare.fit.status == "failed"
+    assert "second state" in spare.fit.reason and "--states 1" in spare.fit.reason  # (unconstrained, or no F)
 
 
 def test_mixed_laws_aging_then_slip_are_recovered():

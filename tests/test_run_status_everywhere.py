@@ -95,3 +95,46 @@ def test_sweep_plot_names_a_mistyped_x_before_asking_for_y(tmp_path, capsys):
     code, _, err = run_main(capsys, "sweep", "plot", str(out), "--x", "foo", "-o", str(tmp_path / "p.png"))
     assert code == 2
     assert "--x foo: not a varied key of this sweep; expected one of pulling_velocity, block.stiffness" in err
+
+
+def test_a_two_state_fit_of_a_one_state_record_fails_by_the_f_test(tmp_path):
+    """The tester's up-down record of one aging state (a 0.010, b 0.015, Dc 20 µm), fitted with two states: "ok"
+    with b ± 0.03 and b2 ± 0.03 in a ridge of b + b2.  Two states lower chi-square by 0.18 % (p = 0.31)."""
+    import numpy as np
+
+    from stickslip import protocols
+    from stickslip.rsf.data import LabRecord
+    from stickslip.rsf.fit import fit_record
+    from stickslip.rsf.params import rsf_params
+    from stickslip.rsf.solver import simulate as rsf_simulate
+
+    t = np.arange(0.0, 130.0, 0.25)
+    history = protocols.segments([(1e-6, 40.0), (10e-6, 30.0), (1e-6, 60.0)])
+    run = rsf_simulate(rsf_params(0.010, 0.015, 20e-6, stiffness=2000.0), history, times=t)
+    rng = np.random.default_rng(1)
+    record = LabRecord.from_arrays(t, run.load_point_displacement, run.friction + 2e-4 * rng.standard_normal(t.size))
+    fit = fit_record(record, states=2, protocol=history)
+    assert fit.status == "failed" and "second state" in fit.reason and "--states 1" in fit.reason
+    assert len(repr(fit)) < 1200 and f"model_friction=<{t.size} values>" in repr(fit)  # was 5 900 characters
+
+
+def test_a_multi_segment_run_s_range_names_its_window(capsys):
+    """The range shown is the last segment's (the regime's window), the mean the run's: "lowest 30.6 Pa, highest
+    61.3 Pa, mean 25.5 Pa over the run" had the mean outside the range (the run starts at 0 Pa)."""
+    code, out, err = run_main(capsys, "transient", "--v0", "100 um/s", "--duration", "1 s", "--segment",
+                              "200 um/s:0.5 s")  # fmt: skip
+    assert code == 0, err
+    line = next(x for x in out.splitlines() if "lowest" in x)
+    assert "over the last segment (from t = 1 s), mean" in line and line.endswith("over the run (no oscillation)")
+    lowest, highest, mean = (float(line.split(word)[1].split()[0]) for word in ("lowest", "highest", "mean"))
+    assert mean < lowest < highest  # the mean is over the whole run, from 0 Pa
+
+
+def test_a_puller_that_never_moves_leaves_the_block_at_rest_not_sliding(tmp_path, capsys):
+    """It read "steady sliding at 0 µm/s ... (tolerance 1e-305 Pa)", with advice to add the stick chains."""
+    hold = tmp_path / "hold.csv"
+    hold.write_text("time,velocity\n0,0\n5,0\n")
+    code, out, err = run_main(capsys, "run", "--model", "transient", "--protocol", str(hold))
+    assert code == 0, err
+    assert "regime: stuck" in out and "the puller never moves" in out
+    assert "sliding" not in out and "--stick-population" not in out

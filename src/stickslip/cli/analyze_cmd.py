@@ -136,10 +136,11 @@ def analyze_command(
     from ..models.run import recorded_status
 
     area = None if area_text is None else positive(area_text, "area", "--contact-area")
-    record = read_trace(trace, contact_area=area)  # first: a file that is no trace says so before --v0 is asked
-    if v0_text is None:
+    v0 = None if v0_text is None else positive(v0_text, "velocity", "--v0")  # a value given: checked at once
+    record = read_trace(trace, contact_area=area)  # before --v0 is asked for: a file that is no trace says so
+    if v0 is None:
         v0_text = _recorded_v0(trace)
-    v0 = positive(v0_text, "velocity", "--v0")
+        v0 = positive(v0_text, "velocity", "--v0")
     params = resolve_params(params_name, overrides)
     for note in record.notes:
         echo_err(f"note: {note}")

@@ -344,10 +344,14 @@ def summary_text(summary: dict[str, Any], units: dict[str, str] | None = None) -
         numbers.append(f"period {summary['period']:.6g} s" + ("" if cycle else " (no whole cycle within the run)"))
     words = ("peak", "trough", "mean") if cycle else ("trough", "peak", "run_mean")
     shown = {} if cycle else {"peak": "highest", "trough": "lowest", "run_mean": "mean"}
+    segments = summary["protocol"]
     for word in words:
         value = summary.get(f"{word}_{signal}")
         if value is not None and math.isfinite(value):
             numbers.append(f"{shown.get(word, word)} {value:.6g}{unit}")
+            if not cycle and word == "peak" and len(segments) > 1:  # the regime's window: the last segment's
+                last = sum(s["duration"] for s in segments[:-1])
+                numbers[-1] += f" over the last segment (from t = {last:.6g} s)"
     if not cycle and numbers:
         numbers[-1] += " over the run" + ("" if summary.get("oscillates", True) else " (no oscillation)")
     if numbers:

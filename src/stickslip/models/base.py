@@ -188,7 +188,7 @@ class FrictionModel(ABC):
             except ModuleNotFoundError as exc:
                 if exc.name is not None and module.startswith(exc.name):
                     raise ParameterError(
-                        f"--model {self.name}: this version of stickslip has no {module} module; use another model"
+                        f"model {self.name}: this version of stickslip has no {module} module; use another model"
                     ) from None
                 raise
 

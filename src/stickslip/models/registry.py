@@ -76,7 +76,7 @@ def get_model(name: Any) -> FrictionModel:
         _entry_points()
         found = _lookup(key)
     if found is None:
-        raise ParameterError(f"--model {name!r}: expected one of {', '.join(available_models())} (or module:attr)")
+        raise ParameterError(f"model {name!r}: expected one of {', '.join(available_models())} (or module:attr)")
     return found
 
 
@@ -143,18 +143,18 @@ def _imported(path: str) -> FrictionModel:
     """``module:attr`` (attr may be dotted): the model there, registered under its name."""
     module_name, _, attr = path.partition(":")
     if not module_name or not attr:
-        raise ParameterError(f"--model {path!r}: expected an import path MODULE:ATTRIBUTE, e.g. my_models:MODEL")
+        raise ParameterError(f"model {path!r}: expected an import path MODULE:ATTRIBUTE, e.g. my_models:MODEL")
     try:
         target: Any = importlib.import_module(module_name)
     except ImportError as exc:
-        raise ParameterError(f"--model {path!r}: cannot import {module_name!r} ({exc})") from None
+        raise ParameterError(f"model {path!r}: cannot import {module_name!r} ({exc})") from None
     for part in attr.split("."):
         if not hasattr(target, part):
-            raise ParameterError(f"--model {path!r}: module {module_name!r} has no attribute {attr!r}")
+            raise ParameterError(f"model {path!r}: module {module_name!r} has no attribute {attr!r}")
         target = getattr(target, part)
-    model = _instance(target, f"--model {path!r}")
+    model = _instance(target, f"model {path!r}")
     if not all(hasattr(model, a) for a in _REQUIRED):
-        raise ParameterError(f"--model {path!r}: {attr} is not a friction model (subclass stickslip.FrictionModel)")
+        raise ParameterError(f"model {path!r}: {attr} is not a friction model (subclass stickslip.FrictionModel)")
     _builtins()
     known = _lookup(model.name)
     if known is None or type(known) is type(model):

@@ -18,6 +18,7 @@ import numpy as np
 from ..columns import with_units
 from ..errors import DataError, ModelError, ParameterError
 from ..protocols import Protocol, Segment
+from ..reprs import compact_repr
 from ..units import to_si
 from .data import LabRecord, change_time_uncertainty, find_segments, forward, refuse_reversal
 from .laws import get_law
@@ -107,6 +108,8 @@ class FitParameter:
 @dataclass(frozen=True)
 class RSFFit:
     """The result of :func:`fit_record`."""
+
+    __repr__ = compact_repr  # counts, not the record's thousands of rows
 
     params: RSFParams
     parameters: dict[str, FitParameter]
@@ -350,6 +353,8 @@ def fit_record(
                         "it was taken by its magnitude, as friction depends on the speed only")  # fmt: skip
     derived = {"a-b": _difference(result, table, widen)}
     problems = _problems(result, record, resid, table, level, setup)
+    if setup.states == 2 and not problems:
+        problems += _second_state_problems(setup, start, result)
     if any(p.startswith(NO_RESPONSE_TEXT) for p in problems):  # then no interval of the friction law means anything
         why = "the friction shows no velocity dependence"
         for key in ("a", "b", "dc", "b2", "dc2", "stiffness"):
@@ -1465,7 +1470,42 @@ def _problems(
     loose = [f"{k} ({table[k].note})" for k in _CORE if not table[k].constrained]
     if loose:
         problems.append("not constrained by the record: " + ", ".join(loose))
+    second = [f"{k} ({table[k].note})" for k in ("b2", "dc2") if k in table and not table[k].constrained]
+    if second:  # the data that do not constrain a fitted parameter: a failure for the second state too
+        problems.append(
+            "the second state is not constrained by the record: "
+            + ", ".join(second)
+            + "; fit one state (--states 1), or hold it (--fix b2=..., --fix dc2=...)"
+        )
     return problems
+
+
+#: a second state variable is kept where the F test against the one-state fit gives p below this
+SECOND_STATE_LEVEL = 1e-3
+
+
+def _second_state_problems(setup: _Setup, start: dict[str, float], result: Any) -> list[str]:
+    """Why a two-state fit cannot be trusted where the record shows one state: the F test of its fitted second
+    state (b2, Dc2) against the best one-state fit (which the two-state search starts from).  Two states of one
+    law can share one state's response in many ways (b + b2 and the Dc's in a ridge), intervals and all; without
+    a second state in the record that ridge is all the fit has found."""
+    from scipy import stats
+
+    extra = sum(result.params[k].vary for k in ("b2", "log_dc2") if k in result.params)
+    dof = result.ndata - result.nvarys
+    if extra == 0 or dof <= 0 or not result.chisqr > 0:
+        return []
+    one, _ = _least_squares(replace(setup, states=1), start)
+    value = max(one.chisqr - result.chisqr, 0.0) / extra / (result.chisqr / dof)
+    p_value = float(stats.f.sf(value, extra, dof))
+    if p_value <= SECOND_STATE_LEVEL:
+        return []
+    drop = 100.0 * max(one.chisqr - result.chisqr, 0.0) / one.chisqr
+    return [
+        f"the record shows no second state: two states lower chi-square by {drop:.3g} % of one state's (F test"
+        f" against one state: p = {p_value:.2g}), so b, Dc, b2 and Dc2 are not determined apart; fit one state"
+        " (--states 1)"
+    ]
 
 
 def _history_mismatch(record: LabRecord, protocol: Protocol) -> str:

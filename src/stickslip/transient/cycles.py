@@ -68,7 +68,10 @@ def with_extremes(time: np.ndarray, stress: np.ndarray, between: Between | None)
 
 
 def stuck_mask(time: np.ndarray, velocity: np.ndarray, protocol: Protocol) -> np.ndarray:
-    return velocity < STUCK_FRACTION * _pace(time, protocol)
+    """Rows where the slider is below STUCK_FRACTION of the puller's pace; at rest under a protocol that never
+    moves (pace 0) too, where it read "steady sliding at 0 µm/s"."""
+    pace = _pace(time, protocol)
+    return (velocity < STUCK_FRACTION * pace) | ((pace == 0.0) & (velocity == 0.0))
 
 
 def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
@@ -393,6 +396,8 @@ def _words(
             motion = f"creeps at {creep}"
         elif control == "velocity":
             motion = "is held at rest by the protocol (V = 0 under velocity control)"
+        elif not np.any(protocol.velocities > 0):
+            motion = "is at rest (the puller never moves: 0 µm/s throughout the protocol)"
         else:
             motion = f"is at rest (the {'stick chains' if chains else 'bonds of Eq 1'} hold it)"
         return (

@@ -1085,7 +1085,8 @@ def _finish(d: _Driver, snapshots: list[Snapshot], stop: str | None, note: str) 
     regime, message = _chains_ahead(d, regime, message, time, sigma)
     message = message + note
     saturating = params.aging.saturation_age is not None  # the extension lets go: its stuck is its own answer
-    held = control == "velocity"  # a rig holds the slider: the chains would change nothing there
+    # a rig holds the slider, or nothing ever pulls it: the chains would change nothing there
+    held = control == "velocity" or not np.any(protocol.velocities > 0)
     if (
         regime == "stuck"
         and not cycles
