@@ -45,3 +45,21 @@ def test_critical_point_to_frame_is_its_dict_with_units():
     assert len(frame) == 1
     assert frame.loc[0, "critical_velocity"] == c.velocity and frame.loc[0, "critical_stress"] == c.stress
     assert frame.attrs["units"]["critical_velocity"] == "m/s" and frame.attrs["units"]["critical_stress"] == "Pa"
+
+
+def test_critical_point_plots_its_extrema_alone_or_over_a_curve():
+    """Every result has plot(ax=None) (the README says so; CriticalPoint had none): the minimum at (Vc, sigma_c)
+    as Eq 9 gives them, the maximum open, over a steady curve's own Axes when given them."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    point = stickslip.critical_point(P)
+    ax = point.plot()
+    (minimum,) = [line for line in ax.get_lines() if line.get_label() == "critical point (Eq 9)"]
+    assert minimum.get_xdata()[0] == pytest.approx(point.velocity * 1e6, rel=1e-12)  # µm/s
+    assert minimum.get_ydata()[0] == pytest.approx(point.stress, rel=1e-12)
+    assert ax.get_xscale() == "log" and any(line.get_label().startswith("maximum at") for line in ax.get_lines())
+    curve = stickslip.steady_state(P, np.geomspace(1e-5, 1e-2, 50)).plot()
+    assert point.plot(ax=curve) is curve and len(curve.get_lines()) == 3
+    flat = stickslip.critical_point(P.with_overrides({"bonds.bond_time": 1e-9}))  # no minimum: its message shown
+    assert not flat.exists and flat.message in [text.get_text() for text in flat.plot().texts]

@@ -180,6 +180,32 @@ def _mark_critical(ax: Axes, vc: float, sc: float, grid: np.ndarray, stress: np.
         ax.text(x * 1.5, 0.82, "→  velocity strengthening\n    (dσ/dV > 0)", ha="left", **style)
 
 
+def plot_critical(point: Any, ax: Axes | None = None) -> Axes:
+    """A :class:`~stickslip.quasistatic.critical.CriticalPoint` drawn: every extremum of the aging curve as a point
+    (the minimum (Vc, sigma_c) labelled, a maximum open), on log V; without a minimum its message in the frame."""
+    drawn_before = ax is not None
+    ax = new_axes(ax)
+    for extremum in point.extrema:
+        minimum = extremum.kind == "minimum"
+        x = extremum.velocity * UM_PER_S
+        ax.plot([x], [extremum.stress], marker="o", markersize=7, linestyle="none", zorder=6,
+                color=CRITICAL_COLOR, markerfacecolor=CRITICAL_COLOR if minimum else "white",
+                label="critical point (Eq 9)" if minimum else f"maximum at {x:.4g} µm/s")  # fmt: skip
+    if point.exists:
+        box = {"boxstyle": "round,pad=0.25", "facecolor": "white", "edgecolor": "none", "alpha": 0.85}
+        ax.annotate(f"$V_c$ = {point.velocity * UM_PER_S:.4g} µm/s\n$\\sigma_c$ = {point.stress:.4g} Pa",
+                    xy=(point.velocity * UM_PER_S, point.stress), xytext=(-12, -12), textcoords="offset points",
+                    ha="right", va="top", fontsize=9, bbox=box, zorder=7)  # fmt: skip
+    else:
+        ax.text(0.5, 0.5, point.message, transform=ax.transAxes, ha="center", va="center", fontsize=9, wrap=True)
+    if not drawn_before:
+        ax.set_xscale("log")
+        ax.set_xlabel(VELOCITY_LABEL)
+        ax.set_ylabel(STRESS_LABEL)
+        apply_style(ax)
+    return ax
+
+
 def _mark_maxima(ax: Axes, maxima: list[Any], grid: np.ndarray) -> None:
     """A maximum of the aging curve (the paper's set: 5.04 mm/s) ends the strengthening branch: above it the
     curve weakens again, and the label says so rather than leave "strengthening" over the whole right side."""

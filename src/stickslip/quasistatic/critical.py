@@ -64,6 +64,14 @@ class CriticalPoint:
         frame = pd.DataFrame([self.as_dict()])
         return with_units(frame, {"exists": None, "turnover_message": None})
 
+    def plot(self, ax: Any = None) -> Any:
+        """The curve's extrema in the (log V, sigma) plane, Vc and sigma_c labelled: on their own, or over a
+        steady curve (``point.plot(ax=curve.plot())``); where there is no minimum, the message in the frame.
+        Returns the Axes (never shows the figure)."""
+        from ..plots.steady import plot_critical
+
+        return plot_critical(self, ax=ax)
+
 
 #: Relative accuracy of sigma and of V dsigma/dV with ACCURATE_QUADRATURE, with margin: slopes below this
 #: (times sigma) are noise, and a minimum must be deeper than this to count.
