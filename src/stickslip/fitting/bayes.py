@@ -227,7 +227,8 @@ class _LogPosterior:
         self.lower, self.upper = centre - SEARCH_BOX, centre + SEARCH_BOX
         data = fit.data
         self.points = len(data)
-        self.stated = data.stress_err is not None
+        # stated errors found too small by the fit: their scale is unknown, integrated out as the relative noise's
+        self.stated = data.stress_err is not None and not fit.stated_errors_scaled
         error = data.stress_err if data.stress_err is not None else data.stress
         # all points with aging; a long record compressed exactly (stickslip.fitting.problem.Block)
         self.block = make_block(data.velocity, data.stress, error, True, fit.parameters)
@@ -528,7 +529,9 @@ def sample_posterior(
         " the start value)"
         for k, lo, hi in zip(keys, log_post.lower, log_post.upper, strict=True)
     )
-    if fit.data.stress_err is not None:
+    if fit.stated_errors_scaled:
+        noise = "Gaussian, the stated stress_err (too small) times an unknown s (Jeffreys prior 1/s, integrated out)"
+    elif fit.data.stress_err is not None:
         noise = "Gaussian with the stated stress_err"
     else:
         noise = "Gaussian, relative error s·σ with unknown s (Jeffreys prior 1/s, integrated out)"

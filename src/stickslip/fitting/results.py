@@ -19,6 +19,9 @@ _DISPLAY = {
     "stress": (("Pa", 1.0), ("kPa", 1e3), ("MPa", 1e6)),
 }
 
+#: The unit of a quantity with no value (undetermined): the one its values usually have.
+_UNDETERMINED = {"velocity": ("µm/s", 1e-6)}
+
 
 def display_unit(value: float | None, dimension: str) -> tuple[str, float]:
     """(unit name, size in SI) for showing ``value`` to people."""
@@ -26,7 +29,9 @@ def display_unit(value: float | None, dimension: str) -> tuple[str, float]:
     if choices is None:
         text = format_si(1.0, dimension)
         return (text.split(" ", 1)[1] if " " in text else "", 1.0)
-    if value is None or value == 0 or not np.isfinite(value):
+    if value is None:  # an undetermined Vc is shown in the unit of the determined ones, not in nm/s
+        return _UNDETERMINED.get(dimension, choices[0])
+    if value == 0 or not np.isfinite(value):
         return choices[0]
     chosen = choices[0]
     for name, size in choices:

@@ -22,11 +22,13 @@ from ..columns import with_units
 from ..errors import DataError, ParameterError
 from ..parameters import Parameters, key_dimension, load_parameters, replace
 from ..quasistatic.critical import critical_point
+from ..reprs import compact_repr
 from ..units import to_si
 from . import identify
 from .data import StickData, read_stick_data
 from .problem import JACOBIAN_STEP, SEARCH_BOX
 from .results import Estimate, human, log_interval, unusable
+from .scatter import STICK_OUTLIER_SPREADS, outlying
 from .stick_batch import stick_times
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -70,6 +72,8 @@ class StickFit:
     messages: tuple[str, ...]
     status: str = "ok"  # "failed" when the fit cannot be trusted; ``reason`` says why
     reason: str = ""
+
+    __repr__ = compact_repr  # counts, not hundreds of array elements
 
     @property
     def success(self) -> bool:
@@ -321,6 +325,8 @@ def fit_stick(
     stick keys at given values; ``free`` lists keys the user insists on
     fitting (they are fixed only if nothing else pins an undetermined direction).
     """
+    if isinstance(free, str):  # one key: iterating the string would give its characters
+        free = [free]
     data = table if isinstance(table, StickData) else read_stick_data(table)
     notes = data.notes()
     if not 0.0 < level < 1.0:
@@ -523,16 +529,13 @@ OUTLIER_FLOOR = 1e-3
 def _outliers(data: StickData, used: np.ndarray, model_t: np.ndarray) -> list[str]:
     """Rows whose stick time is off by more than 4 robust standard deviations of the others."""
     r = np.log(model_t[used] / data.stick_time[used])
-    if r.size < 4 or not np.all(np.isfinite(r)):
-        return []
-    spread = 1.4826 * float(np.median(np.abs(r - np.median(r))))
+    far, spread, _ = outlying(r, STICK_OUTLIER_SPREADS, OUTLIER_FLOOR)
     out = []
-    for row, value in zip(data.rows[used], r, strict=True):
-        if abs(value - np.median(r)) > max(4 * spread, OUTLIER_FLOOR):
-            out.append(
-                f"row {row}: the model's stick time is off by a factor {math.exp(-value):.3g}, far outside the scatter"
-                f" of the other rows ({100 * spread:.2g} %): an outlier? (--exclude-row {row} leaves it out)"
-            )
+    for row, value in zip(data.rows[used][far], r[far], strict=True):
+        out.append(
+            f"row {row}: the model's stick time is off by a factor {math.exp(-value):.3g}, far outside the scatter"
+            f" of the other rows ({100 * spread:.2g} %): an outlier? (--exclude-row {row} leaves it out)"
+        )
     return out
 
 
