@@ -111,7 +111,7 @@ def plot_phase_diagram(
         if ax is not None:
             raise ParameterError("plot_phase_diagram: a 1-D plot (y=None) draws its own figure; give no ax")
         columns = None if color == "regime" else [c.strip() for c in color.split(",") if c.strip()]
-        return figure_sweep_1d(select_rows(frame, spec, at), spec, x, columns).axes[0]
+        return figure_sweep_1d(select_rows(frame, spec, at), spec, x, columns, pinned=tuple(at or ())).axes[0]
     for option, key in (("--x", x), ("--y", y)):
         if key not in spec.keys:
             raise ParameterError(
@@ -122,7 +122,8 @@ def plot_phase_diagram(
         raise ParameterError(f"--y {y}: the same key as --x; a phase diagram needs two keys ({other})")
     if color not in frame.columns or color in NOT_RESULTS:
         choices = [c for c in frame.columns if c not in NOT_RESULTS]
-        raise ParameterError(f"--color {color}: not a column of this sweep; expected one of {', '.join(choices)}")
+        what = "not a result column to colour by" if color in frame.columns else "not a column of this sweep"
+        raise ParameterError(f"--color {color}: {what}; expected one of {', '.join(choices)}")
     frame = select_rows(frame, spec, at)
     model = get_model(spec.model)
     dimensions = model.dimensions()
@@ -317,6 +318,11 @@ def _draw_panel(
     ok = frame[frame["status"] == "ok"]
     xs, ys = (_scaled(ok[k].to_numpy(dtype=float), dimensions[k]) for k in (x, y))
     cells = _is_full_grid(xs, ys)
+    # the scales first: the limits kept below are read in them (read on linear axes, a Latin hypercube's log axes
+    # were frozen at a negative lower limit, and its points fell outside the plot)
+    for setter, on in ((ax.set_xscale, logs[0]), (ax.set_yscale, logs[1])):
+        if on:
+            setter("log")
     mappable = None
     if palette is not None:
         _draw_categories(ax, xs, ys, ok[color].astype(str).to_numpy(), cells, logs, palette)
@@ -418,6 +424,8 @@ def _edges(values: np.ndarray, log: bool) -> np.ndarray:
     w = np.log(u) if log else u
     mid = 0.5 * (w[1:] + w[:-1])
     edges = np.r_[w[0] - (mid[0] - w[0]), mid, w[-1] + (w[-1] - mid[-1])]
+    if not log and u[0] >= 0.0:  # a positive quantity's first cell stops at 0 (it reached -1.4 MPa/m of stiffness)
+        edges[0] = max(edges[0], 0.0)
     return np.exp(edges) if log else edges
 
 
@@ -468,25 +476,32 @@ def _draw_numbers(
 
 
 # --------------------------------------------------------------------------- one key
-def figure_sweep_1d(frame: Any, spec: Any, x: str, columns: Sequence[str] | None = None) -> Figure:
+def figure_sweep_1d(
+    frame: Any, spec: Any, x: str, columns: Sequence[str] | None = None, pinned: Sequence[str] = ()
+) -> Figure:
     """The results of a sweep against one varied key ``x``: one panel per column, sharing the x axis.
 
     ``columns`` default to those of :data:`ONE_KEY_COLUMNS` the sweep holds (period, peak and mean stress, or
     friction for rate-and-state).  Each point's marker has the colour of its regime (a point whose value is
     blank, such as the period of steady sliding, is absent from that panel only); failed points are grey crosses
     on the x axis.  The model's boundary on ``x`` (V0 = Vc, k = kc), where it gives one, is a dashed vertical
-    line.  The x axis is logarithmic for a log-spaced key, a y axis where its values span decades.
+    line.  The x axis is logarithmic for a log-spaced key, a y axis where its values span decades.  ``pinned``:
+    the varied keys ``frame`` was cut to one value of (``--at``): a sweep of several keys, all but x pinned, is a
+    sweep of one key.
     """
     from matplotlib.figure import Figure
 
-    if len(spec.keys) != 1 and x not in spec.keys:  # named first: a mistyped --x, not the --y left out
+    free = [k for k in spec.keys if k not in pinned]
+    if len(free) != 1 and x not in spec.keys:  # named first: a mistyped --x, not the --y left out
         raise ParameterError(f"--x {x}: not a varied key of this sweep; expected one of {', '.join(spec.keys)}")
-    if len(spec.keys) != 1:
+    if len(free) != 1:
+        others = ", ".join(k for k in free if k != x)
         raise ParameterError(
-            f"--y: this sweep varies {', '.join(spec.keys)}; give --y KEY (a plot without --y needs a sweep of one key)"
+            f"--y: this sweep varies {', '.join(spec.keys)}; give --y KEY, or pin {others} with --at KEY=VALUE"
+            " (a plot without --y needs one key left)"
         )
-    if x not in spec.keys:
-        raise ParameterError(f"--x {x}: not the varied key of this sweep; expected {spec.keys[0]}")
+    if x not in free:
+        raise ParameterError(f"--x {x}: not the varied key of this sweep; expected {free[0]}")
     chosen = _one_key_columns(frame, columns)
     model = get_model(spec.model)
     dimensions = model.dimensions()
