@@ -138,3 +138,22 @@ def test_a_puller_that_never_moves_leaves_the_block_at_rest_not_sliding(tmp_path
     assert code == 0, err
     assert "regime: stuck" in out and "the puller never moves" in out
     assert "sliding" not in out and "--stick-population" not in out
+
+
+def test_a_transient_run_the_solver_cannot_follow_keeps_what_it_computed(tmp_path, capsys):
+    """A stiff block (4 MPa/m) loaded at 100 µm/s from a steady start: at 1803 Pa after 5.08 s its resting bonds
+    give way faster than the solver can follow.  The run failed with nothing written (exit 3), and a sweep's row
+    was an "error" without results; now both keep the run up to there, status "failed"."""
+    trace = tmp_path / "fail.csv"
+    args = ["--v0", "100 um/s", "--duration", "10 s", "--start", "steady", "--set", "block.stiffness=4 MPa/m"]
+    code, out, err = run_main(capsys, "run", "--model", "transient", *args, "-o", str(trace), "--json")
+    assert code == 3 and "the run failed: transient solver failed at t = 5.08" in err
+    summary = json.loads(out)
+    assert summary["status"] == "failed" and summary["end_time"] == pytest.approx(5.08327, rel=1e-5)
+    run = Run.read(trace)
+    assert run.status == "failed" and run.time[-1] == pytest.approx(5.08327, rel=1e-5)
+    assert run.stress[-1] == pytest.approx(1803.37, rel=1e-5)
+    from stickslip.sweeps.models import get_model, run_point
+
+    row = run_point(get_model("transient"), {"pulling_velocity": 100e-6, "block.stiffness": 4e6}, {"duration": 10.0})
+    assert row["status"] == "failed" and row["mean_stress"] == pytest.approx(summary["run_mean_stress"], rel=1e-9)

@@ -28,7 +28,17 @@ class ModelError(StickslipError, ArithmeticError):
 
 
 class RunFailed(ModelError):
-    """A run started and could not go on (e.g. its state went non-finite): a failed run (exit 3), not bad input."""
+    """A run started and could not go on (e.g. its state went non-finite): a failed run (exit 3), not bad input.
+
+    ``partial`` is what the solver computed up to there (a result whose status is "failed" and whose message says
+    where it stopped), or None where the solver cannot give it."""
+
+    def __init__(self, message: str, partial: object = None) -> None:
+        super().__init__(message)
+        self.partial = partial
+
+    def __reduce__(self) -> tuple[object, ...]:  # pickled (a sweep's worker) with what it computed
+        return (type(self), (str(self), self.partial))
 
 
 def as_written(message: str, written: str) -> str:

@@ -479,8 +479,10 @@ def execute(
                 raise SystemExit(RUN_FAILED) from None
             stopped, run = exc, as_run(exc.partial, protocol)
         except RunFailed as exc:  # it ran and could not go on: a failed run (exit 3), not bad input
-            click.echo(f"stickslip: the run failed: {exc}", err=True)
-            raise SystemExit(RUN_FAILED) from None
+            if getattr(exc, "partial", None) is None:
+                click.echo(f"stickslip: the run failed: {exc}", err=True)
+                raise SystemExit(RUN_FAILED) from None
+            run = as_run(exc.partial, protocol)  # what it computed, status "failed": written and summarised below
         except (ParameterError, ModelError) as exc:
             raise type(exc)(in_run_words(str(exc), start_option)) from None
     spring = model.spring(params, checked)

@@ -170,19 +170,20 @@ def _summary(folder: Path, total: int) -> str:
     import pyarrow.dataset as ds
 
     regimes: Counter[str] = Counter()
-    errors = rows = 0
+    errors = rows = without_result = 0
     first_error = ""
     for batch in ds.dataset(folder, format="parquet").to_batches(columns=["status", "regime", "message"]):
         frame = batch.to_pydict()
         rows += len(frame["status"])
         errors += sum(s != "ok" for s in frame["status"])
+        without_result += sum(s == "error" for s in frame["status"])  # ("failed": the model ran, kept what it did)
         regimes.update(r for r, s in zip(frame["regime"], frame["status"], strict=True) if s == "ok")
         first_error = first_error or next(
             (m for m, s in zip(frame["message"], frame["status"], strict=True) if s != "ok"), ""
         )
     if rows != total:  # never report success on a folder that does not hold exactly the sweep
         raise DataError(f"{folder}: holds {rows} rows for {total} points; run the same command again to repair it")
-    if total and errors == total:  # nothing was computed: the settings every point shares, most likely
+    if total and without_result == total:  # nothing was computed: the settings every point shares, most likely
         raise ParameterError(
             f"every point of the sweep failed ({total} of {total}; {folder} holds each reason), the first:"
             f" {first_error}"

@@ -120,12 +120,20 @@ class SweepModel:
         return start(constant(velocity, duration)) if callable(start) else start
 
     def run(self, values: Mapping[str, float], settings: Mapping[str, Any]) -> dict[str, Any]:
+        from ..errors import RunFailed
+        from ..models import as_run
         from ..protocols import constant
 
         params, velocity, start = self.point(values, settings["duration"])
         protocol = constant(velocity, settings["duration"])
         taken = {k: v for k, v in settings.items() if self.takes(k)}
-        return self.model.run(params, protocol, self.rig(), start=start, **taken).row(self.results)
+        try:
+            run = self.model.run(params, protocol, self.rig(), start=start, **taken)
+        except RunFailed as exc:  # it ran and could not go on: a "failed" row of what it computed, where it says
+            if getattr(exc, "partial", None) is None:
+                raise
+            run = as_run(exc.partial, protocol)
+        return run.row(self.results)
 
     @property
     def estimates_cost(self) -> bool:

@@ -87,7 +87,8 @@ class TransientResult:
     evidence: Any = field(default=None, repr=False)
     #: the massless block's jumps through rupture cascades (transient.jump.Jump: instant, stresses, travel)
     jumps: tuple[Any, ...] = field(default=(), repr=False)
-    #: "ok", or "failed" where the model cannot continue before the protocol's end (``message`` says where)
+    #: "ok"; "failed" where the model cannot continue before the protocol's end, "stopped" at a budget (the run up
+    #: to there: ``BudgetExhausted.partial``); ``message`` says where
     status: str = "ok"
 
     @property

@@ -540,14 +540,20 @@ class _Driver:
         state, duration = self.state, self.duration
         if collapsed or not all(math.isfinite(q) for q in (state.t, state.x, state.v, state.h)):
             pace = float(np.max(self.protocol.velocities))
-            raise SolverFailed(_non_finite(state.t, self.out[:count], self.rows, pace, self.inertial, state.h))
+            failed = SolverFailed(_non_finite(state.t, self.out[:count], self.rows, pace, self.inertial, state.h))
+            try:  # the run up to its last good row, as a budget's stop keeps it (status "failed")
+                failed.partial = _finish(self, list(self.snapshots), str(failed), self.note)
+            except (ArithmeticError, ValueError, IndexError):  # rows that make no result: the message alone
+                failed.partial = None
+            raise failed
         unfinished = state.t < duration - 1e-12 * max(duration, 1.0)  # a run that got to its end is whole
         if unfinished and (state.acc[4] > self.budget or time.process_time() - self.cpu0 > self.seconds):
             cpu = time.process_time() - self.cpu0
             stopped = over_budget("transient", int(state.acc[4]), self.budget, state.t, duration,
                                   cpu=cpu if cpu > self.seconds else None, max_time=self.seconds)  # fmt: skip
             # the budget's error carries the run up to where it stopped (its message says so; regime undetermined)
-            stopped.partial = _finish(self, [*self.snapshots, _snapshot(state)], str(stopped), self.note)
+            partial = _finish(self, [*self.snapshots, _snapshot(state)], str(stopped), self.note)
+            stopped.partial = replace(partial, status="stopped")  # at its budget: not a failure of the model
             raise stopped
 
 
