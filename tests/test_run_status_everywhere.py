@@ -157,3 +157,11 @@ def test_a_transient_run_the_solver_cannot_follow_keeps_what_it_computed(tmp_pat
 
     row = run_point(get_model("transient"), {"pulling_velocity": 100e-6, "block.stiffness": 4e6}, {"duration": 10.0})
     assert row["status"] == "failed" and row["mean_stress"] == pytest.approx(summary["run_mean_stress"], rel=1e-9)
+
+
+def test_a_key_set_twice_is_refused_not_the_last_taken(capsys):
+    code, _, err = run_main(capsys, "simulate", "--set", "block.height=5 mm", "--set", "block.height=20 mm", "--v0",
+                            "50 um/s", "--duration", "10 s")  # fmt: skip
+    assert code == 2 and err.strip() == (
+        "stickslip: error: --set block.height: given twice ('5 mm', then '20 mm'); give it once"
+    )

@@ -121,6 +121,8 @@ def set_values(
     mapping: dict[str, str] = {}
     for item in items:
         key, value = key_value(item, "--set", form)
+        if key in mapping:  # which one was meant is not ours to guess (a protocol file's repeated column neither)
+            raise ParameterError(f"--set {key}: given twice ({mapping[key]!r}, then {value!r}); give it once")
         check_unit(key, value, dimension_of(key), typical_of)
         mapping[key] = value
     return mapping
