@@ -625,8 +625,9 @@ def _errors_too_small(check: _Check, adequacy: _Adequacy, free: int) -> str:
     reduced = best.chi_square / dof
     scatter = check.scatter
     text = (
-        f"warning: the stated errors (stress_err) are too small for these data: the fit's residuals are"
-        f" {math.sqrt(reduced):.3g} times them (χ²ᵣ = {reduced:.4g} with {dof} degrees of freedom, χ² test: p ="
+        f"warning: the stated errors (stress_err) are too small for these data: the first fit's residuals (every"
+        f" parameter free) are {math.sqrt(reduced):.3g} times them (χ²ᵣ = {reduced:.4g} with {dof} degrees of"
+        f" freedom, χ² test: p ="
         f" {p:.2g}), and the scatter between neighbouring points, measured without the model, is"
         f" {scatter.scale:.3g} times them; the model describes the data within that scatter (F test: p ="
         f" {best.p_value:.2g}), so the errors' scale is estimated from the residuals instead: every interval (Vc, σc,"
