@@ -269,10 +269,12 @@ def write_failed(path: Path | str, exc: OSError) -> click.ClickException:
 
 def save_figure(fig: Any, path: Path) -> None:
     """Save a matplotlib figure atomically, in the format its suffix names; I/O problems are one line."""
+    from ..plots.export import file_tick_labels
+
     path = Path(path)
     fmt = path.suffix[1:].lower() or "png"
     try:
-        with atomic_path(path, suffix=f".{fmt}") as temp:
+        with atomic_path(path, suffix=f".{fmt}") as temp, file_tick_labels(fig):  # log labels that never crowd
             fig.savefig(temp, format=fmt, dpi=120, bbox_inches="tight")
     except StickslipError:
         raise

@@ -223,6 +223,7 @@ def _summary(folder: Path, total: int) -> str:
 def plot_command(folder: Path, x: str, y: str | None, color: str, at: tuple[str, ...], output: Path | None) -> None:
     """Draw the phase diagram of the sweep in OUT, with the model's analytic stability boundary."""
     from ..fileio import atomic_path
+    from ..plots.export import file_tick_labels
     from ..plots.sweeps import keys_not_plotted, plot_phase_diagram, select_rows
     from ..sweeps import load_sweep
 
@@ -242,7 +243,7 @@ def plot_command(folder: Path, x: str, y: str | None, color: str, at: tuple[str,
     # the keys not on the axes, said here too: whoever reads only this line must know the panels' split
     note = keys_not_plotted(select_rows(frame, spec, picked), spec, x, y) if y is not None else ""
     try:
-        with atomic_path(target) as temp:
+        with atomic_path(target) as temp, file_tick_labels(ax.figure):  # log labels that never crowd
             ax.figure.savefig(temp, format=target.suffix.lstrip(".") or "png", dpi=120, bbox_inches="tight")
     except StickslipError:
         raise

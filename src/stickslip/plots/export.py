@@ -3,8 +3,14 @@
 The CSV files are read back from the matplotlib artists themselves, so they
 hold exactly what is drawn: every line and every set of points drawn in data
 coordinates (reference lines such as ``axvline`` and shaded spans are not
-curves and are skipped).  Columns are named after the axis labels; files after
-the ``gid`` a figure gave the curve, else after its legend label.
+curves and are skipped).  Columns are named after the axis labels, ``name [unit]``
+as every CSV of the package (:mod:`stickslip.columns`): a unit in parentheses
+becomes one in brackets, a label without a unit is a pure number (``[1]``), a
+panel without a label of its own takes the one of the axis it shares, of its
+column (row) of panels, or the figure's ``supxlabel`` (``supylabel``); an axis
+whose ticks are named categories writes the names, under its label alone (a
+text column).  Files are named after the ``gid`` a figure gave the curve, else
+after its legend label.
 """
 
 from __future__ import annotations
@@ -12,6 +18,8 @@ from __future__ import annotations
 import base64
 import io
 import re
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 from functools import cache
 from typing import TYPE_CHECKING, Any
@@ -90,6 +98,22 @@ def plain_log_label(label: str) -> str:
     return label
 
 
+@contextmanager
+def file_tick_labels(figure: Figure) -> Iterator[Figure]:
+    """Within the block, ``figure``'s log axes are labelled as in the package's files (plain Unicode labels,
+    :func:`plain_log_label`; minor labels that would touch others left off, :func:`uncrowded_minor_labels`);
+    its own formatters are back afterwards.  :func:`png_and_svg_bytes` draws so; for ``savefig`` elsewhere::
+
+        with file_tick_labels(fig):
+            fig.savefig(path, dpi=120, bbox_inches="tight")
+    """
+    replaced = _plain_log_labels(figure)
+    try:
+        yield figure
+    finally:
+        _restore_formatters(replaced)
+
+
 def _plain_log_labels(figure: Figure) -> list[tuple[Any, str, Any, bool]]:
     """Give every axis labelled by matplotlib's own log formatter (log and symlog scales) the same labels in
     plain Unicode (:func:`plain_log_label`); returns what to put back."""
@@ -102,7 +126,7 @@ def _plain_log_labels(figure: Figure) -> list[tuple[Any, str, Any, bool]]:
                 formatter = level.formatter
                 if type(formatter) in (LogFormatterSciNotation, LogFormatterMathtext):
                     replaced.append((level, flag, formatter, getattr(axis, flag)))
-                    level.formatter = _plain_labels_type()(formatter)
+                    level.formatter = _plain_labels_type()(formatter, minor=level is axis.minor)
     return replaced
 
 
@@ -120,16 +144,21 @@ def _plain_labels_type() -> type:
 
     class PlainLabels(Formatter):
         """``inner``'s labels through :func:`plain_log_label`; the rest is ``inner``'s (which ticks get labels,
-        the offset, the coordinates shown)."""
+        the offset, the coordinates shown).  As the ``minor`` formatter, the labels that would touch a major
+        label or each other are left off (:func:`uncrowded_minor_labels`)."""
 
-        def __init__(self, inner: Any) -> None:
+        def __init__(self, inner: Any, minor: bool = False) -> None:
             self.inner = inner
+            self.minor = minor
 
         def __call__(self, x: float, pos: int | None = None) -> str:
             return plain_log_label(self.inner(x, pos))
 
         def format_ticks(self, values: Any) -> list[str]:
-            return [plain_log_label(label) for label in self.inner.format_ticks(values)]
+            labels = [plain_log_label(label) for label in self.inner.format_ticks(values)]
+            if self.minor and any(labels):
+                labels = uncrowded_minor_labels(self.inner.axis, values, labels)
+            return labels
 
         def set_axis(self, axis: Any) -> None:
             self.inner.set_axis(axis)
@@ -147,6 +176,81 @@ def _plain_labels_type() -> type:
             return str(self.inner.format_data_short(value))
 
     return PlainLabels
+
+
+#: The least space between two tick labels, in units of the labels' font size (an em).
+LABEL_GAP_EM = 0.8
+#: Which minor labels of a log axis stay first where not all fit: those at 2 and 5 times a power of ten.
+_MINOR_ORDER = (2, 5, 3, 4, 6, 7, 8, 9)
+
+
+def uncrowded_minor_labels(axis: Any, values: Any, labels: list[str]) -> list[str]:
+    """``labels`` of a log axis's minor ticks at ``values``, less those that would overlap a major label or each
+    other, or come within :data:`LABEL_GAP_EM` of one.
+
+    matplotlib labels minor ticks where a log axis crosses at most one power of ten (at 2, 3, 4 and 6 times it
+    where it spans more than 0.4 of a decade, at all of them below): 20-500 µm/s in a panel 4 inches wide runs
+    "2×10¹3×10¹4×10¹".  Major labels are kept as they are; minor ones are kept while there is room, those at 2
+    and then 5 times a power first, then 3, 4, 6, ... .  Each label's extent along the axis is measured from the
+    font (the same metrics the renderers use, in points, so the choice is the same at any resolution).
+    """
+    from matplotlib.textpath import text_to_path
+
+    ax = axis.axes
+    horizontal = axis.axis_name == "x"
+    length = ax.bbox.width if horizontal else ax.bbox.height
+    scale = axis.get_transform()
+    low, high = scale.transform(np.asarray(axis.get_view_interval(), dtype=float))
+    if not (np.isfinite(low) and np.isfinite(high)) or high == low or length <= 0:
+        return labels
+    points_to_pixels = axis.figure.dpi / 72.0
+
+    def extents(locs: Any, texts: list[str], tick: Any) -> list[tuple[float, float]]:
+        where = (scale.transform(np.asarray(locs, dtype=float)) - low) / (high - low) * length
+        text = tick.label1
+        prop, angle = text.get_fontproperties(), np.deg2rad(text.get_rotation())
+        pad = 0.5 * LABEL_GAP_EM * prop.get_size_in_points() * points_to_pixels
+        spans = []
+        for centre, label in zip(where, texts, strict=True):
+            width, height, _ = text_to_path.get_text_width_height_descent(label, prop, ismath=False)
+            along = abs(width * np.cos(angle)) + abs(height * np.sin(angle)) if horizontal else (
+                abs(width * np.sin(angle)) + abs(height * np.cos(angle)))  # fmt: skip
+            half = 0.5 * along * points_to_pixels + pad
+            spans.append((centre - half, centre + half))
+        return spans
+
+    def shown(locs: Any) -> np.ndarray:
+        where = (scale.transform(np.asarray(locs, dtype=float)) - low) / (high - low)
+        return (where >= -1e-9) & (where <= 1 + 1e-9)
+
+    major_locs = np.asarray(axis.get_majorticklocs(), dtype=float)
+    major_locs = major_locs[shown(major_locs)] if major_locs.size else major_locs
+    major_labels = [plain_log_label(t) for t in axis.major.formatter.format_ticks(major_locs)]
+    taken = [
+        span
+        for span, text in zip(extents(major_locs, major_labels, axis.get_major_ticks(1)[0]), major_labels, strict=True)
+        if text
+    ]
+    values = np.asarray(values, dtype=float)
+    spans = extents(values, labels, axis.get_minor_ticks(1)[0])
+    candidates = [k for k, text in enumerate(labels) if text and shown(values[k : k + 1])[0]]
+    candidates.sort(key=lambda k: (_minor_rank(values[k]), k))
+    kept = [""] * len(labels)
+    for k in candidates:
+        lo, hi = spans[k]
+        if all(hi <= a or lo >= b for a, b in taken):
+            taken.append((lo, hi))
+            kept[k] = labels[k]
+    return kept
+
+
+def _minor_rank(value: float) -> int:
+    """Where a minor tick at ``value`` stands in :data:`_MINOR_ORDER` (its leading digit; others last)."""
+    size = abs(value)
+    if not np.isfinite(size) or size == 0:
+        return len(_MINOR_ORDER)
+    digit = round(size / 10.0 ** np.floor(np.log10(size) + 1e-9))
+    return _MINOR_ORDER.index(digit) if digit in _MINOR_ORDER else len(_MINOR_ORDER)
 
 
 def _pad_inches() -> float:
@@ -205,7 +309,9 @@ _TEX = {
 
 @dataclass(frozen=True)
 class Curve:
-    """One plotted curve: the x and y values as drawn, with the axis labels as column names."""
+    """One plotted curve: the x and y values as drawn, with the axis labels as column names.  On an axis of named
+    categories (tick labels set in place of numbers) ``x_text`` (``y_text``) holds each point's category, written
+    in place of the position ``x`` (``y``)."""
 
     name: str  # file stem, unique within the report
     figure_id: str
@@ -215,10 +321,14 @@ class Curve:
     y_name: str
     x: np.ndarray
     y: np.ndarray
+    x_text: tuple[str, ...] | None = None
+    y_text: tuple[str, ...] | None = None
 
     def to_csv(self) -> str:
+        xs = [_csv_field(t) for t in self.x_text] if self.x_text is not None else [_num(a) for a in self.x]
+        ys = [_csv_field(t) for t in self.y_text] if self.y_text is not None else [_num(b) for b in self.y]
         lines = [f"{_csv_field(self.x_name)},{_csv_field(self.y_name)}"]
-        lines += [f"{_num(a)},{_num(b)}" for a, b in zip(self.x, self.y, strict=True)]
+        lines += [f"{a},{b}" for a, b in zip(xs, ys, strict=True)]
         return "\n".join(lines) + "\n"
 
 
@@ -234,22 +344,115 @@ def plain_label(text: str) -> str:
     return " ".join(text.split())
 
 
-def _column(label: str, fallback: str) -> str:
-    text = plain_label(label) or fallback
-    # "sliding velocity V (µm/s)" -> "sliding velocity V [µm/s]", the units convention of the package's tables
-    return re.sub(r"\s*\(([^()]*)\)\s*$", r" [\1]", text)
+#: A unit at the end of an axis label, after a space: ``(µm/s)`` or ``[µm/s]`` (not ``ln(V/V₀)``).
+_LABEL_UNIT = re.compile(r"\s+(?:\(([^()]*)\)|\[([^\[\]]*)\])$")
+
+
+def _column(label: str, which: str) -> str:
+    """The CSV header cell of an axis labelled ``label``: ``name [unit]`` (:func:`stickslip.columns.header_cell`).
+
+    "sliding velocity V (µm/s)" -> "sliding velocity V [µm/s]"; a label without a unit names a pure number,
+    "friction σ/σc" -> "friction σ/σc [1]"; an axis without a label is "unlabelled x axis [?]" (neither a
+    bare "x" nor a unit it may not have)."""
+    from ..columns import DIMENSIONLESS, header_cell
+
+    text = plain_label(label)
+    if not text:
+        return f"unlabelled {which} axis [?]"
+    found = _LABEL_UNIT.search(text)
+    if found is None:
+        return header_cell(text, DIMENSIONLESS)
+    name, unit = text[: found.start()].strip(), (found.group(1) if found.group(1) is not None else found.group(2))
+    return header_cell(name, unit.strip() or DIMENSIONLESS) if name else header_cell(text, DIMENSIONLESS)
 
 
 def _axis_label(ax: Axes, which: str) -> str:
-    get = ax.get_xlabel if which == "x" else ax.get_ylabel
-    if get():
-        return get()
+    """``ax``'s own x (y) label; else the one of an axis it shares x (y) with, the one label of the other panels
+    of its column (row) of a grid of subplots (a stack of panels that names x under the last one), or the
+    figure's ``supxlabel`` (``supylabel``); "" when there is none."""
+    own = _label_of(ax, which)
+    if own:
+        return own
     shared = ax.get_shared_x_axes() if which == "x" else ax.get_shared_y_axes()
     for other in shared.get_siblings(ax):
-        text = other.get_xlabel() if which == "x" else other.get_ylabel()
-        if text:
-            return text
+        if _label_of(other, which):
+            return _label_of(other, which)
+    in_line = {_label_of(other, which) for other in _same_column(ax, which)} - {""}
+    if len(in_line) == 1:
+        return in_line.pop()
+    figure = ax.figure
+    while figure is not None:
+        sup = getattr(figure, "_supxlabel" if which == "x" else "_supylabel", None)
+        if sup is not None and sup.get_visible() and sup.get_text():
+            return str(sup.get_text())
+        parent = getattr(figure, "_parent", None)
+        figure = parent if parent is not figure else None
     return ""
+
+
+def _label_of(ax: Axes, which: str) -> str:
+    return str(ax.get_xlabel() if which == "x" else ax.get_ylabel())
+
+
+def _same_column(ax: Axes, which: str) -> list[Axes]:
+    """The other subplots of ``ax``'s grid in the same column (``which`` "x") or row ("y") as ``ax``."""
+    spec = ax.get_subplotspec()
+    if spec is None:
+        return []
+    lines = spec.colspan if which == "x" else spec.rowspan
+    found = []
+    for other in ax.figure.axes:
+        other_spec = other.get_subplotspec() if other is not ax else None
+        if other_spec is None or other_spec.get_gridspec() is not spec.get_gridspec():
+            continue
+        if (other_spec.colspan if which == "x" else other_spec.rowspan) == lines:
+            found.append(other)
+    return found
+
+
+def _categories(axis: Any) -> dict[float, str] | None:
+    """The category of each tick of an axis whose ticks are named (``set_xticks(positions, names)``): position ->
+    name; None for an axis of numbers (its tick labels numbers, or made by a formatter)."""
+    from matplotlib.ticker import FixedFormatter, FixedLocator, FuncFormatter
+
+    locator, formatter = axis.get_major_locator(), axis.get_major_formatter()
+    # set_ticks(positions, names) gives a FixedLocator and the names as a FuncFormatter (matplotlib >= 3.8) or a
+    # FixedFormatter
+    if not isinstance(locator, FixedLocator) or not isinstance(formatter, FixedFormatter | FuncFormatter):
+        return None
+    locs = np.asarray(locator.locs, dtype=float)
+    names = [plain_label(str(t)) for t in formatter.format_ticks(locs)]
+    if not any(names) or all(_is_number(n) for n in names if n):
+        return None
+    return dict(zip(locs.tolist(), names, strict=True))
+
+
+def _is_number(text: str) -> bool:
+    try:
+        float(text.replace(MINUS, "-"))
+    except ValueError:
+        return False
+    return True
+
+
+def _category_text(values: np.ndarray, categories: dict[float, str] | None) -> tuple[str, ...] | None:
+    """Each value's category name, where every value sits on a named tick; else None (the numbers are written)."""
+    if categories is None or values.size == 0:
+        return None
+    locs = np.array(list(categories))
+    names = list(categories.values())
+    nearest = np.abs(values[:, None] - locs[None, :]).argmin(axis=1)
+    if not np.allclose(values, locs[nearest], rtol=0.0, atol=1e-9 * max(1.0, float(np.abs(locs).max()))):
+        return None
+    texts = tuple(names[k] for k in nearest)
+    return texts if all(texts) else None
+
+
+def _category_column(label: str) -> str:
+    """A text column's header: the axis label, bare (a text column has no unit), without a unit it may carry."""
+    text = plain_label(label)
+    found = _LABEL_UNIT.search(text)
+    return (text[: found.start()].strip() if found else text) or "category"
 
 
 #: Longest curve name taken from a legend label, in characters.
@@ -291,8 +494,8 @@ def extract_curves(figure: Figure, figure_id: str) -> list[Curve]:
     panels = [ax for ax in figure.axes if ax.get_lines() or ax.collections]
     for index, ax in enumerate(panels):
         panel = chr(ord("a") + index) if len(panels) > 1 else ""
-        x_name = _column(_axis_label(ax, "x"), "x")
-        y_name = _column(_axis_label(ax, "y"), "y")
+        x_label, y_label = _axis_label(ax, "x"), _axis_label(ax, "y")
+        x_categories, y_categories = _categories(ax.xaxis), _categories(ax.yaxis)
         found: list[tuple[str, str | None, np.ndarray, np.ndarray]] = []
         labels, caps = _errorbar_parts(ax)
         for line in ax.get_lines():
@@ -315,7 +518,10 @@ def extract_curves(figure: Figure, figure_id: str) -> list[Curve]:
             while name in used:
                 name, n = f"{stem}-{n}", n + 1
             used.add(name)
-            curves.append(Curve(name, figure_id, panel, shown, x_name, y_name, x, y))
+            x_text, y_text = _category_text(x, x_categories), _category_text(y, y_categories)
+            x_name = _category_column(x_label) if x_text is not None else _column(x_label, "x")
+            y_name = _category_column(y_label) if y_text is not None else _column(y_label, "y")
+            curves.append(Curve(name, figure_id, panel, shown, x_name, y_name, x, y, x_text, y_text))
     return curves
 
 
