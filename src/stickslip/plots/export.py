@@ -120,7 +120,7 @@ def _plain_log_labels(figure: Figure) -> list[tuple[Any, str, Any, bool]]:
     from matplotlib.ticker import LogFormatterMathtext, LogFormatterSciNotation
 
     replaced: list[tuple[Any, str, Any, bool]] = []
-    for ax in figure.axes:
+    for ax in getattr(figure, "axes", ()):  # (a stand-in with only savefig, as a caller may pass, has none)
         for axis in (ax.xaxis, ax.yaxis):
             for level, flag in ((axis.major, "isDefault_majfmt"), (axis.minor, "isDefault_minfmt")):
                 formatter = level.formatter
