@@ -81,13 +81,13 @@ def test_a_run_the_model_cannot_continue_fails_with_what_it_computed(capsys):
 def test_a_sweep_point_the_model_cannot_continue_is_failed_not_ok(tmp_path, capsys):
     """A failure is never reported as success: the sweep row of that run is "failed" (its message says where the
     model stopped), counted among the failures of the summary line and drawn as one in the phase diagram."""
-    row = run_point(get_model("quasi-static"), {"pulling_velocity": 1.0}, {"duration": 3600.0})
+    row = run_point(get_model("quasi-static"), {"pulling_velocity": 1.0}, {"duration": 60.0})
     assert row["status"] == "failed" and row["regime"] == "undetermined"
     assert "no jump velocity" in row["message"]
     ok = run_point(get_model("quasi-static"), {"pulling_velocity": 50e-6}, {"duration": 60.0})
     assert ok["status"] == "ok"
     out = tmp_path / "sweep"
-    args = ["--vary", "pulling_velocity=50 um/s,1 m/s", "--duration", "1 h", "--workers", "1", "-o", str(out)]
+    args = ["--vary", "pulling_velocity=50 um/s,1 m/s", "--duration", "60 s", "--workers", "0", "-o", str(out)]
     code, text, err = run_main(capsys, "sweep", *args)
     assert code == 0, err
     assert "(1 failed)" in text + err
