@@ -288,7 +288,7 @@ def test_aging_neglect_warning_of_the_two_step_method(two_step):
         ({"method": "three-step"}, ParameterError, "method"),
         ({"intervals": "guess"}, ParameterError, "intervals"),
         ({"level": 1.5}, ParameterError, "level"),
-        ({"intervals": "profile"}, ParameterError, "needs --method joint"),
+        ({"intervals": "profile", "method": "two-step"}, ParameterError, "needs --method joint"),
         ({"split": 1.5e-3}, DataError, "need more points than parameters"),
         ({"split": 1e-2}, DataError, "no data point at or above the split"),
     ],
@@ -426,7 +426,7 @@ def test_two_step_interval_is_widened_by_its_own_bias_on_a_long_record():
     says so.  (Issue 12: 10^5 points gave [120.85, 121.00] around a truth of 124.10.)"""
     velocity = np.geomspace(140e-6, 2000e-6, 2000)
     true = steady_state(TRUE, velocity).stress
-    fit = fit_steady(SteadyData.from_arrays(velocity, true, 0.02 * true))
+    fit = fit_steady(SteadyData.from_arrays(velocity, true, 0.02 * true), method="two-step")
     vc = fit.critical_velocity
     assert abs(vc.value - VC_TRUE) > 3 * vc.stderr  # the method's bias (5.6 standard errors), not noise
     assert vc.interval[0] <= VC_TRUE <= vc.interval[1]
@@ -436,7 +436,7 @@ def test_two_step_interval_is_widened_by_its_own_bias_on_a_long_record():
 
 
 def test_estimated_noise_does_not_print_a_reduced_chi_square():
-    fit = fit_steady(noisy(5, stated=False))
+    fit = fit_steady(noisy(5, stated=False), method="two-step")
     assert fit.reduced_chi_square is None and 0.01 < fit.as_dict()["relative_noise"] < 0.04
     assert "χ²ᵣ = 1 by construction" in fit.report()
 

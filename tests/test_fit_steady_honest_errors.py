@@ -77,7 +77,7 @@ def test_right_errors_are_not_scaled_and_outliers_are_named():
 def test_two_step_bias_widens_every_interval_of_exact_data_to_the_truth():
     """Exact data: only Vc's interval took the split's bias in; tau [236.7, 248.9] us (truth 224), Va [261, 300]
     um/s (360), N0 and Delta l_m/tau excluded the truth too.  Now every reported interval contains it."""
-    fit = fit_steady(SteadyData.from_arrays(VELOCITY, EXACT, None))
+    fit = fit_steady(SteadyData.from_arrays(VELOCITY, EXACT, None), method="two-step")
     assert fit.status == "ok", fit.reason
     truth = TRUE.as_dict()
     for e in fit.estimates:

@@ -82,10 +82,11 @@ def fit_group() -> None:
 @click.argument("data", type=InputFile())
 @click.option(
     "--method",
-    type=click.Choice(["two-step", "joint"]),
-    default="two-step",
+    type=click.Choice(["auto", "two-step", "joint"]),
+    default="auto",
     show_default=True,
-    help="two-step: the paper's (no aging above --split, then aging below it); joint: everything at once.",
+    help="two-step: the paper's (no aging above --split, then aging below it); joint: everything at once; auto:"
+    " two-step, or joint where the two-step's approximation does not describe the data.",
 )
 @click.option(
     "--split", default=SPLIT_DEFAULT, show_default=True, metavar="V", help="Split velocity of the two-step fit."
@@ -188,12 +189,12 @@ def steady_command(
             click.echo(f"stickslip: warning: Bayesian fit: {posterior.messages[0]}", err=True)
     if output is not None and fit.success:
         vc, sc = fit.critical_velocity, fit.critical_stress
-        header = [f"Fitted by stickslip fit steady ({method}) to {data}; fitted keys: {', '.join(fit.free_keys)}."]
+        header = [f"Fitted by stickslip fit steady ({fit.method}) to {data}; fitted keys: {', '.join(fit.free_keys)}."]
         if vc.value is not None and sc.value is not None:
             from ..fitting.results import human  # not at module level: it imports lmfit (start-up time)
 
             header.append(f"Vc = {human(vc.value, 'velocity')}, σc = {human(sc.value, 'stress')} (Eq 9).")
-        description = f"stickslip fit steady --method {method} of {data}, start values from {params.name}"
+        description = f"stickslip fit steady --method {fit.method} of {data}, start values from {params.name}"
         _write_fitted(output, fit.parameters, f"fit of {data.name}", description, header)
     report = fit.report() if posterior is None else fit.report() + "\n" + posterior.report()
     if report_path is not None:

@@ -58,7 +58,7 @@ if TYPE_CHECKING:  # pragma: no cover
     import pandas as pd
     from matplotlib.axes import Axes
 
-METHODS = ("two-step", "joint")
+METHODS = ("auto", "two-step", "joint")
 INTERVAL_METHODS = ("delta", "profile", "bootstrap")
 DEFAULT_SPLIT = 800e-6
 #: Above the split the two-step fit neglects aging; warn when that changes sigma by more than this many errors.
@@ -426,7 +426,7 @@ def _quantile(level: float, dof: int, noise_known: bool) -> float:
 def fit_steady(
     data: SteadyData | str | Path,
     params: Parameters | str | None = None,
-    method: str = "two-step",
+    method: str = "auto",
     split: float | str = DEFAULT_SPLIT,
     fix: Mapping[str, Any] | None = None,
     free: Sequence[str] | None = None,
@@ -437,7 +437,9 @@ def fit_steady(
 ) -> SteadyFit:
     """Fit Eqs 6-8 to a steady friction curve; see the module docstring for the methods.
 
-    ``params`` gives the start values and every value not fitted (default
+    ``method``: ``two-step`` (the paper's), ``joint``, or ``auto`` (the default): the two-step fit, and the joint
+    fit instead where the two-step's split approximation does not describe the data while the model does (a
+    note says so).  ``params`` gives the start values and every value not fitted (default
     gelatin-glass); ``fix`` maps keys to values (SI numbers or strings with
     units) held fixed; ``free`` adds keys to fit (e.g. ``bonds.breakage_weight``).
     ``intervals`` chooses how the intervals of Vc and sigma_c are computed;
@@ -452,6 +454,53 @@ def fit_steady(
         data = read_steady_data(data)
     if method not in METHODS:
         raise ParameterError(f"method: expected one of {', '.join(METHODS)}, got {method!r}")
+    settings = dict(split=split, fix=fix, free=free, level=level, bootstrap_samples=bootstrap_samples, seed=seed)
+    if method != "auto":
+        return _fit_steady(data, params, method, intervals=intervals, **settings)
+    if intervals == "profile":  # the profile likelihood is the joint fit's
+        return _fit_steady(data, params, "joint", intervals=intervals, **settings)
+    paper = _fit_steady(data, params, "two-step", intervals=intervals, **settings)
+    if paper.status != "ok" and paper.reason.startswith(TWO_STEP_MISFIT):
+        why = paper.reason.split("; use --method joint")[0]
+    elif paper.status == "ok" and _shifted_by_the_split(paper):
+        why = (
+            "the two-step estimate (the paper's method) of the critical point differs from the joint fit of all"
+            " points with aging by more than chance (the split's own bias)"
+        )
+    else:
+        return paper
+    joint = _fit_steady(data, params, "joint", intervals=intervals, **settings)
+    note = (
+        f"{why}: the joint fit (every point with aging, started from the two-step result) is reported instead"
+        " (--method two-step keeps the paper's method)"
+    )
+    return dataclasses.replace(joint, messages=(note, *joint.messages))
+
+
+def _shifted_by_the_split(fit: SteadyFit) -> bool:
+    """Whether the two-step fit's interval of Vc or σc was widened for the split approximation's bias."""
+    return any(WIDENED_NOTE in e.note for e in (fit.critical_velocity, fit.critical_stress))
+
+
+#: The note of an interval widened for the two-step method's own bias.
+WIDENED_NOTE = "widened to take in the joint fit's interval"
+#: The start of the reason a two-step fit fails for its split approximation while the model describes the data.
+TWO_STEP_MISFIT = "the two-step method (no aging above the split) does not describe these data"
+
+
+def _fit_steady(
+    data: SteadyData,
+    params: Parameters | str | None,
+    method: str,
+    split: float | str,
+    fix: Mapping[str, Any] | None,
+    free: Sequence[str] | None,
+    intervals: str | None,
+    level: float,
+    bootstrap_samples: int,
+    seed: int | None,
+) -> SteadyFit:
+    """:func:`fit_steady` by one method, ``two-step`` or ``joint``."""
     auto_note = ""
     if intervals is None:
         intervals = "delta" if method == "two-step" or len(data) > PROFILE_MAX_POINTS else "profile"
@@ -623,13 +672,13 @@ def _errors_too_small(check: _Check, adequacy: _Adequacy, free: int) -> str:
     if p > SIGNIFICANCE:
         return ""
     reduced = best.chi_square / dof
-    scatter = check.scatter
+    scatter = best.scatter  # the best fit's residuals between neighbours: the noise without the model's bend
     text = (
         f"warning: the stated errors (stress_err) are too small for these data: the first fit's residuals (every"
         f" parameter free) are {math.sqrt(reduced):.3g} times them (χ²ᵣ = {reduced:.4g} with {dof} degrees of"
         f" freedom, χ² test: p ="
-        f" {p:.2g}), and the scatter between neighbouring points, measured without the model, is"
-        f" {scatter.scale:.3g} times them; the model describes the data within that scatter (F test: p ="
+        f" {p:.2g}), and the scatter of its residuals between neighbouring points is"
+        f" {scatter.scale:.3g} times them; the model describes the data within that scatter (p ="
         f" {best.p_value:.2g}), so the errors' scale is estimated from the residuals instead: every interval (Vc, σc,"
         " the parameters and the combinations) is computed with the errors scaled by √χ²ᵣ (Student-t quantiles)"
     )
@@ -736,7 +785,6 @@ class _Adequacy:
     method_fit: Misfit
     method: str
     searched: int
-    scatter: Scatter
 
     def problems(self) -> list[str]:
         m = self.model
@@ -749,7 +797,8 @@ class _Adequacy:
             return [
                 f"the model does not describe these data: its best fit ({how}) leaves an rms misfit of"
                 f" {100 * m.rms_relative:.3g} % ({m.rms_pa:.4g} Pa), {math.sqrt(m.ratio):.3g} times the noise"
-                f" measured between neighbouring points ({self.scatter.describe()}; F test: p = {m.p_value:.2g});"
+                f" measured between neighbouring points ({m.scatter.describe()}; p = {m.p_value:.2g} that noise"
+                " alone leaves this ratio);"
                 f" the largest residual is {m.worst_pa:+.4g} Pa at {human(m.worst_velocity, 'velocity')} (data"
                 f" {m.worst_stress:.4g} Pa, fit {m.worst_stress - m.worst_pa:.4g} Pa)"
             ]
@@ -762,8 +811,7 @@ class _Adequacy:
             f" leaves {100 * m.rms_relative:.3g} %"
         )
         if self.method == "two-step":
-            return [f"the two-step method (no aging above the split) does not describe these data: {misses}; use"
-                    " --method joint"]  # fmt: skip
+            return [f"{TWO_STEP_MISFIT}: {misses}; use --method joint"]
         return [
             f"the joint fit, with the parameters the data do not determine held at their input values, does not"
             f" describe these data: {misses}; start from values closer to the data (--params/--set) or --fix them"
@@ -776,7 +824,7 @@ def _misfit_of(check: _Check, params: Parameters, everything: Block, free: int) 
         model = everything.model(params)
     except (ModelError, ParameterError):
         model = np.zeros_like(d.stress)
-    return misfit(d.velocity, d.stress, d.stress_err, model, free, check.scatter)
+    return misfit(d.velocity, d.stress, d.stress_err, model, free)
 
 
 def _joint_refit(check: _Check, params: Parameters, keys: Sequence[str], everything: Block) -> Parameters:
@@ -792,10 +840,12 @@ def _joint_refit(check: _Check, params: Parameters, keys: Sequence[str], everyth
 def _judge(check: _Check, progress: _Progress, keys: Sequence[str], everything: Block, searched: int) -> _Adequacy:
     """The method's misfit and, for two-step, that of the joint refit from it (the model's own best nearby)."""
     own = _misfit_of(check, progress.params, everything, len(keys))
-    if check.method == "joint" or not own.significant:
-        return _Adequacy(own, own, check.method, searched, check.scatter)
+    if check.method == "joint":
+        return _Adequacy(own, own, check.method, searched)
+    # the model is judged by its own best fit near the two-step's (the split approximation is the method's), and
+    # so are the stated errors: the two-step's misfit on exact data is no evidence that they are too small
     joint = _misfit_of(check, _joint_refit(check, progress.params, keys, everything), everything, len(keys))
-    return _Adequacy(joint if joint.chi_square < own.chi_square else own, own, check.method, searched, check.scatter)
+    return _Adequacy(joint if joint.chi_square < own.chi_square else own, own, check.method, searched)
 
 
 def _adequate_or_searched(
@@ -830,7 +880,7 @@ def _adequate_or_searched(
         f" search box was scanned ({found.evaluations} trial parameter sets) and the fit restarted from the best"
         f" point: rms misfit now {after:.3g} %"
     )
-    return progress, keys, _Adequacy(best_model, own, check.method, found.evaluations, check.scatter)
+    return progress, keys, _Adequacy(best_model, own, check.method, found.evaluations)
 
 
 def _fit_of_a_flat_looking_curve(
@@ -1046,7 +1096,7 @@ def _widened(
     new_hi = None if hi is None or joint_hi is None else max(hi, joint_hi)
     dim, symbol, size = estimate.dimension, estimate.symbol, abs(bias) / stderr
     note = (
-        f"{estimate.note + '; ' if estimate.note else ''}widened to take in the joint fit's interval: the two-step"
+        f"{estimate.note + '; ' if estimate.note else ''}{WIDENED_NOTE}: the two-step"
         f" method's own bias {human(bias, dim, 3)} ({size:.2g} standard errors) would otherwise leave the truth outside"
     )
     if say:

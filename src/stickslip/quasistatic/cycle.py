@@ -17,7 +17,7 @@ import numpy as np
 
 from .. import regimes
 from ..columns import attribute_frame
-from ..errors import ModelError, ParameterError
+from ..errors import ModelError, ParameterError, RunFailed
 from ..parameters import Parameters
 from ..reprs import compact_repr, field_values
 from ..trace_columns import QUASI_STATIC
@@ -299,6 +299,12 @@ def simulate(
     stiffness = params.block.effective_stiffness
     phases = _Phases(params, v0, jump_curve, end)
     regime, message, period = _outlook(phases, sigma0, sigma_c)
+    if regime == regimes.STUCK and v0 >= float(cp.velocity):
+        # the stick chains' limitation above Vc says nothing of the slip: a block already sliding stays there
+        message += (
+            f"; V0 is above Vc = {float(cp.velocity) * 1e6:.6g} µm/s, where steady sliding is stable: a block"
+            " already sliding at V0 stays there (stickslip transient --start steady)"
+        )
     trace = _Trace(sigma0, stiffness, v0, end)
     if period is not None:
         repeat = phases.cycle(sigma_c)
@@ -337,7 +343,10 @@ def simulate(
         cycles[-1] = dataclasses.replace(cycles[-1], slip_time=slip.duration, period=stick.stick_time + slip.duration)
         sigma = sigma_c
     if regime == regimes.STICK_SLIP:
-        message += f"; {sum(c.period is not None for c in cycles)} whole cycle(s) in {end:.6g} s"
+        whole = sum(c.period is not None for c in cycles)
+        message += f"; {whole} whole cycle(s) in {end:.6g} s"
+        if not whole:  # the numbers above are the cycle the run heads for, not one it has seen
+            message += " (the period and σs are its cycle's once settled, from σc: the run ends before one)"
     elif regime == regimes.STUCK and cycles:
         message += f" (after {len(cycles)} slip(s))"
     columns = trace.build()
@@ -391,7 +400,12 @@ def _without_critical_point(
     else:  # the puller stands still: nothing loads the block
         sigma, rising = 0.0, True
     if not rising:  # velocity-weakening at V0 with no minimum: neither steady sliding nor a cycle to follow
-        raise ModelError(f"no stick-slip cycle: {cp.message}")
+        # valid parameters on which the quasi-static picture has no answer: a failed run (exit 3), not bad input
+        raise RunFailed(
+            f"no answer from the quasi-static model: {cp.message}; steady sliding at V0 would be unstable, and a"
+            " stick has no branch to jump onto, so neither steady sliding nor a stick-slip cycle exists here (the"
+            " time-dependent model, stickslip transient or --model transient, integrates Eq 1 without that picture)"
+        )
     if start_stress is not None:
         # a stick from a given stress ends in a jump onto the curve's right branch, which starts at Vc
         raise ModelError(
