@@ -333,6 +333,7 @@ def parameters_from_mapping(data: Mapping[str, Any], source: str = "parameters")
                 dimension = key_dimension(key)
             except ParameterError as exc:  # an unknown key: named with the file it is in
                 raise ParameterError(f"{source}: {exc}") from None
+            _refuse_quoted_number(raw, dimension, f"{source}: {key}", name)
             values[key] = to_si(raw, dimension, f"{source}: {key}")
             written[key] = raw
     missing = [k for k in parameter_keys() if k not in values and k not in optional_keys()]
@@ -342,6 +343,22 @@ def parameters_from_mapping(data: Mapping[str, Any], source: str = "parameters")
         return _build(values, **meta)
     except ParameterError as exc:  # a value out of range: named with its file, as written and in SI
         raise ParameterError(f"{source}: {_written_and_si(str(exc), written, values)}") from None
+
+
+def _refuse_quoted_number(raw: Any, dimension: str, where: str, name: str) -> None:
+    """``bond_time = "224"``: a quoted value is text with its unit, as on the command line; a quoted bare non-zero
+    number of a dimensional key is refused (unquoted, ``bond_time = 224``, a number is SI)."""
+    from .units import DIMENSIONS, bare_number, quantity_noun
+
+    number = bare_number(raw) if isinstance(raw, str) else None
+    if dimension == "dimensionless" or number is None or number == 0 or not math.isfinite(number):
+        return
+    si = DIMENSIONS[dimension][1]
+    typed = raw.strip()
+    raise ParameterError(
+        f"{where}: {shorten(typed)} is a quoted number without a unit; {quantity_noun(dimension)} needs one,"
+        f' e.g. {name} = "{typed} {si}" (or {name} = {typed}, unquoted, for a number in SI units, {si})'
+    )
 
 
 def _written_and_si(message: str, written: Mapping[str, Any], values: Mapping[str, float]) -> str:

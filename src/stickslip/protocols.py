@@ -207,6 +207,11 @@ def parse_segment(text: str, name: str = "--segment") -> Segment:
     velocity_text, sep, duration_text = str(text).rpartition(":")
     if not sep or not velocity_text.strip() or not duration_text.strip():
         raise ParameterError(f"{name} {text!r}: expected VELOCITY:DURATION, e.g. '100 um/s:10 s'")
+    if ":" in velocity_text:
+        raise ParameterError(
+            f"{name} {text!r}: expected VELOCITY:DURATION (two fields, one colon), got {text.count(':') + 1}"
+            " fields; e.g. '100 um/s:10 s'"
+        )
     velocity = to_si(velocity_text.strip(), "velocity", f"{name} velocity")
     duration = to_si(duration_text.strip(), "time", f"{name} duration")
     try:
@@ -239,6 +244,32 @@ def _refuse_duplicated_columns(text: str, path: Path) -> None:
             return
 
 
+def _refuse_extra_fields(text: str, sep: str, path: Path) -> None:
+    """A data row with more fields than the header (``0,350e-6,5`` under ``time,velocity``) is refused naming
+    that row: pandas would take its first field for an index and blame a later row."""
+    import csv
+
+    from .units import shorten
+
+    header: list[str] | None = None
+    for number, line in enumerate(text.split("\n"), 1):
+        kept = line.split("#", 1)[0]
+        if not kept.strip():
+            continue
+        try:
+            fields = next(csv.reader([kept.rstrip("\r")], delimiter=sep))
+        except (csv.Error, StopIteration):
+            return  # a quoted line end: left to the CSV reader
+        if header is None:
+            header = fields
+        elif len(fields) > len(header):
+            names = ",".join(f.strip() for f in header)
+            raise DataError(
+                f"{path}: row {number}: expected {len(header)} fields ({names}), got {len(fields)}:"
+                f" {shorten(kept.strip())}"
+            )
+
+
 def read_protocol(path: str | Path) -> Protocol:
     """A protocol from a CSV file.
 
@@ -266,10 +297,11 @@ def read_protocol(path: str | Path) -> Protocol:
     protect_inputs([path])  # in a command, no output may replace the protocol
     if not text.strip():
         raise DataError(f"{path}: empty file, expected a CSV with columns time,velocity or velocity,duration")
+    # the separator from the header (pandas' sniffer took the "t" of a lone "time" column for one)
+    header = next((line for line in text.splitlines() if line.strip() and not line.lstrip().startswith("#")), "")
+    sep = "\t" if "\t" in header else ";" if header.count(";") > header.count(",") else ","
+    _refuse_extra_fields(text, sep, path)
     try:
-        # the separator from the header (pandas' sniffer took the "t" of a lone "time" column for one)
-        header = next((line for line in text.splitlines() if line.strip() and not line.lstrip().startswith("#")), "")
-        sep = "\t" if "\t" in header else ";" if header.count(";") > header.count(",") else ","
         frame = pd.read_csv(io.StringIO(text), sep=sep, comment="#", nrows=1_000_000)
     except (ValueError, csv.Error, pd.errors.ParserError) as exc:  # csv.Error: no delimiter could be found
         raise DataError(f"{path}: cannot read as CSV ({(str(exc).splitlines() or [''])[0]})") from None

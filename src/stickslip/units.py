@@ -137,6 +137,23 @@ def quantity_noun(dimension: str) -> str:
     return _NOUNS.get(dimension, f"a {dimension.replace('_', ' ')}")
 
 
+#: A value of each dimension as a message shows one (``e.g. '20 s'``); others: 1 of the SI unit.
+_EXAMPLES = {
+    "dimensionless": "0.5",
+    "time": "20 s",
+    "length": "10 um",
+    "velocity": "350 um/s",
+    "rate": "0.1 1/s",
+    "stress": "5 kPa",
+    "temperature": "300 K",
+}
+
+
+def example_value(dimension: str) -> str:
+    """``"'20 s'"``: a value of ``dimension`` written as a number and a unit, quoted, for a message's e.g."""
+    return repr(_EXAMPLES.get(dimension) or f"1 {DIMENSIONS[dimension][1]}")
+
+
 def _describe(dimension: str) -> str:
     unit = DIMENSIONS[dimension][1]
     return quantity_noun(dimension) + (f" (e.g. in {unit})" if unit else "")
@@ -211,12 +228,13 @@ def _string_to_si(text: str, dimension: str, name: str) -> float:
     if not _readable_unit(unit):
         raise UnitError(
             f"{name}: cannot read {shorten(stripped)} as {_describe(dimension)}:"
-            " expected a number and a unit, e.g. '350 um/s' (digits in a unit only as small exponents, m^2)"
+            f" expected a number and a unit, e.g. {example_value(dimension)}"
+            " (digits in a unit only as small exponents, m^2)"
         )
     if match is None:  # "um/s" alone is a unit, not a value: reading it as 1 um/s would hide a forgotten number
         raise UnitError(
             f"{name}: {shorten(stripped)} has no number; expected {_describe(dimension)} written as a number"
-            " and a unit, e.g. '350 um/s'"
+            f" and a unit, e.g. {example_value(dimension)}"
         )
     fast = _fast_unit(unit)
     if fast is not None:

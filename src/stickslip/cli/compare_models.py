@@ -29,17 +29,35 @@ FAILED = 3
 def model_list(text: str) -> list[Any]:
     """The models of ``--models A,B``: at least two, each named once."""
     from ..models import get_model
+    from ..models.base import checked_dimensions
 
     names = [n.strip() for n in text.split(",") if n.strip()]
     if len(names) < 2:
         raise ParameterError(f"--models {shorten(text)}: expected two or more models, e.g. --models quasi-static,rsf")
     models = [get_model(n) for n in names]
+    for model in models:  # a plug-in's key of an unknown dimension: refused before anything is read
+        checked_dimensions(model)
     seen: dict[str, str] = {}
     for given, model in zip(names, models, strict=True):
         if model.name in seen:
             raise ParameterError(f"--models: {seen[model.name]} and {given} are the same model ({model.name})")
         seen[model.name] = given
     return models
+
+
+def merged_units(top: dict[str, str], each: list[dict[str, str]]) -> dict[str, str]:
+    """The top-level ``units`` map: the top-level numbers' units, then every key of the models' own maps
+    (:func:`~stickslip.cli.run_cmd.summary_units`, the one table) on which they agree.  A key of another unit in
+    another model (a spring: Pa/m in one, 1/m in rate-and-state) is left to each model's own map."""
+    units = dict(top)
+    seen: dict[str, set[str]] = {}
+    for own in each:
+        for key, unit in own.items():
+            seen.setdefault(key, set()).add(unit)
+    for key, found in seen.items():
+        if key not in units and len(found) == 1:
+            units[key] = next(iter(found))
+    return dict(sorted(units.items()))
 
 
 def routed_overrides(models: list[Any], overrides: tuple[str, ...]) -> dict[str, dict[str, str]]:
@@ -141,9 +159,9 @@ def compare_models(options: dict[str, Any]) -> None:
         "models": summaries,
         "status": "ok" if all(r.status == "ok" for r in runs.values()) else "failed",
     }
-    # the top-level map names the top-level numbers only: one map over every model would give one unit to a key
-    # that is Pa/m in one model and 1/m in another
-    document["units"] = json_units({k: v for k, v in document.items() if k != "models"})
+    document["units"] = merged_units(
+        json_units({k: v for k, v in document.items() if k != "models"}), [s["units"] for s in summaries.values()]
+    )
     if options["as_json"]:
         emit_json(document)
     else:

@@ -66,8 +66,11 @@ def output_options(func: Any) -> Any:
 
 def load_model(model_name: str) -> Any:
     from ..models import get_model
+    from ..models.base import checked_dimensions
 
-    return get_model(model_name)
+    model = get_model(model_name)
+    checked_dimensions(model)  # a plug-in's key of an unknown dimension: refused before anything is read
+    return model
 
 
 def model_overrides(model: Any, overrides: tuple[str, ...]) -> dict[str, str]:

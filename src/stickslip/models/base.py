@@ -24,7 +24,7 @@ if TYPE_CHECKING:  # pragma: no cover
     from ..protocols import Protocol
     from .run import Run
 
-__all__ = ["CONTROLS", "CYCLE_RESULTS", "Boundary", "Capabilities", "FrictionModel", "Rig"]
+__all__ = ["CONTROLS", "CYCLE_RESULTS", "Boundary", "Capabilities", "FrictionModel", "Rig", "checked_dimensions"]
 
 #: The results of a sweep row every cycle model reports (SI), beside the inputs, status, message and wall time.
 CYCLE_RESULTS: Mapping[str, str] = {
@@ -99,6 +99,22 @@ class Boundary:
     x: np.ndarray
     y: np.ndarray
     label: str
+
+
+def checked_dimensions(model: Any) -> dict[str, str]:
+    """``model.dimensions()``, each a :data:`stickslip.units.DIMENSIONS` name; a plug-in's key of another
+    dimension is refused in one line naming the model, the key, the dimension and the known ones."""
+    from ..units import DIMENSIONS
+
+    dimensions = dict(model.dimensions())
+    for key, dimension in dimensions.items():
+        if not isinstance(dimension, str) or dimension not in DIMENSIONS:
+            known = ", ".join(sorted(DIMENSIONS))
+            raise ParameterError(
+                f"model {getattr(model, 'name', model)!r}: key {key!r} has dimension {dimension!r},"
+                f" not a known dimension; expected one of {known}"
+            )
+    return dimensions
 
 
 class FrictionModel(ABC):

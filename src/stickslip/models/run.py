@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import io
 import json
+import os
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -318,7 +319,9 @@ class Run:
         from ..columns import split_header
         from ..fileio import read_input_text
 
-        text = read_input_text(path, "run", 1 << 31)
+        if not isinstance(path, (str, os.PathLike)):
+            raise DataError(f"run file: expected a path, got {type(path).__name__}")
+        text = read_input_text(path, f"run file {path}", 1 << 31)
         first, _, body = text.partition("\n")
         meta: dict[str, Any] = {}
         if first.startswith(CSV_MARK):

@@ -65,6 +65,7 @@ def build_spec(
     model = _model_name(model)
     adapter = get_model(model)
     adapter.check_available()
+    adapter.key_units()  # a plug-in's key of an unknown dimension is refused here, before any value is read
     dimensions = adapter.dimensions()
     seed = _whole(seed, "seed", minimum=0)
     samples = None if samples is None else _whole(samples, "samples", minimum=1)

@@ -54,17 +54,11 @@ class SweepModel:
         """The SI unit of each of the model's keys, from its own ``dimensions()`` (a plug-in's keys are unknown to
         the package's column registry, so their units must come from the model)."""
         from ..columns import DIMENSIONLESS
+        from ..models.base import checked_dimensions
         from ..units import DIMENSIONS
 
-        units: dict[str, str | None] = {}
-        for key, dimension in self.dimensions().items():
-            if dimension not in DIMENSIONS:
-                known = ", ".join(sorted(DIMENSIONS))
-                raise ParameterError(
-                    f"model {self.name!r}: key {key!r} has dimension {dimension!r}; expected one of {known}"
-                )
-            units[key] = DIMENSIONS[dimension][1] or DIMENSIONLESS
-        return units
+        dimensions = {**PROTOCOL_KEYS, **checked_dimensions(self.model)}
+        return {key: DIMENSIONS[dimension][1] or DIMENSIONLESS for key, dimension in dimensions.items()}
 
     def check_available(self) -> None:
         self.model.check_available()
