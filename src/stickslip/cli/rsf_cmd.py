@@ -150,6 +150,9 @@ def _run_meta(path: Path) -> tuple[list[dict[str, Any]] | None, float | None]:
     """The protocol and start velocity a ``.params.json`` of an earlier run carries (None where absent)."""
     data = load_params_file(path)
     protocol, start = data.get("protocol"), data.get("start_velocity")
+    fitted = data.get("fit")
+    if protocol is None and isinstance(fitted, dict) and fitted.get("protocol") is not None:
+        protocol = fitted["protocol"]  # a fit's file written before the history was put beside its parameters
     if protocol is not None:
         rows = protocol if isinstance(protocol, list) else None
         if rows is None or not all(isinstance(r, dict) and {"velocity", "duration"} <= set(r) for r in rows):
@@ -489,7 +492,7 @@ def fit_command(**options: Any) -> None:
     report["cost"] = {"seconds": elapsed, "estimated_seconds": cost.seconds, "model_run_seconds": cost.run_seconds,
                       "estimated_model_runs": cost.runs}  # fmt: skip
     if output is not None and fit.status == "ok":
-        as_parameters = json_text({"parameters": fit.params.to_dict(), "fit": report})
+        as_parameters = json_text({**fit.rerun_mapping(), "fit": report})  # what `rsf simulate --params` reads
         if output.suffix.lower() == ".json":  # what its name says: the JSON `--params` reads (no TOML inside)
             write_text(output, as_parameters)
         else:

@@ -86,10 +86,7 @@ class LabRecord:
         if t.size < 10:
             raise DataError(f"{source}: {t.size} data row(s); expected at least 10 to fit a record")
         row = _row_names(rows, t.size)
-        for name, col in (("time", t), ("displacement", d), ("friction", f)):
-            bad = ~np.isfinite(col)
-            if bad.any():
-                raise DataError(f"{source}: row {row[int(np.argmax(bad))]}: {name} is not a finite number")
+        refuse_nonfinite(source, row, {"time": t, "displacement": d, "friction": f})
         step = np.diff(t)
         if np.any(step <= 0):
             i = int(np.argmax(step <= 0)) + 1
@@ -184,7 +181,10 @@ def read_record(
         written = units.get("displacement") or option["length"]
         column = chosen["displacement"]
     else:
-        displacement = _integrated(time, in_si("velocity"), path, rows)
+        velocity = in_si("velocity")  # every column's first bad row before the velocity is integrated
+        refuse_nonfinite(str(path), _row_names(rows, time.size),
+                         {"time": time, "velocity": velocity, "friction": data["friction"]})  # fmt: skip
+        displacement = _integrated(time, velocity, path, rows)
         speed_unit = units.get("velocity")
         written = _length_of(speed_unit) if speed_unit is not None else option["length"]
         column = chosen["velocity"]
@@ -216,6 +216,26 @@ def _numbers(column: Any, path: Path, rows: Any, pd: Any) -> np.ndarray:
         raise DataError(f"{path}: row {_row_names(rows, values.size)[i]}, column {str(column.name)!r}: {cell!r} is "
                         f"not a number{hint}")  # fmt: skip
     return values
+
+
+def refuse_nonfinite(source: str, row: Any, columns: dict[str, np.ndarray]) -> None:
+    """DataError at the first row (in the file's order) where any column is not a finite number, naming every
+    column bad there and, where more rows are bad, how many and where each column's first bad value is."""
+    bad = {name: ~np.isfinite(col) for name, col in columns.items()}
+    anywhere = np.logical_or.reduce(list(bad.values()))
+    if not anywhere.any():
+        return
+    first = int(np.argmax(anywhere))
+    names = [name for name, mask in bad.items() if mask[first]]
+    verb = "is not a finite number" if len(names) == 1 else "are not finite numbers"
+    text = f"{source}: row {row[first]}: {' and '.join(names)} {verb}"
+    count = int(np.count_nonzero(anywhere))
+    if count > 1:
+        firsts = sorted((int(np.argmax(mask)), name, int(np.count_nonzero(mask))) for name, mask in bad.items()
+                        if mask.any())  # fmt: skip
+        where = [f"{name} at row {row[i]}" if n == 1 else f"{name} in {n} from row {row[i]}" for i, name, n in firsts]
+        text += f" ({count} rows in all: {', '.join(where)})"
+    raise DataError(text)
 
 
 def _row_names(rows: Any, size: int) -> Any:
@@ -376,10 +396,7 @@ def _refuse_implausible_speed(record: LabRecord, column: str, written: tuple[flo
 
 def _integrated(time: np.ndarray, velocity: np.ndarray, path: Path, rows: Any = None) -> np.ndarray:
     """Displacement from the load point's velocity column (in SI): row i's velocity holds on [t_i, t_(i+1))."""
-    bad = ~np.isfinite(velocity)
-    if bad.any():
-        raise DataError(f"{path}: row {_row_names(rows, velocity.size)[int(np.argmax(bad))]}: velocity is not a "
-                        "finite number")  # fmt: skip
+    refuse_nonfinite(str(path), _row_names(rows, velocity.size), {"velocity": velocity})
     if velocity.size < 2:
         return np.zeros_like(velocity)
     return np.concatenate([[0.0], np.cumsum(velocity[:-1] * np.diff(time))])

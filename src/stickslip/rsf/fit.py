@@ -38,6 +38,10 @@ WARN_CHI2 = 2.0
 #: an F test at this level decides whether the friction responds to velocity at all
 NO_RESPONSE_LEVEL = 1e-3
 NO_RESPONSE_TEXT = "the friction shows no significant response to the velocity changes"
+#: the start of the reason when the friction varies beyond its noise and the law fitted does not describe it
+MISFIT_TEXT = "{law} does not describe the record"
+#: the start of the reason when the law fits to the noise but not significantly better than constant friction
+WEAK_RESPONSE_TEXT = "the friction's response to the velocity changes is not significant"
 _CORE = ("a", "b", "dc")
 #: with chi-square_r > WARN_CHI2, a fit fails when a linear drift (in slip and time) explains this share of the
 #: residuals: the intervals cannot hold while the model misses a drift
@@ -152,6 +156,18 @@ class RSFFit:
         starts = self.protocol.boundaries
         return [{"start": float(t), "velocity": s.velocity / scale, "duration": s.duration, "unit": f"{unit}/s"}
                 for t, s in zip(starts, self.protocol.segments, strict=False)]  # fmt: skip
+
+    def rerun_mapping(self) -> dict[str, Any]:
+        """What ``rsf simulate --params`` reads to rerun the fitted model (SI): ``parameters``, the fitted history
+        as ``protocol`` ([{velocity, duration}]) and ``start_velocity`` (the fit starts in steady sliding at the
+        first velocity).  The drift terms (``trend``, ``time_trend``) are no part of the spring-slider: a rerun is
+        the model friction without them."""
+        return {
+            "model": "rate-and-state spring-slider",
+            "parameters": self.params.to_dict(),
+            "start_velocity": self.protocol.initial_velocity,
+            "protocol": [{"velocity": s.velocity, "duration": s.duration} for s in self.protocol.segments],
+        }
 
     def summary(self) -> dict[str, Any]:
         """The report as JSON: SI throughout (m, 1/m, m/s; ``units`` says so); the text keeps the record's unit."""
@@ -355,11 +371,13 @@ def fit_record(
     problems = _problems(result, record, resid, table, level, setup)
     if setup.states == 2 and not problems:
         problems += _second_state_problems(setup, start, result)
-    if any(p.startswith(NO_RESPONSE_TEXT) for p in problems):  # then no interval of the friction law means anything
-        why = "the friction shows no velocity dependence"
+    why = _law_not_determined(problems, setup.laws)
+    if why:  # then no interval of the friction law means anything
         for key in ("a", "b", "dc", "b2", "dc2", "stiffness"):
             if key in table and not table[key].fixed:
                 table[key] = replace(table[key], interval=None, scaled_interval=None, constrained=False, note=why)
+        if not derived["a-b"].fixed:
+            derived["a-b"] = replace(derived["a-b"], interval=None, scaled_interval=None, constrained=False, note=why)
     if mismatch:
         problems.insert(0, mismatch)
     drift = _residual_drift(record, resid)
@@ -710,6 +728,8 @@ class _Level:
     method: str
     n_eff: float
     inflation: float
+    #: the noise of each row the fit is judged by (the steady sliding's per sampling rate, or the given level)
+    rows: np.ndarray | None = None
 
 
 def _sampling_classes(time: np.ndarray) -> np.ndarray:
@@ -868,7 +888,7 @@ def _uncertainty(
         redchi = float(np.sum((resid / given) ** 2) / dof)
         if setup.weights is not None:
             _set_covariance(result, _sandwich(setup, base, result, np.full(n, given**2)))
-        return _Level(given, redchi, "given", float(n), 1.0)
+        return _Level(given, redchi, "given", float(n), 1.0, np.full(n, float(given)))
     dc = math.exp(result.params["log_dc"].value)
     rows, how = _quiet_noise(record, setup.protocol, dc, labels)
     redchi = float(np.sum((resid / rows) ** 2) / dof)
@@ -881,7 +901,7 @@ def _uncertainty(
     n_eff = float(np.sum(1.0 / g))
     method = (f"fit judged against the {how}; intervals from the residuals' own scatter and autocorrelation "
               f"(effective independent rows {n_eff:.4g} of {n})")  # fmt: skip
-    return _Level(float(np.sqrt(np.mean(rows**2))), redchi, method, n_eff, n / n_eff)
+    return _Level(float(np.sqrt(np.mean(rows**2))), redchi, method, n_eff, n / n_eff, rows)
 
 
 def _sandwich(setup: _Setup, base: RSFParams, result: Any, variance: np.ndarray) -> np.ndarray | None:
@@ -1463,10 +1483,7 @@ def _problems(
         problems.append("a, b and Dc did not move from their starting values")
     p_value = _response_p_value(result, record, resid, setup.trend, level.inflation)
     if p_value > NO_RESPONSE_LEVEL:
-        problems.append(
-            f"{NO_RESPONSE_TEXT} (F test against constant friction"
-            f"{' with the trends' if setup.trend else ''}: p = {p_value:.2g}), so a, b and Dc are not determined"
-        )
+        problems.append(_no_response_problem(record, resid, setup, level, p_value))
     loose = [f"{k} ({table[k].note})" for k in _CORE if not table[k].constrained]
     if loose:
         problems.append("not constrained by the record: " + ", ".join(loose))
@@ -1482,6 +1499,80 @@ def _problems(
 
 #: a second state variable is kept where the F test against the one-state fit gives p below this
 SECOND_STATE_LEVEL = 1e-3
+
+
+def _constant_chi2(record: LabRecord, trend: frozenset[str], rows: np.ndarray) -> float:
+    """Reduced chi-square of constant friction (plus the fit's trends) against the noise of each row."""
+    columns = [np.ones(len(record))] + ([record.displacement] if "slip" in trend else [])
+    columns += [record.time] if "time" in trend else []
+    design = np.column_stack(columns)
+    coef, *_ = np.linalg.lstsq(design, record.friction, rcond=None)
+    null = record.friction - design @ coef
+    return float(np.sum((null / rows) ** 2) / max(len(record) - design.shape[1], 1))
+
+
+def _lag_one(resid: np.ndarray) -> float:
+    """The residuals' lag-one autocorrelation (near 0 for white noise, near 1 for a misfit's smooth structure)."""
+    r = resid - float(np.mean(resid))
+    total = float(np.sum(r**2))
+    return float(np.sum(r[1:] * r[:-1]) / total) if total > 0 else 0.0
+
+
+def _other_laws(laws: tuple[str, ...]) -> str:
+    """The ``--law`` options of the built-in laws not fitted, for a misfit's reason."""
+    others = [name for name in ("aging", "slip", "prz") if name not in laws]
+    return " or ".join(f"--law {name}" for name in others)
+
+
+def _law_words(laws: tuple[str, ...]) -> str:
+    """``the aging law``, ``the aging and slip laws``."""
+    names = list(dict.fromkeys(laws))
+    return f"the {' and '.join(names)} law{'s' if len(names) > 1 else ''}"
+
+
+def _law_not_determined(problems: list[str], laws: tuple[str, ...]) -> str:
+    """The note for a, b, Dc and the stiffness when no interval of the friction law means anything (the fit is no
+    better than constant friction), in the words of the reason; '' otherwise."""
+    for problem in problems:
+        if problem.startswith(NO_RESPONSE_TEXT):
+            return "the friction shows no velocity dependence"
+        if problem.startswith(MISFIT_TEXT.format(law=_law_words(laws))):
+            return MISFIT_TEXT.format(law=_law_words(laws))
+        if problem.startswith(WEAK_RESPONSE_TEXT):
+            return WEAK_RESPONSE_TEXT
+    return ""
+
+
+def _no_response_problem(record: LabRecord, resid: np.ndarray, setup: _Setup, level: _Level, p_value: float) -> str:
+    """Why a fit no better than constant friction fails: constant friction describes the record to within its noise
+    (no velocity dependence), or the friction does vary but the law fitted does not describe how (a misfit)."""
+    trends = " with the trends" if setup.trend else ""
+    rows = level.rows if level.rows is not None else np.full(len(record), level.noise)
+    constant = _constant_chi2(record, setup.trend, rows)
+    if constant <= WARN_CHI2:
+        return (
+            f"{NO_RESPONSE_TEXT}: constant friction{trends} describes the record to within its noise (reduced "
+            f"chi-square {constant:.3g} against the noise {level.noise:.2g}; F test of the fit against it: p = "
+            f"{p_value:.2g}), so a, b and Dc are not determined"
+        )
+    if level.redchi > WARN_CHI2:
+        others = _other_laws(setup.laws)
+        return (
+            f"{MISFIT_TEXT.format(law=_law_words(setup.laws))}: its residuals are {math.sqrt(level.redchi):.3g} "
+            f"times the noise {level.noise:.2g} (reduced chi-square {level.redchi:.3g}) and structured (lag-one "
+            f"autocorrelation {_lag_one(resid):.3f}), while the friction varies well beyond its noise (constant "
+            f"friction{trends}: reduced chi-square {constant:.3g}), and the fit is no significant improvement on "
+            f"constant friction (F test: p = {p_value:.2g}); so a, b and Dc are not determined; "
+            + (f"fit another law ({others}), or " if others else "")
+            + "check the load-point history (--segment, --protocol) and that the friction follows the velocity "
+            "changes"
+        )
+    return (
+        f"{WEAK_RESPONSE_TEXT} against its correlated noise (F test"
+        f" against constant friction{trends}: p = {p_value:.2g}, with {level.n_eff:.3g} effective independent rows"
+        f" of {len(record)}), though constant friction misses the record (reduced chi-square {constant:.3g}); so "
+        "a, b and Dc are not determined"
+    )
 
 
 def _second_state_problems(setup: _Setup, start: dict[str, float], result: Any) -> list[str]:
