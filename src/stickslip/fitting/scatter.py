@@ -134,10 +134,27 @@ def misfit_p_value(velocity: np.ndarray, stress_err: np.ndarray | None, ratio: f
     if n > DRAWN_POINTS:
         sd = math.sqrt(max(2.0 / scatter.dof - 2.0 / n, 2.0 / n**2)) if scatter.dof > 0 else math.inf
         return float(stats.norm.sf((ratio - 1.0) / sd))
-    z = np.random.default_rng(20261130).standard_normal((DRAWS, n))
-    pseudo = c0 * z[:, :-2] + c1 * z[:, 1:-1] + c2 * z[:, 2:]
-    null = (np.einsum("ij,ij->i", z, z) / n) / (np.einsum("ij,ij->i", pseudo, pseudo) / (n - 2))
-    return float((1 + np.count_nonzero(null >= ratio)) / (1 + DRAWS))
+    null = _null_ratios(c0, c1, c2)
+    above = DRAWS - int(np.searchsorted(null, ratio, side="left"))
+    return float((1 + above) / (1 + DRAWS))
+
+
+_NULLS: dict[bytes, np.ndarray] = {}
+
+
+def _null_ratios(c0: np.ndarray, c1: np.ndarray, c2: np.ndarray) -> np.ndarray:
+    """The misfit ratio's draws under pure noise for these neighbour weights, sorted (one fit asks several
+    times for the same points: remembered for the last few sets)."""
+    key = np.concatenate((c0, c1, c2)).tobytes()
+    if key not in _NULLS:
+        n = c1.size + 2
+        z = np.random.default_rng(20261130).standard_normal((DRAWS, n))
+        pseudo = c0 * z[:, :-2] + c1 * z[:, 1:-1] + c2 * z[:, 2:]
+        null = (np.einsum("ij,ij->i", z, z) / n) / (np.einsum("ij,ij->i", pseudo, pseudo) / (n - 2))
+        if len(_NULLS) >= 8:
+            _NULLS.pop(next(iter(_NULLS)))
+        _NULLS[key] = np.sort(null)
+    return _NULLS[key]
 
 
 #: Robust standard deviations (1.4826 x the median absolute deviation) beyond which a point is named as a

@@ -467,6 +467,10 @@ def fit_steady(
             "the two-step estimate (the paper's method) of the critical point differs from the joint fit of all"
             " points with aging by more than chance (the split's own bias)"
         )
+    elif paper.status == "ok" and any(m.startswith(SPLIT_MISFIT_NOTE) for m in paper.messages):
+        note = next(m for m in paper.messages if m.startswith(SPLIT_MISFIT_NOTE))
+        measured = note.removeprefix(SPLIT_MISFIT_NOTE + ": ").split(", so the")[0]
+        why = f"the two-step method's (the paper's) residuals are mostly its split approximation's: {measured}"
     else:
         return paper
     joint = _fit_steady(data, params, "joint", intervals=intervals, **settings)
@@ -482,6 +486,10 @@ def _shifted_by_the_split(fit: SteadyFit) -> bool:
     return any(WIDENED_NOTE in e.note for e in (fit.critical_velocity, fit.critical_stress))
 
 
+#: A two-step fit whose chi-square the joint refit of all points with aging lowers below this share of it: the
+#: residuals (and the noise estimated from them) are mostly the split approximation's.
+SPLIT_MISFIT_SHARE = 0.5
+SPLIT_MISFIT_NOTE = "note: the two-step's misfit is mostly its own"
 #: The note of an interval widened for the two-step method's own bias.
 WIDENED_NOTE = "widened to take in the joint fit's interval"
 #: The start of the reason a two-step fit fails for its split approximation while the model describes the data.
@@ -610,6 +618,14 @@ def _fit_steady(
         noise = f"relative, estimated from the scatter: {100 * noise_scale:.3g} % of the stress"
     noise += f"; without the model, between neighbouring points: {scatter.describe()}"
     misfits = adequacy.problems()
+    own, best = adequacy.method_fit, adequacy.model
+    if method == "two-step" and not misfits and best.chi_square < SPLIT_MISFIT_SHARE * own.chi_square:
+        progress.messages.append(
+            f"{SPLIT_MISFIT_NOTE}: the joint fit of all points with aging leaves an rms misfit of"
+            f" {100 * best.rms_relative:.3g} % against the two-step's {100 * own.rms_relative:.3g} %, so the"
+            " two-step's residuals are mostly its split approximation's, and so are the noise and intervals taken"
+            " from them (--method joint)"
+        )
     why = "the model does not describe the data (see the reason)"
     vc, sc = undetermined_critical(why)
     samples = None
