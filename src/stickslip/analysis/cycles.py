@@ -444,10 +444,10 @@ def _cycles(sticks: list[_Stick], v0: float, params: Parameters, ends_steady: bo
             notes.append("stick began before the record")
         if end is None:
             notes.append("record ends before the slip")
+        elif nxt is None and following is not None:  # a stick follows, but where it began is not clear
+            notes.append("no clear corner where the next stick begins")
         elif nxt is None:
-            notes.append(
-                "slip ends in steady sliding" if ends_steady and following is None else "record ends during the slip"
-            )
+            notes.append("slip ends in steady sliding" if ends_steady else "record ends during the slip")
         cycles.append(
             CycleResult(
                 index=k + 1,

@@ -2,7 +2,8 @@
 
 This step only finds *where* the phases are, to a few samples (the numbers per cycle come from :mod:`.cycles`):
 a robust noise level, a median-filtered uniform resampling, drops as peaks of prominence above
-:data:`PROMINENCE_SIGMAS` noise levels, and what the record does after its last peak (docs/analysis.md).
+:data:`PROMINENCE_SIGMAS` noise levels that fall faster than they rose, and what the record does after its last
+peak (docs/analysis.md).
 """
 
 from __future__ import annotations
@@ -18,6 +19,17 @@ from ..numerics.quantisation import quantum
 
 #: A drop counts as a slip when it exceeds this many noise standard deviations.
 PROMINENCE_SIGMAS = 10.0
+#: A candidate drop counts only if the record stays near its peak this many times longer before the peak than
+#: after it (the top ASYMMETRY_BAND of the drop): a slip falls faster than the stick rose, noise does not ...
+MIN_ASYMMETRY = 1.5
+ASYMMETRY_BAND = 0.3
+#: ... unless it is this many drop thresholds deep (a start-up slip above Vc falls about as fast as it rose).
+CLEAR_DROP = 3.0
+#: When the candidate stick phases scatter about their lines by more than this factor times the noise estimate,
+#: that scatter is the noise (correlated over longer than the estimate saw), and the drops are sought again ...
+STICK_CONSISTENCY = 1.2
+#: ... at most this many times.
+MAX_REFINEMENTS = 8
 #: Width (samples) of the median filter used for the coarse search.
 MEDIAN_WIDTH = 5
 #: Largest uniform grid used for the coarse search (long records are decimated).
@@ -80,8 +92,9 @@ def noise_level(time: np.ndarray, stress: np.ndarray) -> float:
 NOISE_GROWTH = 1.3
 GROWTH_SCATTER = 6.0
 #: ... up to lags of this fraction of the record (in samples and in time): the stick lines, not the slips'
-#: curvature, must hold the median of the residuals.
-MAX_LAG_FRACTION = 0.01
+#: curvature, must hold the median of the residuals.  (It was 1 %: noise correlated over 10 samples then needed
+#: 13,000 of them to be seen whole, and shorter records of it were read as stick-slip at a third of its level.)
+MAX_LAG_FRACTION = 0.125
 #: Triples per lag beyond which the estimate takes every n-th one (the median needs no more).
 LAG_TRIPLES = 1_000_000
 #: The quantisation step is read off at most this many samples from the start of the record.
@@ -103,12 +116,15 @@ def _correlated_level(time: np.ndarray, stress: np.ndarray, white: float) -> flo
     n = time.size
     longest = max(MAX_LAG_FRACTION * n, 5.0)
     horizon = time[0] + MAX_LAG_FRACTION * float(time[-1] - time[0])
-    levels: list[float] = []
+    lags: list[int] = []
     lag = 1
     while 2 * lag + 1 <= min(longest, n) and (lag == 1 or time[2 * lag] <= horizon):
-        levels.append(_lag_level(time, stress, lag, trimmed=True))
+        lags.append(lag)
         lag *= 2
-    for i in range(len(levels) - 1):
+    levels: list[float] = []  # computed as the ladder climbs: white noise needs three rungs, not all of them
+    for i in range(len(lags) - 1):
+        while len(levels) < min(i + 3, len(lags)):
+            levels.append(_lag_level(time, stress, lags[len(levels)], trimmed=True))
         ahead = levels[i + 1 : i + 3]
         growth = NOISE_GROWTH + GROWTH_SCATTER / math.sqrt(max(n / 2.0 ** (i + len(ahead)), 1.0))
         if all(level**2 <= growth * levels[i] ** 2 for level in ahead):
@@ -186,18 +202,27 @@ def uniform_grid(time: np.ndarray, stress: np.ndarray, step: float | None = None
 
 
 def coarse_segments(time: np.ndarray, stress: np.ndarray) -> Coarse:
-    """Find drop events, troughs and a steady tail in a record of finite samples."""
+    """Find drop events, troughs and a steady tail in a record of finite samples.
+
+    A drop is a slip when it is deeper than :data:`PROMINENCE_SIGMAS` noise levels and falls faster than the
+    stick before it rose (:func:`_drops`); when the sticks so found scatter about their lines by more than the
+    noise estimate allows, their scatter is the noise and the drops are sought again (docs/analysis.md, "Red
+    noise").
+    """
     noise = noise_level(time, stress)
     step = sampling_step(time)
     grid, raw = uniform_grid(time, stress, step)
     smooth = median_filter(raw, size=min(MEDIAN_WIDTH, raw.size), mode="nearest")
     scale = float(np.max(np.abs(smooth))) if smooth.size else 0.0
     threshold = max(PROMINENCE_SIGMAS * noise, 1e-9 * scale, 1e-300)
-    peaks = _separated(smooth, find_peaks(smooth, prominence=threshold)[0], threshold)
-    troughs = np.empty(peaks.size, dtype=int)
-    for k, p in enumerate(peaks):
-        lo = peaks[k - 1] if k else 0
-        troughs[k] = lo + rise_start(smooth[lo : p + 1], threshold)
+    peaks, troughs = _drops(smooth, threshold)
+    for _ in range(MAX_REFINEMENTS):  # the sticks found must be straight lines to within the noise
+        scatter = _stick_scatter(time, stress, grid, peaks, troughs)
+        if not scatter > STICK_CONSISTENCY * noise:
+            break
+        noise = scatter
+        threshold = max(PROMINENCE_SIGMAS * noise, 1e-9 * scale, 1e-300)
+        peaks, troughs = _drops(smooth, threshold)
     final_trough = None
     steady_from = None
     last = peaks[-1] if peaks.size else 0
@@ -224,6 +249,64 @@ def coarse_segments(time: np.ndarray, stress: np.ndarray) -> Coarse:
         steady_from=steady_from,
         step=step,
     )
+
+
+def _drops(smooth: np.ndarray, threshold: float) -> tuple[np.ndarray, np.ndarray]:
+    """Grid indices of the slips' peaks and of the starts of the sticks before them.
+
+    A peak is a slip when its prominence exceeds ``threshold`` and it falls faster than it rose (by
+    :data:`MIN_ASYMMETRY`, :func:`_asymmetry`), unless it is :data:`CLEAR_DROP` thresholds deep.
+    """
+    peaks = _separated(smooth, find_peaks(smooth, prominence=threshold)[0], threshold)
+    asymmetry, depth = _asymmetry(smooth, peaks)
+    peaks = peaks[(asymmetry >= MIN_ASYMMETRY) | (depth >= CLEAR_DROP * threshold)]
+    troughs = np.empty(peaks.size, dtype=int)
+    for k, p in enumerate(peaks):
+        lo = peaks[k - 1] if k else 0
+        troughs[k] = lo + rise_start(smooth[lo : p + 1], threshold)
+    return peaks, troughs
+
+
+def _asymmetry(y: np.ndarray, peaks: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Per peak of ``y``: (time spent near it before it) / (time spent near it after it), and its depth.
+
+    The depth is the peak's height above the higher of the lows on either side (up to the neighbouring peaks);
+    "near" is within :data:`ASYMMETRY_BAND` of that depth below the peak, counted in grid points between the low
+    before and the low after (each count plus half the peak's own point).  A stick rising at K V0 into a slip
+    falling at K (V - V0) stays there (Vs - V0)/V0 times longer before the peak than after it; stationary noise
+    of any spectrum is reversible in time, so for its wanders the ratio is as often below 1 as above.
+    """
+    ratio = np.empty(peaks.size)
+    depth = np.empty(peaks.size)
+    bounds = np.concatenate([[0], peaks, [y.size - 1]]).astype(int)
+    for k, p in enumerate(peaks):
+        before, after = y[bounds[k] : p + 1], y[p : bounds[k + 2] + 1]
+        low_before, low_after = int(np.argmin(before)), int(np.argmin(after))
+        depth[k] = y[p] - max(before[low_before], after[low_after])
+        level = y[p] - ASYMMETRY_BAND * depth[k]
+        rise = np.count_nonzero(before[low_before:-1] >= level) + 0.5
+        fall = np.count_nonzero(after[1 : low_after + 1] >= level) + 0.5
+        ratio[k] = rise / fall
+    return ratio, depth
+
+
+def _stick_scatter(
+    time: np.ndarray, stress: np.ndarray, grid: np.ndarray, peaks: np.ndarray, troughs: np.ndarray
+) -> float:
+    """Median over the candidate stick phases of the RMS about a straight line fitted to its samples (the middle
+    80 % of the phase, so no corner), NaN when there is none of at least 8 samples."""
+    rms = []
+    for a, b in zip(grid[troughs], grid[peaks], strict=True):
+        margin = 0.1 * (b - a)
+        lo, hi = int(np.searchsorted(time, a + margin, "left")), int(np.searchsorted(time, b - margin, "right"))
+        if hi - lo < 8:
+            continue
+        u = time[lo:hi] - np.mean(time[lo:hi])
+        y = stress[lo:hi] - np.mean(stress[lo:hi])
+        slope = float(np.einsum("i,i", u, y)) / float(np.einsum("i,i", u, u))
+        y -= slope * u
+        rms.append(math.sqrt(float(np.einsum("i,i", y, y)) / (y.size - 2)))
+    return float(np.median(rms)) if rms else math.nan
 
 
 def _separated(y: np.ndarray, peaks: np.ndarray, threshold: float) -> np.ndarray:
