@@ -155,3 +155,14 @@ def test_a_quoted_number_without_a_unit_in_a_parameter_file_is_refused(tmp_path,
         )
     )
     assert stickslip.load_parameters(str(weighted)).bonds.breakage_weight == 1.0
+
+
+def test_a_capitalised_header_is_read_as_its_column(tmp_path, capsys):
+    """'Velocity [um/s]' was 'unknown column'; rsf fit already read 'Time (s)'."""
+    from stickslip.fitting.data import read_steady_data
+
+    table = tmp_path / "cap.csv"
+    table.write_text("Velocity [um/s],Stress [kPa]\n10,0.9\n20,0.7\n50,0.4\n100,0.3\n")
+    data = read_steady_data(table)
+    assert list(data.velocity) == pytest.approx([10e-6, 20e-6, 50e-6, 100e-6])
+    assert list(data.stress) == pytest.approx([900.0, 700.0, 400.0, 300.0])

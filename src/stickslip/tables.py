@@ -212,6 +212,8 @@ def _read_header(
                 " expected name, 'name [unit]' or 'name (unit)'"
             )
         name, unit = found
+        if name not in dimensions and name not in ignore and (name.lower() in dimensions or name.lower() in ignore):
+            name = name.lower()  # "Velocity [um/s]", as spreadsheets capitalise headers
         if name not in dimensions and name not in ignore:
             raise DataError(f"{source}: unknown column {name!r}; expected {', '.join(dimensions)}")
         if name in names:
