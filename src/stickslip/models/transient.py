@@ -228,6 +228,8 @@ def _first(result: Any, *names: str) -> Any:
 def _regime(result: Any, protocol: Protocol | None) -> regimes.Regime:
     """The solver's verdict, with the evidence of the one classifier: the slips' exact peaks and the sticks'
     troughs (cycles) in the last segment when it oscillates, the classifier on the solver's steps otherwise."""
+    if getattr(result, "status", "ok") != "ok":  # stopped at a budget, or failed: what it computed
+        return _unfinished(result)
     found = getattr(result, "evidence", None)
     if isinstance(found, regimes.Regime):  # the solver's own verdict: the same periods and extremes, in the same words
         return regimes.Regime(
@@ -261,6 +263,25 @@ def _regime(result: Any, protocol: Protocol | None) -> regimes.Regime:
     return regimes.Regime(
         str(result.regime), found.periods, found.amplitude_ratio, found.period, found.peak, found.trough, result.message
     )
+
+
+def _unfinished(result: Any) -> regimes.Regime:
+    """The evidence of a run that ended before the protocol's end (a budget, a failure): no verdict, so no periods
+    and no period, and the extremes of the whole trace computed (with the solver's states between the rows).
+
+    The classifier on such a run's last segment counted the solver's step-to-step chatter as periods: 1 µm/s under
+    velocity control stopped at t = 1.09 s read 1016 "periods" of 25 µs and a peak of 338.7 kPa, while its trace
+    rose to 699.1 kPa (docs/transient.md section 9)."""
+    time, stress = np.asarray(result.time, dtype=float), np.asarray(result.stress, dtype=float)
+    names = ("lowest_stress", "highest_stress", "lowest_time", "highest_time", "fastest_velocity")
+    columns = [getattr(result, name, None) for name in names]
+    if all(c is not None for c in columns) and time.size > 1:
+        from ..transient.cycles import Between, with_extremes
+
+        time, stress = with_extremes(time, stress, Between(*columns))
+    stress = stress[np.isfinite(stress)]
+    peak, trough = (float(np.max(stress)), float(np.min(stress))) if stress.size else (NAN, NAN)
+    return regimes.Regime(str(result.regime), 0, NAN, NAN, peak, trough, result.message)
 
 
 def last_cycle_numbers(result: Any, protocol: Protocol | None = None) -> dict[str, Any]:
@@ -313,7 +334,7 @@ def _mean_stress(result: Any, start: float, end: float, *exact: float, protocol:
 class _HeldBlock:
     """The stress of a block the stick chains hold, sigma = K (P - X) with the slider fixed: from a row of the stick
     back to its start, K times the puller's travel between (the protocol's, exact; the rows' puller positions,
-    linear between them, without it)."""
+    linear between them, without it), and its integral."""
 
     def __init__(self, result: Any, protocol: Protocol | None) -> None:
         self.stuck = np.isfinite(np.asarray(result.chain_fraction, dtype=float))  # the rows the chains hold
@@ -322,13 +343,23 @@ class _HeldBlock:
         self.time = np.asarray(result.time, dtype=float)
         self.puller = np.asarray(_first(result, "puller_position", "puller_displacement"), dtype=float)
 
-    def stress_before(self, k: int, stress: float, t: float) -> float:
-        """sigma at t, given sigma at row k of the same stick (t <= time[k])."""
+    def integral_before(self, k: int, stress: float, t: float) -> float:
+        """The integral of sigma from t to row k of the same stick (t <= time[k]), given sigma at row k: exact, the
+        puller's path piecewise linear between the protocol's boundaries (a stick that runs into a hold: the line
+        from the stick's start to the row, read across the puller's stop at 22 s, moved the mean of a cycle ending
+        at 21.58 s by 0.85 Pa with rows every 3 s)."""
+        end = float(self.time[k])
         if self.protocol is not None:
-            travel = float(self.protocol.displacement_at(self.time[k]) - self.protocol.displacement_at(t))
+            edges = np.asarray(self.protocol.boundaries, dtype=float)
+            points = np.r_[t, edges[(edges > t) & (edges < end)], end]
+            travel = float(self.protocol.displacement_at(end)) - np.asarray(
+                self.protocol.displacement_at(points), dtype=float
+            )
         else:
-            travel = float(self.puller[k] - np.interp(t, self.time, self.puller))
-        return stress - self.stiffness * travel
+            points = np.array([t, end])
+            travel = np.array([float(self.puller[k] - np.interp(t, self.time, self.puller)), 0.0])
+        sigma = stress - self.stiffness * travel
+        return float(np.sum(0.5 * (sigma[1:] + sigma[:-1]) * np.diff(points)))
 
 
 def _integral_at(
@@ -339,25 +370,25 @@ def _integral_at(
     *sigma: float,
     held: _HeldBlock | None = None,
 ) -> float:
-    """The integral at t between rows: back from the next row by the trapezoid, with sigma(t) given, or from the
-    held block (``held``) where the chains hold it at the next row, else interpolated.
+    """The integral at t between rows: back from the next row, exactly through the held block (``held``) where the
+    chains hold it at the next row, else by the trapezoid with sigma(t) given, or interpolated.
 
     With the stick chains every cycle's ends are stick events, and the first row at or after one lies in its stick
-    (a row is written at each slip, at its exact time): sigma = K (P - X) is linear from t to that row, so the
-    trapezoid is exact once sigma(t) is.  Where no cycle gives sigma(t) (the stick the run ended in), the held
-    block gives it from the row's stress and the puller's travel since t (the line through the next two rows, used
-    before, read the sliding row before the stick when ``every`` left the stick one row: 3 s and 7 s rows moved the
-    paper's mean from empty by 5.9e-4 and 2.5e-3).
+    (a row is written at each slip, at its exact time): sigma = K (P - X) follows the puller from t to that row,
+    and the held block integrates it from the row's stress and the puller's travel since t, across any change of
+    the puller's pace between (the line through the next two rows, used before, read the sliding row before the
+    stick when ``every`` left the stick one row: 3 s and 7 s rows moved the paper's mean from empty by 5.9e-4 and
+    2.5e-3; the line from the stick's start to the row read across a hold's start).
     """
     k = int(np.searchsorted(time, t, side="left"))
     if k >= time.size:
         return float(integral[-1])
     if time[k] == t or k == 0:
         return float(integral[k])
+    if held is not None and held.stuck[k]:
+        return float(integral[k] - held.integral_before(k, float(stress[k]), t))
     if sigma:
         here = sigma[0]
-    elif held is not None and held.stuck[k]:
-        here = held.stress_before(k, float(stress[k]), t)
     else:
         here = float(np.interp(t, time, stress))
     return float(integral[k] - 0.5 * (here + stress[k]) * (time[k] - t))

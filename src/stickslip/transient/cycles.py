@@ -388,7 +388,7 @@ def _words(
         return regimes.STICK_SLIP, text
     if found.kind in (regimes.DECAYING, regimes.GROWING):
         return found.kind, found.evidence
-    if stuck[-1] and found.periods == 0 and time.size > 1:
+    if stuck[-1] and time.size > 1 and (found.periods == 0 or _rang_and_stuck(time, stress, stuck, protocol, scale)):
         slipped = f" after {len(cycles)} slip(s)" if cycles else ""
         if velocity[-1] != 0.0:
             slow = abs(velocity[-1]) < 1e-6  # nm/s for a creep, µm/s (as the end's V is written) from 1 µm/s up
@@ -419,6 +419,26 @@ def _words(
         f"{found.evidence} at the end of the run (t = {time[-1]:.6g} s, σ = {stress[-1]:.6g} Pa,"
         f" V = {show_velocity(velocity[-1], 3)}): run longer to see where it goes"
     )
+
+
+def _rang_and_stuck(time: np.ndarray, stress: np.ndarray, stuck: np.ndarray, protocol: Protocol, scale: float) -> bool:
+    """The slider stuck over (nearly) the whole last segment, the stress without a swing over the second half of
+    that stick: the periods the classifier counted were a block with mass ringing as it stopped, not a cycle.
+
+    50 µm/s for 5 s: the massless block is stuck (creeping at 1.26 nm/s under 76.62 Pa); with 10.5 kg/m^2 it
+    rang for its first 3.7 ms (26 swings of ~0.1 Pa), then crept the same, and read "undetermined: still changing
+    ... no exponential approach" (at 60 s, "about 3.52e+07 Pa still to come") while the stress only rose with the
+    puller's travel."""
+    start = float(protocol.boundaries[-2])
+    moving = np.flatnonzero(~stuck)
+    first = int(moving[-1]) + 1 if moving.size else 0
+    if first >= time.size or time[first] - start > 0.1 * (time[-1] - start):
+        return False
+    tail = time >= 0.5 * (time[first] + time[-1])
+    if np.count_nonzero(tail) < 3:
+        return False
+    maxima, minima = regimes.turning_points(stress[tail], SETTLED * max(scale, 1e-300))
+    return maxima.size + minima.size == 0
 
 
 @dataclasses.dataclass(frozen=True)

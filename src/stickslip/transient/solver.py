@@ -1071,6 +1071,8 @@ def _finish(d: _Driver, snapshots: list[Snapshot], stop: str | None, note: str) 
     table = table[order]
     keep = np.r_[True, np.diff(table[:, 0]) > 0]
     table = table[keep]
+    if control == "velocity":
+        _balanced_integral(table, protocol)
     n0 = params.bonds.site_density
     time, sigma, bonded, v, x, puller = (table[:, k] for k in range(6))
     bonded = bonded / n0
@@ -1137,6 +1139,44 @@ def _finish(d: _Driver, snapshots: list[Snapshot], stop: str | None, note: str) 
         evidence=evidence,
         status="ok" if stop is None else "failed",  # the model could not go on to the protocol's end
     )
+
+
+#: velocity control: the integral of sigma dt between rows from the energy balance where the energy the breaking
+#: bonds lost is within this share of the energy stored (solver._balanced_integral)
+BALANCE_SHARE = 1e-3
+
+
+def _balanced_integral(table: np.ndarray, protocol: Protocol) -> None:
+    """Velocity control: the integral of sigma dt (and the rig's work) between rows from the energy balance,
+    V (integral of sigma dt) = change of the bonds' FENE energy + the energy lost as they broke, wherever the rows
+    lie in one segment at a constant pace V > 0 with Eq 1's bonds holding and hardly breaking (in place, columns
+    8 and 13).
+
+    The kernel's end-corrected trapezoid is the integral of the cubic through each step's ends and slopes; a step
+    the state's error control lets grow long (0.1 um/s for 10 s: one 6 s step from 5.7 to 88.3 kPa near the FENE
+    wall) made it overshoot to a negative mean (-5634 Pa, 13931 Pa with rows every 0.5 s); the balance's ends are
+    the states themselves, exact at any step where the bonds hardly break (energy lost within BALANCE_SHARE of the
+    energy stored): 13940.479 Pa at every sampling (docs/transient.md section 9)."""
+    t = table[:, 0]
+    if t.size < 2:
+        return
+    bounds = protocol.boundaries
+    tol = 1e-12 * max(float(bounds[-1]), 1.0)
+    k = np.clip(np.searchsorted(bounds, 0.5 * (t[1:] + t[:-1]), side="right") - 1, 0, len(protocol.segments) - 1)
+    vp = np.asarray(protocol.velocities, dtype=float)[k]
+    one_segment = (t[:-1] >= bounds[k] - tol) & (t[1:] <= bounds[k + 1] + tol)
+    bonds = ~np.isfinite(table[:, 12])  # rows the stick chains do not hold
+    stored, lost = np.diff(table[:, 10]), np.diff(table[:, 9])  # the bonds' energy, and what broke with them
+    # the energy lost is a quadrature over the breakage (a velocity step at rtol 1e-4: 3e-5 of the integral off,
+    # against the trapezoid's 4e-7): the balance only where little broke, exact there
+    quiet = np.abs(lost) <= BALANCE_SHARE * np.abs(stored)
+    use = one_segment & (vp > 0) & bonds[:-1] & bonds[1:] & quiet
+    if not np.any(use):
+        return
+    gain = stored + lost
+    for column, increment in ((13, gain / np.where(use, vp, 1.0)), (8, gain)):
+        step = np.where(use, increment, np.diff(table[:, column]))
+        table[1:, column] = table[0, column] + np.cumsum(step)
 
 
 def _jumps_note(jumps: list[jump.Jump]) -> str:
@@ -1335,6 +1375,22 @@ BLOCK_SHARE = 0.4
 #: interval after each miss), then a reduced stretch of about REDUCED_STEPS ODE steps
 SETTLE = 4.0
 REDUCED_STEPS = 100.0
+#: a bond's memory for the settling above is the age beyond which the steady population keeps less than the
+#: reduction's share THETA rtol of its bonds and of its stress, at most dl_m/V (bonds that die in a few tau leave
+#: the population in a few tau: tau = 1 ns at 50 um/s, 13 ns, where dl_m/V = 21 ms was counted, 8e7 steps for 10 ms)
+#: Bonds that age into permanence live to the FENE wall and die there within ~1/g of their arrival (g: the climb of
+#: ln r there, 1e6/s at 1 um/s for the gel, 9.4e4/s at 10 um/s): once they arrive the cohorts take about WALL_SHARE g
+#: steps per second more (measured 0.23-0.38 g from 1 to 30 um/s under velocity control, 2.5e5 steps/s at 1 um/s)
+WALL_SHARE = 0.3
+#: where bonds leave the population before dl_m/V, the settling counts this many of their memories (the look for a
+#: stretch comes after about twice the steps it waits for)
+TAIL_SETTLE = 2.0
+#: and the population's disturbance echoes through the wall every dl_m/V, decaying per echo by the root of
+#: z + K (1 - e^-z) = 0 (K = the wall's share of the bonds' lives): at 10 um/s by 0.45 (measured ~0.47), at 1 um/s by
+#: 0.99; the reduction waits until the echo is below THETA rtol, counted from the piece's start (docs/transient.md)
+#: CPU per step and living cohort (s; velocity control from empty, 10 and 1 um/s: 1.0e-7 and 1.9e-7 measured): a
+#: population that remembers dl_m/V = 1 s at 1 um/s keeps ~5e5 cohorts
+COHORT_STEP_SECONDS = 1.5e-7
 #: through the block a piece is reduced only this far above the fold of the steady curve at Vc: below it the slider
 #: decelerates, creeps along the fold and sticks (cohorts), or slips in cycles whose approach to the stick is cohorts
 FOLD_MARGIN = 1.02
@@ -1454,7 +1510,9 @@ def estimate_cost(
     ) else None  # fmt: skip
     natural = b.max_extension / b.bond_time
     own = motion is not None and motion.counts()  # the block's own motion is counted (else the cohorts')
-    steps, fastest, reduced = _pieces_steps(params, protocol, control, aging, v_start, scale, motion, reducing)
+    steps, fastest, reduced, living = _pieces_steps(
+        params, protocol, control, aging, v_start, scale, motion, reducing, start=start, rtol=rtol
+    )
     if control == "block" and start == "empty" and not stick_population and reduced and not own:
         steps += STUCK_STEPS  # a block from rest sticks first (the chains hold a stuck block)
     if control == "block" and mass > 0:
@@ -1483,28 +1541,35 @@ def estimate_cost(
     copied = 0.0 if motion is None else min(motion.copied * scale, steps)  # rows of a repeated limit cycle
     seconds = (steps - copied - samples) * STEP_SECONDS + copied * ROW_SECONDS + samples * SAMPLE_SECONDS
     seconds += moving * per_segment
-    seconds += COHORT_SECONDS * stuck * stuck
+    seconds += COHORT_SECONDS * stuck * stuck + living  # the cohorts each step works through
     return CostEstimate(steps, basis, seconds)
 
 
 def _pieces_steps(  # type: ignore[no-untyped-def]
-    params, protocol, control, aging, v_start, scale, motion, reducing
-) -> tuple[float, float, int]:
-    """:func:`estimate_cost`'s steps piece by piece: (steps, the fastest velocity, the pieces reduced)."""
+    params, protocol, control, aging, v_start, scale, motion, reducing, start="empty", rtol=RTOL
+) -> tuple[float, float, int, float]:
+    """:func:`estimate_cost`'s steps piece by piece: (steps, the fastest velocity, the pieces reduced, the CPU
+    seconds of the living cohorts each step works through, :data:`COHORT_STEP_SECONDS`)."""
     b, g = params.bonds, params.aging
     fold: list[float] = []  # FOLD_MARGIN x Vc, looked for only when a piece needs it
     steps = 0.0
     fastest = 0.0
     reduced = 0
+    living = 0.0
     natural = b.max_extension / b.bond_time
+    memories: dict[float, _Memory] = {}  # by velocity, for this estimate (1e5 segments ask again and again)
+    # the velocity the population was last steady at (None: an empty start, whose first bonds reach the wall dl_m/V on)
+    previous = None if start == "empty" else (v_start if v_start > 0 else abs(protocol.initial_velocity))
     for t0, t1, vp in protocol.pieces():
         v = max(abs(vp), v_start) if control == "block" else abs(vp)
         fastest = max(fastest, v)
         slope = math.exp(-v / g.aging_velocity) / g.aging_time if aging else 0.0
         climb = max(b.force_sensitivity * b.chain_stiffness * v - slope, 0.0)
         rate = 4.0 * (1.0 + b.breakage_weight) / b.bond_time + 10.0 * climb + 100.0 * v / b.max_extension
-        rate *= scale * (BLOCK_SHARE if control == "block" else 1.0)
+        share = scale * (BLOCK_SHARE if control == "block" else 1.0)
+        rate *= share
         cohorts = rate * (t1 - t0)
+        filling, disturbed, previous = previous is None, previous is None or abs(vp) != previous, abs(vp)
         if motion is not None and motion.counts():
             piece = motion.piece(t1 - t0, vp, lambda v=vp: v < _fold(fold, params, control, aging))
             if piece is not None:  # births a block cannot resolve in STUCK_STEPS or a slip (a huge u0) are counted
@@ -1512,14 +1577,100 @@ def _pieces_steps(  # type: ignore[no-untyped-def]
                 bound = math.inf if motion.stuck_for_good else cohorts  # the sticking is one lump, however short
                 steps += min(max(piece, floor) * scale, bound) + motion.segment_steps()
                 continue
+        memory = _memory_of(memories, params, v, aging, rtol) if v > 0 else None
+        wall = 0.0 if memory is None else WALL_SHARE * memory.climb * share  # bonds dying at the FENE wall
+        arrive = b.max_extension / v if (filling and v > 0) else 0.0  # the first of them arrive there
+        cohorts += wall * max(t1 - t0 - arrive, 0.0)
+        span = t1 - t0
         if reducing and 0 < vp <= (BLOCK_FASTEST if control == "block" else 100.0) * natural:
-            settle = rate * SETTLE * b.max_extension / vp + REDUCED_STEPS
+            own = _memory_of(memories, params, abs(vp), aging, rtol)
+            settling = min(SETTLE * b.max_extension / abs(vp), TAIL_SETTLE * own.age)
+            if disturbed:  # the disturbance echoes through the wall until it falls below the reduction's share
+                settling = max(settling, own.echo)
+            settle = rate * settling + wall * max(settling - arrive, 0.0) + REDUCED_STEPS
             if settle < min(cohorts, HOPELESS):  # beyond HOPELESS the fold is not worth finding
                 if vp >= _fold(fold, params, control, aging):
                     cohorts = settle
+                    span = min(span, settling)
                     reduced += 1
+        if wall > 0:  # each step once bonds die at the wall works through those born over the last memory.keep
+            after = max(span - arrive, 0.0)
+            living += COHORT_STEP_SECONDS * (rate + wall) ** 2 * after * 2.0 * min(memory.keep, after)
         steps += cohorts + SEGMENT_STEPS
-    return steps, fastest, reduced
+    return steps, fastest, reduced, living
+
+
+@dataclass(frozen=True)
+class _Memory:
+    """What the steady population at one velocity remembers, for :func:`estimate_cost` (:func:`_memory`)."""
+
+    age: float  # beyond it the bonds carry less than THETA rtol of N and of sigma (at most dl_m/V)
+    keep: float  # a cohort is dropped (survival 1e-30, kernel.LIGHTEST) or reaches the FENE wall
+    climb: float  # d ln r/dt where the bonds that live to the wall die there (0: none do)
+    echo: float  # the time a disturbance of the births takes to fall below THETA rtol (refilling, echoing)
+
+
+def _memory_of(memories: dict[float, _Memory], params: Parameters, v: float, aging: bool, rtol: float) -> _Memory:
+    key = float(f"{v:.3g}")
+    if key not in memories:
+        memories[key] = _memory(params, key, aging, float(rtol))
+    return memories[key]
+
+
+@lru_cache(maxsize=256)
+def _memory(params: Parameters, v: float, aging: bool, rtol: float) -> _Memory:
+    """The steady population's memory at velocity v (:class:`_Memory`) from Eq 1's survival along one bond's life,
+    on ages geometric from tau/1e6 to dl_m/V/2 and towards the FENE wall (~0.3 ms; remembered).
+
+    A share Pw of the bonds lives to the wall (aging makes resting bonds permanent: the gel's 1.8 % at 1 um/s) and
+    dies there in a lump; the rest within c - tau of their birth (c = tau + their mean life).  A disturbance of the
+    birth rate then echoes through the wall every dl_m/V: linearised, c e(t) = -Pw (integral of e over the last
+    dl_m/V), whose slowest root z + K (1 - e^-z) = 0 (K = Pw dl_m/V / c, z = s dl_m/V) decays per echo by
+    e^-delta, delta = ln(1 + (2 pi/K)^2)/2 (large K: 2 pi^2/K^2; small K: ln(2 pi/K))."""
+    from .model import log_hazard
+    from .reduction import THETA
+
+    b = params.bonds
+    share = THETA * rtol
+    tm = b.max_extension / v
+    plain = _Memory(tm, tm, 0.0, 0.0)
+    with np.errstate(all="ignore"):
+        lo = min(b.bond_time, tm) * 1e-6
+        wall = tm - np.geomspace(1e-13 * tm, 0.5 * tm, 600)
+        a = np.unique(np.concatenate(([0.0], np.geomspace(lo, 0.5 * tm, 600), wall)))
+        lr = np.minimum(log_hazard(v * a, a, v, params, aging), 700.0)
+        r = np.exp(lr)
+        da, dl = np.diff(a), np.diff(lr)
+        curved = np.abs(dl) > 1e-9
+        inc = np.where(curved, da * (r[1:] - r[:-1]) / np.where(curved, dl, 1.0), 0.5 * da * (r[1:] + r[:-1]))
+        hazard = np.concatenate(([0.0], np.cumsum(inc)))
+        survival = np.exp(-hazard)
+        force = survival * chain_force(v * a, params)
+        bonds = np.concatenate(([0.0], np.cumsum(0.5 * da * (survival[1:] + survival[:-1]))))
+        stress = np.concatenate(([0.0], np.cumsum(0.5 * da * (force[1:] + force[:-1]))))
+    if not (np.all(np.isfinite(bonds)) and np.all(np.isfinite(stress)) and bonds[-1] > 0 and stress[-1] > 0):
+        return plain
+    forgotten = (bonds >= (1.0 - share) * bonds[-1]) & (stress >= (1.0 - share) * stress[-1])
+    age = float(a[np.argmax(forgotten)]) if forgotten.any() else tm
+    dropped = hazard >= -math.log(K.LIGHTEST)
+    keep = float(a[np.argmax(dropped)]) if dropped.any() else tm
+    half = int(np.searchsorted(a, 0.5 * tm))
+    pw = float(survival[half])
+    died = int(np.searchsorted(hazard, hazard[half] + 1.0))
+    # the births refill the population at 1/tau + 1/(its mean life) (one exponential life: exact)
+    fill = math.log(1.0 / share) / (1.0 / b.bond_time + 1.0 / float(bonds[-1]))
+    if not (pw > 1e-12 and half < died < a.size):
+        return _Memory(age, keep, 0.0, fill)
+    climb = float((lr[died] - lr[died - 1]) / (a[died] - a[died - 1]))
+    a_d = float(a[died])
+    fast = np.where(a < a_d, np.maximum(survival - pw, 0.0), survival)
+    c = b.bond_time + float(np.sum(0.5 * da * (fast[1:] + fast[:-1])))
+    k = pw * a_d / c
+    delta = 0.5 * math.log1p((2.0 * math.pi / k) ** 2) if k > 1e-3 else math.log(2.0 * math.pi / k)
+    echo = math.log(1.0 / share) * a_d / delta
+    if not (math.isfinite(climb) and climb > 0 and math.isfinite(echo)):
+        return _Memory(age, keep, 0.0, fill)
+    return _Memory(age, keep, climb, max(echo, fill))
 
 
 def _fold(found: list[float], params: Parameters, control: str, aging: bool) -> float:
