@@ -633,7 +633,7 @@ def _fit_steady(
         vc, sc, samples = _critical_estimates(check, fitted, keys, covariance, q, everything, scale2, progress)
         if method == "two-step" and vc.value is not None:
             vc, sc, estimates, combos = _flag_split_bias(
-                (vc, sc, estimates, combos), fitted, everything, keys, scale2, level, progress
+                (vc, sc, estimates, combos), fitted, everything, keys, scale2, level, progress, adequacy.refit
             )
         _note_extrapolation(progress, vc, data)
     progress.messages.extend(_outlier_warnings(data, model, stated, noise_scale, dof))
@@ -801,6 +801,8 @@ class _Adequacy:
     method_fit: Misfit
     method: str
     searched: int
+    #: the joint refit from the two-step result (two-step only): where the bias check starts its own
+    refit: Parameters | None = None
 
     def problems(self) -> list[str]:
         m = self.model
@@ -860,8 +862,9 @@ def _judge(check: _Check, progress: _Progress, keys: Sequence[str], everything: 
         return _Adequacy(own, own, check.method, searched)
     # the model is judged by its own best fit near the two-step's (the split approximation is the method's), and
     # so are the stated errors: the two-step's misfit on exact data is no evidence that they are too small
-    joint = _misfit_of(check, _joint_refit(check, progress.params, keys, everything), everything, len(keys))
-    return _Adequacy(joint if joint.chi_square < own.chi_square else own, own, check.method, searched)
+    refit = _joint_refit(check, progress.params, keys, everything)
+    joint = _misfit_of(check, refit, everything, len(keys))
+    return _Adequacy(joint if joint.chi_square < own.chi_square else own, own, check.method, searched, refit)
 
 
 def _adequate_or_searched(
@@ -1031,6 +1034,7 @@ def _flag_split_bias(
     scale2: float,
     level: float,
     progress: _Progress,
+    start: Parameters | None = None,
 ) -> tuple[Estimate, Estimate, tuple[Estimate, ...], tuple[Estimate, ...]]:
     """Widen the two-step intervals of Vc, sigma_c, the parameters and the combinations by the method's own bias
     when it matters.
@@ -1038,15 +1042,16 @@ def _flag_split_bias(
     The two-step fit neglects aging above the split, so even exact data give a shifted answer, and the
     shift does not shrink with more data while the interval does (docs/fitting.md).  The shift is measured
     against the joint fit of the same free keys on all points with aging, started from the two-step
-    result: the joint fit has no such approximation.  With noise the two estimates also differ by chance,
-    by up to about the larger of their standard errors (on 24 points they differ by 0-1.5 of them).  When
-    the difference exceeds that times the interval's quantile -- the bias would carry the truth out of the
-    interval -- the interval is extended by it towards the joint value, and said so.  The parameters and the
-    combinations carry the same bias as Vc (on exact gelatin-glass data tau is off by 8 %, 6 standard errors), so
-    they get the same treatment, from the same joint fit and its covariance.
+    result (``start``: that refit, already made by the adequacy check): the joint fit has no such
+    approximation.  With noise the two estimates also differ by chance, by up to about the larger of their
+    standard errors (on 24 points they differ by 0-1.5 of them).  When the difference exceeds that times the
+    interval's quantile -- the bias would carry the truth out of the interval -- the interval is extended by it
+    towards the joint value, and said so.  The parameters and the combinations carry the same bias as Vc (on
+    exact gelatin-glass data tau is off by 8 %, 6 standard errors), so they get the same treatment, from the
+    same joint fit and its covariance.
     """
     vc, sc, estimates, combos = estimated
-    space = Space(fitted, tuple(keys))
+    space = Space(start if start is not None else fitted, tuple(keys))  # the adequacy check's refit, if made
     try:
         theta = minimize(space, space.vector(), everything).theta
         joint_space = Space(space.params(theta), tuple(keys))
