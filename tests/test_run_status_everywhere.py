@@ -141,8 +141,9 @@ def test_a_puller_that_never_moves_leaves_the_block_at_rest_not_sliding(tmp_path
 
 
 def test_a_transient_run_the_solver_cannot_follow_keeps_what_it_computed(tmp_path, capsys):
-    """A stiff block (4 MPa/m) loaded at 100 µm/s from a steady start: at 1803 Pa after 5.08 s its resting bonds
-    give way faster than the solver can follow.  The run failed with nothing written (exit 3), and a sweep's row
+    """A stiff block (4 MPa/m) loaded at 100 µm/s from a steady start: at 1803 Pa after 5.08 s its aged bonds reach
+    the FENE wall one cohort at a time, too coarse for the wall (docs/transient.md section 17).  The run failed
+    with nothing written (exit 3), and a sweep's row
     was an "error" without results; now both keep the run up to there, status "failed"."""
     trace = tmp_path / "fail.csv"
     args = ["--v0", "100 um/s", "--duration", "10 s", "--start", "steady", "--set", "block.stiffness=4 MPa/m"]
