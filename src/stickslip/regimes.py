@@ -239,10 +239,13 @@ def classify(
     relaxation: float | None = None,
     dense: Dense | None = None,
     unit: str = "",
+    settle_floor: float | None = None,
 ) -> Regime:
     """Classify the signal ``y(t)`` over ``t >= start`` (default: all of it).
 
     ``floor``: changes and amplitudes at or below it are no change (the solver's tolerance in ``y``);
+    ``settle_floor``: the change still to come below which the tail is settled (default ``floor``; a window
+    whose peak dwarfs its tail, a re-slide's, judges the tail on the tail's own level);
     ``relaxation`` (s): the time scale over which the tail's approach is judged (at most half the time since
     the last turning point, and half the window; default those);
     ``dense``: the solver's interpolant of ``y`` (extremes are then those of the solution, not of its steps).
@@ -294,6 +297,7 @@ def classify(
     if not tau > 0:
         return Regime(UNDETERMINED, periods, ratio, period, peak, trough, "undetermined: no tail to judge")
     change, remaining = remaining_change(tw, yw, tau, dense)
+    floor = floor if settle_floor is None else min(float(settle_floor), floor)
     if remaining <= floor or change <= floor * 1e-3:
         left = "nothing measurable" if math.isinf(remaining) else f"{remaining:.3g}{suffix}"
         text = (

@@ -312,11 +312,13 @@ def judge(
     # lost: 93.3 kPa for 3.56 MPa, and the verdict flipped)
     scale = float(np.max(np.abs(s_all[inside]))) if np.any(inside) else 0.0
     floor = SETTLED * max(scale, 1e-300)
+    # settled is judged on the stress the run ends at (not below a thousandth of the peak): within SETTLED of a
+    # 3.56 MPa re-slide peak (35.6 Pa), a re-slide 50 Pa short of steady read as steady
+    settle = SETTLED * max(abs(float(stress[-1])), 1e-3 * scale, 1e-300)
     found = _from_events(events, start, time, stress, lowest)
     if found is None:
-        found = solution_extremes(
-            regimes.classify(time, stress, floor=floor, start=start, unit="Pa"), time, stress, between, start
-        )
+        classified = regimes.classify(time, stress, floor=floor, start=start, unit="Pa", settle_floor=settle)
+        found = solution_extremes(classified, time, stress, between, start)
     chains = any(kind == "stick" for kind, *_ in events)
     return (*_words(found, time, stress, velocity, protocol, cycles, control, resolution, scale, chains), found)
 
