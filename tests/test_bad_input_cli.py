@@ -309,7 +309,8 @@ def test_a_kc_beyond_the_float_range_is_refused_not_printed() -> None:
 SAMPLED_OUT = (*SLOW, "sweep")
 
 
-@settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+# the same sample every run (derandomize): its cost was 1-11 s by which lines a run drew, and a failure must repeat
+@settings(max_examples=25, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(st.sampled_from([i for i, (line, _) in enumerate(CORPUS) if line[0] not in SAMPLED_OUT]))
 def test_a_sample_of_the_corpus_ends_cleanly(files: Path, index: int) -> None:
     line, refuse = CORPUS[index]
