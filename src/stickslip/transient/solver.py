@@ -1634,6 +1634,8 @@ def _memory(params: Parameters, v: float, aging: bool, rtol: float) -> _Memory:
     share = THETA * rtol
     tm = b.max_extension / v
     plain = _Memory(tm, tm, 0.0, 0.0)
+    # the ages reach the FENE wall, where the hazard's integral overflows (survival 0) and the chain force diverges
+    # (0 x inf): what comes of it is checked below, and a non-finite sum gives the plain memory (an estimate only)
     with np.errstate(all="ignore"):
         lo = min(b.bond_time, tm) * 1e-6
         wall = tm - np.geomspace(1e-13 * tm, 0.5 * tm, 600)
