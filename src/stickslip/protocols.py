@@ -200,18 +200,25 @@ def _times(t: Any, method: str) -> np.ndarray:
     return times
 
 
+def split_segment(text: str, name: str, example: str) -> tuple[str, str, str]:
+    """``"V:T"`` as (V, ":", T) (``str.rpartition``), refusing a third field ("50 um/s:30 s:3" is not a duration
+    without its unit); ``example`` ends the message (``'100 um/s:10 s'``)."""
+    velocity_text, sep, duration_text = str(text).rpartition(":")
+    if ":" in velocity_text:
+        raise ParameterError(
+            f"{name} {text!r}: expected VELOCITY:DURATION (two fields, one colon), got {str(text).count(':') + 1}"
+            f" fields; e.g. {example}"
+        )
+    return velocity_text, sep, duration_text
+
+
 def parse_segment(text: str, name: str = "--segment") -> Segment:
     """``"100 um/s:10 s"`` (velocity, colon, duration; units optional, bare numbers SI) to a Segment."""
     from .units import to_si
 
-    velocity_text, sep, duration_text = str(text).rpartition(":")
+    velocity_text, sep, duration_text = split_segment(text, name, "'100 um/s:10 s'")
     if not sep or not velocity_text.strip() or not duration_text.strip():
         raise ParameterError(f"{name} {text!r}: expected VELOCITY:DURATION, e.g. '100 um/s:10 s'")
-    if ":" in velocity_text:
-        raise ParameterError(
-            f"{name} {text!r}: expected VELOCITY:DURATION (two fields, one colon), got {text.count(':') + 1}"
-            " fields; e.g. '100 um/s:10 s'"
-        )
     velocity = to_si(velocity_text.strip(), "velocity", f"{name} velocity")
     duration = to_si(duration_text.strip(), "time", f"{name} duration")
     try:

@@ -100,14 +100,10 @@ def build_protocol(
 def checked_segment_text(text: str, name: str = "--segment") -> str:
     """``--segment "V:T"`` as typed, each of V and T with its unit (the API reads bare numbers as SI; a user who
     types ``50:60`` does not mean 50 m/s); zero needs none.  Returned unchanged for :func:`parse_segment`."""
+    from ..protocols import split_segment
     from ..units import bare_number
 
-    velocity_text, sep, duration_text = str(text).rpartition(":")
-    if ":" in velocity_text:  # "50 um/s:30 s:3": a third field, not a duration without its unit
-        raise ParameterError(
-            f"{name} {text!r}: expected VELOCITY:DURATION (two fields, one colon), got {str(text).count(':') + 1}"
-            f" fields; e.g. {name} '1 mm/s:2 s'"
-        )
+    velocity_text, sep, duration_text = split_segment(text, name, f"{name} '1 mm/s:2 s'")
     for part, what in ((velocity_text, "velocity"), (duration_text, "duration")):
         number = bare_number(part) if sep else None
         if number is not None and number != 0:
