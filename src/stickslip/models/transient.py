@@ -243,14 +243,12 @@ def _regime(result: Any, protocol: Protocol | None) -> regimes.Regime:
         troughs = [c.start_stress for c in whole[1:]] + [_last_trough(result, whole[-1].start_time)]
         found = regimes.classify_cycles([c.start_time + c.stick_time for c in whole], peaks, troughs)
     else:
-        names = ("lowest_stress", "highest_stress", "lowest_time", "highest_time", "fastest_velocity")
-        columns = [getattr(result, name, None) for name in names]
-        if all(c is not None for c in columns):
+        between = _between_rows(result)
+        if between is not None:
             # the solver's own result: the states between its rows (sampled by ``every``) give the tolerance and
             # the extremes (a stand-in solver's result has no such columns, and its package no cycles module)
-            from ..transient.cycles import Between, solution_extremes, with_extremes
+            from ..transient.cycles import solution_extremes, with_extremes
 
-            between = Between(*columns)
             t_all, s_all = with_extremes(time, stress, between)
             inside = t_all >= start
             scale = float(np.max(np.abs(s_all[inside]))) if np.any(inside) else 0.0
@@ -265,6 +263,18 @@ def _regime(result: Any, protocol: Protocol | None) -> regimes.Regime:
     )
 
 
+def _between_rows(result: Any) -> Any:
+    """The solver's states between its rows (``transient.cycles.Between``); None for a stand-in solver's result,
+    which has no such columns."""
+    names = ("lowest_stress", "highest_stress", "lowest_time", "highest_time", "fastest_velocity")
+    columns = [getattr(result, name, None) for name in names]
+    if any(c is None for c in columns):
+        return None
+    from ..transient.cycles import Between
+
+    return Between(*columns)
+
+
 def _unfinished(result: Any) -> regimes.Regime:
     """The evidence of a run that ended before the protocol's end (a budget, a failure): no verdict, so no periods
     and no period, and the extremes of the whole trace computed (with the solver's states between the rows).
@@ -273,12 +283,11 @@ def _unfinished(result: Any) -> regimes.Regime:
     velocity control stopped at t = 1.09 s read 1016 "periods" of 25 µs and a peak of 338.7 kPa, while its trace
     rose to 699.1 kPa (docs/transient.md section 9)."""
     time, stress = np.asarray(result.time, dtype=float), np.asarray(result.stress, dtype=float)
-    names = ("lowest_stress", "highest_stress", "lowest_time", "highest_time", "fastest_velocity")
-    columns = [getattr(result, name, None) for name in names]
-    if all(c is not None for c in columns) and time.size > 1:
-        from ..transient.cycles import Between, with_extremes
+    between = _between_rows(result)
+    if between is not None and time.size > 1:
+        from ..transient.cycles import with_extremes
 
-        time, stress = with_extremes(time, stress, Between(*columns))
+        time, stress = with_extremes(time, stress, between)
     stress = stress[np.isfinite(stress)]
     peak, trough = (float(np.max(stress)), float(np.min(stress))) if stress.size else (NAN, NAN)
     return regimes.Regime(str(result.regime), 0, NAN, NAN, peak, trough, result.message)
