@@ -18,8 +18,9 @@ from typing import Any
 import click
 
 from ..display import symbol
+from ..errors import ParameterError
 from ..parameters import BOLTZMANN, SECTIONS, Parameters, available_parameter_sets, load_parameters
-from ..units import DIMENSIONS
+from ..units import DIMENSIONS, shorten
 from .common import (
     check_output,
     params_options,
@@ -151,6 +152,69 @@ def derived_table(params: Parameters) -> Any:
     return table
 
 
+#: (unit, meaning) of each rate-and-state key as :meth:`stickslip.rsf.RSFParams.to_dict` writes it (SI)
+_RSF_KEYS = {
+    "a": ("", "direct effect"),
+    "mu0": ("", "steady friction at v_ref"),
+    "v_ref": ("m/s", "reference velocity"),
+    "stiffness": ("1/m", "spring stiffness over the normal stress"),
+    "eta": ("s/m", "radiation damping over the normal stress"),
+    "mass": ("kg/m^2", "slider mass per area"),
+    "normal_stress": ("Pa", "normal stress"),
+    "regularized": ("", "arcsinh form near V = 0"),
+    "cutoff": ("m/s", "cut-off velocities V1, V2"),
+}
+_STATE_KEYS = {"law": ("", "evolution law"), "b": ("", "evolution effect"), "dc": ("m", "critical slip distance"),
+               "c": ("", "Nagata's stress coupling")}  # fmt: skip
+
+
+def rate_and_state_file(chosen: str, overrides: Sequence[str]) -> Any:
+    """The :class:`stickslip.rsf.RSFParams` of ``chosen`` where it is a rate-and-state file (a ``.params.json``
+    written by ``rsf fit`` or ``rsf simulate -o``, or a TOML of its keys); None for a bond-model set or file.
+    ``params show`` and ``export`` read both kinds; ``--set`` names the bond model's keys, so it is refused here."""
+    path = Path(chosen)
+    if path.suffix.lower() not in (".json", ".toml") or not path.is_file():
+        return None
+    from ..rsf import RSFParams
+    from .params_files import load_params_mapping
+
+    if path.suffix.lower() == ".toml":
+        mapping = load_params_mapping(path)
+        if not ({"a", "states"} & set(mapping)) or set(mapping) & set(SECTIONS):
+            return None  # a bond-model set: load_parameters reads it and names what is wrong
+    else:
+        mapping = load_params_mapping(path)
+    if overrides:
+        raise ParameterError(
+            f"--set {shorten(overrides[0])}: {chosen} is a rate-and-state parameter file and --set names the bond"
+            " model's keys; edit the file, or run it with `stickslip run --model rsf --params FILE --set KEY=VALUE`"
+        )
+    return RSFParams.from_dict(mapping, source=str(path))
+
+
+def rate_and_state_table(chosen: str, params: Any) -> Any:
+    """A rich table of a rate-and-state parameter set: key, value with its SI unit, meaning."""
+    from rich.table import Table
+
+    table = Table(title=f"Rate-and-state parameters {chosen} (SI)", title_justify="left")
+    for column in ("key", "value", "unit", "meaning"):
+        table.add_column(column, overflow="fold")
+    values = params.to_dict()
+    for key, (unit, meaning) in _RSF_KEYS.items():
+        if key in values:
+            value = values[key]
+            shown = f"{value['v1']:.6g}, {value['v2']:.6g}" if key == "cutoff" else _plain(value)
+            table.add_row(key, shown, unit, meaning)
+    for number, state in enumerate(values["states"], 1):
+        for key, (unit, meaning) in _STATE_KEYS.items():
+            table.add_row(f"states[{number}].{key}", _plain(state[key]), unit, meaning)
+    return table
+
+
+def _plain(value: Any) -> str:
+    return f"{value:.6g}" if isinstance(value, float) else str(value).lower() if isinstance(value, bool) else str(value)
+
+
 def _changed_keys(overrides: Sequence[str]) -> list[str]:
     return [item.partition("=")[0].strip() for item in overrides]
 
@@ -181,9 +245,15 @@ def show_command(ctx: click.Context, name: str | None, params_name: str, overrid
     """Print a parameter set with units, and the derived quantities.
 
     NAME is a built-in set (see `stickslip params list`) or a TOML file;
-    it defaults to --params.
+    it defaults to --params.  A rate-and-state file (a NAME.params.json of
+    `rsf fit` or `rsf simulate -o`, or a TOML of its keys) is shown in SI.
     """
-    params = resolve_params(_chosen_set(ctx, name, params_name), overrides)
+    chosen = _chosen_set(ctx, name, params_name)
+    rate_and_state = rate_and_state_file(chosen, overrides)
+    if rate_and_state is not None:
+        print_rich(rate_and_state_table(chosen, rate_and_state))
+        return
+    params = resolve_params(chosen, overrides)
     params = _with_override_note(params, overrides)
     print_rich(parameter_table(params, _changed_keys(overrides)), derived_table(params))
 
@@ -199,11 +269,16 @@ def export_command(
     """Write a parameter set as an editable TOML file (values with units).
 
     Loading the file back (`--params FILE`) gives exactly the same values.
+    A rate-and-state file (NAME.params.json) is written as its TOML.
     """
     chosen = _chosen_set(ctx, name, params_name)
     refuse_overwriting_inputs([], [("-o", output)], chosen)
     check_output("-o", output)  # -o '' (click reads it as the folder '.'): one line naming -o
-    text = _with_override_note(resolve_params(chosen, overrides), overrides).to_toml()
+    rate_and_state = rate_and_state_file(chosen, overrides)
+    if rate_and_state is not None:
+        text = rate_and_state.to_toml()
+    else:
+        text = _with_override_note(resolve_params(chosen, overrides), overrides).to_toml()
     if output is None:
         click.echo(text, nl=False)
     else:

@@ -9,6 +9,7 @@ from typing import Any
 
 from ..errors import DataError
 from ..fileio import protect_inputs, read_input_text
+from ..units import shorten
 
 #: Largest --params file read (one written by a run or fit is a few kB).
 MAX_PARAMS_BYTES = 1_000_000
@@ -52,8 +53,28 @@ def load_params_file(path: Path) -> dict[str, Any]:
     return data
 
 
+def run_history(path: Path) -> tuple[list[dict[str, Any]] | None, float | None]:
+    """The protocol and start velocity a ``.params.json`` of an earlier run or fit carries (None where absent): what
+    ``rsf simulate --params`` and ``run --model rsf --params`` run when no protocol is given."""
+    data = load_params_file(path)
+    protocol, start = data.get("protocol"), data.get("start_velocity")
+    fitted = data.get("fit")
+    if protocol is None and isinstance(fitted, dict) and fitted.get("protocol") is not None:
+        protocol = fitted["protocol"]  # a fit's file written before the history was put beside its parameters
+    if protocol is not None:
+        rows = protocol if isinstance(protocol, list) else None
+        if rows is None or not all(isinstance(r, dict) and {"velocity", "duration"} <= set(r) for r in rows):
+            raise DataError(
+                f'--params {path}: \'protocol\' must be a list of {{"velocity": ..., "duration": ...}} segments'
+                f" (SI), got {shorten(protocol)}"
+            )
+    if start is not None and (isinstance(start, bool) or not isinstance(start, (int, float))):
+        raise DataError(f"--params {path}: 'start_velocity' must be a number in m/s, got {shorten(start)}")
+    return protocol or None, start
+
+
 def _params_text(path: Path) -> str:
     return read_input_text(path, f"--params {path}", MAX_PARAMS_BYTES)
 
 
-__all__ = ["MAX_PARAMS_BYTES", "load_params_file", "load_params_mapping"]
+__all__ = ["MAX_PARAMS_BYTES", "load_params_file", "load_params_mapping", "run_history"]

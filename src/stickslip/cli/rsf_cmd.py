@@ -25,11 +25,11 @@ from typing import Any
 import click
 import numpy as np
 
-from ..errors import DataError, ModelError, ParameterError, StickslipError, UnitError
+from ..errors import ModelError, ParameterError, StickslipError, UnitError
 from ..numerics.budget import PROGRESS_AFTER_SECONDS
 from ..units import bare_number, quantity_noun, shorten
 from .common import json_text, positive, quantity, refuse_overwriting_inputs, save_figure, stacked, write_text
-from .params_files import load_params_file, load_params_mapping
+from .params_files import load_params_mapping, run_history
 from .protocol_options import build_protocol as build_run_protocol
 from .protocol_options import checked_segment_text, protocol_options, refuse_unsupported
 from .run_cmd import execute, output_options
@@ -146,25 +146,6 @@ def _base_states(base: dict[str, Any], path: Path | None) -> list[dict[str, Any]
     return [dict(s) for s in states]
 
 
-def _run_meta(path: Path) -> tuple[list[dict[str, Any]] | None, float | None]:
-    """The protocol and start velocity a ``.params.json`` of an earlier run carries (None where absent)."""
-    data = load_params_file(path)
-    protocol, start = data.get("protocol"), data.get("start_velocity")
-    fitted = data.get("fit")
-    if protocol is None and isinstance(fitted, dict) and fitted.get("protocol") is not None:
-        protocol = fitted["protocol"]  # a fit's file written before the history was put beside its parameters
-    if protocol is not None:
-        rows = protocol if isinstance(protocol, list) else None
-        if rows is None or not all(isinstance(r, dict) and {"velocity", "duration"} <= set(r) for r in rows):
-            raise DataError(
-                f'--params {path}: \'protocol\' must be a list of {{"velocity": ..., "duration": ...}} segments'
-                f" (SI), got {shorten(protocol)}"
-            )
-    if start is not None and (isinstance(start, bool) or not isinstance(start, (int, float))):
-        raise DataError(f"--params {path}: 'start_velocity' must be a number in m/s, got {shorten(start)}")
-    return protocol or None, start
-
-
 def _number(text: str, name: str) -> float:
     return quantity(text, "dimensionless", name)
 
@@ -234,7 +215,7 @@ def simulate_command(**options: Any) -> None:
 
     fallback, start = None, None
     if options["params_file"] is not None and options["params_file"].suffix.lower() == ".json":
-        fallback, start = _run_meta(options["params_file"])
+        fallback, start = run_history(options["params_file"])
     options["stiffness"] = options.pop("stiffness_text")
     params = build_params(options)
     earlier = segments([(s["velocity"], s["duration"]) for s in fallback]) if fallback else None  # the run's own

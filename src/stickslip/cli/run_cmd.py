@@ -395,7 +395,8 @@ def run_command(**options: Any) -> None:
     o = options
     refuse_overwriting_inputs([o["protocol_file"], o["params_name"]], [("-o", o["output"]), ("--plot", o["plot_path"])])
     model = load_model(o["model_name"])
-    protocol = build_protocol(o["v0_text"], o["duration_text"], o["segment_texts"], o["protocol_file"])
+    earlier, earlier_start = _earlier_run(model, o["params_name"])
+    protocol = build_protocol(o["v0_text"], o["duration_text"], o["segment_texts"], o["protocol_file"], earlier)
     mapping = model_overrides(model, o["overrides"])
     rig, own_spring = build_rig(o["control"], o["stiffness_text"], [model], o["mass_text"], o["damping_text"])
     if own_spring:  # a stiffness in the model's own unit sets its key k, as --set k=... would
@@ -405,8 +406,28 @@ def run_command(**options: Any) -> None:
     settings = settings_of(o["setting_texts"], o["every_text"])
     model.check(protocol, rig, settings)  # what the model cannot do, before any work
     start = start_value(o["start_text"], model)
+    if start is None and protocol is earlier:
+        start = earlier_start
     execute(model, params, protocol, rig, start=start, settings=settings, output=o["output"],
             plot_path=o["plot_path"], as_json=o["as_json"])  # fmt: skip
+
+
+def _earlier_run(model: Any, params_name: str | None) -> tuple[Any, float | None]:
+    """The protocol and start velocity that a ``.params.json`` written by ``rsf fit`` or ``rsf simulate -o``
+    carries, for a model that starts from a velocity (rate-and-state): ``run --model rsf --params F.params.json``
+    reruns that history as ``rsf simulate --params`` does.  (None, None) for any other file or model."""
+    path = Path(params_name) if params_name is not None else None
+    if path is None or path.suffix.lower() != ".json" or not path.is_file():
+        return None, None
+    if getattr(model, "start_dimension", None) != "velocity":
+        return None, None
+    from ..protocols import segments
+    from .params_files import run_history
+
+    rows, start = run_history(path)
+    if not rows:
+        return None, None
+    return segments([(row["velocity"], row["duration"]) for row in rows]), start
 
 
 def run_spelling(
