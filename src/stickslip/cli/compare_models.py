@@ -116,6 +116,8 @@ def _extra_keys(model: Any) -> tuple[str, ...]:
 
 def compare_models(options: dict[str, Any]) -> None:
     """Run every model of ``--models`` and report them side by side (see the module notes)."""
+    from ..models.run import finished
+
     output = options["output"]
     ctx = click.get_current_context()
     params_given = ctx.get_parameter_source("params_name") not in (None, click.core.ParameterSource.DEFAULT)
@@ -140,8 +142,8 @@ def compare_models(options: dict[str, Any]) -> None:
         for model in models:
             try:
                 params = model_parameters(model, params_name, routed[model.name])
-                runs[model.name] = model.run(params, protocol, rig, start=starts.get(model.name),
-                                             **settings[model.name])  # fmt: skip
+                runs[model.name] = finished(model.run(params, protocol, rig, start=starts.get(model.name),
+                                                      **settings[model.name]), protocol)  # fmt: skip
                 springs[model.name] = model.spring(params, checked[model.name])
             except (ParameterError, ModelError) as exc:
                 said = in_run_words(str(exc), f"--start {model.name}=")

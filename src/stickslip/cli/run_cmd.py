@@ -234,7 +234,7 @@ def run_summary(run: Any, protocol: Any, rig: Any, spring: tuple[float, str, str
         "protocol": [{"velocity": s.velocity, "duration": s.duration} for s in protocol.segments],
         "rig": rig_record(rig, spring),
         "regime": run.regime_name,
-        "oscillates": r.kind in OSCILLATING,
+        "oscillates": r.kind in OSCILLATING or (r.kind == regimes.BLOW_UP and r.periods > 0),
         "evidence": r.evidence,
         "periods_seen": r.periods,
         "amplitude_ratio": r.amplitude_ratio,
@@ -342,8 +342,11 @@ def summary_text(summary: dict[str, Any], units: dict[str, str] | None = None) -
     ]
     numbers = []
     # a cycle's peak, trough and mean once the run holds a whole one; else the run's range and its mean
-    cycle = summary.get("oscillates", True) and summary.get("periods_seen", 1) != 0
-    if summary["period"] is not None and math.isfinite(summary["period"]):
+    blow_up = summary["regime"] == regimes.BLOW_UP  # its extremes are the run's, not a cycle's
+    cycle = summary.get("oscillates", True) and summary.get("periods_seen", 1) != 0 and not blow_up
+    if blow_up and summary.get("periods_seen"):
+        numbers.append(f"before it {summary['evidence'].removeprefix('blow-up after ')}")
+    elif summary["period"] is not None and math.isfinite(summary["period"]):
         numbers.append(f"period {summary['period']:.6g} s" + ("" if cycle else " (no whole cycle within the run)"))
     words = ("peak", "trough", "mean") if cycle else ("trough", "peak", "run_mean")
     shown = {} if cycle else {"peak": "highest", "trough": "lowest", "run_mean": "mean"}
@@ -488,6 +491,7 @@ def execute(
     """
     from ..fileio import claim_stdout
     from ..models import as_run
+    from ..models.run import finished
 
     claim_stdout([output, plot_path])  # (rsf simulate's trace goes to standard output without -o)
     checked = model.check(protocol, rig, settings)
@@ -496,7 +500,7 @@ def execute(
         if "progress" in model.capabilities.settings and "progress" not in settings:  # a bar on a terminal only
             settings["progress"] = lambda fraction: bar.update(fraction * protocol.duration)
         try:
-            run = model.run(params, protocol, rig, start=start, **settings)
+            run = finished(model.run(params, protocol, rig, start=start, **settings), protocol)
         except BudgetExhausted as exc:  # it ran and stopped at its budget: what it did is kept (exit 3)
             if getattr(exc, "partial", None) is None:
                 click.echo(f"stickslip: the run failed: {exc}", err=True)

@@ -59,7 +59,9 @@ def run(
         raise ParameterError("protocol: expected a stickslip.protocols.Protocol, e.g. protocols.constant(50e-6, 20)")
     if params is None or isinstance(params, (str, Path, Mapping)):
         params = found.parameters(params)
-    return found.run(params, protocol, rig, start=start, **settings)
+    from .run import finished
+
+    return finished(found.run(params, protocol, rig, start=start, **settings), protocol)
 
 
 def as_run(result: Any, protocol: Any = None) -> Run:

@@ -27,7 +27,7 @@ if TYPE_CHECKING:  # pragma: no cover
     import pandas as pd
     from matplotlib.axes import Axes
 
-__all__ = ["BASE_COLUMNS", "Run", "settled_mean", "time_mean"]
+__all__ = ["BASE_COLUMNS", "Run", "finished", "settled_mean", "time_mean"]
 
 #: The columns every run has (``stress`` or ``friction`` may be absent), in order, with their SI units.
 BASE_COLUMNS: dict[str, str | None] = {
@@ -125,6 +125,82 @@ def _trace_arrays(time: Any, stress: Any, friction: Any) -> tuple[np.ndarray, np
     return t, signal
 
 
+def _first_non_finite(columns: Mapping[str, Any], size: int) -> tuple[int, str] | None:
+    """(row, column) of the first non-finite value among ``columns`` (the earliest row; None where all are finite).
+    A column of another length is left to :class:`Run`'s own check, which names it."""
+    first: tuple[int, str] | None = None
+    for name, values in columns.items():
+        if values is None:
+            continue
+        try:
+            array = np.asarray(values, dtype=float)
+        except (TypeError, ValueError):
+            continue
+        if array.shape != (size,):
+            continue
+        finite = np.isfinite(array)
+        if not finite.all():
+            row = int(np.argmin(finite))
+            if first is None or row < first[0]:
+                first = (row, name)
+    return first
+
+
+def _no_verdict(signal: np.ndarray, evidence: str) -> regimes.Regime:
+    """The regime of a run that did not reach its protocol's end: undetermined, no periods, the trace's extremes."""
+    return regimes.Regime(regimes.UNDETERMINED, 0, NAN, NAN, float(np.max(signal)), float(np.min(signal)), evidence)
+
+
+def _failed_at(
+    model: str,
+    time: np.ndarray,
+    columns: Mapping[str, Any],
+    bad: tuple[int, str],
+    states: Mapping[str, Any] | None,
+    state_units: Mapping[str, str | None] | None,
+    extra: Mapping[str, Any],
+) -> Run:
+    """A model's trace with a non-finite value (a plug-in's NaN or inf) as a failed run of the rows before it: a NaN
+    written as an empty cell and a "steady" regime of the rows around it hid it (round-25 tester)."""
+    from ..errors import RunFailed
+
+    row, name = bad
+    where = f"{model}: its {name} is not finite at row {row} (t = {time[row]:.6g} s)"
+    if row == 0:
+        raise RunFailed(f"{where}, its first: the model computed nothing to keep")
+    kept = {key: None if values is None else np.asarray(values, dtype=float)[:row] for key, values in columns.items()}
+    signal = kept["stress"] if kept["stress"] is not None else kept["friction"]
+    message = f"{where}; the run is kept up to t = {time[row - 1]:.6g} s"
+    regime = _no_verdict(signal, f"of the run up to its failure: {message}")
+    base = {key: kept[key] for key in BASE_COLUMNS if key != "time"}
+    others = {key: value for key, value in extra.items() if key not in ("status", "message", "mean")}
+    others["mean"] = time_mean(time[:row], signal) if row > 1 else float(signal[0])
+    return Run(model=model, time=time[:row], **base, regime=regime,
+               states={key: kept[key] for key in (states or {})}, state_units=state_units or {},
+               status="failed", message=message, **others)  # fmt: skip
+
+
+#: a trace that ends this fraction of the protocol's length (at least 1 ns) short of its end ended early
+END_TOLERANCE = 1e-9
+
+
+def finished(run: Run, protocol: Any) -> Run:
+    """``run`` as the model interface reports it: a run whose trace ends before ``protocol`` does, while the model
+    called it "ok", is a failed run of what it computed (a plug-in's solver that stopped at t = 0 of 1 s read
+    "undetermined: too short to tell" with exit 0).  The command line, sweeps, compare and
+    :func:`stickslip.models.run` pass every run through here."""
+    if run.status != "ok" or protocol is None:
+        return run
+    end, reached = float(protocol.duration), float(run.time[-1])
+    if reached >= end - END_TOLERANCE * max(end, 1.0):
+        return run
+    from dataclasses import replace
+
+    message = (f"{run.model}: the model stopped at t = {reached:.6g} s of the protocol's {end:.6g} s without saying"
+               " why (its trace ends there)")  # fmt: skip
+    return replace(run, status="failed", message=message)
+
+
 @dataclass(frozen=True, eq=False)  # arrays: equality is not a truth value; compare columns instead
 class Run:
     """A model run: the trace (SI, one row per solver output), its regime, and its summary numbers.
@@ -199,6 +275,14 @@ class Run:
         by :func:`stickslip.regimes.classify`, with ``dense`` the solver's interpolant of that signal if there is
         one, over ``t >= start``, changes below ``floor`` (default 1e-9 of the signal's scale) counting as none."""
         t, signal = _trace_arrays(time, stress, friction)
+        columns = {"stress": stress, "friction": friction, "slider_velocity": slider_velocity,
+                   "slider_position": slider_position, "load_point_position": load_point_position,
+                   **(states or {})}  # fmt: skip
+        bad = _first_non_finite(columns, t.size)
+        if bad is not None:  # what the model computed up to there is kept, and the run is a failed one (exit 3)
+            return _failed_at(model, t, columns, bad, states, state_units, extra)
+        if regime is None and extra.get("status", "ok") != "ok":  # a run that did not finish has no verdict
+            regime = _no_verdict(signal, f"of the run up to its {extra['status']} end: {extra.get('message', '')}")
         if regime is None:
             if floor is None:
                 scale = float(np.max(np.abs(signal[np.isfinite(signal)]), initial=0.0))

@@ -160,6 +160,25 @@ def _default_message(regime: Regime) -> str:
     }.get(regime.name, "")
 
 
+def _blow_up(t: np.ndarray, friction: np.ndarray) -> Regime:
+    """The regime of a run that blew up, with the oscillation that grew before it where there was one (a blow-up
+    after 29 growing peaks read "no oscillation", periods 0: round-25 tester)."""
+    finite = np.isfinite(friction)
+    peak = float(np.max(friction[finite])) if finite.any() else math.nan
+    trough = float(np.min(friction[finite])) if finite.any() else math.nan
+    if np.count_nonzero(finite) >= 3:
+        scale = float(np.max(np.abs(friction[finite])))
+        before = regimes.classify(t[finite], friction[finite], floor=1e-9 * scale if scale > 0 else 1e-300)
+        if before.periods >= 1:
+            grew = before.amplitude_ratio > 1 if math.isfinite(before.amplitude_ratio) else None
+            kind = "growing " if grew else "decaying " if grew is False else ""
+            evidence = (f"blow-up after {before.periods} period(s) of {kind}oscillation (period"
+                        f" {before.period:.4g} s, last amplitude ratio {before.amplitude_ratio:.3g})")  # fmt: skip
+            return Regime(regimes.BLOW_UP, before.periods, before.amplitude_ratio, before.period, peak, trough,
+                          evidence)  # fmt: skip
+    return Regime(regimes.BLOW_UP, 0, math.nan, math.nan, peak, trough, "")
+
+
 def assemble_run(
     system: System,
     protocol: Protocol,
@@ -178,7 +197,7 @@ def assemble_run(
     spring = y[0] if system.inertial else friction + system.eta * velocity
     slider = lp_disp - (spring - spring[0]) / system.k
     regime = (
-        Regime(regimes.BLOW_UP, 0, math.nan, math.nan, float(np.max(friction)), float(np.min(friction)), "")
+        _blow_up(t, friction)
         if status != "ok"
         else detect_regime(t, friction, velocity, protocol, system=system, solution=solution, rtol=rtol)
         if detect
@@ -265,14 +284,17 @@ def _stability_note(system: System, velocity: float, kind: str) -> str:
         rule = "b V2/(V2+V) <= a V1/(V1+V) + eta V" if system.params.cutoff else "b <= a + eta V"  # slopes at V
         where = f"steady sliding is linearly stable at every stiffness here ({rule})"
         stable = True
-    elif k > kc:
-        where = f"k = {k:.4g} 1/m is above kc = {kc:.4g} 1/m: steady sliding is linearly stable"
-        stable = True
+    elif abs(k - kc) <= 1e-9 * kc:  # "k = 500 1/m is below kc = 500 1/m" read as a contradiction
+        where = (f"k = {k:.6g} 1/m is kc (to {abs(k - kc) / kc:.1g} of it): steady sliding is neutrally stable,"
+                 " a disturbance neither grows nor decays at first order")  # fmt: skip
+        stable = None
     else:
-        where = f"k = {k:.4g} 1/m is below kc = {kc:.4g} 1/m: steady sliding is linearly unstable"
-        stable = False
+        digits = next(d for d in range(4, 18) if f"{k:.{d}g}" != f"{kc:.{d}g}")  # enough digits to tell them apart
+        relation, stable = ("above", True) if k > kc else ("below", False)
+        where = (f"k = {k:.{digits}g} 1/m is {relation} kc = {kc:.{digits}g} 1/m: steady sliding is linearly"
+                 f" {'stable' if stable else 'unstable'}")  # fmt: skip
     agrees = {regimes.DECAYING: stable, regimes.STEADY: stable, regimes.GROWING: not stable}
-    if kind in agrees and not agrees[kind]:
+    if stable is not None and kind in agrees and not agrees[kind]:
         if kind == regimes.GROWING:
             return f"; {where}, so the growth is a finite-amplitude effect or a transient, not that instability"
         return f"; {where}, yet the run settles (the run may be too short or the start too close to steady)"

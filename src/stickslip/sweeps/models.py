@@ -116,13 +116,14 @@ class SweepModel:
     def run(self, values: Mapping[str, float], settings: Mapping[str, Any]) -> dict[str, Any]:
         from ..errors import RunFailed
         from ..models import as_run
+        from ..models.run import finished
         from ..protocols import constant
 
         params, velocity, start = self.point(values, settings["duration"])
         protocol = constant(velocity, settings["duration"])
         taken = {k: v for k, v in settings.items() if self.takes(k)}
         try:
-            run = self.model.run(params, protocol, self.rig(), start=start, **taken)
+            run = finished(self.model.run(params, protocol, self.rig(), start=start, **taken), protocol)
         except RunFailed as exc:  # it ran and could not go on: a "failed" row of what it computed, where it says
             if getattr(exc, "partial", None) is None:
                 raise
