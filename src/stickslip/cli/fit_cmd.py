@@ -160,7 +160,8 @@ def steady_command(
         raise click.UsageError("--corner needs --bayes")
     posterior_module = _bayes_module() if bayes else None
     params = resolve_params(params_name, overrides)
-    split_value = positive(split, "velocity", "--split")
+    # the default split is not a request: auto may then answer a two-step fit short of points with the joint fit
+    split_value = None if split == SPLIT_DEFAULT else positive(split, "velocity", "--split")
     fit = fit_steady(
         data,
         params=params,

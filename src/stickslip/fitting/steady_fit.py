@@ -47,6 +47,8 @@ from .scatter import (
     Dependence,
     Misfit,
     Scatter,
+    agrees_with_stated_errors,
+    fitted_dependence,
     local_scatter,
     misfit,
     model_dependence,
@@ -61,6 +63,18 @@ if TYPE_CHECKING:  # pragma: no cover
 METHODS = ("auto", "two-step", "joint")
 INTERVAL_METHODS = ("delta", "profile", "bootstrap")
 DEFAULT_SPLIT = 800e-6
+
+
+class TooFewPointsError(DataError):
+    """A method's step has no more data points than free parameters (or none at all): bad input for that method,
+    which ``auto`` answers with the joint fit where the two-step method is the one short of points.  ``short`` is
+    the message without its advice."""
+
+    def __init__(self, short: str, advice: str) -> None:
+        super().__init__(f"{short}; {advice}" if advice else short)
+        self.short = short
+
+
 #: Above the split the two-step fit neglects aging; warn when that changes sigma by more than this many errors.
 AGING_NEGLECT_WARNING = 0.5
 #: Above this many points the joint fit's automatic intervals are the delta method's, not the profile's.
@@ -289,8 +303,17 @@ class _Progress:
     stages: list[Stage]
 
 
+#: What to do when the joint fit has too few points (no method can fit them as asked).
+JOINT_ADVICE = "need more points than parameters (measure more velocities or --fix some parameters)"
+
+
 def _fit_block(
-    progress: _Progress, keys: Sequence[str], block: Block, name: str, precheck: bool = False
+    progress: _Progress,
+    keys: Sequence[str],
+    block: Block,
+    name: str,
+    precheck: bool = False,
+    advice: str = JOINT_ADVICE,
 ) -> tuple[list[str], np.ndarray]:
     """Fit ``keys`` on ``block``; fix and refit while a direction is undetermined.
 
@@ -300,9 +323,8 @@ def _fit_block(
     """
     keys = list(keys)
     if len(keys) >= len(block):
-        raise DataError(
-            f"{name}: {len(block)} data point(s) for {len(keys)} free parameter(s) ({', '.join(keys)});"
-            " need more points than parameters (lower --split, --fix some parameters or use --method joint)"
+        raise TooFewPointsError(
+            f"{name}: {len(block)} data point(s) for {len(keys)} free parameter(s) ({', '.join(keys)})", advice
         )
     while precheck and keys:
         space = Space(progress.params, tuple(keys))
@@ -359,15 +381,20 @@ def _two_step(progress: _Progress, requested: Sequence[str], hi: Block, lo: Bloc
     step1, step2 = _steps(requested)
     progress.messages.extend(step1.messages)
     v_split = human(split, "velocity")
+    # advise the joint fit only where it has the points it needs (4 points for its 5 parameters: it fails too)
+    joint = len(hi) + len(lo) > len(identify.select_identifiable(requested, aging=True).free)
     if len(hi) == 0 or len(lo) == 0:
         side = "at or above" if len(hi) == 0 else "below"
-        raise DataError(
-            f"two-step fit: no data point {side} the split velocity {v_split}; set --split inside the data range"
-            " or use --method joint"
+        raise TooFewPointsError(
+            f"two-step fit: no data point {side} the split velocity {v_split}",
+            "set --split inside the data range" + (" or use --method joint" if joint else ""),
         )
+    advice = "need more points than parameters (lower --split, --fix some parameters" + (
+        " or use --method joint)" if joint else ")"
+    )
     progress.params = _scaled_start(progress.params, hi, step1.free)
-    _fit_block(progress, step1.free, hi, f"step 1 (V >= {v_split}, no aging)")
-    _fit_block(progress, step2, lo, f"step 2 (V < {v_split}, with aging)")
+    _fit_block(progress, step1.free, hi, f"step 1 (V >= {v_split}, no aging)", advice=advice)
+    _fit_block(progress, step2, lo, f"step 2 (V < {v_split}, with aging)", advice=advice)
 
 
 def _joint_start(
@@ -427,7 +454,7 @@ def fit_steady(
     data: SteadyData | str | Path,
     params: Parameters | str | None = None,
     method: str = "auto",
-    split: float | str = DEFAULT_SPLIT,
+    split: float | str | None = None,
     fix: Mapping[str, Any] | None = None,
     free: Sequence[str] | None = None,
     intervals: str | None = None,
@@ -441,7 +468,9 @@ def fit_steady(
     fit instead where the two-step's split approximation does not describe the data while the model does (a
     note says so).  ``params`` gives the start values and every value not fitted (default
     gelatin-glass); ``fix`` maps keys to values (SI numbers or strings with
-    units) held fixed; ``free`` adds keys to fit (e.g. ``bonds.breakage_weight``).
+    units) held fixed; ``free`` adds keys to fit (e.g. ``bonds.breakage_weight``).  ``split``: the two-step
+    method's split velocity (default 800 µm/s); ``auto`` answers a two-step fit short of points at the default
+    split with the joint fit (a note says why), while a split given here is kept and its shortage is an error.
     ``intervals`` chooses how the intervals of Vc and sigma_c are computed;
     None picks the method whose coverage was checked for each fit method
     (docs/fitting.md): ``delta`` for two-step, ``profile`` for joint.
@@ -454,12 +483,27 @@ def fit_steady(
         data = read_steady_data(data)
     if method not in METHODS:
         raise ParameterError(f"method: expected one of {', '.join(METHODS)}, got {method!r}")
+    split_given = split is not None
+    if split is None:
+        split = DEFAULT_SPLIT
     settings = dict(split=split, fix=fix, free=free, level=level, bootstrap_samples=bootstrap_samples, seed=seed)
     if method != "auto":
         return _fit_steady(data, params, method, intervals=intervals, **settings)
     if intervals == "profile":  # the profile likelihood is the joint fit's
         return _fit_steady(data, params, "joint", intervals=intervals, **settings)
-    paper = _fit_steady(data, params, "two-step", intervals=intervals, **settings)
+    try:
+        paper = _fit_steady(data, params, "two-step", intervals=intervals, **settings)
+    except TooFewPointsError as short:
+        if split_given:  # the split asked for is the problem: say so (and what would fit)
+            raise
+        # too few points for the two-step's steps is not bad data: the joint fit may have enough (else its own error)
+        joint = _fit_steady(data, params, "joint", intervals=intervals, **settings)
+        note = (
+            f"the two-step method (the paper's) cannot fit these points at its default split"
+            f" ({human(split, 'velocity')}): {short.short}; the joint fit (every point with aging) is reported"
+            " instead (--split to move the split)"
+        )
+        return dataclasses.replace(joint, messages=(note, *joint.messages))
     if paper.status != "ok" and paper.reason.startswith(TWO_STEP_MISFIT):
         why = paper.reason.split("; use --method joint")[0]
     elif paper.status == "ok" and _shifted_by_the_split(paper):
@@ -548,8 +592,8 @@ def _fit_steady(
     if not dependence.significant:
         # the neighbours' scatter counts a curve's bend between few points as noise: the method's own fit decides
         fitted_anyway = _fit_of_a_flat_looking_curve(check, (everything, hi, lo))
-        if fitted_anyway is None:  # noise: say so (a joint fit of it ran 92 s before issue 29, now ~0.3 s)
-            return _no_response_fit(check, dependence)
+        if isinstance(fitted_anyway, str):  # noise: say so (a joint fit of it ran 92 s before issue 29, now ~0.3 s)
+            return _no_response_fit(check, dependence, fitted_anyway)
         progress, keys = fitted_anyway
     else:
         _require_finite_start(everything, base, fixed)
@@ -904,9 +948,11 @@ def _adequate_or_searched(
 
 def _fit_of_a_flat_looking_curve(
     check: _Check, blocks: tuple[Block, Block, Block]
-) -> tuple[_Progress, list[str]] | None:
+) -> tuple[_Progress, list[str]] | str:
     """The method's fit of data in which the scatter between neighbours finds no velocity dependence, where the
-    fit does find one (:func:`~stickslip.fitting.scatter.model_dependence` at the same significance); else None.
+    fit does find one (:func:`~stickslip.fitting.scatter.model_dependence` or
+    :func:`~stickslip.fitting.scatter.fitted_dependence` at the same significance); else what the fit found ('' if
+    it could not be made).
 
     Few points far apart on a curved σ(V) look like noise to that scatter (ten exact points of the model: p =
     0.02, "no velocity dependence"); flat data and noise stay failed: the model does not explain them better
@@ -917,25 +963,43 @@ def _fit_of_a_flat_looking_curve(
         progress, keys = _run_method(check, blocks)
         model = blocks[0].model(progress.params)
     except (ModelError, ParameterError):
-        return None
-    p = model_dependence(data.stress, data.stress_err, model, len(keys))
+        return ""
+    nested = model_dependence(data.stress, data.stress_err, model, len(keys))
+    # the nested F test has n - k degrees of freedom for its noise (one for six points and the joint fit's five
+    # parameters: p = 0.014 for a curve varying by a factor 25 with 2 % noise); the scatter of the fit's residuals
+    # between neighbours has ~(n - 2)/1.9 whatever k, and with stated errors it agrees with, the errors themselves
+    against, noise = fitted_dependence(data.velocity, data.stress, data.stress_err, model)
+    p = min(nested, against)
     if p > SIGNIFICANCE:
-        return None
+        few = (
+            f"; with {len(data)} points the noise the fit leaves has ≈{noise.dof:.2g} degrees of freedom: stated"
+            " errors (stress_err) or more velocities can show a dependence"
+            if data.stress_err is None and noise.dof < 3
+            else ""
+        )
+        if p >= 1.0:
+            return "the model's fit finds none either (it is no closer to the data than the constant)"
+        return f"the model's fit finds none either (p = {p:.2g}, its residuals scatter {noise.describe()}){few}"
     rms = float(np.sqrt(np.mean(((data.stress - model) / data.stress) ** 2)))
+    if data.stress_err is not None and agrees_with_stated_errors(noise):
+        how = f"χ² of a constant against the stated errors, which the fit's residuals bear out ({noise.describe()})"
+    else:
+        how = f"F test of a constant against the noise the fit leaves, {noise.describe()}"
     progress.messages.append(
         f"the scatter between neighbouring points ({check.scatter.describe()}) finds no velocity dependence"
         f" in these {len(data)} points: it counts the curve's own bend between them as noise; the model's fit"
-        f" does (rms misfit {100 * rms:.3g} %; F test against a constant: p = {p:.2g}), and the noise is measured"
-        " from its residuals"
+        f" does (rms misfit {100 * rms:.3g} %; {how}: p = {against:.2g}; F test of a constant nested in the"
+        f" model: p = {nested:.2g}), and the noise is measured from its residuals"
     )
     return progress, keys
 
 
-def _no_response_fit(check: _Check, dependence: Dependence) -> SteadyFit:
+def _no_response_fit(check: _Check, dependence: Dependence, fitted: str = "") -> SteadyFit:
     """The failed result for data whose stress does not vary by more than its noise: nothing is fitted."""
     data, base = check.data, check.base
     why = "not fitted: the data show no velocity dependence"
-    reason = f"{NO_RESPONSE_TEXT}: {dependence.text}; so Vc, σc and the parameters are not determined"
+    found = f"; {fitted}" if fitted else ""
+    reason = f"{NO_RESPONSE_TEXT}: {dependence.text}{found}; so Vc, σc and the parameters are not determined"
     error = data.stress_err if data.stress_err is not None else data.stress
     weight = 1.0 / error**2
     flat = float(np.sum(weight * data.stress) / np.sum(weight))
