@@ -12,7 +12,7 @@ import pytest
 
 from cli_helpers import run_main
 from stickslip import protocols
-from stickslip.cli import rsf_cmd
+from stickslip.cli.params_files import run_history
 from stickslip.errors import DataError
 from stickslip.rsf import rsf_params, simulate
 from stickslip.rsf.data import LabRecord, read_record
@@ -129,7 +129,7 @@ def test_a_fits_file_with_its_history_under_fit_only_still_reruns(tmp_path):
     rows = [{"start": 0.0, "velocity": 1e-6, "duration": 10.0, "unit": "m/s"},
             {"start": 10.0, "velocity": 1e-5, "duration": 5.0, "unit": "m/s"}]  # fmt: skip
     path.write_text(json.dumps({"parameters": {"a": 0.01}, "fit": {"protocol": rows}}))
-    protocol, start = rsf_cmd._run_meta(path)
+    protocol, start = run_history(path)
     assert [(r["velocity"], r["duration"]) for r in protocol] == [(1e-6, 10.0), (1e-5, 5.0)]
     assert start is None
 

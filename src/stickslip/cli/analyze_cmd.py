@@ -16,6 +16,7 @@ import click
 from ..columns import json_units
 from ..errors import ParameterError
 from .common import (
+    FILE_PATH,
     InputFile,
     echo_err,
     emit_json,
@@ -102,13 +103,13 @@ TABLE_ROWS = (
 @click.option(
     "-o",
     "--output",
-    type=click.Path(dir_okay=False, path_type=Path),
+    type=FILE_PATH,
     help="Write the per-cycle table as CSV (SI units in the header brackets).",
 )
 @click.option(
     "--plot",
     "plot_path",
-    type=click.Path(dir_okay=False, path_type=Path),
+    type=FILE_PATH,
     help="Save a figure of the record with the detected phases (and the model with --compare).",
 )
 @click.option(

@@ -315,6 +315,21 @@ class InputFile(click.ParamType):
         return path
 
 
+class FilePath(click.Path):
+    """A file's name on the command line, as a Path; one that ends with a slash names a folder, and is refused
+    (``-o out/`` wrote a file named ``out``: Path drops the slash).  ``FILE_PATH`` is every command's."""
+
+    def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> Any:
+        text = value if isinstance(value, str) else None
+        if text is not None and len(text) > 1 and text.endswith(("/", os.sep)):
+            self.fail(f"{text!r} ends with '/', so it names a folder; expected a file name", param, ctx)
+        return super().convert(value, param, ctx)
+
+
+#: the type of every file option and argument: a Path, never a folder
+FILE_PATH = FilePath(dir_okay=False, path_type=Path)
+
+
 def check_output(option: str, path: Path | None, plot: bool = False) -> None:
     """Refuse, before computing, an output that cannot be written: no name, no such folder, an unknown format."""
     if path is None:

@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import contextlib
 from collections.abc import Iterator
-from pathlib import Path
 from typing import Any
 
 import click
@@ -22,7 +21,17 @@ from ..columns import json_units
 from ..errors import ModelError, ParameterError
 from ..fileio import refuse_input_as_output
 from ..progress import progress
-from .common import json_safe, json_text, params_options, positive, quantity, resolve_params, save_figure, write_text
+from .common import (
+    FILE_PATH,
+    json_safe,
+    json_text,
+    params_options,
+    positive,
+    quantity,
+    resolve_params,
+    save_figure,
+    write_text,
+)
 from .protocol_options import protocol_options
 from .rsf_cmd import sidecar
 
@@ -101,7 +110,7 @@ _SET_UNITS = {
 @click.option("--b", "rsf_b", default=None, help="Override the RSF b.")
 @click.option("--dc", "rsf_dc", default=None, help='Override the RSF Dc, e.g. "50 um".')
 @click.option("--json", "as_json", is_flag=True, help="Print the summary as JSON (SI units).")
-@click.option("-o", "--output", type=click.Path(dir_okay=False, path_type=Path), help="Save the figure here.")
+@click.option("-o", "--output", type=FILE_PATH, help="Save the figure here.")
 def compare_command(**options: Any) -> None:
     """Models side by side on one protocol (--models A,B), or on a protocol set (--protocol-set).
 

@@ -16,6 +16,7 @@ from ..errors import ParameterError
 from ..parameters import Parameters, key_dimension
 from ..units import shorten
 from .common import (
+    FILE_PATH,
     InputFile,
     emit_json,
     key_value,
@@ -55,11 +56,11 @@ def _write_fitted(output: Path, params: Parameters, name: str, description: str,
 def _fit_outputs(plot_help: str) -> Any:
     """-o, --report, --plot and --json, as both fits take them."""
     options = [
-        click.option("-o", "--output", type=click.Path(dir_okay=False, path_type=Path),
+        click.option("-o", "--output", type=FILE_PATH,
                      help="Write the fitted parameters (TOML)."),
-        click.option("--report", "report_path", type=click.Path(dir_okay=False, path_type=Path),
+        click.option("--report", "report_path", type=FILE_PATH,
                      help="Write the report (Markdown)."),
-        click.option("--plot", "plot_path", type=click.Path(dir_okay=False, path_type=Path), help=plot_help),
+        click.option("--plot", "plot_path", type=FILE_PATH, help=plot_help),
         click.option("--json", "as_json", is_flag=True, help="Print the results as JSON (SI units)."),
     ]  # fmt: skip
 
@@ -122,7 +123,7 @@ def fit_group() -> None:
 @click.option(
     "--corner",
     "corner_path",
-    type=click.Path(dir_okay=False, path_type=Path),
+    type=FILE_PATH,
     help="Save a corner plot (with --bayes).",
 )
 @params_options

@@ -22,6 +22,7 @@ from ..errors import ParameterError
 from ..parameters import BOLTZMANN, SECTIONS, Parameters, available_parameter_sets, load_parameters
 from ..units import DIMENSIONS, shorten
 from .common import (
+    FILE_PATH,
     check_output,
     params_options,
     plain_text,
@@ -261,7 +262,7 @@ def show_command(ctx: click.Context, name: str | None, params_name: str, overrid
 @params_group.command("export")
 @click.argument("name", required=False, metavar="[NAME|FILE]")
 @params_options
-@click.option("-o", "--output", type=click.Path(dir_okay=False, path_type=Path), help="Write here instead of stdout.")
+@click.option("-o", "--output", type=FILE_PATH, help="Write here instead of stdout.")
 @click.pass_context
 def export_command(
     ctx: click.Context, name: str | None, params_name: str, overrides: tuple[str, ...], output: Path | None

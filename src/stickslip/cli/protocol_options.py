@@ -26,7 +26,7 @@ from typing import Any
 import click
 
 from ..errors import ParameterError, UnitError
-from .common import positive, require_unit, stacked
+from .common import FILE_PATH, positive, require_unit, stacked
 
 #: Rigs every run command names the same way.
 CONTROLS = ("spring", "velocity")
@@ -49,7 +49,7 @@ def protocol_options(
                          help='Length of the (first) segment, e.g. "120 s".'),
             click.option("--segment", "segment_texts", multiple=True, metavar='"V:T"',
                          help='A (further) segment: velocity and duration, e.g. "1 mm/s:2 s"; repeatable.'),
-            click.option("--protocol", "protocol_file", type=click.Path(dir_okay=False, path_type=Path),
+            click.option("--protocol", "protocol_file", type=FILE_PATH,
                          help="The protocol as CSV (time,velocity or velocity,duration; docs/protocols.md)."),
             click.option("--stiffness", "stiffness_text", metavar="K", default=None, help=stiffness_help),
             click.option("--control", type=click.Choice([*CONTROLS, *CONTROL_ALIASES]), default=control_default,

@@ -22,6 +22,7 @@ from ..numerics.budget import BudgetExhausted
 from ..progress import progress
 from ..units import shorten
 from .common import (
+    FILE_PATH,
     emit_json,
     key_value,
     refuse_overwriting_inputs,
@@ -55,9 +56,9 @@ def model_spec_options(func: Any) -> Any:
 def output_options(func: Any) -> Any:
     """``-o``, ``--plot`` and ``--json``: what ``run`` and each of its spellings writes, in the same words."""
     options = [
-        click.option("-o", "--output", type=click.Path(dir_okay=False, path_type=Path),
+        click.option("-o", "--output", type=FILE_PATH,
                      help="Write the Run as CSV (units in the header; stickslip analyze reads it)."),
-        click.option("--plot", "plot_path", type=click.Path(dir_okay=False, path_type=Path),
+        click.option("--plot", "plot_path", type=FILE_PATH,
                      help="Save the run's figure."),
         click.option("--json", "as_json", is_flag=True, help="Print the summary as JSON (SI units)."),
     ]  # fmt: skip

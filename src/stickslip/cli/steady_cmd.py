@@ -16,6 +16,7 @@ import numpy as np
 from ..columns import header_cell, unit_of
 from ..errors import ParameterError
 from .common import (
+    FILE_PATH,
     emit_json,
     params_options,
     positive,
@@ -176,11 +177,11 @@ def curve_table(columns: dict[str, np.ndarray], title: str) -> Any:
 @click.option(
     "--format", "fmt", type=click.Choice(["table", "csv", "json"]), default="table", show_default=True, help="Output."
 )
-@click.option("-o", "--output", type=click.Path(dir_okay=False, path_type=Path), help="Write the output here.")
+@click.option("-o", "--output", type=FILE_PATH, help="Write the output here.")
 @click.option(
     "--plot",
     "plot_path",
-    type=click.Path(dir_okay=False, path_type=Path),
+    type=FILE_PATH,
     help="Also save the figure of Fig 1/Fig 4 (σ against log V, with and without aging).",
 )
 @params_options
@@ -245,7 +246,7 @@ def curve_command(
 @click.option(
     "--plot",
     "plot_path",
-    type=click.Path(dir_okay=False, path_type=Path),
+    type=FILE_PATH,
     help="Also save the steady curves around Vc (a decade either side) with the critical point marked.",
 )
 @params_options

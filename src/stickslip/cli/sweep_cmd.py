@@ -9,7 +9,7 @@ from typing import Any
 import click
 
 from ..errors import DataError, ParameterError, StickslipError
-from .common import check_output, echo_err, require_unit, set_values
+from .common import FILE_PATH, check_output, echo_err, require_unit, set_values
 
 MODEL_NAMES = ("quasi-static", "transient", "rsf")  # the built-ins; any registered model or module:attr is taken
 
@@ -216,7 +216,7 @@ def _summary(folder: Path, total: int) -> str:
 @click.option(
     "-o",
     "--output",
-    type=click.Path(dir_okay=False, path_type=Path),
+    type=FILE_PATH,
     default=None,
     help="Image [default: OUT-COLOR.png].",
 )
