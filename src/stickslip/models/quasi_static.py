@@ -94,7 +94,8 @@ def simulation_run(sim: Any) -> Run:
 
 
 def cycle_numbers(sim: Any) -> dict[str, Any]:
-    """The repeating cycle's numbers (SI): period, stick time, sigma_s, Vs, the mean stress over the cycle."""
+    """The repeating cycle's numbers (SI): period, stick time, sigma_s, Vs, the mean stress over the cycle, and how
+    many whole ones the run holds (the run's own extremes are its regime's)."""
     row: dict[str, Any] = {
         "regime": sim.regime.kind,
         "period": NAN,
@@ -102,7 +103,9 @@ def cycle_numbers(sim: Any) -> dict[str, Any]:
         "peak_stress": NAN,
         "jump_velocity": NAN,
         "mean_stress": time_mean(sim.time, sim.stress),
-        "cycles": sum(c.period is not None for c in sim.cycles),
+        # the regime's periods: in stick-slip the whole cycles of the repeating one (a start-up cycle from another
+        # stress than σc does not repeat); otherwise every whole cycle, as counted before
+        "cycles": sim.regime.periods,
         "critical_velocity": sim.critical_velocity,
     }
     k = _repeating_index(sim)

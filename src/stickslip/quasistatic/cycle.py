@@ -47,7 +47,7 @@ class Cycle:
 
     index: int
     start_time: float
-    start_stress: float  # sigma where the stick began (sigma_c after the first)
+    start_stress: float  # sigma where the stick began (sigma_c after the first; else a start-up cycle)
     peak_stress: float  # sigma_s (Eq 16)
     stick_time: float  # t_s
     jump_velocity: float  # Vs
@@ -342,9 +342,14 @@ def simulate(
         t += slip.duration
         cycles[-1] = dataclasses.replace(cycles[-1], slip_time=slip.duration, period=stick.stick_time + slip.duration)
         sigma = sigma_c
+    # the regime's periods: in stick-slip the whole cycles of the repeating one (below), else every whole cycle
+    settled = [c for c in cycles if c.period is not None]
     if regime == regimes.STICK_SLIP:
-        whole = sum(c.period is not None for c in cycles)
-        message += f"; {whole} whole cycle(s) in {end:.6g} s"
+        sigma_s = phases.cycle(sigma_c).stick.peak_stress
+        assert sigma_s is not None
+        settled = settled_cycles(cycles, sigma_c, sigma_s)
+        whole = len(settled)
+        message += f"; {whole} whole cycle(s) in {end:.6g} s" + _start_up_words(cycles, sigma0, sigma_c, sigma_s, end)
         if not whole:  # the numbers above are the cycle the run heads for, not one it has seen
             message += " (the period and σs are its cycle's once settled, from σc: the run ends before one)"
     elif regime == regimes.STUCK and cycles:
@@ -369,7 +374,7 @@ def simulate(
         )
     return Simulation(
         **columns,
-        regime=_regime(regime, message, period, cycles, columns),
+        regime=_regime(regime, message, period, settled, columns),
         cycles=tuple(cycles),
         final_stress=float(columns["stress"][-1]),
         final_velocity=float(columns["velocity"][-1]),
@@ -443,16 +448,51 @@ def _without_critical_point(
     )
 
 
+def settled_cycles(cycles: list[Cycle] | tuple[Cycle, ...], sigma_c: float, sigma_s: float) -> list[Cycle]:
+    """The whole cycles of the repeating one (σc -> σs): every whole cycle after the first, and the first when it
+    starts at σc.  A first stick from another stress is a start-up cycle that does not repeat; one from within
+    :data:`stickslip.regimes.RATIO_TOLERANCE` of the rise σs - σc of σc, to as near a σs, is the repeating cycle
+    (the transient model's rule, docs/regimes.md: a typed σc is σc to its printed digits)."""
+    return [c for c in cycles if c.period is not None and (c.index > 0 or _repeats(c, sigma_c, sigma_s))]
+
+
+def _repeats(first: Cycle | None, sigma_c: float, sigma_s: float, start: float | None = None) -> bool:
+    """Whether the first cycle (or, without one, a stick from ``start``) is the repeating cycle's."""
+    near = regimes.RATIO_TOLERANCE * abs(sigma_s - sigma_c)
+    if first is None:
+        return start is not None and abs(start - sigma_c) <= near
+    return abs(first.start_stress - sigma_c) <= near and abs(first.peak_stress - sigma_s) <= near
+
+
+def _start_up_words(cycles: list[Cycle], sigma0: float, sigma_c: float, sigma_s: float, end: float) -> str:
+    """What the first stick from a start stress other than σc did: it is no cycle of the repeating one."""
+    first = cycles[0] if cycles else None
+    if _repeats(first, sigma_c, sigma_s, sigma0):
+        return ""
+    if first is None:
+        return f", the start-up stick from {sigma0:.6g} Pa still under way at {end:.6g} s"
+    if first.period is None:
+        return (
+            f", the start-up cycle from {sigma0:.6g} Pa (σs = {first.peak_stress:.6g} Pa after"
+            f" {first.stick_time:.6g} s) still slipping at {end:.6g} s"
+        )
+    return (
+        f" after the start-up cycle from {sigma0:.6g} Pa (a transient that does not repeat: σs ="
+        f" {first.peak_stress:.6g} Pa, period {first.period:.6g} s)"
+    )
+
+
 def _regime(
-    kind: str, message: str, period: float | None, cycles: list[Cycle], columns: dict[str, np.ndarray]
+    kind: str, message: str, period: float | None, whole: list[Cycle], columns: dict[str, np.ndarray]
 ) -> regimes.Regime:
-    """The run's regime with its evidence: every cycle after the first is the same cycle (amplitude ratio 1), its
-    peak and trough those of the last whole cycle traced; without a repeating cycle, the run's extremes."""
-    whole = [c for c in cycles if c.period is not None]
+    """The run's regime with its evidence: every cycle from σc is the same cycle (amplitude ratio 1); ``whole``,
+    the whole ones the run holds (:func:`settled_cycles`), are its periods, the peak and trough those of the last
+    of them; without one (a start-up cycle from another stress is none), the run's extremes."""
     time, stress = columns["time"], columns["stress"]
     if period is not None and whole:
         last = whole[-1]
-        inside = (time >= last.start_time) & (time <= last.start_time + period)
+        assert last.period is not None
+        inside = (time >= last.start_time) & (time <= last.start_time + last.period)
         peak, trough = float(np.max(stress[inside])), float(np.min(stress[inside]))
     else:
         peak, trough = float(np.max(stress)), float(np.min(stress))
