@@ -13,6 +13,7 @@ import click
 import numpy as np
 
 from .common import (
+    FILE_PATH,
     emit_json,
     params_options,
     positive,
@@ -105,10 +106,8 @@ def simulate_command(**options: Any) -> None:
     help="When the block stays stuck, follow Nc/Nc0 up to this time [default: 10 aging times of Eq 15].",
 )
 @click.option("--json", "as_json", is_flag=True, help="Print the result and the Nc/Nc0 curve as JSON (SI units).")
-@click.option("-o", "--output", type=click.Path(dir_okay=False, path_type=Path), help="Write the Nc/Nc0 curve as CSV.")
-@click.option(
-    "--plot", "plot_path", type=click.Path(dir_okay=False, path_type=Path), help="Save Nc/Nc0(t) (Fig 6) here."
-)
+@click.option("-o", "--output", type=FILE_PATH, help="Write the Nc/Nc0 curve as CSV.")
+@click.option("--plot", "plot_path", type=FILE_PATH, help="Save Nc/Nc0(t) (Fig 6) here.")
 @params_options
 def stick_command(
     v0_text: str,
