@@ -20,7 +20,7 @@ from ..columns import with_units
 from ..errors import DataError, ParameterError
 from ..parameters import Parameters, load_parameters
 from ..reprs import compact_repr
-from .detect import MEDIAN_WIDTH, Coarse, coarse_segments, rise_start
+from .detect import MEDIAN_WIDTH, MIN_ASYMMETRY, Coarse, coarse_segments, rise_start
 from .fits import QUADRATIC, Corner, Line, fit_corner, fit_line
 from .traces import Trace, check_trace
 
@@ -44,6 +44,15 @@ STICK_WINDOW = 0.3
 LINE_MARGIN = 0.05
 #: R^2 above which a record without slips is one linear stick rise ("stuck").
 STUCK_R2 = 0.9
+#: A record whose stress swings up and down with drops (nearly) all as slow as its rises is a smooth oscillation,
+#: not stick-slip (no slip phase): ``regimes.DECAYING`` or ``regimes.GROWING`` when its peak-to-trough amplitude
+#: changes from period to period by more than ``regimes.RATIO_TOLERANCE`` (and by more than three standard errors
+#: of its trend), this when it does not.
+OSCILLATION = "oscillation"
+#: An oscillation's amplitude trend is judged on at least this many swings (regimes.RATIOS_NEEDED ratios).
+TREND_SWINGS = regimes.RATIOS_NEEDED + 1
+#: ... and counts when the fitted ratio per period is this many standard errors from 1.
+TREND_SIGMAS = 3.0
 
 #: The per-cycle quantities summarised by mean and standard deviation, with their SI units.
 CYCLE_QUANTITIES = {
@@ -113,7 +122,7 @@ class TraceAnalysis:
     time: np.ndarray
     stress: np.ndarray
     pulling_velocity: float
-    regime: str  # "stick-slip" | "steady" | "stuck"
+    regime: str  # "stick-slip" | "steady" | "stuck" | "oscillation" | "decaying oscillation" | "growing oscillation"
     message: str
     cycles: tuple[CycleResult, ...]
     summary: dict[str, Any]
@@ -203,9 +212,12 @@ def analyze_trace(
     for stick in sticks:
         _fit_stick(t, x, coarse, stick, step)
     sticks = [s for s in sticks if s.line is not None]
-    regime, steady_from = _regime(t, x, coarse, sticks)
+    swings = _oscillation(t, x, coarse)
+    regime, steady_from = _regime(t, x, coarse, sticks, swings)
     cycles = _cycles(sticks, v0, params, steady_from is not None)
     summary = _summary(t, x, cycles, regime, steady_from, v0)
+    if swings is not None:
+        summary["oscillation"] = swings
     message = _message(regime, cycles, coarse, summary)
     return TraceAnalysis(
         time=trace.time,
@@ -406,9 +418,77 @@ def _first_index(values: np.ndarray, test: Callable[[np.ndarray], np.ndarray]) -
     return None
 
 
-def _regime(t: np.ndarray, x: np.ndarray, coarse: Coarse, sticks: list[_Stick]) -> tuple[str, float | None]:
+def _oscillation(t: np.ndarray, x: np.ndarray, coarse: Coarse) -> dict[str, Any] | None:
+    """A smooth oscillation's evidence, read off the record (None when ``coarse`` found none): whole periods
+    (maxima − 1, as :func:`stickslip.regimes.classify` counts them), the mean period and its scatter, the mean
+    peak-to-trough swing, the amplitude ratio per period (a straight-line fit to the log of the swings; None
+    with fewer than :data:`TREND_SWINGS`), its kind in :mod:`stickslip.regimes`' words, and the mean stress."""
+    swings = coarse.oscillation
+    if swings is None:
+        return None
+    peaks = swings.peaks
+    amplitudes = swings.peak_levels[:-1] - swings.trough_levels
+    # the period from the rises' mid-level crossings (a peak's time wanders along its flat top with the noise)
+    crossings = _rising_crossings(coarse, swings)
+    marks = crossings if crossings.size >= 2 else peaks
+    intervals = np.diff(marks)
+    period = float(marks[-1] - marks[0]) / (marks.size - 1)
+    ratio = ratio_error = None
+    kind = OSCILLATION
+    positive = amplitudes[amplitudes > 0]
+    if positive.size >= TREND_SWINGS and positive.size == amplitudes.size:
+        k = np.arange(amplitudes.size, dtype=float)
+        (slope, _), cov = np.polyfit(k, np.log(amplitudes), 1, cov="unscaled")
+        residual = np.log(amplitudes) - np.polyval([slope, _], k)
+        dof = max(amplitudes.size - 2, 1)
+        error = math.sqrt(max(float(cov[0, 0]) * float(residual @ residual) / dof, 0.0))
+        ratio, ratio_error = math.exp(slope), math.exp(slope) * error
+        if abs(slope) > TREND_SIGMAS * error and abs(ratio - 1.0) > regimes.RATIO_TOLERANCE:
+            kind = regimes.DECAYING if ratio < 1.0 else regimes.GROWING
+    inside = _between(t, float(peaks[0]), float(peaks[-1]))
+    return {
+        "kind": kind,
+        "periods": int(peaks.size - 1),
+        "period": period,
+        "period_std": float(np.std(intervals, ddof=1)) if intervals.size > 1 else None,
+        "peak_to_trough": float(np.mean(amplitudes)),
+        "amplitude_ratio": ratio,
+        "amplitude_ratio_stderr": ratio_error,
+        "asymmetry": swings.asymmetry,
+        "mean_stress": float(np.mean(x[inside])),
+        "first_peak": float(peaks[0]),
+        "last_peak": float(peaks[-1]),
+    }
+
+
+def _rising_crossings(coarse: Coarse, swings: Any) -> np.ndarray:
+    """Times where each rise from a trough to the next peak crosses its own mid-level (linear interpolation)."""
+    grid, y = coarse.grid_time, coarse.grid_stress
+    times = []
+    for a, b, low, high in zip(swings.troughs, swings.peaks[1:], swings.trough_levels, swings.peak_levels[1:],
+                               strict=True):  # fmt: skip
+        i, j = int(np.searchsorted(grid, a)), int(np.searchsorted(grid, b))
+        level = 0.5 * (low + high)
+        above = np.nonzero(y[i : j + 1] >= level)[0]
+        if above.size == 0 or above[0] == 0:
+            continue
+        k = i + int(above[0])
+        y0, y1 = y[k - 1], y[k]
+        times.append(grid[k - 1] + (grid[k] - grid[k - 1]) * ((level - y0) / (y1 - y0) if y1 > y0 else 1.0))
+    return np.asarray(times, dtype=float)
+
+
+def _regime(
+    t: np.ndarray, x: np.ndarray, coarse: Coarse, sticks: list[_Stick], swings: dict[str, Any] | None = None
+) -> tuple[str, float | None]:
     """(regime in :mod:`stickslip.regimes`' names, where steady sliding starts): a measured record is noisy, so
-    its slips are the drops beyond ten noise levels (``coarse``), not the turning points of a solution."""
+    its slips are the drops beyond ten noise levels (``coarse``), not the turning points of a solution; a record
+    whose drops are as slow as its rises oscillates (``swings``, :func:`_oscillation`): no slip, no cycles."""
+    if swings is not None:
+        sticks.clear()
+        if coarse.steady_from is not None and coarse.steady_from >= swings["last_peak"]:
+            return regimes.STEADY, coarse.steady_from
+        return swings["kind"], None
     if coarse.peaks.size:
         if coarse.steady_from is not None:
             return regimes.STEADY, coarse.steady_from
@@ -534,6 +614,9 @@ def _message(regime: str, cycles: list[CycleResult], coarse: Coarse, summary: di
         return text
     if regime == "stuck":
         return "stuck: the stress rises along one stick line and never drops; no slip in the record"
+    swings = summary.get("oscillation")
+    if swings is not None and regime != regimes.STEADY:
+        return f"{regime}: {_swing_evidence(swings)}"
     mean = summary["mean_stress"]
     if cycles:
         return (
@@ -541,8 +624,28 @@ def _message(regime: str, cycles: list[CycleResult], coarse: Coarse, summary: di
         )
     drop = f"no stress drop larger than {coarse.threshold:.3g} Pa (10 noise levels)" if coarse.noise > 0 else "no drop"
     text = f"steady sliding at {mean:.6g} Pa: {drop}"
+    if swings is not None:
+        kind = "smooth oscillation" if swings["kind"] == OSCILLATION else swings["kind"]
+        text = f"steady sliding at {mean:.6g} Pa after a {kind} ({_swing_evidence(swings)})"
     if summary["steady_from"] > float(coarse.grid_time[0]):
         text += f"; settled from t = {summary['steady_from']:.6g} s"
     elif coarse.steady_from is None:
         text += f"; the stress has not settled (it changes by {summary['stress_slope']:.3g} Pa/s)"
     return text
+
+
+def _swing_evidence(swings: dict[str, Any]) -> str:
+    """An oscillation's evidence in words, as :mod:`stickslip.regimes` gives it, and why it is not stick-slip."""
+    ratio = swings["amplitude_ratio"]
+    trend = (
+        f"amplitude ratio {ratio:.4g} ± {swings['amplitude_ratio_stderr']:.2g} per period"
+        if ratio is not None
+        else f"amplitude ratio not known (fewer than {TREND_SWINGS} swings)"
+    )
+    spread = "" if swings["period_std"] is None else f" ± {swings['period_std']:.2g} s"
+    return (
+        f"{swings['periods']} period(s) of {swings['period']:.6g} s{spread},"
+        f" {swings['peak_to_trough']:.4g} Pa peak to trough about {swings['mean_stress']:.6g} Pa, {trend};"
+        f" the stress falls as slowly as it rises (fall/rise asymmetry {swings['asymmetry']:.2f}; a slip falls at"
+        f" least {MIN_ASYMMETRY:g} times faster), so there is no slip phase: a smooth oscillation, not stick-slip"
+    )

@@ -8,6 +8,7 @@ peak (docs/analysis.md).
 
 from __future__ import annotations
 
+import itertools
 import math
 from dataclasses import dataclass
 
@@ -23,8 +24,21 @@ PROMINENCE_SIGMAS = 10.0
 #: after it (the top ASYMMETRY_BAND of the drop): a slip falls faster than the stick rose, noise does not ...
 MIN_ASYMMETRY = 1.5
 ASYMMETRY_BAND = 0.3
-#: ... unless it is this many drop thresholds deep (a start-up slip above Vc falls about as fast as it rose).
+#: ... unless it is this many drop thresholds deep (a start-up slip above Vc falls about as fast as it rose) ...
 CLEAR_DROP = 3.0
+#: ... and the record is not a smooth oscillation: at least this many such deep drops that fall no faster than
+#: they rose (an isolated one is a start-up slip; several are the swings of an oscillation) ...
+OSCILLATION_SWINGS = 2
+#: ... with at most this fraction of all its candidate drops falling faster than they rose.
+OSCILLATION_FAST_SHARE = 0.2
+#: Shallower swings (above the threshold, below CLEAR_DROP of it) are an oscillation when there are at least this
+#: many, their median asymmetry is below MIN_ASYMMETRY, their median depth is at least REGULAR_DEPTH thresholds,
+#: and they repeat: their depths and the intervals between them scatter by at most REGULAR_SCATTER of their mean
+#: (the wanders of red noise, as often slow to fall as to rise, that pass the threshold barely do so, and are
+#: not evenly spaced).
+REGULAR_SWINGS = 5
+REGULAR_DEPTH = 1.5
+REGULAR_SCATTER = 0.2
 #: When the candidate stick phases scatter about their lines by more than this factor times the noise estimate,
 #: that scatter is the noise (correlated over longer than the estimate saw), and the drops are sought again ...
 STICK_CONSISTENCY = 1.2
@@ -58,6 +72,8 @@ class Coarse:
     start of a stick phase cut by the end of the record, or None.  When the
     record ends in steady sliding, ``steady_from`` is where the flat stretch
     begins (for a record without slips: None when it never settles).
+    ``oscillation`` is set, and ``peaks`` empty, when the record's drops are
+    (nearly) all as slow as its rises: a smooth oscillation, not stick-slip.
     """
 
     noise: float
@@ -72,6 +88,19 @@ class Coarse:
     final_level: float | None
     steady_from: float | None
     step: float = 0.0  # median interval between distinct sample times
+    oscillation: Swings | None = None
+
+
+@dataclass(frozen=True)
+class Swings:
+    """The swings of a smooth oscillation (times in s, stresses of the smoothed curve): its maxima, the minimum
+    between each two successive maxima, and the median over the maxima of the fall/rise asymmetry."""
+
+    peaks: np.ndarray
+    peak_levels: np.ndarray
+    troughs: np.ndarray
+    trough_levels: np.ndarray
+    asymmetry: float
 
 
 def noise_level(time: np.ndarray, stress: np.ndarray) -> float:
@@ -215,14 +244,14 @@ def coarse_segments(time: np.ndarray, stress: np.ndarray) -> Coarse:
     smooth = median_filter(raw, size=min(MEDIAN_WIDTH, raw.size), mode="nearest")
     scale = float(np.max(np.abs(smooth))) if smooth.size else 0.0
     threshold = max(PROMINENCE_SIGMAS * noise, 1e-9 * scale, 1e-300)
-    peaks, troughs = _drops(smooth, threshold)
+    peaks, troughs, swings = _drops(smooth, threshold)
     for _ in range(MAX_REFINEMENTS):  # the sticks found must be straight lines to within the noise
         scatter = _stick_scatter(time, stress, grid, peaks, troughs)
         if not scatter > STICK_CONSISTENCY * noise:
             break
         noise = scatter
         threshold = max(PROMINENCE_SIGMAS * noise, 1e-9 * scale, 1e-300)
-        peaks, troughs = _drops(smooth, threshold)
+        peaks, troughs, swings = _drops(smooth, threshold)
     final_trough = None
     steady_from = None
     last = peaks[-1] if peaks.size else 0
@@ -235,6 +264,7 @@ def coarse_segments(time: np.ndarray, stress: np.ndarray) -> Coarse:
             steady_from = _steady_tail(grid, smooth, last, threshold, _longest_stick(grid, peaks, troughs))
     else:  # no slip: where the record has settled, if it did for a quarter of its length
         steady_from = _steady_tail(grid, smooth, 0, threshold, SETTLED_FRACTION * float(grid[-1] - grid[0]))
+    oscillation = _swings(grid, smooth, swings) if swings is not None else None
     return Coarse(
         noise=noise,
         threshold=threshold,
@@ -248,23 +278,62 @@ def coarse_segments(time: np.ndarray, stress: np.ndarray) -> Coarse:
         final_level=None if final_trough is None else float(smooth[final_trough]),
         steady_from=steady_from,
         step=step,
+        oscillation=oscillation,
     )
 
 
-def _drops(smooth: np.ndarray, threshold: float) -> tuple[np.ndarray, np.ndarray]:
-    """Grid indices of the slips' peaks and of the starts of the sticks before them.
+def _drops(smooth: np.ndarray, threshold: float) -> tuple[np.ndarray, np.ndarray, tuple[np.ndarray, float] | None]:
+    """Grid indices of the slips' peaks and of the starts of the sticks before them, and the swings of a smooth
+    oscillation (its peaks' indices and their median asymmetry; None when the record does not oscillate).
 
     A peak is a slip when its prominence exceeds ``threshold`` and it falls faster than it rose (by
-    :data:`MIN_ASYMMETRY`, :func:`_asymmetry`), unless it is :data:`CLEAR_DROP` thresholds deep.
+    :data:`MIN_ASYMMETRY`, :func:`_asymmetry`), unless it is :data:`CLEAR_DROP` thresholds deep.  That exemption
+    is for an isolated deep drop (a start-up slip above Vc): when :data:`OSCILLATION_SWINGS` or more deep drops
+    fall no faster than they rose and at most :data:`OSCILLATION_FAST_SHARE` of all the candidates fall faster,
+    the record is a smooth oscillation, which has no slip phase: no slips, and its candidates are its swings.
     """
     peaks = _separated(smooth, find_peaks(smooth, prominence=threshold)[0], threshold)
     asymmetry, depth = _asymmetry(smooth, peaks)
-    peaks = peaks[(asymmetry >= MIN_ASYMMETRY) | (depth >= CLEAR_DROP * threshold)]
+    fast = asymmetry >= MIN_ASYMMETRY
+    deep = depth >= CLEAR_DROP * threshold
+    slow_deep = int(np.count_nonzero(deep & ~fast))
+    clear = slow_deep >= OSCILLATION_SWINGS and np.count_nonzero(fast) <= OSCILLATION_FAST_SHARE * peaks.size
+    if clear or _regular_swings(peaks, asymmetry, depth, threshold):
+        empty = np.empty(0, dtype=int)
+        return empty, empty, (peaks, float(np.median(asymmetry)))
+    peaks = peaks[fast | deep]
     troughs = np.empty(peaks.size, dtype=int)
     for k, p in enumerate(peaks):
         lo = peaks[k - 1] if k else 0
         troughs[k] = lo + rise_start(smooth[lo : p + 1], threshold)
-    return peaks, troughs
+    return peaks, troughs, None
+
+
+def _regular_swings(peaks: np.ndarray, asymmetry: np.ndarray, depth: np.ndarray, threshold: float) -> bool:
+    """Whether candidate peaks too shallow to be clear are the repeating swings of a smooth oscillation
+    (:data:`REGULAR_SWINGS`); the first and last depths are left out (the record's ends may cut those swings)."""
+    if peaks.size < REGULAR_SWINGS or not np.median(asymmetry) < MIN_ASYMMETRY:
+        return False
+    if not np.median(depth) >= REGULAR_DEPTH * threshold:
+        return False
+    inner = depth[1:-1]
+    intervals = np.diff(peaks).astype(float)
+    return bool(
+        np.std(inner) <= REGULAR_SCATTER * np.mean(inner) and np.std(intervals) <= REGULAR_SCATTER * np.mean(intervals)
+    )
+
+
+def _swings(grid: np.ndarray, smooth: np.ndarray, swings: tuple[np.ndarray, float]) -> Swings:
+    """The oscillation's maxima and the minimum between each two successive ones."""
+    peaks, asymmetry = swings
+    troughs = np.array([a + int(np.argmin(smooth[a : b + 1])) for a, b in itertools.pairwise(peaks)], dtype=int)
+    return Swings(
+        peaks=grid[peaks],
+        peak_levels=smooth[peaks],
+        troughs=grid[troughs],
+        trough_levels=smooth[troughs],
+        asymmetry=asymmetry,
+    )
 
 
 def _asymmetry(y: np.ndarray, peaks: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
