@@ -889,15 +889,18 @@ def measured_history(record: LabRecord, smoothing: float | None = None) -> Proto
         raise ParameterError(f"smoothing: expected a positive time window in seconds, got {smoothing!r}")
     record, _ = forward(record)
     t, d = record.time, record.displacement
-    try:
-        changes = find_segments(t, d, max_segments=10_000).boundaries
-    except DataError:  # a load point whose speed changes smoothly has no levels: it is followed whole
-        changes = np.array([t[0], t[-1]])
     bins = _bins(t, d)
     scale = float(np.max(np.abs(d - np.polyval(np.polyfit(t, d, 1), t)))) or 1.0
     noise = math.sqrt(float(np.median(bins.var)) * float(bins.inflation[1][0])) * scale  # one bin's mean (m)
     window = float(smoothing) if smoothing is not None else _smoothing_window(t, d, noise, bins.width)
+    kinks = None
+    try:
+        changes = find_segments(t, d, max_segments=10_000).boundaries
+    except DataError:  # not straight pieces: steps, if any, are located as kinks between smoothly varying speeds
+        changes, kinks = _kinks(t, d, window)
     grid_t, grid_d = _smoothed(t, d, changes, window)
+    if kinks is not None:  # at a kink, its own fit's value (over several windows) for the two sides' short lines
+        grid_d[np.searchsorted(grid_t, changes[1:-1])] = kinks
     keep = _bends(grid_t, grid_d, noise, np.searchsorted(grid_t, changes))
     knots_t, knots_d = grid_t[keep], np.maximum.accumulate(grid_d[keep])
     speeds = np.diff(knots_d) / np.diff(knots_t)
@@ -978,3 +981,111 @@ def _bends(t: np.ndarray, d: np.ndarray, tolerance: float, fixed: np.ndarray) ->
             keep[m] = True
             stack += [(a, m), (m, b)]
     return np.flatnonzero(keep)
+
+
+#: a kink's local fit reaches this many smoothing windows either side of it, never past halfway to the next
+#: proposed change; it is confirmed at KINK_CLOSE windows (at least KINK_ROWS rows either side)
+KINK_WINDOWS = 8.0
+KINK_CLOSE = 2.0
+KINK_ROWS = 12
+#: and its rows scatter about it by at most this many times the rows' variance about the smoothing's lines (a
+#: step between drifting levels: 0.5-2.1, with correlated noise too; a servo ramp of 0.5-3 s: 5-440 over the
+#: wider reach, 2-90 close to it)
+KINK_MISFIT = 8.0
+
+
+def _kinks(t: np.ndarray, d: np.ndarray, window: float) -> tuple[np.ndarray, np.ndarray]:
+    """The change times (with the record's ends) of a load point that is not piecewise linear, and its
+    displacement at each: velocity steps between stretches whose speed varies smoothly (a servo accelerating
+    within each level), each a step at one instant located from the rows around it; none when the speed varies
+    smoothly throughout.
+
+    :func:`find_segments`' search proposes the changes (curvature refuses its pieces, not its changes); each is
+    then fitted by a continuous broken line with a quadratic either side over a few smoothing windows
+    (:func:`_local_kink`), which a steady acceleration does not bias as it biases where two whole pieces' lines
+    meet.  It stays where the velocity jumps at that instant by more than ``min_change`` (20 %) of the faster side
+    and by more than the search's critical number of its standard errors, both over those windows and again
+    close to it (KINK_CLOSE windows): a step's jump is the same at every reach, while a smooth ramp, whose
+    changes of acceleration within the wider reach a quadratic cannot follow, shows a jump that vanishes close to
+    it.  And at both reaches the broken line must describe the rows to their noise (KINK_MISFIT): a short servo
+    ramp looks like a jump close to it, but no broken line fits it.
+    """
+    ends = np.array([t[0], t[-1]])
+    if t.size < 20:
+        return ends, np.zeros(0)
+    bins = _bins(t, d)
+    proposed = _pelt(bins)
+    bins = replace(bins, inflation=_slope_inflation(bins.t, bins.d, bins.var, proposed))
+    hinges = _significant_hinges(bins, proposed, 0.2, 10, 5.0 * bins.width)
+    guesses = [float(t[bins.first[h]]) for h in hinges]
+    z_crit = math.sqrt(2.0 * math.log(max(bins.t.size, 3))) + 2.0
+    edges = [float(t[0]), *guesses, float(t[-1])]
+    row = float(np.median(np.diff(t)))
+    scatter = float(np.median((d - _local_lines(t, d, t, window)) ** 2)) / 0.455  # the rows' variance (chi2_1)
+    kept, values = [], []
+    for j, guess in enumerate(guesses):
+        fits = []
+        for reach in (KINK_WINDOWS * window, max(KINK_CLOSE * window, KINK_ROWS * row)):
+            lo = max(guess - reach, 0.5 * (edges[j] + guess))
+            hi = min(guess + reach, 0.5 * (guess + edges[j + 2]))
+            fits.append(_local_kink(t, d, lo, hi, guess, 3.0 * bins.width))
+        if any(f is None or not _a_step(*f[2:5], z_crit) or f[5] > KINK_MISFIT * scatter for f in fits):
+            continue
+        if kept and fits[0][0] <= kept[-1]:  # each is fitted within halfway to its neighbours: kept in order
+            continue
+        kept.append(fits[0][0])
+        values.append(fits[0][1])
+    return np.array([t[0], *kept, t[-1]]), np.array(values)
+
+
+def _a_step(before: float, after: float, se: float, z_crit: float) -> bool:
+    """Whether a velocity jump from ``before`` to ``after`` (standard error ``se``) is a change of level: by more
+    than 20 % of the faster side (find_segments' ``min_change``) and ``z_crit`` standard errors."""
+    jump = abs(after - before)
+    return jump > 0.2 * max(abs(before), abs(after)) and jump > z_crit * se
+
+
+def _local_kink(
+    t: np.ndarray, d: np.ndarray, lo: float, hi: float, guess: float, search: float
+) -> tuple[float, float, float, float, float, float] | None:
+    """The continuous broken line with a quadratic either side that fits the rows in [lo, hi] best, its kink
+    within ``search`` of ``guess``: (kink time, displacement there, velocity before, velocity after, the velocity
+    jump's standard error, the rows' variance about it); None with too few rows either side."""
+    i0, i1 = np.searchsorted(t, [lo, hi])
+    i1 = min(i1 + 1, t.size)
+    tt, dd = t[i0:i1], d[i0:i1]
+    if np.sum(tt < guess) < KINK_ROWS // 2 or np.sum(tt > guess) < KINK_ROWS // 2:
+        return None
+    span = max(hi - lo, 1e-300)
+    level = float(np.interp(guess, tt, dd))
+    size = max(float(np.ptp(dd)), 1e-300)
+    y = (dd - level) / size
+
+    def fit(tau: float) -> tuple[float, np.ndarray, np.ndarray]:
+        u = (tt - tau) / span
+        before, after = np.minimum(u, 0.0), np.maximum(u, 0.0)
+        x = np.column_stack([np.ones_like(u), before, before**2, after, after**2])
+        coef, *_ = np.linalg.lstsq(x, y, rcond=None)
+        r = y - x @ coef
+        return float(r @ r), coef, x
+
+    a = max(guess - search, tt[KINK_ROWS // 2 - 1])
+    b = min(guess + search, tt[-(KINK_ROWS // 2)])
+    if not a < b:
+        return None
+    grid = np.unique(np.concatenate([tt[(tt >= a) & (tt <= b)], np.linspace(a, b, 41)]))
+    costs = [fit(x)[0] for x in grid]
+    k = int(np.argmin(costs))
+    left, right = grid[max(k - 1, 0)], grid[min(k + 1, grid.size - 1)]
+    from scipy.optimize import minimize_scalar
+
+    best = minimize_scalar(lambda x: fit(x)[0], bounds=(left, right), method="bounded",
+                           options={"xatol": 1e-9 * span})  # fmt: skip
+    tau = float(best.x) if best.fun <= costs[k] else float(grid[k])
+    sse, coef, x = fit(tau)
+    dof = max(y.size - x.shape[1], 1)
+    cov = np.linalg.pinv(x.T @ x) * sse / dof
+    contrast = np.array([0.0, -1.0, 0.0, 1.0, 0.0])
+    se = math.sqrt(max(float(contrast @ cov @ contrast), 0.0)) * size / span
+    before, after = float(coef[1]) * size / span, float(coef[3]) * size / span
+    return tau, level + float(coef[0]) * size, before, after, se, sse / dof * size**2
