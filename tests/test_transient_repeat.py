@@ -84,14 +84,15 @@ def test_the_copies_are_the_trace_row_by_row(stiff_runs):
         assert np.max(np.abs(a - b)) <= 0.1 * RTOL * np.max(np.abs(b)), name
 
 
-def test_no_repeat_on_a_sampling_grid_or_without_the_reduction():
-    """With ``every`` the rows are the grid's (a copy would shift them off it); reduction="off" is the reference."""
+def test_no_repeat_without_the_reduction_and_every_grid_instant_a_row_with_every():
+    """reduction="off" is the reference; with ``every`` the cycle is repeated too, its rows sampled onto the grid
+    (tests/test_transient_every_repeat.py)."""
     protocol = constant(100e-6, 40.0)
-    for settings in (dict(every=0.5), dict(reduction="off")):
-        estimate = estimate_cost(STIFF, protocol, stick_population=True, **settings)
-        assert "repeated" not in estimate.basis
+    estimate = estimate_cost(STIFF, protocol, stick_population=True, reduction="off")
+    assert "repeated" not in estimate.basis
+    assert "repeated" in estimate_cost(STIFF, protocol, stick_population=True, every=0.5).basis
     run = run_transient(STIFF, protocol, stick_population=True, every=0.5, rtol=RTOL)
-    assert "repeated" not in run.message
+    assert "repeated" in run.message
     grid = np.arange(81) * 0.5
     assert np.all(np.min(np.abs(run.time[:, None] - grid[None, :]), axis=0) < 1e-12)  # every grid instant a row
 

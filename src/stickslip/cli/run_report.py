@@ -87,13 +87,25 @@ def _transient_record(result: Any) -> list[str]:
         f" N/N0 = {result.final_bonded_fraction:.6g},"
         f" V = {result.slider_velocity[-1] * 1e6:.6g} µm/s ({result.steps} steps)"
     ]
-    for c in result.cycles:
+    cycles = result.cycles
+    # a long run's thousands of cycles: the first few, a count, and the last ones (the settled cycle; --json: all)
+    shown = cycles if len(cycles) <= CYCLE_LINES else (*cycles[:CYCLE_HEAD], None, *cycles[-CYCLE_TAIL:])
+    for c in shown:
+        if c is None:
+            lines.append(f"  … {len(cycles) - CYCLE_HEAD - CYCLE_TAIL} cycles more (--json lists every cycle) …")
+            continue
         slip = "—" if c.slip_time is None else f"{c.slip_time:.4g} s"
         lines.append(
             f"  cycle {c.index + 1}: stick {c.stick_time:.4g} s, σs = {c.peak_stress:.5g} Pa,"
             f" {describe_jump(c.jump_velocity)}, slip {slip}"
         )
     return lines
+
+
+#: a transient run's text lists its cycles one a line up to this many; beyond, the first and the last few
+CYCLE_LINES = 12
+CYCLE_HEAD = 5
+CYCLE_TAIL = 3
 
 
 __all__ = ["model_record", "record_text"]

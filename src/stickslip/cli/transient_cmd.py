@@ -39,7 +39,8 @@ class StepCount(click.ParamType):
     "--every",
     "every_text",
     metavar="DT",
-    help="Sample the trace every DT (the solver lands on the grid; jumps of the stick chains add their instant).",
+    help="Sample the trace every DT (rows on the grid; jumps of the stick chains add their instant; a settled"
+    " cycle is still repeated, docs/transient.md §10).",
 )
 @click.option("--rtol", default=1e-4, show_default=True, type=float, help="Local error tolerance (relative).")
 @click.option(

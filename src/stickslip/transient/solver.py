@@ -33,6 +33,7 @@ from . import kernel as K
 from .arguments import check_progress, check_rig_words, check_snapshot_times
 from .model import Population, chain_force, pack_parameters, stick_chains
 from .result import Bookkeeping, Snapshot, TransientResult
+from .sampling import Sampler
 
 CONTROLS = ("block", "velocity")
 STARTS = ("empty", "steady")
@@ -52,8 +53,18 @@ COHORT_STEPS_PER_CALL = 10_000_000_000
 #: default relative tolerance of the local error (stress and bonded fraction)
 RTOL = 1e-4
 #: a limit cycle of the stick chains is repeated, not integrated again, once its state has settled (``_Repeater``;
-#: ``reduction="auto"`` and no ``every`` only); False integrates every cycle (the reference of the tests)
+#: ``reduction="auto"`` only; with ``every`` its rows are sampled after the fact, ``_Driver.sampler``); False integrates
+#: every cycle (the reference of the tests)
 REPEAT_CYCLES = True
+#: without ``every``, the copies of repeated cycles add at most this many rows to a run's trace (each row ~870 bytes
+#: until the trace is written); beyond, a copy is sampled on a uniform grid of at least THIN_ROWS rows
+#: (``_Repeater._copy``, transient/sampling.py); with ``every`` the copies are sampled onto its grid
+TRACE_COPY_ROWS = 200_000
+THIN_ROWS = 20_000
+#: rows of copies shifted at a time (a bounded working set, whatever the number of periods)
+COPY_BATCH = 200_000
+#: with a sampler, the rows' entries held before the settled ones are sampled (a kernel call adds one)
+SAMPLER_ENTRIES = 64
 #: with the stick chains under a moving puller the births' spacing is bounded by their own Gauss error, not one
 #: lumped cohort's (kernel._relaxed_births, docs/transient.md section 11); False: the lumped bound throughout (the
 #: reference of the benchmark and the tests)
@@ -142,7 +153,10 @@ def run_transient(
     slider jumps onto the steady aging curve at the stress reached (the
     paper's jump) and Eq 1 takes over again.  A run from an empty start then
     begins stuck.  ``every`` (s) samples the trace on a uniform grid hit by
-    the solver itself; otherwise every accepted step is a row.  ``rtol`` is
+    the solver itself (with the stick chains through the massless block and
+    the reduction on, the run is integrated as without it, its settled cycle
+    repeated, and its rows sampled onto the grid: transient/sampling.py);
+    otherwise every accepted step is a row.  ``rtol`` is
     the local error tolerance (relative, in stress and bonded fraction).
     ``progress`` is called with the fraction done.  ``snapshot_times`` (s):
     extra instants to keep the age/extension distribution at (the start and
@@ -298,6 +312,12 @@ class _Driver:
         self.snap_index = 0
         self.out = np.empty((CHUNK, K.ROW_COLUMNS))
         self.repeater: _Repeater | None = None
+        #: with ``every``, a repeating run's rows sampled after the fact (transient/sampling.py); None: the rows kept
+        self.sampler: Sampler | None = None
+        self.dropped = 0  # entries of self.rows already fed to the sampler
+        self.slips_fed = 0  # events looked at for the sampler's instants
+        self.copy_rows_left = TRACE_COPY_ROWS  # rows the copies of repeated cycles may still add without ``every``
+        self.thinned: list[tuple[int, float, int, int]] = []  # (periods, spacing, rows kept, rows in place of)
 
     def start(
         self, start: str, start_velocity: float | None, every: float | None, max_step: float | None,
@@ -340,8 +360,12 @@ class _Driver:
         if reduction == "auto" and max_step is None and not self.inertial:  # a bound on the step: cohorts throughout
             self.reducer = _Reducer(params, self.p, self.functions, control, k_block, self.rtol, self.aging)
             self.reducer.disturbed(state.t)  # from empty, or a steady start: the cohorts first replace every bond
-            if REPEAT_CYCLES and self.stick_population and control == "block" and not self.times.size:
+            if REPEAT_CYCLES and self.stick_population and control == "block":
                 self.repeater = _Repeater(self)
+                if self.times.size:  # the run integrated as without ``every``, its rows sampled onto the grid
+                    self.sampler = Sampler(self.times, k_block)
+                    self.times = np.empty(0)
+                    self.sample_index = 0
 
     def run(self) -> TransientResult:
         """Every piece of the protocol, to its end (or to where the chains' jump has no landing point)."""
@@ -388,6 +412,46 @@ class _Driver:
     def _report_progress(self) -> None:
         if self.progress is not None:
             self.progress(min(1.0, self.state.t / self.duration))
+
+    def _feed(self, keep: int | None = None) -> None:
+        """The rows before entry ``keep`` (counted from the run's first; None: all) to the sampler, and dropped (the
+        repeater still needs those from its last mark on)."""
+        if self.sampler is None:
+            return
+        count = len(self.rows) if keep is None else keep - self.dropped
+        if count <= 0:
+            return
+        fine = np.vstack([np.atleast_2d(r) for r in self.rows[:count]])
+        self.sampler.feed(fine, self._slips_until(float(fine[-1, 0])))
+        del self.rows[:count]
+        self.dropped += count
+
+    def _slips_until(self, t: float) -> np.ndarray:
+        """The slips' instants up to t not yet given to the sampler (each a row of its own)."""
+        events, k, found = self.events, self.slips_fed, []
+        while k < len(events) and events[k][1] <= t:
+            if events[k][0] == "slip":
+                found.append(events[k][1])
+            k += 1
+        self.slips_fed = k
+        return np.array(found)
+
+    def _feed_settled(self) -> None:
+        """The rows the repeater no longer needs (before its last mark) to the sampler."""
+        if self.sampler is not None:
+            marks = self.repeater.marks if self.repeater is not None else []
+            self._feed(marks[-1][2] if marks else None)
+
+    def trace_rows(self) -> list[np.ndarray]:
+        """The trace's rows: all of them, or with a sampler the grid's (and the run's last state)."""
+        if self.sampler is None:
+            return self.rows
+        self._feed()
+        out = list(self.sampler.rows())
+        anchor = self.sampler.anchor
+        if anchor is not None and anchor[0] > self.sampler.last_written:  # a run stopped between grid points
+            out.append(anchor[None, :])
+        return out
 
     def _finish(self, stop: str | None = None) -> TransientResult:
         note = self.note + _jumps_note(self.jumps) + (self.repeater.note() if self.repeater else "")
@@ -495,6 +559,8 @@ class _Driver:
         state.puller = puller0 + vp * (state.t - t0) if control == "block" else state.x
         if count:
             self.rows.extend(_kernel_rows(self.out[:count], self.k_block, control, self.mass))
+            if self.sampler is not None and len(self.rows) > SAMPLER_ENTRIES:
+                self._feed_settled()
         if status == K.FULL:
             state.grow()
         elif status == K.STICK:
@@ -503,6 +569,7 @@ class _Driver:
             self.events.append(("stick", state.t, self.k_block * (state.puller - state.x), state.v))
             if self.repeater is not None:
                 self.repeater.at_stick(t0, t1, vp)
+                self._feed_settled()
         collapsed = status == K.FAILED and not self._jumped(vp)
         self._check(count, collapsed)
         self._report_progress()
@@ -583,8 +650,9 @@ class _Repeater:
         d, state = self.driver, self.driver.state
         sigma = d.k_block * (state.puller - state.x)
         self.marks.append(
-            (state.t, sigma, len(d.rows), len(d.chain_rows), len(d.events), len(d.jumps), state.acc.copy(), t0)
-        )
+            (state.t, sigma, d.dropped + len(d.rows), len(d.chain_rows), len(d.events), len(d.jumps), state.acc.copy(),
+             t0)
+        )  # fmt: skip
         del self.marks[:-3]
         periods = self._periods(t1, vp)
         if periods:
@@ -613,26 +681,52 @@ class _Repeater:
 
     def _copy(self, periods: int, vp: float) -> None:
         d, state = self.driver, self.driver.state
-        (tb, _, rows_b, chains_b, events_b, _, acc_b, _), (tc, _, rows_c, chains_c, events_c, _, acc_c, _) = self.marks[
-            -2:
-        ]
+        (tb, _, rows_b, _c, events_b, _, acc_b, _), (tc, _, rows_c, _c2, events_c, _, acc_c, _) = self.marks[-2:]
         period, travel = tc - tb, vp * (tc - tb)
-        rows = np.vstack([np.atleast_2d(r) for r in d.rows[rows_b:rows_c]])
-        chains = d.chain_rows[chains_b:chains_c]  # each copy below is shifted from these
+        rows = np.vstack([np.atleast_2d(r) for r in d.rows[rows_b - d.dropped : rows_c - d.dropped]])
         events = d.events[events_b:events_c]
         gained = {index: acc_c[index] - acc_b[index] for _, index in self.TOTALS}  # acc[7], the lowest, may be inf
-        for j in range(1, periods + 1):
+        slips = np.array([t for kind, t, *_ in events if kind == "slip"])
+        end = tc + periods * period  # where the copies end (state.t below, to the bit)
+
+        def shifted(j: int) -> np.ndarray:
             copied = rows.copy()
             copied[:, [0, 16, 17]] += j * period  # the time, and those of the row's extremes
             copied[:, 4:6] += j * travel
             for column, index in self.TOTALS:
                 copied[:, column] += j * gained[index]
-            d.rows.append(copied)
-            for c in chains:
-                shifted = c.copy()
-                shifted[:, 0] += j * period
-                d.chain_rows.append(shifted)
-            d.events.extend((kind, t + j * period, s, v) for kind, t, s, v in events)
+            return copied
+
+        # without ``every`` the copies are rows while the run's trace stays within TRACE_COPY_ROWS of them; beyond,
+        # they are sampled on a uniform grid (a note says how); with ``every``, onto its grid
+        sampler = d.sampler
+        last = np.atleast_2d(d.rows[-1])[-1] if d.rows else None  # the stick at tc, the cycle's start
+        if sampler is None and periods * len(rows) > d.copy_rows_left and last is not None and last[0] == tc:
+            kept = max(d.copy_rows_left, THIN_ROWS)
+            grid = tc + (end - tc) * np.arange(1, kept + 1) / kept
+            grid[-1] = end
+            sampler = Sampler(grid, d.k_block)
+            sampler.anchor = last.copy()
+            sampler.last_written = tc
+            d.thinned.append((periods, (end - tc) / kept, kept, periods * len(rows)))
+            d.copy_rows_left = 0
+        elif sampler is None:
+            d.copy_rows_left -= periods * len(rows)
+        else:
+            d._feed()  # everything up to the cycle's end first
+        batch = max(1, COPY_BATCH // max(len(rows), 1))
+        for first in range(1, periods + 1, batch):
+            js = range(first, min(first + batch, periods + 1))
+            block = [shifted(j) for j in js]
+            if sampler is None:
+                d.rows.extend(block)
+            else:
+                sampler.feed(np.vstack(block), np.concatenate([slips + j * period for j in js]))
+            d.events.extend((kind, t + j * period, s, v) for j in js for kind, t, s, v in events)
+        if sampler is not None and sampler is not d.sampler:
+            d.rows.extend(sampler.rows())
+        if d.sampler is not None:
+            d.slips_fed = len(d.events)  # the copies' slips were given with them
         state.t += periods * period
         state.x += periods * travel
         state.puller += periods * travel
@@ -645,9 +739,15 @@ class _Repeater:
     def note(self) -> str:
         if not self.repeated:
             return ""
+        thinned = "".join(
+            f"; the trace holds {periods} of them as {kept} rows, one every {spacing:.3g} s (and each slip's instant),"
+            f" in place of {rows} rows (at most {TRACE_COPY_ROWS:,} copied rows are kept; --every / every sets"
+            " the sampling)"
+            for periods, spacing, kept, rows in self.driver.thinned
+        )
         return (
             f"; {self.repeated} period(s) of the limit cycle repeated, not integrated again: the sticks' stress had"
-            " settled within rtol (reduction='auto')"
+            " settled within rtol (reduction='auto')" + thinned
         )
 
 
@@ -1066,7 +1166,7 @@ def _finish(d: _Driver, snapshots: list[Snapshot], stop: str | None, note: str) 
     from .cycles import Between, detect_cycles, judge
 
     params, protocol, control, k_block, mass, events = d.params, d.protocol, d.control, d.k_block, d.mass, d.events
-    table = np.vstack([np.atleast_2d(r) for r in d.rows])
+    table = np.vstack([np.atleast_2d(r) for r in d.trace_rows()])
     order = np.argsort(table[:, 0], kind="stable")
     table = table[order]
     keep = np.r_[True, np.diff(table[:, 0]) > 0]
@@ -1501,7 +1601,8 @@ def estimate_cost(
     reducing = reduction == "auto" and max_step is None
     k_block = params.block.effective_stiffness if stiffness is None else float(stiffness)
     # the block's own motion: stick-slip with the chains, or stuck for good under Eq 1 alone
-    repeating = REPEAT_CYCLES and reducing and every is None
+    # with ``every`` too: such a run is integrated as without it, its rows sampled onto the grid (transient/sampling.py)
+    repeating = REPEAT_CYCLES and reducing
     # SLIP_STEPS were measured with the reduction: without it a slip costs more than the births' share saves
     relaxed = RELAXED_BIRTHS and reducing and _births_never_held(protocol, bool(stick_population))
     churn = _churn(params, protocol.duration, rtol)
@@ -1520,7 +1621,10 @@ def estimate_cost(
         steps += RING_STEPS * ringing * sum(min(t1 - t0, RING_WINDOW) for t0, t1, _ in protocol.pieces())
     duration = protocol.duration
     samples = 0.0 if every is None else duration / every
-    steps += samples  # a sampling instant may cost a step where the cohorts run (they land on it)
+    # a sampling instant may cost a step where the cohorts run (they land on it); not where the rows are sampled
+    # after the fact (the stick chains' cycle, repeated: _Driver.sampler)
+    sampled_late = repeating and bool(stick_population) and control == "block" and mass == 0
+    steps += 0.0 if sampled_late else samples
     if max_step is not None:
         steps = max(steps, duration / max_step)
     basis = f"{duration:.3g} s at up to {fastest:.3g} m/s, resolving τ = {b.bond_time:.3g} s"
@@ -1539,7 +1643,8 @@ def estimate_cost(
     moving = len(protocol.segments) - (0 if motion is None else motion.stuck_segments)  # a stuck one looks for none
     per_segment = SEGMENT_SECONDS if (reducing and control == "block") else 0.1 * SEGMENT_SECONDS
     copied = 0.0 if motion is None else min(motion.copied * scale, steps)  # rows of a repeated limit cycle
-    seconds = (steps - copied - samples) * STEP_SECONDS + copied * ROW_SECONDS + samples * SAMPLE_SECONDS
+    seconds = (steps - copied - (0.0 if sampled_late else samples)) * STEP_SECONDS + copied * ROW_SECONDS
+    seconds += samples * SAMPLE_SECONDS
     seconds += moving * per_segment
     seconds += COHORT_SECONDS * stuck * stuck + living  # the cohorts each step works through
     return CostEstimate(steps, basis, seconds)
