@@ -28,7 +28,16 @@ import numpy as np
 from ..errors import ModelError, ParameterError, StickslipError, UnitError
 from ..numerics.budget import PROGRESS_AFTER_SECONDS
 from ..units import bare_number, quantity_noun, shorten
-from .common import json_text, positive, quantity, refuse_overwriting_inputs, save_figure, stacked, write_text
+from .common import (
+    FILE_PATH,
+    json_text,
+    positive,
+    quantity,
+    refuse_overwriting_inputs,
+    save_figure,
+    stacked,
+    write_text,
+)
 from .params_files import load_params_mapping, run_history
 from .protocol_options import build_protocol as build_run_protocol
 from .protocol_options import checked_segment_text, protocol_options, refuse_unsupported
@@ -44,7 +53,7 @@ def model_options(func: Callable[..., Any], stiffness: bool = True) -> Callable[
     ``stiffness=False`` leaves ``--stiffness`` to :func:`~stickslip.cli.protocol_options.protocol_options`.
     """
     options = [
-        click.option("--params", "params_file", type=click.Path(dir_okay=False, path_type=Path), default=None,
+        click.option("--params", "params_file", type=FILE_PATH, default=None,
                      help="Start from parameters written by an earlier run or fit (.params.json or .toml)."),
         click.option("--law", default=None, help="State evolution law: aging, slip, prz, nagata or a registered one."),
         click.option("--a", "a", default=None, help="Direct effect a."),
@@ -248,7 +257,7 @@ _STABILITY_UNITS = {"stiffness": "1/m", "critical_stiffness_pa": "Pa/m"}
 @model_options
 @click.option("--velocity", "velocities", multiple=True, required=True, help='Sliding velocity, e.g. "1 um/s".')
 @click.option("--json", "as_json", is_flag=True, help="Print JSON (SI units).")
-@click.option("--plot", "plot_path", type=click.Path(dir_okay=False, path_type=Path),
+@click.option("--plot", "plot_path", type=FILE_PATH,
               help="Save the critical stiffness against velocity.")  # fmt: skip
 def stability_command(**options: Any) -> None:
     """Critical stiffness k_c and neutral period of steady sliding (docs/rsf.md)."""
@@ -339,7 +348,7 @@ def _duration(seconds: float) -> str:
 
 
 @rsf_group.command("fit")
-@click.argument("record_file", metavar="FILE", type=click.Path(dir_okay=False, path_type=Path))
+@click.argument("record_file", metavar="FILE", type=FILE_PATH)
 @click.option(
     "--columns",
     default=None,
@@ -393,7 +402,7 @@ def _duration(seconds: float) -> str:
 @click.option(
     "--protocol",
     "protocol_file",
-    type=click.Path(dir_okay=False, path_type=Path),
+    type=FILE_PATH,
     default=None,
     help="Load-point history as a protocol CSV (time,velocity or velocity,duration; SI), as for simulate.",
 )
@@ -409,10 +418,10 @@ def _duration(seconds: float) -> str:
 @click.option(
     "-o",
     "--output",
-    type=click.Path(dir_okay=False, path_type=Path),
+    type=FILE_PATH,
     help="Write fitted parameters: TOML (with NAME.params.json beside it), or JSON for a NAME.json.",
 )
-@click.option("--plot", "plot_path", type=click.Path(dir_okay=False, path_type=Path), help="Save data and fit.")
+@click.option("--plot", "plot_path", type=FILE_PATH, help="Save data and fit.")
 def fit_command(**options: Any) -> None:
     """Fit rate-and-state friction to a lab record (time, load-point displacement, friction).
 
@@ -431,7 +440,7 @@ def fit_command(**options: Any) -> None:
     status 3; its parameters are not written to -o.  Bad input exits 2.
     """
     from ..rsf.data import parse_columns, read_record
-    from ..rsf.fit import fit_record
+    from ..rsf.fit import FitNotEvaluated, fit_record
 
     output, plot_path = options["output"], options["plot_path"]
     side = None if output is None or output.suffix.lower() == ".json" else sidecar(output)
@@ -458,6 +467,8 @@ def fit_command(**options: Any) -> None:
     try:
         with _deadline(max_time):
             fit = fit_record(record, **settings)
+    except FitNotEvaluated as exc:  # a failed fit whose report (where the search ended) is printed below, exit 3
+        fit = exc.fit
     except ModelError as exc:  # the search ran and ended where the model cannot be run: a failed fit, not bad input
         click.echo(_one_line(f"stickslip: fit failed: {exc}"), err=True)
         raise SystemExit(FIT_FAILED) from None

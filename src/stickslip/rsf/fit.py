@@ -17,6 +17,7 @@ import numpy as np
 
 from ..columns import with_units
 from ..errors import DataError, ModelError, ParameterError
+from ..numerics.quantisation import quantum
 from ..protocols import Protocol, Segment
 from ..reprs import compact_repr
 from ..units import to_si
@@ -25,7 +26,7 @@ from .laws import get_law
 from .params import RSFParams, StateVariable, _cutoff_pair
 from .solver import simulate
 
-__all__ = ["FitParameter", "RSFFit", "fit_record"]
+__all__ = ["FitNotEvaluated", "FitParameter", "RSFFit", "fit_record"]
 
 Z95 = 1.959963984540054
 METHOD_MAX_NFEV = 1500
@@ -256,6 +257,11 @@ def _model_or_why(
         )
     except (ModelError, ParameterError) as exc:
         return np.full(record.time.size, np.nan), f"the solver refused the run: {exc}"
+    if run.status == "blow-up":  # (the solver's own advice, eta or a mass, is no option of a fit)
+        return np.full(record.time.size, np.nan), (
+            f"the run stopped: blow-up at t = {float(run.time[-1]):.6g} s (the model slider's slip rate passed 1e10 "
+            "times the driving velocity: the spring is too soft for these a, b and Dc)"
+        )
     if run.status != "ok":
         return np.full(record.time.size, np.nan), f"the run stopped: {run.message}"
     if run.time.size != record.time.size:
@@ -324,6 +330,8 @@ def fit_record(
     record, protocol, backwards = _fitted_rows(record, protocol, window)
     if protocol.initial_velocity <= 0:
         raise DataError("record: the load point does not move in the first segment; expected steady sliding first")
+    if not _history_mismatch(record, protocol):  # (a given history that is not the record's fails as such)
+        _refuse_one_velocity(record, protocol)
     start = _stable_start(_initial_guess(record, protocol, {**starts, **held}, held.get("stiffness")),
                           "dc" in starts or "dc" in held)  # fmt: skip
     labels = _sampling_classes(record.time)
@@ -352,11 +360,18 @@ def fit_record(
         first = _start_values(result.params.valuesdict())
         setup = replace(setup, weights=_step_weights(record, protocol, first["dc"], weight))
         result, residual = _least_squares(setup, {**start, **first})
+    ladder: list[tuple[float, float, dict[str, float]]] = []
+    if not mismatch and setup.fit_stiffness and _stiffness_loose(result):  # (with the change times, as the fit)
+        result, residual, ladder = _stiffness_ladder(setup, start, result, residual)
     result, residual = _polish(setup, start, result, residual)
     curvature = _quadratic_check(result, residual)  # (with the search's own covariance, before it is replaced)
     base = _base(setup, start)
     values = result.params.valuesdict()
-    model = _evaluated(setup, base, values)
+    try:
+        model = _evaluated(setup, base, values)
+    except ModelError as exc:  # no start tried could leave it: the report still says where the search ended
+        failed = _unevaluated_fit(setup, start, result, str(exc), source, window, weight)
+        raise FitNotEvaluated(str(exc), failed) from None
     level = _uncertainty(setup, base, result, model, labels, float(noise) if given else None)
     resid = record.friction - model
     units = _units(record.length_unit)
@@ -378,6 +393,10 @@ def fit_record(
                 table[key] = replace(table[key], interval=None, scaled_interval=None, constrained=False, note=why)
         if not derived["a-b"].fixed:
             derived["a-b"] = replace(derived["a-b"], interval=None, scaled_interval=None, constrained=False, note=why)
+    if ladder and not table["stiffness"].fixed and not table["stiffness"].constrained and not why:
+        loose, said = _stiffness_dependence(setup, start, result, resid, labels, table, ladder, units)
+        problems += [said] if loose else []
+        warns += [] if loose else [said]
     if mismatch:
         problems.insert(0, mismatch)
     drift = _residual_drift(record, resid)
@@ -387,7 +406,7 @@ def fit_record(
             f"{level.redchi:.3g}): the model misses a drift, so its values and intervals are biased; fit the drift "
             "with --trend slip, time or both"
         )
-    warns += _chi2_warnings(level, given)
+    warns += _chi2_warnings(level, given) + _opening_warnings(record, setup.protocol, resid, level)
     if curvature is not None and not (QUADRATIC_RANGE[0] <= curvature <= QUADRATIC_RANGE[1]):
         warns.append(
             f"the chi-square surface is not quadratic over the intervals: two standard errors along the least "
@@ -431,6 +450,20 @@ def _fitted_rows(record: LabRecord, protocol: Protocol | None, window: Any) -> t
         refuse_reversal(rows, found)
         return rows, found, backwards
     return rows, _covering(_shifted(protocol, rows.t0 - record.t0), rows), backwards
+
+
+def _refuse_one_velocity(rows: LabRecord, protocol: Protocol) -> None:
+    """No law can be fitted to rows at one velocity: a, b and Dc are read off the response to its changes."""
+    speeds = protocol.velocities
+    if np.all(np.abs(speeds - speeds[0]) <= 1e-9 * np.max(np.abs(speeds))):
+        scale = _length_scale(rows.length_unit)
+        clock = rows.t0 + rows.time
+        raise DataError(
+            f"record: the load point moves at one velocity ({speeds[0] / scale:.4g} {rows.length_unit}/s) over all "
+            f"the rows fitted ({rows.source}, {clock[0]:g} ... {clock[-1]:g} s): there are no velocity changes, so "
+            "no rate-and-state law can be fitted (a, b and Dc are read off the friction's response to a change); "
+            "fit rows that hold one (a --window around a step)"
+        )
 
 
 @dataclass(frozen=True)
@@ -562,8 +595,16 @@ def _step_weights(record: LabRecord, protocol: Protocol, dc: float, weight: floa
 
 
 def _best_search(setup: _Setup, start: dict[str, float], mismatch: str, stiffness_given: bool) -> Any:
-    """The search, restarted elsewhere in Dc while it is troubled (a local minimum, no covariance)."""
+    """The search, restarted from other starts when it never got going (the model cannot be run there, or a, b and
+    Dc did not move), and elsewhere in Dc while it is troubled (a local minimum, no covariance)."""
     result, residual = _search(setup, start)
+    if not mismatch and _stuck(setup, start, result):
+        for other in _rescue_starts(setup, start, stiffness_given):
+            retry, retry_residual = _search(setup, other)
+            if retry.chisqr < result.chisqr * (1 - 1e-9):
+                result, residual = retry, retry_residual
+            if not _stuck(setup, other, result):
+                break
     sides: set[bool] = set()  # the sides of the first start in Dc that retries have started from
     for factor in RETRY_DC_FACTORS:  # a troubled search may sit in a local minimum: start it elsewhere in Dc
         if mismatch or not _troubled(result) or "dc" in setup.fixed:  # (no start helps a history not the record's)
@@ -584,14 +625,180 @@ def _best_search(setup: _Setup, start: dict[str, float], mismatch: str, stiffnes
     return result, residual
 
 
+#: halvings (in log k) of the gap between the softest ladder rung within the 95 % region and the next softer one
+STIFFNESS_BISECTIONS = 2
+
+
+def _stiffness_dependence(
+    setup: _Setup, start: dict[str, float], result: Any, resid: np.ndarray, labels: np.ndarray,
+    table: dict[str, FitParameter], ladder: list[tuple[float, float, dict[str, float]]],
+    units: dict[str, tuple[str, float]],
+) -> tuple[bool, str]:  # fmt: skip
+    """Whether a, b or Dc depend on a free stiffness the record leaves unconstrained, and the words: the softest
+    stiffness held (ladder rungs, then bisection) whose chi-square lies within the 95 % region of the best fit's
+    (a rise of 1.96^2 times what each unit of the search's chi-square is worth: :func:`_prior_weight`) gives a, b
+    and Dc; any outside its interval fails the fit."""
+    worth = _prior_weight(resid, start["noise"], labels)
+    best = min([float(result.chisqr)] + [chi for _, chi, _ in ladder])
+    reach = best + Z95**2 * worth
+    rungs = sorted(ladder, key=lambda rung: rung[0])
+    inside = [rung for rung in rungs if rung[1] <= reach]
+    if not inside:
+        inside = [(math.exp(result.params["log_k"].value), float(result.chisqr), _start_values(
+            result.params.valuesdict()))]  # fmt: skip
+    soft = inside[0]
+    outside = [rung for rung in rungs if rung[0] < soft[0]]
+    if outside:
+        hard, low = soft, outside[-1]
+        for _ in range(STIFFNESS_BISECTIONS):
+            k = math.sqrt(hard[0] * low[0])
+            held = replace(setup, fit_stiffness=False, fixed={**setup.fixed, "stiffness": k})
+            fit, _ = _least_squares(held, {**start, **hard[2], "stiffness": k})
+            here = (k, float(fit.chisqr), _start_values(fit.params.valuesdict()))
+            hard, low = (here, low) if here[1] <= reach else (hard, here)
+        soft = hard
+    from ..display import unit as shown_unit
+
+    k_unit, k_scale = units["stiffness"]
+    shown_k = f"{soft[0] / k_scale:.3g} {shown_unit(k_unit)}"
+    off = []
+    for key in _CORE:
+        entry = table[key]
+        if entry.fixed or entry.interval is None:
+            continue
+        value = soft[2][key]
+        if not entry.interval[0] <= value <= entry.interval[1]:
+            unit, scale = units.get(key, ("", 1.0))
+            unit = f" {shown_unit(unit)}" if unit else ""
+            off.append(f"{key} = {value / scale:.4g}{unit} outside [{entry.interval[0] / scale:.4g}, "
+                       f"{entry.interval[1] / scale:.4g}]{unit}")  # fmt: skip
+    what = f"the stiffness is not determined by the record ({table['stiffness'].note})"
+    if off:
+        return True, (
+            f"{what}, and the other values depend on it: held at {shown_k}, where chi-square is still within the 95 %"
+            f" region of the best fit's, {', '.join(off)}; hold the rig's stiffness where it is known (--fix "
+            "stiffness=..., fixed={'stiffness': k})"
+        )
+    return False, (
+        f"{what}: any stiffness above about {shown_k} fits as well, and a, b and Dc stay within their intervals "
+        "over that range"
+    )
+
+
+def _stuck(setup: _Setup, start: dict[str, float], result: Any) -> str:
+    """Why a search never got going ('' when it did): the model cannot be run at its answer (a start past the
+    spring's instability blows up at the first evaluation, and every residual is the same penalty), or a, b and Dc
+    did not move while the fit is troubled (a start that already fits need not move)."""
+    values = result.params.valuesdict()
+    _, why = _model_or_why(setup.record, _history(setup, values), _base(setup, start), values)
+    if why:
+        return why
+    free = [k for k in ("a", "b", "log_dc") if result.params[k].vary]
+    if free and not any(_moved(result.params[k]) for k in free) and _troubled(result):
+        return "a, b and Dc did not move from their starting values"
+    return ""
+
+
+#: a stuck search is started again with a spring this many times stiffer (further from the instability)
+STIFFER_START = 10.0
+
+
+def _rescue_starts(setup: _Setup, start: dict[str, float], stiffness_given: bool) -> list[dict[str, float]]:
+    """Starts for a search that never got going (docs/rsf.md, "Local minima"): the aging law's answer when another
+    law is fitted (its search is the most forgiving), a start neutral in velocity (a = b: stable on any spring) and
+    a stiffer spring."""
+    starts = []
+    if any(law != "aging" for law in setup.laws):
+        aging = replace(setup, laws=("aging",) * len(setup.laws))
+        first, _ = _search(aging, start)
+        if not _stuck(aging, start, first):
+            starts.append({**start, **_start_values(first.params.valuesdict())})
+    if start["b"] > start["a"] and "a" not in setup.fixed and "b" not in setup.fixed:
+        starts.append({**start, "a": start["b"]})
+    if not stiffness_given:
+        starts.append({**start, "stiffness": STIFFER_START * start["stiffness"]})
+    return starts
+
+
+#: a free stiffness left unconstrained is searched again held at the start's stiffness times each of these; the best
+#: is then freed (docs/rsf.md, "Local minima"), and the others say whether a, b and Dc depend on it
+STIFFNESS_LADDER = (0.01, 0.1, 1.0, 10.0, 100.0, 1000.0)
+
+
+def _stiffness_loose(result: Any) -> bool:
+    """A free stiffness the search leaves unconstrained (at the edge of its range, or no usable error)."""
+    par = result.params.get("log_k")
+    if par is None or not par.vary:
+        return False
+    se = par.stderr if par.stderr is not None and math.isfinite(par.stderr) else None
+    return bool(_unconstrained("log_k", par, se))
+
+
+def _stiffness_ladder(
+    setup: _Setup, start: dict[str, float], result: Any, residual: Any
+) -> tuple[Any, Any, list[tuple[float, float, dict[str, float]]]]:
+    """Searches with the stiffness held at each rung of STIFFNESS_LADDER, then a free search from the best rung
+    when it is below the free search's chi-square (a free stiffness ran to a rigid rig at 1e12 1/m, chi-square_r
+    9.568, where held at 1e4 1/m it gave 9.541: the free search had lost its way on a plateau)."""
+    here = {**start, **_start_values(result.params.valuesdict())}
+    rungs = []
+    for factor in STIFFNESS_LADDER:
+        k = factor * start["stiffness"]
+        held = replace(setup, fit_stiffness=False, fixed={**setup.fixed, "stiffness": k})
+        fit, _ = _search(held, {**here, "stiffness": k})
+        rungs.append((k, float(fit.chisqr), _start_values(fit.params.valuesdict())))
+    k, chi, values = min(rungs, key=lambda rung: rung[1])
+    if chi < result.chisqr * (1 - 1e-9):
+        again, again_residual = _search(setup, {**here, **values, "stiffness": k})
+        if again.chisqr < result.chisqr * (1 - 1e-9):
+            result, residual = again, again_residual
+    return result, residual, rungs
+
+
 def _evaluated(setup: _Setup, base: RSFParams, values: dict[str, float]) -> np.ndarray:
     """The model at the best parameters; a ModelError saying exactly what happened where it cannot be had."""
     model, why = _model_or_why(setup.record, _history(setup, values), base, values)
     if why:
         shown = ", ".join(f"{_PUBLIC[k]} = {math.exp(v) if k.startswith('log_') else v:.4g}" for k, v in values.items()
                           if k in _PUBLIC)  # fmt: skip
-        raise ModelError(f"rate-and-state fit: the best parameters found ({shown}) cannot be evaluated: {why}")
+        raise ModelError(
+            f"rate-and-state fit: the best parameters found ({shown}) cannot be evaluated: {why}; no start tried "
+            "led the search where the model runs: give a start where it does (--guess or guess=: another law's fit, "
+            "or a spring stiffer than (b - a)/Dc) or the rig's known stiffness (--fix stiffness=...)"
+        )
     return model
+
+
+class FitNotEvaluated(ModelError):
+    """A fit whose best parameters cannot be evaluated (the model cannot be run there); ``fit`` is its failed report:
+    the values where the search ended, no intervals, no model friction (NaN)."""
+
+    def __init__(self, message: str, fit: RSFFit) -> None:
+        super().__init__(message)
+        self.fit = fit
+
+
+def _unevaluated_fit(
+    setup: _Setup, start: dict[str, float], result: Any, reason: str, source: str, window: Any, weight: float | None
+) -> RSFFit:
+    """The failed report of a fit whose best parameters cannot be evaluated (docs/rsf.md, "Failed means failed")."""
+    record = setup.record
+    values = result.params.valuesdict()
+    table, _, _ = _report(result, values, setup, start["stiffness"], None, _units(record.length_unit))
+    note = "not evaluated: the model cannot be run at these values"
+    for key, par in table.items():
+        if not par.fixed:
+            table[key] = replace(par, stderr=None, interval=None, scaled_interval=None, constrained=False, note=note)
+    a_b = FitParameter("a-b", table["a"].value - table["b"].value, None, None, constrained=False, note=note)
+    nan = np.full(len(record), np.nan)
+    return RSFFit(
+        params=_final_params(_base(setup, start), values), parameters=table, correlations={},
+        reduced_chi_square=math.nan, rms=math.nan, noise=float(start["noise"]), trend=float(values.get("trend", 0.0)),
+        record=record, protocol=_history(setup, values), model_friction=nan, warnings=(), success=False,
+        message=str(result.message), nfev=int(result.nfev), status="failed", reason=reason.split(": ", 1)[-1],
+        derived={"a-b": a_b}, protocol_source=source, window=None if window is None else
+        (float(window[0]), float(window[1])), step_weight=weight,
+    )  # fmt: skip
 
 
 # --- the found history's change times as nuisance parameters ---------------------------------------------------
@@ -717,6 +924,13 @@ QUIET_RENEWALS = 5.0
 PLATEAU = 1.15
 #: blocks per sampling class for the batch-means check of the residuals' correlation
 CORRELATION_BLOCKS = 30
+#: harmonics of the quantisation error's sawtooth counted in its systematic covariance (99 % of its variance)
+QUANTISATION_HARMONICS = 64
+#: the opening stretch of the first segment checked for a start out of steady sliding, and its residuals' limit
+#: (rms, in noise units: out of steady sliding beyond it, with the mean beyond one less and standing out of the rest
+#: by one less)
+OPENING_SHARE = 0.25
+OPENING_MISFIT = 3.0
 
 
 @dataclass(frozen=True)
@@ -760,12 +974,15 @@ def _quiet_rows(record: LabRecord, protocol: Protocol, dc: float) -> np.ndarray:
 
 def _quiet_noise(
     record: LabRecord, protocol: Protocol, dc: float, labels: np.ndarray
-) -> tuple[np.ndarray, str]:  # fmt: skip
+) -> tuple[np.ndarray, str, np.ndarray]:  # fmt: skip
     """Per-row friction noise from steady sliding alone (model-independent), per sampling rate.
 
-    The variogram's plateau (the first doubling of the lag that adds less than PLATEAU - 1; a variogram that never
-    levels off gives its last value, and says so): docs/rsf.md, "Noise, independent of the sampling rate".
-    Returns (noise per row, how it was had).
+    The plateau of the variance of second differences (each row about the line through the rows a lag either side)
+    over lags 1, 2, 4, ... rows: the first doubling of the lag that adds less than PLATEAU - 1; a variogram that
+    never levels off gives its last value, and says so.  Lags with under a quarter of the first lag's triples are
+    not used (as long as the steady stretches, they measure nothing), and the noise is never below the friction's
+    quantisation noise: docs/rsf.md, "Noise, independent of the sampling rate".
+    Returns (noise per row, how it was had, the level measured per row before that floor).
     """
     t, f = record.time, record.friction
     quiet = _quiet_rows(record, protocol, dc)
@@ -779,15 +996,19 @@ def _quiet_noise(
             continue
         step = float(np.median(steps))
         gammas: list[float] = []
-        lag = 1
-        while lag < t.size // 2:
+        lag, first = 1, 0
+        while 2 * lag < t.size:
             pairs = usable[:-lag] & usable[lag:] & (labels[:-lag] == c) & (labels[lag:] == c)
             pairs &= (segment[:-lag] == segment[lag:]) & (np.abs(t[lag:] - t[:-lag] - lag * step) <= 0.5 * lag * step)
-            if int(pairs.sum()) < MIN_CLASS_ROWS:
+            triples = pairs[:-lag] & pairs[lag:]  # rows i, i + lag, i + 2 lag, evenly spaced in one segment
+            count = int(triples.sum())
+            first = first or count
+            if count < max(MIN_CLASS_ROWS, first / 4):  # lags as long as the steady stretches measure nothing
                 break
-            d, group = (f[lag:] - f[:-lag])[pairs], segment[:-lag][pairs]
-            drift = np.bincount(group, d) / np.maximum(np.bincount(group), 1)
-            gammas.append(_clipped_sd(d - drift[group]) ** 2 / 2.0)
+            # each row about the line through its neighbours lag rows either side: a drift, and a transient slower
+            # than the lag (the record's unseen opening one), cancel; white noise gives 6 sigma^2
+            curve = f[2 * lag :] - 2.0 * f[lag:-lag] + f[: -2 * lag]
+            gammas.append(_clipped_sd(curve[triples]) ** 2 / 6.0)
             lag *= 2
         if not gammas:
             continue
@@ -795,15 +1016,62 @@ def _quiet_noise(
         pick = level if level is not None else len(gammas) - 1
         sigma[int(c)] = math.sqrt(gammas[pick])
         lags[int(c)] = (2**pick * step, level is not None)
-    floor = MODEL_PRECISION * max(1.0, float(np.median(np.abs(f))))
+    bit = _quantisation_noise(f)
+    floor = max(MODEL_PRECISION * max(1.0, float(np.median(np.abs(f)))), bit)
     if not sigma:
         level = max(_noise(f), floor)
-        return np.full(t.size, level), "second differences of the friction (no steady sliding to measure)"
+        how = "second differences of the friction (no steady sliding to measure)"
+        return np.full(t.size, level), how, np.full(t.size, _noise(f))
     pooled = math.sqrt(float(np.mean(np.square(list(sigma.values())))))
-    rows = np.array([max(sigma.get(int(c), pooled), floor) for c in labels])
+    measured = np.array([sigma.get(int(c), pooled) for c in labels])
+    rows = np.maximum(measured, floor)
     shown = ", ".join(f"{lag:.3g} s" + ("" if flat else " (not levelled off)") for lag, flat in lags.values())
-    how = f"steady sliding's friction differences where their variance levels off (lags {shown})"
-    return rows, how
+    how = f"steady sliding's friction second differences where their variance levels off (lags {shown})"
+    if bit == floor and any(sigma.get(int(c), pooled) < bit for c in np.unique(labels)):
+        how += f", raised to the quantisation noise {bit:.3g} of friction written in steps of {bit * math.sqrt(12):.3g}"
+    return rows, how, measured
+
+
+def _quantisation_noise(friction: np.ndarray) -> float:
+    """q / sqrt(12) for friction written in whole steps q (its resolution, read from the values), else 0: the
+    least noise such a record can have.  Where the noise is well below q the steady sliding sits on one step and
+    its differences show no noise at all, yet no row is known to better than the step."""
+    return quantum(friction) / math.sqrt(12.0)
+
+
+def _systematic_quantisation(
+    friction: np.ndarray, model: np.ndarray, measured: np.ndarray
+) -> tuple[np.ndarray, float, np.ndarray] | None:  # fmt: skip
+    """The systematic part of the quantisation error of friction written in steps q, as (model, q, c_k): None
+    where there is no step or the noise dithers it away.
+
+    Rounding x + n to steps q leaves, on average over the noise n (Gaussian, sd s), the error
+    b(x) = sum_k (-1)^k (q / pi k) exp(-2 pi^2 k^2 s^2 / q^2) sin(2 pi k x / q): a function of the signal x, the same
+    on every row where x is the same (a steady level sits on one step for good, however many rows it has).  With
+    the grid's phase unknown, rows i and j share sum_k c_k cos(2 pi k (x_i - x_j) / q), c_k = q^2 / (2 pi^2 k^2)
+    exp(-4 pi^2 k^2 s^2 / q^2) (q^2/12 in all at s = 0; nothing once s > q/2).  s is the steady sliding's measured
+    level less q^2/12 (0 where the noise is below the step: the error is then taken as wholly systematic)."""
+    step = quantum(friction)
+    if not step > 0:
+        return None
+    dither2 = max(float(np.mean(measured**2)) - step**2 / 12.0, 0.0)
+    k = np.arange(1, QUANTISATION_HARMONICS + 1, dtype=float)
+    c = step**2 / (2.0 * math.pi**2 * k**2) * np.exp(-4.0 * math.pi**2 * k**2 * dither2 / step**2)
+    if float(np.sum(c)) < 1e-3 * step**2 / 12.0:
+        return None
+    return model, step, c
+
+
+def _quantisation_meat(wj: np.ndarray, model: np.ndarray, step: float, c: np.ndarray) -> np.ndarray:
+    """sum_ij w_i w_j J_i J_j^T sum_k c_k cos(2 pi k (x_i - x_j) / q), x the model's friction (separable: each
+    harmonic is the outer product of the cosine- and of the sine-weighted Jacobian sums)."""
+    phase = 2.0 * math.pi * (model - float(np.min(model))) / step
+    meat = np.zeros((wj.shape[1], wj.shape[1]))
+    for k, weight in enumerate(c, start=1):
+        for wave in (np.cos(k * phase), np.sin(k * phase)):
+            total = wave @ wj
+            meat += weight * np.outer(total, total)
+    return meat
 
 
 def _clipped_sd(x: np.ndarray) -> float:
@@ -824,7 +1092,7 @@ def _pre_fit_noise(record: LabRecord, protocol: Protocol, dc: float, labels: np.
     does (a search in a long valley ends elsewhere for a 1 % change), and the restarts for a troubled search
     judge chi-square by it: the white-noise level ``white`` (second differences) where the steady sliding
     agrees to within 2x, else the steady sliding's (correlated noise at 1 kHz: 5x above the white level)."""
-    rows, _ = _quiet_noise(record, protocol, dc, labels)
+    rows, _, _ = _quiet_noise(record, protocol, dc, labels)
     quiet = float(np.sqrt(np.mean(rows**2)))
     return quiet if quiet > 2.0 * white else white
 
@@ -890,28 +1158,38 @@ def _uncertainty(
             _set_covariance(result, _sandwich(setup, base, result, np.full(n, given**2)))
         return _Level(given, redchi, "given", float(n), 1.0, np.full(n, float(given)))
     dc = math.exp(result.params["log_dc"].value)
-    rows, how = _quiet_noise(record, setup.protocol, dc, labels)
+    rows, how, measured = _quiet_noise(record, setup.protocol, dc, labels)
     redchi = float(np.sum((resid / rows) ** 2) / dof)
     g = _correlation_factor(resid, labels)
     variance = np.zeros(n)
     for c in np.unique(labels):
         inside = labels == c
         variance[inside] = float(np.mean(resid[inside] ** 2)) * n / dof
-    _set_covariance(result, _sandwich(setup, base, result, variance * g))
+    systematic = _systematic_quantisation(record.friction, model, measured)
+    if systematic is not None:  # that part of the residuals' variance is counted by its own covariance instead
+        variance = np.maximum(variance - float(np.sum(systematic[2])), 0.0)
+        how += "; the quantisation's systematic part counted in the intervals"
+    _set_covariance(result, _sandwich(setup, base, result, variance * g, systematic))
     n_eff = float(np.sum(1.0 / g))
     method = (f"fit judged against the {how}; intervals from the residuals' own scatter and autocorrelation "
               f"(effective independent rows {n_eff:.4g} of {n})")  # fmt: skip
     return _Level(float(np.sqrt(np.mean(rows**2))), redchi, method, n_eff, n / n_eff, rows)
 
 
-def _sandwich(setup: _Setup, base: RSFParams, result: Any, variance: np.ndarray) -> np.ndarray | None:
-    """B^-1 (sum_i w_i^2 v_i J_i J_i^T) B^-1, B = sum_i w_i J_i J_i^T (None when J or B is unusable)."""
+def _sandwich(
+    setup: _Setup, base: RSFParams, result: Any, variance: np.ndarray,
+    systematic: tuple[np.ndarray, float, np.ndarray] | None = None,
+) -> np.ndarray | None:  # fmt: skip
+    """B^-1 (sum_i w_i^2 v_i J_i J_i^T) B^-1, B = sum_i w_i J_i J_i^T (None when J or B is unusable); with
+    ``systematic`` the quantisation's systematic error is added to the meat (:func:`_systematic_quantisation`)."""
     jac = _jacobian(setup, base, result)
     if jac is None:
         return None
     w = np.ones(len(setup.record)) if setup.weights is None else setup.weights
     bread = jac.T @ (w[:, None] * jac)
     meat = jac.T @ ((w**2 * variance)[:, None] * jac)
+    if systematic is not None:
+        meat += _quantisation_meat(w[:, None] * jac, *systematic)
     # the change times' priors (rows sqrt(F) u_j, u_j of unit variance, beside friction rows scaled by the search's
     # noise n): n^2 F in the bread, n^4 F^2 in the meat, in friction units
     names = list(result.var_names)
@@ -980,6 +1258,36 @@ def _chi2_warnings(level: _Level, given: bool) -> list[str]:
         f"({level.noise:.3g}), so they hold structure the model does not describe; the intervals, from the "
         "residuals' own scatter and correlation, treat that structure as noise and are optimistic where it is "
         "systematic"
+    ]
+
+
+def _opening_warnings(record: LabRecord, protocol: Protocol, resid: np.ndarray, level: _Level) -> list[str]:
+    """A record that opens on a transient (of a velocity change made before it) while the model starts in steady
+    sliding: over the first OPENING_SHARE of the first segment the residuals are over OPENING_MISFIT times the
+    noise, mostly of one sign (mean over OPENING_MISFIT - 1 noise) and OPENING_MISFIT - 1 times the rest's."""
+    t, f = record.time, record.friction
+    end = float(protocol.boundaries[1]) if len(protocol.segments) > 1 else float(t[-1])
+    opening = t <= t[0] + OPENING_SHARE * (end - t[0])
+    if int(opening.sum()) < MIN_CLASS_ROWS or int((~opening).sum()) < MIN_CLASS_ROWS:
+        return []
+    noise = math.sqrt(float(np.mean(level.rows[opening] ** 2))) if level.rows is not None else level.noise
+    misfit = math.sqrt(float(np.mean(resid[opening] ** 2)))
+    shift = float(np.mean(resid[opening]))
+    standout = misfit / math.sqrt(float(np.mean(resid[~opening] ** 2)))
+    if not (misfit > OPENING_MISFIT * noise and abs(shift) > (OPENING_MISFIT - 1) * noise
+            and standout > OPENING_MISFIT - 1):  # fmt: skip
+        return []
+    tenth = max(int(opening.sum()) // 10, 1)
+    first, last = float(np.mean(f[opening][:tenth])), float(np.mean(f[opening][-tenth:]))
+    return [
+        f"the record seems to start out of steady sliding: over its first {t[opening][-1] - t[0]:.3g} s, before any "
+        f"velocity change, the friction goes from {first:.4g} to {last:.4g} and the residuals are {misfit / noise:.3g} "
+        f"times the noise {noise:.3g}, mostly {'above' if shift > 0 else 'below'} the model (mean "
+        f"{shift / noise:+.3g} noise) and {standout:.3g} times those of the rest, as where a record opens on the "
+        "transient of a change made before it.  The model starts in steady sliding at the first velocity, so the fit "
+        "either misses that opening or bends Dc, a, b and mu0 to absorb it: their values and intervals are biased, "
+        "Dc most (the opening decay has the length scale of the unseen step).  Fit from where the friction has "
+        "settled (--window), or give the history from before the record"
     ]
 
 
@@ -1427,15 +1735,23 @@ def _interval(
     return value, value * se if log else se, pair, scaled
 
 
+#: a log-space parameter this close (in its log) to a bound of its range is at the edge: within 1 %
+LOG_EDGE = 0.01
+
+
 def _unconstrained(key: str, par: Any, se: float | None) -> str:
     """Why the record does not determine this parameter ('' when it does)."""
     if not par.vary:
         return ""
     if par.min is not None and par.max is not None and math.isfinite(par.min) and math.isfinite(par.max):
         span = par.max - par.min
-        if min(abs(par.value - par.min), abs(par.max - par.value)) < 1e-6 * span:
+        # a log-space value within 1 % of its bound is at it: a stiffness of 9.99e11 1/m against the bound 1e12
+        # was "known only to within a factor e^2.4e+06" and nothing more
+        near = max(1e-6 * span, LOG_EDGE) if key.startswith("log_") else 1e-6 * span
+        if min(abs(par.value - par.min), abs(par.max - par.value)) < near:
             edge = par.min if abs(par.value - par.min) < abs(par.max - par.value) else par.max
-            shown = f"{math.exp(edge):.3g} m" if key.startswith("log_") and key != "log_k" else f"{edge:.3g}"
+            unit = " 1/m" if key == "log_k" else " m"
+            shown = f"{math.exp(edge):.3g}{unit}" if key.startswith("log_") else f"{edge:.3g}"
             return f"at the edge of its allowed range ({shown}): the data push it as far as allowed"
     if se is None:
         return "no standard error: the covariance is singular, the record cannot tell it apart from the others"
