@@ -60,6 +60,10 @@ MAD_SCALE = 1.482602218505602
 TRIM_FRACTION = 0.5
 #: ... whose RMS is this many standard deviations for Gaussian noise: sqrt(1 - 2 z phi(z) / 0.5), z = 0.6745.
 TRIM_SCALE = 0.377594
+#: A coarsely sampled sawtooth is sought at this quantile of the absolute deviations of the residuals at lag 1 ...
+LOW_QUANTILE = 0.25
+#: ... which is this many standard deviations for Gaussian noise (the normal quantile at 0.625).
+LOW_SCALE = 0.318639
 
 
 @dataclass(frozen=True)
@@ -110,10 +114,17 @@ def noise_level(time: np.ndarray, stress: np.ndarray) -> float:
     widening that triple (:func:`_correlated_level`) until the estimate stops growing; and a record written in
     whole ADC steps q never gets less than the steps' own q/sqrt(12) (docs/analysis.md, "Noise level").
     """
+    return _noise_levels(time, stress)[1]
+
+
+def _noise_levels(time: np.ndarray, stress: np.ndarray) -> tuple[float, float]:
+    """(white, whole): the noise seen sample by sample (the MAD at lag 1) and the whole noise of
+    :func:`noise_level`, each at least the quantisation's q/sqrt(12)."""
     if time.size < 3:
-        return 0.0
-    level = _correlated_level(time, stress, _lag_level(time, stress, 1))
-    return max(level, _quantisation_level(stress))
+        return 0.0, 0.0
+    white = _lag_level(time, stress, 1)
+    floor = _quantisation_level(stress)
+    return max(white, floor), max(_correlated_level(time, stress, white), floor)
 
 
 #: The noise estimate widens its triples (lag 1, 2, 4, ... samples) while the estimate's variance still grows by
@@ -169,10 +180,11 @@ def _quantisation_level(stress: np.ndarray) -> float:
     return quantum(stress[:QUANTUM_SAMPLES]) / math.sqrt(12.0)
 
 
-def _lag_level(time: np.ndarray, stress: np.ndarray, lag: int, trimmed: bool = False) -> float:
+def _lag_level(time: np.ndarray, stress: np.ndarray, lag: int, trimmed: bool = False, low: bool = False) -> float:
     """Robust standard deviation of the residual of each sample about the line through the samples ``lag``
-    before and after it, scaled to the noise of one sample as if it were white: the MAD, or with ``trimmed``
-    the RMS of the :data:`TRIM_FRACTION` smallest deviations from the median."""
+    before and after it, scaled to the noise of one sample as if it were white: the MAD, with ``trimmed``
+    the RMS of the :data:`TRIM_FRACTION` smallest deviations from the median, with ``low`` their
+    :data:`LOW_QUANTILE` quantile (robust to a larger share of corners)."""
     stride = max(1, (time.size - 2 * lag) // LAG_TRIPLES)
     middle = slice(lag, time.size - lag, stride)
     t_mid, x_mid = time[middle], stress[middle]
@@ -203,6 +215,8 @@ def _lag_level(time: np.ndarray, stress: np.ndarray, lag: int, trimmed: bool = F
     centre = np.median(residual)
     residual -= centre
     deviation = np.abs(residual, out=residual)
+    if low:
+        return float(np.quantile(deviation, LOW_QUANTILE, overwrite_input=True)) / LOW_SCALE
     if not trimmed:
         return float(MAD_SCALE * np.median(deviation, overwrite_input=True))
     kept = max(1, int(TRIM_FRACTION * deviation.size))
@@ -236,22 +250,20 @@ def coarse_segments(time: np.ndarray, stress: np.ndarray) -> Coarse:
     A drop is a slip when it is deeper than :data:`PROMINENCE_SIGMAS` noise levels and falls faster than the
     stick before it rose (:func:`_drops`); when the sticks so found scatter about their lines by more than the
     noise estimate allows, their scatter is the noise and the drops are sought again (docs/analysis.md, "Red
-    noise").
+    noise").  When the correlated-noise estimate exceeds the sample-to-sample one, the drops are also sought at
+    the latter, and kept when the sawtooth they make accounts for the excess (:func:`_coarse_sawtooth`,
+    "Coarse sampling").
     """
-    noise = noise_level(time, stress)
+    white, whole = _noise_levels(time, stress)
     step = sampling_step(time)
     grid, raw = uniform_grid(time, stress, step)
     smooth = median_filter(raw, size=min(MEDIAN_WIDTH, raw.size), mode="nearest")
     scale = float(np.max(np.abs(smooth))) if smooth.size else 0.0
-    threshold = max(PROMINENCE_SIGMAS * noise, 1e-9 * scale, 1e-300)
-    peaks, troughs, swings = _drops(smooth, threshold)
-    for _ in range(MAX_REFINEMENTS):  # the sticks found must be straight lines to within the noise
-        scatter = _stick_scatter(time, stress, grid, peaks, troughs)
-        if not scatter > STICK_CONSISTENCY * noise:
-            break
-        noise = scatter
-        threshold = max(PROMINENCE_SIGMAS * noise, 1e-9 * scale, 1e-300)
-        peaks, troughs, swings = _drops(smooth, threshold)
+    noise, threshold, peaks, troughs, swings = _segment(time, stress, grid, smooth, scale, whole)
+    if whole > STICK_CONSISTENCY * white:  # the ladder climbed: correlated noise, or the sawtooth itself?
+        sawtooth = _coarse_sawtooth(time, stress, grid, (smooth, raw), scale, white)
+        if sawtooth is not None:
+            smooth, (noise, threshold, peaks, troughs, swings) = sawtooth
     final_trough = None
     steady_from = None
     last = peaks[-1] if peaks.size else 0
@@ -280,6 +292,120 @@ def coarse_segments(time: np.ndarray, stress: np.ndarray) -> Coarse:
         step=step,
         oscillation=oscillation,
     )
+
+
+#: (noise, threshold, peaks, troughs, swings) of :func:`_segment`.
+Segmentation = tuple[float, float, np.ndarray, np.ndarray, tuple[np.ndarray, float] | None]
+
+
+def _segment(
+    time: np.ndarray, stress: np.ndarray, grid: np.ndarray, smooth: np.ndarray, scale: float, noise: float
+) -> Segmentation:
+    """Drops at ``noise``, sought again while the sticks found scatter about their lines by more than the noise
+    allows (that scatter then being the noise): (noise, threshold, peaks, troughs, swings) as :func:`_drops`."""
+    threshold = max(PROMINENCE_SIGMAS * noise, 1e-9 * scale, 1e-300)
+    peaks, troughs, swings = _drops(smooth, threshold)
+    for _ in range(MAX_REFINEMENTS):  # the sticks found must be straight lines to within the noise
+        scatter = _stick_scatter(time, stress, grid, peaks, troughs)
+        if not scatter > STICK_CONSISTENCY * noise:
+            break
+        noise = scatter
+        threshold = max(PROMINENCE_SIGMAS * noise, 1e-9 * scale, 1e-300)
+        peaks, troughs, swings = _drops(smooth, threshold)
+    return noise, threshold, peaks, troughs, swings
+
+
+#: The sawtooth found at the sample-to-sample noise explains a correlated-noise estimate above it when at least
+#: this many of its sticks hold EXPLAIN_SAMPLES samples or more (their middle 80 %) ...
+EXPLAIN_STICKS = 3
+EXPLAIN_SAMPLES = 3
+#: ... and the residuals about those sticks' lines have the sample-to-sample noise's RMS (within
+#: :data:`STICK_CONSISTENCY`) with a pooled lag-one correlation of at most this (a line through a stretch of red
+#: noise leaves residuals that move together; white noise about a line of n samples gives about -1/n).
+EXPLAIN_CORRELATION = 0.3
+#: ... and the sticks fill at least this share of the time from one slip to the next (median over the cycles; a
+#: stick starts where the rise leaves the bottom, a sample or two late on a coarse record): the record is a
+#: sawtooth from end to end, not a few straight stretches of a wander picked out between long detours.
+EXPLAIN_STICK_SHARE = 1.0 / 3.0
+
+
+def _coarse_sawtooth(
+    time: np.ndarray,
+    stress: np.ndarray,
+    grid: np.ndarray,
+    curves: tuple[np.ndarray, np.ndarray],
+    scale: float,
+    white: float,
+) -> tuple[np.ndarray, Segmentation] | None:
+    """The slips found near the sample-to-sample noise ``white`` when they account for the growth of the
+    correlated-noise ladder (:func:`_correlated_level`), with the curve they were found on; None when they do
+    not (docs/analysis.md, "Coarse sampling").
+
+    A sawtooth sampled a few tens of times per cycle has its slips inside the ladder's wider triples, which read
+    the sawtooth itself as noise.  The slips are sought at the lower quartile of the lag-1 residuals
+    (:data:`LOW_QUANTILE`, which the corners disturb less than the MAD; at most ``white``), on the
+    median-filtered curve and on the samples themselves (the filter cuts the tops of sticks a few samples long,
+    and can make them as slow to fall as to rise).  They explain the ladder's growth when the record less its
+    piecewise-linear sticks is white noise (:func:`_stick_residual`); of the two, the one with more slips is
+    kept, the filtered one on a tie.  The noise is then the residual's RMS (not below the quantisation's
+    q/sqrt(12)): the sample-to-sample estimate also sees the corners, up to twice the noise at ten samples a
+    cycle.
+    """
+    floor = _quantisation_level(stress)
+    start = min(white, max(_lag_level(time, stress, 1, low=True), floor))
+    found = []
+    for curve in curves:
+        sawtooth = _segment(time, stress, grid, curve, scale, start)
+        residual = _stick_residual(time, stress, grid, sawtooth, white)
+        if residual is None:
+            continue
+        level = max(residual, floor)
+        if level < sawtooth[0]:  # the same slips at the noise left once they are taken out
+            refined = _segment(time, stress, grid, curve, scale, level)
+            if _stick_residual(time, stress, grid, refined, level) is not None:
+                sawtooth = refined
+        found.append((curve, sawtooth))
+    return max(found, key=lambda pair: pair[1][2].size) if found else None
+
+
+def _stick_residual(
+    time: np.ndarray, stress: np.ndarray, grid: np.ndarray, sawtooth: Segmentation, white: float
+) -> float | None:
+    """RMS of the record about the lines of the sticks of ``sawtooth`` (the middle 80 % of each, pooled) when it
+    is white noise of about the level ``white`` and the sticks fill the record: at least :data:`EXPLAIN_STICKS`
+    sticks of :data:`EXPLAIN_SAMPLES` samples, filling :data:`EXPLAIN_STICK_SHARE` of their cycles, an RMS
+    within :data:`STICK_CONSISTENCY` of ``white`` and a lag-one correlation of at most
+    :data:`EXPLAIN_CORRELATION`; else None."""
+    noise, _, peaks, troughs, _ = sawtooth
+    tiny = 1e-9 * float(np.max(np.abs(stress)))  # rounding alone, on a noise-free record
+    if peaks.size < EXPLAIN_STICKS or noise > STICK_CONSISTENCY * white + tiny:
+        return None
+    share = (grid[peaks[1:]] - grid[troughs[1:]]) / (grid[peaks[1:]] - grid[peaks[:-1]])
+    if not np.median(share) >= EXPLAIN_STICK_SHARE:  # stretches of a wander between long detours
+        return None
+    squares, dof, products, pairs, sticks = 0.0, 0, 0.0, 0.0, 0
+    for a, b in zip(grid[troughs], grid[peaks], strict=True):
+        margin = 0.1 * (b - a)
+        lo, hi = int(np.searchsorted(time, a + margin, "left")), int(np.searchsorted(time, b - margin, "right"))
+        if hi - lo < EXPLAIN_SAMPLES:
+            continue
+        u = time[lo:hi] - np.mean(time[lo:hi])
+        spread = float(np.dot(u, u))
+        if not spread > 0:  # a run of rows at one instant
+            continue
+        y = stress[lo:hi] - np.mean(stress[lo:hi])
+        y -= float(np.dot(u, y)) / spread * u
+        squares += float(np.dot(y, y))
+        dof += y.size - 2
+        products += float(np.dot(y[:-1], y[1:]))
+        pairs += float(np.dot(y[:-1], y[:-1]) + np.dot(y[1:], y[1:])) / 2.0
+        sticks += 1
+    if sticks < EXPLAIN_STICKS or dof <= 0:
+        return None
+    rms = math.sqrt(squares / dof)
+    if not rms <= STICK_CONSISTENCY * white + tiny:
+        return None
+    return rms if products <= EXPLAIN_CORRELATION * pairs or rms <= tiny else None
 
 
 def _drops(smooth: np.ndarray, threshold: float) -> tuple[np.ndarray, np.ndarray, tuple[np.ndarray, float] | None]:
