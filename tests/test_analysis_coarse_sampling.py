@@ -12,11 +12,9 @@ stays steady.
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 import pytest
-from scipy.signal import lfilter
+from tests.test_analysis_red_noise import ar1
 
 from stickslip.analysis import analyze_trace
 
@@ -98,14 +96,6 @@ def test_a_noise_free_coarse_sawtooth_is_stick_slip():
 
 
 # --------------------------------------------------------------------------- red noise sampled as coarsely
-def ar1(n: int, phi: float, sd: float, seed: int) -> np.ndarray:
-    """Stationary AR(1) noise of marginal standard deviation ``sd``."""
-    rng = np.random.default_rng(seed)
-    shocks = rng.normal(0.0, sd * math.sqrt(1.0 - phi**2), n)
-    shocks[0] = rng.normal(0.0, sd)
-    return lfilter([1.0], [1.0, -phi], shocks)
-
-
 @pytest.mark.parametrize(
     ("phi", "step", "white", "seed"),
     [
