@@ -278,7 +278,10 @@ class Run:
         columns = {"stress": stress, "friction": friction, "slider_velocity": slider_velocity,
                    "slider_position": slider_position, "load_point_position": load_point_position,
                    **(states or {})}  # fmt: skip
-        bad = _first_non_finite(columns, t.size)
+        # the base columns only: a model's state may be undefined at times (the stick chains' fraction while they
+        # do not hold is empty), and a run the model already calls failed or stopped is kept as it wrote it
+        checked = {key: columns[key] for key in BASE_COLUMNS if key in columns}
+        bad = _first_non_finite(checked, t.size) if extra.get("status", "ok") == "ok" else None
         if bad is not None:  # what the model computed up to there is kept, and the run is a failed one (exit 3)
             return _failed_at(model, t, columns, bad, states, state_units, extra)
         if regime is None and extra.get("status", "ok") != "ok":  # a run that did not finish has no verdict
