@@ -163,8 +163,7 @@ def in_run_words(message: str, start_option: str) -> str:
 
 
 def settings_of(texts: tuple[str, ...], every_text: str | None) -> dict[str, Any]:
-    """``--setting KEY=VALUE`` (a word, true/false, a number, or a time with its unit) and ``--every``."""
-    from ..units import to_si
+    """``--setting KEY=VALUE`` (a word, true/false, a number, or a quantity with its unit, in SI) and ``--every``."""
     from .common import positive
 
     settings: dict[str, Any] = {}
@@ -178,13 +177,27 @@ def settings_of(texts: tuple[str, ...], every_text: str | None) -> dict[str, Any
             continue
         except ValueError:
             pass
-        try:
-            settings[key] = to_si(value, "time", f"--setting {key}")
-        except (UnitError, ParameterError):
-            settings[key] = value
+        settings[key] = _setting_quantity(value, key)
     if every_text is not None:
         settings["every"] = positive(every_text, "time", "--every")
     return settings
+
+
+#: the dimensions a setting's value with a unit may have (its unit says which): every="10 ms",
+#: start_velocity="150 um/s" (a time alone was read: a velocity stayed a string the model refused)
+SETTING_DIMENSIONS = ("time", "velocity", "stress", "length", "stress_per_length", "mass_per_area")
+
+
+def _setting_quantity(value: str, key: str) -> Any:
+    """A setting's value with its unit in SI, or the text as it is (a word such as ``no-aging``)."""
+    from ..units import to_si
+
+    for dimension in SETTING_DIMENSIONS:
+        try:
+            return to_si(value, dimension, f"--setting {key}")
+        except (UnitError, ParameterError):
+            continue
+    return value
 
 
 #: Why a model that takes no ``every`` setting has no --every (its trace is sampled its own way).

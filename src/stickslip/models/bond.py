@@ -33,7 +33,8 @@ class BondModel(FrictionModel):
         return {**{k: key_dimension(k) for k in parameter_keys()}, **STIFFNESS_KEYS}
 
     def parameters(self, spec: Any = None, overrides: Mapping[str, Any] | None = None) -> Parameters:
-        """A parameter set (name, TOML file or :class:`Parameters`; default gelatin-glass) with ``overrides``;
+        """A parameter set (name, TOML file, :class:`Parameters`, or a mapping of ``section.key`` values, nested
+        sections or a whole exported set as a dict, over the default gelatin-glass) with ``overrides``;
         ``block.stiffness`` or ``block.effective_stiffness`` set the block's height."""
         from ..units import to_si
 
@@ -41,6 +42,8 @@ class BondModel(FrictionModel):
             kind = type(overrides).__name__
             raise ParameterError(f"overrides: expected a mapping {{'section.key': value}}, got {kind}")
         given = dict(overrides or {})
+        if isinstance(spec, Mapping):  # {"bonds.bond_time": ...}, {"bonds": {...}} or a whole exported set as a dict
+            given, spec = {**_flat_keys(spec), **given}, None
         stiffness = {k: to_si(given.pop(k), d, k) for k, d in STIFFNESS_KEYS.items() if k in given}
         keys = parameter_keys()
         required = set(keys) - set(optional_keys())  # an extension's key (aging.saturation_age) may be absent
@@ -95,6 +98,22 @@ def with_stiffness(params: Parameters, stiffness: Mapping[str, float]) -> Parame
         height = block.shear_modulus * block.geometric_factor / _positive(stiffness, "block.effective_stiffness")
         params = params.with_overrides({"block.height": height})
     return params
+
+
+#: the top-level entries of an exported set that describe it rather than set a value
+_DESCRIPTIVE = ("name", "description", "reference")
+
+
+def _flat_keys(spec: Mapping[str, Any]) -> dict[str, Any]:
+    """A mapping of parameters as ``section.key`` entries: nested sections (a TOML file read as a dict) flattened,
+    the set's name, description and reference dropped; every key is checked where the set is built."""
+    flat: dict[str, Any] = {}
+    for key, value in spec.items():
+        if isinstance(value, Mapping):
+            flat.update((f"{key}.{inner}", item) for inner, item in value.items())
+        elif str(key) not in _DESCRIPTIVE:
+            flat[str(key)] = value
+    return flat
 
 
 def _is_number(value: Any) -> bool:
