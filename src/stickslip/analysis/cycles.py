@@ -8,6 +8,7 @@ the cycle is ``complete=False``.
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
@@ -20,7 +21,17 @@ from ..columns import with_units
 from ..errors import DataError, ParameterError
 from ..parameters import Parameters, load_parameters
 from ..reprs import compact_repr
-from .detect import MEDIAN_WIDTH, MIN_ASYMMETRY, Coarse, coarse_segments, rise_start
+from .detect import (
+    GAP_STEPS,
+    MEDIAN_WIDTH,
+    MIN_ASYMMETRY,
+    Coarse,
+    coarse_segments,
+    dropouts,
+    gaps,
+    rise_start,
+    sampling_step,
+)
 from .fits import QUADRATIC, Corner, Line, fit_corner, fit_line
 from .traces import Trace, check_trace
 
@@ -131,6 +142,9 @@ class TraceAnalysis:
     steady_from: float | None
     parameters: Parameters = field(repr=False)
     source: str = "trace"
+    #: what the analysis did to the record, or found in it, that a reader of the cycles must know: dropouts
+    #: removed, gaps the record was cut at, stick slopes that change within the record (one V0 assumed)
+    warnings: tuple[str, ...] = ()
 
     def as_dict(self) -> dict[str, Any]:
         """JSON-ready dictionary (SI units)."""
@@ -138,6 +152,7 @@ class TraceAnalysis:
             "source": self.source,
             "regime": self.regime,
             "message": self.message,
+            "warnings": list(self.warnings),
             "pulling_velocity": self.pulling_velocity,
             "noise": self.noise,
             "drop_threshold": self.threshold,
@@ -201,27 +216,41 @@ def analyze_trace(
     params = load_parameters("gelatin-glass") if params is None else params
     valid = trace.valid
     t, x = (trace.time, trace.stress) if np.all(valid) else (trace.time[valid], trace.stress[valid])
-    coarse = coarse_segments(t, x)
+    step = sampling_step(t)
+    coarse = coarse_segments(t, x, step)
     if np.median(x) < -coarse.threshold:
         raise DataError(
             f"{trace.source}: the stress is negative over most of the record (median {np.median(x):.4g} Pa);"
             " friction stress is taken positive: flip the sign of the column"
         )
-    sticks = _stick_phases(t, x, coarse)
-    step = coarse.step
-    for stick in sticks:
-        _fit_stick(t, x, coarse, stick, step)
-    sticks = [s for s in sticks if s.line is not None]
-    swings = _oscillation(t, x, coarse)
-    regime, steady_from = _regime(t, x, coarse, sticks, swings)
-    cycles = _cycles(sticks, v0, params, steady_from is not None)
+    warnings: list[str] = []
+    stress = trace.stress
+    dropped = dropouts(x, coarse.threshold)
+    if dropped.size:  # outlier bursts, not slips: left out, and the record's drops sought again without them
+        warnings.append(_dropout_note(t, dropped))
+        stress = stress.copy()
+        stress[np.flatnonzero(valid)[dropped]] = np.nan
+        keep = np.ones(t.size, dtype=bool)
+        keep[dropped] = False
+        t, x = t[keep], x[keep]
+        coarse = coarse_segments(t, x, step)
+    cuts = gaps(t, step)
+    if cuts.size:
+        warnings.append(_gap_note(t, cuts, step))
+        coarse, swings, regime, steady_from, cycles = _across_gaps(t, x, coarse, cuts, step, v0, params)
+    else:
+        sticks, swings, regime, steady_from = _piece(t, x, coarse, step)
+        cycles = _cycles(sticks, v0, params, steady_from is not None)
+    slopes = _slope_change(cycles, v0)
+    if slopes:
+        warnings.append(slopes)
     summary = _summary(t, x, cycles, regime, steady_from, v0)
     if swings is not None:
         summary["oscillation"] = swings
     message = _message(regime, cycles, coarse, summary)
     return TraceAnalysis(
         time=trace.time,
-        stress=trace.stress,
+        stress=stress,
         pulling_velocity=v0,
         regime=regime,
         message=message,
@@ -232,6 +261,124 @@ def analyze_trace(
         steady_from=steady_from,
         parameters=params,
         source=trace.source,
+        warnings=tuple(warnings),
+    )
+
+
+def _piece(
+    t: np.ndarray, x: np.ndarray, coarse: Coarse, step: float
+) -> tuple[list[_Stick], dict[str, Any] | None, str, float | None]:
+    """The fitted stick phases of one unbroken stretch of record, its oscillation, regime and steady start."""
+    sticks = _stick_phases(t, x, coarse)
+    for stick in sticks:
+        _fit_stick(t, x, coarse, stick, step)
+    sticks = [s for s in sticks if s.line is not None]
+    swings = _oscillation(t, x, coarse)
+    regime, steady_from = _regime(t, x, coarse, sticks, swings)
+    return sticks, swings, regime, steady_from
+
+
+#: A stretch between gaps with fewer usable samples than this is not analysed on its own.
+MIN_PIECE = 20
+
+
+def _gap_text(t: np.ndarray, k: int) -> str:
+    return f"the gap in the record from t = {t[k]:.6g} s to {t[k + 1]:.6g} s"
+
+
+def _gap_note(t: np.ndarray, cuts: np.ndarray, step: float) -> str:
+    shown = ", ".join(f"{t[k]:.6g}–{t[k + 1]:.6g} s" for k in cuts[:5])
+    more = f" and {cuts.size - 5} more" if cuts.size > 5 else ""
+    return (
+        f"{cuts.size} gap(s) in the record (no usable sample for more than {GAP_STEPS:g} sampling intervals of"
+        f" {step:.3g} s): t = {shown}{more}; the record is analysed on either side of each gap, and a cycle whose"
+        " stick or slip runs into one is incomplete (what the gap hides is left empty)"
+    )
+
+
+def _dropout_note(t: np.ndarray, dropped: np.ndarray) -> str:
+    starts = dropped[np.concatenate([[True], np.diff(dropped) > 1])]
+    shown = ", ".join(f"{t[k]:.6g}" for k in starts[:5])
+    more = f" and {starts.size - 5} more" if starts.size > 5 else ""
+    return (
+        f"left out {dropped.size} sample(s) in {starts.size} dropout(s) at t = {shown}{more} s: bursts of a few"
+        " samples that leave the record by more than the drop threshold and return to where it left in one"
+        " sample (outliers, not slips)"
+    )
+
+
+def _across_gaps(
+    t: np.ndarray,
+    x: np.ndarray,
+    coarse: Coarse,
+    cuts: np.ndarray,
+    step: float,
+    v0: float,
+    params: Parameters,
+) -> tuple[Coarse, dict[str, Any] | None, str, float | None, list[CycleResult]]:
+    """A record with gaps, analysed stretch by stretch (each as a record of its own, whose ends at a gap cut its
+    cycles as the record's own ends do); (coarse of the longest stretch, swings, regime, steady start, cycles).
+
+    A record none of whose stretches has a slip is analysed whole, as before (no cycle to invent)."""
+    edges = [0, *(int(k) + 1 for k in cuts), t.size]
+    pieces = []
+    for j in range(len(edges) - 1):
+        a, b = edges[j], edges[j + 1]
+        if b - a < MIN_PIECE:
+            pieces.append(None)
+            continue
+        piece_coarse = coarse_segments(t[a:b], x[a:b], step)
+        pieces.append((a, b, piece_coarse, *_piece(t[a:b], x[a:b], piece_coarse, step)))
+    if not any(p is not None and p[2].peaks.size for p in pieces):
+        sticks, swings, regime, steady_from = _piece(t, x, coarse, step)
+        return coarse, swings, regime, steady_from, _cycles(sticks, v0, params, steady_from is not None)
+    cycles: list[CycleResult] = []
+    last = len(pieces) - 1
+    for j, piece in enumerate(pieces):
+        if piece is None:
+            continue
+        a, b, _, sticks, _, _, steady_from = piece
+        head = _gap_text(t, a - 1) if j > 0 else None
+        tail = _gap_text(t, b - 1) if j < last else None
+        ends_steady = j == last and steady_from is not None
+        cycles.extend(_cycles(sticks, v0, params, ends_steady, head=head, tail=tail, first=len(cycles) + 1))
+    longest = max((p for p in pieces if p is not None), key=lambda p: p[1] - p[0])
+    final = pieces[-1]
+    if final is not None and final[5] == regimes.STEADY and final[6] is not None:
+        return longest[2], None, regimes.STEADY, final[6], cycles
+    return longest[2], None, regimes.STICK_SLIP, None, cycles
+
+
+#: Successive cycles' stick slopes that differ by more than this factor (and by more than SLOPE_SIGMAS of their
+#: standard errors) are a change of the loading rate within the record: a velocity step, or spliced records.
+SLOPE_FACTOR = 1.3
+SLOPE_SIGMAS = 5.0
+#: Only stick lines of at least this many samples are compared.
+SLOPE_POINTS = 10
+
+
+def _slope_change(cycles: list[CycleResult], v0: float) -> str:
+    """A warning where the stick slope (K·V0) changes by a large factor within the record, naming the times and
+    saying that Gd/h per cycle then assumes one V0; "" when it does not."""
+    sticks = [c for c in cycles if c.stick_points >= SLOPE_POINTS and c.stick_slope is not None and c.stick_slope > 0]
+    changes = []
+    for before, after in itertools.pairwise(sticks):
+        ratio = after.stick_slope / before.stick_slope
+        error = math.hypot(before.stick_slope_stderr or 0.0, after.stick_slope_stderr or 0.0)
+        if (
+            max(ratio, 1.0 / ratio) > SLOPE_FACTOR
+            and abs(after.stick_slope - before.stick_slope) > SLOPE_SIGMAS * error
+        ):
+            changes.append(
+                f"from {before.stick_slope:.4g} Pa/s (cycle {before.index}, stick to t = {before.stick_to:.6g} s)"
+                f" to {after.stick_slope:.4g} Pa/s (cycle {after.index}, from t = {after.stick_from:.6g} s)"
+            )
+    if not changes:
+        return ""
+    return (
+        "the stick slope changes within the record " + "; ".join(changes) + ": a change of the pulling velocity"
+        " (a velocity step) or spliced records?  Gd/h per cycle is the slope over one V0"
+        f" ({v0 * 1e6:.6g} µm/s for every cycle), and a stick spanning the change is not one line"
     )
 
 
@@ -504,7 +651,17 @@ def _regime(
     return regimes.STEADY, float(t[0]) if coarse.steady_from is None else coarse.steady_from
 
 
-def _cycles(sticks: list[_Stick], v0: float, params: Parameters, ends_steady: bool) -> list[CycleResult]:
+def _cycles(
+    sticks: list[_Stick],
+    v0: float,
+    params: Parameters,
+    ends_steady: bool,
+    head: str | None = None,
+    tail: str | None = None,
+    first: int = 1,
+) -> list[CycleResult]:
+    """The cycles of the stick phases of one stretch of record, numbered from ``first``; ``head`` and ``tail``
+    name the gaps that begin and end the stretch (None: the record's own ends)."""
     factor = params.block.geometric_factor
     cycles = []
     for k, stick in enumerate(sticks):
@@ -521,16 +678,21 @@ def _cycles(sticks: list[_Stick], v0: float, params: Parameters, ends_steady: bo
         jump, jump_message = _jump(params, peak)
         notes = [jump_message] if jump_message else []
         if start is None:
-            notes.append("stick began before the record")
+            notes.append(f"stick began in {head}" if head and k == 0 else "stick began before the record")
         if end is None:
-            notes.append("record ends before the slip")
+            notes.append(f"{tail} hides the end of the stick" if tail and following is None else
+                         "record ends before the slip")  # fmt: skip
         elif nxt is None and following is not None:  # a stick follows, but where it began is not clear
             notes.append("no clear corner where the next stick begins")
         elif nxt is None:
-            notes.append("slip ends in steady sliding" if ends_steady else "record ends during the slip")
+            notes.append(
+                f"the slip runs into {tail}"
+                if tail
+                else ("slip ends in steady sliding" if ends_steady else "record ends during the slip")
+            )
         cycles.append(
             CycleResult(
-                index=k + 1,
+                index=first + k,
                 complete=start is not None and end is not None and nxt is not None,
                 start_time=start.time if start else None,
                 peak_time=end.time if end else None,

@@ -244,7 +244,7 @@ def uniform_grid(time: np.ndarray, stress: np.ndarray, step: float | None = None
     return grid, np.interp(grid, time, stress)
 
 
-def coarse_segments(time: np.ndarray, stress: np.ndarray) -> Coarse:
+def coarse_segments(time: np.ndarray, stress: np.ndarray, step: float | None = None) -> Coarse:
     """Find drop events, troughs and a steady tail in a record of finite samples.
 
     A drop is a slip when it is deeper than :data:`PROMINENCE_SIGMAS` noise levels and falls faster than the
@@ -252,10 +252,10 @@ def coarse_segments(time: np.ndarray, stress: np.ndarray) -> Coarse:
     noise estimate allows, their scatter is the noise and the drops are sought again (docs/analysis.md, "Red
     noise").  When the correlated-noise estimate exceeds the sample-to-sample one, the drops are also sought at
     the latter, and kept when the sawtooth they make accounts for the excess (:func:`_coarse_sawtooth`,
-    "Coarse sampling").
+    "Coarse sampling").  ``step`` is the sampling interval (:func:`sampling_step` when not given).
     """
     white, whole = _noise_levels(time, stress)
-    step = sampling_step(time)
+    step = sampling_step(time) if step is None else step
     grid, raw = uniform_grid(time, stress, step)
     smooth = median_filter(raw, size=min(MEDIAN_WIDTH, raw.size), mode="nearest")
     scale = float(np.max(np.abs(smooth))) if smooth.size else 0.0
@@ -545,3 +545,82 @@ def _steady_tail(grid: np.ndarray, smooth: np.ndarray, start: int, threshold: fl
     if length >= max(stick, min(20 * step, 0.5 * (grid[-1] - grid[start]))):
         return float(grid[first])
     return None
+
+
+#: A time between successive usable samples longer than this many sampling intervals is a gap in the record
+#: (NaN cells or missing rows): the record is analysed on either side of it, never through it.  (Shorter runs of
+#: NaN, up to a few samples, are bridged as before: they cannot hide a slip that the samples about them miss.)
+#: The interval is the record's median one and, where the sampling changes (a model's adaptive steps), the
+#: larger of the median intervals just before and just after (GAP_NEIGHBOURS each side).
+GAP_STEPS = 10.0
+GAP_NEIGHBOURS = 5
+#: A dropout is a burst of at most this many samples ...
+DROPOUT_SAMPLES = 5
+#: ... that all lie beyond the samples either side of it by more than the drop threshold (the depth), where the
+#: samples either side agree to within this fraction of the depth (the record comes back to where it left:
+#: a slip does not), and the record moves by no more than it in the one sample before the burst and in the one
+#: after (the burst is abrupt: a finely sampled rounded trough is not) ...
+DROPOUT_RETURN = 0.25
+#: ... and the burst itself is flat: its samples agree to within this fraction of the depth (a sawtooth sampled
+#: three or four times a cycle is not flat over its trough).
+DROPOUT_FLAT = 0.25
+
+
+def gaps(time: np.ndarray, step: float) -> np.ndarray:
+    """Indices k of the usable samples after which the record has a gap: time[k + 1] - time[k] longer than
+    :data:`GAP_STEPS` times the sampling interval ``step`` and the local one (:data:`GAP_NEIGHBOURS`)."""
+    if step <= 0 or time.size < 2:
+        return np.empty(0, dtype=int)
+    dt = np.diff(time)
+    cuts = np.flatnonzero(dt > GAP_STEPS * step)  # none in an evenly sampled record without gaps: one pass
+    if cuts.size == 0:
+        return cuts
+    offsets = np.arange(1, GAP_NEIGHBOURS + 1)
+    local = np.zeros(cuts.size)
+    for side in (-offsets, offsets):
+        index = cuts[:, None] + side[None, :]
+        inside = (index >= 0) & (index < dt.size)
+        near = np.where(inside, dt[np.clip(index, 0, dt.size - 1)], np.nan)
+        near[near <= 0] = np.nan  # repeated times (jumps) are no interval
+        with np.errstate(all="ignore"):
+            level = np.nanmedian(np.where(np.isnan(near).all(axis=1)[:, None], 0.0, near), axis=1)
+        local = np.maximum(local, level)
+    return cuts[dt[cuts] > GAP_STEPS * local]
+
+
+def dropouts(stress: np.ndarray, threshold: float) -> np.ndarray:
+    """Indices of the samples in dropouts: bursts of at most :data:`DROPOUT_SAMPLES` samples that leave the record
+    by more than ``threshold`` in one sample and come back to it in one sample (docs/analysis.md, "Dropouts").
+
+    A slip leaves the stick line in a sample or a few, but the stress stays down and climbs back at the stick's
+    loading rate; an outlier burst (a lost connection, a glitch of the sensor) returns to the level it left.
+    Candidates are the one-sample steps larger than ``threshold`` (few in any record), so the cost is one pass.
+    """
+    n = stress.size
+    if n < 3 or not threshold > 0:
+        return np.empty(0, dtype=int)
+    steps = np.diff(stress)
+    entries = np.flatnonzero(np.abs(steps) > threshold)  # the burst starts at entry + 1
+    if entries.size == 0:
+        return np.empty(0, dtype=int)
+    down = steps[entries] < 0
+    found = np.zeros(entries.size, dtype=int)  # burst length per candidate, 0: none
+    for length in range(1, DROPOUT_SAMPLES + 1):
+        open_ = (found == 0) & (entries >= 1) & (entries + length + 2 < n)
+        if not np.any(open_):
+            break
+        k = entries[open_]
+        before, after = stress[k], stress[k + length + 1]
+        outside = np.maximum(np.abs(before - stress[k - 1]), np.abs(stress[k + length + 2] - after))
+        burst = np.stack([stress[k + m] for m in range(1, length + 1)])
+        high, low = np.max(burst, axis=0), np.min(burst, axis=0)
+        is_down = down[open_]
+        depth = np.where(is_down, np.minimum(before, after) - high, low - np.maximum(before, after))
+        ok = (depth > threshold) & (np.abs(after - before) <= DROPOUT_RETURN * depth)
+        ok &= (high - low <= DROPOUT_FLAT * depth) & (outside <= DROPOUT_RETURN * depth)
+        found[np.flatnonzero(open_)[ok]] = length
+    hit = found > 0
+    if not np.any(hit):
+        return np.empty(0, dtype=int)
+    rows = np.concatenate([np.arange(e + 1, e + 1 + m) for e, m in zip(entries[hit], found[hit], strict=True)])
+    return np.unique(rows)

@@ -128,6 +128,57 @@ def recorded_pulling_velocity(path: str | Path) -> tuple[float | None, str]:
     return None, "the trace has no load-point column (" + ", ".join(LOAD_POINT_COLUMNS) + ")"
 
 
+#: Successive load-point velocities within this fraction of the largest one are one velocity ...
+STEP_TOLERANCE = 1e-4
+#: ... and a stretch at one velocity counts when it lasts at least this fraction of the record (the interval that
+#: straddles a step has a velocity between the two).
+STEP_MIN_FRACTION = 0.01
+#: More stretches than this are no velocity steps but a load point that wanders (a measured one): none reported.
+STEP_MAX_SEGMENTS = 20
+
+
+def load_point_velocities(path: str | Path) -> tuple[str | None, list[tuple[float, float, float]]]:
+    """(column, [(from, to, velocity), ...]): the stretches of the record over which its load point moves at one
+    velocity (s, s, m/s), in time order; (None, []) without a load-point column, (column, []) when the load point
+    does not move in stretches of one velocity.  One stretch: the velocity of :func:`recorded_pulling_velocity`;
+    several: velocity steps (a transient protocol, or records spliced together)."""
+    velocity, _ = recorded_pulling_velocity(path)
+    for name in LOAD_POINT_COLUMNS:
+        others = [c for c in (*MODEL_COLUMNS, "stress", "force") if c != name]
+        try:
+            table = read_table(path, {"time": "time", name: "length"}, required=["time", name], ignore=others)
+        except DataError:
+            continue
+        t, x = table["time"], table[name]
+        if t.size < 2 or not (np.all(np.isfinite(t)) and np.all(np.isfinite(x))) or t[-1] <= t[0]:
+            return name, []
+        if velocity is not None:
+            return name, [(float(t[0]), float(t[-1]), velocity)]
+        dt = np.diff(t)
+        moving = dt > 0
+        v = np.diff(x)[moving] / dt[moving]
+        start, end = t[:-1][moving], t[1:][moving]
+        scale = float(np.max(np.abs(v))) if v.size else 0.0
+        if not scale > 0:
+            return name, []
+        breaks = np.flatnonzero(np.abs(np.diff(v)) > STEP_TOLERANCE * scale) + 1
+        segments = []
+        for a, b in zip([0, *breaks], [*breaks, v.size], strict=True):
+            if end[b - 1] - start[a] >= STEP_MIN_FRACTION * float(t[-1] - t[0]):
+                segments.append((float(start[a]), float(end[b - 1]), float(np.median(v[a:b]))))
+        merged: list[tuple[float, float, float]] = []
+        for segment in segments:  # stretches either side of a kink at one velocity (an event of the run) are one
+            if merged and abs(segment[2] - merged[-1][2]) <= STEP_TOLERANCE * scale:
+                merged[-1] = (merged[-1][0], segment[1], merged[-1][2])
+            else:
+                merged.append(segment)
+        segments = merged
+        if not 2 <= len(segments) <= STEP_MAX_SEGMENTS:
+            return name, []
+        return name, segments
+    return None, []
+
+
 def _merge_model_repeats(
     path: str | Path, table: Table, stress: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, str]:

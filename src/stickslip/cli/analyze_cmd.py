@@ -139,9 +139,12 @@ def analyze_command(
     area = None if area_text is None else positive(area_text, "area", "--contact-area")
     v0 = None if v0_text is None else positive(v0_text, "velocity", "--v0")  # a value given: checked at once
     record = read_trace(trace, contact_area=area)  # before --v0 is asked for: a file that is no trace says so
+    steps: list[tuple[float, float, float]] = []  # the load point's stretches at one velocity, when it steps
     if v0 is None:
         v0_text = _recorded_v0(trace)
         v0 = positive(v0_text, "velocity", "--v0")
+    else:
+        steps = _check_recorded_v0(trace, v0, v0_text)
     params = resolve_params(params_name, overrides)
     for note in record.notes:
         echo_err(f"note: {note}")
@@ -150,6 +153,15 @@ def analyze_command(
         echo_err(f"note: {trace} is a run that {'stopped' if status == 'stopped' else 'failed'} before its end: {why}")
     analysis = analyze_trace(record, None, v0, params)
     _refuse_unbounded(analysis, v0_text)
+    for warning in analysis.warnings:
+        echo_err(f"warning: {trace}: {warning}")
+    for start, _, _ in steps[1:]:
+        spanning = [c.index for c in analysis.cycles if c.stick_from < start < c.stick_to]
+        if spanning:
+            echo_err(
+                f"warning: {trace}: the stick of cycle {spanning[0]} spans the velocity step at t = {start:.6g} s:"
+                " it is no one line, and its σc, ts and Gd/h are not those of either velocity"
+            )
     comparison = compare_with_model(analysis, params) if compare else None
     if output is not None:
         write_text(output, cycles_csv(analysis))
@@ -177,6 +189,62 @@ def _recorded_v0(trace: Path) -> str:
         raise ParameterError(f"--v0: needed: {why}; give the pulling velocity with its unit, e.g. --v0 '50 um/s'")
     echo_err(f"note: --v0 not given: the trace's load point moves at {show_velocity(v0, 6)} throughout")
     return f"{v0:.12g} m/s"  # the load point is written to 17 digits; its slope is known to ~1e-12
+
+
+#: --v0 and the velocity of the record's own load point agree when they differ by at most this fraction (the
+#: load point's slope is known to ~1e-12; three significant digits typed, "33.3 um/s", stay within it).
+V0_AGREEMENT = 5e-3
+
+
+def _check_recorded_v0(trace: Path, v0: float, v0_text: str) -> list[tuple[float, float, float]]:
+    """A --v0 that contradicts the load point the record carries is refused: the record's load point is a
+    measurement of the very velocity --v0 states, and Gd/h (the stick slope over V0) would silently be wrong by
+    their ratio; leaving --v0 out uses the record's own.  A load point that changes velocity (a velocity step)
+    is warned of, with the times: Gd/h per cycle then assumes --v0 for every cycle."""
+    from ..analysis.traces import LOAD_POINT_COLUMNS, load_point_velocities
+    from ..display import velocity as show_velocity
+
+    if not {n.lower() for n in _header_names(trace)} & set(LOAD_POINT_COLUMNS):
+        return []  # no load point recorded (a measured record): nothing to check against, and no second read
+    name, segments = load_point_velocities(trace)
+    if name is None:
+        return []
+    if not segments:
+        echo_err(
+            f"warning: {trace}: its load point ({name}) does not move at one velocity throughout; Gd/h per cycle"
+            f" is the stick slope over one V0 (--v0 {show_velocity(v0, 6)} for every cycle)"
+        )
+        return []
+    if len(segments) == 1:
+        recorded = segments[0][2]
+        if abs(v0 - recorded) > V0_AGREEMENT * recorded:
+            raise ParameterError(
+                f"--v0 {v0_text}: {trace}'s own load point ({name}) moves at {show_velocity(recorded, 6)}, not"
+                f" {show_velocity(v0, 6)}; leave --v0 out to use the record's, or give the velocity it records"
+            )
+        return []
+    steps = ", ".join(f"{show_velocity(v, 4)} from t = {a:.6g} s" for a, _, v in segments[:6]) + (
+        f" and {len(segments) - 6} more" if len(segments) > 6 else ""
+    )
+    echo_err(
+        f"warning: {trace}: its load point ({name}) changes velocity within the record ({steps}); Gd/h per cycle"
+        f" is the stick slope over one V0 (--v0 {show_velocity(v0, 6)} for every cycle)"
+    )
+    return segments
+
+
+def _header_names(path: Path) -> list[str]:
+    """Column names of a CSV's header (its first line that is no comment); [] if it cannot be read."""
+    from ..columns import split_header
+
+    try:
+        with open(path, encoding="utf-8", errors="replace") as handle:
+            for line in handle:
+                if line.strip() and not line.lstrip().startswith("#"):
+                    return [split_header(cell, parentheses=True)[0] for cell in line.strip().split(",")]
+    except OSError:
+        pass
+    return []
 
 
 def _refuse_unbounded(analysis: Any, v0_text: str) -> None:
@@ -258,7 +326,7 @@ def _report(analysis: Any, comparison: Any) -> list[Any]:
             )
         if any(not c.complete for c in analysis.cycles):
             notes = [f"cycle {c.index}: {c.message}" for c in analysis.cycles if c.message]
-            parts.append(escape("* cut by the record's ends.  " + "; ".join(notes)))
+            parts.append(escape("* cut by the record's ends or by a gap in it.  " + "; ".join(notes)))
     if "mean_stress" in analysis.summary:
         s = analysis.summary
         spread = "" if s["stress_std"] is None else f" ± {s['stress_std']:.3g} Pa (sd of {s['steady_samples']} samples)"
