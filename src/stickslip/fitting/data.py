@@ -200,8 +200,8 @@ def read_steady_data(path: str | Path) -> SteadyData:
 def read_stick_data(path: str | Path) -> StickData:
     """Read and validate a stick table: Table 1's columns (pulling_velocity, stick_time, optional peak_stress,
     start_stress), or the cycles table of ``stickslip analyze -o`` (its ``critical_stress`` is the start stress;
-    cycles cut by the record's ends, without a stick time, are left out; :meth:`StickData.notes` says so).  The one
-    reader of ``fit stick`` and of the Python API."""
+    cycles cut by the record's ends or a gap in it, without a stick time, are left out; :meth:`StickData.notes`
+    says so).  The one reader of ``fit stick`` and of the Python API."""
     # Table 1's reader first: it reads the file once (a pipe too); a cycles table fails it at its header
     try:
         table = read_table(
@@ -247,7 +247,7 @@ def _read_cycles_table(path: str | Path, names: Sequence[str]) -> StickData:
     notes = [f"{source}: the cycles table of stickslip analyze; its critical_stress (σc) is each row's start_stress"]
     if not whole.all():
         cut = ", ".join(str(r) for r in table.rows[~whole])
-        notes.append(f"{source}: row(s) {cut} left out: cycles cut by the record's ends (no stick time)")
+        notes.append(f"{source}: row(s) {cut} left out: cycles cut by the record's ends or a gap in it (no stick time)")
     data = _validated_stick(Table(source, columns, table.rows[whole]))
     return dataclasses.replace(data, read_notes=tuple(notes))
 
