@@ -38,6 +38,11 @@ NEWTON_DELTA = 1e-4
 PROFILE_STEPS = 12
 PROFILE_TOLERANCE = 0.02
 PROFILE_REACH = math.log(100.0)
+#: Stiffness of the profile's sigma_c constraint against the data: its weight is this many times the data
+#: chi-square's own curvature along ln sigma_c (the delta method's), so a constrained refit lands within
+#: 1/(1 + STRESS_STIFFNESS^2) ~ 1 % of the way back to the best fit.  CONSTRAINT_WEIGHT alone let it land
+#: ~60 % of the way back when the data pin sigma_c to better than 1 % (issue: sigma_c profile 2.3x too wide).
+STRESS_STIFFNESS = 10.0
 
 
 def _steady(params: Parameters, velocity: Any, aging: bool = True) -> Any:
@@ -146,9 +151,14 @@ class Profile:
     model's analytic slope.
     """
 
-    def __init__(self, space: Space, block: Block, centre: np.ndarray) -> None:
+    def __init__(
+        self, space: Space, block: Block, centre: np.ndarray, stress_weight: float = CONSTRAINT_WEIGHT
+    ) -> None:
         self.space = space
         self.block = block
+        # weight of the constraint ln sigma(v) = ln s: see STRESS_STIFFNESS (never below CONSTRAINT_WEIGHT)
+        weight = float(stress_weight)
+        self.stress_weight = max(weight, CONSTRAINT_WEIGHT) if math.isfinite(weight) else CONSTRAINT_WEIGHT
         self.lower = centre - SEARCH_BOX
         self.upper = centre + SEARCH_BOX
         self.evaluations: list[tuple[int, int]] = []
@@ -178,7 +188,7 @@ class Profile:
         r = self.block.residuals_of(model)
         constraints = [CONSTRAINT_WEIGHT * elasticity]
         if log_s is not None:
-            constraints.append(CONSTRAINT_WEIGHT * (math.log(stress) - log_s))
+            constraints.append(self.stress_weight * (math.log(stress) - log_s))
         return np.append(r, constraints)
 
     def _jacobian(self, theta: np.ndarray, log_v: float, log_s: float | None, with_v: bool) -> np.ndarray:
@@ -206,13 +216,13 @@ class Profile:
             out[:n, k] = (stress[up, :n] - stress[down, :n]) / (2 * h)
             out[n, k] = CONSTRAINT_WEIGHT * (elasticity[up] - elasticity[down]) / (2 * h)
             if log_s is not None:
-                out[n + 1, k] = CONSTRAINT_WEIGHT * (math.log(stress[up, n + 1] / stress[down, n + 1])) / (2 * h)
+                out[n + 1, k] = self.stress_weight * (math.log(stress[up, n + 1] / stress[down, n + 1])) / (2 * h)
         if with_v:
             trio = _steady(self.space.params(theta), v * np.exp([-h, h]))
             slopes = trio.stress_slope * trio.velocity / trio.stress
             out[n, -1] = CONSTRAINT_WEIGHT * (slopes[1] - slopes[0]) / (2 * h)
             if log_s is not None:
-                out[n + 1, -1] = CONSTRAINT_WEIGHT * float(np.mean(slopes))  # d ln sigma/d ln v = elasticity
+                out[n + 1, -1] = self.stress_weight * float(np.mean(slopes))  # d ln sigma/d ln v = elasticity
         return out
 
     # -- constrained minima ----------------------------------------------------------
@@ -248,6 +258,15 @@ class Profile:
         )
         return self.data_chi_square(x[:-1]), x
 
+    def attained_stress(self, x: np.ndarray) -> float:
+        """ln of the minimum stress of the curve a constrained refit ``x`` = (theta, ln v) ended on.
+
+        The constraint is a weighted residual, not exact: the refit sits a little back towards the best fit,
+        and its chi-square belongs to the sigma_c it reached (the profile point), not to the one asked for.
+        """
+        got = self._state(x[:-1], math.exp(x[-1]))
+        return math.nan if got is None else math.log(got[1])
+
     # -- the ends of an interval -------------------------------------------------------
     def end(
         self,
@@ -259,6 +278,7 @@ class Profile:
         scale: float,
         guess_sd: float,
         side: int,
+        attained: Callable[[np.ndarray], float] | None = None,
     ) -> ProfileEnd:
         """Where the signed root sqrt((chi - best)/scale) reaches sqrt(threshold) on ``side`` (+1 or -1).
 
@@ -266,7 +286,8 @@ class Profile:
         inside the bracket.  Each constrained fit starts from the last point
         found inside; a point that lands outside is refitted from the best fit
         too (the lower chi-square wins), so one bad local minimum cannot end
-        the interval early.
+        the interval early.  ``attained`` maps a refit to the value (in ln) its curve really reached: each
+        chi-square is placed there, on the profile, rather than at the value asked for.
         """
         target = math.sqrt(threshold)
         inside: list[tuple[float, float, np.ndarray]] = [(centre, 0.0, start)]
@@ -280,6 +301,11 @@ class Profile:
                 if chi2 < chi:
                     chi, solution = chi2, solution2
                     root = math.sqrt(max(chi - best_chi, 0.0) / scale)
+            if attained is not None:
+                reached = attained(solution)
+                # a refit that did not move towards x (or crossed back over the centre) keeps x
+                if math.isfinite(reached) and side * (reached - centre) > 0:
+                    x = reached
             if abs(root - target) <= PROFILE_TOLERANCE * target:
                 return ProfileEnd(x, n, True)
             if root < target:

@@ -26,7 +26,7 @@ from ..quasistatic.steady import steady_state
 from ..reprs import compact_repr
 from ..units import shorten, to_si
 from . import identify
-from .critical_uncertainty import Profile, critical_gradient, local_critical
+from .critical_uncertainty import STRESS_STIFFNESS, Profile, critical_gradient, local_critical
 from .data import SteadyData, read_steady_data
 from .global_search import global_start
 from .problem import (
@@ -53,6 +53,7 @@ from .scatter import (
     misfit,
     model_dependence,
     outlying,
+    residual_scatter,
     velocity_dependence,
 )
 
@@ -660,7 +661,13 @@ def _fit_steady(
         )
     else:
         noise = f"relative, estimated from the scatter: {100 * noise_scale:.3g} % of the stress"
-    noise += f"; without the model, between neighbouring points: {scatter.describe()}"
+    # the neighbours' scatter counts the curve's bend between them as noise (it errs large where the curve bends):
+    # the same measure on the fit's residuals, the model's bend taken out, stands beside it
+    own_scatter = residual_scatter(data.velocity, data.stress, data.stress_err, model)
+    noise += (
+        f"; between neighbouring points, of the fit's residuals: {own_scatter.describe()}; of the data without the"
+        f" model (which counts the curve's bend between neighbours as noise): {scatter.describe()}"
+    )
     misfits = adequacy.problems()
     own, best = adequacy.method_fit, adequacy.model
     if method == "two-step" and not misfits and best.chi_square < SPLIT_MISFIT_SHARE * own.chi_square:
@@ -680,7 +687,13 @@ def _fit_steady(
                 (vc, sc, estimates, combos), fitted, everything, keys, scale2, level, progress, adequacy.refit
             )
         _note_extrapolation(progress, vc, data)
-    progress.messages.extend(_outlier_warnings(data, model, stated, noise_scale, dof))
+    joint_model = None  # two-step: its residuals carry the split approximation's smooth misfit, which can hide a point
+    if method == "two-step" and adequacy.refit is not None:
+        try:
+            joint_model = everything.model(adequacy.refit)
+        except (ModelError, ParameterError):  # pragma: no cover - the refit was evaluated by the adequacy check
+            joint_model = None
+    progress.messages.extend(_outlier_warnings(data, model, stated, noise_scale, dof, joint_model))
     problems = _problems(progress, keys, fitted, base, covariance, chi_square, data) + misfits
     if misfits:
         estimates = tuple(unusable(e, why) for e in estimates)
@@ -750,27 +763,51 @@ def _errors_too_small(check: _Check, adequacy: _Adequacy, free: int) -> str:
     return text
 
 
-def _outlier_warnings(data: SteadyData, model: np.ndarray, error: np.ndarray, scale: float, dof: int) -> list[str]:
+def _outlier_warnings(
+    data: SteadyData, model: np.ndarray, error: np.ndarray, scale: float, dof: int, joint: np.ndarray | None = None
+) -> list[str]:
     """Warnings naming the points far outside the robust scatter of the residuals (as the stick fit's rows).
 
     A chi-square (and the scaled errors above) only says the residuals are large on the whole; one or two
     mistyped points are found by their distance from the median in robust standard deviations, which they do not
     move, and confirmed against the rms of the other points (the noise's own 3.7 sigma point is no outlier).  The
     floor (0.1 % of the stress) keeps the approximations of a fit to exact data from being named.
-    ``error`` is the stated error (or the stress itself, relative noise), ``scale`` the noise in its units."""
+    ``error`` is the stated error (or the stress itself, relative noise), ``scale`` the noise in its units.  The
+    distance quoted is the one tested, from the median residual.  ``joint`` (two-step): the stress of the joint fit
+    of all points with aging; the two-step's residuals carry the split approximation's smooth misfit, which widens
+    their robust scatter and can hide a point that the model's own residuals show (it is named, saying so)."""
     stated = (data.stress - model) / error
     z = stated / scale
-    far, spread, _ = outlying(z, STEADY_OUTLIER_SPREADS, OUTLIER_FLOOR * data.stress / (error * scale), True)
+    floor = OUTLIER_FLOOR * data.stress / (error * scale)
+    far, spread, centre = outlying(z, STEADY_OUTLIER_SPREADS, floor, True)
+    ratio = {int(k): abs(z[k] - centre) / spread for k in far}
+    hidden: set[int] = set()
+    if joint is not None and np.all(np.isfinite(joint)):
+        zj = (data.stress - joint) / (error * scale)
+        far_j, spread_j, centre_j = outlying(zj, STEADY_OUTLIER_SPREADS, floor, True)
+        for k in far_j:
+            if int(k) not in ratio:
+                ratio[int(k)] = abs(zj[k] - centre_j) / spread_j
+                hidden.add(int(k))
+    far = np.array(sorted(ratio), dtype=int)
     out = []
     for k in far:
         if data.stress_err is None:
             size = f"{100 * stated[k]:+.3g} % ({z[k]:+.3g} in units of the noise)"
         else:
             size = f"{stated[k]:+.3g} stated errors" + (f" ({z[k]:+.3g} scaled)" if scale != 1.0 else "")
+        if k in hidden:
+            where = (
+                f"the residuals of the joint fit of all points with aging from their median (threshold"
+                f" {STEADY_OUTLIER_SPREADS:g}; in this two-step fit's residuals, which carry its split approximation's"
+                f" smooth misfit, {abs(z[k] - centre) / spread:.2g} times)"
+            )
+        else:
+            where = f"the residuals from their median (threshold {STEADY_OUTLIER_SPREADS:g})"
         out.append(
             f"warning: row {data.rows[k]} ({human(float(data.velocity[k]), 'velocity', 4)}): σ = {data.stress[k]:.4g}"
-            f" Pa against the fit's {model[k]:.4g} Pa, a residual of {size}; {abs(z[k]) / spread:.2g} times the"
-            f" robust scatter of the residuals: an outlier? check it, or leave it out of the data"
+            f" Pa against the fit's {model[k]:.4g} Pa, a residual of {size}; {ratio[k]:.2g} times the"
+            f" robust scatter of {where}: an outlier? check it, or leave it out of the data"
         )
     if out and data.stress_err is not None and dof > len(far):
         rest = np.delete(stated, far)
@@ -1326,7 +1363,6 @@ def _profile_estimates(
     located = local_critical(space.params(theta), vc)
     if located is not None:
         vc, sc = located
-    profile = Profile(space, everything, centre)
     profile_dof = max(len(everything) - len(keys), 1)
     if progress.noise_known:
         threshold, scale = float(stats.chi2.ppf(level, 1)), 1.0
@@ -1340,11 +1376,17 @@ def _profile_estimates(
     delta_s = math.sqrt(max(float(grad_s @ cov @ grad_s), 0.0)) if cov is not None else None
     guess_v = max(delta_v, 1e-3) if delta_v is not None else 0.1
     guess_s = max(delta_s, 1e-3) if delta_s is not None else 0.05
+    # the σc constraint must be stiff against the data's own curvature along ln σc (scale/guess_s² in the
+    # chi-square's units), or each refit slides back towards the best fit and the interval comes out too wide
+    profile = Profile(space, everything, centre, stress_weight=STRESS_STIFFNESS * math.sqrt(scale) / guess_s)
     both_ends = [
-        [profile.end(chi_at, math.log(x), start, best.chi_square, threshold, scale, sd, side) for side in (-1, 1)]
-        for chi_at, x, start, sd in (
-            (profile.chi_square_at_velocity, vc, theta, guess_v),
-            (profile.chi_square_at_stress, sc, np.append(theta, math.log(vc)), guess_s),
+        [
+            profile.end(chi_at, math.log(x), start, best.chi_square, threshold, scale, sd, side, attained)
+            for side in (-1, 1)
+        ]
+        for chi_at, x, start, sd, attained in (
+            (profile.chi_square_at_velocity, vc, theta, guess_v, None),
+            (profile.chi_square_at_stress, sc, np.append(theta, math.log(vc)), guess_s, profile.attained_stress),
         )
     ]
     note = "profile likelihood"
