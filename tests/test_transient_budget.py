@@ -119,7 +119,8 @@ def test_a_long_quasi_steady_run_is_accepted_and_finishes_fast(capsys):
     ("protocol", "settings", "what"),
     [
         (constant(350e-6, 10000.0), dict(start="steady", reduction="off"), "cohorts throughout"),
-        (segments([(100e-6, 0.01), (0.0, 1000.0)]), dict(control="velocity", start="steady"), "a long hold"),
+        # (a 1000 s hold is no longer here: it takes ~2 700 steps, estimated 2 972, and fails in ~1 s at the clock's
+        # double precision on re-slide: tests/test_transient_estimate_holds.py)
         # 65 000 cycles of ~1500 rows each (a slip's steps, with the births' spacing by their own error), ~10 GB
         (constant(100e-6, 1e6), dict(start="steady", stick_population=True), "65 000 stick-slip cycles"),
         (constant(1e-3, 100.0), dict(start="steady", max_step=1e-6), "a bounded cohort step"),

@@ -607,7 +607,10 @@ class _Driver:
         state, duration = self.state, self.duration
         if collapsed or not all(math.isfinite(q) for q in (state.t, state.x, state.v, state.h)):
             pace = float(np.max(self.protocol.velocities))
-            failed = SolverFailed(_non_finite(state.t, self.out[:count], self.rows, pace, self.inertial, state.h))
+            rigid = _rigid_collapse(state, self.params, self.aging) if self.control == "velocity" else None
+            failed = SolverFailed(
+                _non_finite(state.t, self.out[:count], self.rows, pace, self.inertial, state.h, rigid)
+            )
             try:  # the run up to its last good row, as a budget's stop keeps it (status "failed")
                 failed.partial = _finish(self, list(self.snapshots), str(failed), self.note)
             except (ArithmeticError, ValueError, IndexError):  # rows that make no result: the message alone
@@ -755,8 +758,48 @@ class _Repeater:
 RUNAWAY = 1e6
 
 
+def _rigid_collapse(state: _State, params: Parameters, aging: bool) -> str:
+    """Why the step collapses under velocity control (no block, nothing to run away), in words for
+    :func:`_non_finite`: the loaded cohort nearest the FENE wall, its age, and how fast it dies there.
+
+    A bond aged at rest for a time t_a is held by its aging term A = t_a/tau_a e^(-V/Va) until its force matches it,
+    at 1 - (e/dl_m)^2 ~ c/A (c = lambda M dl_m/kT), and dies there within ~ c dl_m/(2 A^2 V): after a hold of 300 s
+    at 100 um/s (the gel) ~2e-13 s, below what the clock resolves at t = 300 s (the kernel's floor, 1e-15 t)."""
+    b, g = params.bonds, params.aging
+    n = state.n
+    ext = state.x - state.xb[:n]
+    loaded = np.isfinite(state.lw[:n]) & (ext > 0.9 * b.max_extension)
+    clock = f"the clock's resolution at t = {state.t:.6g} s (the solver's floor: 1e-15 of the time reached)"
+    if not (aging and loaded.any()):
+        return f"the bonds' deaths need steps below {clock}"
+    i = int(np.flatnonzero(loaded)[np.argmax(ext[loaded])])
+    age = float(state.t - state.tb[i])
+    v = abs(state.v)
+    from .model import aging_age
+
+    strength = float(aging_age(np.asarray(age), params)) / g.aging_time * math.exp(-v / g.aging_velocity)
+    c = b.force_sensitivity * b.chain_stiffness * b.max_extension
+    words = (
+        f"bonds {age:.3g} s old, aged at rest (a hold), are held by their aging term (t_a/τa e^(-V/Va) ="
+        f" {strength:.3g} in ln r) until their force matches it, at 1 − (e/Δl_m)² ≈ {c / strength:.2g},"
+        " by the FENE wall"
+    )
+    if strength > c and v > 0:
+        words += f", and die there within about {c * b.max_extension / (2.0 * strength**2 * v):.2g} s of their arrival"
+    return (
+        f"{words}: faster than the solver can follow, below {clock}; a shorter hold stays within it (the"
+        " gel's set at 100 µm/s: holds up to ~100 s)"
+    )
+
+
 def _non_finite(
-    t: float, block: np.ndarray, rows: list[np.ndarray], pace: float, inertial: bool = False, step: float = math.nan
+    t: float,
+    block: np.ndarray,
+    rows: list[np.ndarray],
+    pace: float,
+    inertial: bool = False,
+    step: float = math.nan,
+    rigid: str | None = None,
 ) -> str:
     """The failure in words: a runaway slip (the bonds gave way faster than an inertia-free block can follow).
 
@@ -777,6 +820,11 @@ def _non_finite(
     if inertial:
         what = f"the step collapsed to {step:.3g} s" if collapsed else "non-finite state"
         return f"transient solver failed at {when}: {what} of the block with mass"
+    if rigid is not None and collapsed:  # velocity control: the slider's velocity is imposed, nothing runs away
+        return (
+            f"transient solver failed at {when}: the step down to {step:.3g} s under velocity control (the slider's"
+            f" velocity is imposed: no block, nothing runs away): {rigid}; what follows is not known"
+        )
     fast = finite[finite[:, 3] > RUNAWAY * max(pace, 1e-300)] if finite.size else finite
     if not (fast.size or collapsed):
         return f"transient solver failed at {when}: non-finite state"
@@ -1482,6 +1530,11 @@ REDUCED_STEPS = 100.0
 #: ln r there, 1e6/s at 1 um/s for the gel, 9.4e4/s at 10 um/s): once they arrive the cohorts take about WALL_SHARE g
 #: steps per second more (measured 0.23-0.38 g from 1 to 30 um/s under velocity control, 2.5e5 steps/s at 1 um/s)
 WALL_SHARE = 0.3
+#: a steady population not disturbed (a steady start under velocity control, at its own velocity) meets the wall
+#: smoothly: its cohorts take about WALL_STEADY g steps per second more (measured, total steps over the first
+#: memory less the births' count: 0.08 g at 3.5 um/s, 0.1 g at 10 um/s, ~0.004 g at 1 um/s; the tester's 3.5 um/s
+#: for 1 s, 18 913 steps and 33 s of CPU, had been estimated at 7.4e4 steps and 13.9 min)
+WALL_STEADY = 0.08
 #: where bonds leave the population before dl_m/V, the settling counts this many of their memories (the look for a
 #: stretch comes after about twice the steps it waits for)
 TAIL_SETTLE = 2.0
@@ -1508,6 +1561,14 @@ STUCK_STEPS = 2500.0
 #: steps in 0.14 s), and a block stuck for good takes CHURN_SHARE times the churn's steps (2 409 against ~1 020)
 CHURN_STEP = 0.5
 CHURN_SHARE = 2.4
+#: a hold under velocity control relaxes in lengthening steps, at most about this many (2 375-2 377 measured for
+#: holds of 1-100 s at 100 um/s, the gel; 271 for 10 ms, where the churn's count binds: _hold_steps)
+HOLD_STEPS = 2500.0
+#: re-sliding after a hold, the bonds aged at rest die at the FENE wall as stiff lumps once their aging term
+#: A = t_hold/tau_a e^(-V/Va) passes RESLIDE_STRENGTH: the first travel dl_m costs (A/RESLIDE_STRENGTH)^RESLIDE_POWER
+#: times its cohorts' count (_resliding_steps; the gel at 100 um/s: 576, 1 560, 10 529 steps after 1, 10, 100 s)
+RESLIDE_STRENGTH = 1000.0
+RESLIDE_POWER = 0.63
 #: steps no budget allows even with the reduction (the fold's velocity is not looked for then)
 HOPELESS = 1e9
 #: a block with mass rings at f_b = sqrt((K + N0 M)/m)/(2 pi) after each change of the protocol (and lightly damped
@@ -1574,8 +1635,11 @@ def estimate_cost(
       costs :data:`STUCK_STEPS` (and :data:`STOP_STEPS`), one step per later
       segment, whatever its length.
 
-    Holds and pieces below the fold otherwise, ``reduction="off"`` and a
-    ``max_step`` cost the cohorts' steps throughout.  Measured over the box
+    A hold under velocity control costs what the solver does in it (the
+    population relaxes in lengthening steps: :func:`_hold_steps`), and the
+    re-slide after it the aged bonds' stiff deaths at the FENE wall
+    (:func:`_resliding_steps`).  Pieces below the fold otherwise,
+    ``reduction="off"`` and a ``max_step`` cost the cohorts' steps throughout.  Measured over the box
     (docs/transient.md section 2a, tests/test_transient_budget.py): steps
     taken / estimated 0.44-1.55 for the block's own motion (K from 3e5 to
     4e6 Pa/m, 1 um/s to 10 mm/s, 0.1 s to 1e6 s), 0.14-0.29 above the fold,
@@ -1612,7 +1676,7 @@ def estimate_cost(
     natural = b.max_extension / b.bond_time
     own = motion is not None and motion.counts()  # the block's own motion is counted (else the cohorts')
     steps, fastest, reduced, living = _pieces_steps(
-        params, protocol, control, aging, v_start, scale, motion, reducing, start=start, rtol=rtol
+        params, protocol, control, aging, v_start, scale, motion, reducing, start=start, rtol=rtol, every=every
     )
     if control == "block" and start == "empty" and not stick_population and reduced and not own:
         steps += STUCK_STEPS  # a block from rest sticks first (the chains hold a stuck block)
@@ -1651,7 +1715,7 @@ def estimate_cost(
 
 
 def _pieces_steps(  # type: ignore[no-untyped-def]
-    params, protocol, control, aging, v_start, scale, motion, reducing, start="empty", rtol=RTOL
+    params, protocol, control, aging, v_start, scale, motion, reducing, start="empty", rtol=RTOL, every=None
 ) -> tuple[float, float, int, float]:
     """:func:`estimate_cost`'s steps piece by piece: (steps, the fastest velocity, the pieces reduced, the CPU
     seconds of the living cohorts each step works through, :data:`COHORT_STEP_SECONDS`)."""
@@ -1665,6 +1729,8 @@ def _pieces_steps(  # type: ignore[no-untyped-def]
     memories: dict[float, _Memory] = {}  # by velocity, for this estimate (1e5 segments ask again and again)
     # the velocity the population was last steady at (None: an empty start, whose first bonds reach the wall dl_m/V on)
     previous = None if start == "empty" else (v_start if v_start > 0 else abs(protocol.initial_velocity))
+    held = 0.0  # the hold just before a piece (velocity control), and the cohorts it keeps
+    kept = 0.0
     for t0, t1, vp in protocol.pieces():
         v = max(abs(vp), v_start) if control == "block" else abs(vp)
         fastest = max(fastest, v)
@@ -1675,6 +1741,19 @@ def _pieces_steps(  # type: ignore[no-untyped-def]
         rate *= share
         cohorts = rate * (t1 - t0)
         filling, disturbed, previous = previous is None, previous is None or abs(vp) != previous, abs(vp)
+        if control == "velocity" and vp == 0 and aging and g.saturation_age is None:
+            # a hold: the population relaxes smoothly in lengthening steps (not the births' pace throughout); resting
+            # bonds that never age into permanence (no aging, or aging that saturates) churn on: the cohorts' count
+            lump = min(cohorts, _hold_steps(params, t1 - t0, rtol) * scale)
+            steps += lump + SEGMENT_STEPS
+            held += t1 - t0
+            # every step bears two cohorts, and resting ones age into permanence and stay: each step (a sampling
+            # instant's too, counted with the samples) works through those kept so far (10 s held every 0.1 ms:
+            # 1e5 steps past 2e5 cohorts, stopped at 10 min of CPU at 99 % of the hold)
+            taken = lump + (0.0 if every is None else (t1 - t0) / every)
+            living += COHORT_STEP_SECONDS * taken * (kept + taken)
+            kept += 2.0 * taken
+            continue
         if motion is not None and motion.counts():
             piece = motion.piece(t1 - t0, vp, lambda v=vp: v < _fold(fold, params, control, aging))
             if piece is not None:  # births a block cannot resolve in STUCK_STEPS or a slip (a huge u0) are counted
@@ -1683,7 +1762,9 @@ def _pieces_steps(  # type: ignore[no-untyped-def]
                 steps += min(max(piece, floor) * scale, bound) + motion.segment_steps()
                 continue
         memory = _memory_of(memories, params, v, aging, rtol) if v > 0 else None
-        wall = 0.0 if memory is None else WALL_SHARE * memory.climb * share  # bonds dying at the FENE wall
+        # a steady population undisturbed (velocity control, the velocity it is steady at) meets the wall smoothly
+        smooth = control == "velocity" and not disturbed
+        wall = 0.0 if memory is None else (WALL_STEADY if smooth else WALL_SHARE) * memory.climb * share
         arrive = b.max_extension / v if (filling and v > 0) else 0.0  # the first of them arrive there
         cohorts += wall * max(t1 - t0 - arrive, 0.0)
         span = t1 - t0
@@ -1700,9 +1781,43 @@ def _pieces_steps(  # type: ignore[no-untyped-def]
                     reduced += 1
         if wall > 0:  # each step once bonds die at the wall works through those born over the last memory.keep
             after = max(span - arrive, 0.0)
-            living += COHORT_STEP_SECONDS * (rate + wall) ** 2 * after * 2.0 * min(memory.keep, after)
+            # (from a steady start the cohorts born replace the steady ones, ~half of them living on average)
+            living += (
+                COHORT_STEP_SECONDS * (rate + wall) ** 2 * after * (1.0 if smooth else 2.0) * min(memory.keep, after)
+            )
+        if held > 0 and v > 0:  # re-sliding after a hold: the aged bonds die at the FENE wall, stiffly
+            aged = _resliding_steps(params, held, v, aging, rate * min(t1 - t0, b.max_extension / v))
+            cohorts += aged
+            living += COHORT_STEP_SECONDS * kept * (aged + rate * min(t1 - t0, b.max_extension / v))
+            held, kept = 0.0, 0.0
         steps += cohorts + SEGMENT_STEPS
     return steps, fastest, reduced, living
+
+
+def _hold_steps(params: Parameters, duration: float, rtol: float) -> float:
+    """Steps of a hold under velocity control (the slider at rest): the resting bonds churn at steps of ~tau/2
+    until their vacancies fill (:func:`_churn`), after which the population relaxes in lengthening steps, at most
+    :data:`HOLD_STEPS` whatever the hold's length (the gel at 100 um/s: 271 steps for 10 ms, 2 375 for 1 s,
+    2 377 for 10 s and for 100 s); where the vacancies never fill the churn lasts the whole hold."""
+    churn = _churn(params, duration, rtol)
+    if not churn.holds:
+        return churn.steps
+    return max(HOLD_STEPS, CHURN_SHARE * churn.steps)
+
+
+def _resliding_steps(params: Parameters, held: float, v: float, aging: bool, fresh: float) -> float:
+    """The steps a re-slide at v after a hold of ``held`` s adds to ``fresh`` (its cohorts' count over the first
+    dl_m/V): the bonds that aged at rest are held by their aging term A = held/tau_a e^(-V/Va) until their force
+    matches it, at 1 - (e/dl_m)^2 ~ (lambda M dl_m/kT)/A, and die at the FENE wall within ~1/(2 A^2 V/(c dl_m)),
+    each a stiff lump (the gel at 100 um/s: 576, 1 560 and 10 529 steps over that first travel after holds of 1,
+    10 and 100 s, 0.19-3.4 steps per cohort that arrives there)."""
+    if not aging:
+        return 0.0
+    from .model import aging_age
+
+    g = params.aging
+    strength = float(aging_age(np.asarray(held), params)) / g.aging_time * math.exp(-v / g.aging_velocity)
+    return fresh * (max(strength / RESLIDE_STRENGTH, 1.0) ** RESLIDE_POWER - 1.0)
 
 
 @dataclass(frozen=True)
@@ -1836,6 +1951,8 @@ class _BlockMotion:
         self.lump = 0.0  # its sticking, counted with the next piece
         self.stuck_segments = 0
         self.from_rest = start == "empty"  # the first stick starts at sigma = 0
+        self.from_steady = start == "steady"  # still sliding steadily since a steady start (no stop met yet)
+        self.churned = False  # a piece was counted as the resting bonds' churn
         self.clock = 0.0  # time since the slider last stopped (the chains' stick and the cycles after it)
         self.slips = 0.0
         self.clocks: dict[tuple[float, bool], tuple[float, float]] = {}
@@ -1874,7 +1991,13 @@ class _BlockMotion:
             return lump
         if not self.chains and not self.churn.holds and self.params.aging.saturation_age is None:
             # resting bonds never fill the vacancies within the run: the births and deaths churn at steps of ~tau
-            # throughout, whether the block creeps or slides (tau = 10 us: 657 719 steps for 1 s, 1 ns: ~1e10)
+            # throughout, whether the block creeps or slides (tau = 10 us: 657 719 steps for 1 s, 1 ns: ~1e10),
+            # unless it slides steadily above the fold from a steady start (the reduction's count: tau = 1 ns at
+            # 100 um/s from a steady start, 129 steps for 1 s, had been counted as 2e9 churning ones)
+            if self.sliding and self.from_steady and vp > 0 and not below():
+                self.clock = 0.0
+                return None
+            self.from_steady, self.churned = False, True
             return dt / (CHURN_STEP * self.params.bonds.bond_time)
         if not below():
             self.sliding = self.sliding or not self.chains or vp > 0
@@ -1924,7 +2047,7 @@ class _BlockMotion:
             )
         if self.stuck_for_good:
             return ", the block stuck for good under Eq 1 (no stick chains)"
-        if not self.chains and not self.churn.holds and self.params.aging.saturation_age is None:
+        if self.churned:
             return (
                 f", resting bonds that age into permanence with probability e^(-u0 τa/τ) = {self.churn.permanence:.3g}"
                 " (never filling the vacancies within the run): their births and deaths churn at steps of ~τ/2"
