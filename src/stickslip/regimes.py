@@ -20,6 +20,8 @@ __all__ = [
     "DECAYING",
     "GROWING",
     "KINDS",
+    "OSCILLATING",
+    "OSCILLATION",
     "RATIO_TOLERANCE",
     "STEADY",
     "STICK_SLIP",
@@ -40,7 +42,12 @@ GROWING = "growing oscillation"
 STUCK = "stuck"
 BLOW_UP = "blow-up"
 UNDETERMINED = "undetermined"
-KINDS = (STEADY, DECAYING, STICK_SLIP, GROWING, STUCK, BLOW_UP, UNDETERMINED)
+#: a limit cycle without a stick or a slip phase (a block with mass ringing on; a record whose stress falls as slowly
+#: as it rises): not stick-slip.  Named by the transient model and by ``stickslip analyze``, not by ``classify``
+OSCILLATION = "oscillation"
+KINDS = (STEADY, DECAYING, STICK_SLIP, GROWING, OSCILLATION, STUCK, BLOW_UP, UNDETERMINED)
+#: the kinds whose peak and trough are those of an oscillation (the last period's); the others' are the window's
+OSCILLATING = (STICK_SLIP, DECAYING, GROWING, OSCILLATION)
 #: rate-and-state's names where they differ (kept for its JSON and sweep tables)
 RSF_NAMES = {STEADY: "steady sliding"}
 

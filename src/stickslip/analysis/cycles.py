@@ -59,7 +59,7 @@ STUCK_R2 = 0.9
 #: not stick-slip (no slip phase): ``regimes.DECAYING`` or ``regimes.GROWING`` when its peak-to-trough amplitude
 #: changes from period to period by more than ``regimes.RATIO_TOLERANCE`` (and by more than three standard errors
 #: of its trend), this when it does not.
-OSCILLATION = "oscillation"
+OSCILLATION = regimes.OSCILLATION
 #: An oscillation's amplitude trend is judged on at least this many swings (regimes.RATIOS_NEEDED ratios).
 TREND_SWINGS = regimes.RATIOS_NEEDED + 1
 #: ... and counts when the fitted ratio per period is this many standard errors from 1.

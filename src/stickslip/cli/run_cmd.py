@@ -229,7 +229,7 @@ def refuse_every(model: Any, protocol: Any, every_text: str | None) -> None:
 
 
 #: the regimes whose peak and trough are those of an oscillation (the others: the run's highest and lowest)
-OSCILLATING = (regimes.STICK_SLIP, regimes.DECAYING, regimes.GROWING)
+OSCILLATING = regimes.OSCILLATING
 
 
 def run_summary(run: Any, protocol: Any, rig: Any, spring: tuple[float, str, str] | None = None) -> dict[str, Any]:

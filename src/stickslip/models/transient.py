@@ -12,7 +12,7 @@ from ..parameters import Parameters
 from ..protocols import Protocol
 from .base import Boundary, Capabilities, Rig
 from .bond import STIFFNESS_KEYS, BondModel
-from .run import Run, time_mean
+from .run import Run, settled_mean, time_mean
 
 NAN = math.nan
 #: relative stress change that counts as none (stickslip.transient.cycles.SETTLED, the solver's own verdict's)
@@ -193,6 +193,12 @@ def transient_run(result: Any, protocol: Protocol | None = None) -> Run:
     """The :class:`Run` of a :class:`stickslip.transient.TransientResult` (regime from its slip events, in the
     protocol's last segment; over the whole run without the protocol)."""
     summary = last_cycle_numbers(result, protocol)
+    regime = _regime(result, protocol)
+    if regime.kind == regimes.OSCILLATION and math.isfinite(regime.period) and not summary["cycles"]:
+        # a limit cycle without a stick has no whole stick-to-stick cycle: its mean is over its last whole periods
+        # (the run's mean, 298.078 Pa, lay above its period's peak, 297.573 Pa, for a ringing light block)
+        time, stress = np.asarray(result.time, dtype=float), np.asarray(result.stress, dtype=float)
+        summary["mean_stress"] = settled_mean(time, stress, regime.period)
     states: dict[str, Any] = {}
     units: dict[str, str | None] = {}
     if getattr(result, "bonded_fraction", None) is not None:
@@ -210,7 +216,7 @@ def transient_run(result: Any, protocol: Protocol | None = None) -> Run:
         slider_velocity=_first(result, "slider_velocity", "velocity"),
         slider_position=_first(result, "slider_position", "slider_displacement"),
         load_point_position=_first(result, "puller_position", "puller_displacement"),
-        regime=_regime(result, protocol),
+        regime=regime,
         mean=summary["mean_stress"],
         states=states,
         state_units=units,
@@ -299,7 +305,7 @@ def last_cycle_numbers(result: Any, protocol: Protocol | None = None) -> dict[st
     stick, σs 631.6 Pa against the paper's cycle's 556.4 Pa, which the mean is not of); ``run_mean_stress`` over
     the run.  ``protocol``: the run's, for the puller's exact travel into a stick that no cycle of the result
     starts (the run ended in it)."""
-    whole = [c for c in result.cycles if getattr(c, "period", None) is not None]
+    whole = _settled(result, [c for c in result.cycles if getattr(c, "period", None) is not None], protocol)
     time = np.asarray(result.time, dtype=float)
     row: dict[str, Any] = {
         "regime": str(result.regime),  # a kind name (a Regime compares and prints as its kind)
@@ -324,6 +330,25 @@ def last_cycle_numbers(result: Any, protocol: Protocol | None = None) -> dict[st
             result, last.start_time, end, last.start_stress, *following[:1], protocol=protocol
         )
     return row
+
+
+def _settled(result: Any, whole: list[Any], protocol: Protocol | None) -> list[Any]:
+    """The whole cycles without a start-up cycle that does not repeat (as quasistatic.cycle.settled_cycles): the
+    first whole cycle of the last segment (of the run without the protocol) counts only where the stick after it
+    starts where it started, within RATIO_TOLERANCE of its rise (from rest the first stick starts at 0 Pa: its
+    period, 54.8 s at 50 µm/s, is no period of the run's cycle, 23.3 s)."""
+    if not whole:
+        return whole
+    start = float(protocol.boundaries[-2]) if protocol is not None else float(np.asarray(result.time)[0])
+    inside = [c for c in whole if c.start_time >= start]
+    if not inside or inside[0] is not whole[-1]:  # the last whole cycle follows another one of its segment
+        return whole
+    first = inside[0]
+    following = [c.start_stress for c in result.cycles if c.index == first.index + 1]
+    after = following[0] if following else _last_trough(result, first.start_time + first.period)
+    if abs(after - first.start_stress) <= regimes.RATIO_TOLERANCE * abs(first.peak_stress - first.start_stress):
+        return whole
+    return []
 
 
 def _mean_stress(result: Any, start: float, end: float, *exact: float, protocol: Protocol | None = None) -> float:
@@ -408,9 +433,13 @@ def _last_trough(result: Any, start: float) -> float:
     steps it closes: ``every`` must not move the trough) and the stick events' exact stresses."""
     time, stress = np.asarray(result.time, dtype=float), np.asarray(result.stress, dtype=float)
     lowest = getattr(result, "lowest_stress", None)
+    when = getattr(result, "lowest_time", None)
     inside = np.flatnonzero(time >= start)
     values = stress[inside].tolist()
-    if lowest is not None and inside.size > 1:  # the first row's steps began before start: its own stress only
+    if lowest is not None and when is not None:  # the states at or after start, whichever row carries them
+        low, at = np.asarray(lowest, dtype=float), np.asarray(when, dtype=float)
+        values += low[np.isfinite(low) & np.isfinite(at) & (at >= start)].tolist()
+    elif lowest is not None and inside.size > 1:  # the first row's steps began before start: its own stress only
         values += np.asarray(lowest, dtype=float)[inside[1:]].tolist()
     sticks = [c.start_stress for c in result.cycles if c.start_time >= start]
     return float(min([*values, *sticks]))

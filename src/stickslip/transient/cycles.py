@@ -24,6 +24,10 @@ RESOLVED = 10.0
 #: Eq 1 through the block: a slip is the slider outrunning the puller to this many times its pace, after a stick
 #: where it fell below 1/SLIP_FACTOR of it (the saturating set's stick creeps at 5-22 % of V0, its slip jumps to 14x)
 SLIP_FACTOR = 2.0
+#: the verdicts whose peak and trough are an oscillation's (the last period's); the others' are the window's
+OSCILLATING = regimes.OSCILLATING
+#: a limit cycle in which the slider never sticks (a block with mass ringing on): no stick-slip
+OSCILLATION = regimes.OSCILLATION
 
 
 @dataclasses.dataclass(frozen=True)
@@ -65,6 +69,27 @@ def with_extremes(time: np.ndarray, stress: np.ndarray, between: Between | None)
     t, y = np.r_[time, added], np.r_[stress, np.concatenate(extra_y)]
     order = np.argsort(t, kind="stable")
     return t[order], y[order]
+
+
+def window_extremes(
+    time: np.ndarray, stress: np.ndarray, between: Between | None, start: float, end: float = math.inf
+) -> tuple[float, float]:
+    """(highest, lowest) stress of the solution from ``start`` on: the rows there and every state of the solver at
+    or after ``start`` that a row's extremes carry (``between``), wherever that row lies (a row written at a
+    slip closes the steps since the last state it saw, which can be before the grid row before it: 10 s rows
+    of a re-slide from t = 11 s carried its lowest, 255.7 Pa at t = 11 s, on the slip's row at 14.8 s, past the
+    row at 12 s).  Neither depends on the rows kept; NaN where the window holds nothing.  ``end``: the window's
+    end (the states up to it), the run's by default."""
+    time, stress = np.asarray(time, dtype=float), np.asarray(stress, dtype=float)
+    values = [stress[(time >= start) & (time <= end) & np.isfinite(stress)]]
+    if between is not None:
+        for when, value in ((between.lowest_time, between.lowest), (between.highest_time, between.highest)):
+            w, v = np.asarray(when, dtype=float), np.asarray(value, dtype=float)
+            values.append(v[np.isfinite(v) & np.isfinite(w) & (w >= start) & (w <= end)])
+    found = np.concatenate(values)
+    if not found.size:
+        return math.nan, math.nan
+    return float(np.max(found)), float(np.min(found))
 
 
 def stuck_mask(time: np.ndarray, velocity: np.ndarray, protocol: Protocol) -> np.ndarray:
@@ -315,12 +340,17 @@ def judge(
     # settled is judged on the stress the run ends at (not below a thousandth of the peak): within SETTLED of a
     # 3.56 MPa re-slide peak (35.6 Pa), a re-slide 50 Pa short of steady read as steady
     settle = SETTLED * max(abs(float(stress[-1])), 1e-3 * scale, 1e-300)
-    found = _from_events(events, start, time, stress, lowest)
+    found = _from_events(events, start, time, stress, lowest, between)
     if found is None:
         classified = regimes.classify(time, stress, floor=floor, start=start, unit="Pa", settle_floor=settle)
         found = solution_extremes(classified, time, stress, between, start)
     chains = any(kind == "stick" for kind, *_ in events)
-    return (*_words(found, time, stress, velocity, protocol, cycles, control, resolution, scale, chains), found)
+    regime, message = _words(found, time, stress, velocity, protocol, cycles, control, resolution, scale, chains)
+    if regime not in OSCILLATING:  # no oscillation to take a period's extremes of: the window's, as reported
+        peak, trough = window_extremes(time, stress, between, start)
+        if math.isfinite(peak):
+            found = dataclasses.replace(found, peak=peak, trough=trough)
+    return regime, message, found
 
 
 def solution_extremes(
@@ -332,16 +362,16 @@ def solution_extremes(
     The verdict is read from the rows, not from the rows with the states between them (:func:`with_extremes`):
     those states come at the steps, and a cohort of aged bonds dying at the FENE wall within a step that lands on
     a row drops the stress by ~1e-5 of a re-slide's peak, which read as a period and flipped a steady verdict."""
+    if found.kind not in OSCILLATING:  # the window's extremes, not the last "period" of a verdict without one
+        peak, trough = window_extremes(time, stress, between, start)
+        if not math.isfinite(peak):
+            return found
+        return dataclasses.replace(found, peak=peak, trough=trough)
     if between is None:
         return found
-    t_all, s_all = with_extremes(time, stress, between)
+    t_all, _ = with_extremes(time, stress, between)
     if t_all.size == time.size:  # every state a row: the rows' extremes are the solution's
         return found
-    inside = t_all >= start
-    if found.kind not in (regimes.STICK_SLIP, regimes.DECAYING, regimes.GROWING):
-        if not np.any(inside):
-            return found
-        return dataclasses.replace(found, peak=float(np.max(s_all[inside])), trough=float(np.min(s_all[inside])))
     peak, trough = found.peak, found.trough
     for value, highest in ((found.peak, True), (found.trough, False)):
         for k in np.flatnonzero((stress == value) & (time >= start)).tolist():
@@ -378,6 +408,16 @@ def _words(
             f" decays or repeats is not resolved; a smaller rtol resolves it (t = {time[-1]:.6g} s,"
             f" V = {show_velocity(velocity[-1], 3)})"
         )
+    if found.kind == regimes.STICK_SLIP and not chains:
+        never = _never_sticks(found, time, velocity, protocol)
+        if never is not None:
+            seen = found.evidence.removeprefix("stick-slip (limit cycle): ")
+            return OSCILLATION, (
+                f"oscillation (a limit cycle without a stick): {seen}, σ {found.trough:.6g} ... {found.peak:.6g} Pa;"
+                f" the slider never sticks (V {show_velocity(never[0], 4)} ... {show_velocity(never[1], 4)} over the"
+                f" last {never[2]} period(s), never below {STUCK_FRACTION:.0%} of the puller's"
+                f" {show_velocity(vp, 4)}): no stick-slip"
+            )
     if found.kind == regimes.STICK_SLIP:
         seen = found.evidence.removeprefix("stick-slip (limit cycle): ")
         text = f"stick-slip (limit cycle): {seen}, σ {found.trough:.6g} ... {found.peak:.6g} Pa"
@@ -421,6 +461,24 @@ def _words(
         f"{found.evidence} at the end of the run (t = {time[-1]:.6g} s, σ = {stress[-1]:.6g} Pa,"
         f" V = {show_velocity(velocity[-1], 3)}): run longer to see where it goes"
     )
+
+
+def _never_sticks(
+    found: regimes.Regime, time: np.ndarray, velocity: np.ndarray, protocol: Protocol
+) -> tuple[float, float, int] | None:
+    """(slowest, fastest, periods) of the slider over the limit cycle's last periods (the RATIOS_NEEDED + 1 that
+    back the verdict, at most those counted) when it never falls below STUCK_FRACTION of the puller's pace there:
+    no stick in the cycle; None where it sticks (or the rows there are too few to tell).  A block of 0.1 kg/m^2
+    at 300 µm/s rang 683 periods of 29 µs between 184 and 208 µm/s, and read "stick-slip"."""
+    if not (math.isfinite(found.period) and found.period > 0):
+        return None
+    periods = max(1, min(found.periods, regimes.RATIOS_NEEDED + 1))
+    tail = time >= max(float(time[-1]) - periods * found.period, float(protocol.boundaries[-2]))
+    if np.count_nonzero(tail) < 3:
+        return None
+    if np.any(stuck_mask(time[tail], velocity[tail], protocol)):
+        return None
+    return float(np.min(velocity[tail])), float(np.max(velocity[tail])), periods
 
 
 def _rang_and_stuck(time: np.ndarray, stress: np.ndarray, stuck: np.ndarray, protocol: Protocol, scale: float) -> bool:
@@ -477,7 +535,12 @@ def _repeats(first: tuple[float, float], second: tuple[float, float], rise: floa
 
 
 def _from_events(
-    events: list, start: float, time: np.ndarray, stress: np.ndarray, lowest: np.ndarray | None = None
+    events: list,
+    start: float,
+    time: np.ndarray,
+    stress: np.ndarray,
+    lowest: np.ndarray | None = None,
+    between: Between | None = None,
 ) -> regimes.Regime | None:
     """The regime from the stick chains' exact sticks and slips (time, stress), independent of ``every``.
 
@@ -488,10 +551,12 @@ def _from_events(
     ever: a limit cycle, shown by two slips (or by one slip and the stick after it).  Otherwise three or more
     whole cycles are judged by their amplitudes (regimes.classify_cycles); fewer are undetermined, in words.
     None when the last segment has no such cycle, or its last event is more than two periods before the end
-    (the run left stick-slip: the trace decides).  The reported extremes are the events' or the trace's over
-    the last period, whichever reaches further (the slip's lowest stress can come just before the stick);
-    ``lowest``: each row's lowest stress of the solver's steps since the row before (``every`` must not move
-    the trough).
+    (the run left stick-slip: the trace decides).  A limit cycle's period and extremes are its last whole
+    cycle's, stick to stick (the cycle the run's summary reports: one period per run), from the events and the
+    solution between them (``between``: the solver's states between the rows); any other verdict's extremes
+    are the events' or the trace's over the last period, whichever reaches further (the slip's lowest stress can
+    come just before the stick); ``lowest``: each row's lowest stress of the solver's steps since the row before
+    (``every`` must not move the trough).
     """
     cycles = _chain_cycles(events, start)
     if not cycles:
@@ -502,7 +567,15 @@ def _from_events(
     last_event = max(float(t) for _, t, _, _ in events)
     if math.isfinite(period) and float(time[-1]) - last_event > 2 * period:
         return None
-    found = _chain_verdict(cycles, whole, period)
+    found = _chain_verdict(cycles, whole)
+    if found.kind == regimes.STICK_SLIP and whole:
+        cycle = whole[-1]
+        assert cycle.after is not None
+        high, low = window_extremes(time, stress, between, cycle.t_stick, cycle.after[0])
+        events_low = min(cycle.sigma_stick, cycle.after[1])
+        peak = max(cycle.sigma_s, high) if math.isfinite(high) else cycle.sigma_s
+        trough = min(events_low, low) if math.isfinite(low) else events_low
+        return dataclasses.replace(found, peak=peak, trough=trough)
     recent = time >= (cycles[-2].t_slip if len(cycles) >= 2 else cycles[-1].t_stick)
     inside = np.flatnonzero(recent)
     if inside.size:
@@ -513,8 +586,10 @@ def _from_events(
     return found
 
 
-def _chain_verdict(cycles: list[_ChainCycle], whole: list[_ChainCycle], period: float) -> regimes.Regime:
-    """The verdict of the chains' cycles: a limit cycle as soon as one cycle repeats the one before."""
+def _chain_verdict(cycles: list[_ChainCycle], whole: list[_ChainCycle]) -> regimes.Regime:
+    """The verdict of the chains' cycles: a limit cycle as soon as one cycle repeats the one before.  Its period
+    is the last whole cycle's, stick to stick (the run's summary's); a first cycle that does not repeat (the
+    start-up stick, from rest at 0 Pa) gives no period (:func:`settled_chain_cycles`)."""
     last = cycles[-1]
     peak = last.sigma_s
     trough = min(c.sigma_stick for c in cycles[-2:])
@@ -526,10 +601,12 @@ def _chain_verdict(cycles: list[_ChainCycle], whole: list[_ChainCycle], period: 
     if repeating:
         prev = cycles[-2]
         ratio = last.rise / prev.rise
-        slips = [c.t_slip for c in cycles[-repeating - 1 :]]
-        length = float(np.mean(np.diff(slips[-4:])))
+        cycle = whole[-1]  # the last whole cycle (the one before the last slip's, at least)
+        assert cycle.after is not None
+        length = cycle.after[0] - cycle.t_stick
         evidence = (
-            f"stick-slip (limit cycle): {repeating} period(s) of {length:.6g} s, {repeating + 1} slips whose cycles"
+            f"stick-slip (limit cycle): {repeating} period(s) of {length:.6g} s (the last whole cycle, stick to"
+            f" stick), {repeating + 1} slips whose cycles"
             f" repeat (the last two: stick from {prev.sigma_stick:.6g} then {last.sigma_stick:.6g} Pa, σs ="
             f" {prev.sigma_s:.6g} then {last.sigma_s:.6g} Pa, amplitude ratio {ratio:.4g}): with fresh chains at"
             " each stick the cycle repeats from there"
@@ -551,9 +628,32 @@ def _chain_verdict(cycles: list[_ChainCycle], whole: list[_ChainCycle], period: 
     if last.after is not None:
         history += f"; the next stick from {last.after[1]:.6g} Pa"
     why = "no cycle repeats the one before yet" if len(cycles) >= 2 or last.after is not None else "no stick after it"
+    settled = settled_chain_cycles(whole)
     evidence = (
         f"undetermined: {len(cycles)} slip(s) ({history}), {why}: whether the run settles into a limit cycle needs"
         " another slip"
     )
+    if whole and whole[0] not in settled:
+        first = whole[0]
+        assert first.after is not None
+        evidence += (
+            f"; the first is the start-up cycle from {first.sigma_stick:.6g} Pa (a transient that does not repeat:"
+            f" σs = {first.sigma_s:.6g} Pa, period {first.after[0] - first.t_stick:.6g} s)"
+        )
+    lengths = [c.after[0] - c.t_stick for c in settled if c.after is not None]
+    period = float(np.mean(lengths[-3:])) if lengths else math.nan
     ratio = last.rise / cycles[-2].rise if len(cycles) >= 2 and cycles[-2].rise > 0 else math.nan
+    # the periods seen are the whole cycles (the start-up's too); the period only the settled ones'
     return regimes.Regime(regimes.UNDETERMINED, len(whole), ratio, period, peak, trough, evidence)
+
+
+def settled_chain_cycles(whole: list[_ChainCycle]) -> list[_ChainCycle]:
+    """The whole cycles of the repeating one, as quasistatic.cycle.settled_cycles: every whole cycle after the
+    first, and the first when the stick after it starts where it started (within RATIO_TOLERANCE of its rise).
+    A first stick from another stress (from rest: 0 Pa; after a hold) is a start-up cycle that does not repeat."""
+    if not whole:
+        return []
+    first = whole[0]
+    assert first.after is not None
+    keep_first = _repeats((first.sigma_stick,), (first.after[1],), first.rise)
+    return whole if keep_first else whole[1:]
