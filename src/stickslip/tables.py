@@ -38,6 +38,18 @@ def split_header(cell: str, parentheses: bool = False) -> tuple[str, str | None]
 _NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 
 
+def header_names(path: str | Path) -> list[str]:
+    """Column names of a CSV's header (its first line that is no comment); [] if it cannot be read."""
+    try:
+        with open(path, encoding="utf-8", errors="replace") as handle:
+            for line in handle:
+                if line.strip() and not line.lstrip().startswith("#"):
+                    return [split_header(cell, parentheses=True)[0] for cell in line.strip().split(",")]
+    except OSError:
+        pass
+    return []
+
+
 def _header_cell(cell: str) -> tuple[str, str | None] | None:
     """(name, unit or None) of a header cell, ``name [unit]`` as the package writes it or ``name (unit)`` as
     spreadsheets and lab software do; None when the name is no identifier."""

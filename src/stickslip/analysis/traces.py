@@ -111,21 +111,38 @@ def recorded_pulling_velocity(path: str | Path) -> tuple[float | None, str]:
     Returns (velocity, "") or (None, why not): a trace without a load-point column, or whose load point changes
     velocity (a protocol of segments), has no one pulling velocity to analyse at.
     """
+    found = _load_point(path)
+    if found is None:
+        return None, "the trace has no load-point column (" + ", ".join(LOAD_POINT_COLUMNS) + ")"
+    return _one_velocity(*found)
+
+
+def _one_velocity(name: str, t: np.ndarray, x: np.ndarray) -> tuple[float | None, str]:
+    """(velocity, "") of a load point that moves at one velocity throughout, else (None, why not)."""
+    if not _usable(t, x):
+        return None, f"its {name} column does not give a velocity"
+    slope, offset = np.polyfit(t - t[0], x, 1)
+    wander = float(np.max(np.abs(x - (offset + slope * (t - t[0])))))
+    if not slope > 0 or wander > 1e-6 * abs(float(x[-1] - x[0])):
+        return None, f"its load point ({name}) does not move at one velocity throughout"
+    return float(slope), ""
+
+
+def _load_point(path: str | Path) -> tuple[str, np.ndarray, np.ndarray] | None:
+    """(column, time, position) of a trace's first load-point column; None without one."""
     for name in LOAD_POINT_COLUMNS:
         others = [c for c in (*MODEL_COLUMNS, "stress", "force") if c != name]
         try:
             table = read_table(path, {"time": "time", name: "length"}, required=["time", name], ignore=others)
         except DataError:
             continue
-        t, x = table["time"], table[name]
-        if t.size < 2 or not (np.all(np.isfinite(t)) and np.all(np.isfinite(x))) or t[-1] <= t[0]:
-            return None, f"its {name} column does not give a velocity"
-        slope, offset = np.polyfit(t - t[0], x, 1)
-        wander = float(np.max(np.abs(x - (offset + slope * (t - t[0])))))
-        if not slope > 0 or wander > 1e-6 * abs(float(x[-1] - x[0])):
-            return None, f"its load point ({name}) does not move at one velocity throughout"
-        return float(slope), ""
-    return None, "the trace has no load-point column (" + ", ".join(LOAD_POINT_COLUMNS) + ")"
+        return name, table["time"], table[name]
+    return None
+
+
+def _usable(t: np.ndarray, x: np.ndarray) -> bool:
+    """Whether a load-point column gives a velocity: two rows or more, all finite, over a time that moves on."""
+    return bool(t.size >= 2 and np.all(np.isfinite(t)) and np.all(np.isfinite(x)) and t[-1] > t[0])
 
 
 #: Successive load-point velocities within this fraction of the largest one are one velocity ...
@@ -142,41 +159,37 @@ def load_point_velocities(path: str | Path) -> tuple[str | None, list[tuple[floa
     velocity (s, s, m/s), in time order; (None, []) without a load-point column, (column, []) when the load point
     does not move in stretches of one velocity.  One stretch: the velocity of :func:`recorded_pulling_velocity`;
     several: velocity steps (a transient protocol, or records spliced together)."""
-    velocity, _ = recorded_pulling_velocity(path)
-    for name in LOAD_POINT_COLUMNS:
-        others = [c for c in (*MODEL_COLUMNS, "stress", "force") if c != name]
-        try:
-            table = read_table(path, {"time": "time", name: "length"}, required=["time", name], ignore=others)
-        except DataError:
-            continue
-        t, x = table["time"], table[name]
-        if t.size < 2 or not (np.all(np.isfinite(t)) and np.all(np.isfinite(x))) or t[-1] <= t[0]:
-            return name, []
-        if velocity is not None:
-            return name, [(float(t[0]), float(t[-1]), velocity)]
-        dt = np.diff(t)
-        moving = dt > 0
-        v = np.diff(x)[moving] / dt[moving]
-        start, end = t[:-1][moving], t[1:][moving]
-        scale = float(np.max(np.abs(v))) if v.size else 0.0
-        if not scale > 0:
-            return name, []
-        breaks = np.flatnonzero(np.abs(np.diff(v)) > STEP_TOLERANCE * scale) + 1
-        segments = []
-        for a, b in zip([0, *breaks], [*breaks, v.size], strict=True):
-            if end[b - 1] - start[a] >= STEP_MIN_FRACTION * float(t[-1] - t[0]):
-                segments.append((float(start[a]), float(end[b - 1]), float(np.median(v[a:b]))))
-        merged: list[tuple[float, float, float]] = []
-        for segment in segments:  # stretches either side of a kink at one velocity (an event of the run) are one
-            if merged and abs(segment[2] - merged[-1][2]) <= STEP_TOLERANCE * scale:
-                merged[-1] = (merged[-1][0], segment[1], merged[-1][2])
-            else:
-                merged.append(segment)
-        segments = merged
-        if not 2 <= len(segments) <= STEP_MAX_SEGMENTS:
-            return name, []
-        return name, segments
-    return None, []
+    found = _load_point(path)
+    if found is None:
+        return None, []
+    name, t, x = found
+    velocity, _ = _one_velocity(name, t, x)
+    if not _usable(t, x):
+        return name, []
+    if velocity is not None:
+        return name, [(float(t[0]), float(t[-1]), velocity)]
+    dt = np.diff(t)
+    moving = dt > 0
+    v = np.diff(x)[moving] / dt[moving]
+    start, end = t[:-1][moving], t[1:][moving]
+    scale = float(np.max(np.abs(v))) if v.size else 0.0
+    if not scale > 0:
+        return name, []
+    breaks = np.flatnonzero(np.abs(np.diff(v)) > STEP_TOLERANCE * scale) + 1
+    segments = []
+    for a, b in zip([0, *breaks], [*breaks, v.size], strict=True):
+        if end[b - 1] - start[a] >= STEP_MIN_FRACTION * float(t[-1] - t[0]):
+            segments.append((float(start[a]), float(end[b - 1]), float(np.median(v[a:b]))))
+    merged: list[tuple[float, float, float]] = []
+    for segment in segments:  # stretches either side of a kink at one velocity (an event of the run) are one
+        if merged and abs(segment[2] - merged[-1][2]) <= STEP_TOLERANCE * scale:
+            merged[-1] = (merged[-1][0], segment[1], merged[-1][2])
+        else:
+            merged.append(segment)
+    segments = merged
+    if not 2 <= len(segments) <= STEP_MAX_SEGMENTS:
+        return name, []
+    return name, segments
 
 
 def _merge_model_repeats(

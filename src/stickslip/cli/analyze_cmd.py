@@ -203,8 +203,9 @@ def _check_recorded_v0(trace: Path, v0: float, v0_text: str) -> list[tuple[float
     is warned of, with the times: Gd/h per cycle then assumes --v0 for every cycle."""
     from ..analysis.traces import LOAD_POINT_COLUMNS, load_point_velocities
     from ..display import velocity as show_velocity
+    from ..tables import header_names
 
-    if not {n.lower() for n in _header_names(trace)} & set(LOAD_POINT_COLUMNS):
+    if not {n.lower() for n in header_names(trace)} & set(LOAD_POINT_COLUMNS):
         return []  # no load point recorded (a measured record): nothing to check against, and no second read
     name, segments = load_point_velocities(trace)
     if name is None:
@@ -231,20 +232,6 @@ def _check_recorded_v0(trace: Path, v0: float, v0_text: str) -> list[tuple[float
         f" is the stick slope over one V0 (--v0 {show_velocity(v0, 6)} for every cycle)"
     )
     return segments
-
-
-def _header_names(path: Path) -> list[str]:
-    """Column names of a CSV's header (its first line that is no comment); [] if it cannot be read."""
-    from ..columns import split_header
-
-    try:
-        with open(path, encoding="utf-8", errors="replace") as handle:
-            for line in handle:
-                if line.strip() and not line.lstrip().startswith("#"):
-                    return [split_header(cell, parentheses=True)[0] for cell in line.strip().split(",")]
-    except OSError:
-        pass
-    return []
 
 
 def _refuse_unbounded(analysis: Any, v0_text: str) -> None:

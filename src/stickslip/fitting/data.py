@@ -17,7 +17,7 @@ import numpy as np
 
 from ..columns import unit_of, with_units
 from ..errors import DataError
-from ..tables import Table, read_table
+from ..tables import Table, header_names, read_table
 
 if TYPE_CHECKING:  # pragma: no cover
     import pandas as pd
@@ -208,25 +208,11 @@ def read_stick_data(path: str | Path) -> StickData:
             path, STICK_COLUMNS, required=["pulling_velocity", "stick_time"], allow_missing=STICK_OPTIONAL_CELLS
         )
     except DataError:
-        names = _header_names(path)
+        names = header_names(path)
         if not {"critical_stress", "complete"} <= set(names):
             raise
         return _read_cycles_table(path, names)
     return _validated_stick(table)
-
-
-def _header_names(path: str | Path) -> list[str]:
-    """Column names of a CSV's header (its first line that is no comment); [] if it cannot be read."""
-    from ..columns import split_header
-
-    try:
-        with open(path, encoding="utf-8", errors="replace") as handle:
-            for line in handle:
-                if line.strip() and not line.lstrip().startswith("#"):
-                    return [split_header(cell, parentheses=True)[0] for cell in line.strip().split(",")]
-    except OSError:
-        pass
-    return []
 
 
 def _read_cycles_table(path: str | Path, names: Sequence[str]) -> StickData:
