@@ -582,8 +582,8 @@ def gaps(time: np.ndarray, step: float) -> np.ndarray:
         inside = (index >= 0) & (index < dt.size)
         near = np.where(inside, dt[np.clip(index, 0, dt.size - 1)], np.nan)
         near[near <= 0] = np.nan  # repeated times (jumps) are no interval
-        with np.errstate(all="ignore"):
-            level = np.nanmedian(np.where(np.isnan(near).all(axis=1)[:, None], 0.0, near), axis=1)
+        # a gap without a usable neighbouring interval on this side counts 0 there (no all-NaN row for nanmedian)
+        level = np.nanmedian(np.where(np.isnan(near).all(axis=1)[:, None], 0.0, near), axis=1)
         local = np.maximum(local, level)
     return cuts[dt[cuts] > GAP_STEPS * local]
 
