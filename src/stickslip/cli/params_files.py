@@ -73,8 +73,22 @@ def run_history(path: Path) -> tuple[list[dict[str, Any]] | None, float | None]:
     return protocol or None, start
 
 
+def history_protocol(path: Path | None) -> tuple[Any, float | None]:
+    """(Protocol, start velocity) of the history a ``.params.json`` carries (:func:`run_history`); (None, None) for
+    no file, another kind of file, or one without a history.  The fallback protocol of ``rsf simulate --params`` and
+    ``run --model rsf --params``."""
+    if path is None or Path(path).suffix.lower() != ".json":
+        return None, None
+    rows, start = run_history(Path(path))
+    if not rows:
+        return None, start
+    from ..protocols import segments
+
+    return segments([(row["velocity"], row["duration"]) for row in rows]), start
+
+
 def _params_text(path: Path) -> str:
     return read_input_text(path, f"--params {path}", MAX_PARAMS_BYTES)
 
 
-__all__ = ["MAX_PARAMS_BYTES", "load_params_file", "load_params_mapping", "run_history"]
+__all__ = ["MAX_PARAMS_BYTES", "history_protocol", "load_params_file", "load_params_mapping", "run_history"]

@@ -38,7 +38,7 @@ from .common import (
     stacked,
     write_text,
 )
-from .params_files import load_params_mapping, run_history
+from .params_files import history_protocol, load_params_mapping
 from .protocol_options import build_protocol as build_run_protocol
 from .protocol_options import checked_segment_text, protocol_options, refuse_unsupported
 from .run_cmd import execute, output_options
@@ -220,14 +220,10 @@ def simulate_command(**options: Any) -> None:
     figure (--plot) and the same summary.  With -o the parameters go beside it in NAME.params.json.
     """
     from ..models import Rig, get_model
-    from ..protocols import segments
 
-    fallback, start = None, None
-    if options["params_file"] is not None and options["params_file"].suffix.lower() == ".json":
-        fallback, start = run_history(options["params_file"])
+    earlier, start = history_protocol(options["params_file"])  # the earlier run's own, where no protocol is given
     options["stiffness"] = options.pop("stiffness_text")
     params = build_params(options)
-    earlier = segments([(s["velocity"], s["duration"]) for s in fallback]) if fallback else None  # the run's own
     protocol = build_run_protocol(options["v0_text"], options["duration_text"], options["segment_texts"],
                                   options["protocol_file"], earlier)  # fmt: skip
     refuse_unsupported("rsf simulate (the rate-and-state spring-slider)", protocol, options["control"],

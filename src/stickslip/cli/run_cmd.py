@@ -438,13 +438,10 @@ def _earlier_run(model: Any, params_name: str | None) -> tuple[Any, float | None
         return None, None
     if getattr(model, "start_dimension", None) != "velocity":
         return None, None
-    from ..protocols import segments
-    from .params_files import run_history
+    from .params_files import history_protocol
 
-    rows, start = run_history(path)
-    if not rows:
-        return None, None
-    return segments([(row["velocity"], row["duration"]) for row in rows]), start
+    protocol, start = history_protocol(path)
+    return (protocol, start) if protocol is not None else (None, None)
 
 
 def run_spelling(
