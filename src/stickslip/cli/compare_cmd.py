@@ -319,7 +319,7 @@ def _override(rsf: Any, options: dict[str, Any]) -> Any:
     problem = physical_problem(params)
     if problem is not None:
         return dataclasses.replace(rsf, params=params, status="failed", note=f"given on the command line ({shown}) "
-                                   f"but not physical: {problem}")  # fmt: skip
+                                   f"but cannot stand for the bond model: {problem}")  # fmt: skip
     return dataclasses.replace(rsf, params=params, status="given", note=f"given on the command line: {shown}{kept}")
 
 

@@ -806,21 +806,34 @@ def _fit_text(fit: Any) -> str:
         lines.append(f"  state evolution: {laws[0]} law" + (f" ({len(laws)} state variables)" if len(laws) > 1 else ""))
     else:
         lines.append(f"  state evolution: {laws[0]} law (first state), {laws[1]} law (second)")
-    lines.append(f"  load point ({fit.protocol_source}):")
+    # every time in the text is on the record file's own clock, the clock --window and the title use
+    lines.append(f"  load point ({fit.protocol_source}), times on the file's own clock:")
     rows = fit.protocol_rows()
     if len(rows) > SHOWN_SEGMENTS:  # a measured history: hundreds of short pieces
         speeds = [row["velocity"] for row in rows]
-        lines.append(f"    {len(rows)} constant-velocity pieces over {sum(r['duration'] for r in rows):.6g} s,"
-                     f" {min(speeds):.6g} to {max(speeds):.6g} {unit}/s")  # fmt: skip
+        lines.append(f"    {len(rows)} constant-velocity pieces from {_clock(rows[0]['file_time'], fit)} s over "
+                     f"{sum(r['duration'] for r in rows):.6g} s, {min(speeds):.6g} to {max(speeds):.6g} "
+                     f"{unit}/s")  # fmt: skip
     for row in rows if len(rows) <= SHOWN_SEGMENTS else []:
-        lines.append(f"    from {row['start']:.6g} s: {row['velocity']:.6g} {unit}/s for {row['duration']:.6g} s")
+        lines.append(f"    from {_clock(row['file_time'], fit)} s: {row['velocity']:.6g} {unit}/s for "
+                     f"{row['duration']:.6g} s")  # fmt: skip
     for name, p in {**fit.parameters, **fit.derived}.items():
         lines.append(f"  {name:10s} {p.text()}")
-    lines += [f"  {line}" for line in fit.change_lines()]  # (s from the fitted rows' first row)
+    lines += [f"  {line}" for line in fit.change_lines()]  # (on the file's own clock too)
     lines.append(f"  reduced chi-square {fit.reduced_chi_square:.4g} (noise {fit.noise:.3g}), rms {fit.rms:.4g}")
     lines += _posterior_lines(fit)
+    lines += [f"  note: {n}" for n in fit.notes]
     lines += [f"  warning: {w}" for w in fit.warnings]
     return "\n".join(lines)
+
+
+def _clock(seconds: float, fit: Any) -> str:
+    """A time on the file's own clock to six significant digits of the fitted span (a record at 20086 s shows
+    centiseconds over a 2233 s span, as its start times relative to the first row did), trailing zeros cut."""
+    span = float(fit.record.time[-1]) if len(fit.record) else 0.0
+    decimals = min(max(5 - math.floor(math.log10(span)), 0), 9) if span > 0 else 6
+    text = f"{seconds:.{decimals}f}"
+    return text.rstrip("0").rstrip(".") if "." in text else text
 
 
 def _posterior_lines(fit: Any) -> list[str]:

@@ -11,6 +11,7 @@ from __future__ import annotations
 import itertools
 import math
 import re
+import warnings
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
@@ -24,8 +25,8 @@ from ..numerics.quantisation import quantum
 from ..protocols import Protocol, Segment
 
 __all__ = [
-    "LabRecord", "change_time_uncertainty", "find_segments", "forward", "measured_history", "parse_columns",
-    "read_record",
+    "LabRecord", "change_time_uncertainty", "find_segments", "forward", "level_velocity_uncertainty",
+    "measured_history", "parse_columns", "read_record",
 ]  # fmt: skip
 
 ROLES = ("time", "displacement", "friction", "velocity")
@@ -60,6 +61,8 @@ class LabRecord:
     source: str = "record"
     length_unit: str = "m"
     displacement_from: str = "displacement"
+    #: what reading the record did that a report should say (rows with an empty cell left out)
+    notes: tuple[str, ...] = ()
 
     def __len__(self) -> int:
         return int(self.time.size)
@@ -176,22 +179,67 @@ def read_record(
         return data[role] * factor
 
     time = in_si("time")
+    friction = data["friction"]
     if "displacement" in data:
         displacement = in_si("displacement")
         written = units.get("displacement") or option["length"]
         column = chosen["displacement"]
+        cells = {"time": time, "displacement": displacement, "friction": friction}
+        gaps = ("displacement", "friction")
     else:
         velocity = in_si("velocity")  # every column's first bad row before the velocity is integrated
-        refuse_nonfinite(str(path), _row_names(rows, time.size),
-                         {"time": time, "velocity": velocity, "friction": data["friction"]})  # fmt: skip
+        cells = {"time": time, "velocity": velocity, "friction": friction}
+        if not (np.all(np.isfinite(time)) and np.all(np.isfinite(velocity))):  # each row's velocity holds to the
+            refuse_nonfinite(str(path), _row_names(rows, time.size), cells)  # next: none may be missing
         displacement = _integrated(time, velocity, path, rows)
         speed_unit = units.get("velocity")
         written = _length_of(speed_unit) if speed_unit is not None else option["length"]
         column = chosen["velocity"]
+        gaps = ("friction",)
+    keep, note = _dropped_samples(str(path), _row_names(rows, time.size), cells, gaps)
+    if note:
+        warnings.warn(note, UserWarning, stacklevel=2)
+        rows = [r for r, k in zip(_row_names(rows, time.size), keep, strict=True) if k]
+        time, displacement, friction = time[keep], displacement[keep], friction[keep]
     shown_unit = _plain_length(written[1]) if written is not None else "m"
-    record = LabRecord.from_arrays(time, displacement, data["friction"], str(path), shown_unit, rows)
+    record = LabRecord.from_arrays(time, displacement, friction, str(path), shown_unit, rows)
     _refuse_implausible_speed(record, str(column), written)
+    record = replace(record, notes=(note,)) if note else record
     return record if "displacement" in data else replace(record, displacement_from="velocity")
+
+
+#: rows with an empty (or NaN) friction or displacement cell a record may lose (dropped samples: each is left out,
+#: with a note); more is refused
+MISSING_SHARE = 0.01
+
+
+def _dropped_samples(
+    source: str, row: Any, cells: dict[str, np.ndarray], gaps: tuple[str, ...]
+) -> tuple[np.ndarray, str]:  # fmt: skip
+    """Which rows to keep, leaving out those whose ``gaps`` columns hold an empty (or NaN) cell where the time is
+    there (a DAQ's dropped sample), and the one-line note saying so ("" when none is).  More than MISSING_SHARE of
+    the rows is refused, as :func:`refuse_nonfinite` names them; infinities are left to it."""
+    time = cells["time"]
+    gap = {name: np.isnan(cells[name]) & np.isfinite(time) for name in gaps}
+    missing = np.logical_or.reduce(list(gap.values()))
+    count = int(np.count_nonzero(missing))
+    if count == 0:
+        return np.ones(time.size, dtype=bool), ""
+    if count > max(MISSING_SHARE * time.size, 1.0):
+        try:
+            refuse_nonfinite(source, row, cells)
+        except DataError as exc:
+            raise DataError(
+                f"{exc}; {count} of {time.size} rows have an empty or NaN cell, more than {100 * MISSING_SHARE:g} %: "
+                "expected a number in every row, or an occasional dropped sample (fill the gaps, or remove those rows)"
+            ) from None
+    firsts = sorted((int(np.argmax(mask)), name, int(np.count_nonzero(mask))) for name, mask in gap.items()
+                    if mask.any())  # fmt: skip
+    where = ", ".join(f"{name} at row {row[i]}" if n == 1 else f"{name} in {n} rows from row {row[i]}"
+                      for i, name, n in firsts)  # fmt: skip
+    names = " or ".join(name for _, name, _ in firsts)
+    rows = "1 row" if count == 1 else f"{count} rows"
+    return ~missing, f"{source}: {rows} with an empty or NaN {names} cell left out ({where}): dropped samples"
 
 
 #: a rock or gel friction rig's load point moves at nm/s to mm/s: faster than this (m/s) is a unit read wrong
@@ -203,8 +251,8 @@ _TAIL_UNITS |= {"m/s", "mm/s", "um/s", "µm/s", "μm/s", "nm/s"}
 
 
 def _numbers(column: Any, path: Path, rows: Any, pd: Any) -> np.ndarray:
-    """A column as floats; DataError naming the first cell that is text (not a blank or NaN, which
-    :meth:`LabRecord.from_arrays` reports), with the hint a decimal comma needs."""
+    """A column as floats; DataError naming the first cell that is text (not a blank or NaN: a dropped sample,
+    :func:`_dropped_samples`' or :meth:`LabRecord.from_arrays`' to judge), with the hint a decimal comma needs."""
     values = pd.to_numeric(column, errors="coerce").to_numpy(dtype=float)
     cells = column.to_numpy()
     text = np.isnan(values) & pd.notna(column).to_numpy()
@@ -430,14 +478,25 @@ def find_segments(
     proposed = _pelt(bins)
     bins = replace(bins, inflation=_slope_inflation(bins.t, bins.d, bins.var, proposed))
     shortest = 5.0 * bins.width if min_duration is None else float(min_duration)  # PELT leaves 3-bin slivers
-    hinges = _significant_hinges(bins, proposed, min_change, min_points, shortest)
+    spacing = float(np.median(np.diff(t)))  # the record's usual row spacing (a sparse piece's rows count by time)
+    hinges = _significant_hinges(bins, proposed, min_change, min_points, shortest, spacing)
     if len(hinges) + 1 > max_segments:
         raise DataError(
             f"load-point displacement: {len(hinges) + 1} straight pieces found, more than {max_segments}; "
-            "expected piecewise-constant velocity (give the history with --segment or --protocol)"
+            f"expected piecewise-constant velocity ({HISTORY_HINT})"
         )
-    _refuse_curved(bins, hinges, t, d, t0)
-    breaks = _refine(t, d, [0, *[int(bins.first[b]) for b in hinges], n], bins.first, hinges, min_points)
+    short = _short_pieces(t, d, bins, hinges, proposed, min_change, min_points, shortest)
+    hinges, skip = _with_short_pieces(bins, hinges, short)
+    if len(hinges) + 1 > max_segments:
+        raise DataError(
+            f"load-point displacement: {len(hinges) + 1} straight pieces found, more than {max_segments}; "
+            f"expected piecewise-constant velocity ({HISTORY_HINT})"
+        )
+    _refuse_curved(bins, hinges, t, d, t0, skip)
+    fixed = {int(bins.first[h]): row for piece in short for h, row in zip(piece.hinges, piece.rows, strict=True)}
+    breaks = _refine(t, d, [0, *[fixed.get(int(bins.first[b]), int(bins.first[b])) for b in hinges], n],
+                     bins.first, [None if int(bins.first[b]) in fixed else b for b in hinges], min_points)  # fmt: skip
+    exact = set(fixed.values())  # a short piece's changes are placed on rows already, its lines short
     lines = [_line(t[i0:i1], d[i0:i1]) for i0, i1 in itertools.pairwise(breaks)]
     times = [float(t[0])]
     for j, i in enumerate(breaks[1:-1]):
@@ -446,8 +505,9 @@ def find_segments(
         # the lines of two whole pieces date a change better than the best row, which quantisation moves by a
         # few rows at 1 kHz; so their meeting is kept within a bin (the search's resolution) of that row, and
         # only a meeting farther off (nearly parallel lines) falls back to the rows' midpoint
-        lo = min(t[max(i - 2, 0)], t[i - 1] - bins.width)
-        hi = max(t[min(i + 1, n - 1)], t[i] + bins.width)
+        reach = 0.0 if i in exact else bins.width
+        lo = min(t[max(i - 2, 0)], t[i - 1] - reach)
+        hi = max(t[min(i + 1, n - 1)], t[i] + reach)
         times.append(meet if lo <= meet <= hi else 0.5 * (t[i - 1] + t[i]))
     times.append(float(t[-1]))
     items = [Segment(max(line[0], 0.0), b - a) for line, a, b in zip(lines, times[:-1], times[1:], strict=True)]
@@ -530,6 +590,54 @@ def change_time_uncertainty(time: np.ndarray, displacement: np.ndarray, protocol
     return out
 
 
+def level_velocity_uncertainty(time: np.ndarray, displacement: np.ndarray, protocol: Protocol) -> np.ndarray:
+    """Each level's velocity standard uncertainty (m/s, or the displacement's unit per s), as the displacement
+    measures it: the error of the slope of the straight line through the level's rows (the velocity
+    :func:`find_segments` gives it) under :func:`find_segments`' own noise model.
+
+    The line's slope is sum_i c_i d_i over the level's rows, c_i = (t_i - mean t) / sum (t - mean t)^2; with the
+    rows' noise summed bin by bin (C_b = sum of c_i in bin b, each bin mean's variance var_b as measured, without
+    the search's floors: an exact record's levels are exact) its variance is
+    sum_b C_b^2 var_b, times the slope inflation at the level's length (the correlated noise and wander that make
+    neighbouring stretches' velocities differ more than independent bins allow) and the pieces' excess misfit
+    (at least 1; the bins beside a change left out).  0 for a level with fewer than 3 rows, and for every level
+    of a record too short for the bins (docs/rsf.md, "What the history's own uncertainty does to a fit").
+    """
+    t = np.asarray(time, dtype=float)
+    d = np.asarray(displacement, dtype=float)
+    edges_t = protocol.boundaries
+    out = np.zeros(len(protocol.segments))
+    if t.size < 20:
+        return out
+    bins = _bins(t, d)
+    rows = np.searchsorted(t, edges_t[1:-1], side="left")  # each later level's first row
+    cuts = np.unique(np.clip(np.searchsorted(bins.first, rows, side="right") - 1, 1, bins.t.size - 1))
+    bins = replace(bins, inflation=_slope_inflation(bins.t, bins.d, bins.var, list(cuts)))
+    edges = np.array([0, *cuts, bins.t.size])
+    guard = (np.diff(edges) >= 4).astype(int)
+    lo, hi = edges[:-1] + guard, edges[1:] - guard
+    sums = _running(1.0 / bins.var, bins.t, bins.d)
+    used = int(np.sum(hi - lo))
+    excess = max(float(np.sum(_misfit(sums, lo, hi))) / max(used - 2 * (edges.size - 1), 1), 1.0)
+    bin_of = np.searchsorted(bins.first, np.arange(t.size), side="right") - 1
+    tc = (t - t[0]) / bins.time_scale
+    bounds = np.concatenate([[0], rows, [t.size]])
+    for j, (i0, i1) in enumerate(itertools.pairwise(bounds)):
+        if i1 - i0 < 3:
+            continue
+        u = tc[i0:i1] - float(np.mean(tc[i0:i1]))
+        stt = float(np.sum(u * u))
+        if not stt > 0:
+            continue
+        weights = np.bincount(bin_of[i0:i1] - bin_of[i0], weights=u / stt)
+        measured = bins.measured if bins.measured is not None else bins.var
+        inside = measured[bin_of[i0] : bin_of[i0] + weights.size]
+        length = float(np.count_nonzero(weights))  # the level's bins
+        variance = float(np.sum(weights**2 * inside)) * float(_inflation_at(bins, np.array([length]))[0]) * excess
+        out[j] = math.sqrt(variance) * bins.scale / bins.time_scale
+    return out
+
+
 def _line_residuals(t: np.ndarray, d: np.ndarray) -> np.ndarray:
     """Residuals of a straight line through (t, d), with its two degrees of freedom counted (none for < 3 rows)."""
     if t.size < 3:
@@ -560,6 +668,8 @@ class _Bins:
     width: float  # the bins' width in seconds
     time_scale: float  # seconds per scaled time unit
     trend: float  # the slope of the line removed, in scaled units (added back to compare velocities)
+    scale: float = 1.0  # the record's displacement per scaled unit
+    measured: np.ndarray | None = None  # var as measured, without the floor the running sums' digits need
 
 
 def _bins(t: np.ndarray, d: np.ndarray) -> _Bins:
@@ -582,8 +692,8 @@ def _bins(t: np.ndarray, d: np.ndarray) -> _Bins:
     count = np.diff(np.concatenate([first, [n]]))
     bt = np.add.reduceat(tc, first) / count
     bd = np.add.reduceat(dc, first) / count
-    var, inflation = _noise_model(bt, bd, count, quantum(d) / scale)
-    return _Bins(bt, bd, count, first, var, inflation, width, span, float(line[0]) / scale)
+    var, inflation, measured = _noise_model(bt, bd, count, quantum(d) / scale)
+    return _Bins(bt, bd, count, first, var, inflation, width, span, float(line[0]) / scale, scale, measured)
 
 
 def _window_residuals(bt: np.ndarray, bd: np.ndarray, width: int) -> tuple[np.ndarray, np.ndarray]:
@@ -601,9 +711,12 @@ def _window_residuals(bt: np.ndarray, bd: np.ndarray, width: int) -> tuple[np.nd
 
 def _noise_model(
     bt: np.ndarray, bd: np.ndarray, count: np.ndarray, q: float
-) -> tuple[np.ndarray, tuple[np.ndarray, np.ndarray]]:
-    """Each bin mean's noise variance, and how much more the velocities of neighbouring stretches differ than
-    that variance says (:func:`_slope_inflation`).
+) -> tuple[np.ndarray, tuple[np.ndarray, np.ndarray], np.ndarray]:
+    """Each bin mean's noise variance, how much more the velocities of neighbouring stretches differ than that
+    variance says (:func:`_slope_inflation`), and the variance as measured: without the floor of relative 3e-7
+    the running sums' digits need, nor the q^2/12 of a step q (a noise-free record's is its printed precision's,
+    and one that moves a whole number of steps per row, as `rsf simulate --every "0.1 s"` writes 1 um/s, shows no
+    rounding at all; a quantised rig's rounding shows in the residuals).
 
     The variance of a bin mean is modelled as ``white / rows + floor`` from straight lines over a fixed span of
     bins, at least ``q^2 / 12`` per row for a quantisation step ``q`` (docs/rsf.md, "Velocity levels", step 2).
@@ -622,8 +735,9 @@ def _noise_model(
             vs.append(float(np.median(per_window[chosen])) / median_factor)
     white, floor = _two_part_variance(np.array(xs), np.array(vs))
     # the floor sits above the cancellation error of the running sums (relative 1e-16 * n)
-    var = np.maximum(white / count + floor, (q * q / 12.0) / count + (3e-7) ** 2)
-    return var, _slope_inflation(bt, bd, var)
+    measured = white / count + floor
+    var = np.maximum(measured, (q * q / 12.0) / count + (3e-7) ** 2)
+    return var, _slope_inflation(bt, bd, var), measured
 
 
 def _two_part_variance(x: np.ndarray, v: np.ndarray) -> tuple[float, float]:
@@ -751,11 +865,18 @@ def _piece_test(bins: _Bins, sums: list[np.ndarray], hinges: list[int]) -> tuple
     return slopes, np.diff(slopes) / np.sqrt(var)
 
 
+#: a piece with fewer than ``min_points`` rows still counts as long enough where it has at least this many rows and
+#: lasts as long as ``min_points`` rows at the record's usual spacing: a sparsely sampled stretch (an ODE solver's
+#: own steps through steady sliding, as `rsf simulate -o` writes: 6 rows over the first 10 s)
+SPARSE_ROWS = 4
+
+
 def _significant_hinges(
-    bins: _Bins, hinges: list[int], min_change: float, min_points: int, min_duration: float
+    bins: _Bins, hinges: list[int], min_change: float, min_points: int, min_duration: float, spacing: float = 0.0
 ) -> list[int]:
     """Drop changes, weakest first, until each is significant, a real change of velocity and between pieces long
-    enough (see :func:`find_segments`)."""
+    enough (see :func:`find_segments`): at least ``min_points`` rows, or SPARSE_ROWS rows lasting ``min_points``
+    times the record's usual row ``spacing`` (s; 0: rows alone), and ``min_duration`` seconds."""
     hinges = list(hinges)
     n = bins.t.size
     z_crit = math.sqrt(2.0 * math.log(max(n, 3))) + 2.0
@@ -769,7 +890,9 @@ def _significant_hinges(
         edges = [0, *hinges, n]
         for j, (a, b) in enumerate(itertools.pairwise(edges)):
             duration = (bins.t[b - 1] - bins.t[a]) * bins.time_scale + bins.width
-            if rows[b] - rows[a] < min_points or duration < min_duration:
+            count = rows[b] - rows[a]
+            sparse = spacing > 0 and count >= SPARSE_ROWS and duration >= min_points * spacing
+            if (count < min_points and not sparse) or duration < min_duration:
                 neighbours = [k for k in (j - 1, j) if 0 <= k < len(hinges)]
                 weak[min(neighbours, key=lambda k: strength[k])] = True
         if not weak.any():
@@ -779,22 +902,33 @@ def _significant_hinges(
     return hinges
 
 
+#: what a record that is not piecewise linear can do instead (the options as `rsf fit` spells them)
+HISTORY_HINT = (
+    "give the history with --segment or --protocol, or drive the model with the measured displacement: "
+    "--history measured"
+)
 #: the pieces may miss the record by at most this many times its noise at the longest scale (a smooth curve
 #: misses it by 1e5-1e7 times; the real sepiolite records by 0.5-0.9, synthetic quantised ones by about 1)
 CURVED = 100.0
 
 
-def _refuse_curved(bins: _Bins, hinges: list[int], t: np.ndarray, d: np.ndarray, t0: float) -> None:
+def _refuse_curved(
+    bins: _Bins, hinges: list[int], t: np.ndarray, d: np.ndarray, t0: float, skip: np.ndarray | None = None
+) -> None:  # fmt: skip
     """DataError when the straight pieces miss the binned record by far more than its noise: the load point's
-    velocity changes smoothly, not in steps, or its displacement jumps (:func:`_jump`, then named)."""
-    sums = _running(1.0 / bins.var, bins.t, bins.d)
+    velocity changes smoothly, not in steps, or its displacement jumps (:func:`_jump`, then named).  Bins in
+    ``skip`` (a short piece's, checked on its rows by :func:`_short_pieces`) are left out."""
+    kept = np.ones(bins.t.size) if skip is None else (~skip).astype(float)
+    sums = _running(kept / bins.var, bins.t, bins.d)
+    counts = np.concatenate([[0.0], np.cumsum(kept)])
     edges = np.array([0, *hinges, bins.t.size])
     # the bin beside a change may straddle it: its mean lies off both lines by up to |dv| width / 8, which is
     # no curvature but, against bin means precise to a nanometre (exact or finely sampled quantised records),
     # hundreds of times the noise; so it is left out, as in _piece_test
     guard = (np.diff(edges) >= 4).astype(int)
     lo, hi = edges[:-1] + guard, edges[1:] - guard
-    dof = max(int(np.sum(hi - lo)) - 2 * (edges.size - 1), 1)
+    rows = counts[hi] - counts[lo]
+    dof = max(int(np.sum(rows)) - 2 * int(np.count_nonzero(rows > 0)), 1)
     excess = float(np.sum(_misfit(sums, lo, hi))) / dof / float(bins.inflation[1][-1])
     if excess > CURVED:
         i = _jump(t, d)
@@ -807,9 +941,247 @@ def _refuse_curved(bins: _Bins, hinges: list[int], t: np.ndarray, d: np.ndarray,
             )
         raise DataError(
             f"load-point displacement: its {edges.size - 1} straight pieces miss it by {excess:.3g} times its noise; "
-            "expected piecewise-constant velocity (give the history with --segment or --protocol, or drive the "
-            "model with the measured displacement)"
+            f"expected piecewise-constant velocity ({HISTORY_HINT})"
         )
+
+
+#: a short piece (shorter than find_segments' shortest, which drops it) is looked for where a proposed change has a
+#: bin mean this many times its noise off the pieces, and kept where its excess travel (its rows' rms offset from
+#: the best continuous two-piece line) is as many times the rows' noise: a servo overshoot of 0.3 s at 15 um/s
+#: between 1 and 10 um/s, 100 Hz rows in 10 nm bits, is 100 times; the sepiolite records' suspects 1.6-5.2
+SHORT_EXCESS = 10.0
+#: a middle piece whose speed lies between its neighbours' (as a servo ramp's does) needs this much more
+SHORT_RAMP_EXCESS = 3.0 * SHORT_EXCESS
+#: and each of the three pieces must be straight: its rows' variance about its line at most this many times their
+#: variance about lines as long as the search window elsewhere in the pieces either side.  A smooth ramp fails it:
+#: 1 -> 10 um/s at 1 kHz in 10 nm bits over 0.05 s gives 3.4 (excess 10.5), over 0.08 s 8.5 (excess 17), over
+#: 0.2 s 45 (excess 37); a smooth overshoot (1 -> 13 -> 10 um/s) over 0.03 s 9.2 (excess 10.4)
+SHORT_MISFIT = 4.0
+#: bins beyond the shortest piece's each side of a suspect bin searched for a short piece, and suspects tried
+SHORT_MARGIN_BINS = 3
+SHORT_TRIES = 12
+#: above this many rows in the search window the two breaks are searched on a coarse grid first
+SHORT_GRID = 600
+
+
+@dataclass(frozen=True)
+class _ShortPiece:
+    """A short piece found on the rows: its first and one-past-last rows, the bins holding them (as hinges) and
+    the search's hinges it replaces (those about it: the three pieces found on the rows stand for them)."""
+
+    rows: tuple[int, int]
+    hinges: tuple[int, int]
+    replaces: tuple[int, ...]
+
+
+def _short_pieces(
+    t: np.ndarray, d: np.ndarray, bins: _Bins, hinges: list[int], proposed: list[int], min_change: float,
+    min_points: int, shortest: float,
+) -> list[_ShortPiece]:  # fmt: skip
+    """Pieces too short for the binned search (under ``shortest`` seconds) that the record nonetheless holds: a
+    servo's overshoot of a fraction of a second at a step.
+
+    Where a change was proposed (PELT's, kept or not) and a bin mean within two bins of it lies SHORT_EXCESS times
+    its noise off the pieces, the rows about it are searched for three straight pieces (two breaks at rows, the
+    middle piece at least ``min_points`` rows) against the best continuous broken line (one kink).  The middle
+    piece is kept when its rows lie SHORT_EXCESS times the rows' noise (rms) off the broken line (its excess
+    travel), its speed differs from both neighbours' by ``min_change``, and each of the three pieces is straight to
+    within SHORT_MISFIT times the rows' variance about lines as long elsewhere in the pieces either side (a smooth
+    servo ramp is not); a middle speed between the neighbours' (as a ramp's is) needs SHORT_RAMP_EXCESS.  The
+    three pieces replace the search's changes about it.  docs/rsf.md, "Velocity levels", step 6.
+    """
+    n_bins = bins.t.size
+    edges = np.array([0, *hinges, n_bins])
+    width = math.ceil(shortest / bins.width) + SHORT_MARGIN_BINS  # bins searched either side of a suspect
+    z = np.abs(_bin_offsets(bins, edges))
+    suspects = sorted(
+        ((float(np.max(z[max(p - 2, 0) : p + 2])), p) for p in sorted(set(proposed) | set(hinges))), reverse=True
+    )
+    found: list[_ShortPiece] = []
+    taken = np.zeros(n_bins, dtype=bool)
+    for score, centre in suspects[:SHORT_TRIES]:
+        if score <= SHORT_EXCESS:
+            break
+        if taken[centre]:
+            continue
+        piece = _short_piece_at(t, d, bins, edges, int(centre), width, min_change, min_points)
+        taken[max(centre - width, 0) : centre + width + 1] = True
+        if piece is None:
+            continue
+        if any(max(piece.rows[0], p.rows[0]) < min(piece.rows[1], p.rows[1]) + min_points for p in found):
+            continue
+        found.append(piece)
+    return sorted(found, key=lambda p: p.rows[0])
+
+
+def _bin_offsets(bins: _Bins, edges: np.ndarray) -> np.ndarray:
+    """Each bin mean's offset from its piece's line (fitted without the bins beside the changes) over its noise."""
+    z = np.zeros(bins.t.size)
+    w = 1.0 / bins.var
+    noise = np.sqrt(bins.var * float(bins.inflation[1][0]))
+    for a, b in itertools.pairwise(edges):
+        guard = 1 if b - a >= 4 else 0
+        sel = slice(a + guard, b - guard)
+        if b - a < 3:
+            continue
+        coef = np.polyfit(bins.t[sel], bins.d[sel], 1, w=np.sqrt(w[sel])) if b - a - 2 * guard >= 2 else None
+        if coef is None:
+            continue
+        z[a:b] = (bins.d[a:b] - np.polyval(coef, bins.t[a:b])) / noise[a:b]
+    return z
+
+
+def _short_piece_at(
+    t: np.ndarray, d: np.ndarray, bins: _Bins, edges: np.ndarray, centre: int, width: int, min_change: float,
+    min_points: int,
+) -> _ShortPiece | None:  # fmt: skip
+    """The short piece about bin ``centre`` (see :func:`_short_pieces`), or None."""
+    n_bins = bins.t.size
+    inner = edges[1:-1]
+    near = np.abs(inner - centre) <= width
+    replaces = tuple(int(e) for e in inner[near])
+    others = inner[~near]
+    lo_bin = max([centre - width, *[e + 1 for e in others if e <= centre]], default=0)
+    hi_bin = min([centre + width + 1, *[e - 1 for e in others if e > centre]], default=n_bins)
+    lo_bin, hi_bin = max(lo_bin, 0), min(hi_bin, n_bins)
+    first = np.concatenate([bins.first, [t.size]])
+    i0, i1 = int(first[lo_bin]), int(first[hi_bin])
+    side = 3  # rows an outer line needs at least
+    if i1 - i0 < min_points + 2 * side + 2:
+        return None
+    tt, dd = t[i0:i1], d[i0:i1]
+    span = max(float(tt[-1] - tt[0]), 1e-300)
+    tc = (tt - tt[0]) / span
+    scale = max(float(np.ptp(dd)), 1e-300)
+    dc = (dd - np.polyval(np.polyfit(tc, dd, 1), tc)) / scale
+    sums = _running(np.ones_like(tc), tc, dc)
+    m = tc.size
+    # two pieces: the continuous broken line (the load point does not jump), its kink anywhere among the rows
+    s2 = _broken_line_misfit(tc, dc, side)
+    # three pieces: breaks j1 < j2, the middle piece at least min_points rows
+    j1, j2, s3 = _two_breaks(sums, m, side, min_points)
+    if j1 is None:
+        return None
+    noise2 = _line_variance(t, d, i0, i1, edges, bins, m) / scale**2
+    noise2 = max(noise2, (quantum(d) / scale) ** 2 / 12.0 + (3e-7) ** 2)  # as the bins' floor (_noise_model)
+    rows_mid = j2 - j1
+    excess = math.sqrt(max(s2 - s3, 0.0) / rows_mid)  # the middle rows' typical offset from two pieces
+    cuts = np.array([0, j1, j2, m])
+    each = _misfit(sums, cuts[:-1], cuts[1:]) / np.maximum(np.diff(cuts) - 2, 1)
+    if float(np.max(each)) > SHORT_MISFIT * noise2:  # each piece straight: a ramp's middle piece is a chord
+        return None
+    speeds = [_line(tt[a:b], dd[a:b])[0] for a, b in ((0, j1), (j1, j2), (j2, m))]
+    for v in (speeds[0], speeds[2]):
+        if abs(speeds[1] - v) <= min_change * max(abs(speeds[1]), abs(v)):
+            return None
+    between = min(speeds[0], speeds[2]) <= speeds[1] <= max(speeds[0], speeds[2])
+    if excess <= (SHORT_RAMP_EXCESS if between else SHORT_EXCESS) * math.sqrt(noise2):
+        return None
+    a_row, b_row = i0 + j1, i0 + j2
+    bin_of = np.searchsorted(bins.first, [a_row, b_row], side="right") - 1
+    a_bin, b_bin = int(bin_of[0]), int(bin_of[1])
+    if b_row > int(bins.first[b_bin]):  # the break sits inside a bin: the piece after it starts at the next bin
+        b_bin += 1
+    if a_row > int(bins.first[a_bin]):
+        a_bin += 1
+    if not 0 < a_bin < b_bin < n_bins:
+        return None
+    return _ShortPiece((a_row, b_row), (a_bin, b_bin), replaces)
+
+
+def _broken_line_misfit(t: np.ndarray, d: np.ndarray, side: int) -> float:
+    """The least misfit of a continuous broken line (two straight pieces meeting at a kink) through (t, d), the
+    kink at a row's time or halfway between two rows, at least ``side`` rows either side."""
+    w, st, sd, stt, std, sdd = _running(np.ones_like(t), t, d)
+    if t.size <= 2 * side:
+        return math.inf
+    kinks = np.concatenate([t[side:-side], 0.5 * (t[side - 1 : -side] + t[side : -side + 1])])
+    k = np.searchsorted(t, kinks, side="left")  # rows [0, k) before the kink, [k, n) after
+    n = t.size
+
+    def moments(lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, ...]:
+        """Sums of 1, u, u^2, d, u d over rows [lo, hi), u = t - kink."""
+        c, a1, a2, b0, b1 = (x[hi] - x[lo] for x in (w, st, stt, sd, std))
+        return c, a1 - kinks * c, a2 - 2.0 * kinks * a1 + kinks**2 * c, b0, b1 - kinks * b0
+
+    zero, end = np.zeros_like(k), np.full_like(k, n)
+    cl, ul, uul, dl, udl = moments(zero, k)
+    cr, ur, uur, dr, udr = moments(k, end)
+    # d = c0 + v1 min(u, 0) + v2 max(u, 0): normal equations per kink
+    rows = [np.stack([cl + cr, ul, ur], -1), np.stack([ul, uul, 0 * ul], -1), np.stack([ur, 0 * ur, uur], -1)]
+    a = np.stack(rows, -2)
+    b = np.stack([dl + dr, udl, udr], -1)
+    ok = np.abs(np.linalg.det(a)) > 1e-300
+    if not ok.any():
+        return math.inf
+    coef = np.linalg.solve(a[ok], b[ok][..., None])[..., 0]
+    sse = float(sdd[-1]) - np.sum(coef * b[ok], axis=-1)
+    return float(max(np.min(sse), 0.0))
+
+
+def _two_breaks(sums: list[np.ndarray], m: int, side: int, min_points: int) -> tuple[int | None, int | None, float]:
+    """The two break rows that leave three straight pieces with the least misfit (the middle one at least
+    ``min_points`` rows, the outer ones ``side``); a coarse grid first where the rows are many."""
+    step = max(math.ceil(m / SHORT_GRID), 1)
+
+    def best(first_rows: np.ndarray, second_rows: np.ndarray) -> tuple[int | None, int | None, float]:
+        a, b = np.meshgrid(first_rows, second_rows, indexing="ij")
+        ok = (b - a >= min_points) & (a >= side) & (b <= m - side)
+        if not ok.any():
+            return None, None, math.inf
+        a, b = a[ok], b[ok]
+        cost = _misfit(sums, np.zeros_like(a), a) + _misfit(sums, a, b) + _misfit(sums, b, np.full_like(b, m))
+        k = int(np.argmin(cost))
+        return int(a[k]), int(b[k]), float(cost[k])
+
+    grid = np.arange(side, m - side + 1, step)
+    j1, j2, cost = best(grid, grid)
+    if step > 1 and j1 is not None:
+        j1, j2, cost = best(np.arange(max(j1 - step, side), min(j1 + step, m - side) + 1),
+                            np.arange(max(j2 - step, side), min(j2 + step, m - side) + 1))  # fmt: skip
+    return j1, j2, cost
+
+
+def _line_variance(t: np.ndarray, d: np.ndarray, i0: int, i1: int, edges: np.ndarray, bins: _Bins, rows: int) -> float:
+    """The rows' variance about straight lines through ``rows`` consecutive rows, in the pieces either side of
+    rows [i0, i1) (those rows left out): the median over such stretches (a stretch holding a change is an outlier
+    it ignores), over chi-square's median; fewer rows a stretch where the pieces hold under five of them."""
+    first = np.concatenate([bins.first, [t.size]])
+    k = int(np.searchsorted(edges, np.searchsorted(bins.first, i0, side="right") - 1, side="right"))
+    start = int(first[edges[max(k - 1, 0)]])
+    stop = int(first[edges[min(k + 1, edges.size - 1)]])
+    chunks = [(start, i0), (i1, stop)]
+    length = rows
+    while length >= 8:
+        values = []
+        for a, b in chunks:
+            count = (b - a) // length
+            if count <= 0:
+                continue
+            tt = t[a : a + count * length].reshape(count, length)
+            dd = d[a : a + count * length].reshape(count, length)
+            tt = tt - tt.mean(axis=1, keepdims=True)
+            dd = dd - dd.mean(axis=1, keepdims=True)
+            stt = np.sum(tt * tt, axis=1, keepdims=True)
+            slope = np.divide(np.sum(tt * dd, axis=1, keepdims=True), stt, out=np.zeros_like(stt), where=stt > 0)
+            values.append(np.sum((dd - slope * tt) ** 2, axis=1) / (length - 2))
+        pooled = np.concatenate(values) if values else np.zeros(0)
+        if pooled.size >= 5:
+            return float(np.median(pooled)) / _chi2_median_ratio(length - 2)
+        length //= 2
+    return math.inf
+
+
+def _with_short_pieces(bins: _Bins, hinges: list[int], short: list[_ShortPiece]) -> tuple[list[int], np.ndarray]:
+    """The hinges with each short piece's two in place of the one it replaces, and the bins the curvature test
+    leaves out (each short piece's, and one either side: checked on its rows)."""
+    skip = np.zeros(bins.t.size, dtype=bool)
+    kept = set(hinges)
+    for piece in short:
+        kept.difference_update(piece.replaces)
+        kept.update(piece.hinges)
+        skip[max(piece.hinges[0] - 1, 0) : piece.hinges[1] + 1] = True
+    return sorted(kept), skip
 
 
 #: a row-to-row step this many times larger than the record's other large steps is a jump, not motion
@@ -836,15 +1208,20 @@ def _jump(t: np.ndarray, d: np.ndarray) -> int | None:
 
 
 def _refine(
-    t: np.ndarray, d: np.ndarray, breaks: list[int], first: np.ndarray, hinges: list[int], min_points: int
+    t: np.ndarray, d: np.ndarray, breaks: list[int], first: np.ndarray, hinges: list[int | None], min_points: int
 ) -> list[int]:
-    """Each interior break moved to its best row within two bins, between its neighbours."""
+    """Each interior break moved to its best row within two bins, between its neighbours (one whose hinge is None
+    stays where it is), each piece keeping ``min_points`` rows (SPARSE_ROWS, a sparse piece with fewer)."""
     breaks = list(breaks)
     n = t.size
     for k in range(1, len(breaks) - 1):
         h = hinges[k - 1]
-        lo = max(breaks[k - 1] + min_points, int(first[max(h - 2, 0)]))
-        hi = min(breaks[k + 1] - min_points, int(first[h + 2]) if h + 2 < first.size else n)
+        if h is None:  # placed on its row already (a short piece's change)
+            continue
+        before, after = (min_points if b - a >= min_points else SPARSE_ROWS
+                         for a, b in ((breaks[k - 1], breaks[k]), (breaks[k], breaks[k + 1])))  # fmt: skip
+        lo = max(breaks[k - 1] + before, int(first[max(h - 2, 0)]))
+        hi = min(breaks[k + 1] - after, int(first[h + 2]) if h + 2 < first.size else n)
         if hi <= lo:
             continue
         a, b = breaks[k - 1], breaks[k + 1]

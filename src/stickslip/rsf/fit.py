@@ -21,7 +21,14 @@ from ..numerics.quantisation import quantum
 from ..protocols import Protocol, Segment
 from ..reprs import compact_repr
 from ..units import to_si
-from .data import LabRecord, change_time_uncertainty, find_segments, forward, refuse_reversal
+from .data import (
+    LabRecord,
+    change_time_uncertainty,
+    find_segments,
+    forward,
+    level_velocity_uncertainty,
+    refuse_reversal,
+)
 from .laws import get_law
 from .params import RSFParams, StateVariable, _cutoff_pair
 from .solver import simulate
@@ -43,6 +50,8 @@ NO_RESPONSE_TEXT = "the friction shows no significant response to the velocity c
 MISFIT_TEXT = "{law} does not describe the record"
 #: the start of the reason when the law fits to the noise but not significantly better than constant friction
 WEAK_RESPONSE_TEXT = "the friction's response to the velocity changes is not significant"
+#: the start of the reason when freeing the stiffness held describes the record (then "{k} does not describe ...")
+HELD_STIFFNESS_TEXT = "the held stiffness"
 _CORE = ("a", "b", "dc")
 #: with chi-square_r > WARN_CHI2, a fit fails when a linear drift (in slip and time) explains this share of the
 #: residuals: the intervals cannot hold while the model misses a drift
@@ -145,6 +154,11 @@ class RSFFit:
     step_weight: float | None = None
     #: the found history's change times (s from the fitted rows' first row): fitted where they matter, else held
     change_times: tuple[FitParameter, ...] = ()
+    #: the fits tried in place of this one when its residuals exceed the noise (a held stiffness freed, another law):
+    #: what each reached (docs/rsf.md, "Is another model the answer?")
+    alternatives: tuple[dict[str, Any], ...] = ()
+    #: readings of the values that are no warning (a negative b)
+    notes: tuple[str, ...] = ()
 
     @property
     def residuals(self) -> np.ndarray:
@@ -155,7 +169,8 @@ class RSFFit:
         unit = "m" if si else self.record.length_unit
         scale = _length_scale(unit)
         starts = self.protocol.boundaries
-        return [{"start": float(t), "velocity": s.velocity / scale, "duration": s.duration, "unit": f"{unit}/s"}
+        return [{"start": float(t), "file_time": self.record.t0 + float(t), "velocity": s.velocity / scale,
+                 "duration": s.duration, "unit": f"{unit}/s"}
                 for t, s in zip(starts, self.protocol.segments, strict=False)]  # fmt: skip
 
     def rerun_mapping(self) -> dict[str, Any]:
@@ -184,6 +199,7 @@ class RSFFit:
             "effective_rows": self.effective_rows,
             "correlations": self.correlations,
             "warnings": list(self.warnings),
+            "notes": list(self.notes),
             "success": self.success,
             # the optimiser's own words ("Fit succeeded.") only beside a verdict that cannot contradict them
             "message": self.message if self.status == "ok" else f"fit failed: {self.reason}",
@@ -194,6 +210,9 @@ class RSFFit:
                 "time": "s", "length": "m", "velocity": "m/s", "dc": "m", "stiffness": "1/m", "trend": "1/m",
                 "time_trend": "1/s", "friction": "dimensionless", "record_length_unit": self.record.length_unit,
                 "change_times": "s from the fitted rows' first row (file_time: on the file's own clock)",
+                "protocol": "start: s from the fitted rows' first row (file_time: on the file's own clock)",
+                "clock": f"the fitted rows' first row is at record.t0 = {self.record.t0:.10g} s on the file's own "
+                         "clock; every file_time is on that clock, as the window is",
                 "note": "all values SI; the text report gives lengths in the record's unit",
             },
             "record": {"source": self.record.source, "rows": len(self.record), "t0": self.record.t0},
@@ -201,6 +220,7 @@ class RSFFit:
             **({"window": list(self.window)} if self.window else {}),
             **({"step_weight": self.step_weight} if self.step_weight is not None else {}),
             **({"drift_sensitivity": self.drift_sensitivity} if self.drift_sensitivity else {}),
+            **({"alternatives": list(self.alternatives)} if self.alternatives else {}),
             **({"posterior": self.posterior} if self.posterior else {}),
         }  # fmt: skip
 
@@ -209,16 +229,17 @@ class RSFFit:
         return [{"name": p.name, **p.as_dict(), "file_time": self.record.t0 + p.value} for p in self.change_times]
 
     def change_lines(self) -> list[str]:
-        """One line per change time: fitted with its interval, or held and why (s from the fitted rows' first)."""
-        lines = []
+        """One line per change time: fitted with its interval, or held and why (s on the record file's own clock,
+        the clock of ``window`` and of the title, as the text report's history is)."""
+        lines, t0 = [], self.record.t0
         for p in self.change_times:
             if p.fixed or p.stderr is None or p.interval is None:
-                lines.append(f"{p.name:10s} {p.value:.6f} s ({'held: ' if p.fixed else ''}{p.note})")
+                lines.append(f"{p.name:10s} {t0 + p.value:.6f} s ({'held: ' if p.fixed else ''}{p.note})")
                 continue
             digits = _decimals(p.stderr)
             lo, hi = p.interval
-            lines.append(f"{p.name:10s} {p.value:.{digits}f} ± {p.stderr:.2g} s   95 % [{lo:.{digits}f}, "
-                         f"{hi:.{digits}f}] ({p.note})")  # fmt: skip
+            lines.append(f"{p.name:10s} {t0 + p.value:.{digits}f} ± {p.stderr:.2g} s   95 % [{t0 + lo:.{digits}f}, "
+                         f"{t0 + hi:.{digits}f}] ({p.note})")  # fmt: skip
         return lines
 
     def to_toml(self) -> str:
@@ -226,7 +247,8 @@ class RSFFit:
             f"# rate-and-state fit of {self.record.source} ({len(self.record)} rows): {self.status}"
             + (f" ({self.reason})" if self.reason else ""),
             f"# reduced chi-square {self.reduced_chi_square:.4g}, rms {self.rms:.4g}, trend {self.trend:.6g} per m",
-            f"# protocol (load point, from t0 = {self.record.t0:.6g} s): {self.protocol.describe()}",
+            f"# protocol (load point, from t0 = {self.record.t0:.10g} s on the file's own clock, as the change times "
+            f"below): {self.protocol.describe()}",
         ]
         for name, p in {**self.parameters, **self.derived}.items():
             head.append(f"# {name} = {p.text()}")
@@ -259,7 +281,8 @@ def _model_or_why(
         return np.full(record.time.size, np.nan), f"the solver refused the run: {exc}"
     if run.status == "blow-up":  # (the solver's own advice, eta or a mass, is no option of a fit)
         return np.full(record.time.size, np.nan), (
-            f"the run stopped: blow-up at t = {float(run.time[-1]):.6g} s (the model slider's slip rate passed 1e10 "
+            f"the run stopped: blow-up at t = {record.t0 + float(run.time[-1]):.6g} s on the file's clock (the model "
+            "slider's slip rate passed 1e10 "
             "times the driving velocity: the spring is too soft for these a, b and Dc)"
         )
     if run.status != "ok":
@@ -291,6 +314,7 @@ def fit_record(
     noise: float | None = None,
     drift_check: bool | None = None,
     cutoff: tuple[float, float] | None = None,
+    alternatives: bool | None = None,
 ) -> RSFFit:
     """Fit rate-and-state friction to ``record`` (see the module notes).
 
@@ -308,6 +332,10 @@ def fit_record(
     record (``noise_method`` says how).  ``drift_check`` (default: on unless ``noise`` is given) refits with the
     drift term toggled and reports when the conclusion depends on it (``drift_sensitivity``).
     ``cutoff=(V1, V2)`` (m/s, held fixed) fits the cut-off velocity form of the friction law (docs/rsf.md, Laws).
+    ``alternatives`` (default: on unless ``noise`` is given): when chi-square_r > 2 and nothing else is wrong, the
+    fit is tried again with a held stiffness freed and with the other built-in single-state laws, from its answer;
+    one that describes the record significantly better fails the fit (``alternatives`` in the result says what each
+    reached; docs/rsf.md, "Is another model the answer?").
     """
     if noise is not None and not (_real(noise) and math.isfinite(noise) and noise > 0):
         raise ParameterError(f"noise: expected a positive friction level, got {noise!r}")
@@ -346,6 +374,7 @@ def fit_record(
         # the found change times are estimates: those that matter are fitted, so the intervals carry them
         first = result.params.valuesdict()
         changes, seen, prior_weight = _free_changes(setup, _base(setup, start), first, start["noise"], labels)
+        setup = replace(setup, levels=tuple(level_velocity_uncertainty(record.time, record.displacement, protocol)))
         if changes:
             setup = replace(setup, changes=changes, change_noise=start["noise"], change_weight=prior_weight)
             result, residual = _least_squares(setup, {**start, **_start_values(first)})
@@ -383,9 +412,19 @@ def fit_record(
         warns.insert(0, "the load-point displacement decreases (the load point moves in the negative direction): "
                         "it was taken by its magnitude, as friction depends on the speed only")  # fmt: skip
     derived = {"a-b": _difference(result, table, widen)}
-    problems = _problems(result, record, resid, table, level, setup)
+    drift = _drift_reading(setup, start, result, resid, level, refit=not mismatch)
+    problems = _problems(result, record, resid, table, level, setup, drift.advice if drift.leads else "")
     if setup.states == 2 and not problems:
         problems += _second_state_problems(setup, start, result)
+    if drift.text:  # one that explains most of the residuals comes first: no law can be judged before it is fitted
+        problems.insert(0 if drift.leads else len(problems), drift.text)
+    tried: tuple[dict[str, Any], ...] = ()
+    tried_said = ""  # what the alternatives tried reached, beside the chi-square warning
+    if (not problems and not mismatch and level.redchi > WARN_CHI2
+            and (not given if alternatives is None else alternatives)):  # fmt: skip
+        tried, failure, tried_said = _alternatives(setup, start, result, model, level, labels, units,
+                                                   float(noise) if given else None)  # fmt: skip
+        problems += [failure] if failure else []
     why = _law_not_determined(problems, setup.laws)
     if why:  # then no interval of the friction law means anything
         for key in ("a", "b", "dc", "b2", "dc2", "stiffness"):
@@ -399,14 +438,8 @@ def fit_record(
         warns += [] if loose else [said]
     if mismatch:
         problems.insert(0, mismatch)
-    drift = _residual_drift(record, resid)
-    if level.redchi > WARN_CHI2 and drift > DRIFT_SHARE:
-        problems.append(
-            f"a linear drift in slip and time explains {100 * drift:.0f} % of the residuals (reduced chi-square "
-            f"{level.redchi:.3g}): the model misses a drift, so its values and intervals are biased; fit the drift "
-            "with --trend slip, time or both"
-        )
-    warns += _chi2_warnings(level, given) + _opening_warnings(record, setup.protocol, resid, level)
+    warns += _chi2_warnings(level, given) + ([tried_said] if tried_said else [])
+    warns += _opening_warnings(record, setup.protocol, resid, level)
     if curvature is not None and not (QUADRATIC_RANGE[0] <= curvature <= QUADRATIC_RANGE[1]):
         warns.append(
             f"the chi-square surface is not quadratic over the intervals: two standard errors along the least "
@@ -420,6 +453,7 @@ def fit_record(
         if sensitivity["depends"]:
             warns.append(sensitivity["text"])
     posterior = _posterior(residual, result, mcmc_steps, seed) if mcmc_steps > 0 else None
+    notes = () if problems else _sign_notes(table)  # (a failed fit's values are no reading)
     return RSFFit(
         params=_final_params(base, values), parameters=table, correlations=corr, reduced_chi_square=level.redchi,
         rms=float(np.sqrt(np.mean(resid**2))), noise=level.noise, trend=float(values.get("trend", 0.0)),
@@ -429,6 +463,7 @@ def fit_record(
         status="failed" if problems else "ok", reason="; ".join(problems), derived=derived, protocol_source=source,
         noise_method=level.method, effective_rows=level.n_eff, drift_sensitivity=sensitivity,
         window=None if window is None else (float(window[0]), float(window[1])), step_weight=weight,
+        alternatives=tried, notes=notes,
     )  # fmt: skip
 
 
@@ -489,6 +524,9 @@ class _Setup:
     #: how much less each friction row tells than the search's chi-square says (the first fit's residual variance
     #: over the search's noise squared, times rows per independent row): the priors are weighted up by it
     change_weight: float = 1.0
+    #: each level's velocity uncertainty (m/s) where the history was found from the displacement (carried into the
+    #: intervals by :func:`_level_covariance`); empty for a history given (held exact)
+    levels: tuple[float, ...] = ()
 
 
 #: the names ``fixed`` and ``guess`` take (SI values)
@@ -900,14 +938,15 @@ def _change_report(setup: _Setup, result: Any, seen: dict[int, dict[str, float]]
         value = found + (par.value - CHANGE_OFFSET) * sigma
         se = par.stderr * sigma if par.stderr is not None and math.isfinite(par.stderr) else None
         interval = (value - Z95 * se, value + Z95 * se) if se is not None else None
-        shown = f"{found:.{_decimals(sigma)}f} ± {sigma:.2g} s"
+        shown = f"{setup.record.t0 + found:.{_decimals(sigma)}f} ± {sigma:.2g} s on the file's clock"
         note = (f"fitted; the displacement dates it at {shown}, its prior" if se is not None else
                 "fitted, no standard error: the record cannot tell it apart from the others")  # fmt: skip
         out.append(FitParameter(name, value, se, interval, unit="s", constrained=se is not None, note=note,
                                 si_unit="s"))  # fmt: skip
         if abs(value - found) > CHANGE_FAR * sigma:
             warns.append(
-                f"{name}: the friction places the velocity change at {value:.6g} s, {abs(value - found) / sigma:.3g} "
+                f"{name}: the friction places the velocity change at {setup.record.t0 + value:.6g} s, "
+                f"{abs(value - found) / sigma:.3g} "
                 f"times its uncertainty from where the displacement dates it ({shown}): check "
                 "the history (--segment, --protocol or --history measured)"
             )
@@ -918,12 +957,18 @@ def _change_report(setup: _Setup, result: Any, seen: dict[int, dict[str, float]]
 
 #: a sampling class (rows whose spacing is within a factor ~1.4 of each other) needs this many rows of its own
 MIN_CLASS_ROWS = 30
+#: rows over which a row's spacing is its running median (irregular stamps of one rate are one class)
+CLASS_SPAN = 31
 #: rows after a velocity change, in Dc / V, before the sliding counts as steady for the noise estimate
 QUIET_RENEWALS = 5.0
 #: the friction's variogram has levelled off when doubling the lag adds less than this factor
 PLATEAU = 1.15
+#: rows ``lag`` apart count for the variogram at that lag when they are within this factor of lag rows' time apart
+SPACING_SPREAD = 3.0
 #: blocks per sampling class for the batch-means check of the residuals' correlation
 CORRELATION_BLOCKS = 30
+#: a lag correlation counts as correlation where it exceeds this many times white noise's sampling error
+CORRELATION_Z = 3.0
 #: harmonics of the quantisation error's sawtooth counted in its systematic covariance (99 % of its variance)
 QUANTISATION_HARMONICS = 64
 #: the opening stretch of the first segment checked for a start out of steady sliding, and its residuals' limit
@@ -947,11 +992,17 @@ class _Level:
 
 
 def _sampling_classes(time: np.ndarray) -> np.ndarray:
-    """A label per row: its sample spacing rounded in log2 (rates that change mid-record get their own class);
+    """A label per row: its sample spacing (the running median over CLASS_SPAN rows, so jittered stamps stay one
+    rate) in log2 steps from the record's median spacing (rates that change mid-record get their own class);
     classes with fewer than MIN_CLASS_ROWS rows join the nearest larger one."""
+    if time.size < 3:
+        return np.zeros(time.size, dtype=int)
+    from scipy.ndimage import median_filter
+
     dt = np.diff(time)
     spacing = np.r_[dt[0], np.minimum(dt[:-1], dt[1:]), dt[-1]]
-    labels = np.rint(np.log2(spacing)).astype(int)
+    spacing = median_filter(np.log2(np.maximum(spacing, 1e-300)), size=min(CLASS_SPAN, time.size), mode="nearest")
+    labels = np.rint(spacing - float(np.median(spacing))).astype(int)
     kinds, counts = np.unique(labels, return_counts=True)
     big = kinds[counts >= MIN_CLASS_ROWS]
     if big.size == 0:
@@ -999,16 +1050,17 @@ def _quiet_noise(
         lag, first = 1, 0
         while 2 * lag < t.size:
             pairs = usable[:-lag] & usable[lag:] & (labels[:-lag] == c) & (labels[lag:] == c)
-            pairs &= (segment[:-lag] == segment[lag:]) & (np.abs(t[lag:] - t[:-lag] - lag * step) <= 0.5 * lag * step)
-            triples = pairs[:-lag] & pairs[lag:]  # rows i, i + lag, i + 2 lag, evenly spaced in one segment
+            # rows lag apart about lag rows' time apart (irregular stamps allowed; no pause in the sampling)
+            span = (t[lag:] - t[:-lag]) / (lag * step)
+            pairs &= (segment[:-lag] == segment[lag:]) & (span >= 1.0 / SPACING_SPREAD) & (span <= SPACING_SPREAD)
+            triples = pairs[:-lag] & pairs[lag:]  # rows i, i + lag, i + 2 lag in one segment
             count = int(triples.sum())
             first = first or count
             if count < max(MIN_CLASS_ROWS, first / 4):  # lags as long as the steady stretches measure nothing
                 break
-            # each row about the line through its neighbours lag rows either side: a drift, and a transient slower
-            # than the lag (the record's unseen opening one), cancel; white noise gives 6 sigma^2
-            curve = f[2 * lag :] - 2.0 * f[lag:-lag] + f[: -2 * lag]
-            gammas.append(_clipped_sd(curve[triples]) ** 2 / 6.0)
+            # each row about the line through its neighbours lag rows either side, at its own time: a drift, and a
+            # transient slower than the lag (the record's unseen opening one), cancel, at any spacing
+            gammas.append(_clipped_sd(_about_neighbours(t, f, lag)[triples]) ** 2)
             lag *= 2
         if not gammas:
             continue
@@ -1017,11 +1069,11 @@ def _quiet_noise(
         sigma[int(c)] = math.sqrt(gammas[pick])
         lags[int(c)] = (2**pick * step, level is not None)
     bit = _quantisation_noise(f)
-    floor = max(MODEL_PRECISION * max(1.0, float(np.median(np.abs(f)))), bit)
+    floor = _noise_floor(f)
     if not sigma:
-        level = max(_noise(f), floor)
+        white = _noise(f, t)
         how = "second differences of the friction (no steady sliding to measure)"
-        return np.full(t.size, level), how, np.full(t.size, _noise(f))
+        return np.full(t.size, max(white, floor)), how, np.full(t.size, white)
     pooled = math.sqrt(float(np.mean(np.square(list(sigma.values())))))
     measured = np.array([sigma.get(int(c), pooled) for c in labels])
     rows = np.maximum(measured, floor)
@@ -1030,6 +1082,12 @@ def _quiet_noise(
     if bit == floor and any(sigma.get(int(c), pooled) < bit for c in np.unique(labels)):
         how += f", raised to the quantisation noise {bit:.3g} of friction written in steps of {bit * math.sqrt(12):.3g}"
     return rows, how, measured
+
+
+def _noise_floor(friction: np.ndarray) -> float:
+    """The least noise a friction record is judged by: the model's own precision (MODEL_PRECISION of the friction,
+    at least 1e-9) or the quantisation noise of its written step, the larger."""
+    return max(MODEL_PRECISION * max(1.0, float(np.median(np.abs(friction)))), _quantisation_noise(friction))
 
 
 def _quantisation_noise(friction: np.ndarray) -> float:
@@ -1087,6 +1145,17 @@ def _clipped_sd(x: np.ndarray) -> float:
     return float(np.std(keep))
 
 
+def _about_neighbours(t: np.ndarray, f: np.ndarray, lag: int = 1) -> np.ndarray:
+    """Each row's offset from the straight line through the rows ``lag`` either side, evaluated at the row's own
+    time, in units of white noise: divided by sqrt(1 + w^2 + (1 - w)^2), w the row's distance from its later
+    neighbour over the two neighbours' distance (3/2 for even stamps: the classic second difference / sqrt(6)).
+    A slope cancels at any spacing; irregular stamps only change the weights."""
+    t0, t1, t2 = t[: -2 * lag], t[lag:-lag], t[2 * lag :]
+    w = (t2 - t1) / (t2 - t0)
+    offset = f[lag:-lag] - w * f[: -2 * lag] - (1.0 - w) * f[2 * lag :]
+    return offset / np.sqrt(1.0 + w * w + (1.0 - w) ** 2)
+
+
 def _pre_fit_noise(record: LabRecord, protocol: Protocol, dc: float, labels: np.ndarray, white: float) -> float:
     """The noise the search scales its residuals by.  Its answer does not depend on it in principle, but its path
     does (a search in a long valley ends elsewhere for a 1 % change), and the restarts for a troubled search
@@ -1101,8 +1170,9 @@ def _correlation_factor(resid: np.ndarray, labels: np.ndarray) -> np.ndarray:
     """Per row, g = 1 + 2 sum of the residuals' autocorrelations (rows of one sampling rate): each row counts as
     1/g independent rows.
 
-    From the lag-one and lag-two correlations, checked by batch means over CORRELATION_BLOCKS blocks (docs/rsf.md,
-    "Noise, independent of the sampling rate").
+    From the lag-one and lag-two correlations, each read only where it stands out of a white series' sampling
+    error, checked by batch means over CORRELATION_BLOCKS blocks (docs/rsf.md, "Noise, independent of the
+    sampling rate").
     """
     out = np.ones(resid.size)
     for c in np.unique(labels):
@@ -1112,7 +1182,8 @@ def _correlation_factor(resid: np.ndarray, labels: np.ndarray) -> np.ndarray:
         if rows.size < MIN_CLASS_ROWS or not var > 0:
             continue
         rho = [_lag_correlation(r, rows, k, var) for k in (1, 2)]
-        out[rows] = max(_block_factor(r, rows, var, _parametric_factor(*rho)), 1.0 / rows.size)
+        parametric = _parametric_factor(*rho, pairs=int(np.count_nonzero(np.diff(rows) == 1)))
+        out[rows] = max(_block_factor(r, rows, var, parametric), 1.0 / rows.size)
     return out
 
 
@@ -1121,10 +1192,19 @@ def _lag_correlation(r: np.ndarray, rows: np.ndarray, lag: int, var: float) -> f
     return float(np.mean(r[lag:][pairs] * r[:-lag][pairs]) / var) if np.any(pairs) else 0.0
 
 
-def _parametric_factor(rho1: float, rho2: float) -> float:
+def _parametric_factor(rho1: float, rho2: float, pairs: int | None = None) -> float:
+    """1 + 2 sum rho_k for white noise plus an exponentially correlated part: 1 + 2 rho1 / (1 - rho2 / rho1).
+
+    Each is read as correlation only where it stands out of white noise's sampling error, 1 / sqrt(pairs), by
+    CORRELATION_Z of it (g = 1 where rho1 does not), and so is the ratio rho2 / rho1: for white residuals both
+    are +-0.02 on 3000 rows, and their ratio anything up to 1 (g = 54 from rho1 = 0.027, rho2 = 0.038 on a white
+    record)."""
+    error = 1.0 / math.sqrt(pairs) if pairs else 0.0
+    if abs(rho1) <= CORRELATION_Z * error:
+        return 1.0
     if rho1 <= 0:
         return max(1.0 + 2.0 * rho1, 0.05)
-    if rho2 <= 0:
+    if rho2 <= CORRELATION_Z * error:
         return 1.0 + 2.0 * rho1
     phi = min(rho2 / rho1, 0.999)
     return 1.0 + 2.0 * rho1 / (1.0 - phi)
@@ -1154,11 +1234,13 @@ def _uncertainty(
     dof = max(n - p, 1)
     if given is not None:
         redchi = float(np.sum((resid / given) ** 2) / dof)
-        if setup.weights is not None:
-            _set_covariance(result, _sandwich(setup, base, result, np.full(n, given**2)))
+        if setup.weights is not None or any(setup.levels):  # (else the search's own covariance at that noise)
+            core = None if setup.weights is not None else result.covar
+            _set_covariance(result, _sandwich(setup, base, result, np.full(n, given**2), core=core))
         return _Level(given, redchi, "given", float(n), 1.0, np.full(n, float(given)))
     dc = math.exp(result.params["log_dc"].value)
     rows, how, measured = _quiet_noise(record, setup.protocol, dc, labels)
+    rows, how, measured = _followed_signal(setup, dc, labels, resid, rows, how, measured)
     redchi = float(np.sum((resid / rows) ** 2) / dof)
     g = _correlation_factor(resid, labels)
     variance = np.zeros(n)
@@ -1171,20 +1253,54 @@ def _uncertainty(
         how += "; the quantisation's systematic part counted in the intervals"
     _set_covariance(result, _sandwich(setup, base, result, variance * g, systematic))
     n_eff = float(np.sum(1.0 / g))
+    levels = ("; the found levels' velocities' uncertainty (from the displacement) carried in them"
+              if any(setup.levels) else "")  # fmt: skip
     method = (f"fit judged against the {how}; intervals from the residuals' own scatter and autocorrelation "
-              f"(effective independent rows {n_eff:.4g} of {n})")  # fmt: skip
+              f"(effective independent rows {n_eff:.4g} of {n}){levels}")  # fmt: skip
     return _Level(float(np.sqrt(np.mean(rows**2))), redchi, method, n_eff, n / n_eff, rows)
+
+
+#: the steady sliding's friction second differences are signal, not noise, where they exceed the residuals' own
+#: (the same estimator, the model subtracted) this many times: the model follows them
+SIGNAL_FACTOR = 2.0
+
+
+def _followed_signal(
+    setup: _Setup, dc: float, labels: np.ndarray, resid: np.ndarray, rows: np.ndarray, how: str, measured: np.ndarray
+) -> tuple[np.ndarray, str, np.ndarray]:  # fmt: skip
+    """The noise per row (and how it was had, and the level before its floor) where the friction's own second
+    differences in steady sliding are signal the model follows, not noise: a noise-free record (a model's output,
+    as `rsf simulate -o` writes it) whose "steady" rows still ring, or any record sampled too sparsely for a row's
+    neighbours to lie on a line.  There the residuals' second differences (the same estimator, :func:`_quiet_noise`
+    on friction minus model) are the noise, raised to the same floor (the model's precision, the friction's
+    printed step); elsewhere, and on every record whose steady sliding is steady, nothing changes."""
+    record = setup.record
+    _, _, left = _quiet_noise(replace(record, friction=resid), setup.protocol, dc, labels)
+    signal = measured > SIGNAL_FACTOR * left
+    if not np.any(signal):
+        return rows, how, measured
+    floor = _noise_floor(record.friction)
+    kept = np.where(signal, np.maximum(left, floor), rows)
+    was, now = float(np.sqrt(np.mean(measured[signal] ** 2))), float(np.sqrt(np.mean(left[signal] ** 2)))
+    share = "" if signal.all() else f" on {int(np.count_nonzero(signal))} of {signal.size} rows"
+    raised = f", raised to the noise floor {floor:.3g} (the model's precision or the friction's written step)" if (
+        now < floor) else ""  # fmt: skip
+    how += (f"; those follow the model{share} ({was:.3g} against the residuals' {now:.3g}: signal, not noise, as "
+            f"on a noise-free record), so there the residuals' own{raised}")  # fmt: skip
+    return kept, how, np.where(signal, left, measured)
 
 
 def _sandwich(
     setup: _Setup, base: RSFParams, result: Any, variance: np.ndarray,
-    systematic: tuple[np.ndarray, float, np.ndarray] | None = None,
+    systematic: tuple[np.ndarray, float, np.ndarray] | None = None, core: np.ndarray | None = None,
 ) -> np.ndarray | None:  # fmt: skip
     """B^-1 (sum_i w_i^2 v_i J_i J_i^T) B^-1, B = sum_i w_i J_i J_i^T (None when J or B is unusable); with
-    ``systematic`` the quantisation's systematic error is added to the meat (:func:`_systematic_quantisation`)."""
+    ``systematic`` the quantisation's systematic error is added to the meat (:func:`_systematic_quantisation`).
+    The found levels' velocities' share (:func:`_level_covariance`) is added; ``core`` (the search's own
+    covariance, at a given noise) stands in for the sandwich where it is given."""
     jac = _jacobian(setup, base, result)
     if jac is None:
-        return None
+        return core
     w = np.ones(len(setup.record)) if setup.weights is None else setup.weights
     bread = jac.T @ (w[:, None] * jac)
     meat = jac.T @ ((w**2 * variance)[:, None] * jac)
@@ -1201,8 +1317,47 @@ def _sandwich(
         inverse = np.linalg.inv(bread)
     except np.linalg.LinAlgError:
         return None
-    cov = inverse @ meat @ inverse
+    cov = inverse @ meat @ inverse if core is None else np.array(core, dtype=float)
+    levels = _level_covariance(setup, base, result, inverse @ jac.T * w)
+    if levels is None:  # the levels' share cannot be had: no interval claims a precision it may not have
+        return None
+    cov = cov + levels
     return cov if np.all(np.isfinite(cov)) else None
+
+
+def _level_covariance(setup: _Setup, base: RSFParams, result: Any, lever: np.ndarray) -> np.ndarray | None:
+    """What the found levels' velocity errors add to the parameters' covariance: G diag(sigma_v^2) G^T, with
+    G = B^-1 J^T W J_v (``lever`` = B^-1 J^T W) the fitted parameters' shift per unit change of each level's
+    velocity, J_v the model friction's derivative with respect to it (central differences of +-sigma_v, at most
+    half the velocity) and sigma_v from the displacement (:func:`level_velocity_uncertainty`).  The levels are
+    estimates whose errors are independent of the friction's noise, so their share adds.  Zero where the history
+    was given (held exact) or no level has an uncertainty; None where a moved level's model cannot be run.
+    docs/rsf.md, "What the history's own uncertainty does to a fit"."""
+    size = lever.shape[0]
+    if not any(setup.levels):
+        return np.zeros((size, size))
+    values = result.params.valuesdict()
+    history = _history(setup, values)
+    columns, sigmas = [], []
+    for j, (segment, sigma) in enumerate(zip(history.segments, setup.levels, strict=False)):
+        v = segment.velocity
+        if not (sigma > 0 and v > 0 and math.isfinite(sigma)):
+            continue
+        h = min(float(sigma), 0.5 * v)
+        runs = []
+        for moved_v in (v + h, v - h):
+            moved = Protocol(tuple(Segment(moved_v, s.duration) if i == j else s
+                                   for i, s in enumerate(history.segments)), name=history.name)  # fmt: skip
+            model, why = _model_or_why(setup.record, moved, base, values)
+            if why or not np.all(np.isfinite(model)):
+                return None
+            runs.append(model)
+        columns.append((runs[0] - runs[1]) / (2.0 * h))
+        sigmas.append(float(sigma))
+    if not columns:
+        return np.zeros((size, size))
+    shift = lever @ np.column_stack(columns)  # d parameters / d v_j
+    return (shift * np.square(sigmas)) @ shift.T
 
 
 def _jacobian(setup: _Setup, base: RSFParams, result: Any) -> np.ndarray | None:
@@ -1543,8 +1698,13 @@ def _initial_guess(
     }  # fmt: skip
 
 
-def _noise(values: np.ndarray) -> float:
-    """White-noise level from second differences (robust: 1.4826 MAD, so transients do not inflate it)."""
+def _noise(values: np.ndarray, time: np.ndarray | None = None) -> float:
+    """White-noise level from second differences (robust: 1.4826 MAD, so transients do not inflate it); with
+    ``time``, each row about the line through its neighbours at its own time (:func:`_about_neighbours`), so
+    irregular stamps do not turn the slope into noise."""
+    if time is not None and values.size >= 3:
+        second = _about_neighbours(np.asarray(time, dtype=float), values)
+        return float(1.4826 * np.median(np.abs(second - np.median(second))))
     second = np.diff(values, 2)
     return float(1.4826 * np.median(np.abs(second - np.median(second))) / math.sqrt(6.0))
 
@@ -1779,9 +1939,11 @@ def _difference(result: Any, table: dict[str, FitParameter], widen: float | None
 
 
 def _problems(
-    result: Any, record: LabRecord, resid: np.ndarray, table: dict[str, FitParameter], level: Any, setup: _Setup
-) -> list[str]:
-    """Why the fit cannot be trusted (empty when it can)."""
+    result: Any, record: LabRecord, resid: np.ndarray, table: dict[str, FitParameter], level: Any, setup: _Setup,
+    drift: str = "",
+) -> list[str]:  # fmt: skip
+    """Why the fit cannot be trusted (empty when it can); ``drift``: the ``--trend`` word of a drift the fit misses
+    that explains most of the residuals (then a misfit is the drift's, not the law's)."""
     problems = []
     redchi = level.redchi
     if not result.success:
@@ -1799,7 +1961,7 @@ def _problems(
         problems.append("a, b and Dc did not move from their starting values")
     p_value = _response_p_value(result, record, resid, setup.trend, level.inflation)
     if p_value > NO_RESPONSE_LEVEL:
-        problems.append(_no_response_problem(record, resid, setup, level, p_value))
+        problems.append(_no_response_problem(record, resid, setup, level, p_value, drift))
     loose = [f"{k} ({table[k].note})" for k in _CORE if not table[k].constrained]
     if loose:
         problems.append("not constrained by the record: " + ", ".join(loose))
@@ -1848,7 +2010,8 @@ def _law_words(laws: tuple[str, ...]) -> str:
 
 def _law_not_determined(problems: list[str], laws: tuple[str, ...]) -> str:
     """The note for a, b, Dc and the stiffness when no interval of the friction law means anything (the fit is no
-    better than constant friction), in the words of the reason; '' otherwise."""
+    better than constant friction, the law or the held stiffness is not the record's, or a drift the fit misses
+    decides it), in the words of the reason; '' otherwise."""
     for problem in problems:
         if problem.startswith(NO_RESPONSE_TEXT):
             return "the friction shows no velocity dependence"
@@ -1856,12 +2019,19 @@ def _law_not_determined(problems: list[str], laws: tuple[str, ...]) -> str:
             return MISFIT_TEXT.format(law=_law_words(laws))
         if problem.startswith(WEAK_RESPONSE_TEXT):
             return WEAK_RESPONSE_TEXT
+        if problem.startswith(HELD_STIFFNESS_TEXT):
+            return "the held stiffness does not describe the record"
+        if problem.startswith(DRIFT_MASKED_TEXT):
+            return "not determined while the fit misses the drift"
     return ""
 
 
-def _no_response_problem(record: LabRecord, resid: np.ndarray, setup: _Setup, level: _Level, p_value: float) -> str:
+def _no_response_problem(
+    record: LabRecord, resid: np.ndarray, setup: _Setup, level: _Level, p_value: float, drift: str = ""
+) -> str:  # fmt: skip
     """Why a fit no better than constant friction fails: constant friction describes the record to within its noise
-    (no velocity dependence), or the friction does vary but the law fitted does not describe how (a misfit)."""
+    (no velocity dependence), or the friction does vary but the law fitted does not describe how (a misfit) or, where
+    a drift the fit misses explains most of the residuals (``drift``, the --trend word), the drift hides it."""
     trends = " with the trends" if setup.trend else ""
     rows = level.rows if level.rows is not None else np.full(len(record), level.noise)
     constant = _constant_chi2(record, setup.trend, rows)
@@ -1870,6 +2040,12 @@ def _no_response_problem(record: LabRecord, resid: np.ndarray, setup: _Setup, le
             f"{NO_RESPONSE_TEXT}: constant friction{trends} describes the record to within its noise (reduced "
             f"chi-square {constant:.3g} against the noise {level.noise:.2g}; F test of the fit against it: p = "
             f"{p_value:.2g}), so a, b and Dc are not determined"
+        )
+    if level.redchi > WARN_CHI2 and drift:  # the drift leads the reason; the law is judged once it is fitted
+        return (
+            f"{DRIFT_MASKED_TEXT}: with it missed the fit is no significant improvement on constant friction"
+            f"{trends} (F test: p = {p_value:.2g}; constant friction: reduced chi-square {constant:.3g}), so a, b and "
+            f"Dc are not determined until it is fitted (--trend {drift})"
         )
     if level.redchi > WARN_CHI2:
         others = _other_laws(setup.laws)
@@ -1930,12 +2106,332 @@ def _history_mismatch(record: LabRecord, protocol: Protocol) -> str:
     )
 
 
-def _residual_drift(record: LabRecord, resid: np.ndarray) -> float:
-    """Share of the residuals' sum of squares a straight line in slip and time explains."""
-    design = np.column_stack([np.ones(len(record)), record.displacement, record.time])
+def _residual_drift(record: LabRecord, resid: np.ndarray, kinds: tuple[str, ...] = ("slip", "time")) -> float:
+    """Share of the residuals' sum of squares a straight line in slip and time (or in ``kinds``) explains."""
+    columns = {"slip": record.displacement, "time": record.time}
+    design = np.column_stack([np.ones(len(record))] + [columns[k] for k in kinds])
     coef, *_ = np.linalg.lstsq(design, resid, rcond=None)
     total = float(np.sum(resid**2))
     return 1.0 - float(np.sum((resid - design @ coef) ** 2)) / total if total > 0 else 0.0
+
+
+# --- a drift the fit misses ------------------------------------------------------------------------------------
+
+#: a drift that explains more than this share of the residuals leads the reason: no law can be judged before it is
+#: fitted (a law's misfit, and the F test against constant friction, then measure the drift, not the law)
+DRIFT_LEAD = 0.5
+#: a drift in slip and one in time whose refits' chi-square_r are within this share of each other: both are advised
+DRIFT_ALIKE = 0.1
+#: the start of a misfit's reason when a drift the fit misses explains most of the residuals
+DRIFT_MASKED_TEXT = "the law cannot be judged while the fit misses the drift"
+
+
+@dataclass(frozen=True)
+class _Drift:
+    """A drift in the residuals: the share a line in slip and time explains, the ``--trend`` word that would fit it,
+    the reason's words ('' when it is no problem) and whether it leads the reason."""
+
+    share: float
+    advice: str = ""
+    text: str = ""
+    leads: bool = False
+
+
+def _drift_reading(
+    setup: _Setup, start: dict[str, float], result: Any, resid: np.ndarray, level: _Level, refit: bool = True
+) -> _Drift:  # fmt: skip
+    """With chi-square_r > WARN_CHI2 and a line in slip and time explaining over DRIFT_SHARE of the residuals, the
+    problem.  Where it explains over DRIFT_LEAD it leads the reason, and the drift to fit is found by refitting, from
+    the fit's answer, with a drift in slip and with one in time (each not already fitted): the lower chi-square's, or
+    both where the two are within DRIFT_ALIKE of each other.  The residuals' own line is no guide to which: a slip
+    drift of 30 per m on 1 -> 10 -> 1 um/s left residuals a line in time explained better, as a, b, Dc and k had bent
+    to a part of it (refitted from the fit's answer: slip drift chi-square_r 1.11, time drift 8.53)."""
+    record = setup.record
+    both = _residual_drift(record, resid)
+    if not (level.redchi > WARN_CHI2 and both > DRIFT_SHARE):
+        return _Drift(both)
+    if both <= DRIFT_LEAD:
+        return _Drift(both, "slip, time or both", (
+            f"a linear drift in slip and time explains {100 * both:.0f} % of the residuals (reduced chi-square "
+            f"{level.redchi:.3g}): the model misses a drift, so its values and intervals are biased; fit the drift "
+            "with --trend slip, time or both"))  # fmt: skip
+    rows = level.rows if level.rows is not None else np.full(len(record), level.noise)
+    here = {**start, **_start_values(result.params.valuesdict())}
+    reached = {}
+    for kind in ("slip", "time") if refit else ():  # (no refit helps a history that is not the record's)
+        term = "trend" if kind == "slip" else "time_trend"
+        if kind in setup.trend or term in setup.fixed:  # (fitted already, or held where the caller put it)
+            continue
+        alt = replace(setup, trend=setup.trend | {kind})
+        try:
+            fit, _ = _least_squares(alt, {**here, term: 0.0})
+        except ModelError:
+            continue
+        values = fit.params.valuesdict()
+        model, why = _model_or_why(record, _history(alt, values), _base(alt, here), values)
+        if not why:
+            reached[kind] = float(np.sum(((record.friction - model) / rows) ** 2) / max(len(record) - fit.nvarys, 1))
+    if reached:
+        kind = min(reached, key=lambda k: reached[k])
+        alike = len(reached) == 2 and max(reached.values()) <= (1 + DRIFT_ALIKE) * min(reached.values())
+        kinds = ({"slip", "time"} if alike else {kind}) | set(setup.trend)
+        shown = ", ".join(f"a drift in {k} {reached[k]:.3g}" for k in sorted(reached, key=lambda k: reached[k]))
+        refits = f"; refitted from this answer, reduced chi-square with {shown}"
+    else:
+        kinds, refits = {"slip", "time"}, ""
+    advice = "both" if len(kinds) == 2 else next(iter(kinds))
+    return _Drift(both, advice, (
+        f"a linear drift in slip and time explains {100 * both:.0f} % of the residuals (reduced chi-square "
+        f"{level.redchi:.3g}{refits}): the model misses a drift, so its values and intervals are biased, and no law "
+        f"can be judged until the drift is fitted; fit the drift first with --trend {advice}"), True)  # fmt: skip
+
+
+# --- is another model the answer? --------------------------------------------------------------------------------
+
+#: an alternative that describes the record (chi-square_r <= WARN_CHI2) fails the fit where the chi-square it saves
+#: is beyond what the noise allows at this one-sided level (docs/rsf.md, "Is another model the answer?")
+ALTERNATIVE_LEVEL = 1e-3
+#: the built-in single-state laws an alternative fit swaps between
+ALTERNATIVE_LAWS = ("aging", "slip", "prz")
+
+
+@dataclass(frozen=True)
+class _Candidate:
+    """One alternative to the fit: its words, the options that fit it, and its search's setup and start."""
+
+    words: str
+    option: str
+    setup: _Setup
+    start: dict[str, float]
+
+
+def _candidates(setup: _Setup, here: dict[str, float], laws: tuple[str, ...], free: bool) -> list[_Candidate]:
+    """The fit with ``laws`` (each in place of the one fitted) and, with ``free``, the held stiffness freed."""
+    out = []
+    freed = {k: v for k, v in setup.fixed.items() if k != "stiffness"}
+    for law in laws:
+        changed = law != setup.laws[0]
+        parts = (f"the {law} law" if changed else "", "the stiffness free" if free else "")
+        words = " with ".join(w for w in parts if w)
+        option = " ".join(o for o in (f"--law {law}" if changed else "", "--free stiffness" if free else "") if o)
+        alt = replace(setup, laws=(law,) * setup.states if changed else setup.laws,
+                      fit_stiffness=setup.fit_stiffness or free, fixed=freed if free else setup.fixed)  # fmt: skip
+        start = {**here, "stiffness": setup.fixed["stiffness"]} if free else here
+        out.append(_Candidate(words, option, alt, start))
+    return out
+
+
+def _steady_bound(setup: _Setup, protocol: Protocol, rows: np.ndarray) -> float:
+    """Chi-square (against the noise of each row) of the first 90 % of the first segment about its best constant
+    (plus the fitted drifts' columns, less the held ones): every alternative starts in steady sliding at the first
+    velocity, whatever its law or stiffness, and its friction there is mu0 plus the drifts, so none can go below
+    this."""
+    record, trend, held = setup.record, setup.trend, setup.fixed
+    if len(protocol.segments) < 2:
+        return 0.0
+    first = record.time < 0.9 * float(protocol.boundaries[1])
+    columns = [np.ones(len(record))] + ([record.displacement] if "slip" in trend else [])
+    columns += [record.time] if "time" in trend else []
+    design = np.column_stack(columns)[first] / rows[first, None]
+    if int(first.sum()) <= design.shape[1]:
+        return 0.0
+    friction = record.friction - held.get("trend", 0.0) * record.displacement
+    friction = friction - held.get("time_trend", 0.0) * record.time
+    target = friction[first] / rows[first]
+    coef, *_ = np.linalg.lstsq(design, target, rcond=None)
+    return float(np.sum((target - design @ coef) ** 2))
+
+
+def _alternatives(
+    setup: _Setup, start: dict[str, float], result: Any, model: np.ndarray, level: _Level, labels: np.ndarray,
+    units: dict[str, tuple[str, float]], noise: float | None,
+) -> tuple[tuple[dict[str, Any], ...], str, str]:  # fmt: skip
+    """The fit tried again, from its answer, with what the caller chose changed: a held stiffness freed, and a
+    single-state built-in law swapped for each other one (then the best of those with the stiffness freed as well,
+    where a held one was and neither alone describes the record).  Returns what each reached (JSON), the failure
+    (an alternative describes the record, chi-square_r <= WARN_CHI2, and saves more chi-square than the noise
+    allows: :func:`_paired_test`) and the warning's words ('' for none).  None is tried where the first segment
+    alone, where every alternative gives the same steady friction, keeps chi-square_r above WARN_CHI2."""
+    record = setup.record
+    values = result.params.valuesdict()
+    here = {**start, **_start_values(values)}
+    held = not setup.fit_stiffness and "stiffness" in setup.fixed
+    laws = tuple(law for law in ALTERNATIVE_LAWS if law != setup.laws[0]) if (
+        setup.states == 1 and setup.laws[0] in ALTERNATIVE_LAWS) else ()  # fmt: skip
+    if not held and not laws:
+        return (), "", ""
+    rows = level.rows if level.rows is not None else np.full(len(record), level.noise)
+    most = result.nvarys + int(held)
+    floor = _steady_bound(setup, _history(setup, values), rows) / max(len(record) - most, 1)
+    tried_kinds = [f"the {law} law" for law in laws] + (["a free stiffness"] if held else [])
+    kinds = " or ".join(tried_kinds)
+    if floor > WARN_CHI2:
+        subject = f"neither {' nor '.join(tried_kinds)}" if len(tried_kinds) > 1 else tried_kinds[0]
+        return ({"skipped": tried_kinds, "reduced_chi_square_floor": floor},), "", (
+            f"{subject} can describe the record better: over its first segment, where every law and stiffness give "
+            f"the same steady friction, the residuals alone make reduced chi-square at least {floor:.3g} "
+            f"(> {WARN_CHI2:g}), so {'none was' if len(tried_kinds) > 1 else 'it was not'} tried"
+        )  # fmt: skip
+    candidates = _candidates(setup, here, (setup.laws[0],), True) if held else []
+    candidates += _candidates(setup, here, laws, False)
+    reached = [_tried(c, record, model, rows, labels) for c in candidates]
+    swapped = [r for r in reached if r["law"] != setup.laws[0] and "values" in r]
+    if held and swapped and not any(r["describes"] for r in reached):  # both changed: from the best other law
+        best = min(swapped, key=lambda r: r["reduced_chi_square"])
+        both = _candidates(setup, {**here, **best["values"]}, (best["law"],), True)[0]
+        reached.append(_tried(both, record, model, rows, labels))
+    shown = ", ".join(_reached_text(r) for r in reached)
+    good = sorted((r for r in reached if r["describes"] and r["better"]), key=lambda r: r["reduced_chi_square"])
+    if not good:
+        said = (f"alternatives tried from this fit's answer ({kinds}), reduced chi-square against the same noise: "
+                f"{shown}; none describes the record (<= {WARN_CHI2:g}) significantly better")  # fmt: skip
+        return tuple(_public_tried(r) for r in reached), "", said
+    best = good[0]
+    candidate = best.pop("candidate")
+    alt_result = best.pop("result")
+    base = _base(candidate.setup, candidate.start)
+    alt_model = best["model"]
+    _uncertainty(candidate.setup, base, alt_result, alt_model, labels, noise)  # (its covariance, for its intervals)
+    table, _, _ = _report(alt_result, alt_result.params.valuesdict(), candidate.setup, candidate.start["stiffness"],
+                          None, units)  # fmt: skip
+    keys = ("stiffness", "a", "b", "dc") if "free" in candidate.words else ("a", "b", "dc", "stiffness")
+    best["parameters"] = {k: _si_entry(table[k]) for k in keys if k in table}
+    values_text = _values_text(table, keys)
+    from ..display import unit as shown_unit
+
+    k_unit, k_scale = units["stiffness"]
+    held_k = f"{setup.fixed['stiffness'] / k_scale:.4g} {shown_unit(k_unit)}" if held else ""
+    evidence = (f"reduced chi-square {best['reduced_chi_square']:.3g} against this fit's {level.redchi:.3g}, "
+                f"against the same noise; chi-square lower by {best['chi_square_drop']:.3g}, {best['z']:.3g} times "
+                f"its spread under the noise alone: {_p_text(best['p_value'])}")  # fmt: skip
+    others = [r for r in reached if r is not best]
+    also = "; also tried: " + ", ".join(_reached_text(r) for r in others) if others else ""
+    if candidate.words == "the stiffness free":
+        failure = (f"{HELD_STIFFNESS_TEXT} {held_k} does not describe the record: with the stiffness free the fit "
+                   f"does, at {values_text} ({evidence}){also}; free the stiffness ({candidate.option}) or check "
+                   "the rig's stiffness")  # fmt: skip
+    else:
+        law = MISFIT_TEXT.format(law=_law_words(setup.laws)) + (f" with the stiffness held at {held_k}" if held else "")
+        failure = (f"{law}: {candidate.words} does, at {values_text} ({evidence}){also}; fit it with "
+                   f"{candidate.option}")  # fmt: skip
+    return tuple(_public_tried(r) for r in reached), failure, ""
+
+
+def _tried(
+    candidate: _Candidate, record: LabRecord, model: np.ndarray, rows: np.ndarray, labels: np.ndarray
+) -> dict[str, Any]:  # fmt: skip
+    """One alternative's search from the fit's answer and what it reached, judged by the fit's own noise."""
+    out: dict[str, Any] = {"fit": candidate.words, "option": candidate.option, "law": candidate.setup.laws[0],
+                           "reduced_chi_square": math.nan, "describes": False, "better": False, "note": "",
+                           "candidate": candidate}  # fmt: skip
+    try:
+        result, _ = _least_squares(candidate.setup, candidate.start)
+    except ModelError as exc:
+        return {**out, "note": str(exc)}
+    values = result.params.valuesdict()
+    alt, why = _model_or_why(record, _history(candidate.setup, values), _base(candidate.setup, candidate.start), values)
+    if why:
+        return {**out, "note": why}
+    dof = max(len(record) - result.nvarys, 1)
+    redchi = float(np.sum(((record.friction - alt) / rows) ** 2) / dof)
+    drop, z, p_value = _paired_test(record.friction, model, alt, rows, labels, redchi)
+    return {**out, "reduced_chi_square": redchi, "chi_square_drop": drop, "z": z, "p_value": p_value,
+            "describes": redchi <= WARN_CHI2, "better": p_value < ALTERNATIVE_LEVEL, "values": _start_values(values),
+            "result": result, "model": alt}  # fmt: skip
+
+
+def _paired_test(
+    friction: np.ndarray, model: np.ndarray, alt: np.ndarray, rows: np.ndarray, labels: np.ndarray, redchi: float
+) -> tuple[float, float, float]:
+    """The chi-square the alternative saves, D = sum (r_fit^2 - r_alt^2) / sigma^2, against its spread under the
+    noise alone, 2 sqrt(s sum g delta^2 / sigma^2) (delta the two models' difference, g the alternative's residuals'
+    correlation factor per row, s its chi-square_r where above 1): (D, z, one-sided p).  For nested and non-nested
+    alternatives alike (a law swapped has no extra parameter for an F test to count)."""
+    from scipy import stats
+
+    r_fit, r_alt = (friction - model) / rows, (friction - alt) / rows
+    drop = float(np.sum(r_fit**2 - r_alt**2))
+    g = _correlation_factor(friction - alt, labels)
+    spread = 2.0 * math.sqrt(max(redchi, 1.0) * float(np.sum(g * ((alt - model) / rows) ** 2)))
+    if not spread > 0:
+        return drop, 0.0, 1.0
+    z = drop / spread
+    return drop, z, float(stats.norm.sf(z))
+
+
+def _p_text(p_value: float) -> str:
+    """``p = 1.2e-05``, or ``p < 1e-300`` where it underflows."""
+    return f"p = {p_value:.2g}" if p_value >= 1e-300 else "p < 1e-300"
+
+
+def _reached_text(entry: dict[str, Any]) -> str:
+    """``the slip law 17.7`` (its chi-square_r), or why it could not be evaluated."""
+    if math.isfinite(entry["reduced_chi_square"]):
+        weak = f" (not significantly better: {_p_text(entry['p_value'])})" if entry["describes"] and not entry[
+            "better"] else ""  # fmt: skip
+        return f"{entry['fit']} {entry['reduced_chi_square']:.3g}{weak}"
+    return f"{entry['fit']} (not evaluated: {entry['note']})"
+
+
+def _public_tried(entry: dict[str, Any]) -> dict[str, Any]:
+    """An alternative as the JSON gives it (SI values)."""
+    keep = (
+        "fit",
+        "option",
+        "reduced_chi_square",
+        "describes",
+        "better",
+        "chi_square_drop",
+        "z",
+        "p_value",
+        "parameters",
+        "note",
+    )
+    out = {k: entry[k] for k in keep if k in entry and entry[k] != ""}
+    if "parameters" not in out and "values" in entry:
+        out["values"] = {k: entry["values"][k] for k in ("a", "b", "dc", "stiffness") if k in entry["values"]}
+    return out
+
+
+def _values_text(table: dict[str, FitParameter], keys: tuple[str, ...]) -> str:
+    """``a = 0.008 [0.00798, 0.00802], dc = 20 [19.9, 20.1] µm`` in the record's units (free values only)."""
+    from ..display import unit as shown_unit
+
+    parts = []
+    for key in keys:
+        p = table.get(key)
+        if p is None or p.fixed:
+            continue
+        unit, k = (f" {shown_unit(p.unit)}" if p.unit else ""), p.scale
+        if p.interval is None:
+            parts.append(f"{key} = {p.value / k:.4g}{unit} (no interval)")
+        else:
+            parts.append(f"{key} = {p.value / k:.4g} [{p.interval[0] / k:.4g}, {p.interval[1] / k:.4g}]{unit}")
+    return ", ".join(parts)
+
+
+# --- the sign of b ----------------------------------------------------------------------------------------------
+
+
+def _sign_notes(table: dict[str, FitParameter]) -> tuple[str, ...]:
+    """A reading of each fitted negative b (b2): legitimate, and what it says (docs/rsf.md, "A negative b")."""
+    notes = []
+    for key in ("b", "b2"):
+        p = table.get(key)
+        if p is None or p.fixed or not p.value < 0 or p.interval is None:
+            continue
+        if p.interval[1] >= 0:
+            notes.append(f"{key} = {p.value:.3g} is negative, but its interval [{p.interval[0]:.3g}, "
+                         f"{p.interval[1]:.3g}] holds 0: the sign of the state's effect is not determined")  # fmt: skip
+            continue
+        notes.append(
+            f"{key} = {p.value:.3g} [{p.interval[0]:.3g}, {p.interval[1]:.3g}] < 0: the state weakens the surface as "
+            "it ages (and strengthens it as it is renewed by slip): after a step up the friction keeps rising beyond "
+            "the direct effect instead of decaying, steady sliding is more velocity strengthening than a alone "
+            "(a - b > a), and a hold would weaken rather than heal.  A legitimate reading, which clay-rich gouges "
+            "often give; not a failed fit"
+        )
+    return tuple(notes)
 
 
 def _moved(par: Any) -> bool:

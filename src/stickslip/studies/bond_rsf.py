@@ -77,11 +77,15 @@ class BondRSF:
 
 
 def physical_problem(params: RSFParams) -> str | None:
-    """Why an RSF parameter set is physically meaningless (a < 0, b < 0, Dc <= 0), or None."""
+    """Why an RSF parameter set cannot stand for the bond model, or None: a < 0 or Dc <= 0 (meaningless for any
+    material), or b < 0 (a state that weakens in a hold, where the bonds heal; a legitimate reading of some gouges,
+    docs/rsf.md "A negative b", but not of this model)."""
     problems = [f"a = {params.a:.3g} < 0" if params.a < 0 else ""]
     for k, state in enumerate(params.states):
         name = "" if len(params.states) == 1 else str(k + 1)
-        problems.append(f"b{name} = {state.b:.3g} < 0 (weakening with hold time)" if state.b < 0 else "")
+        problems.append(
+            f"b{name} = {state.b:.3g} < 0 (weakening with hold time, where the bonds heal)" if state.b < 0 else ""
+        )
         problems.append(f"Dc{name} = {state.dc:.3g} m is not positive" if not state.dc > 0 else "")
     found = [p for p in problems if p]
     return "; ".join(found) if found else None
