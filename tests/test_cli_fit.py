@@ -65,7 +65,7 @@ def test_fit_steady_prints_the_report_with_units(capsys):
 @pytest.mark.parametrize(
     ("content", "expected"),
     [
-        ("velocity [um/s],stress [Pa]\n100,250\n200,300\n200,310\n400,400\n", "row 4, column 'velocity': duplicates"),
+        ("velocity [um/s],stress [Pa]\n100,250\n200,300\n200,310\n400,400\n", "4 data rows at 3 distinct velocities"),
         ("velocity [um/s],stress [Pa]\n100,250\n200,-3\n300,310\n400,400\n", "row 3, column 'stress'"),
         ("velocity [um/s],friction [Pa]\n100,250\n", "unknown column 'friction'"),
         ("velocity [zorks],stress [Pa]\n100,250\n", "unknown unit"),

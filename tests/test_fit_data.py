@@ -50,7 +50,7 @@ def test_bare_names_are_si_and_stress_err_is_optional(tmp_path):
         ("velocity,stress\n1e-4,250\n2e-4,abc\n4e-4,400\n8e-4,600\n", "row 3, column 'stress': 'abc' is not a number"),
         (
             "velocity,stress\n1e-4,250\n4e-4,300\n4e-4,400\n8e-4,600\n",
-            "row 4, column 'velocity': duplicates the velocity of row 3",
+            "4 data rows at 3 distinct velocities",
         ),
         ("velocity [bananas],stress\n1,2\n", "unknown unit"),
         ("velocity [Pa],stress\n1,2\n", "column 'velocity'"),

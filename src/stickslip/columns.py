@@ -116,6 +116,10 @@ UNITS: dict[str, str | None] = {
     "slip_time": _TIME,
     "period": _TIME,
     "stress_drop": _STRESS,
+    "critical_stress_uncertainty": _STRESS,  # analyze's systematic uncertainty of a cycle's corners
+    "peak_stress_uncertainty": _STRESS,
+    "stick_time_uncertainty": _TIME,
+    "start_stress_uncertainty": _STRESS,  # the same, in a stick table (fit stick)
     "stick_points": None,
     "stick_rms": _STRESS,
     "message": None,
@@ -169,6 +173,8 @@ UNITS: dict[str, str | None] = {
     "reduced_chi_square": DIMENSIONLESS,
     "confidence_level": DIMENSIONLESS,
     "relative_noise": DIMENSIONLESS,
+    "relative_floor": DIMENSIONLESS,  # fit stick's floor of a velocity's mean error (ln), and that mean's scatter
+    "relative_scatter": DIMENSIONLESS,
     "residuals": DIMENSIONLESS,  # (data - fit) / error
     "dof": None,  # counts
     "steps": None,

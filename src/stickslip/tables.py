@@ -36,6 +36,8 @@ def split_header(cell: str, parentheses: bool = False) -> tuple[str, str | None]
 
 #: a column name (its unit, in brackets or in parentheses, is split off by :func:`split_header`)
 _NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
+#: a name of several words ("Shear stress", "Load-cell force"): readable, but no column name of the package
+_WORDS = re.compile(r"[A-Za-z_][A-Za-z0-9_ .\-/]*[A-Za-z0-9_]")
 
 
 def header_names(path: str | Path) -> list[str]:
@@ -218,6 +220,13 @@ def _read_header(
     factors: dict[str, float] = {}
     for position, cell in enumerate(header, start=1):
         found = _header_cell(cell)
+        if found is None and _WORDS.fullmatch(split_header(cell, parentheses=True)[0]):
+            # a readable header whose name is no column of ours ("Shear stress (kPa)"): say so, not "cannot read"
+            raise DataError(
+                f"{source}: row {header_row}, column {position}: unknown column"
+                f" {split_header(cell, parentheses=True)[0]!r} (header {cell.strip()!r}); expected"
+                f" {', '.join(dimensions)}"
+            )
         if found is None:
             raise DataError(
                 f"{source}: row {header_row}, column {position}: cannot read header {cell!r};"

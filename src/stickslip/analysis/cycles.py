@@ -32,7 +32,7 @@ from .detect import (
     rise_start,
     sampling_step,
 )
-from .fits import QUADRATIC, Corner, Line, fit_corner, fit_line
+from .fits import QUADRATIC, Corner, Line, fit_corner, fit_line, with_time_uncertainty
 from .traces import Trace, check_trace
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -112,6 +112,11 @@ class CycleResult:
     stress_drop: float | None
     stick_points: int
     stick_rms: float | None
+    #: the systematic uncertainty of sigma_c, sigma_s (Pa) and t_s (s) from how the corners are located, apart from
+    #: the scatter the noise gives them: the same in every repeat of one cycle (fits.Corner.time_uncertainty)
+    critical_stress_uncertainty: float | None
+    peak_stress_uncertainty: float | None
+    stick_time_uncertainty: float | None
     message: str = ""
     line: Line | None = field(default=None, repr=False, compare=False)
     stick_from: float = field(default=math.nan, repr=False, compare=False)
@@ -133,7 +138,9 @@ class TraceAnalysis:
     time: np.ndarray
     stress: np.ndarray
     pulling_velocity: float
-    regime: str  # "stick-slip" | "steady" | "stuck" | "oscillation" | "decaying oscillation" | "growing oscillation"
+    #: "stick-slip" | "steady" | "stuck" | "oscillation" | "decaying oscillation" | "growing oscillation" |
+    #: "undetermined" (slips, but no whole stick phase: too short a record to tell stick-slip from a transient)
+    regime: str
     message: str
     cycles: tuple[CycleResult, ...]
     summary: dict[str, Any]
@@ -244,6 +251,9 @@ def analyze_trace(
     slopes = _slope_change(cycles, v0)
     if slopes:
         warnings.append(slopes)
+    if regime == regimes.STICK_SLIP and not _whole_stick(cycles):
+        # a slip, but no stick seen from its start to its end: a start-up transient looks the same
+        regime = regimes.UNDETERMINED
     summary = _summary(t, x, cycles, regime, steady_from, v0)
     if swings is not None:
         summary["oscillation"] = swings
@@ -453,6 +463,8 @@ def _fit_stick(t: np.ndarray, x: np.ndarray, coarse: Coarse, stick: _Stick, step
         stick.line = refit
         stick.start = _start_corner(t, x, coarse, stick, step)
         stick.end = _end_corner(t, x, coarse, stick, step)
+    # the final corners only: their systematic uncertainty costs one more hinge fit each
+    stick.start, stick.end = with_time_uncertainty(stick.start), with_time_uncertainty(stick.end)
 
 
 def _line_between(t: np.ndarray, x: np.ndarray, lo: float, hi: float) -> Line | None:
@@ -710,6 +722,11 @@ def _cycles(
                 stress_drop=end.stress - nxt.stress if nxt and end else None,
                 stick_points=line.count,
                 stick_rms=line.rms,
+                critical_stress_uncertainty=_times(abs(line.slope), start),
+                peak_stress_uncertainty=_times(abs(line.slope), end),
+                stick_time_uncertainty=math.hypot(start.time_uncertainty or 0.0, end.time_uncertainty or 0.0)
+                if start and end
+                else None,
                 message="; ".join(notes),
                 line=line,
                 stick_from=start.time if start else line.t_min,
@@ -730,6 +747,16 @@ def _jump(params: Parameters, peak: float | None) -> tuple[float | None, str]:
         return None, f"no jump velocity: peak stress {peak:.4g} Pa is not positive"
     result = jump_velocity(params, peak)
     return (result.velocity, "" if result.velocity is not None else f"no jump velocity: {result.message}")
+
+
+def _times(slope: float, corner: Corner | None) -> float | None:
+    """A stress's uncertainty at a corner of the stick line: the slope times the corner time's."""
+    return None if corner is None or corner.time_uncertainty is None else slope * corner.time_uncertainty
+
+
+def _whole_stick(cycles: list[CycleResult]) -> bool:
+    """Does any cycle show a stick phase from its start corner to its end corner?"""
+    return any(c.start_time is not None and c.peak_time is not None for c in cycles)
 
 
 def _stats(values: list[float]) -> dict[str, Any]:
@@ -769,11 +796,13 @@ def _summary(
 
 def _message(regime: str, cycles: list[CycleResult], coarse: Coarse, summary: dict[str, Any]) -> str:
     complete = sum(c.complete for c in cycles)
-    if regime == "stick-slip":
-        text = f"stick-slip: {len(cycles)} cycle(s), {complete} complete"
-        if not any(c.start_time is not None and c.peak_time is not None for c in cycles):
-            text += " (no whole stick phase: too short a record to tell stick-slip from a transient)"
-        return text
+    if regime == regimes.STICK_SLIP:
+        return f"stick-slip: {len(cycles)} cycle(s), {complete} complete"
+    if regime == regimes.UNDETERMINED:
+        return (
+            f"{regimes.UNDETERMINED}: {len(cycles)} cycle(s), none complete; no whole stick phase: too short a"
+            " record to tell stick-slip from a transient"
+        )
     if regime == "stuck":
         return "stuck: the stress rises along one stick line and never drops; no slip in the record"
     swings = summary.get("oscillation")

@@ -7,8 +7,9 @@ corner's stress is read off the fitted line, never from a single noisy sample (d
 
 from __future__ import annotations
 
+import dataclasses
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from scipy.optimize import minimize_scalar
@@ -25,6 +26,11 @@ QUADRATIC = (1.0, 2.0)
 QUADRATIC_MIN_SAMPLES = 6
 #: A branch is curved when a quadratic fits it better by this many noise variances.
 CURVATURE_CHI2 = 4.0
+#: The corner's shape uncertainty is sought with one more power only where the branch has this many samples
+#: beyond the number of its coefficients.
+SHAPE_SPARE_SAMPLES = 3
+#: ... and among this many samples either side of the corner.
+SHAPE_SAMPLES = 20
 
 
 @dataclass(frozen=True)
@@ -53,6 +59,13 @@ class Corner:
     branch_slope: float
     sse_gain: float
     significant: bool
+    #: how well the corner time is known apart from the scatter the noise gives it (s, systematic: the same in
+    #: every repeat of one cycle): the larger of the corner's shift when its slip branch gains the next power
+    #: (the bias of the branch's shape) and half the finer sampling interval beside it (docs/analysis.md);
+    #: None until :func:`with_time_uncertainty` has worked it out (it costs a second hinge fit)
+    time_uncertainty: float | None = None
+    #: what :func:`with_time_uncertainty` needs: the hinge's samples, line, side, search interval, branch and count
+    basis: tuple | None = field(default=None, repr=False, compare=False)
 
 
 def fit_line(t: np.ndarray, x: np.ndarray) -> Line | None:
@@ -105,9 +118,10 @@ def fit_corner(
     on_line = x - line(t)
     floor = max(noise, 1e-12 * max(1.0, float(np.max(np.abs(x)))))
     if powers is not None:
-        tc, total, branch_slope, _, _ = _hinge(t, x, on_line, line, sign, search, powers)
+        tc, total, branch_slope, _, count = _hinge(t, x, on_line, line, sign, search, powers)
         gain = _dot(on_line, on_line) - total
-        return Corner(tc, float(line(tc)), branch_slope, gain, bool(gain > CORNER_CHI2 * floor**2))
+        basis = (t, x, on_line, line, sign, search, powers, count)
+        return Corner(tc, float(line(tc)), branch_slope, gain, bool(gain > CORNER_CHI2 * floor**2), None, basis)
     first = _hinge(t, x, on_line, line, sign, search, STRAIGHT)
     gain = _dot(on_line, on_line) - first[1]
     significant = gain > CORNER_CHI2 * floor**2
@@ -116,6 +130,7 @@ def fit_corner(
     beyond = distance[distance > 0]  # t is sorted: ascending beyond the upper edge, descending below the lower
     beyond = beyond if branch_after else beyond[::-1]
     reach = float(beyond[-1])
+    shape = STRAIGHT
     while True:
         limit = reach if beyond.size <= MIN_BRANCH_SAMPLES else max(reach, float(beyond[MIN_BRANCH_SAMPLES - 1]))
         keep = distance <= limit
@@ -124,10 +139,40 @@ def fit_corner(
             break
         if limit <= float(beyond[min(MIN_BRANCH_SAMPLES, beyond.size) - 1]):
             if count >= QUADRATIC_MIN_SAMPLES:
-                tc, _, branch_slope, _, count = _hinge(t[keep], x[keep], on_line[keep], line, sign, search, QUADRATIC)
+                shape = QUADRATIC
+                tc, _, branch_slope, _, count = _hinge(t[keep], x[keep], on_line[keep], line, sign, search, shape)
             break
         reach *= BRANCH_SHRINK
-    return Corner(tc, float(line(tc)), branch_slope, gain, bool(significant))
+    basis = (t[keep], x[keep], on_line[keep], line, sign, search, shape, count)
+    return Corner(tc, float(line(tc)), branch_slope, gain, bool(significant), None, basis)
+
+
+def with_time_uncertainty(corner: Corner | None) -> Corner | None:
+    """``corner`` with its :attr:`Corner.time_uncertainty` worked out (a corner that has it, and None, pass).
+
+    The larger of the corner's shift when its slip branch gains the next power (``powers`` + one: a straight
+    branch gets a parabola, the start's c1 s + c2 s^2 a cubic) on the same samples, where the branch has samples
+    enough for it, and half the finer of the sampling intervals next to the corner (the interval holding it and
+    its two neighbours).  The branch's shape is an approximation (docs/analysis.md, "Start of a stick"): on a
+    noise-free record it biases the corner by the same amount in every repeat of a cycle, which no scatter over
+    cycles can show, and the two branches bracket the true corner in the measured cases.
+    """
+    if corner is None or corner.time_uncertainty is not None or corner.basis is None:
+        return corner
+    t, x, on_line, line, sign, search, powers, count = corner.basis
+    tc = corner.time
+    j = int(np.clip(np.searchsorted(t, tc), 1, t.size - 1))
+    steps = np.diff(t[max(j - 2, 0) : j + 2])
+    steps = steps[steps > 0]
+    half_step = 0.5 * float(np.min(steps)) if steps.size else 0.0
+    richer = (*powers, float(int(max(powers)) + 1))
+    shift = 0.0
+    if count >= len(richer) + SHAPE_SPARE_SAMPLES:
+        # sought among the samples next to the corner (a shift as far as the edge of them is reported as that)
+        first, last = float(t[max(j - SHAPE_SAMPLES, 0)]), float(t[min(j + SHAPE_SAMPLES, t.size - 1)])
+        near = (max(search[0], first), min(search[1], last))
+        shift = abs(_hinge(t, x, on_line, line, sign, near, richer)[0] - tc)
+    return dataclasses.replace(corner, time_uncertainty=max(shift, half_step), basis=None)
 
 
 def _adequate(t: np.ndarray, x: np.ndarray, line: Line, tc: float, sign: float, noise: float) -> bool:

@@ -48,6 +48,11 @@ CSV_COLUMNS = (
     ("slip_time", "s"),
     ("period", "s"),
     ("stress_drop", "Pa"),
+    # how well the corners are located, apart from the noise's scatter (systematic: the same in every repeat of a
+    # cycle); fit stick floors the error of each velocity's mean stick time with them
+    ("critical_stress_uncertainty", "Pa"),
+    ("peak_stress_uncertainty", "Pa"),
+    ("stick_time_uncertainty", "s"),
 )
 
 #: Units of the keys of ``--json`` that are particular to analyze (they win over the package's registry, where

@@ -196,6 +196,8 @@ def steady_command(
             from ..fitting.results import human  # not at module level: it imports lmfit (start-up time)
 
             header.append(f"Vc = {human(vc.value, 'velocity')}, σc = {human(sc.value, 'stress')} (Eq 9).")
+        else:
+            header.append(f"Vc, σc (Eq 9): {vc.note or 'not determined'}.")
         description = f"stickslip fit steady --method {fit.method} of {data}, start values from {params.name}"
         _write_fitted(output, fit.parameters, f"fit of {data.name}", description, header)
     report = fit.report() if posterior is None else fit.report() + "\n" + posterior.report()
@@ -217,6 +219,8 @@ def steady_command(
         emit_json(result)
     else:
         click.echo(report)
+    if fit.success and fit.critical_velocity.value is None:  # the curve fits; its minimum is not known (exit 0)
+        click.echo(f"stickslip: warning: Vc and σc: {fit.critical_velocity.note}", err=True)
     _exit_if_failed(fit, output)
 
 

@@ -590,7 +590,12 @@ def _critical_summaries(
         found = located[np.all(np.isfinite(located), axis=1)]
     missing = min(draws, chain.shape[0]) - len(found)
     if guess is None or len(found) < 10:
-        note = "too few posterior samples have a minimum of σ(V)"
+        # the least-squares fit's own reason where it gave no Vc (no minimum, or one the data do not determine)
+        note = (
+            fit.critical_velocity.note
+            if guess is None and fit.critical_velocity.note
+            else ("too few posterior samples have a minimum of σ(V)")
+        )
         messages.append(note)
         return (*undetermined_critical(note), np.zeros((0, 2)))
     note = f"posterior of {len(found)} random samples"

@@ -28,7 +28,7 @@ if TYPE_CHECKING:  # pragma: no cover
 MIN_STEADY_POINTS = 4
 #: Fewest rows of a stick table.
 MIN_STICK_ROWS = 2
-#: Velocities closer than this (relative) count as duplicates.
+#: Velocities closer than this (relative) count as one velocity: repeated measurements there (replicates).
 DUPLICATE_TOLERANCE = 1e-9
 
 STEADY_COLUMNS = {"velocity": "velocity", "stress": "stress", "stress_err": "stress"}
@@ -55,13 +55,21 @@ STICK_COLUMNS = {
     "stick_slope": "stress_rate",
     "stiffness": "stress_per_length",
     "jump_velocity": "velocity",
+    # a measurement's own systematic uncertainty (analyze -o writes them): floors of the fit's errors
+    "stick_time_uncertainty": "time",
+    "start_stress_uncertainty": "stress",
+    "peak_stress_uncertainty": "stress",
 }
+#: The uncertainty columns of a stick table (fit stick floors the error of each velocity's mean with them).
+STICK_UNCERTAINTIES = ("stick_time_uncertainty", "start_stress_uncertainty", "peak_stress_uncertainty")
 #: Stick-table columns that may have empty cells (``--`` in the paper's Table 1 becomes an empty cell).
-STICK_OPTIONAL_CELLS = ("peak_stress", "start_stress", "cycle", "stick_slope", "stiffness", "jump_velocity")
+STICK_OPTIONAL_CELLS = (
+    "peak_stress", "start_stress", "cycle", "stick_slope", "stiffness", "jump_velocity", *STICK_UNCERTAINTIES,
+)  # fmt: skip
 
 
 #: Columns of ``stickslip analyze -o`` (its cycles table) that a stick fit reads, and what it reads them as.
-CYCLES_COLUMNS = {"critical_stress": "start_stress"}
+CYCLES_COLUMNS = {"critical_stress": "start_stress", "critical_stress_uncertainty": "start_stress_uncertainty"}
 #: Columns of that table the stick fit does not use (times within the record, errors, the slip, the model's Vs).
 CYCLES_IGNORED = (
     "complete", "start_time", "peak_time", "end_time", "stick_slope_stderr", "stiffness_stderr",
@@ -83,12 +91,19 @@ class SteadyData:
     def __len__(self) -> int:
         return int(self.velocity.size)
 
+    @property
+    def velocities(self) -> int:
+        """How many distinct velocities the points are at (fewer than the points where some are repeated)."""
+        return _distinct_velocities(self.velocity)
+
     def notes(self) -> list[str]:
-        """What the reader left out (one line, or none)."""
-        if not self.ignored_columns:
-            return []
-        names = ", ".join(self.ignored_columns)
-        return [f"{self.source}: column(s) {names} not used by the steady fit (ignored)"]
+        """What the reader left out, and the repeated measurements it kept (a line each, or none)."""
+        out = []
+        if self.ignored_columns:
+            names = ", ".join(self.ignored_columns)
+            out.append(f"{self.source}: column(s) {names} not used by the steady fit (ignored)")
+        out.extend(_replicate_notes(self))
+        return out
 
     @classmethod
     def from_arrays(cls, velocity: Any, stress: Any, stress_err: Any = None, source: str = "data") -> SteadyData:
@@ -224,7 +239,10 @@ def _read_cycles_table(path: str | Path, names: Sequence[str]) -> StickData:
             " had one): analyze the trace again, or add a column 'pulling_velocity [m/s]' holding its --v0"
         )
     dimensions = {n: d for n, d in STICK_COLUMNS.items() if n in names and n not in ("start_stress", "jump_velocity")}
+    dimensions.pop("start_stress_uncertainty", None)
     dimensions["critical_stress"] = "stress"
+    if "critical_stress_uncertainty" in names:  # written by analyze since it reports its corners' uncertainty
+        dimensions["critical_stress_uncertainty"] = "stress"
     allowed = tuple(n for n in dimensions if n != "pulling_velocity")
     table = read_table(path, dimensions, required=["pulling_velocity", "stick_time"], allow_missing=allowed,
                        ignore=CYCLES_IGNORED)  # fmt: skip
@@ -265,6 +283,20 @@ def _require_positive(table: Table, names: Sequence[str]) -> None:
         )
 
 
+def _require_not_negative(table: Table, names: Sequence[str]) -> None:
+    """DataError at the first row where a named column (an uncertainty) is negative or infinite (empty is none)."""
+    for name in names:
+        if name not in table:
+            continue
+        bad = np.nonzero((table[name] < 0) | np.isinf(table[name]))[0]
+        if bad.size:
+            k = int(bad[0])
+            raise DataError(
+                f"{table.source}: row {table.rows[k]}, column {name!r}: expected a finite uncertainty >= 0 (or an"
+                f" empty cell), got {table[name][k]:g}"
+            )
+
+
 def _require_range(table: Table, name: str, bounds: tuple[float, float], unit: str, what: str) -> None:
     """DataError at the first row where column ``name`` is outside ``bounds`` (after the positivity check)."""
     if name not in table:
@@ -290,16 +322,51 @@ def _validated_steady(table: Table) -> SteadyData:
     for name in ("stress", "stress_err"):
         _require_range(table, name, STRESS_RANGE, "Pa", "a friction stress")
     v = table["velocity"]
-    order = np.argsort(v, kind="stable")
-    close = np.nonzero(np.diff(v[order]) <= DUPLICATE_TOLERANCE * v[order][1:])[0]
-    if close.size:
-        first, second = sorted((int(order[close[0]]), int(order[close[0] + 1])))
+    # repeated velocities are replicates, each row a point of the fit (their scatter measures the noise without the
+    # model); the curve still needs MIN_STEADY_POINTS velocities
+    distinct = _distinct_velocities(v)
+    if distinct < MIN_STEADY_POINTS:
         raise DataError(
-            f"{table.source}: row {table.rows[second]}, column 'velocity': duplicates the velocity of row"
-            f" {table.rows[first]} ({v[first]:g} m/s); average repeated measurements into one row with a stress_err"
+            f"{table.source}: {n} data rows at {distinct} distinct velocit{'y' if distinct == 1 else 'ies'}, expected"
+            f" at least {MIN_STEADY_POINTS} velocities to fit a friction curve (rows repeated at one velocity are"
+            " replicates: they measure the noise, not the curve's shape)"
         )
     err = table["stress_err"] if "stress_err" in table else None
     return SteadyData(v, table["stress"], err, table.rows, table.source)
+
+
+def _distinct_velocities(velocity: np.ndarray) -> int:
+    """The number of velocities, those closer than DUPLICATE_TOLERANCE (relative) counted once."""
+    v = np.sort(np.asarray(velocity, dtype=float))
+    return int(1 + np.count_nonzero(np.diff(v) > DUPLICATE_TOLERANCE * v[1:])) if v.size else 0
+
+
+def _replicate_notes(data: SteadyData) -> list[str]:
+    """A note on the repeated velocities (how many rows, at how many velocities), and one naming identical rows."""
+    n, distinct = len(data), data.velocities
+    if distinct == n:
+        return []
+    order = np.argsort(data.velocity, kind="stable")
+    v = data.velocity[order]
+    group = np.r_[0, np.cumsum(np.diff(v) > DUPLICATE_TOLERANCE * v[1:])]
+    repeated = int(np.count_nonzero(np.bincount(group) > 1))
+    out = [
+        f"{data.source}: {n} rows at {distinct} velocities ({repeated} of them measured more than once): each row is"
+        " a point of the fit, and the scatter of the repeated ones measures the noise without the model"
+    ]
+    err = np.zeros(n) if data.stress_err is None else data.stress_err[order]
+    same_order = np.lexsort((err, data.stress[order], group))  # identical rows side by side
+    key = np.column_stack((group, data.stress[order], err))[same_order]
+    same = np.flatnonzero(np.all(key[1:] == key[:-1], axis=1))
+    if same.size:
+        rows = data.rows[order][same_order]
+        pairs = [f"{min(rows[k], rows[k + 1])} and {max(rows[k], rows[k + 1])}" for k in same[:5]]
+        more = f", and {same.size - 5} more" if same.size > 5 else ""
+        out.append(
+            f"warning: {data.source}: identical rows ({'; '.join(pairs)}{more}): replicates that agree to every digit,"
+            " or a row entered twice? each counts as a measurement (a copy adds weight and no scatter)"
+        )
+    return out
 
 
 def _validated_stick(table: Table) -> StickData:
@@ -310,6 +377,7 @@ def _validated_stick(table: Table) -> StickData:
         table,
         ["pulling_velocity", "stick_time", "peak_stress", "start_stress", "stick_slope", "stiffness", "jump_velocity"],
     )
+    _require_not_negative(table, STICK_UNCERTAINTIES)
     for name, bounds, unit, what in (
         ("pulling_velocity", VELOCITY_RANGE, "m/s", "a pulling velocity"),
         ("jump_velocity", VELOCITY_RANGE, "m/s", "a sliding velocity"),
@@ -331,5 +399,6 @@ def _validated_stick(table: Table) -> StickData:
                 f"{table.source}: row {table.rows[k]}, column 'peak_stress': {peak[k]:g} Pa is not above the"
                 f" start_stress {start[k]:g} Pa of the same row"
             )
-    extra = {name: table[name] for name in ("cycle", "stick_slope", "stiffness", "jump_velocity") if name in table}
+    kept = ("cycle", "stick_slope", "stiffness", "jump_velocity", *STICK_UNCERTAINTIES)
+    extra = {name: table[name] for name in kept if name in table}
     return StickData(table["pulling_velocity"], table["stick_time"], peak, start, table.rows, extra, table.source)

@@ -2,7 +2,10 @@
 
 The pseudo-residuals of Gasser, Sroka and Jennen-Steinmetz (each interior point against the straight line
 through its two neighbours in ln V), with Satterthwaite degrees of freedom, so the steady fit's tests do not
-take the noise from a fit that may have ended far from the data (docs/fitting.md).
+take the noise from a fit that may have ended far from the data (docs/fitting.md).  Repeated velocities add their
+contrasts against each other (pure noise).  Whether the stress depends on velocity at all is asked of the data
+alone too: a polynomial trend in ln V (:func:`trend_dependence`) and, with repeats, the analysis of variance
+(:func:`replicate_dependence`), neither of which depends on where a model fit landed.
 """
 
 from __future__ import annotations
@@ -24,13 +27,15 @@ SIGNIFICANCE = 1e-3
 class Scatter:
     """Noise variance (``variance``, in units of the stated errors, or relative when none are stated) and its
     effective degrees of freedom, from neighbouring points; ``relative`` says which, ``of_residuals`` whether it
-    was measured on the data or on a fit's residuals (:func:`residual_scatter`)."""
+    was measured on the data or on a fit's residuals (:func:`residual_scatter`).  ``replicates``: how many of the
+    contrasts are between points at one velocity (repeated measurements: pure noise, no bend of the curve)."""
 
     variance: float
     dof: float
     relative: bool
     points: int
     of_residuals: bool = False
+    replicates: int = 0
 
     @property
     def scale(self) -> float:
@@ -43,6 +48,8 @@ class Scatter:
             if self.of_residuals
             else "each point about the line through its neighbours"
         )
+        if self.replicates:
+            what = f"{self.replicates} repeated measurement(s) against the others at their velocity, and {what}"
         return f"{size} (scatter of {what}, ≈{self.dof:.3g} degrees of freedom)"
 
 
@@ -77,26 +84,82 @@ def _neighbour_scatter(
     of_residuals: bool,
 ) -> Scatter:
     """Gasser-Sroka-Jennen-Steinmetz pseudo-residuals of ``values`` in ln V, in units of the errors (1 when none
-    are stated: ``values`` are then relative), with Satterthwaite degrees of freedom."""
-    order = np.argsort(velocity)
+    are stated: ``values`` are then relative), with Satterthwaite degrees of freedom.  Points at one velocity
+    (replicates) add their contrasts against each other and enter the neighbours' lines by their mean
+    (:func:`_contrasts`)."""
+    order = np.argsort(velocity, kind="stable")
     x = np.log(velocity[order])
     relative = stress_err is None
     y = values[order]
     e = np.ones_like(y) if relative else stress_err[order]  # type: ignore[index]
     n = x.size
-    if n < 3:
+    starts = _velocity_groups(x)
+    rows = n - 2 if starts.size >= 3 else n - starts.size
+    if rows < 1:
         return Scatter(math.inf, 0.0, relative, n, of_residuals)
-    c0, c1, c2 = _pseudo_rows(x, e)
-    # pseudo = B z with z = y/e standard noise and B banded (row i: columns i, i+1, i+2, unit rows)
-    pseudo = c0 * y[:-2] / e[:-2] + c1 * y[1:-1] / e[1:-1] + c2 * y[2:] / e[2:]
-    variance = float(pseudo @ pseudo) / (n - 2)
-    # Satterthwaite: s^2 = z^T B^T B z/(n - 2), tr(B^T B) = n - 2, tr((B^T B)^2) = |B B^T|_F^2 from its 3 diagonals
-    off1 = c1[:-1] * c0[1:] + c2[:-1] * c1[1:]
-    off2 = c2[:-2] * c0[2:]
-    square_trace = float(np.sum((c0**2 + c1**2 + c2**2) ** 2) + 2 * off1 @ off1 + 2 * off2 @ off2)
-    dof = (n - 2) ** 2 / square_trace
+    pseudo = _contrasts(x, y, e, starts)
+    variance = float(pseudo @ pseudo) / rows
+    # Satterthwaite: s^2 = z^T B^T B z/rows, tr(B^T B) = rows, tr((B^T B)^2) = |B B^T|_F^2: the replicates' contrasts
+    # are orthonormal and orthogonal to the means (an identity block), the neighbours' rows have 3 diagonals
+    square_trace = float(n - starts.size)
+    if starts.size >= 3:
+        c0, c1, c2 = _pseudo_rows(*_group_means(x, e, starts)[::2])
+        off1 = c1[:-1] * c0[1:] + c2[:-1] * c1[1:]
+        off2 = c2[:-2] * c0[2:]
+        square_trace += float(np.sum((c0**2 + c1**2 + c2**2) ** 2) + 2 * off1 @ off1 + 2 * off2 @ off2)
+    dof = rows**2 / square_trace
     floor = SCATTER_FLOOR**2 if relative else (SCATTER_FLOOR * float(np.median(stress / stress_err))) ** 2
-    return Scatter(max(variance, floor), dof, relative, n, of_residuals)
+    return Scatter(max(variance, floor), dof, relative, n, of_residuals, n - starts.size)
+
+
+#: ln V closer than this are one velocity: their points are replicates (as the reader's duplicate tolerance).
+SAME_VELOCITY = 1e-9
+
+
+def _velocity_groups(x: np.ndarray) -> np.ndarray:
+    """The first index of each run of one velocity in sorted ``x`` (ln V)."""
+    return np.flatnonzero(np.r_[True, np.diff(x) > SAME_VELOCITY])
+
+
+def _group_means(
+    x: np.ndarray, e: np.ndarray, starts: np.ndarray, y: np.ndarray | None = None
+) -> tuple[np.ndarray, np.ndarray | None, np.ndarray]:
+    """(ln V, weighted mean of ``y`` (None without ``y``), its error) of each velocity's points."""
+    w = 1.0 / e**2
+    total = np.add.reduceat(w, starts)
+    mean = None
+    if y is not None:
+        tail = (1,) * (y.ndim - 1)
+        mean = np.add.reduceat(w.reshape((-1, *tail)) * y, starts, axis=0) / total.reshape((-1, *tail))
+    return x[starts], mean, 1.0 / np.sqrt(total)
+
+
+def _contrasts(x: np.ndarray, y: np.ndarray, e: np.ndarray, starts: np.ndarray) -> np.ndarray:
+    """The unit-variance contrasts of ``y`` (sorted by ``x`` = ln V, errors ``e``; a trailing axis of draws
+    allowed): each repeated point against the weighted mean of those before it at its velocity (Helmert: pure
+    noise, independent of each other and of the means), then each velocity's mean against the straight line through
+    its neighbours' (:func:`_pseudo_rows`).  Without repeated velocities, exactly the neighbours' pseudo-residuals."""
+    n = x.size
+    shape = y.shape[1:]
+
+    def col(a: np.ndarray) -> np.ndarray:  # a per-point factor, broadcast over the draws
+        return a.reshape((-1, *(1,) * len(shape)))
+
+    parts = []
+    if starts.size < n:
+        w = 1.0 / e**2
+        first = starts[np.cumsum(np.isin(np.arange(n), starts)) - 1]  # the first point at each point's velocity
+        later = np.flatnonzero(np.arange(n) != first)  # every point but the first at its velocity
+        cum_w = np.r_[0.0, np.cumsum(w)]
+        cum_wy = np.concatenate((np.zeros((1, *shape)), np.cumsum(col(w) * y, axis=0)), axis=0)
+        prev_w = cum_w[later] - cum_w[first[later]]  # the points before it at its velocity
+        prev_mean = (cum_wy[later] - cum_wy[first[later]]) / col(prev_w)
+        parts.append((y[later] - prev_mean) / col(np.sqrt(e[later] ** 2 + 1.0 / prev_w)))
+    if starts.size >= 3:
+        xg, mean, eg = _group_means(x, e, starts, y)
+        c0, c1, c2 = (col(c / g) for c, g in zip(_pseudo_rows(xg, eg), (eg[:-2], eg[1:-1], eg[2:]), strict=True))
+        parts.append(c0 * mean[:-2] + c1 * mean[1:-1] + c2 * mean[2:])
+    return np.concatenate(parts, axis=0) if parts else np.zeros((0, *shape))
 
 
 def _pseudo_rows(x: np.ndarray, e: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -106,6 +169,23 @@ def _pseudo_rows(x: np.ndarray, e: np.ndarray) -> tuple[np.ndarray, np.ndarray, 
     w_left, w_right = h_right / (h_left + h_right), h_left / (h_left + h_right)
     sd = np.sqrt(e[1:-1] ** 2 + (w_left * e[:-2]) ** 2 + (w_right * e[2:]) ** 2)
     return -w_left * e[:-2] / sd, e[1:-1] / sd, -w_right * e[2:] / sd
+
+
+def replicate_scatter(velocity: np.ndarray, stress: np.ndarray, stress_err: np.ndarray | None) -> Scatter | None:
+    """The scatter of repeated measurements at one velocity alone (pure error: no model, no bend), relative (of
+    ln σ) or in units of the stated errors; None without repeated velocities."""
+    order = np.argsort(velocity, kind="stable")
+    x = np.log(velocity[order])
+    starts = _velocity_groups(x)
+    n = x.size
+    if starts.size == n:
+        return None
+    relative = stress_err is None
+    y = np.log(stress[order]) if relative else stress[order]
+    e = np.ones(n) if relative else stress_err[order]  # type: ignore[index]
+    pseudo = _contrasts(x, y, e, starts)[: n - starts.size]
+    variance = float(pseudo @ pseudo) / (n - starts.size)
+    return Scatter(variance, float(n - starts.size), relative, n, False, n - starts.size)
 
 
 #: Draws of the misfit ratio under pure noise (:func:`misfit_p_value`); p below 1/DRAWS reads as 1/DRAWS.
@@ -128,13 +208,12 @@ def misfit_p_value(velocity: np.ndarray, stress_err: np.ndarray | None, ratio: f
     n = velocity.size
     if n < 4 or not math.isfinite(ratio) or scatter.variance <= 0.0:
         return 1.0
-    order = np.argsort(velocity)
+    order = np.argsort(velocity, kind="stable")
     e = np.ones(n) if stress_err is None else stress_err[order]
-    c0, c1, c2 = _pseudo_rows(np.log(velocity[order]), e)
     if n > DRAWN_POINTS:
         sd = math.sqrt(max(2.0 / scatter.dof - 2.0 / n, 2.0 / n**2)) if scatter.dof > 0 else math.inf
         return float(stats.norm.sf((ratio - 1.0) / sd))
-    null = _null_ratios(c0, c1, c2)
+    null = _null_ratios(np.log(velocity[order]), e)
     above = DRAWS - int(np.searchsorted(null, ratio, side="left"))
     return float((1 + above) / (1 + DRAWS))
 
@@ -142,15 +221,17 @@ def misfit_p_value(velocity: np.ndarray, stress_err: np.ndarray | None, ratio: f
 _NULLS: dict[bytes, np.ndarray] = {}
 
 
-def _null_ratios(c0: np.ndarray, c1: np.ndarray, c2: np.ndarray) -> np.ndarray:
-    """The misfit ratio's draws under pure noise for these neighbour weights, sorted (one fit asks several
-    times for the same points: remembered for the last few sets)."""
-    key = np.concatenate((c0, c1, c2)).tobytes()
+def _null_ratios(x: np.ndarray, e: np.ndarray) -> np.ndarray:
+    """The misfit ratio's draws under pure noise for these velocities (``x`` = ln V, sorted) and errors, sorted
+    (one fit asks several times for the same points: remembered for the last few sets)."""
+    key = np.concatenate((x, e)).tobytes()
     if key not in _NULLS:
-        n = c1.size + 2
+        n = x.size
+        starts = _velocity_groups(x)
+        rows = n - 2 if starts.size >= 3 else n - starts.size
         z = np.random.default_rng(20261130).standard_normal((DRAWS, n))
-        pseudo = c0 * z[:, :-2] + c1 * z[:, 1:-1] + c2 * z[:, 2:]
-        null = (np.einsum("ij,ij->i", z, z) / n) / (np.einsum("ij,ij->i", pseudo, pseudo) / (n - 2))
+        pseudo = _contrasts(x, (z * e).T, e, starts)
+        null = (np.einsum("ij,ij->i", z, z) / n) / (np.einsum("ij,ij->j", pseudo, pseudo) / max(rows, 1))
         if len(_NULLS) >= 8:
             _NULLS.pop(next(iter(_NULLS)))
         _NULLS[key] = np.sort(null)
@@ -196,12 +277,81 @@ class Dependence:
     spread: float  # rms of ln(stress) about its mean (relative) or of (stress - mean)/error
     significant: bool
     text: str
+    #: p of the test against the scatter between neighbours alone, and the polynomial trend test (None: not made)
+    neighbours_p: float = math.nan
+    trend: Trend | None = None
+    #: the tests of the data alone besides the neighbours' (the trend, the repeated measurements), in words
+    others: str = ""
 
 
-def velocity_dependence(stress: np.ndarray, stress_err: np.ndarray | None, scatter: Scatter) -> Dependence:
+#: Highest degree of the polynomials in ln V of :func:`trend_dependence`.
+TREND_DEGREE = 3
+
+
+@dataclass(frozen=True)
+class Trend:
+    """A polynomial in ln V against a constant (:func:`trend_dependence`)."""
+
+    p_value: float  # Bonferroni-corrected over the degrees tried
+    degree: int  # the degree with the smallest p (0: no test was possible)
+    degrees: int  # how many degrees were tried
+
+    def tried(self) -> str:
+        degrees = "degree 1" if self.degrees == 1 else f"degrees 1 to {self.degrees}, Bonferroni-corrected"
+        return f"F test against its own residuals, {degrees}"
+
+    def describe(self) -> str:
+        if not self.degrees:
+            return "too few velocities for a polynomial in ln V"
+        return (
+            f"a polynomial in ln V against a constant ({self.tried()}; best degree {self.degree}):"
+            f" p = {self.p_value:.2g}"
+        )
+
+
+def trend_dependence(velocity: np.ndarray, stress: np.ndarray, stress_err: np.ndarray | None) -> Trend:
+    """p of "the stress is constant" against a polynomial trend of ln σ in ln V, from the data alone.
+
+    For each degree d = 1 … ``TREND_DEGREE`` (fewer where the points leave the noise under 2 degrees of freedom, or
+    the velocities are fewer than d + 1) the nested F test of the constant within the least-squares polynomial,
+    F(d, n − d − 1), its noise the polynomial's own residuals (weighted by (σ/stress_err)² with stated errors,
+    whose scale does not enter); the smallest p times the number of degrees tried (Bonferroni).  Exact for Gaussian
+    noise in ln σ whatever the start values of any model fit: a curve rising by a factor 3.6 over six points is
+    no constant (p = 2.4e-4), while the scatter between neighbours, which counts its bend as noise, said p = 0.004.
+    The model's fit is not needed to see a trend, only to see a curve a cubic cannot follow."""
+    n = stress.size
+    x = np.log(velocity)
+    distinct = int(np.unique(np.round(x / SAME_VELOCITY)).size) if n else 0
+    degrees = max(min(TREND_DEGREE, n - 3, distinct - 1), 0)
+    if degrees < 1:
+        return Trend(1.0, 0, 0)
+    x = (x - float(np.mean(x))) / (float(np.std(x)) or 1.0)
+    y = np.log(stress)
+    root_w = np.ones(n) if stress_err is None else stress / stress_err
+    level = float(np.sum(root_w**2 * y) / np.sum(root_w**2))
+    flat = float(np.sum((root_w * (y - level)) ** 2))
+    if not flat > 0.0:
+        return Trend(1.0, 0, degrees)
+    best, best_degree = 1.0, 1
+    for d in range(1, degrees + 1):
+        design = np.vander(x, d + 1) * root_w[:, None]
+        coef = np.linalg.lstsq(design, root_w * y, rcond=None)[0]
+        left = float(np.sum((root_w * y - design @ coef) ** 2))
+        left = max(left, flat * 1e-28)  # the values' rounding: no residual is below it
+        p = float(stats.f.sf(((flat - left) / d) / (left / (n - d - 1)), d, n - d - 1)) if left < flat else 1.0
+        if p < best:
+            best, best_degree = p, d
+    return Trend(min(1.0, degrees * best), best_degree, degrees)
+
+
+def velocity_dependence(
+    stress: np.ndarray, stress_err: np.ndarray | None, scatter: Scatter, velocity: np.ndarray | None = None
+) -> Dependence:
     """Does the stress vary by more than its noise?  F test of the spread about a constant against the
     scatter between neighbours; with stated errors also the chi-square of a constant, and the larger p of
-    the two (a dependence is claimed only when both noise estimates say so)."""
+    the two (a dependence is claimed only when both noise estimates say so).  With ``velocity`` also the trend test
+    (:func:`trend_dependence`): a dependence is claimed when either test finds one (each at ``SIGNIFICANCE``), so
+    a curve whose bend the neighbours count as noise is not called flat.  Both use the data alone."""
     n = stress.size
     if stress_err is None:
         y = np.log(stress)
@@ -234,7 +384,47 @@ def velocity_dependence(stress: np.ndarray, stress_err: np.ndarray | None, scatt
     else:
         test = f"F test: p = {p_f:.2g}; χ² test against the stated errors: p = {p_chi:.2g}"
     text = f"the stress varies by {size}, against a scatter of {noise} between neighbouring points ({test})"
-    return Dependence(p, spread, p <= SIGNIFICANCE, text)
+    trend = None
+    combined = p
+    others = []
+    if velocity is not None and spread2 > 0.0:
+        trend = trend_dependence(velocity, stress, stress_err)
+        combined = min(p, trend.p_value)
+        others.append(trend.describe())
+        between = replicate_dependence(velocity, stress, stress_err)
+        if between is not None:
+            combined = min(combined, between)
+            others.append(
+                "the velocities' means against the scatter of the repeated measurements (one-way analysis of"
+                f" variance, F test): p = {between:.2g}"
+            )
+    text += "".join(f"; {other}" for other in others)
+    return Dependence(combined, spread, combined <= SIGNIFICANCE, text, p, trend, "; ".join(others))
+
+
+def replicate_dependence(velocity: np.ndarray, stress: np.ndarray, stress_err: np.ndarray | None) -> float | None:
+    """p of "the stress is constant" from repeated measurements: the one-way analysis of variance of ln σ (weights
+    (σ/stress_err)² with stated errors, whose scale does not enter), the spread of the velocities' means against the
+    scatter within them, F(G − 1, n − G) for n points at G velocities; exact for Gaussian noise, and blind to
+    nothing a curve does between the velocities.  None without repeated velocities (or without scatter in them)."""
+    order = np.argsort(velocity, kind="stable")
+    x = np.log(velocity[order])
+    starts = _velocity_groups(x)
+    n, groups = x.size, starts.size
+    if groups == n or groups < 2:
+        return None
+    y = np.log(stress[order])
+    e = np.ones(n) if stress_err is None else (stress_err / stress)[order]
+    w = 1.0 / e**2
+    _, mean, _ = _group_means(x, e, starts, y)
+    assert mean is not None
+    sizes = np.diff(np.r_[starts, n])
+    within = float(np.sum(w * (y - np.repeat(mean, sizes)) ** 2))
+    level = float(np.sum(w * y) / np.sum(w))
+    between = float(np.sum(np.add.reduceat(w, starts) * (mean - level) ** 2))
+    if not within > 0.0:
+        return None
+    return float(stats.f.sf((between / (groups - 1)) / (within / (n - groups)), groups - 1, n - groups))
 
 
 def agrees_with_stated_errors(scatter: Scatter) -> bool:

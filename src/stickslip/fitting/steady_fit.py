@@ -53,6 +53,7 @@ from .scatter import (
     misfit,
     model_dependence,
     outlying,
+    replicate_scatter,
     residual_scatter,
     velocity_dependence,
 )
@@ -583,7 +584,7 @@ def _fit_steady(
     noise_known = data.stress_err is not None
     # the noise measured without the model: a fit far from the data must not set the yardstick it is judged by
     scatter = local_scatter(data.velocity, data.stress, data.stress_err)
-    dependence = velocity_dependence(data.stress, data.stress_err, scatter)
+    dependence = velocity_dependence(data.stress, data.stress_err, scatter, data.velocity)
     check = _Check(
         method, data, base, requested, explicit, fixed, split, scatter, intervals, level, bootstrap_samples, seed
     )
@@ -592,13 +593,16 @@ def _fit_steady(
     stated, everything, hi, lo = _blocks(data, split, base)  # the stated errors (or the stress: relative)
     if not dependence.significant:
         # the neighbours' scatter counts a curve's bend between few points as noise: the method's own fit decides
-        fitted_anyway = _fit_of_a_flat_looking_curve(check, (everything, hi, lo))
+        fitted_anyway = _fit_of_a_flat_looking_curve(check, (everything, hi, lo), dependence)
         if isinstance(fitted_anyway, str):  # noise: say so (a joint fit of it ran 92 s before issue 29, now ~0.3 s)
             return _no_response_fit(check, dependence, fitted_anyway)
         progress, keys = fitted_anyway
     else:
         _require_finite_start(everything, base, fixed)
         progress, keys = _run_method(check, (everything, hi, lo))
+    # a dependence the neighbours' scatter missed and the data's trend shows: said once, whatever refits follow
+    missed = dependence.neighbours_p > SIGNIFICANCE >= dependence.p_value
+    trend_notes = [_trend_note(check, dependence)] if missed else []
     progress, keys, adequacy = _adequate_or_searched(check, progress, keys, (everything, hi, lo))
     if not _interpolation_holds((everything, hi, lo), progress.params):
         # the curve changed shape on the way from the start: interpolate where the fit ended, and fit again
@@ -667,7 +671,7 @@ def _fit_steady(
     noise += (
         f"; between neighbouring points, of the fit's residuals: {own_scatter.describe()}; of the data without the"
         f" model (which counts the curve's bend between neighbours as noise): {scatter.describe()}"
-    )
+    ) + _replicate_noise(data, noise_scale if not noise_known else None)
     misfits = adequacy.problems()
     own, best = adequacy.method_fit, adequacy.model
     if method == "two-step" and not misfits and best.chi_square < SPLIT_MISFIT_SHARE * own.chi_square:
@@ -686,7 +690,10 @@ def _fit_steady(
             vc, sc, estimates, combos = _flag_split_bias(
                 (vc, sc, estimates, combos), fitted, everything, keys, scale2, level, progress, adequacy.refit
             )
-        _note_extrapolation(progress, vc, data)
+        said = len(progress.messages)
+        vc, sc = _pinned_by_the_data(check, progress, keys, (vc, sc), noise_known)
+        if len(progress.messages) == said:  # what it says includes the extrapolation
+            _note_extrapolation(progress, vc, data)
     joint_model = None  # two-step: its residuals carry the split approximation's smooth misfit, which can hide a point
     if method == "two-step" and adequacy.refit is not None:
         try:
@@ -721,12 +728,30 @@ def _fit_steady(
         interval_method=intervals,
         level=level,
         stages=tuple(progress.stages),
-        messages=tuple(data.notes() + progress.messages),
+        messages=tuple(data.notes() + trend_notes + progress.messages),
         samples=samples,
         status="failed" if problems else "ok",
         reason="; ".join(problems),
         stated_errors_scaled=check.scaled_errors,
     )
+
+
+def _replicate_noise(data: SteadyData, estimated: float | None) -> str:
+    """The noise line's clause on the repeated velocities: their scatter alone, which needs neither the model nor
+    the curve's shape (pure error), beside the scale the fit estimated (``estimated``, relative or in units of the
+    stated errors; None: not estimated)."""
+    pure = replicate_scatter(data.velocity, data.stress, data.stress_err)
+    if pure is None:
+        return ""
+    size = f"{100 * pure.scale:.3g} % of the stress" if pure.relative else f"{pure.scale:.3g} stated errors"
+    text = (
+        f"; of the {pure.replicates} repeated measurement(s) alone, each against the others at its velocity"
+        f" (no model, no bend): {size}, {pure.dof:.0f} degrees of freedom, part of every test of the fit against"
+        " the noise"
+    )
+    if estimated is not None and pure.variance > 0:
+        text += f"; the fit's residuals, which include them, give {estimated / pure.scale:.3g} times it"
+    return text
 
 
 def _errors_too_small(check: _Check, adequacy: _Adequacy, free: int) -> str:
@@ -983,13 +1008,23 @@ def _adequate_or_searched(
     return progress, keys, _Adequacy(best_model, own, check.method, found.evaluations)
 
 
+def _trend_note(check: _Check, dependence: Dependence) -> str:
+    """Why a curve the neighbours' scatter finds flat is fitted: its trend in ln V, from the data alone."""
+    return (
+        f"the scatter between neighbouring points ({check.scatter.describe()}) counts the curve's own bend between"
+        f" these {len(check.data)} points as noise, and against it the stress's variation is not significant (p ="
+        f" {dependence.neighbours_p:.2g}); the other tests of the data alone show the velocity dependence:"
+        f" {dependence.others}"
+    )
+
+
 def _fit_of_a_flat_looking_curve(
-    check: _Check, blocks: tuple[Block, Block, Block]
+    check: _Check, blocks: tuple[Block, Block, Block], dependence: Dependence
 ) -> tuple[_Progress, list[str]] | str:
-    """The method's fit of data in which the scatter between neighbours finds no velocity dependence, where the
-    fit does find one (:func:`~stickslip.fitting.scatter.model_dependence` or
-    :func:`~stickslip.fitting.scatter.fitted_dependence` at the same significance); else what the fit found ('' if
-    it could not be made).
+    """The method's fit of data in which the tests of the data alone (the scatter between neighbours, the trend in
+    ln V, the replicates) find no velocity dependence, where the fit does find one
+    (:func:`~stickslip.fitting.scatter.model_dependence` or :func:`~stickslip.fitting.scatter.fitted_dependence` at
+    the same significance); else what the fit found ('' if it could not be made).
 
     Few points far apart on a curved σ(V) look like noise to that scatter (ten exact points of the model: p =
     0.02, "no velocity dependence"); flat data and noise stay failed: the model does not explain them better
@@ -1022,11 +1057,13 @@ def _fit_of_a_flat_looking_curve(
         how = f"χ² of a constant against the stated errors, which the fit's residuals bear out ({noise.describe()})"
     else:
         how = f"F test of a constant against the noise the fit leaves, {noise.describe()}"
+    polynomial = f"; {dependence.others}" if dependence.others else ""
     progress.messages.append(
-        f"the scatter between neighbouring points ({check.scatter.describe()}) finds no velocity dependence"
-        f" in these {len(data)} points: it counts the curve's own bend between them as noise; the model's fit"
-        f" does (rms misfit {100 * rms:.3g} %; {how}: p = {against:.2g}; F test of a constant nested in the"
-        f" model: p = {nested:.2g}), and the noise is measured from its residuals"
+        f"the tests of the data alone do not settle whether the stress of these {len(data)} points depends on"
+        f" velocity (p = {dependence.neighbours_p:.2g} against the scatter between neighbouring points,"
+        f" {check.scatter.describe()}, which counts the curve's own bend between them as noise{polynomial}); the"
+        f" model's fit shows the dependence (rms misfit {100 * rms:.3g} %; {how}: p = {against:.2g}; F test of a"
+        f" constant nested in the model: p = {nested:.2g}), and the noise is measured from its residuals"
     )
     return progress, keys
 
@@ -1057,8 +1094,10 @@ def _no_response_fit(check: _Check, dependence: Dependence, fitted: str = "") ->
         for c in identify.COMBINATIONS
     )
     noise = (
-        "stated stress_err" if data.stress_err is not None else "relative"
-    ) + f"; between neighbouring points: {check.scatter.describe()}"
+        ("stated stress_err" if data.stress_err is not None else "relative")
+        + f"; between neighbouring points: {check.scatter.describe()}"
+        + _replicate_noise(data, None)
+    )
     vc, sc = undetermined_critical(why)
     return SteadyFit(
         data=data,
@@ -1320,6 +1359,109 @@ def _note_extrapolation(progress: _Progress, vc: Estimate, data: SteadyData) -> 
             f"Vc = {human(vc.value, 'velocity')} lies outside the measured range"
             f" {human(lo, 'velocity')} to {human(hi, 'velocity')}: it is an extrapolation of the fitted curve"
         )
+
+
+#: Fewest residual degrees of freedom the fit with the held keys fitted too must leave for an extrapolated Vc to
+#: be a measurement (:func:`_pinned_by_the_data`).
+RELEASED_DOF = 2
+#: The start of the note of a Vc and σc the data do not determine.
+NOT_PINNED = "not determined by the data"
+
+
+def _pinned_by_the_data(
+    check: _Check, progress: _Progress, keys: Sequence[str], critical: tuple[Estimate, Estimate], noise_known: bool
+) -> tuple[Estimate, Estimate]:
+    """Vc and σc as estimated, or undetermined where the data hold no minimum and do not pin it.
+
+    The data hold a minimum when points lie on both sides of it; the fitted curve's minimum below the second
+    velocity measured (or above the second-highest) is an extrapolation of the curve's shape.  That shape is data
+    only where the data determine it.  Vc and σc are given as undetermined (no value, no interval; the notes say
+    why, in words) when such an extrapolated minimum
+
+    * rests on an aging key held because the data do not determine it (``aging.aging_time``, ``aging.aging_velocity``:
+      the aging branch that turns the curve down below Vc is what the data do not reach): six points rising from
+      200 µm/s to 8 mm/s gave, holding Va (and λ) at the start values, Vc = 173.8 µm/s [154, 190.9] from the
+      default start and 36.7 [21.4, 49.2] from another, each "ok";
+    * or leaves, with its held keys fitted too, fewer than ``RELEASED_DOF`` degrees of freedom (the model would all
+      but pass through the points: with 2 % stated errors on the six points some starts held only λ);
+    * or has a profile interval open on one side (kept as that one-sided bound).
+
+    A minimum extrapolated with only λ held (the Eyring near-degeneracy, docs/fitting.md) stays: on the shipped
+    synthetic curve (Vc 124.1 µm/s, data from 140 µm/s) the profile with λ fitted too is [108.4, 144.9] µm/s from
+    every start tried, against [108.1, 140.8] with λ held."""
+    vc, sc = critical
+    data = check.data
+    velocities = np.unique(data.velocity)
+    low, high = float(velocities[0]), float(velocities[-1])
+    # a minimum the data hold has points on both sides: one point beyond it shows no turn
+    if vc.value is None or float(velocities[1]) <= vc.value <= float(velocities[-2]):
+        return vc, sc
+    below = vc.value < float(velocities[1])
+    if low <= vc.value <= high:
+        pair = (low, float(velocities[1])) if below else (float(velocities[-2]), high)
+        where = f"between the {'two lowest' if below else 'two highest'} velocities measured"
+        where += f" ({human(pair[0], 'velocity')} and {human(pair[1], 'velocity')}), with one point beyond it"
+    else:
+        where = f"{'below' if below else 'above'} the measured range ({human(low, 'velocity')} to"
+        where += f" {human(high, 'velocity')})"
+    found = f"the fitted curve's minimum, Vc = {human(vc.value, 'velocity', 4)} (σc = {human(sc.value, 'stress', 4)})"  # type: ignore[arg-type]
+    found += f", lies {where}{_edge_shape(progress.params, low if below else high, below)}"
+    ends = (None, None) if vc.interval is None else vc.interval
+    if vc.interval is not None and None in ends:
+        return _withdrawn(progress, f"{NOT_PINNED}: {found}, and the data do not bound it on one side", ends, below)
+    interval = "" if None in ends else f" [{human(ends[0], 'velocity', 4)}, {human(ends[1], 'velocity', 4)}]"  # type: ignore[arg-type]
+    aging = [k for k in progress.undetermined if k in identify.AGING_KEYS]
+    released = len(data) - len(keys) - len(progress.undetermined)
+    if aging:
+        why = (
+            f"{NOT_PINNED}: {found}; where the curve turns there is set by its aging branch, and the data do not"
+            f" determine {', '.join(f'{k} ({identify.SYMBOLS[k]})' for k in aging)}, held at the value given: its"
+            f" interval{interval} holds only for that value, and another value the data allow as well puts the"
+            " minimum elsewhere"
+        )
+    elif progress.undetermined and released < RELEASED_DOF:
+        why = (
+            f"{NOT_PINNED}: {found}; its interval{interval} holds only with {', '.join(progress.undetermined)} at the"
+            f" values given, which the data do not determine, and fitted too they leave {len(data)} points"
+            f" {max(released, 0)} degree(s) of freedom: the model would all but pass through them"
+        )
+    else:
+        return vc, sc
+    return _withdrawn(progress, why, (None, None), below)
+
+
+def _withdrawn(
+    progress: _Progress, why: str, bound: tuple[float | None, float | None], below: bool
+) -> tuple[Estimate, Estimate]:
+    """Vc and σc undetermined (``why``, said in the notes too); Vc keeps a one-sided ``bound`` where it has one."""
+    lo, hi = bound
+    one_sided = (lo is None) != (hi is None)
+    if one_sided:
+        side = f"below {human(hi, 'velocity', 4)}" if hi is not None else f"above {human(lo, 'velocity', 4)}"
+        why += f"; the data bound it on one side only: Vc {side}"
+    progress.messages.append(
+        f"Vc and σc are {why}; no value is given{'' if one_sided else ' and no interval'} (measure"
+        f" {'lower' if below else 'higher'} velocities, where the minimum is, to determine them)"
+    )
+    short = why.split(";")[0]
+    return (
+        Estimate(*CRITICAL[0], None, None, bound if one_sided else None, "undetermined", short),
+        Estimate(*CRITICAL[1], None, None, None, "undetermined", short),
+    )
+
+
+def _edge_shape(params: Parameters, edge: float, below: bool) -> str:
+    """', where the fitted curve rises (falls) from the lowest (highest) velocity: the data hold no minimum'."""
+    try:
+        slope = float(np.atleast_1d(steady_state(params, edge).stress_slope)[0])
+    except (ModelError, ParameterError):  # pragma: no cover - the fitted curve is evaluated at the data
+        return ""
+    if slope == 0 or (slope > 0) != below:
+        return ""
+    return (
+        f", where the fitted curve {'rises from the lowest' if below else 'falls to the highest'} velocity measured:"
+        " the data hold no minimum"
+    )
 
 
 def _critical_estimates(

@@ -9,6 +9,7 @@ ln(model/measured); a direction the data do not determine is fixed with a messag
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
@@ -72,6 +73,9 @@ class StickFit:
     messages: tuple[str, ...]
     status: str = "ok"  # "failed" when the fit cannot be trusted; ``reason`` says why
     reason: str = ""
+    #: velocities whose mean's error was floored by the table's own uncertainties:
+    #: (pulling velocity m/s, floor, scatter of the mean; both relative, in ln t_s)
+    floors: tuple[tuple[float, float, float], ...] = ()
 
     __repr__ = compact_repr  # counts, not hundreds of array elements
 
@@ -104,6 +108,10 @@ class StickFit:
             "noise": self.noise,
             "relative_noise": self.noise_scale,
             "confidence_level": self.level,
+            "error_floors": [
+                {"pulling_velocity": v, "relative_floor": floor, "relative_scatter": scatter}
+                for v, floor, scatter in self.floors
+            ],
             "correlation": {"keys": list(self.free_keys), "matrix": self.correlation.tolist()},
             "rows": [
                 {
@@ -159,6 +167,11 @@ class _Rows:
     rate: np.ndarray  # d sigma/dt in the stick phase, Pa/s
     stick_time: np.ndarray
     peak: np.ndarray | None  # only when fitted
+    #: the rows' own systematic uncertainties (the table's *_uncertainty columns; 0 where not given): start stress
+    #: (Pa), stick time (s), peak stress (Pa)
+    start_err: np.ndarray | None = None
+    time_err: np.ndarray | None = None
+    peak_err: np.ndarray | None = None
 
 
 def _params_for_rate(params: Parameters, velocity: float, rate: float) -> Parameters:
@@ -384,7 +397,10 @@ def fit_stick(
     scale2 = chi / dof if dof > 0 else float("nan")
     theta = np.array([math.log(current.as_dict()[k]) for k in keys])
     jac = _jacobian(current, keys, theta, rows) if keys else np.zeros((n_obs, 0))
-    covariance = scale2 * np.linalg.pinv(jac.T @ jac) if keys else np.zeros((0, 0))
+    covariance, floors = np.zeros((0, 0)), []
+    if keys:  # the scatter's covariance, floored at each velocity by the table's own uncertainties (if any)
+        covariance, floors = _covariance(jac, scale2, _floors(current, rows), _blocks(rows))
+    messages.extend(_floor_messages(floors))
     sd = np.sqrt(np.clip(np.diag(covariance), 0, np.inf))
     correlation = covariance / np.outer(sd, sd) if keys else np.zeros((0, 0))
     q = float(stdtrit(max(dof, 1), 0.5 + level / 2))  # Student-t quantile (scipy.stats costs 0.2 s to import)
@@ -433,7 +449,103 @@ def fit_stick(
         messages=tuple(messages),
         status="failed" if problems else "ok",
         reason="; ".join(problems),
+        floors=tuple(floors),
     )
+
+
+def _floors(params: Parameters, rows: _Rows) -> np.ndarray:
+    """Each observation's own systematic standard uncertainty in ln (the stick times', then the peak stresses' when
+    fitted; zeros where the table gives none), from the table's ``*_uncertainty`` columns (docs/fitting.md).
+
+    The start stress's is carried into ln t_s by the model's own derivative d ln t_s / d sigma_0 and added in
+    quadrature to the stick time's.  Where the start and the peak stress both have one and the peaks are not
+    fitted (analyze's cycles: the corners of a measured stick line) they are read as the corners' time
+    uncertainties dt0 = u(sigma_c)/rate and dt1 = u(sigma_s)/rate, which move sigma_c and t_s together.  The
+    columns are bounds (the error lies within +-u): the standard uncertainty is u/sqrt(3) (a uniform error).
+    """
+    n = rows.stick_time.size
+    size = n if rows.peak is None else 2 * n
+    start_err = _or_zeros(rows.start_err, n)
+    time_err = _or_zeros(rows.time_err, n)
+    peak_err = _or_zeros(rows.peak_err, n)
+    if not (np.any(start_err > 0) or np.any(time_err > 0) or (rows.peak is not None and np.any(peak_err > 0))):
+        return np.zeros(size)
+    step = FLOOR_STEP * rows.start
+    shifted = [dataclasses.replace(rows, start=rows.start + sign * step) for sign in (1.0, -1.0)]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        times = _stick_times([params], rows)[0]
+        up, down = (_stick_times([params], r)[0] for r in shifted)
+        dlog_t = (np.log(up) - np.log(down)) / (2 * step)
+        floors = np.hypot(dlog_t * start_err, time_err / rows.stick_time)
+        if rows.peak is None and rows.start_err is not None and rows.peak_err is not None:
+            # the corners of a measured stick line (analyze's cycles): sigma_c = L(t0), sigma_s = L(t1), t_s = t1 - t0,
+            # so an uncertainty dt0 of the start moves sigma_c by rate dt0 and t_s by -dt0 together, and
+            # ln(model/measured) by dt0 (rate d ln t_s/d sigma_0 + 1/t_s): the two partly cancel
+            start_time, end_time = start_err / rows.rate, peak_err / rows.rate
+            corners = np.hypot(start_time * (rows.rate * dlog_t + 1.0 / rows.stick_time), end_time / rows.stick_time)
+            floors = np.where((start_err > 0) & (peak_err > 0), corners, floors)
+        if rows.peak is not None:
+            model_peak = rows.start + rows.rate * times
+            dlog_peak = (1.0 + rows.rate * (up - down) / (2 * step)) / model_peak
+            floors = np.concatenate([floors, np.hypot(dlog_peak * start_err, peak_err / rows.peak)])
+    # the columns bound a systematic error (it lies within +-u); its standard uncertainty is u/sqrt(3) (uniform)
+    return np.where(np.isfinite(floors), floors, 0.0) / math.sqrt(3.0)
+
+
+def _or_zeros(values: np.ndarray | None, n: int) -> np.ndarray:
+    return np.zeros(n) if values is None else np.where(np.isfinite(values), values, 0.0)
+
+
+def _blocks(rows: _Rows) -> list[tuple[np.ndarray, float]]:
+    """The observations at each pulling velocity (stick times, then peak stresses when fitted), with it."""
+    n = rows.stick_time.size
+    blocks = [(g, float(rows.velocity[g[0]])) for g in _groups(rows.velocity)]
+    if rows.peak is not None:
+        blocks += [(g + n, v) for g, v in blocks]
+    return blocks
+
+
+def _covariance(
+    jac: np.ndarray, scale2: float, floors: np.ndarray, blocks: Sequence[tuple[np.ndarray, float]]
+) -> tuple[np.ndarray, list[tuple[float, float, float]]]:
+    """Covariance of the fitted ln-parameters, and the velocities where a floor set the error of the mean.
+
+    The scatter (``scale2``, relative variance per observation) averages out over the repeated cycles at one
+    velocity; the observations' own systematic uncertainty (``floors``) is the same in every repeat and does not.
+    So the error of the mean at each velocity is floored at the mean of its observations' floors: where that is
+    larger than the scatter of the mean, the difference is added to the observations' covariance as an error they
+    share, and the least-squares estimate's covariance is the sandwich (J'J)^-1 J' C J (J'J)^-1.
+    """
+    normal = np.linalg.pinv(jac.T @ jac)
+    if not math.isfinite(scale2) or not np.any(floors > 0):
+        return scale2 * normal, []
+    shared = np.zeros((floors.size, floors.size))
+    floored: list[tuple[float, float, float]] = []
+    for index, velocity in blocks:
+        floor = float(np.mean(floors[index]))
+        scatter2 = scale2 / index.size
+        if floor**2 > scatter2:
+            shared[np.ix_(index, index)] += floor**2 - scatter2
+            floored.append((velocity, floor, math.sqrt(scatter2)))
+    if not floored:
+        return scale2 * normal, []
+    a = normal @ jac.T
+    return a @ (scale2 * np.eye(floors.size) + shared) @ a.T, floored
+
+
+def _floor_messages(floors: Sequence[tuple[float, float, float]]) -> list[str]:
+    if not floors:
+        return []
+    parts = ", ".join(
+        f"{human(v, 'velocity')} {100 * floor:.2g} % (scatter of the mean {100 * scatter:.2g} %)"
+        for v, floor, scatter in sorted(set(floors))
+    )
+    return [
+        "errors floored by the table's own uncertainties (its *_uncertainty columns, as analyze -o writes them: bounds"
+        " ±u on where each cycle's corners are, standard uncertainty u/√3): they are the same in every repeat of a"
+        " cycle and do not average out over the cycles at one velocity as their scatter does; where they exceed"
+        f" the scatter of a velocity's mean they set its error (relative, in ln t_s): {parts}"
+    ]
 
 
 #: Largest rms of the ln-residuals a usable fit may leave: beyond it the model predicts the stick times only
@@ -442,6 +554,8 @@ MAX_RELATIVE_NOISE = 0.5
 #: p of the F test of the stick fit's misfit against the scatter of repeated cycles at one velocity (the noise
 #: measured without the model).
 STICK_SIGNIFICANCE = 1e-3
+#: Relative step in the start stress of the derivative that carries its uncertainty into ln t_s (:func:`_floors`).
+FLOOR_STEP = 1e-5
 #: Pulling velocities closer than this (relative) are the same velocity (repeated cycles).
 SAME_VELOCITY = 1e-6
 
@@ -631,5 +745,19 @@ def _rows(
             "peak stresses compared, not fitted: with the measured loading rate σs = σc + rate·ts repeats"
             " the stick time"
         )
-    rows = _Rows(data.pulling_velocity[used], start[used], rate[used], data.stick_time[used], peak)
+
+    def err(name: str) -> np.ndarray | None:
+        values = data.extra.get(name)
+        return None if values is None else values[used]
+
+    rows = _Rows(
+        data.pulling_velocity[used],
+        start[used],
+        rate[used],
+        data.stick_time[used],
+        peak,
+        err("start_stress_uncertainty"),
+        err("stick_time_uncertainty"),
+        err("peak_stress_uncertainty"),
+    )
     return rows, fitted_peak
