@@ -27,7 +27,7 @@ def test_the_json_gives_the_spring_the_run_used_with_its_unit_and_source():
     assert own["units"]["stiffness"] == "Pa/m"
     assert "K = 306.495 kPa/m from the parameters" in run(CliRunner(), *QS, "--v0", "100 um/s")
     given = as_json(*QS, "--v0", "100 um/s", "--stiffness", "400 kPa/m")
-    assert given["rig"] == {"control": "spring", "stiffness": 4e5}  # as given: no source to say
+    assert given["rig"] == {"control": "spring", "stiffness": 4e5, "stiffness_from": "rig"}  # as given: the rig
     # rate-and-state's spring is friction per slip: 1/m, from its k or from the rig's K over the normal stress
     out = as_json("run", "--model", "rsf", *RSF, "--set", "k=1000 1/m")
     assert out["rig"] == {"control": "spring", "stiffness": pytest.approx(1000.0), "stiffness_from": "parameters"}
@@ -40,7 +40,8 @@ def test_the_json_gives_the_spring_the_run_used_with_its_unit_and_source():
 def test_rsf_simulate_json_gives_its_spring_in_friction_per_slip(tmp_path):
     out = json.loads(run(CliRunner(), "rsf", "simulate", *RSF, "--stiffness", "2e-3 1/um", "-o",
                          str(tmp_path / "r.csv"), "--json"))  # fmt: skip
-    assert out["rig"] == {"control": "spring", "stiffness": pytest.approx(2000.0), "stiffness_from": "parameters"}
+    # --stiffness set k: the stiffness came from the option, not the parameter set (one vocabulary with run)
+    assert out["rig"] == {"control": "spring", "stiffness": pytest.approx(2000.0), "stiffness_from": "rig"}
     assert out["units"]["stiffness"] == "1/m"
 
 

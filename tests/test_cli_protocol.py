@@ -80,7 +80,8 @@ def test_transient_spring_is_the_old_block_and_its_stiffness_reaches_the_solver(
     assert summary(*spring, "--control", "block") == summary(*spring, "--control", "spring") == summary(*spring)
     k_block = load_parameters("gelatin-glass").block.effective_stiffness
     given = summary(*spring, "--stiffness", f"{k_block!r} Pa/m")
-    assert given.pop("rig") == {"control": "spring", "stiffness": pytest.approx(k_block, rel=1e-14)}  # as given
+    assert given.pop("rig") == {"control": "spring", "stiffness": pytest.approx(k_block, rel=1e-14),
+                                "stiffness_from": "rig"}  # as given  # fmt: skip
     assert given == {key: value for key, value in summary(*spring).items() if key != "rig"}
     # from rest the load rises as K V0 t while the slider barely moves: the stress scales with K
     stiffer = summary(*spring, "--stiffness", f"{2 * k_block!r} Pa/m")

@@ -66,6 +66,8 @@ def test_rsf_takes_its_stiffness_in_friction_per_slip_or_as_its_key():
             "--set", "a=0.005", "--set", "b=0.01", "--set", "dc=10 um", "--every", "1 s"]  # fmt: skip
     by_option = as_json(*base, "--stiffness", "1e-3 1/um")
     by_key = as_json(*base, "--set", "k=1000 1/m")
+    # the same run; only the spring's source differs: the option (the rig) or the parameter set's key
+    assert by_option.pop("rig") == {**by_key.pop("rig"), "stiffness_from": "rig"}
     assert by_option == by_key
     assert by_option["regime"] == "decaying oscillation"  # k = 1000/m above kc = (b - a)/dc = 500/m
     assert "mean_friction" in by_option and "mean_stress" not in by_option

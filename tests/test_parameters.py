@@ -213,7 +213,7 @@ def test_overrides_replace_only_their_keys(params):
     before, after = params.as_dict(), p.as_dict()
     assert {k for k in before if before[k] != after[k]} == {"bonds.max_extension"}
     assert params.bonds.max_extension == 1.074e-6  # the original is untouched
-    assert p.name == "gelatin-glass"
+    assert p.name == "gelatin-glass, modified: bonds.max_extension"  # no longer the set it was read as
 
 
 def test_overrides_on_a_parameters_object(params):

@@ -36,10 +36,11 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+import json
 import math
 import os
 import sys
-from collections.abc import Iterator, Mapping
+from collections.abc import Iterable, Iterator, Mapping
 from dataclasses import dataclass, field, fields
 from importlib import resources
 from pathlib import Path
@@ -297,6 +298,18 @@ class Parameters:
             lines.append(f"{f.name} = {shown}  # {f.metadata['symbol']}: {f.metadata['doc']}")
         return "\n".join(lines) + "\n"
 
+    def to_json(self) -> str:
+        """The set as a JSON object, the same entries as :meth:`to_toml` (name, description, reference, then one
+        object per section, values as a person writes them, ``"360 um/s"``; a dimensionless value a number) without
+        its comments; ``--params FILE.json`` and :func:`load_parameters` read it back to the same set."""
+        document: dict[str, Any] = {meta: getattr(self, meta) for meta in _META_KEYS if getattr(self, meta)}
+        for key, f, value in self._held():
+            section, _, name = key.partition(".")
+            dimension = f.metadata["dimension"]
+            text = format_quantity(value, dimension)
+            document.setdefault(section, {})[name] = float(text) if dimension == "dimensionless" else text
+        return json.dumps(document, indent=2, ensure_ascii=False) + "\n"
+
 
 def _toml_str(text: str) -> str:
     return '"' + text.replace("\\", "\\\\").replace('"', '\\"') + '"'
@@ -385,13 +398,59 @@ MAX_PARAMETER_FILE_BYTES = 1_000_000
 
 
 def read_parameter_file(path: str | Path) -> Parameters:
-    """Read a TOML parameter file (a regular file of at most :data:`MAX_PARAMETER_FILE_BYTES`)."""
+    """Read a parameter file, TOML or JSON (:func:`parameter_file_format`; a regular file of at most
+    :data:`MAX_PARAMETER_FILE_BYTES`)."""
     if not isinstance(path, (str, os.PathLike)):
         raise ParameterError(f"parameter file: expected a path, got {type(path).__name__}")
     path = Path(path)
     text = read_input_text(path, f"parameter file {shorten(str(path), 240)}", MAX_PARAMETER_FILE_BYTES, ParameterError)
     protect_inputs([path])  # in a command, no output may replace its parameter file
-    return _parse_toml(text, str(path))
+    return parameters_from_mapping(parse_parameter_text(text, path, str(path)), str(path))
+
+
+#: How the text of each format is parsed (JSONDecodeError and TOMLDecodeError are ValueErrors).
+_PARSERS: dict[str, Any] = {"JSON": json.loads, "TOML": tomllib.loads}
+
+
+def parameter_file_format(path: str | Path, text: str) -> tuple[str, str]:
+    """("JSON" or "TOML", why) of a parameter file: its suffix (.json, .toml) says; a file named otherwise is JSON
+    when its text starts with ``{`` (a TOML file never does), else TOML."""
+    suffix = Path(path).suffix.lower()
+    if suffix in (".json", ".toml"):
+        return suffix[1:].upper(), f"its name ends in {suffix}"
+    if text.lstrip("\ufeff \t\r\n").startswith("{"):
+        return "JSON", "its name ends in neither .json nor .toml and its text starts with '{'"
+    return "TOML", "its name ends in neither .json nor .toml and its text does not start with '{'"
+
+
+def parse_parameter_text(
+    text: str, path: str | Path, source: str, error: type[Exception] = ParameterError
+) -> dict[str, Any]:
+    """The top-level table of a parameter file's ``text``: the one reader of every ``--params FILE`` (the bond
+    model's sets, rate-and-state's ``.params.json`` and TOML), JSON or TOML as :func:`parameter_file_format` says.
+
+    A file whose text is the other format (a ``.json`` holding TOML, as ``params export -o x.json`` wrote before
+    it wrote JSON) is read as that format: the two never parse the same text.  A file that is neither is refused
+    in one line (``error``, prefixed with ``source``) naming the format it was read as, why, and the parser's
+    complaint."""
+    kind, why = parameter_file_format(path, text)
+    other = "TOML" if kind == "JSON" else "JSON"
+    text = text.removeprefix("\ufeff")
+    try:
+        data = _PARSERS[kind](text)
+    except RecursionError:  # "[[[[..." a hundred thousand deep: the parsers recurse
+        raise error(f"{source}: malformed {kind}: nested too deeply to be a parameter file") from None
+    except ValueError as exc:
+        detail = (str(exc).splitlines() or [""])[0]
+        try:
+            data = _PARSERS[other](text)
+        except (ValueError, RecursionError):
+            raise error(f"{source}: malformed {kind} (read as {kind}: {why}): {detail}") from None
+        if not isinstance(data, dict):  # "3" is a JSON number: no sign the file was meant as JSON
+            raise error(f"{source}: malformed {kind} (read as {kind}: {why}): {detail}") from None
+    if not isinstance(data, dict):
+        raise error(f"{source}: expected a table of parameters (a JSON object), got {type(data).__name__}")
+    return data
 
 
 def _parse_toml(text: str, source: str) -> Parameters:
@@ -417,31 +476,60 @@ def _as_written(exc: ParameterError, overrides: Mapping[str, Any]) -> ParameterE
 def load_parameters(
     name_or_path: str | Path | Parameters = "gelatin-glass", overrides: Mapping[str, Any] | None = None
 ) -> Parameters:
-    """A built-in set by name (``"gelatin-glass"``) or a TOML file by path, with optional overrides.
+    """A built-in set by name (``"gelatin-glass"``) or a TOML or JSON file by path, with optional overrides.
+
+    A set whose values the overrides change is no longer the set it was read as: its name says so,
+    ``"gelatin-glass, modified: bonds.bond_time"`` (:func:`modified_name`), wherever it is shown or exported.
 
     >>> p = load_parameters("gelatin-glass", overrides={"bonds.max_extension": "1 m"})
     >>> p.bonds.max_extension
     1.0
+    >>> p.name
+    'gelatin-glass, modified: bonds.max_extension'
     """
     if isinstance(name_or_path, Parameters):
-        return name_or_path.with_overrides(overrides)
+        return _overridden(name_or_path, overrides)
     text = str(name_or_path)
     if not text.strip():
         raise ParameterError(
             "empty parameter set name: expected a built-in name"
-            f" ({', '.join(available_parameter_sets())}) or a TOML file"
+            f" ({', '.join(available_parameter_sets())}) or a TOML or JSON file"
         )
     if text in available_parameter_sets():
         resource = resources.files("stickslip") / "parameter_sets" / f"{text}.toml"
         params = _parse_toml(resource.read_text(encoding="utf-8"), text)
-    elif text.endswith(".toml") or "/" in text or _exists(text):
+    elif text.endswith((".toml", ".json")) or "/" in text or _exists(text):
         params = read_parameter_file(text)
     else:
         raise ParameterError(
             f"unknown parameter set {shorten(text)}: expected a built-in name"
-            f" ({', '.join(available_parameter_sets())}) or a TOML file"
+            f" ({', '.join(available_parameter_sets())}) or a TOML or JSON file"
         )
-    return params.with_overrides(overrides)
+    return _overridden(params, overrides)
+
+
+#: What a set's name says after the keys that overrides changed (``"gelatin-glass, modified: bonds.bond_time"``).
+MODIFIED = ", modified: "
+
+
+def modified_name(name: str, keys: Iterable[str]) -> str:
+    """``name`` with ``keys`` listed as modified (after any it lists already, each once); unchanged without keys."""
+    base, said, earlier = name.partition(MODIFIED)
+    listed = [k for k in earlier.split(", ") if k] if said else []
+    listed += [k for k in keys if k not in listed]
+    return f"{base}{MODIFIED}{', '.join(listed)}" if listed else name
+
+
+def _overridden(params: Parameters, overrides: Mapping[str, Any] | None) -> Parameters:
+    """``params.with_overrides(overrides)``, named for the keys whose values it changed (a value set to what the
+    set holds leaves the name as it is)."""
+    changed = params.with_overrides(overrides)
+    if changed is params:
+        return params
+    before, after = params.as_dict(), changed.as_dict()
+    keys = [k for k in after if before.get(k) != after[k]] + [k for k in before if k not in after]
+    name = modified_name(params.name, keys)
+    return changed if name == changed.name else dataclasses.replace(changed, name=name)
 
 
 def _exists(text: str) -> bool:

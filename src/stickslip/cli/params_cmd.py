@@ -3,13 +3,15 @@
 ``params show [NAME|FILE]`` prints every key with its symbol, value (in a
 readable unit) and meaning, then the derived quantities the paper uses
 (lambda/kT, lambda*M/kT, G_d/h, the Eq 17 geometric factor and K).
-``params export [NAME|FILE] [-o FILE]`` writes an editable TOML file whose
-reload gives exactly the same set.  Both take ``--params`` and ``--set``.
+``params export [NAME|FILE] [-o FILE]`` writes an editable TOML file (JSON for
+``-o FILE.json``) whose reload gives exactly the same set.  Both take ``--params``
+and ``--set``.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import json
 import math
 from collections.abc import Sequence
 from pathlib import Path
@@ -171,7 +173,8 @@ _STATE_KEYS = {"law": ("", "evolution law"), "b": ("", "evolution effect"), "dc"
 
 def rate_and_state_file(chosen: str, overrides: Sequence[str]) -> Any:
     """The :class:`stickslip.rsf.RSFParams` of ``chosen`` where it is a rate-and-state file (a ``.params.json``
-    written by ``rsf fit`` or ``rsf simulate -o``, or a TOML of its keys); None for a bond-model set or file.
+    written by ``rsf fit`` or ``rsf simulate -o``, a JSON of its keys as ``params export -o F.json`` writes, or a
+    TOML of them); None for a bond-model set or file (JSON or TOML, its sections ``bonds``, ``aging``, ...).
     ``params show`` and ``export`` read both kinds; ``--set`` names the bond model's keys, so it is refused here."""
     path = Path(chosen)
     if path.suffix.lower() not in (".json", ".toml") or not path.is_file():
@@ -179,12 +182,9 @@ def rate_and_state_file(chosen: str, overrides: Sequence[str]) -> Any:
     from ..rsf import RSFParams
     from .params_files import load_params_mapping
 
-    if path.suffix.lower() == ".toml":
-        mapping = load_params_mapping(path)
-        if not ({"a", "states"} & set(mapping)) or set(mapping) & set(SECTIONS):
-            return None  # a bond-model set: load_parameters reads it and names what is wrong
-    else:
-        mapping = load_params_mapping(path)
+    mapping = load_params_mapping(path)  # the one reader of --params files, JSON or TOML
+    if not ({"a", "states"} & set(mapping)) or set(mapping) & set(SECTIONS):
+        return None  # a bond-model set: load_parameters reads it and names what is wrong
     if overrides:
         raise ParameterError(
             f"--set {shorten(overrides[0])}: {chosen} is a rate-and-state parameter file and --set names the bond"
@@ -245,7 +245,7 @@ def list_command() -> None:
 def show_command(ctx: click.Context, name: str | None, params_name: str, overrides: tuple[str, ...]) -> None:
     """Print a parameter set with units, and the derived quantities.
 
-    NAME is a built-in set (see `stickslip params list`) or a TOML file;
+    NAME is a built-in set (see `stickslip params list`) or a TOML or JSON file;
     it defaults to --params.  A rate-and-state file (a NAME.params.json of
     `rsf fit` or `rsf simulate -o`, or a TOML of its keys) is shown in SI.
     """
@@ -267,23 +267,45 @@ def show_command(ctx: click.Context, name: str | None, params_name: str, overrid
 def export_command(
     ctx: click.Context, name: str | None, params_name: str, overrides: tuple[str, ...], output: Path | None
 ) -> None:
-    """Write a parameter set as an editable TOML file (values with units).
+    """Write a parameter set as an editable file (values with units): TOML, or JSON for -o FILE.json.
 
     Loading the file back (`--params FILE`) gives exactly the same values.
-    A rate-and-state file (NAME.params.json) is written as its TOML.
+    With --set the set is named for what it changed ("gelatin-glass, modified:
+    bonds.bond_time").  A rate-and-state file (NAME.params.json) is written
+    as its TOML (or JSON).
     """
     chosen = _chosen_set(ctx, name, params_name)
     refuse_overwriting_inputs([], [("-o", output)], chosen)
     check_output("-o", output)  # -o '' (click reads it as the folder '.'): one line naming -o
+    kind = export_format(output)
     rate_and_state = rate_and_state_file(chosen, overrides)
     if rate_and_state is not None:
-        text = rate_and_state.to_toml()
+        text = rate_and_state.to_toml() if kind == "TOML" else json.dumps(rate_and_state.to_dict(), indent=2) + "\n"
     else:
-        text = _with_override_note(resolve_params(chosen, overrides), overrides).to_toml()
+        params = _with_override_note(resolve_params(chosen, overrides), overrides)
+        text = params.to_toml() if kind == "TOML" else params.to_json()
     if output is None:
         click.echo(text, nl=False)
     else:
         write_text(output, text)
+
+
+#: The file formats ``params export`` writes, by the suffix of -o (standard output and a name without one: TOML).
+EXPORT_FORMATS = {".toml": "TOML", ".json": "JSON", "": "TOML"}
+
+
+def export_format(output: Path | None) -> str:
+    """ "TOML" or "JSON", as -o's suffix says; another suffix is refused in one line: the file would be read back
+    by its content while its name promises a third format (``-o set.yaml`` held TOML)."""
+    if output is None or str(output) == "-":
+        return "TOML"
+    suffix = output.suffix.lower()
+    if suffix not in EXPORT_FORMATS:
+        raise ParameterError(
+            f"-o {shorten(str(output))}: params export writes TOML (.toml) or JSON (.json), not {suffix}; name the"
+            f" file {output.stem}.toml or {output.stem}.json"
+        )
+    return EXPORT_FORMATS[suffix]
 
 
 def register(cli: click.Group) -> None:

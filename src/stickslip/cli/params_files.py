@@ -1,9 +1,9 @@
 """``--params FILE`` of the rate-and-state commands and of ``run --model rsf``: a ``.params.json`` written beside
-a trace or a fit, or a ``.toml`` file; every problem with the file is one line."""
+a trace or a fit, or a ``.toml`` file (read as the bond model's files are, JSON or TOML); every problem with the
+file is one line."""
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 from typing import Any
 
@@ -30,27 +30,14 @@ def load_params_mapping(path: Path) -> dict[str, Any]:
 
 
 def load_params_file(path: Path) -> dict[str, Any]:
-    """The whole top-level table of a ``--params`` file; every problem with the file is one DataError line."""
+    """The whole top-level table of a ``--params`` file, JSON or TOML (the one reader,
+    :func:`stickslip.parameters.parse_parameter_text`); every problem with the file is one DataError line."""
+    from ..parameters import parse_parameter_text
+
     path = Path(path)
     text = _params_text(path)
     protect_inputs([path])  # `rsf simulate --params run.params.json -o run.csv` must not rewrite it
-    try:
-        if path.suffix.lower() == ".toml":
-            try:
-                import tomllib
-            except ModuleNotFoundError:  # pragma: no cover - Python 3.10
-                import tomli as tomllib  # type: ignore[no-redef]
-            data = tomllib.loads(text)
-        else:
-            data = json.loads(text)
-    except ValueError as exc:  # JSONDecodeError and TOMLDecodeError are ValueErrors
-        kind = "TOML" if path.suffix.lower() == ".toml" else "JSON"
-        raise DataError(f"--params {path}: malformed {kind} ({(str(exc).splitlines() or [''])[0]})") from None
-    except RecursionError:  # "[[[[..." a hundred thousand deep: the parsers recurse
-        raise DataError(f"--params {path}: nested too deeply to be a parameter file") from None
-    if not isinstance(data, dict):
-        raise DataError(f"--params {path}: expected a table of parameters (a JSON object), got {type(data).__name__}")
-    return data
+    return parse_parameter_text(text, path, f"--params {path}", DataError)
 
 
 def run_history(path: Path) -> tuple[list[dict[str, Any]] | None, float | None]:

@@ -236,11 +236,18 @@ def run_summary(run: Any, protocol: Any, rig: Any, spring: tuple[float, str, str
     """What a run settled into, in SI: regime with its evidence, period, peak, trough, mean, the model's own numbers.
 
     ``mean_*`` is the model's mean of what the run settled into (the repeating cycle's, the steady value; a sweep
-    row's ``mean_stress``), ``run_mean_*`` the mean of the solution over the run.  ``spring``: the stiffness the
-    run used, its unit and where it came from (``model.spring``); without it the rig's as given.
+    row's ``mean_stress``), ``run_mean_*`` the mean of the solution over the run; ``run_peak_*`` and
+    ``run_trough_*`` the run's highest and lowest where the model gives them from its solution (the peak and trough
+    are the last segment's).  ``spring``: the stiffness the run used, its unit and where it came from
+    (``model.spring``); without it the rig's as given.
     """
     signal = "stress" if run.stress is not None else "friction"
     r = run.regime
+    extremes = {  # the model's own, from its solution (the transient model's: every state, whatever the rows kept)
+        f"run_{word}_{signal}": _above_round_off(float(run.summary[f"run_{word}_{signal}"]))
+        for word in ("peak", "trough")
+        if run.summary.get(f"run_{word}_{signal}") is not None
+    }
     return {
         "model": run.model,
         "status": run.status,
@@ -257,6 +264,7 @@ def run_summary(run: Any, protocol: Any, rig: Any, spring: tuple[float, str, str
         f"trough_{signal}": _above_round_off(run.trough),
         f"mean_{signal}": _above_round_off(run.mean),
         f"run_mean_{signal}": _above_round_off(run_mean(run)),
+        **extremes,
         f"final_{signal}": float(run.signal[-1]) if run.time.size else None,
         "end_time": float(run.time[-1]) if run.time.size else None,
         "summary": dict(run.summary),
@@ -276,6 +284,8 @@ def run_mean(run: Any) -> float:
 SUMMARY_UNITS = {
     "run_mean_stress": "Pa",
     "run_mean_friction": "1",
+    "run_peak_stress": "Pa",
+    "run_trough_stress": "Pa",
     "stiffness_from": None,
     "mass": "kg/m^2",  # the rig's block (--mass, --damping)
     "damping": "Pa s/m",
@@ -293,16 +303,37 @@ def summary_units(summary: dict[str, Any], spring: tuple[float, str, str] | None
 
 
 def rig_record(rig: Any, spring: tuple[float, str, str] | None = None) -> dict[str, Any]:
-    """The summary's ``rig``: control, the stiffness of ``spring`` (``model.spring``; else the rig's as given) and,
-    where it is not the rig's as given, ``stiffness_from``; the block's mass and damping where it has them."""
+    """The summary's ``rig``, in one vocabulary for every model: ``control`` ("spring" or "velocity", the
+    :class:`~stickslip.models.Rig`'s words), the stiffness of ``spring`` (``model.spring``; else the rig's as given)
+    and, wherever there is a stiffness, ``stiffness_from``: "rig" (given: ``--stiffness``, in Pa/m or in the model's
+    own unit, or ``Rig(stiffness=...)``) or "parameters" (the parameter set's: Eq 17's K, rate-and-state's k, a
+    ``--set``); under velocity control no stiffness and no source.  The block's mass and damping where it has
+    them."""
     record: dict[str, Any] = {"control": rig.control, "stiffness": rig.stiffness}
-    if spring is not None:  # the stiffness used; "stiffness_from" unless it is the rig's as given
+    if spring is not None:  # the stiffness used, and where it came from
         record["stiffness"] = spring[0]
-        if spring[2] != "rig" or spring[0] != rig.stiffness:
-            record["stiffness_from"] = spring[2]
+        # --stiffness in the model's own unit (rate-and-state's "1e-3 1/um") set its k: given, not the set's
+        record["stiffness_from"] = "rig" if spring[2] == "rig" or stiffness_option_given() else spring[2]
+    elif rig.stiffness is not None:
+        record["stiffness_from"] = "rig"
     if rig.mass is not None:  # the block's inertia (transient --mass/--damping)
         record.update(mass=rig.mass, damping=rig.damping)
     return record
+
+
+def stiffness_option_given() -> bool:
+    """Whether the command being run was given ``--stiffness`` (every spring of its run then has that stiffness:
+    the rig's, or the model's k it set; :func:`~stickslip.cli.protocol_options.build_rig`)."""
+    ctx = click.get_current_context(silent=True)
+    source = ctx.get_parameter_source("stiffness_text") if ctx is not None else None
+    return source is not None and source is not click.core.ParameterSource.DEFAULT
+
+
+def record_in_rig_words(record: dict[str, Any], rig: dict[str, Any]) -> dict[str, Any]:
+    """The model's own record with its ``control`` and ``stiffness`` (the transient solver's: "block", and the
+    block's K even under velocity control) in the words and values of the summary's ``rig``, which they must not
+    contradict: "spring" for "block", no stiffness without a spring."""
+    return {**record, **{key: rig[key] for key in ("control", "stiffness") if key in record}}
 
 
 #: a protocol of more segments is described in one line by its count, length and range of velocities
@@ -331,6 +362,18 @@ def _above_round_off(value: float) -> float:
     return 0.0 if value is not None and math.isfinite(value) and abs(value) < ROUND_OFF else value
 
 
+def _run_range(summary: dict[str, Any], signal: str, unit: str) -> list[str]:
+    """The run's lowest and highest (``run_trough_*``, ``run_peak_*``) where they lie beyond the last segment's: a
+    350 -> 1000 -> 350 µm/s step's overshoot to 713.6 Pa, before the last segment, was in no line."""
+    low, high = summary.get(f"run_trough_{signal}"), summary.get(f"run_peak_{signal}")
+    if low is None or high is None or not (math.isfinite(low) and math.isfinite(high)):
+        return []
+    window_low, window_high = summary.get(f"trough_{signal}"), summary.get(f"peak_{signal}")
+    if low == window_low and high == window_high:
+        return []
+    return [f"  range over the whole run: {low:.6g} ... {high:.6g}{unit}"]
+
+
 #: how the summary's regime line marks a run that did not finish
 _STATUS_WORDS = {"ok": "", "stopped": " (of the run up to its stop: it used up its budget)"}
 
@@ -344,8 +387,8 @@ def summary_text(summary: dict[str, Any], units: dict[str, str] | None = None) -
     if rig["stiffness"] is not None:
         per_slip = (units or {}).get("stiffness") == "1/m"  # rate-and-state's k, friction per slip
         spring = f", k = {rig['stiffness']:.6g} 1/m" if per_slip else f", K = {rig['stiffness'] / 1e3:.6g} kPa/m"
-        if rig.get("stiffness_from") is not None:
-            spring += f" from the {rig['stiffness_from']}" + ("" if rig["stiffness_from"] != "rig" else "'s K")
+        if rig.get("stiffness_from") is not None:  # (files before 'rig' was said for a stiffness as given: none)
+            spring += f" from the {rig['stiffness_from']}"
     if rig.get("mass") is not None:
         spring += f", block mass {rig['mass']:g} kg/m², damping {rig.get('damping') or 0:g} Pa·s/m"
     signal, unit = ("stress", " Pa") if "peak_stress" in summary else ("friction", "")
@@ -376,6 +419,8 @@ def summary_text(summary: dict[str, Any], units: dict[str, str] | None = None) -
         numbers[-1] += " over the run" + ("" if summary.get("oscillates", True) else " (no oscillation)")
     if numbers:
         lines.append("  " + ", ".join(numbers))
+    if not cycle and len(segments) > 1:  # the run's own range where the last segment's is not all of it
+        lines.extend(_run_range(summary, signal, unit))
     return "\n".join(lines)
 
 
@@ -526,7 +571,8 @@ def execute(
             raise type(exc)(in_run_words(str(exc), start_option)) from None
     spring = model.spring(params, checked)
     summary = run_summary(run, protocol, rig, spring)
-    summary.update((key, value) for key, value in model_record(run).items() if key not in summary)
+    record = record_in_rig_words(model_record(run), summary["rig"])
+    summary.update((key, value) for key, value in record.items() if key not in summary)
     units = summary_units(summary, spring)
     if stopped is not None:
         summary["status"] = "stopped"

@@ -61,9 +61,15 @@ def _simulation_record(sim: Any) -> list[Any]:
         out.append("  no stick phase ended in a slip within the run")
         return out
     table = Table(title="Cycles", title_justify="left")
-    for heading in ("#", "start (s)", "σ start (Pa)", "σs (Pa)", "ts (s)", "Vs (µm/s)", "slip (s)", "period (s)"):
+    headings = ("#", "start (s)", "σ start (Pa)", "σs (Pa)", "ts (s)", "Vs (µm/s)", "slip (s)", "period (s)")
+    for heading in headings:
         table.add_column(heading, justify="right")
-    for c in sim.cycles:
+    # a long run's tens of thousands of cycles (1e6 s at 50 µm/s: 43,316, 35 s and 550 MB to draw): the first few,
+    # the count left out, the last ones, as the transient run's text (--json lists every cycle)
+    for c in shown_cycles(sim.cycles):
+        if c is None:
+            table.add_row(*("…" for _ in headings))
+            continue
         table.add_row(
             str(c.index + 1),
             _fmt(c.start_time, digits=6),
@@ -75,6 +81,8 @@ def _simulation_record(sim: Any) -> list[Any]:
             _fmt(c.period),
         )
     out.append(table)
+    if len(sim.cycles) > CYCLE_LINES:
+        out.append(left_out(len(sim.cycles)))
     return out
 
 
@@ -89,10 +97,9 @@ def _transient_record(result: Any) -> list[str]:
     ]
     cycles = result.cycles
     # a long run's thousands of cycles: the first few, a count, and the last ones (the settled cycle; --json: all)
-    shown = cycles if len(cycles) <= CYCLE_LINES else (*cycles[:CYCLE_HEAD], None, *cycles[-CYCLE_TAIL:])
-    for c in shown:
+    for c in shown_cycles(cycles):
         if c is None:
-            lines.append(f"  … {len(cycles) - CYCLE_HEAD - CYCLE_TAIL} cycles more (--json lists every cycle) …")
+            lines.append(left_out(len(cycles)))
             continue
         slip = "—" if c.slip_time is None else f"{c.slip_time:.4g} s"
         lines.append(
@@ -102,10 +109,28 @@ def _transient_record(result: Any) -> list[str]:
     return lines
 
 
-#: a transient run's text lists its cycles one a line up to this many; beyond, the first and the last few
+#: a run's text lists its cycles (the transient run's one a line, the quasi-static run's table) up to this many;
+#: beyond, the first CYCLE_HEAD and the last CYCLE_TAIL, with the count left out between
 CYCLE_LINES = 12
 CYCLE_HEAD = 5
 CYCLE_TAIL = 3
+
+
+def shown_cycles(cycles: Any) -> list[Any]:
+    """The cycles a run's text lists: all of them up to CYCLE_LINES, else the first CYCLE_HEAD, None where the
+    others are left out (:func:`left_out` says how many), and the last CYCLE_TAIL (the settled cycle)."""
+    cycles = list(cycles)
+    if len(cycles) <= CYCLE_LINES:
+        return cycles
+    return [*cycles[:CYCLE_HEAD], None, *cycles[-CYCLE_TAIL:]]
+
+
+def left_out(count: int) -> str:
+    """The line for the cycles :func:`shown_cycles` leaves out of ``count``, and where the full table is."""
+    return (
+        f"  … {count - CYCLE_HEAD - CYCLE_TAIL:,} cycles more (cycles {CYCLE_HEAD + 1} to {count - CYCLE_TAIL:,} of"
+        f" {count:,} left out; --json lists every cycle) …"
+    )
 
 
 __all__ = ["model_record", "record_text"]

@@ -54,7 +54,13 @@ MODEL_NAMES = ("quasi-static", "transient", "rsf")  # the built-ins; any registe
     is_flag=True,
     help="--model transient: add the paper's stick chains (Eqs 13-16); without them Eq 1 never lets a stuck block go.",
 )
-@click.option("-o", "--output", default=None, metavar="OUT", help="Output folder OUT.")
+@click.option(
+    "-o",
+    "--output",
+    default=None,
+    metavar="OUT",
+    help="Output folder OUT, named without a file suffix (-o sw.csv is refused: no CSV is written).",
+)
 @click.option(
     "--workers",
     type=int,
@@ -121,6 +127,7 @@ def _run(
         raise ParameterError("-o OUT: give the output folder of the sweep")
     if not output.strip() or output.strip() == "-":
         raise ParameterError(f"-o {output!r}: a sweep writes a folder; give its name, e.g. -o sweep-out")
+    _refuse_file_name(output)
     if not vary:
         raise ParameterError(
             "--vary: give at least one varied key, e.g. --vary 'pulling_velocity=5 um/s..5 mm/s:20:log'"
@@ -145,6 +152,8 @@ def _run(
         stick_population=stick_population,
         unit_check=require_unit,
     )
+    if not overwrite:
+        spec = _as_labelled_before(spec, output)
     store = run_sweep(
         spec,
         output,
@@ -161,6 +170,56 @@ def _run(
         summary += f"; {store.report.words()}"
     if not quiet:
         echo_err(summary)
+
+
+#: Suffixes of the files a sweep's -o may be taken for: a sweep writes a folder of Parquet chunks, never one file.
+FILE_SUFFIXES = frozenset(
+    ".csv .tsv .txt .dat .json .jsonl .parquet .pq .feather .arrow .xlsx .xls .h5 .hdf5 .nc .npz .npy .pkl"
+    " .pickle .zip .gz .png .svg .pdf".split()
+)
+
+
+def _refuse_file_name(output: str) -> None:
+    """Refuse, in one line, a new sweep folder named as a file (``-o sw.csv`` made a folder ``sw.csv/`` of Parquet
+    chunks, no CSV, and no word said); a sweep folder of that name made earlier is resumed as ever."""
+    from ..sweeps.store import MANIFEST
+
+    path = Path(output)
+    suffix = path.suffix.lower()
+    if suffix not in FILE_SUFFIXES or (path / MANIFEST).is_file():
+        return
+    folder = str(path.with_suffix(""))
+    table = {".csv": f".to_csv('{output}')", ".tsv": f".to_csv('{output}', sep='\\t')",
+             ".txt": f".to_csv('{output}')", ".json": f".to_json('{output}')"}  # fmt: skip
+    read = f"pandas.read_parquet('{folder}')"
+    kind = suffix[1:].upper()
+    then = f"{read}{table[suffix]} writes its rows as one {kind} file" if suffix in table else f"{read} reads its rows"
+    raise ParameterError(
+        f"-o {output}: a sweep writes a folder of Parquet chunks (resumable), not a {suffix} file; name the folder"
+        f" without a suffix, e.g. -o {folder}; then {then}"
+    )
+
+
+def _as_labelled_before(spec: Any, output: str) -> Any:
+    """``spec`` under the label of the sweep in ``output`` where that sweep differs only in it, its label the bare
+    name of the set whose --set values this label lists (a folder made before a set's name said what --set changed,
+    "gelatin-glass" now "gelatin-glass, modified: bonds.bond_time"): the same sweep, resumed, not refused."""
+    import dataclasses
+    import json
+
+    from ..parameters import MODIFIED
+    from ..sweeps.store import MANIFEST
+
+    try:
+        earlier = json.loads((Path(output) / MANIFEST).read_text(encoding="utf-8"))["specification"]
+    except (OSError, ValueError, KeyError, TypeError):  # no sweep there yet, or one the store judges itself
+        return spec
+    now = json.loads(spec.to_json())
+    label = earlier.get("label") if isinstance(earlier, dict) else None
+    renamed = label != now["label"] and label == now["label"].partition(MODIFIED)[0]
+    if renamed and {**earlier, "label": now["label"]} == now:
+        return dataclasses.replace(spec, label=label)
+    return spec
 
 
 def _summary(folder: Path, total: int) -> str:

@@ -227,7 +227,8 @@ def rsf_run(result: Any) -> Run:
     )  # fmt: skip
     # the solver's integral over the settled window where it was carried; the rows' otherwise (a fit's runs)
     settled = result.settled_mean_friction
-    mean = settled if math.isfinite(settled) else settled_mean(result.time, result.friction, r.period)
+    begin = float(protocol.boundaries[-2])  # the settled window lies in the last segment, as the solver's does
+    mean = settled if math.isfinite(settled) else settled_mean(result.time, result.friction, r.period, begin)
     velocity = protocol.segments[-1].velocity  # the last segment's, whose regime is reported
     kc = critical_stiffness(params, velocity) if velocity > 0 else NAN
     summary = {

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import io
 import json
+import math
 import os
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -76,9 +77,14 @@ def time_mean(time: np.ndarray, values: np.ndarray) -> float:
     return float(np.sum(share * (0.5 * values[1:] + 0.5 * values[:-1])))
 
 
-def settled_mean(time: np.ndarray, values: np.ndarray, period: float) -> float:
-    """Mean over the last whole periods within the run's second half (over that half if it does not oscillate)."""
-    return window_mean(time, values, regimes.settled_window_start(float(time[0]), float(time[-1]), period))
+def settled_mean(time: np.ndarray, values: np.ndarray, period: float, begin: float | None = None) -> float:
+    """Mean over what the run settled into: the last whole periods within the second half of the window from
+    ``begin`` (the protocol's last segment, whose regime is reported; the run's start by default) to the end, or
+    over that half if it does not oscillate.  Steady, that is the settled value (a slide-hold-slide's mean over
+    the run's second half held the hold's end: 0.576136 for the steady 0.576974)."""
+    first = float(time[0])
+    begin = first if begin is None or not math.isfinite(begin) else min(max(float(begin), first), float(time[-1]))
+    return window_mean(time, values, regimes.settled_window_start(begin, float(time[-1]), period))
 
 
 def window_mean(time: np.ndarray, values: np.ndarray, start: float) -> float:
@@ -296,8 +302,8 @@ class Run:
             slider_position=slider_position, load_point_position=load_point_position, regime=regime,
             states=states or {}, state_units=state_units or {}, **extra,
         )  # fmt: skip
-        if "mean" not in extra and t.size:
-            object.__setattr__(run, "mean", settled_mean(t, run.signal, regime.period))
+        if "mean" not in extra and t.size:  # over the settled part of the classified window (t >= start)
+            object.__setattr__(run, "mean", settled_mean(t, run.signal, regime.period, start))
         return run
 
     # ---------------------------------------------------------------- what it settled into

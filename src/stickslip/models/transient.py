@@ -12,7 +12,7 @@ from ..parameters import Parameters
 from ..protocols import Protocol
 from .base import Boundary, Capabilities, Rig
 from .bond import STIFFNESS_KEYS, BondModel
-from .run import Run, settled_mean, time_mean
+from .run import Run, time_mean
 
 NAN = math.nan
 #: relative stress change that counts as none (stickslip.transient.cycles.SETTLED, the solver's own verdict's)
@@ -194,11 +194,21 @@ def transient_run(result: Any, protocol: Protocol | None = None) -> Run:
     protocol's last segment; over the whole run without the protocol)."""
     summary = last_cycle_numbers(result, protocol)
     regime = _regime(result, protocol)
-    if regime.kind == regimes.OSCILLATION and math.isfinite(regime.period) and not summary["cycles"]:
-        # a limit cycle without a stick has no whole stick-to-stick cycle: its mean is over its last whole periods
-        # (the run's mean, 298.078 Pa, lay above its period's peak, 297.573 Pa, for a ringing light block)
-        time, stress = np.asarray(result.time, dtype=float), np.asarray(result.stress, dtype=float)
-        summary["mean_stress"] = settled_mean(time, stress, regime.period)
+    settled = getattr(result, "status", "ok") == "ok" and (
+        regime.kind == regimes.STEADY
+        or (regime.kind == regimes.OSCILLATION and math.isfinite(regime.period) and not summary["cycles"])
+    )
+    if settled:
+        # what the run settled into, over its settled window (regimes.settled_window_start) within the last
+        # segment, from the solver's integral (not the rows: ``every`` must not move it): steady, sigma(V0) once
+        # steady, where the mean of a whole cycle of an earlier segment or of the run (478.903 Pa for a 350 ->
+        # 1000 -> 350 µm/s step, ending steady at 391.535 Pa) was reported; a limit cycle without a stick, its last
+        # whole periods (the run's mean, 298.078 Pa, lay above its period's peak, 297.573 Pa, for a ringing block)
+        time = np.asarray(result.time, dtype=float)
+        begin = float(protocol.boundaries[-2]) if protocol is not None else float(time[0])
+        period = regime.period if regime.kind == regimes.OSCILLATION else NAN
+        start = regimes.settled_window_start(max(begin, float(time[0])), float(time[-1]), period)
+        summary["mean_stress"] = _mean_stress(result, start, float(time[-1]), protocol=protocol)
     states: dict[str, Any] = {}
     units: dict[str, str | None] = {}
     if getattr(result, "bonded_fraction", None) is not None:
@@ -318,6 +328,9 @@ def last_cycle_numbers(result: Any, protocol: Protocol | None = None) -> dict[st
         "critical_velocity": NAN,
     }
     row["run_mean_stress"] = row["mean_stress"]  # the mean over the run, whatever the cycles (run --json)
+    # the run's highest and lowest stress, from the solver's states (a 350 -> 1000 µm/s step's overshoot to 713.6 Pa
+    # lies before the last segment, whose extremes the regime reports): every state, whatever rows ``every`` kept
+    row["run_peak_stress"], row["run_trough_stress"] = _run_extremes(result)
     if whole:
         last = whole[-1]
         row.update(
@@ -330,6 +343,19 @@ def last_cycle_numbers(result: Any, protocol: Protocol | None = None) -> dict[st
             result, last.start_time, end, last.start_stress, *following[:1], protocol=protocol
         )
     return row
+
+
+def _run_extremes(result: Any) -> tuple[float, float]:
+    """(highest, lowest) stress of the run: every state of the solver (the rows and the extremes each row carries
+    of the states since the row before); the rows' own for a stand-in solver's result."""
+    time, stress = np.asarray(result.time, dtype=float), np.asarray(result.stress, dtype=float)
+    between = _between_rows(result)
+    if between is not None and time.size:
+        from ..transient.cycles import window_extremes
+
+        return window_extremes(time, stress, between, float(time[0]))
+    finite = stress[np.isfinite(stress)]
+    return (float(np.max(finite)), float(np.min(finite))) if finite.size else (NAN, NAN)
 
 
 def _settled(result: Any, whole: list[Any], protocol: Protocol | None) -> list[Any]:

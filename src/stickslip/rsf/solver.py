@@ -175,13 +175,15 @@ def _settled_mean(
     carried: WithIntegral, t_rows: np.ndarray, y_rows: np.ndarray, starts: list[tuple[float, np.ndarray, float]],
     integral: float, end: float, period: float, rtol: float, atol: Any,
 ) -> float:  # fmt: skip
-    """The mean of mu over :func:`stickslip.models.run.settled_mean`'s window of [0, end] from the carried integral
-    q: q(end) less q at the window's start, which the solver reaches from the last row or piece start before it
-    (each holds the solver's own q; none is interpolated), so that the mean does not depend on the sampling.  NaN
-    where that short integration fails (the caller then takes the rows')."""
+    """The mean of mu over :func:`stickslip.models.run.settled_mean`'s window of the last piece integrated (the
+    protocol's last segment, whose regime is reported) from the carried integral q: q(end) less q at the window's
+    start, which the solver reaches from the last row or piece start before it (each holds the solver's own q;
+    none is interpolated), so that the mean does not depend on the sampling.  NaN where that short integration
+    fails (the caller then takes the rows').  (The window was of [0, end]: a slide-hold-slide's second half held
+    the hold's end, and its "steady sliding" mean read 0.576136 for the settled 0.576974.)"""
     if not end > 0:
         return math.nan
-    start = regimes.settled_window_start(0.0, end, period)
+    start = regimes.settled_window_start(min(starts[-1][0], end) if starts else 0.0, end, period)
     k = max(int(np.searchsorted(t_rows, start, side="right")) - 1, 0)
     j = max(int(np.searchsorted([s[0] for s in starts], start, side="right")) - 1, 0)
     t_anchor, y_anchor = float(t_rows[k]), y_rows[:, k]

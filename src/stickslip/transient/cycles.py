@@ -143,6 +143,28 @@ def _pace(time: np.ndarray, protocol: Protocol) -> np.ndarray:
     return np.where(vp > 0, vp, np.max(protocol.velocities))
 
 
+def _pace_bounds(time: np.ndarray, protocol: Protocol, pace: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(slower, faster) of the puller's paces at each row: :func:`_pace`'s, but at a row written at a protocol
+    boundary both segments' (the row is the state that ends the segment before it, whose velocity it carries,
+    while the pace read at that instant is the next segment's).  A slider is behind the puller there only when
+    below both, ahead only when above both: under velocity control the boundary row of 350 -> 1000 µm/s carried
+    350 µm/s against a pace of 1000 ("a stick"), and that of 1000 -> 350 µm/s 1000 against 350 ("a jump"), and the
+    rigidly driven slider read as one stick-slip cycle (stick 0.0397 s, σs = 653.43 Pa, jump to 1000 µm/s)."""
+    edges = np.asarray(protocol.boundaries[1:-1], dtype=float)
+    if not edges.size or not time.size:
+        return pace, pace
+    k = np.searchsorted(edges, time)
+    nearest = [edges[np.clip(j, 0, edges.size - 1)] for j in (k - 1, k)]
+    at = np.isclose(time, nearest[0], rtol=1e-12, atol=0.0) | np.isclose(time, nearest[1], rtol=1e-12, atol=0.0)
+    if not at.any():
+        return pace, pace
+    before = protocol.velocity_at(np.nextafter(time[at], -np.inf))
+    before = np.where(before > 0, before, np.max(protocol.velocities))
+    low, high = pace.copy(), pace.copy()
+    low[at], high[at] = np.minimum(pace[at], before), np.maximum(pace[at], before)
+    return low, high
+
+
 def _trace_cycles(
     time: np.ndarray,
     stress: np.ndarray,
@@ -170,7 +192,8 @@ def _trace_cycles(
     if n < 3:
         return ()
     pace = _pace(time, protocol)
-    ahead = velocity > pace
+    slower, faster = _pace_bounds(time, protocol, pace)  # a row at a protocol boundary: both segments' paces
+    ahead = velocity > faster
     runs = [(a, z) for a, z in _runs(ahead) if a > 0]  # a run from the first row is the start, not a slip
     cycles: list[Cycle] = []
     behind = np.flatnonzero(~ahead)  # the first stick starts at the first row, or after a start faster than the puller
@@ -178,14 +201,14 @@ def _trace_cycles(
     for a, z in runs:
         if a <= stick_from:
             continue
-        slow = float(np.min(velocity[stick_from:a] / pace[stick_from:a]))
+        slow = float(np.min(velocity[stick_from:a] / slower[stick_from:a]))
         jump = float(np.max(velocity[a : z + 1]))
         if between is not None:  # the states between the rows, to the one back below the puller
             jump = max(jump, float(np.max(between.fastest[a : z + 2])))
         end = z + 1 if z + 1 < n else None  # the row where the slider is back below the puller
         if any(time[a - 1] <= instant <= time[n - 1 if end is None else end] for instant in jumps):
             jump = math.inf
-        if not (slow <= 1.0 / SLIP_FACTOR and jump >= SLIP_FACTOR * float(np.max(pace[a : z + 1]))):
+        if not (slow <= 1.0 / SLIP_FACTOR and jump >= SLIP_FACTOR * float(np.max(faster[a : z + 1]))):
             if slow > 1.0 / SLIP_FACTOR and end is not None:
                 stick_from = end  # a swing while sliding: a stick, if any, starts after it
             continue  # else a creep that briefly outran the puller without a jump: the stick goes on
