@@ -201,3 +201,30 @@ def test_an_estimate_the_rows_cannot_check_says_so():
     assert regime == "undetermined"
     if _still_to_come(message) is not None:
         assert "if the approach is one exponential, which 7 rows cannot check" in message
+
+
+def test_an_undetermined_run_with_periods_is_not_said_to_have_no_oscillation():
+    """The text said "94 period(s) ...", "period 0.000444168 s (no whole cycle within the run)" and "(no
+    oscillation)" of one run: "no oscillation" is said only where no period was seen."""
+    from stickslip.cli.run_cmd import summary_text
+
+    base = {
+        "model": "transient",
+        "protocol": [{"velocity": 1e-6, "duration": 0.02}],
+        "rig": {"control": "velocity", "stiffness": None},
+        "regime": "undetermined",
+        "status": "ok",
+        "message": "undetermined: 94 period(s), ...",
+        "evidence": "",
+        "oscillates": False,
+        "periods_seen": 94,
+        "period": 0.000444168,
+        "peak_stress": 40661.5,
+        "trough_stress": 37500.7,
+        "run_mean_stress": 39024.0,
+    }
+    text = summary_text(base)
+    assert "period 0.000444168 s (no whole cycle within the run)" in text
+    assert "no oscillation" not in text
+    quiet = summary_text({**base, "periods_seen": 0, "period": None})
+    assert "over the run (no oscillation)" in quiet

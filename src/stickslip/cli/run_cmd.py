@@ -416,7 +416,10 @@ def summary_text(summary: dict[str, Any], units: dict[str, str] | None = None) -
                 last = sum(s["duration"] for s in segments[:-1])
                 numbers[-1] += f" over the last segment (from t = {last:.6g} s)"
     if not cycle and numbers:
-        numbers[-1] += " over the run" + ("" if summary.get("oscillates", True) else " (no oscillation)")
+        # "no oscillation" only where none was seen: an undetermined run may hold periods not yet settled
+        seen = summary["period"] is not None and math.isfinite(summary["period"])
+        quiet = not summary.get("oscillates", True) and not seen
+        numbers[-1] += " over the run" + (" (no oscillation)" if quiet else "")
     if numbers:
         lines.append("  " + ", ".join(numbers))
     if not cycle and len(segments) > 1:  # the run's own range where the last segment's is not all of it
