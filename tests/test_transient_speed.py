@@ -117,8 +117,11 @@ def test_velocity_steps_match_a_tight_cohort_run():
     tight = run_transient(GEL, protocol, rtol=1e-6, reduction="off", **kw)
     i, j = _common(auto, tight)
     assert i.size >= 220
-    assert np.max(np.abs(auto.stress[i] / tight.stress[j] - 1)) < 5e-5
-    assert np.max(np.abs(auto.bonded_fraction[i] / tight.bonded_fraction[j] - 1)) < 5e-5
+    # rows sampled onto the 0.2 ms grid after the integration (docs/transient.md section 19) are interpolated
+    # between the solver's rows, and kept within them: 1.4e-4 at the trough after the step down, where the grid
+    # landing steps had 1.9e-5
+    assert np.max(np.abs(auto.stress[i] / tight.stress[j] - 1)) < 3e-4
+    assert np.max(np.abs(auto.bonded_fraction[i] / tight.bonded_fraction[j] - 1)) < 3e-4
     steady = stickslip.steady_state(GEL, np.array([1000e-6, 100e-6]))
     assert auto.stress[np.searchsorted(auto.time, 0.025) - 1] == pytest.approx(steady.stress[0], rel=1e-5)
     assert auto.final_stress == pytest.approx(steady.stress[1], rel=1e-5)

@@ -207,7 +207,27 @@ def test_the_split_changes_no_number(name: str, reference: dict[str, np.ndarray]
     keys = sorted(key.split("/", 1)[1] for key in reference if key.startswith(name + "/"))
     assert keys == sorted(got), (keys, sorted(got))
     for key in keys:
+        if (name, key) in SAMPLED_LOWEST:
+            _check_sampled_lowest(got, reference[f"{name}/{key}"])
+            continue
         assert _same(got[key], reference[f"{name}/{key}"]), f"{name}: {key} differs"
+
+
+#: the cases whose rows are sampled onto a grid after the integration (docs/transient.md section 19): a row's lowest
+#: stress is now the least of every state the solver took since the row before, the glide's own rows included, where
+#: it was the least of the states the grid-landing steps took (1.2e-3 of the largest value lower at one row)
+SAMPLED_LOWEST = {("steady_reduced", "lowest_stress")}
+
+
+def _check_sampled_lowest(got: dict[str, np.ndarray], old: np.ndarray) -> None:
+    """The new lowest stress of each row sees at least the states the old one saw: at or below the old value (to
+    SAME), and at or below the row's own stress."""
+    new, stress = got["lowest_stress"], got["stress"]
+    assert new.shape == old.shape
+    scale = float(np.max(np.abs(old[np.isfinite(old)]), initial=0.0))
+    finite = np.isfinite(old) & np.isfinite(new)
+    assert np.all(new[finite] <= old[finite] + SAME * scale)
+    assert np.all(new[finite] <= stress[finite] + SAME * scale)
 
 
 def test_the_comparison_can_fail(reference: dict[str, np.ndarray]) -> None:

@@ -1,9 +1,9 @@
 """The steady population of Eqs 6-7 as cells, compiled: model.steady_population's march in numba.
 
 Two layouts of the same march: the Gauss rule's two cohorts per cell (:func:`steady_cohorts`, the solver's steady
-starts and rebuilt populations) and one cohort per cell at its middle with its force, stiffness, hazard and aging
-sensitivity (:func:`_steady_cells`: the quasi-steady reduction's lag and the linear stability's response).  Apart
-from both so that neither imports the other for it.
+starts, their cells cut ahead of the FENE cliff by :func:`_refine`, and rebuilt populations) and one cohort per cell
+at its middle with its force, stiffness, hazard and aging sensitivity (:func:`_steady_cells`: the quasi-steady
+reduction's lag and the linear stability's response).  Apart from both so that neither imports the other for it.
 """
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ import numpy as np
 from ..parameters import Parameters
 from . import kernel
 from .kernel import P_AGING, P_DLM, P_FORCE_SENS, P_INV_TAU_A, P_LOG_U0_TAU, P_M, P_N0, P_TAU, P_VA
-from .model import CELL_HAZARD, GAUSS, MAX_CELLS
+from .model import CELL_HAZARD, GAUSS, MAX_CELLS, REFINED_MOST, WALL_CELL
 
 #: the compiled steady cells (model.steady_population's, with its CELL_HAZARD, GAUSS and MAX_CELLS)
 _CELLS: list = []
@@ -30,7 +30,7 @@ def _steady_cells():  # type: ignore[no-untyped-def]
         kernel.compiled()  # the kernel's chain functions, compiled in place
         g["_force"], g["_stiffness"], g["_energy"] = kernel._chain_force, kernel._chain_stiffness, kernel._chain_energy
         g["_aging_clock"] = kernel._aging_clock
-        for name in ("_log_rate", "_march"):
+        for name in ("_log_rate", "_march", "_lumping", "_need", "_cut_cells", "_refine"):
             g[name] = njit(cache=True)(g[name])
         _CELLS.append(njit(cache=True)(_cells))
         _CELLS.append(njit(cache=True)(_gauss))
@@ -38,15 +38,27 @@ def _steady_cells():  # type: ignore[no-untyped-def]
 
 
 def steady_cohorts(  # type: ignore[no-untyped-def]
-    params: Parameters, velocity: float, aging: bool, cell_hazard: float = CELL_HAZARD, cells_least: float = 1000.0
+    params: Parameters,
+    velocity: float,
+    aging: bool,
+    cell_hazard: float = CELL_HAZARD,
+    cells_least: float = 1000.0,
+    reach: float = 0.0,
+    ripple: float = 0.0,
 ):
-    """model.steady_population(params, velocity, aging) (the Gauss rule), compiled: the same cohorts, faster."""
+    """model.steady_population(params, velocity, aging) (the Gauss rule), compiled: the same cohorts, faster.
+
+    ``reach`` (s of age at ``velocity``: how far the run carries the cohorts) and ``ripple`` (relative): the cells
+    whose cohorts reach the FENE cliff within ``reach`` are cut until the ripple their lumped deaths leave in the
+    stress there is at most ``ripple`` (:func:`_refine`, docs/transient.md section 18); 0 (the default): the cells
+    of model.steady_population, uncut."""
     from .model import Population, pack_parameters, steady_population
 
     if not (velocity > 0 and math.isfinite(velocity)):
         return steady_population(params, velocity, aging)  # its error, in words
     _steady_cells()
-    age, weight = _CELLS[1](float(velocity), pack_parameters(params, aging, 1.0), cell_hazard, cells_least)
+    p = pack_parameters(params, aging, 1.0)
+    age, weight = _CELLS[1](float(velocity), p, cell_hazard, cells_least, float(reach), float(ripple))
     if age.size >= 2 * MAX_CELLS:
         return steady_population(params, velocity, aging)  # its error, in words
     return Population(extension=velocity * age, age=age, weight=weight)
@@ -75,7 +87,7 @@ def _march(v, p, cell_hazard, cells_least=1000.0):  # type: ignore[no-untyped-de
     while big_h < 45.0 and a < t_max and len(edges) <= MAX_CELLS:
         lr = _log_rate(a, v, slope, p)
         step = widest if lr < -700.0 else min(widest, cell_hazard / math.exp(lr))
-        step = min(step, 0.05 * (t_max - a))
+        step = min(step, WALL_CELL * (t_max - a))
         if step <= 1e-15 * a:
             break
         while True:  # as model.steady_population: shrink a cell over which the hazard climbs
@@ -95,9 +107,12 @@ def _march(v, p, cell_hazard, cells_least=1000.0):  # type: ignore[no-untyped-de
     return np.array(edges), np.array(cum), slope
 
 
-def _gauss(v, p, cell_hazard, cells_least):  # type: ignore[no-untyped-def]
-    """(age, weight) of model.steady_population(rule="gauss"): two cohorts per cell at its Gauss points."""
+def _gauss(v, p, cell_hazard, cells_least, reach, ripple):  # type: ignore[no-untyped-def]
+    """(age, weight) of model.steady_population(rule="gauss"): two cohorts per cell at its Gauss points (the cells
+    cut by :func:`_refine` where ``reach`` and ``ripple`` ask for it)."""
     edges, cum, slope = _march(v, p, cell_hazard, cells_least)
+    if reach > 0.0 and ripple > 0.0:
+        edges, cum = _refine(edges, cum, v, p, slope, reach, ripple)
     n = edges.size - 1
     age = np.empty(2 * n)
     weight = np.empty(2 * n)
@@ -118,6 +133,138 @@ def _gauss(v, p, cell_hazard, cells_least):  # type: ignore[no-untyped-def]
     for k in range(2 * n):
         weight[k] *= birth
     return age, weight
+
+
+def _lumping(x):  # type: ignore[no-untyped-def]
+    """The lumping ripple of cells h = x/g wide, in units of (e/pi) D/g^2 (:func:`_refine`): the Gauss pairs'
+    harmonics k = 1, 2, 3 at 2 pi k/h, each |cos(2 pi k GAUSS)|/k times |Gamma(1 - 2 pi i k/x)|."""
+    out = 0.0
+    for k in range(1, 4):
+        arg = 2.0 * math.pi * math.pi * k / x  # pi y, y = 2 pi k/x
+        if arg > 700.0:
+            break
+        gamma = 1.0 if arg < 1e-6 else math.sqrt(arg / math.sinh(arg))
+        out += abs(math.cos(2.0 * math.pi * k * GAUSS)) / k * gamma
+    return x * out
+
+
+def _need(a, hazard, v, p, slope, scale, ripple):  # type: ignore[no-untyped-def]
+    """1/h: the inverse of the widest cell whose cohorts, passing age ``a`` (cumulative hazard ``hazard`` there),
+    leave a lumping ripple within ``ripple`` of the stress (``scale``: the integral of S f over the ages); 0 where the
+    hazard does not rise with age (no cliff) or nothing dies there."""
+    g = p[P_FORCE_SENS] * _stiffness(v * a, p[P_M], p[P_DLM]) * v - slope * _aging_clock(a, p)[1]
+    if not g > 0.0:
+        return 0.0
+    force = _force(v * a, p[P_M], p[P_DLM])
+    if not force > 0.0:
+        return 0.0
+    log_death = _log_rate(a, v, slope, p) - hazard + math.log(force / scale)
+    if log_death < -700.0:
+        return 0.0
+    # the ripple (e/pi) (D/g^2) _lumping(h g) <= ripple, D = r S f/scale the stress dying per unit age
+    log_quota = math.log(ripple * math.pi / math.e * g * g) - log_death
+    if log_quota > 30.0:  # cells far wider than the cliff: _lumping(x) is x times its harmonics' sum, 0.905
+        return 0.0
+    quota = math.exp(log_quota)
+    lo, hi = 0.05, 2.0 * quota + 10.0
+    if _lumping(hi) <= quota:
+        return g / hi
+    for _ in range(60):
+        mid = math.sqrt(lo * hi)
+        if _lumping(mid) <= quota:
+            lo = mid
+        else:
+            hi = mid
+        if hi < 1.001 * lo:
+            break
+    return g / lo
+
+
+def _cut_cells(edges, cum, v, p, slope, reach, ripple):  # type: ignore[no-untyped-def]
+    """How many equal parts each cell takes: enough that its cohorts, swept over the ages [a_k, a_k+1 + reach] the
+    run carries them through, stay within ``ripple`` wherever they die on a rising hazard (:func:`_need` at every
+    edge of that window, and at its far end), and that up to where the most stress dies (the cliff) the cell keeps
+    the march's resolution of the chain force, WALL_CELL of its distance from the FENE wall, where it arrives."""
+    n = edges.size - 1
+    t_max = p[P_DLM] / v
+    scale = 0.0
+    for k in range(n):
+        f0 = _force(v * edges[k], p[P_M], p[P_DLM]) * math.exp(-cum[k])
+        f1 = _force(v * edges[k + 1], p[P_M], p[P_DLM]) * math.exp(-cum[k + 1])
+        scale += 0.5 * (f0 + f1) * (edges[k + 1] - edges[k])
+    need = np.empty(n + 1)
+    cliff, most_death = edges[n], -np.inf  # where r S f, the stress dying per unit age, peaks
+    for j in range(n + 1):
+        need[j] = _need(edges[j], cum[j], v, p, slope, scale, ripple)
+        force = max(_force(v * edges[j], p[P_M], p[P_DLM]), 1e-300)
+        death = _log_rate(edges[j], v, slope, p) - cum[j] + math.log(force)
+        if death > most_death:
+            cliff, most_death = edges[j], death
+    parts = np.ones(n, dtype=np.int64)
+    queue = np.empty(n + 1, dtype=np.int64)  # the window's edges, their need decreasing (a sliding maximum)
+    head, tail, nxt = 0, 0, 0
+    for k in range(n):
+        far = edges[k + 1] + reach
+        while nxt <= n and edges[nxt] <= far:
+            while tail > head and need[queue[tail - 1]] <= need[nxt]:
+                tail -= 1
+            queue[tail] = nxt
+            tail += 1
+            nxt += 1
+        while tail > head and queue[head] < k:
+            head += 1
+        most = need[queue[head]] if tail > head else 0.0
+        if nxt <= n:  # the window ends inside cell nxt - 1: its far end, its hazard by Simpson from that cell's start
+            a0 = edges[nxt - 1]
+            r0 = math.exp(_log_rate(a0, v, slope, p))
+            r1 = math.exp(_log_rate(0.5 * (a0 + far), v, slope, p))
+            r2 = math.exp(_log_rate(far, v, slope, p))
+            hazard = cum[nxt - 1] + (far - a0) * (r0 + 4.0 * r1 + r2) / 6.0
+            most = max(most, _need(far, hazard, v, p, slope, scale, ripple))
+        arrival = min(far, cliff)
+        if arrival > edges[k + 1]:
+            most = max(most, 1.0 / (WALL_CELL * (t_max - arrival)))
+        cut = most * (edges[k + 1] - edges[k])
+        if cut > 1.0:
+            parts[k] = math.ceil(min(cut, 1e9))
+    return parts
+
+
+def _refine(edges, cum, v, p, slope, reach, ripple):  # type: ignore[no-untyped-def]
+    """The march's cells cut into equal parts where :func:`_cut_cells` asks, each part's hazard by Simpson's rule;
+    at most REFINED_MOST cells added, from the oldest cells down (those reach the cliff first)."""
+    parts = _cut_cells(edges, cum, v, p, slope, reach, ripple)
+    n = edges.size - 1
+    added = 0
+    for k in range(n - 1, -1, -1):
+        if added + parts[k] - 1 > REFINED_MOST:
+            for j in range(k + 1):
+                parts[j] = 1
+            break
+        added += parts[k] - 1
+    if added == 0:
+        return edges, cum
+    out_edges = np.empty(n + 1 + added)
+    out_cum = np.empty(n + 1 + added)
+    out_edges[0], out_cum[0] = edges[0], cum[0]
+    i = 0
+    for k in range(n):
+        if parts[k] == 1:
+            out_edges[i + 1] = edges[k + 1]
+            out_cum[i + 1] = out_cum[i] + (cum[k + 1] - cum[k])
+            i += 1
+            continue
+        h = (edges[k + 1] - edges[k]) / parts[k]
+        for j in range(parts[k]):
+            a0 = edges[k] + j * h
+            a1 = edges[k + 1] if j == parts[k] - 1 else a0 + h
+            r0 = math.exp(_log_rate(a0, v, slope, p))
+            r1 = math.exp(_log_rate(0.5 * (a0 + a1), v, slope, p))
+            r2 = math.exp(_log_rate(a1, v, slope, p))
+            out_edges[i + 1] = a1
+            out_cum[i + 1] = out_cum[i] + (a1 - a0) * (r0 + 4.0 * r1 + r2) / 6.0
+            i += 1
+    return out_edges, out_cum
 
 
 def _cells(v, p, cell_hazard):  # type: ignore[no-untyped-def]

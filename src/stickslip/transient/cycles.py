@@ -28,6 +28,9 @@ SLIP_FACTOR = 2.0
 OSCILLATING = regimes.OSCILLATING
 #: a limit cycle in which the slider never sticks (a block with mass ringing on): no stick-slip
 OSCILLATION = regimes.OSCILLATION
+#: under velocity control at a constant velocity, a swing up to this share of the stress read as a limit cycle or a
+#: growing oscillation is the discretisation's ripple on a steady state (:func:`_ripple`, docs/transient.md section 18)
+RIPPLE_STEADY = 1e-2
 
 
 @dataclasses.dataclass(frozen=True)
@@ -368,12 +371,80 @@ def judge(
         classified = regimes.classify(time, stress, floor=floor, start=start, unit="Pa", settle_floor=settle)
         found = solution_extremes(classified, time, stress, between, start)
     chains = any(kind == "stick" for kind, *_ in events)
+    ripple = _ripple(found, time, stress, velocity, protocol, control, resolution, scale, between)
+    if ripple is not None:
+        return ripple
     regime, message = _words(found, time, stress, velocity, protocol, cycles, control, resolution, scale, chains)
     if regime not in OSCILLATING:  # no oscillation to take a period's extremes of: the window's, as reported
         peak, trough = window_extremes(time, stress, between, start)
         if math.isfinite(peak):
             found = dataclasses.replace(found, peak=peak, trough=trough)
     return regime, message, found
+
+
+def _ripple(  # type: ignore[no-untyped-def]
+    found: regimes.Regime, time, stress, velocity, protocol: Protocol, control: str, resolution, scale: float, between
+) -> tuple[str, str, regimes.Regime] | None:
+    """Under velocity control at a constant velocity (the last segment's, > 0) Eq 1 is linear in the population and
+    asymptotically stable (docs/transient.md section 18): it has no limit cycle and no growing oscillation, and its
+    own transients decay.  A trace read as either, or as periods without a trend within RESOLVED x rtol, carries the
+    discretisation's ripple.  (regime, message, evidence) saying so: "steady" where the mean over the last quarter
+    of the segment is that of the quarter before within SETTLED and the swing there is at most RIPPLE_STEADY of the
+    stress; "undetermined" (still changing, or a large swing) for a limit cycle or a growing oscillation otherwise;
+    None for every other verdict (the classifier's stands) and under block control."""
+    vp = protocol.segments[-1].velocity
+    if control != "velocity" or not vp > 0 or time.size < 3:
+        return None
+    start, end = float(protocol.boundaries[-2]), float(time[-1])
+    quarter = regimes.TAIL * (end - start)
+    peak, trough = window_extremes(time, stress, between, end - quarter)  # the ripple: the last quarter's swing
+    if not (math.isfinite(peak) and quarter > 0):
+        return None
+    swing = peak - trough
+    tolerance = RESOLVED * (resolution if resolution is not None else 10.0 * SETTLED) * scale
+    impossible = found.kind in (regimes.STICK_SLIP, regimes.GROWING)
+    unresolved = found.kind in (regimes.UNDETERMINED, regimes.DECAYING) and found.periods > 0 and swing < tolerance
+    if not (impossible or unresolved):
+        return None
+    last = _mean_over(time, stress, end - quarter, end)
+    drift = last - _mean_over(time, stress, end - 2.0 * quarter, end - quarter)
+    settled = abs(drift) <= SETTLED * abs(last) and swing <= RIPPLE_STEADY * abs(last)
+    if not (settled or impossible):
+        return None
+    read = f"{found.periods} swing(s)" + (f" of {found.period:.3g} s" if math.isfinite(found.period) else "")
+    ripple = f"{swing:.3g} Pa peak to trough ({swing / abs(last):.2g} of σ; {read}) over the last {quarter:.3g} s"
+    why = (
+        "under velocity control at a constant velocity Eq 1 is linear in the bonds and asymptotically stable"
+        " (docs/transient.md section 18): it has no oscillation of its own"
+    )
+    window = window_extremes(time, stress, between, start)
+    if settled:
+        message = (
+            f"steady sliding at {vp * 1e6:.6g} µm/s: σ = {stress[-1]:.6g} Pa at t = {end:.6g} s; the trace ripples by"
+            f" {ripple}, which is numerical: {why}"
+        )
+        steady = dataclasses.replace(
+            found, kind=regimes.STEADY, periods=0, amplitude_ratio=math.nan, period=math.nan, peak=window[0],
+            trough=window[1], evidence=message,
+        )  # fmt: skip
+        return regimes.STEADY, message, steady
+    message = (
+        f"undetermined: σ still changes ({drift:+.3g} Pa in its mean over the last {quarter:.3g} s, to {last:.6g} Pa at"
+        f" t = {end:.6g} s) and swings by {ripple}; {why}: its transients decay, and a ripple is numerical (a smaller"
+        " rtol shrinks it); run longer to see it settle"
+    )
+    unsettled = dataclasses.replace(
+        found, kind=regimes.UNDETERMINED, peak=window[0], trough=window[1], evidence=message
+    )  # fmt: skip
+    return regimes.UNDETERMINED, message, unsettled
+
+
+def _mean_over(time: np.ndarray, stress: np.ndarray, a: float, b: float) -> float:
+    """The time mean of the rows' stress over [a, b] (trapezoid, linear between the rows)."""
+    inside = (time > a) & (time < b)
+    t = np.concatenate([[a], time[inside], [b]])
+    s = np.concatenate([[np.interp(a, time, stress)], stress[inside], [np.interp(b, time, stress)]])
+    return float(np.sum(0.5 * (s[1:] + s[:-1]) * np.diff(t)) / (b - a))
 
 
 def solution_extremes(

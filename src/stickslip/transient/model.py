@@ -119,8 +119,17 @@ class Population:
 #: steady populations: largest hazard increment per age cell, and where the survival counts as zero
 CELL_HAZARD = 0.05
 HAZARD_END = 45.0
+#: a cell spans at most this share of its distance in age from the FENE wall (the chain force, 1/(1 - y^2), resolved)
+WALL_CELL = 0.05
 #: most age cells a steady population may take (the gel's set takes ~2000-20000)
 MAX_CELLS = 1_000_000
+#: a steady start's cells whose cohorts reach the FENE cliff within the run are cut until the ripple their lumped
+#: deaths there leave in the stress is at most this share of the run's rtol (cells.steady_cohorts, the lumping
+#: ripple's estimate cells._lumping; docs/transient.md section 18)
+RIPPLE_SHARE = 0.1
+#: and the cells so cut add at most this many, those nearest the cliff first (they arrive first): the gel at 1 um/s
+#: adds ~5 600 for a run of 20 ms (its CPU 4.7 s against 0.44 s uncut), and would add ~4e5 for one of 1 s
+REFINED_MOST = 40_000
 
 
 def steady_population(
@@ -151,7 +160,7 @@ def steady_population(
         lr = float(log_hazard(np.array(velocity * a), np.array(a), velocity, params, aging))
         step = widest if lr < -700 else min(widest, cell_hazard / math.exp(min(lr, 700.0)))
         # never step past the FENE wall; approach it geometrically
-        step = min(step, 0.05 * (t_max - a))  # resolves the FENE force as well as the survival
+        step = min(step, WALL_CELL * (t_max - a))  # resolves the FENE force as well as the survival
         if step <= 1e-15 * a:  # no progress left in floating point (the FENE wall approached geometrically)
             break
         # Simpson on the cell for the cumulative hazard; a cell over which the hazard climbs (a force cliff the

@@ -31,7 +31,7 @@ from ..units import checked_number
 from . import jump
 from . import kernel as K
 from .arguments import check_progress, check_rig_words, check_snapshot_times
-from .model import Population, chain_force, pack_parameters, stick_chains
+from .model import RIPPLE_SHARE, Population, chain_force, pack_parameters, stick_chains
 from .result import Bookkeeping, Snapshot, TransientResult
 from .sampling import Sampler
 
@@ -65,6 +65,10 @@ THIN_ROWS = 20_000
 COPY_BATCH = 200_000
 #: with a sampler, the rows' entries held before the settled ones are sampled (a kernel call adds one)
 SAMPLER_ENTRIES = 64
+#: with ``every`` a run is integrated as without it and its rows are sampled onto the grid afterwards
+#: (transient/sampling.py, docs/transient.md section 19), whatever the control; False (with REPEAT_CYCLES = False):
+#: the solver lands a step on each grid instant (the reference of the tests)
+SAMPLED_AFTER = True
 #: with the stick chains under a moving puller the births' spacing is bounded by their own Gauss error, not one
 #: lumped cohort's (kernel._relaxed_births, docs/transient.md section 11); False: the lumped bound throughout (the
 #: reference of the benchmark and the tests)
@@ -152,10 +156,11 @@ def run_transient(
     load and the bonds of Eq 1 are set aside; when the chains collapse, the
     slider jumps onto the steady aging curve at the stress reached (the
     paper's jump) and Eq 1 takes over again.  A run from an empty start then
-    begins stuck.  ``every`` (s) samples the trace on a uniform grid hit by
-    the solver itself (with the stick chains through the massless block and
-    the reduction on, the run is integrated as without it, its settled cycle
-    repeated, and its rows sampled onto the grid: transient/sampling.py);
+    begins stuck.  ``every`` (s) samples the trace on a uniform grid (and
+    each slip's instant): the run is integrated as without it, whatever the
+    control (the same steps, events and summary; a settled cycle of the stick
+    chains still repeated), and its rows are sampled onto the grid
+    afterwards (transient/sampling.py, docs/transient.md section 19);
     otherwise every accepted step is a row.  ``rtol`` is
     the local error tolerance (relative, in stress and bonded fraction).
     ``progress`` is called with the fraction done.  ``snapshot_times`` (s):
@@ -317,6 +322,9 @@ class _Driver:
         self.dropped = 0  # entries of self.rows already fed to the sampler
         self.slips_fed = 0  # events looked at for the sampler's instants
         self.copy_rows_left = TRACE_COPY_ROWS  # rows the copies of repeated cycles may still add without ``every``
+        #: velocity control with a sampler: the last row balanced (as the solver gave it) and the corrections of its
+        #: integral of sigma dt and work (_balanced_integral), carried on to the rows fed next
+        self.balanced_from: tuple[np.ndarray, tuple[float, float]] | None = None
         self.thinned: list[tuple[int, float, int, int]] = []  # (periods, spacing, rows kept, rows in place of)
 
     def start(
@@ -334,7 +342,11 @@ class _Driver:
                 raise ParameterError(
                     f"start velocity: a steady start needs a positive sliding velocity, got {v_start!r}"
                 )
-            state.load(_steady_cohorts(params, v_start, self.aging))
+            # the cells whose cohorts reach the FENE cliff within the run cut to the tolerance (section 18); a start
+            # held while the velocity stays (below) carries them only from the first change on
+            held = _held_start(self.protocol, control, start, reduction, max_step, self.mass, start_velocity)
+            reach = _start_reach(params, self.protocol, v_start, self.aging, control, k_block, held)
+            state.load(_steady_cohorts(params, v_start, self.aging, reach=reach, ripple=RIPPLE_SHARE * self.rtol))
             state.v = v_start
         elif start_velocity is not None:
             raise ParameterError("start velocity: only used with start='steady'")
@@ -366,9 +378,15 @@ class _Driver:
                     self.sampler = Sampler(self.times, k_block)
                     self.times = np.empty(0)
                     self.sample_index = 0
+        # under velocity control a steady start at the first piece's velocity is the exact solution until the
+        # velocity changes (docs/transient.md section 18): held, not integrated (:meth:`_held_steady`)
+        self.held = _held_start(self.protocol, control, start, reduction, max_step, self.mass, start_velocity)
+        self.start_population = state.population() if self.held else None
+        self.start_population_velocity = state.v
 
     def run(self) -> TransientResult:
         """Every piece of the protocol, to its end (or to where the chains' jump has no landing point)."""
+        self._sample_after()
         state = self.state
         for t0, t1, vp in self.protocol.pieces():
             while self.snap_index < len(self.wanted) and self.wanted[self.snap_index] <= t0 + 1e-15:
@@ -389,12 +407,35 @@ class _Driver:
                 following = bisect.bisect_right(self.wanted, state.t + 1e-15, lo=self.snap_index)  # 1e5 segments
                 wanted = self.wanted
                 t_stop = wanted[following] if following < len(wanted) and wanted[following] < t1 else t1
-                if self._glide(t0, t_stop, t1, vp):
+                if self._held_steady(t_stop, t1, vp) or self._glide(t0, t_stop, t1, vp):
                     continue
                 self._cohorts(t0, t_stop, t1, vp)
         while self.snap_index < len(self.wanted):
             self._snapshot()
         return self._finish()
+
+    def _sample_after(self) -> None:
+        """With ``every``, the run integrated as without it and its rows sampled onto the grid as they come
+        (transient/sampling.py): the steps never land on the grid, so ``every`` changes neither them nor the summary.
+        The protocol's boundaries are rows too (a summary's window starts at one: the last segment), all of them for
+        a protocol of at most SNAPSHOT_SEGMENTS segments, else the last segment's start.  (A repeating run's
+        sampler, set up with its repeater in :meth:`start` before any row, is set up again here.)"""
+        grid = self.sampler.grid if self.sampler is not None else self.times
+        if not (grid.size and (SAMPLED_AFTER or self.sampler is not None)):
+            return
+        bounds = self.protocol.boundaries
+        kept = bounds[1:] if len(self.protocol.segments) <= SNAPSHOT_SEGMENTS else bounds[-2:]  # (and the end)
+        self.sampler = Sampler(
+            grid, self.k_block, control=self.control, mass=self.mass, damping=self.damping, breaks=bounds[1:-1],
+            instants=kept,
+        )  # fmt: skip
+        self.times = np.empty(0)
+        self.sample_index = 0
+
+    def _bound_rows(self) -> None:
+        """With a sampler, the rows it may take are sampled once they pile up (a bounded working set)."""
+        if self.sampler is not None and len(self.rows) > SAMPLER_ENTRIES:
+            self._feed_settled()
 
     def _snapshot(self) -> None:
         self.snapshots.append(_snapshot(self.state))
@@ -422,9 +463,21 @@ class _Driver:
         if count <= 0:
             return
         fine = np.vstack([np.atleast_2d(r) for r in self.rows[:count]])
+        if self.control == "velocity":  # the integral between rows from the energy balance, as over the whole trace
+            fine = self._balanced(fine)
         self.sampler.feed(fine, self._slips_until(float(fine[-1, 0])))
         del self.rows[:count]
         self.dropped += count
+
+    def _balanced(self, fine: np.ndarray) -> np.ndarray:
+        """Velocity control: the rows' integral of sigma dt and work from the energy balance
+        (:func:`_balanced_integral`), carried on from the rows fed before: the numbers of the whole trace balanced at
+        once (solver._finish), to the bit."""
+        before = self.balanced_from
+        table = fine.copy() if before is None else np.vstack([before[0][None, :], fine])
+        carried = _balanced_integral(table, self.protocol, (0.0, 0.0) if before is None else before[1])
+        self.balanced_from = (fine[-1].copy(), carried)
+        return table if before is None else table[1:]
 
     def _slips_until(self, t: float) -> np.ndarray:
         """The slips' instants up to t not yet given to the sampler (each a row of its own)."""
@@ -447,6 +500,7 @@ class _Driver:
         if self.sampler is None:
             return self.rows
         self._feed()
+        self.sampler.flush()
         out = list(self.sampler.rows())
         anchor = self.sampler.anchor
         if anchor is not None and anchor[0] > self.sampler.last_written:  # a run stopped between grid points
@@ -461,6 +515,7 @@ class _Driver:
     def _stuck(self, t1: float, vp: float) -> TransientResult | None:
         """The stuck block to the piece's end or the chains' collapse: the slider fixed, the chains of Eq 15 carry
         sigma = K (P - X); at a collapse the jump (None), or the run's end where it has no landing point."""
+        self._bound_rows()
         state, k_block, times, rows, params = self.state, self.k_block, self.times, self.rows, self.params
         stress0 = k_block * (state.puller - state.x)
         chain = self.chain_state
@@ -522,9 +577,42 @@ class _Driver:
         state.v = self.functions["_slider_velocity"](
             vs, vp, state.n, state.xb, state.tb, state.lw, state.x, state.t, p, *_scratch(state)
         )
-        self.rows.append(_row(state, self.params, self.control, self.k_block))
+        # the new bonds carry sigma_s (balanced to ~1e-12 of it): the row says so, as the stuck block's at this instant
+        self.rows.append(_row(state, self.params, self.control, self.k_block, sigma=sigma_s))
         if self.reducer is not None:
             self.reducer.loaded_steady(state)
+
+    def _held_steady(self, t_stop: float, t1: float, vp: float) -> bool:
+        """A steady start under velocity control while the velocity is still the start's: at constant V Eq 1 is
+        linear and asymptotically stable and its steady state is the exact solution (docs/transient.md section 18),
+        so the stretch to ``t_stop`` (in the piece ending at ``t1``) is written as steady sliding
+        (reduction.steady_glide, the steady solver's sigma and N) and the start's cohorts are carried on unchanged in
+        age and extension, not integrated: the discretised start's ripple never enters.  False once the velocity has
+        changed (or without the reduction)."""
+        state = self.state
+        if not (self.held and vp == self.start_population_velocity):
+            self.held, self.start_population = False, None
+            return False
+        from . import reduction as R
+
+        assert self.reducer is not None  # held only with the reduction on
+        steady = self.reducer._steady_at(vp)
+        nn, _ss, _k, uu = self.functions["_sums"](state.n, state.xb, state.lw, state.x, self.p)
+        glide = R.steady_glide(
+            self.params, t=state.t, t_end=t_stop, x=state.x, puller=state.puller, vp=vp, sigma=steady[0],
+            steady=steady, bonded=nn, energy=uu, k_block=self.k_block, block=False, acc=state.acc,
+            sample_times=self.times, sample_index=self.sample_index,
+        )  # fmt: skip
+        self.rows.extend(_kernel_rows(glide.rows, self.k_block, "velocity"))
+        self.sample_index = glide.sample_index
+        state.x += vp * (glide.t - state.t)
+        state.t, state.puller = glide.t, state.x
+        state.load(self.start_population)  # the same ages and extensions, now
+        state.acc[1] += glide.bonded - nn  # the cohorts' N carries on, as after a reduced stretch
+        state.h = 1e-2 * self.params.bonds.bond_time  # and their first step, as there
+        self._snapshots_through(t1)
+        self._report_progress()
+        return True
 
     def _glide(self, t0: float, t_stop: float, t1: float, vp: float) -> bool:
         """A quasi-steady stretch where the reduction takes one (when it is time to look for one)."""
@@ -535,6 +623,7 @@ class _Driver:
         if glided:
             self._snapshots_through(t1)
             self._report_progress()
+            self._bound_rows()
         return glided
 
     def _cohorts(self, t0: float, t_stop: float, t1: float, vp: float) -> None:
@@ -559,8 +648,7 @@ class _Driver:
         state.puller = puller0 + vp * (state.t - t0) if control == "block" else state.x
         if count:
             self.rows.extend(_kernel_rows(self.out[:count], self.k_block, control, self.mass))
-            if self.sampler is not None and len(self.rows) > SAMPLER_ENTRIES:
-                self._feed_settled()
+            self._bound_rows()
         if status == K.FULL:
             state.grow()
         elif status == K.STICK:
@@ -597,6 +685,8 @@ class _Driver:
         acc[4] += 1.0  # a step, so that the step budget bounds a run that jumps again and again
         state.h = self.params.bonds.bond_time * 1e-3
         self.jumps.append(found)
+        if self.sampler is not None:  # no row holds the state it jumped to: the next row's, from this instant
+            self.sampler.jumps.append(state.t)
         if self.reducer is not None:
             self.reducer.disturbed(state.t)
         return True
@@ -1084,19 +1174,43 @@ def _rebuilt_cells(rtol: float) -> tuple[float, float]:
 
 
 def _steady_cohorts(
-    params: Parameters, velocity: float, aging: bool, cell_hazard: float = 0.05, cells_least: float = 1000.0
+    params: Parameters,
+    velocity: float,
+    aging: bool,
+    cell_hazard: float = 0.05,
+    cells_least: float = 1000.0,
+    reach: float = 0.0,
+    ripple: float = 0.0,
 ) -> Population:
-    """steady_population, remembered (a steady run starts and ends on the same one)."""
+    """steady_population, remembered (a steady run starts and ends on the same one); ``reach`` and ``ripple``: its
+    cells cut ahead of the FENE cliff (cells.steady_cohorts, the steady start: docs/transient.md section 18)."""
     from ..quasistatic.jump import steady_curve_key
 
-    key = (steady_curve_key(params), float(velocity), bool(aging), cell_hazard, cells_least)
+    key = (steady_curve_key(params), float(velocity), bool(aging), cell_hazard, cells_least, reach, ripple)
     if key not in _STEADY_COHORTS:
         if len(_STEADY_COHORTS) > 16:
             _STEADY_COHORTS.clear()
         from .cells import steady_cohorts
 
-        _STEADY_COHORTS[key] = steady_cohorts(params, velocity, aging, cell_hazard, cells_least)
+        _STEADY_COHORTS[key] = steady_cohorts(params, velocity, aging, cell_hazard, cells_least, reach, ripple)
     return _STEADY_COHORTS[key]
+
+
+def _start_reach(
+    params: Parameters, protocol: Protocol, velocity: float, aging: bool, control: str, k_block: float, held: bool
+) -> float:
+    """The ages (s, at the steady start's ``velocity``) through which the run may carry the start's cohorts: the
+    slider's travel over the protocol (through the block the puller's plus the spring's release of the start's
+    stress; ``held``: from the first piece at another velocity on), at most dl_m, over ``velocity``."""
+    b = params.bonds
+    pieces = list(protocol.pieces())
+    if held:
+        while pieces and pieces[0][2] == velocity:
+            pieces.pop(0)
+    travel = float(sum(abs(vp) * (t1 - t0) for t0, t1, vp in pieces))
+    if control == "block":
+        travel += abs(float(_steady_state(params, velocity, aging).stress)) / k_block
+    return min(travel, b.max_extension) / velocity
 
 
 def _chains_ahead(d: Any, regime: str, message: str, time: np.ndarray, sigma: np.ndarray) -> tuple[str, str]:
@@ -1122,10 +1236,14 @@ def _scratch(state: _State) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return np.empty(state.xb.size), np.empty(state.xb.size), np.full((3, state.xb.size), -1.0)
 
 
-def _row(state: _State, params: Parameters, control: str, k_block: float, mass: float = 0.0) -> np.ndarray:
+def _row(
+    state: _State, params: Parameters, control: str, k_block: float, mass: float = 0.0, sigma: float | None = None
+) -> np.ndarray:
+    """The trace's row of ``state`` (``sigma``: the stress where known otherwise than from the bonds' sum)."""
     pop = state.population()
     f = chain_force(pop.extension, params)
-    sigma = float(pop.weight @ f)
+    if sigma is None:
+        sigma = float(pop.weight @ f)
     block_energy = sigma * sigma / (2 * k_block) if control == "block" else 0.0
     if mass > 0:  # the spring's own stretch, and the moving block's kinetic energy
         block_energy = 0.5 * k_block * (state.puller - state.x) ** 2 + 0.5 * mass * state.v**2
@@ -1219,7 +1337,7 @@ def _finish(d: _Driver, snapshots: list[Snapshot], stop: str | None, note: str) 
     table = table[order]
     keep = np.r_[True, np.diff(table[:, 0]) > 0]
     table = table[keep]
-    if control == "velocity":
+    if control == "velocity" and d.sampler is None:  # (a sampler's rows were balanced as they came: _Driver._balanced)
         _balanced_integral(table, protocol)
     n0 = params.bonds.site_density
     time, sigma, bonded, v, x, puller = (table[:, k] for k in range(6))
@@ -1294,7 +1412,9 @@ def _finish(d: _Driver, snapshots: list[Snapshot], stop: str | None, note: str) 
 BALANCE_SHARE = 1e-3
 
 
-def _balanced_integral(table: np.ndarray, protocol: Protocol) -> None:
+def _balanced_integral(
+    table: np.ndarray, protocol: Protocol, carried: tuple[float, float] = (0.0, 0.0)
+) -> tuple[float, float]:
     """Velocity control: the integral of sigma dt (and the rig's work) between rows from the energy balance,
     V (integral of sigma dt) = change of the bonds' FENE energy + the energy lost as they broke, wherever the rows
     lie in one segment at a constant pace V > 0 with Eq 1's bonds holding and hardly breaking (in place, columns
@@ -1304,10 +1424,15 @@ def _balanced_integral(table: np.ndarray, protocol: Protocol) -> None:
     the state's error control lets grow long (0.1 um/s for 10 s: one 6 s step from 5.7 to 88.3 kPa near the FENE
     wall) made it overshoot to a negative mean (-5634 Pa, 13931 Pa with rows every 0.5 s); the balance's ends are
     the states themselves, exact at any step where the bonds hardly break (energy lost within BALANCE_SHARE of the
-    energy stored): 13940.479 Pa at every sampling (docs/transient.md section 9)."""
+    energy stored): 13940.479 Pa at every sampling (docs/transient.md section 9).
+
+    ``carried``: the corrections (balanced less the solver's) of columns 13 and 8 at the first row, from the rows
+    before it; returns those at the last row.  The corrections add up row by row (one running sum), so rows balanced
+    a block at a time (_Driver._balanced, with ``every``) get the numbers of the whole trace at once, to the bit; a
+    trace without a balanced pair keeps the solver's columns as they are."""
     t = table[:, 0]
     if t.size < 2:
-        return
+        return carried
     bounds = protocol.boundaries
     tol = 1e-12 * max(float(bounds[-1]), 1.0)
     k = np.clip(np.searchsorted(bounds, 0.5 * (t[1:] + t[:-1]), side="right") - 1, 0, len(protocol.segments) - 1)
@@ -1319,12 +1444,14 @@ def _balanced_integral(table: np.ndarray, protocol: Protocol) -> None:
     # against the trapezoid's 4e-7): the balance only where little broke, exact there
     quiet = np.abs(lost) <= BALANCE_SHARE * np.abs(stored)
     use = one_segment & (vp > 0) & bonds[:-1] & bonds[1:] & quiet
-    if not np.any(use):
-        return
     gain = stored + lost
-    for column, increment in ((13, gain / np.where(use, vp, 1.0)), (8, gain)):
-        step = np.where(use, increment, np.diff(table[:, column]))
-        table[1:, column] = table[0, column] + np.cumsum(step)
+    out = []
+    for column, increment, start in ((13, gain / np.where(use, vp, 1.0), carried[0]), (8, gain, carried[1])):
+        change = np.where(use, increment - np.diff(table[:, column]), 0.0)
+        correction = np.cumsum(np.r_[start, change])  # (sequential: the same sums, whatever the blocks)
+        table[:, column] += correction
+        out.append(float(correction[-1]))
+    return out[0], out[1]
 
 
 def _jumps_note(jumps: list[jump.Jump]) -> str:
@@ -1535,6 +1662,28 @@ WALL_SHARE = 0.3
 #: memory less the births' count: 0.08 g at 3.5 um/s, 0.1 g at 10 um/s, ~0.004 g at 1 um/s; the tester's 3.5 um/s
 #: for 1 s, 18 913 steps and 33 s of CPU, had been estimated at 7.4e4 steps and 13.9 min)
 WALL_STEADY = 0.08
+#: but the wall's steps are the loaded cohorts' arrivals there, each landed on in a few steps (kernel.WALL_LANDING
+#: ends a step at 0.9 of the gap to the next: ~log10(g h) steps), not g a second: over the first memory dl_m/V of a
+#: piece the population it starts with arrives (the steady start's ~2 000 cohorts, two per cell of at most
+#: dl_m/V/1000: about WALL_ARRIVALS steps over that memory), then the run's own births, at most WALL_ECHO steps per
+#: step that bore them.  g grows as 1/V below ~3 um/s (the aging term a bond brings to the wall, dl_m/(V tau_a),
+#: leaves only the FENE divergence to break it, ever closer to the wall): 0.08 g was 4.9e6 steps/s at 0.01 um/s,
+#: whose run takes ~3 000-7 000 (the wall adds ~6 000 steps/s at 1 um/s, ~26 000 at 3.5 um/s; 0.3 g from empty at
+#: 1 um/s, 2.5e5 steps/s measured, is ~7 steps per step of births)
+WALL_ARRIVALS = 8000.0
+WALL_ECHO = 8.0
+#: the births' pace 4 (1 + u0)/tau was calibrated where at least this share of the sites is vacant (>= 1 um/s for
+#: the gel); where fewer are (slower sliding: aged bonds hold their sites to the FENE wall) the births' flux into
+#: them, whose error the step's third-order control bounds, falls with the vacancy, and the steps with its cube
+#: root (velocity control from a steady start, steps/s: 0.1 um/s ~9 300-12 000, 0.01 um/s ~2 600-7 100 against
+#: 35 700 counted; the vacancy there 1.2e-3 and 1.2e-4)
+VACANT = 0.01
+#: under velocity control each step of a steady start's first memory works through the start's cohorts that outlive
+#: its first steps (of its 3 100-4 100 for the gel, those nearest the wall die at once: 1 810 of 4 084 within 0.05 s
+#: at 0.01 um/s; about this many counted beyond STEP_SECONDS) and about one of the two born at each step so far
+#: (measured 0.5-1.5 kept a step from 0.01 to 1 um/s): 0.01 um/s for 4 s took 17 365 steps and 22 s of CPU, its step
+#: cost growing from ~0.35 to ~2 ms (estimated as all of the two born a step kept: 160 s; so: 88 s)
+STEADY_COHORTS = 1000.0
 #: where bonds leave the population before dl_m/V, the settling counts this many of their memories (the look for a
 #: stretch comes after about twice the steps it waits for)
 TAIL_SETTLE = 2.0
@@ -1544,6 +1693,14 @@ TAIL_SETTLE = 2.0
 #: CPU per step and living cohort (s; velocity control from empty, 10 and 1 um/s: 1.0e-7 and 1.9e-7 measured): a
 #: population that remembers dl_m/V = 1 s at 1 um/s keeps ~5e5 cohorts
 COHORT_STEP_SECONDS = 1.5e-7
+#: a steady start held as exact steady sliding until the velocity first changes (_Driver._held_steady): one
+#: steady stretch a piece, whatever its length (10 um/s for 0.15 s: 1 step, 2 ms of CPU)
+HELD_STEPS = 1.0
+#: each cohort the start's cells cut ahead of the FENE cliff add (cells._refine, docs/transient.md section 18) costs
+#: about this many steps where it reaches the cliff (velocity control, rtol 1e-4, the gel: 0.13-0.19 at 1 um/s,
+#: 0.20-0.25 at 3 um/s, 0.71-0.74 at 10 um/s, 0.25 after 0.1 um/s held and slowed to 0.01 um/s, 0.52 after 10 um/s
+#: held and sped to 20 um/s), and each step works through those not yet arrived (COHORT_STEP_SECONDS)
+CUT_STEPS = 0.35
 #: through the block a piece is reduced only this far above the fold of the steady curve at Vc: below it the slider
 #: decelerates, creeps along the fold and sticks (cohorts), or slips in cycles whose approach to the stick is cohorts
 FOLD_MARGIN = 1.02
@@ -1611,7 +1768,8 @@ def estimate_cost(
     calibrated on the gel's set from 10 um/s to 1 m/s and the audit set of
     issue 17 (within 0.4-5x of the cohorts' steps while sliding; through the
     block the estimate is scaled by :data:`BLOCK_SHARE`).  Every protocol
-    segment and every sampling instant costs at least a step.
+    segment costs at least a step; a sampling instant none (the rows are sampled after the steps,
+    :data:`SAMPLE_SECONDS` each).
 
     With ``reduction="auto"`` (and no ``max_step``) a piece the quasi-steady
     reduction can take (any sliding piece under velocity control; through the
@@ -1628,7 +1786,10 @@ def estimate_cost(
       step), and a piece below the fold costs :data:`SLIP_STEPS` per slip, the
       slips counted from the quasi-static model's first stick and period
       (:mod:`stickslip.quasistatic.cycle`, at the block's K; a slider that was
-      sliding first decelerates, :data:`STOP_STEPS`);
+      sliding first decelerates, :data:`STOP_STEPS`); from rest the chains hold
+      the block at any puller velocity until Eq 15 lets them go
+      (:func:`_chains_let_go`), and where the paper's jump then has no landing
+      point the run, and the count, stop there;
     * without it (and with aging that never saturates) one population of Eq 1
       never lets go: a block from rest is stuck for good, and a sliding block
       that meets a piece below the fold stops and is stuck for good; the run
@@ -1638,13 +1799,22 @@ def estimate_cost(
     A hold under velocity control costs what the solver does in it (the
     population relaxes in lengthening steps: :func:`_hold_steps`), and the
     re-slide after it the aged bonds' stiff deaths at the FENE wall
-    (:func:`_resliding_steps`).  Pieces below the fold otherwise,
+    (:func:`_resliding_steps`).  A steady start under velocity control with the reduction on, at the first piece's
+    velocity, is held as exact steady sliding until the velocity first changes (:func:`_held_start`, the solver's
+    ``_Driver._held_steady``): :data:`HELD_STEPS` a piece; what follows is counted as below.  Where the run carries
+    the start's cohorts (the reduction off, or after that first change) the cells cut ahead of the FENE cliff
+    (docs/transient.md section 18) add cohorts, each :data:`CUT_STEPS` steps where it arrives there, and each step
+    works through those still to arrive (:func:`_cut_start`).  Pieces below the fold otherwise,
     ``reduction="off"`` and a ``max_step`` cost the cohorts' steps throughout.  Measured over the box
     (docs/transient.md section 2a, tests/test_transient_budget.py): steps
     taken / estimated 0.44-1.55 for the block's own motion (K from 3e5 to
     4e6 Pa/m, 1 um/s to 10 mm/s, 0.1 s to 1e6 s), 0.14-0.29 above the fold,
-    0.07-2.4 under velocity control; a run that takes more than its budget
-    after all is stopped with the reason (and what it computed).
+    0.07-2.4 under velocity control (0.3-1 at 0.01-1 um/s, where the FENE
+    wall costs its cohorts' arrivals, :func:`_wall_steps`, and the births slow
+    with the vacant sites, :func:`_births_steps`; a held start: 1 step taken, 1
+    estimated; the reduction off, through the cut cells: 0.66-1.5 from 0.1 to
+    10 um/s, 5-6 at 0.01 um/s); a run that takes more than
+    its budget after all is stopped with the reason (and what it computed).
 
     A block with ``mass`` (kg/m^2; ``stiffness`` K in Pa/m, default the set's block) is never reduced, and its
     ringing at f_b = sqrt((K + N0 M)/m)/(2 pi) costs :data:`RING_STEPS` per period over up to
@@ -1675,19 +1845,27 @@ def estimate_cost(
     ) else None  # fmt: skip
     natural = b.max_extension / b.bond_time
     own = motion is not None and motion.counts()  # the block's own motion is counted (else the cohorts')
+    # a steady start held while the velocity stays (velocity control, the reduction on), and the cohorts its cut
+    # cells add where the run carries them (docs/transient.md section 18)
+    holds = _held_start(protocol, control, start, reduction, max_step, mass, start_velocity)
+    # (beyond 100 dl_m/tau, a likely slip of units, the cohorts are counted, as for the reduction: the refusal says
+    # "check the unit")
+    held = _held_pieces(protocol) if (holds and abs(protocol.initial_velocity) <= 100.0 * natural) else 0
+    cut = _cut_start(params, protocol, control, start, start_velocity, aging, rtol, k_block, holds)
     steps, fastest, reduced, living = _pieces_steps(
-        params, protocol, control, aging, v_start, scale, motion, reducing, start=start, rtol=rtol, every=every
-    )
+        params, protocol, control, aging, v_start, scale, motion, reducing, start=start, rtol=rtol, every=every,
+        steady_held=held, cut=cut,
+    )  # fmt: skip
     if control == "block" and start == "empty" and not stick_population and reduced and not own:
         steps += STUCK_STEPS  # a block from rest sticks first (the chains hold a stuck block)
     if control == "block" and mass > 0:
         ringing = math.sqrt((k_block + b.site_density * b.chain_stiffness) / mass) / (2.0 * math.pi)
         steps += RING_STEPS * ringing * sum(min(t1 - t0, RING_WINDOW) for t0, t1, _ in protocol.pieces())
     duration = protocol.duration
-    samples = 0.0 if every is None else duration / every
-    # a sampling instant may cost a step where the cohorts run (they land on it); not where the rows are sampled
-    # after the fact (the stick chains' cycle, repeated: _Driver.sampler)
-    sampled_late = repeating and bool(stick_population) and control == "block" and mass == 0
+    ended = duration if (motion is None or motion.ended is None) else min(motion.ended, duration)
+    samples = 0.0 if every is None else ended / every  # none after the run stops
+    # a sampling instant costs no step: the rows are sampled after the fact (_Driver.sampler), whatever the control
+    sampled_late = SAMPLED_AFTER or (repeating and bool(stick_population) and control == "block" and mass == 0)
     steps += 0.0 if sampled_late else samples
     if max_step is not None:
         steps = max(steps, duration / max_step)
@@ -1696,6 +1874,11 @@ def estimate_cost(
         basis += f", {len(protocol.segments)} segments"
     if reduced:
         basis += f", {reduced} quasi-steady"
+    if held:
+        span = float(protocol.boundaries[held])
+        basis += f", the steady start held for {span:.3g} s (exact steady sliding until the velocity changes)"
+    if cut[0] > 0:
+        basis += f", {cut[0]:.3g} cohorts of the start cut ahead of the FENE cliff"
     if motion is not None:
         basis += motion.describe()
     unit = ""
@@ -1715,10 +1898,13 @@ def estimate_cost(
 
 
 def _pieces_steps(  # type: ignore[no-untyped-def]
-    params, protocol, control, aging, v_start, scale, motion, reducing, start="empty", rtol=RTOL, every=None
-) -> tuple[float, float, int, float]:
+    params, protocol, control, aging, v_start, scale, motion, reducing, start="empty", rtol=RTOL, every=None,
+    steady_held=0, cut=(0.0, 0.0),
+) -> tuple[float, float, int, float]:  # fmt: skip
     """:func:`estimate_cost`'s steps piece by piece: (steps, the fastest velocity, the pieces reduced, the CPU
-    seconds of the living cohorts each step works through, :data:`COHORT_STEP_SECONDS`)."""
+    seconds of the living cohorts each step works through, :data:`COHORT_STEP_SECONDS`).  ``steady_held``: the pieces
+    held as the exact steady start (:func:`_held_pieces`), :data:`HELD_STEPS` each; ``cut``: (cohorts, travel in m)
+    that the start's cells cut ahead of the FENE cliff add and over which they arrive there (:func:`_cut_start`)."""
     b, g = params.bonds, params.aging
     fold: list[float] = []  # FOLD_MARGIN x Vc, looked for only when a piece needs it
     steps = 0.0
@@ -1731,49 +1917,73 @@ def _pieces_steps(  # type: ignore[no-untyped-def]
     previous = None if start == "empty" else (v_start if v_start > 0 else abs(protocol.initial_velocity))
     held = 0.0  # the hold just before a piece (velocity control), and the cohorts it keeps
     kept = 0.0
-    for t0, t1, vp in protocol.pieces():
+    cut_total, cut_travel = cut
+    cut_left = cut_total  # the cut cells' cohorts not yet at the FENE cliff, and the travel that brings them there
+    for index, (t0, t1, vp) in enumerate(protocol.pieces()):
+        if motion is not None and motion.ended is not None:
+            break  # the chains collapsed beyond the steady curve's reach: the run stops there
         v = max(abs(vp), v_start) if control == "block" else abs(vp)
         fastest = max(fastest, v)
+        if index < steady_held:  # the steady start held, exact: one steady stretch (_Driver._held_steady)
+            steps += HELD_STEPS
+            continue
+        arriving, before = 0.0, cut_left  # the cut cells' cohorts that reach the cliff within this piece
+        if cut_left > 0:
+            travel = min(abs(vp) * (t1 - t0), cut_travel)
+            arriving = min(cut_total * travel / cut[1], cut_left)
+            cut_left, cut_travel = cut_left - arriving, cut_travel - travel
         slope = math.exp(-v / g.aging_velocity) / g.aging_time if aging else 0.0
         climb = max(b.force_sensitivity * b.chain_stiffness * v - slope, 0.0)
-        rate = 4.0 * (1.0 + b.breakage_weight) / b.bond_time + 10.0 * climb + 100.0 * v / b.max_extension
+        births = 4.0 * (1.0 + b.breakage_weight) / b.bond_time
         share = scale * (BLOCK_SHARE if control == "block" else 1.0)
-        rate *= share
-        cohorts = rate * (t1 - t0)
         filling, disturbed, previous = previous is None, previous is None or abs(vp) != previous, abs(vp)
+        memory = _memory_of(memories, params, v, aging, rtol) if (v > 0 and control == "velocity") else None
+        vacant = memory.vacant if memory is not None else 1.0  # (through the block: the births' full pace)
+        others = 10.0 * climb + 100.0 * v / b.max_extension
+        rate = (births * min((vacant / VACANT) ** (1.0 / 3.0), 1.0) + others) * share
+        cohorts = (_births_steps(births, vacant, b.bond_time, t1 - t0, filling) + others * (t1 - t0)) * share
         if control == "velocity" and vp == 0 and aging and g.saturation_age is None:
             # a hold: the population relaxes smoothly in lengthening steps (not the births' pace throughout); resting
             # bonds that never age into permanence (no aging, or aging that saturates) churn on: the cohorts' count
             lump = min(cohorts, _hold_steps(params, t1 - t0, rtol) * scale)
             steps += lump + SEGMENT_STEPS
             held += t1 - t0
-            # every step bears two cohorts, and resting ones age into permanence and stay: each step (a sampling
-            # instant's too, counted with the samples) works through those kept so far (10 s held every 0.1 ms:
-            # 1e5 steps past 2e5 cohorts, stopped at 10 min of CPU at 99 % of the hold)
-            taken = lump + (0.0 if every is None else (t1 - t0) / every)
-            living += COHORT_STEP_SECONDS * taken * (kept + taken)
+            # every step bears two cohorts, and resting ones age into permanence and stay: each step works through
+            # those kept so far (a sampling instant was a step until the rows were sampled after the fact: 10 s held
+            # every 0.1 ms, 1e5 steps past 2e5 cohorts, stopped at 10 min of CPU at 99 % of the hold)
+            taken = lump + (0.0 if (every is None or SAMPLED_AFTER) else (t1 - t0) / every)
+            living += COHORT_STEP_SECONDS * taken * (kept + taken + cut_left)  # (none of the cut cells' arrive)
             kept += 2.0 * taken
             continue
         if motion is not None and motion.counts():
             piece = motion.piece(t1 - t0, vp, lambda v=vp: v < _fold(fold, params, control, aging))
+            if motion.ended is not None:
+                motion.ended += t0  # the run's end, where the chains' collapse has no landing point
             if piece is not None:  # births a block cannot resolve in STUCK_STEPS or a slip (a huge u0) are counted
                 floor = rate * FORMING * b.bond_time if piece > 0 else 0.0  # a piece held by the chains: no step
                 bound = math.inf if motion.stuck_for_good else cohorts  # the sticking is one lump, however short
                 steps += min(max(piece, floor) * scale, bound) + motion.segment_steps()
                 continue
-        memory = _memory_of(memories, params, v, aging, rtol) if v > 0 else None
+            if motion.held > 0:  # held by the chains from rest until they let go: the rest of the piece slides,
+                t0 += motion.held  # from the steady population the paper's jump lands on
+                cohorts, filling, disturbed = rate * (t1 - t0), False, True
+        if memory is None and v > 0:
+            memory = _memory_of(memories, params, v, aging, rtol)
         # a steady population undisturbed (velocity control, the velocity it is steady at) meets the wall smoothly
         smooth = control == "velocity" and not disturbed
         wall = 0.0 if memory is None else (WALL_STEADY if smooth else WALL_SHARE) * memory.climb * share
         arrive = b.max_extension / v if (filling and v > 0) else 0.0  # the first of them arrive there
-        cohorts += wall * max(t1 - t0 - arrive, 0.0)
+        walled = _wall_steps(wall, rate, share, b.max_extension / v, not filling, t1 - t0 - arrive) if v > 0 else 0.0
+        cohorts += walled
         span = t1 - t0
         if reducing and 0 < vp <= (BLOCK_FASTEST if control == "block" else 100.0) * natural:
             own = _memory_of(memories, params, abs(vp), aging, rtol)
             settling = min(SETTLE * b.max_extension / abs(vp), TAIL_SETTLE * own.age)
             if disturbed:  # the disturbance echoes through the wall until it falls below the reduction's share
                 settling = max(settling, own.echo)
-            settle = rate * settling + wall * max(settling - arrive, 0.0) + REDUCED_STEPS
+            settle = (_births_steps(births, vacant, b.bond_time, settling, filling) + others * settling) * share
+            settle += REDUCED_STEPS
+            settle += _wall_steps(wall, rate, share, b.max_extension / v, not filling, settling - arrive)
             if settle < min(cohorts, HOPELESS):  # beyond HOPELESS the fold is not worth finding
                 if vp >= _fold(fold, params, control, aging):
                     cohorts = settle
@@ -1781,17 +1991,54 @@ def _pieces_steps(  # type: ignore[no-untyped-def]
                     reduced += 1
         if wall > 0:  # each step once bonds die at the wall works through those born over the last memory.keep
             after = max(span - arrive, 0.0)
-            # (from a steady start the cohorts born replace the steady ones, ~half of them living on average)
-            living += (
-                COHORT_STEP_SECONDS * (rate + wall) ** 2 * after * (1.0 if smooth else 2.0) * min(memory.keep, after)
-            )
+            wall = _wall_steps(wall, rate, share, b.max_extension / v, not filling, after) / after if after > 0 else 0.0
+            if smooth:  # the steady start's cohorts, and about one of the two born each step kept (STEADY_COHORTS)
+                taken = (rate + wall) * after
+                living += COHORT_STEP_SECONDS * taken * (STEADY_COHORTS + 0.5 * (rate + wall) * min(memory.keep, after))
+            else:
+                living += COHORT_STEP_SECONDS * (rate + wall) ** 2 * after * 2.0 * min(memory.keep, after)
         if held > 0 and v > 0:  # re-sliding after a hold: the aged bonds die at the FENE wall, stiffly
             aged = _resliding_steps(params, held, v, aging, rate * min(t1 - t0, b.max_extension / v))
             cohorts += aged
             living += COHORT_STEP_SECONDS * kept * (aged + rate * min(t1 - t0, b.max_extension / v))
             held, kept = 0.0, 0.0
+        if before > 0:  # the cut cells' cohorts: their arrivals' steps, and each step works through those left
+            cohorts += CUT_STEPS * arriving
+            living += COHORT_STEP_SECONDS * cohorts * 0.5 * (before + cut_left)
         steps += cohorts + SEGMENT_STEPS
     return steps, fastest, reduced, living
+
+
+def _births_steps(births: float, vacant: float, tau: float, span: float, filling: bool) -> float:
+    """The births' steps over ``span`` (s) at ``births`` steps/s, slowed where fewer than :data:`VACANT` of the sites
+    are vacant as the cube root of the vacancy: the steady population's ``vacant``, or an empty start's filling one,
+    tau/(tau + t) while above it (its bonds, aging into permanence, are at most t old)."""
+    if not vacant < VACANT:
+        return births * span
+    if not filling:
+        return births * (vacant / VACANT) ** (1.0 / 3.0) * span
+    t_full = tau / VACANT - tau  # the filling population's vacancy tau/(tau + t) falls to VACANT, then to vacant
+    t_low = max(tau / vacant - tau, t_full)
+    steps = births * min(span, t_full)
+    if span > t_full:
+        end = min(span, t_low)  # the integral of (tau/(VACANT (tau + t)))^(1/3)
+        grown = (tau + end) ** (2.0 / 3.0) - (tau + t_full) ** (2.0 / 3.0)
+        steps += births * (tau / VACANT) ** (1.0 / 3.0) * 1.5 * grown
+    if span > t_low:
+        steps += births * (vacant / VACANT) ** (1.0 / 3.0) * (span - t_low)
+    return steps
+
+
+def _wall_steps(wall: float, rate: float, share: float, memory: float, present: bool, duration: float) -> float:
+    """The steps bonds dying at the FENE wall add over ``duration`` (s) from the first arrivals: ``wall`` (steps/s,
+    the climb's count), at most the arrivals' count: over the first ``memory`` (dl_m/V) the population the piece
+    started with (``present``; else none: an empty start's births), :data:`WALL_ARRIVALS` steps, then
+    :data:`WALL_ECHO` per step of births (``rate``, steps/s)."""
+    if not duration > 0:
+        return 0.0
+    first = min(duration, memory) if present else 0.0
+    arrivals = WALL_ARRIVALS * share * first / memory + WALL_ECHO * rate * (duration - first)
+    return min(wall * duration, arrivals)
 
 
 def _hold_steps(params: Parameters, duration: float, rtol: float) -> float:
@@ -1803,6 +2050,67 @@ def _hold_steps(params: Parameters, duration: float, rtol: float) -> float:
     if not churn.holds:
         return churn.steps
     return max(HOLD_STEPS, CHURN_SHARE * churn.steps)
+
+
+def _held_start(
+    protocol: Protocol, control: str, start: str, reduction: str, max_step: float | None, mass: float,
+    start_velocity: float | None,
+) -> bool:  # fmt: skip
+    """Whether the run holds its steady start as exact steady sliding until the velocity first changes (one
+    predicate for ``_Driver.start``, which sets ``self.held`` for :meth:`_Driver._held_steady`, and for the cost
+    estimate): the reduction on (``reduction="auto"``, no ``max_step``, no mass: the driver's reducer), velocity
+    control, a steady start, at the first piece's velocity (no ``start_velocity``, or the same number)."""
+    reducer = reduction == "auto" and max_step is None and not mass > 0
+    v_first = protocol.initial_velocity
+    v_start = v_first if start_velocity is None else float(start_velocity)
+    return reducer and control == "velocity" and start == "steady" and v_start == v_first
+
+
+def _held_pieces(protocol: Protocol) -> int:
+    """The leading pieces of a held steady start: those at the first piece's velocity (_Driver._held_steady holds
+    while ``vp`` is the start's, and never again once it has changed)."""
+    v_first = protocol.initial_velocity
+    count = 0
+    for _t0, _t1, vp in protocol.pieces():
+        if vp != v_first:
+            break
+        count += 1
+    return count
+
+
+def _cut_start(
+    params: Parameters, protocol: Protocol, control: str, start: str, start_velocity: float | None, aging: bool,
+    rtol: float, k_block: float, held: bool,
+) -> tuple[float, float]:  # fmt: skip
+    """(cohorts, travel in m): the cohorts that a steady start's cells cut ahead of the FENE cliff add to the uncut
+    start (cells._refine, docs/transient.md section 18), and the slider's travel over which they arrive there (the
+    reach, :func:`_start_reach`, at the start velocity); (0, 0) where none.  The start is the run's own: the same
+    reach and ripple, so the population is built once (``_steady_cohorts`` remembers it) and the run loads it; the
+    uncut one is only counted (:func:`_uncut_cohorts`).  Under velocity control only: through the block a steady start
+    below Vc is moved to Vc by the run after the estimate (:func:`_steady_start_below_vc`), and nothing is cut from
+    ~50 um/s up for the gel."""
+    if control != "velocity" or start != "steady":
+        return 0.0, 0.0
+    v = protocol.initial_velocity if start_velocity is None else float(start_velocity)
+    if not (v > 0 and math.isfinite(v)):
+        return 0.0, 0.0
+    reach = _start_reach(params, protocol, v, aging, control, k_block, held)
+    if not reach > 0:
+        return 0.0, 0.0
+    try:
+        cut = _steady_cohorts(params, v, aging, reach=reach, ripple=RIPPLE_SHARE * float(rtol)).age.size
+        added = float(cut - _uncut_cohorts(params, v, aging))
+    except (ModelError, ParameterError):  # the run says what is wrong with the steady start, in its words
+        return 0.0, 0.0
+    return (added, reach * v) if added > 0 else (0.0, 0.0)
+
+
+@lru_cache(maxsize=64)
+def _uncut_cohorts(params: Parameters, velocity: float, aging: bool) -> int:
+    """The cohorts of the uncut steady start at ``velocity`` (cells.steady_cohorts' march, ~1 ms; remembered)."""
+    from .cells import steady_cohorts
+
+    return int(steady_cohorts(params, velocity, aging).age.size)
 
 
 def _resliding_steps(params: Parameters, held: float, v: float, aging: bool, fresh: float) -> float:
@@ -1828,6 +2136,7 @@ class _Memory:
     keep: float  # a cohort is dropped (survival 1e-30, kernel.LIGHTEST) or reaches the FENE wall
     climb: float  # d ln r/dt where the bonds that live to the wall die there (0: none do)
     echo: float  # the time a disturbance of the births takes to fall below THETA rtol (refilling, echoing)
+    vacant: float = 1.0  # the steady population's share of vacant sites, tau/(tau + its mean life)
 
 
 def _memory_of(memories: dict[float, _Memory], params: Parameters, v: float, aging: bool, rtol: float) -> _Memory:
@@ -1881,8 +2190,9 @@ def _memory(params: Parameters, v: float, aging: bool, rtol: float) -> _Memory:
     died = int(np.searchsorted(hazard, hazard[half] + 1.0))
     # the births refill the population at 1/tau + 1/(its mean life) (one exponential life: exact)
     fill = math.log(1.0 / share) / (1.0 / b.bond_time + 1.0 / float(bonds[-1]))
+    vacant = b.bond_time / (b.bond_time + float(bonds[-1]))
     if not (pw > 1e-12 and half < died < a.size):
-        return _Memory(age, keep, 0.0, fill)
+        return _Memory(age, keep, 0.0, fill, vacant)
     climb = float((lr[died] - lr[died - 1]) / (a[died] - a[died - 1]))
     a_d = float(a[died])
     fast = np.where(a < a_d, np.maximum(survival - pw, 0.0), survival)
@@ -1891,8 +2201,8 @@ def _memory(params: Parameters, v: float, aging: bool, rtol: float) -> _Memory:
     delta = 0.5 * math.log1p((2.0 * math.pi / k) ** 2) if k > 1e-3 else math.log(2.0 * math.pi / k)
     echo = math.log(1.0 / share) * a_d / delta
     if not (math.isfinite(climb) and climb > 0 and math.isfinite(echo)):
-        return _Memory(age, keep, 0.0, fill)
-    return _Memory(age, keep, climb, max(echo, fill))
+        return _Memory(age, keep, 0.0, fill, vacant)
+    return _Memory(age, keep, climb, max(echo, fill), vacant)
 
 
 def _fold(found: list[float], params: Parameters, control: str, aging: bool) -> float:
@@ -1957,6 +2267,9 @@ class _BlockMotion:
         self.slips = 0.0
         self.clocks: dict[tuple[float, bool], tuple[float, float]] = {}
         self.failed = False
+        self.held = 0.0  # the part of the last piece the chains held from rest before they let go
+        self.ended: float | None = None  # the run stops there (the chains' first collapse has no landing point)
+        self.let_go: tuple[float, float] | None = None  # (time, stress) of the first collapse counted
         if not chains and params.aging.saturation_age is None and start == "empty" and self.churn.holds:
             self._stick_for_good(stop=False)
 
@@ -1999,7 +2312,18 @@ class _BlockMotion:
                 return None
             self.from_steady, self.churned = False, True
             return dt / (CHURN_STEP * self.params.bonds.bond_time)
+        self.held = 0.0
+        on_chains = self.chains and self.from_rest and not self.sliding  # held by the chains since the start
+        if on_chains and vp > 0:
+            stopped = self._first_collapse(dt, vp)
+            if stopped is not None:
+                return stopped
         if not below():
+            if on_chains and vp > 0:
+                if self.clock + dt < self._let_go(vp)[0]:
+                    self.clock += dt  # held by the chains throughout: their closed form, no step
+                    return 0.0
+                self.held = max(self._let_go(vp)[0] - self.clock, 0.0)  # the rest of the piece slides
             self.sliding = self.sliding or not self.chains or vp > 0
             self.clock, self.from_rest = 0.0, False
             return None  # sliding: the cohorts' (or the reduction's) count
@@ -2029,6 +2353,20 @@ class _BlockMotion:
             self.clock += dt
         return steps
 
+    def _let_go(self, vp: float) -> tuple[float, float, bool]:
+        """(time, stress, whether the paper's jump lands) of the chains' first collapse from rest at vp (Eq 15)."""
+        return _chains_let_go(self.params, float(f"{vp:.3g}"), self.aging, self.k_block)
+
+    def _first_collapse(self, dt: float, vp: float) -> float | None:
+        """0 steps where the chains' first collapse from rest falls within this piece beyond the steady curve's
+        reach: the run stops there (the solver's "no landing point"), the pieces after it cost nothing; else None."""
+        t_go, sigma_s, lands = self._let_go(vp)
+        if lands or not self.clock + dt >= t_go:
+            return None
+        self.held = max(t_go - self.clock, 0.0)
+        self.ended, self.let_go = self.held, (t_go, sigma_s)
+        return 0.0
+
     def _cycle(self, vp: float) -> tuple[float, float]:
         """(time to the first slip, period after it) of the quasi-static model at vp (inf: never), remembered by
         velocity to 1 %."""
@@ -2038,6 +2376,12 @@ class _BlockMotion:
         return self.clocks[key]
 
     def describe(self) -> str:
+        if self.let_go is not None:
+            t_go, sigma_s = self.let_go
+            return (
+                f", the block held by the stick chains until t = {t_go:.6g} s, where they collapse (Eq 15) at σs ="
+                f" {sigma_s:.6g} Pa, beyond the steady curve's reach: the run stops there"
+            )
         if self._churning():
             c = self.churn
             return (
@@ -2063,6 +2407,28 @@ def _slips(t: float, first: float, period: float) -> float:
     if not t >= first:
         return 0.0
     return 1.0 + ((t - first) / period if math.isfinite(period) else 0.0)
+
+
+@lru_cache(maxsize=64)
+def _chains_let_go(params: Parameters, vp: float, aging: bool, k_block: float) -> tuple[float, float, bool]:
+    """(time, stress, whether the paper's jump lands on the steady curve) of the stick chains' first collapse
+    under a block at rest from sigma = 0 pulled at vp (Eq 15 at K, quasistatic.stick; inf: they never collapse),
+    ~1-5 ms, remembered.  The solver's stuck block follows the same closed form (transient.model.stick_chains)."""
+    from ..quasistatic.jump import jump_velocity
+    from ..quasistatic.stick import stick_time
+
+    k_set = params.block.effective_stiffness
+    scaled = params
+    if not math.isclose(k_block, k_set, rel_tol=1e-9):
+        scaled = params.with_overrides({"block.shear_modulus": params.block.shear_modulus * k_block / k_set})
+    try:
+        first = stick_time(scaled, vp, 0.0, aging=aging)
+        if first is None or not first[0]:
+            return math.inf, math.inf, True
+        landing = jump_velocity(params, first[1], "aging" if aging else "no-aging")
+    except (ModelError, ParameterError):
+        return 0.0, 0.0, True  # not known: counted as sliding from the start, as before
+    return float(first[0]), float(first[1]), bool(landing.reachable and landing.velocity is not None)
 
 
 @lru_cache(maxsize=64)
