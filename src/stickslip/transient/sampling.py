@@ -355,9 +355,7 @@ def _rate_weights(t: np.ndarray, i: np.ndarray, broken: np.ndarray) -> tuple[np.
     return rows, found[0], found[1]
 
 
-def _read_rates(
-    y: np.ndarray, weights: tuple[np.ndarray, np.ndarray, np.ndarray]
-) -> tuple[np.ndarray, np.ndarray]:
+def _read_rates(y: np.ndarray, weights: tuple[np.ndarray, np.ndarray, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
     """The rates of y, read from the rows with :func:`_rate_weights`' ``weights``, at the intervals' two rows."""
     rows, at_a, at_b = weights
     values = y[rows]
