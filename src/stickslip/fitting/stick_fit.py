@@ -488,7 +488,8 @@ def _floors(params: Parameters, rows: _Rows) -> np.ndarray:
             model_peak = rows.start + rows.rate * times
             dlog_peak = (1.0 + rows.rate * (up - down) / (2 * step)) / model_peak
             floors = np.concatenate([floors, np.hypot(dlog_peak * start_err, peak_err / rows.peak)])
-    # the columns bound a systematic error (it lies within +-u); its standard uncertainty is u/sqrt(3) (uniform)
+    # the columns bound a systematic error (it lies within +-u); its standard uncertainty is u/sqrt(3) (uniform); a
+    # row whose model stick time is not finite (no stick from its start: silenced above) keeps no floor, as before
     return np.where(np.isfinite(floors), floors, 0.0) / math.sqrt(3.0)
 
 

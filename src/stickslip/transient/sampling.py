@@ -294,6 +294,7 @@ def _stress_with_integral(
     um/s, one 6 s step from 5.7 to 88.3 kPa), sigma_a + (sigma_b - sigma_a) s^p with that integral.  Where the
     interval's integral is rounding (or not known), the cubic with the rates read."""
     sa, sb = a[:, SIGMA], b[:, SIGMA]
+    # an integral not carried (NaN) gives a NaN mean, which ``known`` leaves out: the cubic with the rates read
     with np.errstate(invalid="ignore"):
         mean = (b[:, IMPULSE] - a[:, IMPULSE]) / h
         trapezoid = 0.5 * (sa + sb)
@@ -345,6 +346,8 @@ def _rate_weights(t: np.ndarray, i: np.ndarray, broken: np.ndarray) -> tuple[np.
     gaps = x[:, :, None] - x[:, None, :]
     pair = valid[:, :, None] & valid[:, None, :] & ~np.eye(width, dtype=bool)[None, :, :]
     found = []
+    # the row's own term (x_j - x_j = 0) and the rows left out are computed and then dropped by np.where: the
+    # warnings silenced are theirs alone (valid rows have distinct times)
     with np.errstate(divide="ignore", invalid="ignore"):
         weights = 1.0 / np.prod(np.where(pair, gaps, 1.0), axis=2)
         for j in (NEIGHBOURS, NEIGHBOURS + 1):
