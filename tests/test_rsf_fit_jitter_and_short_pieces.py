@@ -227,6 +227,20 @@ def test_rsf_fit_fits_a_record_with_a_dropped_sample(tmp_path, capsys, short_rec
     assert "1 row with an empty or NaN friction cell left out (friction at row 252)" in err
 
 
+def test_a_failed_fit_still_names_the_rows_left_out(tmp_path, capsys, short_record):
+    """The CLI prints warnings on success only: the record's note is in every fit report (text and JSON), a failed
+    one too (here the slip law with the stiffness held at a tenth of the truth)."""
+    import json
+
+    t, d, mu = short_record
+    path = _write(tmp_path / "gap.txt", t, d, mu, {250: "friction"})
+    code, out, _ = run_main(capsys, "rsf", "fit", str(path), "--json", "--law", "slip", "--stiffness", "3e-4 1/um")
+    assert code == 3
+    assert any("friction at row 252" in note for note in json.loads(out)["notes"])
+    code, out, _ = run_main(capsys, "rsf", "fit", str(path), "--law", "slip", "--stiffness", "3e-4 1/um")
+    assert code == 3 and "friction at row 252" in out, out
+
+
 def test_too_many_empty_cells_and_text_cells_are_still_refused(tmp_path, capsys, short_record):
     """Over 1 % of the rows empty: refused, naming how many and where; a text cell: refused as before."""
     t, d, mu = short_record

@@ -453,7 +453,9 @@ def fit_record(
         if sensitivity["depends"]:
             warns.append(sensitivity["text"])
     posterior = _posterior(residual, result, mcmc_steps, seed) if mcmc_steps > 0 else None
-    notes = () if problems else _sign_notes(table)  # (a failed fit's values are no reading)
+    # the record's own notes (rows left out) belong to every report, a failed one too (the CLI prints warnings only
+    # on success); the signs' notes only to a fit whose values are a reading
+    notes = (*record.notes, *(() if problems else _sign_notes(table)))
     return RSFFit(
         params=_final_params(base, values), parameters=table, correlations=corr, reduced_chi_square=level.redchi,
         rms=float(np.sqrt(np.mean(resid**2))), noise=level.noise, trend=float(values.get("trend", 0.0)),
