@@ -163,7 +163,7 @@ def test_page_loads_nothing_from_outside(page) -> None:
 def test_page_fits_an_800_pixel_window(page) -> None:
     """At 800 px the page itself never scrolls sideways; wide tables scroll inside their own box."""
     driver, _ = page
-    driver.set_window_size(800, 900)
+    _resize(driver, 800, 900)
     try:
         widths = driver.execute_script(
             "return [document.documentElement.scrollWidth, document.documentElement.clientWidth,"
@@ -171,7 +171,23 @@ def test_page_fits_an_800_pixel_window(page) -> None:
         )
         assert widths[0] <= widths[1] and widths[2] <= widths[1], f"page overflows at 800 px: {widths}"
     finally:
-        driver.set_window_size(1280, 1024)
+        _resize(driver, 1280, 1024)
+
+
+#: How long a resize may take to reach the page (seconds); on a loaded machine the next script ran before it did
+RESIZE_WAIT = 10.0
+
+
+def _resize(driver, width: int, height: int) -> None:
+    """Resize the window and wait until the page sees the new width: ``set_window_size`` returns before the layout
+    follows, and a script run at once read the old window (an 800 px window measured "at 1280 px")."""
+    import time
+
+    driver.set_window_size(width, height)
+    deadline = time.monotonic() + RESIZE_WAIT
+    while driver.execute_script("return window.outerWidth") != width and time.monotonic() < deadline:
+        time.sleep(0.05)
+    driver.execute_script("return document.documentElement.getBoundingClientRect().width")  # the layout, done
 
 
 #: Window widths the report is checked at: a small laptop or tablet, a common laptop, a desktop.
@@ -181,7 +197,7 @@ WHOLE_FROM = 1280
 
 
 def _tables_at(driver, width: int) -> list[dict]:
-    driver.set_window_size(width, 1000)
+    _resize(driver, width, 1000)
     try:
         return driver.execute_script(
             "return Array.from(document.querySelectorAll('main table')).map(t => {"
@@ -192,7 +208,7 @@ def _tables_at(driver, width: int) -> list[dict]:
             " right: box.getBoundingClientRect().right, page: document.documentElement.clientWidth}; })"
         )
     finally:
-        driver.set_window_size(1280, 1024)
+        _resize(driver, 1280, 1024)
 
 
 @pytest.mark.parametrize("width", WIDTHS)
@@ -213,12 +229,12 @@ def test_every_figure_is_drawn_near_its_own_size_at_760_pixels(page) -> None:
     """Figures are drawn at the report's width (760 px PNGs): shown in a 760 px window they are scaled by no less
     than 0.85, so that their 8-10 pt text stays readable (the Eq 1 figure was 1473 px wide, shown at 0.48)."""
     driver, _ = page
-    driver.set_window_size(760, 1000)
+    _resize(driver, 760, 1000)
     try:
         scales = driver.execute_script(
             "return Array.from(document.images).map(i => [i.alt, i.getBoundingClientRect().width / i.naturalWidth])"
         )
     finally:
-        driver.set_window_size(1280, 1024)
+        _resize(driver, 1280, 1024)
     small = [(alt, round(scale, 2)) for alt, scale in scales if scale < 0.85]
     assert scales and not small, f"figures shrunk below 0.85 of their size at 760 px: {small}"
