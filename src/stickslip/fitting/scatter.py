@@ -336,9 +336,7 @@ def trend_dependence(velocity: np.ndarray, stress: np.ndarray, stress_err: np.nd
     for d in range(1, degrees + 1):
         design = np.vander(x, d + 1) * root_w[:, None]
         coef = np.linalg.lstsq(design, root_w * y, rcond=None)[0]
-        left = float(np.sum((root_w * y - design @ coef) ** 2))
-        left = max(left, flat * 1e-28)  # the values' rounding: no residual is below it
-        p = float(stats.f.sf(((flat - left) / d) / (left / (n - d - 1)), d, n - d - 1)) if left < flat else 1.0
+        p = nested_constant_p(flat, float(np.sum((root_w * y - design @ coef) ** 2)), d, n - d - 1)
         if p < best:
             best, best_degree = p, d
     return Trend(min(1.0, degrees * best), best_degree, degrees)
@@ -481,10 +479,18 @@ def model_dependence(stress: np.ndarray, stress_err: np.ndarray | None, model: n
     level = float(np.sum(weight * stress) / np.sum(weight))
     flat = float(np.sum(weight * (stress - level) ** 2))
     fitted = float(np.sum(weight * (stress - model) ** 2))
-    if not (math.isfinite(fitted) and flat > 0.0) or fitted >= flat:
+    if not (math.isfinite(fitted) and flat > 0.0):
         return 1.0
-    fitted = max(fitted, flat * 1e-28)  # the values' rounding: an exact curve's residuals are never below it
-    return float(stats.f.sf(((flat - fitted) / (free - 1)) / (fitted / dof), free - 1, dof))
+    return nested_constant_p(flat, fitted, free - 1, dof)
+
+
+def nested_constant_p(flat: float, left: float, extra: int, dof: int) -> float:
+    """p of the F test of a constant (residual sum ``flat``) within a fit with ``extra`` more parameters (residual
+    sum ``left``, ``dof`` degrees of freedom left): F(extra, dof); 1 where the fit does no better."""
+    if not left < flat:
+        return 1.0
+    left = max(left, flat * 1e-28)  # the values' rounding: an exact curve's residuals are never below it
+    return float(stats.f.sf(((flat - left) / extra) / (left / dof), extra, dof))
 
 
 @dataclass(frozen=True)
