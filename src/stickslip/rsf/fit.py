@@ -1981,11 +1981,16 @@ def _problems(
 SECOND_STATE_LEVEL = 1e-3
 
 
-def _constant_chi2(record: LabRecord, trend: frozenset[str], rows: np.ndarray) -> float:
-    """Reduced chi-square of constant friction (plus the fit's trends) against the noise of each row."""
+def _constant_design(record: LabRecord, trend: frozenset[str]) -> np.ndarray:
+    """The columns of constant friction plus the trends ``trend`` names (slip, time): one row per record row."""
     columns = [np.ones(len(record))] + ([record.displacement] if "slip" in trend else [])
     columns += [record.time] if "time" in trend else []
-    design = np.column_stack(columns)
+    return np.column_stack(columns)
+
+
+def _constant_chi2(record: LabRecord, trend: frozenset[str], rows: np.ndarray) -> float:
+    """Reduced chi-square of constant friction (plus the fit's trends) against the noise of each row."""
+    design = _constant_design(record, trend)
     coef, *_ = np.linalg.lstsq(design, record.friction, rcond=None)
     null = record.friction - design @ coef
     return float(np.sum((null / rows) ** 2) / max(len(record) - design.shape[1], 1))
@@ -2232,9 +2237,7 @@ def _steady_bound(setup: _Setup, protocol: Protocol, rows: np.ndarray) -> float:
     if len(protocol.segments) < 2:
         return 0.0
     first = record.time < 0.9 * float(protocol.boundaries[1])
-    columns = [np.ones(len(record))] + ([record.displacement] if "slip" in trend else [])
-    columns += [record.time] if "time" in trend else []
-    design = np.column_stack(columns)[first] / rows[first, None]
+    design = _constant_design(record, trend)[first] / rows[first, None]
     if int(first.sum()) <= design.shape[1]:
         return 0.0
     friction = record.friction - held.get("trend", 0.0) * record.displacement
@@ -2448,9 +2451,7 @@ def _response_p_value(
     correlated residuals each row counts 1/``inflation`` (the F statistic and its degrees of freedom shrink)."""
     from scipy import stats
 
-    columns = [np.ones(len(record))] + ([record.displacement] if "slip" in trend else [])
-    columns += [record.time] if "time" in trend else []
-    design = np.column_stack(columns)
+    design = _constant_design(record, trend)
     coef, *_ = np.linalg.lstsq(design, record.friction, rcond=None)
     null = float(np.sum((record.friction - design @ coef) ** 2))
     extra = result.nvarys - design.shape[1]
