@@ -15,9 +15,11 @@ from __future__ import annotations
 import math
 import os
 import re
+import signal
 import sys
 import warnings
 from collections.abc import Iterator
+from contextlib import contextmanager
 from importlib import import_module
 from typing import TYPE_CHECKING, Any
 
@@ -159,7 +161,10 @@ def _run(argv: list[str] | None) -> int:
     except click.exceptions.NoArgsIsHelpError as exc:  # `stickslip` or `stickslip fit` alone: the help
         click.echo(exc.ctx.get_help())
         return 0
-    except click.exceptions.Abort:
+    except click.exceptions.Abort as exc:  # click's word for an interrupt (it turns KeyboardInterrupt into Abort)
+        if isinstance(exc.__context__, Terminated):
+            click.echo("stickslip: terminated", err=True)
+            return 128 + signal.SIGTERM
         click.echo("stickslip: aborted", err=True)
         return 130
     except click.exceptions.Exit as exc:
@@ -168,6 +173,9 @@ def _run(argv: list[str] | None) -> int:
         return _fail(exc.format_message())
     except StickslipError as exc:
         return _fail(str(exc))
+    except Terminated:
+        click.echo("stickslip: terminated", err=True)
+        return 128 + signal.SIGTERM
     except KeyboardInterrupt:
         return 130
     except BrokenPipeError:  # `stickslip curve --format csv | head`: the reader left
@@ -274,13 +282,45 @@ def main(argv: list[str] | None = None) -> None:
     shown = warnings.showwarning
     warnings.showwarning = collect  # numpy's "overflow encountered in exp" is not for the user's eyes
     try:
-        status = _run(argv)
+        with sigterm_unwinds():
+            status = _run(argv)
         status = _flush_stdout() or status
     finally:
         warnings.showwarning = shown
     if status == 0 and caught:
         click.echo(_one_line(f"stickslip: warning: {_warning_summary(caught)}"), err=True)
     sys.exit(status)
+
+
+class Terminated(KeyboardInterrupt):
+    """SIGTERM arrived: raised where the program stands, so that every ``finally`` runs on the way out."""
+
+
+@contextmanager
+def sigterm_unwinds() -> Iterator[None]:
+    """Within the block SIGTERM raises :class:`Terminated` instead of ending the process where it stands.
+
+    Killed outright, a command left its half-written temporary output behind (``.out.csv.x1y2.tmp``; the next
+    writer into that folder cleans it, but a user sees it first); unwound, the atomic writers remove it and the
+    command ends with status 143 and one line.  Only the main thread can set a handler, and a handler someone
+    else installed (an application embedding the CLI) is left alone.
+    """
+    import threading
+
+    if threading.current_thread() is not threading.main_thread() or (
+        signal.getsignal(signal.SIGTERM) is not signal.SIG_DFL
+    ):
+        yield
+        return
+
+    def unwind(signum: int, frame: Any) -> None:
+        raise Terminated
+
+    signal.signal(signal.SIGTERM, unwind)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, signal.SIG_DFL)
 
 
 def _warning_summary(caught: list[tuple[type[Warning], str]]) -> str:

@@ -6,6 +6,7 @@ The run is a list of named steps so that a caller can show progress
 
 from __future__ import annotations
 
+import contextlib
 import json
 import multiprocessing
 import os
@@ -332,11 +333,27 @@ def _rendered_figures(
             futures: list[Any] = [None] * len(FIGURE_BUILDERS)
             for i in _slowest_first():  # a slow figure started last would leave the other worker idle at the end
                 futures[i] = pool.submit(_render_in_worker, i, folder)
-            for (description, _), future in zip(FIGURE_BUILDERS, futures, strict=True):
-                step(description)
-                yield future.result()
+            try:
+                for (description, _), future in zip(FIGURE_BUILDERS, futures, strict=True):
+                    step(description)
+                    yield future.result()
+            except BaseException:  # interrupted or terminated: leaving the pool would first draw every figure
+                _stop_workers(pool)
+                raise
     finally:
         _SHARED_RUN = None
+
+
+def _stop_workers(pool: ProcessPoolExecutor) -> None:
+    """Cancel what the workers have not started and end them now (their half-written temporaries are cleaned by
+    the next report written into the folder)."""
+    import signal
+
+    processes = list((getattr(pool, "_processes", None) or {}).values())
+    pool.shutdown(wait=False, cancel_futures=True)
+    for process in processes:
+        with contextlib.suppress(OSError, ValueError, AttributeError):
+            os.kill(process.pid, signal.SIGKILL)
 
 
 #: The figures that take longest to draw (2-6 s each; the others 0.3-1.5 s), started first in the workers.
