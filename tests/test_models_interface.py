@@ -21,7 +21,7 @@ from stickslip.models.bond import with_stiffness
         ({"stiffness": -1.0}, "rig stiffness: expected a finite value > 0 Pa/m"),
         ({"stiffness": 0.0}, "rig stiffness"),
         ({"damping": float("nan")}, "rig damping"),
-        ({"mass": "heavy"}, "rig mass: expected a number"),
+        ({"mass": "heavy"}, "rig mass: 'heavy' has no number; expected a mass per area"),
         ({"control": "velocity", "stiffness": 1e5}, "velocity control has no spring"),
     ],
 )

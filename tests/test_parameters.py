@@ -270,7 +270,7 @@ def test_a_minimal_file_with_bare_si_numbers_loads(params, tmp_path):
         lines += [f"{name} = {value!r}" for name, value in values.items() if value is not None]  # None: key absent
     p = load_parameters(str(_write(tmp_path, "\n".join(lines))))
     assert p.as_dict() == params.as_dict()
-    assert p.name == "custom"
+    assert p.name == "p.toml"  # a file without a name is named by the file
 
 
 def _without(params: Parameters, line_start: str) -> str:

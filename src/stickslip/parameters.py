@@ -30,6 +30,9 @@ block.height              h        height of the block (Eq 5)
 block.top_length          B        trapezoid length on the puller side (Eq 17)
 block.base_length         l        trapezoid length on the contact side (Eq 17)
 ========================  =======  ===============================================
+
+Overrides take two keys more, the block's stiffness (Pa/m): ``block.stiffness`` (G_d/h, Eq 5) and
+``block.effective_stiffness`` (K of Eq 17); each sets the height that gives it (:data:`STIFFNESS_KEYS`).
 """
 
 from __future__ import annotations
@@ -215,6 +218,24 @@ def optional_keys() -> list[str]:
     return [f"{s}.{f.name}" for s, cls in SECTIONS.items() for f in fields(cls) if _optional(f)]
 
 
+#: Keys that set the block's stiffness, through its height (shear modulus and trapezoid kept): G_d/h (Eq 5) and
+#: K = (G_d/h) ln(B/l)/(B/l - 1) (Eq 17).  Overrides take them (:meth:`Parameters.with_overrides`), as sweeps
+#: and ``--set`` do; a set holds the height.
+STIFFNESS_KEYS = {"block.stiffness": "stress_per_length", "block.effective_stiffness": "stress_per_length"}
+
+
+def override_dimension(key: str) -> str:
+    """The dimension of a key an override may set: a canonical key (:func:`key_dimension`) or a stiffness key of
+    :data:`STIFFNESS_KEYS`; an unknown key is one ParameterError listing them all."""
+    if key in STIFFNESS_KEYS:
+        return STIFFNESS_KEYS[key]
+    try:
+        return key_dimension(key)
+    except ParameterError:
+        known = ", ".join([*parameter_keys(), *STIFFNESS_KEYS])
+        raise ParameterError(f"unknown parameter key {shorten(key)}; expected one of: {known}") from None
+
+
 def key_dimension(key: str) -> str:
     """The dimension (see :data:`stickslip.units.DIMENSIONS`) of a canonical key."""
     section, _, name = key.partition(".")
@@ -258,18 +279,29 @@ class Parameters:
         return {key: value for key, _, value in self._held()}
 
     def with_overrides(self, overrides: Mapping[str, Any] | None) -> Parameters:
-        """A new set with ``section.key`` values replaced (numbers in SI, or strings with units)."""
+        """A new set with ``section.key`` values replaced (numbers in SI, or strings with units).
+
+        ``block.stiffness`` (G_d/h) or ``block.effective_stiffness`` (K of Eq 17) sets the block's height to give
+        that stiffness with the set's shear modulus and trapezoid (after the other overrides, so a
+        ``block.shear_modulus`` given beside it is the one used); with ``block.height``, or both, it is refused.
+        """
         if not overrides:
             return self
         if not isinstance(overrides, Mapping):
             raise ParameterError(f"overrides: expected a mapping of 'section.key' to values, got {shorten(overrides)}")
         values: dict[str, Any] = self.as_dict()
+        stiffness: dict[str, float] = {}
         for key, raw in overrides.items():
             if not isinstance(key, str):
                 raise ParameterError(f"overrides: expected 'section.key' names, got {shorten(key)}")
-            dimension = key_dimension(key)
-            values[key] = to_si(raw, dimension, key)
+            dimension = override_dimension(key)
+            (stiffness if key in STIFFNESS_KEYS else values)[key] = to_si(raw, dimension, key)
+        setting = [k for k in ("block.height", *STIFFNESS_KEYS) if k in overrides]
+        if stiffness and len(setting) > 1:
+            raise ParameterError(f"{' and '.join(setting)} both set the block's height; give only one of them")
         try:
+            if stiffness:
+                values["block.height"] = _height_for(values, *next(iter(stiffness.items())))
             return _build(values, name=self.name, description=self.description, reference=self.reference)
         except ParameterError as exc:
             raise _as_written(exc, overrides) from None
@@ -309,6 +341,16 @@ class Parameters:
             text = format_quantity(value, dimension)
             document.setdefault(section, {})[name] = float(text) if dimension == "dimensionless" else text
         return json.dumps(document, indent=2, ensure_ascii=False) + "\n"
+
+
+def _height_for(values: Mapping[str, float], key: str, stiffness: float) -> float:
+    """The block height (m) at which stiffness ``key`` of :data:`STIFFNESS_KEYS` is ``stiffness`` (Pa/m), with the
+    shear modulus and trapezoid of ``values``: h = G_d/stiffness, times the Eq 17 factor for K."""
+    if not (math.isfinite(stiffness) and stiffness > 0):
+        raise ParameterError(f"{key}: expected a positive finite value in Pa/m, got {stiffness:g}")
+    block = BlockParameters(**{f.name: values[f"block.{f.name}"] for f in fields(BlockParameters)})
+    factor = block.geometric_factor if key == "block.effective_stiffness" else 1.0
+    return block.shear_modulus * factor / stiffness
 
 
 def _toml_str(text: str) -> str:
@@ -405,7 +447,8 @@ def read_parameter_file(path: str | Path) -> Parameters:
     path = Path(path)
     text = read_input_text(path, f"parameter file {shorten(str(path), 240)}", MAX_PARAMETER_FILE_BYTES, ParameterError)
     protect_inputs([path])  # in a command, no output may replace its parameter file
-    return parameters_from_mapping(parse_parameter_text(text, path, str(path)), str(path))
+    data = parse_parameter_text(text, path, str(path))
+    return _named_by_file(parameters_from_mapping(data, str(path)), path, "name" in data)
 
 
 #: How the text of each format is parsed (JSONDecodeError and TOMLDecodeError are ValueErrors).
@@ -522,14 +565,43 @@ def modified_name(name: str, keys: Iterable[str]) -> str:
 
 def _overridden(params: Parameters, overrides: Mapping[str, Any] | None) -> Parameters:
     """``params.with_overrides(overrides)``, named for the keys whose values it changed (a value set to what the
-    set holds leaves the name as it is)."""
+    set holds leaves the name as it is; a height set by a stiffness key is named by that key)."""
     changed = params.with_overrides(overrides)
     if changed is params:
         return params
-    before, after = params.as_dict(), changed.as_dict()
-    keys = [k for k in after if before.get(k) != after[k]] + [k for k in before if k not in after]
+    keys = _differing(params, changed)
+    given = next((k for k in STIFFNESS_KEYS if k in (overrides or {})), None)
+    if given is not None:
+        keys = [given if k == "block.height" else k for k in keys]
     name = modified_name(params.name, keys)
     return changed if name == changed.name else dataclasses.replace(changed, name=name)
+
+
+def _differing(before: Parameters, after: Parameters) -> list[str]:
+    """The keys whose values differ between two sets (in ``after``'s order; a key one of them lacks included)."""
+    old, new = before.as_dict(), after.as_dict()
+    return [k for k in new if old.get(k) != new[k]] + [k for k in old if k not in new]
+
+
+def _named_by_file(params: Parameters, path: Path, named: bool) -> Parameters:
+    """A set read from ``path`` named by its file: a file without a ``name`` by the file's name; one that carries a
+    built-in set's name (``gelatin-glass``, or ``gelatin-glass, modified: ...``) with other values than the name
+    says is named so, ``"gelatin-glass from my.toml, modified: bonds.bond_time"`` (every key whose value differs
+    from the built-in set's and the name does not list); otherwise by the name it carries."""
+    if not named:
+        return dataclasses.replace(params, name=path.name)
+    base, said, listed = params.name.partition(MODIFIED)
+    if base not in available_parameter_sets():
+        return params
+    shipped = load_parameters(base)
+    already = listed.split(", ") if said else []
+    if any(k in already for k in STIFFNESS_KEYS):  # a stiffness key set the height
+        already.append("block.height")
+    unsaid = [k for k in _differing(shipped, params) if k not in already]
+    if not unsaid:
+        return params
+    name = modified_name(f"{base} from {path.name}" + (f"{MODIFIED}{listed}" if said else ""), unsaid)
+    return dataclasses.replace(params, name=name)
 
 
 def _exists(text: str) -> bool:

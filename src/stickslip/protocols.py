@@ -27,6 +27,7 @@ from .columns import data_lines, split_header, with_units
 from .display import velocity as velocity_text
 from .errors import DataError, ParameterError, UnitError, as_written
 from .fileio import protect_inputs, read_input_text
+from .units import is_quantity, refused_as_written, si_argument
 
 __all__ = [
     "Protocol",
@@ -42,23 +43,39 @@ __all__ = [
 
 @dataclass(frozen=True)
 class Segment:
-    """The load point moves at ``velocity`` (m/s, >= 0) for ``duration`` (s, > 0)."""
+    """The load point moves at ``velocity`` (m/s, >= 0) for ``duration`` (s, > 0).
+
+    Each is a number in SI or a value with its unit (``Segment("0.2 mm/s", "3 s")``, a pint quantity too), read by
+    :func:`stickslip.units.si_argument`; the segment holds SI floats."""
 
     velocity: float
     duration: float
 
     def __post_init__(self) -> None:
-        for name, value in (("velocity", self.velocity), ("duration", self.duration)):
-            if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
-                raise ParameterError(f"segment {name}: expected a number in SI units, got {value!r}")
-            if not math.isfinite(float(value)):
-                raise ParameterError(f"segment {name}: expected a finite number, got {value!r}")
-        if self.velocity < 0:
-            raise ParameterError(f"segment velocity: expected a value >= 0 m/s, got {self.velocity:g}")
-        if self.duration <= 0:
-            raise ParameterError(f"segment duration: expected a positive time, got {self.duration:g} s")
-        object.__setattr__(self, "velocity", float(self.velocity))
-        object.__setattr__(self, "duration", float(self.duration))
+        for name, dimension in (("velocity", "velocity"), ("duration", "time")):
+            value = given = getattr(self, name)
+            if isinstance(given, str) or (not isinstance(given, float) and is_quantity(given)):  # a number as is
+                value = si_argument(given, dimension, f"segment {name}")
+                with refused_as_written(given):
+                    _check_segment_value(name, value)
+            else:
+                _check_segment_value(name, value)
+            object.__setattr__(self, name, float(value))
+
+
+def _check_segment_value(name: str, value: Any) -> None:
+    """A segment's velocity (m/s, >= 0) or duration (s, > 0), in SI: one ParameterError naming it otherwise."""
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
+        raise ParameterError(
+            f"segment {name}: expected a number in SI units or a value with its unit"
+            f" ({'0.2 mm/s' if name == 'velocity' else '3 s'!r}), got {value!r}"
+        )
+    if not math.isfinite(float(value)):
+        raise ParameterError(f"segment {name}: expected a finite number, got {value!r}")
+    if name == "velocity" and value < 0:
+        raise ParameterError(f"segment velocity: expected a value >= 0 m/s, got {value:g}")
+    if name == "duration" and value <= 0:
+        raise ParameterError(f"segment duration: expected a positive time, got {value:g} s")
 
 
 @dataclass(frozen=True)
@@ -140,8 +157,9 @@ class Protocol:
         return protocol_plot(self, ax=ax)
 
 
-def constant(velocity: float, duration: float) -> Protocol:
-    """Pulling at one velocity for ``duration``."""
+def constant(velocity: float | str, duration: float | str) -> Protocol:
+    """Pulling at one velocity for ``duration``: numbers in SI (m/s, s) or values with their units
+    (``constant("0.2 mm/s", "3 s")``), as every builder here takes them."""
     return Protocol((Segment(velocity, duration),), name="constant")
 
 
@@ -160,10 +178,13 @@ def _sequence(items: Any, name: str, what: str = "numbers in SI units") -> list[
 
 
 def velocity_steps(velocities: Sequence[float], durations: Sequence[float] | float) -> Protocol:
-    """Velocity steps: ``velocities[i]`` held for ``durations[i]`` (or one duration for all)."""
+    """Velocity steps: ``velocities[i]`` held for ``durations[i]`` (or one duration for all); each a number in SI
+    or a value with its unit (``velocity_steps(["1 um/s", "10 um/s"], "20 s")``)."""
     velocities = _sequence(velocities, "velocities")
-    if isinstance(durations, (int, float, np.floating, np.integer)) and not isinstance(durations, bool):
-        durations = [float(durations)] * len(velocities)
+    if isinstance(durations, (str, int, float, np.floating, np.integer)) and not isinstance(durations, bool):
+        durations = [durations] * len(velocities)  # one duration for all ("10 s" too: each segment reads it)
+    elif is_quantity(durations) and np.ndim(durations.magnitude) == 0:
+        durations = [durations] * len(velocities)
     durations = _sequence(durations, "durations")
     if len(durations) != len(velocities):
         raise ParameterError(
@@ -179,7 +200,8 @@ def slide_hold_slide(
     reslide_time: float | None = None,
     hold_velocity: float = 0.0,
 ) -> Protocol:
-    """Slide at ``slide_velocity``, hold (load point still, or at ``hold_velocity``), slide again."""
+    """Slide at ``slide_velocity``, hold (load point still, or at ``hold_velocity``), slide again (numbers in SI
+    or values with their units, ``slide_hold_slide("10 um/s", "20 s", "100 s")``)."""
     reslide = slide_time if reslide_time is None else reslide_time
     return Protocol(
         (Segment(slide_velocity, slide_time), Segment(hold_velocity, hold_time), Segment(slide_velocity, reslide)),

@@ -21,10 +21,12 @@ from __future__ import annotations
 
 import math
 import re
+from collections.abc import Iterator
+from contextlib import contextmanager
 from functools import lru_cache
 from typing import Any
 
-from .errors import ParameterError, UnitError
+from .errors import ParameterError, UnitError, as_written
 
 #: Dimensions used by the model, as pint dimensionality strings, with the
 #: unit used to *display* a value of that dimension.
@@ -205,9 +207,42 @@ def to_si(value: Any, dimension: str, name: str = "value") -> float:
             raise UnitError(f"{name}: {shorten(value)} is beyond the range of a float") from None
     if isinstance(value, str):
         return _string_to_si(value, dimension, name)
-    if hasattr(value, "dimensionality") and hasattr(value, "to"):
+    if is_quantity(value):
         return _quantity_to_si(value, dimension, name, value)
     raise UnitError(f"{name}: expected {_describe(dimension)}, got {shorten(value)}")
+
+
+def is_quantity(value: Any) -> bool:
+    """Whether ``value`` is a pint quantity (of any registry): what :func:`to_si` reads with its unit."""
+    return hasattr(value, "dimensionality") and hasattr(value, "to")
+
+
+def si_argument(value: Any, dimension: str, name: str) -> Any:
+    """A dimensional argument of a public function, the one reader of them all: a string with a unit
+    (``"0.2 mm/s"``, ``"100 ms"``, ``"300 kPa/m"``) or a pint quantity becomes a float in SI of ``dimension``
+    (:func:`to_si`; a unit of another dimension is a :class:`UnitError` naming ``name``, the value and the
+    dimension expected; a bare number as text is SI); anything else (a number, already SI) is returned as it is,
+    for the caller's own checks of type and range.
+
+    Arrays are not read here: an array of velocities or times is numbers in SI.
+    """
+    if isinstance(value, str) or is_quantity(value):
+        return to_si(value, dimension, name)
+    return value
+
+
+@contextmanager
+def refused_as_written(value: Any) -> Iterator[None]:
+    """A caller's range check of a value :func:`si_argument` read from text, refused naming the value as the user
+    wrote it (``"got '-50 um/s'"``, not ``"got -5e-05"``); a :class:`UnitError` (already so named) passes as is."""
+    try:
+        yield
+    except UnitError:
+        raise
+    except ParameterError as exc:
+        if not isinstance(value, str):
+            raise
+        raise type(exc)(as_written(str(exc), value)) from None
 
 
 def _string_to_si(text: str, dimension: str, name: str) -> float:

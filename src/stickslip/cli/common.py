@@ -31,7 +31,7 @@ from ..columns import json_safe as json_safe
 from ..columns import json_text
 from ..errors import ParameterError, StickslipError, UnitError
 from ..fileio import atomic_path, atomic_write_text, is_stdout, protect_inputs, refuse_input_as_output
-from ..parameters import Parameters, key_dimension, load_parameters
+from ..parameters import Parameters, load_parameters, override_dimension
 from ..units import DIMENSIONS, bare_number, quantity_noun, shorten, to_si
 
 #: Largest data file (CSV) a command reads: a 10^7-sample record is about 0.4 GB.
@@ -88,7 +88,7 @@ def params_options(func: Callable[..., Any]) -> Callable[..., Any]:
 
 def resolve_params(params_name: str, overrides: Sequence[str]) -> Parameters:
     """Parameters from ``--params`` and ``--set`` values."""
-    mapping = set_values(overrides, key_dimension, typical_of=typical_value, form="SECTION.KEY=VALUE")
+    mapping = set_values(overrides, override_dimension, typical_of=typical_value, form="SECTION.KEY=VALUE")
     protect_inputs([params_name])  # a TOML file is an input: no output of this command may replace it
     return load_parameters(params_name, overrides=mapping)
 
@@ -205,7 +205,9 @@ def typical_value(key: str) -> float | None:
     from ..parameters import load_parameters
 
     try:
-        return load_parameters("gelatin-glass").as_dict().get(key)
+        block = load_parameters("gelatin-glass").block
+        stiffness = {"block.stiffness": block.stiffness, "block.effective_stiffness": block.effective_stiffness}
+        return stiffness.get(key, load_parameters("gelatin-glass").as_dict().get(key))
     except ParameterError:  # pragma: no cover - the built-in set always loads
         return None
 

@@ -21,7 +21,14 @@ import click
 
 from ..display import symbol
 from ..errors import ParameterError
-from ..parameters import BOLTZMANN, SECTIONS, Parameters, available_parameter_sets, load_parameters
+from ..parameters import (
+    BOLTZMANN,
+    SECTIONS,
+    STIFFNESS_KEYS,
+    Parameters,
+    available_parameter_sets,
+    load_parameters,
+)
 from ..units import DIMENSIONS, shorten
 from .common import (
     FILE_PATH,
@@ -116,6 +123,8 @@ def parameter_table(params: Parameters, changed: Sequence[str] = ()) -> Any:
                 continue
             value = human(getattr(getattr(params, s), f.name), f.metadata["dimension"])
             flag = " (set)" if key in changed else ""
+            if key == "block.height":  # a stiffness key sets the height (stickslip.parameters.STIFFNESS_KEYS)
+                flag = next((f" (set by {k})" for k in STIFFNESS_KEYS if k in changed), flag)
             table.add_row(key + flag, symbol(f.metadata["symbol"]), value, f.metadata["doc"])
     return table
 

@@ -49,19 +49,44 @@ def run(
 ) -> Run:
     """Run ``protocol`` on ``model`` (a name, ``module:attr``, or a model) and return its :class:`Run`.
 
-    ``params``: the model's parameter object, or what its ``parameters()`` takes (a set name, a file, a
-    mapping; None for the model's defaults).  ``rig``: default a spring of the model's own stiffness.
+    ``params``: the model's parameter object; a set name or a file (what its ``parameters()`` takes); a mapping
+    ``{key: value}`` of the model's own keys (``model.dimensions()``: ``{"a": 0.01, "b": 0.015, "dc": "10 um"}``
+    for rsf, ``{"block.height": "5 mm"}`` for the bond models; numbers in SI or values with their units) over the
+    model's defaults, read by the model's own reader, ``model.parameters(None, mapping)``, so an unknown key is
+    refused naming that model's keys (a nested mapping, a whole set as a file holds it, is read as a file is); None
+    for the model's defaults.  ``rig``: default a spring of the model's own stiffness.  ``start``: a word the model
+    takes, or a number (SI) or value with its unit of the model's ``start_dimension`` (``"300 Pa"``).
     """
     from ..errors import ParameterError
 
     found = get_model(model)
     if protocol is None:
         raise ParameterError("protocol: expected a stickslip.protocols.Protocol, e.g. protocols.constant(50e-6, 20)")
-    if params is None or isinstance(params, (str, Path, Mapping)):
+    if isinstance(params, Mapping) and not _nested(params):
+        params = found.parameters(None, params)  # the model's keys over its defaults (its own reader and message)
+    elif params is None or isinstance(params, (str, Path, Mapping)):
         params = found.parameters(params)
+    start = _start(found, start)
     from .run import finished
 
     return finished(found.run(params, protocol, rig, start=start, **settings), protocol)
+
+
+def _nested(mapping: Mapping[Any, Any]) -> bool:
+    """Whether a mapping of parameters is a whole set as a file holds it (sections as tables, rate-and-state's list
+    of states) rather than ``{key: value}`` of the model's keys."""
+    return any(isinstance(value, (Mapping, list, tuple)) for value in mapping.values())
+
+
+def _start(model: FrictionModel, start: Any) -> Any:
+    """``start`` with a unit (``"300 Pa"``, a pint quantity) in SI of the model's ``start_dimension``; a word
+    (``"steady"``), a number or None as given (the model judges them)."""
+    from ..units import is_quantity, si_argument
+
+    dimension = getattr(model, "start_dimension", None)
+    if dimension is None or not (is_quantity(start) or (isinstance(start, str) and not start.strip().isalpha())):
+        return start
+    return si_argument(start, dimension, "start")
 
 
 def as_run(result: Any, protocol: Any = None) -> Run:

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from ..errors import ModelError, ParameterError
-from ..units import checked_number
+from ..units import DIMENSIONS, checked_number, refused_as_written, si_argument
 
 if TYPE_CHECKING:  # pragma: no cover
     import numpy as np
@@ -40,8 +40,14 @@ CYCLE_RESULTS: Mapping[str, str] = {
 CONTROLS = ("velocity", "spring")
 
 
-def _optional_positive(name: str, value: Any, unit: str, strict: bool) -> float | None:
-    return None if value is None else checked_number(f"rig {name}", value, unit, strict=strict)
+def _optional_positive(name: str, value: Any, dimension: str, strict: bool) -> float | None:
+    """The rig's ``name``: None, or a number in SI or a value with its unit of ``dimension``, checked >= 0 (> 0
+    with ``strict``)."""
+    if value is None:
+        return None
+    number = si_argument(value, dimension, f"rig {name}")
+    with refused_as_written(value):
+        return checked_number(f"rig {name}", number, DIMENSIONS[dimension][1], strict=strict)
 
 
 @dataclass(frozen=True)
@@ -51,7 +57,8 @@ class Rig:
     ``control="velocity"``: the protocol is the slider's own velocity.  ``control="spring"``: the protocol moves
     the load point of a spring of ``stiffness`` K (Pa/m); ``stiffness=None`` takes the model's own (the bond
     model's Eq 17 block, rate-and-state's ``k``).  ``damping`` eta (Pa s/m) and ``mass`` (kg/m^2) are optional
-    and only for models whose capabilities include them.
+    and only for models whose capabilities include them.  Each is a number in SI or a value with its unit
+    (``Rig(stiffness="300 kPa/m", mass="10 kg/m^2")``); the rig holds SI floats.
     """
 
     control: str = "spring"
@@ -62,9 +69,10 @@ class Rig:
     def __post_init__(self) -> None:
         if self.control not in CONTROLS:
             raise ParameterError(f"rig control: expected one of {', '.join(CONTROLS)}, got {self.control!r}")
-        object.__setattr__(self, "stiffness", _optional_positive("stiffness", self.stiffness, "Pa/m", strict=True))
-        object.__setattr__(self, "damping", _optional_positive("damping", self.damping, "Pa s/m", strict=False))
-        object.__setattr__(self, "mass", _optional_positive("mass", self.mass, "kg/m^2", strict=False))
+        stiffness = _optional_positive("stiffness", self.stiffness, "stress_per_length", strict=True)
+        object.__setattr__(self, "stiffness", stiffness)
+        object.__setattr__(self, "damping", _optional_positive("damping", self.damping, "stress_per_velocity", False))
+        object.__setattr__(self, "mass", _optional_positive("mass", self.mass, "mass_per_area", strict=False))
         if self.control == "velocity" and any(v is not None for v in (self.stiffness, self.damping, self.mass)):
             raise ParameterError(
                 "rig: velocity control has no spring; give stiffness, damping or mass with control='spring'"

@@ -182,8 +182,12 @@ def _mark_critical(ax: Axes, vc: float, sc: float, grid: np.ndarray, stress: np.
 
 def plot_critical(point: Any, ax: Axes | None = None) -> Axes:
     """A :class:`~stickslip.quasistatic.critical.CriticalPoint` drawn: every extremum of the aging curve as a point
-    (the minimum (Vc, sigma_c) labelled, a maximum open), on log V; without a minimum its message in the frame."""
-    drawn_before = ax is not None
+    (the minimum (Vc, sigma_c) labelled, a maximum open), on log V; without a minimum its message in the frame.
+
+    On axes of its own or on empty ones given (``plot(ax=ax)``) it sets the log V axis, the style and both axis
+    labels with their units; on axes that hold a drawing already (a steady curve) it keeps their scale, and labels
+    an axis only where it has no label yet."""
+    drawn_before = ax is not None and ax.has_data()
     ax = new_axes(ax)
     for extremum in point.extrema:
         minimum = extremum.kind == "minimum"
@@ -200,9 +204,11 @@ def plot_critical(point: Any, ax: Axes | None = None) -> Axes:
         ax.text(0.5, 0.5, point.message, transform=ax.transAxes, ha="center", va="center", fontsize=9, wrap=True)
     if not drawn_before:
         ax.set_xscale("log")
-        ax.set_xlabel(VELOCITY_LABEL)
-        ax.set_ylabel(STRESS_LABEL)
         apply_style(ax)
+    if not ax.get_xlabel():
+        ax.set_xlabel(VELOCITY_LABEL)
+    if not ax.get_ylabel():
+        ax.set_ylabel(STRESS_LABEL)
     return ax
 
 

@@ -269,7 +269,8 @@ def simulate(
 ) -> Simulation:
     """Simulate the block pulled at ``pulling_velocity`` (m/s, >= 0) for ``duration`` seconds.
 
-    Starts stuck at ``start_stress`` (Pa; default sigma_c) with fresh chains
+    Each of ``pulling_velocity``, ``duration`` and ``start_stress`` is a number in SI or a value with its unit
+    (``simulate(p, "50 um/s", "2 min")``).  Starts stuck at ``start_stress`` (Pa; default sigma_c) with fresh chains
     and chains stick -> jump -> slip -> jump -> ...  ``jump_curve`` is the
     steady curve on which the jump lands (``"aging"``, default, keeps the
     stress continuous; ``"no-aging"`` is the paper's Section 3 reading).
@@ -282,13 +283,19 @@ def simulate(
     shown to end nor to last for ever, or the cycle degenerates); ``message``
     says which and why.  Runs longer than MAX_CYCLES periods are refused.
     """
+    from ..units import refused_as_written, si_argument
     from .stick import _number, check_stress, check_velocity
 
     require_parameters(params)
-    v0 = check_velocity(pulling_velocity)
-    end = _number(duration, "duration", "s")
-    if end <= 0:
-        raise ParameterError(f"duration: expected a positive time in s, got {end!r}")
+    with refused_as_written(pulling_velocity):
+        v0 = check_velocity(si_argument(pulling_velocity, "velocity", "pulling_velocity"))
+    with refused_as_written(duration):
+        end = _number(si_argument(duration, "time", "duration"), "duration", "s")
+        if end <= 0:
+            raise ParameterError(f"duration: expected a positive time in s, got {end!r}")
+    if start_stress is not None:
+        with refused_as_written(start_stress):
+            start_stress = check_stress(si_argument(start_stress, "stress", "start_stress"))
     check_curve(jump_curve)
     cp = cached_critical_point(steady_curve_key(params))
     if not cp.exists:

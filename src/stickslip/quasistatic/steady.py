@@ -16,11 +16,11 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..columns import attribute_frame
-from ..errors import ModelError, ParameterError
+from ..errors import DataError, ModelError, ParameterError
 from ..numerics.quadrature import panel_rule
 from ..parameters import BOLTZMANN, Parameters, require_flag
 from ..reprs import compact_repr
-from ..units import shorten
+from ..units import refused_as_written, shorten, si_argument
 
 if TYPE_CHECKING:  # pragma: no cover
     import pandas as pd
@@ -564,6 +564,24 @@ def _check_velocity(velocity: Any) -> np.ndarray:
     return v
 
 
+def _velocity_argument(velocity: Any) -> np.ndarray:
+    """``velocity`` of a public entry: numbers in m/s (scalar or array), one value with its unit (``"0.2 mm/s"``)
+    or a pint quantity; checked by :func:`_check_velocity`.  An empty one is a DataError (it gave an empty result),
+    an array of texts a ParameterError saying that arrays are numbers in SI."""
+    if isinstance(velocity, str):
+        with refused_as_written(velocity):
+            return _check_velocity(si_argument(velocity, "velocity", "velocity"))
+    if isinstance(velocity, (list, tuple)) and any(isinstance(item, str) for item in velocity):
+        raise ParameterError(
+            f"velocity: an array of velocities holds numbers in m/s (SI); a unit is read from one velocity"
+            f" alone ('0.2 mm/s'), got {shorten(velocity)}"
+        )
+    v = _check_velocity(velocity)
+    if v.size == 0:
+        raise DataError(f"velocity: empty ({shorten(velocity)}); expected at least one velocity in m/s")
+    return v
+
+
 def _require_finite_stress(params: Parameters, which: str = "") -> None:
     if params.bonds.activation_length == 0.0:
         raise ModelError(
@@ -598,7 +616,8 @@ def steady_state(
     """The steady friction stress, bonded fraction and dsigma/dV at each sliding velocity (Eqs 6-8).
 
     ``velocity`` is in m/s (real numbers, scalar or array: True or a complex value is a
-    ParameterError, not 1 m/s or its real part); ``aging=False`` drops the aging
+    ParameterError, not 1 m/s or its real part), or one velocity with its unit (``"0.2 mm/s"``, a pint
+    quantity); an empty one is a DataError.  ``aging=False`` drops the aging
     term of Eq 6 (the paper's no-aging curve).  With ``distribution=True`` the
     age distribution n(t_a) of Eqs 6-7 is kept at the quadrature nodes.
     ``quadrature`` sets the panel rule (see :class:`QuadratureSettings`).  The march runs compiled from
@@ -613,7 +632,7 @@ def steady_state(
     aging, distribution = require_flag(aging, "aging"), require_flag(distribution, "distribution")
     if not isinstance(quadrature, QuadratureSettings):
         raise ParameterError(f"quadrature: expected QuadratureSettings, got {type(quadrature).__name__}")
-    v = _check_velocity(velocity)
+    v = _velocity_argument(velocity)
     _require_finite_stress(params)
     flat = np.ravel(v)
     s = _scales(params, flat, aging)

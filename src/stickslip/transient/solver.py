@@ -200,6 +200,9 @@ def run_transient(
     (a ParameterError) whose ``partial`` is the result up to there (its message
     says where it stopped).
     """
+    from ..units import si_argument
+
+    every = None if every is None else si_argument(every, "time", "every")  # "100 ms" too, as rsf.simulate reads it
     progress, mass, damping, k_block, start_velocity, budget, seconds = _checked_arguments(
         params, protocol, control, start, reduction, aging, stick_population, rtol, progress, stiffness, mass, damping,
         every, max_step, start_velocity, max_steps, max_time,
