@@ -154,15 +154,21 @@ def _run(
     )
     if not overwrite:
         spec = _as_labelled_before(spec, output)
-    store = run_sweep(
-        spec,
-        output,
-        workers=workers,
-        scheduler=scheduler,
-        overwrite=overwrite,
-        progress=reporter(quiet),
-        batch_size=batch_size,
-    )
+    try:
+        store = run_sweep(
+            spec,
+            output,
+            workers=workers,
+            scheduler=scheduler,
+            overwrite=overwrite,
+            progress=reporter(quiet),
+            batch_size=batch_size,
+        )
+    except KeyboardInterrupt:  # Ctrl-C, or SIGTERM (cli.main.Terminated): what is kept, and how to go on
+        note = interrupted_note(output)
+        if note:
+            echo_err(note)
+        raise
     if store.damaged:  # said even with --quiet: the folder was not as the last run left it
         echo_err(damage_note(store))
     summary = _summary(store.folder, spec.size)
@@ -170,6 +176,23 @@ def _run(
         summary += f"; {store.report.words()}"
     if not quiet:
         echo_err(summary)
+
+
+def interrupted_note(output: str) -> str:
+    """The line an interrupted sweep adds to "stickslip: aborted" (or "terminated"): the points its folder keeps and
+    that the same command resumes; "" where it keeps none (rerunning starts afresh) or holds no sweep."""
+    from ..sweeps.store import saved_points
+
+    found = saved_points(output)
+    if found is None or found[0] == 0:
+        return ""
+    saved, total = found
+    if saved == total:  # stopped after its last chunk: nothing is left to compute
+        return f"sweep: stopped with all {total} points saved in {output}; run the same command again for its summary"
+    return (
+        f"sweep: stopped with {saved} of {total} points saved in {output}; run the same command again to resume"
+        f" (the other {total - saved} points)"
+    )
 
 
 #: Suffixes of the files a sweep's -o may be taken for: a sweep writes a folder of Parquet chunks, never one file.

@@ -13,6 +13,7 @@ import io
 import json
 import math
 import os
+import weakref
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -193,18 +194,80 @@ END_TOLERANCE = 1e-9
 def finished(run: Run, protocol: Any) -> Run:
     """``run`` as the model interface reports it: a run whose trace ends before ``protocol`` does, while the model
     called it "ok", is a failed run of what it computed (a plug-in's solver that stopped at t = 0 of 1 s read
-    "undetermined: too short to tell" with exit 0).  The command line, sweeps, compare and
-    :func:`stickslip.models.run` pass every run through here."""
+    "undetermined: too short to tell" with exit 0).  A finished run that :meth:`Run.from_trace` classified over
+    its whole trace is classified over ``protocol``'s last segment (:func:`in_last_segment`).  The command line,
+    sweeps, compare and :func:`stickslip.models.run` pass every run through here."""
     if run.status != "ok" or protocol is None:
         return run
     end, reached = float(protocol.duration), float(run.time[-1])
     if reached >= end - END_TOLERANCE * max(end, 1.0):
-        return run
+        return in_last_segment(run, protocol)
     from dataclasses import replace
 
     message = (f"{run.model}: the model stopped at t = {reached:.6g} s of the protocol's {end:.6g} s without saying"
                " why (its trace ends there)")  # fmt: skip
     return replace(run, status="failed", message=message)
+
+
+#: the relative tolerance of a trace whose model states none (``Run.from_trace`` without ``floor``): changes below
+#: this fraction of the window's largest |signal| are no change.  scipy's ``solve_ivp`` at its defaults (RK45, rtol
+#: 1e-3) ends a relaxation that has long settled with steps that still move it by up to 1e-3 of the scale (0.998e-3
+#: the worst of 96 settled lags), which 1e-9 read as still changing, or as periods (docs/regimes.md, "A plug-in's
+#: tolerance and window")
+TRACE_TOLERANCE = 1e-3
+
+#: the Runs :meth:`Run.from_trace` classified over the whole trace, knowing no protocol: (floor as given, dense,
+#: whether the model gave its mean), for :func:`in_last_segment` (weak keys: a Run copied or pickled has none)
+_WHOLE_TRACE: weakref.WeakKeyDictionary[Run, tuple[float | None, Any, bool]] = weakref.WeakKeyDictionary()
+
+
+def last_segment_start(protocol: Any) -> float:
+    """Where ``protocol``'s last segment starts (s): the window whose regime a run reports (0 for one segment)."""
+    from ..protocols import Protocol
+
+    if not isinstance(protocol, Protocol):
+        raise ParameterError(f"protocol: expected a stickslip.protocols.Protocol, got {type(protocol).__name__}")
+    return float(protocol.boundaries[-2])
+
+
+def in_last_segment(run: Run, protocol: Any) -> Run:
+    """``run`` classified, and its mean taken, over ``protocol``'s last segment, as every built-in model reports:
+    for a Run that :meth:`Run.from_trace` classified over its whole trace (a plug-in that gave neither ``start`` nor
+    ``protocol``); any other Run as it is.  A lag model stepped 100 -> 1000 -> 100 µm/s (20 ms each, relaxation time
+    2 ms) reported the mean of the whole run, 346.0 Pa, for the 300.154 Pa of its last segment's settled half."""
+    whole = _WHOLE_TRACE.get(run)
+    if whole is None or protocol is None:
+        return run
+    begin = last_segment_start(protocol)
+    if not begin > float(run.time[0]):
+        return run
+    from dataclasses import replace
+
+    floor, dense, mean_given = whole
+    regime = _classified(run.time, run.signal, floor, begin, dense, run.signal_unit)
+    mean = run.mean if mean_given else settled_mean(run.time, run.signal, regime.period, begin)
+    return replace(run, regime=regime, mean=mean)
+
+
+def trace_floor(time: np.ndarray, signal: np.ndarray, start: float | None) -> float:
+    """The default ``floor`` of :meth:`Run.from_trace`: :data:`TRACE_TOLERANCE` of the largest |signal| at
+    ``t >= start`` (the classified window)."""
+    inside = np.isfinite(signal) & (time >= (time[0] if start is None else start))
+    scale = float(np.max(np.abs(signal[inside]), initial=0.0))
+    return TRACE_TOLERANCE * scale if scale > 0 else 1e-300
+
+
+def _classified(
+    time: np.ndarray,
+    signal: np.ndarray,
+    floor: float | None,
+    start: float | None,
+    dense: regimes.Dense | None,
+    unit: str,
+) -> regimes.Regime:
+    """The classifier's verdict on a trace over ``t >= start``, its words in ``unit`` (Pa; none for friction)."""
+    floor = trace_floor(time, signal, start) if floor is None else floor
+    return regimes.classify(time, signal, floor=floor, start=start, dense=dense, unit="" if unit == "1" else unit)
 
 
 @dataclass(frozen=True, eq=False)  # arrays: equality is not a truth value; compare columns instead
@@ -275,11 +338,22 @@ class Run:
         floor: float | None = None,
         dense: regimes.Dense | None = None,
         start: float | None = None,
+        protocol: Any = None,
         **extra: Any,
     ) -> Run:
         """A Run from the model's solution; without ``regime`` it is classified on the stress (or friction)
         by :func:`stickslip.regimes.classify`, with ``dense`` the solver's interpolant of that signal if there is
-        one, over ``t >= start``, changes below ``floor`` (default 1e-9 of the signal's scale) counting as none."""
+        one, over ``t >= start``, changes below ``floor`` counting as none; ``mean`` is taken over the settled part
+        of that window.
+
+        ``start`` (s): default the start of ``protocol``'s last segment, the window every built-in model reports;
+        with neither, the whole trace, which the interface that ran the model (:func:`stickslip.run`, the command
+        line, sweeps, compare: :func:`finished`) classifies again over the protocol's last segment.
+        ``floor``: the model's accuracy in the signal's unit (Pa, or 1 for friction): changes and swings at or below
+        it are no change; default :data:`TRACE_TOLERANCE` (1e-3) of the window's largest |signal|, the accuracy of
+        scipy's ``solve_ivp`` at its defaults.  A model whose solver is more accurate says so here."""
+        if start is None and protocol is not None:
+            start = last_segment_start(protocol)
         t, signal = _trace_arrays(time, stress, friction)
         columns = {"stress": stress, "friction": friction, "slider_velocity": slider_velocity,
                    "slider_position": slider_position, "load_point_position": load_point_position,
@@ -292,11 +366,9 @@ class Run:
             return _failed_at(model, t, columns, bad, states, state_units, extra)
         if regime is None and extra.get("status", "ok") != "ok":  # a run that did not finish has no verdict
             regime = _no_verdict(signal, f"of the run up to its {extra['status']} end: {extra.get('message', '')}")
+        whole = regime is None and start is None  # classified here knowing no protocol: see in_last_segment
         if regime is None:
-            if floor is None:
-                scale = float(np.max(np.abs(signal[np.isfinite(signal)]), initial=0.0))
-                floor = 1e-9 * scale if scale > 0 else 1e-300
-            regime = regimes.classify(t, signal, floor=floor, start=start, dense=dense)
+            regime = _classified(t, signal, floor, start, dense, "Pa" if stress is not None else "1")
         run = cls(
             model=model, time=t, stress=stress, friction=friction, slider_velocity=slider_velocity,
             slider_position=slider_position, load_point_position=load_point_position, regime=regime,
@@ -304,6 +376,8 @@ class Run:
         )  # fmt: skip
         if "mean" not in extra and t.size:  # over the settled part of the classified window (t >= start)
             object.__setattr__(run, "mean", settled_mean(t, run.signal, regime.period, start))
+        if whole:
+            _WHOLE_TRACE[run] = (floor, dense, "mean" in extra)
         return run
 
     # ---------------------------------------------------------------- what it settled into

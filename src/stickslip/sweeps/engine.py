@@ -92,6 +92,15 @@ def check_scheduler_address(scheduler: str) -> None:
 @contextlib.contextmanager
 def dask_client(workers: int | None = None, scheduler: str | None = None) -> Iterator[Any]:
     """A client of the cluster at ``scheduler``, or of a local cluster of ``workers`` processes started here."""
+    from .quiet import quiet_closing
+
+    # a closed connection's traceback at the cluster's close (a worker's heartbeat in flight) is not the user's:
+    # kept off the terminal here and in the workers (quiet.py), every other record shown as before
+    with quiet_closing():
+        yield from _client(workers, scheduler)
+
+
+def _client(workers: int | None, scheduler: str | None) -> Iterator[Any]:
     import logging
 
     from distributed import Client, LocalCluster
@@ -107,22 +116,62 @@ def dask_client(workers: int | None = None, scheduler: str | None = None) -> Ite
     count = workers if workers is not None else (os.cpu_count() or 1)
     if count < 1:
         raise StickslipError(f"--workers: expected at least 1 worker process, got {count}")
+    with workers_without_ctrl_c() as hear:  # the workers started meanwhile never hear a terminal's Ctrl-C
+        try:
+            cluster = LocalCluster(
+                n_workers=count,
+                threads_per_worker=1,  # the model is Python and numpy on small arrays: processes, not threads
+                processes=True,
+                dashboard_address=None,
+                scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},  # its status server on a free port, not 8787
+                silence_logs=logging.ERROR,
+                preload=["stickslip.sweeps.quiet"],  # each worker process: its closed connections' records dropped
+            )
+        except RuntimeError as exc:  # typically a script without the __main__ guard that spawned processes need
+            raise StickslipError(
+                f"could not start {count} local dask worker processes ({exc}); a script that runs a sweep must call"
+                " it under `if __name__ == '__main__':`, or use workers=0 to run in this process"
+            ) from None
+        with cluster:
+            hear()
+            with Client(cluster) as client:
+                yield client
+
+
+@contextlib.contextmanager
+def workers_without_ctrl_c() -> Iterator[Callable[[], None]]:
+    """SIGINT blocked in this thread while the block starts processes, and so in the threads it starts (distributed's
+    event loop, which spawns the workers, and so in the workers); ``hear()`` unblocks it here.  This process still
+    hears Ctrl-C meanwhile (another of its threads takes it, and Python raises it in the main thread).
+
+    A terminal sends Ctrl-C to every process of its foreground group: each worker process died of it with
+    multiprocessing's traceback ("Process Dask Worker process (from Nanny): ... KeyboardInterrupt") and its nanny
+    logged a CancelledError's, between the progress and "stickslip: aborted".  Spawned with SIGINT blocked, a
+    worker inherits the mask and never hears it; this process does, and closes the cluster, which ends them.
+    """
+    import signal
+    from multiprocessing import resource_tracker
+
+    block = getattr(signal, "pthread_sigmask", None)
+    if block is None:  # pragma: no cover - POSIX has it
+        yield lambda: None
+        return
+    # multiprocessing starts its resource tracker with the first worker, blocking then unblocking SIGINT in the
+    # thread that starts it (bpo-33613), which lifted this block before the workers were spawned: started here first
+    resource_tracker.ensure_running()
+    before = block(signal.SIG_BLOCK, {signal.SIGINT})
+    restored = False
+
+    def hear() -> None:
+        nonlocal restored
+        if not restored:
+            restored = True
+            block(signal.SIG_SETMASK, before)
+
     try:
-        cluster = LocalCluster(
-            n_workers=count,
-            threads_per_worker=1,  # the model is Python and numpy on small arrays: processes, not threads
-            processes=True,
-            dashboard_address=None,
-            scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},  # its status server on a free port, not 8787
-            silence_logs=logging.ERROR,
-        )
-    except RuntimeError as exc:  # typically a script without the __main__ guard that spawned processes need
-        raise StickslipError(
-            f"could not start {count} local dask worker processes ({exc}); a script that runs a sweep must call it"
-            " under `if __name__ == '__main__':`, or use workers=0 to run in this process"
-        ) from None
-    with cluster, Client(cluster) as client:
-        yield client
+        yield hear
+    finally:
+        hear()
 
 
 #: Seconds a local cluster takes to start and ship the first batches (measured on the 2-core machine: a 60-point

@@ -282,6 +282,24 @@ def _ledger(folder: Path) -> dict[int, dict[str, Any]]:
     return entries
 
 
+def saved_points(folder: str | Path) -> tuple[int, int] | None:
+    """(points whose chunk is in ``folder``, the sweep's points), read off its manifest and ledger without the
+    lock (what an interrupted command says it leaves); None where the folder holds no sweep's manifest."""
+    path = Path(folder)
+    try:
+        manifest = json.loads((path / MANIFEST).read_text(encoding="utf-8"))
+        total = int(manifest["points"])
+    except (OSError, ValueError, KeyError, TypeError):
+        return None
+    saved = 0
+    for batch, entry in _ledger(path).items():
+        if not (path / chunk_name(batch)).is_file():  # recorded, then renamed: one killed in between is not saved
+            continue
+        with contextlib.suppress(KeyError, TypeError, ValueError):
+            saved += max(int(entry["stop"]) - int(entry["start"]), 0)
+    return min(saved, total), total
+
+
 def _check_chunks(store: SweepStore) -> None:
     """Keep the chunks that are whole and of this sweep's batches; remove (and list) the others."""
     ledger = _ledger(store.folder)
