@@ -39,6 +39,8 @@ def test_rsf_blow_up_and_unanalysed_runs_carry_a_classifier_kind() -> None:
     blown = simulate(slip, protocols.constant(1e-6, 300.0), start_velocity=1.1e-6)
     assert blown.status == "blow-up"
     assert isinstance(blown.regime, regimes.Regime) and blown.regime.kind == regimes.BLOW_UP
-    assert blown.regime.peak == max(blown.friction) and blown.regime.trough == min(blown.friction)
+    # the extremes of the solution, placed between the solver's steps (round 27): at or beyond the rows' own
+    assert max(blown.friction) <= blown.regime.peak <= max(blown.friction) + 1e-6
+    assert min(blown.friction) - 1e-6 <= blown.regime.trough <= min(blown.friction)
     fit_like = simulate(_params(2000.0), protocols.constant(3e-6, 10.0), detect=False)
     assert fit_like.regime.kind == regimes.UNDETERMINED and fit_like.regime.evidence == "not analysed"

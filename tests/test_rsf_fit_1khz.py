@@ -171,10 +171,13 @@ def test_a_re_zeroed_displacement_is_refused_naming_the_jump():
     assert "\n" not in str(info.value)
 
 
-def test_decimal_commas_between_semicolons_are_named(tmp_path):
+def test_decimal_commas_between_semicolons_are_read(tmp_path):
+    """Round 27: with ';' between the cells and no decimal point anywhere a comma is a decimal mark (it was
+    refused, "'0,000000' is not a number; a decimal comma?"); tests/test_readers_round27.py has the rest."""
     path = tmp_path / "semi.csv"
     lines = [f"{0.1 * i:.6f};{0.1 * i:.6f};{0.6:.6f}".replace(".", ",") for i in range(20)]
     path.write_text("Time(s);Displ(microns);Friction\n" + "\n".join(lines) + "\n")
     columns = {"time": "Time(s)", "displacement": "Displ(microns)", "friction": "Friction"}
-    with pytest.raises(DataError, match=r"row 2, column 'Time\(s\)': '0,000000' is not a number; a decimal comma"):
-        read_record(path, columns=columns)
+    record = read_record(path, columns=columns)
+    assert np.allclose(record.time, 0.1 * np.arange(20)) and np.allclose(record.displacement, 0.1e-6 * np.arange(20))
+    assert "decimal commas" in record.notes[0]

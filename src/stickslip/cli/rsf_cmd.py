@@ -305,8 +305,9 @@ MIN_WINDOW_ROWS = 10
 MAX_TIME_DEFAULT = "5 min"
 #: Jacobians (each n + 1 model runs, n the free parameters) of one least-squares search (docs/rsf.md, "Cost estimate").
 JACOBIANS_PER_SEARCH = 10
-#: At most this many times the typical cost: a troubled search restarts in Dc (3) and is polished (up to 3).
-RESTART_FACTOR = 7
+#: Jacobians of each search a troubled fit adds (a restart from another Dc, another law tried): at most 37 counted
+#: on the measured records of docs/rsf.md ("Cost estimate and --max-time"), 12-27 typically
+RESTART_JACOBIANS = 30
 #: A model run this long is timed once (the first run's set-up, about a second, is then a small part of it).
 SLOW_RUN_SECONDS = 10.0
 #: More rows than this in the text report's history are summarised (a measured history has hundreds).
@@ -315,20 +316,33 @@ SHOWN_SEGMENTS = 12
 
 @dataclass(frozen=True)
 class FitCost:
-    """The up-front estimate of an ``rsf fit``: one model run (measured) times the runs a fit typically takes."""
+    """The up-front estimate of an ``rsf fit``: one model run (measured) times the runs a fit typically takes, and
+    the runs it may take when its first search does not fit the record to its noise (``restart_runs``, from the
+    searches it then adds: ``restarts`` says which)."""
 
     run_seconds: float
     runs: int
     free: int
+    restart_runs: int = 0
+    restarts: str = ""
 
     @property
     def seconds(self) -> float:
         return self.run_seconds * self.runs
 
+    @property
+    def restart_seconds(self) -> float:
+        return self.run_seconds * max(self.restart_runs, self.runs)
+
     def text(self) -> str:
+        typical = (f"about {_duration(self.seconds)} ({self.runs} model runs of {_duration(self.run_seconds)} each for"
+                   f" {self.free} free parameters)")  # fmt: skip
+        if self.restart_runs <= self.runs:
+            return typical
         return (
-            f"about {_duration(self.seconds)} ({self.runs} model runs of {_duration(self.run_seconds)} each for"
-            f" {self.free} free parameters; up to {_duration(RESTART_FACTOR * self.seconds)} if the search restarts)"
+            f"{typical}; a record its first search does not fit to the noise (reduced chi-square > 2, as measured "
+            f"records usually are) adds {self.restarts}: up to {_duration(self.restart_seconds)} "
+            f"({self.restart_runs} runs)"
         )
 
 
@@ -349,7 +363,8 @@ def _duration(seconds: float) -> str:
     "--columns",
     default=None,
     metavar="ROLE=HEADER,...",
-    help='Map headers: time="Time(s)",displacement="Displ(microns)",friction=Friction.',
+    help='Map headers: time="Time(s)",displacement="Displ(microns)",friction=Friction; a shear stress and the '
+    'normal stress instead of friction: shear_stress="Tau (kPa)",normal_stress="Sn (MPa)".',
 )
 @click.option("--displacement-unit", default=None,
               help="Unit of the displacement column [the unit its header names, e.g. (um), else m].")  # fmt: skip
@@ -371,7 +386,9 @@ def _duration(seconds: float) -> str:
 @click.option("--stiffness", default=None,
               help='Spring stiffness ("1e-3 1/um", or Pa/m with --normal-stress): held fixed, as --fix stiffness=K; '
                    "with --fit-stiffness the free stiffness starts there, as --guess stiffness=K.")  # fmt: skip
-@click.option("--normal-stress", default=None, help="Normal stress, to read a stiffness in Pa/m.")
+@click.option("--normal-stress", default=None,
+              help='Normal stress ("10 MPa"): divides a shear-stress column into friction, and reads a stiffness in '
+                   "Pa/m.")  # fmt: skip
 @click.option("--fit-stiffness", is_flag=True,
               help="Fit the stiffness (the default without --stiffness), as --free stiffness.")  # fmt: skip
 @click.option(
@@ -436,7 +453,7 @@ def fit_command(**options: Any) -> None:
     status 3; its parameters are not written to -o.  Bad input exits 2.
     """
     from ..rsf.data import parse_columns, read_record
-    from ..rsf.fit import FitNotEvaluated, fit_record
+    from ..rsf.fit import FitNotEvaluated, fit_record, restart_notice
 
     output, plot_path = options["output"], options["plot_path"]
     side = None if output is None or output.suffix.lower() == ".json" else sidecar(output)
@@ -446,8 +463,10 @@ def fit_command(**options: Any) -> None:
     )
     window = _window(options["window_text"])  # the options first: a typing error is said before the record is read
     max_time = positive(options["max_time"], "time", "--max-time")
+    sigma = options["normal_stress"]  # divides a shear-stress column into friction
+    sigma = None if sigma is None else positive(sigma, "stress", "--normal-stress")
     record = read_record(options["record_file"], parse_columns(options["columns"]), options["displacement_unit"],
-                         options["time_unit"])  # fmt: skip
+                         options["time_unit"], normal_stress=sigma)  # fmt: skip
     settings = _fit_settings(options, record, window)
     if settings["mcmc_steps"] and importlib.util.find_spec("emcee") is None:  # said before any work, as --bayes
         raise ParameterError("--mcmc: the posterior needs emcee: pip install stickslip[bayes]")
@@ -461,7 +480,7 @@ def fit_command(**options: Any) -> None:
         click.echo(f"stickslip: rsf fit: {cost.text()}", err=True)
     started = time.perf_counter()
     try:
-        with _deadline(max_time):
+        with _deadline(max_time), restart_notice(_restart_notice(cost)):
             fit = fit_record(record, **settings)
     except FitNotEvaluated as exc:  # a failed fit whose report (where the search ended) is printed below, exit 3
         fit = exc.fit
@@ -750,7 +769,43 @@ def estimate_fit_cost(record: Any, settings: dict[str, Any]) -> FitCost:
     runs = searches * (free + 1) * JACOBIANS_PER_SEARCH
     if settings["mcmc_steps"]:
         runs += max(4 * free, 16) * settings["mcmc_steps"]
-    return FitCost(_timed_run(record, settings), runs, free)
+    added, words = _restart_searches(settings)
+    restart_runs = runs + added * (free + 1) * RESTART_JACOBIANS
+    return FitCost(_timed_run(record, settings), runs, free, restart_runs, words)
+
+
+def _restart_notice(cost: FitCost) -> Callable[[str, int], None]:
+    """What ``rsf fit`` says on stderr when the first search restarts (fit_record's ``notify``): the searches it adds
+    and their time at the estimate's pace, where that is above PROGRESS_AFTER_SECONDS (the tester's velstep1 fit,
+    estimated at 2.3 s, ran 17 s without a word)."""
+
+    def notice(text: str, searches: int) -> None:
+        more = cost.run_seconds * searches * (cost.free + 1) * RESTART_JACOBIANS
+        if more > PROGRESS_AFTER_SECONDS:
+            click.echo(f"stickslip: rsf fit: {text} (up to {searches} more searches, up to {_duration(more)} more)",
+                       err=True)  # fmt: skip
+
+    return notice
+
+
+def _restart_searches(settings: dict[str, Any]) -> tuple[int, str]:
+    """The searches a fit adds when its first search ends troubled (reduced chi-square > 2: every measured record of
+    docs/rsf.md), and their words: one per other start in Dc (each in as many stages as the first: a one-state
+    search before a two-state one, one without the time drift first), and, for one state of a built-in law, one
+    per other law tried (and with a held stiffness, the stiffness freed, alone and with the best other law)."""
+    from ..rsf.fit import ALTERNATIVE_LAWS, RETRY_DC_FACTORS
+
+    fixed, states = settings.get("fixed", {}), settings["states"]
+    stages = 1 + (states == 2) + (settings["trend"] in ("time", "both"))
+    retries = 0 if "dc" in fixed else len(RETRY_DC_FACTORS)
+    law = settings["law"] if isinstance(settings["law"], str) else settings["law"][0]
+    laws = len(ALTERNATIVE_LAWS) - 1 if states == 1 and law in ALTERNATIVE_LAWS else 0
+    held = "stiffness" in fixed and not settings.get("fit_stiffness")
+    others = laws + (1 + (laws > 0) if held else 0)
+    words = [f"{retries} searches from other starts in Dc" if retries else "",
+             f"{laws} other law{'s' if laws > 1 else ''}" if laws else "",
+             "the stiffness freed" if held else ""]  # fmt: skip
+    return retries * stages + others, " and ".join(w for w in words if w)
 
 
 def _timed_run(record: Any, settings: dict[str, Any]) -> float:
@@ -818,7 +873,8 @@ def _fit_text(fit: Any) -> str:
         lines.append(f"    from {_clock(row['file_time'], fit)} s: {row['velocity']:.6g} {unit}/s for "
                      f"{row['duration']:.6g} s")  # fmt: skip
     for name, p in {**fit.parameters, **fit.derived}.items():
-        lines.append(f"  {name:10s} {p.text()}")
+        # mu0 is the friction at the fit's reference velocity (the first load-point velocity), not at any other
+        lines.append(f"  {name:10s} {p.text()}" + (f", at {fit.reference_velocity_text()}" if name == "mu0" else ""))
     lines += [f"  {line}" for line in fit.change_lines()]  # (on the file's own clock too)
     lines.append(f"  reduced chi-square {fit.reduced_chi_square:.4g} (noise {fit.noise:.3g}), rms {fit.rms:.4g}")
     lines += _posterior_lines(fit)

@@ -87,6 +87,7 @@ class SteadyData:
     rows: np.ndarray
     source: str = "data"
     ignored_columns: tuple[str, ...] = ()
+    read_notes: tuple[str, ...] = ()  # how the file was read where it is not the usual way (decimal commas)
 
     def __len__(self) -> int:
         return int(self.velocity.size)
@@ -98,7 +99,7 @@ class SteadyData:
 
     def notes(self) -> list[str]:
         """What the reader left out, and the repeated measurements it kept (a line each, or none)."""
-        out = []
+        out = list(self.read_notes)
         if self.ignored_columns:
             names = ", ".join(self.ignored_columns)
             out.append(f"{self.source}: column(s) {names} not used by the steady fit (ignored)")
@@ -208,8 +209,8 @@ def read_steady_data(path: str | Path) -> SteadyData:
         allow_missing=tuple(STEADY_IGNORED_COLUMNS),
     )
     ignored = tuple(name for name in STEADY_IGNORED_COLUMNS if name in table)
-    kept = Table(table.source, {k: v for k, v in table.columns.items() if k in STEADY_COLUMNS}, table.rows)
-    return dataclasses.replace(_validated_steady(kept), ignored_columns=ignored)
+    kept = dataclasses.replace(table, columns={k: v for k, v in table.columns.items() if k in STEADY_COLUMNS})
+    return dataclasses.replace(_validated_steady(kept), ignored_columns=ignored, read_notes=table.notes)
 
 
 def read_stick_data(path: str | Path) -> StickData:
@@ -227,7 +228,7 @@ def read_stick_data(path: str | Path) -> StickData:
         if not {"critical_stress", "complete"} <= set(names):
             raise
         return _read_cycles_table(path, names)
-    return _validated_stick(table)
+    return dataclasses.replace(_validated_stick(table), read_notes=table.notes)
 
 
 def _read_cycles_table(path: str | Path, names: Sequence[str]) -> StickData:
@@ -248,11 +249,13 @@ def _read_cycles_table(path: str | Path, names: Sequence[str]) -> StickData:
                        ignore=CYCLES_IGNORED)  # fmt: skip
     whole = np.isfinite(table["stick_time"])
     columns = {CYCLES_COLUMNS.get(n, n): v[whole] for n, v in table.columns.items()}
-    notes = [f"{source}: the cycles table of stickslip analyze; its critical_stress (σc) is each row's start_stress"]
+    notes = [*table.notes,
+             f"{source}: the cycles table of stickslip analyze; its critical_stress (σc) is each row's start_stress"]
     if not whole.all():
         cut = ", ".join(str(r) for r in table.rows[~whole])
         notes.append(f"{source}: row(s) {cut} left out: cycles cut by the record's ends or a gap in it (no stick time)")
-    data = _validated_stick(Table(source, columns, table.rows[whole]))
+    written = {CYCLES_COLUMNS.get(n, n): w for n, w in table.written.items()}
+    data = _validated_stick(Table(source, columns, table.rows[whole], written=written))
     return dataclasses.replace(data, read_notes=tuple(notes))
 
 
@@ -279,7 +282,8 @@ def _require_positive(table: Table, names: Sequence[str]) -> None:
         k = int(rows[0])
         name = present[int(np.argmax(bad[k]))]
         raise DataError(
-            f"{table.source}: row {table.rows[k]}, column {name!r}: expected a positive value, got {table[name][k]:g}"
+            f"{table.source}: row {table.rows[k]}, column {name!r}: expected a positive value, got"
+            f" {table.as_written(name, table[name][k])}"
         )
 
 
@@ -293,7 +297,7 @@ def _require_not_negative(table: Table, names: Sequence[str]) -> None:
             k = int(bad[0])
             raise DataError(
                 f"{table.source}: row {table.rows[k]}, column {name!r}: expected a finite uncertainty >= 0 (or an"
-                f" empty cell), got {table[name][k]:g}"
+                f" empty cell), got {table.as_written(name, table[name][k])}"
             )
 
 
@@ -305,22 +309,27 @@ def _require_range(table: Table, name: str, bounds: tuple[float, float], unit: s
     bad = np.nonzero((column < bounds[0]) | (column > bounds[1]))[0]
     if bad.size:
         k = int(bad[0])
+        written = ""
+        if table.written.get(name, ("", 1.0))[1] != 1.0:  # in SI, and as the file wrote it
+            written = f" (written {table.as_written(name, column[k])})"
         raise DataError(
             f"{table.source}: row {table.rows[k]}, column {name!r}: {column[k]:g} {unit} is outside the range of"
-            f" {what} ({bounds[0]:g} to {bounds[1]:g} {unit}); check the units in the header"
+            f" {what} ({bounds[0]:g} to {bounds[1]:g} {unit}); check the units in the header{written}"
         )
 
 
 def _validated_steady(table: Table) -> SteadyData:
+    # every row's values first, the count after: a file with a wrong value (a unit forgotten, a sign) says so
+    # however few rows it has
+    _require_positive(table, ["velocity", "stress", "stress_err"])
+    _require_range(table, "velocity", VELOCITY_RANGE, "m/s", "a sliding velocity")
+    for name in ("stress", "stress_err"):
+        _require_range(table, name, STRESS_RANGE, "Pa", "a friction stress")
     n = len(table)
     if n < MIN_STEADY_POINTS:
         raise DataError(
             f"{table.source}: {n} data row(s), expected at least {MIN_STEADY_POINTS} to fit a friction curve"
         )
-    _require_positive(table, ["velocity", "stress", "stress_err"])
-    _require_range(table, "velocity", VELOCITY_RANGE, "m/s", "a sliding velocity")
-    for name in ("stress", "stress_err"):
-        _require_range(table, name, STRESS_RANGE, "Pa", "a friction stress")
     v = table["velocity"]
     # repeated velocities are replicates, each row a point of the fit (their scatter measures the noise without the
     # model); the curve still needs MIN_STEADY_POINTS velocities
@@ -371,8 +380,6 @@ def _replicate_notes(data: SteadyData) -> list[str]:
 
 def _validated_stick(table: Table) -> StickData:
     n = len(table)
-    if n < MIN_STICK_ROWS:
-        raise DataError(f"{table.source}: {n} data row(s), expected at least {MIN_STICK_ROWS} stick phases")
     _require_positive(
         table,
         ["pulling_velocity", "stick_time", "peak_stress", "start_stress", "stick_slope", "stiffness", "jump_velocity"],
@@ -388,6 +395,8 @@ def _validated_stick(table: Table) -> StickData:
         ("stiffness", STIFFNESS_RANGE, "Pa/m", "a block's stiffness"),
     ):
         _require_range(table, name, bounds, unit, what)
+    if n < MIN_STICK_ROWS:  # after the values: a wrong one says so however few rows there are
+        raise DataError(f"{table.source}: {n} data row(s), expected at least {MIN_STICK_ROWS} stick phases")
     peak = table["peak_stress"] if "peak_stress" in table else None
     start = table["start_stress"] if "start_stress" in table else None
     if peak is not None and start is not None:

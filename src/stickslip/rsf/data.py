@@ -1,9 +1,11 @@
 """Lab records for rate-and-state fits: delimited text as rigs write it, and the load-point history.
 
-A record has time, load-point displacement (or the load point's velocity, integrated) and friction, its columns
-found by name or mapped with ``columns={...}``, each in the unit its header names, else ``displacement_unit`` /
-``time_unit``, else SI.  The history comes from the displacement: :func:`find_segments` (velocity levels) or
-:func:`measured_history` (the smoothed displacement).  How each works: docs/rsf.md, "Reading a record".
+A record has time, load-point displacement (or the load point's velocity, integrated) and friction (or a shear
+stress over a normal stress), its columns found by name or mapped with ``columns={...}``, each in the unit its
+header names, else ``displacement_unit`` / ``time_unit``, else SI; its separator and decimal mark are
+:func:`stickslip.tables.text_format`'s, as every reader's.  The history comes from the displacement:
+:func:`find_segments` (velocity levels) or :func:`measured_history` (the smoothed displacement).  How each works:
+docs/rsf.md, "Reading a record".
 """
 
 from __future__ import annotations
@@ -18,7 +20,7 @@ from typing import Any
 
 import numpy as np
 
-from ..columns import data_lines, split_header, with_units
+from ..columns import data_lines, with_units
 from ..errors import DataError, ParameterError
 from ..fileio import protect_inputs, require_input_file
 from ..numerics.quantisation import quantum
@@ -29,21 +31,29 @@ __all__ = [
     "measured_history", "parse_columns", "read_record",
 ]  # fmt: skip
 
-ROLES = ("time", "displacement", "friction", "velocity")
+ROLES = ("time", "displacement", "friction", "velocity", "shear_stress", "normal_stress")
+#: the load point's words, before "displacement", "disp", "velocity", ... ("LP disp", "load_point_velocity")
+_LOAD_POINT = ("", "lp ", "load point ", "loadpoint ", "lvdt ")
+#: The names each role is found by without --columns, as :func:`_phrase` writes a header (lower case, its unit
+#: left off, words split at blanks, "_", "-" and "."), in the order they are preferred.  "shear_stress" is the
+#: friction's stress (divided by the normal stress) where no friction column is found.
 _DEFAULT_NAMES = {
-    "time": ("time", "time(s)", "time_s", "t"),
+    "time": ("time", "t", "elapsed time"),
     "displacement": (
-        "load_point_displacement",
-        "load_point_position",
-        "displacement",
-        "displ",
-        "disp",
-        "lp_disp",
-        "lp displacement",
+        *(f"{p}{w}" for w in ("displacement", "displ", "disp") for p in _LOAD_POINT),
+        "load point position", "lp position",
     ),
-    "friction": ("friction", "mu", "friction_coefficient"),
-    "velocity": ("load_point_velocity", "velocity", "vel", "lp_velocity", "lp_vel"),
-}
+    "friction": (
+        "friction", "mu", "μ", "µ", "friction coefficient", "coefficient of friction", "friction coeff", "cof",
+    ),
+    "velocity": tuple(f"{p}{w}" for w in ("velocity", "vel") for p in _LOAD_POINT),
+    "shear_stress": ("shear stress", "shear", "tau", "τ"),
+    "normal_stress": ("normal stress", "normal", "sigma n", "sn", "σn"),
+}  # fmt: skip
+
+
+#: the fewest rows a record may have
+MIN_RECORD_ROWS = 10
 
 
 @dataclass(frozen=True)
@@ -63,6 +73,51 @@ class LabRecord:
     displacement_from: str = "displacement"
     #: what reading the record did that a report should say (rows with an empty cell left out)
     notes: tuple[str, ...] = ()
+
+    def __post_init__(self) -> None:
+        """Each array 1-D, finite and of one length (at least MIN_RECORD_ROWS), the time increasing: a DataError
+        naming the field, never a TypeError in the fit."""
+        arrays = {}
+        for name in ("time", "displacement", "friction"):
+            value = getattr(self, name)
+            if value is None:
+                raise DataError(f"{self.source}: LabRecord {name} is None; expected an array of numbers")
+            try:
+                array = np.asarray(value, dtype=float)
+            except (TypeError, ValueError):
+                raise DataError(
+                    f"{self.source}: LabRecord {name}: expected an array of numbers, got {type(value).__name__}"
+                ) from None
+            if array.ndim != 1:
+                raise DataError(f"{self.source}: LabRecord {name}: expected a 1-D array, got shape {array.shape}")
+            arrays[name] = array
+            object.__setattr__(self, name, array)
+        sizes = {name: array.size for name, array in arrays.items()}
+        if len(set(sizes.values())) != 1:
+            raise DataError(
+                f"{self.source}: LabRecord time, displacement and friction have {sizes['time']},"
+                f" {sizes['displacement']} and {sizes['friction']} values; expected one length"
+            )
+        if sizes["time"] < MIN_RECORD_ROWS:
+            raise DataError(
+                f"{self.source}: LabRecord has {sizes['time']} row(s); expected at least {MIN_RECORD_ROWS} to fit a"
+                " record"
+            )
+        for name, array in arrays.items():
+            bad = ~np.isfinite(array)
+            if bad.any():
+                k = int(np.argmax(bad))
+                raise DataError(
+                    f"{self.source}: LabRecord {name}[{k}] is {array[k]}; expected finite numbers"
+                    f"{f' ({int(bad.sum())} in all)' if bad.sum() > 1 else ''}"
+                )
+        step = np.diff(arrays["time"])
+        if np.any(step <= 0):
+            k = int(np.argmax(step <= 0)) + 1
+            raise DataError(
+                f"{self.source}: LabRecord time[{k}] = {arrays['time'][k]:g} s does not increase (time[{k - 1}] ="
+                f" {arrays['time'][k - 1]:g} s)"
+            )
 
     def __len__(self) -> int:
         return int(self.time.size)
@@ -86,8 +141,8 @@ class LabRecord:
                 f"{source}: time, displacement and friction have {t.size}, {d.size} and {f.size} values; expected"
                 " one length"
             )
-        if t.size < 10:
-            raise DataError(f"{source}: {t.size} data row(s); expected at least 10 to fit a record")
+        if t.size < MIN_RECORD_ROWS:
+            raise DataError(f"{source}: {t.size} data row(s); expected at least {MIN_RECORD_ROWS} to fit a record")
         row = _row_names(rows, t.size)
         refuse_nonfinite(source, row, {"time": t, "displacement": d, "friction": f})
         step = np.diff(t)
@@ -111,14 +166,15 @@ class LabRecord:
 
 
 def parse_columns(text: str | None) -> dict[str, str]:
-    """``time="Time(s)",displacement="Displ(microns)",friction=Friction`` to a mapping role -> header."""
+    """``time="Time(s)",displacement="Displ(microns)",friction=Friction`` to a mapping role -> header (roles:
+    :data:`ROLES`; ``shear_stress`` and ``normal_stress`` give the friction as their ratio)."""
     if not text:
         return {}
     mapping: dict[str, str] = {}
     for item in re.findall(r'(\w+)\s*=\s*("[^"]*"|\'[^\']*\'|[^,]*)', text):
         role, name = item[0].strip().lower(), item[1].strip().strip("\"'")
         if role not in ROLES:
-            raise ParameterError(f"--columns: unknown role {role!r}; expected time, displacement, friction or velocity")
+            raise ParameterError(f"--columns: unknown role {role!r}; expected {', '.join(ROLES)}")
         mapping[role] = name
     if not mapping:
         raise ParameterError(f'--columns {text!r}: expected ROLE=HEADER pairs, e.g. time="Time(s)",friction=Friction')
@@ -130,6 +186,7 @@ def read_record(
     columns: dict[str, str] | None = None,
     displacement_unit: str | None = None,
     time_unit: str | None = None,
+    normal_stress: float | str | None = None,
 ) -> LabRecord:
     """A :class:`LabRecord` from delimited text (see the module notes).
 
@@ -137,8 +194,16 @@ def read_record(
     ``time_ms``), else from ``displacement_unit`` / ``time_unit``, else metres and seconds.  A header and an
     option that name different units are refused (DataError), as is a load point moving faster than
     :data:`FASTEST_LOAD_POINT` (a unit forgotten: the message names the likely one).
+
+    A shear-stress column instead of the friction (a stress unit in its header, or found or mapped as
+    ``shear_stress``) is divided by the normal stress: a ``normal_stress`` column (found by name or mapped), else
+    ``normal_stress`` (Pa, or a string with its unit, "10 MPa"); μ = τ/σn, each in the unit its header names.
+    The file's separator and decimal mark: :func:`stickslip.tables.text_format`, as every reader's.
     """
     import pandas as pd
+
+    from ..tables import text_format
+    from ..units import to_si
 
     path = Path(path)
     require_input_file(path, str(path))  # not found, a folder, a device or pipe: each in its own words
@@ -148,24 +213,23 @@ def read_record(
         "length": _option_scale(displacement_unit, "length", "--displacement-unit"),
     }
     option["velocity"] = _velocity_option(option["length"], option["time"])
-    frame = _read_frame(path, pd)
-    with open(path, encoding="utf-8", errors="replace") as handle:
+    sigma = None if normal_stress is None else to_si(normal_stress, "stress", "--normal-stress")
+    if sigma is not None and not (math.isfinite(sigma) and sigma > 0):
+        raise ParameterError(f"--normal-stress: expected a positive stress, got {sigma:g} Pa")
+    form = text_format(path)
+    frame = _read_frame(path, pd, form)
+    with open(path, encoding="utf-8-sig", errors="replace") as handle:  # a byte-order mark is no content
         rows = data_lines(handle, len(frame))
     headers = {str(c).strip(): c for c in frame.columns}
-    bracketed = {str(c): split_header(str(c)) for c in frame.columns}  # "time [s]" as this package writes it
-    lower = {k.lower(): v for k, v in headers.items()}
-    lower.update(
-        {name.lower(): c for c, (name, unit) in bracketed.items() if unit is not None and name.lower() not in lower}
-    )
-    for header, column in headers.items():  # "Time (s)" is found as time
-        bare = re.sub(r"\s*[\(\[][^\(\)\[\]]*[\)\]]\s*$", "", header).strip().lower()
-        lower.setdefault(bare, column)
-    chosen = _choose_columns(path, columns, headers, lower)
-    data = {role: _numbers(frame[col], path, rows, pd) for role, col in chosen.items()}
+    chosen, by_stress = _choose_columns(path, columns, headers)
+    data = {role: _numbers(frame[col], path, rows, pd, form) for role, col in chosen.items() if role != "normal_stress"}
+    if "normal_stress" in chosen:  # its cells read only where the friction is a stress to divide by it
+        data["normal_stress"] = lambda: _numbers(frame[chosen["normal_stress"]], path, rows, pd, form)
     dimension = {"time": "time", "displacement": "length", "velocity": "velocity"}
     units = {role: _header_unit(str(chosen[role]), dimension[role], path) for role in chosen if role in dimension}
-    if "friction" in chosen:
-        _header_unit(str(chosen["friction"]), "dimensionless", path)  # mu: a stress column is refused
+    friction, read_notes = _friction(path, chosen, data, by_stress, sigma, _row_names(rows, len(frame)))
+    if form.note:
+        read_notes.insert(0, form.note)
 
     def in_si(role: str) -> np.ndarray:
         """A column in SI: by the unit its header names, else by the option, else SI."""
@@ -179,7 +243,6 @@ def read_record(
         return data[role] * factor
 
     time = in_si("time")
-    friction = data["friction"]
     if "displacement" in data:
         displacement = in_si("displacement")
         written = units.get("displacement") or option["length"]
@@ -201,11 +264,87 @@ def read_record(
         warnings.warn(note, UserWarning, stacklevel=2)
         rows = [r for r, k in zip(_row_names(rows, time.size), keep, strict=True) if k]
         time, displacement, friction = time[keep], displacement[keep], friction[keep]
+        read_notes.append(note)
     shown_unit = _plain_length(written[1]) if written is not None else "m"
     record = LabRecord.from_arrays(time, displacement, friction, str(path), shown_unit, rows)
     _refuse_implausible_speed(record, str(column), written)
-    record = replace(record, notes=(note,)) if note else record
+    record = replace(record, notes=tuple(read_notes)) if read_notes else record
     return record if "displacement" in data else replace(record, displacement_from="velocity")
+
+
+#: a friction coefficient read as shear stress over normal stress lies between these (its median): beyond them a
+#: unit is wrong (a kPa column read as Pa gives 1e-3 of it)
+FRICTION_RANGE = (1e-3, 10.0)
+#: a normal-stress column and --normal-stress agree within this fraction (the column's median)
+NORMAL_STRESS_AGREEMENT = 0.05
+
+
+def _friction(
+    path: Path, chosen: dict[str, Any], data: dict[str, Any], by_stress: bool, sigma: float | None, row: Any
+) -> tuple[np.ndarray, list[str]]:
+    """The friction coefficient, and what reading it did that a report should say: the friction column as it
+    stands, or a shear-stress column divided by the normal stress (a column, else ``sigma`` in Pa)."""
+    header = str(chosen["friction"])
+    if by_stress:
+        stress = _header_unit(header, "stress", path)  # a bare header: Pa
+    else:
+        try:
+            _header_unit(header, "dimensionless", path)
+            return data["friction"], []
+        except DataError as refused:  # a stress unit ("Shear stress [kPa]" mapped as friction) is a shear stress
+            try:
+                stress = _header_unit(header, "stress", path)
+            except DataError:
+                stress = None
+            if stress is None:
+                raise refused from None
+    tau = data["friction"] * (stress[0] if stress is not None else 1.0)
+    tau_unit = stress[1] if stress is not None else "Pa"
+    if "normal_stress" in chosen:
+        column = str(chosen["normal_stress"])
+        unit = _header_unit(column, "stress", path)
+        factor, unit_name = unit if unit is not None else (1.0, "Pa")
+        written = data["normal_stress"]()
+        sn = written * factor
+        bad = np.flatnonzero(np.isfinite(sn) & (sn <= 0))
+        if bad.size:
+            k = int(bad[0])
+            raise DataError(
+                f"{path}: row {row[k]}, column {column!r}: {written[k]:.10g} {unit_name}; expected a positive"
+                " normal stress"
+            )
+        typical = float(np.nanmedian(sn)) if np.any(np.isfinite(sn)) else math.nan
+        if sigma is not None and not abs(typical - sigma) <= NORMAL_STRESS_AGREEMENT * typical:
+            raise DataError(
+                f"{path}: column {column!r} gives the normal stress {typical / factor:.6g} {unit_name} (median) but"
+                f" --normal-stress says {sigma / factor:.6g} {unit_name}; give one of them"
+            )
+        divisor, said = sn, f"column {column!r}"
+    elif sigma is not None:
+        divisor, said = np.full(tau.size, sigma), f"--normal-stress {_stress_text(sigma)}"
+    else:
+        raise DataError(
+            f"{path}: column {header!r} is in {tau_unit}, a stress; expected the friction coefficient, or the"
+            " normal stress to divide this shear stress by: give --normal-stress (e.g. \"10 MPa\"; Python:"
+            " normal_stress=) or a normal-stress column (--columns normal_stress=\"HEADER\")"
+        )
+    with np.errstate(invalid="ignore", divide="ignore"):
+        friction = tau / divisor
+    typical = float(np.nanmedian(np.abs(friction))) if np.any(np.isfinite(friction)) else math.nan
+    if not FRICTION_RANGE[0] <= typical <= FRICTION_RANGE[1]:
+        raise DataError(
+            f"{path}: friction = column {header!r} / {said} is {typical:.3g} (median), outside"
+            f" {FRICTION_RANGE[0]:g} to {FRICTION_RANGE[1]:g}; check the units of the two (a bare header is Pa)"
+        )
+    return friction, [f"{path}: friction read as column {header!r} ({tau_unit}) divided by {said}: μ = τ/σn"]
+
+
+def _stress_text(value: float) -> str:
+    """A stress (Pa) in the unit people write it in: "10 MPa", "250 kPa"."""
+    for unit, scale in (("GPa", 1e9), ("MPa", 1e6), ("kPa", 1e3)):
+        if value >= scale:
+            return f"{value / scale:.6g} {unit}"
+    return f"{value:.6g} Pa"
 
 
 #: rows with an empty (or NaN) friction or displacement cell a record may lose (dropped samples: each is left out,
@@ -250,19 +389,25 @@ _TAIL_UNITS = {"m", "mm", "um", "µm", "μm", "nm", "micron", "microns", "s", "m
 _TAIL_UNITS |= {"m/s", "mm/s", "um/s", "µm/s", "μm/s", "nm/s"}
 
 
-def _numbers(column: Any, path: Path, rows: Any, pd: Any) -> np.ndarray:
+def _numbers(column: Any, path: Path, rows: Any, pd: Any, form: Any = None) -> np.ndarray:
     """A column as floats; DataError naming the first cell that is text (not a blank or NaN: a dropped sample,
-    :func:`_dropped_samples`' or :meth:`LabRecord.from_arrays`' to judge), with the hint a decimal comma needs."""
-    values = pd.to_numeric(column, errors="coerce").to_numpy(dtype=float)
+    :func:`_dropped_samples`' or :meth:`LabRecord.from_arrays`' to judge), with the hint a comma needs
+    (:meth:`stickslip.tables.TextFormat.hint`).  ``form``: the file's :class:`~stickslip.tables.TextFormat`."""
+    from ..tables import TextFormat
+
+    form = form if form is not None else TextFormat()
+    numbers = column
+    if form.decimal == "," and column.dtype == object:  # a column the parser left as text: its commas are marks
+        numbers = column.astype(str).str.replace(",", ".", regex=False).where(column.notna())
+    values = pd.to_numeric(numbers, errors="coerce").to_numpy(dtype=float)
     cells = column.to_numpy()
     text = np.isnan(values) & pd.notna(column).to_numpy()
     text &= np.array([str(c).strip().lower() not in ("", "nan") for c in cells], dtype=bool)  # bool: no rows too
     if text.any():
         i = int(np.argmax(text))
         cell = str(cells[i])
-        hint = "; a decimal comma? expected numbers with a decimal point (0.5, not 0,5)" if "," in cell else ""
         raise DataError(f"{path}: row {_row_names(rows, values.size)[i]}, column {str(column.name)!r}: {cell!r} is "
-                        f"not a number{hint}")  # fmt: skip
+                        f"not a number{form.hint(cell.strip())}")  # fmt: skip
     return values
 
 
@@ -291,19 +436,16 @@ def _row_names(rows: Any, size: int) -> Any:
     return rows if rows is not None and len(rows) == size else range(1, size + 1)
 
 
-def _read_frame(path: Path, pd: Any) -> Any:
+def _read_frame(path: Path, pd: Any, form: Any) -> Any:
+    """The file's table as pandas reads it, with the separator and decimal mark of ``form``
+    (:func:`stickslip.tables.text_format`, every reader's one decision)."""
     try:
-        with open(path, encoding="utf-8", errors="replace") as handle:
+        if form.delimiter != " ":
+            return pd.read_csv(path, sep=form.delimiter, comment="#", engine="c", decimal=form.decimal)
+        with open(path, encoding="utf-8-sig", errors="replace") as handle:
             # the first 20 lines, each with its place in the file (comments counted), comments left out
             numbered = [(i, line) for i, line in zip(range(20), handle, strict=False) if not line.startswith("#")]
-        head = "".join(line for _, line in numbered)
-        header = next((line for _, line in numbered if line.strip()), "")
-        # a header split by semicolons names the delimiter: its rows' decimal commas outnumber the semicolons
-        semicolons = header.count(";") > header.count(",") or head.count(";") > head.count(",")
-        sep = "\t" if "\t" in head else ";" if semicolons else "," if "," in head else r"\s+"
-        if sep != r"\s+":
-            return pd.read_csv(path, sep=sep, comment="#", engine="c")
-        return _read_whitespace_frame(path, pd, numbered)
+        return _read_whitespace_frame(path, pd, numbered, form.decimal)
     except (OSError, ValueError, pd.errors.ParserError) as exc:
         raise DataError(f"{path}: cannot read as delimited text ({str(exc).splitlines()[0]})") from None
 
@@ -313,11 +455,12 @@ def whitespace_headers(line: str) -> list[str]:
     return re.findall(r"[^\s\[\(]+(?:\s*[\[\(][^\]\)]*[\]\)])?|[\[\(][^\]\)]*[\]\)]", line)
 
 
-def _read_whitespace_frame(path: Path, pd: Any, numbered: list[tuple[int, str]]) -> Any:
+def _read_whitespace_frame(path: Path, pd: Any, numbered: list[tuple[int, str]], decimal: str = ".") -> Any:
     """Columns split at blanks; the header's names by :func:`whitespace_headers` ("time [s]" is not two columns)."""
     place, header = next(((i, line) for i, line in numbered if line.strip()), (-1, ""))
     names = whitespace_headers(header)
-    frame = pd.read_csv(path, sep=r"\s+", comment="#", engine="python", header=None, skiprows=place + 1)
+    frame = pd.read_csv(path, sep=r"\s+", comment="#", engine="python", header=None, skiprows=place + 1,
+                        decimal=decimal)  # fmt: skip
     if frame.shape[1] != len(names):
         raise DataError(
             f"{path}: the header names {len(names)} column(s) ({', '.join(names) or 'none'}) but the rows have"
@@ -327,30 +470,68 @@ def _read_whitespace_frame(path: Path, pd: Any, numbered: list[tuple[int, str]])
     return frame
 
 
-def _choose_columns(path: Path, columns: dict[str, str] | None, headers: dict, lower: dict) -> dict[str, Any]:
+def _phrase(header: str) -> str:
+    """A header as the columns are found by name: lower case, its unit left off (in brackets or parentheses at its
+    end, or a last word that is a unit: "time_ms"), its words split at blanks, "_", "-" and "."."""
+    text = re.sub(r"\s*[\(\[][^\(\)\[\]]*[\)\]]\s*$", "", header.strip())
+    words = [w for w in re.split(r"[\s_.\-]+", text.lower()) if w]
+    if len(words) > 1 and words[-1] in _TAIL_UNITS:
+        words.pop()
+    return " ".join(words)
+
+
+def _choose_columns(path: Path, columns: dict[str, str] | None, headers: dict) -> tuple[dict[str, Any], bool]:
+    """The column of each role (mapped with ``columns``, else found by :data:`_DEFAULT_NAMES`, the first in the
+    file where two have one name), and whether the "friction" is a shear stress to divide by the normal stress
+    (mapped or found as ``shear_stress``)."""
+    columns = dict(columns or {})
+    if "friction" in columns and "shear_stress" in columns:
+        raise DataError(f"{path}: --columns maps both friction and shear_stress; map one of them")
+    found = ", ".join(headers) or "none"
+    phrases: dict[str, Any] = {}
+    for header, column in headers.items():
+        phrases.setdefault(_phrase(header), column)
+
+    def mapped(role: str) -> Any:
+        wanted = columns[role]
+        if wanted not in headers:
+            raise DataError(f"{path}: no column {wanted!r} (for {role}); found {found}")
+        return headers[wanted]
+
+    def by_name(role: str) -> Any:
+        return next((phrases[n] for n in _DEFAULT_NAMES[role] if n in phrases), None)
+
     chosen: dict[str, Any] = {}
-    for role in ROLES:
+    for role in ("time", "displacement", "velocity"):
         if role == "velocity" and "displacement" in chosen:
             continue
-        if columns and role in columns:
-            wanted = columns[role]
-            if wanted not in headers:
-                found = ", ".join(headers) or "none"
-                raise DataError(f"{path}: no column {wanted!r} (for {role}); found {found}")
-            chosen[role] = headers[wanted]
-            continue
-        match = next((lower[n] for n in _DEFAULT_NAMES[role] if n in lower), None)
-        by_velocity = (columns and "velocity" in columns) or any(n in lower for n in _DEFAULT_NAMES["velocity"])
+        match = mapped(role) if role in columns else by_name(role)
+        by_velocity = "velocity" in columns or by_name("velocity") is not None
         if match is None and role == "displacement" and by_velocity:
             continue  # the velocity column gives it
         if match is None:
-            found = ", ".join(headers) or "none"
             raise DataError(
                 f"{path}: no {role} column; found {found} (map them with --columns time=...,displacement=...,"
                 "friction=...)"
             )
         chosen[role] = match
-    return chosen
+    by_stress = "shear_stress" in columns
+    if "friction" in columns or by_stress:
+        chosen["friction"] = mapped("shear_stress" if by_stress else "friction")
+    elif (match := by_name("friction")) is not None:
+        chosen["friction"] = match
+    elif (match := by_name("shear_stress")) is not None:
+        chosen["friction"], by_stress = match, True
+    else:
+        raise DataError(
+            f"{path}: no friction column; found {found} (map them with --columns time=...,displacement=...,"
+            'friction=..., or a shear stress and the normal stress: shear_stress=...,normal_stress=...)'
+        )
+    if "normal_stress" in columns:
+        chosen["normal_stress"] = mapped("normal_stress")
+    elif (match := by_name("normal_stress")) is not None:
+        chosen["normal_stress"] = match
+    return chosen, by_stress
 
 
 def _option_scale(unit: str | None, dimension: str, flag: str) -> tuple[float, str] | None:

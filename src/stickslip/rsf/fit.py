@@ -10,6 +10,8 @@ from __future__ import annotations
 import contextlib
 import io
 import math
+from collections.abc import Callable, Iterator
+from contextvars import ContextVar
 from dataclasses import dataclass, field, replace
 from typing import Any
 
@@ -33,7 +35,7 @@ from .laws import get_law
 from .params import RSFParams, StateVariable, _cutoff_pair
 from .solver import simulate
 
-__all__ = ["FitNotEvaluated", "FitParameter", "RSFFit", "fit_record"]
+__all__ = ["FitNotEvaluated", "FitParameter", "RSFFit", "fit_record", "restart_notice"]
 
 Z95 = 1.959963984540054
 METHOD_MAX_NFEV = 1500
@@ -137,7 +139,9 @@ class RSFFit:
     model_friction: np.ndarray
     warnings: tuple[str, ...]
     success: bool
-    message: str
+    #: the optimiser's own words (lmfit/MINPACK: "Fit succeeded." means only that its search ended normally; the
+    #: verdict is ``status``/``reason``, and :attr:`message` says it)
+    optimizer_message: str
     nfev: int
     posterior: dict[str, Any] | None = field(default=None)
     status: str = "ok"
@@ -159,6 +163,13 @@ class RSFFit:
     alternatives: tuple[dict[str, Any], ...] = ()
     #: readings of the values that are no warning (a negative b)
     notes: tuple[str, ...] = ()
+
+    @property
+    def message(self) -> str:
+        """The fit's verdict in words: the optimiser's message beside ``status == "ok"``, else "fit failed: REASON"
+        (an optimiser's "Fit succeeded." beside a failed fit read as the opposite of the status; its words stay in
+        :attr:`optimizer_message`)."""
+        return self.optimizer_message if self.status == "ok" else f"fit failed: {self.reason}"
 
     @property
     def residuals(self) -> np.ndarray:
@@ -192,6 +203,7 @@ class RSFFit:
             **({"reason": self.reason} if self.reason else {}),
             "parameters": {k: v.as_dict() for k, v in self.parameters.items()},
             "derived": {k: v.as_dict() for k, v in self.derived.items()},
+            "v_ref": self.params.v_ref,  # the velocity mu0 is the friction at (m/s)
             "reduced_chi_square": self.reduced_chi_square,
             "rms": self.rms,
             "noise": self.noise,
@@ -202,13 +214,14 @@ class RSFFit:
             "notes": list(self.notes),
             "success": self.success,
             # the optimiser's own words ("Fit succeeded.") only beside a verdict that cannot contradict them
-            "message": self.message if self.status == "ok" else f"fit failed: {self.reason}",
-            "optimizer_message": self.message,
+            "message": self.message,
+            "optimizer_message": self.optimizer_message,
             "protocol": self.protocol_rows(si=True),
             "protocol_source": self.protocol_source,
             "units": {
-                "time": "s", "length": "m", "velocity": "m/s", "dc": "m", "stiffness": "1/m", "trend": "1/m",
-                "time_trend": "1/s", "friction": "dimensionless", "record_length_unit": self.record.length_unit,
+                "time": "s", "length": "m", "velocity": "m/s", "v_ref": "m/s", "dc": "m", "stiffness": "1/m",
+                "trend": "1/m", "time_trend": "1/s", "friction": "dimensionless",
+                "record_length_unit": self.record.length_unit,
                 "change_times": "s from the fitted rows' first row (file_time: on the file's own clock)",
                 "protocol": "start: s from the fitted rows' first row (file_time: on the file's own clock)",
                 "clock": f"the fitted rows' first row is at record.t0 = {self.record.t0:.10g} s on the file's own "
@@ -223,6 +236,12 @@ class RSFFit:
             **({"alternatives": list(self.alternatives)} if self.alternatives else {}),
             **({"posterior": self.posterior} if self.posterior else {}),
         }  # fmt: skip
+
+    def reference_velocity_text(self) -> str:
+        """``v_ref = 1 µm/s``: the velocity mu0 is the friction at (the fit's V0, its first load-point velocity)."""
+        from ..display import velocity
+
+        return f"v_ref = {velocity(self.params.v_ref)}"
 
     def change_rows(self) -> list[dict[str, Any]]:
         """The change times as JSON: s from the fitted rows' first row, and ``file_time`` on the file's clock."""
@@ -251,7 +270,7 @@ class RSFFit:
             f"below): {self.protocol.describe()}",
         ]
         for name, p in {**self.parameters, **self.derived}.items():
-            head.append(f"# {name} = {p.text()}")
+            head.append(f"# {name} = {p.text()}" + (f", at {self.reference_velocity_text()}" if name == "mu0" else ""))
         head += [f"# {line}" for line in self.change_lines()]
         head.append("# values below in SI units (m, 1/m)")
         return "\n".join(head) + "\n" + self.params.to_toml()
@@ -296,6 +315,22 @@ def _model_or_why(
     return run.friction + drift, ""
 
 
+#: the callback of :func:`restart_notice` in force (None: nobody is told)
+_RESTART_NOTICE: ContextVar[Callable[[str, int], None] | None] = ContextVar("rsf_fit_restart_notice", default=None)
+
+
+@contextlib.contextmanager
+def restart_notice(notify: Callable[[str, int], None] | None) -> Iterator[None]:
+    """Within the block, :func:`fit_record` calls ``notify(text, searches)`` when its first search ends troubled and
+    it restarts from other starts in Dc (``searches`` more at most): what makes a fit cost several times the typical
+    estimate (docs/rsf.md, "Cost estimate and --max-time")."""
+    token = _RESTART_NOTICE.set(notify)
+    try:
+        yield
+    finally:
+        _RESTART_NOTICE.reset(token)
+
+
 def fit_record(
     record: LabRecord,
     *,
@@ -336,6 +371,9 @@ def fit_record(
     fit is tried again with a held stiffness freed and with the other built-in single-state laws, from its answer;
     one that describes the record significantly better fails the fit (``alternatives`` in the result says what each
     reached; docs/rsf.md, "Is another model the answer?").
+    Within ``with restart_notice(notify):``, ``notify(text, searches)`` is told when the first search ends troubled
+    and the fit restarts it from other starts in Dc (``searches`` more at most): the moment a fit's cost leaves the
+    typical estimate (``rsf fit`` says it on stderr).
     """
     if noise is not None and not (_real(noise) and math.isfinite(noise) and noise > 0):
         raise ParameterError(f"noise: expected a positive friction level, got {noise!r}")
@@ -461,7 +499,7 @@ def fit_record(
         rms=float(np.sqrt(np.mean(resid**2))), noise=level.noise, trend=float(values.get("trend", 0.0)),
         record=record, protocol=_history(setup, values), model_friction=model, warnings=tuple(warns),
         success=not problems, change_times=change_times,
-        message=str(result.message), nfev=int(result.nfev), posterior=posterior,
+        optimizer_message=str(result.message), nfev=int(result.nfev), posterior=posterior,
         status="failed" if problems else "ok", reason="; ".join(problems), derived=derived, protocol_source=source,
         noise_method=level.method, effective_rows=level.n_eff, drift_sensitivity=sensitivity,
         window=None if window is None else (float(window[0]), float(window[1])), step_weight=weight,
@@ -636,7 +674,9 @@ def _step_weights(record: LabRecord, protocol: Protocol, dc: float, weight: floa
 
 def _best_search(setup: _Setup, start: dict[str, float], mismatch: str, stiffness_given: bool) -> Any:
     """The search, restarted from other starts when it never got going (the model cannot be run there, or a, b and
-    Dc did not move), and elsewhere in Dc while it is troubled (a local minimum, no covariance)."""
+    Dc did not move), and elsewhere in Dc while it is troubled (a local minimum, no covariance); the
+    :func:`restart_notice` callback is told before the first restart in Dc."""
+    notify = _RESTART_NOTICE.get()
     result, residual = _search(setup, start)
     if not mismatch and _stuck(setup, start, result):
         for other in _rescue_starts(setup, start, stiffness_given):
@@ -649,6 +689,9 @@ def _best_search(setup: _Setup, start: dict[str, float], mismatch: str, stiffnes
     for factor in RETRY_DC_FACTORS:  # a troubled search may sit in a local minimum: start it elsewhere in Dc
         if mismatch or not _troubled(result) or "dc" in setup.fixed:  # (no start helps a history not the record's)
             break
+        if notify is not None and not sides:
+            notify(f"the first search ended {_trouble_words(result)}: restarting it from other starts in Dc",
+                   len(RETRY_DC_FACTORS))  # fmt: skip
         other = {**start, "dc": min(max(start["dc"] * factor, 2e-9), 0.5 * start["max_dc"])}
         if not stiffness_given:
             other["stiffness"] = start["stiffness"] * start["dc"] / other["dc"]
@@ -835,7 +878,7 @@ def _unevaluated_fit(
         params=_final_params(_base(setup, start), values), parameters=table, correlations={},
         reduced_chi_square=math.nan, rms=math.nan, noise=float(start["noise"]), trend=float(values.get("trend", 0.0)),
         record=record, protocol=_history(setup, values), model_friction=nan, warnings=(), success=False,
-        message=str(result.message), nfev=int(result.nfev), status="failed", reason=reason.split(": ", 1)[-1],
+        optimizer_message=str(result.message), nfev=int(result.nfev), status="failed", reason=reason.split(": ", 1)[-1],
         derived={"a-b": a_b}, protocol_source=source, window=None if window is None else
         (float(window[0]), float(window[1])), step_weight=weight,
     )  # fmt: skip
@@ -1643,6 +1686,17 @@ def _troubled(result: Any) -> bool:
         if _unconstrained(key, par, se):
             return True
     return False
+
+
+def _trouble_words(result: Any) -> str:
+    """Why :func:`_troubled` holds, in words ("at reduced chi-square 109 > 2")."""
+    if not result.success:
+        return "without converging"
+    if not result.errorbars:
+        return "without a covariance"
+    if result.chisqr > WARN_CHI2 * max(result.nfree, 1):
+        return f"at reduced chi-square {result.chisqr / max(result.nfree, 1):.3g} > {WARN_CHI2:g}"
+    return "with a, b, Dc or the stiffness unconstrained"
 
 
 def _start_values(values: dict[str, float]) -> dict[str, float]:
