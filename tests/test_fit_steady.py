@@ -32,7 +32,7 @@ def synthetic() -> SteadyData:
 
 @pytest.fixture(scope="module")
 def two_step(synthetic):
-    return fit_steady(synthetic)
+    return fit_steady(synthetic, method="two-step")  # auto reports the joint fit (round 27)
 
 
 def noisy(seed: int, relative: float = 0.02, velocity: np.ndarray = PAPER_RANGE, stated: bool = True) -> SteadyData:
@@ -221,7 +221,7 @@ def test_two_step_coverage_of_vc_and_sigma_c_over_seeds():
 
 
 def test_estimated_noise_uses_t_quantiles_and_reports_the_noise():
-    fit = fit_steady(noisy(3, stated=False))
+    fit = fit_steady(noisy(3, stated=False), method="two-step")  # Wald intervals (auto: profile, round 27)
     assert "estimated from the scatter" in fit.noise
     assert 0.012 < fit.noise_scale < 0.03
     e = fit.estimate("aging.aging_velocity")
@@ -243,7 +243,7 @@ def test_freeing_a_degenerate_key_changes_nothing_but_which_key_is_fixed(synthet
     """Asking for dl_m: lambda becomes structurally redundant (exact degeneracy) and dl_m itself is then the
     undetermined FENE direction (in the Eyring limit N0 kT/lambda and kT/(lambda M tau) do not contain it);
     the model space, hence the best chi-square and Vc, is the default's."""
-    fit = fit_steady(synthetic, free=["bonds.max_extension"])
+    fit = fit_steady(synthetic, free=["bonds.max_extension"], method="two-step")
     assert any("bonds.activation_length (λ) is not separately identifiable" in m for m in fit.messages)
     assert any("bonds.max_extension (Δl_m) is not determined" in m for m in fit.messages)
     assert fit.chi_square == pytest.approx(two_step.chi_square, rel=1e-5)

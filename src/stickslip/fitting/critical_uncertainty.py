@@ -293,11 +293,13 @@ class Profile:
         inside: list[tuple[float, float, np.ndarray]] = [(centre, 0.0, start)]
         outside: tuple[float, float] | None = None
         x = centre + side * target * max(guess_sd, 1e-3)
+        lag = 0.0  # how far short of the value asked a refit stops (attained): the next request asks that much more
         for n in range(1, PROFILE_STEPS + 1):
-            chi, solution = chi_at(x, inside[-1][2])
+            ask = x + lag
+            chi, solution = chi_at(ask, inside[-1][2])
             root = math.sqrt(max(chi - best_chi, 0.0) / scale)
             if root > target and len(inside) > 1:
-                chi2, solution2 = chi_at(x, start)
+                chi2, solution2 = chi_at(ask, start)
                 if chi2 < chi:
                     chi, solution = chi2, solution2
                     root = math.sqrt(max(chi - best_chi, 0.0) / scale)
@@ -305,6 +307,10 @@ class Profile:
                 reached = attained(solution)
                 # a refit that did not move towards x (or crossed back over the centre) keeps x
                 if math.isfinite(reached) and side * (reached - centre) > 0:
+                    # asked x again, a refit stopping short by the same amount would stall the search there (the
+                    # shipped curve's sigma_c: asked 269.41 Pa again and again, each refit stopped at 268.87, until
+                    # the steps ran out): the shortfall is carried over, never more than half the way from the centre
+                    lag = float(np.clip(ask - reached, -0.5 * abs(reached - centre), 0.5 * abs(reached - centre)))
                     x = reached
             if abs(root - target) <= PROFILE_TOLERANCE * target:
                 return ProfileEnd(x, n, True)

@@ -295,17 +295,28 @@ class Trend:
     p_value: float  # Bonferroni-corrected over the degrees tried
     degree: int  # the degree with the smallest p (0: no test was possible)
     degrees: int  # how many degrees were tried
-
-    def tried(self) -> str:
-        degrees = "degree 1" if self.degrees == 1 else f"degrees 1 to {self.degrees}, Bonferroni-corrected"
-        return f"F test against its own residuals, {degrees}"
+    smallest: float = math.nan  # the smallest p of the degrees tried, before the correction
 
     def describe(self) -> str:
+        """In words, with the threshold and the correction that decide ("p = 0.035 against 0.05/3" left the reader
+        to guess both: the threshold is ``SIGNIFICANCE``, and the correction multiplies the smallest p)."""
         if not self.degrees:
             return "too few velocities for a polynomial in ln V"
+        verdict = "significant" if self.p_value <= SIGNIFICANCE else "not significant"
+        if self.degrees == 1:
+            return (
+                f"a polynomial in ln V of degree 1 (a straight line) against a constant (F test against its own"
+                f" residuals): p = {self.p_value:.2g},"
+                f" {verdict} at the threshold p ≤ {SIGNIFICANCE:g}"
+            )
+        raw = "" if not math.isfinite(self.smallest) else f": {self.degrees} × {self.smallest:.2g}"
+        if self.degrees * self.smallest > 1.0:
+            raw += ", capped at 1"
         return (
-            f"a polynomial in ln V against a constant ({self.tried()}; best degree {self.degree}):"
-            f" p = {self.p_value:.2g}"
+            f"a polynomial in ln V (degrees 1 to {self.degrees} tried) against a constant (nested F tests against its"
+            f" own residuals; smallest p at degree {self.degree}): p = {self.p_value:.2g} after the Bonferroni"
+            f" correction for the {self.degrees} degrees tried (the smallest p times {self.degrees}{raw}), {verdict}"
+            f" at the threshold p ≤ {SIGNIFICANCE:g}"
         )
 
 
@@ -339,7 +350,7 @@ def trend_dependence(velocity: np.ndarray, stress: np.ndarray, stress_err: np.nd
         p = nested_constant_p(flat, float(np.sum((root_w * y - design @ coef) ** 2)), d, n - d - 1)
         if p < best:
             best, best_degree = p, d
-    return Trend(min(1.0, degrees * best), best_degree, degrees)
+    return Trend(min(1.0, degrees * best), best_degree, degrees, best)
 
 
 def velocity_dependence(
