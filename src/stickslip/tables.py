@@ -280,7 +280,7 @@ def _text_format(path: str, mtime: int, size: int) -> TextFormat:
     if not _NO_GROUPING.search(data):
         row = header_row + 1 + data[: first.start()].count(b"\n")
         line_start = data.rfind(b"\n", 0, first.start()) + 1
-        cell = re.search(rb"[-+\d,]*\d,\d+", data[line_start:first.end() + 40])
+        cell = re.search(rb"[-+\d,]*\d,\d+", data[line_start : first.end() + 40])
         text = cell.group(0).decode() if cell else "1,000"
         raise DataError(
             f"{path}: row {row}: {text!r}: a decimal comma or a thousands separator? every comma in the file's"

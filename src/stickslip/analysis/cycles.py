@@ -27,10 +27,12 @@ from .detect import (
     MIN_ASYMMETRY,
     Coarse,
     coarse_segments,
+    coarse_spacing,
     dropouts,
     gaps,
     rise_start,
     sampling_step,
+    unresolved_swings,
 )
 from .fits import QUADRATIC, Corner, Line, fit_corner, fit_line, with_time_uncertainty
 from .traces import Trace, check_trace
@@ -254,7 +256,18 @@ def analyze_trace(
     if regime == regimes.STICK_SLIP and not _whole_stick(cycles):
         # a slip, but no stick seen from its start to its end: a start-up transient looks the same
         regime = regimes.UNDETERMINED
+    unresolved = None
+    if regime == regimes.STEADY and steady_from is not None:  # or a sawtooth of too few samples a cycle?
+        tail = _between(t, steady_from, math.inf)
+        unresolved = unresolved_swings(t[tail], x[tail], coarse.noise, step)
+        if unresolved is not None:
+            regime, steady_from = regimes.UNDETERMINED, None
+    long_cycles = _long_cycles(cycles, step)
+    if long_cycles:
+        warnings.append(long_cycles)
     summary = _summary(t, x, cycles, regime, steady_from, v0)
+    if unresolved is not None:
+        summary["unresolved_swings"] = unresolved.as_dict()
     if swings is not None:
         summary["oscillation"] = swings
     message = _message(regime, cycles, coarse, summary)
@@ -456,8 +469,11 @@ def _fit_stick(t: np.ndarray, x: np.ndarray, coarse: Coarse, stick: _Stick, step
     a = stick.start.time if began else (float(t[0]) if stick.prev_peak is None else inner_lo)
     b = stick.end.time if stick.end is not None else inner_hi
     span = b - a
-    lo_cut = a + max(2 * step, LINE_MARGIN * span) if began else a
-    hi_cut = b - max(2 * step, LINE_MARGIN * span) if stick.end is not None else b
+    # two samples clear of each corner; one in a coarse record, whose sticks hold a handful (ten samples a cycle
+    # left three of them to the line, and a line of three carried on to the next corner found it early)
+    clear = (1 if coarse_spacing(coarse.peaks, step) else 2) * step
+    lo_cut = a + max(clear, LINE_MARGIN * span) if began else a
+    hi_cut = b - max(clear, LINE_MARGIN * span) if stick.end is not None else b
     refit = _line_between(t, x, lo_cut, hi_cut) if hi_cut > lo_cut else None
     if refit is not None:
         stick.line = refit
@@ -504,7 +520,7 @@ def _start_corner(t: np.ndarray, x: np.ndarray, coarse: Coarse, stick: _Stick, s
     off = near[x[near] - line(t[near]) > _deviation(coarse)]
     if off.size == 0:
         return None
-    last = int(off[-1])
+    last = int(_slip_run(off, coarse, step, first=True)[-1])
     branch_lo = t[last] - START_TIME_FRACTION * (t[last] - top)
     if level is not None:
         branch_lo = max(
@@ -531,7 +547,7 @@ def _end_corner(t: np.ndarray, x: np.ndarray, coarse: Coarse, stick: _Stick, ste
     off = near[line(t[near]) - x[near] > _deviation(coarse)]
     if off.size == 0:
         return None
-    first = int(off[0])
+    first = int(_slip_run(off, coarse, step, first=False)[0])
     branch_hi = t[first] + BRANCH_TIME_FRACTION * (bottom - t[first])
     branch_hi = min(
         branch_hi,
@@ -541,6 +557,22 @@ def _end_corner(t: np.ndarray, x: np.ndarray, coarse: Coarse, stick: _Stick, ste
     search = (float(t[first]) - reach, float(t[first]))
     inside = _between(t, search[0] - max(STICK_WINDOW * span, reach), branch_hi)
     return fit_corner(t[inside], x[inside], line, True, search, coarse.noise)
+
+
+def _slip_run(off: np.ndarray, coarse: Coarse, step: float, first: bool) -> np.ndarray:
+    """The samples off the stick line (indices, ascending) that belong to the slip: all of them in a finely sampled
+    record; in one whose slips come fewer than ``detect.COARSE_CYCLE`` samples apart, the run of consecutive
+    ones that the slip makes, the first run after the previous peak (``first``) or the last before the next
+    trough.  There a stick line rests on a handful of samples and, carried a few samples on, can be off by several
+    noise levels: a lone sample beyond the band inside the stick is that, not the slip (a stick of 10 samples at
+    15 a cycle ended two samples early, at a sample 9 Pa below a line fitted to 5 samples at 2 Pa of noise, the
+    next one back within the band)."""
+    if off.size < 2 or not coarse_spacing(coarse.peaks, step):
+        return off
+    breaks = np.flatnonzero(np.diff(off) > 1)  # where a run of consecutive samples ends
+    if not breaks.size:
+        return off
+    return off[: breaks[0] + 1] if first else off[breaks[-1] + 1 :]
 
 
 def _deviation(coarse: Coarse) -> float:
@@ -736,6 +768,35 @@ def _cycles(
     return cycles
 
 
+#: A complete cycle longer than this many times the median period of the complete cycles is warned of: a slip
+#: inside it may have been missed (judged with at least LONG_CYCLE_AMONG complete cycles).
+LONG_CYCLE = 1.6
+LONG_CYCLE_AMONG = 3
+
+
+def _long_cycles(cycles: list[CycleResult], step: float) -> str:
+    """A warning naming the complete cycles that last LONG_CYCLE times the median period or more, "" when none."""
+    periods = [c.period for c in cycles if c.complete and c.period is not None]
+    if len(periods) < LONG_CYCLE_AMONG:
+        return ""
+    median = float(np.median(periods))
+    long = [c for c in cycles if c.complete and c.period is not None and c.period >= LONG_CYCLE * median]
+    if not long or not median > 0:
+        return ""
+    shown = "; ".join(
+        f"cycle {c.index} lasts {c.period:.4g} s ({c.period / median:.2g} times; stick {c.stick_time:.4g} s, slip"
+        f" {c.slip_time:.4g} s)"
+        for c in long[:5]
+    )
+    more = f" and {len(long) - 5} more" if len(long) > 5 else ""
+    samples = f", {median / step:.3g} samples per cycle" if step > 0 else ""
+    return (
+        f"{shown}{more}, against a median period of {median:.4g} s over the {len(periods)} complete cycles"
+        f"{samples}: a slip inside may have been missed (two cycles read as one), and such a cycle's slip time,"
+        " period and stress drop are not one cycle's"
+    )
+
+
 def _jump(params: Parameters, peak: float | None) -> tuple[float | None, str]:
     if peak is None:
         return None, ""
@@ -798,6 +859,16 @@ def _message(regime: str, cycles: list[CycleResult], coarse: Coarse, summary: di
     complete = sum(c.complete for c in cycles)
     if regime == regimes.STICK_SLIP:
         return f"stick-slip: {len(cycles)} cycle(s), {complete} complete"
+    swings = summary.get("unresolved_swings")
+    if swings is not None:
+        after = f" after {len(cycles)} stick-slip cycle(s)" if cycles else ""
+        return (
+            f"{regimes.UNDETERMINED}: {swings['samples_per_swing']:.3g} samples per cycle{after}: the stress swings"
+            f" regularly by {swings['peak_to_trough']:.4g} Pa peak to trough every {swings['period']:.4g} s"
+            f" ({swings['swings']} swings; sd {swings['spread']:.3g} Pa about its trend, against a sample-to-sample"
+            f" noise of {swings['noise']:.3g} Pa), so it is not steady sliding, but too few samples a swing to"
+            f" resolve a stick and a slip (no drop above {coarse.threshold:.3g} Pa found): sample faster"
+        )
     if regime == regimes.UNDETERMINED:
         return (
             f"{regimes.UNDETERMINED}: {len(cycles)} cycle(s), none complete; no whole stick phase: too short a"

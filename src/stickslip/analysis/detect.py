@@ -11,6 +11,7 @@ from __future__ import annotations
 import itertools
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from scipy.ndimage import median_filter, uniform_filter1d
@@ -60,6 +61,18 @@ MAD_SCALE = 1.482602218505602
 TRIM_FRACTION = 0.5
 #: ... whose RMS is this many standard deviations for Gaussian noise: sqrt(1 - 2 z phi(z) / 0.5), z = 0.6745.
 TRIM_SCALE = 0.377594
+#: A candidate drop whose top (its top ASYMMETRY_BAND, on the median-filtered curve) spans fewer than this many
+#: filter widths of grid points has its asymmetry read on the samples themselves, from the times its rise and its
+#: fall take between these two fractions of its depth below the peak (the filter flattens such a top into a
+#: symmetric plateau, and a band of one or two samples a side counts where they fall, not how fast).
+NARROW_TOP = 3
+MID_BAND = (0.25, 0.75)
+#: A fall between two samples takes at least this many sampling intervals between the MID_BAND levels.
+MIN_CROSSING = 0.01
+#: A record whose slips (or swings) come fewer than this many samples apart is coarse: its slips are sought again
+#: near the sample-to-sample noise (which its corners inflate: 11.6 Pa for 5 Pa at eight samples a cycle), its
+#: stick lines fitted one sample clear of the corners, and regular swings found no slip in are no steady sliding.
+COARSE_CYCLE = 40
 #: A coarsely sampled sawtooth is sought at this quantile of the absolute deviations of the residuals at lag 1 ...
 LOW_QUANTILE = 0.25
 #: ... which is this many standard deviations for Gaussian noise (the normal quantile at 0.625).
@@ -259,10 +272,18 @@ def coarse_segments(time: np.ndarray, stress: np.ndarray, step: float | None = N
     grid, raw = uniform_grid(time, stress, step)
     smooth = median_filter(raw, size=min(MEDIAN_WIDTH, raw.size), mode="nearest")
     scale = float(np.max(np.abs(smooth))) if smooth.size else 0.0
-    noise, threshold, peaks, troughs, swings = _segment(time, stress, grid, smooth, scale, whole)
+    noise, threshold, peaks, troughs, swings = _segment(time, stress, grid, smooth, scale, whole, raw)
     if whole > STICK_CONSISTENCY * white:  # the ladder climbed: correlated noise, or the sawtooth itself?
         sawtooth = _coarse_sawtooth(time, stress, grid, (smooth, raw), scale, white)
         if sawtooth is not None:
+            smooth, (noise, threshold, peaks, troughs, swings) = sawtooth
+    elif _doubtful(grid, raw, peaks, noise, whole):  # more slips near the sample-to-sample noise than were found?
+        sawtooth = _coarse_sawtooth(time, stress, grid, (smooth, raw), scale, white)
+        # kept when it finds more slips, or as many in a coarse record (its noise is then the sticks' scatter, which
+        # the corners do not inflate as they do the sample-to-sample noise)
+        if sawtooth is not None and (
+            sawtooth[1][2].size > peaks.size or (sawtooth[1][2].size == peaks.size and coarse_spacing(peaks))
+        ):
             smooth, (noise, threshold, peaks, troughs, swings) = sawtooth
     final_trough = None
     steady_from = None
@@ -294,24 +315,51 @@ def coarse_segments(time: np.ndarray, stress: np.ndarray, step: float | None = N
     )
 
 
+def coarse_spacing(peaks: np.ndarray, step: float = 1.0) -> bool:
+    """Whether slips at ``peaks`` (grid indices, or times with the sampling interval ``step``) come fewer than
+    :data:`COARSE_CYCLE` samples apart (the median of their intervals)."""
+    return peaks.size >= 2 and step > 0 and float(np.median(np.diff(peaks))) < COARSE_CYCLE * step
+
+
+def _doubtful(grid: np.ndarray, raw: np.ndarray, peaks: np.ndarray, noise: float, whole: float) -> bool:
+    """Whether a search at the record's noise ``whole`` that found the slips ``peaks`` (grid indices) at the noise
+    ``noise`` may have missed slips a search near the sample-to-sample noise finds (:func:`_coarse_sawtooth`):
+    at most one found (a sawtooth of a few samples a cycle, which the 5-point median flattens, looks steady), the
+    sticks found scatter by more than ``whole`` allows (a stick that spans a missed slip reads the slip as noise),
+    or the slips found, or the record's swings about its trend (on the uniform grid ``grid``, ``raw``), come fewer
+    than :data:`COARSE_CYCLE` samples apart (where the corners inflate the sample-to-sample noise, and the drop
+    threshold with it)."""
+    if peaks.size < 2 or noise > STICK_CONSISTENCY * whole or coarse_spacing(peaks):
+        return True
+    swings = _swings_about_trend(grid, raw, _sample_level(raw, grid))
+    return swings is not None and float(np.median(np.diff(swings[0]))) < COARSE_CYCLE
+
+
 #: (noise, threshold, peaks, troughs, swings) of :func:`_segment`.
 Segmentation = tuple[float, float, np.ndarray, np.ndarray, tuple[np.ndarray, float] | None]
 
 
 def _segment(
-    time: np.ndarray, stress: np.ndarray, grid: np.ndarray, smooth: np.ndarray, scale: float, noise: float
+    time: np.ndarray,
+    stress: np.ndarray,
+    grid: np.ndarray,
+    smooth: np.ndarray,
+    scale: float,
+    noise: float,
+    raw: np.ndarray | None = None,
 ) -> Segmentation:
     """Drops at ``noise``, sought again while the sticks found scatter about their lines by more than the noise
-    allows (that scatter then being the noise): (noise, threshold, peaks, troughs, swings) as :func:`_drops`."""
+    allows (that scatter then being the noise): (noise, threshold, peaks, troughs, swings) as :func:`_drops`,
+    which reads narrow peaks on ``raw``."""
     threshold = max(PROMINENCE_SIGMAS * noise, 1e-9 * scale, 1e-300)
-    peaks, troughs, swings = _drops(smooth, threshold)
+    peaks, troughs, swings = _drops(smooth, threshold, raw)
     for _ in range(MAX_REFINEMENTS):  # the sticks found must be straight lines to within the noise
         scatter = _stick_scatter(time, stress, grid, peaks, troughs)
         if not scatter > STICK_CONSISTENCY * noise:
             break
         noise = scatter
         threshold = max(PROMINENCE_SIGMAS * noise, 1e-9 * scale, 1e-300)
-        peaks, troughs, swings = _drops(smooth, threshold)
+        peaks, troughs, swings = _drops(smooth, threshold, raw)
     return noise, threshold, peaks, troughs, swings
 
 
@@ -354,14 +402,15 @@ def _coarse_sawtooth(
     floor = _quantisation_level(stress)
     start = min(white, max(_lag_level(time, stress, 1, low=True), floor))
     found = []
+    raw = curves[1]
     for curve in curves:
-        sawtooth = _segment(time, stress, grid, curve, scale, start)
+        sawtooth = _segment(time, stress, grid, curve, scale, start, raw)
         residual = _stick_residual(time, stress, grid, sawtooth, white)
         if residual is None:
             continue
         level = max(residual, floor)
         if level < sawtooth[0]:  # the same slips at the noise left once they are taken out
-            refined = _segment(time, stress, grid, curve, scale, level)
+            refined = _segment(time, stress, grid, curve, scale, level, raw)
             if _stick_residual(time, stress, grid, refined, level) is not None:
                 sawtooth = refined
         found.append((curve, sawtooth))
@@ -408,7 +457,9 @@ def _stick_residual(
     return rms if products <= EXPLAIN_CORRELATION * pairs or rms <= tiny else None
 
 
-def _drops(smooth: np.ndarray, threshold: float) -> tuple[np.ndarray, np.ndarray, tuple[np.ndarray, float] | None]:
+def _drops(
+    smooth: np.ndarray, threshold: float, raw: np.ndarray | None = None
+) -> tuple[np.ndarray, np.ndarray, tuple[np.ndarray, float] | None]:
     """Grid indices of the slips' peaks and of the starts of the sticks before them, and the swings of a smooth
     oscillation (its peaks' indices and their median asymmetry; None when the record does not oscillate).
 
@@ -417,9 +468,15 @@ def _drops(smooth: np.ndarray, threshold: float) -> tuple[np.ndarray, np.ndarray
     is for an isolated deep drop (a start-up slip above Vc): when :data:`OSCILLATION_SWINGS` or more deep drops
     fall no faster than they rose and at most :data:`OSCILLATION_FAST_SHARE` of all the candidates fall faster,
     the record is a smooth oscillation, which has no slip phase: no slips, and its candidates are its swings.
+    A peak whose top spans fewer than :data:`NARROW_TOP` filter widths of ``smooth`` (a record of a few tens of
+    samples a cycle or fewer) has its asymmetry read on ``raw``, the samples on the grid, by
+    :func:`_crossing_asymmetry` (docs/analysis.md, "Six to fifteen samples a cycle").
     """
     peaks = _separated(smooth, find_peaks(smooth, prominence=threshold)[0], threshold)
-    asymmetry, depth = _asymmetry(smooth, peaks)
+    asymmetry, depth, width = _asymmetry(smooth, peaks, with_width=True)
+    narrow = width < NARROW_TOP * MEDIAN_WIDTH
+    if raw is not None and np.any(narrow):
+        asymmetry = np.where(narrow, _crossing_asymmetry(raw, _raw_peaks(raw, peaks)), asymmetry)
     fast = asymmetry >= MIN_ASYMMETRY
     deep = depth >= CLEAR_DROP * threshold
     slow_deep = int(np.count_nonzero(deep & ~fast))
@@ -462,7 +519,7 @@ def _swings(grid: np.ndarray, smooth: np.ndarray, swings: tuple[np.ndarray, floa
     )
 
 
-def _asymmetry(y: np.ndarray, peaks: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _asymmetry(y: np.ndarray, peaks: np.ndarray, with_width: bool = False) -> Any:
     """Per peak of ``y``: (time spent near it before it) / (time spent near it after it), and its depth.
 
     The depth is the peak's height above the higher of the lows on either side (up to the neighbouring peaks);
@@ -473,6 +530,7 @@ def _asymmetry(y: np.ndarray, peaks: np.ndarray) -> tuple[np.ndarray, np.ndarray
     """
     ratio = np.empty(peaks.size)
     depth = np.empty(peaks.size)
+    width = np.empty(peaks.size)
     bounds = np.concatenate([[0], peaks, [y.size - 1]]).astype(int)
     for k, p in enumerate(peaks):
         before, after = y[bounds[k] : p + 1], y[p : bounds[k + 2] + 1]
@@ -482,7 +540,61 @@ def _asymmetry(y: np.ndarray, peaks: np.ndarray) -> tuple[np.ndarray, np.ndarray
         rise = np.count_nonzero(before[low_before:-1] >= level) + 0.5
         fall = np.count_nonzero(after[1 : low_after + 1] >= level) + 0.5
         ratio[k] = rise / fall
-    return ratio, depth
+        width[k] = rise + fall  # the top's grid points, the peak's own included
+    return (ratio, depth, width) if with_width else (ratio, depth)
+
+
+def _raw_peaks(raw: np.ndarray, peaks: np.ndarray) -> np.ndarray:
+    """The sample on the grid ``raw`` highest within half a median-filter width of each peak of the filtered curve
+    (whose flat top of a coarse peak ends where the samples' own peak is); never past a neighbouring peak."""
+    half = MEDIAN_WIDTH // 2
+    found = np.empty(peaks.size, dtype=int)
+    for k, p in enumerate(peaks):
+        lo = max(int(p) - half, 0 if k == 0 else int(peaks[k - 1]) + 1)
+        hi = min(int(p) + half + 1, raw.size if k + 1 == peaks.size else int(peaks[k + 1]))
+        found[k] = lo + int(np.argmax(raw[lo:hi]))
+    return found
+
+
+def _crossing_asymmetry(y: np.ndarray, peaks: np.ndarray) -> np.ndarray:
+    """Per peak of ``y``: how long its rise takes to climb from :data:`MID_BAND`'s deeper to its shallower level
+    below the peak, over how long its fall takes back down between them (each time where the samples cross the
+    level, linearly interpolated; the depth as in :func:`_asymmetry`).
+
+    On a peak of a few samples the top band of :func:`_asymmetry` holds one or two of them on either side, and its
+    ratio of counts is that of where the samples happen to fall: 0.6 to 1.7 on a sinusoid sampled ten times a
+    period, 1 on a sawtooth whose slip spans two samples.  The middle of the swing is where both a stick and a
+    sinusoid are straight, so its crossing times are read to a fraction of a sample: a sinusoid gives 1, a
+    stick rising at K V0 into a slip falling at K (V - V0) the ratio of their rates; stationary noise, reversible
+    in time, is as often above 1 as below.  A fall between two samples counts a hundredth of a sample.
+    """
+    ratio = np.empty(peaks.size)
+    bounds = np.concatenate([[0], peaks, [y.size - 1]]).astype(int)
+    for k, p in enumerate(peaks):
+        first, last = int(bounds[k]), int(bounds[k + 2])
+        low = max(float(np.min(y[first : p + 1])), float(np.min(y[p : last + 1])))
+        depth = float(y[p]) - low
+        if not depth > 0:
+            ratio[k] = 1.0
+            continue
+        shallow, deep = (float(y[p]) - f * depth for f in MID_BAND)
+        rise = _crossing(y, p, first, shallow, -1) - _crossing(y, p, first, deep, -1)
+        fall = _crossing(y, p, last, deep, 1) - _crossing(y, p, last, shallow, 1)
+        ratio[k] = rise / max(fall, MIN_CROSSING)
+    return ratio
+
+
+def _crossing(y: np.ndarray, start: int, stop: int, level: float, direction: int) -> float:
+    """(Fractional) index where ``y``, followed from ``start`` towards ``stop`` in ``direction``, first falls below
+    ``level``: linear interpolation between the last sample at or above it and the first below; ``stop`` when
+    it never does."""
+    i = start
+    while i != stop and y[i + direction] >= level:
+        i += direction
+    if i == stop:
+        return float(stop)
+    above, below = float(y[i]), float(y[i + direction])
+    return i + direction * (above - level) / (above - below)
 
 
 def _stick_scatter(
@@ -624,3 +736,121 @@ def dropouts(stress: np.ndarray, threshold: float) -> np.ndarray:
         return np.empty(0, dtype=int)
     rows = np.concatenate([np.arange(e + 1, e + 1 + m) for e, m in zip(entries[hit], found[hit], strict=True)])
     return np.unique(rows)
+
+
+#: A stretch the search calls steady is no steady sliding when it swings regularly about its trend, too few samples
+#: a swing for the slips to be resolved: at least this many whole swings ...
+UNRESOLVED_SWINGS = 5
+#: ... each crossing from below to above this many noise levels (the sample-to-sample noise, read at the lower
+#: quartile of the lag-1 residuals, which the swing itself inflates least) about the trend ...
+SWING_SIGMAS = 2.0
+#: ... or this fraction of the residuals' RMS about the trend if that is more ...
+SWING_SPREAD = 0.5
+#: ... whose durations and peak-to-trough heights scatter by at most this fraction of their means (red noise
+#: wanders about its mean at no one period or height; a sawtooth sampled six times a cycle, its peak anywhere in
+#: the last sampling interval, scatters by about 0.2/sqrt(12) = 0.06 in height) ...
+UNRESOLVED_SCATTER = 0.1
+#: ... and that spread about the trend by this many noise levels or more.
+SWING_NOISE = 2.0
+
+
+@dataclass(frozen=True)
+class UnresolvedSwings:
+    """Regular swings of a stretch of record about its trend, too coarsely sampled to be resolved into slips: how
+    many whole swings, their mean duration (s), sampling intervals a swing, mean peak-to-trough height (Pa), the
+    standard deviation about the trend (Pa) and the noise level the swings were judged against (Pa)."""
+
+    swings: int
+    period: float
+    samples: float
+    height: float
+    spread: float
+    noise: float
+
+    def as_dict(self) -> dict[str, float | int]:
+        return {
+            "swings": self.swings,
+            "period": self.period,
+            "samples_per_swing": self.samples,
+            "peak_to_trough": self.height,
+            "spread": self.spread,
+            "noise": self.noise,
+        }
+
+
+def _sample_level(stress: np.ndarray, time: np.ndarray) -> float:
+    """The sample-to-sample noise at the lower quartile of the lag-1 residuals (which a sawtooth of a few samples a
+    cycle inflates least), not below the quantisation's q/sqrt(12)."""
+    return max(_lag_level(time, stress, 1, low=True), _quantisation_level(stress))
+
+
+def _swings_about_trend(
+    time: np.ndarray, stress: np.ndarray, level: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None:
+    """The swings of a record about its straight-line trend: (sample index of each rise above a band after a fall
+    below minus the band, the band :data:`SWING_SIGMAS` ``level`` or :data:`SWING_SPREAD` of the residuals' RMS if
+    that is more (a sawtooth of six samples a cycle is all corners, and inflates any sample-to-sample noise
+    estimate to a good part of its swing), the time of the zero crossing before it
+    (interpolated), the peak-to-trough height of each whole swing between two such rises, the residuals about
+    the trend); None with fewer than two rises."""
+    n = time.size
+    u = time - float(np.mean(time))
+    spread = float(np.einsum("i,i", u, u))
+    if n < 4 or not spread > 0:
+        return None
+    residual = stress - float(np.mean(stress))
+    residual -= float(np.einsum("i,i", u, residual)) / spread * u
+    band = max(SWING_SIGMAS * level, SWING_SPREAD * math.sqrt(float(np.einsum("i,i", residual, residual)) / n))
+    if not band > 0:
+        return None
+    index = np.arange(n)
+    sign = np.where(residual > band, 1, np.where(residual < -band, -1, 0))
+    beyond = index[sign != 0]
+    turns = beyond[1:][(sign[beyond[1:]] > 0) & (sign[beyond[:-1]] < 0)]  # first sample above +band after a low
+    if turns.size < 2:
+        return None
+    last_low = np.maximum.accumulate(np.where(residual <= 0, index, -1))[turns - 1]  # the zero crossing before
+    a, b = residual[last_low], residual[last_low + 1]
+    ups = time[last_low] + (time[last_low + 1] - time[last_low]) * (-a / (b - a))
+    # peak to trough of each whole swing: the highest point after one rise over the lowest before the next
+    heights = (np.maximum.reduceat(residual, turns) - np.minimum.reduceat(residual, turns))[:-1]
+    return turns, ups, heights, residual
+
+
+def unresolved_swings(time: np.ndarray, stress: np.ndarray, noise: float, step: float) -> UnresolvedSwings | None:
+    """The regular swings of a stretch that the search found no slip in (or no more after its last), when they come
+    fewer than :data:`COARSE_CYCLE` samples apart; None when it has none.
+
+    The swings are counted on the stretch less its straight-line trend, from each rise above
+    :data:`SWING_SIGMAS` noise levels (or :data:`SWING_SPREAD` of the residuals' RMS) after a fall below minus as
+    many (the zero crossing between them, interpolated, times the swing); ``noise`` is capped by the lower
+    quartile of the lag-1 residuals, which a sawtooth of a few samples a cycle inflates least (the drop
+    threshold's noise may be a stick line drawn across missed slips).  A sawtooth of six or eight samples a cycle
+    swings by tens of noise levels at one period and one height; steady sliding, white or red noise, does neither
+    (docs/analysis.md, "Six to fifteen samples a cycle").
+    """
+    if time.size < 2 * UNRESOLVED_SWINGS + 2 or not step > 0:
+        return None
+    level = min(noise, _sample_level(stress, time))
+    found = _swings_about_trend(time, stress, level)
+    if found is None:
+        return None
+    _, ups, heights, residual = found
+    intervals = np.diff(ups)
+    if intervals.size < UNRESOLVED_SWINGS:
+        return None
+    scatter = max(np.std(intervals) / np.mean(intervals), np.std(heights) / np.mean(heights))
+    if not scatter <= UNRESOLVED_SCATTER:
+        return None
+    period = float(np.mean(intervals))
+    spread = float(np.std(residual, ddof=2))
+    if not period / step < COARSE_CYCLE or not spread >= SWING_NOISE * level:
+        return None
+    return UnresolvedSwings(
+        swings=int(intervals.size),
+        period=period,
+        samples=period / step,
+        height=float(np.mean(heights)),
+        spread=spread,
+        noise=level,
+    )

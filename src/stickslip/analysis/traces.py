@@ -91,7 +91,7 @@ def read_trace(path: str | Path, contact_area: float | None = None) -> Trace:
                 f"{table.source}: a contact area was given but the trace has a 'stress' column; it needs none"
             )
         stress = table["stress"]
-    notes = []
+    notes = list(table.notes)  # how the file was read, where not as usual (decimal commas)
     if table.ignored:
         notes.append(f"ignored column(s) {', '.join(table.ignored)}: analyze reads time and stress only")
     time, stress, rows, merged = _merge_model_repeats(path, table, stress)

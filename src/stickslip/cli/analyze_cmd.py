@@ -67,6 +67,9 @@ JSON_UNITS = {
     "steady_to": "s",
     "shift": "s",
     "rms_misfit": "Pa",
+    "peak_to_trough": "Pa",  # the swings of summary.oscillation and summary.unresolved_swings
+    "spread": "Pa",
+    "samples_per_swing": "1",
     "model": None,  # the comparison's per-cycle table of the model's values, not a number
 }
 

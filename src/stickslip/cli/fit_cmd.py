@@ -87,7 +87,8 @@ def fit_group() -> None:
     default="auto",
     show_default=True,
     help="two-step: the paper's (no aging above --split, then aging below it); joint: everything at once; auto:"
-    " two-step, or joint where the two-step's approximation does not describe the data.",
+    " the joint fit started from the two-step result, with profile-likelihood intervals (the two-step where the"
+    " joint fit fails, or with --intervals delta/bootstrap).",
 )
 @click.option(
     "--split", default=SPLIT_DEFAULT, show_default=True, metavar="V", help="Split velocity of the two-step fit."
@@ -101,7 +102,8 @@ def fit_group() -> None:
     type=click.Choice(["auto", "delta", "profile", "bootstrap"]),
     default="auto",
     show_default=True,
-    help="Intervals of Vc and σc; auto: delta for two-step, profile likelihood for joint (docs/fitting.md).",
+    help="Intervals of Vc and σc (profile: of the parameters too); auto: delta for two-step, profile likelihood"
+    " for joint (docs/fitting.md).",
 )
 @click.option("--samples", type=click.IntRange(min=20), default=200, show_default=True, help="Bootstrap refits.")
 @click.option("--level", type=click.FloatRange(0.5, 0.999), default=0.95, show_default=True, help="Confidence level.")

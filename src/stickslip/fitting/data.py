@@ -145,6 +145,8 @@ class StickData:
     extra: dict[str, np.ndarray]
     source: str = "table"
     read_notes: tuple[str, ...] = ()
+    #: the file rows the reader left out, with why (a cycles table's cycles without a stick time): not in ``rows``
+    left_out: tuple[tuple[int, str], ...] = ()
 
     def __len__(self) -> int:
         return int(self.pulling_velocity.size)
@@ -249,14 +251,18 @@ def _read_cycles_table(path: str | Path, names: Sequence[str]) -> StickData:
                        ignore=CYCLES_IGNORED)  # fmt: skip
     whole = np.isfinite(table["stick_time"])
     columns = {CYCLES_COLUMNS.get(n, n): v[whole] for n, v in table.columns.items()}
-    notes = [*table.notes,
-             f"{source}: the cycles table of stickslip analyze; its critical_stress (σc) is each row's start_stress"]
+    notes = [
+        *table.notes,
+        f"{source}: the cycles table of stickslip analyze; its critical_stress (σc) is each row's start_stress",
+    ]
     if not whole.all():
         cut = ", ".join(str(r) for r in table.rows[~whole])
         notes.append(f"{source}: row(s) {cut} left out: cycles cut by the record's ends or a gap in it (no stick time)")
     written = {CYCLES_COLUMNS.get(n, n): w for n, w in table.written.items()}
     data = _validated_stick(Table(source, columns, table.rows[whole], written=written))
-    return dataclasses.replace(data, read_notes=tuple(notes))
+    why = "cycles cut by the record's ends or a gap in it: no stick time"
+    cut_rows = tuple((int(r), why) for r in table.rows[~whole])
+    return dataclasses.replace(data, read_notes=tuple(notes), left_out=cut_rows)
 
 
 def _as_column(values: Any, name: str, source: str, allow_nan: bool = False) -> np.ndarray:

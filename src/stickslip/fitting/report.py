@@ -84,7 +84,7 @@ def steady_report(fit: Any) -> str:
             if fit.flat_level is not None
             else goodness_line(fit.chi_square, fit.dof, fit.noise_estimated)
         ),
-        f"- intervals: {level}; parameters symmetric in ln (Wald); Vc and σc by {fit.interval_method}",
+        f"- intervals: {level}; parameters {_parameter_interval_method(fit)}; Vc and σc by {fit.interval_method}",
         "",
         "## Critical point (Eq 9)",
         "",
@@ -125,6 +125,12 @@ def steady_report(fit: Any) -> str:
         *_residual_table(fit),
     ]
     return "\n".join(lines)
+
+
+def _parameter_interval_method(fit: Any) -> str:
+    if getattr(fit, "parameter_intervals", "wald") == "profile":
+        return "by profile likelihood (combinations carried by one key likewise, the others symmetric in ln)"
+    return "symmetric in ln (Wald)"
 
 
 #: Longest residual table printed in full; longer records get a summary and their largest residuals.
@@ -184,7 +190,7 @@ def stick_report(fit: Any) -> str:
         "# Stick-phase fit (Eqs 13-16)",
         "",
         *([f"**Fit failed:** {fit.reason}.", ""] if fit.status != "ok" else []),
-        f"- data: `{data.source}`, {int(fit.used.sum())} of {len(data)} rows fitted",
+        f"- data: `{data.source}`, {fit.rows_line()}",
         f"- noise: {fit.noise}",
         goodness_line(fit.chi_square, fit.dof, True),
         f"- intervals: {level}, symmetric in ln (Wald)",

@@ -88,6 +88,31 @@ class StickFit:
         """Not a test of the fit: the noise is estimated from the residuals, so chi^2/dof is 1 by construction."""
         return None
 
+    def left_out(self) -> dict[int, str]:
+        """Every file row not fitted, with why: those the reader left out (a cycles table's cut cycles) and those the
+        fit did (--exclude-row, V0 above Vc), in file order."""
+        rows = dict(self.data.left_out)
+        rows.update((int(r), self.excluded.get(int(r), "")) for r, u in zip(self.data.rows, self.used, strict=True)
+                    if not u)  # fmt: skip
+        return dict(sorted(rows.items()))
+
+    def rows_line(self) -> str:
+        """ "13 of 18 rows fitted; 5 left out: rows 2, 3, 9, 10, 19 (why)": the table's rows, the reader's left-outs
+        counted in (the Notes and the Rows table say the same)."""
+        left = self.left_out()
+        total = len(self.data) + len(self.data.left_out)
+        text = f"{int(self.used.sum())} of {total} rows fitted"
+        if not left:
+            return text
+        reasons: dict[str, list[int]] = {}
+        for row, why in left.items():
+            reasons.setdefault(why, []).append(row)
+        groups = "; ".join(
+            f"{'rows' if len(rows) > 1 else 'row'} {', '.join(map(str, rows))}" + (f" ({why})" if why else "")
+            for why, rows in reasons.items()
+        )
+        return f"{text}; {len(left)} left out: {groups}"
+
     def to_frame(self) -> pd.DataFrame:
         frame = self.data.to_frame()
         frame["used"] = self.used
@@ -133,6 +158,8 @@ class StickFit:
                     strict=True,
                 )
             ],
+            # the file rows the reader left out (a cycles table's cut cycles): not in "rows", counted in the report
+            "left_out_rows": [{"row": r, "reason": why} for r, why in self.data.left_out],
             "messages": list(self.messages),
         }
 

@@ -325,8 +325,8 @@ def _friction(
     else:
         raise DataError(
             f"{path}: column {header!r} is in {tau_unit}, a stress; expected the friction coefficient, or the"
-            " normal stress to divide this shear stress by: give --normal-stress (e.g. \"10 MPa\"; Python:"
-            " normal_stress=) or a normal-stress column (--columns normal_stress=\"HEADER\")"
+            ' normal stress to divide this shear stress by: give --normal-stress (e.g. "10 MPa"; Python:'
+            ' normal_stress=) or a normal-stress column (--columns normal_stress="HEADER")'
         )
     with np.errstate(invalid="ignore", divide="ignore"):
         friction = tau / divisor
@@ -525,7 +525,7 @@ def _choose_columns(path: Path, columns: dict[str, str] | None, headers: dict) -
     else:
         raise DataError(
             f"{path}: no friction column; found {found} (map them with --columns time=...,displacement=...,"
-            'friction=..., or a shear stress and the normal stress: shear_stress=...,normal_stress=...)'
+            "friction=..., or a shear stress and the normal stress: shear_stress=...,normal_stress=...)"
         )
     if "normal_stress" in columns:
         chosen["normal_stress"] = mapped("normal_stress")
