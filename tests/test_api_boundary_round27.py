@@ -4,7 +4,6 @@ mapping given to ``run``, a set read from a file, and the critical point's plot.
 * docs/api.md said "strings with units are read at the boundary", but only overrides read them:
   ``steady_state(p, "0.2 mm/s")``, ``simulate(p, "50 um/s", "2 min")``, ``protocols.constant("0.2 mm/s", "3 s")``,
   ``Rig(stiffness="300 kPa/m")`` were refused, and ``every="100 ms"`` was "expected a positive time ..., got '100 ms'";
-* ``steady_state(p, [])`` returned an empty result;
 * ``run("rsf", {"a": .., "b": .., "dc": ..})`` was "unknown key 'b'" (the keys of a rate-and-state file);
 * ``block.effective_stiffness`` / ``block.stiffness``, documented keys, were unknown to ``load_parameters`` and
   ``params show --set``;
@@ -22,7 +21,7 @@ from tests.cli_helpers import run_main
 
 import stickslip
 from stickslip import Rig, protocols
-from stickslip.errors import DataError, ParameterError, UnitError
+from stickslip.errors import ParameterError, UnitError
 from stickslip.parameters import load_parameters
 
 # ----------------------------------------------------------------------------- 1. values with units
@@ -95,15 +94,6 @@ def test_run_reads_every_and_start_with_units(params):
     )
     with pytest.raises(UnitError, match=r"start: '300 m/s' has dimension .*expected a stress"):
         stickslip.run("quasi-static", params, slow, start="300 m/s")
-
-
-# ----------------------------------------------------------------------------- 2. empty input
-
-
-@pytest.mark.parametrize("empty", [[], np.array([]), ()])
-def test_an_empty_velocity_is_refused_naming_it(params, empty):
-    with pytest.raises(DataError, match=r"^velocity: empty .*expected at least one velocity"):
-        stickslip.steady_state(params, empty)
 
 
 # ----------------------------------------------------------------------------- 3. run() with a mapping

@@ -13,7 +13,8 @@ from stickslip.models import Rig
 from stickslip.parameters import load_parameters
 from stickslip.transient.stability import critical_stiffness
 
-BAD = [True, -1.0, math.nan, math.inf, "10 kg/m^2", None]
+#: text with a unit is read (round 27: "10 kg/m^2" is a mass to both); text of another dimension is refused by both
+BAD = [True, -1.0, math.nan, math.inf, "10 m/s", "-10 kg/m^2", None]
 
 
 @pytest.mark.parametrize("value", BAD, ids=repr)
@@ -29,6 +30,14 @@ def test_the_stability_analysis_refuses_what_the_rig_refuses(name, value):
     with pytest.raises(ParameterError) as rig:
         Rig(**{name: value})
     assert f"rig {analysis.value}" == str(rig.value)
+
+
+def test_values_with_their_units_are_read_alike():
+    params = load_parameters("gelatin-glass")
+    rig = Rig(mass="10 kg/m^2", damping="2 kPa s/m")
+    assert (rig.mass, rig.damping) == (10.0, 2000.0)
+    with_units = critical_stiffness(params, 120e-6, mass="10 kg/m^2", damping="2 kPa s/m")
+    assert with_units == critical_stiffness(params, 120e-6, mass=10.0, damping=2000.0)
 
 
 def test_numpy_numbers_are_numbers_to_both():

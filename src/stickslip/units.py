@@ -176,6 +176,15 @@ def checked_number(name: str, value: Any, unit: str, *, strict: bool = False) ->
     return number
 
 
+def checked_value(name: str, value: Any, dimension: str, *, strict: bool = False) -> float:
+    """A number in SI or a value with its unit of ``dimension`` (:func:`si_argument`), checked by
+    :func:`checked_number` in the dimension's display unit; a refusal quotes the value as written.  The rig's and
+    the stability analysis' stiffness, damping and mass are read by it alike."""
+    number = si_argument(value, dimension, name)
+    with refused_as_written(value):
+        return checked_number(name, number, DIMENSIONS[dimension][1], strict=strict)
+
+
 def bare_number(text: str) -> float | None:
     """The number if ``text`` is a number without a unit (``"50"``, ``" 1e-4 "``), else None."""
     if len(text) > MAX_VALUE_LENGTH:

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from ..errors import ModelError, ParameterError
-from ..units import DIMENSIONS, checked_number, refused_as_written, si_argument
+from ..units import checked_value
 
 if TYPE_CHECKING:  # pragma: no cover
     import numpy as np
@@ -43,11 +43,7 @@ CONTROLS = ("velocity", "spring")
 def _optional_positive(name: str, value: Any, dimension: str, strict: bool) -> float | None:
     """The rig's ``name``: None, or a number in SI or a value with its unit of ``dimension``, checked >= 0 (> 0
     with ``strict``)."""
-    if value is None:
-        return None
-    number = si_argument(value, dimension, f"rig {name}")
-    with refused_as_written(value):
-        return checked_number(f"rig {name}", number, DIMENSIONS[dimension][1], strict=strict)
+    return None if value is None else checked_value(f"rig {name}", value, dimension, strict=strict)
 
 
 @dataclass(frozen=True)

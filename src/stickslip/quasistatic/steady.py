@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..columns import attribute_frame
-from ..errors import DataError, ModelError, ParameterError
+from ..errors import ModelError, ParameterError
 from ..numerics.quadrature import panel_rule
 from ..parameters import BOLTZMANN, Parameters, require_flag
 from ..reprs import compact_repr
@@ -566,8 +566,8 @@ def _check_velocity(velocity: Any) -> np.ndarray:
 
 def _velocity_argument(velocity: Any) -> np.ndarray:
     """``velocity`` of a public entry: numbers in m/s (scalar or array), one value with its unit (``"0.2 mm/s"``)
-    or a pint quantity; checked by :func:`_check_velocity`.  An empty one is a DataError (it gave an empty result),
-    an array of texts a ParameterError saying that arrays are numbers in SI."""
+    or a pint quantity; checked by :func:`_check_velocity`; an array of texts is a ParameterError saying that arrays are
+    numbers in SI.  An empty array gives an empty curve (tests/test_robust_box.py), as numpy's own functions do."""
     if isinstance(velocity, str):
         with refused_as_written(velocity):
             return _check_velocity(si_argument(velocity, "velocity", "velocity"))
@@ -576,10 +576,7 @@ def _velocity_argument(velocity: Any) -> np.ndarray:
             f"velocity: an array of velocities holds numbers in m/s (SI); a unit is read from one velocity"
             f" alone ('0.2 mm/s'), got {shorten(velocity)}"
         )
-    v = _check_velocity(velocity)
-    if v.size == 0:
-        raise DataError(f"velocity: empty ({shorten(velocity)}); expected at least one velocity in m/s")
-    return v
+    return _check_velocity(velocity)  # an empty array gives an empty curve, as a numpy function does
 
 
 def _require_finite_stress(params: Parameters, which: str = "") -> None:
@@ -617,7 +614,7 @@ def steady_state(
 
     ``velocity`` is in m/s (real numbers, scalar or array: True or a complex value is a
     ParameterError, not 1 m/s or its real part), or one velocity with its unit (``"0.2 mm/s"``, a pint
-    quantity); an empty one is a DataError.  ``aging=False`` drops the aging
+    quantity); an empty array gives an empty curve.  ``aging=False`` drops the aging
     term of Eq 6 (the paper's no-aging curve).  With ``distribution=True`` the
     age distribution n(t_a) of Eqs 6-7 is kept at the quadrature nodes.
     ``quadrature`` sets the panel rule (see :class:`QuadratureSettings`).  The march runs compiled from

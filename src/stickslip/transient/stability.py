@@ -31,7 +31,7 @@ import numpy as np
 from ..errors import ModelError, ParameterError
 from ..numerics.roots import brentq  # scipy.optimize would add 0.3 s to start-up
 from ..parameters import Parameters
-from ..units import checked_number
+from ..units import checked_value
 from .model import aging_age, chain_force, log_hazard, steady_population
 
 #: frequencies / growth rates scanned, in units of 1/tau: from 1e-6 to 1e4
@@ -199,8 +199,9 @@ class CriticalStiffness:
 
 
 def _block_terms(mass: float, damping: float) -> tuple[float, float]:
-    """The block's mass per unit area (kg/m^2) and viscous damping (Pa s/m), checked."""
-    return checked_number("mass", mass, "kg/m^2"), checked_number("damping", damping, "Pa s/m")
+    """The block's mass per unit area (kg/m^2) and viscous damping (Pa s/m), checked as the rig checks them (a value
+    with its unit too)."""
+    return checked_value("mass", mass, "mass_per_area"), checked_value("damping", damping, "stress_per_velocity")
 
 
 def _block_polynomial(s: np.ndarray | complex, stiffness: float, mass: float, damping: float) -> np.ndarray | complex:
