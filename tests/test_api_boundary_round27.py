@@ -193,3 +193,15 @@ def test_the_critical_points_plot_labels_both_axes_with_units(params):
     own.set_xlabel("V [um/s]")
     point.plot(ax=own)
     assert own.get_xlabel() == "V [um/s]" and own.get_xscale() == "linear" and "(Pa)" in own.get_ylabel()
+
+
+def test_a_models_own_reader_names_a_set_changed_by_a_stiffness_key():
+    """`run --model quasi-static --set block.stiffness=...` kept the name gelatin-glass (the model's reader set the
+    height itself); it now reads the key as load_parameters does, and the height gives G/h = the stiffness."""
+    model = stickslip.get_model("quasi-static")
+    params = model.parameters(None, {"block.stiffness": "300 kPa/m"})
+    assert params.name == "gelatin-glass, modified: block.stiffness"
+    assert params.block.shear_modulus / params.block.height == pytest.approx(3e5, rel=1e-12)
+    full = {**load_parameters("gelatin-glass").as_dict(), "block.effective_stiffness": 2e5}
+    full.pop("block.height")
+    assert model.parameters(None, full).block.effective_stiffness == pytest.approx(2e5, rel=1e-12)

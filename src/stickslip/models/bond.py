@@ -44,7 +44,7 @@ class BondModel(FrictionModel):
         given = dict(overrides or {})
         if isinstance(spec, Mapping):  # {"bonds.bond_time": ...}, {"bonds": {...}} or a whole exported set as a dict
             given, spec = {**_flat_keys(spec), **given}, None
-        stiffness = {k: to_si(given.pop(k), d, k) for k, d in STIFFNESS_KEYS.items() if k in given}
+        stiffness = {k: given.pop(k) for k in STIFFNESS_KEYS if k in given}
         keys = parameter_keys()
         required = set(keys) - set(optional_keys())  # an extension's key (aging.saturation_age) may be absent
         present = [k for k in keys if k in given]
@@ -52,9 +52,9 @@ class BondModel(FrictionModel):
             if len(given) > len(present):
                 key_dimension(next(k for k in given if k not in keys))  # the one-line error naming the key
             params = _parameter_set(tuple(float(given[k]) if k in given else None for k in keys))
-        else:
-            params = load_parameters(DEFAULT_SET if spec is None else spec, given)
-        return with_stiffness(params, stiffness)
+            return with_stiffness(params, {k: to_si(v, STIFFNESS_KEYS[k], k) for k, v in stiffness.items()})
+        # load_parameters reads the stiffness keys itself and names the set after them ("modified: block.stiffness")
+        return load_parameters(DEFAULT_SET if spec is None else spec, {**given, **stiffness})
 
     def values(self, params: Parameters) -> dict[str, float]:
         return params.as_dict()
