@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 import subprocess
 import sys
 import time
@@ -208,7 +209,7 @@ def test_every_paper_error_and_model_limitation_names_an_existing_erratum(result
     known = {entry["id"] for entry in results["errata"]}
     assert known == {e.id for e in load_errata().entries}
     for row in results["comparisons"]:
-        if row["class"] in ("erratum", "limitation"):
+        if row["class"] in ("erratum", "unstated", "limitation"):
             assert row.get("errata") in known, f"{row['key']}: {row['class']} without an erratum"
         if row["class"] == "agrees":
             assert abs(row["relative_difference"]) <= TOLERANCE
@@ -217,22 +218,32 @@ def test_every_paper_error_and_model_limitation_names_an_existing_erratum(result
 
 
 def test_headline_counts_every_row_once_by_class(report: Path, results: dict) -> None:
+    """Every distinct statement once: a row that repeats another (counted: false) is left out of every total."""
     counts = results["summary"]["by_class"]
-    assert sum(counts.values()) == results["summary"]["compared"] == len(results["comparisons"])
+    rows = results["comparisons"]
+    distinct = [row for row in rows if row["counted"]]
+    assert results["summary"]["compared"] == len(distinct) and results["summary"]["rows"] == len(rows)
+    assert results["summary"]["repeats"] == len(rows) - len(distinct)
+    assert sum(counts.values()) == len(distinct) < len(rows)
     for name, count in counts.items():
-        assert count == sum(row["class"] == name for row in results["comparisons"])
+        assert count == sum(row["class"] == name for row in distinct)
     html = (report / "report.html").read_text(encoding="utf-8")
-    lead = unescape(html.split('<p class="lead">', 1)[1].split("</p>", 1)[0])
-    assert f"{counts['input']} are the paper's own inputs" in lead and f"{counts['agrees']} agree" in lead
-    assert f"{counts['erratum']} differ because of an error in the paper" in lead
+    lead = unescape(re.sub(r"<[^>]+>", "", html.split('<p class="lead">', 1)[1].split("</p>", 1)[0]))
+    assert f"Of the {len(distinct)} distinct numbers" in lead and f"{counts['agrees']} agree" in lead
+    assert f"{counts['input']} are the paper's own inputs" in lead
+    assert f"{counts['erratum']} are errors in the paper" in lead
+    assert f"{counts['unstated']} are numbers of the paper that its own stated inputs do not give" in lead
     assert f"{counts['limitation']} are limitations of the model" in lead
+    assert f"{len(rows) - len(distinct)} state again a number that another row states" in lead
     # the README quotes the same counts (it said 11 errors and 3 limitations while the report said 8 and 6)
     readme = (Path(__file__).resolve().parents[1] / "README.md").read_text(encoding="utf-8")
-    quoted = (f"{results['summary']['compared']} numbers stated in the paper are compared with the computation, each in"
-              " one class:"
-              f" {counts['input']} are the paper's inputs handed back (not counted as agreement), {counts['agrees']}"
-              f" agree within 2 %, {counts['scatter']} lie within the scatter the paper states or shows,"
-              f" {counts['erratum']} are paper errors and {counts['limitation']} model limitations")  # fmt: skip
+    quoted = (f"{len(distinct)} distinct numbers stated in the paper ({len(rows)} rows: {len(rows) - len(distinct)}"
+              " repeat a number stated elsewhere and are counted once) are compared with the computation, each in"
+              f" one class: {counts['input']} are the paper's inputs handed back (not counted as agreement),"
+              f" {counts['agrees']} agree within 2 %, {counts['scatter']} lie within the scatter the paper states or"
+              f" shows, {counts['erratum']} are paper errors, {counts['unstated']} are numbers the paper's stated"
+              f" inputs do not give (each row names the unstated input that does) and {counts['limitation']} model"
+              " limitations")  # fmt: skip
     assert quoted in readme
 
 
@@ -274,9 +285,10 @@ def test_differences_from_the_model_are_not_filed_as_paper_errors(rows: dict) ->
     """A paper error is the paper contradicting itself (wrong unit, own arithmetic, own numbers), never the size of
     a difference between the model and a measurement or a number the paper computed with unstated inputs."""
     # 9.6 % between the nominal 400 kPa/m and Table 1's mean; the paper's simulated stick times +5.4 %, +4.9 %
-    # (reproduced by G_d/h = 420 kPa/m, which the paper does not state): limitations of the model's inputs
+    # (reproduced by G_d/h = 420 kPa/m, which the paper does not state): the paper's unstated or inconsistent
+    # inputs, neither its error nor the model's limitation (round 27)
     for key in ("stiffness_against_table1", "stick_time_50", "stick_time_100"):
-        assert rows[key]["class"] == "limitation", key
+        assert rows[key]["class"] == "unstated", key
         assert rows[key]["relative_difference"] > 0.04  # beyond the tolerance: a real difference, not agreement
     for key, row in rows.items():
         if row["class"] == "erratum":
@@ -346,7 +358,7 @@ def test_one_stiffness_fact_counted_once(rows: dict, params) -> None:
         assert row["alternative"]["value"] == pytest.approx(factor * 400e3 * v_um * 1e-6, rel=1e-9)
         ks.append(slope / (v_um * 1e-6) / factor)
     whole = rows["stiffness_against_table1"]
-    assert whole["computed"] == pytest.approx(sum(ks) / len(ks), rel=1e-9) and whole["class"] == "limitation"
+    assert whole["computed"] == pytest.approx(sum(ks) / len(ks), rel=1e-9) and whole["class"] == "unstated"
     # the paper's own arithmetic, slope/(0.766 V0), fails only in the 350 um/s column (432.5 vs 457 kPa/m)
     assert rows["table1_stiffness_350_1"]["class"] == "erratum"
     assert all(rows[f"table1_stiffness_{c}"]["class"] == "input" for c in ("50_1", "50_2", "100_1", "100_4"))
@@ -371,9 +383,10 @@ def test_start_up_sticks_start_from_rest(results: dict, rows: dict, params) -> N
     first = results["model"]["simulations"]["350 um/s"]
     assert first["start_stress"] == 0.0
     assert first["cycles"][0]["jump_velocity"] == pytest.approx(929e-6, abs=0.5e-6)
-    # 100 um/s cycle 1 from rest at its own 35 Pa/s: ts within 2.1 % of 18.2 s, the rest of sigma_s a limitation
+    # 100 um/s cycle 1 from rest at its own 35 Pa/s: ts within 2.1 % of 18.2 s; the rest of sigma_s is the aging
+    # before shearing, an input the paper does not state (round 27: was filed as a model limitation)
     assert rows["table1_stick_time_100_1"]["relative_difference"] == pytest.approx(0.0, abs=0.021)
-    assert rows["table1_slip_stress_100_1"]["class"] == "limitation"
+    assert rows["table1_slip_stress_100_1"]["class"] == "unstated"
 
 
 def test_stuck_threshold_is_reported_as_a_limitation(report: Path, results: dict) -> None:
@@ -381,7 +394,8 @@ def test_stuck_threshold_is_reported_as_a_limitation(report: Path, results: dict
     assert 19.0e-6 < threshold["velocity"] < 19.3e-6  # the issue's ~19.1 um/s
     html = (report / "report.html").read_text(encoding="utf-8")
     paragraph = html.split('<p class="limitation">', 1)[1].split("</p>", 1)[0]
-    assert f"{threshold['velocity'] * 1e6:.2f} µm/s" in paragraph and "conflicts with experiment" in paragraph
+    assert f"{threshold['velocity'] * 1e6:.2f} µm/s" in paragraph and "not because of a measurement" in paragraph
+    assert "10 µm/s" not in paragraph  # no claim the paper does not make (round 27)
     assert 20.3e-6 < results["model"]["lowest_velocity_with_a_jump"] < 20.6e-6  # the issue's ~20.5 um/s
 
 

@@ -44,7 +44,7 @@ SAMPLES = 400
 #: Said whenever Eq 15 keeps a pulled block stuck for ever (docs/stick-phase.md §5).
 STUCK_LIMITATION = (
     "this is a limitation of Eq 15, whose aging term −t/τa grows without bound, not a prediction:"
-    " Baumberger et al. saw stick-slip of the same gel down to 10 µm/s"
+    " the paper has no stick-slip data below 50 µm/s"
 )
 #: Largest bound of the aging exponent accepted by the bounded-aging extension (e^-100: aging has long won).
 MAX_AGING_CAP = 100.0

@@ -155,7 +155,7 @@ def _caption(fit, stick, slip, jump, two) -> str:  # type: ignore[no-untyped-def
         f"{CYCLE_VELOCITY * UM:.0f} µm/s: one population creeps {stick:.2f} s from σc to σs (Table 1: 17.8–18.3 s) "
         f"and slips {slip:.2f} s; {paper_cycle}. Stick–slip needs the puller between the maximum and Vc: "
         f"{fit.peak.velocity * UM:.1f}–{fit.minimum.velocity * UM:.1f} µm/s, so this model slides steadily at "
-        "10 µm/s (no stick–slip, where Baumberger et al. saw it) and at 100 µm/s after the first slip (Table 1 "
+        "10 µm/s (no stick–slip; the paper has no data at 10 µm/s) and at 100 µm/s after the first slip (Table 1 "
         "shows cycles there). Held bonds now let go within ~0.1 s, so the static threshold stops growing after "
         "~0.1 s of hold instead of growing logarithmically as in gels (docs/extensions.md)."
     )

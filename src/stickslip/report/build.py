@@ -25,7 +25,7 @@ from ..fileio import atomic_write_text
 from ..parameters import Parameters, load_parameters
 from ..units import shorten
 from .aging_section import AGING_FIGURES
-from .comparisons import TOLERANCE, Comparison, compare, count_classes
+from .comparisons import TOLERANCE, Comparison, compare, summary_counts
 from .computations import ModelRun, computed_values, run_steps
 from .errata import Errata, load_errata
 from .figures import Curve, save_figure_files
@@ -204,7 +204,6 @@ def _results(
 ) -> dict[str, Any]:
     from ..columns import json_safe
 
-    flagged = [c for c in comparisons if c.flagged]
     return json_safe(
         {
             "paper": PAPER,
@@ -214,12 +213,7 @@ def _results(
             "parameter_set": run.params.name,
             "parameters": run.params.as_dict(),
             "tolerance": TOLERANCE,
-            "summary": {
-                "compared": len(comparisons),
-                "by_class": count_classes(comparisons),
-                "flagged": len(flagged),
-                "flagged_with_errata": sum(c.errata is not None for c in flagged),
-            },
+            "summary": summary_counts(comparisons),  # distinct statements of the paper; repeats counted once
             "comparisons": [c.as_dict() for c in comparisons],
             "model": run.summary(),
             "errata": [{"id": e.id, "title": e.title} for e in errata.entries],

@@ -1,8 +1,11 @@
 """The comparison table: each number the paper states beside the value computed here, and what the difference is.
 
 relative_difference = (computed - paper) / |paper| (None where the units differ).  Every row is put in one class
-of :data:`CLASSES` (input, agrees within :data:`TOLERANCE`, scatter, model limitation or paper error, decided in
-that order: docs/report.md, "Classes, and the headline") and carries its reason in words (:func:`class_reason`).
+of :data:`CLASSES` (input, agrees within :data:`TOLERANCE`, scatter, then paper error, the paper's unstated or
+inconsistent inputs, or model limitation, decided in that order: docs/report.md, "Classes, and the headline") and
+carries its reason in words (:func:`class_reason`).  A row that states again what another row states (the paper
+printing one number in two places) is shown and marked, and counted once: :func:`count_classes` counts distinct
+statements only.
 """
 
 from __future__ import annotations
@@ -13,7 +16,17 @@ from typing import Any
 
 from .paper import PAPER_NUMBERS, TOLERANCE, PaperNumber
 
-__all__ = ["CLASSES", "TOLERANCE", "Comparison", "Computed", "class_reason", "classify", "compare", "count_classes"]
+__all__ = [
+    "CLASSES",
+    "TOLERANCE",
+    "Comparison",
+    "Computed",
+    "class_reason",
+    "classify",
+    "compare",
+    "count_classes",
+    "summary_counts",
+]
 
 #: Class -> how the report names it, in the order the headline counts them.
 CLASSES = {
@@ -21,6 +34,7 @@ CLASSES = {
     "agrees": f"agrees (≤ {100 * TOLERANCE:g} %)",
     "scatter": "within the paper's scatter",
     "erratum": "paper error (erratum)",
+    "unstated": "paper: stated inputs do not give it",
     "limitation": "model limitation",
 }
 
@@ -33,6 +47,8 @@ class Computed:
     prediction).  ``alternative`` is a second value shown beside it, e.g. the
     model with the nominal stiffness where ``value`` uses the stiffness
     measured in that Table 1 column; it is shown, not classified.
+    ``reproduced_by`` names, with its value, an input the paper does not
+    state that gives the paper's number (rows whose stated inputs do not).
     """
 
     value: float | None
@@ -40,6 +56,7 @@ class Computed:
     echo: bool = False
     alternative: float | None = None
     alternative_label: str = ""
+    reproduced_by: str = ""
 
 
 def classify(number: PaperNumber, computed: float | None, echo: bool) -> str:
@@ -75,9 +92,9 @@ def class_reason(number: PaperNumber, computed: float | None, echo: bool) -> str
         return "the paper contradicts itself: " + number.contradiction
     if echo:
         return "the paper's arithmetic on its own numbers does not give its printed value"
-    if cls == "erratum":
-        return "the paper contradicts itself: " + number.contradiction
-    return "the model with the paper's stated inputs does not give this number; the linked erratum says why"
+    if cls == "unstated":
+        return number.unstated
+    return "the model cannot give this number with any input; the linked entry says why"
 
 
 def relative_difference(number: PaperNumber, computed: float | None) -> float | None:
@@ -95,6 +112,7 @@ class Comparison:
     echo: bool = False
     alternative: float | None = None
     alternative_label: str = ""
+    reproduced_by: str = ""
 
     @property
     def relative_difference(self) -> float | None:
@@ -110,7 +128,15 @@ class Comparison:
 
     @property
     def reason(self) -> str:
-        return class_reason(self.number, self.computed, self.echo)
+        reason = class_reason(self.number, self.computed, self.echo)
+        if self.classification == "unstated" and self.reproduced_by:
+            reason += f"; {self.reproduced_by}"
+        return reason
+
+    @property
+    def counted(self) -> bool:
+        """False for a row that states again what another row states (counted there)."""
+        return not self.number.repeat_of
 
     @property
     def flagged(self) -> bool:
@@ -134,7 +160,13 @@ class Comparison:
             "class": self.classification,
             "class_reason": self.reason,
             "how": self.how,
+            "counted": self.counted,
         }
+        if n.repeat_of:
+            out["repeat_of"] = list(n.repeat_of)
+            out["repeat_note"] = n.repeat_note
+        if self.reproduced_by:
+            out["reproduced_by"] = self.reproduced_by
         if n.units_differ:
             out["difference"] = "units differ"
         if n.scatter is not None:
@@ -161,16 +193,37 @@ def compare(computed: dict[str, Computed], errata: dict[str, str]) -> list[Compa
     for n in PAPER_NUMBERS:
         c = computed[n.key]
         value = _finite(c.value)
-        rows.append(Comparison(n, value, c.how, errata.get(n.key), c.echo, _finite(c.alternative), c.alternative_label))
+        rows.append(
+            Comparison(
+                n, value, c.how, errata.get(n.key), c.echo, _finite(c.alternative), c.alternative_label,
+                c.reproduced_by,
+            )
+        )  # fmt: skip
     return rows
 
 
 def count_classes(rows: list[Comparison] | tuple[Comparison, ...]) -> dict[str, int]:
-    """Rows per class, every class present (0 when none)."""
+    """Distinct statements of the paper per class, every class present (0 when none): a row that repeats another
+    (``Comparison.counted`` False) is counted once, in the row it repeats."""
     counts = dict.fromkeys(CLASSES, 0)
     for row in rows:
-        counts[row.classification] += 1
+        if row.counted:
+            counts[row.classification] += 1
     return counts
+
+
+def summary_counts(rows: list[Comparison] | tuple[Comparison, ...]) -> dict[str, Any]:
+    """The headline's numbers: distinct statements (by class), rows shown and repeats among them."""
+    counted = [r for r in rows if r.counted]
+    flagged = [r for r in counted if r.flagged]
+    return {
+        "compared": len(counted),
+        "rows": len(rows),
+        "repeats": len(rows) - len(counted),
+        "by_class": count_classes(rows),
+        "flagged": len(flagged),
+        "flagged_with_errata": sum(r.errata is not None for r in flagged),
+    }
 
 
 def _finite(value: float | None) -> float | None:

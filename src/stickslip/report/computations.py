@@ -8,6 +8,7 @@ short note on how.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
@@ -77,6 +78,8 @@ class ModelRun:
     jumps: dict[float, Jump] = field(default_factory=dict)  # by stress: V_s on the aging curve (Eq 8)
     simulations: dict[int, Simulation] = field(default_factory=dict)  # by pulling velocity in um/s
     table1_first_slip_100: SlipPhase | None = None  # slip from Table 1's sigma_s = 658 Pa at 100 um/s (Fig 5d)
+    # inputs the paper does not state that give its numbers where its stated inputs do not (paper key -> words)
+    reproduced_by: dict[str, str] = field(default_factory=dict)
     trace_analyses: dict[int, TraceAnalysis] = field(default_factory=dict)  # Table 1 measured on the model's traces
 
     def summary(self) -> dict[str, Any]:
@@ -153,6 +156,72 @@ def _sticks(run: ModelRun) -> None:
     run.thresholds["from sigma_c"] = stuck_threshold(run.params)
     run.thresholds["from rest"] = stuck_threshold(run.params, start_stress=0.0)
     run.jump_floor = _jump_floor(run)
+    run.reproduced_by.update(_reproducing_inputs(run))
+
+
+def _solve(f: Callable[[float], float], low: float, high: float) -> float | None:
+    """The root of ``f`` in [low, high], or None when the interval does not bracket one (then nothing is said)."""
+    from scipy.optimize import brentq
+
+    try:
+        fl, fh = f(low), f(high)
+    except (ModelError, TypeError):
+        return None
+    if not (math.isfinite(fl) and math.isfinite(fh)) or fl * fh > 0.0:
+        return None
+    return float(brentq(f, low, high, xtol=1e-12 * high))
+
+
+def _reproducing_inputs(run: ModelRun) -> dict[str, str]:
+    """For the paper's numbers that its stated inputs do not give (stickslip.report.paper.PAPER_UNSTATED), an input
+    it does not state that does, found by solving the model for it: the stiffness of the simulated stick times
+    18.3 s and 9.3 s (E18), and the chain breakage rate of the first cycle at 100 um/s, whose contact aged before
+    shearing began (E22)."""
+    p, out = run.params, {}
+    height = p.block.height
+
+    def stick(gd_h: float, velocity: float) -> StickPhase:
+        return stick_phase(p.with_overrides({"block.shear_modulus": gd_h * height}), velocity)
+
+    def time_of(gd_h: float, velocity: float) -> float:
+        ts = stick(gd_h, velocity).stick_time
+        return math.nan if ts is None else ts
+
+    found = {}
+    for v0, printed in ((50, 18.3), (100, 9.3)):
+        found[v0] = _solve(lambda g, v=v0 * 1e-6, ts=printed: time_of(g, v) - ts, 300e3, 600e3)
+    if found[50] is not None and found[100] is not None:
+        other = time_of(found[50], 100e-6)
+        out["stick_time_50"] = (
+            f"Gd/h = {found[50] / 1e3:.1f} kPa/m, which the paper does not state, gives 18.30 s (and {other:.2f} s at"
+            " 100 µm/s: one stiffness gives both printed values)"
+        )
+        out["stick_time_100"] = (
+            f"Gd/h = {found[100] / 1e3:.1f} kPa/m, which the paper does not state, gives 9.30 s; the"
+            f" {found[50] / 1e3:.1f} kPa/m that gives 18.3 s at 50 µm/s gives {other:.2f} s"
+        )
+    # 100 um/s cycle 1: from sigma_s - slope t_s (Eq 12) at the column's own stiffness, the breakage rate of chains
+    # that aged before shearing gives sigma_s and t_s together
+    slope = table1_value("stick_slope", 100e-6, 1)
+    sigma_s, t_s = table1_value("slip_stress", 100e-6, 1), table1_value("stick_time", 100e-6, 1)
+    assert slope is not None and sigma_s is not None and t_s is not None
+    start = sigma_s - slope * t_s
+    column = with_stiffness(p, slope / 100e-6)
+
+    def peak(rate: float) -> float:
+        s = stick_phase(column.with_overrides({"stick.break_rate": rate}), 100e-6, start)
+        return math.nan if s.peak_stress is None else s.peak_stress
+
+    rate = _solve(lambda r: peak(r) - sigma_s, 1e-3 * p.stick.break_rate, p.stick.break_rate)
+    if rate is not None:
+        s = stick_phase(column.with_overrides({"stick.break_rate": rate}), 100e-6, start)
+        words = (
+            f"from σ0 = σs − slope × ts = {start:.0f} Pa at the column's stiffness, uc/τ = {rate:.3g} 1/s (stated:"
+            f" {p.stick.break_rate:.3g} 1/s; chains aged longer break more slowly), which the paper does not state,"
+            f" gives σs = {s.peak_stress:.1f} Pa and ts = {s.stick_time:.2f} s together"
+        )
+        out["table1_slip_stress_100_1"] = out["table1_stick_time_100_1"] = words
+    return out
 
 
 def _jump_floor(run: ModelRun) -> float | None:
@@ -270,7 +339,9 @@ def computed_values(run: ModelRun) -> dict[str, Computed]:
         nominal, measured = run.sticks[v0], run.mean_sticks[v0]
         k = measured.stiffness / 1e3
         simulated = "Eq 15 from σc until Nc = 0 with the paper's parameters, K = 0.766 × 400 kPa/m (Eqs 12, 17)"
-        out[f"stick_time_{v0}"] = Computed(nominal.stick_time, simulated)
+        out[f"stick_time_{v0}"] = Computed(
+            nominal.stick_time, simulated, reproduced_by=run.reproduced_by.get(f"stick_time_{v0}", "")
+        )
         with_k = f"with K = {k:.1f} kPa/m, the mean of Table 1's slopes at {v0} µm/s"
         how = f"Eq 15 from σc {with_k}"
         for prefix in ("stick_time_measured", "stick_time_table"):
@@ -284,10 +355,14 @@ def computed_values(run: ModelRun) -> dict[str, Computed]:
         out[key] = Computed(_jump(run, stress), f"steady curve with aging carries {stress:g} Pa (Eq 8, right branch)")
     for v0 in (50, 100, 350):
         slip = run.simulations[v0].slip_phases[0]
-        how = "end of the first slip phase (Eq 10): " + (
-            "dσ/dV = 0 at Vc, where the block sticks" if slip.ends == "stick" else "V settles at V0 (steady sliding)"
-        )
-        out[f"slip_asymptote_{v0}"] = Computed(slip.end_velocity, how)
+        if slip.ends == "stick":
+            how = "end of the first slip phase (Eq 10): dσ/dV = 0 at Vc, where the block sticks"
+            out[f"slip_asymptote_{v0}"] = Computed(slip.end_velocity, how)
+        else:
+            # steady sliding above Vc: Eq 5 with dσ/dt = 0 is V = V0, the pulling velocity handed back; what the
+            # row checks is that the slip ends in steady sliding, not a number
+            how = "end of the first slip phase (Eq 10): V settles at V0, the pulling velocity (steady sliding, Eq 5)"
+            out[f"slip_asymptote_{v0}"] = Computed(slip.end_velocity, how, echo=True)
     for key, _label, _unit, _display, values, _scale in TABLE1_ROWS:
         for (velocity, cycle), value in zip(TABLE1_COLUMNS, values, strict=True):
             if value is None:
@@ -320,15 +395,16 @@ def _table1_value(run: ModelRun, key: str, velocity: float, cycle: int, sc: floa
             column.stiffness / p.block.geometric_factor, "slope / (0.766 V0): the paper's arithmetic redone (Eq 17)",
             echo=True, alternative=p.block.stiffness, alternative_label="nominal Gd/h",
         )  # fmt: skip
+    reproduced_by = run.reproduced_by.get(f"table1_{key}_{_um(velocity)}_{cycle}", "")
     if key == "slip_stress":
         return Computed(
             column.measured.peak_stress, f"σs = σ0 + K V0 ts (Eqs 15-16), {start}, {own}",
-            alternative=column.nominal.peak_stress, alternative_label=NOMINAL,
+            alternative=column.nominal.peak_stress, alternative_label=NOMINAL, reproduced_by=reproduced_by,
         )  # fmt: skip
     if key == "stick_time":
         return Computed(
             column.measured.stick_time, f"Eq 15 {start} until Nc = 0, {own}",
-            alternative=column.nominal.stick_time, alternative_label=NOMINAL,
+            alternative=column.nominal.stick_time, alternative_label=NOMINAL, reproduced_by=reproduced_by,
         )  # fmt: skip
     if key == "jump_velocity":
         stress = _TABLE1_SLIP_STRESSES[(velocity, cycle)]

@@ -1,7 +1,10 @@
 """The errata (``stickslip/report/errata.md``), rendered into the report so that its links work offline.
 
-Entries are level-2 headings ``## E<n> title``; each becomes an element with
-``id="e<n>"`` so that the comparison table can link ``#e<n>``.  The text is
+Entries are level-2 headings ``## E<n> title`` (errata of the paper) or
+``## M<n> title`` (properties and limitations of the model, listed after the
+errata under their own heading: not errors of the paper); each becomes an
+element with ``id="e<n>"`` (``id="m<n>"``) so that the report can link
+``#e<n>``.  The text is
 package data, the one source of the errata (docs/errata.md only points to
 it), so that an installed wheel renders it.
 """
@@ -16,15 +19,20 @@ from importlib import resources
 from ..errors import DataError
 from .markup import inline_html
 
-_ENTRY = re.compile(r"^(E\d+)\b[\s.:—–-]*(.*)$")
+_ENTRY = re.compile(r"^([EM]\d+)\b[\s.:—–-]*(.*)$")
 #: The one piece of raw HTML the errata may use: an empty anchor, ``<a id="e1"></a>``.
 _ANCHOR = re.compile(r'^\s*<a\s+(?:id|name)="([A-Za-z][\w.-]*)"\s*>\s*</a>\s*$')
 
 
 @dataclass(frozen=True)
 class ErrataEntry:
-    id: str  # "E3"
+    id: str  # "E3" (an erratum of the paper) or "M1" (a property of the model)
     title: str
+
+    @property
+    def erratum(self) -> bool:
+        """True for an error of the paper (E<n>), False for a property of the model (M<n>)."""
+        return self.id.startswith("E")
 
     @property
     def anchor(self) -> str:

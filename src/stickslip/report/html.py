@@ -12,7 +12,7 @@ from string import Template
 from ..analysis import TraceAnalysis
 from ..parameters import Parameters
 from ..quasistatic.stick import StuckThreshold
-from .comparisons import CLASSES, TOLERANCE, Comparison, count_classes
+from .comparisons import CLASSES, TOLERANCE, Comparison, summary_counts
 from .errata import Errata
 from .figures import Curve, ReportFigure, data_uri
 from .formatting import DISPLAY_UNITS, format_parameter, format_percent, format_quantity
@@ -106,16 +106,19 @@ def comparison_table(rows: Sequence[Comparison], errata: Errata) -> str:
     )
     out = [head]
     group = None
+    quantities = {r.number.key: r.number.quantity for r in rows}
     for row in rows:
         n = row.number
         if n.group != group:
             group = n.group
             out.append(f'<tr class="group"><th colspan="9">{escape(group)}</th></tr>')
         css = "flagged" if row.flagged else "agrees"
+        if not row.counted:
+            css += " repeat"
         out.append(
             f'<tr id="cmp-{escape(n.key)}" class="{css}" data-key="{escape(n.key)}"'
-            f' data-class="{escape(row.classification)}">'
-            f"<td>{escape(n.quantity)}{_note(n.note)}</td>"
+            f' data-class="{escape(row.classification)}" data-counted="{str(row.counted).lower()}">'
+            f"<td>{escape(n.quantity)}{_note(n.note)}{_repeat_note(n, quantities)}</td>"
             f'<td><span class="badge">{escape(KIND_LABELS[n.kind])}</span></td>'
             f'<td class="printed">{escape(paper_text(n))}</td>'
             f"<td>{escape(n.source)}</td>"
@@ -123,7 +126,7 @@ def comparison_table(rows: Sequence[Comparison], errata: Errata) -> str:
             f'<td class="num diff">{escape(difference_text(row))}</td>'
             f"<td>{class_badge(row)}</td>"
             f"<td>{_errata_link(row, errata)}</td>"
-            f'<td class="how">{escape(row.how)}</td></tr>'
+            f'<td class="how">{escape(row.how)}{_reproduced(row)}</td></tr>'
         )
     out.append("</tbody>\n</table></div>")
     return "\n".join(out)
@@ -196,6 +199,24 @@ def _note(text: str) -> str:
     return f'<br><span class="note">{escape(text)}</span>' if text else ""
 
 
+def _reproduced(row: Comparison) -> str:
+    """For a number the paper's stated inputs do not give: the unstated input that does, in the row itself."""
+    if row.classification != "unstated" or not row.reproduced_by:
+        return ""
+    return f'<br><span class="note">Not stated in the paper: {escape(row.reproduced_by)}.</span>'
+
+
+def _repeat_note(n: PaperNumber, quantities: Mapping[str, str]) -> str:
+    """For a row that states again what other rows state: which, linked, and that it is counted there."""
+    if not n.repeat_of:
+        return ""
+    links = " and ".join(f'<a href="#cmp-{escape(k)}">{escape(quantities.get(k, k))}</a>' for k in n.repeat_of)
+    return (
+        f'<br><span class="note repeat">Same statement as row {links}: counted once, there, not in this row'
+        f" ({escape(n.repeat_note)}).</span>"
+    )
+
+
 #: The paper's symbols where a parameter's own (ASCII, to be typed on a command line) differs; the two aging times
 #: the paper calls τa both get a label saying which one they are.
 PAPER_SYMBOLS = {
@@ -225,12 +246,27 @@ def parameter_symbol(key: str, symbol: str) -> str:
     return re.sub(r"_([A-Za-z0-9]+)", r"_{\1}", written)
 
 
+#: Parameters of the set that the paper does not give: the package's reading (key -> what the paper gives instead).
+PACKAGE_READINGS = {
+    "bonds.chain_stiffness": "the package's reading, not the paper's: the paper gives only λM/kT, with a wrong"
+    " dimension; M sets the scale of every steady stress (Eq 8), so every stress agreement rests on it",
+    "bonds.activation_length": "the package's reading, not the paper's: λ = (λM/kT) kT / M with the M above;"
+    " Eq 15 uses λ/kT",
+    "bonds.temperature": "the experiments' 20 °C (Section 3)",
+}
+
+
 def parameter_table(params: Parameters) -> str:
     out = ["<table>\n<thead><tr><th>Key</th><th>Symbol</th><th>Value</th><th>Meaning</th></tr></thead>\n<tbody>"]
     for key, symbol, value, dimension, meaning in parameter_rows(params):
+        reading = PACKAGE_READINGS.get(key)
+        note = f'<br><span class="note reading">{escape(reading)}</span>' if reading else ""
+        link = ' (<a href="#e1">E1</a>)' if key in ("bonds.chain_stiffness", "bonds.activation_length") else ""
         out.append(
-            f"<tr><td><code>{escape(key)}</code></td><td>{inline_html(parameter_symbol(key, symbol))}</td>"
-            f'<td class="num">{escape(format_parameter(value, dimension))}</td><td>{escape(meaning)}</td></tr>'
+            f"<tr><td><code>{escape(key)}</code></td>"
+            f"<td>{inline_html(parameter_symbol(key, symbol))}</td>"
+            f'<td class="num">{escape(format_parameter(value, dimension))}</td>'
+            f"<td>{escape(meaning)}{note}{link}</td></tr>"
         )
     out.append("</tbody>\n</table>")
     return "\n".join(out)
@@ -257,18 +293,34 @@ def file_list(names: Sequence[str]) -> str:
 
 
 def summary_sentence(rows: Sequence[Comparison]) -> str:
-    """The headline: how many rows fall in each class."""
-    counts = count_classes(list(rows))
+    """The headline: how many distinct statements of the paper fall in each class (a row that repeats another is
+    counted once), and what the stress agreements rest on."""
+    s = summary_counts(list(rows))
+    counts = s["by_class"]
     text = (
-        f"Of the {len(rows)} numbers the paper states, {counts['agrees']} agree with this package's computation "
-        f"within {100 * TOLERANCE:g} % and {counts['scatter']} lie within the scatter the paper states or shows. "
-        f"{counts['erratum']} differ because of an error in the paper (where the paper contradicts itself; each "
-        f"links its erratum) and {counts['limitation']} are limitations of the model (the model with the paper's "
-        f"stated inputs does not give them; each explained). The other {counts['input']} are the paper's own inputs "
-        "handed back (parameters and arithmetic on them), not counted as agreement. A difference between the model "
-        "and a measurement is never counted as the paper's error."
+        f"Of the {s['compared']} distinct numbers the paper states, {counts['agrees']} agree with this package's "
+        f"computation within {100 * TOLERANCE:g} % and {counts['scatter']} lie within the scatter the paper states "
+        f"or shows. {counts['erratum']} are errors in the paper (it contradicts itself or prints a wrong unit; each "
+        f"links its erratum), {counts['unstated']} are numbers of the paper that its own stated inputs do not give "
+        f"(each row names the input, not stated in the paper, that gives it) and {counts['limitation']} are "
+        "limitations of the model (numbers it cannot give with any input). The other "
+        f"{counts['input']} are the paper's own inputs handed back (parameters and arithmetic on them), not counted "
+        f"as agreement. The table has {s['rows']} rows: {s['repeats']} state again a number that another row "
+        "states (the paper printing it twice) and are marked and counted once. A difference between the model and a "
+        "measurement is never counted as the paper's error by its size alone. "
     )
-    return escape(text)
+    basis = (
+        "Every stress agreement rests on the package's reading of the paper's λM/kT, which has a wrong dimension: "
+        "M = 100 µN/m and λ = 0.1 nm, values the paper does not give (Parameters used; erratum "
+    )
+    return f'{escape(text)}{escape(basis)}<a href="#e1">E1</a>{escape(RESTS_ON)}'
+
+
+#: What the M of E1 decides, after the link to E1 in the headline.
+RESTS_ON = (
+    "): at a fixed λM/kT every steady stress of Eq 8 is proportional to M, and Eq 15 uses λ/kT = (λM/kT)/M. Vc "
+    "does not depend on it."
+)
 
 
 def stiffness_paragraph(rows: Sequence[Comparison]) -> str:
@@ -280,8 +332,10 @@ def stiffness_paragraph(rows: Sequence[Comparison]) -> str:
     gap = "" if fact is None or fact.relative_difference is None else f", {format_percent(fact.relative_difference)}"
     return (
         "<p><strong>Stiffness.</strong> The nominal stiffness 0.766 × 400 kPa/m gives stick slopes "
-        f"{span} below Table 1's: one fact, counted once, as a limitation of the model's nominal block (the row "
-        f"“Gd/h = 400 kPa/m compares well”{gap}: not an error in the paper). So that it "
+        f"{span} below Table 1's: one fact, counted once, as a disagreement between two of the paper's own inputs "
+        f"(the row “Gd/h = 400 kPa/m compares well”{gap}, class “{escape(CLASSES['unstated'])}”: the nominal "
+        "4 kPa / 10 mm against the stiffness its measured slopes give; not a limitation of the model, which takes "
+        "either). So that it "
         "is not counted again in every slope, Gd/h and stick time, Table 1's σs and ts are computed with the "
         "stiffness each column's own slope implies (K = slope / V0), and the model with the nominal stiffness is "
         "shown beside (“nominal”). The start-up sticks (100 µm/s cycle 1, where σs − slope × ts = 21 Pa, and the "
@@ -300,6 +354,7 @@ def threshold_paragraph(
     v_star = sigma_c.velocity * 1e6
     extra = f" ({rest.velocity * 1e6:.1f} µm/s for a stick from rest)" if rest and rest.velocity else ""
     gap = ""
+    narrowed = f" to {jump_floor * 1e6:.1f} µm/s–Vc" if jump_floor is not None else ""
     if jump_floor is not None and curve_maximum is not None:
         gap = (
             f" Between {v_star:.1f} and {jump_floor * 1e6:.1f} µm/s the chains collapse at a σs above the steady "
@@ -310,9 +365,11 @@ def threshold_paragraph(
         "τa = 10 s the aging term −t/τa of Eq 15 grows without bound, so below this pulling velocity the breakage "
         f"rate of the attached chains decays faster than the load raises it and the block never slips{escape(extra)};"
         f" no block stays stuck above Nc0 kT/(λ K τa) = {sigma_c.ceiling * 1e6:.2f} µm/s.{escape(gap)} "
-        "Baumberger et al. drove the same gel from 10 µm/s to 2 mm/s and saw stick-slip below Vc, so this is a "
-        "limitation of Eq 15 that conflicts with experiment, not a prediction (errata: “Where stick–slip "
-        "happens”; <code>stickslip.quasistatic.stick.stuck_threshold</code>).</p>"
+        "It is a limitation because the aging term is unbounded (the aging of a real contact saturates), not "
+        "because of a measurement: the paper's stick–slip data are at 50, 100 and 350 µm/s only, and its general "
+        f"statement that stick–slip occurs below Vc is narrowed by its own Eq 15{escape(narrowed)}. Whether the gel "
+        "stick-slips at lower pulling velocities is not in the paper and not checked here (<a href=\"#m1\">M1</a>; "
+        "<code>stickslip.quasistatic.stick.stuck_threshold</code>).</p>"
     )
 
 
@@ -322,8 +379,10 @@ def limitations_section(paragraphs: str) -> str:
         return ""
     return (
         '<section id="limitations">\n<h2>Limitations of the model</h2>\n'
-        "<p>Where the model, with the paper's inputs, cannot give what the experiment shows. The numbers it cannot"
-        " give are in the table below, class “model limitation”.</p>\n"
+        "<p>What the model, as the paper writes it, cannot do whatever its inputs. A number the paper states that"
+        " the model cannot give with any input would be in the table below, class “model limitation”; where the"
+        " model gives the paper's number with an input the paper does not state, the row is the paper's (class"
+        f" “{escape(CLASSES['unstated'])}”), not the model's.</p>\n"
         f"{paragraphs}\n</section>"
     )
 

@@ -19,6 +19,10 @@ PULLING_VELOCITIES = (50e-6, 100e-6, 350e-6)
 DATA_RANGE = (140e-6, 2000e-6)
 
 
+#: How a difference beyond tolerance and scatter is explained (see PaperNumber.explanation).
+EXPLANATIONS = ("erratum", "unstated", "limitation")
+
+
 @dataclass(frozen=True)
 class PaperNumber:
     """One number the paper states.
@@ -42,16 +46,27 @@ class PaperNumber:
     paper_unit: str | None = None  # SI unit of the paper value, set only where the printed unit is wrong
     note: str = ""  # context a reader needs beside the number
     scatter: tuple[float, float] | None = None  # SI band the paper states (or shows) for this measurement
-    # the class of a difference beyond tolerance and scatter: "limitation" (the model with the paper's stated inputs
-    # does not give the number) unless the paper contradicts itself there, then "erratum" with ``contradiction``
+    # the class of a difference beyond tolerance and scatter: "erratum" where the paper contradicts itself (with
+    # ``contradiction``), "unstated" where the paper's stated inputs do not give its number and an input it does not
+    # state would (with ``unstated``), "limitation" where the model cannot give the number with any input
     explanation: str = "limitation"
     contradiction: str = ""  # how the paper contradicts itself (required for explanation="erratum")
+    unstated: str = ""  # which stated input fails and what would give the number (required for "unstated")
+    # the row states again what the rows ``repeat_of`` state (the same number for the same quantity, said twice):
+    # it is shown, marked, and counted once, there
+    repeat_of: tuple[str, ...] = ()
+    repeat_note: str = ""  # in words: where the paper says it again
 
     def __post_init__(self) -> None:
-        if self.explanation not in ("erratum", "limitation"):
-            raise ValueError(f"{self.key}: explanation must be 'erratum' or 'limitation', not {self.explanation!r}")
+        if self.explanation not in EXPLANATIONS:
+            expected = ", ".join(EXPLANATIONS)
+            raise ValueError(f"{self.key}: explanation must be one of {expected}, not {self.explanation!r}")
         if self.explanation == "erratum" and not self.contradiction:
             raise ValueError(f"{self.key}: a paper error must say how the paper contradicts itself")
+        if self.explanation == "unstated" and not self.unstated:
+            raise ValueError(f"{self.key}: a number the stated inputs do not give must say which input would")
+        if self.repeat_of and not self.repeat_note:
+            raise ValueError(f"{self.key}: a repeated statement must say where the paper states it first")
 
     @property
     def units_differ(self) -> bool:
@@ -288,8 +303,8 @@ TABLE1_SET_APART = frozenset({(100e-6, 1)})
 #: Context for Table 1 columns that the model is not meant to reproduce cycle by cycle.
 TABLE1_NOTES = {
     (100e-6, 1): "first cycle, a stick from rest (σs − slope·ts = 21 Pa); the paper puts its higher σs down to"
-    " extra aging before shearing began, which the model does not have",
-    (350e-6, 1): "above Vc: one start-up stick from rest, then steady sliding; the column is inconsistent in itself",
+    " extra aging before shearing began, by an amount it does not state",
+    (350e-6, 1): "above Vc: one start-up stick from rest, then steady sliding; the column contradicts itself (E13)",
 }
 
 #: Table 1 rows: key, label, SI unit, display unit, values as printed (None for "--"), SI value of one printed unit.
@@ -330,23 +345,81 @@ TABLE1_KINDS = {
 #: Relative difference up to which a computed value agrees with the paper's; also the margin of the scatter bands.
 TOLERANCE = 0.02
 
-#: The only rows where a difference beyond tolerance and scatter is an error in the paper: there the paper
-#: contradicts itself (its own numbers, not the model, show it), and the text says how.  A difference between the
-#: model and a measurement, or between the model and a number the paper computed with inputs it does not state, is
-#: never the paper's error: every other such row is a limitation of the model (its erratum entry explains it).
-#: Wrong printed units and echoes that do not match are errors by rule (comparisons.classify).
+#: Rows where a difference beyond tolerance and scatter is an error in the paper: there the paper contradicts itself
+#: (its own numbers, not the model, show it), and the text says how.  A difference between the model and a
+#: measurement is never the paper's error by its size alone.  Wrong printed units and echoes that do not match are
+#: errors by rule (comparisons.classify).
+_COLUMN_350 = (
+    "in its 350 µm/s column of Table 1, 116 Pa/s × 7.51 s = 871 Pa is more than its σs = 800 Pa even from rest,"
+    " and its Vs = 760 µm/s carries 575 Pa on the paper's curve, where 800 Pa needs 1643 µm/s; which of σs, ts, Vs"
+    " (or the slope) is wrong cannot be told, so none of them is a test of the model (E13, E9)"
+)
 PAPER_CONTRADICTIONS = {
     "stick_time_table_50": "the text's 18.9 s contradicts Table 1's own 18.3, 18.3 and 17.8 s at 50 µm/s (E9)",
     "table1_stiffness_350_1": "457 kPa/m is not the column's own slope 116 Pa/s over 0.766 V0 (432.7 kPa/m), the"
-    " rule every other column follows (E14)",
-    "table1_stick_time_350_1": "the column contradicts itself: 116 Pa/s × 7.51 s = 871 Pa is more than its"
-    " σs = 800 Pa even from rest (E9)",
+    " rule every other column follows; it is the 100 µm/s cycle 1 value (E14)",
+    "table1_slip_stress_350_1": _COLUMN_350,
+    "table1_stick_time_350_1": _COLUMN_350,
+    "table1_jump_velocity_350_1": _COLUMN_350,
     "table1_jump_velocity_50_3": "Vs does not follow the paper's own curve: 720 µm/s for σs = 552 Pa but 702 µm/s for"
     " the larger 554 and 556 Pa (E15)",
     "table1_jump_velocity_100_3": "Vs does not follow the paper's own curve: the same 702 µm/s for σs = 542 Pa as"
     " for 549 and 554 Pa (E15)",
-    "table1_jump_velocity_350_1": "σs = 800 Pa with Vs = 760 µm/s lies on neither of the paper's curves, which carry"
-    " 800 Pa at 1643 µm/s (aging) and 1651 µm/s (no aging) (E13)",
+}
+
+#: Rows where the paper's own stated inputs do not give its number, while an input it does not state would (or two
+#: of its stated inputs disagree): a gap in the paper, not a limitation of the model, which can give the number.
+#: Each row names the input; where it is computed, ``Computed.reproduced_by`` gives it with its value.
+PAPER_UNSTATED = {
+    "stick_time_50": "the paper's stated inputs (Nc0, uc/τ, τa = 10 s, λ/kT, K = 0.766 × 400 kPa/m, from σc) do not"
+    " give its simulated stick time; it does not say which stiffness (or σc) its simulation used (E18)",
+    "stick_time_100": "the paper's stated inputs (Nc0, uc/τ, τa = 10 s, λ/kT, K = 0.766 × 400 kPa/m, from σc) do not"
+    " give its simulated stick time; it does not say which stiffness (or σc) its simulation used (E18)",
+    "stiffness_against_table1": "two of the paper's stated inputs disagree: the nominal Gd/h = 4 kPa / 10 mm ="
+    " 400 kPa/m and the Gd/h its own Table 1 slopes give (424–457 kPa/m), which it says “compares well”; the model"
+    " takes each Table 1 column's stiffness from its slope and the nominal one elsewhere (E14)",
+    "table1_slip_stress_100_1": "the paper sets this cycle apart: the contact aged before shearing began, by an"
+    " amount the paper does not state; the stated uc/τ (fresh chains at every stick) gives the model's value (E22)",
+    "table1_stick_time_100_1": "the paper sets this cycle apart: the contact aged before shearing began, by an"
+    " amount the paper does not state; the stated uc/τ (fresh chains at every stick) gives the model's value (E22)",
+}
+
+#: Rows that state again what other rows state: the same number for the same quantity, printed in two places (or a
+#: Table 1 cell that a text row repeats).  Shown and marked, counted once (in the first row named).
+REPEATS: dict[str, tuple[tuple[str, ...], str]] = {
+    "critical_stress_cycles": (
+        ("critical_stress",),
+        "259 Pa is the paper's σc of Section 3 said again, as the centre of Table 1's σc row (254–264 Pa), whose"
+        " cells are rows of their own",
+    ),
+    "slip_stress_50": (
+        ("table1_slip_stress_50_1",),
+        "Table 1's 554 Pa (50 µm/s, cycle 1); the text does not print it again; here at the mean stiffness of the"
+        " 50 µm/s cycles",
+    ),
+    "slip_stress_100": (
+        ("table1_slip_stress_100_2", "table1_slip_stress_100_4"),
+        "Table 1's 549 Pa (100 µm/s, cycles 2 and 4); the text does not print it again; here at the mean stiffness"
+        " of cycles 2–4",
+    ),
+    "jump_velocity_50": (
+        ("table1_jump_velocity_50_1",),
+        "Table 1's 702 µm/s for σs = 554 Pa (50 µm/s, cycle 1), the same computation",
+    ),
+    "jump_velocity_100": (
+        ("table1_jump_velocity_100_2", "table1_jump_velocity_100_4"),
+        "Table 1's 702 µm/s for σs = 549 Pa (100 µm/s, cycles 2 and 4), the same computation",
+    ),
+    "slip_asymptote_50": (
+        ("critical_velocity",),
+        "the slip below Vc ends at Vc (Eq 10, where dσ/dV = 0): the paper's 125 µm/s is its Vc said again, and the"
+        " model's end velocity is its Vc",
+    ),
+    "slip_asymptote_100": (
+        ("critical_velocity",),
+        "the slip below Vc ends at Vc (Eq 10, where dσ/dV = 0): the paper's 125 µm/s is its Vc said again, and the"
+        " model's end velocity is its Vc",
+    ),
 }
 
 
@@ -373,11 +446,17 @@ def scatter_band(key: str, velocity: float) -> tuple[float, float] | None:
     return min(values) * (1.0 - TOLERANCE), max(values) * (1.0 + TOLERANCE)
 
 
-def _explanation(key: str) -> dict[str, str]:
-    """The class of a difference beyond tolerance and scatter for row ``key`` (see PAPER_CONTRADICTIONS)."""
+def _explanation(key: str) -> dict:
+    """How row ``key`` explains a difference beyond tolerance and scatter (PAPER_CONTRADICTIONS, PAPER_UNSTATED),
+    and whether it repeats another row (REPEATS)."""
+    out: dict = {"explanation": "limitation", "contradiction": "", "unstated": ""}
     if key in PAPER_CONTRADICTIONS:
-        return {"explanation": "erratum", "contradiction": PAPER_CONTRADICTIONS[key]}
-    return {"explanation": "limitation"}
+        out.update(explanation="erratum", contradiction=PAPER_CONTRADICTIONS[key])
+    elif key in PAPER_UNSTATED:
+        out.update(explanation="unstated", unstated=PAPER_UNSTATED[key])
+    if key in REPEATS:
+        out.update(repeat_of=REPEATS[key][0], repeat_note=REPEATS[key][1])
+    return out
 
 
 def _table1_numbers() -> tuple[PaperNumber, ...]:
@@ -431,6 +510,21 @@ PAPER_NUMBERS: tuple[PaperNumber, ...] = (
     )
     + TABLE1_NUMBERS
 )
+
+
+def _check_references() -> None:
+    """Every row the tables above name exists, and a repeat names rows that are counted themselves."""
+    keys = {n.key for n in PAPER_NUMBERS}
+    named = set(PAPER_CONTRADICTIONS) | set(PAPER_UNSTATED) | set(REPEATS)
+    named |= {k for originals, _ in REPEATS.values() for k in originals}
+    if named - keys:
+        raise KeyError(f"no paper number for: {', '.join(sorted(named - keys))}")
+    chained = {k for originals, _ in REPEATS.values() for k in originals} & set(REPEATS)
+    if chained:
+        raise ValueError(f"a repeat must name a counted row, not another repeat: {', '.join(sorted(chained))}")
+
+
+_check_references()
 
 
 def _topics_for(number: PaperNumber) -> tuple[str, ...]:
@@ -489,8 +583,8 @@ TABLE1_ERRATA: dict[tuple[str, tuple[int, int] | None], tuple[str, ...]] = {
     ("slip_stress", (100, 3)): (r"^Table 1 σs",),
     ("slip_stress", (350, 1)): COLUMN_350,
     ("stick_time", None): STICK_TIMES,
-    ("stick_time", (100, 1)): TABLE1_STICK_TIMES,
-    ("stick_time", (350, 1)): TABLE1_STICK_TIMES,
+    ("stick_time", (100, 1)): (r"^Table 1 σs", *TABLE1_STICK_TIMES),
+    ("stick_time", (350, 1)): (*COLUMN_350, *TABLE1_STICK_TIMES),
     ("jump_velocity", None): JUMP,
     ("jump_velocity", (350, 1)): COLUMN_350,
 }
