@@ -368,7 +368,7 @@ def threshold_paragraph(
         "It is a limitation because the aging term is unbounded (the aging of a real contact saturates), not "
         "because of a measurement: the paper's stick–slip data are at 50, 100 and 350 µm/s only, and its general "
         f"statement that stick–slip occurs below Vc is narrowed by its own Eq 15{escape(narrowed)}. Whether the gel "
-        "stick-slips at lower pulling velocities is not in the paper and not checked here (<a href=\"#m1\">M1</a>; "
+        'stick-slips at lower pulling velocities is not in the paper and not checked here (<a href="#m1">M1</a>; '
         "<code>stickslip.quasistatic.stick.stuck_threshold</code>).</p>"
     )
 
