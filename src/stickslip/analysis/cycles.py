@@ -265,6 +265,10 @@ def analyze_trace(
     long_cycles = _long_cycles(cycles, step)
     if long_cycles:
         warnings.append(long_cycles)
+    if regime == regimes.STEADY and steady_from is not None:
+        scattered = _wide_steady_scatter(x[_between(t, steady_from, math.inf)])
+        if scattered:
+            warnings.append(scattered)
     summary = _summary(t, x, cycles, regime, steady_from, v0)
     if unresolved is not None:
         summary["unresolved_swings"] = unresolved.as_dict()
@@ -772,6 +776,26 @@ def _cycles(
 #: inside it may have been missed (judged with at least LONG_CYCLE_AMONG complete cycles).
 LONG_CYCLE = 1.6
 LONG_CYCLE_AMONG = 3
+
+
+#: A steady stretch scattering by more than this fraction of its mean (sd) is warned: friction is measured to a few
+#: per cent, and stick-slip sampled about twice a cycle or less looks like such scatter (aliased, no regular swing)
+WIDE_STEADY_SCATTER = 0.05
+
+
+def _wide_steady_scatter(stress: np.ndarray) -> str:
+    """A warning when a steady stretch's scatter is WIDE_STEADY_SCATTER of its mean or more, "" otherwise."""
+    stress = stress[np.isfinite(stress)]
+    if stress.size < 3:
+        return ""
+    mean, spread = float(np.mean(stress)), float(np.std(stress, ddof=1))
+    if not (mean > 0 and spread >= WIDE_STEADY_SCATTER * mean):
+        return ""
+    return (
+        f"the steady stretch scatters by {100 * spread / mean:.2g} % of its mean (sd {spread:.4g} Pa over"
+        f" {stress.size} samples), more than a friction measurement's noise usually is: stick-slip sampled about"
+        " twice a cycle or less looks the same; sample faster to tell them apart"
+    )
 
 
 def _long_cycles(cycles: list[CycleResult], step: float) -> str:
