@@ -32,6 +32,7 @@ __all__ = [
     "classify_cycles",
     "extremes",
     "remaining_change",
+    "repeat_tolerance",
     "turning_points",
 ]
 
@@ -223,10 +224,19 @@ def remaining_change(t: np.ndarray, y: np.ndarray, tau: float, dense: Dense | No
     The tail is read at T - 2 tau, T - tau and T (the interpolant or linear interpolation between steps);
     with successive changes d1, d2 of one sign and q = d2/d1 < 1, what is left is d2 q/(1 - q).
     """
+    return _aitken(*_tail_changes(t, y, tau, dense))
+
+
+def _tail_changes(t: np.ndarray, y: np.ndarray, tau: float, dense: Dense | None) -> tuple[float, float]:
+    """(d1, d2): the changes over [T - 2 tau, T - tau] and [T - tau, T]."""
     end = float(t[-1])
     points = np.array([end - 2 * tau, end - tau, end])
     values = np.asarray(dense(points), dtype=float) if dense is not None else np.interp(points, t, y)
-    d1, d2 = float(values[1] - values[0]), float(values[2] - values[1])
+    return float(values[1] - values[0]), float(values[2] - values[1])
+
+
+def _aitken(d1: float, d2: float) -> tuple[float, float]:
+    """(|d2|, what is still to come after two successive changes d1, d2 of an exponential approach)."""
     if d2 == 0.0:
         return 0.0, 0.0
     q = d2 / d1 if d1 != 0 else math.inf
@@ -270,7 +280,7 @@ def classify(
     window = float(tw[-1] - tw[0])
     floor = max(float(floor), 0.0)
     # an extremum at the window's first point is where the window starts, not a turning point of the solution
-    ext = [i for i in _alternating(yw, floor) if i > 0]
+    ext = _without_leading_wiggles(yw, [i for i in _alternating(yw, floor) if i > 0])
     placed = [extremes(tw, yw, i, dense) for i in ext]
     is_max = _kinds(yw, ext)
     peaks = [placed[k] for k in range(len(ext)) if is_max[k]]
@@ -281,6 +291,10 @@ def classify(
     ratios = [b / a for a, b in itertools.pairwise(amplitudes) if a > 0]
     ratio = ratios[-1] if ratios else math.nan
     period, latest = _period(tw, yw, ext, is_max, placed, dense)
+    if not math.isfinite(period) and len(peaks) >= 2:
+        # one fall through mid-level, two peaks: their spacing is the period seen (a settled run that rang for one
+        # period read "1 period(s), period not known" and, without a period to be quiet for, oscillating for ever)
+        period = latest = peaks[-1][0] - peaks[-2][0]
     last_extremum = placed[-1][0] if placed else float(tw[0])
     quiet = float(tw[-1]) - last_extremum
     oscillating = periods >= 1 and not (math.isfinite(period) and quiet > 2 * period)
@@ -298,13 +312,26 @@ def classify(
     if verdict is not None:
         return verdict
     # not (or no longer) oscillating: steady only when the tail has stopped changing
-    tail_from = last_extremum if placed else float(tw[0])
+    tail_from = _last_turn(tw, yw, ext[-1], is_max[-1]) if placed else float(tw[0])
     tau = min(relaxation if relaxation else math.inf, (float(tw[-1]) - tail_from) / 2.0, window / 2.0)
     peak, trough = _window_extremes(tw, yw, dense)
     if not tau > 0:
         return Regime(UNDETERMINED, periods, ratio, period, peak, trough, "undetermined: no tail to judge")
     change, remaining = remaining_change(tw, yw, tau, dense)
     floor = floor if settle_floor is None else min(float(settle_floor), floor)
+    ringing = None
+    if not (remaining <= floor or change <= floor * 1e-3) and math.isfinite(period) and period > 0:
+        ringing = _ringing_tail(tw, yw, period, floor, dense)
+    if ringing is not None and ringing[0] <= floor and ringing[2] <= floor:
+        swing, drift, left = ringing
+        text = (
+            f"steady: rings by {swing:.3g}{suffix} peak to trough over the last period ({_seconds(period)}), below the"
+            f" tolerance; its mean over a period changed {drift:.3g}{suffix} from the period before,"
+            f" {left:.3g}{suffix} still to come (tolerance {floor:.3g}{suffix})"
+        )
+        if periods:
+            text += f" after {periods} decayed period(s)"
+        return Regime(STEADY, periods, ratio, math.nan, peak, trough, text)
     if remaining <= floor or change <= floor * 1e-3:
         left = "nothing measurable" if math.isinf(remaining) else f"{remaining:.3g}{suffix}"
         text = (
@@ -327,6 +354,72 @@ APPROACH_AGREEMENT = 2.0
 RESOLVING_POINTS = 8
 
 
+#: a tail that rings below the floor is read as means over whole periods only where it holds this many periods
+RINGING_PERIODS = 3
+
+
+def _ringing_tail(
+    t: np.ndarray, y: np.ndarray, period: float, floor: float, dense: Dense | None
+) -> tuple[float, float, float] | None:
+    """(swing over the last period, change of the mean over a period from the period before, change of that mean
+    still to come) of a tail that still rings below ``floor`` at the ``period`` seen before it; None where the
+    window holds fewer than RINGING_PERIODS periods.
+
+    Read at three instants (:func:`remaining_change`) a ringing tail is read at its phases: a decaying oscillation
+    of 0.187 s whose swing had fallen to the tolerance (0.0027 Pa of 257.36 Pa), read over 0.36 s, changed
+    0.00046 Pa after 0.00035 Pa, "no exponential approach", and the run was "still changing" with a change below
+    the tolerance it quoted.  Means over whole periods carry no phase: where they have stopped and the last
+    period's swing is within ``floor``, the tail has settled."""
+    end = float(t[-1])
+    if not (period > 0 and end - RINGING_PERIODS * period >= float(t[0])):
+        return None
+    edges = end - period * np.arange(RINGING_PERIODS, -1, -1, dtype=float)
+    means = [_mean_between(t, y, a, b, dense) for a, b in itertools.pairwise(edges.tolist())]
+    last = (t >= edges[-2]) & (t <= end)
+    span = np.r_[y[last], np.interp(edges[-2], t, y)]
+    if dense is not None:
+        span = np.r_[span, np.asarray(dense(np.linspace(edges[-2], end, 201)), dtype=float)]
+    drift, left = _aitken(means[-2] - means[-3], means[-1] - means[-2])
+    return float(np.ptp(span)), drift, left
+
+
+def _mean_between(t: np.ndarray, y: np.ndarray, a: float, b: float, dense: Dense | None) -> float:
+    """The time mean of y over [a, b]: the trapezoid on the samples (and the interpolant's grid where given)."""
+    inside = (t > a) & (t < b)
+    tt = np.r_[a, t[inside], b]
+    if dense is not None:
+        tt = np.union1d(tt, np.linspace(a, b, 201))
+        yy = np.asarray(dense(tt), dtype=float)
+    else:
+        yy = np.interp(tt, t, y)
+    return float(np.sum(0.5 * (yy[1:] + yy[:-1]) * np.diff(tt)) / (b - a))
+
+
+def _last_turn(t: np.ndarray, y: np.ndarray, last: int, was_max: bool) -> float:
+    """Where the tail's approach starts: the last counted extremum, or the turn after it that the hysteresis could
+    not count, where the swing into it is a large one (TAIL of the window's range at least) and the swing out of it
+    is too small to count (a re-slide's rupture from 39.2 MPa to 6.18 Pa, then its refill of 236 Pa, within the
+    392 Pa tolerance of the peak: read from the peak, across the rupture, the refill's 35 Pa still to come read
+    67.8 Pa).  The turn is the lowest (after a maximum) or highest point after the extremum, unless the signal ends
+    there."""
+    after = y[last:]
+    k = int(np.argmin(after) if was_max else np.argmax(after))
+    large = abs(after[k] - after[0]) >= TAIL * float(np.ptp(y))
+    return float(t[last + k]) if 0 < k < after.size - 1 and large else float(t[last])
+
+
+def _without_leading_wiggles(y: np.ndarray, ext: list[int]) -> list[int]:
+    """The alternating extrema without a first swing smaller than WIGGLE of the swing after it: a wiggle on the
+    window's first rise or fall, as :func:`_alternating` merges one inside.  A re-slide after a 10 s hold rises
+    from 0.3 kPa to 39.2 MPa, its aged bonds reaching the FENE wall a cohort at a time (docs/transient.md section
+    17): a dip of 849 Pa at 31.9 kPa counted as a period beside the 39.2 MPa peak, and the re-slide, a transient,
+    read "undetermined: 1 period(s), period not known"."""
+    ext = list(ext)
+    while len(ext) >= 3 and abs(y[ext[1]] - y[ext[0]]) < WIGGLE * abs(y[ext[2]] - y[ext[1]]):
+        del ext[:2]
+    return ext
+
+
 def _still_changing(
     t: np.ndarray,
     y: np.ndarray,
@@ -347,7 +440,12 @@ def _still_changing(
     head = f"still changing ({change:.3g}{suffix} over the last {tau:.3g} s"
     tolerance = f"tolerance {floor:.3g}{suffix}"
     if math.isinf(remaining):
-        return f"{head}, no exponential approach; {tolerance})"
+        # what was compared with the tolerance is the change still to come, not the change seen: say both changes
+        before = abs(_tail_changes(t, y, tau, dense)[0])
+        return (
+            f"{head} after {before:.3g}{suffix} over the {tau:.3g} s before: not slowing down, so no exponential"
+            f" approach bounds the change still to come, which is what the {tolerance} is for)"
+        )
     # a span is read only where points resolve it (a line between two rows sampled by ``every`` is no approach)
     divisors = [1.0]
     if dense is None:
@@ -431,6 +529,16 @@ def _ratio(ratio: float) -> str:
         if math.isfinite(ratio)
         else "amplitude ratio not known (fewer than two swings)"
     )
+
+
+def repeat_tolerance(a: float, b: float, rise: float, resolution: float | None = None) -> float:
+    """How far a stress of one cycle may be from the same stress of the cycle before and the cycle still repeat:
+    RATIO_TOLERANCE of the cycle's rise, and no more than the run's tolerance, ``resolution`` (its rtol) x the
+    stress, where it is known (the time-dependent model's stick chains: their sticks and σs are exact events)."""
+    tolerance = RATIO_TOLERANCE * abs(rise)
+    if resolution is not None and resolution > 0:
+        tolerance = min(tolerance, resolution * max(abs(a), abs(b)))
+    return tolerance
 
 
 def settled_window_start(begin: float, end: float, period: float) -> float:

@@ -418,7 +418,7 @@ def summary_text(summary: dict[str, Any], units: dict[str, str] | None = None) -
     if not cycle and numbers:
         # "no oscillation" only where none was seen: an undetermined run may hold periods not yet settled
         seen = summary["period"] is not None and math.isfinite(summary["period"])
-        quiet = not summary.get("oscillates", True) and not seen
+        quiet = not summary.get("oscillates", True) and not seen and not summary.get("periods_seen")
         numbers[-1] += " over the run" + (" (no oscillation)" if quiet else "")
     if numbers:
         lines.append("  " + ", ".join(numbers))

@@ -366,7 +366,7 @@ def judge(
     # settled is judged on the stress the run ends at (not below a thousandth of the peak): within SETTLED of a
     # 3.56 MPa re-slide peak (35.6 Pa), a re-slide 50 Pa short of steady read as steady
     settle = SETTLED * max(abs(float(stress[-1])), 1e-3 * scale, 1e-300)
-    found = _from_events(events, start, time, stress, lowest, between)
+    found = _from_events(events, start, time, stress, lowest, between, resolution)
     if found is None:
         classified = regimes.classify(time, stress, floor=floor, start=start, unit="Pa", settle_floor=settle)
         found = solution_extremes(classified, time, stress, between, start)
@@ -551,10 +551,23 @@ def _words(
             f"steady sliding at {v_end * 1e6:.6g} µm/s: σ = {stress[-1]:.6g} Pa at t = {time[-1]:.6g} s"
             f" ({found.evidence.removeprefix('steady: ')})"
         )
+    evidence = found.evidence
+    change = _last_change(protocol)
+    if change is not None and found.periods == 0 and evidence.startswith("undetermined: "):
+        evidence = f"undetermined: {change} has not settled: {evidence.removeprefix('undetermined: ')}"
     return regimes.UNDETERMINED, (
-        f"{found.evidence} at the end of the run (t = {time[-1]:.6g} s, σ = {stress[-1]:.6g} Pa,"
+        f"{evidence} at the end of the run (t = {time[-1]:.6g} s, σ = {stress[-1]:.6g} Pa,"
         f" V = {show_velocity(velocity[-1], 3)}): run longer to see where it goes"
     )
+
+
+def _last_change(protocol: Protocol) -> str | None:
+    """The re-slide that starts the last segment after a hold, in words ("the re-slide after the 10 s hold");
+    None where the last segment follows no hold."""
+    if len(protocol.segments) < 2 or not protocol.segments[-1].velocity > 0:
+        return None
+    before = protocol.segments[-2]
+    return f"the re-slide after the {before.duration:.6g} s hold" if before.velocity == 0.0 else None
 
 
 def _never_sticks(
@@ -623,9 +636,18 @@ def _chain_cycles(events: list, start: float) -> list[_ChainCycle]:
     return found
 
 
-def _repeats(first: tuple[float, float], second: tuple[float, float], rise: float) -> bool:
-    """The cycle's state repeated: both stresses within RATIO_TOLERANCE of the stick's rise."""
-    return all(abs(b - a) <= regimes.RATIO_TOLERANCE * abs(rise) for a, b in zip(first, second, strict=True))
+def _repeats(first: tuple[float, ...], second: tuple[float, ...], rise: float, resolution: float | None = None) -> bool:
+    """The cycle's state repeated: each stress within :func:`_repeat_tolerance` of the one it repeats."""
+    return all(abs(b - a) <= _repeat_tolerance(a, b, rise, resolution) for a, b in zip(first, second, strict=True))
+
+
+def _repeat_tolerance(a: float, b: float, rise: float, resolution: float | None) -> float:
+    """:func:`stickslip.regimes.repeat_tolerance`: 2 % of the rise, and no more than the run's rtol x the stress.
+
+    2 % of the rise alone called a soft gel's cycles repeating whose sticks started 0.108 Pa apart and whose σs were
+    0.241 Pa apart, 4x the run's tolerance (rtol 1e-4 of 624 Pa = 0.062 Pa), while the cycle after them repeats to
+    1e-10 Pa (the solver's error there: 1.2e-3 Pa, against rtol 1e-6): the first was a start-up cycle."""
+    return regimes.repeat_tolerance(a, b, rise, resolution)
 
 
 def _from_events(
@@ -635,6 +657,7 @@ def _from_events(
     stress: np.ndarray,
     lowest: np.ndarray | None = None,
     between: Between | None = None,
+    resolution: float | None = None,
 ) -> regimes.Regime | None:
     """The regime from the stick chains' exact sticks and slips (time, stress), independent of ``every``.
 
@@ -650,7 +673,8 @@ def _from_events(
     solution between them (``between``: the solver's states between the rows); any other verdict's extremes
     are the events' or the trace's over the last period, whichever reaches further (the slip's lowest stress can
     come just before the stick); ``lowest``: each row's lowest stress of the solver's steps since the row before
-    (``every`` must not move the trough).
+    (``every`` must not move the trough); ``resolution``: the run's rtol, which bounds how far apart the stresses of
+    two cycles that repeat may be (:func:`_repeat_tolerance`).
     """
     cycles = _chain_cycles(events, start)
     if not cycles:
@@ -661,7 +685,7 @@ def _from_events(
     last_event = max(float(t) for _, t, _, _ in events)
     if math.isfinite(period) and float(time[-1]) - last_event > 2 * period:
         return None
-    found = _chain_verdict(cycles, whole)
+    found = _chain_verdict(cycles, whole, resolution)
     if found.kind == regimes.STICK_SLIP and whole:
         cycle = whole[-1]
         assert cycle.after is not None
@@ -680,16 +704,19 @@ def _from_events(
     return found
 
 
-def _chain_verdict(cycles: list[_ChainCycle], whole: list[_ChainCycle]) -> regimes.Regime:
-    """The verdict of the chains' cycles: a limit cycle as soon as one cycle repeats the one before.  Its period
-    is the last whole cycle's, stick to stick (the run's summary's); a first cycle that does not repeat (the
-    start-up stick, from rest at 0 Pa) gives no period (:func:`settled_chain_cycles`)."""
+def _chain_verdict(
+    cycles: list[_ChainCycle], whole: list[_ChainCycle], resolution: float | None = None
+) -> regimes.Regime:
+    """The verdict of the chains' cycles: a limit cycle as soon as one cycle repeats the one before, within the
+    run's tolerance (:func:`_repeat_tolerance`).  Its period is the last whole cycle's, stick to stick (the run's
+    summary's); a first cycle that does not repeat (the start-up stick, from rest at 0 Pa) gives no period
+    (:func:`settled_chain_cycles`).  Cycles that do not repeat are said to drift, by how much per cycle."""
     last = cycles[-1]
     peak = last.sigma_s
     trough = min(c.sigma_stick for c in cycles[-2:])
     repeating = 0  # the trailing cycles that repeat the one before each: the periods that back the verdict
     for prev, this in zip(reversed(cycles[:-1]), reversed(cycles[1:]), strict=True):
-        if not _repeats((prev.sigma_stick, prev.sigma_s), (this.sigma_stick, this.sigma_s), prev.rise):
+        if not _repeats((prev.sigma_stick, prev.sigma_s), (this.sigma_stick, this.sigma_s), prev.rise, resolution):
             break
         repeating += 1
     if repeating:
@@ -702,27 +729,41 @@ def _chain_verdict(cycles: list[_ChainCycle], whole: list[_ChainCycle]) -> regim
             f"stick-slip (limit cycle): {repeating} period(s) of {length:.6g} s (the last whole cycle, stick to"
             f" stick), {repeating + 1} slips whose cycles"
             f" repeat (the last two: stick from {prev.sigma_stick:.6g} then {last.sigma_stick:.6g} Pa, σs ="
-            f" {prev.sigma_s:.6g} then {last.sigma_s:.6g} Pa, amplitude ratio {ratio:.4g}): with fresh chains at"
-            " each stick the cycle repeats from there"
+            f" {prev.sigma_s:.6g} then {last.sigma_s:.6g} Pa, amplitude ratio {ratio:.4g};"
+            f" {_apart(prev, last, resolution)}): with fresh chains at each stick the cycle repeats from there"
         )
         return regimes.Regime(regimes.STICK_SLIP, repeating, ratio, length, peak, trough, evidence)
-    if last.after is not None and _repeats((last.sigma_stick,), (last.after[1],), last.rise):
+    if last.after is not None and _repeats((last.sigma_stick,), (last.after[1],), last.rise, resolution):
         length = last.after[0] - last.t_stick
+        gap = abs(last.after[1] - last.sigma_stick)
+        tolerance = _repeat_tolerance(last.sigma_stick, last.after[1], last.rise, resolution)
         evidence = (
             f"stick-slip (limit cycle): 1 period of {length:.6g} s: the stick after the slip (σs = {last.sigma_s:.6g}"
-            f" Pa) starts under {last.after[1]:.6g} Pa, where the one before started ({last.sigma_stick:.6g} Pa),"
-            " and with fresh chains the cycle repeats from there"
+            f" Pa) starts under {last.after[1]:.6g} Pa, where the one before started ({last.sigma_stick:.6g} Pa;"
+            f" {gap:.2g} Pa apart, within {tolerance:.3g} Pa), and with fresh chains the cycle repeats from there"
         )
+        if len(cycles) >= 2:  # the cycle before did not repeat this one: a start-up cycle, not the limit cycle
+            before = cycles[-2]
+            evidence += (
+                f"; the cycle before it, from {before.sigma_stick:.6g} Pa to σs = {before.sigma_s:.6g} Pa, was a"
+                f" start-up cycle ({_apart(before, last, resolution)})"
+            )
         return regimes.Regime(regimes.STICK_SLIP, 1, math.nan, length, peak, trough, evidence)
     if len(whole) >= 3:
         times = [c.t_slip for c in whole]
         troughs = [c.after[1] for c in whole if c.after is not None]
-        return regimes.classify_cycles(times, [c.sigma_s for c in whole], troughs)
+        found = regimes.classify_cycles(times, [c.sigma_s for c in whole], troughs)
+        if found.kind != regimes.STICK_SLIP:  # growing or decaying beyond RATIO_TOLERANCE a period: the amplitudes
+            return found
+        # amplitudes within RATIO_TOLERANCE, but the cycles do not repeat within the run's tolerance: drifting
+        return dataclasses.replace(found, kind=regimes.UNDETERMINED, evidence=_drifting(cycles, resolution))
     history = "; ".join(f"stick from {c.sigma_stick:.6g} Pa to σs = {c.sigma_s:.6g} Pa" for c in cycles[-3:])
     if last.after is not None:
         history += f"; the next stick from {last.after[1]:.6g} Pa"
     why = "no cycle repeats the one before yet" if len(cycles) >= 2 or last.after is not None else "no stick after it"
-    settled = settled_chain_cycles(whole)
+    if len(cycles) >= 2:
+        why += f" ({_apart(cycles[-2], last, resolution)})"
+    settled = settled_chain_cycles(whole, resolution)
     evidence = (
         f"undetermined: {len(cycles)} slip(s) ({history}), {why}: whether the run settles into a limit cycle needs"
         " another slip"
@@ -741,13 +782,46 @@ def _chain_verdict(cycles: list[_ChainCycle], whole: list[_ChainCycle]) -> regim
     return regimes.Regime(regimes.UNDETERMINED, len(whole), ratio, period, peak, trough, evidence)
 
 
-def settled_chain_cycles(whole: list[_ChainCycle]) -> list[_ChainCycle]:
+def _apart(prev: _ChainCycle, this: _ChainCycle, resolution: float | None) -> str:
+    """How far two cycles' sticks and σs are apart, against the tolerances they repeat within, in words."""
+    gaps = (abs(this.sigma_stick - prev.sigma_stick), abs(this.sigma_s - prev.sigma_s))
+    tolerances = (
+        _repeat_tolerance(prev.sigma_stick, this.sigma_stick, prev.rise, resolution),
+        _repeat_tolerance(prev.sigma_s, this.sigma_s, prev.rise, resolution),
+    )
+    within = all(g <= t for g, t in zip(gaps, tolerances, strict=True))
+    rule = "2 % of the rise" if resolution is None else f"rtol {resolution:g} of each stress"
+    return (
+        f"sticks {gaps[0]:.3g} Pa apart and σs {gaps[1]:.3g} Pa, {'within' if within else 'beyond'} the run's"
+        f" tolerance of {tolerances[0]:.3g} and {tolerances[1]:.3g} Pa, {rule}"
+    )
+
+
+def _drifting(cycles: list[_ChainCycle], resolution: float | None) -> str:
+    """Cycles whose amplitudes agree but whose state does not repeat within the run's tolerance, in words: how far
+    each stick still moves, and, where successive moves shrink geometrically, how far they still go."""
+    sticks = [c.sigma_stick for c in cycles]
+    if cycles[-1].after is not None:
+        sticks.append(cycles[-1].after[1])
+    moves = np.diff(sticks[-3:])
+    text = (
+        f"undetermined: {len(cycles)} slips whose cycles still drift: the sticks start under"
+        f" {', '.join(f'{v:.6g}' for v in sticks[-3:])} Pa, by {moves[-1]:+.3g} Pa in the last cycle"
+        f" ({_apart(cycles[-2], cycles[-1], resolution)})"
+    )
+    if moves.size == 2 and moves[0] != 0 and 0 < moves[1] / moves[0] < 1:
+        q = float(moves[1] / moves[0])
+        text += f", shrinking by {q:.3g} a cycle: about {abs(moves[1]) * q / (1 - q):.3g} Pa still to come"
+    return text + ": run longer to see whether they settle"
+
+
+def settled_chain_cycles(whole: list[_ChainCycle], resolution: float | None = None) -> list[_ChainCycle]:
     """The whole cycles of the repeating one, as quasistatic.cycle.settled_cycles: every whole cycle after the
-    first, and the first when the stick after it starts where it started (within RATIO_TOLERANCE of its rise).
+    first, and the first when the stick after it starts where it started (within :func:`_repeat_tolerance`).
     A first stick from another stress (from rest: 0 Pa; after a hold) is a start-up cycle that does not repeat."""
     if not whole:
         return []
     first = whole[0]
     assert first.after is not None
-    keep_first = _repeats((first.sigma_stick,), (first.after[1],), first.rise)
+    keep_first = _repeats((first.sigma_stick,), (first.after[1],), first.rise, resolution)
     return whole if keep_first else whole[1:]
