@@ -13,7 +13,8 @@ protocol boundary, where the pace jumps), so the last two rows fed wait for the 
 the solver's own integral over the interval (:func:`_stress_with_integral`).  A held block is in closed form, and
 under velocity control the velocity is the protocol's.  An interpolated stress, velocity or bonded count stays
 within its two rows' (a cubic's overshoot at a turn is no state of the solver), so the rows carry no extreme the
-solver did not reach.
+solver did not reach; but a peak of the stress between two rows is located on that cubic into the row's highest
+stress (:func:`locate_peaks`, as on the unsampled trace: docs/transient.md section 19).
 
 The slips' instants are rows of their own (the jump's state, the last of the rows there).  Each row carries the
 extremes of the rows it closes (lowest, highest stress and their times, the fastest slider), as the kernel's rows
@@ -79,6 +80,7 @@ class Sampler:
         self.known_rate = not self.rigid and self.mass == 0.0
         self.breaks = np.unique(np.asarray(breaks, dtype=float))
         self.jumps: list[float] = []  # instants of the massless block's jumps (no row holds the state after one)
+        self.slips = np.empty(0)  # the slips' instants given with the rows (no peak is located across one)
         self.next = 0  # the next grid point to write
         self.anchor: np.ndarray | None = None  # the last row sampled through (the left end of the next interval)
         self.before = np.empty((0, 0))  # the rows before it (its left neighbours, for the rates read from rows)
@@ -100,6 +102,7 @@ class Sampler:
         fine = fine[np.argsort(fine[:, TIME], kind="stable")]
         if instants is not None and np.size(instants):
             self.instants = np.union1d(self.instants, np.asarray(instants, dtype=float))
+            self.slips = np.union1d(self.slips, np.asarray(instants, dtype=float))
         # the last rows wait for the next: the rates read from the rows take up to NEIGHBOURS on each side
         self.waiting = fine[-NEIGHBOURS:].copy()
         self._sample(fine[:-NEIGHBOURS], self.waiting)
@@ -121,6 +124,12 @@ class Sampler:
         context = [] if self.anchor is None else [self.before.reshape(-1, fine.shape[1]), self.anchor[None, :]]
         offset = sum(len(r) for r in context)  # rows of ``every`` before ``fine``
         every = np.vstack([*context, fine, *([] if ahead is None else [ahead])])
+        # the stress's peaks between the rows fed, into their highest (each row closes the interval before it)
+        locate_peaks(
+            every, offset, offset + fine.shape[0], k_block=self.k_block, known_rate=self.known_rate,
+            breaks=self.breaks, events=np.r_[self.slips, self.jumps],
+        )  # fmt: skip
+        fine = every[offset : offset + fine.shape[0]]
         times = every[:, TIME]
         first, last = times[offset - 1] if self.anchor is not None else times[0], float(fine[-1, TIME])
         start = self.next
@@ -242,14 +251,7 @@ class Sampler:
 
     def _broken(self, times: np.ndarray) -> np.ndarray:
         """Rows at a protocol boundary (the pace jumps there: a rate read from the rows takes no neighbour across)."""
-        n = self.breaks.size
-        if not n:
-            return np.zeros(times.size, dtype=bool)
-        k = np.searchsorted(self.breaks, times)
-        near = np.minimum(
-            np.abs(times - self.breaks[np.clip(k - 1, 0, n - 1)]), np.abs(times - self.breaks[np.clip(k, 0, n - 1)])
-        )
-        return near <= 1e-12 * np.maximum(np.abs(times), 1.0)
+        return broken_rows(times, self.breaks)
 
     def _close(self, fine: np.ndarray, wanted: np.ndarray, rows: np.ndarray) -> None:
         """Each written row's extremes: those of the rows fed since the row written before it (and its own state),
@@ -283,6 +285,167 @@ class Sampler:
         rows[:, FAST] = np.fmax(fast[:m], own_v)
 
 
+def broken_rows(times: np.ndarray, breaks: np.ndarray) -> np.ndarray:
+    """Rows at a protocol boundary ``breaks`` (sorted; the pace jumps there: a rate read from the rows takes no
+    neighbour across)."""
+    n = breaks.size
+    if not n:
+        return np.zeros(times.size, dtype=bool)
+    k = np.searchsorted(breaks, times)
+    near = np.minimum(np.abs(times - breaks[np.clip(k - 1, 0, n - 1)]), np.abs(times - breaks[np.clip(k, 0, n - 1)]))
+    return near <= 1e-12 * np.maximum(np.abs(times), 1.0)
+
+
+#: a peak located between two rows counts only within this share of the largest change of the stress over its
+#: interval and the intervals either side beyond the rows (a smooth peak lies within an eighth of it where the steps are
+#: even, a third where one is twice the other) ...
+PEAK_REACH = 0.5
+#: ... and where the polynomial through the peak's row and two rows on each side puts it within this share of that
+#: excess (a resolved peak: the two agree to 3e-3-0.08 of it at rtol 1e-7-1e-3 on a velocity step; a block with mass
+#: ringing at three steps a period, whose rows do not resolve the ring, disagrees by more than the excess)
+PEAK_AGREEMENT = 0.5
+#: points on which that polynomial is searched between the peak's neighbours
+PEAK_GRID = 129
+#: and beyond the rows by more than this share of the stress (rounding: a flat stretch's rates are rounding), at a
+#: peak whose rows change by more than PEAK_FLOOR of it (no peak below is worth locating)
+ROUNDING = 1e-12
+PEAK_FLOOR = 1e-10
+
+
+def locate_peaks(
+    every: np.ndarray,
+    first: int,
+    last: int,
+    *,
+    k_block: float,
+    known_rate: bool,
+    breaks: np.ndarray,
+    events: np.ndarray,
+) -> None:
+    """The stress's peaks between rows, located on the interpolant the rows are sampled on, into the highest stress
+    of the rows that close them (in place; rows ``first`` to ``last`` - 1 of ``every``, each closing the interval
+    from the row before it).
+
+    A row's highest stress was the highest of the solver's states at its steps, and a peak between two steps was
+    read at the nearer step: a velocity step from 350 um/s to 3.5 mm/s peaks 105 us later at 1495.7563 Pa, read
+    0.65 Pa low at rtol 1e-4 (steps of 5.9 us there; 0.004 Pa high, 0.093, 0.041 and 0.0038 Pa low at rtol 1e-3,
+    1e-5, 1e-6, 1e-7), while the states at the steps were within 1.1e-3 Pa of a tight run's.  At each row where
+    the rows peak (a rise before it, none after), the intervals either side are searched on their cubic: the rows'
+    values and rates, the rates K (Vp - V) of a massless block or read from the rows and held to the solver's
+    integral over the interval (:func:`_integral_rates`, the cubic :func:`_stress_with_integral` samples).  Left
+    out: an interval with a held slider (the stick chains'), with no length, or whose rows within two of it reach
+    one of ``events`` (the slips' and jumps' instants, and any with two rows: a kink no cubic follows), and a peak
+    beyond :data:`PEAK_REACH` or away from the polynomial through five rows (:data:`PEAK_AGREEMENT`).  The troughs
+    are the steps' (a trough located so moved tests/test_transient_split.py's ``velocity_step`` lowest stress by
+    7.7e-4 Pa at one row, beyond the 1e-6 of its largest value that test holds)."""
+    n = every.shape[0]
+    if last <= max(first, 1) or n < 3:
+        return
+    times, sigma = every[:, TIME], every[:, SIGMA]
+    # two rows at one instant are a jump's (the trace keeps the first: solver._finish, which gives their instants)
+    events = np.union1d(np.asarray(events, dtype=float), times[1:][np.diff(times) == 0.0])
+    with np.errstate(invalid="ignore"):
+        d = np.diff(sigma)
+        peak = np.flatnonzero((d[:-1] > 0.0) & (d[1:] <= 0.0)) + 1  # rows with a rise before and none after
+    peak = peak[(peak + 1 >= max(first, 1)) & (peak < last)]  # (either interval closed by a row of first..last - 1)
+    # how far the stress changes over the two intervals and those either side
+    reach = np.abs(d[peak - 1])
+    for k in (peak - 2, peak, peak + 1):
+        inside = (k >= 0) & (k < d.size)
+        reach = np.fmax(reach, np.where(inside, np.abs(d[np.clip(k, 0, d.size - 1)]), 0.0))
+    worth = reach > PEAK_FLOOR * np.abs(sigma[peak])  # (steady sliding's rows wander by ~2e-12: 60 000 such peaks)
+    peak, reach = peak[worth], reach[worth]
+    if not peak.size:
+        return
+    y1 = sigma[peak]
+    vertex = _quartic_peaks(times, sigma, peak)  # the polynomial through the peak's row and two on each side
+    for j in (peak, peak + 1):  # the intervals (j - 1, j) either side of the peak's row, each on its own
+        mine = (j >= max(first, 1)) & (j < last)
+        value, when = _cubic_peaks(every, j[mine], k_block=k_block, known_rate=known_rate, breaks=breaks, events=events)
+        excess = value - y1[mine]
+        with np.errstate(invalid="ignore"):
+            ok = (excess > ROUNDING * np.abs(y1[mine])) & (excess <= PEAK_REACH * reach[mine])
+            ok &= np.abs(value - vertex[mine]) <= PEAK_AGREEMENT * excess
+        rows = j[mine][ok]
+        raise_ = value[ok] > every[rows, HIGH]
+        every[rows[raise_], HIGH], every[rows[raise_], T_HIGH] = value[ok][raise_], when[ok][raise_]
+
+
+def _quartic_peaks(times: np.ndarray, sigma: np.ndarray, peak: np.ndarray) -> np.ndarray:
+    """The highest value between rows peak - 1 and peak + 1 of the polynomial through rows peak - 2 ... peak + 2
+    (fourth degree; on :data:`PEAK_GRID` points), nan where those rows do not exist or are not in time order."""
+    n = times.size
+    offsets = np.arange(-2, 3)
+    rows = peak[:, None] + offsets[None, :]
+    exists = np.all((rows >= 0) & (rows < n), axis=1)
+    rows = np.clip(rows, 0, n - 1)
+    scale = times[rows[:, 3]] - times[rows[:, 1]]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        x = (times[rows] - times[peak][:, None]) / scale[:, None]  # (centred and scaled: well conditioned)
+        coef = sigma[rows].astype(float)  # Newton's divided differences, in place
+        for level in range(1, 5):
+            coef[:, level:] = (coef[:, level:] - coef[:, level - 1 : -1]) / (x[:, level:] - x[:, : 5 - level])
+        grid = x[:, 1:2] + (x[:, 3:4] - x[:, 1:2]) * np.linspace(0.0, 1.0, PEAK_GRID)[None, :]
+        value = np.repeat(coef[:, 4:5], PEAK_GRID, axis=1)
+        for level in range(3, -1, -1):
+            value = value * (grid - x[:, level : level + 1]) + coef[:, level : level + 1]
+        best = np.max(value, axis=1)
+    ordered = np.all(np.diff(times[rows], axis=1) > 0, axis=1)
+    return np.where(exists & ordered & np.isfinite(best), best, np.nan)
+
+
+def _cubic_peaks(
+    every: np.ndarray, j: np.ndarray, *, k_block: float, known_rate: bool, breaks: np.ndarray, events: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """(the highest value, its time) of the cubic over each interval (j - 1, j) of ``every`` (:func:`locate_peaks`)
+    where it peaks inside; -inf, nan where it does not or the interval is left out."""
+    n = every.shape[0]
+    value = np.full(j.size, -np.inf)
+    when = np.full(j.size, np.nan)
+    i = j - 1
+    inside = (i >= 0) & (j < n)
+    i, jj = np.clip(i, 0, n - 1), np.clip(j, 0, n - 1)
+    times, sigma = every[:, TIME], every[:, SIGMA]
+    a, b = every[i], every[jj]
+    h = b[:, TIME] - a[:, TIME]
+    ok = inside & (h > 0) & np.isfinite(a[:, SIGMA]) & np.isfinite(b[:, SIGMA])
+    ok &= ~np.isfinite(a[:, CHAINS]) & ~np.isfinite(b[:, CHAINS])  # the stick chains hold the slider
+    if np.size(events):
+        marks = events  # (sorted)
+        near_lo, near_hi = times[np.maximum(i - 2, 0)], times[np.minimum(jj + 2, n - 1)]
+        ok &= np.searchsorted(marks, near_lo, side="left") == np.searchsorted(marks, near_hi, side="right")
+    if not ok.any():
+        return value, when
+    pick = np.flatnonzero(ok)
+    i, a, b, h = i[pick], a[pick], b[pick], h[pick]
+    if known_rate:  # the massless block: dsigma/dt = K (Vp - V)
+        vp = (b[:, P] - a[:, P]) / h
+        rate_a, rate_b = k_block * (vp - a[:, V]), k_block * (vp - b[:, V])
+    else:
+        rate_a, rate_b = _read_rates(sigma, _rate_weights(times, i, broken_rows(times, breaks)))
+        rate_a, rate_b, _, _ = _integral_rates(a, b, rate_a, rate_b, h)
+    sa, sb = a[:, SIGMA], b[:, SIGMA]
+    # the cubic's turns: the roots in (0, 1) of its derivative in s, quad s^2 + lin s + const
+    quad = 6.0 * (sa - sb) + 3.0 * h * (rate_a + rate_b)
+    lin = -6.0 * (sa - sb) - 4.0 * h * rate_a - 2.0 * h * rate_b
+    const = h * rate_a
+    with np.errstate(invalid="ignore", divide="ignore"):
+        root = np.sqrt(np.where(lin * lin - 4.0 * quad * const >= 0.0, lin * lin - 4.0 * quad * const, np.nan))
+        q = -0.5 * (lin + np.copysign(root, lin))
+        flat = np.abs(quad) <= 1e-12 * (np.abs(lin) + np.abs(const))
+        roots = (np.where(flat, -const / lin, q / quad), np.where(flat, np.nan, const / q))
+    top = np.full(pick.size, -np.inf)
+    top_t = np.full(pick.size, np.nan)
+    for s in roots:
+        found = np.isfinite(s) & (s > 0.0) & (s < 1.0)
+        at = np.where(found, s, 0.5)
+        cubic = np.where(found, _hermite(sa, sb, rate_a, rate_b, h, at), -np.inf)
+        higher = cubic > top
+        top, top_t = np.where(higher, cubic, top), np.where(higher, a[:, TIME] + at * h, top_t)
+    value[pick], when[pick] = top, top_t
+    return value, when
+
+
 def _stress_with_integral(
     a: np.ndarray, b: np.ndarray, rate_a: np.ndarray, rate_b: np.ndarray, h: np.ndarray, s: np.ndarray
 ) -> np.ndarray:
@@ -294,15 +457,7 @@ def _stress_with_integral(
     um/s, one 6 s step from 5.7 to 88.3 kPa), sigma_a + (sigma_b - sigma_a) s^p with that integral.  Where the
     interval's integral is rounding (or not known), the cubic with the rates read."""
     sa, sb = a[:, SIGMA], b[:, SIGMA]
-    # an integral not carried (NaN) gives a NaN mean, which ``known`` leaves out: the cubic with the rates read
-    with np.errstate(invalid="ignore"):
-        mean = (b[:, IMPULSE] - a[:, IMPULSE]) / h
-        trapezoid = 0.5 * (sa + sb)
-        rounding = 8.0 * np.finfo(float).eps * np.fmax(np.abs(a[:, IMPULSE]), np.abs(b[:, IMPULSE])) / h
-        known = np.isfinite(mean) & (np.abs(mean - trapezoid) > rounding)
-        # the cubic's integral is h (trapezoid + h (rate_a - rate_b) / 12): the rates' difference that gives the mean
-        shift = np.where(known, 0.5 * ((rate_b - rate_a) - 12.0 * (trapezoid - mean) / h), 0.0)
-    rate_a, rate_b = rate_a + shift, rate_b - shift
+    rate_a, rate_b, mean, known = _integral_rates(a, b, rate_a, rate_b, h)
     value = _hermite(sa, sb, rate_a, rate_b, h, s)
     low, high = np.fmin(sa, sb), np.fmax(sa, sb)
     inside = known & (mean > low) & (mean < high)
@@ -315,6 +470,24 @@ def _stress_with_integral(
             rise = sb[power] - sa[power]
             value[power] = sa[power] + rise * s[power] ** (rise / (mean[power] - sa[power]) - 1.0)
     return value
+
+
+def _integral_rates(
+    a: np.ndarray, b: np.ndarray, rate_a: np.ndarray, rate_b: np.ndarray, h: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The stress's rates read from the rows at rows a and b, shifted alike so that the cubic through the two rows
+    with them integrates over the interval to the solver's integral (:func:`_stress_with_integral`); with the
+    interval's mean stress and where that integral is known (beyond rounding)."""
+    sa, sb = a[:, SIGMA], b[:, SIGMA]
+    # an integral not carried (NaN) gives a NaN mean, which ``known`` leaves out: the cubic with the rates read
+    with np.errstate(invalid="ignore"):
+        mean = (b[:, IMPULSE] - a[:, IMPULSE]) / h
+        trapezoid = 0.5 * (sa + sb)
+        rounding = 8.0 * np.finfo(float).eps * np.fmax(np.abs(a[:, IMPULSE]), np.abs(b[:, IMPULSE])) / h
+        known = np.isfinite(mean) & (np.abs(mean - trapezoid) > rounding)
+        # the cubic's integral is h (trapezoid + h (rate_a - rate_b) / 12): the rates' difference that gives the mean
+        shift = np.where(known, 0.5 * ((rate_b - rate_a) - 12.0 * (trapezoid - mean) / h), 0.0)
+    return rate_a + shift, rate_b - shift, mean, known
 
 
 def _rate_weights(t: np.ndarray, i: np.ndarray, broken: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -33,7 +33,7 @@ from . import kernel as K
 from .arguments import check_progress, check_rig_words, check_snapshot_times
 from .model import RIPPLE_SHARE, Population, chain_force, pack_parameters, stick_chains
 from .result import Bookkeeping, Snapshot, TransientResult
-from .sampling import Sampler
+from .sampling import Sampler, locate_peaks
 
 CONTROLS = ("block", "velocity")
 STARTS = ("empty", "steady")
@@ -1339,9 +1339,16 @@ def _finish(d: _Driver, snapshots: list[Snapshot], stop: str | None, note: str) 
     order = np.argsort(table[:, 0], kind="stable")
     table = table[order]
     keep = np.r_[True, np.diff(table[:, 0]) > 0]
+    doubled = table[~keep, 0]  # instants of two rows (a jump's), where no peak is located across
     table = table[keep]
     if control == "velocity" and d.sampler is None:  # (a sampler's rows were balanced as they came: _Driver._balanced)
         _balanced_integral(table, protocol)
+    if d.sampler is None:  # the stress's peaks between rows, into their highest (a sampler's located as they came)
+        locate_peaks(
+            table, 1, table.shape[0], k_block=k_block, known_rate=control != "velocity" and mass == 0,
+            breaks=np.unique(np.asarray(protocol.boundaries[1:-1], dtype=float)),
+            events=np.r_[[e[1] for e in events if e[0] == "slip"], [j.time for j in d.jumps], doubled],
+        )  # fmt: skip
     n0 = params.bonds.site_density
     time, sigma, bonded, v, x, puller = (table[:, k] for k in range(6))
     bonded = bonded / n0
@@ -1625,7 +1632,9 @@ SEGMENT_STEPS = 10.0
 #: 1000 segments of 1 ms at 350/400 um/s), a tenth of that otherwise
 SEGMENT_SECONDS = 0.02
 #: CPU per step and cohort (s): a block stuck for good keeps every cohort it bears, its run costs ~ this x steps^2
-#: (1000 segments of 1 ms from rest: 3291 steps, 7 s; one segment: 2409 steps, 1.5-2 s)
+#: (1000 segments of 1 ms from rest: 3291 steps, 7 s; one segment: 2409 steps, 1.5-2 s; measured on the kernel of
+#: issue 31's start: the kernel now takes 1.25 s, 3.16 s for 3000 segments and 0.39 s for one, ~1.2e-7 s per cohort
+#: and step, but this count is the default runs' estimate too, and tests hold refusals on it: docs/transient.md 2a)
 COHORT_SECONDS = 5e-7
 #: with the paper's attached chains a stuck block is their closed form: a stick-slip cycle costs the steps of its
 #: slip and re-stick, measured 3100-5550 from 30 to 120 um/s (gel, K = 3.06e5 Pa/m, rtol 1e-4); a stiffer block
@@ -1696,6 +1705,17 @@ TAIL_SETTLE = 2.0
 #: CPU per step and living cohort (s; velocity control from empty, 10 and 1 um/s: 1.0e-7 and 1.9e-7 measured): a
 #: population that remembers dl_m/V = 1 s at 1 um/s keeps ~5e5 cohorts
 COHORT_STEP_SECONDS = 1.5e-7
+#: CPU of a step besides its cohorts (s) where those are counted (COHORT_STEP_SECONDS or SLIDING_COHORT_SECONDS for
+#: the plain cohorts' pieces and holds): ~1 us measured (the rest of
+#: STEP_SECONDS' 100 us, which stands for a step's cohorts where they are not counted, is theirs; plain cohorts
+#: sliding at 350 um/s take 10-12 us a step over ~150 cohorts, where 100 us a step had been counted besides them:
+#: 7.1 s of CPU estimated for 2 s through the block, 0.65-0.72 s taken)
+PLAIN_STEP_SECONDS = 1.5e-6
+#: CPU per step and living cohort (s) where the count holds, two cohorts a step alive over the memory (the plain
+#: cohorts sliding through the block, and under velocity control after a change of velocity or from empty): measured
+#: 7.5e-8-8.3e-8 s through the block from 200 um/s to 5 mm/s (the count 0.44-1.56 of the cohorts alive), 5.5e-8-9e-8
+#: under velocity control from 10 um/s to 2 mm/s, the step's own cost included
+SLIDING_COHORT_SECONDS = 7e-8
 #: a steady start held as exact steady sliding until the velocity first changes (_Driver._held_steady): one
 #: steady stretch a piece, whatever its length (10 um/s for 0.15 s: 1 step, 2 ms of CPU)
 HELD_STEPS = 1.0
@@ -1855,7 +1875,7 @@ def estimate_cost(
     # "check the unit")
     held = _held_pieces(protocol) if (holds and abs(protocol.initial_velocity) <= 100.0 * natural) else 0
     cut = _cut_start(params, protocol, control, start, start_velocity, aging, rtol, k_block, holds)
-    steps, fastest, reduced, living = _pieces_steps(
+    steps, fastest, reduced, living, plain = _pieces_steps(
         params, protocol, control, aging, v_start, scale, motion, reducing, start=start, rtol=rtol, every=every,
         steady_held=held, cut=cut,
     )  # fmt: skip
@@ -1893,7 +1913,11 @@ def estimate_cost(
     moving = len(protocol.segments) - (0 if motion is None else motion.stuck_segments)  # a stuck one looks for none
     per_segment = SEGMENT_SECONDS if (reducing and control == "block") else 0.1 * SEGMENT_SECONDS
     copied = 0.0 if motion is None else min(motion.copied * scale, steps)  # rows of a repeated limit cycle
-    seconds = (steps - copied - (0.0 if sampled_late else samples)) * STEP_SECONDS + copied * ROW_SECONDS
+    # the steps of the plain cohorts' pieces, whose cohorts ``living`` counts, cost PLAIN_STEP_SECONDS besides; the
+    # others STEP_SECONDS, which stands for their cohorts too (a block stuck for good: both, as calibrated)
+    counted = min(plain, steps - copied)
+    seconds = (steps - copied - counted - (0.0 if sampled_late else samples)) * STEP_SECONDS + copied * ROW_SECONDS
+    seconds += counted * PLAIN_STEP_SECONDS
     seconds += samples * SAMPLE_SECONDS
     seconds += moving * per_segment
     seconds += COHORT_SECONDS * stuck * stuck + living  # the cohorts each step works through
@@ -1903,17 +1927,20 @@ def estimate_cost(
 def _pieces_steps(  # type: ignore[no-untyped-def]
     params, protocol, control, aging, v_start, scale, motion, reducing, start="empty", rtol=RTOL, every=None,
     steady_held=0, cut=(0.0, 0.0),
-) -> tuple[float, float, int, float]:  # fmt: skip
+) -> tuple[float, float, int, float, float]:  # fmt: skip
     """:func:`estimate_cost`'s steps piece by piece: (steps, the fastest velocity, the pieces reduced, the CPU
-    seconds of the living cohorts each step works through, :data:`COHORT_STEP_SECONDS`).  ``steady_held``: the pieces
-    held as the exact steady start (:func:`_held_pieces`), :data:`HELD_STEPS` each; ``cut``: (cohorts, travel in m)
-    that the start's cells cut ahead of the FENE cliff add and over which they arrive there (:func:`_cut_start`)."""
+    seconds of the living cohorts each step works through, :data:`COHORT_STEP_SECONDS`, and the steps of the pieces
+    whose living cohorts that counts: the plain cohorts' sliding pieces and holds, at :data:`PLAIN_STEP_SECONDS`).
+    ``steady_held``: the pieces held as the exact steady start (:func:`_held_pieces`), :data:`HELD_STEPS` each;
+    ``cut``: (cohorts, travel in m) that the start's cells cut ahead of the FENE cliff add and over which they arrive
+    there (:func:`_cut_start`)."""
     b, g = params.bonds, params.aging
     fold: list[float] = []  # FOLD_MARGIN x Vc, looked for only when a piece needs it
     steps = 0.0
     fastest = 0.0
     reduced = 0
     living = 0.0
+    plain = 0.0  # steps whose living cohorts are counted (the others' cost is STEP_SECONDS, their cohorts included)
     natural = b.max_extension / b.bond_time
     memories: dict[float, _Memory] = {}  # by velocity, for this estimate (1e5 segments ask again and again)
     # the velocity the population was last steady at (None: an empty start, whose first bonds reach the wall dl_m/V on)
@@ -1957,6 +1984,7 @@ def _pieces_steps(  # type: ignore[no-untyped-def]
             taken = lump + (0.0 if (every is None or SAMPLED_AFTER) else (t1 - t0) / every)
             living += COHORT_STEP_SECONDS * taken * (kept + taken + cut_left)  # (none of the cut cells' arrive)
             kept += 2.0 * taken
+            plain += lump
             continue
         if motion is not None and motion.counts():
             piece = motion.piece(t1 - t0, vp, lambda v=vp: v < _fold(fold, params, control, aging))
@@ -1979,6 +2007,7 @@ def _pieces_steps(  # type: ignore[no-untyped-def]
         walled = _wall_steps(wall, rate, share, b.max_extension / v, not filling, t1 - t0 - arrive) if v > 0 else 0.0
         cohorts += walled
         span = t1 - t0
+        reduced_here = False
         if reducing and 0 < vp <= (BLOCK_FASTEST if control == "block" else 100.0) * natural:
             own = _memory_of(memories, params, abs(vp), aging, rtol)
             settling = min(SETTLE * b.max_extension / abs(vp), TAIL_SETTLE * own.age)
@@ -1992,14 +2021,22 @@ def _pieces_steps(  # type: ignore[no-untyped-def]
                     cohorts = settle
                     span = min(span, settling)
                     reduced += 1
+                    reduced_here = True
+        covered = 0.0  # the share of this piece's steps whose living cohorts are counted (plain cohorts, not reduced)
         if wall > 0:  # each step once bonds die at the wall works through those born over the last memory.keep
             after = max(span - arrive, 0.0)
             wall = _wall_steps(wall, rate, share, b.max_extension / v, not filling, after) / after if after > 0 else 0.0
-            if smooth:  # the steady start's cohorts, and about one of the two born each step kept (STEADY_COHORTS)
+            if smooth:  # the steady start's cohorts over its memory (STEADY_COHORTS; gone after it: 2 358 cohorts
+                # at 350 um/s, 150 from 3 ms on, and counted over the whole piece 0.5 s there was estimated at 9.6 s
+                # of CPU, 0.15 s taken), and about one of the two born each step kept
+                first = (rate + wall) * min(after, memory.keep)
                 taken = (rate + wall) * after
-                living += COHORT_STEP_SECONDS * taken * (STEADY_COHORTS + 0.5 * (rate + wall) * min(memory.keep, after))
-            else:
-                living += COHORT_STEP_SECONDS * (rate + wall) ** 2 * after * 2.0 * min(memory.keep, after)
+                half = 0.5 * (rate + wall) * min(memory.keep, after)
+                living += COHORT_STEP_SECONDS * (first * STEADY_COHORTS + taken * half)
+            else:  # two cohorts born a step, alive over the memory (SLIDING_COHORT_SECONDS: a count that holds)
+                living += SLIDING_COHORT_SECONDS * (rate + wall) ** 2 * after * 2.0 * min(memory.keep, after)
+            # (before the first arrivals the cohorts are not counted: STEP_SECONDS stands for them)
+            covered = after / span if (span > 0 and not reduced_here) else 0.0
         if held > 0 and v > 0:  # re-sliding after a hold: the aged bonds die at the FENE wall, stiffly
             aged = _resliding_steps(params, held, v, aging, rate * min(t1 - t0, b.max_extension / v))
             cohorts += aged
@@ -2008,8 +2045,9 @@ def _pieces_steps(  # type: ignore[no-untyped-def]
         if before > 0:  # the cut cells' cohorts: their arrivals' steps, and each step works through those left
             cohorts += CUT_STEPS * arriving
             living += COHORT_STEP_SECONDS * cohorts * 0.5 * (before + cut_left)
+        plain += covered * cohorts
         steps += cohorts + SEGMENT_STEPS
-    return steps, fastest, reduced, living
+    return steps, fastest, reduced, living, plain
 
 
 def _births_steps(births: float, vacant: float, tau: float, span: float, filling: bool) -> float:
