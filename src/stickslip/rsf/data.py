@@ -328,6 +328,8 @@ def _friction(
             ' normal stress to divide this shear stress by: give --normal-stress (e.g. "10 MPa"; Python:'
             ' normal_stress=) or a normal-stress column (--columns normal_stress="HEADER")'
         )
+    # a normal stress <= 0 was refused above with its row; an empty cell (NaN) gives a NaN friction, which the reader
+    # treats as any empty friction cell (dropped with a note, or refused beyond 1 %)
     with np.errstate(invalid="ignore", divide="ignore"):
         friction = tau / divisor
     typical = float(np.nanmedian(np.abs(friction))) if np.any(np.isfinite(friction)) else math.nan

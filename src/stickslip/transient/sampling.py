@@ -344,7 +344,7 @@ def locate_peaks(
     times, sigma = every[:, TIME], every[:, SIGMA]
     # two rows at one instant are a jump's (the trace keeps the first: solver._finish, which gives their instants)
     events = np.union1d(np.asarray(events, dtype=float), times[1:][np.diff(times) == 0.0])
-    with np.errstate(invalid="ignore"):
+    with np.errstate(invalid="ignore"):  # a row without a stress (NaN) compares False: it is never a peak
         d = np.diff(sigma)
         peak = np.flatnonzero((d[:-1] > 0.0) & (d[1:] <= 0.0)) + 1  # rows with a rise before and none after
     peak = peak[(peak + 1 >= max(first, 1)) & (peak < last)]  # (either interval closed by a row of first..last - 1)
@@ -380,6 +380,8 @@ def _quartic_peaks(times: np.ndarray, sigma: np.ndarray, peak: np.ndarray) -> np
     exists = np.all((rows >= 0) & (rows < n), axis=1)
     rows = np.clip(rows, 0, n - 1)
     scale = times[rows[:, 3]] - times[rows[:, 1]]
+    # rows beyond the trace (clipped) or at one instant give NaN or inf here; ``exists`` and the agreement test
+    # below reject such a peak, so it keeps its row's value
     with np.errstate(invalid="ignore", divide="ignore"):
         x = (times[rows] - times[peak][:, None]) / scale[:, None]  # (centred and scaled: well conditioned)
         coef = sigma[rows].astype(float)  # Newton's divided differences, in place
@@ -429,6 +431,7 @@ def _cubic_peaks(
     quad = 6.0 * (sa - sb) + 3.0 * h * (rate_a + rate_b)
     lin = -6.0 * (sa - sb) - 4.0 * h * rate_a - 2.0 * h * rate_b
     const = h * rate_a
+    # no real turn (negative discriminant) is NaN by construction and a flat cubic divides by ~0: both are left out
     with np.errstate(invalid="ignore", divide="ignore"):
         root = np.sqrt(np.where(lin * lin - 4.0 * quad * const >= 0.0, lin * lin - 4.0 * quad * const, np.nan))
         q = -0.5 * (lin + np.copysign(root, lin))
