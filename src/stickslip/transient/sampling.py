@@ -363,6 +363,7 @@ def locate_peaks(
         mine = (j >= max(first, 1)) & (j < last)
         value, when = _cubic_peaks(every, j[mine], k_block=k_block, known_rate=known_rate, breaks=breaks, events=events)
         excess = value - y1[mine]
+        # an interval with no turn inside gives NaN (value, vertex): NaN compares False, so its row keeps its own value
         with np.errstate(invalid="ignore"):
             ok = (excess > ROUNDING * np.abs(y1[mine])) & (excess <= PEAK_REACH * reach[mine])
             ok &= np.abs(value - vertex[mine]) <= PEAK_AGREEMENT * excess
