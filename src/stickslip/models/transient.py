@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from typing import Any
 
@@ -58,8 +57,6 @@ class Transient(BondModel):
         if rig.has_mass or rig.has_damping:  # the block's inertia and damping (docs/extensions.md section 4)
             settings.update(mass=rig.mass, damping=rig.damping)
         result = run_transient(params, protocol, control=control, start="empty" if start is None else start, **settings)
-        if settings.get("stick_population") and control == "block":
-            result = chains_at_the_end(result, params, protocol, aging=settings.get("aging", True))
         return transient_run(result, protocol, resolution=settings.get("rtol", _default_rtol()))
 
     def estimate_seconds(
@@ -190,105 +187,6 @@ def _critical_stiffness_for_plot(params: Parameters, velocity: float) -> float:
         except FloatingPointError:
             return NAN
     return found.value
-
-
-#: Eq 15 is followed past the run's end for at most this many of the stick's aging times
-CHAINS_HORIZON = 1e4
-#: the stick's instant is an end of its bracket (the rows either side) where Eq 15 from there misses the end's
-#: fraction by at most this share of what the bracket spans (the solver's own Eq 15 is solved to rtol 1e-10)
-CARRIED_TOLERANCE = 1e-3
-
-
-def chains_at_the_end(result: Any, params: Parameters, protocol: Protocol, aging: bool = True) -> Any:
-    """A run that ends with the stick chains holding the slider, in a stick that began under another pace: the
-    verdict a stick within one pace gets (the solver's), "undetermined" with the instant Eq 15 has the chains
-    collapse at under the last segment's loading, after the run's end; "stuck" only where they hold on for
-    CHAINS_HORIZON aging times.  The result as it was otherwise.
-
-    The solver says when fresh chains would collapse (the quasi-static stick solver's answer under one constant
-    loading), not for chains that aged under another pace: 350 -> 35 -> 350 µm/s (2, 10, 2 s) ended mid-stick at
-    551.875 Pa and read "stuck ... the stick chains hold it", while a constant 35 µm/s ending mid-stick read
-    "undetermined: ... they collapse at t = 30.1723 s"; it now reads "undetermined: ... they collapse at
-    t = 14.9424 s (σs = 652.964 Pa)", where the same protocol run on for a second slips (14.94235 s, 652.964 Pa).
-    The chains' state at the end is their fraction there (the trace's, exact at the run's end) and their age, the
-    time since the stick.  The stick began between the last row the chains did not hold and their first; its
-    instant is where fresh chains, followed by Eq 15 along the stick's exact loading sigma = sigma_end -
-    K (P_end - P(t)) (the slider held), reach the end's fraction: with every row, the row before (4.4327 s, the
-    stick event's instant); with rows every 0.1, 1 or 3 s, the same instant."""
-    chains = getattr(result, "chain_fraction", None)
-    message = str(getattr(result, "message", ""))
-    if (
-        getattr(result, "status", "ok") != "ok" or result.regime != regimes.STUCK or chains is None
-        or "never collapse" in message
-    ):  # fmt: skip
-        return result
-    held_words = "(the stick chains hold it) under σ = "
-    time, stress = np.asarray(result.time, dtype=float), np.asarray(result.stress, dtype=float)
-    fraction = np.asarray(chains, dtype=float)
-    if time.size < 2 or not math.isfinite(fraction[-1]) or held_words not in message:
-        return result
-    from ..transient.model import stick_chains
-
-    loose = np.flatnonzero(~np.isfinite(fraction))
-    first = int(loose[-1]) + 1 if loose.size else 0  # the stick's first row
-    k_block, end, sigma_end, f_end = float(result.stiffness), float(time[-1]), float(stress[-1]), float(fraction[-1])
-    edges = np.asarray(protocol.boundaries, dtype=float)
-
-    def sigma_at(t: float) -> float:  # the slider held: the spring follows the puller
-        travel = float(protocol.displacement_at(end)) - float(protocol.displacement_at(t))
-        return sigma_end - k_block * travel
-
-    def carried(t_stick: float) -> float:  # ln of the fraction at the end, from fresh chains at t_stick
-        t, f, age = t_stick, 1.0, 0.0
-        for b in [*edges[(edges > t) & (edges < end)].tolist(), end]:
-            pace = float(protocol.velocity_at(np.nextafter(b, -np.inf)))
-            res = stick_chains(params, aging, sigma_at(t), k_block * pace, age, f, b - t)
-            if res.collapsed:
-                return -math.inf
-            t, f, age = b, res.fraction, age + b - t
-        return math.log(max(f, 1e-300))
-
-    # the stick began after the last row the chains did not hold and at or before their first (from rest: at 0)
-    lo = float(time[first - 1]) if first > 0 else float(time[0])
-    hi = float(time[first])
-    sticks = [lo, hi]
-    if hi > lo:
-        from scipy.optimize import brentq
-
-        target = math.log(f_end)
-        g_lo, g_hi = carried(lo) - target, carried(hi) - target
-        if math.isfinite(g_lo) and math.isfinite(g_hi) and g_lo * g_hi < 0:
-            found = brentq(lambda t: carried(t) - target, lo, hi, xtol=1e-9 * (hi - lo), rtol=1e-12)
-            sticks = [float(found)] * 2
-        elif min(abs(g_lo), abs(g_hi)) <= CARRIED_TOLERANCE * abs(g_hi - g_lo):
-            # an end of the bracket is the answer (the row before the stick is its instant: the run without ``every``)
-            sticks = [lo if abs(g_lo) < abs(g_hi) else hi] * 2
-    ages_end = [end - t for t in sticks]
-    pace = float(protocol.segments[-1].velocity)
-    horizon = CHAINS_HORIZON * float(params.stick.aging_time)
-    ahead = {a: stick_chains(params, aging, sigma_end, k_block * pace, a, f_end, horizon) for a in set(ages_end)}
-    outcomes = [ahead[a] for a in ages_end]  # (a collapse takes ~0.4 s of Eq 15's explosive end: each age once)
-    head = f"stuck to the end of the run (t = {end:.6g} s, σ = {sigma_end:.6g} Pa), the stick chains holding"
-    cut = message.index(" Pa", message.index(held_words) + len(held_words)) + 3
-    if not all(o.collapsed for o in outcomes):
-        words = (
-            f"; under this loading Eq 15 has them hold for {CHAINS_HORIZON:g} of their aging times ({horizon:.3g} s)"
-            " more at least"
-        )
-        return dataclasses.replace(result, message=message[:cut] + words + message[cut:])
-    due = [end + o.duration for o in outcomes]
-    sigma_s = [sigma_end + k_block * pace * o.duration for o in outcomes]
-    when = (
-        f"at t = {due[0]:.6g} s (σs = {sigma_s[0]:.6g} Pa, Eq 15)"
-        if abs(due[1] - due[0]) <= 1e-6 * max(due[1] - end, 1e-300)
-        else f"between t = {min(due):.6g} and {max(due):.6g} s (σs {min(sigma_s):.6g} to {max(sigma_s):.6g} Pa, Eq 15:"
-        f" the stick began between the rows at {time[first - 1]:.6g} and {time[first]:.6g} s)"
-    )
-    words = (
-        f"undetermined: {head}; under this loading they collapse {when}, after the run's end: run longer to see"
-        " the slip"
-    )
-    return dataclasses.replace(result, regime=regimes.UNDETERMINED, message=words + message[cut:])
 
 
 def transient_run(result: Any, protocol: Protocol | None = None, resolution: float | None = None) -> Run:

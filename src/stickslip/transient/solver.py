@@ -1223,6 +1223,9 @@ def _chains_ahead(d: Any, regime: str, message: str, time: np.ndarray, sigma: np
     if regime != "stuck" or not d.chains_on:
         return regime, message
     due, never = d.chains_ahead
+    held_on = False
+    if due is None and not never:  # aged chains (a stick begun under another pace): follow Eq 15 on from the end
+        due, held_on = _aged_chains_ahead(d, float(time[-1]), float(sigma[-1]))
     if due is not None and due[0] > float(time[-1]):
         return "undetermined", (
             f"undetermined: stuck to the end of the run (t = {time[-1]:.6g} s, σ = {sigma[-1]:.6g} Pa), the stick"
@@ -1231,7 +1234,30 @@ def _chains_ahead(d: Any, regime: str, message: str, time: np.ndarray, sigma: np
         )
     if never:
         return regime, message + "; Eq 15 proves the chains never collapse under this loading"
+    if held_on:
+        horizon = CHAINS_HORIZON * float(d.params.stick.aging_time)
+        return regime, message + (
+            f"; under this loading Eq 15 has them hold for {CHAINS_HORIZON:g} of their aging times ({horizon:.3g} s)"
+            " more at least"
+        )
     return regime, message
+
+
+#: Eq 15 is followed past the run's end for at most this many of the stick's aging times
+CHAINS_HORIZON = 1e4
+
+
+def _aged_chains_ahead(d: Any, end: float, sigma_end: float) -> tuple[tuple[float, float] | None, bool]:
+    """When chains that aged under other paces collapse under the last pace's loading, from their exact state at
+    the run's end (their age and fraction): ((t, σs), False), or (None, True) where they hold for CHAINS_HORIZON
+    aging times (the solver's own stick stretches look ahead only for fresh chains, quasistatic.stick)."""
+    pace = max(float(d.protocol.velocity_at(np.nextafter(end, -np.inf))), 0.0)  # (held: the stress stays)
+    chain = d.chain_state
+    horizon = CHAINS_HORIZON * float(d.params.stick.aging_time)
+    ahead = stick_chains(d.params, d.aging, sigma_end, d.k_block * pace, chain["elapsed"], chain["fraction"], horizon)
+    if not ahead.collapsed:
+        return None, True
+    return (end + ahead.duration, sigma_end + d.k_block * pace * ahead.duration), False
 
 
 def _scratch(state: _State) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
