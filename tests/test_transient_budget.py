@@ -370,7 +370,7 @@ def test_a_run_estimated_far_over_its_time_budget_is_refused_at_once():
     with pytest.raises(ParameterError, match=r"of CPU .* more than 3 x the time budget of 1 s"):
         # reduction="off": every cycle integrated (with the reduction the limit cycle is repeated: ~2 s of CPU)
         run_transient(GEL, constant(100e-6, 300.0), stick_population=True, max_time=1.0, reduction="off")
-    for bad in (0, -1.0, float("nan"), "1 s", True):
+    for bad in (0, -1.0, float("nan"), "1 m", True):  # (round 28: "1 s" is read as a time, a length is not)
         with pytest.raises(ParameterError, match="max_time"):
             run_transient(GEL, SHORT, max_time=bad)
 

@@ -228,9 +228,13 @@ def jump_velocity(params: Parameters, stress: float, curve: str = "aging") -> Ju
     ``curve`` is ``"aging"`` (default: the curve the slip then follows, so the
     stress is continuous) or ``"no-aging"`` (Eq 8 as written in Section 3).
     """
+    from ..units import refused_as_written, si_argument
+
     check_curve(curve)
-    if isinstance(stress, bool) or not isinstance(stress, (int, float, np.floating)) or not math.isfinite(stress):
-        raise ParameterError(f"stress: expected a finite number in Pa, got {stress!r}")
+    with refused_as_written(stress):
+        stress = si_argument(stress, "stress", "stress")
+        if isinstance(stress, bool) or not isinstance(stress, (int, float, np.floating)) or not math.isfinite(stress):
+            raise ParameterError(f"stress: expected a finite number in Pa, got {stress!r}")
     stress = float(stress)
     cp = require_critical_point(params)
     assert cp.velocity is not None

@@ -268,8 +268,12 @@ def slip_phase(params: Parameters, pulling_velocity: float, start_velocity: floa
     Ends at Vc when V0 < Vc (``ends="stick"``, reached in finite time) or when
     V has settled at V0 >= Vc (``ends="steady"``, within SETTLE_TOLERANCE).
     """
-    v0 = check_velocity(pulling_velocity)
-    vs = check_velocity(start_velocity, "start_velocity")
+    from ..units import refused_as_written, si_argument
+
+    with refused_as_written(pulling_velocity):
+        v0 = check_velocity(si_argument(pulling_velocity, "velocity", "pulling_velocity"))
+    with refused_as_written(start_velocity):
+        vs = check_velocity(si_argument(start_velocity, "velocity", "start_velocity"), "start_velocity")
     cp = require_critical_point(params)
     assert cp.velocity is not None and cp.stress is not None
     vc = cp.velocity
@@ -319,8 +323,12 @@ def slip_phase(params: Parameters, pulling_velocity: float, start_velocity: floa
 def slip_duration(params: Parameters, pulling_velocity: float, start_velocity: float) -> tuple[str, float]:
     """(how the slip ends, its duration in s) of :func:`slip_phase`, the same numbers, without its output points (a
     time-dependent run's cost estimate asks for these two alone: half of slip_phase's CPU is its output)."""
-    v0 = check_velocity(pulling_velocity)
-    vs = check_velocity(start_velocity, "start_velocity")
+    from ..units import refused_as_written, si_argument
+
+    with refused_as_written(pulling_velocity):
+        v0 = check_velocity(si_argument(pulling_velocity, "velocity", "pulling_velocity"))
+    with refused_as_written(start_velocity):
+        vs = check_velocity(si_argument(start_velocity, "velocity", "start_velocity"), "start_velocity")
     cp = require_critical_point(params)
     assert cp.velocity is not None
     ends, _v_end, trajectory = _trajectory(params, v0, vs, cp.velocity)

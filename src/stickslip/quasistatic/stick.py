@@ -375,12 +375,18 @@ def _solved(
     aging_cap: float | None,
 ) -> _Solved | StickPhase:
     """The arguments checked and Eq 15 integrated (a StickPhase at once where nothing loads the block)."""
+    from ..units import refused_as_written, si_argument
+
     require_parameters(params)
-    v0 = check_velocity(pulling_velocity)
-    sigma0 = _start_stress(params, start_stress)
+    with refused_as_written(pulling_velocity):
+        v0 = check_velocity(si_argument(pulling_velocity, "velocity", "pulling_velocity"))
+    with refused_as_written(start_stress):
+        sigma0 = _start_stress(
+            params, None if start_stress is None else si_argument(start_stress, "stress", "start_stress")
+        )
     aging = require_flag(aging, "aging")
     if horizon is not None:
-        horizon = _number(horizon, "horizon", "s")
+        horizon = _number(si_argument(horizon, "time", "horizon"), "horizon", "s")
         if horizon < 0:  # 0 is allowed: the time-dependent model asks with what is left of a segment
             raise ParameterError(f"horizon: expected a time >= 0 in s, got {horizon!r}")
     cap = math.inf

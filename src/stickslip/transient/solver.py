@@ -202,7 +202,15 @@ def run_transient(
     """
     from ..units import si_argument
 
-    every = None if every is None else si_argument(every, "time", "every")  # "100 ms" too, as rsf.simulate reads it
+    # "100 ms", "50 um/s", "300 kPa/m" too, as rsf.simulate and the rig read them (a number is SI)
+    every, max_step, max_time, start_velocity, stiffness, mass, damping = (
+        None if value is None else si_argument(value, dimension, name)
+        for value, dimension, name in (
+            (every, "time", "every"), (max_step, "time", "max_step"), (max_time, "time", "max_time"),
+            (start_velocity, "velocity", "start_velocity"), (stiffness, "stress_per_length", "stiffness"),
+            (mass, "mass_per_area", "mass"), (damping, "stress_per_velocity", "damping"),
+        )
+    )  # fmt: skip
     progress, mass, damping, k_block, start_velocity, budget, seconds = _checked_arguments(
         params, protocol, control, start, reduction, aging, stick_population, rtol, progress, stiffness, mass, damping,
         every, max_step, start_velocity, max_steps, max_time,
