@@ -74,8 +74,8 @@ def test_a_bad_protocol_row_is_named_by_its_line_in_the_file(tmp_path):
     commented = tmp_path / "commented.csv"
     commented.write_text("# slide-hold-slide\n# by hand\ntime,velocity\n0,1e-6\n10,nan\n20,0\n")
     with pytest.raises(
-        DataError, match=r"commented.csv: row 5: expected two finite numbers in SI units, got \[10.0, nan\]"
-    ):
+        DataError, match=r"commented.csv: row 5: expected two finite numbers \(time, velocity\); velocity: 'nan'"
+    ):  # (round 28: the row quoted as written, each column with its unit)
         protocols.read_protocol(commented)
     blank = tmp_path / "blank.csv"
     blank.write_text("time,velocity\n0,1e-6\n\n10,1e-5\n5,0\n")

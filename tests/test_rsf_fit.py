@@ -81,8 +81,9 @@ def test_rig_text_with_mapped_columns(tmp_path):
     cols = parse_columns('time="Time(s)",displacement="Displ(microns)",friction=Friction')
     read = read_record(path, cols, displacement_unit="um")
     assert read.t0 == pytest.approx(500.0) and read.displacement[-1] == pytest.approx(rec.displacement[-1], rel=1e-6)
-    with pytest.raises(DataError, match="no column 'Displ'"):
-        read_record(path, {"displacement": "Displ"})
+    # (round 28: a name given without its header's unit finds the column, "Displ" is "Displ(microns)")
+    with pytest.raises(DataError, match="no column 'Slip'"):
+        read_record(path, {"displacement": "Slip"})
     with pytest.raises(ParameterError, match="unknown role 'speed'"):
         parse_columns("speed=V")
 
@@ -134,5 +135,7 @@ def test_optional_emcee_posterior():
     fit = fit_record(synthetic(11, rows=300), stiffness=3e3, protocol=STEP, mcmc_steps=40, seed=2)
     post = fit.posterior
     assert post is not None and {"a", "b", "dc", "mu0"} <= set(post)
-    lo, hi = post["a"]["interval"]
+    # 40 steps are short of 50 autocorrelation times: no interval, the rough percentiles kept apart (round 28)
+    assert post["converged"] is False and post["a"]["interval"] is None
+    lo, hi = post["a"]["unconverged_percentiles"]
     assert lo < post["a"]["median"] < hi and 0.004 < post["a"]["median"] < 0.012

@@ -342,25 +342,38 @@ def read_protocol(path: str | Path) -> Protocol:
             f"{path}: the header has both time and duration; give time,velocity (change points) or velocity,duration"
             " (segments)"
         )
-    lines = data_lines(text.split("\n"), len(frame)) or list(range(2, len(frame) + 2))
+    text_lines = text.split("\n")
+    found_lines = data_lines(text_lines, len(frame))
+    lines = found_lines or list(range(2, len(frame) + 2))
+    raw = _RawRows(text_lines if found_lines else None, sep, list(frame.columns))
     if {"velocity", "duration"} <= set(columns):
-        pairs = _numeric_rows(frame, path, [columns["velocity"], columns["duration"]], lines)
+        cols = [columns["velocity"], columns["duration"]]
+        pairs = _numeric_rows(frame, path, cols, lines, raw)
+        velocity, duration = (_Written(c, d, path) for c, d in zip(cols, ("velocity", "time"), strict=True))
         try:
             return Protocol(
-                tuple(_checked_segment(v, d, path, lines[i]) for i, (v, d) in enumerate(pairs)), name=path.name
+                tuple(
+                    _checked_segment(v, d, path, lines[i], velocity.text(v), duration.text(d))
+                    for i, (v, d) in enumerate(pairs)
+                ),
+                name=path.name,
             )
         except ParameterError as exc:
             raise DataError(str(exc)) from None
     if {"time", "velocity"} <= set(columns):
-        rows = _numeric_rows(frame, path, [columns["time"], columns["velocity"]], lines)
+        cols = [columns["time"], columns["velocity"]]
+        rows = _numeric_rows(frame, path, cols, lines, raw)
         if len(rows) < 2:
             raise DataError(f"{path}: expected at least two rows (a start and an end time), got {len(rows)}")
+        time, velocity = (_Written(c, d, path) for c, d in zip(cols, ("time", "velocity"), strict=True))
         items = []
         for i in range(len(rows) - 1):
             (t0, v), (t1, _) = rows[i], rows[i + 1]
             if not t1 > t0:
-                raise DataError(f"{path}: row {lines[i + 1]}: time {t1:g} s does not increase (previous {t0:g} s)")
-            items.append(_checked_segment(v, t1 - t0, path, lines[i]))
+                raise DataError(
+                    f"{path}: row {lines[i + 1]}: time {time.text(t1)} does not increase (previous {time.text(t0)})"
+                )
+            items.append(_checked_segment(v, t1 - t0, path, lines[i], velocity.text(v), time.text(t1 - t0)))
         return Protocol(tuple(items), name=path.name)
     found = ", ".join(str(c) for c in frame.columns) or "none"
     raise DataError(f"{path}: expected columns time,velocity or velocity,duration (SI units); found {found}")
@@ -371,11 +384,70 @@ MAX_PROTOCOL_BYTES = 100_000_000
 
 
 def _protocol_text(path: Path) -> str:
-    return read_input_text(path, f"protocol file {path}", MAX_PROTOCOL_BYTES)
+    """The protocol file's text; a gzip file (:func:`stickslip.tables.is_gzip`, as every reader) decompressed."""
+    from .tables import is_gzip, open_input
+
+    subject = f"protocol file {path}"
+    if not is_gzip(path):
+        return read_input_text(path, subject, MAX_PROTOCOL_BYTES)
+    with open_input(path, "rb") as handle:
+        data = handle.read(MAX_PROTOCOL_BYTES + 1)
+    if len(data) > MAX_PROTOCOL_BYTES:
+        raise DataError(f"{subject}: more than {MAX_PROTOCOL_BYTES} bytes decompressed; at most that many are read")
+    try:
+        return data.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        raise DataError(f"{subject}: not a text (UTF-8) file ({exc.reason} at byte {exc.start})") from None
 
 
-def _numeric_rows(frame: Any, path: Path, cols: list[Any], lines: list[int]) -> list[tuple[float, float]]:
+@dataclass(frozen=True)
+class _RawRows:
+    """The file's lines (None where its rows cannot be matched to them), its separator and the frame's columns:
+    a bad row quoted as written."""
+
+    lines: list[str] | None
+    sep: str
+    columns: list[Any]
+
+    def cells(self, line: int, frame_row: Any, cols: list[Any]) -> tuple[list[str], str]:
+        """The cells of ``cols`` in file line ``line`` as written, and the whole line ("" where not known)."""
+        import csv
+
+        if self.lines is not None and 0 < line <= len(self.lines):
+            text = self.lines[line - 1].split("#", 1)[0].strip()
+            try:
+                fields = next(csv.reader([text], delimiter=self.sep))
+            except (csv.Error, StopIteration):
+                fields = text.split(self.sep)
+            positions = [self.columns.index(c) for c in cols]
+            return [fields[k].strip() if k < len(fields) else "" for k in positions], text
+        values = frame_row.tolist()
+        return ["" if isinstance(v, float) and math.isnan(v) else str(v).strip() for v in values], ""
+
+
+class _Written:
+    """A protocol column's values as the file writes them: its unit from its header (SI where it names none)."""
+
+    def __init__(self, column: Any, dimension: str, path: Path) -> None:
+        from .units import DIMENSIONS
+
+        self.name = str(column).strip()
+        self.factor = _header_factor(column, dimension, path)
+        self.unit = split_header(self.name, parentheses=True)[1] or DIMENSIONS[dimension][1]
+
+    def text(self, value: float) -> str:
+        """``value`` (SI) as written: "400 ms", "-5 um/s"."""
+        return f"{value / self.factor:.10g} {self.unit}"
+
+
+def _numeric_rows(
+    frame: Any, path: Path, cols: list[Any], lines: list[int], raw: _RawRows | None = None
+) -> list[tuple[float, float]]:
+    """The two columns' numbers in SI, row by row; a DataError naming the first row with a cell that is empty,
+    no number or not finite, quoting that cell and the row as written."""
     import pandas as pd
+
+    from .units import shorten
 
     data = frame[cols].apply(pd.to_numeric, errors="coerce").to_numpy(dtype=float)
     data = data * [
@@ -385,8 +457,23 @@ def _numeric_rows(frame: Any, path: Path, cols: list[Any], lines: list[int]) -> 
     bad = ~np.isfinite(data).all(axis=1)
     if bad.any():
         row = int(np.argmax(bad))
-        raw = ", ".join(str(value) for value in frame.iloc[row][cols].tolist())
-        raise DataError(f"{path}: row {lines[row]}: expected two finite numbers in SI units, got [{raw}]")
+        raw = raw if raw is not None else _RawRows(None, ",", list(frame.columns))
+        cells, text = raw.cells(lines[row], frame.iloc[row][cols], cols)
+        problems = []
+        for column, cell, value in zip(cols, cells, data[row], strict=True):
+            if math.isfinite(value):
+                continue
+            name = str(column).strip()
+            if not cell:
+                problems.append(f"{name}: empty cell")
+            elif math.isnan(value) and cell.lower() not in ("nan", "-nan", "+nan"):
+                problems.append(f"{name}: {shorten(cell)} is not a number")
+            else:
+                problems.append(f"{name}: {shorten(cell)} is not a finite number")
+        names = ", ".join(str(c).strip() for c in cols)
+        quoted = f" (the row reads {shorten(text)})" if text else ""
+        said = "; ".join(problems)
+        raise DataError(f"{path}: row {lines[row]}: expected two finite numbers ({names}); {said}{quoted}")
     return [(float(a), float(b)) for a, b in data]
 
 
@@ -403,11 +490,26 @@ def _header_factor(column: Any, dimension: str, path: Path) -> float:
         raise DataError(f"{path}: {exc}") from None
 
 
-def _checked_segment(velocity: float, duration: float, path: Path, line: int) -> Segment:
+def _checked_segment(
+    velocity: float, duration: float, path: Path, line: int, velocity_text: str = "", duration_text: str = ""
+) -> Segment:
+    """A segment of a protocol file's row; refused naming the row and the value as the file writes it, with its
+    unit (``velocity_text``, ``duration_text``: "-5 um/s", "400 ms")."""
     try:
         return Segment(velocity, duration)
     except ParameterError as exc:
-        raise DataError(f"{path}: row {line}: {exc}") from None
+        message = str(exc)
+        written = velocity_text if message.startswith("segment velocity") else duration_text
+        if written:
+            message = f"{message.split(':', 1)[0]}: {_expected(message)}, got {written}"
+        raise DataError(f"{path}: row {line}: {message}") from None
+
+
+def _expected(message: str) -> str:
+    """The "expected ..." part of a segment's refusal, without its value: "expected a value >= 0"."""
+    body = message.split(":", 1)[1].strip() if ":" in message else message
+    body = body.rsplit(", got ", 1)[0]
+    return body.replace(" >= 0 m/s", " >= 0").replace("a positive time", "a positive duration")
 
 
 def _as_segment(item: tuple[float, float] | Segment) -> Segment:

@@ -20,11 +20,12 @@ from typing import Any
 
 import numpy as np
 
-from ..columns import data_lines, with_units
+from ..columns import with_units
 from ..errors import DataError, ParameterError
 from ..fileio import protect_inputs, require_input_file
 from ..numerics.quantisation import quantum
 from ..protocols import Protocol, Segment
+from ..tables import open_input
 
 __all__ = [
     "LabRecord", "change_time_uncertainty", "find_segments", "forward", "level_velocity_uncertainty",
@@ -145,10 +146,16 @@ class LabRecord:
             raise DataError(f"{source}: {t.size} data row(s); expected at least {MIN_RECORD_ROWS} to fit a record")
         row = _row_names(rows, t.size)
         refuse_nonfinite(source, row, {"time": t, "displacement": d, "friction": f})
-        step = np.diff(t)
-        if np.any(step <= 0):
-            i = int(np.argmax(step <= 0)) + 1
-            raise DataError(f"{source}: row {row[i]}: time {t[i]:g} s does not increase")
+        for name, values, unit in (("time", t, "s"), ("displacement", d, "m"), ("friction", f, "")):
+            # the fits square sums of these (analyze's limit): no measured record comes near it
+            bad = np.flatnonzero(np.abs(values) > MAX_MAGNITUDE)
+            if bad.size:
+                k = int(bad[0])
+                raise DataError(
+                    f"{source}: row {row[k]}: {name} {values[k]:g}{f' {unit}' if unit else ''} is beyond"
+                    f" {MAX_MAGNITUDE:g}{f' {unit}' if unit else ''} in magnitude; not a measured record"
+                )
+        _refuse_time_order(source, row, t)
         return cls(t - t[0], d - d[0], f, float(t[0]), source, length_unit)
 
     def to_frame(self) -> Any:
@@ -163,6 +170,32 @@ class LabRecord:
         from ..plots.rsf import plot_record
 
         return plot_record(self, ax=ax)
+
+
+#: no value of a record may exceed this in magnitude (SI), as analyze's records (a time of 1e300 s is a typing error)
+MAX_MAGNITUDE = 1e100
+
+
+def _refuse_time_order(source: str, row: Any, t: np.ndarray) -> None:
+    """DataError at the first row whose time does not increase, naming the row that is out of place: where the
+    row before it stands alone above both its neighbours (a 1e5 among 0.3 and 0.5 s), that one, with both
+    neighbours; else the row that does not increase, with the time before it."""
+    step = np.diff(t)
+    if not np.any(step <= 0):
+        return
+    i = int(np.argmax(step <= 0)) + 1
+    odd = i - 1  # the row before, out of place where the rows either side of it increase
+    above = t[odd] > t[i]  # (not a repeated time: that row does not increase)
+    if above and ((odd >= 1 and t[odd - 1] < t[i]) or (odd == 0 and t.size > 2 and t[1] < t[2] < t[0])):
+        before = f"row {row[odd - 1]}: {t[odd - 1]:g} s, " if odd >= 1 else ""
+        raise DataError(
+            f"{source}: row {row[odd]}: time {t[odd]:g} s is out of order ({before}row {row[i]}: {t[i]:g} s);"
+            " expected times that increase row by row"
+        )
+    raise DataError(
+        f"{source}: row {row[i]}: time {t[i]:g} s does not increase (row {row[i - 1]}: {t[i - 1]:g} s); expected"
+        " times that increase row by row"
+    )
 
 
 def parse_columns(text: str | None) -> dict[str, str]:
@@ -198,7 +231,9 @@ def read_record(
     A shear-stress column instead of the friction (a stress unit in its header, or found or mapped as
     ``shear_stress``) is divided by the normal stress: a ``normal_stress`` column (found by name or mapped), else
     ``normal_stress`` (Pa, or a string with its unit, "10 MPa"); μ = τ/σn, each in the unit its header names.
-    The file's separator and decimal mark: :func:`stickslip.tables.text_format`, as every reader's.
+    The file's separator, decimal mark and layout (title lines before the header, a units row under it, no header
+    row: its columns then mapped by number, ``columns={"time": "1", ...}``): :func:`stickslip.tables.text_format`,
+    as every reader's; a gzip file is read decompressed.
     """
     import pandas as pd
 
@@ -217,19 +252,18 @@ def read_record(
     if sigma is not None and not (math.isfinite(sigma) and sigma > 0):
         raise ParameterError(f"--normal-stress: expected a positive stress, got {sigma:g} Pa")
     form = text_format(path)
-    frame = _read_frame(path, pd, form)
-    with open(path, encoding="utf-8-sig", errors="replace") as handle:  # a byte-order mark is no content
-        rows = data_lines(handle, len(frame))
+    frame = _with_row_units(_read_frame(path, pd, form), form.layout, path)
+    with open_input(path, "rt", encoding="utf-8-sig", errors="replace") as handle:  # a byte-order mark: no content
+        rows = _data_lines(handle, form.layout.data_after, len(frame))
     headers = {str(c).strip(): c for c in frame.columns}
-    chosen, by_stress = _choose_columns(path, columns, headers)
+    chosen, by_stress = _choose_columns(path, columns, headers, form.layout)
     data = {role: _numbers(frame[col], path, rows, pd, form) for role, col in chosen.items() if role != "normal_stress"}
     if "normal_stress" in chosen:  # its cells read only where the friction is a stress to divide by it
         data["normal_stress"] = lambda: _numbers(frame[chosen["normal_stress"]], path, rows, pd, form)
     dimension = {"time": "time", "displacement": "length", "velocity": "velocity"}
     units = {role: _header_unit(str(chosen[role]), dimension[role], path) for role in chosen if role in dimension}
     friction, read_notes = _friction(path, chosen, data, by_stress, sigma, _row_names(rows, len(frame)))
-    if form.note:
-        read_notes.insert(0, form.note)
+    read_notes[:0] = [n for n in (form.layout.note(str(path)), form.note) if n]
 
     def in_si(role: str) -> np.ndarray:
         """A column in SI: by the unit its header names, else by the option, else SI."""
@@ -439,17 +473,68 @@ def _row_names(rows: Any, size: int) -> Any:
 
 
 def _read_frame(path: Path, pd: Any, form: Any) -> Any:
-    """The file's table as pandas reads it, with the separator and decimal mark of ``form``
-    (:func:`stickslip.tables.text_format`, every reader's one decision)."""
+    """The file's table as pandas reads it, with the separator, decimal mark and layout of ``form``
+    (:func:`stickslip.tables.text_format`, every reader's one decision): title lines and a units row skipped, a
+    header in a ``#`` comment read from it, a file with no header row its columns numbered from 1 ("1", "2", ...).
+    A gzip file is read decompressed."""
+    from ..tables import pandas_compression
+
+    layout = form.layout
+    compression = pandas_compression(path)
     try:
-        if form.delimiter != " ":
-            return pd.read_csv(path, sep=form.delimiter, comment="#", engine="c", decimal=form.decimal)
-        with open(path, encoding="utf-8-sig", errors="replace") as handle:
-            # the first 20 lines, each with its place in the file (comments counted), comments left out
-            numbered = [(i, line) for i, line in zip(range(20), handle, strict=False) if not line.startswith("#")]
-        return _read_whitespace_frame(path, pd, numbered, form.decimal)
-    except (OSError, ValueError, pd.errors.ParserError) as exc:
+        if form.delimiter == " ":
+            return _read_whitespace_frame(path, pd, layout, form.decimal, compression)
+        if layout.header_row is None or layout.commented:  # the names are not a row of the table
+            frame = pd.read_csv(path, sep=form.delimiter, comment="#", engine="c", decimal=form.decimal, header=None,
+                                skiprows=layout.data_after, compression=compression)  # fmt: skip
+            return _named(frame, layout, path)
+        skipped = {row - 1 for row in (*layout.title_rows, layout.units_row) if row is not None}  # 0-based lines
+        return pd.read_csv(path, sep=form.delimiter, comment="#", engine="c", decimal=form.decimal,
+                           skiprows=(lambda i: i in skipped) if skipped else None, compression=compression)  # fmt: skip
+    except (OSError, EOFError, ValueError, pd.errors.ParserError) as exc:
         raise DataError(f"{path}: cannot read as delimited text ({str(exc).splitlines()[0]})") from None
+
+
+def _named(frame: Any, layout: Any, path: Path) -> Any:
+    """A frame read without a header row, its columns named by the header in a ``#`` comment, else numbered from 1
+    as ``--columns time=1`` maps them."""
+    if not layout.commented:
+        frame.columns = [str(k) for k in range(1, frame.shape[1] + 1)]
+        return frame
+    if frame.shape[1] != len(layout.commented):
+        raise DataError(
+            f"{path}: the header in the comment on row {layout.header_row} names {len(layout.commented)} column(s)"
+            f" ({', '.join(layout.commented)}) but the rows have {frame.shape[1]}"
+        )
+    frame.columns = list(layout.commented)
+    return frame
+
+
+def _with_row_units(frame: Any, layout: Any, path: Path) -> Any:
+    """The frame's columns named with the unit a units row under the header gives them (``Time`` over ``ms``:
+    "Time [ms]"), where their header names none; one that names another unit is refused."""
+    if layout.units_row is None:
+        return frame
+    names = []
+    for position, column in enumerate(frame.columns):
+        header, unit = str(column).strip(), layout.unit(position)
+        written = re.search(r"[\(\[]\s*([^\(\)\[\]]+?)\s*[\)\]]\s*$", header)
+        if unit is not None and written is not None and written.group(1) != unit:
+            raise DataError(
+                f"{path}: column {header!r} names its unit {written.group(1)!r} but the units row (row"
+                f" {layout.units_row}) says {unit!r}; give one of them"
+            )
+        names.append(f"{header} [{unit}]" if unit is not None and written is None else column)
+    frame.columns = names
+    return frame
+
+
+def _data_lines(lines: Any, after: int, count: int) -> list[int] | None:
+    """The 1-based file line of each of the ``count`` data rows after file row ``after`` (the header, or the units
+    row under it), blank lines and ``#`` comments skipped as the reader skips them; None where the numbers do not
+    match what the reader kept (a quoted line end)."""
+    numbers = [n for n, line in enumerate(lines, 1) if n > after and line.split("#", 1)[0].strip()]
+    return numbers if len(numbers) == count else None
 
 
 def whitespace_headers(line: str) -> list[str]:
@@ -457,12 +542,15 @@ def whitespace_headers(line: str) -> list[str]:
     return re.findall(r"[^\s\[\(]+(?:\s*[\[\(][^\]\)]*[\]\)])?|[\[\(][^\]\)]*[\]\)]", line)
 
 
-def _read_whitespace_frame(path: Path, pd: Any, numbered: list[tuple[int, str]], decimal: str = ".") -> Any:
+def _read_whitespace_frame(path: Path, pd: Any, layout: Any, decimal: str = ".", compression: str | None = None) -> Any:
     """Columns split at blanks; the header's names by :func:`whitespace_headers` ("time [s]" is not two columns)."""
-    place, header = next(((i, line) for i, line in numbered if line.strip()), (-1, ""))
+    frame = pd.read_csv(path, sep=r"\s+", comment="#", engine="python", header=None, skiprows=layout.data_after,
+                        decimal=decimal, compression=compression)  # fmt: skip
+    if layout.header_row is None or layout.commented:
+        return _named(frame, layout, path)
+    with open_input(path, "rt", encoding="utf-8-sig", errors="replace") as handle:
+        header = next(itertools.islice(handle, layout.header_row - 1, None), "") if layout.header_row else ""
     names = whitespace_headers(header)
-    frame = pd.read_csv(path, sep=r"\s+", comment="#", engine="python", header=None, skiprows=place + 1,
-                        decimal=decimal)  # fmt: skip
     if frame.shape[1] != len(names):
         raise DataError(
             f"{path}: the header names {len(names)} column(s) ({', '.join(names) or 'none'}) but the rows have"
@@ -482,23 +570,57 @@ def _phrase(header: str) -> str:
     return " ".join(words)
 
 
-def _choose_columns(path: Path, columns: dict[str, str] | None, headers: dict) -> tuple[dict[str, Any], bool]:
+#: how the messages say the columns are mapped
+_MAP_HINT = (
+    "map them with --columns time=HEADER,displacement=HEADER,friction=HEADER; a header as written, or a column's"
+    " number, 1-based"
+)
+
+
+def _choose_columns(
+    path: Path, columns: dict[str, str] | None, headers: dict, layout: Any = None
+) -> tuple[dict[str, Any], bool]:
     """The column of each role (mapped with ``columns``, else found by :data:`_DEFAULT_NAMES`, the first in the
     file where two have one name), and whether the "friction" is a shear stress to divide by the normal stress
-    (mapped or found as ``shear_stress``)."""
+    (mapped or found as ``shear_stress``).
+
+    A mapped column is its header as written, else its name without the unit (``time=Time`` for "Time [ms]",
+    the unit a units row gave it), else its number in the file, 1-based (``time=1``: a file with no header row
+    has only these).  ``layout``: :class:`stickslip.tables.Layout`, for the messages."""
     columns = dict(columns or {})
     if "friction" in columns and "shear_stress" in columns:
         raise DataError(f"{path}: --columns maps both friction and shear_stress; map one of them")
-    found = ", ".join(headers) or "none"
+    found = f"found {', '.join(headers) or 'none'}"
+    if layout is not None and layout.header_row is None and not columns:
+        raise DataError(
+            f"{path}: no header row (row {layout.first_data_row} holds numbers); map its {len(headers)} columns by"
+            " number, 1-based: --columns time=1,displacement=2,friction=3 (their units: --time-unit,"
+            " --displacement-unit; Python: columns={'time': '1', ...})"
+        )
+    if layout is not None and layout.header_row is None:
+        found = f"the file has no header row: its {len(headers)} columns are numbered from 1"
     phrases: dict[str, Any] = {}
     for header, column in headers.items():
         phrases.setdefault(_phrase(header), column)
+    bare: dict[str, list[Any]] = {}
+    for header, column in headers.items():
+        bare.setdefault(re.sub(r"\s*[\(\[][^\(\)\[\]]*[\)\]]\s*$", "", header), []).append(column)
+    positions = list(headers.values())
 
     def mapped(role: str) -> Any:
-        wanted = columns[role]
-        if wanted not in headers:
-            raise DataError(f"{path}: no column {wanted!r} (for {role}); found {found}")
-        return headers[wanted]
+        wanted = str(columns[role]).strip()
+        if wanted in headers:
+            return headers[wanted]
+        if len(bare.get(wanted, ())) == 1:  # "Time" for "Time [ms]"
+            return bare[wanted][0]
+        if wanted.isdigit() and 1 <= int(wanted) <= len(positions):
+            return positions[int(wanted) - 1]
+        if wanted.isdigit():
+            raise DataError(
+                f"{path}: --columns {role}={wanted}: no column {wanted}; the file has {len(positions)} (numbered"
+                " from 1)"
+            )
+        raise DataError(f"{path}: no column {wanted!r} (for {role}); {found} (or give a column's number, 1-based)")
 
     def by_name(role: str) -> Any:
         return next((phrases[n] for n in _DEFAULT_NAMES[role] if n in phrases), None)
@@ -512,10 +634,7 @@ def _choose_columns(path: Path, columns: dict[str, str] | None, headers: dict) -
         if match is None and role == "displacement" and by_velocity:
             continue  # the velocity column gives it
         if match is None:
-            raise DataError(
-                f"{path}: no {role} column; found {found} (map them with --columns time=...,displacement=...,"
-                "friction=...)"
-            )
+            raise DataError(f"{path}: no {role} column; {found} ({_MAP_HINT})")
         chosen[role] = match
     by_stress = "shear_stress" in columns
     if "friction" in columns or by_stress:
@@ -526,8 +645,8 @@ def _choose_columns(path: Path, columns: dict[str, str] | None, headers: dict) -
         chosen["friction"], by_stress = match, True
     else:
         raise DataError(
-            f"{path}: no friction column; found {found} (map them with --columns time=...,displacement=...,"
-            "friction=..., or a shear stress and the normal stress: shear_stress=...,normal_stress=...)"
+            f"{path}: no friction column; {found} ({_MAP_HINT}, or a shear stress and the normal stress:"
+            " shear_stress=...,normal_stress=...)"
         )
     if "normal_stress" in columns:
         chosen["normal_stress"] = mapped("normal_stress")
