@@ -499,7 +499,7 @@ def fit_command(**options: Any) -> None:
     report["cost"] = {"seconds": elapsed, "estimated_seconds": cost.seconds, "model_run_seconds": cost.run_seconds,
                       "estimated_model_runs": cost.runs}  # fmt: skip
     if output is not None and fit.status == "ok":
-        as_parameters = json_text({**fit.rerun_mapping(), "fit": report})  # what `rsf simulate --params` reads
+        as_parameters = json_text(fit.parameters_document(report))  # what `rsf simulate --params` reads
         if output.suffix.lower() == ".json":  # what its name says: the JSON `--params` reads (no TOML inside)
             write_text(output, as_parameters)
         else:
@@ -514,6 +514,9 @@ def fit_command(**options: Any) -> None:
         from ..plots.rsf import fit_figure
 
         save_figure(fit_figure(fit), plot_path)
+    if fit.posterior and not fit.posterior.get("converged", True):  # said, as fit steady --bayes says it; exit 0
+        click.echo(_one_line(f"stickslip: warning: rsf fit --mcmc: {fit.posterior.get('warning', 'NOT CONVERGED')}"),
+                   err=True)  # fmt: skip
     if fit.status != "ok":
         unwritten = f" ({output} not written)" if output is not None else ""
         click.echo(_one_line(f"stickslip: fit failed: {fit.reason}{unwritten}"), err=True)
@@ -899,13 +902,22 @@ def _posterior_lines(fit: Any) -> list[str]:
     post = fit.posterior
     if not post:
         return []
-    lines = [f"  posterior (emcee, {post['steps']} steps x {post['walkers']} walkers): median, 95 % [2.5 %, 97.5 %]"]
+    size = f"emcee, {post['steps']} steps x {post['walkers']} walkers"
+    mixed = post.get("converged", True)
+    lines = [
+        f"  posterior ({size}): median, 95 % [2.5 %, 97.5 %]"
+        if mixed
+        else f"  posterior ({size}) NOT CONVERGED: medians only, no interval (the least-squares ones above stand)"
+    ]
     for name, entry in post.items():
-        if not isinstance(entry, dict):
+        if not isinstance(entry, dict) or "median" not in entry:
             continue
         shown = fit.parameters.get(name)
         k = shown.scale if shown is not None else 1.0
         unit = f" {shown_unit(shown.unit)}" if shown is not None and shown.unit else ""
+        if entry.get("interval") is None:  # an unmixed chain's percentiles are no interval (too narrow, off centre)
+            lines.append(f"    {name:10s} {entry['median'] / k:.6g}{unit}")
+            continue
         lo, hi = entry["interval"]
         lines.append(f"    {name:10s} {entry['median'] / k:.6g}{unit}   95 % [{lo / k:.6g}, {hi / k:.6g}]")
     if post.get("warning"):

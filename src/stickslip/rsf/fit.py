@@ -8,7 +8,6 @@ when a fit is ``failed`` with a ``reason``: docs/rsf.md, "Fitting lab records".
 from __future__ import annotations
 
 import contextlib
-import io
 import math
 from collections.abc import Callable, Iterator
 from contextvars import ContextVar
@@ -195,6 +194,16 @@ class RSFFit:
             "start_velocity": self.protocol.initial_velocity,
             "protocol": [{"velocity": s.velocity, "duration": s.duration} for s in self.protocol.segments],
         }
+
+    def parameters_document(self, report: dict[str, Any] | None = None) -> dict[str, Any]:
+        """The parameters file ``rsf fit -o`` writes (NAME.params.json, or NAME.json): :meth:`rerun_mapping`, the
+        report as ``fit`` (``report``, else :meth:`summary`) and a top-level ``units`` map of every key in it that has
+        a unit, rate-and-state's own first (PARAMETER_FILE_UNITS: the package's registry gives ``stiffness`` the
+        bond model's Pa/m, which the file's 2002.1, friction per metre of slip, is not)."""
+        from ..columns import json_safe, json_units
+
+        document = {**self.rerun_mapping(), "fit": self.summary() if report is None else report}
+        return {**document, "units": json_units(json_safe(document), PARAMETER_FILE_UNITS)}
 
     def summary(self) -> dict[str, Any]:
         """The report as JSON: SI throughout (m, 1/m, m/s; ``units`` says so); the text keeps the record's unit."""
@@ -490,7 +499,8 @@ def fit_record(
         sensitivity = _drift_sensitivity(setup, start, result, table, derived, labels, given, noise)
         if sensitivity["depends"]:
             warns.append(sensitivity["text"])
-    posterior = _posterior(residual, result, mcmc_steps, seed) if mcmc_steps > 0 else None
+    tempered = None if level.scale is None else start["noise"] / level.scale  # the search's residuals' scale undone
+    posterior = _posterior(residual, result, mcmc_steps, seed, tempered) if mcmc_steps > 0 else None
     # the record's own notes (rows left out) belong to every report, a failed one too (the CLI prints warnings only
     # on success); the signs' notes only to a fit whose values are a reading
     notes = (*record.notes, *(() if problems else _sign_notes(table)))
@@ -1034,6 +1044,9 @@ class _Level:
     inflation: float
     #: the noise of each row the fit is judged by (the steady sliding's per sampling rate, or the given level)
     rows: np.ndarray | None = None
+    #: each row's likelihood scale for the posterior: the residuals' own sd per sampling rate times sqrt(g), each row
+    #: counting 1/g of one as in the intervals (the given noise where one is given)
+    scale: np.ndarray | None = None
 
 
 def _sampling_classes(time: np.ndarray) -> np.ndarray:
@@ -1057,19 +1070,51 @@ def _sampling_classes(time: np.ndarray) -> np.ndarray:
     return labels
 
 
-def _quiet_rows(record: LabRecord, protocol: Protocol, dc: float) -> np.ndarray:
-    """Rows of steady sliding: not in a hold and more than QUIET_RENEWALS Dc / V after a velocity change."""
+def _quiet_rows(
+    record: LabRecord, protocol: Protocol, dc: float, settle: Callable[[float], float] | None = None
+) -> np.ndarray:  # fmt: skip
+    """Rows of steady sliding: not in a hold and more than QUIET_RENEWALS decay times after a velocity change.
+
+    The decay time at velocity V is ``settle(V)`` (the fitted spring-slider's own, :func:`_settling`), else the
+    renewal time Dc / V: the slowest transient of a stiff rig, but an underdamped one near k_c rings for longer."""
     t = record.time
     quiet = protocol.velocity_at(t) > 0
     edges, speeds = protocol.boundaries, protocol.velocities
     for i in range(1, speeds.size):
         if speeds[i] != speeds[i - 1] and speeds[i] > 0:
-            quiet &= ~((t >= edges[i]) & (t < edges[i] + QUIET_RENEWALS * dc / speeds[i]))
+            decay = dc / speeds[i] if settle is None else settle(float(speeds[i]))
+            quiet &= ~((t >= edges[i]) & (t < edges[i] + QUIET_RENEWALS * decay))
     return quiet
 
 
+#: the fitted system's decay time counts for the noise's steady rows up to this many renewal times Dc / V (beyond,
+#: as at and past k_c, where it never settles, the rows left would be too few; the residuals then judge the rest)
+SETTLING_RENEWALS = 10.0
+
+
+def _settling(params: RSFParams, dc: float) -> Callable[[float], float]:
+    """The decay time (s) of the fitted spring-slider's slowest transient after a step to velocity V: 1 / |the
+    largest real part| of its linearised equations' eigenvalues (:func:`stickslip.rsf.stability.growth_rate`), at
+    least Dc / V and at most SETTLING_RENEWALS Dc / V.  A stiff rig's slowest mode is the state's renewal, Dc / V;
+    an underdamped one decays at the rate V (k - k_c) / (2 a) (one aging state: 2.3 Dc / V at k = 3.3 k_c, whose
+    ringing 5 Dc / V after a step raised the steady sliding's second differences by a quarter)."""
+    from .stability import growth_rate
+
+    def settle(velocity: float) -> float:
+        renewal = dc / velocity
+        try:
+            growth = growth_rate(params, velocity)
+        except (ModelError, ParameterError, ArithmeticError, ValueError, np.linalg.LinAlgError):
+            return renewal
+        if not (math.isfinite(growth) and growth < 0):
+            return SETTLING_RENEWALS * renewal
+        return min(max(-1.0 / growth, renewal), SETTLING_RENEWALS * renewal)
+
+    return settle
+
+
 def _quiet_noise(
-    record: LabRecord, protocol: Protocol, dc: float, labels: np.ndarray
+    record: LabRecord, protocol: Protocol, dc: float, labels: np.ndarray, settle: Callable[[float], float] | None = None
 ) -> tuple[np.ndarray, str, np.ndarray]:  # fmt: skip
     """Per-row friction noise from steady sliding alone (model-independent), per sampling rate.
 
@@ -1081,7 +1126,7 @@ def _quiet_noise(
     Returns (noise per row, how it was had, the level measured per row before that floor).
     """
     t, f = record.time, record.friction
-    quiet = _quiet_rows(record, protocol, dc)
+    quiet = _quiet_rows(record, protocol, dc, settle)
     segment = np.clip(np.searchsorted(protocol.boundaries, t, side="right") - 1, 0, len(protocol.segments) - 1)
     sigma: dict[int, float] = {}
     lags: dict[int, tuple[float, bool]] = {}
@@ -1282,16 +1327,18 @@ def _uncertainty(
         if setup.weights is not None or any(setup.levels):  # (else the search's own covariance at that noise)
             core = None if setup.weights is not None else result.covar
             _set_covariance(result, _sandwich(setup, base, result, np.full(n, given**2), core=core))
-        return _Level(given, redchi, "given", float(n), 1.0, np.full(n, float(given)))
+        return _Level(given, redchi, "given", float(n), 1.0, np.full(n, float(given)), np.full(n, float(given)))
     dc = math.exp(result.params["log_dc"].value)
-    rows, how, measured = _quiet_noise(record, setup.protocol, dc, labels)
-    rows, how, measured = _followed_signal(setup, dc, labels, resid, rows, how, measured)
+    settle = _settling(_final_params(base, result.params.valuesdict()), dc)  # the fitted rig's own ringing left out
+    rows, how, measured = _quiet_noise(record, setup.protocol, dc, labels, settle)
+    rows, how, measured = _followed_signal(setup, dc, labels, resid, rows, how, measured, settle)
     redchi = float(np.sum((resid / rows) ** 2) / dof)
     g = _correlation_factor(resid, labels)
     variance = np.zeros(n)
     for c in np.unique(labels):
         inside = labels == c
         variance[inside] = float(np.mean(resid[inside] ** 2)) * n / dof
+    scale = np.sqrt(np.maximum(variance * g, _noise_floor(record.friction) ** 2))
     systematic = _systematic_quantisation(record.friction, model, measured)
     if systematic is not None:  # that part of the residuals' variance is counted by its own covariance instead
         variance = np.maximum(variance - float(np.sum(systematic[2])), 0.0)
@@ -1302,7 +1349,7 @@ def _uncertainty(
               if any(setup.levels) else "")  # fmt: skip
     method = (f"fit judged against the {how}; intervals from the residuals' own scatter and autocorrelation "
               f"(effective independent rows {n_eff:.4g} of {n}){levels}")  # fmt: skip
-    return _Level(float(np.sqrt(np.mean(rows**2))), redchi, method, n_eff, n / n_eff, rows)
+    return _Level(float(np.sqrt(np.mean(rows**2))), redchi, method, n_eff, n / n_eff, rows, scale)
 
 
 #: the steady sliding's friction second differences are signal, not noise, where they exceed the residuals' own
@@ -1311,7 +1358,8 @@ SIGNAL_FACTOR = 2.0
 
 
 def _followed_signal(
-    setup: _Setup, dc: float, labels: np.ndarray, resid: np.ndarray, rows: np.ndarray, how: str, measured: np.ndarray
+    setup: _Setup, dc: float, labels: np.ndarray, resid: np.ndarray, rows: np.ndarray, how: str, measured: np.ndarray,
+    settle: Callable[[float], float] | None = None,
 ) -> tuple[np.ndarray, str, np.ndarray]:  # fmt: skip
     """The noise per row (and how it was had, and the level before its floor) where the friction's own second
     differences in steady sliding are signal the model follows, not noise: a noise-free record (a model's output,
@@ -1320,7 +1368,7 @@ def _followed_signal(
     on friction minus model) are the noise, raised to the same floor (the model's precision, the friction's
     printed step); elsewhere, and on every record whose steady sliding is steady, nothing changes."""
     record = setup.record
-    _, _, left = _quiet_noise(replace(record, friction=resid), setup.protocol, dc, labels)
+    _, _, left = _quiet_noise(replace(record, friction=resid), setup.protocol, dc, labels, settle)
     signal = measured > SIGNAL_FACTOR * left
     if not np.any(signal):
         return rows, how, measured
@@ -1936,6 +1984,13 @@ def _report(
 
 #: SI unit of each public value that has one (the JSON is SI)
 _SI_UNITS = {"dc": "m", "dc2": "m", "stiffness": "1/m", "trend": "1/m", "time_trend": "1/s"}
+#: the SI units of a fit's parameters file's keys where the package's registry (stickslip.columns) has none or
+#: another model's (its ``stiffness`` is the bond model's Pa/m): as RSFParams.to_toml's header and ``fit.units`` say
+PARAMETER_FILE_UNITS = {
+    **_SI_UNITS, "eta": "s/m", "mass": "kg/m^2", "normal_stress": "Pa", "c": "1", "v1": "m/s", "v2": "m/s",
+    "start_velocity": "m/s", "v_ref": "m/s", "velocity": "m/s", "duration": "s", "start": "s", "file_time": "s",
+    "rms": "1", "noise": "1", "t0": "s", "seconds": "s", "estimated_seconds": "s", "model_run_seconds": "s",
+}  # fmt: skip
 
 
 def _interval(
@@ -2517,28 +2572,154 @@ def _response_p_value(
     return float(stats.f.sf(f_value, extra, dof))
 
 
-def _posterior(residual: Any, result: Any, steps: int, seed: int | None) -> dict[str, Any]:
-    import lmfit
+#: a posterior's chain has mixed when it is this many integrated autocorrelation times long after its burn-in (the
+#: check of ``fit steady --bayes``, :data:`stickslip.fitting.bayes.CONVERGED_TIMES`); short of it no interval is given
+MIXED_TIMES = 50
+#: the independence proposal's t (degrees of freedom) about the least-squares answer and covariance, and its share
+#: of the moves (the rest differential evolution), as ``fit steady --bayes`` (stickslip.fitting.bayes)
+PROPOSAL_DOF = 10.0
+INDEPENDENCE_SHARE = 0.5
 
-    walkers = max(4 * result.nvarys, 16)
-    said = io.StringIO()  # lmfit prints emcee's "chain is shorter than 50 autocorrelation times" on stdout
-    with contextlib.redirect_stdout(said):
-        mc = lmfit.minimize(
-            residual, result.params, method="emcee", steps=int(steps), nwalkers=walkers, burn=int(steps) // 3,
-            is_weighted=True, progress=False, seed=seed,
-        )  # fmt: skip
-    out: dict[str, Any] = {"steps": int(steps), "walkers": walkers}
-    if said.getvalue().strip():
-        out["warning"] = " ".join(said.getvalue().split())
-    for key in result.var_names:
-        if key not in _PUBLIC:  # (the change times' chains are nuisance)
-            continue
-        chain = np.asarray(mc.flatchain[key])
-        if key.startswith("log_"):
-            chain = np.exp(chain)
-        lo, med, hi = np.percentile(chain, [2.5, 50, 97.5])
-        out[_PUBLIC[key]] = {"median": float(med), "interval": [float(lo), float(hi)]}
+
+class _Independence:
+    """Independence proposal q(x): a multivariate t about the least-squares answer with its covariance."""
+
+    def __init__(self, centre: np.ndarray, root: np.ndarray) -> None:
+        self.centre, self.root = centre, root
+        self.inverse = np.linalg.pinv(root)
+
+    def log_q(self, x: np.ndarray) -> np.ndarray:
+        z = (x - self.centre) @ self.inverse.T
+        return -0.5 * (PROPOSAL_DOF + self.centre.size) * np.log1p(np.sum(z * z, axis=1) / PROPOSAL_DOF)
+
+    def __call__(self, x0: np.ndarray, random: np.random.RandomState) -> tuple[np.ndarray, np.ndarray]:
+        count, dim = x0.shape
+        w = np.sqrt(PROPOSAL_DOF / random.chisquare(PROPOSAL_DOF, size=count))
+        x = self.centre + (random.standard_normal((count, dim)) @ self.root.T) * w[:, None]
+        return x, self.log_q(x0) - self.log_q(x)  # log q(x0)/q(x): the Hastings factor
+
+
+def _covariance_root(result: Any) -> np.ndarray | None:
+    """A square root R (R R^T = covariance) of the fit's covariance over its varied parameters; None without one."""
+    names = list(result.var_names)
+    cov = getattr(result, "covar", None)
+    if cov is None or np.shape(cov) != (len(names), len(names)) or not np.all(np.isfinite(cov)):
+        return None
+    values, vectors = np.linalg.eigh(0.5 * (cov + np.transpose(cov)))
+    if not np.any(values > 0):
+        return None
+    return vectors * np.sqrt(np.clip(values, 0.0, None))
+
+
+def _integrated_times(chain: np.ndarray) -> np.ndarray:
+    """Each parameter's integrated autocorrelation time (steps) over the walkers of ``chain`` (steps, walkers,
+    parameters); infinite where a walker never moved (emcee would divide by its zero variance)."""
+    from emcee.autocorr import integrated_time
+
+    out = np.full(chain.shape[2], np.inf)
+    for k in range(chain.shape[2]):
+        values = chain[:, :, k]
+        if values.shape[0] > 1 and np.all(np.ptp(values, axis=0) > 0):
+            out[k] = float(integrated_time(values[:, :, None], tol=0)[0])
     return out
+
+
+def _posterior(
+    residual: Any, result: Any, steps: int, seed: int | None, tempered: np.ndarray | None = None
+) -> dict[str, Any]:  # fmt: skip
+    """The emcee posterior of the fitted parameters (medians and 2.5/97.5 % percentiles, SI).
+
+    The likelihood: Gaussian, each row's residual (the search's, times ``tempered`` per row) at the residuals' own
+    scatter, each row counting 1/g of one for their correlation, as the least-squares intervals count them (the
+    search's white noise at the steady sliding's level made a posterior 3x narrower than those intervals on a
+    record with 731 effective rows of 30000); the change times' priors as in the search.  Sampled as ``fit steady
+    --bayes`` samples: the walkers start drawn from the least-squares covariance about its answer, and half the
+    moves are independence proposals from it, half differential evolution (lmfit's emcee started every walker
+    within 1e-4 of each value, 10x narrower than a's interval and 300x wider than a change time's, with emcee's
+    stretch move alone: 30 steps gave a 4x narrower interval for a, and one for Dc excluding the truth).  A chain
+    shorter than MIXED_TIMES autocorrelation times after its burn-in (a third of the steps) has not mixed:
+    ``converged`` is false, every ``interval`` is None (the percentiles stay as ``unconverged_percentiles``) and
+    ``warning`` says so and about how many steps would do."""
+    import emcee
+
+    names = list(result.var_names)
+    walkers = max(4 * len(names), 16)
+    burn = int(steps) // 3
+    rng = np.random.default_rng(seed)
+    centre = np.array([float(result.params[n].value) for n in names])
+    lower = np.array([float(result.params[n].min) for n in names])
+    upper = np.array([float(result.params[n].max) for n in names])
+    root = _covariance_root(result)
+    trial = result.params.copy()
+
+    def log_prob(x: np.ndarray) -> float:
+        if not np.all((x > lower) & (x < upper)):
+            return -np.inf
+        for name, value in zip(names, x, strict=True):
+            trial[name].value = float(value)
+        r = np.asarray(residual(trial), dtype=float)
+        if tempered is not None:
+            r[: tempered.size] *= tempered
+        total = float(np.dot(r, r))
+        return -0.5 * total if math.isfinite(total) else -np.inf
+
+    if root is None:  # no covariance: a small ball and differential evolution alone
+        scale = 1e-4 * np.maximum(np.abs(centre), 1e-12)
+        pos = centre + scale * rng.standard_normal((walkers, len(names)))
+        moves: Any = [(emcee.moves.DEMove(), 0.8), (emcee.moves.DESnookerMove(), 0.2)]
+        began = "a ball of 1e-4 of each value (the fit has no covariance), differential-evolution moves"
+    else:
+        pos = centre + rng.standard_normal((walkers, len(names))) @ root.T
+        moves = [(emcee.moves.MHMove(_Independence(centre, root)), INDEPENDENCE_SHARE),
+                 (emcee.moves.DEMove(), 1.0 - INDEPENDENCE_SHARE)]  # fmt: skip
+        began = ("drawn from the least-squares covariance about the fit's answer; moves: independence proposals "
+                 "from it (t, 10 degrees of freedom) and differential evolution")  # fmt: skip
+    inside = (lower + 1e-9 * np.maximum(np.abs(centre), 1.0), upper - 1e-9 * np.maximum(np.abs(centre), 1.0))
+    pos = np.clip(pos, *inside)  # (strictly inside: the prior is 0 on a bound)
+    sampler = emcee.EnsembleSampler(walkers, len(names), log_prob, moves=moves)
+    sampler.random_state = np.random.RandomState(int(rng.integers(2**31))).get_state()
+    with np.errstate(over="ignore", invalid="ignore"):  # (a walker's model overflowing is a -inf, not a warning)
+        sampler.run_mcmc(pos, int(steps))
+    kept = int(steps) - burn
+    chain = sampler.get_chain(discard=burn)
+    tau = _integrated_times(chain)
+    public = [j for j, key in enumerate(names) if key in _PUBLIC]  # (the change times' chains are nuisance)
+    worst = float(np.max(tau[public])) if public else math.inf
+    converged = math.isfinite(worst) and kept >= MIXED_TIMES * worst
+    likelihood = ("Gaussian at the residuals' own scatter per sampling rate, each row counting 1/g of one (their "
+                  "correlation), as the least-squares intervals count them" if tempered is not None else
+                  "Gaussian at the search's noise")  # fmt: skip
+    out: dict[str, Any] = {"steps": int(steps), "walkers": walkers, "burn": burn, "start": began,
+                           "likelihood": likelihood,
+                           "acceptance": float(np.mean(sampler.acceptance_fraction)),
+                           "autocorrelation_time": {_PUBLIC[names[j]]: _finite_or_none(tau[j]) for j in public},
+                           "converged": converged}  # fmt: skip
+    if not converged:
+        if math.isfinite(worst):
+            need = math.ceil(1.5 * MIXED_TIMES * worst / 10.0) * 10
+            short = (f"its {kept} steps after the burn-in ({burn}) are {kept / worst:.2g} autocorrelation times "
+                     f"(up to {worst:.3g} steps), short of the {MIXED_TIMES} a mixed chain needs")  # fmt: skip
+            more = f"; run --mcmc {need} or more ({MIXED_TIMES} autocorrelation times after a third's burn-in)"
+        else:
+            short, more = f"some walker did not move in the {kept} steps after the burn-in ({burn})", "; run more steps"
+        out["warning"] = (
+            f"NOT CONVERGED: {short}: the chain has not mixed, so its percentiles are no interval (too "
+            f"narrow, or off centre) and none is given; the least-squares intervals stand{more}"
+        )
+    flat = chain.reshape(-1, len(names))
+    for j in public:
+        key = names[j]
+        values = np.exp(flat[:, j]) if key.startswith("log_") else flat[:, j]
+        lo, med, hi = np.percentile(values, [2.5, 50, 97.5])
+        entry: dict[str, Any] = {"median": float(med), "interval": [float(lo), float(hi)] if converged else None}
+        if not converged:
+            entry["unconverged_percentiles"] = [float(lo), float(hi)]
+        out[_PUBLIC[key]] = entry
+    return out
+
+
+def _finite_or_none(x: float) -> float | None:
+    return float(x) if math.isfinite(x) else None
 
 
 def _exp(x: float) -> float:
