@@ -45,6 +45,8 @@ STUCK_RESIDUAL = 5.0
 FIRST_PASS_EVALUATIONS = 4
 #: Factors of Nc0 tried for the start (:func:`_scanned_start`).
 SCAN_FACTORS = (0.25, 0.4, 0.63, 0.8, 1.0, 1.25, 1.6, 2.5, 4.0)
+#: Confidence levels the fit's intervals may have (``fit stick --level`` takes the same: one range, tested).
+LEVEL_RANGE = (0.5, 0.999)
 
 
 @dataclass(frozen=True)
@@ -363,14 +365,17 @@ def fit_stick(
     ``params`` supplies the bond parameters (lambda/kT, and sigma_c where a
     row has no start stress), the block and the start values; ``fix`` holds
     stick keys at given values; ``free`` lists keys the user insists on
-    fitting (they are fixed only if nothing else pins an undetermined direction).
+    fitting (they are fixed only if nothing else pins an undetermined direction); ``level``, the intervals'
+    confidence level, is taken from LEVEL_RANGE (0.5-0.999), as ``--level``.
     """
     if isinstance(free, str):  # one key: iterating the string would give its characters
         free = [free]
     data = table if isinstance(table, StickData) else read_stick_data(table)
     notes = data.notes()
-    if not 0.0 < level < 1.0:
-        raise ParameterError(f"level: expected a confidence level between 0 and 1, got {level!r}")
+    low, high = LEVEL_RANGE
+    number = isinstance(level, (int, float, np.integer, np.floating)) and not isinstance(level, bool)
+    if not (number and low <= level <= high):
+        raise ParameterError(f"level: expected a confidence level from {low:g} to {high:g} (as --level), got {level!r}")
     base = params if isinstance(params, Parameters) else load_parameters(params or "gelatin-glass")
     fixed: dict[str, float] = {}
     for key, raw in (fix or {}).items():
@@ -647,31 +652,96 @@ def _stick_problems(
     n, p = log_t.size, len(keys)  # the stick times alone: with fitted peaks the test is conservative
     if np.all(np.isfinite(r_t)) and n - p > 0 and len(groups) >= 2:
         s_model = float(r_t @ r_t) / (n - p)
-        replicate = _replicate_scatter(log_t, groups)
+        replicate = _replicate_scatter(log_t, groups, printed_resolution(rows.stick_time))
         if replicate is not None:
-            s_rep, dof_rep = replicate
+            s_rep, dof_rep, rounded = replicate
             shared = float(np.mean(time_floors**2)) if time_floors is not None and time_floors.size else 0.0
             expected = s_rep + shared
             p_misfit = float(stats.f.sf(s_model / expected, n - p, dof_rep)) if expected > 0 else 0.0
             if p_misfit < STICK_SIGNIFICANCE:
                 worst = int(np.argmax(np.abs(r_t)))
+                floored, repeated = rounded
+                rounding = (
+                    f" ({floored} of {repeated} velocities' repeats floored at the rounding of their printed values)"
+                    if floored
+                    else ""
+                )
                 problems.append(
                     f"the model does not describe these stick times: rms misfit {100 * math.sqrt(s_model):.3g} %"
                     f" against a scatter of {100 * math.sqrt(s_rep):.3g} % between repeated cycles at one velocity"
+                    + rounding
                     + (f" and the table's own uncertainties of {100 * math.sqrt(shared):.2g} %" if shared > 0 else "")
-                    + f" (F test: p = {p_misfit:.2g}); the largest is a factor {math.exp(-r_t[worst]):.3g} at"
+                    + f" (F test, {n - p} and {dof_rep} degrees of freedom: p = {p_misfit:.2g}); the largest is a"
+                    f" factor {math.exp(-r_t[worst]):.3g} at"
                     f" {human(float(rows.velocity[worst]), 'velocity')}"
                 )
     return problems
 
 
-def _replicate_scatter(log_t: np.ndarray, groups: Sequence[np.ndarray]) -> tuple[float, int] | None:
-    """Pooled variance of ln t_s within groups of repeated cycles and its degrees of freedom (None: no repeats)."""
+def _replicate_scatter(
+    log_t: np.ndarray, groups: Sequence[np.ndarray], resolution: np.ndarray | None = None
+) -> tuple[float, int, tuple[int, int]] | None:
+    """Pooled variance of ln t_s within groups of repeated cycles, its degrees of freedom, and how many of the
+    velocities with repeats were floored, of how many (None: no repeats).
+
+    ``resolution``: each stick time's printed resolution d (s, :func:`printed_resolution`).  Values rounded to d
+    are off by a uniform error of variance d^2/12 that repeats closer than d do not show (two cycles printed as the
+    same "30" scatter by 0): each velocity's sum of squares is floored at its degrees of freedom times the mean
+    (d/t_s)^2/12 of its rows.  The degrees of freedom stay those of the repeats: the F test still knows how little
+    one pair says.
+    """
     dof = sum(g.size - 1 for g in groups)
     if dof < 1:
         return None
-    ss = sum(float(np.sum((log_t[g] - np.mean(log_t[g])) ** 2)) for g in groups)
-    return ss / dof, dof
+    ss, floored, repeated = 0.0, 0, 0
+    for g in groups:
+        if g.size < 2:
+            continue
+        repeated += 1
+        measured = float(np.sum((log_t[g] - np.mean(log_t[g])) ** 2))
+        floor = 0.0
+        if resolution is not None:
+            floor = (g.size - 1) * float(np.mean((resolution[g] / np.exp(log_t[g])) ** 2)) / 12.0
+        floored += floor > measured
+        ss += max(measured, floor)
+    return ss / dof, dof, (floored, repeated)
+
+
+#: Relative agreement with which a value is taken to be its shortest decimal form (:func:`printed_resolution`):
+#: a value read in ms or µm/s and converted to SI is off its decimal form by an ulp or two.
+DECIMAL_MATCH = 1e-12
+
+
+def printed_resolution(values: np.ndarray) -> np.ndarray:
+    """The unit d of the last printed digit of each value of one column (in its unit, SI as read), from the values.
+
+    A value alone gives the last significant digit of its shortest decimal form (within DECIMAL_MATCH), and for a
+    whole number at least its units digit ("30" is 30 +- 0.5, not 30 +- 5: trailing zeros may be printed digits).
+    A number does not keep the trailing zeros it was printed with ("14.0" reads as "14"), so the column completes
+    it: printed alike, its values have at most its largest count of significant digits K (as "%.3g" prints) or at
+    most its finest digit (as "%.1f" prints), whichever is the coarser for the value; d is the finer of that and
+    the value's own reading.  What stays unknowable errs small (a column in minutes converted to seconds, "1.4e2"
+    written as 140 among values read to the units).
+    """
+    flat = np.ravel(np.asarray(values, dtype=float))
+    own = np.zeros(flat.size)
+    exponents = np.zeros(flat.size, dtype=int)
+    significant = 0
+    for k, value in enumerate(flat):
+        if not (math.isfinite(value) and value > 0):
+            continue
+        for digits in range(1, 18):
+            text = f"{value:.{digits - 1}e}"
+            if abs(float(text) - value) <= DECIMAL_MATCH * value:
+                break
+        exponents[k] = int(text.split("e")[1])
+        own[k] = min(10.0 ** (exponents[k] - digits + 1), 1.0)
+        significant = max(significant, digits)
+    if not np.any(own > 0):
+        return own
+    finest = float(np.min(own[own > 0]))
+    column = np.maximum(finest, 10.0 ** (exponents - significant + 1.0))
+    return np.where(own > 0, np.minimum(own, column), 0.0)
 
 
 #: Least ln-misfit a row needs to be flagged as an outlier: on exact stick times (a simulated trace's cycles) the
