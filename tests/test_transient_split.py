@@ -210,7 +210,14 @@ def test_the_split_changes_no_number(name: str, reference: dict[str, np.ndarray]
         if (name, key) in SAMPLED_LOWEST:
             _check_sampled_lowest(got, reference[f"{name}/{key}"])
             continue
-        assert _same(got[key], reference[f"{name}/{key}"]), f"{name}: {key} differs"
+        expected = reference[f"{name}/{key}"]
+        if key == "verdict":  # the words after "(docs/transient.md section 7); " are a hint, reworded in round 28
+            got[key], expected = (np.array([str(v).split(HINT)[0] for v in pair]) for pair in (got[key], expected))
+        assert _same(got[key], expected), f"{name}: {key} differs"
+
+
+#: where the stuck block's hint to add the stick chains begins (its wording is no number of the run)
+HINT = "(docs/transient.md section 7); "
 
 
 #: the cases whose rows are sampled onto a grid after the integration (docs/transient.md section 19): a row's lowest

@@ -78,12 +78,15 @@ def test_csv_header_carries_units_and_read_table_converts_them(tmp_path):
     np.testing.assert_allclose(table["stress"], [1000.0, 2000.0])
 
 
-def test_csv_numbers_round_trip_exactly():
-    values = np.array([1 / 3, 8e-4, np.pi * 1e-300, 1e300])
+def test_csv_numbers_at_15_digits_read_back_within_5e_15():
+    """Round 28: CSV numbers at 15 significant digits, as the JSON (before: every digit, a 1e-05 of a unit's
+    rounding written 0.000009999999999999999)."""
+    values = np.array([1 / 3, 8e-4, np.pi * 1e-300, 1e300, 10 * 1e-6])
     frame = with_units(pd.DataFrame({"time": values}))
     text = csv_text(frame)
+    assert text.splitlines()[1:] == ["0.333333333333333", "0.0008", "3.14159265358979e-300", "1e+300", "1e-05"]
     back = [float(x) for x in text.splitlines()[1:]]
-    assert back == list(values)
+    np.testing.assert_allclose(back, values, rtol=1e-14, atol=0)
 
 
 def test_parquet_keeps_units_for_pandas_and_pyarrow(tmp_path):

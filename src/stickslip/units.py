@@ -169,6 +169,7 @@ def checked_number(name: str, value: Any, unit: str, *, strict: bool = False) ->
     """
     if isinstance(value, bool) or not (isinstance(value, (int, float)) or hasattr(value, "__float__")):
         raise ParameterError(f"{name}: expected a number in {unit}, got {shorten(value)}")
+    refuse_beyond_float(value, name)
     number = float(value)
     if not math.isfinite(number) or number < 0 or (strict and number == 0):
         expected = f"a finite value > 0 {unit}" if strict else f"a non-negative finite value in {unit}"
@@ -233,11 +234,27 @@ def si_argument(value: Any, dimension: str, name: str) -> Any:
     dimension expected; a bare number as text is SI); anything else (a number, already SI) is returned as it is,
     for the caller's own checks of type and range.
 
-    Arrays are not read here: an array of velocities or times is numbers in SI.
+    Arrays are not read here: an array of velocities or times is numbers in SI.  A number beyond the float range
+    (``10**400``, a Fraction) is refused here, a :class:`ParameterError` naming ``name``, not a raw OverflowError of
+    the caller's ``float()``.
     """
     if isinstance(value, str) or is_quantity(value):
         return to_si(value, dimension, name)
+    refuse_beyond_float(value, name)
     return value
+
+
+def refuse_beyond_float(value: Any, name: str) -> None:
+    """Refuse a number that ``float()`` cannot hold (an OverflowError: Python's big ints, Fractions), naming
+    ``name``; anything else (a float, numpy's, a non-number) is the caller's to check."""
+    if isinstance(value, (bool, float)) or not hasattr(value, "__float__"):
+        return
+    try:
+        float(value)
+    except OverflowError:
+        raise ParameterError(f"{name}: {shorten(value)} is beyond the range of a float (about ±1.8e308)") from None
+    except (TypeError, ValueError):  # the caller's type check names it
+        return
 
 
 @contextmanager

@@ -37,6 +37,9 @@ def stability_command(
     Steady sliding is linearly stable for a block stiffer than Kc; the mode is "oscillatory" (a Hopf
     point, with its frequency) or "real" (a runaway).  --growth-at F follows the Hopf eigenvalue to
     K = F x Kc and prints its growth rate (1/s) and frequency (Hz).
+
+    --damping without --mass is the massless block with a dashpot, D(s) = ETA s + K + Z(s): well posed,
+    and the limit of a vanishing mass (unlike `transient`, whose solver takes a damping only with a mass).
     """
     from ..errors import ParameterError
     from ..transient.stability import critical_stiffness_details, hopf_root
@@ -67,7 +70,8 @@ def stability_command(
     if as_json:
         emit_json({"units": UNITS, "rows": rows})
         return
-    click.echo(f"block mass {mass:.6g} kg/m^2, damping {damping:.6g} Pa s/m")
+    massless = " (a massless block with a dashpot: D(s) = η s + K + Z(s))" if mass == 0 and damping > 0 else ""
+    click.echo(f"block mass {mass:.6g} kg/m^2, damping {damping:.6g} Pa s/m{massless}")
     for row in rows:
         click.echo(f"V0 = {row['velocity'] * 1e6:.6g} µm/s: {row['message']}")
         if "growth_rate" in row:

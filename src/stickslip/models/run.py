@@ -104,6 +104,15 @@ def _column(values: Any, name: str, size: int | None) -> np.ndarray:
         raise ParameterError(f"run column {name}: expected one value per time, got an array of shape {array.shape}")
     if size is not None and array.size != size:
         raise ParameterError(f"run column {name}: {array.size} values for {size} times")
+    return _read_only(array)
+
+
+def _read_only(array: np.ndarray) -> np.ndarray:
+    """``array`` frozen as a Run holds it: a read-only view (the caller's own array, that np.asarray may have passed
+    through, stays writable; ``np.array(run.time)`` or ``run.time.copy()`` is a writable copy)."""
+    if array.flags.writeable:
+        array = array.view()
+        array.setflags(write=False)
     return array
 
 
@@ -320,6 +329,14 @@ class Run:
         if self.status not in STATUSES:
             raise ParameterError(f"run status: expected one of {', '.join(map(repr, STATUSES))}, got {self.status!r}")
 
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        """Unpickled with its columns read-only again (numpy's pickle gives back writable arrays)."""
+        for name in ("time", "stress", "friction", "slider_velocity", "slider_position", "load_point_position"):
+            if state.get(name) is not None:
+                state[name] = _read_only(state[name])
+        state["states"] = {k: _read_only(v) for k, v in state.get("states", {}).items()}
+        self.__dict__.update(state)
+
     # ---------------------------------------------------------------- building
     @classmethod
     def from_trace(
@@ -467,7 +484,8 @@ class Run:
         })  # fmt: skip
 
     def to_csv(self, path: str | Path) -> Path:
-        """Write the trace as CSV (units in the header, every digit), the regime in a first comment line.
+        """Write the trace as CSV (units in the header, numbers at 15 significant digits:
+        :func:`stickslip.columns.csv_number`), the regime in a first comment line (every digit).
 
         Written atomically (a symlink's target, a FIFO or a device as it is); ``stickslip analyze`` reads it
         as a measured trace, :meth:`read` as a Run.

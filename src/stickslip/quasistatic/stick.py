@@ -9,6 +9,7 @@ docs/stick-phase.md.
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -21,6 +22,7 @@ from ..errors import ModelError, ParameterError
 from ..numerics.roots import brentq  # scipy's Brent bit for bit (tests/test_roots.py), without scipy.optimize
 from ..parameters import Parameters, require_flag
 from ..reprs import compact_repr, field_values
+from ..units import refuse_beyond_float, shorten
 from .jump import require_critical_point
 from .steady import require_parameters
 
@@ -42,10 +44,11 @@ SHORTEST_LOG_TIME = 690.0
 #: Samples of the output curve.
 SAMPLES = 400
 #: Said whenever Eq 15 keeps a pulled block stuck for ever (docs/stick-phase.md §5).
-STUCK_LIMITATION = (
-    "this is a limitation of Eq 15, whose aging term −t/τa grows without bound, not a prediction:"
-    " the paper has no stick-slip data below 50 µm/s"
-)
+STUCK_LIMITATION = "this is a limitation of Eq 15, whose aging term −t/τa grows without bound, not a prediction"
+#: Added for the paper's gel alone (:data:`PAPER_SETS`): a user's own gel was never measured by the paper.
+PAPER_DATA_NOTE = "the paper has no stick-slip data below 50 µm/s"
+#: The built-in parameter sets of the paper's gelatin gel (overrides keep the name).
+PAPER_SETS = ("gelatin-glass", "gelatin-glass-saturating")
 #: Largest bound of the aging exponent accepted by the bounded-aging extension (e^-100: aging has long won).
 MAX_AGING_CAP = 100.0
 #: Relative width to which :func:`stuck_threshold` brackets the threshold velocity.
@@ -137,7 +140,8 @@ def _start_stress(params: Parameters, start_stress: Any) -> float:
 def _number(value: Any, name: str, unit: str, at_least_zero: str = "") -> float:
     """``value`` as a finite float; given ``at_least_zero`` (what it is, "a stress"), one >= 0."""
     if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
-        raise ParameterError(f"{name}: expected a number in {unit}, got {value!r}")
+        raise ParameterError(f"{name}: expected a number in {unit}, got {shorten(value)}")
+    refuse_beyond_float(value, name)
     v = float(value)
     if not math.isfinite(v):
         raise ParameterError(f"{name}: expected a finite number in {unit}, got {v!r}")
@@ -196,6 +200,13 @@ def never_slips(rates: _Rates, t: float, n: float) -> float | None:
     return None
 
 
+def stuck_limitation(params: Parameters) -> str:
+    """What a "stuck for ever" verdict of Eq 15 means: :data:`STUCK_LIMITATION`, and for the paper's gel
+    (:data:`PAPER_SETS`) that the paper has no data there; a user's own gel (tester J, round 28) gets the first
+    alone."""
+    return f"{STUCK_LIMITATION}: {PAPER_DATA_NOTE}" if params.name in PAPER_SETS else STUCK_LIMITATION
+
+
 def _no_load_phase(
     params: Parameters, rates: _Rates, v0: float, stress: float, aging: bool, horizon: float
 ) -> StickPhase:
@@ -224,32 +235,41 @@ def _no_load_phase(
     )
 
 
+def _hold(log_rt: float, s0: float, k: float, inv_aging: float, cap: float, scale: float, tp: float, n: float) -> float:
+    """dt'/dtheta = 1/(1 + w) at (t', n), the aging exponent bounded by ``cap`` (the bounded-aging extension)."""
+    if n <= N_GONE:  # the collapse, continued smoothly through n = 0
+        return 0.0
+    t = tp * scale
+    log_w = log_rt + math.log(n) + (s0 + k * t) / n - min(t * inv_aging, cap)
+    if log_w > 0.0:  # 1/(1 + w) without overflow
+        e = math.exp(-log_w)
+        return e / (1.0 + e)
+    return 1.0 / (1.0 + math.exp(log_w))
+
+
+def _hold_unbounded(log_rt: float, s0: float, k: float, inv_aging: float, scale: float, tp: float, n: float) -> float:
+    """:func:`_hold` without the bound of aging (most calls)."""
+    if n <= N_GONE:
+        return 0.0
+    t = tp * scale
+    log_w = log_rt + math.log(n) + (s0 + k * t) / n - t * inv_aging
+    if log_w > 0.0:
+        e = math.exp(-log_w)
+        return e / (1.0 + e)
+    return 1.0 / (1.0 + math.exp(log_w))
+
+
 def _hold_function(rates: _Rates, scale: float, log_rt: float) -> Callable[[float, float], float]:
-    """dt'/dtheta = 1/(1 + w) at (t', n); dn/dtheta is that minus 1 (docs/stick-phase.md §3)."""
+    """dt'/dtheta = 1/(1 + w) at (t', n); dn/dtheta is that minus 1 (docs/stick-phase.md §3).
+
+    A :func:`functools.partial` of a module-level function, not a closure: the dense output keeps it (to fill its
+    interpolation coefficients lazily) and the StickPhase keeps the dense output, so a closure made every
+    quasi-static result unpicklable (round 28).
+    """
     s0, k, inv_aging, cap = rates.s0, rates.k, rates.inv_aging, rates.aging_cap
-    log, exp = math.log, math.exp
-
-    def hold(tp: float, n: float) -> float:
-        if n <= N_GONE:  # the collapse, continued smoothly through n = 0
-            return 0.0
-        t = tp * scale
-        log_w = log_rt + log(n) + (s0 + k * t) / n - min(t * inv_aging, cap)
-        if log_w > 0.0:  # 1/(1 + w) without overflow
-            e = exp(-log_w)
-            return e / (1.0 + e)
-        return 1.0 / (1.0 + exp(log_w))
-
-    def hold_unbounded(tp: float, n: float) -> float:  # the same without the bound of aging (most calls)
-        if n <= N_GONE:
-            return 0.0
-        t = tp * scale
-        log_w = log_rt + log(n) + (s0 + k * t) / n - t * inv_aging
-        if log_w > 0.0:
-            e = exp(-log_w)
-            return e / (1.0 + e)
-        return 1.0 / (1.0 + exp(log_w))
-
-    return hold if math.isfinite(cap) else hold_unbounded
+    if math.isfinite(cap):
+        return functools.partial(_hold, log_rt, s0, k, inv_aging, cap, scale)
+    return functools.partial(_hold_unbounded, log_rt, s0, k, inv_aging, scale)
 
 
 def _solve_steps(
@@ -457,7 +477,7 @@ def _phase(params: Parameters, solved: _Solved) -> StickPhase:
             f" (Eq 15; checked at t = {y_end[0] * scale:.4g} s)"
         )
         if v0 > 0.0:
-            message += f"; {STUCK_LIMITATION}"
+            message += f"; {stuck_limitation(params)}"
     else:
         status, stuck, stick_time, peak = "undetermined", False, None, None
         message = (
@@ -554,5 +574,6 @@ def stuck_threshold(
         lower,
         upper,
         f"from {sigma0:.6g} Pa the block never slips below V0 = {velocity * 1e6:.5g} µm/s (Eq 15 with"
-        f" τa = {params.stick.aging_time:g} s; every V0 above {ceiling * 1e6:.5g} µm/s slips); {STUCK_LIMITATION}",
+        f" τa = {params.stick.aging_time:g} s; every V0 above {ceiling * 1e6:.5g} µm/s slips);"
+        f" {stuck_limitation(params)}",
     )

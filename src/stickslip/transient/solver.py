@@ -1413,8 +1413,9 @@ def _finish(d: _Driver, snapshots: list[Snapshot], stop: str | None, note: str) 
     ):
         message += (
             "; one population of Eq 1 never lets go: its aging term makes a resting bond unbreakable within"
-            " milliseconds (docs/transient.md section 7); stick_population=True (--stick-population) adds the"
-            " paper's attached chains, which give its stick-slip cycle"
+            " milliseconds (docs/transient.md section 7); to let the paper's stick chains (Eqs 13-16) end it, with"
+            " its stick-slip cycle, run with --stick-population (with `run --model transient`: --setting"
+            " stick_population=true; in Python: stick_population=True)"
         )
     chain = table[:, 12] if d.chain_rows else None
     book = Bookkeeping(

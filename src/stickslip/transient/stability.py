@@ -31,7 +31,7 @@ import numpy as np
 from ..errors import ModelError, ParameterError
 from ..numerics.roots import brentq  # scipy.optimize would add 0.3 s to start-up
 from ..parameters import Parameters
-from ..units import checked_value
+from ..units import checked_value, refuse_beyond_float
 from .model import aging_age, chain_force, log_hazard, steady_population
 
 #: frequencies / growth rates scanned, in units of 1/tau: from 1e-6 to 1e4
@@ -60,6 +60,7 @@ def _stiffness(extension: np.ndarray, params: Parameters) -> np.ndarray:
 
 def _check_velocity(params: Parameters, velocity: float) -> None:
     """A positive, finite sliding velocity below FASTEST x the set's dl_m/tau, else a ParameterError."""
+    refuse_beyond_float(velocity, "velocity")  # 10**400: a ParameterError, not an OverflowError of isfinite
     if not (isinstance(velocity, (int, float)) and math.isfinite(velocity) and velocity > 0):
         raise ParameterError(f"velocity: expected a positive sliding velocity in m/s, got {velocity!r}")
     b = params.bonds
@@ -248,6 +249,11 @@ def critical_stiffness(
     ``mass`` (kg/m^2) and ``damping`` (Pa s/m) add the block's inertia and a viscous damping (default 0:
     the paper's massless block).  Returns 0.0 when steady sliding is stable for every stiffness (never
     NaN).  :func:`critical_stiffness_details` gives the mode and a message.
+
+    A damping without a mass is the massless block with a dashpot, D(s) = eta s + K + Z(s): its Hopf point
+    solves eta w + Im Z(iw) = 0, Kc = -Re Z(iw), the limit m -> 0 of the block with a mass (Kc then grows by
+    m w^2).  The nonlinear solver (:func:`stickslip.transient.run_transient`) takes a damping only with a mass:
+    without one its force balance is a differential-algebraic system it does not solve, not a physics limit.
     """
     return critical_stiffness_details(params, velocity, aging, mass, damping).value
 
