@@ -8,6 +8,7 @@ the cycle is ``complete=False``.
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 import math
 from collections.abc import Callable
@@ -120,6 +121,11 @@ class CycleResult:
     peak_stress_uncertainty: float | None
     stick_time_uncertainty: float | None
     message: str = ""
+    #: where the drop falls between two samples (none lies off both stick lines, :func:`_unresolved_slips`): the
+    #: slip lasts less than this (s), the sampling interval that holds it.  Both corners are then at the middle of
+    #: that interval, so ``slip_time`` is 0, no measurement, and σs and the next σc are known to their resolution
+    #: (``peak_stress_uncertainty``, ``critical_stress_uncertainty``: the stick slope times half the interval)
+    slip_time_bound: float | None = None
     line: Line | None = field(default=None, repr=False, compare=False)
     stick_from: float = field(default=math.nan, repr=False, compare=False)
     stick_to: float = field(default=math.nan, repr=False, compare=False)
@@ -168,6 +174,7 @@ class TraceAnalysis:
             "cycles": [c.as_dict() for c in self.cycles],
             "summary": self.summary,
             "model_derived": dict(MODEL_DERIVED),
+            "parameter_set": self.parameters.name,  # the set Vs and Gd/h's block geometry come from
         }
 
     def to_frame(self) -> pd.DataFrame:
@@ -175,7 +182,8 @@ class TraceAnalysis:
         import pandas as pd
 
         columns = [name for name in CycleResult.__dataclass_fields__ if name not in _PRIVATE_FIELDS]
-        return with_units(pd.DataFrame([c.as_dict() for c in self.cycles], columns=columns))
+        frame = pd.DataFrame([c.as_dict() for c in self.cycles], columns=columns)
+        return with_units(frame, {"slip_time_bound": "s"})
 
     def plot(self, ax: Axes | None = None, **kwargs: Any) -> Axes:
         from ..plots.traces import plot_analysis
@@ -197,6 +205,9 @@ class _Stick:
     line: Line | None = None
     start: Corner | None = None
     end: Corner | None = None
+    slip_first: int | None = None  # the first sample of the slip after the stick (clearly below its line)
+    slip_last: int | None = None  # the last sample of the slip before the stick (clearly above its line)
+    slip_bound: float | None = None  # the drop after the stick falls between two samples: the interval (s)
 
 
 def analyze_trace(
@@ -300,9 +311,53 @@ def _piece(
     for stick in sticks:
         _fit_stick(t, x, coarse, stick, step)
     sticks = [s for s in sticks if s.line is not None]
+    _unresolved_slips(t, x, coarse.noise, sticks)
     swings = _oscillation(t, x, coarse)
     regime, steady_from = _regime(t, x, coarse, sticks, swings)
     return sticks, swings, regime, steady_from
+
+
+#: A drop between two samples: the sample before it and the one after it (and their neighbours on the same side)
+#: lie within this many noise levels of their stick lines, and no sample lies off both lines.  The slip then left
+#: no sample to place a hinge's branch by, and the hinge placed the corners of identical cycles anywhere within the
+#: sampling interval (an exact sawtooth sampled every 0.1 s: slip times 0.035 s and 0.123 s, σc 255.5 Pa and
+#: 256.8 Pa for 257 Pa).  The band is tighter than the 5 noise levels that mark a slip's samples: a slip that
+#: ends gently (the model's, whose slope changes by only K·Vc at the trough) leaves samples a few noise levels
+#: above the next stick line, which the hinge reads better than the middle of an interval would
+ON_LINE_SIGMAS = 2.0
+#: ... the samples either side of the drop that must be on their lines (the two bracketing it among them)
+ON_LINE_SAMPLES = 2
+
+
+def _unresolved_slips(t: np.ndarray, x: np.ndarray, noise: float, sticks: list[_Stick]) -> None:
+    """Corners at a drop that falls between two samples, placed by the sampling rather than by a hinge fit.
+
+    With i the first sample below the stick line before the slip and j the last above the one after it, a drop
+    between samples i - 1 and i has j = i - 1 (no sample off both lines), and the samples either side of it on
+    their lines (ON_LINE_SIGMAS, ON_LINE_SAMPLES).  Then the stick ended, and the next began, within
+    (t[i-1], t[i]), no closer: both corners go to its middle, on their stick lines, with half the interval as
+    their time uncertainty, and the slip is said to last less than the interval (its time is not measured: the
+    slip time between the corners is 0).  A drop at one instant written as two rows (a jump) is left to the hinge:
+    its time is known."""
+    band = ON_LINE_SIGMAS * max(noise, 1e-12 * float(np.max(np.abs(x))))
+    for before, after in itertools.pairwise(sticks):
+        i, j = before.slip_first, after.slip_last
+        if before.end is None or after.start is None or i is None or j != i - 1 or after.line is None:
+            continue
+        below, above = np.arange(i - ON_LINE_SAMPLES, i), np.arange(i, i + ON_LINE_SAMPLES)
+        if below[0] < 0 or above[-1] >= t.size or not t[i] > t[i - 1]:
+            continue
+        off = np.concatenate([x[below] - before.line(t[below]), x[above] - after.line(t[above])])
+        if np.any(np.abs(off) > band):
+            continue
+        middle, half = 0.5 * float(t[i - 1] + t[i]), 0.5 * float(t[i] - t[i - 1])
+        before.end = dataclasses.replace(
+            before.end, time=middle, stress=float(before.line(middle)), time_uncertainty=half, basis=None
+        )
+        after.start = dataclasses.replace(
+            after.start, time=middle, stress=float(after.line(middle)), time_uncertainty=half, basis=None
+        )
+        before.slip_bound = 2.0 * half
 
 
 #: A stretch between gaps with fewer usable samples than this is not analysed on its own.
@@ -522,9 +577,11 @@ def _start_corner(t: np.ndarray, x: np.ndarray, coarse: Coarse, stick: _Stick, s
     near = _indices(t, top, hi)
     # the last sample clearly above the stick line is the last one of the slip
     off = near[x[near] - line(t[near]) > _deviation(coarse)]
+    stick.slip_last = None
     if off.size == 0:
         return None
     last = int(_slip_run(off, coarse, step, first=True)[-1])
+    stick.slip_last = last
     branch_lo = t[last] - START_TIME_FRACTION * (t[last] - top)
     if level is not None:
         branch_lo = max(
@@ -549,9 +606,11 @@ def _end_corner(t: np.ndarray, x: np.ndarray, coarse: Coarse, stick: _Stick, ste
     near = _indices(t, lo, bottom)
     # the first sample clearly below the stick line is the first one of the slip
     off = near[line(t[near]) - x[near] > _deviation(coarse)]
+    stick.slip_first = None
     if off.size == 0:
         return None
     first = int(_slip_run(off, coarse, step, first=False)[0])
+    stick.slip_first = first
     branch_hi = t[first] + BRANCH_TIME_FRACTION * (bottom - t[first])
     branch_hi = min(
         branch_hi,
@@ -764,6 +823,7 @@ def _cycles(
                 if start and end
                 else None,
                 message="; ".join(notes),
+                slip_time_bound=stick.slip_bound if nxt and end else None,
                 line=line,
                 stick_from=start.time if start else line.t_min,
                 stick_to=end.time if end else line.t_max,
@@ -809,7 +869,7 @@ def _long_cycles(cycles: list[CycleResult], step: float) -> str:
         return ""
     shown = "; ".join(
         f"cycle {c.index} lasts {c.period:.4g} s ({c.period / median:.2g} times; stick {c.stick_time:.4g} s, slip"
-        f" {c.slip_time:.4g} s)"
+        f" {_slip_text(c)})"
         for c in long[:5]
     )
     more = f" and {len(long) - 5} more" if len(long) > 5 else ""
@@ -819,6 +879,13 @@ def _long_cycles(cycles: list[CycleResult], step: float) -> str:
         f"{samples}: a slip inside may have been missed (two cycles read as one), and such a cycle's slip time,"
         " period and stress drop are not one cycle's"
     )
+
+
+def _slip_text(cycle: CycleResult) -> str:
+    """A cycle's slip time in words: its value, or its bound where the slip falls between samples."""
+    if cycle.slip_time_bound is not None:
+        return f"< {cycle.slip_time_bound:.4g} s, between samples"
+    return "--" if cycle.slip_time is None else f"{cycle.slip_time:.4g} s"
 
 
 def _jump(params: Parameters, peak: float | None) -> tuple[float | None, str]:
@@ -831,7 +898,9 @@ def _jump(params: Parameters, peak: float | None) -> tuple[float | None, str]:
     if peak <= 0:
         return None, f"no jump velocity: peak stress {peak:.4g} Pa is not positive"
     result = jump_velocity(params, peak)
-    return (result.velocity, "" if result.velocity is not None else f"no jump velocity: {result.message}")
+    # the note names the set: the aging curve it quotes (Vc, its stresses) is the parameter set's, not the record's
+    why = f"no jump velocity with the parameter set {params.name}: {result.message}"
+    return (result.velocity, "" if result.velocity is not None else why)
 
 
 def _times(slope: float, corner: Corner | None) -> float | None:
@@ -862,7 +931,12 @@ def _summary(
         "n_complete": sum(c.complete for c in cycles),
     }
     for name in CYCLE_QUANTITIES:
-        summary[name] = _stats([getattr(c, name) for c in cycles if getattr(c, name) is not None])
+        # a slip between samples has no measured time (its 0 is the corners' difference): only its bound, below
+        timed = [c for c in cycles if name != "slip_time" or c.slip_time_bound is None]
+        summary[name] = _stats([getattr(c, name) for c in timed if getattr(c, name) is not None])
+    bounds = [c.slip_time_bound for c in cycles if c.slip_time_bound is not None]
+    if bounds:
+        summary["unresolved_slips"] = {"n": len(bounds), "slip_time_bound": max(bounds)}
     if steady_from is not None:
         inside = _between(t, steady_from, math.inf)
         tail = x[inside]

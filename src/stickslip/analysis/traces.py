@@ -7,6 +7,7 @@ with a note) are handled as docs/analysis.md says.  Every problem is a typed err
 
 from __future__ import annotations
 
+import json
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
@@ -60,8 +61,9 @@ def read_trace(path: str | Path, contact_area: float | None = None) -> Trace:
     """Read a trace CSV: ``time`` and ``stress``, or ``time`` and ``force`` with ``contact_area`` (m^2).
 
     Raises :class:`DataError` for a missing column, a bad cell, a time that
-    goes back, a duplicated row, or too few usable samples (two rows at one
-    time with different stresses are a jump and are kept); :class:`ParameterError` for a
+    goes back, a duplicated row of a record of time and stress alone, or too few usable samples (two rows at one
+    time with different stresses are a jump and are kept; a model trace's row that repeats the time and stress
+    of the row before is read once, with a note); :class:`ParameterError` for a
     missing, superfluous or non-positive contact area.
     """
     if not isinstance(path, (str, Path)) and not hasattr(path, "__fspath__"):
@@ -95,8 +97,7 @@ def read_trace(path: str | Path, contact_area: float | None = None) -> Trace:
     if table.ignored:
         notes.append(f"ignored column(s) {', '.join(table.ignored)}: analyze reads time and stress only")
     time, stress, rows, merged = _merge_model_repeats(path, table, stress)
-    if merged:
-        notes.append(merged)
+    notes.extend(merged)
     trace = check_trace(time, stress, source=table.source, rows=rows)
     return replace(trace, notes=tuple(notes))
 
@@ -115,6 +116,65 @@ def recorded_pulling_velocity(path: str | Path) -> tuple[float | None, str]:
     if found is None:
         return None, "the trace has no load-point column (" + ", ".join(LOAD_POINT_COLUMNS) + ")"
     return _one_velocity(*found)
+
+
+#: the package's bond models, whose Run CSV records the critical velocity of the parameter set it was run with
+BOND_MODELS = ("quasi-static", "transient")
+#: a recorded Vc and the parameter set's agree within this fraction (both come from one solver, to ~1e-12)
+VC_AGREEMENT = 1e-4
+
+
+def recorded_run(path: str | Path) -> dict[str, Any] | None:
+    """The metadata a Run CSV (``run -o`` and its spellings) holds in its first line, ``# stickslip run {...}``;
+    None for any other file (or one whose first line is no such mapping)."""
+    from ..models.run import CSV_MARK
+
+    path = Path(path)
+    if not path.is_file():
+        return None
+    try:
+        with open(path, encoding="utf-8", errors="replace") as handle:
+            first = handle.readline(1 << 20)
+    except OSError:
+        return None
+    if not first.startswith(CSV_MARK):
+        return None
+    try:
+        meta = json.loads(first[len(CSV_MARK) :])
+    except ValueError:
+        return None
+    return meta if isinstance(meta, dict) else None
+
+
+def parameter_mismatch(path: str | Path, params: Any) -> str:
+    """Why the bond-model run a trace records was not made with ``params`` ("" when it was, or cannot be told).
+
+    A Run CSV holds no parameter set, but a bond model's (quasi-static, transient) records its critical velocity
+    Vc, which depends on the bond and aging parameters alone: a Vc other than ``params``' is a run made with
+    another set (the block's geometry, which Gd/h uses, is not seen by it).
+    """
+    meta = recorded_run(path)
+    if meta is None or meta.get("model") not in BOND_MODELS:
+        return ""
+    summary = meta.get("summary")
+    recorded = summary.get("critical_velocity") if isinstance(summary, dict) else None
+    if not isinstance(recorded, (int, float)) or not math.isfinite(recorded) or recorded <= 0:
+        return ""  # no Vc recorded (the transient model's summary has none): nothing to check against
+    from ..quasistatic.critical import critical_minimum
+
+    try:
+        point = critical_minimum(params)
+    except (ParameterError, DataError):
+        return ""
+    ours = None if point is None else point.velocity
+    if ours is not None and abs(ours - recorded) <= VC_AGREEMENT * recorded:
+        return ""
+    said = "none (no minimum of its aging curve)" if ours is None else f"{ours * 1e6:.6g} µm/s"
+    return (
+        f"the {meta['model']} run it records was made with another parameter set: its critical velocity Vc is"
+        f" {recorded * 1e6:.6g} µm/s, {params.name}'s is {said}; Vs and Gd/h here are {params.name}'s (give"
+        " --params with the set the run was made with)"
+    )
 
 
 def _one_velocity(name: str, t: np.ndarray, x: np.ndarray) -> tuple[float | None, str]:
@@ -194,29 +254,37 @@ def load_point_velocities(path: str | Path) -> tuple[str | None, list[tuple[floa
 
 def _merge_model_repeats(
     path: str | Path, table: Table, stress: np.ndarray
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, str]:
-    """Rows that repeat the time and stress of the row before but differ in an ignored column, read once.
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, tuple[str, ...]]:
+    """Rows of a model trace (one with ignored columns) that repeat the time and stress of the row before, read once.
 
-    A model trace writes such rows where its state changes at one instant (the chain fraction running
-    out at the end of a stick); for the analysis they are one sample.  Returns (time, stress, rows, note).
+    A model trace writes such rows where its state changes at one instant (the chain fraction running out at the
+    end of a stick: they differ in an ignored column), and where its solver stops at an event and starts again from
+    the state it stopped at (a stick of the docs' velocity-weakening plug-in: the row repeats in every column); for
+    the analysis either is one sample.  A record of time and stress alone has no other column to tell a model's
+    repeat by: there a repeated row stays refused (:func:`check_trace`).  Returns (time, stress, rows, notes).
     """
     time, rows = table["time"], table.rows
     repeats = _repeated_samples(time, stress)
     if repeats.size == 0 or not table.ignored:
-        return time, stress, rows, ""
+        return time, stress, rows, ()
     same = np.ones(repeats.size, dtype=bool)
     for column in read_text_cells(path, table.ignored, count=time.size).values():
         same &= column[repeats] == column[repeats - 1]
-    merged = repeats[~same]
-    if merged.size == 0:
-        return time, stress, rows, ""
     keep = np.ones(time.size, dtype=bool)
-    keep[merged] = False
-    note = (
-        f"{merged.size} row(s) repeat the time and stress of the row before and differ only in the"
-        f" ignored columns (first: row {rows[merged[0]]}): read once"
-    )
-    return time[keep], stress[keep], rows[keep], note
+    keep[repeats] = False
+    notes = []
+    exact, merged = repeats[same], repeats[~same]
+    if exact.size:
+        notes.append(
+            f"{exact.size} row(s) repeat the row before in every column (first: row {rows[exact[0]]}), as a"
+            " model's solver writes where it stops at an event and starts again: read once"
+        )
+    if merged.size:
+        notes.append(
+            f"{merged.size} row(s) repeat the time and stress of the row before and differ only in the"
+            f" ignored columns (first: row {rows[merged[0]]}): read once"
+        )
+    return time[keep], stress[keep], rows[keep], tuple(notes)
 
 
 def _repeated_samples(time: np.ndarray, stress: np.ndarray) -> np.ndarray:

@@ -70,6 +70,7 @@ JSON_UNITS = {
     "peak_to_trough": "Pa",  # the swings of summary.oscillation and summary.unresolved_swings
     "spread": "Pa",
     "samples_per_swing": "1",
+    "slip_time_bound": "s",  # a slip between samples lasts less than this (cycles, and summary.unresolved_slips)
     "model": None,  # the comparison's per-cycle table of the model's values, not a number
 }
 
@@ -142,6 +143,7 @@ def analyze_command(
     """
     refuse_overwriting_inputs([trace], [("-o", output), ("--plot", plot_path)], params_name)
     from ..analysis import analyze_trace, compare_with_model, read_trace
+    from ..analysis.traces import parameter_mismatch
     from ..models.run import recorded_status
 
     area = None if area_text is None else positive(area_text, "area", "--contact-area")
@@ -154,8 +156,12 @@ def analyze_command(
     else:
         steps = _check_recorded_v0(trace, v0, v0_text)
     params = resolve_params(params_name, overrides)
+    parameter_set, default_set = _parameter_set(params, params_name)
     for note in record.notes:
         echo_err(f"note: {note}")
+    mismatch = parameter_mismatch(trace, params)
+    if mismatch:
+        echo_err(f"warning: {trace}: {mismatch}")
     status, why = recorded_status(trace)
     if status != "ok":  # a run cut short is still a record, but not of the run asked for
         echo_err(f"note: {trace} is a run that {'stopped' if status == 'stopped' else 'failed'} before its end: {why}")
@@ -175,12 +181,13 @@ def analyze_command(
         write_text(output, cycles_csv(analysis))
     if as_json:
         data = analysis.as_dict()
+        data["parameter_set_default"] = default_set
         if comparison is not None:
             data["comparison"] = comparison.as_dict()
         data["units"] = json_units(data, JSON_UNITS)
         emit_json(data)
     else:
-        print_rich(*_report(analysis, comparison))
+        print_rich(*_report(analysis, comparison, parameter_set))
     if plot_path is not None:
         from ..plots.traces import figure_analysis
 
@@ -242,6 +249,17 @@ def _check_recorded_v0(trace: Path, v0: float, v0_text: str) -> list[tuple[float
     return segments
 
 
+def _parameter_set(params: Any, params_name: str) -> tuple[str, bool]:
+    """(how the report names the parameter set its model comparisons use, whether it is the default one)."""
+    from click.core import ParameterSource
+
+    context = click.get_current_context(silent=True)
+    source = None if context is None else context.get_parameter_source("params_name")
+    if source in (None, ParameterSource.DEFAULT, ParameterSource.DEFAULT_MAP):
+        return f"{params.name} (the default: give --params NAME|FILE with the set the record belongs to)", True
+    return (params.name if params_name == params.name else f"{params.name} (--params {params_name})"), False
+
+
 def _refuse_unbounded(analysis: Any, v0_text: str) -> None:
     """A per-cycle statistic beyond the floating-point range (the stiffness slope/V0 at --v0 '1e-300 um/s') is no
     answer: refuse, naming --v0, rather than print inf."""
@@ -284,7 +302,7 @@ def _cell(value: Any) -> str:
     return str(value)
 
 
-def _report(analysis: Any, comparison: Any) -> list[Any]:
+def _report(analysis: Any, comparison: Any, parameter_set: str | None = None) -> list[Any]:
     from rich.markup import escape
     from rich.table import Table
 
@@ -294,6 +312,8 @@ def _report(analysis: Any, comparison: Any) -> list[Any]:
         f"V0 = {v0 * 1e6:.6g} µm/s, noise {analysis.noise:.3g} Pa,"
         f" drops above {analysis.threshold:.3g} Pa count as slips"
     )
+    if parameter_set is not None:
+        head += f"\nmodel comparisons (Vs, Gd/h's block geometry, --compare) with {parameter_set}"
     parts: list[Any] = [escape(head)]
     if analysis.cycles:
         shown = analysis.cycles[:TABLE_CYCLES]
@@ -305,15 +325,21 @@ def _report(analysis: Any, comparison: Any) -> list[Any]:
             f"mean ± sd ({len(analysis.cycles)} cycles)" if len(shown) < len(analysis.cycles) else "mean ± sd",
             justify="right",
         )
+        between = [c for c in analysis.cycles if c.slip_time_bound is not None]
+        after = {c.index + 1 for c in between}  # the cycles whose stick began after a slip between samples
         for name, heading, factor, digits in TABLE_ROWS:
-            cells = [_number(getattr(c, name), factor, digits) for c in shown]
+            cells = [_table_cell(c, name, factor, digits, c.index in after) for c in shown]
             stats = analysis.summary[name]
             spread = "" if stats["std"] is None else f" ± {stats['std'] * factor:.2g}"
-            table.add_row(
-                escape(heading), *cells, "" if stats["mean"] is None else f"{stats['mean'] * factor:.{digits}g}{spread}"
-            )
+            mean = "" if stats["mean"] is None else f"{stats['mean'] * factor:.{digits}g}{spread}"
+            if name == "slip_time" and between:  # the mean is over the timed slips (summary): the others bounded
+                bound = f"< {max(c.slip_time_bound for c in between):.3g}"
+                mean = f"{mean} ({len(between)}: {bound})" if mean else bound
+            table.add_row(escape(heading), *cells, mean)
         parts.append(table)
-        parts.append(escape(_model_note()))
+        parts.append(escape(_model_note(analysis.parameters.name)))
+        if between:
+            parts.append(escape(_between_samples_note(between, analysis.cycles)))
         if len(shown) < len(analysis.cycles):
             parts.append(
                 f"the table shows the first {len(shown)} of {len(analysis.cycles)} cycles;"
@@ -333,11 +359,12 @@ def _report(analysis: Any, comparison: Any) -> list[Any]:
     return parts
 
 
-def _model_note() -> str:
+def _model_note(parameter_set: str | None = None) -> str:
     from ..analysis.cycles import MODEL_DERIVED
 
     headings = {name: heading for name, heading, _, _ in TABLE_ROWS}
-    return "(model) " + "; ".join(f"{headings[name].split(' [')[0]}: {how}" for name, how in MODEL_DERIVED.items())
+    note = "(model) " + "; ".join(f"{headings[name].split(' [')[0]}: {how}" for name, how in MODEL_DERIVED.items())
+    return note if parameter_set is None else f"{note} (here {parameter_set})"
 
 
 def _comparison_text(comparison: Any) -> str:
@@ -360,6 +387,32 @@ def _comparison_text(comparison: Any) -> str:
     if len(comparison.cycles) > TABLE_CYCLES:
         lines.append(f"(first {TABLE_CYCLES} of {len(comparison.cycles)} compared cycles; --json gives every one)")
     return "\n".join(lines)
+
+
+def _table_cell(cycle: Any, name: str, factor: float, digits: int, began_between: bool) -> str:
+    """A cycle's value in the table; a slip between samples as its bound ("< 0.1"), and σs before it and σc after
+    it with their resolution (± the stick slope times half the sampling interval)."""
+    value = getattr(cycle, name)
+    if name == "slip_time" and cycle.slip_time_bound is not None:
+        return f"< {cycle.slip_time_bound:.3g}"
+    text = _number(value, factor, digits)
+    resolution = None
+    if name == "peak_stress" and cycle.slip_time_bound is not None:
+        resolution = cycle.peak_stress_uncertainty
+    elif name == "critical_stress" and began_between:
+        resolution = cycle.critical_stress_uncertainty
+    return text if value is None or resolution is None else f"{text} ± {resolution * factor:.2g}"
+
+
+def _between_samples_note(between: list[Any], cycles: Any) -> str:
+    """What the table's bounds and ± mean where slips fall between samples."""
+    names = ", ".join(str(c.index) for c in between[:8]) + (f" and {len(between) - 8} more" if len(between) > 8 else "")
+    return (
+        f"the drop of cycle(s) {names} falls between two samples, each on its stick line: the slip lasts less than"
+        " that sampling interval (< shown), and σs before it and σc after it are read at the interval's middle,"
+        " ± the stick slope times half the interval (their resolution, not noise); ts and the period run between"
+        " those middles"
+    )
 
 
 def _number(value: float | None, factor: float, digits: int) -> str:
