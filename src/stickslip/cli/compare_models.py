@@ -20,7 +20,16 @@ from ..progress import progress
 from ..units import shorten
 from .common import check_output, check_unit, emit_json, key_value, refuse_overwriting_inputs, save_figure
 from .protocol_options import build_protocol, build_rig
-from .run_cmd import in_run_words, model_parameters, rig_record, run_summary, settings_of, start_value, summary_units
+from .run_cmd import (
+    in_run_words,
+    model_parameters,
+    plugin_refusal,
+    rig_record,
+    run_summary,
+    settings_of,
+    start_value,
+    summary_units,
+)
 
 #: Exit status when a model's run failed (status "failed"); 2 is bad input.
 FAILED = 3
@@ -148,6 +157,11 @@ def compare_models(options: dict[str, Any]) -> None:
             except (ParameterError, ModelError) as exc:
                 said = in_run_words(str(exc), f"--start {model.name}=")
                 raise type(exc)(f"model {model.name}: {said}") from None
+            except Exception as exc:  # a plug-in's own (ValueError, ...): named as the plug-in's, not stickslip's bug
+                refusal = plugin_refusal(model, exc, "its run", starts.get(model.name), f"--start {model.name}=")
+                if refusal is exc:
+                    raise
+                raise refusal from None
             bar.advance(note=model.name)
     summaries = {name: run_summary(run, protocol, rig, springs[name]) for name, run in runs.items()}
     for model in models:  # models that start differently do not settle alike: each row says where it began

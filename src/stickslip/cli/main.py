@@ -316,6 +316,7 @@ def sigterm_unwinds() -> Iterator[None]:
     def unwind(signum: int, frame: Any) -> None:
         raise Terminated
 
+    unwind.stickslip_unwinds = True  # type: ignore[attr-defined]  # a sweep raises it where it cannot be lost
     signal.signal(signal.SIGTERM, unwind)
     try:
         yield

@@ -80,7 +80,30 @@ def model_overrides(model: Any, overrides: tuple[str, ...]) -> dict[str, str]:
 
 
 def model_parameters(model: Any, params_name: str | None, overrides: dict[str, str]) -> Any:
-    """The model's parameters from ``--params`` (a name or a file; a JSON/TOML mapping for models that take one)."""
+    """The model's parameters from ``--params`` (a name or a file; a JSON/TOML mapping for models that take one);
+    a plug-in's own exception is refused in one line naming the plug-in (:func:`plugin_refusal`)."""
+    try:
+        return _model_parameters(model, params_name, overrides)
+    except Exception as exc:
+        refusal = plugin_refusal(model, exc, "its parameters()")
+        if refusal is exc:
+            raise
+        raise refusal from None
+
+
+def plugin_refusal(model: Any, exc: Exception, doing: str, start: Any = None, start_option: str = "--start ") -> Any:
+    """``exc`` as it is, unless it is a plug-in's own (not a stickslip error): then a ParameterError (exit 2) that
+    names the model, the plug-in's class, the exception and, for a word ``--start``, that option (before: "internal
+    error (ValueError): could not convert string to float: np.str_('steady')", exit 1, as if stickslip's bug)."""
+    from ..errors import StickslipError
+    from ..models.registry import is_plugin, plugin_error
+
+    if isinstance(exc, (StickslipError, MemoryError)) or not is_plugin(model):
+        return exc
+    return ParameterError(plugin_error(model, exc, doing, start, start_option))
+
+
+def _model_parameters(model: Any, params_name: str | None, overrides: dict[str, str]) -> Any:
     from ..fileio import protect_inputs
 
     if params_name is not None:
@@ -572,6 +595,11 @@ def execute(
             run = as_run(exc.partial, protocol)  # what it computed, status "failed": written and summarised below
         except (ParameterError, ModelError) as exc:
             raise type(exc)(in_run_words(str(exc), start_option)) from None
+        except Exception as exc:  # a plug-in's own (ValueError, ...): named as the plug-in's, not stickslip's bug
+            refusal = plugin_refusal(model, exc, "its run", start, start_option)
+            if refusal is exc:
+                raise
+            raise refusal from None
     spring = model.spring(params, checked)
     summary = run_summary(run, protocol, rig, spring)
     record = record_in_rig_words(model_record(run), summary["rig"])

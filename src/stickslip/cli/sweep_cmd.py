@@ -93,7 +93,8 @@ def sweep_command(ctx: click.Context, **options: Any) -> None:
     Re-running the same command continues where it stopped (also after kill -9);
     a different specification into the same OUT is refused unless --overwrite.
     `pandas.read_parquet(OUT)` reads the rows: one per point, the varied keys and
-    the results in SI units, status 'ok', 'failed' (the model could not finish the run) or 'error'
+    the results in SI units (its `.attrs["units"]` names each column's), status
+    'ok', 'failed' (the model could not finish the run) or 'error'
     (no result) with the message.  Then draw
     the phase diagram with `stickslip sweep plot OUT --x KEY --y KEY --color regime`.
     """

@@ -19,7 +19,7 @@ from ..errors import ParameterError
 from ..parameters import require_flag
 from .base import FrictionModel
 
-__all__ = ["ENTRY_POINT_GROUP", "available_models", "get_model", "register_model"]
+__all__ = ["ENTRY_POINT_GROUP", "available_models", "get_model", "is_plugin", "plugin_error", "register_model"]
 
 ENTRY_POINT_GROUP = "stickslip.models"
 _MODELS: dict[str, FrictionModel] = {}
@@ -119,6 +119,38 @@ def _entry_points() -> None:
                           UserWarning, stacklevel=3)  # fmt: skip
             continue
         register_model(model)
+
+
+def is_plugin(model: Any) -> bool:
+    """Whether ``model`` is a plug-in: its class defined outside the stickslip package."""
+    module = getattr(type(model), "__module__", "") or ""
+    return module != "stickslip" and not module.startswith("stickslip.")
+
+
+def plugin_error(model: Any, exc: BaseException, doing: str, start: Any = None, start_option: str = "--start ") -> str:
+    """A plug-in's own exception (not a stickslip error) in one line that names the model, where it came from and,
+    for a word ``start`` the model declares no words for (``start_words`` None: every word goes to its ``run`` as
+    given), that option: ``--start steady: model velocity-weakening (the plug-in vwdoc.VelocityWeakening) raised
+    ValueError in its run: ...``.  ``doing``: "its run", "its parameters()"."""
+    from ..units import DIMENSIONS, quantity_noun, shorten
+
+    cls = type(model)
+    said = " ".join(str(exc).split()) or "(no message)"
+    if len(said) > 300:
+        said = said[:280] + f"… ({len(said)} characters)"
+    line = (
+        f"model {getattr(model, 'name', '?')} (the plug-in {cls.__module__}.{cls.__qualname__}) raised"
+        f" {type(exc).__name__} in {doing}: {said}"
+    )
+    if isinstance(start, str) and getattr(model, "start_words", None) is None:
+        line = (
+            f"{start_option}{shorten(start)}: {line}; the model declares no start words (start_words), so the word"
+            " went to its run as given"
+        )
+        dimension = getattr(model, "start_dimension", None)
+        if dimension in DIMENSIONS:
+            line += f"; it starts from {quantity_noun(dimension)}: give one with its unit"
+    return line
 
 
 def _instance(target: Any, where: str) -> Any:

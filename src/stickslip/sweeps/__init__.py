@@ -19,6 +19,7 @@ from ..errors import DataError, ParameterError
 from ..parameters import Parameters, require_flag
 from ..units import to_si
 from .engine import check_scheduler_address, compute, compute_while_cheap, dask_client, default_batch_size, read_results
+from .interrupts import heard_at_safe_points, stop_if_asked
 from .main_guard import unguarded_script_line
 from .models import ALIASES, MODELS, get_model
 from .progress import Silent, reporter
@@ -133,18 +134,24 @@ def run_sweep(
     store = open_store(output, spec, batch_size or default_batch_size(spec.size), overwrite=overwrite)
     shown = progress if progress is not None else Silent()
     report = RunReport(schedule)
+
+    def advance(points: int) -> None:  # after each chunk written: where a Ctrl-C noted meanwhile stops the sweep
+        shown.advance(points)
+        stop_if_asked()
+
     try:
         finished = store.finished()
         shown.start(spec.size, store.rows_done(finished))
         try:
-            if len(finished) == store.batches:
-                pass  # all done already: no cluster to start
-            elif workers == 0 and scheduler is None:
-                compute(store, None, shown.advance)
-            elif workers is None and scheduler is None and compute_while_cheap(store, shown.advance):
-                pass  # a small sweep: done in this process before a cluster would have started
-            else:
-                _on_cluster(store, workers, scheduler, shown, report)
+            with heard_at_safe_points():  # a Ctrl-C is never lost in a gc callback (interrupts.py)
+                if len(finished) == store.batches:
+                    pass  # all done already: no cluster to start
+                elif workers == 0 and scheduler is None:
+                    compute(store, None, advance)
+                elif workers is None and scheduler is None and compute_while_cheap(store, advance):
+                    pass  # a small sweep: done in this process before a cluster would have started
+                else:
+                    _on_cluster(store, workers, scheduler, shown, report, advance)
         finally:
             shown.close()
         report.in_process_points += store.points_written - report.points
@@ -156,7 +163,12 @@ def run_sweep(
 
 
 def _on_cluster(
-    store: SweepStore, workers: int | None, scheduler: str | None, shown: Silent, report: RunReport
+    store: SweepStore,
+    workers: int | None,
+    scheduler: str | None,
+    shown: Silent,
+    report: RunReport,
+    advance: Callable[[int], None] | None = None,
 ) -> None:
     """Run the chunks still missing on a cluster, timing the cluster's part (for the parallel efficiency)."""
     import time
@@ -167,7 +179,7 @@ def _on_cluster(
         began = time.perf_counter()
         report.cluster_start = began - asked
         report.workers = sum(client.nthreads().values()) or 1
-        compute(store, client, shown.advance, schedule=report.schedule)
+        compute(store, client, advance or shown.advance, schedule=report.schedule)
         report.wall = time.perf_counter() - began
     report.points = store.points_written - points
     report.point_seconds = store.point_seconds - seconds

@@ -10,12 +10,14 @@ from __future__ import annotations
 import contextlib
 import math
 import os
+import time
 from collections.abc import Callable, Iterable, Iterator, Sequence
 from functools import lru_cache
 from pathlib import Path
 from typing import Any
 
 from ..errors import DataError, ParameterError, StickslipError
+from .interrupts import POLL_SECONDS, deferred, stop_if_asked
 from .models import get_model, key_units, result_columns, run_point
 from .schedule import check_schedule, plan_tasks, usable_costs
 from .spec import SweepSpec
@@ -253,10 +255,22 @@ def cost_ordered_tasks(store: SweepStore, batches: Iterable[int], workers: int, 
         ahead = next(groups, None)
         planning = None if ahead is None else planner.submit(_plan, store, model, *ahead, workers)
         while planning is not None:
-            tasks = planning.result()
+            tasks = _waited(planning)
             ahead = next(groups, None)
             planning = None if ahead is None else planner.submit(_plan, store, model, *ahead, workers)
             yield from tasks
+
+
+def _waited(planning: Any) -> Any:
+    """The planner's result, looking for a noted Ctrl-C meanwhile (a group's costs can take seconds to estimate)."""
+    from concurrent.futures import TimeoutError as NotYet  # (the built-in TimeoutError from Python 3.11 on)
+
+    while True:
+        stop_if_asked()
+        try:
+            return planning.result(timeout=POLL_SECONDS)
+        except NotYet:
+            continue
 
 
 def _groups(store: SweepStore, batches: Iterator[int], points: int) -> Iterator[tuple[list[int], int]]:
@@ -306,24 +320,43 @@ def _run_window(
         future.points = points  # type: ignore[attr-defined]
         return future
 
-    finished = as_completed([submit(t) for _, t in zip(range(window), tasks, strict=False)])
-    for future in finished:
-        following = next(tasks, None)
-        if following is not None:  # before fetching and writing the rows: the freed worker starts at once
-            finished.add(submit(following))
-        try:
-            columns = future.result()
-        except Exception as exc:  # a worker died or the cluster went away: what is written stays written
-            raise StickslipError(
-                f"points {_shown_points(future.points)} failed on the cluster ({type(exc).__name__}: {exc});"
-                " run the same command again to resume"
-            ) from None
-        future.release()
-        chunks.add(columns)
-        progress(len(columns["point"]))
+    with deferred():  # a Ctrl-C meanwhile is raised by the loop (interrupts.py), never lost in a gc callback
+        finished = as_completed([submit(t) for _, t in zip(range(window), tasks, strict=False)])
+        for future in _completed(finished):
+            following = next(tasks, None)
+            if following is not None:  # before fetching and writing the rows: the freed worker starts at once
+                finished.add(submit(following))
+            try:
+                columns = future.result()
+            except Exception as exc:  # a worker died or the cluster went away: what is written stays written
+                raise StickslipError(
+                    f"points {_shown_points(future.points)} failed on the cluster ({type(exc).__name__}: {exc});"
+                    " run the same command again to resume"
+                ) from None
+            future.release()
+            chunks.add(columns)
+            progress(len(columns["point"]))
     if chunks.parts:  # pragma: no cover - every point of every chunk run was in some task
         raise StickslipError(f"sweep: chunks {sorted(chunks.parts)[:3]} were left incomplete; run it again")
     return chunks.written
+
+
+def _completed(finished: Any) -> Iterator[Any]:
+    """The futures of ``finished`` (distributed's as_completed) as they complete, looking for a noted Ctrl-C every
+    :data:`~stickslip.sweeps.interrupts.POLL_SECONDS` meanwhile (``next(finished)`` alone waits until one does)."""
+    condition = getattr(finished, "thread_condition", None)  # notified by as_completed as each future completes
+    while True:
+        stop_if_asked()
+        if finished.has_ready():
+            yield next(finished)
+        elif finished.is_empty():
+            return
+        elif condition is None:  # pragma: no cover - distributed's as_completed has it
+            time.sleep(POLL_SECONDS / 4)
+        else:
+            with condition:
+                if not finished.has_ready():
+                    condition.wait(timeout=POLL_SECONDS)
 
 
 def _shown_points(points: Sequence[int]) -> str:

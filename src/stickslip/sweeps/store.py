@@ -61,7 +61,18 @@ def arrow_schema(
     types.update({name: kinds[kind] for name, kind in columns.items()})
     units = {name: unit_of(name, key_units) for name in types}  # every column names its unit (pyarrow field metadata)
     fields = [pa.field(name, kind, metadata=_unit_metadata(units[name])) for name, kind in types.items()]
-    return pa.schema(fields, metadata={PARQUET_KEY: json.dumps(units).encode()})
+    # PANDAS_ATTRS: the key pandas (>= 2.1) restores DataFrame.attrs from, so that a plain pandas.read_parquet(OUT)
+    # holds attrs["units"] as stickslip.columns.read_parquet does (before: empty attrs; the units in PARQUET_KEY only)
+    return pa.schema(fields, metadata={PARQUET_KEY: json.dumps(units).encode(), **pandas_attrs(units)})
+
+
+#: The Parquet schema metadata key from which pandas (2.1 and later) restores ``DataFrame.attrs`` (JSON).
+PANDAS_ATTRS = b"PANDAS_ATTRS"
+
+
+def pandas_attrs(units: Mapping[str, str | None]) -> dict[bytes, bytes]:
+    """``{PANDAS_ATTRS: '{"units": {column: unit}}'}``: the frame's ``attrs`` as pandas reads them back."""
+    return {PANDAS_ATTRS: json.dumps({"units": dict(units)}).encode()}
 
 
 def _unit_metadata(unit: str | None) -> dict[bytes, bytes] | None:
@@ -120,8 +131,11 @@ class SweepStore:
         atomic_write_text(self.folder / RUN, json.dumps(report.as_dict(), indent=2) + "\n")
 
     def close(self) -> None:
-        """Release the folder's lock (also released by the kernel if the process dies)."""
+        """Release the folder's lock and remove its file (a killed process's lock is released by the kernel; its
+        file, left with the dead process's id, is taken over by the next run)."""
         if self.lock is not None:
+            with contextlib.suppress(OSError):  # removed while still held: a writer waiting on it tries again
+                (self.folder / LOCK).unlink()
             os.close(self.lock)
             self.lock = None
 
@@ -215,19 +229,37 @@ def _lock_folder(path: Path, folder: str | Path) -> int:
     """An exclusive, non-blocking flock on the folder's lock file; a second writer is refused."""
     import fcntl
 
-    descriptor = os.open(path / LOCK, os.O_RDWR | os.O_CREAT, 0o644)
-    try:
-        fcntl.flock(descriptor, fcntl.LOCK_EX | fcntl.LOCK_NB)
-    except OSError:
-        holder = os.pread(descriptor, 32, 0).decode("ascii", errors="replace").strip()
-        os.close(descriptor)
-        who = f" (process {holder})" if holder.isdigit() else ""
-        raise DataError(
-            f"-o {folder}: another sweep is writing into this folder{who}; wait for it to end or choose another folder"
-        ) from None
+    while True:
+        try:
+            descriptor = os.open(path / LOCK, os.O_RDWR | os.O_CREAT, 0o644)
+        except OSError as exc:
+            raise DataError(f"-o {folder}: cannot create its lock file ({exc.strerror or exc})") from None
+        try:
+            fcntl.flock(descriptor, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            holder = os.pread(descriptor, 32, 0).decode("ascii", errors="replace").strip()
+            os.close(descriptor)
+            who = f" (process {holder})" if holder.isdigit() else ""
+            raise DataError(
+                f"-o {folder}: another sweep is writing into this folder{who}; wait for it to end or choose another"
+                " folder"
+            ) from None
+        if _same_file(descriptor, path / LOCK):
+            break
+        os.close(descriptor)  # the run that held it ended and removed the file meanwhile: lock the one there now
     os.ftruncate(descriptor, 0)
     os.pwrite(descriptor, f"{os.getpid()}\n".encode(), 0)
     return descriptor
+
+
+def _same_file(descriptor: int, path: Path) -> bool:
+    """Whether ``descriptor`` is still the file at ``path`` (not one removed since it was opened)."""
+    try:
+        there = os.stat(path)
+    except FileNotFoundError:
+        return False
+    here = os.fstat(descriptor)
+    return (here.st_dev, here.st_ino) == (there.st_dev, there.st_ino)
 
 
 def _refuse_too_large(store: SweepStore, folder: str | Path) -> None:
