@@ -27,7 +27,7 @@ from .columns import data_lines, split_header, with_units
 from .display import velocity as velocity_text
 from .errors import DataError, ParameterError, UnitError, as_written
 from .fileio import protect_inputs, read_input_text
-from .units import is_quantity, refused_as_written, si_argument
+from .units import is_quantity, refuse_beyond_float, refused_as_written, si_argument
 
 __all__ = [
     "Protocol",
@@ -70,6 +70,7 @@ def _check_segment_value(name: str, value: Any) -> None:
             f"segment {name}: expected a number in SI units or a value with its unit"
             f" ({'0.2 mm/s' if name == 'velocity' else '3 s'!r}), got {value!r}"
         )
+    refuse_beyond_float(value, f"segment {name}")  # 10**400: a ParameterError, not float()'s OverflowError
     if not math.isfinite(float(value)):
         raise ParameterError(f"segment {name}: expected a finite number, got {value!r}")
     if name == "velocity" and value < 0:

@@ -295,10 +295,12 @@ def _csv_heading(name: str, unit: str) -> str:
 
 
 def _cell(value: Any) -> str:
+    from ..columns import csv_number
+
     if value is None:
         return ""
-    if isinstance(value, float):
-        return repr(value) if math.isfinite(value) else ""
+    if isinstance(value, float):  # at the package's CSV digits, as every CSV it writes (columns.csv_number)
+        return csv_number(value) if math.isfinite(value) else ""
     return str(value)
 
 

@@ -487,7 +487,12 @@ def fit_steady(
     (docs/fitting.md): ``delta`` for two-step, ``profile`` for joint.
     """
     if not isinstance(data, SteadyData | str | Path):
-        raise DataError(f"data: expected SteadyData or the path of a steady-sliding table, got {shorten(data)}")
+        # a frame or an array is named by its type: its repr runs over many lines
+        got = shorten(data) if isinstance(data, str | int | float | None) else f"a {type(data).__name__}"
+        raise DataError(
+            f"data: expected SteadyData (SteadyData.from_arrays(velocity, stress[, stress_err]), SI) or the path of a"
+            f" steady-sliding table, got {got}"
+        )
     if isinstance(free, str):  # one key: iterating the string would give its characters ("unknown key 'b'")
         free = [free]
     if not isinstance(data, SteadyData):

@@ -534,7 +534,9 @@ def _shown_name(label: str, gid: str | None) -> str:
 
 
 def _num(value: float) -> str:
-    return "" if not np.isfinite(value) else repr(float(value))
+    from ..columns import csv_number  # the package's CSV digits, as every CSV it writes
+
+    return "" if not np.isfinite(value) else csv_number(float(value))
 
 
 def _csv_field(text: str) -> str:

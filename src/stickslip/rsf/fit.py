@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import contextlib
 import math
+import os
 from collections.abc import Callable, Iterator
 from contextvars import ContextVar
 from dataclasses import dataclass, field, replace
@@ -340,6 +341,17 @@ def restart_notice(notify: Callable[[str, int], None] | None) -> Iterator[None]:
         _RESTART_NOTICE.reset(token)
 
 
+def _lab_record(record: Any) -> LabRecord:
+    """``record`` as a LabRecord: one already, or read from its path (fit_steady and fit_stick take paths too)."""
+    if isinstance(record, LabRecord):
+        return record
+    if isinstance(record, (str, os.PathLike)):
+        from .data import read_record
+
+        return read_record(record)
+    raise ParameterError(f"record: expected a LabRecord or the path of a record file, got {type(record).__name__}")
+
+
 def fit_record(
     record: LabRecord,
     *,
@@ -383,7 +395,10 @@ def fit_record(
     Within ``with restart_notice(notify):``, ``notify(text, searches)`` is told when the first search ends troubled
     and the fit restarts it from other starts in Dc (``searches`` more at most): the moment a fit's cost leaves the
     typical estimate (``rsf fit`` says it on stderr).
+    ``record`` may also be the path of a record file, read by :func:`stickslip.rsf.data.read_record` with its columns
+    found by name (``read_record`` itself takes a column map and units).
     """
+    record = _lab_record(record)
     if noise is not None and not (_real(noise) and math.isfinite(noise) and noise > 0):
         raise ParameterError(f"noise: expected a positive friction level, got {noise!r}")
     if states not in (1, 2):

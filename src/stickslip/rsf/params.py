@@ -284,7 +284,18 @@ def rsf_params(
     regularized: bool = False,
     cutoff: tuple[float, float] | None = None,
 ) -> RSFParams:
-    """Convenience constructor for one or two state variables (SI values)."""
+    """Convenience constructor for one or two state variables: numbers in SI, or values with their units
+    (``dc="10 um"``, ``v_ref="1 um/s"``, ``stiffness="1e-3 1/um"``, ``eta="10 s/m"``, ``normal_stress="10 MPa"``)."""
+    from ..units import si_argument
+
+    dc, dc2, v_ref, stiffness, eta, normal_stress = (
+        None if value is None else si_argument(value, dimension, name)
+        for value, dimension, name in (
+            (dc, "length", "dc"), (dc2, "length", "dc2"), (v_ref, "velocity", "v_ref"),
+            (stiffness, "per_length", "stiffness"), (eta, "slowness", "eta"),
+            (normal_stress, "stress", "normal_stress"),
+        )
+    )  # fmt: skip
     states = [StateVariable(law, b, dc, c)]
     if (b2 is None) != (dc2 is None):
         raise ParameterError("b2/dc2: a second state variable needs both b2 and dc2")

@@ -1,0 +1,62 @@
+"""Round 28, tester K's smaller API findings: each refused or read as the rest of the API does.
+
+``fit_record`` takes the path of a record (``fit_steady`` and ``fit_stick`` take paths; a path was a raw
+AttributeError), ``rsf_params`` reads values with their units (``dc="10 um"`` was "expected a number"), a protocol
+segment beyond the float range is a ParameterError (was a raw OverflowError), and ``fit_steady`` given a DataFrame
+says so in one line (its repr ran over many lines)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+import pytest
+
+import stickslip
+from stickslip import protocols
+from stickslip.rsf import rsf_params, simulate
+from stickslip.rsf.data import read_record
+from stickslip.rsf.fit import fit_record
+
+UM = 1e-6
+
+
+def test_fit_record_reads_a_path_as_read_record_does(tmp_path) -> None:
+    truth = rsf_params(0.010, 0.015, 10 * UM, v_ref=UM, stiffness=1600.0, mu0=0.6)
+    t = np.arange(0.0, 40.0 + 1e-9, 0.25)
+    run = simulate(truth, protocols.velocity_steps([1 * UM, 10 * UM], [20, 20]), times=t)
+    noise = 1e-4 * np.random.default_rng(3).standard_normal(t.size)
+    frame = pd.DataFrame(
+        {
+            "time [s]": t,
+            "load_point_displacement [um]": run.load_point_displacement / UM,
+            "friction": run.friction + noise,
+        }
+    )
+    path = tmp_path / "record.csv"
+    frame.to_csv(path, index=False)
+    by_path = fit_record(path, fixed={"stiffness": 1600.0})
+    by_record = fit_record(read_record(path), fixed={"stiffness": 1600.0})
+    assert by_path.params.a == pytest.approx(by_record.params.a, rel=1e-12)
+    assert by_path.params.a == pytest.approx(0.010, abs=5 * by_path.parameters["a"].stderr)  # the truth, within 5 se
+    with pytest.raises(stickslip.ParameterError, match="record: expected a LabRecord or the path"):
+        fit_record(None)
+
+
+def test_rsf_params_reads_units() -> None:
+    written = rsf_params(0.005, 0.01, "10 um", v_ref="1 um/s", stiffness="1e-3 1/um", eta="10 s/m")
+    by_hand = rsf_params(0.005, 0.01, 10e-6, v_ref=1e-6, stiffness=1e3, eta=10.0)
+    assert written.states[0].dc == pytest.approx(by_hand.states[0].dc, rel=1e-12)
+    assert (written.v_ref, written.stiffness, written.eta) == pytest.approx((1e-6, 1e3, 10.0), rel=1e-12)
+    with pytest.raises(stickslip.UnitError, match="dc: '10 um/s' has dimension"):
+        rsf_params(0.005, 0.01, "10 um/s")
+
+
+def test_a_segment_beyond_the_float_range_is_a_parameter_error() -> None:
+    with pytest.raises(stickslip.ParameterError, match=r"segment velocity: .* beyond the range of a float"):
+        protocols.constant(10**400, 1.0)
+
+
+def test_fit_steady_given_a_frame_says_so_in_one_line() -> None:
+    with pytest.raises(stickslip.DataError) as caught:
+        stickslip.fit_steady(pd.DataFrame({"v": [1.0, 2.0], "s": [3.0, 4.0]}))
+    assert "\n" not in str(caught.value) and "got a DataFrame" in str(caught.value)
