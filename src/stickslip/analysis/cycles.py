@@ -80,6 +80,12 @@ CYCLE_QUANTITIES = {
     "period": "s",
     "stress_drop": "Pa",
 }
+#: Of those, the stick line's: its slope (and Gd/h from it) is measured on a stick cut by the record or a gap too,
+#: the same in a start-up stick as in the limit cycle (the elastic loading K*V0), so their summary is over every
+#: stick line.  The others are read at corners that a cut cycle lacks or does not have as a repeat of the cycle (a
+#: start-up stick from rest ages longer, to a higher sigma_s and a faster, longer slip): their summary is over the
+#: complete cycles alone (SUMMARY_LEFT_OUT says which and why).
+LINE_QUANTITIES = ("stick_slope", "stiffness")
 
 
 #: Per-cycle quantities that come from the model, not from the record: field -> how (they change with the
@@ -931,9 +937,14 @@ def _summary(
         "n_complete": sum(c.complete for c in cycles),
     }
     for name in CYCLE_QUANTITIES:
+        # a cycle the record or a gap cuts (a start-up stick, one the record ends in) is no repeat of the cycle:
+        # left out of the corners' quantities, whose mean would move with it (LINE_QUANTITIES)
+        counted = cycles if name in LINE_QUANTITIES else [c for c in cycles if c.complete]
         # a slip between samples has no measured time (its 0 is the corners' difference): only its bound, below
-        timed = [c for c in cycles if name != "slip_time" or c.slip_time_bound is None]
+        timed = [c for c in counted if name != "slip_time" or c.slip_time_bound is None]
         summary[name] = _stats([getattr(c, name) for c in timed if getattr(c, name) is not None])
+    summary["averaged_cycles"] = [c.index for c in cycles if c.complete]
+    summary["left_out_cycles"] = [{"cycle": c.index, "why": _cut_reason(c)} for c in cycles if not c.complete]
     bounds = [c.slip_time_bound for c in cycles if c.slip_time_bound is not None]
     if bounds:
         summary["unresolved_slips"] = {"n": len(bounds), "slip_time_bound": max(bounds)}
@@ -951,6 +962,40 @@ def _summary(
             steady_samples=int(tail.size),
         )
     return summary
+
+
+def _cut_reason(cycle: CycleResult) -> str:
+    """Why a cycle is incomplete, in the words of its message (without its note on the jump velocity)."""
+    parts = [p for p in cycle.message.split("; ") if p and "jump velocity" not in p]
+    return "; ".join(parts) or "cut by the record's ends or a gap in it"
+
+
+def summary_note(summary: dict[str, Any]) -> str:
+    """Which cycles the summary's means are over, in words ("" when every cycle is complete)."""
+    left_out = summary.get("left_out_cycles") or []
+    if not left_out:
+        return ""
+    averaged = summary.get("averaged_cycles") or []
+    reasons = "; ".join(f"cycle {e['cycle']} ({e['why']})" for e in left_out[:6])
+    more = f" and {len(left_out) - 6} more" if len(left_out) > 6 else ""
+    lines = ", ".join(_runs(averaged))
+    if averaged:
+        over = f"mean ± sd of the complete cycle(s) {lines}"
+    else:
+        over = "no complete cycle: σc, σs, ts, Vs, the slip time and the period are not averaged (no mean)"
+    return (
+        f"{over}; left out, cut by the record's ends or a gap in it: {reasons}{more};"
+        f" dσ/dt and Gd/h are over every stick line ({summary['stick_slope']['n']})"
+    )
+
+
+def _runs(indices: list[int]) -> list[str]:
+    """Consecutive cycle numbers as ranges: [2, 3, 4, 7] -> ["2-4", "7"]."""
+    out: list[str] = []
+    for _, group in itertools.groupby(enumerate(indices), key=lambda pair: pair[1] - pair[0]):
+        run = [k for _, k in group]
+        out.append(str(run[0]) if len(run) == 1 else f"{run[0]}-{run[-1]}")
+    return out
 
 
 def _message(regime: str, cycles: list[CycleResult], coarse: Coarse, summary: dict[str, Any]) -> str:

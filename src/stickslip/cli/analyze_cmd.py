@@ -308,6 +308,8 @@ def _report(analysis: Any, comparison: Any, parameter_set: str | None = None) ->
     from rich.markup import escape
     from rich.table import Table
 
+    from ..analysis.cycles import summary_note
+
     v0 = analysis.pulling_velocity
     head = (
         f"{analysis.source}: {analysis.message}\n"
@@ -323,9 +325,9 @@ def _report(analysis: Any, comparison: Any, parameter_set: str | None = None) ->
         table.add_column("")
         for cycle in shown:
             table.add_column(f"cycle {cycle.index}" + ("" if cycle.complete else "*"), justify="right")
-        table.add_column(
-            f"mean ± sd ({len(analysis.cycles)} cycles)" if len(shown) < len(analysis.cycles) else "mean ± sd",
-            justify="right",
+        complete = len(analysis.summary.get("averaged_cycles", ()))
+        table.add_column(  # over the complete cycles (dσ/dt, Gd/h: every stick line); the note below says which
+            f"mean ± sd ({complete} complete)" if complete < len(analysis.cycles) else "mean ± sd", justify="right"
         )
         between = [c for c in analysis.cycles if c.slip_time_bound is not None]
         after = {c.index + 1 for c in between}  # the cycles whose stick began after a slip between samples
@@ -350,6 +352,7 @@ def _report(analysis: Any, comparison: Any, parameter_set: str | None = None) ->
         if any(not c.complete for c in analysis.cycles):
             notes = [f"cycle {c.index}: {c.message}" for c in analysis.cycles if c.message]
             parts.append(escape("* cut by the record's ends or by a gap in it.  " + "; ".join(notes)))
+            parts.append(escape(summary_note(analysis.summary)))  # the mean leaves them out: which, and why
     if "mean_stress" in analysis.summary:
         s = analysis.summary
         spread = "" if s["stress_std"] is None else f" ± {s['stress_std']:.3g} Pa (sd of {s['steady_samples']} samples)"
