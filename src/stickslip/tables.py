@@ -320,6 +320,8 @@ def _text_format(path: str, mtime: int, size: int) -> TextFormat:
 _LAYOUT_LINES = 200
 #: cells a reader takes as a missing value (pandas' words), neither a number nor a name
 _MISSING_WORDS = frozenset({"nan", "-nan", "na", "n/a", "#n/a", "null", "none", "inf", "-inf", "+inf", "infinity"})
+#: at most this many rows of numbers above a header are read as title text ("2024,05,01"), not as data
+_NUMERIC_TITLES = 3
 #: a units row's cell that names no unit: a pure number, or nothing
 _NO_UNIT = frozenset({"", "-", "--", "1", "()", "[]", "(-)", "[-]", "(1)", "[1]"})
 #: the dimensions a units row's words are read in (a friction record's or a measurement table's columns, and the
@@ -474,6 +476,17 @@ def _unit_cell(cell: str) -> str | None:
     return None
 
 
+#: a units row's cell that is a number glued to a unit ("10um", "1e-6 m"): no unit a reader reads (the scale
+#: belongs in the numbers); kept so that the reader refuses it at its row instead of taking the row as the header
+SCALED_UNIT = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?\s*[A-Za-zµμ][\w/^]*")
+
+
+def _row_unit(cell: str) -> str | None:
+    """:func:`_unit_cell`, or a number glued to a unit as written (:data:`SCALED_UNIT`)."""
+    unit = _unit_cell(cell)
+    return cell.strip() if unit is None and SCALED_UNIT.fullmatch(cell.strip()) else unit
+
+
 def _layout(lines: list[tuple[int, int, int, str]]) -> tuple[Layout, int]:
     """The table's :class:`Layout`, and the index in ``lines`` of its header (where it has none: the number of
     cells of its data rows)."""
@@ -497,8 +510,16 @@ def _layout(lines: list[tuple[int, int, int, str]]) -> tuple[Layout, int]:
     first = next((k for k, line in enumerate(lines) if data_like(line[3])), None)
     if first is None or first == 1:
         return usual, 0
+    fallback = usual, 0
     if first == 0:
-        return Layout(header_row=None, first_data_row=lines[0][0]), width
+        fallback = Layout(header_row=None, first_data_row=lines[0][0]), width
+        # a title of numbers ("2024,05,01") above a header: a few numeric rows, then text, then the data
+        gap = next((k for k, line in enumerate(lines) if not data_like(line[3])), None)
+        if gap is None or gap > _NUMERIC_TITLES:
+            return fallback
+        first = next((k for k in range(gap + 1, len(lines)) if data_like(lines[k][3])), None)
+        if first is None:
+            return fallback
 
     def header_like(text: str) -> bool:
         cells = _header_cells(text, separator)
@@ -506,11 +527,11 @@ def _layout(lines: list[tuple[int, int, int, str]]) -> tuple[Layout, int]:
 
     units: list[str | None] = []
     if first >= 2:
-        units = [_unit_cell(c) for c in _cells(lines[first - 1][3], separator)]
+        units = [_row_unit(c) for c in _cells(lines[first - 1][3], separator)]
     if (
         len(units) == width
         and all(u is not None for u in units)
-        and any(units)
+        and any(u and not SCALED_UNIT.fullmatch(u) for u in units)
         and header_like(lines[first - 2][3])
         and not all(_unit_cell(c) is not None for c in _header_cells(lines[first - 2][3], separator))
     ):
@@ -521,7 +542,7 @@ def _layout(lines: list[tuple[int, int, int, str]]) -> tuple[Layout, int]:
     if header_like(lines[first - 1][3]):
         at = first - 1
         return Layout(lines[at][0], None, (), tuple(line[0] for line in lines[:at]), lines[first][0]), at
-    return usual, 0
+    return fallback
 
 
 def _header_line(head: bytes, complete: bool = True) -> tuple[Layout, int, str, str] | None:
@@ -714,6 +735,11 @@ def _read_header(
             )
         name, unit = found
         below = layout.unit(position - 1)  # a units row's word under a header that names none ("ms")
+        if below is not None and SCALED_UNIT.fullmatch(below):
+            raise DataError(
+                f"{source}: row {layout.units_row} (the units row), column {position}: {below!r} is no unit; expected"
+                " a unit word (s, ms, um, mm, -); a scale such as 10 um belongs in the numbers"
+            )
         if below is not None and unit is not None and unit.strip() and unit.strip() != below:
             raise DataError(
                 f"{source}: column {cell.strip()!r} names its unit {unit.strip()!r} but the units row (row"

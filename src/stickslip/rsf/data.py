@@ -252,6 +252,7 @@ def read_record(
     if sigma is not None and not (math.isfinite(sigma) and sigma > 0):
         raise ParameterError(f"--normal-stress: expected a positive stress, got {sigma:g} Pa")
     form = text_format(path)
+    form, header_note = _numbered_header(path, form, columns)
     frame = _with_row_units(_read_frame(path, pd, form), form.layout, path)
     with open_input(path, "rt", encoding="utf-8-sig", errors="replace") as handle:  # a byte-order mark: no content
         rows = _data_lines(handle, form.layout.data_after, len(frame))
@@ -263,7 +264,7 @@ def read_record(
     dimension = {"time": "time", "displacement": "length", "velocity": "velocity"}
     units = {role: _header_unit(str(chosen[role]), dimension[role], path) for role in chosen if role in dimension}
     friction, read_notes = _friction(path, chosen, data, by_stress, sigma, _row_names(rows, len(frame)))
-    read_notes[:0] = [n for n in (form.layout.note(str(path)), form.note) if n]
+    read_notes[:0] = [n for n in (form.layout.note(str(path)), header_note, form.note) if n]
 
     def in_si(role: str) -> np.ndarray:
         """A column in SI: by the unit its header names, else by the option, else SI."""
@@ -277,6 +278,7 @@ def read_record(
         return data[role] * factor
 
     time = in_si("time")
+    _refuse_numbers_row(path, form, rows, time)
     if "displacement" in data:
         displacement = in_si("displacement")
         written = units.get("displacement") or option["length"]
@@ -467,6 +469,78 @@ def refuse_nonfinite(source: str, row: Any, columns: dict[str, np.ndarray]) -> N
     raise DataError(text)
 
 
+def _line_cells(path: Path, row: int, delimiter: str) -> list[str]:
+    """File row ``row``'s (1-based) cells as written, split at ``delimiter`` (" ": blanks)."""
+    from ..tables import _cells
+
+    with open_input(path, "rt", encoding="utf-8-sig", errors="replace") as handle:
+        text = next(itertools.islice(handle, row - 1, None), "")
+    return [c.strip() for c in _cells(text.rstrip("\r\n"), delimiter)]
+
+
+def _numbered_header(path: Path, form: Any, columns: dict[str, str] | None) -> tuple[Any, str]:
+    """The file's form with its first row read as the header where that row holds numbers and ``columns`` names
+    its cells as written (``time=1`` where row 1 reads ``1,2,3``: the docs' own example), and the note that says
+    so ("" and ``form`` as it is otherwise).  A map whose numbers would pick other columns by position than by
+    name is refused (DataError)."""
+    layout = form.layout
+    if layout.header_row is not None or layout.commented or not columns or not layout.first_data_row:
+        return form, ""
+    row = layout.first_data_row
+    cells = _line_cells(path, row, form.delimiter)
+    wanted = {role: str(name).strip() for role, name in columns.items()}
+    if len(set(cells)) != len(cells) or not all(name in cells for name in wanted.values()):
+        return form, ""
+    for role, name in wanted.items():
+        if name.isdigit() and 1 <= int(name) <= len(cells) and cells.index(name) != int(name) - 1:
+            raise DataError(
+                f"{path}: --columns {role}={name}: row {row} ({', '.join(cells)}) may be the header (where {name!r}"
+                f" is column {cells.index(name) + 1}) or data (column {name}); map the columns by their header"
+                " names, or remove the header row"
+            )
+    header = replace(layout, header_row=row, first_data_row=0)
+    note = f"{path}: row {row} ({', '.join(cells)}) read as the header: --columns names its cells"
+    return replace(form, layout=header), note
+
+
+#: a first data row whose time step to the next exceeds this many times the next rows' (median) is out of line
+OUT_OF_LINE_STEP = 10.0
+
+
+def _refuse_numbers_row(path: Path, form: Any, rows: Any, time: np.ndarray) -> None:
+    """DataError naming the first data row where it is whole numbers only (``1,2,3``, ``2024,05,01``, ``1,1,1``)
+    and out of line with the data: its time not before the next row's, or its step to the next more than
+    :data:`OUT_OF_LINE_STEP` times the next rows' median step: a header, title or units row of numbers, never
+    read silently as a sample."""
+    if rows is None or len(rows) != time.size or time.size < 3 or not np.all(np.isfinite(time[:3])):
+        return
+    cells = _line_cells(path, rows[0], form.delimiter)
+    if not cells or not all(re.fullmatch(r"[+-]?\d+", c) for c in cells):
+        return
+    steps = np.diff(time[1:52])
+    steps = steps[np.isfinite(steps) & (steps > 0)]
+    typical = float(np.median(steps)) if steps.size else math.nan
+    first = time[1] - time[0]
+    if first > 0 and not (math.isfinite(typical) and first > OUT_OF_LINE_STEP * typical):
+        return
+    after = f", the rows after stepping by {typical:g} s" if math.isfinite(typical) else ""
+    layout = form.layout
+    if layout.header_row is None:
+        what = (
+            "a header or title row of numbers? remove it, or where it is the header map the columns by its cells"
+            f" as written (--columns time={cells[0]},...)"
+        )
+    else:
+        what = (
+            f"a units row? expected the data right under the header (row {layout.header_row}), units as words"
+            " (s, um, -); remove the row"
+        )
+    raise DataError(
+        f"{path}: row {rows[0]} ({', '.join(cells)}) is out of line with the data (time {time[0]:g} s, then"
+        f" {time[1]:g} s at row {rows[1]}{after}): {what}"
+    )
+
+
 def _row_names(rows: Any, size: int) -> Any:
     """Each sample's row for messages: ``rows`` when it names every sample, else 1, 2, ..."""
     return rows if rows is not None and len(rows) == size else range(1, size + 1)
@@ -513,11 +587,18 @@ def _named(frame: Any, layout: Any, path: Path) -> Any:
 def _with_row_units(frame: Any, layout: Any, path: Path) -> Any:
     """The frame's columns named with the unit a units row under the header gives them (``Time`` over ``ms``:
     "Time [ms]"), where their header names none; one that names another unit is refused."""
+    from ..tables import SCALED_UNIT
+
     if layout.units_row is None:
         return frame
     names = []
     for position, column in enumerate(frame.columns):
         header, unit = str(column).strip(), layout.unit(position)
+        if unit is not None and SCALED_UNIT.fullmatch(unit):
+            raise DataError(
+                f"{path}: row {layout.units_row} (the units row), column {header!r}: {unit!r} is no unit; expected a"
+                " unit word (s, ms, um, mm, -); a scale such as 10 um belongs in the numbers"
+            )
         written = re.search(r"[\(\[]\s*([^\(\)\[\]]+?)\s*[\)\]]\s*$", header)
         if unit is not None and written is not None and written.group(1) != unit:
             raise DataError(
