@@ -629,6 +629,8 @@ def _fit_steady(
         progress, keys = fitted_anyway
         # why the fit went on: said once, whatever refits follow (the scaled errors' pass dropped it; round 28)
         trend_notes = [progress.messages.pop()]
+        if trend_notes[0].startswith(LEFT_OUT_WARNING):  # and the outlier found by leaving each point out
+            trend_notes.insert(0, progress.messages.pop())
     else:
         _require_finite_start(everything, base, fixed)
         progress, keys = _run_method(check, (everything, hi, lo))
@@ -1098,11 +1100,25 @@ def _fit_of_a_flat_looking_curve(
     # between neighbours has ~(n - 2)/1.9 whatever k, and with stated errors it agrees with, the errors themselves
     against, noise = fitted_dependence(data.velocity, data.stress, data.stress_err, model)
     p = min(nested, against)
-    outliers = ""
+    outliers = left_out = ""
     if p > SIGNIFICANCE:
         # one point far off the fit inflates both noise estimates (a tester's 12 points, one typed 3.9 for 1.74 kPa:
         # 23.6 and 19.5 stated errors, "described by a constant" that misses three points by 30-48 errors; round 28)
         far, keep = _outliers_of_the_fit(data, model, len(keys))
+        if not far.size:  # a fit that one point pulled hides it from the robust scatter: each point left out in turn
+            far, keep, model_out = _outlier_left_out(check, blocks, len(keys))
+            if far.size:
+                # judged against the fit of the others, which it did not pull (8 exact points, one halved: the fit
+                # of all 8 missed it by 25 % and its neighbour by 40 %, "described by a constant"; round 28)
+                k = int(far[0])
+                left_out = (
+                    f"{LEFT_OUT_WARNING} {data.rows[k]} ({human(float(data.velocity[k]), 'velocity', 4)}): σ ="
+                    f" {data.stress[k]:.4g} Pa against {model_out[k]:.4g} Pa of the fit of the other {len(data) - 1}"
+                    f" points, a residual of {100 * (data.stress[k] / model_out[k] - 1):+.3g} %, far outside their"
+                    f" own residuals' scatter ({STEADY_OUTLIER_SPREADS:g} times it at least): an outlier? check it,"
+                    " or leave it out of the data; the fit below includes it, which pulls the curve toward it"
+                )
+                model = model_out
         if far.size:
             e = None if data.stress_err is None else data.stress_err[keep]
             kept_nested = model_dependence(data.stress[keep], e, model[keep], len(keys))
@@ -1148,7 +1164,13 @@ def _fit_of_a_flat_looking_curve(
         f" of a constant nested in the model: p = {nested:.2g}; the smaller p of the two decides, at the threshold p ≤"
         f" {SIGNIFICANCE:g} of every test of a velocity dependence here), and the noise is measured from its residuals"
     )
+    if left_out:
+        progress.messages.append(left_out)
     return progress, keys
+
+
+#: How the warning on a point found by leaving each out in turn starts (the caller keeps it with the trend note).
+LEFT_OUT_WARNING = "warning: the fit of the others misses row"
 
 
 #: At most this share of the points may be left out as outliers when the model's fit decides a velocity dependence.
@@ -1167,6 +1189,57 @@ def _outliers_of_the_fit(data: SteadyData, model: np.ndarray, free: int) -> tupl
         return np.zeros(0, dtype=int), keep
     keep[far] = False
     return far, keep
+
+
+#: At most this many points are each left out in turn to find one outlier that pulls the fit of all of them.
+LEAVE_ONE_OUT_MAX = 20
+
+
+def _outlier_left_out(
+    check: _Check, blocks: tuple[Block, Block, Block], free: int
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """One point that the fit of the others misses by more than ``STEADY_OUTLIER_SPREADS`` times the robust scatter
+    of their residuals (and their rms, and the floor): its index, the mask of the others and, where it is left out,
+    the stress of the others' fit (all points).  The one the others' fit misses most, and none with more than
+    ``LEAVE_ONE_OUT_MAX`` points or too few left for the fit (:func:`_outliers_of_the_fit`'s limits)."""
+    data = check.data
+    n = len(data)
+    none = np.zeros(0, dtype=int), np.ones(n, dtype=bool), np.full(n, np.nan)
+    if n > LEAVE_ONE_OUT_MAX or 1 > OUTLIER_SHARE * n or n - 1 - free <= 2:
+        return none
+    error = data.stress if data.stress_err is None else data.stress_err
+    best, best_ratio, best_model = -1, 0.0, None
+    for k in range(n):
+        keep = np.ones(n, dtype=bool)
+        keep[k] = False
+        rest = SteadyData(
+            data.velocity[keep], data.stress[keep], None if data.stress_err is None else data.stress_err[keep],
+            data.rows[keep], data.source,
+        )  # fmt: skip
+        try:
+            _, everything, hi, lo = _blocks(rest, check.split, check.base)
+            progress, _ = _run_method(dataclasses.replace(check, data=rest), (everything, hi, lo))
+            model = blocks[0].model(progress.params)
+        except (ModelError, ParameterError):
+            continue
+        if not np.all(np.isfinite(model)):
+            continue
+        z = (data.stress - model) / error
+        others = z[keep]
+        centre = float(np.median(others))
+        spread = 1.4826 * float(np.median(np.abs(others - centre)))
+        rms = float(np.sqrt(np.mean((others - centre) ** 2)))
+        distance = abs(z[k] - centre)
+        if distance <= max(OUTLIER_FLOOR * data.stress[k] / error[k], STEADY_OUTLIER_SPREADS * max(spread, rms)):
+            continue
+        ratio = distance / max(spread, rms, 1e-300)
+        if ratio > best_ratio:
+            best, best_ratio, best_model = k, ratio, model
+    if best < 0 or best_model is None:
+        return none
+    keep = np.ones(n, dtype=bool)
+    keep[best] = False
+    return np.array([best]), keep, best_model
 
 
 def _no_response_fit(check: _Check, dependence: Dependence, fitted: str = "") -> SteadyFit:
