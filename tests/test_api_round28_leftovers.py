@@ -60,3 +60,36 @@ def test_fit_steady_given_a_frame_says_so_in_one_line() -> None:
     with pytest.raises(stickslip.DataError) as caught:
         stickslip.fit_steady(pd.DataFrame({"v": [1.0, 2.0], "s": [3.0, 4.0]}))
     assert "\n" not in str(caught.value) and "got a DataFrame" in str(caught.value)
+
+
+@pytest.mark.parametrize(
+    ("call", "words"),
+    [
+        (
+            lambda p: stickslip.stick_phase(p, "50"),
+            'pulling_velocity=50: a velocity needs a unit, e.g. pulling_velocity="50 um/s"',
+        ),
+        (lambda p: rsf_params(0.005, 0.01, "10"), 'dc=10: a length needs a unit, e.g. dc="10 um"'),
+        (lambda p: stickslip.simulate(p, "50 um/s", "60"), "duration=60: a time needs a unit"),
+    ],
+)
+def test_a_number_written_as_text_without_a_unit_is_refused_as_in_files(call, words) -> None:
+    """Tester N: ``stick_phase(p, "50")`` ran at 50 m/s and ``rsf_params(..., "10")`` made Dc 10 m, without a word,
+    while a quoted number without a unit in a parameter file, and a bare number on the command line, are refused."""
+    with pytest.raises(stickslip.UnitError) as caught:
+        call(stickslip.load_parameters("gelatin-glass"))
+    assert words in str(caught.value)
+    assert stickslip.stick_phase(stickslip.load_parameters("gelatin-glass"), "0").stuck  # zero needs no unit
+
+
+def test_out_of_range_values_are_quoted_as_written() -> None:
+    """Tester N: ``every="-10 ms"`` was refused as "got -0.01", ``dc="-10 um"`` as "got -1e-05"."""
+    from stickslip.transient import run_transient
+
+    gel = stickslip.load_parameters("gelatin-glass")
+    with pytest.raises(stickslip.ParameterError, match="got '-10 ms'"):
+        run_transient(gel, protocols.constant(1e-4, 1.0), every="-10 ms")
+    with pytest.raises(stickslip.ParameterError, match="got '-3 kPa/m'"):
+        run_transient(gel, protocols.constant(1e-4, 1.0), stiffness="-3 kPa/m")
+    with pytest.raises(stickslip.ParameterError, match="got '-10 um'"):
+        rsf_params(0.005, 0.01, "-10 um")

@@ -29,43 +29,13 @@ import click
 from ..columns import JSON_DIGITS as JSON_DIGITS  # re-exported: the JSON helpers live in stickslip.columns
 from ..columns import json_safe as json_safe
 from ..columns import json_text
-from ..errors import ParameterError, StickslipError, UnitError
+from ..errors import ParameterError, StickslipError
 from ..fileio import atomic_path, atomic_write_text, is_stdout, protect_inputs, refuse_input_as_output
 from ..parameters import Parameters, load_parameters, override_dimension
-from ..units import DIMENSIONS, bare_number, quantity_noun, shorten, to_si
+from ..units import bare_number, require_unit, shorten, to_si
 
 #: Largest data file (CSV) a command reads: a 10^7-sample record is about 0.4 GB.
 MAX_INPUT_BYTES = 2_000_000_000
-
-#: Per dimension: a typical size (SI) of an option's value, and the units a bare number may have been meant in,
-#: as (unit, factor to SI).  A bare number is taken to be in the unit that puts it nearest the typical size
-#: (pulling velocities of um/s to mm/s, stresses of kPa, times of seconds...).
-_MEANT_UNITS: dict[str, tuple[float, tuple[tuple[str, float], ...]]] = {
-    "time": (10.0, (("s", 1.0), ("ms", 1e-3), ("us", 1e-6), ("ns", 1e-9), ("min", 60.0), ("h", 3600.0))),
-    "length": (1e-5, (("m", 1.0), ("mm", 1e-3), ("um", 1e-6), ("nm", 1e-9), ("angstrom", 1e-10))),
-    "velocity": (1e-4, (("m/s", 1.0), ("mm/s", 1e-3), ("um/s", 1e-6), ("nm/s", 1e-9))),
-    "rate": (1.0, (("1/s", 1.0),)),
-    "per_area": (1e14, (("1/m^2", 1.0), ("1/um^2", 1e12))),
-    "stiffness": (1e-4, (("N/m", 1.0), ("mN/m", 1e-3))),
-    "temperature": (300.0, (("K", 1.0),)),
-    "stress": (1e3, (("Pa", 1.0), ("kPa", 1e3), ("MPa", 1e6), ("GPa", 1e9))),
-    "stress_rate": (1e2, (("Pa/s", 1.0), ("kPa/s", 1e3))),
-    "stress_per_length": (1e5, (("Pa/m", 1.0), ("kPa/m", 1e3), ("MPa/m", 1e6))),
-    "force": (1.0, (("N", 1.0), ("mN", 1e-3), ("uN", 1e-6))),
-    "area": (1e-3, (("m^2", 1.0), ("cm^2", 1e-4), ("mm^2", 1e-6))),
-    "stress_per_velocity": (1e6, (("Pa s/m", 1.0), ("MPa s/m", 1e6))),
-    "per_length": (1e3, (("1/m", 1.0), ("1/mm", 1e3), ("1/um", 1e6))),
-    "slowness": (1.0, (("s/m", 1.0), ("s/mm", 1e3), ("s/um", 1e6))),
-    "mass_per_area": (100.0, (("kg/m^2", 1.0), ("g/m^2", 1e-3))),
-}
-
-
-def _meant_unit(number: float, dimension: str, typical: float | None) -> str:
-    """The unit that puts ``number`` nearest (in decades) to a typical value of its quantity."""
-    typical_si, candidates = _MEANT_UNITS.get(dimension, (1.0, ((DIMENSIONS[dimension][1], 1.0),)))
-    target = math.log10(typical if typical and typical > 0 else typical_si)
-    size = math.log10(abs(number))
-    return min(candidates, key=lambda unit: abs(size + math.log10(unit[1]) - target))[0]
 
 
 def stacked(options: Sequence[Callable[[Any], Any]], func: Callable[..., Any]) -> Callable[..., Any]:
@@ -178,26 +148,6 @@ def refuse_printed_beside(printed: str | None, outputs: Sequence[tuple[str, Path
             raise ParameterError(
                 f"{printed} and {option} {path}: both write standard output; give {option} a file name"
             )
-
-
-def require_unit(text: str, dimension: str, prefix: str, typical: float | None = None) -> None:
-    """Refuse a bare non-zero number for a dimensional value typed on the command line.
-
-    ``prefix`` is how the value was introduced (``"--v0 "``, ``"--set bonds.bond_time="``):
-    the message quotes it and shows the same value with the unit it was presumably meant in,
-    the one that puts it nearest ``typical`` (SI; a typical size of that dimension by default),
-    and the SI unit beside it when that differs.
-    """
-    number = bare_number(text)
-    if dimension == "dimensionless" or number is None or number == 0 or not math.isfinite(number):
-        return
-    typed = text.strip()
-    if len(typed) > 40:
-        typed = shorten(typed, 40)
-    unit = _meant_unit(number, dimension, typical)
-    si = DIMENSIONS[dimension][1]
-    hint = f'e.g. {prefix}"{typed} {unit}"' + (f' (or "{typed} {si}" if you mean SI)' if si != unit else "")
-    raise UnitError(f"{prefix}{typed}: {quantity_noun(dimension)} needs a unit, {hint}")
 
 
 def typical_value(key: str) -> float | None:

@@ -289,6 +289,13 @@ def main(argv: list[str] | None = None) -> None:
         warnings.showwarning = shown
     if status == 0 and caught:
         click.echo(_one_line(f"stickslip: warning: {_warning_summary(caught)}"), err=True)
+    if status == 128 + signal.SIGTERM:
+        # terminated, its temporaries removed and its one line said: end here, past the interpreter's exit
+        # handlers, which wake a process pool the command has already stopped through pipes already closed and
+        # printed "Exception ignored ... OSError: [Errno 9] Bad file descriptor" after that line (seen under load)
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(status)
     sys.exit(status)
 
 

@@ -286,8 +286,9 @@ def rsf_params(
 ) -> RSFParams:
     """Convenience constructor for one or two state variables: numbers in SI, or values with their units
     (``dc="10 um"``, ``v_ref="1 um/s"``, ``stiffness="1e-3 1/um"``, ``eta="10 s/m"``, ``normal_stress="10 MPa"``)."""
-    from ..units import si_argument
+    from ..units import refused_as_written_by_name, si_argument
 
+    written = {"dc": dc, "dc2": dc2, "v_ref": v_ref, "stiffness": stiffness, "eta": eta, "normal_stress": normal_stress}
     dc, dc2, v_ref, stiffness, eta, normal_stress = (
         None if value is None else si_argument(value, dimension, name)
         for value, dimension, name in (
@@ -296,9 +297,10 @@ def rsf_params(
             (normal_stress, "stress", "normal_stress"),
         )
     )  # fmt: skip
-    states = [StateVariable(law, b, dc, c)]
-    if (b2 is None) != (dc2 is None):
-        raise ParameterError("b2/dc2: a second state variable needs both b2 and dc2")
-    if b2 is not None and dc2 is not None:
-        states.append(StateVariable(law2 or law, b2, dc2, c))
-    return RSFParams(a, tuple(states), mu0, v_ref, stiffness, eta, mass, normal_stress, regularized, cutoff)
+    with refused_as_written_by_name(written):  # "got '-10 um'", not "got -1e-05"
+        states = [StateVariable(law, b, dc, c)]
+        if (b2 is None) != (dc2 is None):
+            raise ParameterError("b2/dc2: a second state variable needs both b2 and dc2")
+        if b2 is not None and dc2 is not None:
+            states.append(StateVariable(law2 or law, b2, dc2, c))
+        return RSFParams(a, tuple(states), mu0, v_ref, stiffness, eta, mass, normal_stress, regularized, cutoff)

@@ -200,9 +200,11 @@ def run_transient(
     (a ParameterError) whose ``partial`` is the result up to there (its message
     says where it stopped).
     """
-    from ..units import si_argument
+    from ..units import refused_as_written_by_name, si_argument
 
     # "100 ms", "50 um/s", "300 kPa/m" too, as rsf.simulate and the rig read them (a number is SI)
+    written = {"every": every, "max_step": max_step, "max_time": max_time, "start velocity": start_velocity,
+               "stiffness": stiffness, "mass": mass, "damping": damping}  # fmt: skip
     every, max_step, max_time, start_velocity, stiffness, mass, damping = (
         None if value is None else si_argument(value, dimension, name)
         for value, dimension, name in (
@@ -211,10 +213,11 @@ def run_transient(
             (mass, "mass_per_area", "mass"), (damping, "stress_per_velocity", "damping"),
         )
     )  # fmt: skip
-    progress, mass, damping, k_block, start_velocity, budget, seconds = _checked_arguments(
-        params, protocol, control, start, reduction, aging, stick_population, rtol, progress, stiffness, mass, damping,
-        every, max_step, start_velocity, max_steps, max_time,
-    )  # fmt: skip
+    with refused_as_written_by_name(written):  # "got '-10 ms'", not "got -0.01"
+        progress, mass, damping, k_block, start_velocity, budget, seconds = _checked_arguments(
+            params, protocol, control, start, reduction, aging, stick_population, rtol, progress, stiffness, mass,
+            damping, every, max_step, start_velocity, max_steps, max_time,
+        )  # fmt: skip
     cpu0 = time.process_time()
     _require_finite_chains(params, protocol, control, start, start_velocity, k_block)
     _require_steady_range(params, protocol, aging, start_velocity)
