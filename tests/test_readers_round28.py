@@ -19,22 +19,15 @@ import numpy as np
 import pytest
 
 from stickslip import protocols
-from stickslip.cli.main import main
 from stickslip.errors import DataError
 from stickslip.rsf import rsf_params, simulate
 from stickslip.rsf.data import read_record
 from stickslip.tables import read_table
+from test_readers_round27 import run_cli
 
 UM = 1e-6
 TRUTH = {"a": 0.008, "b": 0.012, "dc": 20 * UM, "stiffness": 3e3}
 STEP = protocols.velocity_steps([1 * UM, 10 * UM], [60.0, 40.0])
-
-
-def run_cli(capsys, *args: str) -> tuple[int, str, str]:
-    with pytest.raises(SystemExit) as info:
-        main(list(args))
-    out = capsys.readouterr()
-    return int(info.value.code or 0), out.out, out.err
 
 
 @pytest.fixture(scope="module")
