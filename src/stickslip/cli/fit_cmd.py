@@ -98,6 +98,9 @@ def fit_group() -> None:
 )
 @click.option("--free", "free_keys", multiple=True, metavar="KEY", help="Also fit this parameter (repeatable).")
 @click.option(
+    "--exclude-row", "exclude_rows", multiple=True, type=int, metavar="N", help="Leave out file row N (repeatable)."
+)
+@click.option(
     "--intervals",
     type=click.Choice(["auto", "delta", "profile", "bootstrap"]),
     default="auto",
@@ -135,6 +138,7 @@ def steady_command(
     split: str,
     fix_items: tuple[str, ...],
     free_keys: tuple[str, ...],
+    exclude_rows: tuple[int, ...],
     intervals: str,
     samples: int,
     level: float,
@@ -176,6 +180,7 @@ def steady_command(
         level=level,
         bootstrap_samples=samples,
         seed=seed,
+        exclude_rows=list(exclude_rows),
     )
     posterior = None
     if posterior_module is not None and fit.success:  # a failed fit has no posterior worth sampling

@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..columns import unit_of, with_units
-from ..errors import DataError
+from ..errors import DataError, ParameterError
 from ..tables import Table, header_names, read_table
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -88,9 +88,39 @@ class SteadyData:
     source: str = "data"
     ignored_columns: tuple[str, ...] = ()
     read_notes: tuple[str, ...] = ()  # how the file was read where it is not the usual way (decimal commas)
+    #: the file rows left out by request (``--exclude-row``, ``exclude_rows=``): not in ``rows``
+    excluded: tuple[int, ...] = ()
 
     def __len__(self) -> int:
         return int(self.velocity.size)
+
+    def without_rows(self, exclude: Sequence[int]) -> SteadyData:
+        """These data less the file rows ``exclude`` (``--exclude-row``), a note naming them; a row that is not a
+        data row, or too few points (or velocities) left to fit, is a :class:`DataError`."""
+        gone = requested_rows(exclude, self.rows, self.source)
+        if not gone:
+            return self
+        keep = ~np.isin(self.rows, sorted(gone))
+        n, distinct = int(np.count_nonzero(keep)), _distinct_velocities(self.velocity[keep])
+        named = ", ".join(map(str, sorted(gone)))
+        if n < MIN_STEADY_POINTS or distinct < MIN_STEADY_POINTS:
+            raise DataError(
+                f"{self.source}: --exclude-row {named}: {n} data row(s) at {distinct} velocities left, expected at"
+                f" least {MIN_STEADY_POINTS} velocities to fit a friction curve"
+            )
+        note = (
+            f"{self.source}: {'rows' if len(gone) > 1 else 'row'} {named} left out by request (--exclude-row):"
+            f" {n} of {len(self)} points fitted"
+        )
+        return dataclasses.replace(
+            self,
+            velocity=self.velocity[keep],
+            stress=self.stress[keep],
+            stress_err=None if self.stress_err is None else self.stress_err[keep],
+            rows=self.rows[keep],
+            read_notes=(*self.read_notes, note),
+            excluded=tuple(sorted({*self.excluded, *gone})),
+        )
 
     @property
     def velocities(self) -> int:
@@ -378,6 +408,30 @@ def _replicate_notes(data: SteadyData) -> list[str]:
             " or a row entered twice? each counts as a measurement (a copy adds weight and no scatter)"
         )
     return out
+
+
+def requested_rows(exclude: Sequence[int], rows: np.ndarray, source: str) -> set[int]:
+    """The file rows ``exclude`` (``--exclude-row N``, as the warnings number them: the header is row 1), checked
+    against the data rows ``rows``: both fits' one parser.  A number that is not an integer is a ParameterError, one
+    that is not a data row a DataError, each in one line."""
+    if isinstance(exclude, (str, bytes)) or not isinstance(exclude, Sequence | set | frozenset | np.ndarray):
+        exclude = [exclude]  # type: ignore[list-item]  # one row given alone: refused below unless an integer
+    known = {int(r) for r in rows}
+    out: set[int] = set()
+    for row in exclude:
+        if isinstance(row, bool) or not isinstance(row, (int, np.integer)):
+            raise ParameterError(f"exclude_rows: expected file row numbers (integers), got {row!r}")
+        if int(row) not in known:
+            raise DataError(f"{source}: --exclude-row {row}: no such data row (rows are {_row_span(sorted(known))})")
+        out.add(int(row))
+    return out
+
+
+def _row_span(rows: list[int]) -> str:
+    """The data rows in a message: all of them where few, else the first and last and how many."""
+    if len(rows) <= 12:
+        return str(rows)
+    return f"{rows[0]} to {rows[-1]}, {len(rows)} rows"
 
 
 def identical_rows(rows: np.ndarray, columns: Sequence[np.ndarray], shown: int = 5) -> str:

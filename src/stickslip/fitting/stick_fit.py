@@ -26,7 +26,7 @@ from ..quasistatic.critical import critical_point
 from ..reprs import compact_repr
 from ..units import to_si
 from . import identify
-from .data import StickData, read_stick_data
+from .data import StickData, read_stick_data, requested_rows
 from .problem import JACOBIAN_STEP, SEARCH_BOX
 from .results import Estimate, human, log_interval, unusable
 from .scatter import STICK_OUTLIER_SPREADS, outlying
@@ -323,12 +323,7 @@ def _select_rows(
     data: StickData, params: Parameters, exclude: Sequence[int], include_steady: bool
 ) -> tuple[np.ndarray, dict[int, str], float | None, list[str]]:
     messages: list[str] = []
-    known_rows = {int(r) for r in data.rows}
-    for row in exclude:
-        if isinstance(row, bool) or not isinstance(row, (int, np.integer)):
-            raise ParameterError(f"exclude_rows: expected file row numbers (integers), got {row!r}")
-        if int(row) not in known_rows:
-            raise DataError(f"{data.source}: --exclude-row {row}: no such data row (rows are {sorted(known_rows)})")
+    exclude = requested_rows(exclude, data.rows, data.source)  # the steady fit's parser too
     point = critical_point(params)
     vc = point.velocity if point.exists else None
     used = np.ones(len(data), dtype=bool)
