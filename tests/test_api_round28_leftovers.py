@@ -93,3 +93,16 @@ def test_out_of_range_values_are_quoted_as_written() -> None:
         run_transient(gel, protocols.constant(1e-4, 1.0), stiffness="-3 kPa/m")
     with pytest.raises(stickslip.ParameterError, match="got '-10 um'"):
         rsf_params(0.005, 0.01, "-10 um")
+
+
+@pytest.mark.parametrize(
+    ("text", "dimension", "literal"),
+    [("10 um", "length", 10e-6), ("50 um/s", "velocity", 50e-6), ("1.6e-3 1/um", "per_length", 1.6e3),
+     ("0.2 mm/s", "velocity", 0.2e-3), ("224 us", "time", 224e-6), ("300 1/um^2", "per_area", 300e12)],
+)  # fmt: skip
+def test_a_decimal_prefix_gives_the_literal_s_float(text, dimension, literal) -> None:
+    """Tester N: "10 um" was 10 * 1e-6 = 9.999999999999999e-06, one float step from the literal 10e-6, so a call
+    with units and its SI twin differed in the 15th digit; the prefix now shifts the written number's exponent."""
+    from stickslip.units import to_si
+
+    assert to_si(text, dimension) == literal

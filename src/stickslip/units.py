@@ -19,6 +19,8 @@ tests check every entry of the table against pint.  Anything else (``degC``,
 
 from __future__ import annotations
 
+import contextlib
+import decimal
 import math
 import re
 from collections.abc import Iterator
@@ -320,8 +322,21 @@ def _string_to_si(text: str, dimension: str, name: str) -> float:
             raise UnitError(
                 f"{name}: {shorten(stripped)} has dimension {_dimension_text(fast[1])}, expected {_describe(dimension)}"
             )
-        return magnitude * fast[0]
+        return _scaled(match.group(1), magnitude, fast[0])
     return _quantity_to_si(_pint_quantity(magnitude, unit, stripped, name, dimension), dimension, name, stripped)
+
+
+def _scaled(written: str, magnitude: float, factor: float) -> float:
+    """``magnitude`` (``written`` as text) times a unit's ``factor`` to SI.  A decimal prefix's factor (a power of
+    ten, to the rounding of the table's products) shifts the written decimal number's exponent, correctly rounded:
+    "10 um" is 1e-05, as the literal 10e-6 is (the product 10 * 1e-6 is 9.999999999999999e-06, one step off, so
+    ``stick_phase(p, "50 um/s")`` and ``stick_phase(p, 50e-6)`` differed in their 15th digit)."""
+    if factor > 0 and math.isfinite(magnitude):
+        power = round(math.log10(factor))
+        if abs(factor / 10.0**power - 1.0) < 1e-14:
+            with contextlib.suppress(ArithmeticError, ValueError):
+                return float(decimal.Decimal(written).scaleb(power))
+    return magnitude * factor
 
 
 def _readable_unit(unit: str) -> bool:
@@ -466,7 +481,10 @@ def _shortest(value: float, unit: str) -> str | None:
     scaled = value / factor
     candidates = [_plain(scaled, digits) for digits in range(1, 18)]
     candidates += [repr(math.nextafter(scaled, math.copysign(math.inf, step))) for step in (1, -1)]
-    return next((text for text in candidates if float(text) * factor == value), None)
+    power = round(math.log10(factor))
+    if abs(factor / 10.0**power - 1.0) < 1e-14:  # a decimal prefix: value's own shortest digits, shifted, read exactly
+        candidates.append(format(decimal.Decimal(repr(value)).scaleb(-power).normalize(), "g"))
+    return next((text for text in candidates if _scaled(text, float(text), factor) == value), None)
 
 
 def _plain(number: float, digits: int) -> str:
