@@ -52,8 +52,13 @@ def recorded_status(path: str | Path) -> tuple[str, str]:
     path = Path(path)
     if not path.is_file():
         return "ok", ""
-    with open(path, encoding="utf-8", errors="replace") as handle:
-        first = handle.readline(1 << 20)
+    from ..tables import open_input  # a gzipped trace too, as its rows are read (a failed run read as "ok")
+
+    try:
+        with open_input(path, "r", encoding="utf-8", errors="replace") as handle:
+            first = handle.readline(1 << 20)
+    except (OSError, EOFError, DataError):  # a damaged gzip file: its reader refuses it in one line
+        return "ok", ""
     if not first.startswith(CSV_MARK):
         return "ok", ""
     try:
