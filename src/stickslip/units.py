@@ -331,12 +331,19 @@ def _scaled(written: str, magnitude: float, factor: float) -> float:
     ten, to the rounding of the table's products) shifts the written decimal number's exponent, correctly rounded:
     "10 um" is 1e-05, as the literal 10e-6 is (the product 10 * 1e-6 is 9.999999999999999e-06, one step off, so
     ``stick_phase(p, "50 um/s")`` and ``stick_phase(p, 50e-6)`` differed in their 15th digit)."""
-    if factor > 0 and math.isfinite(magnitude):
-        power = round(math.log10(factor))
-        if abs(factor / 10.0**power - 1.0) < 1e-14:
-            with contextlib.suppress(ArithmeticError, ValueError):
-                return float(decimal.Decimal(written).scaleb(power))
+    power = _decimal_power(factor)
+    if power is not None and math.isfinite(magnitude):
+        with contextlib.suppress(ArithmeticError, ValueError):
+            return float(decimal.Decimal(written).scaleb(power))
     return magnitude * factor
+
+
+def _decimal_power(factor: float) -> int | None:
+    """k where a unit's ``factor`` is 10^k (to the rounding of the unit table's products), else None."""
+    if not (factor > 0 and math.isfinite(factor)):
+        return None
+    power = round(math.log10(factor))
+    return power if abs(factor / 10.0**power - 1.0) < 1e-14 else None
 
 
 def _readable_unit(unit: str) -> bool:
@@ -481,8 +488,8 @@ def _shortest(value: float, unit: str) -> str | None:
     scaled = value / factor
     candidates = [_plain(scaled, digits) for digits in range(1, 18)]
     candidates += [repr(math.nextafter(scaled, math.copysign(math.inf, step))) for step in (1, -1)]
-    power = round(math.log10(factor))
-    if abs(factor / 10.0**power - 1.0) < 1e-14:  # a decimal prefix: value's own shortest digits, shifted, read exactly
+    power = _decimal_power(factor)
+    if power is not None:  # a decimal prefix: the value's own shortest digits, shifted, read back exactly
         candidates.append(format(decimal.Decimal(repr(value)).scaleb(-power).normalize(), "g"))
     return next((text for text in candidates if _scaled(text, float(text), factor) == value), None)
 
