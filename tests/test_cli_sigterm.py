@@ -58,3 +58,37 @@ def test_reproduce_terminated_ends_with_one_line_143_and_no_temporaries(tmp_path
     assert time.monotonic() - started < 10  # the workers are stopped, not waited for
     assert "stickslip: terminated" in err and "Traceback" not in err
     assert not [p.name for p in folder.iterdir() if p.name.endswith(".tmp")]
+
+
+def _write_slowly(target: Path) -> None:
+    with atomic_open(target) as handle:
+        handle.write("time (s),stress (Pa)\n")
+        handle.flush()
+        time.sleep(60)  # killed here, inside the write
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="forked figure workers")
+def test_stopping_the_figure_workers_removes_the_temporary_a_killed_worker_was_writing(tmp_path: Path) -> None:
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor
+
+    from stickslip.report.build import _stop_workers
+
+    pool = ProcessPoolExecutor(max_workers=1, mp_context=multiprocessing.get_context("fork"))
+    pool.submit(_write_slowly, tmp_path / "figure.csv")
+    deadline = time.monotonic() + 30
+    while not list(tmp_path.glob(".figure.csv.*.tmp")) and time.monotonic() < deadline:
+        time.sleep(0.02)
+    assert list(tmp_path.glob(".figure.csv.*.tmp")), "the worker never started its write"
+    _stop_workers(pool, tmp_path)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_temporary_a_live_writer_holds_is_kept(tmp_path: Path) -> None:
+    from stickslip.fileio import remove_orphaned_temporaries
+
+    with atomic_open(tmp_path / "out.csv") as handle:
+        handle.write("x\n")
+        assert remove_orphaned_temporaries(tmp_path) == []
+        assert len(list(tmp_path.glob(".out.csv.*.tmp"))) == 1
+    assert [p.name for p in tmp_path.iterdir()] == ["out.csv"]

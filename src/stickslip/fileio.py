@@ -52,6 +52,7 @@ __all__ = [
     "protect_inputs",
     "read_input_text",
     "refuse_input_as_output",
+    "remove_orphaned_temporaries",
     "same_file",
 ]
 
@@ -437,11 +438,31 @@ def remove_stale_temporaries(target: str | Path) -> list[Path]:
     return removed
 
 
-def _remove_if_stale(path: Path) -> bool:
-    """Remove ``path`` if it is a regular file, older than this process and unlocked; True if removed."""
+def remove_orphaned_temporaries(folder: str | Path) -> list[Path]:
+    """Remove this module's temporaries in ``folder`` that no live writer holds, however new; returns those removed.
+
+    For a caller that has just killed its own writers (a report's forked figure workers): their temporaries are
+    newer than this process, so :func:`remove_stale_temporaries` would keep them.  A temporary another live
+    process is writing stays: it is locked.
+    """
+    pattern = re.compile(r"\..+" + _TEMP_TAIL)
+    removed = []
+    try:
+        entries = list(os.scandir(folder))
+    except OSError:
+        return removed
+    for entry in entries:
+        if pattern.fullmatch(entry.name) and _remove_if_stale(Path(entry.path), any_age=True):
+            removed.append(Path(entry.path))
+    return removed
+
+
+def _remove_if_stale(path: Path, any_age: bool = False) -> bool:
+    """Remove ``path`` if it is a regular file, older than this process (unless ``any_age``) and unlocked; True if
+    removed."""
     try:
         info = path.lstat()
-        if not stat.S_ISREG(info.st_mode) or info.st_mtime >= _STARTED:
+        if not stat.S_ISREG(info.st_mode) or (info.st_mtime >= _STARTED and not any_age):
             return False
         descriptor = os.open(path, os.O_RDONLY)
     except OSError:

@@ -21,7 +21,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import DataError
-from ..fileio import atomic_write_text
+from ..fileio import atomic_write_text, remove_orphaned_temporaries
 from ..parameters import Parameters, load_parameters
 from ..units import shorten
 from .aging_section import AGING_FIGURES
@@ -332,15 +332,18 @@ def _rendered_figures(
                     step(description)
                     yield future.result()
             except BaseException:  # interrupted or terminated: leaving the pool would first draw every figure
-                _stop_workers(pool)
+                _stop_workers(pool, folder)
                 raise
     finally:
         _SHARED_RUN = None
 
 
-def _stop_workers(pool: ProcessPoolExecutor) -> None:
-    """Cancel what the workers have not started and end them now (their half-written temporaries are cleaned by
-    the next report written into the folder)."""
+def _stop_workers(pool: ProcessPoolExecutor, folder: Path) -> None:
+    """Cancel what the workers have not started, end them now and remove the temporaries they were writing.
+
+    A worker killed inside an atomic write leaves its ``.name.xxxxxxxx.csv.tmp``; once it is gone (reaped, its
+    file lock released) the temporary is removed here rather than by the next report written into the folder.
+    """
     import signal
 
     processes = list((getattr(pool, "_processes", None) or {}).values())
@@ -348,6 +351,10 @@ def _stop_workers(pool: ProcessPoolExecutor) -> None:
     for process in processes:
         with contextlib.suppress(OSError, ValueError, AttributeError):
             os.kill(process.pid, signal.SIGKILL)
+    for process in processes:
+        with contextlib.suppress(OSError, ValueError, AttributeError, AssertionError):
+            process.join(timeout=5)
+    remove_orphaned_temporaries(folder)
 
 
 #: The figures that take longest to draw (2-6 s each; the others 0.3-1.5 s), started first in the workers.
