@@ -3,7 +3,9 @@
 The CSV files are read back from the matplotlib artists themselves, so they
 hold exactly what is drawn: every line and every set of points drawn in data
 coordinates (reference lines such as ``axvline`` and shaded spans are not
-curves and are skipped).  Columns are named after the axis labels, ``name [unit]``
+curves and are skipped), and the cells of a colour mesh whose colours the legend
+names (a phase diagram's regimes, :func:`mesh_cells`): one file per legend entry,
+the centre of each cell drawn in its colour.  Columns are named after the axis labels, ``name [unit]``
 as every CSV of the package (:mod:`stickslip.columns`): a unit in parentheses
 becomes one in brackets, a label without a unit is a pure number (``[1]``), a
 panel without a label of its own takes the one of the axis it shares, of its
@@ -510,6 +512,7 @@ def extract_curves(figure: Figure, figure_id: str) -> list[Curve]:
             if offsets.ndim != 2 or offsets.shape[0] == 0 or collection.get_offset_transform() != ax.transData:
                 continue
             found.append((str(collection.get_label()), collection.get_gid(), offsets[:, 0], offsets[:, 1]))
+        found += [(label, None, x, y) for label, x, y in mesh_cells(ax)]
         for k, (label, gid, x, y) in enumerate(found):
             shown = _shown_name(label, gid)
             unnamed = f"{'point' if x.size == 1 else 'curve'}-{k + 1}"
@@ -523,6 +526,62 @@ def extract_curves(figure: Figure, figure_id: str) -> list[Curve]:
             y_name = _category_column(y_label) if y_text is not None else _column(y_label, "y")
             curves.append(Curve(name, figure_id, panel, shown, x_name, y_name, x, y, x_text, y_text))
     return curves
+
+
+def mesh_cells(ax: Axes) -> list[tuple[str, np.ndarray, np.ndarray]]:
+    """The cells of each colour mesh of ``ax`` (``pcolormesh``) whose every colour is named by one legend entry
+    of ``ax`` (a handle of one face colour: the squares a phase diagram's legend shows for its regimes): for each
+    such entry, its label and the x and y of the centres of the cells drawn in its colour, sorted by x, then y.
+
+    A cell's centre is the middle of its edges in the axis's scale (geometric on a log axis): for a sweep's cells,
+    whose edges lie halfway between its grid points in that scale, the grid point itself (to :data:`CELL_DIGITS`
+    digits) where the grid is evenly spaced in it (``a..b:n`` and ``a..b:n:log``, as the report's phase diagram),
+    else the middle of the drawn cell.
+    Masked cells (no value) are not written; a mesh on a colour scale, whose colours no legend entry names, is
+    not a set of named cells and is skipped (it is not a curve)."""
+    from matplotlib.collections import QuadMesh
+    from matplotlib.colors import to_rgba_array
+
+    named: list[tuple[str, np.ndarray]] = []
+    for handle, label in zip(*ax.get_legend_handles_labels(), strict=True):
+        faces = to_rgba_array(handle.get_facecolor()) if hasattr(handle, "get_facecolor") else np.empty((0, 4))
+        if faces.shape[0] == 1:
+            named.append((str(label), faces[0, :3]))
+    found: list[tuple[str, np.ndarray, np.ndarray]] = []
+    for mesh in ax.collections:
+        if not isinstance(mesh, QuadMesh) or mesh.get_transform() != ax.transData or mesh.get_array() is None:
+            continue
+        corners = np.asarray(mesh.get_coordinates(), dtype=float)  # (rows + 1, columns + 1, 2)
+        shape = (corners.shape[0] - 1, corners.shape[1] - 1)
+        values = np.ma.masked_invalid(np.ma.asarray(mesh.get_array(), dtype=float).reshape(shape))
+        drawn = ~np.ma.getmaskarray(values)
+        if not drawn.any():
+            continue
+        colors = np.asarray(mesh.to_rgba(values.filled(0.0)), dtype=float)[..., :3][drawn]
+        matches = np.array([np.all(np.abs(colors - rgb) <= 1e-6, axis=1) for _, rgb in named]).reshape(-1, len(colors))
+        if not named or np.any(matches.sum(axis=0) != 1):  # a colour no entry (or more than one) names
+            continue
+        x, y = (_cell_centres(corners[..., k], axis)[drawn] for k, axis in ((0, ax.xaxis), (1, ax.yaxis)))
+        for (label, _), mine in zip(named, matches, strict=True):
+            if mine.any():
+                order = np.lexsort((y[mine], x[mine]))
+                found.append((label, x[mine][order], y[mine][order]))
+    return found
+
+
+#: Significant digits of a cell's centre: the edges are the grid's values taken into the axis's scale and back,
+#: which leaves round-off in the 15th digit (4000000.00000001 for a grid point of 4e6 on a log axis).
+CELL_DIGITS = 12
+
+
+def _cell_centres(corners: np.ndarray, axis: Any) -> np.ndarray:
+    """The centre of each cell of a mesh's corner coordinates on one axis, taken in that axis's scale, to
+    :data:`CELL_DIGITS` significant digits."""
+    scale = axis.get_transform()
+    shown = scale.transform(corners.reshape(-1, 1)).reshape(corners.shape)
+    middle = 0.25 * (shown[:-1, :-1] + shown[1:, :-1] + shown[:-1, 1:] + shown[1:, 1:])
+    centres = np.asarray(scale.inverted().transform(middle.reshape(-1, 1)), dtype=float).reshape(middle.shape)
+    return np.vectorize(lambda v: float(f"{v:.{CELL_DIGITS}g}"), otypes=[float])(centres)
 
 
 def _shown_name(label: str, gid: str | None) -> str:

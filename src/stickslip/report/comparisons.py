@@ -1,9 +1,10 @@
 """The comparison table: each number the paper states beside the value computed here, and what the difference is.
 
 relative_difference = (computed - paper) / |paper| (None where the units differ).  Every row is put in one class
-of :data:`CLASSES` (input, agrees within :data:`TOLERANCE`, scatter, then paper error, the paper's unstated or
-inconsistent inputs, or model limitation, decided in that order: docs/report.md, "Classes, and the headline") and
-carries its reason in words (:func:`class_reason`).  A row that states again what another row states (the paper
+of :data:`CLASSES` (input, agrees within :data:`TOLERANCE`, within the scatter the paper states or shows, then paper
+error or the paper's unstated or inconsistent inputs, outside the measured range, an open difference, or model
+limitation, decided in that order: docs/report.md, "Classes, and the headline") and carries its reason in words
+(:func:`class_reason`).  A row that states again what another row states (the paper
 printing one number in two places) is shown and marked, and counted once: :func:`count_classes` counts distinct
 statements only.
 """
@@ -18,6 +19,7 @@ from .paper import PAPER_NUMBERS, TOLERANCE, PaperNumber
 
 __all__ = [
     "CLASSES",
+    "MODEL_DIFFERENCES",
     "TOLERANCE",
     "Comparison",
     "Computed",
@@ -25,6 +27,7 @@ __all__ = [
     "classify",
     "compare",
     "count_classes",
+    "outside_by",
     "summary_counts",
 ]
 
@@ -33,10 +36,15 @@ CLASSES = {
     "input": "input (echo)",
     "agrees": f"agrees (≤ {100 * TOLERANCE:g} %)",
     "scatter": "within the paper's scatter",
+    "outside": "outside the measured range",
     "erratum": "paper error (erratum)",
     "unstated": "paper: stated inputs do not give it",
+    "open": "open difference",
     "limitation": "model limitation",
 }
+#: The classes that are the model's differences from the paper, never the paper's error (the headline counts them
+#: apart): a measurement outside the range of the cycles the paper measured, and an open difference.
+MODEL_DIFFERENCES = ("outside", "open")
 
 
 @dataclass(frozen=True)
@@ -73,6 +81,8 @@ def classify(number: PaperNumber, computed: float | None, echo: bool) -> str:
         low, high = number.scatter
         if low <= computed <= high:
             return "scatter"
+        if number.explanation not in ("erratum", "unstated"):
+            return "outside"
     return number.explanation
 
 
@@ -83,9 +93,17 @@ def class_reason(number: PaperNumber, computed: float | None, echo: bool) -> str
         return "the paper's own input (or arithmetic on its numbers) handed back: not a prediction"
     if cls == "agrees":
         return f"within {100 * TOLERANCE:g} %"
-    if cls == "scatter":
+    if cls in ("scatter", "outside"):
         low, high = number.scatter or (math.nan, math.nan)
-        return f"inside the scatter the paper states or shows ({low:.4g} to {high:.4g} {number.unit})"
+        band = f"{number.scatter_source} ({low:.4g} to {high:.4g} {number.unit})"
+        if cls == "scatter":
+            return f"inside {band}"
+        beyond = outside_by(number, computed) or 0.0
+        side = f"{100 * abs(beyond):.2f} % {'above its highest' if beyond > 0 else 'below its lowest'} value"
+        return (
+            f"outside {band}: {side}; the model's difference from the measurements, not the paper's error and not"
+            " within the scatter the paper shows"
+        )
     if number.units_differ:
         return "the paper prints the number with a wrong unit"
     if number.contradiction:
@@ -94,7 +112,22 @@ def class_reason(number: PaperNumber, computed: float | None, echo: bool) -> str
         return "the paper's arithmetic on its own numbers does not give its printed value"
     if cls == "unstated":
         return number.unstated
+    if cls == "open":
+        return number.open_reason
     return "the model cannot give this number with any input; the linked entry says why"
+
+
+def outside_by(number: PaperNumber, computed: float | None) -> float | None:
+    """How far ``computed`` lies outside the row's scatter band, relative to the edge it passes: positive above the
+    highest value, negative below the lowest; 0 inside; None without a band or a value."""
+    if computed is None or number.scatter is None:
+        return None
+    low, high = number.scatter
+    if computed > high:
+        return (computed - high) / abs(high)
+    if computed < low:
+        return (computed - low) / abs(low)
+    return 0.0
 
 
 def relative_difference(number: PaperNumber, computed: float | None) -> float | None:

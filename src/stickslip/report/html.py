@@ -12,7 +12,7 @@ from string import Template
 from ..analysis import TraceAnalysis
 from ..parameters import Parameters
 from ..quasistatic.stick import StuckThreshold
-from .comparisons import CLASSES, TOLERANCE, Comparison, summary_counts
+from .comparisons import CLASSES, MODEL_DIFFERENCES, TOLERANCE, Comparison, outside_by, summary_counts
 from .errata import Errata
 from .figures import Curve, ReportFigure, data_uri
 from .formatting import DISPLAY_UNITS, format_parameter, format_percent, format_quantity
@@ -159,6 +159,23 @@ def table1_matrix(rows: Sequence[Comparison]) -> str:
 
 #: Table 1 row -> the trace analysis' name for it (stickslip.analysis.CYCLE_QUANTITIES).
 _ANALYSIS_NAMES = {"slip_stress": "peak_stress"}
+#: The Table 1 rows a start-up stick from rest shows (it has no sigma_c: it began at zero stress).
+_START_UP_ROWS = ("slip_stress", "stick_time", "jump_velocity")
+
+
+def start_up_stick(analysis: TraceAnalysis) -> dict[str, float] | None:
+    """sigma_s, t_s and V_s of a record's start-up stick, where the record starts from rest (zero stress) and the
+    analysis holds no complete cycle: the stick from the record's start to its first peak (left out of the cycle
+    averages, which are over repeats of a cycle)."""
+    if analysis.summary.get("n_complete", 0) or not analysis.cycles or len(analysis.stress) == 0:
+        return None
+    first = analysis.cycles[0]
+    if first.peak_stress is None or first.peak_time is None or analysis.stress[0] != 0.0:
+        return None
+    values = {"slip_stress": first.peak_stress, "stick_time": first.peak_time - float(analysis.time[0])}
+    if first.jump_velocity is not None:
+        values["jump_velocity"] = first.jump_velocity
+    return values
 
 
 def trace_table(analyses: Mapping[int, TraceAnalysis]) -> str:
@@ -174,18 +191,30 @@ def trace_table(analyses: Mapping[int, TraceAnalysis]) -> str:
             k for k, (v, c) in enumerate(TABLE1_COLUMNS) if round(v * 1e6) == velocity_um and (v, c) != (100e-6, 1)
         ]
         paper_cells, model_cells = [], []
+        start_up = start_up_stick(analysis)
         for key, _label, _unit, display, values, scale in TABLE1_ROWS:
             measured = [float(v) * scale for k in columns if (v := values[k]) is not None]
             paper_cells.append(format_quantity(sum(measured) / len(measured), display, 3) if measured else "--")
             stats = analysis.summary.get(_ANALYSIS_NAMES.get(key, key), {})
-            model_cells.append(
-                format_quantity(stats.get("mean"), display, 4) if stats.get("mean") is not None else "--"
-            )
+            if stats.get("mean") is not None:
+                model_cells.append(format_quantity(stats.get("mean"), display, 4))
+            elif start_up is not None and key in start_up:
+                model_cells.append(f"{format_quantity(start_up[key], display, 4)} (start-up stick)")
+            else:
+                model_cells.append("--")
         used = "cycles 2-4" if velocity == 100e-6 else f"{len(columns)} cycle(s)"
         complete = analysis.summary.get("n_complete", 0)
+        count = f"{complete} complete"
+        regime = analysis.regime
+        if start_up is not None:
+            regime += " after a start-up stick from rest"
+            count += (
+                "; σs, ts and Vs are its start-up stick, from rest at the record's start to the first peak (not a"
+                " repeated cycle: no σc)"
+            )
         rows = (
             ("paper, Table 1 mean", paper_cells, used),
-            (f"model trace ({analysis.regime})", model_cells, f"{complete} complete"),
+            (f"model trace ({regime})", model_cells, count),
         )
         for k, (what, cells, count) in enumerate(rows):
             first = f'<th rowspan="2">{velocity_um} µm/s</th>' if k == 0 else ""
@@ -297,11 +326,17 @@ def summary_sentence(rows: Sequence[Comparison]) -> str:
     counted once), and what the stress agreements rest on."""
     s = summary_counts(list(rows))
     counts = s["by_class"]
+    differences = sum(counts[c] for c in MODEL_DIFFERENCES)
     text = (
         f"Of the {s['compared']} distinct numbers the paper states, {counts['agrees']} agree with this package's "
         f"computation within {100 * TOLERANCE:g} % and {counts['scatter']} lie within the scatter the paper states "
-        f"or shows. {counts['erratum']} are errors in the paper (it contradicts itself or prints a wrong unit; each "
-        f"links its erratum), {counts['unstated']} are numbers of the paper that its own stated inputs do not give "
+        "or shows (its σc band 259 ± 5 Pa, the one significant figure of “0.4 kPa”, or the range of the cycles it "
+        f"measured at one V0, as printed, not widened). {counts['outside']} lie outside that measured range"
+        f"{_outside_span(rows)} and {counts['open']} are open differences{_open_span(rows)}, where nothing in the "
+        f"paper settles why: these {differences} are the model's differences, not the paper's errors. "
+        f"{counts['erratum']} are errors in the paper (it contradicts itself or prints a wrong unit; each "
+        "links its erratum; a contradiction among several of its numbers is one error, counted once), "
+        f"{counts['unstated']} are numbers of the paper that its own stated inputs do not give "
         f"(each row names the input, not stated in the paper, that gives it) and {counts['limitation']} are "
         "limitations of the model (numbers it cannot give with any input). The other "
         f"{counts['input']} are the paper's own inputs handed back (parameters and arithmetic on them), not counted "
@@ -314,6 +349,27 @@ def summary_sentence(rows: Sequence[Comparison]) -> str:
         "M = 100 µN/m and λ = 0.1 nm, values the paper does not give (Parameters used; erratum "
     )
     return f'{escape(text)}{escape(basis)}<a href="#e1">E1</a>{escape(RESTS_ON)}'
+
+
+def _outside_span(rows: Sequence[Comparison]) -> str:
+    """How far beyond the measured range the rows outside it lie, e.g. " (by 0.62 to 1.97 % of its edge)"."""
+    beyond = [100 * abs(b) for r in rows if r.counted and r.classification == "outside" and
+              (b := outside_by(r.number, r.computed)) is not None]  # fmt: skip
+    if not beyond:
+        return ""
+    if len(beyond) == 1:
+        return f" (by {beyond[0]:.2f} % of its edge)"
+    return f" (by {min(beyond):.2f} to {max(beyond):.2f} % of its edge)"
+
+
+def _open_span(rows: Sequence[Comparison]) -> str:
+    """How far the open differences are from the paper's numbers, e.g. " (2.8 to 27 % from the paper's number)"."""
+    sizes = [100 * abs(d) for r in rows if r.counted and r.classification == "open" and
+             (d := r.relative_difference) is not None]  # fmt: skip
+    if not sizes:
+        return ""
+    low, high = min(sizes), max(sizes)
+    return f" ({low:.2g} to {high:.2g} % from the paper's number)" if len(sizes) > 1 else f" ({low:.2g} %)"
 
 
 #: What the M of E1 decides, after the link to E1 in the headline.
@@ -382,7 +438,10 @@ def limitations_section(paragraphs: str) -> str:
         "<p>What the model, as the paper writes it, cannot do whatever its inputs. A number the paper states that"
         " the model cannot give with any input would be in the table below, class “model limitation”; where the"
         " model gives the paper's number with an input the paper does not state, the row is the paper's (class"
-        f" “{escape(CLASSES['unstated'])}”), not the model's.</p>\n"
+        f" “{escape(CLASSES['unstated'])}”), not the model's. Where the model and the paper differ and nothing in"
+        f" the paper settles why, the row is the model's: class “{escape(CLASSES['open'])}” (the 350 µm/s"
+        " start-up stick among them) or, beyond the range of the cycles the paper measured,"
+        f" “{escape(CLASSES['outside'])}”.</p>\n"
         f"{paragraphs}\n</section>"
     )
 
