@@ -300,8 +300,11 @@ def _refuse_extra_fields(text: str, sep: str, path: Path) -> None:
             )
 
 
-def read_protocol(path: str | Path) -> Protocol:
+def read_protocol(path: str | Path, *, negative_time: str = "") -> Protocol:
     """A protocol from a CSV file.
+
+    ``negative_time``: where a reader's time starts at 0 (``rsf fit``: the record's first row), why a negative
+    change time is refused (a DataError naming the row); by default the first row's time is the start, whatever it is.
 
     Two layouts, told apart by the header (SI units, or the unit a header cell names as the package writes
     them, ``time [ms]``; comma, tab or semicolon separated):
@@ -368,6 +371,10 @@ def read_protocol(path: str | Path) -> Protocol:
             raise DataError(f"{path}: expected at least two rows (a start and an end time), got {len(rows)}")
         time, velocity = (_Written(c, d, path) for c, d in zip(cols, ("time", "velocity"), strict=True))
         items = []
+        early = next((i for i, (t, _) in enumerate(rows) if t < 0), None) if negative_time else None
+        if early is not None:
+            shown = time.text(rows[early][0])
+            raise DataError(f"{path}: row {lines[early]}: time {shown} is negative; {negative_time}")
         for i in range(len(rows) - 1):
             (t0, v), (t1, _) = rows[i], rows[i + 1]
             if not t1 > t0:
