@@ -71,6 +71,7 @@ of its largest value; against the plain cohorts unchanged.
 
 from __future__ import annotations
 
+import re
 import sys
 from collections.abc import Callable
 from pathlib import Path
@@ -213,11 +214,16 @@ def test_the_split_changes_no_number(name: str, reference: dict[str, np.ndarray]
         expected = reference[f"{name}/{key}"]
         if key == "verdict":  # the words after "(docs/transient.md section 7); " are a hint, reworded in round 28
             got[key], expected = (np.array([str(v).split(HINT)[0] for v in pair]) for pair in (got[key], expected))
+            # round 29: an undetermined run whose last event is a slip says how far it is from settling (words)
+            got[key] = np.array([re.sub(NOT_SETTLED, "", str(v)) for v in got[key]])
         assert _same(got[key], expected), f"{name}: {key} differs"
 
 
 #: where the stuck block's hint to add the stick chains begins (its wording is no number of the run)
 HINT = "(docs/transient.md section 7); "
+#: the clause round 29 added to a run whose stick chains' last event is a slip and that has not settled after it
+#: (docs/transient.md section 20; its numbers are the steady curve's, checked in tests/test_transient_verdicts_r29.py)
+NOT_SETTLED = r"; the slide since has not settled to steady sliding \(.*?lies within [^)]* of it\)"
 
 
 #: the cases whose rows are sampled onto a grid after the integration (docs/transient.md section 19): a row's lowest

@@ -36,6 +36,17 @@ def unit(name: str) -> str:
     return UNITS.get(name, name)
 
 
+def velocities_apart(a: float, b: float, digits: int = 4) -> tuple[str, str]:
+    """Two different velocities (SI) as :func:`velocity` writes them, with at least ``digits`` significant digits and
+    as many more as they need to read different: "124.05 µm/s is below Vc = 124.097 µm/s", not "124.1 µm/s is
+    below Vc = 124.1 µm/s"."""
+    for shown in range(digits, 16):
+        first, second = velocity(a, shown), velocity(b, shown)
+        if first != second or a == b:
+            return first, second
+    return velocity(a, 17), velocity(b, 17)
+
+
 def velocity(value: float, digits: int = 6) -> str:
     """A velocity (SI) in µm/s, the unit of every velocity the package prints: ``velocity(7.02e-4) == "702 µm/s"``;
     a whole number of µm/s is written out up to 1 km/s (``velocity(0.1, 4) == "100000 µm/s"``, not "1e+05")."""

@@ -95,7 +95,8 @@ def sweep_command(ctx: click.Context, **options: Any) -> None:
     `pandas.read_parquet(OUT)` reads the rows: one per point, the varied keys and
     the results in SI units (its `.attrs["units"]` names each column's), status
     'ok', 'failed' (the model could not finish the run) or 'error'
-    (no result) with the message.  Then draw
+    (no result) with the message.  Exit status 3 when no point is 'ok' and
+    some 'failed'; 2 when every point is an 'error'.  Then draw
     the phase diagram with `stickslip sweep plot OUT --x KEY --y KEY --color regime`.
     """
     if ctx.invoked_subcommand is not None:
@@ -172,11 +173,14 @@ def _run(
         raise
     if store.damaged:  # said even with --quiet: the folder was not as the last run left it
         echo_err(damage_note(store))
-    summary = _summary(store.folder, spec.size)
+    summary, no_run_finished = _summary(store.folder, spec.size)
     if store.report is not None:  # workers and parallel efficiency (issue 31), also in OUT/_run.json
         summary += f"; {store.report.words()}"
     if not quiet:
         echo_err(summary)
+    if no_run_finished:  # no point ran to its end and some ran and failed: the sweep failed, as such a run does
+        echo_err(f"stickslip: the sweep failed: {no_run_finished}")
+        raise SystemExit(SWEEP_FAILED)
 
 
 def interrupted_note(output: str) -> str:
@@ -212,12 +216,19 @@ def _refuse_file_name(output: str) -> None:
     suffix = path.suffix.lower()
     if suffix not in FILE_SUFFIXES or (path / MANIFEST).is_file():
         return
+    from ..sweeps.export import TABLE_SUFFIXES
+
     folder = str(path.with_suffix(""))
-    table = {".csv": f".to_csv('{output}')", ".tsv": f".to_csv('{output}', sep='\\t')",
-             ".txt": f".to_csv('{output}')", ".json": f".to_json('{output}')"}  # fmt: skip
-    read = f"pandas.read_parquet('{folder}')"
-    kind = suffix[1:].upper()
-    then = f"{read}{table[suffix]} writes its rows as one {kind} file" if suffix in table else f"{read} reads its rows"
+    if suffix in TABLE_SUFFIXES:  # the package's writer: 'name [unit]' headers, no index (pandas' to_csv: neither)
+        kind = {".json": "JSON document with a units map", ".parquet": "Parquet file naming its units"}.get(
+            suffix, f"{suffix[1:].upper()} file with 'name [unit]' headers"
+        )
+        then = (
+            f"python -c \"import stickslip.sweeps as s; s.write_table('{folder}', '{output}')\" writes its rows as one"
+            f" {kind}"
+        )
+    else:
+        then = f"stickslip.sweeps.load_sweep('{folder}')[0] is its rows as a DataFrame, units in .attrs['units']"
     raise ParameterError(
         f"-o {output}: a sweep writes a folder of Parquet chunks (resumable), not a {suffix} file; name the folder"
         f" without a suffix, e.g. -o {folder}; then {then}"
@@ -246,33 +257,59 @@ def _as_labelled_before(spec: Any, output: str) -> Any:
     return spec
 
 
-def _summary(folder: Path, total: int) -> str:
-    """One line: points, errors, regimes, counted chunk by chunk (never the whole table in memory)."""
+#: Exit status of a sweep none of whose points ran to its end, some of them run and failed (that of a failed run)
+SWEEP_FAILED = 3
+
+
+def _summary(folder: Path, total: int) -> tuple[str, str]:
+    """(the summary line, "" or why the sweep failed), counted chunk by chunk (never the whole table in memory).
+
+    The regimes count every row that has one, a failed run's too (named: "undetermined 13 (12 failed)"),
+    and the rows without a result ("error"), so the counts add up to the points.  A sweep whose every point is an
+    error (nothing was computed: most likely the settings every point shares) is refused (exit 2); one with no
+    point "ok" and some "failed" (the model ran and could not finish) failed, as such a run does (exit 3)."""
     from collections import Counter
 
     import pyarrow.dataset as ds
 
     regimes: Counter[str] = Counter()
-    errors = rows = without_result = 0
-    first_error = ""
+    failed_in: Counter[str] = Counter()
+    statuses: Counter[str] = Counter()
+    first: dict[str, str] = {}
     for batch in ds.dataset(folder, format="parquet").to_batches(columns=["status", "regime", "message"]):
         frame = batch.to_pydict()
-        rows += len(frame["status"])
-        errors += sum(s != "ok" for s in frame["status"])
-        without_result += sum(s == "error" for s in frame["status"])  # ("failed": the model ran, kept what it did)
-        regimes.update(r for r, s in zip(frame["regime"], frame["status"], strict=True) if s == "ok")
-        first_error = first_error or next(
-            (m for m, s in zip(frame["message"], frame["status"], strict=True) if s != "ok"), ""
-        )
+        for status, regime, message in zip(frame["status"], frame["regime"], frame["message"], strict=True):
+            kind = status if status in ("ok", "error") else "failed"  # (a plug-in's "stopped" run did not finish)
+            statuses[kind] += 1
+            first.setdefault(kind, message or "")
+            if kind != "error" and regime:
+                regimes[regime] += 1
+                failed_in[regime] += kind == "failed"
+    rows = sum(statuses.values())
     if rows != total:  # never report success on a folder that does not hold exactly the sweep
         raise DataError(f"{folder}: holds {rows} rows for {total} points; run the same command again to repair it")
-    if total and without_result == total:  # nothing was computed: the settings every point shares, most likely
+    failed, errors = statuses["failed"], statuses["error"]
+    if total and errors == total:  # nothing was computed: the settings every point shares, most likely
         raise ParameterError(
-            f"every point of the sweep failed ({total} of {total}; {folder} holds each reason), the first:"
-            f" {first_error}"
+            f"every point of the sweep failed ({total} of {total}; each an error, no result; {folder} holds each"
+            f" reason), the first: {first['error']}"
         )
-    shown = ", ".join(f"{name} {count}" for name, count in regimes.most_common())
-    return f"sweep: {total} points in {folder} ({errors} failed){'; regimes: ' + shown if shown else ''}"
+    shown = [
+        f"{name} {count}" + (f" ({failed_in[name]} failed)" if failed_in[name] else "")
+        for name, count in regimes.most_common()
+    ]
+    if errors:
+        shown.append(f"none (error) {errors}")
+    said = f"{failed} failed" + (f", {errors} error{'s' if errors != 1 else ''}" if errors else "")
+    line = f"sweep: {total} points in {folder} ({said}){'; regimes: ' + ', '.join(shown) if shown else ''}"
+    why = ""
+    if total and not statuses["ok"]:
+        kinds = f"{failed} failed" + (f" and {errors} error(s)" if errors else "")
+        why = (
+            f"no point of the {total} ran to its end ({kinds}; {folder} holds each row), the first failed:"
+            f" {first['failed']}"
+        )
+    return line, why
 
 
 @sweep_command.command("plot")

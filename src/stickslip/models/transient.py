@@ -52,6 +52,14 @@ class Transient(BondModel):
 
         rig = self.check(protocol, rig, settings)
         control = "velocity" if rig.control == "velocity" else "block"
+        if control == "velocity" and settings.get("stick_population") is True:
+            # in the interface's words (a rig's control 'spring', --control spring), not run_transient's 'block'
+            from ..errors import ParameterError
+
+            raise ParameterError(
+                "stick_population: the attached chains hold a slider that a spring drives: they need spring control"
+                " (--control spring; in Python a Rig(control='spring'), the default rig), got velocity control"
+            )
         if rig.stiffness is not None:
             settings["stiffness"] = rig.stiffness
         if rig.has_mass or rig.has_damping:  # the block's inertia and damping (docs/extensions.md section 4)
@@ -76,14 +84,26 @@ class Transient(BondModel):
         start = "empty" if start is None else start
         return estimate_cost(params, protocol, control=control, start=start, **options).seconds
 
-    def describe_start(self, start: Any, protocol: Protocol, settings: Any = None) -> str:
+    def describe_start(self, start: Any, protocol: Protocol, settings: Any = None, run: Run | None = None) -> str:
+        """Where the run begins; given the ``run``, the start it really made: a steady start below Vc through the
+        block begins sliding just above Vc under σc (run_transient moves it to the stable side), not at V0."""
         from ..display import velocity
 
         if start is None or start == "empty":
             return "empty: no bonds, no stress"
         if start == "steady":
-            at = (settings or {}).get("start_velocity") or protocol.segments[0].velocity
-            return f"steady population at {velocity(float(at), 4)}"
+            at = float((settings or {}).get("start_velocity") or protocol.segments[0].velocity)
+            began = float(run.slider_velocity[0]) if run is not None and run.slider_velocity.size else at
+            vc = float(run.summary.get("critical_velocity", NAN)) if run is not None else NAN
+            if math.isfinite(began) and abs(began - at) > 1e-9 * max(abs(at), abs(began)):
+                held = run is not None and run.stress is not None
+                sigma = f", σ = {float(run.stress[0]):.4g} Pa" if held else ""
+                critical = f" = {velocity(vc, 4)}" if math.isfinite(vc) else ""
+                return (
+                    f"steady population at {velocity(began, 4)}, just above Vc{critical}{sigma}: {velocity(at, 4)} is"
+                    " below Vc"
+                )
+            return f"steady population at {velocity(at, 4)}"
         return f"start {start!r}"
 
     def stability_boundary(self, fixed: Any, x: str, y: str, frame: Any = None) -> list[Boundary]:
@@ -193,7 +213,16 @@ def transient_run(result: Any, protocol: Protocol | None = None, resolution: flo
     """The :class:`Run` of a :class:`stickslip.transient.TransientResult` (regime from its slip events, in the
     protocol's last segment; over the whole run without the protocol)."""
     summary = last_cycle_numbers(result, protocol, resolution)
+    summary["critical_velocity"] = float(getattr(result, "critical_velocity", NAN))  # the run's parameters' Vc
     regime = _regime(result, protocol)
+    if regime.kind not in regimes.OSCILLATING:
+        # a period is an oscillation's: the last whole cycle of a run that does not repeat it (a slide-hold-slide,
+        # steady at its end, carried its last stick-to-stick span, 30.15 or 35 s, holds included) is no period
+        summary["period"] = NAN
+    elif regime.kind == regimes.STICK_SLIP and getattr(result, "chain_fraction", None) is not None:
+        # the stick chains' limit cycle: its whole cycles, as the verdict counts them (periods), not the run's with
+        # its start-up cycles (19 whole cycles beside "18 period(s)", the first from rest, that did not repeat)
+        summary["cycles"] = regime.periods
     settled = getattr(result, "status", "ok") == "ok" and (
         regime.kind == regimes.STEADY
         or (regime.kind == regimes.OSCILLATION and math.isfinite(regime.period) and not summary["cycles"])
@@ -321,10 +350,10 @@ def last_cycle_numbers(
     result: Any, protocol: Protocol | None = None, resolution: float | None = None
 ) -> dict[str, Any]:
     """The last whole cycle's numbers (the run has settled onto its cycle by then, if ever) and the mean stress
-    over it (over the run when there is none; the whole cycles from an empty surface began with the start-up
-    stick, σs 631.6 Pa against the paper's cycle's 556.4 Pa, which the mean is not of); ``run_mean_stress`` over
-    the run.  ``protocol``: the run's, for the puller's exact travel into a stick that no cycle of the result
-    starts (the run ended in it)."""
+    over it (over the run when there is none, and then the stick time, σs and Vs of the run's last slip, if any;
+    the whole cycles from an empty surface began with the start-up stick, σs 631.6 Pa against the paper's cycle's
+    556.4 Pa, which the mean is not of); ``run_mean_stress`` over the run.  ``protocol``: the run's, for the
+    puller's exact travel into a stick that no cycle of the result starts (the run ended in it)."""
     whole = [c for c in result.cycles if getattr(c, "period", None) is not None]
     whole = _settled(result, whole, protocol, resolution)
     time = np.asarray(result.time, dtype=float)
@@ -353,6 +382,11 @@ def last_cycle_numbers(
         row["mean_stress"] = _mean_stress(
             result, last.start_time, end, last.start_stress, *following[:1], protocol=protocol
         )
+    elif result.cycles:
+        # no cycle that repeats (a start-up cycle, a slip before the run settled or stuck for good): the last slip
+        # the run saw, its stick and jump, were NaN beside a message quoting them; no period (nothing repeats)
+        last = result.cycles[-1]
+        row.update(stick_time=last.stick_time, peak_stress=last.peak_stress, jump_velocity=last.jump_velocity)
     return row
 
 

@@ -19,6 +19,7 @@ from ..errors import DataError, ParameterError
 from ..parameters import Parameters, require_flag
 from ..units import to_si
 from .engine import check_scheduler_address, compute, compute_while_cheap, dask_client, default_batch_size, read_results
+from .export import write_table
 from .interrupts import heard_at_safe_points, stop_if_asked
 from .main_guard import unguarded_script_line
 from .models import ALIASES, MODELS, get_model
@@ -37,6 +38,7 @@ __all__ = [
     "read_manifest",
     "run_sweep",
     "sweep",
+    "write_table",
 ]
 
 DEFAULT_DURATION = 100.0  # s: several cycles at the paper's stick-slip velocities

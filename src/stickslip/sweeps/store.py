@@ -194,6 +194,9 @@ def _open_locked(path: Path, folder: str | Path, spec: SweepSpec, batch_size: in
         else:
             store = SweepStore(path, spec, manifest["batch_size"], __version__)
             _check_chunks(store)
+            if "units" not in manifest:  # a folder made before the manifest named its units (round 29)
+                named = {**manifest, "units": manifest_units(spec)}
+                atomic_write_text(path / MANIFEST, json.dumps(named, indent=2) + "\n")
             return store
         raise ParameterError(
             f"-o {folder}: holds a sweep of {why}; give another output folder, or --overwrite to replace it"
@@ -397,7 +400,29 @@ def _manifest(store: SweepStore) -> dict[str, Any]:
         "columns": "point, the varied keys (SI), then the model's results; status is 'ok', 'failed' (the model"
         " stopped short; what it computed) or 'error' (no result)",
         "specification": json.loads(store.spec.to_json()),
+        "units": manifest_units(store.spec),
     }
+
+
+def manifest_units(spec: SweepSpec) -> dict[str, str]:
+    """The SI unit of every value the manifest holds and of every column of the rows, by name (the package's JSON
+    convention: the keys that have a unit, "1" for a pure number; text, flags and the point index have none):
+    the fixed and varied keys, the settings' ``duration``, and the chunks' columns."""
+    from ..columns import unit_of
+    from .models import get_model, key_units, result_columns
+
+    model = get_model(spec.model)
+    known = key_units(model)
+    names = [*spec.fixed, *spec.keys, *spec.settings, *result_columns(model)]
+    units: dict[str, str] = {}
+    for name in dict.fromkeys(names):
+        try:
+            unit = unit_of(name, known)
+        except KeyError:  # a setting or a fixed index without a unit (rate-and-state's law)
+            continue
+        if unit is not None:
+            units[name] = unit
+    return units
 
 
 def read_manifest(folder: str | Path) -> dict[str, Any]:

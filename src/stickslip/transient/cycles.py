@@ -338,6 +338,7 @@ def judge(
     resolution: float | None = None,
     lowest: np.ndarray | None = None,
     between: Between | None = None,
+    steady: SteadyReference | None = None,
 ) -> tuple[str, str, regimes.Regime | None]:
     """(regime, message, evidence) of the last protocol segment, by :func:`stickslip.regimes.classify` on the
     stress.
@@ -353,6 +354,8 @@ def judge(
     growing, or as a limit cycle, while it decays).  The third item: the classifier's evidence (periods seen,
     amplitude ratio, period, extremes), None when the run stopped.  ``between``: each row's extremes of the
     solver's states since the row before, which the classifier reads with the rows (:func:`with_extremes`).
+    ``steady``: the steady state at the last segment's pace, against which a run whose stick chains' last event is
+    a slip is found settled after it (:func:`settled_after_slip`).
     """
     if stop is not None:
         return regimes.UNDETERMINED, stop, None
@@ -367,6 +370,12 @@ def judge(
     # 3.56 MPa re-slide peak (35.6 Pa), a re-slide 50 Pa short of steady read as steady
     settle = SETTLED * max(abs(float(stress[-1])), 1e-3 * scale, 1e-300)
     found = _from_events(events, start, time, stress, lowest, between, resolution)
+    if found is not None and found.kind in (regimes.UNDETERMINED, regimes.DECAYING) and steady is not None:
+        settled = settled_after_slip(events, start, time, stress, velocity, between, resolution, steady)
+        if isinstance(settled, regimes.Regime):  # no stick since its last slip, and at the steady state long enough
+            return settled.kind, settled.evidence, settled
+        if settled is not None:  # sliding since its last slip, not (yet) settled: say how far from it
+            found = dataclasses.replace(found, evidence=f"{found.evidence}; {settled}")
     if found is None:
         classified = regimes.classify(time, stress, floor=floor, start=start, unit="Pa", settle_floor=settle)
         found = solution_extremes(classified, time, stress, between, start)
@@ -380,6 +389,103 @@ def judge(
         if math.isfinite(peak):
             found = dataclasses.replace(found, peak=peak, trough=trough)
     return regime, message, found
+
+
+#: steady after the stick chains' last slip: the solution within the run's tolerance of the steady state at the
+#: puller's pace over at least this many of its relaxation times (:class:`SteadyReference`) before the end
+SETTLED_RELAXATIONS = 10.0
+
+
+@dataclasses.dataclass(frozen=True)
+class SteadyReference:
+    """The steady state at the last segment's pace, from the steady solver (Eqs 6-8): what a run that slides on
+    after its last slip settles to, and how fast.
+
+    ``relaxation`` (s): the longer of the block's decay along the steady curve, |dσ/dV| / K (the quasi-static
+    slip phase, σ'(V) dV/dt = K (Vp - V), relaxes V - Vp as exp(-t K / σ')), and the bonds' memory, dl_m / Vp
+    (every bond of the steady population is born within it: the population renews itself within that time)."""
+
+    velocity: float  # m/s, the puller's pace over the last segment
+    stress: float  # Pa, sigma of the steady curve at it
+    slope: float  # Pa s/m, dsigma/dV there
+    stiffness: float  # Pa/m, the block's
+    memory: float  # s, dl_m / Vp
+
+    @property
+    def block_decay(self) -> float:
+        return abs(self.slope) / self.stiffness if self.stiffness > 0 else math.inf
+
+    @property
+    def relaxation(self) -> float:
+        return max(self.block_decay, self.memory)
+
+
+def settled_after_slip(
+    events: list,
+    start: float,
+    time: np.ndarray,
+    stress: np.ndarray,
+    velocity: np.ndarray,
+    between: Between | None,
+    resolution: float | None,
+    steady: SteadyReference,
+) -> regimes.Regime | str | None:
+    """Steady sliding after the stick chains' last slip (a start-up stick-slip from rest, above Vc), judged from
+    the solution; where it is not (yet), why not in words; None where the last event is no slip.
+
+    The chains' events say what happened (a stick ended by a slip, and no stick since), but not what the slide
+    did after: the verdict on the events alone, "1 slip, no stick after it: needs another slip", could never
+    change however long the run.  The slide has settled when the solution is the steady state at the puller's
+    pace Vp and has stayed it: every state of the solver over the last SETTLED_RELAXATIONS relaxation times (the
+    rows and the extremes each row carries of the states between, from the row at or before the stretch's start:
+    the sampling can only delay the verdict, by one row's interval at most) within the run's tolerance,
+    max(rtol, SETTLED) x σ(Vp), of the steady curve's σ(Vp), that stretch after the last slip, and the slider at
+    Vp within STEADY_TOLERANCE at the end.  Why so long: under the block dσ/dt = K (Vp - V), so a stress held
+    within ±B over a stretch L pins the slider's mean pace to Vp within 2 B / (K L); with L = 10 |σ'| / K that is
+    a fifth of B / |σ'|, the velocity that moves the steady stress by B, and a departure from the steady state
+    decays as exp(-L / relaxation) = 4.5e-5 over it (the quasi-static model calls its slip phase steady where V
+    is within 1e-9 of Vp, docs/slip-phase.md; a steady start, where the trace's tail has stopped changing)."""
+    marks = [(kind, float(t), float(s)) for kind, t, s, _ in events if kind in ("stick", "slip") and t >= start]
+    slips = [k for k, mark in enumerate(marks) if mark[0] == "slip"]
+    vp = steady.velocity
+    if not slips or marks[-1][0] != "slip" or not (vp > 0 and math.isfinite(steady.stress)) or time.size < 2:
+        return None
+    t_slip, sigma_s = marks[-1][1], marks[-1][2]
+    end = float(time[-1])
+    span = SETTLED_RELAXATIONS * steady.relaxation
+    v_end = float(velocity[-1])
+    rtol = max(resolution if resolution is not None else 0.0, SETTLED)
+    band = rtol * abs(steady.stress)
+    since = end - span
+    # every state from the row at or before the stretch's start: the whole of the rows' interval that holds it (a
+    # sampling coarser than the stretch can only delay the verdict, by that interval at most; never advance it)
+    first = float(time[max(int(np.searchsorted(time, since, side="right")) - 1, 0)])
+    high, low = window_extremes(time, stress, between, first)
+    within = math.isfinite(high) and high - steady.stress <= band and steady.stress - low <= band
+    if not (math.isfinite(span) and since >= t_slip and abs(v_end - vp) <= STEADY_TOLERANCE * vp and within):
+        return (
+            f"the slide since has not settled to steady sliding (σ = {float(stress[-1]):.6g} Pa and"
+            f" V = {show_velocity(v_end, 4)} at the end, against the steady curve's σ({vp * 1e6:.6g} µm/s) ="
+            f" {steady.stress:.6g} Pa: it counts as settled once every state over the last {span:.3g} s"
+            f" ({SETTLED_RELAXATIONS:g} relaxation times of {steady.relaxation:.3g} s), after the slip, lies within"
+            f" {band:.3g} Pa of it)"
+        )
+    before = marks[slips[-1] - 1] if slips[-1] > 0 and marks[slips[-1] - 1][0] == "stick" else None
+    stick = f"stick from {before[2]:.6g} Pa at t = {before[1]:.6g} s to " if before is not None else ""
+    n = len(slips)
+    what = "a start-up stick-slip" if n == 1 else f"{n} stick-slip cycles (the last:"
+    close = ")" if n == 1 else "))"
+    words = (
+        f"steady sliding at {v_end * 1e6:.6g} µm/s after {what}"
+        f"{' (' if n == 1 else ' '}{stick}σs = {sigma_s:.6g} Pa at t = {t_slip:.6g} s, no stick since{close}:"
+        f" σ = {float(stress[-1]):.6g} Pa at t = {end:.6g} s, and every state over the last {span:.3g} s within"
+        f" {band:.3g} Pa (rtol {rtol:g}) of the steady curve's σ({vp * 1e6:.6g} µm/s) = {steady.stress:.6g} Pa"
+        f" ({high - low:.3g} Pa peak to trough; {SETTLED_RELAXATIONS:g} relaxation times of {steady.relaxation:.3g} s:"
+        f" the block's decay along the steady curve |dσ/dV|/K = {steady.block_decay:.3g} s, the bonds' memory"
+        f" dl_m/V = {steady.memory:.3g} s)"
+    )
+    peak, trough = window_extremes(time, stress, between, start)
+    return regimes.Regime(regimes.STEADY, 0, math.nan, math.nan, peak, trough, words)
 
 
 def _ripple(  # type: ignore[no-untyped-def]
@@ -518,7 +624,7 @@ def _words(
         if whole:
             c = whole[-1]
             text += (
-                f"; {len(cycles)} slip(s), the last whole cycle: stick {c.stick_time:.4g} s up to"
+                f"; {len(cycles)} slip(s) in the run, the last whole cycle: stick {c.stick_time:.4g} s up to"
                 f" σs = {c.peak_stress:.5g} Pa, {describe_jump(c.jump_velocity)}, slip {c.slip_time:.4g} s"
             )
         return regimes.STICK_SLIP, text
@@ -725,14 +831,18 @@ def _chain_verdict(
         cycle = whole[-1]  # the last whole cycle (the one before the last slip's, at least)
         assert cycle.after is not None
         length = cycle.after[0] - cycle.t_stick
+        members = cycles[-(repeating + 1) :]  # the slips whose cycles repeat one another: the limit cycle's
+        periods = sum(1 for c in members if c.after is not None)  # its whole cycles, stick to stick: the periods
+        before = len(cycles) - len(members)  # the window's cycles before it: start-up cycles, which do not repeat
         evidence = (
-            f"stick-slip (limit cycle): {repeating} period(s) of {length:.6g} s (the last whole cycle, stick to"
-            f" stick), {repeating + 1} slips whose cycles"
-            f" repeat (the last two: stick from {prev.sigma_stick:.6g} then {last.sigma_stick:.6g} Pa, σs ="
+            f"stick-slip (limit cycle): {periods} period(s) of {length:.6g} s (its whole cycles, stick to stick; the"
+            f" period is the last one's), {len(members)} slips whose cycles repeat"
+            + (f", after {before} start-up cycle{' that does' if before == 1 else 's that do'} not" if before else "")
+            + f" (the last two: stick from {prev.sigma_stick:.6g} then {last.sigma_stick:.6g} Pa, σs ="
             f" {prev.sigma_s:.6g} then {last.sigma_s:.6g} Pa, amplitude ratio {ratio:.4g};"
             f" {_apart(prev, last, resolution)}): with fresh chains at each stick the cycle repeats from there"
         )
-        return regimes.Regime(regimes.STICK_SLIP, repeating, ratio, length, peak, trough, evidence)
+        return regimes.Regime(regimes.STICK_SLIP, periods, ratio, length, peak, trough, evidence)
     if last.after is not None and _repeats((last.sigma_stick,), (last.after[1],), last.rise, resolution):
         length = last.after[0] - last.t_stick
         gap = abs(last.after[1] - last.sigma_stick)

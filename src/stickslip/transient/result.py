@@ -90,6 +90,8 @@ class TransientResult:
     #: "ok"; "failed" where the model cannot continue before the protocol's end, "stopped" at a budget (the run up
     #: to there: ``BudgetExhausted.partial``); ``message`` says where
     status: str = "ok"
+    #: Vc of Eq 9 (m/s), the aging steady curve's minimum for the run's parameters; NaN without aging or a minimum
+    critical_velocity: float = float("nan")
 
     @property
     def final_stress(self) -> float:

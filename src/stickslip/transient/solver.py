@@ -12,6 +12,7 @@ from typing import Any
 
 import numpy as np
 
+from ..display import velocities_apart
 from ..display import velocity as show_velocity
 from ..errors import ModelError, ParameterError, RunFailed
 from ..numerics.budget import (
@@ -1227,6 +1228,42 @@ def _start_reach(
     return min(travel, b.max_extension) / velocity
 
 
+def _critical_velocity(params: Parameters, aging: bool) -> float:
+    """Vc (m/s) of Eq 9, the aging steady curve's minimum, as a steady start below Vc reads it (``critical_minimum``,
+    remembered per curve); NaN without aging (that curve has no minimum) or where the curve has none."""
+    from ..quasistatic.critical import critical_minimum
+
+    if not aging:
+        return math.nan
+    try:
+        found = critical_minimum(params)
+    except (ModelError, ParameterError):
+        return math.nan
+    return math.nan if found is None else float(found.velocity)
+
+
+def _steady_reference(d: Any) -> Any:
+    """The steady state at the last segment's pace (cycles.SteadyReference), against which a run whose stick chains'
+    last event is a slip is judged settled after it; None where there is none to judge (no chains, no slip in the
+    last segment, the puller held, or the steady solver cannot give it)."""
+    from .cycles import SteadyReference
+
+    start = float(d.protocol.boundaries[-2])
+    vp = float(d.protocol.segments[-1].velocity)
+    slipped = any(kind == "slip" and t >= start for kind, t, *_ in d.events)
+    if not (d.stick_population and d.control == "block" and vp > 0 and slipped):
+        return None
+    try:
+        found = _steady_state(d.params, vp, d.aging)
+    except (ModelError, ParameterError):  # beyond the steady population's range: no steady state to settle to
+        return None
+    stress, slope = float(np.ravel(found.stress)[0]), float(np.ravel(found.stress_slope)[0])
+    if not (math.isfinite(stress) and math.isfinite(slope)):
+        return None
+    memory = float(d.params.bonds.max_extension) / vp
+    return SteadyReference(vp, stress, slope, float(d.k_block), memory)
+
+
 def _chains_ahead(d: Any, regime: str, message: str, time: np.ndarray, sigma: np.ndarray) -> tuple[str, str]:
     """A run that ends with the stick chains holding is stuck only if they would hold on: where Eq 15 has them
     collapse later under the same loading it is undetermined, saying when; where it proves they never do, stuck
@@ -1401,7 +1438,7 @@ def _finish(d: _Driver, snapshots: list[Snapshot], stop: str | None, note: str) 
     )  # fmt: skip
     regime, message, evidence = judge(
         time, sigma, v, protocol, cycles, events, control, stop, resolution=d.rtol, lowest=table[:, 14],
-        between=between,
+        between=between, steady=_steady_reference(d) if stop is None else None,
     )  # fmt: skip
     regime, message = _chains_ahead(d, regime, message, time, sigma)
     message = message + note
@@ -1452,6 +1489,7 @@ def _finish(d: _Driver, snapshots: list[Snapshot], stop: str | None, note: str) 
         damping=d.damping,
         evidence=evidence,
         status="ok" if stop is None else "failed",  # the model could not go on to the protocol's end
+        critical_velocity=_critical_velocity(d.params, d.aging),
     )
 
 
@@ -1636,14 +1674,15 @@ def _steady_start_below_vc(
         return start_velocity, ""
     if cp is None or v_start >= cp.velocity:
         return start_velocity, ""
+    start_shown, vc_shown = velocities_apart(v_start, cp.velocity)
     if start_velocity is not None:
         return start_velocity, (
-            f" (steady start at {show_velocity(v_start, 4)}, below Vc = {show_velocity(cp.velocity, 4)}: on the"
+            f" (steady start at {start_shown}, below Vc = {vc_shown}: on the"
             " unstable branch of the steady curve unless the block is stiffer than Kc(V), transient.critical_stiffness)"
         )
     v_stable = cp.velocity * (1.0 + STABLE_SIDE)
     return v_stable, (
-        f" (steady start: {show_velocity(v_start, 4)} is below Vc = {show_velocity(cp.velocity, 4)}, where steady"
+        f" (steady start: {start_shown} is below Vc = {vc_shown}, where steady"
         " sliding is unstable,"
         f" so the run starts on the stable side of the critical point, sliding at Vc under σc ="
         f" {cp.stress:.6g} Pa; give start_velocity / --start-velocity to start elsewhere)"
