@@ -21,7 +21,7 @@ from ..errors import ModelError, ParameterError, RunFailed
 from ..parameters import Parameters
 from ..reprs import compact_repr, field_values
 from ..trace_columns import QUASI_STATIC
-from .critical import CriticalPoint, cached_critical_point, steady_curve_key
+from .critical import NOISE, CriticalPoint, cached_critical_point, steady_curve_key
 from .jump import Jump, branch_maximum, check_curve, jump_velocity
 from .steady import ACCURATE_QUADRATURE, require_parameters, steady_state
 
@@ -39,6 +39,10 @@ CYCLE_COLUMNS = QUASI_STATIC
 MAX_ROWS = 1_000_000
 #: Runs of more cycles than this are refused (the trace would be mostly thinning).
 MAX_CYCLES = 100_000
+#: A stick whose σs is within this fraction of σc has not left the steady curve's minimum: the model resolves the
+#: curve's stress to this (critical.NOISE, its stated accuracy with margin, below which a dip of the curve is no
+#: minimum), so the jump lands at Vc and the cycle is degenerate (docs/slip-phase.md §6).
+DEGENERATE_RTOL = NOISE
 
 
 @dataclass(frozen=True)
@@ -233,6 +237,9 @@ class _Phases:
                 " is no stick phase, so no stick-slip cycle; the quasi-static model has no answer here"
             )
             return _Cycle(stick, None, None, regimes.UNDETERMINED, message)
+        degenerate = self._degenerate(stick)
+        if degenerate is not None:
+            return degenerate
         jump = jump_velocity(self.params, stick.peak_stress, self.curve)
         if not jump.reachable or jump.velocity is None:
             message = f"the chains collapse at σs = {stick.peak_stress:.6g} Pa, but {jump.message}"
@@ -247,14 +254,51 @@ class _Phases:
             )
             return _Cycle(stick, jump, None, regimes.UNDETERMINED, message)
         slip = slip_phase(self.params, self.v0, jump.velocity)
-        if slip.ends == "stick" and slip.duration == 0.0:
+        if slip.ends == "stick" and slip.duration == 0.0:  # the no-aging curve's jump landing at Vc
             message = (
                 f"degenerate cycle: the chains collapse after {stick.stick_time:.6g} s at σs ="
-                f" {stick.peak_stress:.6g} Pa, no more than σc, so the jump lands at Vc where the slip ends at"
+                f" {stick.peak_stress:.6g} Pa, so the jump lands at Vc where the slip ends at"
                 " once and the block sticks again without moving (creep by infinitesimal slips, outside the model)"
             )
             return _Cycle(stick, jump, slip, regimes.UNDETERMINED, message)
         return _Cycle(stick, jump, slip, None)
+
+    def _degenerate(self, stick: StickPhase) -> _Cycle | None:
+        """The cycle of a stick whose σs is σc to the steady curve's resolution (:data:`DEGENERATE_RTOL`), below Vc
+        and jumping onto the aging curve: the jump lands at Vc, where the slip ends at once (None otherwise).
+
+        The test is on the stress, not on the slip's length: at N0 = 1e15 m^-2 and 50 µm/s the chains collapse
+        3.17 ns after sticking at every stiffness, σs - σc = K V0 ts = 2e-12 to 2e-10 of σc from 40 kPa/m to
+        4 MPa/m; the root finder put the jump exactly at Vc (a slip of 0 s) at the first alone and a 2.1 ns slip
+        at the others, whose 5.3 ns "cycles" were then refused as too many (round 29)."""
+        from .slip import slip_phase
+
+        cp = cached_critical_point(steady_curve_key(self.params))
+        assert cp.velocity is not None and cp.stress is not None and stick.peak_stress is not None
+        sigma_c, v_c = float(cp.stress), float(cp.velocity)
+        rise = stick.peak_stress - sigma_c
+        if self.curve != "aging" or self.v0 >= v_c or abs(rise) > DEGENERATE_RTOL * sigma_c:
+            return None  # at V0 >= Vc the slip from Vc to V0 is steady sliding, whatever σs
+        _, s_max = branch_maximum(self.params, "aging")
+        jump = Jump(
+            stick.peak_stress,
+            v_c,
+            True,
+            "aging",
+            f"σs = {stick.peak_stress:.6g} Pa is σc to the steady curve's resolution: the jump lands at Vc ="
+            f" {v_c:.6g} m/s",
+            sigma_c,
+            s_max,
+        )
+        slip = slip_phase(self.params, self.v0, v_c)  # from Vc to Vc: no slip
+        message = (
+            f"degenerate cycle: the chains collapse after {stick.stick_time:.6g} s at σs ="
+            f" {stick.peak_stress:.6g} Pa, σs − σc = {rise:.3g} Pa ({abs(rise) / sigma_c:.2g} of σc, within the"
+            f" {DEGENERATE_RTOL:g} of σc to which the model resolves the steady curve's stress), so the jump lands"
+            " at Vc where the slip ends at once and the block sticks again without moving (creep by infinitesimal"
+            " slips, outside the model)"
+        )
+        return _Cycle(stick, jump, slip, regimes.UNDETERMINED, message)
 
     def all(self, kind: str) -> tuple[Any, ...]:
         return tuple(getattr(c, kind) for c in self.cycles.values() if getattr(c, kind) is not None)
@@ -320,15 +364,18 @@ def simulate(
         if count > MAX_CYCLES:
             raise ParameterError(
                 f"duration: {end:.6g} s holds {count:.3g} cycles of {period:.6g} s; at most {MAX_CYCLES:g} are"
-                " traced, so give a shorter duration"
+                f" traced, so give a shorter duration (at most {MAX_CYCLES * period:.3g} s)"
             )
         rows = count * (repeat.stick.time.size + repeat.slip.time.size)
         trace.stride = max(1, math.ceil(rows / MAX_ROWS))
     cycles: list[Cycle] = []
     t, slider, sigma = 0.0, 0.0, sigma0
+    problem: tuple[float, _Cycle] | None = None  # the cycle the model has no answer for, and when its stick began
     while True:  # one stick (and the slip after it) per pass; t advances by a period > 0
         cycle = phases.cycle(sigma)
         stick, jump, slip = cycle.stick, cycle.jump, cycle.slip
+        if cycle.problem is not None and problem is None:
+            problem = (t, cycle)
         _add_stick(trace, stick, t, slider)
         if slip is None or jump is None or jump.velocity is None:
             break  # stuck, or no answer; _outlook has the words
@@ -379,6 +426,9 @@ def simulate(
             f"; the model stops at t = {columns['time'][-1]:.6g} s of the {end:.6g} s asked for:"
             " what follows is not known"
         )
+    elif regime == regimes.UNDETERMINED:
+        # the run computed all it asked for, and the phase the model has no answer for lies beyond it: say so
+        message += _beyond_the_run(problem, sigma_c, end, columns)
     return Simulation(
         **columns,
         regime=_regime(regime, message, period, settled, columns),
@@ -505,6 +555,30 @@ def _regime(
         peak, trough = float(np.max(stress)), float(np.min(stress))
     ratio = 1.0 if kind == regimes.STICK_SLIP and len(whole) >= 2 else math.nan
     return regimes.Regime(kind, len(whole), ratio, math.nan if period is None else period, peak, trough, message)
+
+
+def _beyond_the_run(
+    problem: tuple[float, _Cycle] | None, sigma_c: float, end: float, columns: dict[str, np.ndarray]
+) -> str:
+    """Words for an undetermined run that reached its end: the phase the model has no answer for comes after it,
+    which is no failure of the run, so the run is ``ok`` and says when that phase comes (round 29: 8.02 µm/s at
+    958 kPa/m for 300 s read "the chains collapse at σs = 2335.68 Pa ... no jump velocity", the collapse being at
+    353.1 s, while neighbours that reach their collapse within the run are ``failed``)."""
+    where = "stuck" if columns["phase"][-1] == "stick" else "slipping"
+    final = f"the run ends {where}, at σ = {float(columns['stress'][-1]):.6g} Pa"
+    if problem is None:  # the start-up cycle is still under way at the end: the stick from σc has not begun
+        return (
+            f"; the stick from σc = {sigma_c:.6g} Pa that this describes begins after the run's end at {end:.6g} s:"
+            f" {final}"
+        )
+    began, cycle = problem
+    ts = cycle.stick.stick_time
+    if ts is None:  # a stick neither proven to end nor to last (its own message gives the times)
+        return ""
+    return (
+        f"; that collapse comes at t = {began + ts:.6g} s, after the run's end at {end:.6g} s: {final}, and what"
+        " follows the collapse is not known"
+    )
 
 
 def _settle_time(phases: _Phases, sigma0: float, sigma_c: float) -> float:
