@@ -212,3 +212,21 @@ def test_compare_says_a_steady_start_below_vc_starts_just_above_vc(capsys, vc):
     argv[argv.index("100 um/s")] = "200 um/s"  # above Vc: the steady start is at V0 itself
     status, out, err = run_main(capsys, *argv)
     assert json.loads(out)["models"]["transient"]["start"] == "steady population at 200 µm/s"
+
+
+def test_a_table_is_not_written_into_the_sweeps_own_folder(tmp_path, capsys):
+    """Tester S: write_table(folder, folder/'all.parquet') made every point read twice, and folder/_manifest.json
+    replaced the sweep's manifest; both are refused and the sweep reads as before."""
+    from stickslip.errors import DataError
+    from stickslip.sweeps import load_sweep, write_table
+
+    out = tmp_path / "sw"
+    run_main(capsys, "sweep", "--vary", "pulling_velocity=50 um/s,1 m/s", "--duration", "60 s", "--workers", "0",
+             "-o", str(out))  # fmt: skip
+    before = sorted(p.name for p in out.iterdir())
+    for name in ("all.parquet", "_manifest.json", "rows.csv"):
+        with pytest.raises(DataError, match="inside the sweep's folder"):
+            write_table(out, out / name)
+    assert sorted(p.name for p in out.iterdir()) == before
+    frame, _ = load_sweep(out)
+    assert len(frame) == 2

@@ -38,6 +38,7 @@ def write_table(folder: str | Path, path: str | Path) -> Path:
         raise ParameterError(
             f"{path}: expected a file named .csv, .tsv, .txt, .json or .parquet, got {suffix or 'no suffix'}"
         )
+    _refuse_inside(Path(folder), target)
     frame = read_results(folder)
     units: dict[str, str | None] = dict(frame.attrs.get("units") or {})
     if suffix == ".parquet":
@@ -53,6 +54,23 @@ def write_table(folder: str | Path, path: str | Path) -> Path:
         document = {"rows": rows, "units": {name: unit for name, unit in units.items() if unit is not None}}
         return atomic_write_text(target, json.dumps(document, indent=2, ensure_ascii=False) + "\n")
     return atomic_write_text(target, csv_rows(frame, units, TABLE_SUFFIXES[suffix] or ","))
+
+
+def _refuse_inside(folder: Path, target: Path) -> None:
+    """A table written into the sweep's own folder became part of the sweep (a .parquet file is read as a chunk:
+    every point twice; a _manifest.json replaced the sweep's), so it is refused, naming the folder."""
+    from ..errors import DataError
+
+    try:
+        home = folder.resolve(strict=True)
+        where = target.parent.resolve()
+    except OSError:  # no such folder: read_results says so
+        return
+    if where == home or home in where.parents:
+        raise DataError(
+            f"{target}: inside the sweep's folder {folder}, whose files are the sweep (a table there is read as part"
+            " of it, or replaces its manifest); write it elsewhere"
+        )
 
 
 def csv_rows(frame: Any, units: dict[str, str | None], separator: str = ",") -> str:
