@@ -205,6 +205,7 @@ def steady_command(
             header.append(f"Vc = {human(vc.value, 'velocity')}, σc = {human(sc.value, 'stress')} (Eq 9).")
         else:
             header.append(f"Vc, σc (Eq 9): {vc.note or 'not determined'}.")
+        header.extend(_covariance_lines(fit))
         description = f"stickslip fit steady --method {fit.method} of {data}, start values from {params.name}"
         _write_fitted(output, fit.parameters, f"fit of {data.name}", description, header)
     report = fit.report() if posterior is None else fit.report() + "\n" + posterior.report()
@@ -231,6 +232,24 @@ def steady_command(
     _exit_if_failed(fit, output)
 
 
+def _covariance_lines(fit: Any) -> list[str]:
+    """The comment line of the fitted keys' ln-covariance that ``fit stick --params`` reads back (round 29:
+    its intervals carry the bond parameters' uncertainty); none where the fit has no finite covariance."""
+    import numpy as np
+
+    from ..fitting.input_uncertainty import covariance_comment
+
+    keys = list(fit.free_keys)
+    covariance = np.asarray(fit.covariance, dtype=float)
+    if not keys or covariance.shape != (len(keys), len(keys)) or not np.all(np.isfinite(covariance)):
+        return []
+    values = [fit.parameters.as_dict()[k] for k in keys]
+    return [
+        "The covariance of the fitted keys' ln-values (Wald): fit stick --params reads it into its intervals.",
+        covariance_comment(keys, values, covariance),
+    ]
+
+
 def _bayes_module() -> Any:
     try:
         import corner  # noqa: F401
@@ -249,6 +268,15 @@ def _bayes_module() -> Any:
 @click.option("--exclude-row", "exclude_rows", multiple=True, type=int, metavar="N", help="Leave out file row N.")
 @click.option("--include-steady", is_flag=True, help="Keep rows whose pulling velocity is above Vc.")
 @click.option("--level", type=click.FloatRange(0.5, 0.999), default=0.95, show_default=True, help="Confidence level.")
+@click.option(
+    "--start-stress",
+    "start_stress",
+    type=click.Choice(["measured", "model"]),
+    default="measured",
+    show_default=True,
+    help="Where each stick starts: measured (the table's start_stress or critical_stress) or model (σc of the bond"
+    " parameters in every row: for forces with a drift or an offset; docs/fitting.md).",
+)
 @_fit_outputs("Save stick times, data and fit (PNG).")
 @params_options
 def stick_command(
@@ -258,6 +286,7 @@ def stick_command(
     exclude_rows: tuple[int, ...],
     include_steady: bool,
     level: float,
+    start_stress: str,
     output: Path | None,
     report_path: Path | None,
     plot_path: Path | None,
@@ -270,12 +299,16 @@ def stick_command(
     Columns: pulling_velocity, stick_time, optional peak_stress, start_stress (and the
     other columns of the paper's Table 1); or the cycles of 'stickslip analyze -o'
     (of traces at two or more velocities, stacked).  Bond parameters, block and start values
-    come from --params/--set: use the file written by 'stickslip fit steady -o'.
+    come from --params/--set: use the file written by 'stickslip fit steady -o', whose
+    uncertainty the intervals then include (otherwise they are conditional on the bond parameters).
     """
     refuse_overwriting_inputs([table], [("-o", output), ("--report", report_path), ("--plot", plot_path)], params_name)
+    from ..fitting.input_uncertainty import read_fit_covariance
     from ..fitting.stick_fit import fit_stick
+    from ..parameters import available_parameter_sets
 
     params = resolve_params(params_name, overrides)
+    written = None if params_name in available_parameter_sets() else read_fit_covariance(params_name)
     fit = fit_stick(
         table,
         params=params,
@@ -284,6 +317,8 @@ def stick_command(
         exclude_rows=list(exclude_rows),
         include_steady=include_steady,
         level=level,
+        start_stress=start_stress,
+        bond_covariance=written if written is not None else False,
     )
     if output is not None and fit.success:
         header = [f"Fitted by stickslip fit stick to {table}; fitted keys: {', '.join(fit.free_keys)}."]
@@ -302,7 +337,12 @@ def stick_command(
 
         _figure_to(plot_path, make)
     if as_json:
-        emit_json(fit.as_dict())
+        from ..columns import json_units
+        from ..fitting.stick_fit import JSON_UNITS
+
+        result = fit.as_dict()
+        result["units"] = json_units(result, JSON_UNITS)  # the drift's and the combination's keys too
+        emit_json(result)
     else:
         click.echo(report)
     _exit_if_failed(fit, output)

@@ -72,9 +72,16 @@ STICK_OPTIONAL_CELLS = (
 CYCLES_COLUMNS = {"critical_stress": "start_stress", "critical_stress_uncertainty": "start_stress_uncertainty"}
 #: Columns of that table the stick fit does not use (times within the record, errors, the slip, the model's Vs).
 CYCLES_IGNORED = (
-    "complete", "start_time", "peak_time", "end_time", "stick_slope_stderr", "stiffness_stderr",
+    "complete", "peak_time", "end_time", "stick_slope_stderr", "stiffness_stderr",
     "model_jump_velocity", "slip_time", "period", "stress_drop",
 )  # fmt: skip
+#: Columns only analyze's cycles table has: a table with any of them (and without the columns Table 1's reader
+#: knows alone) is read as a cycles table, with or without its critical_stress (round 29: a table whose
+#: critical_stress columns were deleted to fit without the measured start stresses was "unknown column 'complete'").
+CYCLES_ONLY = ("critical_stress", "critical_stress_uncertainty", "start_time", *CYCLES_IGNORED)
+#: The time of each cycle's start within its record (s): read from a cycles table to date its start stress
+#: (the drift check of fit stick, docs/fitting.md); not a fit input.
+CYCLE_START_TIME = "start_time"
 
 
 @dataclass(frozen=True)
@@ -258,7 +265,7 @@ def read_stick_data(path: str | Path) -> StickData:
         )
     except DataError:
         names = header_names(path)
-        if not {"critical_stress", "complete"} <= set(names):
+        if not set(CYCLES_ONLY) & set(names):
             raise
         return _read_cycles_table(path, names)
     return dataclasses.replace(_validated_stick(table), read_notes=table.notes)
@@ -274,18 +281,21 @@ def _read_cycles_table(path: str | Path, names: Sequence[str]) -> StickData:
         )
     dimensions = {n: d for n, d in STICK_COLUMNS.items() if n in names and n not in ("start_stress", "jump_velocity")}
     dimensions.pop("start_stress_uncertainty", None)
-    dimensions["critical_stress"] = "stress"
-    if "critical_stress_uncertainty" in names:  # written by analyze since it reports its corners' uncertainty
-        dimensions["critical_stress_uncertainty"] = "stress"
+    for name in ("critical_stress", "critical_stress_uncertainty"):  # both optional: deleted, the sticks start
+        if name in names:  # from the bond parameters' σc (docs/fitting.md)
+            dimensions[name] = "stress"
+    if CYCLE_START_TIME in names:
+        dimensions[CYCLE_START_TIME] = "time"
     allowed = tuple(n for n in dimensions if n != "pulling_velocity")
     table = read_table(path, dimensions, required=["pulling_velocity", "stick_time"], allow_missing=allowed,
                        ignore=CYCLES_IGNORED)  # fmt: skip
     whole = np.isfinite(table["stick_time"])
     columns = {CYCLES_COLUMNS.get(n, n): v[whole] for n, v in table.columns.items()}
-    notes = [
-        *table.notes,
-        f"{source}: the cycles table of stickslip analyze; its critical_stress (σc) is each row's start_stress",
-    ]
+    if "critical_stress" in names:
+        said = "its critical_stress (σc) is each row's start_stress"
+    else:
+        said = "without its critical_stress column: no row has a measured start stress"
+    notes = [*table.notes, f"{source}: the cycles table of stickslip analyze; {said}"]
     if not whole.all():
         cut = ", ".join(str(r) for r in table.rows[~whole])
         notes.append(f"{source}: row(s) {cut} left out: cycles cut by the record's ends or a gap in it (no stick time)")
@@ -502,6 +512,6 @@ def _validated_stick(table: Table) -> StickData:
                 f"{table.source}: row {table.rows[k]}, column 'peak_stress': {peak[k]:g} Pa is not above the"
                 f" start_stress {start[k]:g} Pa of the same row"
             )
-    kept = ("cycle", "stick_slope", "stiffness", "jump_velocity", *STICK_UNCERTAINTIES)
+    kept = ("cycle", "stick_slope", "stiffness", "jump_velocity", *STICK_UNCERTAINTIES, CYCLE_START_TIME)
     extra = {name: table[name] for name in kept if name in table}
     return StickData(table["pulling_velocity"], table["stick_time"], peak, start, table.rows, extra, table.source)

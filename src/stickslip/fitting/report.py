@@ -167,6 +167,20 @@ def goodness_line(chi_square: float, dof: int, noise_estimated: bool) -> str:
     return f"- χ² = {_g(chi_square)}, degrees of freedom {dof}, reduced χ² = {_g(chi_square / dof if dof else None)}"
 
 
+#: How the stick report names where the sticks start (``fit stick --start-stress``).
+_START_MODES = {
+    "measured": "measured (each row's start_stress; σc of the bond parameters where a cell is empty)",
+    "model": "the bond parameters' σc in every row (--start-stress model)",
+}
+
+
+def _stick_combinations(combinations: Sequence[Estimate], level: str) -> list[str]:
+    if not combinations:
+        return []
+    header = ["combination", "value", "std. error", f"{level} interval", "unit", "status"]
+    return ["## Identifiable combination", "", *_table(header, estimate_rows(combinations, with_key=False)), ""]
+
+
 def stick_report(fit: Any) -> str:
     """The Markdown report of a :class:`stickslip.fitting.StickFit`."""
     level = f"{100 * fit.level:g} %"
@@ -193,10 +207,13 @@ def stick_report(fit: Any) -> str:
         f"- data: `{data.source}`, {fit.rows_line()}",
         f"- noise: {fit.noise}",
         goodness_line(fit.chi_square, fit.dof, True),
-        f"- intervals: {level}, symmetric in ln (Wald)",
+        f"- intervals: {level}, symmetric in ln (Wald)"
+        + (f"; {fit.intervals_note}" if getattr(fit, "intervals_note", "") else ""),
+        *([f"- start stresses: {_START_MODES[fit.start_stress_mode]}"] if hasattr(fit, "start_stress_mode") else []),
         "",
         *_messages(fit.messages),
         *_parameters(fit.estimates, level),
+        *_stick_combinations(getattr(fit, "combinations", ()), level),
         *_correlation(fit.free_keys, fit.correlation),
         "## Rows",
         "",

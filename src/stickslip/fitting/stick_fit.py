@@ -1,7 +1,8 @@
 """Fit the stick-phase parameters (Eq 15) to measured stick times, like the paper's Table 1.
 
-Each row is one stick phase from ``start_stress`` (sigma_c where the cell is empty) at the measured loading rate
-``stick_slope``, else K V0 (Eq 17); the model's t_s and sigma_s come from
+Each row is one stick phase from ``start_stress`` (sigma_c of the bond parameters where the cell is empty, or in
+every row with ``start_stress="model"``: for start stresses a sensor's drift or offset moved) at the measured
+loading rate ``stick_slope``, else K V0 (Eq 17); the model's t_s and sigma_s come from
 :func:`stickslip.quasistatic.stick.stick_phase`.  Nc0, uc/tau and tau_a are fitted as ln-values on the residuals
 ln(model/measured); a direction the data do not determine is fixed with a message, as the steady fit does
 (docs/fitting.md).
@@ -21,12 +22,13 @@ from scipy.special import stdtrit
 
 from ..columns import with_units
 from ..errors import DataError, ParameterError
-from ..parameters import Parameters, key_dimension, load_parameters, replace
+from ..parameters import Parameters, available_parameter_sets, key_dimension, load_parameters, replace
 from ..quasistatic.critical import critical_point
 from ..reprs import compact_repr
 from ..units import to_si
 from . import identify
-from .data import StickData, read_stick_data, requested_rows
+from .data import CYCLE_START_TIME, StickData, read_stick_data, requested_rows
+from .input_uncertainty import FitCovariance, matching_covariance, read_fit_covariance
 from .problem import JACOBIAN_STEP, SEARCH_BOX
 from .results import Estimate, human, log_interval, unusable
 from .scatter import STICK_OUTLIER_SPREADS, outlying
@@ -47,6 +49,47 @@ FIRST_PASS_EVALUATIONS = 4
 SCAN_FACTORS = (0.25, 0.4, 0.63, 0.8, 1.0, 1.25, 1.6, 2.5, 4.0)
 #: Confidence levels the fit's intervals may have (``fit stick --level`` takes the same: one range, tested).
 LEVEL_RANGE = (0.5, 0.999)
+#: Where each stick starts (``fit stick --start-stress``): "measured", the table's start_stress (σc of the bond
+#: parameters where a cell is empty); "model", σc of the bond parameters in every row (the table's are compared).
+START_STRESS_MODES = ("measured", "model")
+
+
+@dataclass(frozen=True)
+class StartDrift:
+    """A trend of the measured start stresses within one pulling velocity's rows (:func:`_start_drifts`)."""
+
+    pulling_velocity: float  # m/s
+    rows: tuple[int, ...]  # file rows, in the order of the trend's axis
+    drift: float  # Pa, from the first row to the last along the fitted line
+    rate: float | None  # Pa/s where the table dates its cycles (start_time), else None
+    t_value: float  # the trend's slope over its standard error
+    scatter: float  # Pa, the start stresses' scatter about the line
+    sensitivity: float  # d ln t_s / d sigma_0 of the model (1/Pa), median over the rows
+    time_scatter: float  # relative scatter of the rows' stick times (about their mean)
+    loading_rate: float | None = None  # Pa/s, the rows' median measured stick_slope (None: not measured)
+
+    def as_dict(self) -> dict[str, Any]:
+        """The drift in the JSON's names (their units: :data:`JSON_UNITS`)."""
+        return {
+            "pulling_velocity": self.pulling_velocity,
+            "rows": list(self.rows),
+            "drift": self.drift,
+            "drift_rate": self.rate,
+            "t_value": self.t_value,
+            "scatter": self.scatter,
+            "sensitivity": self.sensitivity,
+            "relative_time_scatter": self.time_scatter,
+            "loading_rate": self.loading_rate,
+        }
+
+
+#: Units of the keys of :meth:`StickFit.as_dict` that the column registry does not name (``fit stick --json``'s
+#: ``units`` map): the start stresses' drift (Pa over the rows, Pa/s, the t value of its slope, the scatter about
+#: it, d ln t_s/d sigma_0, the stick times' relative scatter) and the combination Nc0·kT/lambda.
+JSON_UNITS = {
+    "drift": "Pa", "drift_rate": "Pa/s", "t_value": "1", "scatter": "Pa", "sensitivity": "1/Pa",
+    "relative_time_scatter": "1", "stick_stress_scale": "Pa",
+}  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -78,6 +121,19 @@ class StickFit:
     #: velocities whose mean's error was floored by the table's own uncertainties:
     #: (pulling velocity m/s, floor, scatter of the mean; both relative, in ln t_s)
     floors: tuple[tuple[float, float, float], ...] = ()
+    #: where the sticks start (START_STRESS_MODES)
+    start_stress_mode: str = "measured"
+    #: Nc0·kT/λ, the combination the stick times determine whatever λ is (derived; Eq 15 holds Nc0 only there)
+    combinations: tuple[Estimate, ...] = ()
+    #: what the intervals are conditional on, or whose uncertainty they include (one sentence)
+    intervals_note: str = ""
+    #: the bond-parameter keys whose covariance (written by fit steady -o) the intervals include (empty: conditional)
+    input_keys: tuple[str, ...] = ()
+    #: the covariance of the fitted ln-parameters with the bond parameters held fixed (= ``covariance`` when
+    #: ``input_keys`` is empty)
+    conditional_covariance: np.ndarray | None = None
+    #: trends of the measured start stresses within a velocity's rows beyond their scatter (a sensor drift?)
+    start_drifts: tuple[StartDrift, ...] = ()
 
     __repr__ = compact_repr  # counts, not hundreds of array elements
 
@@ -129,6 +185,14 @@ class StickFit:
             "status": self.status,
             **({"reason": self.reason} if self.reason else {}),
             "parameters": {e.key: e.as_dict() for e in self.estimates},
+            "combinations": {e.key: e.as_dict() | {"symbol": e.symbol} for e in self.combinations},
+            "start_stress": self.start_stress_mode,
+            "intervals": {
+                "conditional_on_bond_parameters": not self.input_keys,
+                "bond_parameter_uncertainty_of": list(self.input_keys),
+                "note": self.intervals_note,
+            },
+            "start_stress_drifts": [d.as_dict() for d in self.start_drifts],
             "chi_square": self.chi_square,
             "dof": self.dof,
             "reduced_chi_square": self.reduced_chi_square,
@@ -354,6 +418,8 @@ def fit_stick(
     exclude_rows: Sequence[int] = (),
     include_steady: bool = False,
     level: float = 0.95,
+    start_stress: str = "measured",
+    bond_covariance: FitCovariance | bool | None = None,
 ) -> StickFit:
     """Fit Nc0, uc/tau and the stick aging time (Eq 15) to measured stick times (module docstring).
 
@@ -362,15 +428,34 @@ def fit_stick(
     stick keys at given values; ``free`` lists keys the user insists on
     fitting (they are fixed only if nothing else pins an undetermined direction); ``level``, the intervals'
     confidence level, is taken from LEVEL_RANGE (0.5-0.999), as ``--level``.
+
+    ``start_stress``: "measured" (each row's start_stress; sigma_c of the bond parameters where empty) or "model"
+    (sigma_c of the bond parameters in every row: for start stresses a sensor's drift or offset has moved; Eq 15
+    turns 1 Pa of start stress into ~1 % of t_s).  ``bond_covariance``: the covariance of the bond parameters'
+    ln-values that ``fit steady -o`` writes into its file (:mod:`stickslip.fitting.input_uncertainty`), carried
+    into the intervals; None reads it from ``params`` where that is such a file, False holds the bond parameters
+    exact (the intervals are then conditional on them, and the result says so).
     """
     if isinstance(free, str):  # one key: iterating the string would give its characters
         free = [free]
+    if start_stress not in START_STRESS_MODES:
+        raise ParameterError(
+            f"start_stress: expected one of {', '.join(START_STRESS_MODES)} (as --start-stress), got {start_stress!r}"
+        )
     data = table if isinstance(table, StickData) else read_stick_data(table)
     notes = data.notes()
     low, high = LEVEL_RANGE
     number = isinstance(level, (int, float, np.integer, np.floating)) and not isinstance(level, bool)
     if not (number and low <= level <= high):
         raise ParameterError(f"level: expected a confidence level from {low:g} to {high:g} (as --level), got {level!r}")
+    if bond_covariance is None:  # a file's, not a built-in set's (they carry none)
+        builtin = isinstance(params, str) and params in available_parameter_sets()
+        bond_covariance = read_fit_covariance(params if isinstance(params, (str, Path)) and not builtin else None)
+    elif bond_covariance is True or not (bond_covariance is False or isinstance(bond_covariance, FitCovariance)):
+        raise ParameterError(
+            f"bond_covariance: expected a FitCovariance, None (read from the params file) or False, got"
+            f" {bond_covariance!r}"
+        )
     base = params if isinstance(params, Parameters) else load_parameters(params or "gelatin-glass")
     fixed: dict[str, float] = {}
     for key, raw in (fix or {}).items():
@@ -384,8 +469,9 @@ def fit_stick(
     keys = [k for k in STICK_KEYS if k not in fixed]
     used, excluded, sigma_c, messages = _select_rows(data, base, exclude_rows, include_steady)
     messages[:0] = notes
-    start, rate = _start_column(data, sigma_c), _rate_column(data, base)
-    rows, fitted_peak = _rows(data, used, start, rate, sigma_c, messages)
+    start, rate = _start_column(data, sigma_c, start_stress), _rate_column(data, base)
+    from_model = _from_model(data, start_stress)  # rows whose stick starts at the bond parameters' σc
+    rows, fitted_peak = _rows(data, used, start, rate, sigma_c, messages, start_stress)
     n_obs = rows.stick_time.size + (0 if rows.peak is None else rows.peak.size)
     if rows.stick_time.size < 2:
         raise DataError(f"{data.source}: {rows.stick_time.size} usable row(s); need at least 2 stick phases to fit")
@@ -425,10 +511,17 @@ def fit_stick(
     theta = np.array([math.log(current.as_dict()[k]) for k in keys])
     jac = _jacobian(current, keys, theta, rows) if keys else np.zeros((n_obs, 0))
     covariance, floors = np.zeros((0, 0)), []
-    own = _floors(current, rows)  # the table's own uncertainties in ln (zeros where it gives none)
+    own = _floors(current, rows, from_model[used])  # the table's own uncertainties in ln (zeros where none)
     if keys:  # the scatter's covariance, floored at each velocity by the table's own uncertainties (if any)
         covariance, floors = _covariance(jac, scale2, own, _blocks(rows))
     messages.extend(_floor_messages(floors))
+    conditional = covariance
+    inputs, unused_note = matching_covariance(bond_covariance or None, base)
+    if unused_note:
+        messages.append(unused_note)
+    propagated = _bond_propagation(current, keys, rows, from_model[used], inputs, jac)
+    if propagated is not None:
+        covariance = covariance + propagated.stick
     sd = np.sqrt(np.clip(np.diag(covariance), 0, np.inf))
     correlation = covariance / np.outer(sd, sd) if keys else np.zeros((0, 0))
     q = float(stdtrit(max(dof, 1), 0.5 + level / 2))  # Student-t quantile (scipy.stats costs 0.2 s to import)
@@ -442,6 +535,11 @@ def fit_stick(
         else:
             reason = "fixed by request" if key in fixed else "not determined by the data; fixed at its input value"
             estimates.append(Estimate(key, identify.SYMBOLS[key], dim, value, status="fixed", note=reason))
+    combinations = _combinations(current, keys, conditional, propagated, q)
+    source = str(params) if isinstance(params, (str, Path)) else f"the set {base.name!r}"
+    source = inputs.source if propagated is not None and inputs is not None and inputs.source else source
+    intervals_note = _intervals_note(current, keys, conditional, propagated, bool(np.any(from_model[used])),
+                                     sigma_c, source, inputs is not None)  # fmt: skip
     times, peaks, problems = _model(current, rows)
     model_t = np.full(len(data), np.nan)
     model_s = np.full(len(data), np.nan)
@@ -452,8 +550,18 @@ def fit_stick(
         messages.append("no degrees of freedom left: the noise cannot be estimated and the errors are undefined")
     noise = f"relative (ln), estimated from the scatter: {100 * math.sqrt(scale2):.3g} %" if dof > 0 else "undefined"
     problems = _stick_problems(rows, current, keys, fixed, dof, scale2, problems, own[: rows.stick_time.size])
+    sensitivity = _start_sensitivity(current, rows)
+    drifts = _start_drifts(data, used, from_model, sensitivity) if start_stress == "measured" else []
+    messages.extend(_offset_note(data, used, sigma_c, sensitivity, start_stress))
+    if drifts:
+        advice = _drift_advice(drifts, sigma_c)
+        if problems:  # the likely cause, said in the reason
+            problems.append(advice)
+        else:
+            messages.append(f"warning: {advice}")
     if problems:
         estimates = [unusable(e, "the fit failed") for e in estimates]
+        combinations = [unusable(e, "the fit failed") for e in combinations]
     return StickFit(
         data=data,
         parameters=current,
@@ -478,12 +586,22 @@ def fit_stick(
         status="failed" if problems else "ok",
         reason="; ".join(problems),
         floors=tuple(floors),
+        start_stress_mode=start_stress,
+        combinations=tuple(combinations),
+        intervals_note=intervals_note,
+        input_keys=() if propagated is None else propagated.keys,
+        conditional_covariance=conditional,
+        start_drifts=tuple(drifts),
     )
 
 
-def _floors(params: Parameters, rows: _Rows) -> np.ndarray:
+def _floors(params: Parameters, rows: _Rows, from_model: np.ndarray | None = None) -> np.ndarray:
     """Each observation's own systematic standard uncertainty in ln (the stick times', then the peak stresses' when
     fitted; zeros where the table gives none), from the table's ``*_uncertainty`` columns (docs/fitting.md).
+
+    ``from_model``: the rows whose stick starts at the bond parameters' σc, not at the measured start stress
+    (--start-stress model): the start stress's own uncertainty does not enter their start, and a start corner's
+    time uncertainty moves only their measured t_s (it no longer cancels against a measured σc).
 
     The start stress's is carried into ln t_s by the model's own derivative d ln t_s / d sigma_0 and added in
     quadrature to the stick time's.  Where the start and the peak stress both have one and the peaks are not
@@ -504,18 +622,23 @@ def _floors(params: Parameters, rows: _Rows) -> np.ndarray:
         times = _stick_times([params], rows)[0]
         up, down = (_stick_times([params], r)[0] for r in shifted)
         dlog_t = (np.log(up) - np.log(down)) / (2 * step)
-        floors = np.hypot(dlog_t * start_err, time_err / rows.stick_time)
+        # a start at the model's σc does not carry the measured start stress's uncertainty
+        own_start = start_err if from_model is None else np.where(from_model, 0.0, start_err)
+        floors = np.hypot(dlog_t * own_start, time_err / rows.stick_time)
         if rows.peak is None and rows.start_err is not None and rows.peak_err is not None:
             # the corners of a measured stick line (analyze's cycles): sigma_c = L(t0), sigma_s = L(t1), t_s = t1 - t0,
             # so an uncertainty dt0 of the start moves sigma_c by rate dt0 and t_s by -dt0 together, and
             # ln(model/measured) by dt0 (rate d ln t_s/d sigma_0 + 1/t_s): the two partly cancel
             start_time, end_time = start_err / rows.rate, peak_err / rows.rate
             corners = np.hypot(start_time * (rows.rate * dlog_t + 1.0 / rows.stick_time), end_time / rows.stick_time)
+            if from_model is not None:  # a start at the model's σc: the start corner's time moves t_s alone
+                alone = np.hypot(start_time, end_time) / rows.stick_time
+                corners = np.where(from_model, alone, corners)
             floors = np.where((start_err > 0) & (peak_err > 0), corners, floors)
         if rows.peak is not None:
             model_peak = rows.start + rows.rate * times
             dlog_peak = (1.0 + rows.rate * (up - down) / (2 * step)) / model_peak
-            floors = np.concatenate([floors, np.hypot(dlog_peak * start_err, peak_err / rows.peak)])
+            floors = np.concatenate([floors, np.hypot(dlog_peak * own_start, peak_err / rows.peak)])
     # the columns bound a systematic error (it lies within +-u); its standard uncertainty is u/sqrt(3) (uniform); a
     # row whose model stick time is not finite (no stick from its start: silenced above) keeps no floor, as before
     return np.where(np.isfinite(floors), floors, 0.0) / math.sqrt(3.0)
@@ -800,11 +923,23 @@ def _check_stick_key(key: str, option: str) -> None:
         )
 
 
-def _start_column(data: StickData, sigma_c: float | None) -> np.ndarray:
-    start = data.start_stress if data.start_stress is not None else np.full(len(data), np.nan)
-    missing = ~np.isfinite(start)
+def _from_model(data: StickData, mode: str) -> np.ndarray:
+    """The rows whose stick starts at the bond parameters' σc: all with --start-stress model, else the empty cells."""
+    if mode == "model" or data.start_stress is None:
+        return np.ones(len(data), dtype=bool)
+    return ~np.isfinite(data.start_stress)
+
+
+def _start_column(data: StickData, sigma_c: float | None, mode: str = "measured") -> np.ndarray:
+    missing = _from_model(data, mode)
+    start = np.full(len(data), np.nan) if data.start_stress is None else np.array(data.start_stress, dtype=float)
     if np.any(missing):
         if sigma_c is None:
+            if mode == "model":
+                raise ParameterError(
+                    "--start-stress model: the bond parameters have no critical stress (no stick-slip: σ(V) has no"
+                    " minimum) to start the sticks from; give the measured start stresses (--start-stress measured)"
+                )
             raise DataError(
                 f"{data.source}: row {data.rows[np.nonzero(missing)[0][0]]}, column 'start_stress' is empty and the"
                 " bond parameters have no critical stress to start from; give the start stress"
@@ -822,9 +957,22 @@ def _rate_column(data: StickData, params: Parameters) -> np.ndarray:
 
 
 def _rows(
-    data: StickData, used: np.ndarray, start: np.ndarray, rate: np.ndarray, sigma_c: float | None, messages: list[str]
+    data: StickData,
+    used: np.ndarray,
+    start: np.ndarray,
+    rate: np.ndarray,
+    sigma_c: float | None,
+    messages: list[str],
+    mode: str = "measured",
 ) -> tuple[_Rows, bool]:
-    if data.start_stress is None or np.any(~np.isfinite(data.start_stress[used])):
+    if mode == "model":
+        have = 0 if data.start_stress is None else int(np.count_nonzero(np.isfinite(data.start_stress[used])))
+        unused = f": the table's start stresses ({have} rows) are not used" if have else ""
+        messages.append(
+            f"every stick starts at the critical stress σc = {human(sigma_c or 0.0, 'stress')} of the bond parameters"
+            f" (--start-stress model){unused}"
+        )
+    elif data.start_stress is None or np.any(~np.isfinite(data.start_stress[used])):
         messages.append(
             f"rows without start_stress start at the critical stress σc = {human(sigma_c or 0.0, 'stress')} of the"
             " bond parameters"
@@ -834,7 +982,11 @@ def _rows(
         messages.append("loading rate of each stick phase from its measured stick_slope (instead of K·V0 of Eq 17)")
     peak = None
     fitted_peak = False
-    if data.peak_stress is not None and not measured:
+    if data.peak_stress is not None and mode == "model":
+        messages.append(
+            "peak stresses not fitted: with --start-stress model the table's stresses are not taken as absolute"
+        )
+    elif data.peak_stress is not None and not measured:
         have = np.isfinite(data.peak_stress)
         if np.any(have & used):
             if not np.all(have[used]):
@@ -865,3 +1017,282 @@ def _rows(
         err("peak_stress_uncertainty"),
     )
     return rows, fitted_peak
+
+
+# --- the start stresses: drift and offset (round 29) --------------------------------------------------------------
+
+#: Fewest rows at one velocity whose start stresses are tested for a trend (two degrees of freedom).
+DRIFT_MIN_ROWS = 4
+#: Least effect on ln t_s (relative) a drift or offset of the start stresses must have to be said: below it the
+#: start stresses move the model's stick times less than stick times are measured to.
+START_EFFECT_FLOOR = 1e-2
+#: How many times the stick times' own scatter a drift's effect must exceed to be said (else the stick times would
+#: show it themselves).
+DRIFT_EFFECT_FACTOR = 3.0
+#: How many standard errors of their mean the table's start stresses must lie from the model's σc to be said.
+OFFSET_SIGNIFICANCE = 4.0
+
+
+def _start_sensitivity(params: Parameters, rows: _Rows) -> np.ndarray:
+    """d ln t_s / d sigma_0 of each row (1/Pa) at ``params``: how Eq 15 turns a start stress into a stick time."""
+    step = FLOOR_STEP * rows.start
+    shifted = [dataclasses.replace(rows, start=rows.start + sign * step) for sign in (1.0, -1.0)]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        up, down = (_stick_times([params], r)[0] for r in shifted)
+        return (np.log(up) - np.log(down)) / (2 * step)
+
+
+def _start_drifts(
+    data: StickData, used: np.ndarray, from_model: np.ndarray, sensitivity: np.ndarray
+) -> list[StartDrift]:
+    """The velocities whose measured start stresses trend along the record (start_time where the table has it,
+    else the row order) beyond their scatter (t test of the slope, p < STICK_SIGNIFICANCE), where the trend moves
+    the model's stick times by more than START_EFFECT_FLOOR and DRIFT_EFFECT_FACTOR times the rows' own scatter
+    of ln t_s: a sensor's drift that the stick times, measured as differences of times, do not carry."""
+    from scipy.special import stdtr
+
+    if data.start_stress is None:
+        return []
+    index = np.nonzero(used)[0]
+    per_row = np.full(len(data), np.nan)
+    per_row[index] = sensitivity
+    when = data.extra.get(CYCLE_START_TIME)
+    out = []
+    for group in _groups(data.pulling_velocity[index]):
+        k = index[group]
+        k = k[np.isfinite(data.start_stress[k]) & ~from_model[k]]
+        if k.size < DRIFT_MIN_ROWS:
+            continue
+        dated = when is not None and bool(np.all(np.isfinite(when[k])))
+        x = np.asarray(when[k] if dated else data.rows[k], dtype=float)
+        order = np.argsort(x, kind="stable")
+        k, x = k[order], x[order]
+        y = data.start_stress[k]
+        centred = x - x.mean()
+        sxx = float(centred @ centred)
+        if not sxx > 0:
+            continue
+        slope = float(centred @ (y - y.mean())) / sxx
+        rest = y - y.mean() - slope * centred
+        s2 = float(rest @ rest) / (k.size - 2)
+        se = math.sqrt(s2 / sxx)
+        t_value = abs(slope) / se if se > 0 else math.inf
+        if not 2.0 * float(stdtr(k.size - 2, -t_value)) < STICK_SIGNIFICANCE:
+            continue
+        drift = slope * float(x[-1] - x[0])
+        gain = per_row[k][np.isfinite(per_row[k])]
+        if not gain.size:
+            continue
+        gain_median = float(np.median(gain))
+        time_scatter = float(np.std(np.log(data.stick_time[k]), ddof=1))
+        effect = abs(drift * gain_median)
+        if not effect > max(START_EFFECT_FLOOR, DRIFT_EFFECT_FACTOR * time_scatter):
+            continue
+        rows = tuple(int(r) for r in data.rows[k])
+        velocity = float(data.pulling_velocity[k[0]])
+        measured = data.extra.get("stick_slope")
+        loading = None if measured is None or not np.any(np.isfinite(measured[k])) else float(np.nanmedian(measured[k]))
+        out.append(StartDrift(velocity, rows, drift, slope if dated else None, t_value, math.sqrt(s2), gain_median,
+                              time_scatter, loading))  # fmt: skip
+    return sorted(out, key=lambda d: -abs(d.drift * d.sensitivity))
+
+
+def _drift_advice(drifts: Sequence[StartDrift], sigma_c: float | None) -> str:
+    """One sentence: which velocities' start stresses drift, by how much, what Eq 15 makes of it, and what to do."""
+    worst = drifts[0]
+    span = f"rows {worst.rows[0]} to {worst.rows[-1]}"
+    rate = f", {worst.rate:+.2g} Pa/s" if worst.rate is not None else ""
+    others = [f"{d.drift:+.2g} Pa at {human(d.pulling_velocity, 'velocity', 3)}" for d in drifts[1:3]]
+    if len(drifts) > 3:
+        others.append(f"{len(drifts) - 3} more")
+    also = f" ({', '.join(others)})" if others else ""
+    where = f"at {len(drifts)} velocities" if len(drifts) > 1 else "within one velocity's rows"
+    start = f" = {human(sigma_c, 'stress', 4)}" if sigma_c is not None else ""
+    effect = abs(worst.drift * worst.sensitivity)
+    return (
+        f"the start stresses drift along the record {where}, far beyond their scatter: those of the"
+        f" {human(worst.pulling_velocity, 'velocity', 3)} rows by {worst.drift:+.2g} Pa ({span}{rate}; scatter"
+        f" about the trend {worst.scatter:.2g} Pa){also} (a sensor drift or offset?); Eq 15 turns 1 Pa of start"
+        f" stress into {100 * abs(worst.sensitivity):.2g} % of ts there, {100 * effect:.2g} % over these rows,"
+        f" whose measured stick times scatter by {100 * worst.time_scatter:.2g} %: fit without"
+        f" them with --start-stress model (each stick from the bond parameters' σc{start})"
+        + (
+            f"; the measured stick_slope carries a sensor's drift too ({worst.rate:+.2g} of"
+            f" {worst.loading_rate:.3g} Pa/s there): correct it where the drift is the sensor's"
+            if worst.rate is not None and worst.loading_rate is not None
+            else ""
+        )
+    )
+
+
+def _offset_note(
+    data: StickData, used: np.ndarray, sigma_c: float | None, sensitivity: np.ndarray, mode: str
+) -> list[str]:
+    """A note where the table's start stresses lie off the bond parameters' σc by more than OFFSET_SIGNIFICANCE
+    standard errors of their mean and by more than START_EFFECT_FLOOR in ln t_s (a sensor's offset, not zeroed?)."""
+    if data.start_stress is None or sigma_c is None:
+        return []
+    measured = data.start_stress[used]
+    have = np.isfinite(measured)
+    gain = sensitivity[have & np.isfinite(sensitivity)]
+    if np.count_nonzero(have) < 2 or not gain.size:
+        return []
+    values = measured[have]
+    offset = float(np.mean(values)) - sigma_c
+    sem = float(np.std(values, ddof=1)) / math.sqrt(values.size)
+    per_pascal = abs(float(np.median(gain)))
+    if not (abs(offset) * per_pascal > START_EFFECT_FLOOR and abs(offset) > OFFSET_SIGNIFICANCE * sem):
+        return []
+    where = f"{abs(offset):.3g} Pa {'above' if offset > 0 else 'below'}"
+    said = (
+        f"the table's start stresses (mean {human(float(np.mean(values)), 'stress', 5)} over {values.size} rows,"
+        f" standard error {sem:.2g} Pa) lie {where} the critical stress σc = {human(sigma_c, 'stress', 5)} of the bond"
+        f" parameters; Eq 15 turns 1 Pa of start stress into {100 * per_pascal:.2g} % of ts"
+    )
+    if mode == "model":
+        return [f"{said} (not used: --start-stress model): a force sensor's offset, or bond parameters of another"
+                " sample?"]  # fmt: skip
+    return [
+        f"{said}, {100 * abs(offset) * per_pascal:.2g} % here.  The fit takes them as absolute: a force sensor's"
+        " offset (not zeroed with the block unloaded) moves uc/τ and Nc0 without failing the fit; if the forces have"
+        " one, or the bond parameters are another sample's, --start-stress model starts every stick from σc"
+    ]
+
+
+# --- the bond parameters' uncertainty (round 29) ------------------------------------------------------------------
+
+#: Step in the ln of a bond parameter of the derivatives that carry its uncertainty into the stick fit.
+BOND_STEP = 1e-3
+
+
+@dataclass(frozen=True)
+class _Propagation:
+    keys: tuple[str, ...]  # the bond-parameter keys carried
+    sensitivity: np.ndarray  # d theta / d ln p: free stick ln-parameters by keys
+    log_force_sensitivity: np.ndarray  # d ln(lambda/kT) / d ln p
+    critical_stress: np.ndarray  # d sigma_c / d ln p (Pa), zeros where no row starts at the model's σc
+    inputs: np.ndarray  # the covariance of ln p
+    stick: np.ndarray  # S inputs S': what it adds to the fitted ln-parameters' covariance
+
+
+def _bond_propagation(
+    params: Parameters,
+    keys: Sequence[str],
+    rows: _Rows,
+    from_model: np.ndarray,
+    inputs: FitCovariance | None,
+    jac: np.ndarray,
+) -> _Propagation | None:
+    """The bond parameters' covariance (``inputs``, ln-values) carried into the fitted stick ln-parameters to first
+    order: d theta/d ln p = -(J'J)^-1 J' dr/d ln p at the optimum, dr/d ln p by central differences (through
+    lambda/kT, and sigma_c where a row starts at the model's)."""
+    if inputs is None or not keys:
+        return None
+    carried = [k for k in inputs.keys if k not in STICK_KEYS]
+    if not carried:
+        return None
+    at = [inputs.keys.index(k) for k in carried]
+    normal = np.linalg.pinv(jac.T @ jac)
+    sens = np.zeros((len(keys), len(carried)))
+    log_b = np.zeros(len(carried))
+    d_sigma = np.zeros(len(carried))
+    value = params.as_dict()
+    for j, key in enumerate(carried):
+        residuals, logs, sigmas = [], [], []
+        for sign in (1.0, -1.0):
+            shifted = params.with_overrides({key: value[key] * math.exp(sign * BOND_STEP)})
+            these = rows
+            if np.any(from_model):
+                point = critical_point(shifted)
+                if not point.exists:
+                    return None
+                these = dataclasses.replace(rows, start=np.where(from_model, point.stress, rows.start))
+                sigmas.append(point.stress)
+            residuals.append(_residuals(shifted, these))
+            logs.append(math.log(shifted.bonds.force_sensitivity))
+        dr = (residuals[0] - residuals[1]) / (2 * BOND_STEP)
+        sens[:, j] = -normal @ (jac.T @ dr)
+        log_b[j] = (logs[0] - logs[1]) / (2 * BOND_STEP)
+        d_sigma[j] = (sigmas[0] - sigmas[1]) / (2 * BOND_STEP) if sigmas else 0.0
+    sigma = inputs.covariance[np.ix_(at, at)]
+    return _Propagation(tuple(carried), sens, log_b, d_sigma, sigma, sens @ sigma @ sens.T)
+
+
+#: The combination Eq 15 determines: Nc0 enters it only through (lambda/kT)/Nc0.
+STRESS_SCALE = ("stick_stress_scale", "Nc0·kT/λ")
+
+
+def _combinations(
+    params: Parameters, keys: Sequence[str], conditional: np.ndarray, propagated: _Propagation | None, q: float
+) -> list[Estimate]:
+    """Nc0·kT/lambda (Pa): the stress at which each attached chain carries kT/lambda, what the stick times determine
+    of Nc0 whatever lambda is; its error from the fit (and from the bond parameters where carried)."""
+    if "stick.attached_chains" not in keys:
+        return []
+    i = keys.index("stick.attached_chains")
+    value = params.stick.attached_chains / params.bonds.force_sensitivity
+    var = float(conditional[i, i])
+    if propagated is not None:
+        g = propagated.sensitivity[i] - propagated.log_force_sensitivity
+        var += float(g @ propagated.inputs @ g)
+    s = math.sqrt(max(var, 0.0))
+    key, symbol = STRESS_SCALE
+    note = "derived: what the stick times determine of Nc0 (Eq 15 holds it only through (λ/kT)/Nc0)"
+    return [Estimate(key, symbol, "stress", value, value * s, log_interval(value, s, q), status="derived", note=note)]
+
+
+def _intervals_note(
+    params: Parameters,
+    keys: Sequence[str],
+    conditional: np.ndarray,
+    propagated: _Propagation | None,
+    model_start: bool,
+    sigma_c: float | None,
+    source: str,
+    had_inputs: bool = False,
+) -> str:
+    """What the intervals are conditional on, or whose uncertainty they include (the report's and --json's line)."""
+    sc = f"σc = {human(sigma_c, 'stress', 4)}" if sigma_c is not None else "σc"
+    scale = params.stick.attached_chains / params.bonds.force_sensitivity
+    if propagated is None:
+        why = (
+            f"the covariance of them in {source} could not be carried into this fit"
+            if had_inputs
+            else f"{source} carries no covariance of them, as the file of fit steady -o does"
+        )
+        text = f"conditional on the bond parameters, held exact ({why})"
+        if "stick.attached_chains" in keys:
+            text += (
+                f": the stick times determine Nc0 only as Nc0·kT/λ = {human(scale, 'stress', 4)} (its interval holds"
+                " whatever λ is), so an error of x % in λ/kT is one of x % in Nc0"
+            )
+            text += (
+                f"; the sticks start from the bond parameters' {sc}, whose error moves all three"
+                if model_start
+                else ", and uc/τ and τa(stick) do not depend on λ"
+            )
+        return text
+    se = np.sqrt(np.clip(np.diag(conditional), 0, np.inf))
+    total = np.sqrt(np.clip(np.diag(conditional + propagated.stick), 0, np.inf))
+    changes = ", ".join(
+        f"{identify.SYMBOLS[k]} {100 * a:.2g} % → {100 * b:.2g} %" for k, a, b in zip(keys, se, total, strict=True)
+    )
+    inputs = []
+    if "bonds.activation_length" in propagated.keys:
+        j = propagated.keys.index("bonds.activation_length")
+        inputs.append(f"λ ±{100 * math.sqrt(propagated.inputs[j, j]):.2g} %")
+    if model_start:
+        g = propagated.critical_stress
+        inputs.append(f"{sc} ±{math.sqrt(max(float(g @ propagated.inputs @ g), 0.0)):.2g} Pa")
+    text = (
+        f"including the uncertainty of the bond parameters that fit steady wrote into {source} (the covariance of"
+        f" {len(propagated.keys)} keys{': ' + ', '.join(inputs) if inputs else ''}; to first order): standard errors"
+        f" of the ln-values, the fit's alone → with it: {changes}"
+    )
+    held = [k for k in ("bonds.activation_length", "bonds.temperature") if k not in propagated.keys]
+    if "stick.attached_chains" in keys and "bonds.activation_length" in held:
+        text += (
+            f"; λ is not among them (fit steady held it fixed), so Nc0 stays conditional on λ: the stick times"
+            f" determine Nc0·kT/λ = {human(scale, 'stress', 4)}"
+        )
+    return text
