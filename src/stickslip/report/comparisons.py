@@ -4,9 +4,11 @@ relative_difference = (computed - paper) / |paper| (None where the units differ)
 of :data:`CLASSES` (input, agrees within :data:`TOLERANCE`, within the scatter the paper states or shows, then paper
 error or the paper's unstated or inconsistent inputs, outside the measured range, an open difference, or model
 limitation, decided in that order: docs/report.md, "Classes, and the headline") and carries its reason in words
-(:func:`class_reason`).  A row that states again what another row states (the paper
-printing one number in two places) is shown and marked, and counted once: :func:`count_classes` counts distinct
-statements only.
+(:func:`class_reason`).  Table 1's Vs cells, the paper's own computation from their column, are classed by one
+rule, :data:`stickslip.report.paper.JUMP_VELOCITY_RULE`: a cell the model gives only at the σs its column's other
+cells give is the column disagreeing with itself (a paper error), never the model's difference.  A row that states
+again what another row states (the paper printing one number in two places) is shown and marked, and counted once:
+:func:`count_classes` counts distinct statements only.
 """
 
 from __future__ import annotations

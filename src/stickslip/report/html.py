@@ -17,7 +17,14 @@ from .errata import Errata
 from .figures import Curve, ReportFigure, data_uri
 from .formatting import DISPLAY_UNITS, format_parameter, format_percent, format_quantity
 from .markup import inline_html
-from .paper import TABLE1_COLUMNS, TABLE1_ROWS, PaperNumber
+from .paper import (
+    JUMP_VELOCITY_BRANCHES,
+    JUMP_VELOCITY_RULE,
+    TABLE1_COLUMNS,
+    TABLE1_ROWS,
+    PaperNumber,
+    jump_velocity_branch,
+)
 
 #: Opening of a wide table's box: it scrolls sideways when the window is too narrow, and then says so
 #: (style.css shows the line only while the box can scroll).
@@ -400,6 +407,41 @@ def stiffness_paragraph(rows: Sequence[Comparison]) -> str:
     )
 
 
+#: What each branch of the Vs rule (paper.JUMP_VELOCITY_RULE) says of its cells, for one cell and for several.
+_BRANCH_WORDS = {
+    "agrees": ("agrees at its printed σs", "agree at their printed σs"),
+    "column": ("is in a column that disagrees with itself, a paper error",
+               "are in columns that disagree with themselves, paper errors"),
+    "contradiction": ("is in a column whose measured cells contradict each other, a paper error",
+                      "are in columns whose measured cells contradict each other, paper errors"),
+    "model": ("is an open difference of the model", "are open differences of the model"),
+}  # fmt: skip
+
+
+def jump_velocity_paragraph(rows: Sequence[Comparison]) -> str:
+    """The one rule for Table 1's Vs cells (paper.JUMP_VELOCITY_RULE) and which cells each of its branches holds."""
+    branches: dict[str, list[str]] = {b: [] for b in JUMP_VELOCITY_BRANCHES}
+    for row in rows:
+        key = row.number.key
+        if not key.startswith("table1_jump_velocity_"):
+            continue
+        branch = jump_velocity_branch(key) or ("agrees" if row.classification == "agrees" else None)
+        if branch is None:  # a cell the rule does not settle is a "model limitation" row, shown as such
+            continue
+        v_um, cycle = key[len("table1_jump_velocity_") :].split("_")
+        branches[branch].append(f"{v_um} µm/s" + ("" if v_um == "350" else f" cycle {cycle}"))
+    counted = sum(len(cells) for cells in branches.values())
+    if not counted:
+        return ""
+    parts = []
+    for branch, cells in branches.items():
+        label = JUMP_VELOCITY_BRANCHES[branch][0]
+        where = f": {', '.join(cells)}" if cells and branch != "agrees" else ""
+        parts.append(f"{len(cells)} {_BRANCH_WORDS[branch][len(cells) != 1]} ({label}{where})")
+    text = f"{JUMP_VELOCITY_RULE}. Of Table 1's {counted} Vs cells, {'; '.join(parts)}."
+    return f"<p><strong>Jump velocity Vs, one rule.</strong> {escape(text)}</p>"
+
+
 def threshold_paragraph(
     thresholds: Mapping[str, StuckThreshold], jump_floor: float | None = None, curve_maximum: float | None = None
 ) -> str:
@@ -484,7 +526,7 @@ def render_report(
         elapsed=f"{elapsed:.1f}",
         summary=summary_sentence(comparisons),
         limitations=limitations_section(limitation),
-        stiffness=stiffness_paragraph(comparisons),
+        stiffness=f"{stiffness_paragraph(comparisons)}\n{jump_velocity_paragraph(comparisons)}",
         contents="\n".join(contents),
         figures="\n".join(figure_section(f) for f in figures),
         tolerance=f"{100 * TOLERANCE:g} %",

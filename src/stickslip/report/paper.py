@@ -377,17 +377,11 @@ TOLERANCE = 0.02
 #: measurement is never the paper's error by its size alone, and one contradiction is one error: where several cells
 #: take part and which is wrong cannot be told, it is counted once, in the cell the paper computed from the others
 #: (the others are compared with the model like any number).  Wrong printed units and echoes that do not match are
-#: errors by rule (comparisons.classify).
+#: errors by rule (comparisons.classify).  Table 1's Vs cells are added below, by JUMP_VELOCITY_RULE.
 PAPER_CONTRADICTIONS = {
     "stick_time_table_50": "the text's 18.9 s contradicts Table 1's own 18.3, 18.3 and 17.8 s at 50 µm/s (E9)",
     "table1_stiffness_350_1": "457 kPa/m is not the column's own slope 116 Pa/s over 0.766 V0 (432.7 kPa/m), the"
     " rule every other column follows; it is the 100 µm/s cycle 1 value (E14)",
-    "table1_jump_velocity_350_1": "in its 350 µm/s column of Table 1, whichever entry is wrong: its"
-    " Vs = 760 µm/s is where the paper's curve carries 575 Pa, not any σs the column allows (800 Pa as printed"
-    " needs 1643 µm/s; the 871 Pa of its slope × ts, 116 Pa/s × 7.51 s from rest, needs 2152 µm/s), and it is below"
-    " the 1026 µm/s the paper prints for the lower σs = 658 Pa, where its curve rises with σs; its slope × ts ="
-    " 871 Pa is more than its σs = 800 Pa even from rest (E13, E9). One error of the column, counted once, here, in"
-    " the cell the paper computed from the others; its σs and ts are compared with the model as measurements",
 }
 
 #: Rows where the model and the paper differ beyond tolerance and scatter and nothing in the paper settles why: not
@@ -405,19 +399,99 @@ PAPER_OPEN = {
     " 116 Pa/s (5.890 s at the nominal stiffness) against the printed 7.51 s (−27.1 %) or against the 6.90 s of"
     " σs/slope if ts is the wrong entry (−20.6 %); with the 106.5 Pa/s that σs/ts give if the slope is wrong,"
     " 5.929 s (−21 %). The model's difference, not the paper's error",
-    "table1_jump_velocity_50_3": "the paper prints 720 µm/s for σs = 552 Pa but 702 µm/s for the larger 554 and"
-    " 556 Pa, where either of its curves rises by 2.4–2.6 µm/s per Pa (E15): which of these cells is off cannot be"
-    " told from the paper. At the printed 552 Pa the aging curve, which Table 1 follows, gives 699.5 µm/s (−2.8 %)"
-    " and the no-aging curve the text prescribes 748.5 µm/s (+4.0 %); at the σs the column's other cells give,"
-    " σc + slope × ts = 563.0 Pa, the aging curve gives 728.6 µm/s (+1.2 %). Not the paper's error by the size of"
-    " a difference: an open difference",
-    "table1_jump_velocity_100_3": "the paper prints the same 702 µm/s for σs = 542 Pa as for 549, 554 and 556 Pa,"
-    " where either of its curves rises by 2.4–2.6 µm/s per Pa (E15): which of these cells is off cannot be told"
-    " from the paper. At the printed 542 Pa the aging curve, which Table 1 follows, gives 673.8 µm/s (−4.0 %) and"
-    " the no-aging curve the text prescribes 725.0 µm/s (+3.3 %); at the σs the column's other cells give,"
-    " σc + slope × ts = 553.7 Pa, the aging curve gives 704.1 µm/s (+0.3 %). Not the paper's error by the size of"
-    " a difference: an open difference",
 }
+
+#: The one rule for every Table 1 Vs cell, stated once (the report shows it above Table 1; docs/report.md, errata
+#: E15).  Vs is the paper's own computation from its column (Eq 8), so a cell is read against its column before a
+#: difference is called the model's: by branch (i) it agrees, by (ii) the column disagrees with itself (a paper
+#: error), by (iii) a paper error where the column's measured cells contradict each other, else the model's open
+#: difference.  The size of a difference decides nothing beyond branch (i).
+JUMP_VELOCITY_RULE = (
+    "Table 1's Vs is the paper's own computation from its column (Eq 8: where its steady curve carries σs), so every"
+    " Vs cell is judged by one rule: (i) the model's Vs at the printed σs is within 2 % of the printed Vs: it agrees;"
+    " (ii) it is not, but the model's Vs at the σs the column's other cells give (σc + slope × ts; slope × ts from"
+    " rest for a start-up stick) is: the column disagrees with itself under the paper's own curve, a paper error,"
+    " not the model's difference, counted once per column, in its Vs (the cell the paper computed from the others;"
+    " its σs and ts are compared with the model as measurements); (iii) neither: a paper error where the column's"
+    " measured cells contradict each other (a stick whose slope × ts exceeds its σs even from rest), otherwise an"
+    " open difference, the model's"
+)
+
+#: Branch of JUMP_VELOCITY_RULE -> (its label in the rule, the class it gives).
+JUMP_VELOCITY_BRANCHES = {
+    "agrees": ("i", "agrees"),
+    "column": ("ii", "erratum"),
+    "contradiction": ("iii", "erratum"),
+    "model": ("iii", "open"),
+}
+
+#: The Vs cells that branch (i) does not settle: (V0 in µm/s, cycle) -> (branch of JUMP_VELOCITY_RULE, what the
+#: column says, with the numbers).  Every other Vs cell agrees at its printed σs (branch i);
+#: tests/test_report_classes_r29b.py applies the rule to every cell with independent solves.
+JUMP_VELOCITY_CELLS: dict[tuple[int, int], tuple[str, str]] = {
+    (50, 3): (
+        "column",
+        "the printed σs = 552 Pa disagrees with the column's σc, slope and ts, which give σc + slope × ts = 264 Pa +"
+        " 16.8 Pa/s × 17.8 s = 563.0 Pa ((σs − σc)/slope = 17.14 s against the printed ts = 17.8 s, −3.7 %, E9), and"
+        " with its Vs = 720 µm/s: the paper's curve with aging, which Table 1 follows (E15), gives 699.5 µm/s at"
+        " 552 Pa (−2.8 %; without aging, as the text prescribes, 748.5 µm/s, +4.0 %) but 728.6 µm/s at 563.0 Pa"
+        " (+1.2 %). Read at 552 Pa, 720 µm/s is also above the 702 µm/s printed for the larger σs = 554 and 556 Pa,"
+        " where the curve rises by 2.4–2.6 µm/s per Pa; read at 563.0 Pa it is not",
+    ),
+    (100, 3): (
+        "column",
+        "the printed σs = 542 Pa disagrees with the column's σc, slope and ts, which give σc + slope × ts = 261 Pa +"
+        " 34.0 Pa/s × 8.61 s = 553.7 Pa ((σs − σc)/slope = 8.26 s against the printed ts = 8.61 s, −4.0 %, E9), and"
+        " with its Vs = 702 µm/s: the paper's curve with aging, which Table 1 follows (E15), gives 673.8 µm/s at"
+        " 542 Pa (−4.0 %; without aging, as the text prescribes, 725.0 µm/s, +3.3 %) but 704.1 µm/s at 553.7 Pa"
+        " (+0.3 %). Read at 542 Pa, the 702 µm/s it shares with σs = 549, 554 and 556 Pa breaks the curve's rise of"
+        " 2.4–2.6 µm/s per Pa; read at 553.7 Pa it does not",
+    ),
+    (350, 1): (
+        "contradiction",
+        "whichever entry is wrong: its Vs = 760 µm/s is where the paper's curve carries 575 Pa, not any σs the"
+        " column allows on either curve (800 Pa as printed needs 1643 µm/s; the 871 Pa of its slope × ts,"
+        " 116 Pa/s × 7.51 s from rest, needs 2152 µm/s), and it is below the 1026 µm/s the paper prints for the lower"
+        " σs = 658 Pa, where its curve rises with σs; its slope × ts = 871 Pa is more than its σs = 800 Pa even from"
+        " rest (E13, E9)",
+    ),
+}
+
+#: What the reason of a Vs cell says after the column's numbers, by branch.
+_JUMP_VELOCITY_ENDINGS = {
+    "column": ". Which is wrong, σs or the cells that agree with Vs, cannot be told from the paper: one error of"
+    " the column, counted once, here, in the cell the paper computed from the others; its σs and ts are compared"
+    " with the model as measurements. At the σs the column's other cells give, the model gives the printed Vs: the"
+    " difference is inside the paper's column, not the model's",
+    "contradiction": ". One error of the column, counted once, here, in the cell the paper computed from the"
+    " others; its σs and ts are compared with the model as measurements",
+    "model": ". The column agrees with itself and no σs it allows gives its Vs: the model's difference, not the"
+    " paper's error",
+}
+
+
+def jump_velocity_branch(key: str) -> str | None:
+    """The branch of JUMP_VELOCITY_RULE a Table 1 Vs row falls in when branch (i) does not settle it ("column",
+    "contradiction" or "model"); None for a Vs cell that agrees at its printed σs, and for any other row."""
+    if not key.startswith("table1_jump_velocity_"):
+        return None
+    v_um, cycle = key[len("table1_jump_velocity_") :].split("_")
+    declared = JUMP_VELOCITY_CELLS.get((int(v_um), int(cycle)))
+    return declared[0] if declared else None
+
+
+def _jump_velocity_reasons() -> None:
+    """Each Vs cell that branch (i) does not settle, into PAPER_CONTRADICTIONS or PAPER_OPEN by its branch, its
+    reason naming the column, the branch and what the column says."""
+    for (v_um, cycle), (branch, says) in JUMP_VELOCITY_CELLS.items():
+        label, cls = JUMP_VELOCITY_BRANCHES[branch]
+        column = f"{v_um} µm/s" + (f" cycle {cycle}" if v_um != 350 else "")
+        text = f"in its {column} column of Table 1 (Vs rule ({label})), {says}{_JUMP_VELOCITY_ENDINGS[branch]}"
+        key = f"table1_jump_velocity_{v_um}_{cycle}"
+        (PAPER_CONTRADICTIONS if cls == "erratum" else PAPER_OPEN)[key] = text
+
+
+_jump_velocity_reasons()
 
 #: Rows where the paper's own stated inputs do not give its number, while an input it does not state would (or two
 #: of its stated inputs disagree): a gap in the paper, not a limitation of the model, which can give the number.
