@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -12,6 +13,9 @@ from .. import regimes
 from ..display import velocity as show_velocity
 from ..protocols import Protocol
 from ..quasistatic.cycle import Cycle
+
+if TYPE_CHECKING:  # pragma: no cover
+    from ..parameters import Parameters
 
 #: the slider counts as stuck below this fraction of the puller velocity
 STUCK_FRACTION = 0.01
@@ -394,6 +398,9 @@ def judge(
 #: steady after the stick chains' last slip: the solution within the run's tolerance of the steady state at the
 #: puller's pace over at least this many of its relaxation times (:class:`SteadyReference`) before the end
 SETTLED_RELAXATIONS = 10.0
+#: real rates s (in units of 1/tau, the bond time) at which a slide's instability is looked for first (a real root
+#: of m s^2 + eta s + K + Z(s), :func:`steady_instability`): two a decade over Kc's scan, ~0.04 s at 100 um/s
+INSTABILITY_RATES = np.geomspace(1e-6, 1e6, 25)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -403,13 +410,19 @@ class SteadyReference:
 
     ``relaxation`` (s): the longer of the block's decay along the steady curve, |dσ/dV| / K (the quasi-static
     slip phase, σ'(V) dV/dt = K (Vp - V), relaxes V - Vp as exp(-t K / σ')), and the bonds' memory, dl_m / Vp
-    (every bond of the steady population is born within it: the population renews itself within that time)."""
+    (every bond of the steady population is born within it: the population renews itself within that time).
+    ``every`` (s): the spacing of the rows where ``every`` sampled them (None: every solver state a row), named in
+    the words where the rows' spacing is what keeps the verdict back.  ``instability``: called only where the run
+    has not settled, words saying that steady sliding at the pace is unstable for the run's block (None where it
+    is not, or not known): :func:`steady_instability`."""
 
     velocity: float  # m/s, the puller's pace over the last segment
     stress: float  # Pa, sigma of the steady curve at it
     slope: float  # Pa s/m, dsigma/dV there
     stiffness: float  # Pa/m, the block's
     memory: float  # s, dl_m / Vp
+    every: float | None = None
+    instability: Callable[[], str | None] | None = dataclasses.field(default=None, compare=False, repr=False)
 
     @property
     def block_decay(self) -> float:
@@ -418,6 +431,66 @@ class SteadyReference:
     @property
     def relaxation(self) -> float:
         return max(self.block_decay, self.memory)
+
+
+def steady_instability(
+    params: Parameters,
+    velocity: float,
+    stiffness: float,
+    mass: float = 0.0,
+    damping: float = 0.0,
+    aging: bool = True,
+    critical_velocity: float = math.nan,
+) -> str | None:
+    """Words saying that steady sliding at ``velocity`` is linearly unstable through the run's block (K below
+    Kc(V), transient.stability), for a slide that has not settled; None where it is stable or not known.
+
+    First, cheaply, a real runaway: D(s) = m s^2 + eta s + K + Z(s) is K > 0 at s = 0, so D < 0 at a real rate
+    s > 0 (:data:`INSTABILITY_RATES`) proves a real root in between, and K below Kc, which is at least the largest
+    -(m s^2 + eta s + Z(s)) seen (the paper's set at 100 µm/s: 2.84e8 Pa/m in ~0.04 s, Kc 1.26e9 Pa/m).  Where
+    that finds none (near Vc: at 123 µm/s the bound is 3.4e5 Pa/m, Kc 3.3e7), Kc itself (~1.5 s)."""
+    from ..errors import ModelError, ParameterError
+    from .stability import critical_stiffness_details, interface_response
+
+    speed = f"{velocity * 1e6:.6g} µm/s"
+    below = (
+        f"V0 below Vc = {critical_velocity * 1e6:.4g} µm/s, and "
+        if math.isfinite(critical_velocity) and velocity < critical_velocity
+        else ""
+    )
+    block = f"K = {stiffness / 1e3:.6g} kPa/m"
+    try:
+        rates = INSTABILITY_RATES / float(params.bonds.bond_time)
+        with np.errstate(over="ignore", invalid="ignore"):
+            z = interface_response(params, velocity, rates, aging).z.real
+            margin = mass * rates**2 + damping * rates + stiffness + z
+        finite = np.isfinite(margin)
+        if np.any(finite & (margin < 0.0)):
+            bound = float(np.max(stiffness - margin[finite]))
+            return f"{below}{block} below Kc({speed}), which is at least {bound:.3g} Pa/m (a real unstable root)"
+        found = critical_stiffness_details(params, velocity, aging, mass, damping)
+    except (ModelError, ParameterError, FloatingPointError, ValueError):
+        return None
+    if not stiffness < found.value:
+        return None
+    mode = {"real": "a real unstable root", "oscillatory": "an oscillation that grows"}.get(found.mode, found.mode)
+    return f"{below}{block} below Kc({speed}) = {found.value:.4g} Pa/m ({mode})"
+
+
+def _known_states(
+    time: np.ndarray, stress: np.ndarray, between: Between | None, start: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """(times, stresses) of every state the trace knows at or after ``start``: the rows, and the extremes each row
+    carries of the solver's states between (wherever that row lies, as :func:`window_extremes`), in time order."""
+    times, values = [np.asarray(time, dtype=float)], [np.asarray(stress, dtype=float)]
+    if between is not None:
+        for when, value in ((between.lowest_time, between.lowest), (between.highest_time, between.highest)):
+            times.append(np.asarray(when, dtype=float))
+            values.append(np.asarray(value, dtype=float))
+    t, y = np.concatenate(times), np.concatenate(values)
+    ok = np.isfinite(t) & np.isfinite(y) & (t >= start)
+    order = np.argsort(t[ok], kind="stable")
+    return t[ok][order], y[ok][order]
 
 
 def settled_after_slip(
@@ -437,14 +510,24 @@ def settled_after_slip(
     did after: the verdict on the events alone, "1 slip, no stick after it: needs another slip", could never
     change however long the run.  The slide has settled when the solution is the steady state at the puller's
     pace Vp and has stayed it: every state of the solver over the last SETTLED_RELAXATIONS relaxation times (the
-    rows and the extremes each row carries of the states between, from the row at or before the stretch's start:
-    the sampling can only delay the verdict, by one row's interval at most) within the run's tolerance,
+    rows and the extremes each row carries of the states between: where the stretch starts between two rows, the
+    states there are known only by the later row's extremes, so the sampling can only delay the verdict, by about
+    a row's interval, never advance it) within the run's tolerance,
     max(rtol, SETTLED) x σ(Vp), of the steady curve's σ(Vp), that stretch after the last slip, and the slider at
     Vp within STEADY_TOLERANCE at the end.  Why so long: under the block dσ/dt = K (Vp - V), so a stress held
     within ±B over a stretch L pins the slider's mean pace to Vp within 2 B / (K L); with L = 10 |σ'| / K that is
     a fifth of B / |σ'|, the velocity that moves the steady stress by B, and a departure from the steady state
     decays as exp(-L / relaxation) = 4.5e-5 over it (the quasi-static model calls its slip phase steady where V
-    is within 1e-9 of Vp, docs/slip-phase.md; a steady start, where the trace's tail has stopped changing)."""
+    is within 1e-9 of Vp, docs/slip-phase.md; a steady start, where the trace's tail has stopped changing).
+
+    Judged as: the last state known off that band (the slip's at the latest); the run is steady once the stretch
+    starts after it where it is a row (the next row's extremes bound every state between), or at or after the
+    first row after it where it is an extreme between two rows (the states between it and that row are not
+    known).  Where the rows skip the solver's states (``every``), a row knows those between it and the row
+    before only by their extremes, so the last state off the band is known only to lie between such an extreme
+    and the next row; the words say so, with the end from which these rows read steady (that row + the stretch)
+    and the earliest from which rows finer could (the extreme + the stretch).  Where steady sliding at Vp is
+    unstable for the block (``steady.instability``), the words say the slide will not settle onto it."""
     marks = [(kind, float(t), float(s)) for kind, t, s, _ in events if kind in ("stick", "slip") and t >= start]
     slips = [k for k, mark in enumerate(marks) if mark[0] == "slip"]
     vp = steady.velocity
@@ -457,19 +540,34 @@ def settled_after_slip(
     rtol = max(resolution if resolution is not None else 0.0, SETTLED)
     band = rtol * abs(steady.stress)
     since = end - span
-    # every state from the row at or before the stretch's start: the whole of the rows' interval that holds it (a
-    # sampling coarser than the stretch can only delay the verdict, by that interval at most; never advance it)
+    # the row at or before the stretch's start: where its words say the stretch is judged from
     first = float(time[max(int(np.searchsorted(time, since, side="right")) - 1, 0)])
-    high, low = window_extremes(time, stress, between, first)
-    within = math.isfinite(high) and high - steady.stress <= band and steady.stress - low <= band
-    if not (math.isfinite(span) and since >= t_slip and abs(v_end - vp) <= STEADY_TOLERANCE * vp and within):
-        return (
-            f"the slide since has not settled to steady sliding (σ = {float(stress[-1]):.6g} Pa and"
-            f" V = {show_velocity(v_end, 4)} at the end, against the steady curve's σ({vp * 1e6:.6g} µm/s) ="
-            f" {steady.stress:.6g} Pa: it counts as settled once every state over the last {span:.3g} s"
-            f" ({SETTLED_RELAXATIONS:g} relaxation times of {steady.relaxation:.3g} s), after the slip, lies within"
-            f" {band:.3g} Pa of it)"
+    # the last state known off the band since the slip (the slip's own at the latest), and the first row after it:
+    # from there on every state is known within the band
+    known_t, known_y = _known_states(time, stress, between, t_slip)
+    off = np.abs(known_y - steady.stress) > band
+    last_off = max(t_slip, float(known_t[off][-1])) if np.any(off) else t_slip
+    after = time[time > last_off]
+    entered = float(after[0]) if after.size else math.nan
+    # a row off the band: the next row's extremes bound every state after it, so the band holds from just after it;
+    # an extreme between two rows: the states between it and the next row are not known, so from that row
+    on_row = bool(np.any(time == last_off))
+    clear = math.isfinite(entered) and (since > last_off if on_row else since >= entered)
+    pace = abs(v_end - vp) <= STEADY_TOLERANCE * vp
+    if not (math.isfinite(span) and clear and pace):
+        instability = steady.instability() if steady.instability is not None else None
+        if instability is not None:
+            return (
+                f"steady sliding at {vp * 1e6:.6g} µm/s is unstable for this block ({instability};"
+                f" transient.stability): the slide since the slip at t = {t_slip:.6g} s (σ = {float(stress[-1]):.6g}"
+                f" Pa, V = {show_velocity(v_end, 4)} at the end) will not settle onto it; what comes next is a stick,"
+                " and the slip after that stick says whether the cycles repeat"
+            )
+        return _not_settled(
+            stress, steady, known_t, known_y, t_slip, first, since, (last_off, on_row, entered), span, band, v_end
         )
+    settled = known_y[known_t > last_off]  # every state known after the last off the band: the stretch's, and within
+    high, low = float(np.max(settled)), float(np.min(settled))
     before = marks[slips[-1] - 1] if slips[-1] > 0 and marks[slips[-1] - 1][0] == "stick" else None
     stick = f"stick from {before[2]:.6g} Pa at t = {before[1]:.6g} s to " if before is not None else ""
     n = len(slips)
@@ -486,6 +584,97 @@ def settled_after_slip(
     )
     peak, trough = window_extremes(time, stress, between, start)
     return regimes.Regime(regimes.STEADY, 0, math.nan, math.nan, peak, trough, words)
+
+
+def _not_settled(
+    stress: np.ndarray,
+    steady: SteadyReference,
+    known_t: np.ndarray,
+    known_y: np.ndarray,
+    t_slip: float,
+    first: float,
+    since: float,
+    band_from: tuple[float, bool, float],
+    span: float,
+    band: float,
+    v_end: float,
+) -> str:
+    """Why a slide after the chains' last slip is not (yet) steady, in words (:func:`settled_after_slip`): how far
+    the run ends from the steady state, the largest departure over the stretch judged, since when the run has been
+    within the band (or that it never was after the slip), and, where the rows' spacing keeps the verdict back,
+    that it does and by how much.  ``band_from``: the last state known off the band, whether it is a row's, and the
+    first row after it.  Each stress to a hundredth of the band, each departure on its own."""
+    vp, level = steady.velocity, steady.stress
+    last_off, on_row, entered = band_from
+    digits = max(0, math.ceil(-math.log10(band / 100.0))) if band > 0 else 6
+    sigma_end = float(stress[-1])
+    text = (
+        f"the slide since has not settled to steady sliding (σ = {sigma_end:.{digits}f} Pa and V ="
+        f" {show_velocity(v_end, 7)} at the end, {sigma_end - level:+.3g} Pa and {(v_end - vp) / vp:+.2g} × V0 from"
+        f" the steady curve's σ({vp * 1e6:.6g} µm/s) = {level:.{digits}f} Pa at V0 = {vp * 1e6:.6g} µm/s"
+    )
+    if not math.isfinite(span):
+        return text + (
+            f"; with no relaxation time to judge it by, it counts as settled once every state lies within {band:.3g} Pa"
+            " of it)"
+        )
+    judged = max(first, t_slip)
+    inside = known_t >= judged
+    gaps = known_y[inside] - level
+    worst = int(np.argmax(np.abs(gaps))) if gaps.size else -1
+    where = f"{gaps[worst]:+.4g} Pa at t = {known_t[inside][worst]:.6g} s" if worst >= 0 else "none known"
+    if since < t_slip:
+        text += (
+            f"; the last {span:.3g} s reach back before the slip at t = {t_slip:.6g} s, and the largest departure"
+            f" since the slip is {where}"
+        )
+    else:
+        text += (
+            f"; the largest departure over the stretch judged, from the row at t = {judged:.6g} s (the last at or"
+            f" before the start of the last {span:.3g} s), is {where}"
+        )
+    if not math.isfinite(entered):
+        text += f"; not within {band:.3g} Pa of it at any row since the slip"
+    elif on_row:
+        text += (
+            f"; within {band:.3g} Pa of it after t = {last_off:.6g} s, the last state off it: staying so, the run"
+            f" reads steady from about t = {last_off + span:.4g} s on"
+        )
+    else:
+        every, end = steady.every, since + span
+        row = entered
+        if every is not None and entered >= end:  # the run's last row: a longer run's next row is the grid's
+            row = every * math.floor(last_off / every + 1.0)
+        text += (
+            f"; within {band:.3g} Pa of it from the row at t = {entered:.6g} s on, which carries a state"
+            f" {_gap_at(known_t, known_y, level, last_off):+.3g} Pa off at t = {last_off:.6g} s (a row knows the"
+            f" solver's states since the row before only by their extremes, so the last state off the band lies"
+            f" between t = {last_off:.6g} s and that row): staying so, the run reads steady from about t ="
+            f" {row + span:.4g} s on"
+        )
+        if every is not None:
+            text += (
+                f" with rows every {every:.6g} s, and unsampled, or with rows finer, from as early as about t ="
+                f" {last_off + span:.4g} s"
+            )
+            if last_off < since < entered:
+                text += (
+                    f"; it is these rows that keep it undetermined now: the stretch starts at t = {since:.6g} s,"
+                    f" between the rows at {first:.6g} and {entered:.6g} s, and counts from the row at {first:.6g} s"
+                )
+    if abs(v_end - vp) > STEADY_TOLERANCE * vp:
+        text += f"; the slider not within {STEADY_TOLERANCE:g} × V0 of V0 at the end"
+    return (
+        text + f"; it counts as settled once every state over the last {span:.3g} s"
+        f" ({SETTLED_RELAXATIONS:g} relaxation times of {steady.relaxation:.3g} s), after the slip, lies within"
+        f" {band:.3g} Pa of it)"
+    )
+
+
+def _gap_at(known_t: np.ndarray, known_y: np.ndarray, level: float, when: float) -> float:
+    """The departure from ``level`` of the known state at ``when`` farthest from it (signed)."""
+    gaps = known_y[known_t == when] - level
+    return float(gaps[np.argmax(np.abs(gaps))]) if gaps.size else math.nan
 
 
 def _ripple(  # type: ignore[no-untyped-def]
