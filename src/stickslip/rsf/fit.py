@@ -388,9 +388,10 @@ def fit_record(
     record (``noise_method`` says how).  ``drift_check`` (default: on unless ``noise`` is given) refits with the
     drift term toggled and reports when the conclusion depends on it (``drift_sensitivity``).
     ``cutoff=(V1, V2)`` (m/s, held fixed) fits the cut-off velocity form of the friction law (docs/rsf.md, Laws).
-    ``alternatives`` (default: on unless ``noise`` is given): when chi-square_r > 2 and nothing else is wrong, the
-    fit is tried again with a held stiffness freed and with the other built-in single-state laws, from its answer,
-    and (one state, where none of those describes the record) with a second state variable of the same law;
+    ``alternatives`` (default: on unless ``noise`` is given): when chi-square_r > 2 and nothing else is wrong (or
+    the law's misfit, its F test against constant friction failed, is the one thing wrong), the fit is tried again
+    with a held stiffness freed and with the other built-in single-state laws, from its answer, and (one state,
+    where none of those describes the record) with a second state variable of the same law;
     one that describes the record significantly better fails the fit (``alternatives`` in the result says what each
     reached; docs/rsf.md, "Is another model the answer?").
     Within ``with restart_notice(notify):``, ``notify(text, searches)`` is told when the first search ends troubled
@@ -496,11 +497,23 @@ def fit_record(
         problems.insert(0, opening_problem or opening.problem)
     tried: tuple[dict[str, Any], ...] = ()
     tried_said = ""  # what the alternatives tried reached, beside the chi-square warning
-    if (not problems and not mismatch and level.redchi > WARN_CHI2
+    # a law's misfit alone (its F test against constant friction not significant with its own smooth residuals as
+    # the noise) is no reason to skip them: which model does describe the record is the advice it needs, and that F
+    # test's effective rows grow with the sampling rate (the tester's two-state record: p = 0.001 at 100 Hz, 9e-35
+    # at 1 kHz), so at 100 Hz it said "fit another law" where at 1 kHz it named --states 2
+    misfit = _misfit_alone(problems, setup.laws)
+    if ((not problems or misfit) and not mismatch and level.redchi > WARN_CHI2
             and (not given if alternatives is None else alternatives)):  # fmt: skip
+        p_response = _response_p_value(result, record, resid, setup.trend, level.inflation) if misfit else 1.0
         tried, failure, tried_said = _alternatives(setup, start, result, model, level, labels, units,
-                                                   float(noise) if given else None)  # fmt: skip
-        problems += [failure] if failure else []
+                                                   float(noise) if given else None,
+                                                   _misfit_words(record, resid, setup, level, p_response)
+                                                   if misfit else "")  # fmt: skip
+        if misfit and (failure or not any("skipped" in r for r in tried)):  # (else the floor's warning says why)
+            problems = [failure or _no_response_problem(record, resid, setup, level, p_response, tried=tried_said)]
+            tried_said = ""  # (in the reason)
+        else:
+            problems += [failure] if failure else []
     why = _law_not_determined(problems, setup.laws)
     if why:  # then no interval of the friction law means anything
         for key in ("a", "b", "dc", "b2", "dc2", "stiffness"):
@@ -2228,11 +2241,13 @@ def _law_not_determined(problems: list[str], laws: tuple[str, ...]) -> str:
 
 def _no_response_problem(
     record: LabRecord, resid: np.ndarray, setup: _Setup, level: _Level, p_value: float, drift: str = "",
-    opening: bool = False,
+    opening: bool = False, tried: str = "",
 ) -> str:  # fmt: skip
     """Why a fit no better than constant friction fails: constant friction describes the record to within its noise
     (no velocity dependence), or the friction does vary but the law fitted does not describe how (a misfit) or, where
-    a drift the fit misses explains most of the residuals (``drift``, the --trend word), the drift hides it."""
+    a drift the fit misses explains most of the residuals (``drift``, the --trend word), the drift hides it.
+    ``tried``: what the alternatives tried at a misfit reached (none describing the record), said in place of the
+    advice to fit another law."""
     trends = " with the trends" if setup.trend else ""
     rows = level.rows if level.rows is not None else np.full(len(record), level.noise)
     constant = _constant_chi2(record, setup.trend, rows)
@@ -2244,25 +2259,20 @@ def _no_response_problem(
         )
     if level.redchi > WARN_CHI2 and drift:  # the drift leads the reason; the law is judged once it is fitted
         return (
-            f"{DRIFT_MASKED_TEXT}: with it missed the fit is no significant improvement on constant friction"
-            f"{trends} (F test: p = {p_value:.2g}; constant friction: reduced chi-square {constant:.3g}), so a, b and "
-            f"Dc are not determined until it is fitted (--trend {drift})"
+            f"{DRIFT_MASKED_TEXT}: with it missed, {_f_test_short(p_value, trends, constant)}, so a, b and Dc are not "
+            f"determined until it is fitted (--trend {drift})"
         )
     if level.redchi > WARN_CHI2 and opening:  # the opening leads the reason: no law can start on its transient
         return (
-            f"{OPENING_MASKED_TEXT}: bent to it, the fit is no significant improvement on constant friction{trends} "
-            f"(F test: p = {p_value:.2g}; constant friction: reduced chi-square {constant:.3g}), so a, b and Dc are "
-            "not determined until the rows from where the friction has settled are fitted (--window)"
+            f"{OPENING_MASKED_TEXT}: bent to it, {_f_test_short(p_value, trends, constant)}, so a, b and Dc are not "
+            "determined until the rows from where the friction has settled are fitted (--window)"
         )
     if level.redchi > WARN_CHI2:
         others = _other_laws(setup.laws)
         return (
-            f"{MISFIT_TEXT.format(law=_law_words(setup.laws))}: its residuals are {math.sqrt(level.redchi):.3g} "
-            f"times the noise {level.noise:.2g} (reduced chi-square {level.redchi:.3g}) and structured (lag-one "
-            f"autocorrelation {_lag_one(resid):.3f}), while the friction varies well beyond its noise (constant "
-            f"friction{trends}: reduced chi-square {constant:.3g}), and the fit is no significant improvement on "
-            f"constant friction (F test: p = {p_value:.2g}); so a, b and Dc are not determined; "
-            + (f"fit another law ({others}), or " if others else "")
+            f"{MISFIT_TEXT.format(law=_law_words(setup.laws))}: {_misfit_words(record, resid, setup, level, p_value)}"
+            "; so a, b and Dc are not determined; "
+            + (f"{tried}; " if tried else f"fit another law ({others}), or " if others else "")
             + "check the load-point history (--segment, --protocol) and that the friction follows the velocity "
             "changes"
         )
@@ -2272,6 +2282,62 @@ def _no_response_problem(
         f" of {len(record)}), though constant friction misses the record (reduced chi-square {constant:.3g}); so "
         "a, b and Dc are not determined"
     )
+
+
+#: what follows the law's words in the reason of a misfit (:func:`_misfit_words`)
+MISFIT_RESIDUALS = "its residuals are"
+
+
+def _misfit_alone(problems: list[str], laws: tuple[str, ...]) -> bool:
+    """Whether the one problem is the law's misfit (its F test against constant friction not significant while the
+    friction varies beyond its noise): then the alternatives are tried for the advice."""
+    head = f"{MISFIT_TEXT.format(law=_law_words(laws))}: {MISFIT_RESIDUALS}"
+    return len(problems) == 1 and problems[0].startswith(head)
+
+
+def _misfit_words(record: LabRecord, resid: np.ndarray, setup: _Setup, level: _Level, p_value: float) -> str:
+    """What a misfit's residuals are, against the noise and against constant friction, and what the F test against
+    constant friction found with them as the noise."""
+    trends = " with the trends" if setup.trend else ""
+    rows = level.rows if level.rows is not None else np.full(len(record), level.noise)
+    constant = _constant_chi2(record, setup.trend, rows)
+    return (
+        f"{MISFIT_RESIDUALS} {math.sqrt(level.redchi):.3g} times the noise {level.noise:.2g} (reduced chi-square "
+        f"{level.redchi:.3g}) and structured (lag-one autocorrelation {_lag_one(resid):.3f}), while the friction "
+        f"varies well beyond its noise (constant friction{trends}: reduced chi-square {constant:.3g}); "
+        + _f_test_words(record, level, p_value, trends)
+    )
+
+
+def _f_test_words(record: LabRecord, level: _Level, p_value: float, trends: str) -> str:
+    """The F test of the fit against constant friction as :func:`_response_p_value` makes it: the fit's own
+    residuals are its noise, each row counting 1/g of one, so a misfit's smooth residuals leave a handful of rows
+    (and that handful grows with the sampling rate: g stops near 2000 rows)."""
+    return (
+        f"with the fit's own residuals taken as the noise (their correlation leaves {level.n_eff:.3g} effective "
+        f"independent rows of {len(record)}), its improvement on constant friction{trends} is not significant at the "
+        f"{NO_RESPONSE_LEVEL:g} level this check requires (F test: {_p_beside(p_value, NO_RESPONSE_LEVEL)})"
+    )
+
+
+def _f_test_short(p_value: float, trends: str, constant: float) -> str:
+    """:func:`_f_test_words` where the reason's cause is another (a drift, an opening), with constant friction's
+    chi-square_r."""
+    return (
+        f"the fit's improvement on constant friction{trends} is not significant at the {NO_RESPONSE_LEVEL:g} level "
+        f"against its own residuals taken as the noise (F test: {_p_beside(p_value, NO_RESPONSE_LEVEL)}; constant "
+        f"friction: reduced chi-square {constant:.3g})"
+    )
+
+
+def _p_beside(p_value: float, level: float) -> str:
+    """``p = 0.00101``: with the digits that tell p from ``level`` (0.00101 beside 1e-3 printed 0.001 read as if it
+    passed the level it failed)."""
+    for digits in range(2, 7):
+        text = f"{p_value:.{digits}g}"
+        if (float(text) > level) == (p_value > level) and float(text) != level:
+            return f"p = {text}"
+    return f"p = {p_value:.6g}"
 
 
 def _second_state_problems(setup: _Setup, start: dict[str, float], result: Any) -> list[str]:
@@ -2485,14 +2551,15 @@ def _steady_bound(setup: _Setup, protocol: Protocol, rows: np.ndarray) -> float:
 
 def _alternatives(
     setup: _Setup, start: dict[str, float], result: Any, model: np.ndarray, level: _Level, labels: np.ndarray,
-    units: dict[str, tuple[str, float]], noise: float | None,
+    units: dict[str, tuple[str, float]], noise: float | None, diagnosis: str = "",
 ) -> tuple[tuple[dict[str, Any], ...], str, str]:  # fmt: skip
     """The fit tried again, from its answer, with what the caller chose changed: a held stiffness freed, and a
     single-state built-in law swapped for each other one (then the best of those with the stiffness freed as well,
     where a held one was and neither alone describes the record).  Returns what each reached (JSON), the failure
     (an alternative describes the record, chi-square_r <= WARN_CHI2, and saves more chi-square than the noise
     allows: :func:`_paired_test`) and the warning's words ('' for none).  None is tried where the first segment
-    alone, where every alternative gives the same steady friction, keeps chi-square_r above WARN_CHI2."""
+    alone, where every alternative gives the same steady friction, keeps chi-square_r above WARN_CHI2.
+    ``diagnosis``: what the fit's misfit shows (:func:`_misfit_words`), said in the failure after its head."""
     record = setup.record
     values = result.params.valuesdict()
     here = {**start, **_start_values(values)}
@@ -2558,17 +2625,18 @@ def _alternatives(
                 f"its spread under the noise alone: {_p_text(best['p_value'])}")  # fmt: skip
     others = [r for r in reached if r is not best]
     also = "; also tried: " + ", ".join(_reached_text(r) for r in others) if others else ""
+    lead = f"{diagnosis}; " if diagnosis else ""
     if candidate.words == "the stiffness free":
-        failure = (f"{HELD_STIFFNESS_TEXT} {held_k} does not describe the record: with the stiffness free the fit "
-                   f"does, at {values_text} ({evidence}){also}; free the stiffness ({candidate.option}) or check "
+        failure = (f"{HELD_STIFFNESS_TEXT} {held_k} does not describe the record: {lead}with the stiffness free the "
+                   f"fit does, at {values_text} ({evidence}){also}; free the stiffness ({candidate.option}) or check "
                    "the rig's stiffness")  # fmt: skip
     elif candidate.staged:
-        failure = (f"{ONE_STATE_TEXT}{f' with the stiffness held at {held_k}' if held else ''}: a second one does "
-                   f"({candidate.words}), at {values_text} ({evidence}){also}; fit it with "
+        failure = (f"{ONE_STATE_TEXT}{f' with the stiffness held at {held_k}' if held else ''}: {lead}a second one "
+                   f"does ({candidate.words}), at {values_text} ({evidence}){also}; fit it with "
                    f"{candidate.option}")  # fmt: skip
     else:
         law = MISFIT_TEXT.format(law=_law_words(setup.laws)) + (f" with the stiffness held at {held_k}" if held else "")
-        failure = (f"{law}: {candidate.words} does, at {values_text} ({evidence}){also}; fit it with "
+        failure = (f"{law}: {lead}{candidate.words} does, at {values_text} ({evidence}){also}; fit it with "
                    f"{candidate.option}")  # fmt: skip
     return tuple(_public_tried(r) for r in reached), failure, ""
 
