@@ -36,6 +36,7 @@ from .detect import (
     unresolved_swings,
 )
 from .fits import QUADRATIC, Corner, Line, fit_corner, fit_line, with_time_uncertainty
+from .steady import integrated_time, mean_and_error, settled_start
 from .traces import Trace, check_trace
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -95,6 +96,16 @@ MODEL_DERIVED = {
     "measured peak stress σs; it changes with the parameter set",
 }
 
+#: Units of the CycleResult fields particular to the analysis (the package's registry, stickslip.columns, has the
+#: others): the JSON's "units" and :meth:`TraceAnalysis.to_frame` name them.
+CYCLE_UNITS: dict[str, str | None] = {
+    "slip_time_bound": "s",
+    "stick_curvature": "Pa/s^2",
+    "stick_curvature_stderr": "Pa/s^2",
+    "stick_sagitta": "Pa",
+    "stick_curved": None,  # a flag
+}
+
 #: CycleResult fields kept for plotting, not reported.
 _PRIVATE_FIELDS = ("line", "stick_from", "stick_to")
 
@@ -132,6 +143,15 @@ class CycleResult:
     #: that interval, so ``slip_time`` is 0, no measurement, and σs and the next σc are known to their resolution
     #: (``peak_stress_uncertainty``, ``critical_stress_uncertainty``: the stick slope times half the interval)
     slip_time_bound: float | None = None
+    #: the stick's curvature (Pa/s^2, d2sigma/dt2 of a parabola fitted to the stick between its corners; 0 for the
+    #: model's straight stick), its standard error under the record's correlated noise, the parabola's largest
+    #: departure from the straight line over the stick (Pa, the sagitta: curvature * stick time^2 / 8), and whether
+    #: the stick is curved beyond its noise (:data:`CURVE_SIGMAS` standard errors and :data:`CURVE_NOISE` noise
+    #: levels): then σc and σs are read on the parabola's tangent at each corner (docs/analysis.md, "Curved sticks")
+    stick_curvature: float | None = None
+    stick_curvature_stderr: float | None = None
+    stick_sagitta: float | None = None
+    stick_curved: bool = False
     line: Line | None = field(default=None, repr=False, compare=False)
     stick_from: float = field(default=math.nan, repr=False, compare=False)
     stick_to: float = field(default=math.nan, repr=False, compare=False)
@@ -189,7 +209,7 @@ class TraceAnalysis:
 
         columns = [name for name in CycleResult.__dataclass_fields__ if name not in _PRIVATE_FIELDS]
         frame = pd.DataFrame([c.as_dict() for c in self.cycles], columns=columns)
-        return with_units(frame, {"slip_time_bound": "s"})
+        return with_units(frame, CYCLE_UNITS)
 
     def plot(self, ax: Axes | None = None, **kwargs: Any) -> Axes:
         from ..plots.traces import plot_analysis
@@ -214,6 +234,8 @@ class _Stick:
     slip_first: int | None = None  # the first sample of the slip after the stick (clearly below its line)
     slip_last: int | None = None  # the last sample of the slip before the stick (clearly above its line)
     slip_bound: float | None = None  # the drop after the stick falls between two samples: the interval (s)
+    curve: _Curve | None = None  # the parabola through the stick, where measured
+    curve_passes: int = 0
 
 
 def analyze_trace(
@@ -267,6 +289,9 @@ def analyze_trace(
     else:
         sticks, swings, regime, steady_from = _piece(t, x, coarse, step)
         cycles = _cycles(sticks, v0, params, steady_from is not None)
+    bent = _curvature_note(cycles, coarse.noise)
+    if bent:
+        warnings.append(bent)
     slopes = _slope_change(cycles, v0)
     if slopes:
         warnings.append(slopes)
@@ -286,6 +311,12 @@ def analyze_trace(
         scattered = _wide_steady_scatter(x[_between(t, steady_from, math.inf)])
         if scattered:
             warnings.append(scattered)
+        # the relaxation is sought after the last slip (and the last gap) on
+        ends = [float(t[0]), *(c.peak_time for c in cycles if c.peak_time is not None)]
+        ends.extend(float(t[k + 1]) for k in cuts)
+        steady_from, unsettled = _settled(t, x, steady_from, max(ends), coarse.threshold)
+        if unsettled:
+            warnings.append(unsettled)
     summary = _summary(t, x, cycles, regime, steady_from, v0)
     if unresolved is not None:
         summary["unresolved_swings"] = unresolved.as_dict()
@@ -447,8 +478,13 @@ SLOPE_POINTS = 10
 
 def _slope_change(cycles: list[CycleResult], v0: float) -> str:
     """A warning where the stick slope (K·V0) changes by a large factor within the record, naming the times and
-    saying that Gd/h per cycle then assumes one V0; "" when it does not."""
+    saying that Gd/h per cycle then assumes one V0; "" when it does not.  Where the sticks are curved
+    (:func:`_curvature_note`) a cut stick's slope is that of the part of it the record holds, which differs from a
+    whole one's with no change of V0: only complete sticks are compared."""
+    curved = any(c.stick_curved for c in cycles)
     sticks = [c for c in cycles if c.stick_points >= SLOPE_POINTS and c.stick_slope is not None and c.stick_slope > 0]
+    if curved:
+        sticks = [c for c in sticks if c.complete]
     changes = []
     for before, after in itertools.pairwise(sticks):
         ratio = after.stick_slope / before.stick_slope
@@ -467,6 +503,57 @@ def _slope_change(cycles: list[CycleResult], v0: float) -> str:
         "the stick slope changes within the record " + "; ".join(changes) + ": a change of the pulling velocity"
         " (a velocity step) or spliced records?  Gd/h per cycle is the slope over one V0"
         f" ({v0 * 1e6:.6g} µm/s for every cycle), and a stick spanning the change is not one line"
+    )
+
+
+def _curvature_note(cycles: list[CycleResult], noise: float) -> str:
+    """A warning naming the sticks that are curved beyond their noise (:data:`CURVE_SIGMAS`, :data:`CURVE_NOISE`)
+    with how much, and what the analysis did about it; "" when none is."""
+    curved = [c for c in cycles if c.stick_curved and c.stick_curvature is not None]
+    if not curved:
+        return ""
+    measured = [c for c in cycles if c.stick_curvature is not None]
+    which = "every one" if len(curved) == len(measured) else "cycles " + ", ".join(_runs([c.index for c in curved]))
+    if noise > 0 and 2 * len(curved) < len(measured):  # a few sticks bent, the others straight
+        bends = ", ".join(f"{c.stick_sagitta:.3g} Pa" for c in curved[:5] if c.stick_sagitta is not None)
+        return (
+            f"{len(curved)} of {len(measured)} sticks ({which}) are curved beyond their noise (by {bends}, against a"
+            f" noise of {noise:.3g} Pa), the others are straight: noise correlated over seconds, or an event within"
+            " those sticks?  Their σc, σs and ts are read where the slips meet the tangents of the parabola fitted to"
+            ' each (docs/analysis.md, "Curved sticks")'
+        )
+    curvature = float(np.median([c.stick_curvature for c in curved]))
+    sigmas = float(np.median([abs(c.stick_curvature) / c.stick_curvature_stderr for c in curved
+                              if c.stick_curvature_stderr]))  # fmt: skip
+    sagitta = float(np.median([c.stick_sagitta for c in curved if c.stick_sagitta is not None]))
+    whole = [c for c in curved if c.stick_time is not None and c.stick_slope is not None]
+    slopes = ""
+    if whole:
+        mean = float(np.median([c.stick_slope for c in whole]))
+        first = float(np.median([c.stick_slope - 0.5 * c.stick_curvature * c.stick_time for c in whole]))
+        last = float(np.median([c.stick_slope + 0.5 * c.stick_curvature * c.stick_time for c in whole]))
+        slopes = (
+            f"; within a stick its slope goes from {first:.4g} Pa/s at σc to {last:.4g} Pa/s at σs"
+            f" ({first / mean:.2g} to {last / mean:.2g} times its mean slope {mean:.4g} Pa/s)"
+        )
+    cut = [c.index for c in cycles if not c.complete and c.stick_slope is not None]
+    cut_text = (
+        f"; the stick slopes of the cut cycle(s) {', '.join(str(k) for k in cut)} are those of the part of a curved"
+        " stick the record holds, not a change of the pulling velocity"
+        if cut
+        else ""
+    )
+    return (
+        (
+            f"the stick phases are not straight lines: {len(curved)} of {len(measured)} sticks ({which}) are curved,"
+            f" d²σ/dt² = {curvature:.3g} Pa/s² ({sigmas:.3g} standard errors under the record's correlated noise), which"
+            f" bends a stick {sagitta:.3g} Pa off a straight line, {sagitta / noise:.3g} times the noise ({noise:.3g} Pa)"
+            f"{slopes}.  The spring-block model's stick is the straight line σ = σc + K·V0·t: here σc, σs and ts are"
+            " read where the slips meet the parabola's tangents, dσ/dt and Gd/h are the mean slope over each stick"
+            f" (not K·V0 at any one point), and a fit of the model to these cycles fits a stick it does not have{cut_text}"
+        )
+        if noise > 0
+        else ""
     )
 
 
@@ -544,8 +631,107 @@ def _fit_stick(t: np.ndarray, x: np.ndarray, coarse: Coarse, stick: _Stick, step
         stick.line = refit
         stick.start = _start_corner(t, x, coarse, stick, step)
         stick.end = _end_corner(t, x, coarse, stick, step)
+        _curved_corners(t, x, coarse, stick, step, clear)
     # the final corners only: their systematic uncertainty costs one more hinge fit each
     stick.start, stick.end = with_time_uncertainty(stick.start), with_time_uncertainty(stick.end)
+
+
+#: A stick is curved when the parabola fitted to it (between its corners, LINE_MARGIN clear of them) has a curvature
+#: this many standard errors from zero (under the record's correlated noise: the residuals' integrated
+#: autocorrelation time, analysis.steady) ...
+CURVE_SIGMAS = 5.0
+#: ... that departs from the straight line over the stick by more than this many noise levels (its sagitta).
+CURVE_NOISE = 1.0
+#: Fewest samples a stick needs for its curvature to be measured.
+CURVE_SAMPLES = 20
+#: The corners of a curved stick are sought again on the parabola's tangents this many times (the window the
+#: parabola is fitted on moves with them).
+CURVE_PASSES = 2
+
+
+@dataclass(frozen=True)
+class _Curve:
+    """sigma = a + b (t - t_ref) + c (t - t_ref)^2 fitted to a stick; c's standard error; whether it is curved."""
+
+    t_ref: float
+    a: float
+    b: float
+    c: float
+    c_stderr: float
+    sagitta: float
+    curved: bool
+
+    def __call__(self, t: np.ndarray | float) -> np.ndarray | float:
+        u = np.asarray(t) - self.t_ref
+        return self.a + self.b * u + self.c * u * u
+
+    def tangent(self, at: float, like: Line) -> Line:
+        """The parabola's tangent at ``at``, as a stick line (the other fields of ``like``)."""
+        u = at - self.t_ref
+        return dataclasses.replace(like, t_ref=at, intercept=self.a + self.b * u + self.c * u * u,
+                                   slope=self.b + 2.0 * self.c * u)  # fmt: skip
+
+
+def _fit_curve(t: np.ndarray, x: np.ndarray, lo: float, hi: float, span: float, noise: float) -> _Curve | None:
+    """The parabola through the samples in [lo, hi] and whether it is curved beyond the noise over a stick of
+    duration ``span`` (s): None with fewer than :data:`CURVE_SAMPLES` samples."""
+    inside = _between(t, lo, hi)
+    tt, xx = t[inside], x[inside]
+    if tt.size < CURVE_SAMPLES or not tt[-1] > tt[0]:
+        return None
+    t_ref = float(np.mean(tt))
+    u = tt - t_ref
+    design = np.column_stack([np.ones_like(u), u, u * u])
+    coef, *_ = np.linalg.lstsq(design, xx, rcond=None)
+    residual = xx - design @ coef
+    variance = float(np.einsum("i,i", residual, residual)) / (tt.size - 3)
+    w = u * u - np.mean(u * u)  # the curvature's own direction, clear of the line's
+    w -= float(np.einsum("i,i", u, w)) / float(np.einsum("i,i", u, u)) * u
+    ww = float(np.einsum("i,i", w, w))
+    if not ww > 0:
+        return None
+    c = float(coef[2])
+    stderr = math.sqrt(variance * integrated_time(residual) / ww)
+    sagitta = abs(c) * span * span / 4.0  # the parabola c u^2 over a stick of duration span, off its chord
+    # a noise-free record's stick is straight to its rounding, ~1e-16 of the stress, whatever its standard errors
+    floor = max(noise, 1e-9 * float(np.max(np.abs(xx))))
+    curved = abs(c) > CURVE_SIGMAS * stderr and sagitta > CURVE_NOISE * floor
+    return _Curve(t_ref, float(coef[0]), float(coef[1]), c, stderr, sagitta, bool(curved))
+
+
+def _curved_corners(t: np.ndarray, x: np.ndarray, coarse: Coarse, stick: _Stick, step: float, clear: float) -> None:
+    """Measure the stick's curvature; where it is curved beyond its noise, seek its corners again on the tangents of
+    the parabola at each of them (a straight line through a stick whose slope grows lies above it in its middle and
+    below it at its ends, and the hinges found the corners well inside the stick: t_s 9.6 s for 12.6 s)."""
+    straight = stick.line
+    if straight is None:
+        return
+    for _ in range(CURVE_PASSES + 1):
+        began = stick.start is not None and stick.start.significant
+        a = stick.start.time if began else max(float(t[0]), straight.t_min)
+        b = stick.end.time if stick.end is not None else straight.t_max
+        span = b - a
+        lo = a + max(clear, LINE_MARGIN * span) if began else a
+        hi = b - max(clear, LINE_MARGIN * span) if stick.end is not None else b
+        curve = _fit_curve(t, x, lo, hi, span, coarse.noise) if hi > lo else None
+        stick.curve = curve
+        if curve is None or not curve.curved or stick.curve_passes >= CURVE_PASSES:
+            break
+        stick.curve_passes += 1
+        # the slip's samples are those off the parabola (a stick cut by the record's start lies above the tangent at
+        # its first sample, and read as a slip onto it); the hinge joins the slip to the tangent at the corner
+        stick.line = curve.tangent(a, straight)
+        stick.start = _start_corner(t, x, coarse, stick, step)
+        stick.line = curve.tangent(b, straight)
+        stick.end = _end_corner(t, x, coarse, stick, step)
+        stick.line = straight
+    if stick.curve is not None and stick.curve.curved:  # the mean slope over the stick between its final corners
+        began = stick.start is not None and stick.start.significant
+        a = stick.start.time if began else max(float(t[0]), straight.t_min)
+        b = stick.end.time if stick.end is not None else straight.t_max
+        lo = a + max(clear, LINE_MARGIN * (b - a)) if began else a
+        hi = b - max(clear, LINE_MARGIN * (b - a)) if stick.end is not None else b
+        stick.line = (_line_between(t, x, lo, hi) if hi > lo else None) or straight
 
 
 def _line_between(t: np.ndarray, x: np.ndarray, lo: float, hi: float) -> Line | None:
@@ -581,8 +767,8 @@ def _start_corner(t: np.ndarray, x: np.ndarray, coarse: Coarse, stick: _Stick, s
     top, level = stick.prev_peak if stick.prev_peak is not None else (float(t[0]), None)
     hi = guess + reach if stick.end_guess is None else min(guess + reach, 0.5 * (guess + stick.end_guess))
     near = _indices(t, top, hi)
-    # the last sample clearly above the stick line is the last one of the slip
-    off = near[x[near] - line(t[near]) > _deviation(coarse)]
+    # the last sample clearly above the stick line (a curved stick's parabola) is the last one of the slip
+    off = near[x[near] - _stick_curve(stick)(t[near]) > _deviation(coarse)]
     stick.slip_last = None
     if off.size == 0:
         return None
@@ -610,8 +796,8 @@ def _end_corner(t: np.ndarray, x: np.ndarray, coarse: Coarse, stick: _Stick, ste
     bottom = stick.next_time if stick.next_time is not None else float(t[-1])
     lo = guess - reach if stick.start_guess is None else max(guess - reach, 0.5 * (guess + stick.start_guess))
     near = _indices(t, lo, bottom)
-    # the first sample clearly below the stick line is the first one of the slip
-    off = near[line(t[near]) - x[near] > _deviation(coarse)]
+    # the first sample clearly below the stick line (a curved stick's parabola) is the first one of the slip
+    off = near[_stick_curve(stick)(t[near]) - x[near] > _deviation(coarse)]
     stick.slip_first = None
     if off.size == 0:
         return None
@@ -626,6 +812,12 @@ def _end_corner(t: np.ndarray, x: np.ndarray, coarse: Coarse, stick: _Stick, ste
     search = (float(t[first]) - reach, float(t[first]))
     inside = _between(t, search[0] - max(STICK_WINDOW * span, reach), branch_hi)
     return fit_corner(t[inside], x[inside], line, True, search, coarse.noise)
+
+
+def _stick_curve(stick: _Stick) -> Callable[[np.ndarray], Any]:
+    """What a stick's samples lie on: its parabola where it is curved, else its line."""
+    curve = stick.curve
+    return curve if curve is not None and curve.curved else stick.line  # type: ignore[return-value]
 
 
 def _slip_run(off: np.ndarray, coarse: Coarse, step: float, first: bool) -> np.ndarray:
@@ -830,6 +1022,10 @@ def _cycles(
                 else None,
                 message="; ".join(notes),
                 slip_time_bound=stick.slip_bound if nxt and end else None,
+                stick_curvature=None if stick.curve is None else 2.0 * stick.curve.c,
+                stick_curvature_stderr=None if stick.curve is None else 2.0 * stick.curve.c_stderr,
+                stick_sagitta=None if stick.curve is None else stick.curve.sagitta,
+                stick_curved=stick.curve is not None and stick.curve.curved,
                 line=line,
                 stick_from=start.time if start else line.t_min,
                 stick_to=end.time if end else line.t_max,
@@ -847,6 +1043,25 @@ LONG_CYCLE_AMONG = 3
 #: A steady stretch scattering by more than this fraction of its mean (sd) is warned: friction is measured to a few
 #: per cent, and stick-slip sampled about twice a cycle or less looks like such scatter (aliased, no regular swing)
 WIDE_STEADY_SCATTER = 0.05
+
+
+def _settled(t: np.ndarray, x: np.ndarray, steady_from: float, earliest: float, band: float) -> tuple[float, str]:
+    """(start of the averaging window, a warning or "") of a steady stretch found from ``steady_from``: where its
+    relaxation, sought from ``earliest`` (after the last slip, or a gap) on, has decayed below the mean's standard
+    error (:func:`.steady.settled_start`); the warning when it has not by the latest start that keeps half the
+    stretch."""
+    inside = _between(t, min(earliest, steady_from), math.inf)
+    start, left, tau, _ = settled_start(t[inside], x[inside], steady_from, band)
+    if left is None or tau is None:
+        return start, ""
+    error = mean_and_error(t[_between(t, start, math.inf)], x[_between(t, start, math.inf)])
+    if error is None or abs(left) <= 1.01 * error.sem:
+        return start, ""
+    return start, (
+        f"the steady stretch is still relaxing: a relaxation of time constant {tau:.3g} s is {abs(left):.3g} Pa at"
+        f" t = {start:.6g} s, the latest start that keeps half the stretch, above the standard error of the mean"
+        f" ({error.sem:.2g} Pa): the mean stress is not yet the steady one; record for longer"
+    )
 
 
 def _wide_steady_scatter(stress: np.ndarray) -> str:
@@ -952,10 +1167,14 @@ def _summary(
         inside = _between(t, steady_from, math.inf)
         tail = x[inside]
         trend = fit_line(t[inside], tail)
+        # the standard error from the effective sample size (correlated noise: analysis.steady)
+        error = mean_and_error(t[inside], tail)
         summary.update(
             mean_stress=float(np.mean(tail)),
             stress_std=float(np.std(tail, ddof=1)) if tail.size > 1 else None,
-            stress_sem=float(np.std(tail, ddof=1) / np.sqrt(tail.size)) if tail.size > 1 else None,
+            stress_sem=None if error is None else error.sem,
+            stress_correlation_time=None if error is None else error.correlation_time,
+            steady_effective_samples=None if error is None else error.effective_samples,
             stress_slope=None if trend is None else trend.slope,
             steady_from=float(steady_from),
             steady_to=float(t[-1]),

@@ -53,6 +53,8 @@ MAX_GRID = 200_000
 STEADY_BAND = 0.25
 #: ... judged on a running mean over this many grid points.
 STEADY_AVERAGE = 25
+#: ... times the noise's correlation time in samples (a correlated-noise record), at most this many.
+MAX_CORRELATION = 100.0
 #: A record without slips has settled if its final flat stretch is at least this fraction of it.
 SETTLED_FRACTION = 0.25
 #: MAD -> standard deviation for Gaussian noise.
@@ -288,15 +290,20 @@ def coarse_segments(time: np.ndarray, stress: np.ndarray, step: float | None = N
     final_trough = None
     steady_from = None
     last = peaks[-1] if peaks.size else 0
+    # the steady tail's running mean spans as many independent samples whatever the noise's correlation: its
+    # correlation time in samples is about (whole / white)^2 (6.8 for AR(1) noise of coefficient 0.8, whose
+    # integrated autocorrelation time is 9), when the record's noise is the correlated one
+    correlated = noise >= 0.9 * whole and white > 0
+    average = STEADY_AVERAGE * (min((whole / white) ** 2, MAX_CORRELATION) if correlated else 1.0)
     tail = smooth[last:]
     if peaks.size:
         q = last + rise_start(tail, threshold)
         if smooth[-1] - np.min(tail) > threshold and q < smooth.size - 1:
             final_trough = q
         else:
-            steady_from = _steady_tail(grid, smooth, last, threshold, _longest_stick(grid, peaks, troughs))
+            steady_from = _steady_tail(grid, smooth, last, threshold, _longest_stick(grid, peaks, troughs), average)
     else:  # no slip: where the record has settled, if it did for a quarter of its length
-        steady_from = _steady_tail(grid, smooth, 0, threshold, SETTLED_FRACTION * float(grid[-1] - grid[0]))
+        steady_from = _steady_tail(grid, smooth, 0, threshold, SETTLED_FRACTION * float(grid[-1] - grid[0]), average)
     oscillation = _swings(grid, smooth, swings) if swings is not None else None
     return Coarse(
         noise=noise,
@@ -601,19 +608,41 @@ def _stick_scatter(
     time: np.ndarray, stress: np.ndarray, grid: np.ndarray, peaks: np.ndarray, troughs: np.ndarray
 ) -> float:
     """Median over the candidate stick phases of the RMS about a straight line fitted to its samples (the middle
-    80 % of the phase, so no corner), NaN when there is none of at least 8 samples."""
-    rms = []
+    80 % of the phase, so no corner), less a curvature common to them all; NaN when there is none of at least 8
+    samples.
+
+    The common curvature (one d2sigma/dt2, Pa/s^2, fitted to every stick at once; taken out of a stick where it
+    brings the stick's RMS down) is the record's: sticks that bend
+    alike (a stick slope that grows within each stick) are no noise, and read as noise they raised the drop
+    threshold (8.0 Pa for 3.3 Pa with sticks rising from 0.5 to 1.5 times K V0) and moved the corners.  The wander
+    of red noise bends each stick its own way and is left in the scatter (docs/analysis.md, "Curved sticks")."""
+    pieces = []
     for a, b in zip(grid[troughs], grid[peaks], strict=True):
         margin = 0.1 * (b - a)
         lo, hi = int(np.searchsorted(time, a + margin, "left")), int(np.searchsorted(time, b - margin, "right"))
         if hi - lo < 8:
             continue
         u = time[lo:hi] - np.mean(time[lo:hi])
+        uu = float(np.einsum("i,i", u, u))
+        if not uu > 0:
+            continue
         y = stress[lo:hi] - np.mean(stress[lo:hi])
-        slope = float(np.einsum("i,i", u, y)) / float(np.einsum("i,i", u, u))
-        y -= slope * u
-        rms.append(math.sqrt(float(np.einsum("i,i", y, y)) / (y.size - 2)))
-    return float(np.median(rms)) if rms else math.nan
+        y -= float(np.einsum("i,i", u, y)) / uu * u
+        w = u * u  # the curvature's shape, less its mean and its share along the line
+        w -= np.mean(w)
+        w -= float(np.einsum("i,i", u, w)) / uu * u
+        pieces.append((y, w))
+    if not pieces:
+        return math.nan
+    ww = sum(float(np.einsum("i,i", w, w)) for _, w in pieces)
+    bend = sum(float(np.einsum("i,i", w, y)) for y, w in pieces) / ww if ww > 0 else 0.0
+    # each stick's RMS about its line, less the common curvature where that brings it closer (a stick that bends
+    # otherwise, or not at all, keeps its line's)
+    rms = []
+    for y, w in pieces:
+        bent = y - bend * w
+        rms.append(math.sqrt(min(float(np.einsum("i,i", y, y)), float(np.einsum("i,i", bent, bent))) / (y.size - 2)))
+    return float(np.median(rms))
 
 
 def _separated(y: np.ndarray, peaks: np.ndarray, threshold: float) -> np.ndarray:
@@ -638,13 +667,16 @@ def _longest_stick(grid: np.ndarray, peaks: np.ndarray, troughs: np.ndarray) -> 
     return float(np.max(grid[peaks] - grid[troughs])) if peaks.size else 0.0
 
 
-def _steady_tail(grid: np.ndarray, smooth: np.ndarray, start: int, threshold: float, stick: float) -> float | None:
+def _steady_tail(
+    grid: np.ndarray, smooth: np.ndarray, start: int, threshold: float, stick: float, average: float = STEADY_AVERAGE
+) -> float | None:
     """Start of the flat stretch that ends the record, if it outlasts the longest stick phase.
 
     Flat means within :data:`STEADY_BAND` drop thresholds of the final level,
-    judged on a running mean (so that the noise itself never leaves the band).
+    judged on a running mean of ``average`` grid points (so that the noise itself never leaves the band: for
+    correlated noise, :data:`STEADY_AVERAGE` times its correlation time in samples).
     """
-    width = min(STEADY_AVERAGE, max(1, (smooth.size - start) // 4))
+    width = min(max(1, round(average)), max(1, (smooth.size - start) // 4))
     mean = uniform_filter1d(smooth[start:], size=width, mode="nearest")
     count = max(10, mean.size // 20)
     level = float(np.median(mean[-count:]))

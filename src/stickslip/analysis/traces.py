@@ -177,15 +177,43 @@ def parameter_mismatch(path: str | Path, params: Any) -> str:
     )
 
 
+#: A load point moves at one velocity when no position lies further from the straight line fitted to them all than
+#: this fraction of its travel (a model's load point, written to 17 digits) ...
+WANDER_FRACTION = 1e-6
+#: ... or than the column's own rounding, QUANTUM_WANDER of its quantum q (an encoder writing whole steps q lies
+#: within q/2 of the line), plus this many standard deviations of the noise it has beyond that rounding.
+QUANTUM_WANDER = 0.6
+WANDER_SIGMAS = 6.0
+
+
 def _one_velocity(name: str, t: np.ndarray, x: np.ndarray) -> tuple[float | None, str]:
-    """(velocity, "") of a load point that moves at one velocity throughout, else (None, why not)."""
+    """(velocity, "") of a load point that moves at one velocity throughout, else (None, why not).
+
+    The positions lie on one straight line to within :func:`_wander_tolerance`: the travel's 1e-6, or the column's
+    own quantum and noise (a measured load point written in whole encoder steps).  A velocity step moves them off
+    any one line by a good part of the travel times the step's relative size."""
     if not _usable(t, x):
         return None, f"its {name} column does not give a velocity"
     slope, offset = np.polyfit(t - t[0], x, 1)
     wander = float(np.max(np.abs(x - (offset + slope * (t - t[0])))))
-    if not slope > 0 or wander > 1e-6 * abs(float(x[-1] - x[0])):
+    if not slope > 0 or wander > _wander_tolerance(t, x):
         return None, f"its load point ({name}) does not move at one velocity throughout"
     return float(slope), ""
+
+
+def _wander_tolerance(t: np.ndarray, x: np.ndarray) -> float:
+    """How far (m) a load point moving at one velocity may lie from its fitted line: :data:`WANDER_FRACTION` of its
+    travel, or :data:`QUANTUM_WANDER` of the column's quantum (numerics.quantisation) plus :data:`WANDER_SIGMAS`
+    of its noise beyond the rounding's q/sqrt(12) (detect.noise_level, which sees correlated noise too), if more."""
+    from ..numerics.quantisation import quantum
+    from .detect import noise_level
+
+    travel = WANDER_FRACTION * abs(float(x[-1] - x[0]))
+    if t.size < 3:
+        return travel
+    q = quantum(x[:1_000_000])
+    extra = math.sqrt(max(noise_level(t, x) ** 2 - q**2 / 12.0, 0.0))
+    return max(travel, QUANTUM_WANDER * q + WANDER_SIGMAS * extra)
 
 
 def _load_point(path: str | Path) -> tuple[str, np.ndarray, np.ndarray] | None:

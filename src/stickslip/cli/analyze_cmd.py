@@ -71,6 +71,12 @@ JSON_UNITS = {
     "spread": "Pa",
     "samples_per_swing": "1",
     "slip_time_bound": "s",  # a slip between samples lasts less than this (cycles, and summary.unresolved_slips)
+    "stick_curvature": "Pa/s^2",  # a curved stick's d2sigma/dt2 (cycles; docs/analysis.md, "Curved sticks")
+    "stick_curvature_stderr": "Pa/s^2",
+    "stick_sagitta": "Pa",
+    "stick_curved": None,  # a flag
+    "stress_correlation_time": "s",  # the steady stretch's integrated autocorrelation time (its SEM's n_eff)
+    "steady_effective_samples": "1",
     "model": None,  # the comparison's per-cycle table of the model's values, not a number
 }
 
@@ -91,47 +97,57 @@ TABLE_ROWS = (
 
 
 @click.command("analyze")
-@click.argument("trace", type=InputFile())
+@click.argument("traces", metavar="TRACE...", nargs=-1, required=True, type=InputFile())
 @click.option(
     "--v0",
-    "v0_text",
-    default=None,
+    "v0_texts",
+    multiple=True,
     metavar="V",
     help='Pulling velocity with its unit, e.g. "50 um/s"; without it, the one a stickslip trace records in its load'
-    " point (a run at one velocity).",
+    " point (a run at one velocity).  With several traces: none, or one --v0 per trace, in their order.",
 )
 @click.option(
     "--contact-area",
     "area_text",
     default=None,
     metavar="A",
-    help='Contact area with its unit, e.g. "15 cm^2", to turn a force column into stress.',
+    help='Contact area with its unit, e.g. "15 cm^2", to turn a force column into stress (every trace).',
 )
 @params_options
-@click.option("--json", "as_json", is_flag=True, help="Print the analysis as JSON (SI units).")
+@click.option("--json", "as_json", is_flag=True, help="Print the analysis as JSON (SI units; one trace).")
 @click.option(
     "-o",
     "--output",
     type=FILE_PATH,
-    help="Write the per-cycle table as CSV (SI units in the header brackets).",
+    help="Write the per-cycle table as CSV (SI units in the header brackets; several traces: their rows stacked).",
+)
+@click.option(
+    "--steady-table",
+    "steady_path",
+    type=FILE_PATH,
+    help="Write the steady curve of steady-sliding traces as CSV, one row per trace (velocity, stress, stress_err:"
+    " the mean and its standard error), as `fit steady` reads it.",
 )
 @click.option(
     "--plot",
     "plot_path",
     type=FILE_PATH,
-    help="Save a figure of the record with the detected phases (and the model with --compare).",
+    help="Save a figure of the record with the detected phases (and the model with --compare; one trace).",
 )
 @click.option(
-    "--compare", is_flag=True, help="Simulate the model at V0, align it at the first whole cycle, report the misfit."
+    "--compare",
+    is_flag=True,
+    help="Simulate the model at V0, align it at the first whole cycle, report the misfit (one trace).",
 )
 def analyze_command(
-    trace: Path,
-    v0_text: str | None,
+    traces: tuple[Path, ...],
+    v0_texts: tuple[str, ...],
     area_text: str | None,
     params_name: str,
     overrides: tuple[str, ...],
     as_json: bool,
     output: Path | None,
+    steady_path: Path | None,
     plot_path: Path | None,
     compare: bool,
 ) -> None:
@@ -139,24 +155,71 @@ def analyze_command(
 
     TRACE is a CSV file with columns ``time`` and ``stress`` (or ``force``
     with --contact-area), units in header brackets (``time [s],stress [kPa]``;
-    bare names are SI).  Empty stress cells are gaps.
+    bare names are SI).  Empty stress cells are gaps.  Several traces (records
+    at several velocities) are analysed one after the other; --steady-table
+    writes the steady curve of those that slide steadily, for `fit steady`.
     """
-    refuse_overwriting_inputs([trace], [("-o", output), ("--plot", plot_path)], params_name)
-    from ..analysis import analyze_trace, compare_with_model, read_trace
+    refuse_overwriting_inputs(
+        list(traces), [("-o", output), ("--steady-table", steady_path), ("--plot", plot_path)], params_name
+    )
+    several = len(traces) > 1
+    if several:
+        for option, given in (("--json", as_json), ("--plot", plot_path is not None), ("--compare", compare)):
+            if given:
+                raise ParameterError(f"{option}: one trace at a time ({len(traces)} given)")
+    if v0_texts and len(v0_texts) != len(traces):
+        raise ParameterError(
+            f"--v0: given {len(v0_texts)} time(s) for {len(traces)} trace(s); expected one per trace, in their order,"
+            " or none (each trace's own load point)"
+        )
+    from ..analysis import compare_with_model
+
+    area = None if area_text is None else positive(area_text, "area", "--contact-area")
+    velocities = [None if not v0_texts else v0_texts[k] for k in range(len(traces))]
+    for text in velocities:  # a value given: checked at once, before any trace is read
+        if text is not None:
+            positive(text, "velocity", "--v0")
+    params = resolve_params(params_name, overrides)
+    parameter_set, default_set = _parameter_set(params, params_name)
+    analyses = [_analyze(trace, text, area, params, several) for trace, text in zip(traces, velocities, strict=True)]
+    steady_rows = _steady_rows(traces, analyses) if steady_path is not None else None
+    comparison = compare_with_model(analyses[0], params) if compare else None
+    if output is not None:
+        tables = [cycles_csv(a) for a in analyses]
+        write_text(output, tables[0] + "".join(t.split("\n", 1)[1] for t in tables[1:]))
+    if steady_rows is not None and steady_path is not None:
+        write_text(steady_path, steady_rows)
+    if as_json:
+        data = analyses[0].as_dict()
+        data["parameter_set_default"] = default_set
+        if comparison is not None:
+            data["comparison"] = comparison.as_dict()
+        data["units"] = json_units(data, JSON_UNITS)
+        emit_json(data)
+    else:
+        for analysis in analyses:
+            print_rich(*_report(analysis, comparison, parameter_set))
+    if plot_path is not None:
+        from ..plots.traces import figure_analysis
+
+        save_figure(figure_analysis(analyses[0], comparison), plot_path)
+
+
+def _analyze(trace: Path, v0_text: str | None, area: float | None, params: Any, several: bool) -> Any:
+    """One trace read, its pulling velocity found (--v0, or its load point) and checked, and analysed; the notes and
+    warnings on stderr."""
+    from ..analysis import analyze_trace, read_trace
     from ..analysis.traces import parameter_mismatch
     from ..models.run import recorded_status
 
-    area = None if area_text is None else positive(area_text, "area", "--contact-area")
-    v0 = None if v0_text is None else positive(v0_text, "velocity", "--v0")  # a value given: checked at once
     record = read_trace(trace, contact_area=area)  # before --v0 is asked for: a file that is no trace says so
     steps: list[tuple[float, float, float]] = []  # the load point's stretches at one velocity, when it steps
-    if v0 is None:
-        v0_text = _recorded_v0(trace)
+    if v0_text is None:
+        v0_text = _recorded_v0(trace, several)
         v0 = positive(v0_text, "velocity", "--v0")
     else:
+        v0 = positive(v0_text, "velocity", "--v0")
         steps = _check_recorded_v0(trace, v0, v0_text)
-    params = resolve_params(params_name, overrides)
-    parameter_set, default_set = _parameter_set(params, params_name)
     for note in record.notes:
         echo_err(f"note: {note}")
     mismatch = parameter_mismatch(trace, params)
@@ -176,33 +239,72 @@ def analyze_command(
                 f"warning: {trace}: the stick of cycle {spanning[0]} spans the velocity step at t = {start:.6g} s:"
                 " it is no one line, and its σc, ts and Gd/h are not those of either velocity"
             )
-    comparison = compare_with_model(analysis, params) if compare else None
-    if output is not None:
-        write_text(output, cycles_csv(analysis))
-    if as_json:
-        data = analysis.as_dict()
-        data["parameter_set_default"] = default_set
-        if comparison is not None:
-            data["comparison"] = comparison.as_dict()
-        data["units"] = json_units(data, JSON_UNITS)
-        emit_json(data)
-    else:
-        print_rich(*_report(analysis, comparison, parameter_set))
-    if plot_path is not None:
-        from ..plots.traces import figure_analysis
-
-        save_figure(figure_analysis(analysis, comparison), plot_path)
+    return analysis
 
 
-def _recorded_v0(trace: Path) -> str:
+#: A steady stretch whose mean's standard error is below this fraction of the mean is noise-free (a model's run).
+NOISE_FREE = 1e-9
+#: Columns of ``--steady-table``: what `fit steady` reads (docs/fitting.md, "Data files"), SI units.
+STEADY_TABLE_COLUMNS = (("velocity", "m/s"), ("stress", "Pa"), ("stress_err", "Pa"))
+
+
+def _steady_rows(traces: tuple[Path, ...], analyses: list[Any]) -> str:
+    """The steady curve of the traces as `fit steady` reads it: per trace its pulling velocity (the sliding velocity
+    of steady sliding), the mean stress over its steady window and that mean's standard error (under correlated
+    noise: docs/analysis.md, section 6).  A trace that does not end in steady sliding has no point on the curve:
+    refused, naming it.  Noise-free records (every error 0, as the model's own runs) get no stress_err column."""
+    from ..display import velocity as show_velocity
+
+    rows = []
+    for trace, analysis in zip(traces, analyses, strict=True):
+        summary = analysis.summary
+        mean, error = summary.get("mean_stress"), summary.get("stress_sem")
+        if analysis.regime != "steady" or mean is None:
+            raise ParameterError(
+                f"--steady-table: {trace} is {analysis.regime} at {show_velocity(analysis.pulling_velocity, 4)}, not"
+                " steady sliding: it has no point on the steady curve; leave it out (analyze it alone for its cycles)"
+            )
+        if error is None:
+            raise ParameterError(
+                f"--steady-table: {trace}: its steady stretch has {summary.get('steady_samples')} sample(s), too"
+                " few for a standard error of its mean"
+            )
+        # a noise-free record (a model's run) has an error of rounding alone: none
+        rows.append((analysis.pulling_velocity, float(mean), float(error) if error > NOISE_FREE * abs(mean) else 0.0))
+    columns = STEADY_TABLE_COLUMNS if any(row[2] > 0 for row in rows) else STEADY_TABLE_COLUMNS[:2]
+    if len(columns) < len(STEADY_TABLE_COLUMNS):
+        echo_err(
+            "note: --steady-table: every steady stretch is noise-free (a standard error of 0 Pa): no stress_err"
+            " column, and fit steady weighs every point alike"
+        )
+    elif any(not row[2] > 0 for row in rows):
+        raise ParameterError(
+            "--steady-table: "
+            + ", ".join(str(t) for t, row in zip(traces, rows, strict=True) if not row[2] > 0)
+            + " have a noise-free steady stretch (standard error 0 Pa) beside noisy ones: fit steady needs a"
+            " positive stress_err in every row; analyze them apart"
+        )
+    out = io.StringIO()
+    out.write(",".join(f"{name} [{unit}]" for name, unit in columns) + "\n")
+    for row in rows:
+        out.write(",".join(_cell(value) for value in row[: len(columns)]) + "\n")
+    return out.getvalue()
+
+
+def _recorded_v0(trace: Path, several: bool = False) -> str:
     """--v0 from the trace's own load point (what `run -o` and its spellings write), said on stderr."""
     from ..analysis.traces import recorded_pulling_velocity
     from ..display import velocity as show_velocity
 
     v0, why = recorded_pulling_velocity(trace)
+    name = f"{trace}: " if several else ""
     if v0 is None:
-        raise ParameterError(f"--v0: needed: {why}; give the pulling velocity with its unit, e.g. --v0 '50 um/s'")
-    echo_err(f"note: --v0 not given: the trace's load point moves at {show_velocity(v0, 6)} throughout")
+        raise ParameterError(
+            f"--v0: needed: {name}{why}; give the pulling velocity with its unit, e.g. --v0 '50 um/s'"
+            + (" (one --v0 per trace, in their order)" if several else "")
+        )
+    whose = f"{trace}: its" if several else "the trace's"
+    echo_err(f"note: --v0 not given: {whose} load point moves at {show_velocity(v0, 6)} throughout")
     return f"{v0:.12g} m/s"  # the load point is written to 17 digits; its slope is known to ~1e-12
 
 
@@ -356,6 +458,11 @@ def _report(analysis: Any, comparison: Any, parameter_set: str | None = None) ->
     if "mean_stress" in analysis.summary:
         s = analysis.summary
         spread = "" if s["stress_std"] is None else f" ± {s['stress_std']:.3g} Pa (sd of {s['steady_samples']} samples)"
+        if s.get("stress_sem") is not None and s.get("steady_effective_samples") is not None:
+            spread += (
+                f"; standard error of the mean {s['stress_sem']:.2g} Pa ({s['steady_effective_samples']:.4g} effective"
+                f" samples: correlation time {s['stress_correlation_time']:.3g} s)"
+            )
         parts.append(
             escape(f"steady sliding from t = {s['steady_from']:.6g} s: mean stress {s['mean_stress']:.6g} Pa{spread}")
         )
