@@ -546,11 +546,14 @@ def _curvature_note(cycles: list[CycleResult], noise: float) -> str:
     return (
         (
             f"the stick phases are not straight lines: {len(curved)} of {len(measured)} sticks ({which}) are curved,"
-            f" d²σ/dt² = {curvature:.3g} Pa/s² ({sigmas:.3g} standard errors under the record's correlated noise), which"
-            f" bends a stick {sagitta:.3g} Pa off a straight line, {sagitta / noise:.3g} times the noise ({noise:.3g} Pa)"
+            f" d²σ/dt² = {curvature:.3g} Pa/s² ({sigmas:.3g} standard errors under the record's correlated noise),"
+            " which"
+            f" bends a stick {sagitta:.3g} Pa off a straight line, {sagitta / noise:.3g} times the noise"
+            f" ({noise:.3g} Pa)"
             f"{slopes}.  The spring-block model's stick is the straight line σ = σc + K·V0·t: here σc, σs and ts are"
             " read where the slips meet the parabola's tangents, dσ/dt and Gd/h are the mean slope over each stick"
-            f" (not K·V0 at any one point), and a fit of the model to these cycles fits a stick it does not have{cut_text}"
+            " (not K·V0 at any one point), and a fit of the model to these cycles fits a stick it does not"
+            f" have{cut_text}"
         )
         if noise > 0
         else ""
