@@ -1037,6 +1037,8 @@ def _start_sensitivity(params: Parameters, rows: _Rows) -> np.ndarray:
     """d ln t_s / d sigma_0 of each row (1/Pa) at ``params``: how Eq 15 turns a start stress into a stick time."""
     step = FLOOR_STEP * rows.start
     shifted = [dataclasses.replace(rows, start=rows.start + sign * step) for sign in (1.0, -1.0)]
+    # a row whose stick never collapses at these parameters has an infinite (or no) stick time: its sensitivity is
+    # not finite, and both readers (_start_drifts, _offset_note) keep only the finite ones
     with np.errstate(invalid="ignore", divide="ignore"):
         up, down = (_stick_times([params], r)[0] for r in shifted)
         return (np.log(up) - np.log(down)) / (2 * step)
