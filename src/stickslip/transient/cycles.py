@@ -461,6 +461,8 @@ def steady_instability(
     block = f"K = {stiffness / 1e3:.6g} kPa/m"
     try:
         rates = INSTABILITY_RATES / float(params.bonds.bond_time)
+        # at the fastest trial rates the response's exponentials may overflow: those margins are not finite and
+        # are left out below (only a finite negative margin proves a root); the full Kc search decides otherwise
         with np.errstate(over="ignore", invalid="ignore"):
             z = interface_response(params, velocity, rates, aging).z.real
             margin = mass * rates**2 + damping * rates + stiffness + z
