@@ -490,12 +490,31 @@ def _still_changing(
     estimates = [remaining] + [remaining_change(t, y, tau / d, dense)[1] for d in divisors[1:]]
     if all(math.isfinite(e) and e > 0 for e in estimates) and max(estimates) <= APPROACH_AGREEMENT * min(estimates):
         return f"{head}, about {remaining:.3g}{suffix} still to come; {tolerance})"
-    spans = ", ".join(f"{tau / d:.3g}" for d in divisors[:-1]) + f" and {tau / divisors[-1]:.3g} s"
-    values = ", ".join(f"{e:.3g}" for e in estimates[:-1]) + f" and {estimates[-1]:.3g}{suffix}"
+    spans = ", ".join(f"{2 * tau / d:.3g}" for d in divisors[:-1]) + f" and {2 * tau / divisors[-1]:.3g} s"
+    readings = [_approach_reading(*_tail_changes(t, y, tau / d, dense), suffix) for d in divisors]
+    read = ", ".join(readings[:-1]) + f" and {readings[-1]}"
     return (
-        f"{head}; {tolerance}), and not as one exponential approach (the change still to come, read as one over"
-        f" the last {spans}: {values}): how far it still goes is not known"
+        f"{head}; {tolerance}), and not as one exponential approach, which slows down by one factor on every"
+        f" scale (its changes over the two halves of the last {spans}: {read}): how far it still goes is not known"
     )
+
+
+def _approach_reading(d1: float, d2: float, suffix: str) -> str:
+    """Two successive changes of a tail in words: what still comes where they slow down, else that they do not.
+
+    A tail that turns back (changes of opposite signs) or speeds up (|d2| >= |d1|, or d1 = 0) is no exponential
+    approach and bounds nothing: the change still to come of d2 q/(1 - q) was printed as "inf Pa" for a decaying
+    oscillation that sped up over its last 0.17 s (-0.0135 then -0.021 Pa), and as the last change itself (the
+    bound that :func:`remaining_change` keeps for a turn too small to count) where it turned (round-30 tester)."""
+    changes = f"{d1:+.3g}{suffix} then {d2:+.3g}{suffix}"
+    if d2 == 0.0:
+        return f"{changes} (stopped)"
+    if d1 * d2 < 0:
+        return f"{changes} (turns back)"
+    left = _aitken(d1, d2)[1]
+    if not math.isfinite(left):
+        return f"{changes} (not slowing down)"
+    return f"{changes} (slows down: {left:.3g}{suffix} more as one exponential)"
 
 
 def _verdict(

@@ -264,6 +264,7 @@ def analyze_trace(
     params = load_parameters("gelatin-glass") if params is None else params
     valid = trace.valid
     t, x = (trace.time, trace.stress) if np.all(valid) else (trace.time[valid], trace.stress[valid])
+    rows = np.flatnonzero(valid)  # each usable sample's index in the record: NaN rows between two are a hole
     step = sampling_step(t)
     coarse = coarse_segments(t, x, step)
     if np.median(x) < -coarse.threshold:
@@ -280,9 +281,10 @@ def analyze_trace(
         stress[np.flatnonzero(valid)[dropped]] = np.nan
         keep = np.ones(t.size, dtype=bool)
         keep[dropped] = False
-        t, x = t[keep], x[keep]
+        t, x, rows = t[keep], x[keep], rows[keep]
         coarse = coarse_segments(t, x, step)
-    cuts = gaps(t, step)
+    # a long interval is a gap unless the record runs straight across it (a model's two-sample stick)
+    cuts = gaps(t, step, x, coarse.noise, holes=np.diff(rows) > 1)
     if cuts.size:
         warnings.append(_gap_note(t, cuts, step))
         coarse, swings, regime, steady_from, cycles = _across_gaps(t, x, coarse, cuts, step, v0, params)

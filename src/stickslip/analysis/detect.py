@@ -710,9 +710,79 @@ DROPOUT_RETURN = 0.25
 DROPOUT_FLAT = 0.25
 
 
-def gaps(time: np.ndarray, step: float) -> np.ndarray:
+#: A long interval is no gap where the record runs straight across it, as a model's solver (or an event-driven
+#: logger) writes a straight stick as its two ends (the docs' velocity-weakening plug-in: 0.46 s between two rows,
+#: among slips sampled every 1e-6 s).  Straight: no sample removed inside it (no NaN row, no dropout), and on one
+#: side at least the samples over STRAIGHT_REACH times the time in which a slope STRAIGHT_SLOPE (relative) off the
+#: chord's moves STRAIGHT_SIGMAS noise levels off it (and STRAIGHT_SAMPLES samples at least) all lie within
+#: STRAIGHT_SIGMAS noise levels, plus that slope's reach, of the chord run on past its end; that span must be no
+#: longer than the interval, and the side must have it (before another gap or the record's end).  A record that
+#: rises across the interval as fast as its sticks rise hides no slip in it (the slip's drop would have to be made
+#: up by a faster rise); a gap over a slip of a sawtooth has a chord whose slope is half the sticks' or less, whose
+#: sides leave it by 10 such bands and more.  A side too short or too noisy to tell leaves it a gap: the record
+#: must rise across it by 2·STRAIGHT_REACH·STRAIGHT_SIGMAS/STRAIGHT_SLOPE = 80 noise levels at least.
+STRAIGHT_SLOPE = 0.1
+STRAIGHT_SIGMAS = 4.0
+STRAIGHT_REACH = 2.0
+STRAIGHT_SAMPLES = 3
+
+
+def gaps(
+    time: np.ndarray,
+    step: float,
+    stress: np.ndarray | None = None,
+    noise: float = 0.0,
+    holes: np.ndarray | None = None,
+) -> np.ndarray:
     """Indices k of the usable samples after which the record has a gap: time[k + 1] - time[k] longer than
-    :data:`GAP_STEPS` times the sampling interval ``step`` and the local one (:data:`GAP_NEIGHBOURS`)."""
+    :data:`GAP_STEPS` times the sampling interval ``step`` and the local one (:data:`GAP_NEIGHBOURS`).
+
+    With ``stress`` (and its ``noise`` level), an interval across which the record is one straight line
+    (:func:`straight_across`) is no gap; ``holes[k]`` True marks an interval that lost samples (NaN rows, a
+    dropout), which stays a gap whatever the line."""
+    found = _long_intervals(time, step)
+    if stress is None or found.size == 0:
+        return found
+    bridged = [
+        k for k in found if not (holes is not None and holes[k]) and straight_across(time, stress, k, noise, found)
+    ]
+    return np.setdiff1d(found, np.asarray(bridged, dtype=int))
+
+
+def straight_across(time: np.ndarray, stress: np.ndarray, k: int, noise: float, cuts: np.ndarray) -> bool:
+    """Whether the record is one straight line across the interval after sample k (see :data:`STRAIGHT_SLOPE`):
+    the samples on either side, up to the next of the long intervals ``cuts`` or the record's end, continue the
+    chord from sample k to sample k + 1."""
+    t0, t1 = float(time[k]), float(time[k + 1])
+    x0, x1 = float(stress[k]), float(stress[k + 1])
+    span = t1 - t0
+    slope = (x1 - x0) / span
+    band = STRAIGHT_SIGMAS * max(noise, 1e-12 * max(abs(x0), abs(x1)))
+    if not abs(slope) > 0:
+        return False
+    reach = STRAIGHT_REACH * band / (STRAIGHT_SLOPE * abs(slope))  # the span each side must show
+    if not reach <= span:
+        return False
+    others = cuts[cuts != k]
+    first = int(others[others < k].max()) + 1 if np.any(others < k) else 0  # the stretches about the interval
+    last = int(others[others > k].min()) if np.any(others > k) else time.size - 1
+    sides = []  # a side shorter than the reach (another gap, the record's end) cannot tell: not asked
+    lo = min(int(np.searchsorted(time, t0 - reach, side="left")), k - STRAIGHT_SAMPLES)
+    if lo >= first and float(time[first]) <= t0 - reach:
+        sides.append((slice(lo, k), k))
+    hi = max(int(np.searchsorted(time, t1 + reach, side="right")), k + 2 + STRAIGHT_SAMPLES)
+    if hi <= last + 1 and float(time[last]) >= t1 + reach:
+        sides.append((slice(k + 2, hi), k + 1))
+    for near, edge in sides:
+        dt = time[near] - time[edge]
+        off = np.abs(stress[near] - (float(stress[edge]) + slope * dt))
+        if np.all(off <= band + STRAIGHT_SLOPE * abs(slope) * np.abs(dt)):
+            return True
+    return False
+
+
+def _long_intervals(time: np.ndarray, step: float) -> np.ndarray:
+    """The gaps by the sampling alone (:func:`gaps` without a stress)."""
     if step <= 0 or time.size < 2:
         return np.empty(0, dtype=int)
     dt = np.diff(time)

@@ -1,8 +1,9 @@
 """Measured stress-time records: reading a CSV trace and checking it.
 
 A ``time`` column and ``stress`` or ``force`` (over a contact area), units in header brackets (bare names are SI);
-gaps, jumps at one instant, duplicated rows and the package's own trace columns (:data:`MODEL_COLUMNS`, ignored
-with a note) are handled as docs/analysis.md says.  Every problem is a typed error naming the file and row.
+gaps, jumps at one instant, duplicated rows and the package's own trace columns (:data:`MODEL_COLUMNS`, and any
+state column of a Run CSV: :func:`run_state_columns`; ignored with a note) are handled as docs/analysis.md says.
+Every problem is a typed error naming the file and row.
 """
 
 from __future__ import annotations
@@ -68,8 +69,13 @@ def read_trace(path: str | Path, contact_area: float | None = None) -> Trace:
     """
     if not isinstance(path, (str, Path)) and not hasattr(path, "__fspath__"):
         raise DataError(f"read_trace: expected a file name (str or Path), got {type(path).__name__}")
+    states = run_state_columns(path)
     table = read_table(
-        path, TRACE_DIMENSIONS, required=["time"], allow_missing=["stress", "force"], ignore=MODEL_COLUMNS
+        path,
+        TRACE_DIMENSIONS,
+        required=["time"],
+        allow_missing=["stress", "force"],
+        ignore=(*MODEL_COLUMNS, *states),
     )
     has_stress, has_force = "stress" in table, "force" in table
     if has_stress and has_force:
@@ -95,11 +101,30 @@ def read_trace(path: str | Path, contact_area: float | None = None) -> Trace:
         stress = table["stress"]
     notes = list(table.notes)  # how the file was read, where not as usual (decimal commas)
     if table.ignored:
-        notes.append(f"ignored column(s) {', '.join(table.ignored)}: analyze reads time and stress only")
+        own = [n for n in table.ignored if n in states]
+        said = f" ({', '.join(own)}: the model's state, as Run.read reads it)" if own else ""
+        notes.append(f"ignored column(s) {', '.join(table.ignored)}{said}: analyze reads time and stress only")
     time, stress, rows, merged = _merge_model_repeats(path, table, stress)
     notes.extend(merged)
     trace = check_trace(time, stress, source=table.source, rows=rows)
     return replace(trace, notes=tuple(notes))
+
+
+#: the columns by which a CSV is a Run CSV (``Run.read`` requires them; any further column is a model's state)
+RUN_BASE = ("time", "slider_velocity", "slider_position", "load_point_position")
+
+
+def run_state_columns(path: str | Path) -> tuple[str, ...]:
+    """The columns of a Run CSV (one with :data:`RUN_BASE`, which ``Run.read`` reads) beyond the package's known
+    ones: a plug-in model's state variables (``theta [s]``), read by ``Run.read`` as states and ignored by
+    ``analyze`` as the built-in models' are.  () for any other file: there an unknown column stays an error."""
+    from ..tables import header_names
+
+    names = header_names(path)
+    if not set(RUN_BASE) <= set(names):
+        return ()
+    known = {*TRACE_DIMENSIONS, *MODEL_COLUMNS}
+    return tuple(dict.fromkeys(n for n in names if n and n not in known))
 
 
 #: the load-point columns of the package's own traces (Run CSV; old transient and rate-and-state traces)
@@ -219,7 +244,7 @@ def _wander_tolerance(t: np.ndarray, x: np.ndarray) -> float:
 def _load_point(path: str | Path) -> tuple[str, np.ndarray, np.ndarray] | None:
     """(column, time, position) of a trace's first load-point column; None without one."""
     for name in LOAD_POINT_COLUMNS:
-        others = [c for c in (*MODEL_COLUMNS, "stress", "force") if c != name]
+        others = [c for c in (*MODEL_COLUMNS, *run_state_columns(path), "stress", "force") if c != name]
         try:
             table = read_table(path, {"time": "time", name: "length"}, required=["time", name], ignore=others)
         except DataError:

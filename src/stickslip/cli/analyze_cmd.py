@@ -53,6 +53,11 @@ CSV_COLUMNS = (
     ("critical_stress_uncertainty", "Pa"),
     ("peak_stress_uncertainty", "Pa"),
     ("stick_time_uncertainty", "s"),
+    # the stick's bend (d2sigma/dt2 of a parabola through it) and whether it is beyond its noise: fit stick's model
+    # sticks are straight, so it names the curved rows it reads (docs/analysis.md, "Curved sticks")
+    ("stick_curvature", "Pa/s^2"),
+    ("stick_curvature_stderr", "Pa/s^2"),
+    ("stick_curved", "1"),
 )
 
 #: Units of the keys of ``--json`` that are particular to analyze (they win over the package's registry, where
@@ -384,6 +389,7 @@ def cycles_csv(analysis: Any) -> str:
         data["cycle"] = cycle.index
         data["pulling_velocity"] = analysis.pulling_velocity
         data["complete"] = int(cycle.complete)
+        data["stick_curved"] = int(cycle.stick_curved)  # a flag, written as the 0/1 the other flags are
         out.write(",".join(_cell(data[name]) for name, _ in CSV_COLUMNS) + "\n")
     return out.getvalue()
 

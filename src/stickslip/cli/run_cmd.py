@@ -138,18 +138,24 @@ def start_value(text: str | None, model: Any = None) -> Any:
         words = getattr(model, "start_words", None)
         if words is not None and text.strip() not in words:
             dimension = getattr(model, "start_dimension", None)
+            example = _START_EXAMPLES.get(dimension, "a value with its unit")
+            if words:  # a plug-in's start_words=("steady",) with a velocity: name both ("not a word" was untrue)
+                number = "" if dimension is None else f", or {quantity_noun(dimension)} with its unit ({example})"
+                raise ParameterError(
+                    f"--start {shorten(text)}: --model {model.name} starts from {_word_list(words)}{number};"
+                    f" got the word {text.strip()!r}"
+                )
             raise ParameterError(
                 f"--start {shorten(text)}: --model {model.name} starts from {quantity_noun(dimension)}, not a word;"
-                f" expected one with its unit, e.g. {_START_EXAMPLES.get(dimension, 'a value with its unit')}"
+                f" expected one with its unit, e.g. {example}"
             )
         return text.strip()
     if model is not None:
         dimension = getattr(model, "start_dimension", None)
         if dimension is None:
-            raise ParameterError(
-                f"--start {shorten(text)}: --model {model.name} starts from a word (transient: empty or steady),"
-                " not a number"
-            )
+            words = getattr(model, "start_words", None)
+            named = _word_list(words) if words else "a word (transient: empty or steady)"
+            raise ParameterError(f"--start {shorten(text)}: --model {model.name} starts from {named}, not a number")
         require_unit(text, dimension, "--start ")
         try:
             value = to_si(text, dimension, "--start")
@@ -172,6 +178,13 @@ def start_value(text: str | None, model: Any = None) -> Any:
 
 #: How a start of each dimension is written, in refusals.
 _START_EXAMPLES = {"stress": "--start '400 Pa'", "velocity": "--start '50 um/s'"}
+
+
+def _word_list(words: tuple[str, ...]) -> str:
+    """A model's start words in a refusal: "the word steady", "one of the words empty or steady"."""
+    if len(words) == 1:
+        return f"the word {words[0]}"
+    return f"one of the words {', '.join(words[:-1])} or {words[-1]}"
 
 
 def _finite_start(value: float, text: str) -> float:
@@ -397,6 +410,15 @@ def _run_range(summary: dict[str, Any], signal: str, unit: str) -> list[str]:
     return [f"  range over the whole run: {low:.6g} ... {high:.6g}{unit}"]
 
 
+def _settled_here(summary: dict[str, Any], signal: str) -> bool:
+    """Whether the summary's ``mean_*`` is a value the run settled at within itself: the classifier found its tail
+    steady (its evidence "steady: ..."; the quasi-static model's steady σ(V0) may lie beyond a run that ends
+    before it settles).  A steady plug-in run printed only its mean over the run, which depends on its length."""
+    value = summary.get(f"mean_{signal}")
+    settled = summary["status"] == "ok" and str(summary.get("evidence", "")).startswith(f"{regimes.STEADY}:")
+    return settled and value is not None and math.isfinite(value)
+
+
 #: how the summary's regime line marks a run that did not finish
 _STATUS_WORDS = {"ok": "", "stopped": " (of the run up to its stop: it used up its budget)"}
 
@@ -433,6 +455,8 @@ def summary_text(summary: dict[str, Any], units: dict[str, str] | None = None) -
     segments = summary["protocol"]
     for word in words:
         value = summary.get(f"{word}_{signal}")
+        if word == "run_mean" and _settled_here(summary, signal):  # the value it settled at, not only the run's mean
+            numbers.append(f"settled at {summary[f'mean_{signal}']:.6g}{unit}")
         if value is not None and math.isfinite(value):
             numbers.append(f"{shown.get(word, word)} {value:.6g}{unit}")
             if not cycle and word == "peak" and len(segments) > 1:  # the regime's window: the last segment's
@@ -617,7 +641,7 @@ def execute(
     if as_json:
         emit_json({**summary, "units": units})
     else:  # (beside a trace on standard output, claim_stdout above sends it to stderr)
-        record = record_text(run)
+        record = record_text(run, summary["rig"])
         click.echo(summary_text(summary, units) + ("\n" + record if record else ""))
     if stopped is not None:
         written = [str(path) for path in (output, plot_path) if path is not None]

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from typing import Any
 
+from ..display import velocity
 from .common import plain_text
 
 #: Width of the plain text a table is drawn in (as ``print_rich`` draws it to a pipe).
@@ -25,13 +26,15 @@ def model_record(run: Any) -> dict[str, Any]:
     return record
 
 
-def record_text(run: Any) -> str:
-    """The model's own record in words, below the shared summary ("" for a model without one)."""
+def record_text(run: Any, rig: dict[str, Any] | None = None) -> str:
+    """The model's own record in words, below the shared summary ("" for a model without one).  ``rig``: the
+    summary's (its ``stiffness_from`` says whether the quasi-static model's K is Eq 17's or the rig's)."""
     native = run.native
     kind = type(native).__name__
     if kind == "Simulation":
         return "\n".join(
-            item if isinstance(item, str) else plain_text([item], PLAIN_WIDTH) for item in _simulation_record(native)
+            item if isinstance(item, str) else plain_text([item], PLAIN_WIDTH)
+            for item in _simulation_record(native, (rig or {}).get("stiffness_from"))
         )
     if kind == "TransientResult":
         return "\n".join(_transient_record(native))
@@ -44,16 +47,21 @@ def _fmt(value: float | None, scale: float = 1.0, digits: int = 5) -> str:
     return "—" if value is None else f"{value * scale:.{digits}g}"
 
 
-def _simulation_record(sim: Any) -> list[Any]:
-    """The quasi-static run: its parameter set, start and critical point, where it ended, and its cycles."""
+#: where the quasi-static run's K came from, as its record says it (the summary rig's ``stiffness_from``)
+K_SOURCE = {"rig": "the rig's, as given", "parameters": "Eq 17"}
+
+
+def _simulation_record(sim: Any, stiffness_from: str | None = None) -> list[Any]:
+    """The quasi-static run: its parameter set, start and critical point, where it ended, and its cycles.
+    ``stiffness_from``: "rig" where K was given (``--stiffness``: "(Eq 17)" was written beside it), else Eq 17's."""
     from rich.table import Table
 
     name = sim.parameters.name if sim.parameters is not None else "parameters"
     head = [
         f"  {name}: starting stuck at {sim.start_stress:.6g} Pa (jump onto the {sim.jump_curve} curve);"
-        f" Vc = {sim.critical_velocity * 1e6:.6g} µm/s, σc = {sim.critical_stress:.6g} Pa,"
-        f" K = {sim.stiffness / 1e3:.6g} kPa/m (Eq 17)",
-        f"  at t = {sim.time[-1]:.6g} s: σ = {sim.final_stress:.6g} Pa, V = {sim.final_velocity * 1e6:.6g} µm/s"
+        f" Vc = {velocity(sim.critical_velocity)}, σc = {sim.critical_stress:.6g} Pa,"
+        f" K = {sim.stiffness / 1e3:.6g} kPa/m ({K_SOURCE.get(stiffness_from or 'parameters', 'Eq 17')})",
+        f"  at t = {sim.time[-1]:.6g} s: σ = {sim.final_stress:.6g} Pa, V = {velocity(sim.final_velocity)}"
         + ("" if sim.time[-1] >= sim.duration else " (the model stops here)"),
     ]
     out: list[Any] = ["\n".join(head)]

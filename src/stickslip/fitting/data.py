@@ -73,12 +73,15 @@ CYCLES_COLUMNS = {"critical_stress": "start_stress", "critical_stress_uncertaint
 #: Columns of that table the stick fit does not use (times within the record, errors, the slip, the model's Vs).
 CYCLES_IGNORED = (
     "complete", "peak_time", "end_time", "stick_slope_stderr", "stiffness_stderr",
-    "model_jump_velocity", "slip_time", "period", "stress_drop",
+    "model_jump_velocity", "slip_time", "period", "stress_drop", "stick_curvature", "stick_curvature_stderr",
 )  # fmt: skip
 #: Columns only analyze's cycles table has: a table with any of them (and without the columns Table 1's reader
 #: knows alone) is read as a cycles table, with or without its critical_stress (round 29: a table whose
 #: critical_stress columns were deleted to fit without the measured start stresses was "unknown column 'complete'").
 CYCLES_ONLY = ("critical_stress", "critical_stress_uncertainty", "start_time", *CYCLES_IGNORED)
+#: analyze's flag of a stick curved beyond its noise (round 30; its curvature and that error are in
+#: CYCLES_IGNORED): not a fit input; the stick fit's sticks are straight, so the rows it flags are named
+CYCLE_CURVED = "stick_curved"
 #: The time of each cycle's start within its record (s): read from a cycles table to date its start stress
 #: (the drift check of fit stick, docs/fitting.md); not a fit input.
 CYCLE_START_TIME = "start_time"
@@ -286,11 +289,14 @@ def _read_cycles_table(path: str | Path, names: Sequence[str]) -> StickData:
             dimensions[name] = "stress"
     if CYCLE_START_TIME in names:
         dimensions[CYCLE_START_TIME] = "time"
+    if CYCLE_CURVED in names:
+        dimensions[CYCLE_CURVED] = "dimensionless"
     allowed = tuple(n for n in dimensions if n != "pulling_velocity")
     table = read_table(path, dimensions, required=["pulling_velocity", "stick_time"], allow_missing=allowed,
                        ignore=CYCLES_IGNORED)  # fmt: skip
     whole = np.isfinite(table["stick_time"])
     columns = {CYCLES_COLUMNS.get(n, n): v[whole] for n, v in table.columns.items()}
+    curved = columns.pop(CYCLE_CURVED, np.zeros(int(whole.sum()))) > 0
     if "critical_stress" in names:
         said = "its critical_stress (σc) is each row's start_stress"
     else:
@@ -299,7 +305,13 @@ def _read_cycles_table(path: str | Path, names: Sequence[str]) -> StickData:
     if not whole.all():
         cut = ", ".join(str(r) for r in table.rows[~whole])
         notes.append(f"{source}: row(s) {cut} left out: cycles cut by the record's ends or a gap in it (no stick time)")
-    written = {CYCLES_COLUMNS.get(n, n): w for n, w in table.written.items()}
+    if curved.any():
+        bent = ", ".join(str(r) for r in table.rows[whole][curved])
+        notes.append(
+            f"{source}: row(s) {bent}: analyze found the stick curved beyond its noise (stick_curved); the stick fit's"
+            " sticks are straight (the block loaded at K V0), so their stick times carry the bend (docs/analysis.md)"
+        )
+    written = {CYCLES_COLUMNS.get(n, n): w for n, w in table.written.items() if n != CYCLE_CURVED}
     data = _validated_stick(Table(source, columns, table.rows[whole], written=written))
     why = "cycles cut by the record's ends or a gap in it: no stick time"
     cut_rows = tuple((int(r), why) for r in table.rows[~whole])

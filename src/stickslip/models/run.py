@@ -99,7 +99,38 @@ def window_mean(time: np.ndarray, values: np.ndarray, start: float) -> float:
     if not time.size or start <= float(time[0]):
         return time_mean(time, values)
     inside = time > start
-    return time_mean(np.r_[start, time[inside]], np.r_[np.interp(start, time, values), values[inside]])
+    return time_mean(np.r_[start, time[inside]], np.r_[_value_from(time, values, start), values[inside]])
+
+
+def _value_from(time: np.ndarray, values: np.ndarray, start: float) -> float:
+    """The trace's value at ``start`` as the window from there sees it: at a time written more than once (a segment
+    boundary: the old segment's value, then the new one's) the last sample, else linear interpolation."""
+    j = int(np.searchsorted(time, start, side="right"))
+    if j > 0 and time[j - 1] == start:
+        return float(values[j - 1])
+    return float(np.interp(start, time, values))
+
+
+def segment_window(
+    time: np.ndarray, signal: np.ndarray, start: float | None
+) -> tuple[np.ndarray, np.ndarray, float | None]:
+    """(time, signal, start) of the window ``t >= start`` that a segment starting at ``start`` reads, right-continuous
+    at its start: where the trace holds several samples at the boundary (within :data:`END_TOLERANCE` of the run's
+    length, at least 1 ns; a model solved segment by segment writes the boundary twice, the old segment's last value
+    then the new one's first), only the last of them is kept, and the window starts at it.
+
+    A velocity step under velocity control with a direct effect jumps the stress at the boundary: the window took in
+    the hold's last value, and a re-slide that never fell below 1092.2 Pa reported "lowest 1000.3 Pa" (round-30
+    tester).  A single sample at the boundary is kept as it is (a continuous signal's value there)."""
+    if start is None or time.size < 2:
+        return time, signal, start
+    tolerance = END_TOLERANCE * max(abs(float(time[-1])), abs(float(start)), 1.0)
+    near = np.flatnonzero(np.abs(time - start) <= tolerance)
+    if near.size < 2:
+        return time, signal, start
+    keep = np.ones(time.size, dtype=bool)
+    keep[near[:-1]] = False
+    return time[keep], signal[keep], min(float(start), float(time[near[-1]]))
 
 
 def _column(values: Any, name: str, size: int | None) -> np.ndarray:
@@ -279,7 +310,9 @@ def _classified(
     dense: regimes.Dense | None,
     unit: str,
 ) -> regimes.Regime:
-    """The classifier's verdict on a trace over ``t >= start``, its words in ``unit`` (Pa; none for friction)."""
+    """The classifier's verdict on a trace over ``t >= start``, its words in ``unit`` (Pa; none for friction); at a
+    boundary written twice, over the samples of the window's own segment (:func:`segment_window`)."""
+    time, signal, start = segment_window(time, signal, start)
     floor = trace_floor(time, signal, start) if floor is None else floor
     return regimes.classify(time, signal, floor=floor, start=start, dense=dense, unit="" if unit == "1" else unit)
 
@@ -435,18 +468,22 @@ class Run:
 
     def row(self, columns: Mapping[str, str]) -> dict[str, Any]:
         """One sweep row: each of ``columns`` (name -> kind) from the model's summary, else from the Run."""
+        # a run that settled (or never moved) had no stick-slip cycles, whatever oscillation decayed on the way
+        cycles = 0 if self.regime.kind in (regimes.STEADY, regimes.STUCK) else self.regime.periods
+        # a row's peak and trough are a cycle's (docs/sweep.md: "NaN if the block never slips"): a steady run's
+        # window extremes (its start-up, or its steady value) read as a stick's peak stress beside the cycles' ones
+        peak, trough = (self.peak, self.trough) if cycles > 0 else (NAN, NAN)
         generic = {
             "regime": self.regime_name,
             "period": self.period,
-            "peak_stress": self.peak if self.stress is not None else NAN,
-            "trough_stress": self.trough if self.stress is not None else NAN,
+            "peak_stress": peak if self.stress is not None else NAN,
+            "trough_stress": trough if self.stress is not None else NAN,
             "mean_stress": self.mean if self.stress is not None else NAN,
-            "peak_friction": self.peak if self.stress is None else NAN,
-            "trough_friction": self.trough if self.stress is None else NAN,
+            "peak_friction": peak if self.stress is None else NAN,
+            "trough_friction": trough if self.stress is None else NAN,
             "mean_friction": self.mean if self.stress is None else NAN,
             "growth": self.regime.amplitude_ratio,
-            # a run that settled (or never moved) had no stick-slip cycles, whatever oscillation decayed on the way
-            "cycles": 0 if self.regime.kind in (regimes.STEADY, regimes.STUCK) else self.regime.periods,
+            "cycles": cycles,
         }
         row: dict[str, Any] = {}
         for name, kind in columns.items():

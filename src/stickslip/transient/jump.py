@@ -126,3 +126,138 @@ def cascade(
         broken_share=float((n_before - n_after) / p[K.P_N0]), survivors=m,
     )  # fmt: skip
     return x, v, m, jump, released - (bond_energy_after - bond_energy_before)
+
+
+#: a creeping massless block whose step collapsed (docs/transient.md section 22): at most this many cohorts at the
+#: FENE wall are broken at once, one at a time, to give the slider its creeping balance back
+WALL_LUMPS = 8
+#: the cohorts that may be broken so: stretched beyond this share of the FENE length (aged bonds die at the wall,
+#: 1 - y ~ 2e-5 after a minute of rest at the paper's set, ~2e-4 after 5 s)
+WALL_REACH = 0.99
+#: the block counts as creeping (stopped) below this share of the protocol's pace: the solver's stick threshold
+CREEP = 1e-2
+#: a creeping root of g is one within this share of the largest of its terms (K Vp, (k_int + K) V)
+ROOT_TOLERANCE = 1e-8
+
+
+@dataclass(frozen=True)
+class WallLumps:
+    """Cohorts broken at once at the FENE wall under a creeping massless block: the instant (s), how many, their
+    bonds' share of N0, the load they carried (Pa), the slider's advance (m) and the stress before and after (Pa),
+    the creep velocity before and after (m/s)."""
+
+    time: float
+    cohorts: int
+    broken_share: float
+    load: float
+    travel: float
+    stress_before: float
+    stress_after: float
+    velocity_before: float
+    velocity_after: float
+
+
+def _creeping_root(
+    x: float, t: float, v: float, vp: float, n: int, xb: np.ndarray, tb: np.ndarray, lw: np.ndarray, p: np.ndarray,
+    functions: dict[str, Any], scratch: tuple[np.ndarray, np.ndarray, np.ndarray], creep: float,
+) -> float | None:  # fmt: skip
+    """The stable root of g nearest the creep velocity v at slider position x, if it is one (g there within
+    :data:`ROOT_TOLERANCE` of its terms, g' > 0, below ``creep``); None where g has no creeping root."""
+    lc, aa, known = scratch
+    known.fill(-1.0)
+    root = float(functions["_slider_velocity"](v, vp, n, xb, tb, lw, x, t, p, lc, aa, known))
+    if not (math.isfinite(root) and 0.0 <= root <= creep):
+        return None
+    known.fill(-1.0)
+    k_int = functions["_velocity_prepare"](n, xb, tb, lw, x, t, p, lc, aa, known, np.empty((2, 0)))
+    g, slope, _ = functions["_velocity_residual"](root, vp, n, lc, aa, known, k_int, p)
+    scale = max(p[K.P_K] * abs(vp), (k_int + p[K.P_K]) * root)
+    return root if abs(g) <= ROOT_TOLERANCE * scale and slope > 0.0 else None
+
+
+def wall_lumps(
+    t: float, x: float, v: float, puller: float, vp: float, pace: float, n: int, xb: np.ndarray, tb: np.ndarray,
+    lw: np.ndarray, p: np.ndarray, functions: dict[str, Any],
+) -> tuple[float, float, int, WallLumps, float] | None:  # fmt: skip
+    """A creeping massless block whose step collapsed because a cohort at the FENE wall holds the slider alone.
+
+    A cohort stands for the bonds born over its cell (0.3-2 nm of slider travel on a slip's way to rest); held at
+    rest those bonds age until they die only at the FENE wall, within ~1e-16 m of it, and a continuous density of
+    them dies there as the slider creeps on: the interface stays stiff (dS/dX ~ 1e10 Pa/m, far above K) and the
+    creep goes on.  The cohort instead arrives as one lump carrying up to a fifth of sigma, whose death the slider
+    cannot follow by creep (g has no creeping root: the step collapses).  Such a cohort is broken at once (the
+    largest loss w r f at the wall first), the slider put where the survivors balance the spring, until g has a
+    creeping root again, at most :data:`WALL_LUMPS` cohorts.  None (nothing changed) where the block is not
+    creeping, where the cohort that carries the largest loss is not at the wall, or where no creeping balance
+    comes back (the block may then let go: the caller says so).  Otherwise the survivors are compacted in place,
+    as :func:`cascade` does, and (x, v, n, the record, the energy dissipated, J/m^2) is returned."""
+    creep = CREEP * pace
+    if not (0.0 <= v <= creep and n > 0):
+        return None
+    balance, sums = functions["_balance_weights"], functions["_sums"]
+    n_before, sigma_before, _, bond_energy_before = sums(n, xb, lw, x, p)
+    x_before = x
+    alive = np.isfinite(lw[:n])
+    weights = np.where(alive, np.exp(np.where(alive, lw[:n], 0.0)), 0.0)
+    live_lw = lw[:n].copy()
+    scratch = (np.empty(n), np.empty(n), np.empty((3, n)))
+    broken = 0
+    load = 0.0
+    while True:
+        x = balance(x, puller, n, xb, weights, p)
+        root = _creeping_root(x, t, v, vp, n, xb, tb, live_lw, p, functions, scratch, creep) if broken else None
+        if root is not None:
+            break
+        if broken == WALL_LUMPS:
+            return None
+        live = np.flatnonzero(alive)
+        e = x - xb[live]
+        y = e / p[K.P_DLM]
+        force = p[K.P_M] * e / (1.0 - y * y)
+        with np.errstate(divide="ignore"):
+            loss = np.log(weights[live] * np.maximum(force, 0.0)) + _log_hazard(e, t - tb[live], v, p)
+        first = int(np.argmax(loss))
+        if not y[first] >= WALL_REACH:  # the collapse is not a lump at the wall
+            return None
+        j = live[first]
+        load += float(weights[j] * force[first])
+        alive[j], weights[j], live_lw[j] = False, 0.0, -np.inf
+        broken += 1
+    keep = np.flatnonzero(alive)
+    m = keep.size
+    xb[:m], tb[:m], lw[:m] = xb[keep], tb[keep], lw[keep]
+    n_after, sigma_after, _, bond_energy_after = sums(m, xb, lw, x, p)
+    released = 0.5 * p[K.P_K] * ((puller - x_before) ** 2 - (puller - x) ** 2)
+    record = WallLumps(
+        time=t, cohorts=broken, broken_share=float((n_before - n_after) / p[K.P_N0]), load=load, travel=x - x_before,
+        stress_before=float(sigma_before), stress_after=float(sigma_after), velocity_before=v, velocity_after=root,
+    )  # fmt: skip
+    return x, root, m, record, released - (bond_energy_after - bond_energy_before)
+
+
+def lumps_note(lumps: list[WallLumps]) -> str:
+    """The cohorts broken at the FENE wall under a creeping block, in words for the run's message ('' if none)."""
+    if not lumps:
+        return ""
+    count = sum(lump.cohorts for lump in lumps)
+    share = sum(lump.broken_share for lump in lumps)
+    travel = max(lump.travel for lump in lumps)
+    change = max(abs(lump.stress_after - lump.stress_before) for lump in lumps)
+    return (
+        f"; the block stayed stopped while its oldest bonds reached the FENE wall, and {count} cohort(s) of them that"
+        f" held the creeping slider alone were broken at once, from t = {lumps[0].time:.6g} s ({share:.3g} N0 in all;"
+        f" each time the slider moved at most {travel * 1e9:.3g} nm and σ by at most {change:.2g} Pa): the cohort"
+        " method lumps bonds that die one by one as the slider creeps, and the creep velocity it gives is the lumps'"
+        " too, far below the bonds' own (docs/transient.md section 22)"
+    )
+
+
+def creep_collapse(t: float, sigma: float, v: float, lumps: int) -> str:
+    """The failure in words where no creeping balance came back after :data:`WALL_LUMPS` cohorts at the wall."""
+    return (
+        f"transient solver failed at t = {t:.6g} s: the block had stopped and was creeping ({v * 1e6:.3g} µm/s under"
+        f" σ = {sigma:.6g} Pa) when its oldest bonds reached the FENE wall and gave way, and breaking the {lumps}"
+        " cohorts there did not leave the slider a creeping balance: the block may let go here, from rest, and a"
+        " block without mass cannot follow that (no finite slip velocity); give the block a mass (--mass, with"
+        " --damping; docs/extensions.md section 4) to follow it; what follows is not known"
+    )

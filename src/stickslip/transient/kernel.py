@@ -34,6 +34,8 @@ Everything is SI.
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator
+from contextlib import contextmanager
 
 import numpy as np
 
@@ -95,12 +97,16 @@ CORRECTION_SERIES = 1e-3
 # integer status returned by advance()
 DONE, FULL, STEPS, STICK, FAILED = 0, 1, 2, 3, 4
 #: advance's running totals at the start of a run (its docstring names them): the extremes since the last row
-#: start empty
-ACC_START = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, math.inf, -math.inf, math.nan, math.nan, -math.inf)
+#: start empty; the last entry, ACC_SPLIT, is a switch: 1 splits cohorts ahead of a hazard cliff (:func:`_split`), 0
+#: not (the reference: :func:`cohorts_unsplit`)
+ACC_START = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, math.inf, -math.inf, math.nan, math.nan, -math.inf, 1.0)
+ACC_SPLIT = 12
 #: the columns of advance's rows (:func:`_write_row`)
 ROW_COLUMNS = 17
 #: half-distance of the two Gauss-Legendre points from the middle of a step, as a fraction of the step
 GAUSS = 0.5 / math.sqrt(3.0)
+#: the weight of the first harmonic of a train of Gauss pairs, |cos 2 pi GAUSS| (docs/transient.md section 18)
+GAUSS_HARMONIC = abs(math.cos(2.0 * math.pi * GAUSS))
 #: a stick is taken within this share of rtol x sigma past the slider's crossing of the stick velocity
 STICK_LANDING = 0.01
 #: largest fraction by which the stress may fall within one step (the trace resolves ruptures)
@@ -113,6 +119,31 @@ WALL_SHARE = 0.1
 #: the balanced end's bond energies follow from the predicted end's while the two lie within this share of dl_m
 #: (:func:`_energy_at_end`: the rule's error, ~(shift/dl_m)^5 of the energy, is then below rounding)
 ENERGY_SHIFT = 1e-4
+#: cohorts cut ahead of a hazard cliff under velocity control (:func:`_split_plan`, docs/transient.md section 21): a
+#: cohort stands for the bonds born over its cell (halfway to its neighbours); reaching a cliff (ln r climbing at g)
+#: whose width 1/g is shorter than the time tau its cell takes to cross it, it dies as one lump, and a train of such
+#: lumps leaves a sawtooth of (2/pi) s |Gamma(1 - 2 pi i/(tau g))| in the stress (s: its stress at the cliff).  Where
+#: that exceeds SPLIT_TRIGGER x SPLIT_SHARE x rtol x |sigma|, the cohort is cut into the fewest equal pieces over its
+#: cell (SPLIT_FEWEST to SPLIT_MOST) that bring it below SPLIT_SHARE x rtol x |sigma|, as soon as its cell's leading
+#: edge is within SPLIT_FAR (in ln r) of the cliff, and while it is at least SPLIT_LATE short of it; cells that cross
+#: the cliff in less than SPLIT_SPACING/g, or in more than SPLIT_STEEPEST/g (re-sliding after a 1 s hold: ~100-300/g,
+#: where the pieces cost 10x the CPU), are left whole.  The cliff by Newton (SPLIT_NEWTON steps, SPLIT_TARGETS rounds
+#: of ln g there); pieces are recognised as three equally spaced cohorts (relative SPLIT_EVEN); at most SPLIT_SLOTS
+#: cohorts are cut per step (the others the step after)
+SPLIT_SHARE = 0.1
+SPLIT_TRIGGER = 2.0
+SPLIT_FEWEST = 4
+SPLIT_MOST = 128
+SPLIT_LATE = 3.0
+SPLIT_ALIVE = math.exp(SPLIT_LATE)
+SPLIT_FAR = 60.0
+SPLIT_SPACING = 0.4
+SPLIT_EVEN = 1e-9
+SPLIT_SLOTS = 64
+SPLIT_NEWTON = 80
+SPLIT_TARGETS = 8
+SPLIT_STEEPEST = 64.0
+SPLIT_ESTIMATE = 4.0
 #: four-point Gauss-Legendre rule on [-1, 1]
 GL4_X = np.array([-0.8611363115940526, -0.3399810435848563, 0.3399810435848563, 0.8611363115940526])
 GL4_W = np.array([0.3478548451374538, 0.6521451548625461, 0.6521451548625461, 0.3478548451374538])
@@ -597,6 +628,257 @@ def _light_spread(spread, log_ratio, load, s_mean):  # type: ignore[no-untyped-d
     return spread * 2.0 ** min(k, LIGHT_LEVELS)
 
 
+def _edge(xi, a, b, c, three):  # type: ignore[no-untyped-def]
+    """The edge between a cohort born at xi and its neighbour born at a (b and c the next two beyond a, where
+    ``three``): half their spacing beyond a where a, b, c are equally spaced (the pieces of a cut cohort, whose cell
+    ends there), else halfway to a."""
+    if three:
+        d = a - b
+        if d != 0.0 and abs(d - (b - c)) <= SPLIT_EVEN * abs(d):
+            edge = a + 0.5 * d
+            if (edge - a) * (xi - edge) > 0.0:
+                return edge
+    return 0.5 * (a + xi)
+
+
+def _piece(i, n, xb):  # type: ignore[no-untyped-def]
+    """Whether cohort i of n is a piece of a cut cohort (:func:`_split`), equally spaced with two of its neighbours:
+    the first of those three (so its spacing is xb[j + 1] - xb[j]), else -1."""
+    for j in range(max(i - 2, 0), min(i, n - 3) + 1):
+        d = xb[j + 1] - xb[j]
+        if d != 0.0 and abs(xb[j + 2] - xb[j + 1] - d) <= SPLIT_EVEN * abs(d):
+            return j
+    return -1
+
+
+def _cell(i, n, xb, tb):  # type: ignore[no-untyped-def]
+    """(x_lo, x_hi, t_lo, t_hi): the birth positions cohort i of n stands for, towards its older and its younger
+    neighbour (:func:`_edge`; a missing neighbour mirrors the other side), and the birth times there (linear
+    between the cohort and that neighbour).  A cell whose two edges lie on one side of the cohort (the slider turned
+    between the births) comes back empty (both edges at the cohort)."""
+    xi = xb[i]
+    ti = tb[i]
+    j = _piece(i, n, xb)
+    if j >= 0:  # a piece of a cut cohort: its own spacing, on both sides
+        d = xb[j + 1] - xb[j]
+        dt = 0.5 * (tb[j + 1] - tb[j])
+        return xi - 0.5 * d, xi + 0.5 * d, ti - dt, ti + dt
+    lo = hi = math.nan
+    t_lo = t_hi = ti
+    if i > 0:
+        a = xb[i - 1]
+        lo = _edge(xi, a, xb[i - 2] if i > 1 else a, xb[i - 3] if i > 2 else a, i > 2)
+        if a != xi:
+            t_lo = ti + (lo - xi) * (ti - tb[i - 1]) / (xi - a)
+    if i + 1 < n:
+        a = xb[i + 1]
+        hi = _edge(xi, a, xb[i + 2] if i + 2 < n else a, xb[i + 3] if i + 3 < n else a, i + 3 < n)
+        if a != xi:
+            t_hi = ti + (hi - xi) * (tb[i + 1] - ti) / (a - xi)
+    if lo != lo and hi != hi:
+        return xi, xi, ti, ti
+    if lo != lo:
+        lo = 2.0 * xi - hi
+        t_lo = 2.0 * ti - t_hi
+    elif hi != hi:
+        hi = 2.0 * xi - lo
+        t_hi = 2.0 * ti - t_lo
+    if not ((xi - lo) * (hi - xi) > 0.0):
+        return xi, xi, ti, ti
+    return lo, hi, t_lo, t_hi
+
+
+def _cliff(u, lr, g, speed, aging, p):  # type: ignore[no-untyped-def]
+    """(force, g) where a cohort at extension u > 0 moving outwards at ``speed``, its log hazard lr climbing at g > 0,
+    dies: ln r = ln g there (its cumulative hazard ~1), along ln r(u') = lr + beta (f(u') - f(u)) - aging (u' - u)/
+    speed (the velocity and the aging term's rate held).  Newton inside the bracket [u, dl_m) (ln r is convex in u'),
+    again with ln g at the cliff found until that moves by less than 0.01."""
+    m = p[P_M]
+    dlm = p[P_DLM]
+    beta = p[P_FORCE_SENS]
+    f_u = _chain_force(u, m, dlm)
+    target = math.log(g)
+    x = u
+    g_c = g
+    for _ in range(SPLIT_TARGETS):
+        lo, hi = u, dlm
+        x = u
+        fx = lr - target
+        for _ in range(SPLIT_NEWTON):
+            if fx > 0.0:
+                hi = x
+            else:
+                lo = x
+            if abs(fx) < 1e-3:
+                break
+            d = beta * _chain_stiffness(x, m, dlm) - aging / speed
+            xn = x - fx / d if d > 0.0 else math.nan
+            if not (lo < xn < hi):
+                xn = 0.5 * (lo + hi)
+            x = xn
+            fx = lr + beta * (_chain_force(x, m, dlm) - f_u) - aging * (x - u) / speed - target
+        g_c = beta * _chain_stiffness(x, m, dlm) * speed - aging
+        if not (g_c > 0.0):
+            return _chain_force(x, m, dlm), g
+        if abs(math.log(g_c) - target) < 1e-2:
+            break
+        target = math.log(g_c)
+    return _chain_force(x, m, dlm), g_c
+
+
+def _ripple(stress, pieces, crossing):  # type: ignore[no-untyped-def]
+    """The stress's sawtooth from a train of lumps each carrying stress/pieces, crossing = tau g/pieces apart in
+    units of the cliff's width: (2/pi)(stress/pieces)|Gamma(1 - 2 pi i/crossing)|, |Gamma(1 - iy)|^2 =
+    pi y/sinh(pi y) (a cliff's death profile is Gumbel's; its Fourier transform is Gamma)."""
+    py = 2.0 * math.pi * math.pi / crossing
+    if py > 30.0:
+        mod = math.exp(0.5 * (math.log(2.0 * py) - py))
+    elif py > 1e-8:
+        mod = math.sqrt(py / math.sinh(py))
+    else:
+        mod = 1.0
+    return 2.0 / math.pi * stress / pieces * mod
+
+
+def _split_plan(w, e, lr, g, v, aging, lo, hi, xi, paired, floor, p):  # type: ignore[no-untyped-def]
+    """The pieces to cut a cohort into (1: none): weight w, extension e, log hazard lr climbing at g > 0, cell [lo, hi]
+    (born at xi; ``paired``: one of a Gauss pair, not a piece of a cut cohort), the slider at v, the sawtooth allowed
+    ``floor``.  None where it is dying already (z = ln g - ln r < SPLIT_LATE, or its cell's leading edge past the
+    cliff: those bonds are gone in truth), where that edge is more than SPLIT_FAR below the cliff (not yet), where the
+    cliff (:func:`_cliff`) is more than SPLIT_STEEPEST times steeper than the cell's crossing, or where its lump leaves
+    a sawtooth of at most SPLIT_TRIGGER x floor (:func:`_ripple`); else the fewest (at least SPLIT_FEWEST) that leave
+    at most floor."""
+    speed = abs(v)
+    if speed == 0.0 or e * v <= 0.0:
+        return 1
+    crossing = abs(hi - lo) / speed * g
+    if crossing < SPLIT_SPACING:
+        return 1
+    z = math.log(g) - lr
+    if z < SPLIT_LATE:
+        return 1
+    lead = (xi - min(lo, hi)) if v > 0.0 else (max(lo, hi) - xi)
+    # far from its cliff yet, with g there as the FENE stiffening makes it (g ~ f^2 near the wall, beta f climbing by
+    # z; more than g itself everywhere), or that g far steeper than SPLIT_STEEPEST (SPLIT_ESTIMATE times, for the
+    # estimate): not planned (the cliff's own Newton, ~1e-5 of dl_m from the wall after a 10 s hold, not spent)
+    force = p[P_FORCE_SENS] * abs(_chain_force(e, p[P_M], p[P_DLM]))
+    ahead = g * (1.0 + z / force) ** 2 if force > 0.0 else g
+    if z - ahead * lead / speed > SPLIT_FAR or crossing / g * ahead > SPLIT_ESTIMATE * SPLIT_STEEPEST:
+        return 1
+    f_c, g_c = _cliff(abs(e), lr, g, speed, aging, p)
+    crossing = abs(hi - lo) / speed * g_c
+    if crossing > SPLIT_STEEPEST or z - g_c * lead / speed < SPLIT_LATE:
+        return 1
+    stress = w * abs(f_c)
+    # births come in Gauss pairs (a step's, a cell's): their train repeats every two cells, its first harmonic
+    # weighted |cos 2 pi GAUSS| = 0.24 (docs/transient.md section 18), and it is the wider of the two that a cliff
+    # about as wide as a cell lets through (not so the pieces of a cut cohort, evenly spaced)
+    ripple = _ripple(stress, 1.0, crossing)
+    if paired:
+        ripple = max(ripple, _ripple(2.0 * GAUSS_HARMONIC * stress, 1.0, 2.0 * crossing))
+    if ripple <= SPLIT_TRIGGER * floor:
+        return 1
+    k = SPLIT_FEWEST
+    while k < SPLIT_MOST and _ripple(stress, k, crossing / k) > floor:
+        k += 1
+    return k
+
+
+def _split_look(i, n, xb, tb, w, e, lr, g, v, aging, floor, p):  # type: ignore[no-untyped-def]
+    """The pieces :func:`_split_plan` cuts cohort i of the pass into (weight w, extension e, log hazard lr climbing at
+    g > 0 at the step's end, the slider at v; its cell from its neighbours), 1: none.  Out of the pass's loop (not
+    inlined): most cohorts never come here, and the loop stays as fast as before."""
+    lo, hi, _t_lo, _t_hi = _cell(i, n, xb, tb)
+    return _split_plan(w, e, lr, g, v, aging, lo, hi, xb[i], _piece(i, n, xb) < 0, floor, p)
+
+
+def _in_pairs(n, count, split_at, split_pieces, xb):  # type: ignore[no-untyped-def]
+    """split_at[:count] (ascending) kept two neighbours at a time, each pair cut into the larger number of pieces; one
+    whose younger neighbour is to be cut too but not yet waits for it (unless that neighbour is a piece already, or a
+    newborn).  Returns the new count."""
+    kept = 0
+    c = 0
+    while c < count:
+        i = split_at[c]
+        if c + 1 < count and split_at[c + 1] == i + 1:
+            k = max(split_pieces[c], split_pieces[c + 1])
+            split_at[kept] = i
+            split_pieces[kept] = k
+            split_at[kept + 1] = i + 1
+            split_pieces[kept + 1] = k
+            kept += 2
+            c += 2
+            continue
+        if i + 1 >= n - 2 or _piece(i + 1, n, xb) >= 0:
+            split_at[kept] = i
+            split_pieces[kept] = split_pieces[c]
+            kept += 1
+        c += 1
+    return kept
+
+
+def _split(n, count, split_at, split_pieces, cells, xb, tb, lw, rate0, known, clock_end):  # type: ignore[no-untyped-def]
+    """Cut the cohorts split_at[:count] (ascending), two neighbours at a time (:func:`_in_pairs`), into split_pieces
+    equal pieces spread evenly over their cells (:func:`_cell`, from the neighbours before any cut), each with its
+    share of the weight, its birth position and time; the others moved up.  Returns (n, False), or (n, True)
+    unchanged where the arrays lack the room.
+
+    Two neighbours at once: a Gauss cohort sits 0.039 of a step off its cell's middle, the next one as far the other
+    way, so that spreading one alone over its cell moved sigma by its weight x f' x that offset (0.9 Pa, 3e-5 of
+    sigma, for the report's gel, each cut undone at the next: a floor of 2e-5 on the error at rtol 1e-5)."""
+    count = _in_pairs(n, count, split_at, split_pieces, xb)
+    extra = 0
+    for c in range(count):
+        extra += split_pieces[c] - 1
+    if n + extra + 3 >= xb.shape[0]:
+        return n, True
+    for c in range(count):
+        lo, hi, t_lo, t_hi = _cell(split_at[c], n, xb, tb)
+        cells[0, c] = lo
+        cells[1, c] = hi
+        cells[2, c] = t_lo
+        cells[3, c] = t_hi
+    src_end = n
+    dest_end = n + extra
+    for c in range(count - 1, -1, -1):
+        i = split_at[c]
+        k = split_pieces[c]
+        for j in range(src_end - 1, i, -1):  # the cohorts after it move up
+            d = dest_end - (src_end - j)
+            xb[d] = xb[j]
+            tb[d] = tb[j]
+            lw[d] = lw[j]
+            rate0[d] = rate0[j]
+            for r in range(4):
+                known[r, d] = known[r, j]
+            clock_end[0, d] = clock_end[0, j]
+            clock_end[1, d] = clock_end[1, j]
+        dest_end -= src_end - i - 1
+        xi, ti, lw_i, rate_i = xb[i], tb[i], lw[i], rate0[i]
+        lo, hi, t_lo, t_hi = cells[0, c], cells[1, c], cells[2, c], cells[3, c]
+        lw_piece = lw_i - math.log(k)
+        base = dest_end - k
+        for j in range(k):
+            x_j = lo + (j + 0.5) / k * (hi - lo)
+            if (x_j - xi) * (lo - xi) > 0.0:  # on the older neighbour's side
+                t_j = ti + (x_j - xi) / (lo - xi) * (t_lo - ti)
+            else:
+                t_j = ti + (x_j - xi) / (hi - xi) * (t_hi - ti)
+            xb[base + j] = x_j
+            tb[base + j] = t_j
+            lw[base + j] = lw_piece
+            rate0[base + j] = rate_i
+            known[0, base + j] = -1.0
+            known[1, base + j] = np.nan
+            known[2, base + j] = np.nan
+            known[3, base + j] = np.nan
+            clock_end[0, base + j] = np.nan
+            clock_end[1, base + j] = np.nan
+        dest_end = base
+        src_end = i
+    return n + extra, False
+
+
 def _step_length(t, t_end, h, h_max, sample_times, sample_index):  # type: ignore[no-untyped-def]
     """(hh, landing): the step tried from t, the proposed h cut to h_max and to the piece's end, or landing exactly
     on the next sample time; a sliver left before the end is taken with this step."""
@@ -707,14 +989,16 @@ def _cohort_dissipation(trap, hh, w0, wn, r0, r1, g0, g1, f0, f1, v0, v1p, e0, u
 
 def _cohort_pass(  # type: ignore[no-untyped-def]
     n, t, t1, t0, hh, x, x1p, x_mid, v0, v1p, slope0, slope1, accel, xb, tb, lw, lw_new, rate0, w1, known,
-    predicted, cache, cached, clock_end, wall_load, p,
+    predicted, cache, cached, clock_end, wall_load, split_floor, split_at, split_pieces, p,
 ):  # fmt: skip
     """One pass over the cohorts: each one's log weight at the step's end (``lw_new``, ``w1``; its hazard there in
     ``rate0``, its force and stiffness at the predicted end in ``predicted``), and the sums over them:
     (N and sigma at both ends, the breakage rate and its time derivative at both ends, bonds broken, energy
     dissipated, sum r w f and the interface stiffness at both ends, the errors in stress and bonds, the step's
     stress loss's sensitivity to the slider's position and to the aging slope, bonds freed by the FENE wall, the
-    stress dying at a hazard cliff of bonds born within and before this piece)."""
+    stress dying at a hazard cliff of bonds born within and before this piece, the least extension left to the FENE
+    wall of a cohort carrying wall_load, and how many cohorts to cut ahead of their cliff (:func:`_split_plan`; their
+    indices and pieces in split_at and split_pieces; split_floor: the sawtooth allowed, inf: none cut))."""
     m = p[P_M]
     dlm = p[P_DLM]
     beta = p[P_FORCE_SENS]
@@ -737,6 +1021,7 @@ def _cohort_pass(  # type: ignore[no-untyped-def]
     cliff = 0.0  # stress dying at a hazard cliff steeper than the step (see _cohort_weight)
     cliff_old = 0.0  # the same for bonds born before this piece of the protocol
     wall_gap = np.inf  # the least extension left to the FENE wall of a cohort carrying wall_load or more towards it
+    n_split = 0
     for i in range(n):
         w0 = cache[0, i] if cached else math.exp(lw[i])
         e0 = x - xb[i]
@@ -801,7 +1086,8 @@ def _cohort_pass(  # type: ignore[no-untyped-def]
         known[0, i] = wn if exact else -1.0
         if tb[i] >= t0:
             cliff += dying
-        else:
+        elif dying > 0.0 and not (split_floor < np.inf and _piece(i, n, xb) >= 0):
+            # (a piece of a cut cohort dies in lumps the cut already holds below its share of rtol: not counted)
             cliff_old += dying
         err_s += abs(f1) * dw
         err_n += dw
@@ -828,9 +1114,18 @@ def _cohort_pass(  # type: ignore[no-untyped-def]
         rate0[i] = r1  # kept for the merging of quiet cohorts after the step
         if e1 * v1p > 0.0 and wn * abs(f1) >= wall_load:
             wall_gap = min(wall_gap, dlm - abs(e1))
+        # a cohort whose hazard climbs fast against the time its cell takes to pass (a first look at one neighbour)
+        if split_floor < np.inf and g1 > r1 * SPLIT_ALIVE:  # climbing, and short of its cliff (z > SPLIT_LATE)
+            j = i + 1 if i + 1 < n else i - 1
+            if j >= 0 and abs(xb[j] - xb[i]) * g1 >= 0.5 * SPLIT_SPACING * abs(v1p):
+                k = _split_look(i, n, xb, tb, wn, e1, lr1, g1, v1p, slope1 * clock1, split_floor, p)
+                if k > 1 and n_split < split_at.shape[0]:
+                    split_at[n_split] = i
+                    split_pieces[n_split] = k
+                    n_split += 1
     return (
         nn0, s0, nn1, s1, loss0, loss1, dloss0, dloss1, broken, dissip, rate_s0, rate_s1, kint0, kint1, err_s, err_n,
-        sens_x, sens_a, walled, cliff, cliff_old, wall_gap,
+        sens_x, sens_a, walled, cliff, cliff_old, wall_gap, n_split,
     )  # fmt: skip
 
 
@@ -1322,7 +1617,8 @@ def advance(  # type: ignore[no-untyped-def]
     step (:func:`_next_step`) and a row (:func:`_write_row`).
 
     ``acc`` accumulates [born, broken, puller work, dissipation, steps, rejected, integral of sigma dt, lowest
-    and highest sigma since the last row, the times of those two, the fastest V since the last row]
+    and highest sigma since the last row, the times of those two, the fastest V since the last row, then the switch
+    ACC_SPLIT: cohorts cut ahead of a hazard cliff under velocity control (:func:`_split`), 1, or not, 0]
     (:data:`ACC_START`).  Rows (:data:`ROW_COLUMNS`) are written to ``out`` every accepted step when
     ``sample_times`` is empty, else only at those times (the steps land on them exactly).  ``t0``: the start of
     the protocol's piece (puller0 is the puller there; bonds born before it were born at other steps).  ``block``:
@@ -1335,6 +1631,16 @@ def advance(  # type: ignore[no-untyped-def]
     h_prev = 0.0
     s_floor = 1e-9 * p[P_M] * p[P_N0] * p[P_DLM]
     wall_load = np.inf  # no landing before the first step's stress is known
+    # cohorts cut ahead of a hazard cliff (:func:`_split`), under velocity control: none before the first step's
+    # stress is known.  Not through the block: there the cohorts at the wall of a creeping block are too coarse for
+    # the slider's balance itself (docs/transient.md section 17), which the cut moves (4 MPa/m: failed at 4.66 s
+    # instead of 5.08 s) without mending it
+    splitting = block == 0 and acc.shape[0] > ACC_SPLIT and acc[ACC_SPLIT] > 0.0
+    split_floor = np.inf
+    split_at = np.zeros(SPLIT_SLOTS, np.int64)
+    split_pieces = np.zeros(SPLIT_SLOTS, np.int64)
+    split_cells = np.empty((4, SPLIT_SLOTS))
+    need_room = False
     while sample_index < n_samples and sample_times[sample_index] <= t:  # grid points already passed
         sample_index += 1
     cache = np.empty((8, xb.shape[0]))  # the cohorts' values at the start of the step, when ``cached``
@@ -1355,7 +1661,7 @@ def advance(  # type: ignore[no-untyped-def]
     while t < t_end:
         if steps >= max_steps:
             return STEPS, t, x, v, h, n, sample_index, rows
-        if n + 3 >= xb.shape[0]:
+        if n + 3 >= xb.shape[0] or need_room:
             return FULL, t, x, v, h, n, sample_index, rows
         hh, landing = _step_length(t, t_end, h, h_max, sample_times, sample_index)
         t1 = t + hh
@@ -1367,10 +1673,10 @@ def advance(  # type: ignore[no-untyped-def]
         accel = (v1p - v0) / hh
         (
             nn0, s0, nn1, s1, loss0, loss1, dloss0, dloss1, broken, dissip, rate_s0, rate_s1, kint0, kint1, err_s,
-            err_n, sens_x, sens_a, walled, cliff, cliff_old, wall_gap,
+            err_n, sens_x, sens_a, walled, cliff, cliff_old, wall_gap, n_split,
         ) = _cohort_pass(
             n, t, t1, t0, hh, x, x1p, x_mid, v0, v1p, slope0, slope1, accel, xb, tb, lw, lw_new, rate0, w1, known,
-            predicted, cache, cached, clock_end, wall_load, p,
+            predicted, cache, cached, clock_end, wall_load, split_floor, split_at, split_pieces, p,
         )  # fmt: skip
         clock_end[0, n] = np.nan  # the newborns' clock is not computed by the pass
         clock_end[0, n + 1] = np.nan
@@ -1418,6 +1724,8 @@ def advance(  # type: ignore[no-untyped-def]
             accel_prev = accel_now
             accel_now = (p[P_K] * (puller0 + vp * (t - t0) - x) - p[P_DAMPING] * v - s1) / p[P_MASS]
         steps += 1
+        if n_split > 0:  # cohorts coming to a cliff in lumps: cut (the newborns, last, stay where _book_step read them)
+            n, need_room = _split(n, n_split, split_at, split_pieces, split_cells, xb, tb, lw, rate0, known, clock_end)
         n = _housekeeping(
             n, t, t_end, x, nn1, s1, s_floor, rtol, xb, tb, lw, rate0, known, block == 1 and not inertial,
             steps % MERGE_EVERY == 0, acc, clock_end, p,
@@ -1429,6 +1737,8 @@ def advance(  # type: ignore[no-untyped-def]
             # three times on average, re-sliding after a hold, where aged bonds die at the wall one after another)
             h = min(h, p[P_WALL_LANDING] * wall_gap / abs(v1))
         wall_load = WALL_SHARE * rtol * max(abs(s1), s_floor)
+        if splitting:
+            split_floor = SPLIT_SHARE * rtol * max(abs(s1), s_floor)
         record = n_samples == 0
         if landing:
             sample_index += 1
@@ -1448,12 +1758,29 @@ def advance(  # type: ignore[no-untyped-def]
     return DONE, t, x, v, h, n, sample_index, rows
 
 
+@contextmanager
+def cohorts_unsplit() -> Iterator[None]:
+    """Runs started within keep every cohort whole up to its cliff (the kernel before docs/transient.md section 21):
+    the reference of tests/test_transient_low_velocity.py and of the section's measurements."""
+    global ACC_START
+    saved = ACC_START
+    ACC_START = (*saved[:ACC_SPLIT], 0.0)
+    try:
+        yield
+    finally:
+        ACC_START = saved
+
+
 _COMPILED: dict[str, object] = {}
 #: inlined into their callers by numba: the per-cohort steps (they take numbers, never arrays: helpers taking arrays
 #: once per cohort left the kernel 1.4x slower) and the steps ``advance`` takes once per step.  The two loops over
 #: the cohorts (_cohort_pass, _housekeeping) stay functions of their own: inlined, the kernel was 5-9 % slower.
 #: Measured against the kernel before the split in one process (docs/transient.md section 8).
 INLINED = (
+    "_piece",
+    "_edge",
+    "_cell",
+    "_split_plan",
     "_hazard_slopes",
     "_cohort_weight",
     "_cohort_dissipation",
@@ -1502,6 +1829,8 @@ def compiled() -> dict[str, object]:
             "_same_bin",
             "_saturation_decay",
             "_energy_at_end",
+            "_cliff",
+            "_ripple",
         ):
             g[name] = _jit(g[name])
         for name in INLINED:
@@ -1517,8 +1846,11 @@ def compiled() -> dict[str, object]:
             "_saturated_bins",
             "_sums",
             "_sums_keeping",
+            "_split_look",
             "_cohort_pass",
             "_housekeeping",
+            "_in_pairs",
+            "_split",
             "advance",
         ):
             g[name] = _jit(g[name])

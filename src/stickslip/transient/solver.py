@@ -680,11 +680,45 @@ class _Driver:
 
     def _jumped(self, vp: float) -> bool:
         """A collapsed step of the massless block in a rupture cascade: the jump (transient/jump.py), in no time;
-        False where the collapse is not one (the run then fails in words)."""
+        on a creeping block, the cohorts at the FENE wall that hold it alone broken at once (jump.wall_lumps,
+        docs/transient.md section 22; a creep that does not come back fails in its own words); False where the
+        collapse is neither (the run then fails in words)."""
         state, pace = self.state, float(np.max(self.protocol.velocities))
         cascade = self.control == "block" and not self.inertial and math.isfinite(state.x)
-        if not (cascade and math.isfinite(state.v) and state.v > jump.ENTRY * pace):
+        if not (cascade and math.isfinite(state.v)):
             return False
+        if state.v <= jump.ENTRY * pace:  # a creeping block: lumps at the FENE wall, or a let-go from rest
+            sigma = self.k_block * (state.puller - state.x)
+            lumps = jump.wall_lumps(
+                state.t, state.x, state.v, state.puller, vp, pace, state.n, state.xb, state.tb, state.lw, self.p,
+                self.functions,
+            )  # fmt: skip
+            if lumps is None:
+                if 0.0 <= state.v <= jump.CREEP * pace and np.any(
+                    state.x - state.xb[: state.n][np.isfinite(state.lw[: state.n])]
+                    >= jump.WALL_REACH * self.params.bonds.max_extension
+                ):  # stopped, its oldest bonds at the wall, and no creep comes back: said so, the run kept
+                    failed = SolverFailed(jump.creep_collapse(state.t, sigma, state.v, jump.WALL_LUMPS))
+                    try:
+                        failed.partial = _finish(self, list(self.snapshots), str(failed), self.note)
+                    except (ArithmeticError, ValueError, IndexError):
+                        failed.partial = None
+                    raise failed
+                return False
+            state.x, state.v, state.n, found, dissipated = lumps
+            acc = state.acc
+            acc[1] += found.broken_share * self.params.bonds.site_density
+            acc[3] += dissipated
+            _extremes_at(acc, state.t, found.stress_after)
+            acc[4] += 1.0
+            state.h = self.params.bonds.bond_time * 1e-3
+            if not hasattr(self, "wall_lumps"):  # the message's note, with the lumps said once at its end
+                self.wall_lumps, self.note_before_lumps = [], self.note
+            self.wall_lumps.append(found)
+            self.note = self.note_before_lumps + jump.lumps_note(self.wall_lumps)
+            if self.reducer is not None:
+                self.reducer.disturbed(state.t)
+            return True
         cohorts = state.n
         x, v, n, found, dissipated = jump.cascade(
             state.t, state.x, state.v, state.puller, vp, pace, state.n, state.xb, state.tb, state.lw, self.p,
