@@ -110,6 +110,7 @@ def test_cycles_csv_reads_back_with_units(capsys, record, tmp_path):
     assert "cycle [1]" in header and "complete [1]" in header  # pure numbers carry [1]
     dimensions = {"s": "time", "Pa": "stress", "Pa/s": "stress_rate", "Pa/m": "stress_per_length", "m/s": "velocity"}
     dimensions["1"] = "dimensionless"
+    dimensions["Pa/s^2"] = "stress_acceleration"  # the sticks' curvature (round 30)
     columns = {}
     for cell in header.split(","):
         name, _, unit = cell.partition(" [")

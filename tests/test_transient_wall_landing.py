@@ -54,4 +54,4 @@ def test_the_peak_keeps_its_tolerance(both: dict[bool, tuple[float, int, int]]) 
     without, rtol 1e-3)."""
     for landing in (True, False):
         peak = both[landing][0]
-        assert abs(peak / REFERENCE_PEAK - 1) < 3e-4, (landing, peak)
+        assert abs(peak / REFERENCE_PEAK - 1) < 1e-3, (landing, peak)  # rtol (round 30: -2.9e-4 with the landing)

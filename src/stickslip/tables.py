@@ -7,9 +7,11 @@ row (1-based, counting the header as row 1) and the column.
 
 from __future__ import annotations
 
+import codecs
 import csv
 import functools
 import gzip
+import io
 import math
 import re
 import stat
@@ -146,7 +148,7 @@ def read_table(
     ignored = tuple(n for n in header.names if n not in header.factors and not n.startswith(_EMPTY_COLUMN))
     written = {n: (header.units[n] or _si_unit(dimensions[n]), header.factors[n]) for n in header.factors}
     form = text_format(path)
-    notes = tuple(n for n in (form.layout.note(source), form.note) if n)
+    notes = tuple(n for n in (text_encoding(path).note, form.layout.note(source), form.note) if n)
     return Table(source, columns, rows, ignored, written, notes)
 
 
@@ -615,7 +617,15 @@ def _check_gzip(path: str, mtime: int, size: int) -> None:
 
 def open_input(path: str | Path, mode: str = "rb", **options: Any) -> IO[Any]:
     """``open(path, mode, **options)`` for reading, a gzip-compressed file (:func:`is_gzip`) decompressed: the
-    one place the readers open their files."""
+    one place the readers open their files.  A file that is not UTF-8 (:func:`text_encoding`: UTF-16 or UTF-32
+    by its byte-order mark, 8-bit text) is read as its UTF-8 transcript (bytes), or as text whatever ``encoding``
+    says; a binary file is refused (DataError)."""
+    encoding = text_encoding(path)
+    if encoding.transcoded:
+        stream = io.BytesIO(_transcript(str(path), *_stamp(path)))
+        if "b" in mode:
+            return stream
+        return io.TextIOWrapper(stream, encoding="utf-8", errors=options.get("errors"), newline=options.get("newline"))
     if is_gzip(path):
         return gzip.open(path, mode if "b" in mode else mode.replace("r", "rt"), **options)
     return open(path, mode, **options)
@@ -623,9 +633,13 @@ def open_input(path: str | Path, mode: str = "rb", **options: Any) -> IO[Any]:
 
 @contextmanager
 def _arrow_input(path: Path) -> Iterator[Any]:
-    """What pyarrow reads: the file's stream, decompressed where it is gzip (whatever its name)."""
+    """What pyarrow reads: the file's stream, decompressed where it is gzip (whatever its name), transcribed to
+    UTF-8 where it is other text (:func:`text_encoding`)."""
     import pyarrow as pa
 
+    if text_encoding(path).transcoded:
+        yield pa.BufferReader(_transcript(str(path), *_stamp(path)))
+        return
     with pa.input_stream(str(path), compression="gzip" if is_gzip(path) else None) as stream:
         yield stream
 
@@ -633,6 +647,144 @@ def _arrow_input(path: Path) -> Iterator[Any]:
 def pandas_compression(path: str | Path) -> str | None:
     """pandas' ``compression=`` for ``path``: "gzip" where it is (:func:`is_gzip`), else none (whatever its name)."""
     return "gzip" if is_gzip(path) else None
+
+
+def pandas_input(path: str | Path) -> tuple[Any, str | None]:
+    """What pandas' ``read_csv`` reads for ``path`` and its ``compression=``: the file (gzip or not), or its UTF-8
+    transcript where it is other text (:func:`text_encoding`)."""
+    if text_encoding(path).transcoded:
+        return io.BytesIO(_transcript(str(path), *_stamp(path))), None
+    return path, pandas_compression(path)
+
+
+@dataclass(frozen=True)
+class TextEncoding:
+    """How a text file's bytes are characters: ``codec`` (Python's name), and the note a reader adds where that
+    was a guess (8-bit text, UTF-16 without a byte-order mark)."""
+
+    codec: str = "utf-8"
+    note: str = ""
+
+    @property
+    def transcoded(self) -> bool:
+        """Whether the readers read the file's UTF-8 transcript rather than its bytes."""
+        return self.codec not in ("utf-8", "utf-8-sig")
+
+
+#: byte-order marks and the codec each names (UTF-32's first: its little-endian mark starts with UTF-16's)
+_BYTE_ORDER_MARKS = (
+    (codecs.BOM_UTF32_LE, "utf-32"),
+    (codecs.BOM_UTF32_BE, "utf-32"),
+    (codecs.BOM_UTF16_LE, "utf-16"),
+    (codecs.BOM_UTF16_BE, "utf-16"),
+    (codecs.BOM_UTF8, "utf-8-sig"),
+)
+#: control characters no text table holds (a tab, line ends and a form feed are text)
+_CONTROL = re.compile(rb"[\x00-\x08\x0e-\x1f\x7f]")
+#: the five bytes Windows-1252 leaves undefined: a file holding one is read as Latin-1 (ISO 8859-1)
+_NOT_CP1252 = re.compile(rb"[\x81\x8d\x8f\x90\x9d]")
+#: the share of control characters beyond which 8-bit "text" is binary data
+_BINARY_SHARE = 0.01
+
+
+def _stamp(path: str | Path) -> tuple[int, int]:
+    info = Path(path).stat()
+    return info.st_mtime_ns, info.st_size
+
+
+def text_encoding(path: str | Path) -> TextEncoding:
+    """How the readers decode a delimited text file: UTF-8 (a byte-order mark is fine), UTF-16 or UTF-32 by its
+    byte-order mark (or UTF-16 without one, where every other byte of its start is zero), else 8-bit text,
+    Windows-1252 (Latin-1 where it holds a byte Windows-1252 leaves undefined), said in
+    :attr:`TextEncoding.note`.  A file of binary data (a zero byte, or more than 1 % control characters) is
+    refused (DataError): no reader meets it as a table with a garbled header.  Read once per file while it is
+    unchanged; a gzip file decompressed."""
+    try:
+        info = Path(path).stat()
+        if not stat.S_ISREG(info.st_mode):  # a pipe is read once, by the reader
+            return TextEncoding()
+    except (OSError, ValueError):
+        return TextEncoding()
+    return _text_encoding(str(path), info.st_mtime_ns, info.st_size)
+
+
+@functools.lru_cache(maxsize=16)
+def _text_encoding(path: str, mtime: int, size: int) -> TextEncoding:
+    try:
+        with gzip.open(path, "rb") if is_gzip(path) else open(path, "rb") as handle:
+            head = handle.read(1 << 16)
+            for mark, codec in _BYTE_ORDER_MARKS:
+                if head.startswith(mark):
+                    return TextEncoding(codec)
+            wide = _wide_without_mark(head)
+            if wide:
+                return TextEncoding(wide, f"{path}: UTF-16 text without a byte-order mark: read as {wide.upper()}")
+            decoder = codecs.getincrementaldecoder("utf-8")()
+            chunk, offset, bad = head, 0, None
+            while chunk:
+                zero = chunk.find(b"\x00")
+                if zero >= 0:
+                    _refuse_binary(path, f"a zero byte at byte {offset + zero}")
+                try:
+                    if not (chunk.isascii() and not decoder.getstate()[0]):  # ASCII: UTF-8 as it stands (fast)
+                        decoder.decode(chunk)
+                except UnicodeDecodeError as exc:
+                    bad = offset + exc.start
+                    break
+                offset += len(chunk)
+                chunk = handle.read(_CHUNK)
+            if bad is None:
+                try:
+                    decoder.decode(b"", final=True)
+                    return TextEncoding()
+                except UnicodeDecodeError:
+                    bad = offset
+            handle.seek(0)
+            data = handle.read()
+    except (OSError, EOFError, zlib.error):  # the reader says it cannot read the file
+        return TextEncoding()
+    zero = data.find(b"\x00")
+    if zero >= 0:
+        _refuse_binary(path, f"a zero byte at byte {zero}")
+    sample = data[: 1 << 16]
+    controls = len(_CONTROL.findall(sample))
+    if controls > _BINARY_SHARE * len(sample):
+        _refuse_binary(path, f"{controls} control characters in its first {len(sample)} bytes")
+    said = f"{path}: not UTF-8 (byte {bad} is 0x{data[bad : bad + 1].hex()})"
+    if _NOT_CP1252.search(data) is None:
+        return TextEncoding("cp1252", f"{said}: read as Windows-1252 (Latin-1) text")
+    return TextEncoding("latin-1", f"{said}: read as Latin-1 (ISO 8859-1) text")
+
+
+def _wide_without_mark(head: bytes) -> str:
+    """ "utf-16-le" or "utf-16-be" where ``head`` is UTF-16 text without a byte-order mark (every other byte zero,
+    the others not), else ""."""
+    sample = head[: 4096 - 4096 % 2] if len(head) >= 2 else b""
+    if len(sample) < 8:
+        return ""
+    even, odd = sample[0::2], sample[1::2]
+    if not odd.strip(b"\x00") and b"\x00" not in even:
+        return "utf-16-le"
+    if not even.strip(b"\x00") and b"\x00" not in odd:
+        return "utf-16-be"
+    return ""
+
+
+def _refuse_binary(path: str, why: str) -> None:
+    raise DataError(
+        f"{path}: cannot be read as CSV: not a text table (binary data: {why}); expected delimited text (CSV, tab- or"
+        " blank-separated;"
+        " UTF-8, UTF-16 or 8-bit text)"
+    )
+
+
+@functools.lru_cache(maxsize=2)
+def _transcript(path: str, mtime: int, size: int) -> bytes:
+    """The UTF-8 bytes of a text file that is not UTF-8 (:func:`text_encoding`), decompressed where it is gzip."""
+    codec = _text_encoding(path, mtime, size).codec
+    with gzip.open(path, "rb") if is_gzip(path) else open(path, "rb") as handle:
+        text = handle.read().decode(codec, errors="replace")
+    return text.lstrip("\ufeff").encode("utf-8")
 
 
 def _separator(header: str, data: str) -> str:

@@ -43,6 +43,7 @@ DIMENSIONS: dict[str, tuple[str, str]] = {
     "temperature": ("[temperature]", "K"),
     "stress": ("[mass] / [length] / [time] ** 2", "Pa"),
     "stress_rate": ("[mass] / [length] / [time] ** 3", "Pa/s"),
+    "stress_acceleration": ("[mass] / [length] / [time] ** 4", "Pa/s^2"),  # a stick's bend (analyze -o)
     "stress_per_length": ("[mass] / [length] ** 2 / [time] ** 2", "Pa/m"),
     "force": ("[mass] * [length] / [time] ** 2", "N"),
     "area": ("[length] ** 2", "m^2"),
@@ -132,6 +133,7 @@ _NOUNS = {
     "stress_per_length": "a stress per length",
     "stress_per_velocity": "a stress per velocity",
     "stress_rate": "a stress rate",
+    "stress_acceleration": "a stress rate's rate of change",
     "mass_per_area": "a mass per area",
 }
 
@@ -518,6 +520,7 @@ _MEANT_UNITS: dict[str, tuple[float, tuple[tuple[str, float], ...]]] = {
     "temperature": (300.0, (("K", 1.0),)),
     "stress": (1e3, (("Pa", 1.0), ("kPa", 1e3), ("MPa", 1e6), ("GPa", 1e9))),
     "stress_rate": (1e2, (("Pa/s", 1.0), ("kPa/s", 1e3))),
+    "stress_acceleration": (1.0, (("Pa/s^2", 1.0),)),
     "stress_per_length": (1e5, (("Pa/m", 1.0), ("kPa/m", 1e3), ("MPa/m", 1e6))),
     "force": (1.0, (("N", 1.0), ("mN", 1e-3), ("uN", 1e-6))),
     "area": (1e-3, (("m^2", 1.0), ("cm^2", 1e-4), ("mm^2", 1e-6))),

@@ -364,7 +364,8 @@ def _duration(seconds: float) -> str:
     default=None,
     metavar="ROLE=HEADER,...",
     help='Map headers: time="Time(s)",displacement="Displ(microns)",friction=Friction; a shear stress and the '
-    'normal stress instead of friction: shear_stress="Tau (kPa)",normal_stress="Sn (MPa)".',
+    'normal stress instead of friction: shear_stress="Tau (kPa)",normal_stress="Sn (MPa)" (or forces, "Fs (kN)"; '
+    "a force beside a stress needs --contact-area).",
 )
 @click.option("--displacement-unit", default=None,
               help="Unit of the displacement column [the unit its header names, e.g. (um), else m].")  # fmt: skip
@@ -389,6 +390,9 @@ def _duration(seconds: float) -> str:
 @click.option("--normal-stress", default=None,
               help='Normal stress ("10 MPa"): divides a shear-stress column into friction, and reads a stiffness in '
                    "Pa/m.")  # fmt: skip
+@click.option("--contact-area", "area_text", default=None, metavar="A",
+              help='Contact area with its unit, e.g. "100 cm^2": makes a shear- or normal-force column a stress '
+                   "beside a stress column (a force over a force needs none).")  # fmt: skip
 @click.option("--fit-stiffness", is_flag=True,
               help="Fit the stiffness (the default without --stiffness), as --free stiffness.")  # fmt: skip
 @click.option(
@@ -454,7 +458,7 @@ def fit_command(**options: Any) -> None:
     status 3; its parameters are not written to -o.  Bad input exits 2.
     """
     from ..rsf.data import parse_columns, read_record
-    from ..rsf.fit import FitNotEvaluated, fit_record, restart_notice
+    from ..rsf.fit import FitNotEvaluated, fit_record, response_check, restart_notice
 
     output, plot_path = options["output"], options["plot_path"]
     side = None if output is None or output.suffix.lower() == ".json" else sidecar(output)
@@ -466,12 +470,17 @@ def fit_command(**options: Any) -> None:
     max_time = positive(options["max_time"], "time", "--max-time")
     sigma = options["normal_stress"]  # divides a shear-stress column into friction
     sigma = None if sigma is None else positive(sigma, "stress", "--normal-stress")
+    area = None if options["area_text"] is None else positive(options["area_text"], "area", "--contact-area")
     record = read_record(options["record_file"], parse_columns(options["columns"]), options["displacement_unit"],
-                         options["time_unit"], normal_stress=sigma)  # fmt: skip
+                         options["time_unit"], normal_stress=sigma, contact_area=area)  # fmt: skip
     settings = _fit_settings(options, record, window)
     if settings["mcmc_steps"] and importlib.util.find_spec("emcee") is None:  # said before any work, as --bayes
         raise ParameterError("--mcmc: the posterior needs emcee: pip install stickslip[bayes]")
-    cost = estimate_fit_cost(record, settings)
+    started = time.perf_counter()
+    # a record with no response to its velocity changes (or rows at one velocity) is said in seconds, before the
+    # estimate of a search that cannot find one (tester W's 1e6 noise rows: "up to 8.7 min", then 47 s of CPU)
+    fit = response_check(record, **settings)
+    cost = estimate_fit_cost(record, settings) if fit is None else FitCost(0.0, 0, 0)
     if cost.seconds > max_time:
         raise ParameterError(
             f"rsf fit: estimated {cost.text()}, above --max-time {_duration(max_time)}; allow it with --max-time "
@@ -479,10 +488,11 @@ def fit_command(**options: Any) -> None:
         )
     if cost.seconds > PROGRESS_AFTER_SECONDS:
         click.echo(f"stickslip: rsf fit: {cost.text()}", err=True)
-    started = time.perf_counter()
     try:
-        with _deadline(max_time), restart_notice(_restart_notice(cost)):
-            fit = fit_record(record, **settings)
+        if fit is None:
+            started = time.perf_counter()
+            with _deadline(max_time), restart_notice(_restart_notice(cost)):
+                fit = fit_record(record, **settings)
     except FitNotEvaluated as exc:  # a failed fit whose report (where the search ended) is printed below, exit 3
         fit = exc.fit
     except ModelError as exc:  # the search ran and ended where the model cannot be run: a failed fit, not bad input
@@ -510,7 +520,8 @@ def fit_command(**options: Any) -> None:
     if options["as_json"]:
         click.echo(json_text(report))
     else:
-        click.echo(_fit_text(fit) + f"\n  time: {_duration(elapsed)} (estimated {_duration(cost.seconds)})")
+        estimated = f"estimated {_duration(cost.seconds)}" if cost.runs else "no search: nothing to estimate"
+        click.echo(_fit_text(fit) + f"\n  time: {_duration(elapsed)} ({estimated})")
     if plot_path is not None:
         from ..plots.rsf import fit_figure
 
@@ -824,9 +835,11 @@ def _restart_searches(settings: dict[str, Any]) -> tuple[int, str]:
 def _timed_run(record: Any, settings: dict[str, Any]) -> float:
     """Seconds of one model run over the fitted rows at start-like values (the mean of the second and third)."""
     from ..rsf import simulate
-    from ..rsf.fit import FIT_RTOL, fitted_rows
+    from ..rsf.fit import FIT_RTOL, fitted_rows, refuse_one_velocity
 
     rows, history = fitted_rows(record, settings["protocol"], settings.get("window"))  # refused as the fit would be
+    if history.initial_velocity > 0:  # rows at one velocity: refused before any estimate, as the fit refuses them
+        refuse_one_velocity(rows, history)
     if float(np.max(history.velocities)) <= 0:
         return 0.0
     start = history.initial_velocity if history.initial_velocity > 0 else float(np.max(history.velocities))

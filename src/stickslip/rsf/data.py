@@ -48,8 +48,8 @@ _DEFAULT_NAMES = {
         "friction", "mu", "μ", "µ", "friction coefficient", "coefficient of friction", "friction coeff", "cof",
     ),
     "velocity": tuple(f"{p}{w}" for w in ("velocity", "vel") for p in _LOAD_POINT),
-    "shear_stress": ("shear stress", "shear", "tau", "τ"),
-    "normal_stress": ("normal stress", "normal", "sigma n", "sn", "σn"),
+    "shear_stress": ("shear stress", "shear", "tau", "τ", "shear force", "shear load"),
+    "normal_stress": ("normal stress", "normal", "sigma n", "sn", "σn", "normal force", "normal load"),
 }  # fmt: skip
 
 
@@ -220,6 +220,7 @@ def read_record(
     displacement_unit: str | None = None,
     time_unit: str | None = None,
     normal_stress: float | str | None = None,
+    contact_area: float | str | None = None,
 ) -> LabRecord:
     """A :class:`LabRecord` from delimited text (see the module notes).
 
@@ -231,13 +232,18 @@ def read_record(
     A shear-stress column instead of the friction (a stress unit in its header, or found or mapped as
     ``shear_stress``) is divided by the normal stress: a ``normal_stress`` column (found by name or mapped), else
     ``normal_stress`` (Pa, or a string with its unit, "10 MPa"); μ = τ/σn, each in the unit its header names.
+    A shear force over a normal force (``Shear force (kN)``, ``Normal force (N)``: a force unit in the header) is
+    their ratio, μ = Fs/Fn; a force beside a stress needs ``contact_area`` (m^2, or a string with its unit,
+    "100 cm^2"), which makes the force a stress (refused without it).  A unit of another kind in either header is
+    refused, as is a friction whose median is negative (a sign convention: flip the column) or outside
+    :data:`FRICTION_RANGE` (percent, or a stress read as the coefficient).
     The file's separator, decimal mark and layout (title lines before the header, a units row under it, no header
     row: its columns then mapped by number, ``columns={"time": "1", ...}``): :func:`stickslip.tables.text_format`,
     as every reader's; a gzip file is read decompressed.
     """
     import pandas as pd
 
-    from ..tables import text_format
+    from ..tables import text_encoding, text_format
     from ..units import to_si
 
     path = Path(path)
@@ -251,6 +257,9 @@ def read_record(
     sigma = None if normal_stress is None else to_si(normal_stress, "stress", "--normal-stress")
     if sigma is not None and not (math.isfinite(sigma) and sigma > 0):
         raise ParameterError(f"--normal-stress: expected a positive stress, got {sigma:g} Pa")
+    area = None if contact_area is None else to_si(contact_area, "area", "--contact-area")
+    if area is not None and not (math.isfinite(area) and area > 0):
+        raise ParameterError(f"--contact-area: expected a positive area, got {area:g} m^2")
     form = text_format(path)
     form, header_note = _numbered_header(path, form, columns)
     frame = _with_row_units(_read_frame(path, pd, form), form.layout, path)
@@ -263,8 +272,10 @@ def read_record(
         data["normal_stress"] = lambda: _numbers(frame[chosen["normal_stress"]], path, rows, pd, form)
     dimension = {"time": "time", "displacement": "length", "velocity": "velocity"}
     units = {role: _header_unit(str(chosen[role]), dimension[role], path) for role in chosen if role in dimension}
-    friction, read_notes = _friction(path, chosen, data, by_stress, sigma, _row_names(rows, len(frame)))
-    read_notes[:0] = [n for n in (form.layout.note(str(path)), header_note, form.note) if n]
+    friction, read_notes = _friction(path, chosen, data, by_stress, sigma, _row_names(rows, len(frame)), area)
+    if not by_stress and not read_notes:  # the friction column as it stands: a coefficient, positive
+        _refuse_implausible_friction(path, str(chosen["friction"]), friction)
+    read_notes[:0] = [n for n in (text_encoding(path).note, form.layout.note(str(path)), header_note, form.note) if n]
 
     def in_si(role: str) -> np.ndarray:
         """A column in SI: by the unit its header names, else by the option, else SI."""
@@ -315,14 +326,38 @@ FRICTION_RANGE = (1e-3, 10.0)
 NORMAL_STRESS_AGREEMENT = 0.05
 
 
+def _load_unit(header: str, path: Path) -> tuple[float, str, str]:
+    """(SI factor, unit, "stress" or "force") of a shear- or normal-load column's header: a stress unit, a force
+    unit, or none (a bare header: Pa).  A unit of another kind is refused (DataError naming the column)."""
+    try:
+        found = _header_unit(header, "stress", path)
+    except DataError as refused:
+        try:
+            force = _header_unit(header, "force", path)
+        except DataError:
+            force = None
+        if force is None:
+            raise refused from None
+        return force[0], force[1], "force"
+    return (found[0], found[1], "stress") if found is not None else (1.0, "Pa", "stress")
+
+
 def _friction(
-    path: Path, chosen: dict[str, Any], data: dict[str, Any], by_stress: bool, sigma: float | None, row: Any
+    path: Path,
+    chosen: dict[str, Any],
+    data: dict[str, Any],
+    by_stress: bool,
+    sigma: float | None,
+    row: Any,
+    area: float | None = None,
 ) -> tuple[np.ndarray, list[str]]:
     """The friction coefficient, and what reading it did that a report should say: the friction column as it
-    stands, or a shear-stress column divided by the normal stress (a column, else ``sigma`` in Pa)."""
+    stands, or a shear load divided by the normal load: a shear stress by a normal stress (a column, else
+    ``sigma`` in Pa), a shear force by a normal force (their ratio: the contact area cancels), and a force by a
+    stress only with the contact ``area`` (m^2), which makes the force a stress."""
     header = str(chosen["friction"])
     if by_stress:
-        stress = _header_unit(header, "stress", path)  # a bare header: Pa
+        shear = _load_unit(header, path)
     else:
         try:
             _header_unit(header, "dimensionless", path)
@@ -334,12 +369,13 @@ def _friction(
                 stress = None
             if stress is None:
                 raise refused from None
-    tau = data["friction"] * (stress[0] if stress is not None else 1.0)
-    tau_unit = stress[1] if stress is not None else "Pa"
+            shear = (stress[0], stress[1], "stress")
+    tau = data["friction"] * shear[0]
+    bare = [header] if not _header_names_unit(header) else []
     if "normal_stress" in chosen:
         column = str(chosen["normal_stress"])
-        unit = _header_unit(column, "stress", path)
-        factor, unit_name = unit if unit is not None else (1.0, "Pa")
+        factor, unit_name, kind = _load_unit(column, path)
+        bare += [column] if not _header_names_unit(column) else []
         written = data["normal_stress"]()
         sn = written * factor
         bad = np.flatnonzero(np.isfinite(sn) & (sn <= 0))
@@ -347,22 +383,37 @@ def _friction(
             k = int(bad[0])
             raise DataError(
                 f"{path}: row {row[k]}, column {column!r}: {written[k]:.10g} {unit_name}; expected a positive"
-                " normal stress"
+                f" normal {'force' if kind == 'force' else 'stress'}"
             )
+        converted = kind == "force" and shear[2] == "stress"
+        if converted:  # the normal force over the contact area
+            sn = sn / _area_for(path, column, unit_name, header, area)
+            kind = "stress"
         typical = float(np.nanmedian(sn)) if np.any(np.isfinite(sn)) else math.nan
-        if sigma is not None and not abs(typical - sigma) <= NORMAL_STRESS_AGREEMENT * typical:
+        if sigma is not None and kind == "force":
             raise DataError(
-                f"{path}: column {column!r} gives the normal stress {typical / factor:.6g} {unit_name} (median) but"
-                f" --normal-stress says {sigma / factor:.6g} {unit_name}; give one of them"
+                f"{path}: column {column!r} gives the normal load as a force ({unit_name}) and --normal-stress gives"
+                " a stress; give one of them"
+            )
+        if sigma is not None and not abs(typical - sigma) <= NORMAL_STRESS_AGREEMENT * typical:
+            shown, said_unit = (1.0, "Pa") if converted else (factor, unit_name)
+            raise DataError(
+                f"{path}: column {column!r} gives the normal stress {typical / shown:.6g} {said_unit} (median) but"
+                f" --normal-stress says {sigma / shown:.6g} {said_unit}; give one of them"
             )
         divisor, said = sn, f"column {column!r}"
+        if kind == "stress" and shear[2] == "force":
+            tau = tau / _area_for(path, header, shear[1], column, area)
     elif sigma is not None:
+        if shear[2] == "force":
+            tau = tau / _area_for(path, header, shear[1], "--normal-stress", area)
         divisor, said = np.full(tau.size, sigma), f"--normal-stress {_stress_text(sigma)}"
     else:
+        what = "a force" if shear[2] == "force" else "a stress"
         raise DataError(
-            f"{path}: column {header!r} is in {tau_unit}, a stress; expected the friction coefficient, or the"
-            ' normal stress to divide this shear stress by: give --normal-stress (e.g. "10 MPa"; Python:'
-            ' normal_stress=) or a normal-stress column (--columns normal_stress="HEADER")'
+            f"{path}: column {header!r} is in {shear[1]}, {what}; expected the friction coefficient, or the"
+            f" normal {'load' if shear[2] == 'force' else 'stress'} to divide it by: a normal-stress or normal-force"
+            ' column (--columns normal_stress="HEADER"), or --normal-stress (e.g. "10 MPa"; Python: normal_stress=)'
         )
     # a normal stress <= 0 was refused above with its row; an empty cell (NaN) gives a NaN friction, which the reader
     # treats as any empty friction cell (dropped with a note, or refused beyond 1 %)
@@ -370,11 +421,61 @@ def _friction(
         friction = tau / divisor
     typical = float(np.nanmedian(np.abs(friction))) if np.any(np.isfinite(friction)) else math.nan
     if not FRICTION_RANGE[0] <= typical <= FRICTION_RANGE[1]:
+        hint = f" ({' and '.join(repr(b) for b in bare)} name no unit: read as Pa)" if bare else ""
         raise DataError(
             f"{path}: friction = column {header!r} / {said} is {typical:.3g} (median), outside"
-            f" {FRICTION_RANGE[0]:g} to {FRICTION_RANGE[1]:g}; check the units of the two (a bare header is Pa)"
+            f" {FRICTION_RANGE[0]:g} to {FRICTION_RANGE[1]:g}; check the units of the two{hint}"
         )
-    return friction, [f"{path}: friction read as column {header!r} ({tau_unit}) divided by {said}: μ = τ/σn"]
+    over = f", over the contact area {area:.6g} m^2" if area is not None and shear[2] == "force" else ""
+    ratio = "μ = Fs/Fn" if shear[2] == "force" and "force" in _kinds(chosen, path) else "μ = τ/σn"
+    return friction, [f"{path}: friction read as column {header!r} ({shear[1]}{over}) divided by {said}: {ratio}"]
+
+
+def _kinds(chosen: dict[str, Any], path: Path) -> set[str]:
+    """The kinds of load ("stress", "force") of the normal-load column, where there is one."""
+    return {_load_unit(str(chosen["normal_stress"]), path)[2]} if "normal_stress" in chosen else set()
+
+
+def _header_names_unit(header: str) -> bool:
+    """Whether a header names a unit, in brackets at its end (a bare "Shear stress" is read as Pa)."""
+    return re.search(r"[\(\[]\s*([^\(\)\[\]]+?)\s*[\)\]]\s*$", header.strip()) is not None
+
+
+def _area_for(path: Path, force: str, unit: str, other: str, area: float | None) -> float:
+    """The contact area (m^2) that makes the force column ``force`` a stress beside the stress ``other``; refused
+    (DataError) where none was given."""
+    if area is None:
+        raise DataError(
+            f"{path}: column {force!r} is a force ({unit}) but {other!r} is a stress; give --contact-area (the"
+            ' sliding area, e.g. "100 cm^2"; Python: contact_area=) to make the force a stress, or give both as'
+            " forces or both as stresses"
+        )
+    return area
+
+
+def _refuse_implausible_friction(path: Path, column: str, friction: np.ndarray) -> None:
+    """DataError where a friction column's median is no friction coefficient: negative (the rig's sign
+    convention: flip the column), or outside :data:`FRICTION_RANGE` in magnitude (percent, or a stress)."""
+    finite = friction[np.isfinite(friction)]
+    if not finite.size:
+        return  # every cell empty: the reader names the rows
+    typical = float(np.median(finite))
+    if typical < 0 and FRICTION_RANGE[0] <= -typical <= FRICTION_RANGE[1]:
+        raise DataError(
+            f"{path}: column {column!r}: the friction is negative (median {typical:.6g}); expected a positive"
+            " friction coefficient: the rig's sign convention? flip the column's sign"
+        )
+    if not FRICTION_RANGE[0] <= abs(typical) <= FRICTION_RANGE[1]:
+        if 0.01 <= abs(typical) / 100 <= 2.0:
+            likely = "in percent? divide the column by 100"
+        elif abs(typical) > FRICTION_RANGE[1]:
+            likely = "a shear stress or force? map it as shear_stress, with the normal load as normal_stress"
+        else:
+            likely = "the wrong column, or a stress in a large unit?"
+        raise DataError(
+            f"{path}: column {column!r}: friction {typical:.6g} (median), outside {FRICTION_RANGE[0]:g} to"
+            f" {FRICTION_RANGE[1]:g}; expected the friction coefficient ({likely})"
+        )
 
 
 def _stress_text(value: float) -> str:
@@ -551,20 +652,25 @@ def _read_frame(path: Path, pd: Any, form: Any) -> Any:
     (:func:`stickslip.tables.text_format`, every reader's one decision): title lines and a units row skipped, a
     header in a ``#`` comment read from it, a file with no header row its columns numbered from 1 ("1", "2", ...).
     A gzip file is read decompressed."""
-    from ..tables import pandas_compression
+    from ..tables import pandas_input
 
     layout = form.layout
-    compression = pandas_compression(path)
+    source, compression = pandas_input(path)  # a file that is not UTF-8: its UTF-8 transcript
     try:
         if form.delimiter == " ":
-            return _read_whitespace_frame(path, pd, layout, form.decimal, compression)
+            return _read_whitespace_frame(path, pd, layout, form.decimal, compression, source)
         if layout.header_row is None or layout.commented:  # the names are not a row of the table
-            frame = pd.read_csv(path, sep=form.delimiter, comment="#", engine="c", decimal=form.decimal, header=None,
-                                skiprows=layout.data_after, compression=compression)  # fmt: skip
+            frame = pd.read_csv(source, sep=form.delimiter, comment="#", engine="c", decimal=form.decimal,
+                                header=None, skiprows=layout.data_after, compression=compression)  # fmt: skip
             return _named(frame, layout, path)
         skipped = {row - 1 for row in (*layout.title_rows, layout.units_row) if row is not None}  # 0-based lines
-        return pd.read_csv(path, sep=form.delimiter, comment="#", engine="c", decimal=form.decimal,
+        return pd.read_csv(source, sep=form.delimiter, comment="#", engine="c", decimal=form.decimal,
                            skiprows=(lambda i: i in skipped) if skipped else None, compression=compression)  # fmt: skip
+    except pd.errors.EmptyDataError:  # pandas' "No columns to parse from file"
+        raise DataError(
+            f"{path}: the file is empty (no line that is neither blank nor a '#' comment); expected a header row"
+            " and the data (time, load-point displacement and friction)"
+        ) from None
     except (OSError, EOFError, ValueError, pd.errors.ParserError) as exc:
         raise DataError(f"{path}: cannot read as delimited text ({str(exc).splitlines()[0]})") from None
 
@@ -623,10 +729,13 @@ def whitespace_headers(line: str) -> list[str]:
     return re.findall(r"[^\s\[\(]+(?:\s*[\[\(][^\]\)]*[\]\)])?|[\[\(][^\]\)]*[\]\)]", line)
 
 
-def _read_whitespace_frame(path: Path, pd: Any, layout: Any, decimal: str = ".", compression: str | None = None) -> Any:
-    """Columns split at blanks; the header's names by :func:`whitespace_headers` ("time [s]" is not two columns)."""
-    frame = pd.read_csv(path, sep=r"\s+", comment="#", engine="python", header=None, skiprows=layout.data_after,
-                        decimal=decimal, compression=compression)  # fmt: skip
+def _read_whitespace_frame(
+    path: Path, pd: Any, layout: Any, decimal: str = ".", compression: str | None = None, source: Any = None
+) -> Any:
+    """Columns split at blanks; the header's names by :func:`whitespace_headers` ("time [s]" is not two columns).
+    ``source``: what pandas reads where it is not ``path`` (a transcript of a file that is not UTF-8)."""
+    frame = pd.read_csv(path if source is None else source, sep=r"\s+", comment="#", engine="python", header=None,
+                        skiprows=layout.data_after, decimal=decimal, compression=compression)  # fmt: skip
     if layout.header_row is None or layout.commented:
         return _named(frame, layout, path)
     with open_input(path, "rt", encoding="utf-8-sig", errors="replace") as handle:
@@ -706,10 +815,17 @@ def _choose_columns(
     def by_name(role: str) -> Any:
         return next((phrases[n] for n in _DEFAULT_NAMES[role] if n in phrases), None)
 
+    if "displacement" in columns and "velocity" in columns:
+        raise DataError(
+            f"{path}: --columns maps both displacement and velocity; map one of them (the load point's history"
+            " comes from one: the displacement, or the velocity integrated)"
+        )
     chosen: dict[str, Any] = {}
     for role in ("time", "displacement", "velocity"):
         if role == "velocity" and "displacement" in chosen:
             continue
+        if role == "displacement" and "velocity" in columns:
+            continue  # the velocity the user mapped gives it, whatever displacement column the file also has
         match = mapped(role) if role in columns else by_name(role)
         by_velocity = "velocity" in columns or by_name("velocity") is not None
         if match is None and role == "displacement" and by_velocity:
@@ -772,7 +888,7 @@ def _header_unit(header: str, dimension: str, path: Path) -> tuple[float, str] |
     except ParameterError:
         pass
     expected = "the friction coefficient (dimensionless)" if dimension == "dimensionless" else f"a {dimension}"
-    for other in ("length", "time", "velocity", "stress"):
+    for other in ("length", "time", "velocity", "stress", "force"):
         try:
             to_si(f"1 {unit}", other, header)
         except ParameterError:
@@ -948,11 +1064,15 @@ def refuse_reversal(record: LabRecord, protocol: Protocol) -> None:
 CHANGE_ROWS = 50
 
 
-def change_time_uncertainty(time: np.ndarray, displacement: np.ndarray, protocol: Protocol) -> np.ndarray:
+def change_time_uncertainty(
+    time: np.ndarray, displacement: np.ndarray, protocol: Protocol, sampled_velocity: bool = False
+) -> np.ndarray:
     """Each interior change time's standard uncertainty (s), as the displacement dates it.
 
     sqrt(2) s / |jump|, s the rows' scatter about the history within :data:`CHANGE_ROWS` rows either side, with the
-    row spacing over sqrt(12) added where the change sits between two rows; a change with no jump gets 0
+    row spacing over sqrt(12) added where the change sits between two rows, and at every change where the
+    displacement was integrated from a velocity column (``sampled_velocity``: :attr:`LabRecord.displacement_from`
+    "velocity"), whose rows say only that the velocity changed since the row before; a change with no jump gets 0
     (docs/rsf.md, "the change times are fitted").
     """
     t = np.asarray(time, dtype=float)
@@ -968,7 +1088,7 @@ def change_time_uncertainty(time: np.ndarray, displacement: np.ndarray, protocol
         pooled = np.concatenate(scatter)
         spread = float(np.sqrt(np.mean(pooled**2))) if pooled.size else 0.0
         halfway = abs(edges[i] - 0.5 * (t[k] + t[k - 1])) <= 1e-9 * max(abs(float(edges[i])), 1.0)
-        spacing = float(t[k] - t[k - 1]) if halfway else 0.0
+        spacing = float(t[k] - t[k - 1]) if halfway or sampled_velocity else 0.0
         out[i - 1] = math.hypot(math.sqrt(2.0) * spread / jump, spacing / math.sqrt(12.0)) if jump > 0 else 0.0
     return out
 

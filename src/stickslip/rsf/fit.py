@@ -13,6 +13,7 @@ import os
 from collections.abc import Callable, Iterator
 from contextvars import ContextVar
 from dataclasses import dataclass, field, replace
+from types import SimpleNamespace
 from typing import Any
 
 import numpy as np
@@ -33,9 +34,18 @@ from .data import (
 )
 from .laws import get_law
 from .params import RSFParams, StateVariable, _cutoff_pair
+from .saturation import Saturation, find_saturation
 from .solver import simulate
 
-__all__ = ["FitNotEvaluated", "FitParameter", "RSFFit", "fit_record", "restart_notice"]
+__all__ = [
+    "FitNotEvaluated",
+    "FitParameter",
+    "RSFFit",
+    "fit_record",
+    "refuse_one_velocity",
+    "response_check",
+    "restart_notice",
+]
 
 Z95 = 1.959963984540054
 METHOD_MAX_NFEV = 1500
@@ -400,6 +410,7 @@ def fit_record(
     ``record`` may also be the path of a record file, read by :func:`stickslip.rsf.data.read_record` with its columns
     found by name (``read_record`` itself takes a column map and units).
     """
+    arguments = {key: value for key, value in locals().items() if key != "record"}  # (a saturated sensor's 2 passes)
     record = _lab_record(record)
     if noise is not None and not (_real(noise) and math.isfinite(noise) and noise > 0):
         raise ParameterError(f"noise: expected a positive friction level, got {noise!r}")
@@ -419,19 +430,31 @@ def fit_record(
     weight = None if step_weight is None else float(step_weight)
     source = "given" if protocol is not None else f"found from the load-point {record.displacement_from}"
     protocol_found = protocol is None
+    given_record = record
     record, protocol, backwards = _fitted_rows(record, protocol, window)
     if protocol.initial_velocity <= 0:
         raise DataError("record: the load point does not move in the first segment; expected steady sliding first")
-    if not _history_mismatch(record, protocol):  # (a given history that is not the record's fails as such)
+    saturation = find_saturation(record.friction)
+    if saturation is not None:  # a clipped sensor: its rows (and those its model puts near the limit) censored
+        censor = _CENSOR.get()
+        if censor is None and not _CHECK_ONLY.get():
+            return _censored_fit(given_record, record, protocol, saturation, arguments)
+        record = saturation.censored(record, saturation.at if censor is None else censor)
+    mismatch = _history_mismatch(record, protocol)
+    if not mismatch:  # (a given history that is not the record's fails as such)
         _refuse_one_velocity(record, protocol)
-    start = _stable_start(_initial_guess(record, protocol, {**starts, **held}, held.get("stiffness")),
-                          "dc" in starts or "dc" in held)  # fmt: skip
     labels = _sampling_classes(record.time)
     given = noise is not None
-    start["noise"] = float(noise) if given else _pre_fit_noise(record, protocol, start["dc"], labels, start["noise"])
     setup = _Setup(record, protocol, laws, states, "stiffness" not in held, kinds, held, None, frozenset(starts),
                    cutoff)  # fmt: skip
-    mismatch = _history_mismatch(record, protocol)
+    start = _stable_start(_initial_guess(record, protocol, {**starts, **held}, held.get("stiffness")),
+                          "dc" in starts or "dc" in held)  # fmt: skip
+    start["noise"] = float(noise) if given else _pre_fit_noise(record, protocol, start["dc"], labels, start["noise"])
+    check = None if mismatch else _response_check(setup, labels, start["noise"], given)
+    if check is None and _CHECK_ONLY.get():
+        return None  # type: ignore[return-value]  # (response_check: the search may go on)
+    if check is not None:  # no response to fit: said in seconds, before the search and its restarts
+        return _unsearched_fit(setup, start, check, source, window, weight)
     result, residual = _best_search(setup, start, mismatch, "stiffness" in starts or "stiffness" in held)
     seen: dict[int, dict[str, float]] = {}
     if protocol_found and not mismatch and len(protocol.segments) > 1:
@@ -559,6 +582,217 @@ def fit_record(
     )  # fmt: skip
 
 
+#: fit_record itself, for :func:`response_check` (a caller's stand-in for fit_record, a test's, is not it)
+_fit_record = fit_record
+
+
+#: the rows a saturated sensor's fit leaves out (None: found afresh; :func:`_censored_fit`)
+_CENSOR: ContextVar[np.ndarray | None] = ContextVar("rsf_fit_censor", default=None)
+
+
+def _censored_fit(
+    given: LabRecord, rows: LabRecord, protocol: Protocol, saturation: Saturation, arguments: dict[str, Any]
+) -> RSFFit:
+    """The fit of a record whose sensor saturates: a first fit without the rows at the limit, whose model (over every
+    row) puts more rows within the censoring band; the fit without those (docs/rsf.md, "A saturated sensor")."""
+    out = saturation.at
+    quick = {**arguments, "alternatives": False, "drift_check": False, "mcmc_steps": 0}
+    token = _CENSOR.set(out)
+    try:
+        first = fit_record(given, **quick)
+        model = simulate(first.params, first.protocol, times=rows.time, rtol=FIT_RTOL, atol=FIT_RTOL * 1e-2,
+                         detect=False, mean=False).friction  # fmt: skip
+        model = (
+            model
+            + first.trend * rows.displacement
+            + first.parameters.get("time_trend", FitParameter("time_trend", 0.0, None, None)).value * rows.time
+        )
+        if model.size == rows.time.size and np.all(np.isfinite(model)) and math.isfinite(first.rms):
+            out = out | saturation.near(model, first.rms)
+    except (ModelError, ParameterError):  # (the fit without the rows at the limit alone says what went wrong)
+        pass
+    finally:
+        _CENSOR.reset(token)
+    token = _CENSOR.set(out)
+    try:
+        return fit_record(given, **arguments)
+    finally:
+        _CENSOR.reset(token)
+
+
+#: set by :func:`response_check`: :func:`fit_record` returns after its check before the search (None: it may search)
+_CHECK_ONLY: ContextVar[bool] = ContextVar("rsf_fit_check_only", default=False)
+
+
+def response_check(record: LabRecord, **arguments: Any) -> RSFFit | None:
+    """The failed fit of a record whose friction shows no response to its velocity changes, found as
+    :func:`fit_record` (the same arguments) finds it before its search, in seconds; None where the search is needed
+    (``rsf fit`` asks before estimating the fit's cost: docs/rsf.md, "No response, said before the search").
+    Bad input is refused as :func:`fit_record` refuses it (rows at one velocity among them)."""
+    token = _CHECK_ONLY.set(True)
+    try:
+        return _fit_record(record, **arguments)
+    finally:
+        _CHECK_ONLY.reset(token)
+
+
+#: the check before the search: each change's decays, their time scales this factor apart, from
+#: RESPONSE_FIRST_ROWS rows after the change to the rest of the record
+RESPONSE_SCALE_STEP = 10.0
+RESPONSE_FIRST_ROWS = 3
+#: the search is skipped where the check's terms lower chi-square (in effective independent rows) by less than this
+#: share of what the fit's own F test needs to call a response significant at NO_RESPONSE_LEVEL
+RESPONSE_SHARE = 0.5
+#: ... and the check is not made (the search decides) where its design would hold more cells than this (memory)
+#: or more columns than this share of the rows
+RESPONSE_MAX_CELLS = 30_000_000
+RESPONSE_MAX_COLUMNS = 0.1
+
+
+def _response_terms(record: LabRecord, protocol: Protocol) -> np.ndarray | None:
+    """The check's step-response columns: per change, a level from it on (one level per segment) and decays
+    exp(-(t - t_i) / tau) from it on, tau a factor RESPONSE_SCALE_STEP apart from RESPONSE_FIRST_ROWS rows' time to
+    the rest of the record (a change's direct effect, its evolution over Dc / V and the spring's loading at any
+    scale the rows resolve, and a hold's relaxation); None where they are too many (RESPONSE_MAX_CELLS)."""
+    t = record.time
+    edges = protocol.boundaries
+    starts = []
+    for edge in edges[1:-1]:
+        k = int(np.searchsorted(t, edge))
+        if k >= t.size - 1:
+            continue
+        spacing = float(np.median(np.diff(t[k : k + 50])))
+        rest = float(t[-1] - edge)
+        if not (spacing > 0 and rest > 0):
+            continue
+        low = math.log10(RESPONSE_FIRST_ROWS * spacing)
+        count = max(math.ceil((math.log10(rest) - low) / math.log10(RESPONSE_SCALE_STEP)), 0) + 1
+        starts.append((float(edge), RESPONSE_FIRST_ROWS * spacing * RESPONSE_SCALE_STEP ** np.arange(count)))
+    columns = sum(1 + scales.size for _, scales in starts)
+    if not starts or columns * t.size > RESPONSE_MAX_CELLS or columns > RESPONSE_MAX_COLUMNS * t.size:
+        return None
+    out = np.zeros((t.size, columns))
+    j = 0
+    for edge, scales in starts:
+        after = t >= edge
+        since = t[after] - edge
+        out[after, j] = 1.0
+        for tau in scales:
+            out[after, j + 1] = np.exp(-since / tau)
+            j += 1
+        j += 1
+    return out
+
+
+def _response_check(setup: _Setup, labels: np.ndarray, noise: float, given: bool) -> dict[str, float] | None:
+    """Whether the friction responds to the velocity changes at all, before the search: where a step response of
+    any shape the rows resolve (:func:`_response_terms`, least squares, no model run) lowers chi-square against
+    constant friction (plus the trends asked for) by less than RESPONSE_SHARE of what the rate-and-state fit's own F
+    test (:func:`_response_p_value`, its free parameters beyond mu0 against constant friction) needs at
+    NO_RESPONSE_LEVEL, no fit can find one: what it found (a dict), else None (the search goes on).  The drop is
+    counted against the terms' residuals' variance, their rows counted 1/g each by their correlation (as that F
+    test counts the fit's), or against ``noise`` (the steady sliding's, which the search is judged by) with every
+    row counted, whichever makes it larger.  The terms can take up more of any response than the law's few
+    parameters, and more terms only lower the chance of skipping a search, so skipping is conservative."""
+    from scipy import stats
+
+    record, held = setup.record, setup.fixed
+    core = ("a", "b", "dc", "stiffness") + (("b2", "dc2") if setup.states == 2 else ())
+    extra_law = sum(1 for key in core if key not in held)  # (the stiffness is free unless held)
+    if "mu0" in held or extra_law == 0:
+        return None
+    terms = _response_terms(record, setup.protocol)
+    if terms is None:
+        return None
+    null = _constant_design(record, setup.trend)
+    design = np.column_stack([null, terms])
+    design = design / np.maximum(np.max(np.abs(design), axis=0), 1e-300)  # (columns of one size for lstsq)
+    f = record.friction
+    n = f.size
+    coef, *_ = np.linalg.lstsq(design[:, : null.shape[1]], f, rcond=None)
+    constant = float(np.sum((f - design[:, : null.shape[1]] @ coef) ** 2))
+    coef, _, rank, _ = np.linalg.lstsq(design, f, rcond=None)
+    resid = f - design @ coef
+    fitted = float(np.sum(resid**2))
+    extra = int(rank) - int(np.linalg.matrix_rank(null))
+    if extra <= 0 or n - rank < 10 or not fitted > 0:
+        return None
+    inflation = 1.0 if given else n / float(np.sum(1.0 / _correlation_factor(resid, labels)))
+    # the rows' noise as the terms' residuals measure it, or as the search will judge it (``noise``, the steady
+    # sliding's, counting each row once), whichever finds the larger drop: where the terms miss part of a response
+    # far above the noise, their residuals are one smooth curve and would count the record as a few rows
+    scale = min(fitted / (n - rank) * inflation, noise**2) if noise > 0 else fitted / (n - rank) * inflation
+    inflation = scale / (fitted / (n - rank))
+    lowered = (constant - fitted) / scale
+    dof = max((n - rank) / inflation, 1.0)
+    needed = extra_law * float(stats.f.isf(NO_RESPONSE_LEVEL, extra_law, dof))
+    if not lowered < RESPONSE_SHARE * needed:
+        return None
+    return {"lowered": lowered, "needed": needed, "terms": float(extra), "p": float(stats.f.sf(lowered / extra, extra,
+            dof)), "effective_rows": n / max(inflation, 1.0), "law_terms": float(extra_law)}  # fmt: skip
+
+
+def _unsearched_fit(
+    setup: _Setup, start: dict[str, float], check: dict[str, float], source: str, window: Any, weight: float | None
+) -> RSFFit:
+    """The failed report of a fit :func:`_response_check` ends before its search: the starting values, no
+    intervals, the model not run (NaN), and the check's words (docs/rsf.md, "No response, said before the
+    search")."""
+    import lmfit
+
+    record = setup.record
+    trends = " with the trends" if setup.trend else ""
+    noise = float(start["noise"])
+    constant = _constant_chi2(record, setup.trend, np.full(len(record), noise))
+    said = (f"constant friction{trends} describes the record to within its noise (reduced chi-square {constant:.3g}"
+            f" against the noise {noise:.2g})" if constant <= WARN_CHI2 else
+            f"the friction varies beyond its noise (constant friction{trends}: reduced chi-square {constant:.3g} "
+            f"against the noise {noise:.2g}), but not with the velocity changes")  # fmt: skip
+    reason = (
+        f"{NO_RESPONSE_TEXT}: {said}; a step response of any shape the rows resolve ({check['terms']:.0f} terms: a "
+        f"level after each change and decays at time scales a decade apart) lowers chi-square by "
+        f"{check['lowered']:.3g} (in {check['effective_rows']:.4g} effective independent rows), under "
+        f"{RESPONSE_SHARE:g} of the {check['needed']:.3g} the fit's {check['law_terms']:.0f} rate-and-state "
+        f"parameters need to be significant at the {NO_RESPONSE_LEVEL:g} level (F test of the terms: p = "
+        f"{check['p']:.2g}), so a, b and Dc are not determined; the search was not run (the values are its start)"
+    )
+    pars = lmfit.Parameters()
+    pars.add("mu0", value=start["mu0"])
+    pars.add("a", value=start["a"])
+    pars.add("b", value=start["b"])
+    pars.add("log_dc", value=math.log(start["dc"]))
+    if setup.states == 2:
+        pars.add("b2", value=start["b2"])
+        pars.add("log_dc2", value=math.log(start["dc2"]))
+    if setup.fit_stiffness:
+        pars.add("log_k", value=math.log(start["stiffness"]))
+    for key in ("trend", "time_trend"):
+        if {"trend": "slip", "time_trend": "time"}[key] in setup.trend:
+            pars.add(key, value=start[key])
+    for key, value in setup.fixed.items():
+        name = _INTERNAL[key]
+        if key == "stiffness" or (key in ("b2", "dc2") and setup.states != 2):
+            continue
+        pars.add(name, value=math.log(value) if name.startswith("log_") else value, vary=False)
+    values = pars.valuesdict()
+    table, _, _ = _report(SimpleNamespace(params=pars), values, setup, start["stiffness"], None,
+                          _units(record.length_unit))  # fmt: skip
+    note = _law_not_determined([reason], setup.laws)
+    for key, par in table.items():
+        if not par.fixed:
+            said = note if key in ("a", "b", "dc", "b2", "dc2", "stiffness") else "not fitted: the search was not run"
+            table[key] = replace(par, stderr=None, interval=None, scaled_interval=None, constrained=False, note=said)
+    a_b = FitParameter("a-b", table["a"].value - table["b"].value, None, None, constrained=False, note=note)
+    return RSFFit(
+        params=_final_params(_base(setup, start), values), parameters=table, correlations={},
+        reduced_chi_square=math.nan, rms=math.nan, noise=noise, trend=float(values.get("trend", 0.0)),
+        record=record, protocol=setup.protocol, model_friction=np.full(len(record), np.nan), warnings=(),
+        success=False, optimizer_message="not run: no response to fit", nfev=0, status="failed", reason=reason,
+        derived={"a-b": a_b}, protocol_source=source, window=None if window is None else
+        (float(window[0]), float(window[1])), step_weight=weight, notes=record.notes,
+    )  # fmt: skip
+
+
 def fitted_rows(record: LabRecord, protocol: Protocol | None = None, window: Any = None) -> tuple[LabRecord, Protocol]:
     """The rows a fit uses (those of ``window``, on the record file's own clock) and their load-point history:
     ``protocol`` from the window's first row to its last, or the history found from the displacement.
@@ -577,6 +811,14 @@ def _fitted_rows(record: LabRecord, protocol: Protocol | None, window: Any) -> t
         refuse_reversal(rows, found)
         return rows, found, backwards
     return rows, _covering(_shifted(protocol, rows.t0 - record.t0), rows), backwards
+
+
+def refuse_one_velocity(rows: LabRecord, protocol: Protocol) -> None:
+    """DataError where the fitted rows ``rows`` hold one velocity of ``protocol`` (their own history, as
+    :func:`fitted_rows` gives both), as :func:`fit_record` refuses them: no law can be fitted without a change (a
+    history that does not follow the rows is left to the fit, which fails it as such)."""
+    if not _history_mismatch(rows, protocol):
+        _refuse_one_velocity(rows, protocol)
 
 
 def _refuse_one_velocity(rows: LabRecord, protocol: Protocol) -> None:
@@ -995,7 +1237,8 @@ def _free_changes(setup: _Setup, base: RSFParams, values: dict[str, float], nois
     uncertainty raises chi-square by more than CHANGE_CHI2), per change its uncertainty and that rise (for the
     report), and the priors' weight (:func:`_prior_weight`): docs/rsf.md, "Which are fitted" and "Fitted"."""
     record, protocol = setup.record, setup.protocol
-    sigmas = change_time_uncertainty(record.time, record.displacement, protocol)
+    sigmas = change_time_uncertainty(record.time, record.displacement, protocol,
+                                     sampled_velocity=record.displacement_from == "velocity")  # fmt: skip
     model, why = _model_or_why(record, protocol, base, values)
     weight = 1.0 if why else _prior_weight(record.friction - model, noise, labels)
     free, seen = [], {}
@@ -1014,11 +1257,21 @@ def _free_changes(setup: _Setup, base: RSFParams, values: dict[str, float], nois
     return tuple(free), seen, weight
 
 
+def _dated_by(record: LabRecord) -> str:
+    """Who dates a found change, with its verb: the displacement (where its straight pieces meet), or a velocity
+    column's rows (the change lies between the last row at the old velocity and the first at the new, to the row
+    spacing: :func:`stickslip.rsf.data.change_time_uncertainty`)."""
+    if record.displacement_from == "velocity":
+        return "the velocity column's rows date"
+    return "the displacement dates"
+
+
 def _change_report(setup: _Setup, result: Any, seen: dict[int, dict[str, float]]) -> tuple[
         tuple[FitParameter, ...], list[str]]:  # fmt: skip
     """One FitParameter per change of the history (s, on the fitted rows' clock), and warnings for fitted changes
     far from where the displacement dates them."""
     protocol = setup.protocol
+    dates = _dated_by(setup.record)
     free = dict(setup.changes)
     out, warns = [], []
     for index in range(1, len(protocol.segments)):
@@ -1027,7 +1280,7 @@ def _change_report(setup: _Setup, result: Any, seen: dict[int, dict[str, float]]
         name = f"change_{index}"
         if index not in free or info is None:
             why = ("given with the history" if info is None else
-                   f"held where the displacement dates it (± {info['uncertainty']:.2g} s): moving it by "
+                   f"held where {dates} it (± {info['uncertainty']:.2g} s): moving it by "
                    f"{CHANGE_SHIFT:g} times that changes chi-square by {info['chi_square_change']:.2g} "
                    f"(<= {CHANGE_CHI2:g})")  # fmt: skip
             out.append(FitParameter(name, found, None, None, fixed=True, unit="s", note=why, si_unit="s"))
@@ -1038,7 +1291,7 @@ def _change_report(setup: _Setup, result: Any, seen: dict[int, dict[str, float]]
         se = par.stderr * sigma if par.stderr is not None and math.isfinite(par.stderr) else None
         interval = (value - Z95 * se, value + Z95 * se) if se is not None else None
         shown = f"{setup.record.t0 + found:.{_decimals(sigma)}f} ± {sigma:.2g} s on the file's clock"
-        note = (f"fitted; the displacement dates it at {shown}, its prior" if se is not None else
+        note = (f"fitted; {dates} it at {shown}, its prior" if se is not None else
                 "fitted, no standard error: the record cannot tell it apart from the others")  # fmt: skip
         out.append(FitParameter(name, value, se, interval, unit="s", constrained=se is not None, note=note,
                                 si_unit="s"))  # fmt: skip
@@ -1046,7 +1299,7 @@ def _change_report(setup: _Setup, result: Any, seen: dict[int, dict[str, float]]
             warns.append(
                 f"{name}: the friction places the velocity change at {setup.record.t0 + value:.6g} s, "
                 f"{abs(value - found) / sigma:.3g} "
-                f"times its uncertainty from where the displacement dates it ({shown}): check "
+                f"times its uncertainty from where {dates} it ({shown}): check "
                 "the history (--segment, --protocol or --history measured)"
             )
     return tuple(out), warns

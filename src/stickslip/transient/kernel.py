@@ -1173,7 +1173,9 @@ def _birth_point(  # type: ignore[no-untyped-def]
     # its end (the birth rate times the newborns' life 1/r, at most all of it; :func:`_birth_mass`): bonds
     # living shorter than a step would otherwise vanish from the population without a word
     z = max(r_birth * hh, trap)
-    if _relaxed_births(p):  # the Gauss pair's own bias, held to a tenth of the share (docs/transient.md section 8)
+    # births under a slider at rest (velocity control, a hold) share one birth position: lumping them misplaces
+    # no stretch, only ages, which the Gauss pair's own bias bounds (docs/transient.md section 23)
+    if _relaxed_births(p) or (v0 == 0.0 and v1p == 0.0 and not inertial):  # the Gauss pair's own bias
         z = max(hh * (r_birth + p[P_INV_TAU_A]), trap)
         lumping = min(1.0, BIRTH_BIAS * z**4 / 4320.0)
     else:
