@@ -22,36 +22,10 @@ import scipy.special
 import stickslip
 from stickslip.protocols import segments
 from stickslip.transient import kernel, run_transient
+from tester_sets import TESTER_GEL
 
 #: the tester's parameter file (mygel.toml), as they wrote it
-MYGEL = """
-name = "my-gel-8pct"
-description = "8 wt% gelatin on glass, my rig (guesses)"
-
-[bonds]
-site_density = "1.5e14 1/m^2"
-bond_time = "300 us"
-breakage_weight = 1.0
-chain_stiffness = "1.2e-4 N/m"
-activation_length = "1 angstrom"
-temperature = "295 K"
-max_extension = "1.0 um"
-
-[aging]
-aging_time = "1.2 ms"
-aging_velocity = "300 um/s"
-
-[stick]
-attached_chains = "2.5e12 1/m^2"
-break_rate = "2e-4 1/s"
-aging_time = "8 s"
-
-[block]
-shear_modulus = "8 kPa"
-height = "8 mm"
-top_length = "40 mm"
-base_length = "25 mm"
-"""
+MYGEL = TESTER_GEL
 
 #: 10 um/s from an empty surface past the bonds' memory (1 um of travel: 0.1 s), then 1 um/s, where the bonds born
 #: at 10 um/s reach the FENE cliff one after another
