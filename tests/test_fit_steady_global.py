@@ -108,7 +108,9 @@ def test_joint_fit_of_a_decreasing_curve_with_stated_errors_fails():
     stress = power_law()
     fit = fit_steady(SteadyData.from_arrays(WIDE, stress, 0.01 * stress), method="joint")
     assert fit.status == "failed" and "does not describe these data" in fit.reason
-    assert fit.chi_square / fit.dof > 100
+    # round 30: the keys the data leave open held at the global search's values, no longer put back at the input's:
+    # χ²ᵣ 28.7 (was > 100), still p ~ 1e-90 against the stated 1 % errors
+    assert fit.chi_square / fit.dof > 10
 
 
 # --------------------------------------------------------------------------- curves the model can follow

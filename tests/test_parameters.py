@@ -454,8 +454,10 @@ def test_huge_numbers_become_inf_and_are_refused_by_validation(params):
 
 
 def test_bare_numbers_are_si_in_the_python_api(params):
-    p = params.with_overrides({"bonds.bond_time": "2.24e-4", "aging.aging_velocity": 3.6e-4})
+    p = params.with_overrides({"bonds.bond_time": 2.24e-4, "aging.aging_velocity": 3.6e-4})
     assert (p.bonds.bond_time, p.aging.aging_velocity) == (2.24e-4, 3.6e-4)
+    with pytest.raises(UnitError, match="needs a unit"):  # a number as text is refused (round 30; was SI)
+        params.with_overrides({"bonds.bond_time": "2.24e-4"})
 
 
 def test_export_writes_what_a_person_would_write(params):

@@ -27,8 +27,8 @@ def test_a_curve_falling_everywhere_is_a_failed_run_not_bad_input(capsys):
 
     params = GEL.with_overrides({"bonds.bond_time": 1.0})
     assert float(steady_state(params, 60e-6).stress) < float(steady_state(params, 50e-6).stress)  # weakening
-    with pytest.raises(RunFailed):
-        simulate(params, 50e-6, 60.0)
+    sim = simulate(params, 50e-6, 60.0)  # a failed run returned with its words (round 30; it raised RunFailed)
+    assert sim.status == "failed" and "no answer from the quasi-static model" in sim.message
     assert issubclass(RunFailed, ModelError)
 
 

@@ -341,9 +341,9 @@ def test_rsf_phase_diagram_draws_kc_of_rsf(rsf_sweep):
 @pytest.mark.parametrize(
     ("option", "expected"),
     [
-        ("law=nagata", "--set law=nagata: expected one of aging, slip, prz"),
+        ("law=nagata", "law: expected one of aging, slip, prz"),
         ("k=1 MPa/m", "expected an inverse length"),
-        ("sigma=1 MPa", "--set sigma: unknown rate-and-state key"),
+        ("sigma=1 MPa", "unknown rate-and-state key 'sigma'"),
         ("dc=-1 um", "dc: expected a value > 0"),
     ],
 )

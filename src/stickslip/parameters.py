@@ -51,7 +51,7 @@ from typing import Any
 
 from .errors import ParameterError, as_written
 from .fileio import protect_inputs, read_input_text
-from .units import format_quantity, format_si, shorten, to_si
+from .units import format_quantity, format_si, override_to_si, shorten, to_si
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -279,7 +279,10 @@ class Parameters:
         return {key: value for key, _, value in self._held()}
 
     def with_overrides(self, overrides: Mapping[str, Any] | None) -> Parameters:
-        """A new set with ``section.key`` values replaced (numbers in SI, or strings with units).
+        """A new set with ``section.key`` values replaced (numbers in SI, or values with their units: strings such
+        as ``"224 us"`` or pint quantities).  A number written as text without a unit (``"224"``) is refused, a
+        :class:`~stickslip.errors.UnitError` naming the key, as everywhere in the Python API (zero and dimensionless
+        keys need no unit).
 
         ``block.stiffness`` (G_d/h) or ``block.effective_stiffness`` (K of Eq 17) sets the block's height to give
         that stiffness with the set's shear modulus and trapezoid (after the other overrides, so a
@@ -290,12 +293,13 @@ class Parameters:
         if not isinstance(overrides, Mapping):
             raise ParameterError(f"overrides: expected a mapping of 'section.key' to values, got {shorten(overrides)}")
         values: dict[str, Any] = self.as_dict()
+        held = {**values, **{key: getattr(self.block, key.partition(".")[2]) for key in STIFFNESS_KEYS}}
         stiffness: dict[str, float] = {}
         for key, raw in overrides.items():
             if not isinstance(key, str):
                 raise ParameterError(f"overrides: expected 'section.key' names, got {shorten(key)}")
             dimension = override_dimension(key)
-            (stiffness if key in STIFFNESS_KEYS else values)[key] = to_si(raw, dimension, key)
+            (stiffness if key in STIFFNESS_KEYS else values)[key] = override_to_si(raw, dimension, key, held.get(key))
         setting = [k for k in ("block.height", *STIFFNESS_KEYS) if k in overrides]
         if stiffness and len(setting) > 1:
             raise ParameterError(f"{' and '.join(setting)} both set the block's height; give only one of them")

@@ -2,10 +2,12 @@
 
 Inside the package every number is a float in SI base units.  A value string
 is a number followed by a unit expression (``"224 us"``, ``"1.22e14 1/m^2"``,
-``"20 degC"``); a bare number (``0.000224``, ``"0.000224"``) is already SI,
-in TOML files and in the Python API alike.  (The command line is stricter and
-refuses a bare non-zero number for a dimensional option: see
-:func:`bare_number` and :mod:`stickslip.cli.common`.)
+``"20 degC"``); a bare number (``0.000224``) is already SI, in TOML files and
+in the Python API alike.  A non-zero number written as text without a unit
+(``"0.000224"``) is refused for a dimensional value, on the command line, in a
+file's quoted value and by the Python API (:func:`require_unit`,
+:func:`si_argument`, :func:`override_to_si`); :func:`to_si` itself still reads
+it as SI for the callers that check it first.
 
 What is parsed is bounded before anything is evaluated: at most
 :data:`MAX_VALUE_LENGTH` characters, one leading number, and a unit
@@ -226,6 +228,17 @@ def to_si(value: Any, dimension: str, name: str = "value") -> float:
     raise UnitError(f"{name}: expected {_describe(dimension)}, got {shorten(value)}")
 
 
+def override_to_si(value: Any, dimension: str, name: str, typical: float | None = None) -> float:
+    """A parameter override's or a model key's value (``{"bonds.bond_time": "224 us"}``) in SI of ``dimension``, as
+    :func:`to_si` reads it, except that a non-zero number written as text without a unit (``"224"``) is refused, a
+    :class:`UnitError` naming ``name`` (:func:`require_unit`), as every other argument of the Python API and a quoted
+    value in a file refuse it; a number (not text) is SI.  Before round 30 ``with_overrides({"bonds.bond_time":
+    "224"})`` was 224 s without a word.  ``typical`` (SI; the value the key holds) sizes the unit suggested."""
+    if isinstance(value, str):
+        require_unit(value, dimension, f"{name}=", typical)
+    return to_si(value, dimension, name)
+
+
 def is_quantity(value: Any) -> bool:
     """Whether ``value`` is a pint quantity (of any registry): what :func:`to_si` reads with its unit."""
     return hasattr(value, "dimensionality") and hasattr(value, "to")
@@ -431,7 +444,7 @@ def _quantity_to_si(quantity: Any, dimension: str, name: str, shown: Any) -> flo
 
     ureg = registry()
     if not isinstance(quantity, ureg.Quantity):
-        raise UnitError(f"{name}: a quantity from another pint registry; pass a string such as '350 um/s'")
+        quantity = _own_quantity(quantity, name, shown)
     try:
         if dimension == "dimensionless":
             return float(quantity.to("dimensionless").magnitude)
@@ -442,6 +455,22 @@ def _quantity_to_si(quantity: Any, dimension: str, name: str, shown: Any) -> flo
         ) from None
     except (OverflowError, ZeroDivisionError, ValueError, TypeError):
         raise UnitError(f"{name}: cannot read {shorten(shown)} as {_describe(dimension)}") from None
+
+
+def _own_quantity(quantity: Any, name: str, shown: Any) -> Any:
+    """A quantity of another pint registry (the user's own ``pint.UnitRegistry()``) as one of :func:`registry`: its
+    magnitude and its units' name, or, for a unit only its registry defines, its value in that registry's base
+    units.  (Before round 30 such a quantity was refused, "a quantity from another pint registry".)"""
+    ureg = registry()
+    try:
+        return ureg.Quantity(quantity.magnitude, ureg.parse_units(str(quantity.units)))
+    except Exception:  # a unit the user's registry defines and ours does not: go through its base units
+        pass
+    try:
+        base = quantity.to_base_units()
+        return ureg.Quantity(base.magnitude, ureg.parse_units(str(base.units)))
+    except Exception:
+        raise UnitError(f"{name}: cannot read the pint quantity {shorten(shown)}: its unit is unknown here") from None
 
 
 def format_si(value: float, dimension: str) -> str:

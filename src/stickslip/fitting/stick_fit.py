@@ -25,7 +25,7 @@ from ..errors import DataError, ParameterError
 from ..parameters import Parameters, available_parameter_sets, key_dimension, load_parameters, replace
 from ..quasistatic.critical import critical_point
 from ..reprs import compact_repr
-from ..units import to_si
+from ..units import override_to_si
 from . import identify
 from .data import CYCLE_START_TIME, StickData, read_stick_data, requested_rows
 from .input_uncertainty import FitCovariance, matching_covariance, read_fit_covariance
@@ -410,6 +410,39 @@ def _select_rows(
     return used, excluded, (point.stress if point.exists else None), messages
 
 
+def _too_few_rows(data: StickData, usable: int, excluded: Mapping[int, str], params: Parameters) -> str:
+    """The error for fewer than two usable rows, naming which rows were left out and why (a tester's Table 1 with
+    its velocities headed [m/s] for µm/s: "0 usable row(s)" and nothing else; round 30), and, where rows were left
+    out above Vc, the unit that would put them below it."""
+    text = f"{data.source}: {usable} usable row(s); need at least 2 stick phases to fit"
+    reasons: dict[str, list[int]] = {}
+    for row, why in excluded.items():
+        reasons.setdefault(why, []).append(row)
+    parts = []
+    for why, rows in reasons.items():
+        shown = ", ".join(map(str, rows[:8])) + (f" and {len(rows) - 8} more" if len(rows) > 8 else "")
+        parts.append(f"{'rows' if len(rows) > 1 else 'row'} {shown} left out ({why})")
+    if parts:
+        text += ": " + "; ".join(parts)
+    above = [k for k, row in enumerate(data.rows) if excluded.get(int(row), "").startswith("V0 above")]
+    if above:
+        v = data.pulling_velocity[above]
+        vc = critical_point(params).velocity
+        low, high = human(float(np.min(v)), "velocity"), human(float(np.max(v)), "velocity")
+        text += f"; their pulling velocities are {low} to {high}"
+        for unit, factor in (("mm/s", 1e-3), ("um/s", 1e-6), ("nm/s", 1e-9)):
+            if float(np.max(v)) * factor < vc:  # the unit that would put every one of them below Vc
+                column = "pulling_velocity"
+                text += (
+                    f": if they are in {unit}, the column's unit is wrong (a header such as {column} [{unit}]); if"
+                    " they are right, --include-steady keeps them"
+                )
+                break
+        else:
+            text += "; --include-steady keeps them"
+    return text
+
+
 def fit_stick(
     table: StickData | str | Path,
     params: Parameters | str | None = None,
@@ -460,7 +493,7 @@ def fit_stick(
     fixed: dict[str, float] = {}
     for key, raw in (fix or {}).items():
         _check_stick_key(key, "--fix")
-        fixed[key] = to_si(raw, key_dimension(key), key)
+        fixed[key] = override_to_si(raw, key_dimension(key), key)
     base = base.with_overrides(fixed) if fixed else base
     for key in free or ():
         _check_stick_key(key, "--free")
@@ -474,7 +507,7 @@ def fit_stick(
     rows, fitted_peak = _rows(data, used, start, rate, sigma_c, messages, start_stress)
     n_obs = rows.stick_time.size + (0 if rows.peak is None else rows.peak.size)
     if rows.stick_time.size < 2:
-        raise DataError(f"{data.source}: {rows.stick_time.size} usable row(s); need at least 2 stick phases to fit")
+        raise DataError(_too_few_rows(data, rows.stick_time.size, excluded, base))
     undetermined: list[str] = []
     centre_all = {k: math.log(base.as_dict()[k]) for k in STICK_KEYS}
     current = base

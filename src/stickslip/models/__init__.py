@@ -63,6 +63,7 @@ def run(
     if protocol is None:
         raise ParameterError("protocol: expected a stickslip.protocols.Protocol, e.g. protocols.constant(50e-6, 20)")
     if isinstance(params, Mapping) and not _nested(params):
+        _refuse_text_numbers(found, params)
         params = found.parameters(None, params)  # the model's keys over its defaults (its own reader and message)
     elif params is None or isinstance(params, (str, Path, Mapping)):
         params = found.parameters(params)
@@ -70,6 +71,22 @@ def run(
     from .run import finished
 
     return finished(found.run(params, protocol, rig, start=start, **settings), protocol)
+
+
+def _refuse_text_numbers(model: FrictionModel, mapping: Mapping[Any, Any]) -> None:
+    """Refuse a non-zero number written as text without a unit (``{"dc": "10"}``) for a key the model gives a
+    dimension, naming the key, before the model's own reader (a plug-in's may read it with ``to_si`` as SI): a number
+    (not text) is SI, as everywhere in the Python API."""
+    texts = {key: value for key, value in mapping.items() if isinstance(value, str)}
+    if not texts:
+        return
+    from ..units import require_unit
+    from .base import checked_dimensions
+
+    dimensions = checked_dimensions(model)
+    for key, value in texts.items():
+        if key in dimensions:
+            require_unit(value, dimensions[key], f"{key}=")
 
 
 def _nested(mapping: Mapping[Any, Any]) -> bool:
@@ -81,9 +98,20 @@ def _nested(mapping: Mapping[Any, Any]) -> bool:
 def _start(model: FrictionModel, start: Any) -> Any:
     """``start`` with a unit (``"300 Pa"``, a pint quantity) in SI of the model's ``start_dimension``; a word
     (``"steady"``), a number or None as given (the model judges them)."""
-    from ..units import is_quantity, si_argument
+    from ..errors import ParameterError
+    from ..units import example_value, is_quantity, quantity_noun, shorten, si_argument
 
     dimension = getattr(model, "start_dimension", None)
+    words = getattr(model, "start_words", None)
+    if isinstance(start, str) and start.strip().isalpha() and words is not None and start.strip() not in words:
+        # a word the model does not take, named as the argument is (the engine's own name, start_stress or
+        # start_velocity, is no argument of run(): round 30)
+        takes = f"one of {', '.join(words)}" if words else "no word"
+        value = f"{quantity_noun(dimension)}, e.g. {example_value(dimension)}, " if dimension else ""
+        raise ParameterError(
+            f"start: {shorten(start)} is no start of model {model.name}: it takes {takes}; expected {value}or None"
+            " for its own start"
+        )
     if dimension is None or not (is_quantity(start) or (isinstance(start, str) and not start.strip().isalpha())):
         return start
     return si_argument(start, dimension, "start")

@@ -36,7 +36,7 @@ class BondModel(FrictionModel):
         """A parameter set (name, TOML file, :class:`Parameters`, or a mapping of ``section.key`` values, nested
         sections or a whole exported set as a dict, over the default gelatin-glass) with ``overrides``;
         ``block.stiffness`` or ``block.effective_stiffness`` set the block's height."""
-        from ..units import to_si
+        from ..units import override_to_si
 
         if overrides is not None and not isinstance(overrides, Mapping):
             kind = type(overrides).__name__
@@ -52,7 +52,7 @@ class BondModel(FrictionModel):
             if len(given) > len(present):
                 key_dimension(next(k for k in given if k not in keys))  # the one-line error naming the key
             params = _parameter_set(tuple(float(given[k]) if k in given else None for k in keys))
-            return with_stiffness(params, {k: to_si(v, STIFFNESS_KEYS[k], k) for k, v in stiffness.items()})
+            return with_stiffness(params, {k: override_to_si(v, STIFFNESS_KEYS[k], k) for k, v in stiffness.items()})
         # load_parameters reads the stiffness keys itself and names the set after them ("modified: block.stiffness")
         return load_parameters(DEFAULT_SET if spec is None else spec, {**given, **stiffness})
 

@@ -11,6 +11,7 @@ import numpy as np
 from .. import regimes
 from ..errors import ParameterError
 from ..protocols import Protocol
+from ..units import shorten
 from .base import Boundary, Capabilities, FrictionModel, Rig
 from .run import Run, settled_mean
 
@@ -81,7 +82,7 @@ class RSFModel(FrictionModel):
         """:class:`stickslip.rsf.RSFParams` from ``spec`` (RSFParams, a mapping as in a TOML file, or None for
         the defaults) and ``overrides`` of :attr:`KEYS` and ``law`` (a name, or its index in :attr:`LAW_NAMES`)."""
         from ..rsf import RSFParams, rsf_params
-        from ..units import to_si
+        from ..units import override_to_si
 
         if overrides is not None and not isinstance(overrides, Mapping):
             raise ParameterError(f"overrides: expected a mapping {{key: value}}, got {type(overrides).__name__}")
@@ -101,10 +102,10 @@ class RSFModel(FrictionModel):
             if key == "law":
                 values["law"] = float(self._law_code(raw))
             elif key in self.KEYS:
-                values[key] = to_si(raw, self.KEYS[key], key)
+                values[key] = override_to_si(raw, self.KEYS[key], key, values.get(key))
             else:
                 expected = ", ".join((*self.KEYS, "law"))
-                raise ParameterError(f"--set {given}: unknown rate-and-state key; expected one of: {expected}")
+                raise ParameterError(f"unknown rate-and-state key {shorten(given)}; expected one of: {expected}")
         _refuse_unphysical(values, overrides)
         return rsf_params(
             values["a"],
@@ -132,7 +133,7 @@ class RSFModel(FrictionModel):
                 if others
                 else ""
             )
-            raise ParameterError(f"--set law={raw}: expected one of {', '.join(self.LAW_NAMES)}{beyond}")
+            raise ParameterError(f"law: expected one of {', '.join(self.LAW_NAMES)}{beyond}, got {shorten(raw)}")
         return self.LAW_NAMES.index(name)
 
     def values(self, params: Any) -> dict[str, float]:

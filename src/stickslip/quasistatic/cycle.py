@@ -17,7 +17,7 @@ import numpy as np
 
 from .. import regimes
 from ..columns import attribute_frame
-from ..errors import ModelError, ParameterError, RunFailed
+from ..errors import ModelError, ParameterError
 from ..parameters import Parameters
 from ..reprs import compact_repr, field_values
 from ..trace_columns import QUASI_STATIC
@@ -132,8 +132,9 @@ class Simulation:
 
 @dataclass(frozen=True)
 class SteadySliding(Simulation):
-    """A run on a steady curve that rises at every velocity: no Vc, so no stick and no cycle, only steady sliding
-    at V0 (``critical_velocity`` and ``critical_stress`` are NaN).  Its own type, so that what describes a
+    """A run on a steady curve without a minimum: no Vc, so no stick and no cycle, only steady sliding at V0 where
+    the curve rises there, else a failed run (status "failed", the start alone; ``critical_velocity`` and
+    ``critical_stress`` are NaN).  Its own type, so that what describes a
     cycle's start and critical point (the command line's record) is not printed; the figure draws no σc."""
 
 
@@ -502,12 +503,21 @@ def _without_critical_point(
     else:  # the puller stands still: nothing loads the block
         sigma, rising = 0.0, True
     if not rising:  # velocity-weakening at V0 with no minimum: neither steady sliding nor a cycle to follow
-        # valid parameters on which the quasi-static picture has no answer: a failed run (exit 3), not bad input
-        raise RunFailed(
+        # valid parameters on which the quasi-static picture has no answer: a failed run (exit 3), not bad input,
+        # returned with status "failed" and the words as the model's other stops are (it raised RunFailed before
+        # round 30), its trace the start alone (t = 0), where the model stops
+        message = (
             f"no answer from the quasi-static model: {cp.message}; steady sliding at V0 would be unstable, and a"
             " stick has no branch to jump onto, so neither steady sliding nor a stick-slip cycle exists here (the"
-            " time-dependent model, stickslip transient or --model transient, integrates Eq 1 without that picture)"
+            " time-dependent model, stickslip transient or --model transient, integrates Eq 1 without that picture);"
+            f" the model stops at t = 0 s of the {end:.6g} s asked for: what follows is not known"
         )
+        start = sigma if start_stress is None else float(start_stress)
+        trace = _Trace(start, params.block.effective_stiffness, v0, end)
+        at_rest = start_stress is not None  # a stick from the given stress; else steady sliding at V0, unstable
+        trace.add(*(np.array([x]) for x in (0.0, start, 0.0 if at_rest else v0, 0.0, 1.0 if at_rest else 0.0)),
+                  "stick" if at_rest else "steady")  # fmt: skip
+        return _failed_without_critical_point(params, trace.build(), message, v0, end, start, jump_curve)
     if start_stress is not None:
         # a stick from a given stress ends in a jump onto the curve's right branch, which starts at Vc
         raise ModelError(
@@ -542,6 +552,36 @@ def _without_critical_point(
         critical_stress=math.nan,
         stiffness=stiffness,
         parameters=params,
+    )
+
+
+def _failed_without_critical_point(
+    params: Parameters,
+    columns: dict[str, np.ndarray],
+    message: str,
+    v0: float,
+    end: float,
+    start: float,
+    jump_curve: str,
+) -> Simulation:
+    """The failed run of :func:`_without_critical_point` (status "failed", regime undetermined, no Vc)."""
+    sigma = float(columns["stress"][-1])
+    return SteadySliding(
+        **columns,
+        regime=regimes.Regime(regimes.UNDETERMINED, 0, math.nan, math.nan, sigma, sigma, message),
+        cycles=(),
+        final_stress=sigma,
+        final_velocity=float(columns["velocity"][-1]),
+        message=message,
+        pulling_velocity=v0,
+        duration=end,
+        start_stress=start,
+        jump_curve=jump_curve,
+        critical_velocity=math.nan,
+        critical_stress=math.nan,
+        stiffness=params.block.effective_stiffness,
+        parameters=params,
+        status="failed",
     )
 
 

@@ -235,6 +235,8 @@ def jump_velocity(params: Parameters, stress: float, curve: str = "aging") -> Ju
         stress = si_argument(stress, "stress", "stress")
         if isinstance(stress, bool) or not isinstance(stress, (int, float, np.floating)) or not math.isfinite(stress):
             raise ParameterError(f"stress: expected a finite number in Pa, got {stress!r}")
+        if stress < 0:  # a friction stress on the steady curve is >= 0 (a negative one was "below the branch")
+            raise ParameterError(f"stress: expected a stress >= 0 in Pa, got {float(stress)!r}")
     stress = float(stress)
     cp = require_critical_point(params)
     assert cp.velocity is not None

@@ -19,8 +19,8 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import ParameterError
-from ..units import shorten, to_si
+from ..errors import ParameterError, UnitError
+from ..units import DIMENSIONS, bare_number, quantity_noun, shorten, to_si
 from .laws import StateLaw, get_law
 
 __all__ = ["RSFParams", "StateVariable", "rsf_params"]
@@ -182,7 +182,7 @@ class RSFParams:
         for key in ("a", "mu0", "v_ref", "normal_stress", "mass", "regularized"):
             if key in mapping and not (key == "normal_stress" and mapping[key] is None):
                 value = mapping[key]
-                values[key] = to_si(value, dims[key], f"{source}: {key}") if key in dims else value
+                values[key] = _read(value, dims[key], f"{source}: {key}") if key in dims else value
         if mapping.get("cutoff") is not None:
             values["cutoff"] = _cutoff_from(mapping["cutoff"], f"{source}: cutoff")
         sigma = values.get("normal_stress")
@@ -215,17 +215,36 @@ def _states_from(items: Any, source: str) -> tuple[StateVariable, ...]:
             StateVariable(
                 law=item.get("law", "aging"),
                 b=to_si(item.get("b", 0.01), "dimensionless", f"{source}: states[{i}].b"),
-                dc=to_si(item.get("dc", 10e-6), "length", f"{source}: states[{i}].dc"),
+                dc=_read(item.get("dc", 10e-6), "length", f"{source}: states[{i}].dc"),
                 c=to_si(item.get("c", 0.0), "dimensionless", f"{source}: states[{i}].c"),
             )
         )
     return tuple(states)
 
 
+def _refuse_text_number(value: Any, dimension: str, name: str) -> None:
+    """``dc = "10"`` (a file's quoted value, or text in a Python mapping): a non-zero number written as text without
+    a unit is refused for a dimensional key, as the bond model's files and every argument of the Python API refuse
+    it (before round 30 ``stickslip.run("rsf", {"dc": "10"}, ...)`` ran with dc = 10 m); a number is SI."""
+    number = bare_number(value) if isinstance(value, str) else None
+    if dimension == "dimensionless" or number is None or number == 0 or not math.isfinite(number):
+        return
+    typed, si, key = value.strip(), DIMENSIONS[dimension][1], name.rpartition(".")[2].rpartition(" ")[2]
+    raise UnitError(
+        f"{name}: {shorten(typed)} is a number written as text without a unit; {quantity_noun(dimension)} needs one,"
+        f' e.g. {key} = "{typed} {si}" (or {key} = {typed}, a number, not text, for SI units, {si})'
+    )
+
+
+def _read(value: Any, dimension: str, name: str) -> float:
+    """A value of a rate-and-state mapping in SI (:func:`to_si`), a number written as text without a unit refused."""
+    _refuse_text_number(value, dimension, name)
+    return to_si(value, dimension, name)
+
+
 def _friction_units(value: Any, dimension: str, stress_dimension: str, sigma: float | None, name: str) -> float:
     """A value in friction units, or in stress units (Pa/m, Pa s/m) divided by the normal stress."""
-    from ..errors import UnitError
-
+    _refuse_text_number(value, dimension, name)
     try:
         return to_si(value, dimension, name)
     except UnitError:
@@ -252,7 +271,7 @@ def _cutoff_from(value: Any, name: str) -> tuple[float, float]:
         value = (keys["v1"], keys["v2"])
     if isinstance(value, (str, bytes)) or not isinstance(value, (list, tuple)) or len(value) != 2:
         raise ParameterError(f"{name}: expected v1 and v2 (velocities), got {shorten(value)}")
-    return to_si(value[0], "velocity", f"{name}.v1"), to_si(value[1], "velocity", f"{name}.v2")
+    return _read(value[0], "velocity", f"{name}.v1"), _read(value[1], "velocity", f"{name}.v2")
 
 
 def _toml_value(value: Any) -> str:

@@ -95,6 +95,12 @@ class RSFRun:
     #: integrated so)
     settled_mean_friction: float = math.nan
 
+    def __post_init__(self) -> None:
+        # a run the solver had nothing to say about carries the words its summary gives (its regime's evidence), as
+        # every other result's message does (round 30: RSFRun.message was always '' then)
+        if not self.message:
+            object.__setattr__(self, "message", _default_message(self.regime))
+
     @property
     def final_friction(self) -> float:
         return float(self.friction[-1])

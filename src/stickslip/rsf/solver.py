@@ -21,7 +21,7 @@ from .. import regimes
 from ..errors import ModelError, ParameterError, StickslipError
 from ..numerics.grid import sample_grid
 from ..protocols import Protocol
-from ..units import shorten, to_si
+from ..units import override_to_si, shorten, si_argument
 from .params import RSFParams
 from .results import RSFRun, Solution, assemble_run
 from .stability import jacobian_at
@@ -73,7 +73,9 @@ def simulate(
 
     ``start_velocity`` defaults to the first segment's velocity; ``every``
     samples the trace every ``every`` seconds from t = 0, and at the run's end
-    (the protocol's, or a blow-up's); ``times`` (sorted,
+    (the protocol's, or a blow-up's; a step longer than the run gives those two
+    rows, t = 0 and the end, where ``run_transient`` refuses it; a number or a
+    value with its unit, ``"0.5 s"``: text without a unit is refused); ``times`` (sorted,
     within the protocol) samples it at given times instead; neither changes
     the regime or the summary, which come from the solver's accepted steps.
     ``detect=False`` skips the regime detection (for fits, which call this
@@ -85,9 +87,8 @@ def simulate(
     if not isinstance(protocol, Protocol):
         raise ParameterError(f"protocol: expected a Protocol, got {type(protocol).__name__}")
     _check_tolerances(rtol, atol)
-    v_start = (
-        protocol.initial_velocity if start_velocity is None else to_si(start_velocity, "velocity", "start_velocity")
-    )
+    given = start_velocity
+    v_start = protocol.initial_velocity if given is None else override_to_si(given, "velocity", "start_velocity")
     if not (math.isfinite(v_start) and v_start > 0):
         raise ParameterError(
             f"start velocity: expected a positive velocity for the initial steady state, got {v_start:g} m/s"
@@ -390,16 +391,23 @@ def _grid(protocol: Protocol, every: float | None, times: Any) -> np.ndarray | N
         raise ParameterError("every/times: give one of them, not both")
     end = protocol.duration
     if every is not None:
-        every = to_si(every, "time", "every")
+        written = every
+        every = si_argument(every, "time", "every")  # text needs its unit ("5" is refused, as everywhere)
+        if isinstance(every, bool) or not isinstance(every, (int, float, np.floating, np.integer)):
+            raise ParameterError(f"every: expected a positive time step in s, got {shorten(written)}")
+        every = float(every)
         if not (math.isfinite(every) and every > 0):
-            raise ParameterError(f"every: expected a positive time step, got {every!r}")
+            shown = repr(written.strip()) if isinstance(written, str) else repr(every)
+            raise ParameterError(f"every: expected a positive time step, got {shown}")
         count = end / every * (1 + 1e-12) + 1  # a float: end / 5e-324 s is beyond any integer we would build
         if not count <= MAX_SAMPLES:  # each sample holds about 180 bytes in memory until the trace is written
             raise ParameterError(
                 f"every: {every:g} s gives {count:.3g} samples over {end:g} s; expected at most {MAX_SAMPLES:.0e}"
             )
         grid = sample_grid(every, end)
-        if grid[-1] < end:  # (a multiple within rounding of the end, or every beyond it): the end's row is at the end
+        # (a multiple within rounding of the end, or a step beyond it: then the run's two ends, t = 0 and its end,
+        # as the docstring says; tests/test_rsf_simulate_every.py and test_edges.py's --every 1e300 s hold it)
+        if grid[-1] < end:
             grid = np.append(grid[:-1] if grid.size > 1 else grid, end)
         return grid
     if times is None:

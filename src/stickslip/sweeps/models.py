@@ -72,7 +72,7 @@ class SweepModel:
         Keys the model's parameter values do not hold (e.g. the bond model's ``block.stiffness``, which sets
         the height) are kept as given, in SI, and applied again at each point, after the varied keys.
         """
-        from ..units import to_si
+        from ..units import override_to_si
 
         dimensions = self.dimensions()
         given = {ALIASES.get(k, k) if ALIASES.get(k, k) in dimensions else k: v for k, v in overrides.items()}
@@ -83,7 +83,7 @@ class SweepModel:
         built = self.model.parameters(base, inside) if inside else base
         fixed = self.model.values(built)
         for key, raw in apart.items():
-            fixed[key] = to_si(raw, dimensions[key], key)
+            fixed[key] = override_to_si(raw, dimensions[key], key)  # "400" refused: a unit, or a number (SI)
         return fixed, self.model.label(built)
 
     def check_keys(self, varied: tuple[str, ...], fixed: Mapping[str, float]) -> None:
