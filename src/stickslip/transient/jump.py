@@ -19,6 +19,7 @@ from typing import Any
 
 import numpy as np
 
+from ..display import velocity as show_velocity
 from . import kernel as K
 
 #: the kernel's step collapsed with the slider faster than this many times the protocol's fastest velocity: a
@@ -260,4 +261,83 @@ def creep_collapse(t: float, sigma: float, v: float, lumps: int) -> str:
         " cohorts there did not leave the slider a creeping balance: the block may let go here, from rest, and a"
         " block without mass cannot follow that (no finite slip velocity); give the block a mass (--mass, with"
         " --damping; docs/extensions.md section 4) to follow it; what follows is not known"
+    )
+
+
+#: under velocity control, a cohort whose hazard would leave it e^-INSTANT of its weight within the kernel's floor
+#: step (1e-15 of the time reached) dies at once: the clock cannot resolve its death (docs/transient.md section 24)
+INSTANT = 30.0
+
+
+@dataclass(frozen=True)
+class InstantDeaths:
+    """Cohorts that died at once under velocity control: the instant (s), the imposed velocity (m/s), how many, their
+    bonds' share of N0, the stress before and after (Pa), and the age of the oldest (s)."""
+
+    time: float
+    velocity: float
+    cohorts: int
+    broken_share: float
+    stress_before: float
+    stress_after: float
+    oldest: float
+
+
+def instant_deaths(
+    t: float, x: float, v: float, n: int, xb: np.ndarray, tb: np.ndarray, lw: np.ndarray, p: np.ndarray,
+    functions: dict[str, Any],
+) -> tuple[int, InstantDeaths, float, float] | None:  # fmt: skip
+    """Under velocity control (the slider at x moving at the imposed v), the cohorts that die within the kernel's
+    floor step, broken at once.
+
+    Eq 1 as printed erases the aging term at the velocity's pace: a velocity step from V to 3 V takes
+    t_a/tau_a (e^(-V/V_a) - e^(-3V/V_a)) off ln r at once, over 100 for the oldest bonds of a steady population whose
+    aging held them against the FENE force (tester Y's set 31: ln r from 16 to 139, 23 % of sigma on cohorts that
+    die within 1e-17 s).  Their stress falls in no time; a step of the kernel loses more than a fifth of sigma
+    however short (kernel.MAX_DROP) and collapsed to the floor.  Each cohort with ln r + ln(floor) >= ln INSTANT is
+    broken (its bonds keep e^-30 of their weight within the floor step, within the e^-30 that bounds the rest), the
+    survivors compacted in place (oldest first, as :func:`cascade` keeps them).  None where no cohort dies so (the
+    collapse is another: the caller says so in words); else (n, the record, the energy dissipated in J/m^2, the
+    largest surviving ln r)."""
+    if n <= 0:
+        return None
+    floor = 1e-15 * max(t, p[K.P_TAU])
+    alive = np.isfinite(lw[:n])
+    live = np.flatnonzero(alive)
+    if not live.size:
+        return None
+    hazard = _log_hazard(x - xb[live], t - tb[live], v, p)
+    dying = hazard + math.log(floor) >= math.log(INSTANT)
+    if not dying.any():
+        return None
+    sums = functions["_sums"]
+    n_before, sigma_before, _, bond_energy_before = sums(n, xb, lw, x, p)
+    dead = live[dying]
+    oldest = float(t - np.min(tb[dead]))
+    alive[dead] = False
+    keep = np.flatnonzero(alive)
+    m = keep.size
+    xb[:m], tb[:m], lw[:m] = xb[keep], tb[keep], lw[keep]
+    n_after, sigma_after, _, bond_energy_after = sums(m, xb, lw, x, p)
+    record = InstantDeaths(
+        time=t, velocity=v, cohorts=int(dead.size), broken_share=float((n_before - n_after) / p[K.P_N0]),
+        stress_before=float(sigma_before), stress_after=float(sigma_after), oldest=oldest,
+    )  # fmt: skip
+    rest = float(np.max(hazard[~dying])) if (~dying).any() else -math.inf
+    return m, record, float(bond_energy_before - bond_energy_after), rest
+
+
+def instant_note(deaths: list[InstantDeaths]) -> str:
+    """The cohorts that died at once under velocity control, in words for the run's message ('' if none)."""
+    if not deaths:
+        return ""
+    first = deaths[0]
+    share = sum(d.broken_share for d in deaths)
+    more = f" (and {len(deaths) - 1} more time(s) after it, {share:.3g} N0 in all)" if len(deaths) > 1 else ""
+    return (
+        f"; at t = {first.time:.6g} s, sliding at {show_velocity(first.velocity, 4)}, {first.cohorts} cohort(s) of"
+        f" bonds up to {first.oldest:.3g} s old ({first.broken_share:.3g} N0) died at once,"
+        f" σ {first.stress_before:.6g} → {first.stress_after:.6g} Pa{more}: Eq 1 erases the aging term at the"
+        " velocity's pace, and the aged bonds it held against their stretch died faster than the clock resolves"
+        " (docs/transient.md section 24)"
     )

@@ -684,6 +684,8 @@ class _Driver:
         docs/transient.md section 22; a creep that does not come back fails in its own words); False where the
         collapse is neither (the run then fails in words)."""
         state, pace = self.state, float(np.max(self.protocol.velocities))
+        if self.control == "velocity":
+            return self._instant_deaths()
         cascade = self.control == "block" and not self.inertial and math.isfinite(state.x)
         if not (cascade and math.isfinite(state.v)):
             return False
@@ -740,13 +742,46 @@ class _Driver:
             self.reducer.disturbed(state.t)
         return True
 
+    def _instant_deaths(self) -> bool:
+        """A collapsed step under velocity control: the cohorts that die within the kernel's floor step (a velocity
+        step erasing the aging term that held aged bonds against their stretch) broken at once (jump.instant_deaths,
+        docs/transient.md section 24); False where none does (the run then fails in words)."""
+        state = self.state
+        if not (math.isfinite(state.x) and math.isfinite(state.v)):
+            return False
+        found = jump.instant_deaths(
+            state.t, state.x, state.v, state.n, state.xb, state.tb, state.lw, self.p, self.functions
+        )
+        if found is None:
+            return False
+        state.n, deaths, dissipated, rest = found
+        acc = state.acc
+        acc[1] += deaths.broken_share * self.params.bonds.site_density
+        acc[3] += dissipated
+        _extremes_at(acc, state.t, deaths.stress_after)
+        acc[4] += 1.0  # a step, so that the step budget bounds a run that breaks cohorts so again and again
+        # the next step from the survivors' fastest death (the kernel's own control shortens it where needed)
+        floor = 1e-15 * max(state.t, self.params.bonds.bond_time)
+        state.h = min(max(math.exp(-min(rest, K.LOG_RATE_CAP)), 10.0 * floor), self.params.bonds.bond_time * 1e-3)
+        if not hasattr(self, "instant_deaths"):  # the message's note, with the deaths said once at its end
+            self.instant_deaths, self.note_before_deaths = [], self.note
+        self.instant_deaths.append(deaths)
+        self.note = self.note_before_deaths + jump.instant_note(self.instant_deaths)
+        if self.sampler is not None:  # no row holds the state after the deaths: the next row's, from this instant
+            self.sampler.jumps.append(state.t)
+        if self.reducer is not None:
+            self.reducer.disturbed(state.t)
+        return True
+
     def _check(self, count: int, collapsed: bool = False) -> None:
         """A state gone non-finite, or a step that collapsed to the kernel's floor and still failed, fails the run
         (SolverFailed, in words); a budget used up stops it (BudgetExhausted, with the run so far)."""
         state, duration = self.state, self.duration
         if collapsed or not all(math.isfinite(q) for q in (state.t, state.x, state.v, state.h)):
             pace = float(np.max(self.protocol.velocities))
-            rigid = _rigid_collapse(state, self.params, self.aging) if self.control == "velocity" else None
+            rigid = (
+                _rigid_collapse(state, self.params, self.aging, self.protocol) if self.control == "velocity" else None
+            )
             failed = SolverFailed(
                 _non_finite(state.t, self.out[:count], self.rows, pace, self.inertial, state.h, rigid)
             )
@@ -897,9 +932,16 @@ class _Repeater:
 RUNAWAY = 1e6
 
 
-def _rigid_collapse(state: _State, params: Parameters, aging: bool) -> str:
+def _rested(protocol: Protocol, born: float, t: float) -> float:
+    """The time (s) a bond born at ``born`` spent at rest (the protocol's holds, vp = 0) up to t."""
+    return float(sum(max(0.0, min(t1, t) - max(t0, born)) for t0, t1, vp in protocol.pieces() if vp == 0))
+
+
+def _rigid_collapse(state: _State, params: Parameters, aging: bool, protocol: Protocol | None = None) -> str:
     """Why the step collapses under velocity control (no block, nothing to run away), in words for
-    :func:`_non_finite`: the loaded cohort nearest the FENE wall, its age, and how fast it dies there.
+    :func:`_non_finite`: the loaded cohort nearest the FENE wall, its age, and how fast it dies there.  Its age is
+    said as what it was: time at rest (a hold of ``protocol``) or sliding (tester Y: a plain velocity step's bonds
+    were said "aged at rest (a hold)" where the protocol had no hold; such a step no longer collapses: section 24).
 
     A bond aged at rest for a time t_a is held by its aging term A = t_a/tau_a e^(-V/Va) until its force matches it,
     at 1 - (e/dl_m)^2 ~ c/A (c = lambda M dl_m/kT), and dies there within ~ c dl_m/(2 A^2 V): after a hold of 300 s
@@ -918,13 +960,17 @@ def _rigid_collapse(state: _State, params: Parameters, aging: bool) -> str:
 
     strength = float(aging_age(np.asarray(age), params)) / g.aging_time * math.exp(-v / g.aging_velocity)
     c = b.force_sensitivity * b.chain_stiffness * b.max_extension
+    rest = _rested(protocol, float(state.tb[i]), float(state.t)) if protocol is not None else 0.0
+    aged = f"aged at rest (a hold: {rest:.3g} s of it)" if rest > 0 else "aged while sliding (no hold)"
     words = (
-        f"bonds {age:.3g} s old, aged at rest (a hold), are held by their aging term (t_a/τa e^(-V/Va) ="
+        f"bonds {age:.3g} s old, {aged}, are held by their aging term (t_a/τa e^(-V/Va) ="
         f" {strength:.3g} in ln r) until their force matches it, at 1 − (e/Δl_m)² ≈ {c / strength:.2g},"
         " by the FENE wall"
     )
     if strength > c and v > 0:
         words += f", and die there within about {c * b.max_extension / (2.0 * strength**2 * v):.2g} s of their arrival"
+    if rest <= 0:
+        return f"{words}: faster than the solver can follow, below {clock}"
     return (
         f"{words}: faster than the solver can follow, below {clock}; a shorter hold stays within it (the"
         " gel's set at 100 µm/s: holds up to ~100 s)"
