@@ -620,18 +620,29 @@ def _period(
 ) -> tuple[float, float]:  # fmt: skip
     """(Mean of the last up to three intervals between the falls through mid-level, one per period; the last one).
 
-    A fall through the middle of the swing is steep, so its time is well defined; a flat peak's is not.
+    A fall through the middle of the swing is steep, so its time is well defined; a flat peak's is not.  Where the
+    last swings repeat (each fall's size within RATIO_TOLERANCE of the one before, as :func:`_verdict` judges a limit
+    cycle) the mean is over those settled swings only: a start-up swing, smaller, falls through its own mid-level at
+    another phase, and its interval (143.764 s against the cycle's 144.591 s) made the period 144.315 s until a
+    fourth settled swing pushed it out, so the period changed with the run's length.
     """
-    falls = []
+    falls, sizes = [], []
     for k in range(len(ext) - 1):
         if not is_max[k]:
             continue
         level = 0.5 * (placed[k][1] + placed[k + 1][1])
         falls.append(_crossing(t, y, ext[k], ext[k + 1], level, dense))
+        sizes.append(placed[k][1] - placed[k + 1][1])
     if len(falls) < 2:
         return math.nan, math.nan
-    intervals = np.diff(falls[-4:])
-    return float(np.mean(intervals)), float(intervals[-1])
+    settled = 1  # the trailing falls whose swings repeat, each the size of the one after it
+    while settled < len(falls):
+        before, after = sizes[-settled - 1], sizes[-settled]
+        if not (before > 0 and abs(after / before - 1) <= RATIO_TOLERANCE):
+            break
+        settled += 1
+    intervals = np.diff(falls[-min(settled, 4) :] if settled >= 3 else falls[-4:])
+    return float(np.mean(intervals)), float(np.diff(falls[-2:])[0])
 
 
 def _crossing(t: np.ndarray, y: np.ndarray, i: int, k: int, level: float, dense: Dense | None) -> float:

@@ -198,10 +198,30 @@ def compare_command(**options: Any) -> None:
         save_figure(figure_bond_and_rsf(panels, pair, rsf, _how(rsf.status)), options["output"])
         side = sidecar(options["output"])
         if side is not None:
-            write_text(side, json_text(summary) + "\n")
+            write_text(side, json_text(_parameters_document(rsf, step, summary)) + "\n")
     if failures:
         click.echo("stickslip: the rate-and-state side failed: " + failures[0], err=True)
         raise SystemExit(FAILED)
+
+
+def _parameters_document(rsf: Any, step: Any, summary: dict[str, Any]) -> dict[str, Any]:
+    """What ``-o NAME.png`` writes beside the figure, NAME.params.json: a parameter file every ``--params`` reads
+    (``run --model rsf``, ``rsf simulate``, ``params show``), as ``rsf simulate -o`` and ``rsf fit -o`` write it:
+    the RSF set standing for the bond model (``parameters``: a, b, Dc, mu0 at v_ref = --v0, the fitted rig
+    stiffness), the velocity step it was fitted to (``protocol``, ``start_velocity``: a rerun without a protocol
+    runs that step), then the comparison's report as before (status, failures, panels, ...).  Before, the file was
+    the report alone and ``run --model rsf --params`` refused it ("unknown key 'bond_model'")."""
+    from ..rsf.fit import PARAMETER_FILE_UNITS
+
+    report = {key: value for key, value in summary.items() if key != "units"}
+    document = {
+        "model": "rate-and-state spring-slider",
+        "parameters": rsf.params.to_dict(),
+        "start_velocity": step.initial_velocity,
+        "protocol": [{"velocity": s.velocity, "duration": s.duration} for s in step.segments],
+        **report,
+    }
+    return {**document, "units": json_units(json_safe(document), {**PARAMETER_FILE_UNITS, **_SET_UNITS})}
 
 
 def _bond_model_of(options: dict[str, Any]) -> str:

@@ -238,6 +238,13 @@ def transient_run(result: Any, protocol: Protocol | None = None, resolution: flo
         period = regime.period if regime.kind == regimes.OSCILLATION else NAN
         start = regimes.settled_window_start(max(begin, float(time[0])), float(time[-1]), period)
         summary["mean_stress"] = _mean_stress(result, start, float(time[-1]), protocol=protocol)
+    elif regime.kind == regimes.UNDETERMINED:
+        # settled into nothing (a run stopped or failed is undetermined too): the run's mean, as docs/models.md
+        # says, not the last whole cycle's of an earlier segment (a slide-hold-slide on a spring, held by the
+        # chains at its end, reported cycle 4's 364.267 Pa, which ended 133 s before the run, for the run's
+        # 422.449 Pa).  A run stuck for good after its slips keeps its last whole cycle's, with that cycle's
+        # stick time, sigma_s and jump (tests/test_transient_summary_consistency.py)
+        summary["mean_stress"] = summary["run_mean_stress"]
     states: dict[str, Any] = {}
     units: dict[str, str | None] = {}
     if getattr(result, "bonded_fraction", None) is not None:
