@@ -517,7 +517,8 @@ def _without_critical_point(
         at_rest = start_stress is not None  # a stick from the given stress; else steady sliding at V0, unstable
         trace.add(*(np.array([x]) for x in (0.0, start, 0.0 if at_rest else v0, 0.0, 1.0 if at_rest else 0.0)),
                   "stick" if at_rest else "steady")  # fmt: skip
-        return _failed_without_critical_point(params, trace.build(), message, v0, end, start, jump_curve)
+        columns = trace.build()
+        return _run_without_critical_point(params, columns, regimes.UNDETERMINED, message, v0, end, start, jump_curve)
     if start_stress is not None:
         # a stick from a given stress ends in a jump onto the curve's right branch, which starts at Vc
         raise ModelError(
@@ -537,38 +538,26 @@ def _without_critical_point(
     else:
         kind = regimes.STUCK
         message = f"the puller stands still and the block stays at rest, unloaded (σ = 0 Pa): {cp.message}"
-    return SteadySliding(
-        **columns,
-        regime=regimes.Regime(kind, 0, math.nan, math.nan, sigma, sigma, message),
-        cycles=(),
-        final_stress=sigma,
-        final_velocity=v0,
-        message=message,
-        pulling_velocity=v0,
-        duration=end,
-        start_stress=sigma,
-        jump_curve=jump_curve,
-        critical_velocity=math.nan,
-        critical_stress=math.nan,
-        stiffness=stiffness,
-        parameters=params,
-    )
+    return _run_without_critical_point(params, columns, kind, message, v0, end, sigma, jump_curve)
 
 
-def _failed_without_critical_point(
+def _run_without_critical_point(
     params: Parameters,
     columns: dict[str, np.ndarray],
+    kind: str,
     message: str,
     v0: float,
     end: float,
     start: float,
     jump_curve: str,
 ) -> Simulation:
-    """The failed run of :func:`_without_critical_point` (status "failed", regime undetermined, no Vc)."""
+    """A run of :func:`_without_critical_point` (no Vc): steady or stuck from the start, or, with ``kind``
+    undetermined, the failed run where the model has no answer (status "failed")."""
+    failed = kind == regimes.UNDETERMINED
     sigma = float(columns["stress"][-1])
     return SteadySliding(
         **columns,
-        regime=regimes.Regime(regimes.UNDETERMINED, 0, math.nan, math.nan, sigma, sigma, message),
+        regime=regimes.Regime(kind, 0, math.nan, math.nan, sigma, sigma, message),
         cycles=(),
         final_stress=sigma,
         final_velocity=float(columns["velocity"][-1]),
@@ -581,7 +570,7 @@ def _failed_without_critical_point(
         critical_stress=math.nan,
         stiffness=params.block.effective_stiffness,
         parameters=params,
-        status="failed",
+        status="failed" if failed else "ok",
     )
 
 
