@@ -215,6 +215,8 @@ def wall_lumps(
         e = x - xb[live]
         y = e / p[K.P_DLM]
         force = p[K.P_M] * e / (1.0 - y * y)
+        # log 0 = -inf for a cohort that carries no load (force <= 0) or no weight: it cannot be the largest loss,
+        # which argmax picks from the others, so -inf is the right answer there, not a hidden error
         with np.errstate(divide="ignore"):
             loss = np.log(weights[live] * np.maximum(force, 0.0)) + _log_hazard(e, t - tb[live], v, p)
         first = int(np.argmax(loss))
