@@ -50,14 +50,13 @@ def params():
 
 @pytest.fixture(scope="module")
 def comparisons(params):
+    from report_helpers import model_run
     from stickslip.report.comparisons import compare
-    from stickslip.report.computations import ModelRun, computed_values, run_steps
+    from stickslip.report.computations import computed_values
     from stickslip.report.errata import load_errata
     from stickslip.report.paper import resolve_errata
 
-    model = ModelRun(params)
-    for _name, step in run_steps():
-        step(model)
+    model = model_run(params)
     errata = load_errata()
     return compare(computed_values(model), resolve_errata({e.id: e.title for e in errata.entries}))
 

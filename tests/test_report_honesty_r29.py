@@ -48,12 +48,9 @@ def params():
 
 @pytest.fixture(scope="module")
 def run(params):
-    from stickslip.report.computations import ModelRun, run_steps
+    from report_helpers import model_run
 
-    model = ModelRun(params)
-    for _name, step in run_steps():
-        step(model)
-    return model
+    return model_run(params)
 
 
 @pytest.fixture(scope="module")
