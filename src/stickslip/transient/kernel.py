@@ -989,7 +989,8 @@ def _cohort_dissipation(trap, hh, w0, wn, r0, r1, g0, g1, f0, f1, v0, v1p, e0, u
 
 def _cohort_pass(  # type: ignore[no-untyped-def]
     n, t, t1, t0, hh, x, x1p, x_mid, v0, v1p, slope0, slope1, accel, xb, tb, lw, lw_new, rate0, w1, known,
-    predicted, cache, cached, clock_end, wall_load, split_floor, split_at, split_pieces, p,
+    predicted, cache, cached, clock_end, wall_load, old_walls_free, old_wall_count, split_floor, split_at, split_pieces,
+    p,
 ):  # fmt: skip
     """One pass over the cohorts: each one's log weight at the step's end (``lw_new``, ``w1``; its hazard there in
     ``rate0``, its force and stiffness at the predicted end in ``predicted``), and the sums over them:
@@ -997,8 +998,15 @@ def _cohort_pass(  # type: ignore[no-untyped-def]
     dissipated, sum r w f and the interface stiffness at both ends, the errors in stress and bonds, the step's
     stress loss's sensitivity to the slider's position and to the aging slope, bonds freed by the FENE wall, the
     stress dying at a hazard cliff of bonds born within and before this piece, the least extension left to the FENE
-    wall of a cohort carrying wall_load, and how many cohorts to cut ahead of their cliff (:func:`_split_plan`; their
-    indices and pieces in split_at and split_pieces; split_floor: the sawtooth allowed, inf: none cut))."""
+    wall of a cohort carrying wall_load, how many cohorts to cut ahead of their cliff (:func:`_split_plan`; their
+    indices and pieces in split_at and split_pieces; split_floor: the sawtooth allowed, inf: none cut), and the sites
+    freed at the wall within the step still vacant at its two Gauss points (:func:`_births` refills them)).
+
+    ``old_walls_free`` (velocity control): a cohort born before this piece that reaches the wall within the step is
+    dead at its end whichever way it died and nothing else depends on how, so its stress counts as a cliff of old
+    bonds (where the stress falls: the peak the trace must resolve), the sites it freed refill from its arrival,
+    and what that timing may miss, its bonds times min(1, h/tau), counts in N; such a cohort is landed on only where
+    it holds ``old_wall_count`` bonds or more (docs/transient.md section 25)."""
     m = p[P_M]
     dlm = p[P_DLM]
     beta = p[P_FORCE_SENS]
@@ -1021,6 +1029,9 @@ def _cohort_pass(  # type: ignore[no-untyped-def]
     cliff = 0.0  # stress dying at a hazard cliff steeper than the step (see _cohort_weight)
     cliff_old = 0.0  # the same for bonds born before this piece of the protocol
     wall_gap = np.inf  # the least extension left to the FENE wall of a cohort carrying wall_load or more towards it
+    refill_a = refill_b = 0.0  # sites freed at the wall by bonds born before this piece, vacant at the Gauss points
+    gauss_a = hh * (0.5 - GAUSS)
+    gauss_b = hh * (0.5 + GAUSS)
     n_split = 0
     for i in range(n):
         w0 = cache[0, i] if cached else math.exp(lw[i])
@@ -1044,10 +1055,20 @@ def _cohort_pass(  # type: ignore[no-untyped-def]
             known[0, i] = -1.0
             predicted[2, i] = np.nan
             broken += w0
-            walled += w0
             dissip += w0 * _chain_energy(e0, m, dlm)
-            err_s += w0 * abs(f0)
-            err_n += w0
+            if old_walls_free and tb[i] < t0:  # (see the docstring)
+                arrival = hh * min(max((dlm - abs(e0)) / max(abs(e1 - e0), 1e-300), 0.0), 1.0)
+                walled += w0 * math.exp(-(hh - arrival) / p[P_TAU])
+                if arrival < gauss_a:
+                    refill_a += w0 * math.exp(-(gauss_a - arrival) / p[P_TAU])
+                if arrival < gauss_b:
+                    refill_b += w0 * math.exp(-(gauss_b - arrival) / p[P_TAU])
+                cliff_old += w0 * abs(f0)
+                err_n += w0 * min(1.0, hh / p[P_TAU])
+            else:
+                walled += w0
+                err_s += w0 * abs(f0)
+                err_n += w0
             continue
         if saturating:  # the age the aging term sees, and its rate (at the start as the last row kept it)
             if cached:
@@ -1112,7 +1133,7 @@ def _cohort_pass(  # type: ignore[no-untyped-def]
         lw_new[i] = new
         w1[i] = wn
         rate0[i] = r1  # kept for the merging of quiet cohorts after the step
-        if e1 * v1p > 0.0 and wn * abs(f1) >= wall_load:
+        if e1 * v1p > 0.0 and (wn >= old_wall_count if old_walls_free and tb[i] < t0 else wn * abs(f1) >= wall_load):
             wall_gap = min(wall_gap, dlm - abs(e1))
         # a cohort whose hazard climbs fast against the time its cell takes to pass (a first look at one neighbour)
         if split_floor < np.inf and g1 > r1 * SPLIT_ALIVE:  # climbing, and short of its cliff (z > SPLIT_LATE)
@@ -1125,7 +1146,7 @@ def _cohort_pass(  # type: ignore[no-untyped-def]
                     n_split += 1
     return (
         nn0, s0, nn1, s1, loss0, loss1, dloss0, dloss1, broken, dissip, rate_s0, rate_s1, kint0, kint1, err_s, err_n,
-        sens_x, sens_a, walled, cliff, cliff_old, wall_gap, n_split,
+        sens_x, sens_a, walled, cliff, cliff_old, wall_gap, n_split, refill_a, refill_b,
     )  # fmt: skip
 
 
@@ -1189,13 +1210,14 @@ def _birth_point(  # type: ignore[no-untyped-def]
 
 
 def _birth_mass(  # type: ignore[no-untyped-def]
-    u, q0, hh, loss0, dloss0, l1, d1, r_birth, survival, energy, lumping, r_end, g_end, dec, c0, c1, c2, c3, p
+    u, q0, hh, loss0, dloss0, l1, d1, r_birth, survival, energy, lumping, r_end, g_end, dec, c0, c1, c2, c3, refill,
+    p,
 ):  # fmt: skip
     """The births of half the step at its Gauss point (:func:`_birth_point`), from the vacancy's relaxation from
     q0 with the breakage rate's Hermite cubic (l1, d1 at the end): (born, alive at the step's end, the energy of
     those that broke, the error of lumping them, their breakage rate at the end and its derivative)."""
     tau = p[P_TAU]
-    q = _vacancy_from(u, q0, tau, hh, loss0, dloss0, l1, d1, dec, c0, c1, c2, c3)
+    q = _vacancy_from(u, q0, tau, hh, loss0, dloss0, l1, d1, dec, c0, c1, c2, c3) + refill
     mass = 0.5 * hh * max(q, 0.0) / tau
     alive = mass * survival
     dissip = (mass - alive) * energy
@@ -1205,7 +1227,7 @@ def _birth_mass(  # type: ignore[no-untyped-def]
 
 def _births(  # type: ignore[no-untyped-def]
     n, t, hh, x, x1p, v0, v1p, accel, accel_now, jerk, slope1, nn0, nn1, loss0, dloss0, loss1, dloss1, inertial,
-    xb, tb, lw_new, w1, known, rate0, predicted, p,
+    xb, tb, lw_new, w1, known, rate0, predicted, refill_a, refill_b, p,
 ):  # fmt: skip
     """Births over the step, as two cohorts at the Gauss-Legendre points (fourth order in h): the vacancy
     Q = N0 - N relaxes at 1/tau and is refilled by breakage, a Hermite cubic over the step; the newborns' own
@@ -1237,7 +1259,7 @@ def _births(  # type: ignore[no-untyped-def]
         d1 = dloss1 + newborn_dloss + r_birth * q_end / tau
         mass, alive_a, dissip, lumped, loss_k, dloss_k = _birth_mass(
             u_a, q0, hh, loss0, dloss0, l1, d1, r_birth, surv_a, energy_a, lumping_a, r_a, g_a, dec_a, a0, a1, a2,
-            a3, p,
+            a3, refill_a, p,
         )  # fmt: skip
         born = mass
         born_alive = alive_a
@@ -1247,7 +1269,7 @@ def _births(  # type: ignore[no-untyped-def]
         newborn_dloss = dloss_k
         mass, alive_b, dissip, lumped, loss_k, dloss_k = _birth_mass(
             u_b, q0, hh, loss0, dloss0, l1, d1, r_birth, surv_b, energy_b, lumping_b, r_b, g_b, dec_b, b0, b1, b2,
-            b3, p,
+            b3, refill_b, p,
         )  # fmt: skip
         born += mass
         born_alive += alive_b
@@ -1639,6 +1661,8 @@ def advance(  # type: ignore[no-untyped-def]
     h_prev = 0.0
     s_floor = 1e-9 * p[P_M] * p[P_N0] * p[P_DLM]
     wall_load = np.inf  # no landing before the first step's stress is known
+    old_wall_count = np.inf
+    old_walls_free = block == 0  # (velocity control: :func:`_cohort_pass`)
     # cohorts cut ahead of a hazard cliff (:func:`_split`), under velocity control: none before the first step's
     # stress is known.  Not through the block: there the cohorts at the wall of a creeping block are too coarse for
     # the slider's balance itself (docs/transient.md section 17), which the cut moves (4 MPa/m: failed at 4.66 s
@@ -1681,16 +1705,17 @@ def advance(  # type: ignore[no-untyped-def]
         accel = (v1p - v0) / hh
         (
             nn0, s0, nn1, s1, loss0, loss1, dloss0, dloss1, broken, dissip, rate_s0, rate_s1, kint0, kint1, err_s,
-            err_n, sens_x, sens_a, walled, cliff, cliff_old, wall_gap, n_split,
+            err_n, sens_x, sens_a, walled, cliff, cliff_old, wall_gap, n_split, refill_a, refill_b,
         ) = _cohort_pass(
             n, t, t1, t0, hh, x, x1p, x_mid, v0, v1p, slope0, slope1, accel, xb, tb, lw, lw_new, rate0, w1, known,
-            predicted, cache, cached, clock_end, wall_load, split_floor, split_at, split_pieces, p,
+            predicted, cache, cached, clock_end, wall_load, old_walls_free, old_wall_count, split_floor, split_at,
+            split_pieces, p,
         )  # fmt: skip
         clock_end[0, n] = np.nan  # the newborns' clock is not computed by the pass
         clock_end[0, n + 1] = np.nan
         born, born_alive, newborn_loss, newborn_dissip, lump, e_nb, q0, dloss0, d1 = _births(
             n, t, hh, x, x1p, v0, v1p, accel, accel_now, jerk, slope1, nn0, nn1, loss0, dloss0, loss1, dloss1,
-            inertial, xb, tb, lw_new, w1, known, rate0, predicted, p,
+            inertial, xb, tb, lw_new, w1, known, rate0, predicted, refill_a, refill_b, p,
         )  # fmt: skip
         born, born_alive, newborn_dissip, err_n = _births_within_vacancy(
             n, hh, q0, loss0, dloss0, loss1, newborn_loss, d1, walled, nn1, born, born_alive, newborn_dissip, err_n,
@@ -1745,6 +1770,7 @@ def advance(  # type: ignore[no-untyped-def]
             # three times on average, re-sliding after a hold, where aged bonds die at the wall one after another)
             h = min(h, p[P_WALL_LANDING] * wall_gap / abs(v1))
         wall_load = WALL_SHARE * rtol * max(abs(s1), s_floor)
+        old_wall_count = WALL_SHARE * rtol * p[P_N0]
         if splitting:
             split_floor = SPLIT_SHARE * rtol * max(abs(s1), s_floor)
         record = n_samples == 0
