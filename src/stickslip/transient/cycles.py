@@ -343,6 +343,7 @@ def judge(
     lowest: np.ndarray | None = None,
     between: Between | None = None,
     steady: SteadyReference | None = None,
+    since_slip: np.ndarray | None = None,
 ) -> tuple[str, str, regimes.Regime | None]:
     """(regime, message, evidence) of the last protocol segment, by :func:`stickslip.regimes.classify` on the
     stress.
@@ -359,7 +360,8 @@ def judge(
     amplitude ratio, period, extremes), None when the run stopped.  ``between``: each row's extremes of the
     solver's states since the row before, which the classifier reads with the rows (:func:`with_extremes`).
     ``steady``: the steady state at the last segment's pace, against which a run whose stick chains' last event is
-    a slip is found settled after it (:func:`settled_after_slip`).
+    a slip is found settled after it (:func:`settled_after_slip`), on ``since_slip`` where given: the solver's
+    rows (:data:`Between`'s columns 14-18) from the last slip on, which a sampler keeps whatever ``every`` wrote.
     """
     if stop is not None:
         return regimes.UNDETERMINED, stop, None
@@ -375,7 +377,9 @@ def judge(
     settle = SETTLED * max(abs(float(stress[-1])), 1e-3 * scale, 1e-300)
     found = _from_events(events, start, time, stress, lowest, between, resolution)
     if found is not None and found.kind in (regimes.UNDETERMINED, regimes.DECAYING) and steady is not None:
-        settled = settled_after_slip(events, start, time, stress, velocity, between, resolution, steady)
+        settled = settled_after_slip(
+            events, start, time, stress, velocity, between, resolution, steady, since_slip=since_slip
+        )
         if isinstance(settled, regimes.Regime):  # no stick since its last slip, and at the steady state long enough
             return settled.kind, settled.evidence, settled
         if settled is not None:  # sliding since its last slip, not (yet) settled: say how far from it
@@ -504,6 +508,7 @@ def settled_after_slip(
     between: Between | None,
     resolution: float | None,
     steady: SteadyReference,
+    since_slip: np.ndarray | None = None,
 ) -> regimes.Regime | str | None:
     """Steady sliding after the stick chains' last slip (a start-up stick-slip from rest, above Vc), judged from
     the solution; where it is not (yet), why not in words; None where the last event is no slip.
@@ -529,7 +534,17 @@ def settled_after_slip(
     before only by their extremes, so the last state off the band is known only to lie between such an extreme
     and the next row; the words say so, with the end from which these rows read steady (that row + the stretch)
     and the earliest from which rows finer could (the extreme + the stretch).  Where steady sliding at Vp is
-    unstable for the block (``steady.instability``), the words say the slide will not settle onto it."""
+    unstable for the block (``steady.instability``), the words say the slide will not settle onto it.
+
+    ``since_slip``: where the rows were sampled, the solver's own rows from the last slip on (trace columns, the
+    sampler's :meth:`~stickslip.transient.sampling.Sampler.since_last_slip`): judged on them, the verdict and its
+    words are the unsampled run's, whatever ``every`` (the stress's peak and trough over the segment stay the
+    sampled trace's, which carries every extreme)."""
+    window = (time, stress, between)
+    if since_slip is not None and since_slip.shape[0] >= 2:
+        time, stress, velocity = since_slip[:, 0], since_slip[:, 1], since_slip[:, 3]
+        between = Between(*(since_slip[:, k] for k in range(14, 19)))
+        steady = dataclasses.replace(steady, every=None)
     marks = [(kind, float(t), float(s)) for kind, t, s, _ in events if kind in ("stick", "slip") and t >= start]
     slips = [k for k, mark in enumerate(marks) if mark[0] == "slip"]
     vp = steady.velocity
@@ -584,7 +599,7 @@ def settled_after_slip(
         f" the block's decay along the steady curve |dσ/dV|/K = {steady.block_decay:.3g} s, the bonds' memory"
         f" dl_m/V = {steady.memory:.3g} s)"
     )
-    peak, trough = window_extremes(time, stress, between, start)
+    peak, trough = window_extremes(*window, start)
     return regimes.Regime(regimes.STEADY, 0, math.nan, math.nan, peak, trough, words)
 
 

@@ -42,6 +42,9 @@ BATCH = 20_000
 #: a rate read from the rows takes up to this many rows on each side of the interval (the polynomial through six
 #: rows: its rates within O(h^5), the cubic Hermite with them then within about h^4 max|f^(4)|/384)
 NEIGHBOURS = 2
+#: the most rows a sampler keeps since the last slip (:meth:`Sampler.since_last_slip`, what the verdict on a slide
+#: settling after it reads: cycles.settled_after_slip); beyond them the verdict reads the sampled rows
+TAIL_ROWS = 500_000
 
 
 class Sampler:
@@ -89,6 +92,9 @@ class Sampler:
         self.pending = np.array(NONE_SEEN)  # extremes of the rows fed after the last row written
         self.out: list[np.ndarray] = []
         self.last_written = -np.inf
+        # every row since the last slip, as the unsampled trace has them (None: more than TAIL_ROWS)
+        self.tail: list[np.ndarray] | None = []
+        self.tail_from = -np.inf
 
     def feed(self, fine: np.ndarray, instants: np.ndarray | None = None) -> None:
         """Rows in time order after those fed before; ``instants``: times at which the row itself is kept (the
@@ -147,12 +153,35 @@ class Sampler:
         # of rows at one instant the trace keeps the first (solver._finish): the others close no extreme
         previous = np.r_[-np.inf if self.anchor is None else self.anchor[TIME], fine[:-1, TIME]]
         self._close(fine[fine[:, TIME] > previous], wanted, rows)
+        self._keep_since_slip(fine[fine[:, TIME] > previous])
         if wanted.size:
             self.out.append(rows)
             self.last_written = float(wanted[-1])
         chain = every[: offset + fine.shape[0]]
         self.before = chain[-1 - NEIGHBOURS : -1].copy()
         self.anchor = chain[-1].copy()
+
+    def since_last_slip(self) -> np.ndarray | None:
+        """Every row from the last slip on (the first at each instant, the stress's peaks between them located), as
+        the unsampled trace holds them: a slide's settling after its last slip is judged on these, so that ``every``
+        cannot move the verdict (cycles.settled_after_slip); None where no slip was given or they were too many."""
+        if not self.tail:
+            return None
+        return np.vstack(self.tail)
+
+    def _keep_since_slip(self, rows: np.ndarray) -> None:
+        if self.tail is None or not self.slips.size:
+            return
+        last = float(self.slips[-1])
+        if last > self.tail_from:  # a later slip: the rows before it are no longer needed
+            kept = np.vstack(self.tail) if self.tail else np.empty((0, rows.shape[1]))
+            self.tail = [kept[kept[:, TIME] >= last]]
+            self.tail_from = last
+        rows = rows[rows[:, TIME] >= last]
+        if rows.size:
+            self.tail.append(rows.copy())
+        if sum(len(r) for r in self.tail) > TAIL_ROWS:
+            self.tail = None
 
     def _values(self, every: np.ndarray, wanted: np.ndarray) -> np.ndarray:
         """The state at each wanted instant: the last row at it, else the interpolant between its two rows."""

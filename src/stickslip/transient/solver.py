@@ -1529,6 +1529,7 @@ def _finish(d: _Driver, snapshots: list[Snapshot], stop: str | None, note: str) 
     regime, message, evidence = judge(
         time, sigma, v, protocol, cycles, events, control, stop, resolution=d.rtol, lowest=table[:, 14],
         between=between, steady=_steady_reference(d) if stop is None else None,
+        since_slip=d.sampler.since_last_slip() if d.sampler is not None else None,
     )  # fmt: skip
     regime, message = _chains_ahead(d, regime, message, time, sigma)
     message = message + note
