@@ -1066,24 +1066,10 @@ def _adequate_or_searched(
     # where a fit of 4.7 % without a minimum in the data existed (round 30); the better of the two is kept
     if first.model.p_value > SEARCH_P:
         return progress, keys, first, check
-    joint_keys = identify.select_identifiable(check.requested, aging=True).free
-    found = global_start(check.base, check.base, joint_keys, everything)
-    # polished without the fix-and-refit loop: the model's best, even where the data leave a direction open
-    polished = _joint_refit(check, found.params, joint_keys, everything)
-    polished_fit = _misfit_of(check, polished, everything, len(joint_keys))
+    searched, again, again_keys, again_fit, polished_fit, evaluations = _searched_refit(check, blocks)
     best_model = polished_fit if polished_fit.chi_square < first.model.chi_square else first.model
-    again, again_keys = _run_method(check, blocks, start=polished)
-    again_fit = _misfit_of(check, again.params, everything, len(again_keys))
-    if again_fit.chi_square > LOST_OPTIMUM * polished_fit.chi_square:
-        # the keys the data do not determine, put back at their input values, lost the search's minimum (8 points
-        # falling steeply: 3.3 % at the search's best, 18.8 % with λ, τa and Va back at the input; round 30):
-        # held at the search's values instead, where the method's fit can keep it
-        moved = dataclasses.replace(check, base=polished, held="the global search's best value")
-        held, held_keys = _run_method(moved, blocks, start=polished)
-        held_fit = _misfit_of(moved, held.params, everything, len(held_keys))
-        if held_fit.chi_square < again_fit.chi_square:
-            check, again, again_keys, again_fit = moved, held, held_keys, held_fit
     if again_fit.chi_square < first.method_fit.chi_square:
+        check = searched
         progress, keys, own = again, again_keys, again_fit
     else:
         own = first.method_fit
@@ -1097,10 +1083,35 @@ def _adequate_or_searched(
         why = "more than the scatter of the repeated measurements explains"
     progress.messages.append(
         f"the least-squares fit from the input values left an rms misfit of {before:.3g} %, {why}, so the whole"
-        f" search box was scanned ({found.evaluations} trial parameter sets) and the fit restarted from the best"
+        f" search box was scanned ({evaluations} trial parameter sets) and the fit restarted from the best"
         f" point: rms misfit now {after:.3g} %"
     )
-    return progress, keys, _Adequacy(best_model, own, check.method, found.evaluations), check
+    return progress, keys, _Adequacy(best_model, own, check.method, evaluations), check
+
+
+def _searched_refit(
+    check: _Check, blocks: tuple[Block, Block, Block]
+) -> tuple[_Check, _Progress, list[str], Misfit, Misfit, int]:
+    """The method's fit restarted from the best point of a scan of the whole search box: (the check it was made
+    with, its progress, its free keys, its misfit, the misfit at the polished search point, the trial sets)."""
+    everything = blocks[0]
+    joint_keys = identify.select_identifiable(check.requested, aging=True).free
+    found = global_start(check.base, check.base, joint_keys, everything)
+    # polished without the fix-and-refit loop: the model's best, even where the data leave a direction open
+    polished = _joint_refit(check, found.params, joint_keys, everything)
+    polished_fit = _misfit_of(check, polished, everything, len(joint_keys))
+    again, again_keys = _run_method(check, blocks, start=polished)
+    again_fit = _misfit_of(check, again.params, everything, len(again_keys))
+    if again_fit.chi_square > LOST_OPTIMUM * polished_fit.chi_square:
+        # the keys the data do not determine, put back at their input values, lost the search's minimum (8 points
+        # falling steeply: 3.3 % at the search's best, 18.8 % with λ, τa and Va back at the input; round 30):
+        # held at the search's values instead, where the method's fit can keep it
+        moved = dataclasses.replace(check, base=polished, held="the global search's best value")
+        held, held_keys = _run_method(moved, blocks, start=polished)
+        held_fit = _misfit_of(moved, held.params, everything, len(held_keys))
+        if held_fit.chi_square < again_fit.chi_square:
+            check, again, again_keys, again_fit = moved, held, held_keys, held_fit
+    return check, again, again_keys, again_fit, polished_fit, found.evaluations
 
 
 def _trend_note(check: _Check, dependence: Dependence) -> str:
@@ -1137,6 +1148,21 @@ def _fit_of_a_flat_looking_curve(
     # parameters: p = 0.014 for a curve varying by a factor 25 with 2 % noise); the scatter of the fit's residuals
     # between neighbours has ~(n - 2)/1.9 whatever k, and with stated errors it agrees with, the errors themselves
     against, noise = fitted_dependence(data.velocity, data.stress, data.stress_err, model)
+    if min(nested, against) >= 1.0:
+        # no closer to the data than a constant: a fit from the input values that stopped in a minimum of its own
+        # (seven points of a U, 500 -> 300 -> 800 Pa: "no closer than the constant" where the model's curve has a
+        # minimum; round 31); the whole search box is scanned and the better fit kept, as where a fit misses
+        try:
+            _, again, again_keys, again_fit, _, _ = _searched_refit(check, blocks)
+        except (ModelError, ParameterError):
+            again_fit = None
+        if (
+            again_fit is not None
+            and again_fit.chi_square < _misfit_of(check, progress.params, blocks[0], len(keys)).chi_square
+        ):
+            progress, keys, model = again, again_keys, blocks[0].model(again.params)
+            nested = model_dependence(data.stress, data.stress_err, model, len(keys))
+            against, noise = fitted_dependence(data.velocity, data.stress, data.stress_err, model)
     p = min(nested, against)
     outliers = left_out = ""
     if p > SIGNIFICANCE:
