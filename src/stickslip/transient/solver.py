@@ -568,14 +568,17 @@ class _Driver:
         sigma_s = k_block * (state.puller - state.x)
         from ..quasistatic.jump import jump_velocity
 
-        landing = jump_velocity(params, sigma_s, "aging" if self.aging else "no-aging")
-        vs = landing.velocity if landing.reachable else None
+        where = "beyond the steady curve's reach"
+        try:
+            landing = jump_velocity(params, sigma_s, "aging" if self.aging else "no-aging")
+        except ModelError as exc:  # no critical point: nothing for the jump to land beyond (words, not a traceback)
+            landing, where = None, f"and {str(exc).removeprefix('no stick-slip cycle: ')}"
+        vs = landing.velocity if landing is not None and landing.reachable else None
         if vs is None:
             self.events.append(("unreachable", state.t, sigma_s, 0.0))
-            return self._finish(stop=f"the chains collapse at σs = {sigma_s:.6g} Pa, beyond the steady curve's"
-                                " reach: the paper's jump has no landing point; the model stops at t ="
-                                f" {state.t:.6g} s of the {self.duration:.6g} s asked for: what follows is not"
-                                " known")  # fmt: skip
+            return self._finish(stop=f"the chains collapse at σs = {sigma_s:.6g} Pa, {where}: the paper's jump has"
+                                f" no landing point; the model stops at t = {state.t:.6g} s of the"
+                                f" {self.duration:.6g} s asked for: what follows is not known")  # fmt: skip
         self._jump_to_steady(sigma_s, vs, vp)
         return None
 
@@ -2634,9 +2637,12 @@ def _chains_let_go(params: Parameters, vp: float, aging: bool, k_block: float) -
         first = stick_time(scaled, vp, 0.0, aging=aging)
         if first is None or not first[0]:
             return math.inf, math.inf, True
-        landing = jump_velocity(params, first[1], "aging" if aging else "no-aging")
     except (ModelError, ParameterError):
         return 0.0, 0.0, True  # not known: counted as sliding from the start, as before
+    try:
+        landing = jump_velocity(params, first[1], "aging" if aging else "no-aging")
+    except (ModelError, ParameterError):  # no critical point to land beyond: the solver stops at the collapse
+        return float(first[0]), float(first[1]), False
     return float(first[0]), float(first[1]), bool(landing.reachable and landing.velocity is not None)
 
 
