@@ -21,6 +21,7 @@ import numpy as np
 import pytest
 
 import stickslip
+from cli_helpers import ctrl_c_as_at_a_terminal
 from stickslip import Rig, protocols
 from stickslip.models import Capabilities, FrictionModel, Run
 from stickslip.models.run import TRACE_TOLERANCE, finished
@@ -232,7 +233,7 @@ def test_a_stopped_sweep_says_what_it_kept_and_resumes_without_a_traceback(tmp_p
                "--duration", "1 s", "-o", str(out), "--workers", "1", "--batch-size", "4"]  # fmt: skip
     env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(tmp_path), os.environ.get("PYTHONPATH", "")])}
     stopped = subprocess.Popen(command, cwd=tmp_path, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                               start_new_session=True)  # fmt: skip
+                               start_new_session=True, preexec_fn=ctrl_c_as_at_a_terminal)  # fmt: skip
     try:
         deadline = time.monotonic() + 60
         while len(_chunks(out)) < 2 and stopped.poll() is None and time.monotonic() < deadline:

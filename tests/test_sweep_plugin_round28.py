@@ -18,6 +18,7 @@ import numpy as np
 import pytest
 
 # ------------------------------------------------------------------------------ S1: a Ctrl-C lost in a gc callback
+from cli_helpers import ctrl_c_as_at_a_terminal
 from test_plugin_and_sweep_round27 import NAP_MODEL
 
 # what distributed's GCDiagnosis._gc_callback does to a Ctrl-C, made certain: once two chunks are written, the first
@@ -66,7 +67,7 @@ def test_a_ctrl_c_handled_inside_a_gc_callback_still_stops_the_sweep(tmp_path):
     env = {**os.environ, "TRAP_FOLDER": str(out), "TRAP_MARKER": str(marker),
            "PYTHONPATH": os.pathsep.join([str(tmp_path), os.environ.get("PYTHONPATH", "")])}  # fmt: skip
     stopped = subprocess.Popen(command, cwd=tmp_path, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                               start_new_session=True)  # fmt: skip
+                               start_new_session=True, preexec_fn=ctrl_c_as_at_a_terminal)  # fmt: skip
     try:
         deadline = time.monotonic() + 60
         while not marker.exists() and stopped.poll() is None and time.monotonic() < deadline:
