@@ -94,6 +94,7 @@ class Sampler:
         self.last_written = -np.inf
         # every row since the last slip, as the unsampled trace has them (None: more than TAIL_ROWS)
         self.tail: list[np.ndarray] | None = []
+        self.tail_rows = 0
         self.tail_from = -np.inf
 
     def feed(self, fine: np.ndarray, instants: np.ndarray | None = None) -> None:
@@ -152,8 +153,9 @@ class Sampler:
         rows = self._values(every, wanted)
         # of rows at one instant the trace keeps the first (solver._finish): the others close no extreme
         previous = np.r_[-np.inf if self.anchor is None else self.anchor[TIME], fine[:-1, TIME]]
-        self._close(fine[fine[:, TIME] > previous], wanted, rows)
-        self._keep_since_slip(fine[fine[:, TIME] > previous])
+        first = fine[fine[:, TIME] > previous]
+        self._close(first, wanted, rows)
+        self._keep_since_slip(first)
         if wanted.size:
             self.out.append(rows)
             self.last_written = float(wanted[-1])
@@ -176,11 +178,12 @@ class Sampler:
         if last > self.tail_from:  # a later slip: the rows before it are no longer needed
             kept = np.vstack(self.tail) if self.tail else np.empty((0, rows.shape[1]))
             self.tail = [kept[kept[:, TIME] >= last]]
-            self.tail_from = last
+            self.tail_rows, self.tail_from = len(self.tail[0]), last
         rows = rows[rows[:, TIME] >= last]
         if rows.size:
             self.tail.append(rows.copy())
-        if sum(len(r) for r in self.tail) > TAIL_ROWS:
+            self.tail_rows += len(rows)
+        if self.tail_rows > TAIL_ROWS:
             self.tail = None
 
     def _values(self, every: np.ndarray, wanted: np.ndarray) -> np.ndarray:
