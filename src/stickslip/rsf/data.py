@@ -326,20 +326,28 @@ FRICTION_RANGE = (1e-3, 10.0)
 NORMAL_STRESS_AGREEMENT = 0.05
 
 
+def _unit_among(header: str, kinds: tuple[str, ...], path: Path) -> tuple[Any, str]:
+    """(what :func:`_header_unit` found, its kind) for the first of ``kinds`` the header's unit is of: the first
+    kind also takes a bare header (None found), a later one only a unit it names.  Else the first kind's DataError
+    (naming the column)."""
+    refused: DataError | None = None
+    for k, kind in enumerate(kinds):
+        try:
+            found = _header_unit(header, kind, path)
+        except DataError as exc:
+            refused = refused or exc
+            continue
+        if found is not None or k == 0:
+            return found, kind
+    assert refused is not None  # the first kind either returned or refused
+    raise refused
+
+
 def _load_unit(header: str, path: Path) -> tuple[float, str, str]:
     """(SI factor, unit, "stress" or "force") of a shear- or normal-load column's header: a stress unit, a force
     unit, or none (a bare header: Pa).  A unit of another kind is refused (DataError naming the column)."""
-    try:
-        found = _header_unit(header, "stress", path)
-    except DataError as refused:
-        try:
-            force = _header_unit(header, "force", path)
-        except DataError:
-            force = None
-        if force is None:
-            raise refused from None
-        return force[0], force[1], "force"
-    return (found[0], found[1], "stress") if found is not None else (1.0, "Pa", "stress")
+    found, kind = _unit_among(header, ("stress", "force"), path)
+    return (found[0], found[1], kind) if found is not None else (1.0, "Pa", "stress")
 
 
 def _friction(
@@ -359,17 +367,11 @@ def _friction(
     if by_stress:
         shear = _load_unit(header, path)
     else:
-        try:
-            _header_unit(header, "dimensionless", path)
+        # a stress unit ("Shear stress [kPa]" mapped as friction) is a shear stress
+        found, kind = _unit_among(header, ("dimensionless", "stress"), path)
+        if kind == "dimensionless":
             return data["friction"], []
-        except DataError as refused:  # a stress unit ("Shear stress [kPa]" mapped as friction) is a shear stress
-            try:
-                stress = _header_unit(header, "stress", path)
-            except DataError:
-                stress = None
-            if stress is None:
-                raise refused from None
-            shear = (stress[0], stress[1], "stress")
+        shear = (found[0], found[1], "stress")
     tau = data["friction"] * shear[0]
     bare = [header] if not _header_names_unit(header) else []
     if "normal_stress" in chosen:
