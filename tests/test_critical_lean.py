@@ -50,10 +50,10 @@ def test_a_refinement_solves_each_point_once(monkeypatch):
     seen: list[float] = []
     real = critical._curve
 
-    def counting(params, velocity, aging):
+    def counting(params, velocity, aging, compiled=False):
         if np.ndim(velocity) == 0:
             seen.append(float(velocity))
-        return real(params, velocity, aging)
+        return real(params, velocity, aging, compiled)
 
     monkeypatch.setattr(critical, "_curve", counting)
     _forget()
@@ -75,9 +75,9 @@ def test_the_whole_point_after_vc_alone_solves_nothing_twice(monkeypatch):
     calls: list[float] = []
     real = critical._curve
 
-    def counting(params, velocity, aging):
+    def counting(params, velocity, aging, compiled=False):
         calls.append(np.size(velocity))
-        return real(params, velocity, aging)
+        return real(params, velocity, aging, compiled)
 
     monkeypatch.setattr(critical, "_curve", counting)
     params = OTHERS[1]

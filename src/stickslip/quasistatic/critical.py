@@ -80,9 +80,18 @@ NOISE = 1e-9
 MAX_EXTREMA = 8
 
 
-def _curve(params: Parameters, velocity: np.ndarray | float, aging: bool) -> tuple[np.ndarray, np.ndarray]:
-    """(sigma, V dsigma/dV) with the accurate quadrature: the same function on the grid and in the root search."""
-    state = steady_state(params, np.atleast_1d(velocity), aging=aging, quadrature=ACCURATE_QUADRATURE)
+def _curve(
+    params: Parameters, velocity: np.ndarray | float, aging: bool, compiled: bool = False
+) -> tuple[np.ndarray, np.ndarray]:
+    """(sigma, V dsigma/dV) with the accurate quadrature: the same function on the grid and in the root search
+    (its march compiled at every width where ``compiled``)."""
+    state = steady_state(
+        params,
+        np.atleast_1d(velocity),
+        aging=aging,
+        quadrature=ACCURATE_QUADRATURE,
+        compiled_from=1 if compiled else None,
+    )
     stress, log_slope = state.stress, state.stress_slope * state.velocity
     if not (np.all(np.isfinite(stress)) and np.all(np.isfinite(log_slope))):
         raise ModelError(
@@ -100,7 +109,7 @@ def _significant_signs(stress: np.ndarray, log_slope: np.ndarray) -> np.ndarray:
 
 
 @lru_cache(maxsize=128)
-def _refine(params: Parameters, aging: bool, lo: float, hi: float) -> tuple[float, float]:
+def _refine(params: Parameters, aging: bool, lo: float, hi: float, compiled: bool = False) -> tuple[float, float]:
     """(ln V, sigma) at the zero of V dsigma/dV between ln V = lo and hi (Brent), or at the better end if the signs
     disagree.  Each point is evaluated once: Brent asks for the ends again, and the root it returns is one of its
     points (a third of the scalar steady states of a search saved, the same numbers).  Remembered, as
@@ -110,7 +119,7 @@ def _refine(params: Parameters, aging: bool, lo: float, hi: float) -> tuple[floa
 
     def at(log_v: float) -> tuple[float, float]:
         if log_v not in seen:
-            stress, log_slope = _curve(params, math.exp(log_v), aging)
+            stress, log_slope = _curve(params, math.exp(log_v), aging, compiled)
             seen[log_v] = (float(stress[0]), float(log_slope[0]))
         return seen[log_v]
 
@@ -130,7 +139,7 @@ def _refine(params: Parameters, aging: bool, lo: float, hi: float) -> tuple[floa
 
 
 def find_extrema(
-    params: Parameters, aging: bool, search_range: tuple[float, float] = SEARCH_RANGE
+    params: Parameters, aging: bool, search_range: tuple[float, float] = SEARCH_RANGE, *, compiled: bool = False
 ) -> tuple[Extremum, ...]:
     """Every local extremum of sigma(V) in ``search_range`` that the converged curve resolves, lowest first.
 
@@ -139,35 +148,46 @@ def find_extrema(
     function, and kept only if the stress there is below (minimum) or above
     (maximum) both ends of its bracket by more than NOISE: a verified
     extremum of the converged curve, not a flicker of quadrature noise.
+
+    ``compiled`` runs every steady state of the search on the compiled march (numba), ~15x cheaper a search
+    once numba is loaded; the extrema agree with the numpy march's to ~1e-13 (tests/test_critical_compiled.py).
+    For a caller that searches many curves in one process (a fit, a study); a single search stays on numpy,
+    which costs less than loading numba (docs/steady-state.md, "Wide batches run compiled").
     """
-    return tuple(_extrema(params, aging, search_range, ("minimum", "maximum")))
+    return tuple(_extrema(params, aging, search_range, ("minimum", "maximum"), compiled))
 
 
 def _extrema(
-    params: Parameters, aging: bool, search_range: tuple[float, float], kinds: tuple[str, ...]
+    params: Parameters,
+    aging: bool,
+    search_range: tuple[float, float],
+    kinds: tuple[str, ...],
+    compiled: bool = False,
 ) -> Iterator[Extremum]:
     """The verified extrema of :func:`find_extrema` of the ``kinds`` asked for, lowest velocity first, each
     refined only when asked for (a bracket refined costs ~10 scalar steady states, the grid one call)."""
     require_parameters(params)
-    grid, stress, sign = _grid_signs(params, aging, *search_range)
+    grid, stress, sign = _grid_signs(params, aging, *search_range, compiled)
     clear = np.nonzero(sign)[0]
     changes = [(a, b) for a, b in pairwise(clear) if sign[a] != sign[b]]
     for a, b in changes[:MAX_EXTREMA]:
         kind = "minimum" if sign[a] < 0 else "maximum"
         if kind not in kinds:
             continue
-        log_v, s = _refine(params, aging, math.log(grid[a]), math.log(grid[b]))
+        log_v, s = _refine(params, aging, math.log(grid[a]), math.log(grid[b]), compiled)
         depth = (min(stress[a], stress[b]) - s) if kind == "minimum" else (s - max(stress[a], stress[b]))
         if depth > NOISE * abs(s):
             yield Extremum(math.exp(log_v), s, kind)
 
 
 @lru_cache(maxsize=32)
-def _grid_signs(params: Parameters, aging: bool, lo: float, hi: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _grid_signs(
+    params: Parameters, aging: bool, lo: float, hi: float, compiled: bool = False
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(grid, sigma, significant sign of the slope) of :func:`_extrema`'s search grid, read-only (remembered)."""
     n = int(np.ceil(np.log10(hi / lo) * POINTS_PER_DECADE)) + 1
     grid = np.geomspace(lo, hi, n)
-    stress, log_slope = _curve(params, grid, aging)
+    stress, log_slope = _curve(params, grid, aging, compiled)
     found = grid, stress, _significant_signs(stress, log_slope)
     for array in found:
         array.setflags(write=False)
@@ -245,14 +265,15 @@ def cached_critical_point(params: Parameters) -> CriticalPoint:
     return CriticalPoint(v, s, v is not None, message, tv, ts, turnover_message, extrema)
 
 
-def critical_minimum(params: Parameters) -> Extremum | None:
+def critical_minimum(params: Parameters, *, compiled: bool = False) -> Extremum | None:
     """Vc and sigma_c alone (Eq 9), as :func:`critical_point` finds them, or None where the aging curve has no
     minimum: the same numbers at about half the cost, for a study that needs nothing else of the point (the
-    curve's maximum and the no-aging turnover are neither refined nor searched)."""
+    curve's maximum and the no-aging turnover are neither refined nor searched).  ``compiled``: as in
+    :func:`find_extrema` (the same point to ~1e-13)."""
     require_parameters(params)
-    return _cached_minimum(steady_curve_key(params))
+    return _cached_minimum(steady_curve_key(params), compiled)
 
 
 @lru_cache(maxsize=32)
-def _cached_minimum(params: Parameters) -> Extremum | None:
-    return next(_extrema(params, True, SEARCH_RANGE, ("minimum",)), None)
+def _cached_minimum(params: Parameters, compiled: bool = False) -> Extremum | None:
+    return next(_extrema(params, True, SEARCH_RANGE, ("minimum",), compiled), None)

@@ -360,9 +360,8 @@ def _march(s: _Scales, q: QuadratureSettings, keep_nodes: bool = False, compiled
     The working arrays hold only the points still marching: finished ones are
     written out and dropped, so a step costs what the remaining points cost.
     """
-    # the compiled march ages linearly (the paper's Eq 1): the saturating-aging extension stays on numpy
     lanes = COMPILED_LANES if compiled_from is None else compiled_from
-    if not keep_nodes and s.log_t.size >= lanes and s.sat is None:
+    if not keep_nodes and s.log_t.size >= lanes:
         return _march_compiled(s, q)
     rule = panel_rule(q.order)
     # Node arrays are (K, n): the long axis innermost, so that per-point factors broadcast along rows cheaply
@@ -487,8 +486,10 @@ def _march_compiled(s: _Scales, q: QuadratureSettings) -> _Integrals:
         [STEP_ULPS, _LOG_WIDTH_RATIO, START_OFFSET, FIRST_REACH, _TINY, MAX_BISECTIONS, _CLIFF_LOG_HAZARD]
     )
     out = np.empty((4, s.log_t.size))
+    sat = np.zeros_like(s.log_t) if s.sat is None else s.sat  # 0: the paper's linear aging
+    ratio = np.ones_like(s.log_t) if s.ratio is None else s.ratio
     status = steady_kernel.compiled()(
-        *(np.ascontiguousarray(v, dtype=float) for v in (s.log_t, s.a, s.alpha, s.beta)),
+        *(np.ascontiguousarray(v, dtype=float) for v in (s.log_t, s.a, s.alpha, s.beta, sat, ratio)),
         settings,
         search,
         0.5 * (rule.nodes + 1.0),

@@ -2,7 +2,9 @@
 
 The same panels, nodes and sums as the numpy march, lane by lane, so the two agree to rounding (~1e-15;
 tests/test_steady_speed.py); :mod:`stickslip.quasistatic.steady` uses it for batches of ``COMPILED_LANES``
-velocities or more, where it pays for loading numba (docs/steady-state.md).
+velocities or more, where it pays for loading numba, and for callers that repeat narrow calls (``compiled_from``:
+fits, studies, the time-dependent solver; docs/steady-state.md).  Linear aging (the paper's) and the
+saturating-aging extension alike.
 """
 
 from __future__ import annotations
@@ -56,9 +58,28 @@ def _exp_into(values: np.ndarray, out: np.ndarray, bits: np.ndarray) -> None:
         out[k] = out[k] * scale[k] if values[k] >= _EXP_FLOOR else 0.0
 
 
-def _log_hazard(x: float, y: float, log_t: float, a: float, alpha: float) -> tuple[float, float]:
+def _aged(x: float, sat: float) -> float:
+    """The scaled age the aging term sees (steady._aged): x, or (1 - e^(-x sat))/sat with saturation (sat > 0)."""
+    return -math.expm1(-x * sat) / sat if sat > 0.0 else x
+
+
+def _aged_rate(x: float, sat: float) -> float:
+    """d(aged)/dx (steady._aged_rate): 1, or e^(-x sat) with saturation."""
+    return math.exp(-x * sat) if sat > 0.0 else 1.0
+
+
+def _ln_v_moment(x: float, sat: float, ratio: float) -> float:
+    """m(x) of steady._ln_v_moment: x, or (ratio aged + x aged')/(1 + ratio) with saturation."""
+    if sat > 0.0:
+        return (ratio * _aged(x, sat) + x * _aged_rate(x, sat)) / (1.0 + ratio)
+    return x
+
+
+def _log_hazard(x: float, y: float, log_t: float, a: float, alpha: float, sat: float) -> tuple[float, float]:
     """L and |L'| at x (y = 1 - x), as steady._log_hazard_and_slope."""
     d = y * (1.0 + x)
+    if sat > 0.0:
+        return log_t + a * x / d - alpha * _aged(x, sat), abs(a * (1.0 + x * x) / (d * d) - alpha * _aged_rate(x, sat))
     return log_t + a * x / d - alpha * x, abs(a * (1.0 + x * x) / (d * d) - alpha)
 
 
@@ -69,6 +90,7 @@ def _good(
     log_t: float,
     a: float,
     alpha: float,
+    sat: float,
     cap_resolved: float,
     cap_negligible: float,
     log_negligible: float,
@@ -77,7 +99,7 @@ def _good(
 ) -> bool:
     """Is the panel [x, x + e^log_w] resolved or negligible (steady._panel_width's test)?"""
     w = math.exp(log_w)
-    l_right, slope_right = _log_hazard(x + w, y - w, log_t, a, alpha)
+    l_right, slope_right = _log_hazard(x + w, y - w, log_t, a, alpha, sat)
     log_integral = l_right + log_w
     resolved = log_w <= cap_resolved and slope_right * w <= log_hazard_step and log_integral <= log_resolved
     return resolved or (log_w <= cap_negligible and log_integral <= log_negligible)
@@ -89,6 +111,7 @@ def _width(
     log_t: float,
     a: float,
     alpha: float,
+    sat: float,
     log_negligible: float,
     settings: np.ndarray,
     search: np.ndarray,
@@ -107,14 +130,14 @@ def _width(
         int(search[5]),
     )
     log_widest = math.log(min(widest_panel, end_ratio * y))
-    l_left, slope_left = _log_hazard(x, y, log_t, a, alpha)
+    l_left, slope_left = _log_hazard(x, y, log_t, a, alpha, sat)
     log_slope_left = math.log(max(slope_left, tiny))
     log_step, log_resolved = settings[10], settings[11]
     cap_resolved = min(log_resolved - l_left, log_step - log_slope_left)
     cap_negligible = log_negligible - l_left
     if not (log_widest > cap_resolved and log_widest > cap_negligible):
         if _good(
-            log_widest, x, y, log_t, a, alpha, cap_resolved, cap_negligible, log_negligible, log_hazard_step,
+            log_widest, x, y, log_t, a, alpha, sat, cap_resolved, cap_negligible, log_negligible, log_hazard_step,
             log_resolved,
         ):  # fmt: skip
             return math.exp(log_widest), False
@@ -125,7 +148,18 @@ def _width(
     closed = False
     for _ in range(max_bisections):
         better = _good(
-            guess, x, y, log_t, a, alpha, cap_resolved, cap_negligible, log_negligible, log_hazard_step, log_resolved
+            guess,
+            x,
+            y,
+            log_t,
+            a,
+            alpha,
+            sat,
+            cap_resolved,
+            cap_negligible,
+            log_negligible,
+            log_hazard_step,
+            log_resolved,
         )
         if better:
             low = guess
@@ -144,7 +178,18 @@ def _width(
     step = False
     if not confirmed:
         step = not _good(
-            found, x, y, log_t, a, alpha, cap_resolved, cap_negligible, log_negligible, log_hazard_step, log_resolved
+            found,
+            x,
+            y,
+            log_t,
+            a,
+            alpha,
+            sat,
+            cap_resolved,
+            cap_negligible,
+            log_negligible,
+            log_hazard_step,
+            log_resolved,
         )
     return math.exp(found), step
 
@@ -154,6 +199,8 @@ def march(
     a: np.ndarray,
     alpha: np.ndarray,
     beta: np.ndarray,
+    sat: np.ndarray,
+    ratio: np.ndarray,
     settings: np.ndarray,
     search: np.ndarray,
     t_half: np.ndarray,
@@ -162,6 +209,9 @@ def march(
     out: np.ndarray,
 ) -> int:  # pragma: no cover - run compiled (numba), see compiled()
     """i, j, di/dlnV, dj/dlnV of every lane into out (4, n); returns MARCHED or TOO_MANY_PANELS.
+
+    ``sat`` and ``ratio``: the saturating-aging extension's dl_m/(V t_s) and V/V_a per lane (sat 0: the paper's
+    linear aging, ratio unused), as steady._Scales.
 
     ``settings``: log_hazard_step, hazard_step, end_ratio, widest_panel, negligible_hazard, hazard_cutoff,
     tail_tolerance, smallest gap, log cap, MAX_PANELS, ln log_hazard_step, ln hazard_step; ``search``:
@@ -175,6 +225,8 @@ def march(
     g = np.empty(order)
     stretch = np.empty(order)
     at = np.empty(order)
+    aged = np.empty(order)
+    weight = np.empty(order)
     exponent = np.empty(order)
     survivals = np.empty(order)
     bits = np.empty(order, dtype=np.int64)
@@ -182,18 +234,18 @@ def march(
     big_g_at = np.empty(order + 1)
     integrate_t = np.ascontiguousarray(integrate.T)  # (K, K+1)
     for p in range(log_t.size):
-        lt, ap, al, be = log_t[p], a[p], alpha[p], beta[p]
+        lt, ap, al, be, sa, ra = log_t[p], a[p], alpha[p], beta[p], sat[p], ratio[p]
         log_negligible = math.log(settings[4]) - math.log1p(be)
         x_left, y_left, hazard, moment = 0.0, 1.0, 0.0, 0.0
         s0, s1, s2, s3 = 0.0, 0.0, 0.0, 0.0
         finished = False
         for _ in range(max_panels):
-            w, step = _width(x_left, y_left, lt, ap, al, log_negligible, settings, search)
+            w, step = _width(x_left, y_left, lt, ap, al, sa, log_negligible, settings, search)
             if step:
                 # the survival steps to 0 within a few ulps; where it lies moves with V (steady._march)
                 d = y_left * (1.0 + x_left)
-                rise = ap * (1.0 + x_left * x_left) / (d * d) - al
-                shift = math.exp(-hazard) * (be * x_left - 1.0) / rise
+                rise = ap * (1.0 + x_left * x_left) / (d * d) - al * _aged_rate(x_left, sa)
+                shift = math.exp(-hazard) * (be * _ln_v_moment(x_left, sa, ra) - 1.0) / rise
                 s2 += shift
                 s3 += shift * (x_left / d)
                 finished = True
@@ -203,14 +255,24 @@ def march(
                 offset = t_half[k] * w
                 x = offset + x_left
                 y = y_left - offset
-                fene = x / ((1.0 + x) * y)
-                stretch[k] = fene
+                stretch[k] = x / ((1.0 + x) * y)
                 at[k] = x
-                exponent[k] = min(fene * ap - x * al + lt, log_cap)
+            # the scaled age the aging term sees and the ln V moment's weight: x for the paper's linear aging; the
+            # saturating extension's apart, so that the loops the compiler vectorises have no branch
+            if sa > 0.0:
+                for k in range(order):
+                    aged[k] = _aged(at[k], sa)
+                    weight[k] = _ln_v_moment(at[k], sa, ra)
+            else:
+                for k in range(order):
+                    aged[k] = at[k]
+                    weight[k] = at[k]
+            for k in range(order):
+                exponent[k] = min(stretch[k] * ap - aged[k] * al + lt, log_cap)
             _exp_into(exponent, h, bits)
             for k in range(order):
                 h[k] *= half
-                g[k] = at[k] * h[k]
+                g[k] = weight[k] * h[k]
             # H and G at the nodes and over the panel: columns of the integration matrix accumulated one node at
             # a time (independent rows: the compiler vectorises this without reordering any sum)
             for m in range(order + 1):
@@ -267,7 +329,15 @@ def compiled():  # type: ignore[no-untyped-def]
         from numba import njit
 
         g = globals()
-        for name in ("_exp_into", "_log_hazard", "_good", "_width"):  # callees first, so that the callers bind to them
+        for name in (
+            "_exp_into",
+            "_aged",
+            "_aged_rate",
+            "_ln_v_moment",
+            "_log_hazard",
+            "_good",
+            "_width",
+        ):  # callees first, so that the callers bind to them
             g[name] = njit(cache=True, nogil=True, fastmath=_FAST)(g[name])
         _COMPILED.append(njit(cache=True, nogil=True, fastmath=_FAST)(march))
         announce_if_uncached(_COMPILED[0], "the steady curve's kernel")
