@@ -148,19 +148,9 @@ def _width(
     closed = False
     for _ in range(max_bisections):
         better = _good(
-            guess,
-            x,
-            y,
-            log_t,
-            a,
-            alpha,
-            sat,
-            cap_resolved,
-            cap_negligible,
-            log_negligible,
-            log_hazard_step,
+            guess, x, y, log_t, a, alpha, sat, cap_resolved, cap_negligible, log_negligible, log_hazard_step,
             log_resolved,
-        )
+        )  # fmt: skip
         if better:
             low = guess
         else:
@@ -178,19 +168,9 @@ def _width(
     step = False
     if not confirmed:
         step = not _good(
-            found,
-            x,
-            y,
-            log_t,
-            a,
-            alpha,
-            sat,
-            cap_resolved,
-            cap_negligible,
-            log_negligible,
-            log_hazard_step,
+            found, x, y, log_t, a, alpha, sat, cap_resolved, cap_negligible, log_negligible, log_hazard_step,
             log_resolved,
-        )
+        )  # fmt: skip
     return math.exp(found), step
 
 
