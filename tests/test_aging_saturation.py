@@ -115,15 +115,17 @@ def _steady_by_ode(velocity: float) -> tuple[float, float]:
     return birth * j, birth * i / b.site_density
 
 
+@pytest.mark.parametrize("compiled_from", [None, 1], ids=["numpy", "compiled"])  # the compiled march too (round 32)
 @pytest.mark.parametrize("velocity", [1e-6, 5e-6, 20e-6, 100e-6, 350e-6])
-def test_steady_curve_with_saturation_against_an_ode(velocity: float) -> None:
+def test_steady_curve_with_saturation_against_an_ode(velocity: float, compiled_from: int | None) -> None:
     stress, fraction = _steady_by_ode(velocity)
-    got = steady_state(SAT, velocity)
+    got = steady_state(SAT, velocity, compiled_from=compiled_from)
     assert float(got.stress) == pytest.approx(stress, rel=1e-8)
     assert float(got.bonded_fraction) == pytest.approx(fraction, rel=1e-8)
     # dsigma/dV under the integral against a central difference
     h = 1e-5
-    diff = (steady_state(SAT, velocity * (1 + h)).stress - steady_state(SAT, velocity * (1 - h)).stress) / (2 * h)
+    up, down = (steady_state(SAT, velocity * (1 + e), compiled_from=compiled_from).stress for e in (h, -h))
+    diff = (up - down) / (2 * h)
     assert float(got.stress_slope) * velocity == pytest.approx(float(diff), rel=1e-5, abs=1e-6 * stress)
 
 

@@ -86,3 +86,22 @@ def test_the_saturation_fit_s_extrema_are_the_plain_search_s():
     assert peak.stress == pytest.approx(kinds["maximum"].stress, rel=1e-12)
     assert minimum.stress == pytest.approx(kinds["minimum"].stress, rel=1e-12)
     assert minimum.velocity == pytest.approx(kinds["minimum"].velocity, rel=1e-10)
+
+
+def test_the_two_marches_agree_on_saturating_sets_over_the_box(monkeypatch):
+    """tests/test_steady_speed.py's box (half in the deep-dip/cliff corner), each set given a saturation age from
+    10 us to 100 s: the compiled and the numpy march to 1e-10, as for the paper's linear aging."""
+    from reference_steady import box_cases
+
+    rng = np.random.default_rng(3201)
+    cases = [
+        (p.with_overrides({"aging.saturation_age": f"{10 ** rng.uniform(-5, 2)!r} s"}), v, aging)
+        for p, v, aging in box_cases(seed=3201, count=120, base=GEL, corner_share=0.5)
+    ]
+    marches = []
+    for lanes in (1, 10**12):
+        monkeypatch.setattr(steady, "COMPILED_LANES", lanes)
+        got = [steady.steady_state(p, v, aging=aging) for p, v, aging in cases]
+        marches.append([np.array([float(getattr(g, name)) for g in got]) for name in ("stress", "bonded_fraction")])
+    for fast, plain in zip(*marches, strict=True):
+        assert float(np.max(np.abs(fast / plain - 1.0))) <= 1e-10
