@@ -40,7 +40,7 @@ def test_row_sums_keep_exactly_what_the_next_step_computes():
     cache = np.empty((6, n))
     unknown = np.full((3, n), -1.0)
     no_clock = np.full((2, n), np.nan)  # the saturating clock at t, not known (the paper's aging has none)
-    nn, ss, uu, ok = functions["_sums_keeping"](n, xb, tb, lw, x, t, slope, p, cache, unknown, False, no_clock)
+    nn, ss, uu, ok = functions["_sums_keeping"](n, xb, tb, lw, x, t, slope, p, cache, unknown, False, no_clock, False)
     assert ok
     direct_n, direct_sigma, _k, direct_energy = functions["_sums"](n, xb, lw, x, p)
     assert (nn, ss, uu) == (direct_n, direct_sigma, direct_energy)
@@ -61,7 +61,12 @@ def test_row_sums_keep_exactly_what_the_next_step_computes():
     known[3] = np.nan  # no bond energy carried from a step's pass (kernel._energy_at_end): computed
     functions["_velocity_prepare"](n, xb, tb, lw, x, t, p, lc, aa, known, no_clock)
     again = np.empty((6, n))
-    assert functions["_sums_keeping"](n, xb, tb, lw, x, t, slope, p, again, known, True, no_clock) == (nn, ss, uu, True)
+    assert functions["_sums_keeping"](n, xb, tb, lw, x, t, slope, p, again, known, True, no_clock, False) == (
+        nn,
+        ss,
+        uu,
+        True,
+    )
     assert np.array_equal(again, cache)
 
 
@@ -72,7 +77,7 @@ def test_a_dead_cohort_keeps_nothing():
     lw[3] = -np.inf
     n = xb.size
     *_sums, ok = functions["_sums_keeping"](
-        n, xb, tb, lw, 0.0, 0.0, 0.0, p, np.empty((6, n)), np.full((3, n), -1.0), False, np.full((2, n), np.nan)
+        n, xb, tb, lw, 0.0, 0.0, 0.0, p, np.empty((6, n)), np.full((3, n), -1.0), False, np.full((2, n), np.nan), False
     )
     assert not ok
 

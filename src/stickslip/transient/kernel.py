@@ -72,6 +72,9 @@ CLOCK_PLAIN_DECAY = 0.5
 #: saturating aging: saturated cohorts are merged, and the negligible dropped, every MERGE_EVERY accepted steps (the
 #: bin tests were ~15 % of a step's CPU at the fold; in between at most 2 (MERGE_EVERY - 1) more cohorts are kept)
 MERGE_EVERY = 4
+#: at rest under velocity control, a cohort whose hazard times the step is below this keeps its weight to the last
+#: bit (1 - e^(-c) < 2^-60 of it): only its age and hazard move (:func:`_cohort_pass`, docs/transient.md section 27)
+FROZEN_HAZARD = 2.0**-60
 #: a cohort's error by the series of 1 - e^(-c) below this end correction c (:func:`_cohort_weight`)
 CORRECTION_SERIES = 1e-3
 
@@ -315,12 +318,14 @@ def _sums(n, xb, lw, x, p):  # type: ignore[no-untyped-def]
     return nn, s, k, u
 
 
-def _sums_keeping(n, xb, tb, lw, x, t, slope, p, cache, known, prepared, clock_end):  # type: ignore[no-untyped-def]
+def _sums_keeping(n, xb, tb, lw, x, t, slope, p, cache, known, prepared, clock_end, frozen_known):  # type: ignore[no-untyped-def]
     """(N, sigma, bond energy) as _sums, keeping each cohort's weight, force, stiffness, energy and hazard at
     (x, t, slope) in ``cache``: exactly what the next step computes at its start (so it reuses them, bit for bit);
     ``known`` as _velocity_prepare leaves it (its force and stiffness used where ``prepared``, and then its row 3, the
     bond energy :func:`_energy_at_end` derived, where not nan); ``clock_end``: the
     saturating clock at t where the step's pass left it (nan where not: the newborns, merged cohorts).
+    ``frozen_known`` (velocity control): the force, stiffness and energy in known[1:4] where known[3] is not nan,
+    which :func:`_cohort_pass` leaves only for a cohort frozen at rest (the same numbers at the same extension).
     Returns ok = False (nothing kept) if a cohort is dead or beyond the FENE wall."""
     nn = 0.0
     s = 0.0
@@ -334,9 +339,12 @@ def _sums_keeping(n, xb, tb, lw, x, t, slope, p, cache, known, prepared, clock_e
             ok = False
             if w == 0.0:
                 continue
-        have = prepared and known[1, i] == known[1, i]
+        frozen = frozen_known and known[3, i] == known[3, i]
+        have = (prepared and known[1, i] == known[1, i]) or frozen
         f = known[1, i] if have else _chain_force(e, p[P_M], p[P_DLM])
-        energy = known[3, i] if prepared and known[3, i] == known[3, i] else _chain_energy(e, p[P_M], p[P_DLM])
+        energy = (
+            known[3, i] if (prepared or frozen) and known[3, i] == known[3, i] else _chain_energy(e, p[P_M], p[P_DLM])
+        )
         nn += w
         s += w * f
         u += w * energy
@@ -1033,11 +1041,55 @@ def _cohort_pass(  # type: ignore[no-untyped-def]
     gauss_a = hh * (0.5 - GAUSS)
     gauss_b = hh * (0.5 + GAUSS)
     n_split = 0
+    # a slider at rest under velocity control (its path the protocol's: x1p = x), the paper's linear aging: each
+    # cohort's extension, force, stiffness and energy stay, its log hazard falls by h/tau_a; where the hazard breaks
+    # less than FROZEN_HAZARD of the cohort over the step, nothing but those sums is computed (one exp, where the
+    # full pass takes ~8 transcendental functions: a hold's aged bonds, most of its cohorts; section 27)
+    frozen = old_walls_free and cached and v0 == 0.0 and v1p == 0.0 and x1p == x and slope0 == slope1
+    frozen = frozen and not saturating
     for i in range(n):
         w0 = cache[0, i] if cached else math.exp(lw[i])
         e0 = x - xb[i]
         e1 = x1p - xb[i]
         nn0 += w0
+        if frozen and cache[5, i] * hh < FROZEN_HAZARD:
+            f0 = cache[1, i]
+            k0 = cache[2, i]
+            u0 = cache[3, i]
+            r0 = cache[5, i]
+            age1 = t1 - tb[i]
+            lr1 = min(log_u0_tau + beta * abs(f0) - age1 * slope1, LOG_RATE_CAP)
+            r1 = math.exp(lr1)
+            g = -slope1  # d ln r/dt at rest: the aging alone
+            s0 += w0 * f0
+            loss0 += w0 * r0
+            loss1 += w0 * r1
+            dloss0 += w0 * r0 * (g - r0)
+            dloss1 += w0 * r1 * (g - r1)
+            dissip += _cohort_dissipation(0.0, hh, w0, w0, r0, r1, g, g, f0, f0, 0.0, 0.0, e0, u0, e0, u0, m, dlm)
+            err_s += abs(f0) * w0 * r0 * hh  # the breakage the weight cannot show
+            err_n += w0 * r0 * hh
+            sens_x += w0 * abs(f0) * r1 * beta * k0
+            sens_a += w0 * abs(f0) * r1 * age1
+            rate_s0 += w0 * r0 * f0
+            rate_s1 += w0 * r1 * f0
+            kint0 += w0 * k0
+            kint1 += w0 * k0
+            nn1 += w0
+            s1 += w0 * f0
+            predicted[0, i] = f0
+            predicted[1, i] = k0
+            predicted[2, i] = u0
+            lw_new[i] = lw[i]
+            w1[i] = w0
+            known[0, i] = w0
+            known[1, i] = f0  # its values at the end, where it is (:func:`_sums_keeping` takes them)
+            known[2, i] = k0
+            known[3, i] = u0
+            rate0[i] = r1
+            continue
+        if old_walls_free:  # (velocity control: known[3] marks the frozen cohorts' values at the end alone)
+            known[3, i] = np.nan
         if e0 >= dlm or -e0 >= dlm:  # beyond the FENE wall already (cannot happen for a live cohort)
             lw_new[i] = -np.inf
             rate0[i] = np.inf
@@ -1204,6 +1256,7 @@ def _birth_point(  # type: ignore[no-untyped-def]
     xb[n + k] = x_k
     tb[n + k] = t + u
     known[0, n + k] = -1.0
+    known[3, n + k] = np.nan
     rate0[n + k] = r_end
     dec, c0, c1, c2, c3 = _vacancy_kernel(u, p[P_TAU])
     return u, survival, energy, lumping, r_end, g_end, e_k, dec, c0, c1, c2, c3
@@ -1781,7 +1834,7 @@ def advance(  # type: ignore[no-untyped-def]
             # the next step starts from this state: its opening values are kept (rejected steps keep them too)
             slope = _aging_factor(v if block == 1 else vp, p)
             nn, ss, uu, cached = _sums_keeping(
-                n, xb, tb, lw, x, t, slope, p, cache, known, block == 1 and not inertial, clock_end
+                n, xb, tb, lw, x, t, slope, p, cache, known, block == 1 and not inertial, clock_end, block == 0
             )
             _write_row(out, rows, t, x, v, nn, ss, uu, puller0, vp, t0, block, acc)
             rows += 1
