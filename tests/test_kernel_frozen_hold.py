@@ -61,7 +61,7 @@ def test_the_short_path_gives_what_the_full_pass_gives(hh, every):
     unknown = np.full((4, n + 3), -1.0)
     unknown[3] = np.nan
     functions["_sums_keeping"](n, xb, tb, lw, 0.0, 0.0, p[K.P_INV_TAU_A], p, cache, unknown, False,
-                               np.full((2, n + 3), np.nan), True)  # fmt: skip
+                               np.full((2, n + 3), np.nan), True, np.zeros(n + 3))  # fmt: skip
     frozen = cache[5, :n] * hh < K.FROZEN_HAZARD
     # both paths taken; aged alike, the frozen carry the whole of the rate sums, which then test the short path
     assert 0.1 * n < frozen.sum() < 0.9 * n if every > 1 else frozen.sum() >= 0.75 * n
@@ -93,15 +93,19 @@ def test_the_row_after_a_frozen_step_is_the_fresh_computation():
     fresh_known = np.full((4, n + 3), -1.0)
     fresh_known[3] = np.nan
     no_clock = np.full((2, n + 3), np.nan)
-    functions["_sums_keeping"](n, xb, tb, lw, 0.0, 0.0, slope, p, cache, fresh_known, False, no_clock, True)
+    functions["_sums_keeping"](
+        n, xb, tb, lw, 0.0, 0.0, slope, p, cache, fresh_known, False, no_clock, True, np.zeros(n)
+    )
     hh = 3e-4
-    _sums, lw_new, _w, _r, _pred, known = _pass(functions, p, xb, tb, lw, cache, True, hh)
+    _sums, lw_new, _w, rate, _pred, known = _pass(functions, p, xb, tb, lw, cache, True, hh)
     known = np.concatenate([known, np.full((4, 3), np.nan)], axis=1)
     kept, again = np.empty((8, n + 3)), np.empty((8, n + 3))
-    got = functions["_sums_keeping"](n, xb, tb, lw_new, 0.0, hh, slope, p, kept, known, False, no_clock, True)
+    got = functions["_sums_keeping"](n, xb, tb, lw_new, 0.0, hh, slope, p, kept, known, False, no_clock, True, rate)
     plain = np.full((4, n + 3), -1.0)
     plain[3] = np.nan
-    direct = functions["_sums_keeping"](n, xb, tb, lw_new, 0.0, hh, slope, p, again, plain, False, no_clock, False)
+    direct = functions["_sums_keeping"](
+        n, xb, tb, lw_new, 0.0, hh, slope, p, again, plain, False, no_clock, False, np.zeros(n)
+    )
     assert got == direct
     assert np.array_equal(kept[:6, :n], again[:6, :n])
     assert math.isfinite(got[1])

@@ -40,7 +40,9 @@ def test_row_sums_keep_exactly_what_the_next_step_computes():
     cache = np.empty((6, n))
     unknown = np.full((3, n), -1.0)
     no_clock = np.full((2, n), np.nan)  # the saturating clock at t, not known (the paper's aging has none)
-    nn, ss, uu, ok = functions["_sums_keeping"](n, xb, tb, lw, x, t, slope, p, cache, unknown, False, no_clock, False)
+    nn, ss, uu, ok = functions["_sums_keeping"](
+        n, xb, tb, lw, x, t, slope, p, cache, unknown, False, no_clock, False, np.zeros(n)
+    )
     assert ok
     direct_n, direct_sigma, _k, direct_energy = functions["_sums"](n, xb, lw, x, p)
     assert (nn, ss, uu) == (direct_n, direct_sigma, direct_energy)
@@ -61,7 +63,9 @@ def test_row_sums_keep_exactly_what_the_next_step_computes():
     known[3] = np.nan  # no bond energy carried from a step's pass (kernel._energy_at_end): computed
     functions["_velocity_prepare"](n, xb, tb, lw, x, t, p, lc, aa, known, no_clock)
     again = np.empty((6, n))
-    assert functions["_sums_keeping"](n, xb, tb, lw, x, t, slope, p, again, known, True, no_clock, False) == (
+    assert functions["_sums_keeping"](
+        n, xb, tb, lw, x, t, slope, p, again, known, True, no_clock, False, np.zeros(n)
+    ) == (
         nn,
         ss,
         uu,
@@ -77,7 +81,20 @@ def test_a_dead_cohort_keeps_nothing():
     lw[3] = -np.inf
     n = xb.size
     *_sums, ok = functions["_sums_keeping"](
-        n, xb, tb, lw, 0.0, 0.0, 0.0, p, np.empty((6, n)), np.full((3, n), -1.0), False, np.full((2, n), np.nan), False
+        n,
+        xb,
+        tb,
+        lw,
+        0.0,
+        0.0,
+        0.0,
+        p,
+        np.empty((6, n)),
+        np.full((3, n), -1.0),
+        False,
+        np.full((2, n), np.nan),
+        False,
+        np.zeros(n),
     )
     assert not ok
 

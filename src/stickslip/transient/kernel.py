@@ -318,14 +318,15 @@ def _sums(n, xb, lw, x, p):  # type: ignore[no-untyped-def]
     return nn, s, k, u
 
 
-def _sums_keeping(n, xb, tb, lw, x, t, slope, p, cache, known, prepared, clock_end, frozen_known):  # type: ignore[no-untyped-def]
+def _sums_keeping(n, xb, tb, lw, x, t, slope, p, cache, known, prepared, clock_end, frozen_known, rate0):  # type: ignore[no-untyped-def]
     """(N, sigma, bond energy) as _sums, keeping each cohort's weight, force, stiffness, energy and hazard at
     (x, t, slope) in ``cache``: exactly what the next step computes at its start (so it reuses them, bit for bit);
     ``known`` as _velocity_prepare leaves it (its force and stiffness used where ``prepared``, and then its row 3, the
     bond energy :func:`_energy_at_end` derived, where not nan); ``clock_end``: the
     saturating clock at t where the step's pass left it (nan where not: the newborns, merged cohorts).
     ``frozen_known`` (velocity control): the force, stiffness and energy in known[1:4] where known[3] is not nan,
-    which :func:`_cohort_pass` leaves only for a cohort frozen at rest (the same numbers at the same extension).
+    which :func:`_cohort_pass` leaves only for a cohort frozen at rest (the same numbers at the same extension), and
+    its hazard in ``rate0`` (the pass's exp of the same log hazard at the same time).
     Returns ok = False (nothing kept) if a cohort is dead or beyond the FENE wall."""
     nn = 0.0
     s = 0.0
@@ -363,7 +364,7 @@ def _sums_keeping(n, xb, tb, lw, x, t, slope, p, cache, known, prepared, clock_e
             cache[2, i] = known[2, i] if have else _chain_stiffness(e, p[P_M], p[P_DLM])
             cache[3, i] = energy
             cache[4, i] = lr
-            cache[5, i] = math.exp(lr)
+            cache[5, i] = rate0[i] if frozen else math.exp(lr)
     return nn, s, u, ok
 
 
@@ -1834,7 +1835,7 @@ def advance(  # type: ignore[no-untyped-def]
             # the next step starts from this state: its opening values are kept (rejected steps keep them too)
             slope = _aging_factor(v if block == 1 else vp, p)
             nn, ss, uu, cached = _sums_keeping(
-                n, xb, tb, lw, x, t, slope, p, cache, known, block == 1 and not inertial, clock_end, block == 0
+                n, xb, tb, lw, x, t, slope, p, cache, known, block == 1 and not inertial, clock_end, block == 0, rate0
             )
             _write_row(out, rows, t, x, v, nn, ss, uu, puller0, vp, t0, block, acc)
             rows += 1
