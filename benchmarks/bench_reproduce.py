@@ -8,7 +8,8 @@ CPU columns is what the parallel drawing costs.  The target is <= 7 s CPU for ``
 
     python benchmarks/bench_reproduce.py [--repeat N] [--compare OTHER_SRC] [--only reproduce|one-process]
 
-The package is taken from this checkout's ``src/``.  ``--compare`` times a second copy of the package (e.g. an
+The package is taken from this checkout's ``src/``, with its bytecode (``PYTHONDONTWRITEBYTECODE`` is dropped, as
+in bench_startup.py).  ``--compare`` times a second copy of the package (e.g. an
 older commit unpacked with ``git archive COMMIT src | tar -x -C /tmp/old``, then ``--compare /tmp/old/src``) in
 the same run, build by build in turn, so that both see the same machine load.  Issue 31's baseline is commit
 1e04c4c (15.0 s CPU quiet when the issue was filed; README's speed table has this round's figures beside it).
@@ -49,7 +50,9 @@ def main() -> None:
     parser.add_argument("--only", choices=sorted(CASES), default=None, help="time this case alone")
     args = parser.parse_args()
     sources = {"": ROOT / "src"} if args.compare is None else {"this: ": ROOT / "src", "other: ": args.compare}
-    envs = {label: {**os.environ, "PYTHONPATH": str(src)} for label, src in sources.items()}
+    # with the bytecode, as bench_startup.py: the warm-up build writes it (an installed package has it)
+    base = {name: value for name, value in os.environ.items() if name != "PYTHONDONTWRITEBYTECODE"}
+    envs = {label: {**base, "PYTHONPATH": str(src)} for label, src in sources.items()}
     machine = f"Python {platform.python_version()} on {platform.machine()}, {os.cpu_count()} cores"
     print(f"{machine}; {args.repeat} builds each after a warm-up, wall and CPU (user + system, children included)")
     print(f"{'build':50s} {'best':>8s} {'median':>8s} {'cpu best':>9s} {'cpu med':>8s}")

@@ -8,7 +8,7 @@ the script prints the best and the median wall time and the child's CPU time
 with a few velocities, and <= 1 s for ``stickslip fit stick`` on Table 1 (issue 21).  Issue 31: <= 0.8 s CPU
 for ``stickslip transient ... --stick-population`` with a short run, beside the libraries such a run needs:
 ``import numpy, numba``, and that with numba's CPU target built as the first kernel loaded from numba's cache
-builds it (without numba's BLAS probe, as the command does: stickslip.cli.numba_start), the floor of any command
+builds it (without numba's BLAS probe, as the command does: stickslip.numerics.numba_start), the floor of any command
 that runs a kernel.  No scipy on that path (tests/test_cli_boundary.py).
 
     python benchmarks/bench_startup.py [--repeat N] [--compare OTHER_SRC] [--only TEXT]
@@ -45,7 +45,7 @@ LIBRARIES_LABEL = 'python -c "import numpy, numba" (reference: a transient run\'
 #: numba's CPU target as the first call of a cached kernel on an array builds it (its typing and target registries,
 #: the array's type, which loads numpy.ma), without the BLAS probe
 NUMBA_READY = (
-    "from stickslip.cli.numba_start import skip_blas_probe; skip_blas_probe(); import numpy, numba;"
+    "from stickslip.numerics.numba_start import skip_blas_probe; skip_blas_probe(); import numpy, numba;"
     " from numba.core.registry import cpu_target; cpu_target.target_context.refresh();"
     " cpu_target.typing_context.refresh(); numba.typeof(numpy.zeros(1))"
 )

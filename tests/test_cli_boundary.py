@@ -332,7 +332,7 @@ def test_the_light_commands_import_no_heavy_library():
 
 
 #: what a short transient run must not load (issue 31: scipy.fft and scipy.optimize came in at import through
-#: stickslip.quasistatic.jump, scipy.linalg through numba's BLAS probe, stickslip.cli.numba_start)
+#: stickslip.quasistatic.jump, scipy.linalg through numba's BLAS probe, stickslip.numerics.numba_start)
 TRANSIENT_HEAVY = (*HEAVY, "scipy.fft", "scipy.linalg", "scipy.interpolate", "scipy.sparse")
 
 
@@ -389,12 +389,12 @@ def test_the_quasi_static_cycle_loads_no_scipy():
 
 
 def test_numba_without_its_blas_probe_still_compiles_linear_algebra():
-    """The command skips numba's BLAS probe (stickslip.cli.numba_start); np.dot and @ still compile (numba's
+    """The command skips numba's BLAS probe (stickslip.numerics.numba_start); np.dot and @ still compile (numba's
     linear algebra imports scipy.linalg itself; np.linalg's LAPACK bindings, 5 s more to compile, the same way)
     and agree with numpy's."""
     code = (
         "import sys\n"
-        "from stickslip.cli.numba_start import skip_blas_probe\n"
+        "from stickslip.numerics.numba_start import skip_blas_probe\n"
         "skip_blas_probe()\n"
         "import numba, numpy as np\n"
         "from numba.core.registry import cpu_target\n"

@@ -27,7 +27,7 @@ import click
 
 from .. import __version__
 from ..errors import StickslipError
-from .numba_start import skip_blas_probe
+from ..numerics.numba_start import skip_blas_probe
 
 if TYPE_CHECKING:  # loaded by name (COMMAND_MODULES); named here for the type checker and the import graph
     from . import (  # noqa: F401

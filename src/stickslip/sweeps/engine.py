@@ -127,7 +127,8 @@ def _client(workers: int | None, scheduler: str | None) -> Iterator[Any]:
                 dashboard_address=None,
                 scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},  # its status server on a free port, not 8787
                 silence_logs=logging.ERROR,
-                preload=["stickslip.sweeps.quiet"],  # each worker process: its closed connections' records dropped
+                # each worker: its closed connections' records dropped (quiet), numba without its BLAS probe
+                preload=["stickslip.sweeps.quiet", "stickslip.sweeps.worker_start"],
             )
         except RuntimeError as exc:  # typically a script without the __main__ guard that spawned processes need
             raise StickslipError(

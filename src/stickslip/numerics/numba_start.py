@@ -1,4 +1,4 @@
-"""numba's start in the command's own process, without its BLAS probe (issue 31).
+"""numba's start in the package's own processes, without its BLAS probe (issue 31).
 
 numba builds its CPU target the first time a kernel is loaded from its cache; that imports
 ``numba.np.arraymath``, whose module-level ``_check_blas()`` probes for BLAS by importing
@@ -9,8 +9,9 @@ as much as the rest of numba's target).  The probe's answer is used for one thin
 uses them, and ``np.dot``, ``@`` and the rest of ``numba.np.linalg`` import scipy.linalg themselves when one
 is compiled (tests/test_cli_boundary.py compiles np.dot after the skipped probe).
 
-So in the command's process, never on ``import stickslip`` (a user's own numba code in a notebook keeps its
-BLAS convolutions), the probe's import of scipy.linalg is refused and numba takes "no BLAS" for those two.
+So in the command's process and in a sweep's local worker processes (:mod:`stickslip.sweeps.worker_start`),
+never on ``import stickslip`` (a user's own numba code in a notebook keeps its BLAS convolutions), the probe's
+import of scipy.linalg is refused and numba takes "no BLAS" for those two.
 """
 
 from __future__ import annotations
