@@ -107,6 +107,8 @@ def _client(workers: int | None, scheduler: str | None) -> Iterator[Any]:
 
     from distributed import Client, LocalCluster
 
+    from . import quiet, worker_start
+
     if scheduler is not None:
         try:
             client = Client(scheduler, timeout="20s")
@@ -128,7 +130,7 @@ def _client(workers: int | None, scheduler: str | None) -> Iterator[Any]:
                 scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},  # its status server on a free port, not 8787
                 silence_logs=logging.ERROR,
                 # each worker: its closed connections' records dropped (quiet), numba without its BLAS probe
-                preload=["stickslip.sweeps.quiet", "stickslip.sweeps.worker_start"],
+                preload=[quiet.__name__, worker_start.__name__],
             )
         except RuntimeError as exc:  # typically a script without the __main__ guard that spawned processes need
             raise StickslipError(

@@ -9,6 +9,12 @@ sweep starts, the sweep's own process.  A cluster the user runs (``--scheduler``
 
 from __future__ import annotations
 
+from typing import Any
+
 from ..numerics.numba_start import skip_blas_probe
 
-skip_blas_probe()
+
+def dask_setup(worker: Any) -> None:
+    """distributed's hook for a preload module, run as the worker starts (importing this module does nothing: the
+    sweep's own process imports it for its name)."""
+    skip_blas_probe()
