@@ -25,7 +25,7 @@ import sys
 import tempfile
 from pathlib import Path
 
-from timing import child_run
+from timing import child_run, package_environments
 
 ROOT = Path(__file__).resolve().parent.parent
 REPRODUCE = [sys.executable, "-m", "stickslip.cli.main", "reproduce", "--quiet", "-o"]
@@ -50,9 +50,7 @@ def main() -> None:
     parser.add_argument("--only", choices=sorted(CASES), default=None, help="time this case alone")
     args = parser.parse_args()
     sources = {"": ROOT / "src"} if args.compare is None else {"this: ": ROOT / "src", "other: ": args.compare}
-    # with the bytecode, as bench_startup.py: the warm-up build writes it (an installed package has it)
-    base = {name: value for name, value in os.environ.items() if name != "PYTHONDONTWRITEBYTECODE"}
-    envs = {label: {**base, "PYTHONPATH": str(src)} for label, src in sources.items()}
+    envs = package_environments(sources)
     machine = f"Python {platform.python_version()} on {platform.machine()}, {os.cpu_count()} cores"
     print(f"{machine}; {args.repeat} builds each after a warm-up, wall and CPU (user + system, children included)")
     print(f"{'build':50s} {'best':>8s} {'median':>8s} {'cpu best':>9s} {'cpu med':>8s}")

@@ -30,7 +30,7 @@ import statistics
 import sys
 from pathlib import Path
 
-from timing import child_run
+from timing import child_run, package_environments
 
 ROOT = Path(__file__).resolve().parent.parent
 STICKSLIP = [sys.executable, "-m", "stickslip.cli.main"]
@@ -77,9 +77,7 @@ def main() -> None:
     parser.add_argument("--only", default=None, help="time only the commands whose label contains TEXT")
     args = parser.parse_args()
     sources = {"": ROOT / "src"} if args.compare is None else {"this: ": ROOT / "src", "other: ": args.compare}
-    # with the bytecode: the warm-up run writes it (an installed package has it)
-    base = {name: value for name, value in os.environ.items() if name != "PYTHONDONTWRITEBYTECODE"}
-    envs = {label: {**base, "PYTHONPATH": str(src)} for label, src in sources.items()}
+    envs = package_environments(sources)
     machine = f"Python {platform.python_version()} on {platform.machine()}, {os.cpu_count()} cores"
     print(f"{machine}; {args.repeat} runs each, wall time and the child's CPU time (user + system)")
     print(f"{'command':50s} {'best':>8s} {'median':>8s} {'cpu best':>9s} {'cpu med':>8s}")

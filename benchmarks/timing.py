@@ -8,6 +8,7 @@ import statistics
 import subprocess
 import time
 from collections.abc import Callable
+from pathlib import Path
 from typing import Any
 
 
@@ -42,3 +43,10 @@ def child_run(command: list[str], env: dict[str, str]) -> tuple[float, float]:
     if done.returncode != 0:
         raise SystemExit(f"{' '.join(command)} failed: {done.stderr.decode(errors='replace')[-2000:]}")
     return wall, (after.children_user - before.children_user) + (after.children_system - before.children_system)
+
+
+def package_environments(sources: dict[str, Path]) -> dict[str, dict[str, str]]:
+    """For each labelled ``src/`` folder, this process's environment with ``PYTHONPATH`` on it and the bytecode
+    allowed (``PYTHONDONTWRITEBYTECODE`` dropped): the warm-up run writes it, as an installed package has it."""
+    base = {name: value for name, value in os.environ.items() if name != "PYTHONDONTWRITEBYTECODE"}
+    return {label: {**base, "PYTHONPATH": str(src)} for label, src in sources.items()}
