@@ -169,9 +169,9 @@ def predict(folder: Path, counts: list[int], worker_start: float = 0.0) -> None:
               f" {measured['workers']} workers (points {firsts}); the work alone: sum {sum(times):.1f} s,"
               f" longest {max(times):.2f} s")  # fmt: skip
     work = sum(times)
+    chunks = [sum(times[i : i + size]) for i in range(0, spec.size, size)]
     for workers in counts:
         starts = workers * worker_start
-        chunks = [sum(times[i : i + size]) for i in range(0, spec.size, size)]
         given = worker_start + predicted_makespan(chunks, workers)
         plan = plan_tasks(estimates, workers, size)
         cost = worker_start + predicted_makespan([sum(times[k] for k in task) for task in plan], workers)
