@@ -21,7 +21,7 @@ from ..errors import ModelError
 from ..numerics.roots import brentq  # scipy.optimize would add 0.3 s to start-up
 from ..parameters import BlockParameters, Parameters, StickParameters
 from ..reprs import compact_repr, field_values
-from .steady import ACCURATE_QUADRATURE, require_parameters, steady_state
+from .steady import ACCURATE_QUADRATURE, marches_compiled, require_parameters, steady_state
 
 #: Velocity range searched for extrema, m/s, and the grid density per decade.
 SEARCH_RANGE = (1e-9, 1e2)
@@ -154,7 +154,7 @@ def find_extrema(
     For a caller that searches many curves in one process (a fit, a study); a single search stays on numpy,
     which costs less than loading numba (docs/steady-state.md, "Wide batches run compiled").
     """
-    return tuple(_extrema(params, aging, search_range, ("minimum", "maximum"), compiled))
+    return tuple(_extrema(params, aging, search_range, ("minimum", "maximum"), compiled or marches_compiled()))
 
 
 def _extrema(
@@ -226,7 +226,7 @@ def critical_point(params: Parameters) -> CriticalPoint:
     plot asks for the same one several times (~30 ms each).
     """
     require_parameters(params)  # before the cache: a dict is unhashable
-    return cached_critical_point(steady_curve_key(params))
+    return cached_critical_point(steady_curve_key(params), marches_compiled())
 
 
 _ANY_STICK = StickParameters(1.0, 1.0, 1.0)
@@ -243,9 +243,11 @@ def steady_curve_key(params: Parameters) -> Parameters:
 
 
 @lru_cache(maxsize=32)
-def cached_critical_point(params: Parameters) -> CriticalPoint:
-    """The critical point of one steady curve; callers pass :func:`steady_curve_key` (the one cache of the point)."""
-    extrema = find_extrema(params, aging=True)
+def cached_critical_point(params: Parameters, compiled: bool = False) -> CriticalPoint:
+    """The critical point of one steady curve; callers pass :func:`steady_curve_key` (the one cache of the point)
+    and ``compiled``, :func:`~stickslip.quasistatic.steady.marches_compiled` (its steady states on the compiled
+    march)."""
+    extrema = find_extrema(params, aging=True, compiled=compiled)
     minima = [e for e in extrema if e.kind == "minimum"]
     if minima:
         v, s = minima[0].velocity, minima[0].stress
@@ -253,7 +255,7 @@ def cached_critical_point(params: Parameters) -> CriticalPoint:
     else:
         v = s = None
         message = _no_minimum_message(params, extrema)
-    maxima = [e for e in find_extrema(params, aging=False) if e.kind == "maximum"]
+    maxima = [e for e in find_extrema(params, aging=False, compiled=compiled) if e.kind == "maximum"]
     if maxima:
         tv, ts = maxima[0].velocity, maxima[0].stress
         turnover_message = f"maximum of the no-aging curve at {tv:.6g} m/s, {ts:.6g} Pa"
@@ -271,7 +273,7 @@ def critical_minimum(params: Parameters, *, compiled: bool = False) -> Extremum 
     curve's maximum and the no-aging turnover are neither refined nor searched).  ``compiled``: as in
     :func:`find_extrema` (the same point to ~1e-13)."""
     require_parameters(params)
-    return _cached_minimum(steady_curve_key(params), compiled)
+    return _cached_minimum(steady_curve_key(params), compiled or marches_compiled())
 
 
 @lru_cache(maxsize=32)

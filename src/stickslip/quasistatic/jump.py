@@ -22,7 +22,7 @@ from ..numerics.transforms import dct1  # scipy.fft's, bit for bit, without its 
 from ..parameters import Parameters
 from ..reprs import field_values
 from .critical import CriticalPoint, cached_critical_point, steady_curve_key
-from .steady import ACCURATE_QUADRATURE, require_parameters, steady_state
+from .steady import ACCURATE_QUADRATURE, marches_compiled, require_parameters, steady_state
 
 CURVES = ("aging", "no-aging")
 
@@ -100,18 +100,21 @@ def to_unit(x: np.ndarray | float, lo: float, hi: float) -> np.ndarray:
 
 
 # --------------------------------------------------------------------------- the steady curve, cached
-def require_critical_point(params: Parameters) -> CriticalPoint:
-    """The critical point, or a ModelError saying why stick-slip is undefined without it."""
+def require_critical_point(params: Parameters, compiled: bool | None = None) -> CriticalPoint:
+    """The critical point, or a ModelError saying why stick-slip is undefined without it (``compiled``: as
+    :func:`~stickslip.quasistatic.critical.cached_critical_point`'s; None: :func:`marches_compiled`)."""
     require_parameters(params)  # before the cache: a dict is unhashable
-    cp = cached_critical_point(steady_curve_key(params))
+    compiled = marches_compiled() if compiled is None else compiled
+    cp = cached_critical_point(steady_curve_key(params), compiled)
     if not cp.exists:
         raise ModelError(f"no stick-slip cycle: {cp.message}")
     return cp
 
 
-def branch_maximum(params: Parameters, curve: str) -> tuple[float, float]:
-    """(velocity, stress) where the right branch of ``curve`` ends: the curve's maximum above Vc."""
-    cp = require_critical_point(params)
+def branch_maximum(params: Parameters, curve: str, compiled: bool | None = None) -> tuple[float, float]:
+    """(velocity, stress) where the right branch of ``curve`` ends: the curve's maximum above Vc (``compiled``: as
+    :func:`require_critical_point`'s)."""
+    cp = require_critical_point(params, compiled)
     assert cp.velocity is not None
     if curve == "aging":
         maxima = [e for e in cp.extrema if e.kind == "maximum" and e.velocity > cp.velocity]
@@ -168,17 +171,20 @@ class BranchInterpolant:
 
 
 @lru_cache(maxsize=32)
-def branch_interpolant(params: Parameters, curve: str) -> BranchInterpolant:
-    """The branch series of ``curve``, computed once per parameter set (cached)."""
-    cp = require_critical_point(params)
+def branch_interpolant(params: Parameters, curve: str, compiled: bool = False) -> BranchInterpolant:
+    """The branch series of ``curve``, computed once per parameter set (cached; ``compiled``: its steady states on
+    the compiled march, :func:`marches_compiled` at the callers)."""
+    cp = require_critical_point(params, compiled)
     assert cp.velocity is not None
-    v_max, _ = branch_maximum(params, curve)
+    v_max, _ = branch_maximum(params, curve, compiled)
     aging = curve == "aging"
     hi = math.log(v_max)
 
     def sample(x: np.ndarray) -> np.ndarray:
         v = np.exp(x)
-        state = steady_state(params, v, aging=aging, quadrature=ACCURATE_QUADRATURE)
+        state = steady_state(
+            params, v, aging=aging, quadrature=ACCURATE_QUADRATURE, compiled_from=1 if compiled else None
+        )
         return np.array([state.stress, state.stress_slope * v])
 
     # Below Vc the aging curve can fall off a near-vertical cliff (issue 12: sigma dropping 1e6-fold within
@@ -259,7 +265,7 @@ def jump_velocity(params: Parameters, stress: float, curve: str = "aging") -> Ju
             s_low,
             s_max,
         )
-    branch = branch_interpolant(steady_curve_key(params), curve)
+    branch = branch_interpolant(steady_curve_key(params), curve, marches_compiled())
 
     def excess(x: float) -> float:
         return float(branch.stress(math.exp(x))) - stress

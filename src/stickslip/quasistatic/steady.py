@@ -9,7 +9,9 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
+from contextvars import ContextVar
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
@@ -593,10 +595,34 @@ def _stress_scale(params: Parameters) -> float:
     return b.chain_stiffness * b.site_density * b.max_extension
 
 
+#: Set for the length of a time-dependent run (:func:`compiled_marches`): numba is loaded there in any case, so every
+#: steady state the run asks for, however narrow (its critical point, the quasi-static cycle its cost estimate reads,
+#: the jump's branch), runs on the compiled march, the same numbers to ~1e-13.  A critical point found so is cached
+#: apart from the numpy march's (critical.cached_critical_point's ``compiled``), so no result depends on what ran
+#: before it in the process.
+_COMPILED_MARCHES: ContextVar[bool] = ContextVar("stickslip_compiled_marches", default=False)
+
+
+@contextmanager
+def compiled_marches() -> Iterator[None]:
+    """Within: every steady state runs on the compiled march (see :data:`_COMPILED_MARCHES`)."""
+    token = _COMPILED_MARCHES.set(True)
+    try:
+        yield
+    finally:
+        _COMPILED_MARCHES.reset(token)
+
+
+def marches_compiled() -> bool:
+    """Whether this is within :func:`compiled_marches`."""
+    return _COMPILED_MARCHES.get()
+
+
 def _lanes(compiled_from: Any, default: int) -> int:
-    """The width from which the march runs compiled: ``compiled_from`` (a positive integer) or ``default``."""
+    """The width from which the march runs compiled: ``compiled_from`` (a positive integer) or ``default`` (1 within
+    :func:`compiled_marches`)."""
     if compiled_from is None:
-        return default
+        return 1 if _COMPILED_MARCHES.get() else default
     if isinstance(compiled_from, bool) or not isinstance(compiled_from, int | np.integer) or compiled_from < 1:
         raise ParameterError(f"compiled_from: expected a positive whole number of lanes, got {compiled_from!r}")
     return int(compiled_from)

@@ -28,6 +28,7 @@ from ..numerics.grid import sample_grid as _sample_grid
 from ..parameters import Parameters
 from ..protocols import Protocol
 from ..quasistatic.cycle import Cycle
+from ..quasistatic.steady import compiled_marches
 from ..units import checked_number
 from . import jump
 from . import kernel as K
@@ -222,26 +223,27 @@ def run_transient(
     cpu0 = time.process_time()
     _require_finite_chains(params, protocol, control, start, start_velocity, k_block)
     _require_steady_range(params, protocol, aging, start_velocity)
-    require_within(
-        estimate_cost(params, protocol, control=control, start_velocity=start_velocity, rtol=rtol, every=every,
-                      max_step=max_step, aging=aging, reduction=reduction, start=start, mass=mass, stiffness=k_block,
-                      stick_population=bool(stick_population)),
-        budget,
-        "transient",
-        max_time=seconds,
-        factor=REFUSE_FACTOR,
-        time_factor=TIME_REFUSE_FACTOR,
-    )  # fmt: skip
-    note = ""
-    if start == "steady" and control == "block" and aging:
-        start_velocity, note = _steady_start_below_vc(params, protocol, start_velocity)
-    driver = _Driver(
-        params, protocol, control=control, k_block=k_block, aging=aging, stick_population=bool(stick_population),
-        rtol=float(rtol), mass=mass, damping=damping, budget=budget, seconds=seconds, cpu0=cpu0, note=note,
-        progress=progress,
-    )  # fmt: skip
-    driver.start(start, start_velocity, every, max_step, snapshot_times, reduction)
-    return driver.run()
+    with compiled_marches():  # numba runs the kernels in any case: every steady state the run asks for runs compiled
+        require_within(
+            estimate_cost(params, protocol, control=control, start_velocity=start_velocity, rtol=rtol,
+                          every=every, max_step=max_step, aging=aging, reduction=reduction, start=start, mass=mass,
+                          stiffness=k_block, stick_population=bool(stick_population)),
+            budget,
+            "transient",
+            max_time=seconds,
+            factor=REFUSE_FACTOR,
+            time_factor=TIME_REFUSE_FACTOR,
+        )  # fmt: skip
+        note = ""
+        if start == "steady" and control == "block" and aging:
+            start_velocity, note = _steady_start_below_vc(params, protocol, start_velocity)
+        driver = _Driver(
+            params, protocol, control=control, k_block=k_block, aging=aging, stick_population=bool(stick_population),
+            rtol=float(rtol), mass=mass, damping=damping, budget=budget, seconds=seconds, cpu0=cpu0, note=note,
+            progress=progress,
+        )  # fmt: skip
+        driver.start(start, start_velocity, every, max_step, snapshot_times, reduction)
+        return driver.run()
 
 
 def _checked_arguments(  # type: ignore[no-untyped-def]
