@@ -357,9 +357,8 @@ def _trajectory(params: Parameters, v0: float, vs: float, vc: float) -> tuple[st
         v_end = v0 * (1.0 + gap)
         if abs(vs - v0) <= SETTLE_TOLERANCE * v0:
             v_end, gap = vs, None
-    curve = branch_interpolant(
-        steady_curve_key(params), "aging", marches_compiled()
-    )  # spectrally accurate, solved once per curve
+    # spectrally accurate, solved once per curve
+    curve = branch_interpolant(steady_curve_key(params), "aging", marches_compiled())
     if abs(math.log(vs / v_end)) < 1e-14:
         return ends, v_end, None
     trajectory = slip_trajectory(
