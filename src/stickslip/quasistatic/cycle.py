@@ -21,9 +21,9 @@ from ..errors import ModelError, ParameterError
 from ..parameters import Parameters
 from ..reprs import compact_repr, field_values
 from ..trace_columns import QUASI_STATIC
-from .critical import NOISE, CriticalPoint, cached_critical_point, steady_curve_key
+from .critical import NOISE, CriticalPoint, critical_point
 from .jump import Jump, branch_maximum, check_curve, jump_velocity
-from .steady import ACCURATE_QUADRATURE, marches_compiled, require_parameters, steady_state
+from .steady import ACCURATE_QUADRATURE, require_parameters, steady_state
 
 if TYPE_CHECKING:  # pragma: no cover
     import pandas as pd
@@ -286,7 +286,7 @@ class _Phases:
         stick, slip = cycle.stick, cycle.slip
         if slip is None or slip.ends != "stick" or stick.stick_time is None or stick.peak_stress is None:
             return None
-        cp = cached_critical_point(steady_curve_key(self.params), marches_compiled())
+        cp = critical_point(self.params)
         assert cp.velocity is not None
         v_c, extension, bond_time = float(cp.velocity), self.params.bonds.max_extension, self.params.bonds.bond_time
         memory = extension / v_c
@@ -314,7 +314,7 @@ class _Phases:
         it decides where the stick is long, e.g. a puller standing still under chains that do not age."""
         from .slip import slip_phase
 
-        cp = cached_critical_point(steady_curve_key(self.params), marches_compiled())
+        cp = critical_point(self.params)
         assert cp.velocity is not None and cp.stress is not None and stick.peak_stress is not None
         sigma_c, v_c = float(cp.stress), float(cp.velocity)
         rise = stick.peak_stress - sigma_c
@@ -382,7 +382,7 @@ def simulate(
         with refused_as_written(start_stress):
             start_stress = check_stress(si_argument(start_stress, "stress", "start_stress"))
     check_curve(jump_curve)
-    cp = cached_critical_point(steady_curve_key(params), marches_compiled())
+    cp = critical_point(params)
     if not cp.exists:
         return _without_critical_point(params, cp, v0, end, start_stress, jump_curve)
     assert cp.velocity is not None and cp.stress is not None

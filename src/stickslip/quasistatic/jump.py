@@ -170,6 +170,12 @@ class BranchInterpolant:
         )
 
 
+def curve_branch(params: Parameters, curve: str) -> BranchInterpolant:
+    """:func:`branch_interpolant` of ``params``'s steady curve (its cache key, :func:`steady_curve_key`) on the march
+    in use (:func:`marches_compiled`)."""
+    return branch_interpolant(steady_curve_key(params), curve, marches_compiled())
+
+
 @lru_cache(maxsize=32)
 def branch_interpolant(params: Parameters, curve: str, compiled: bool = False) -> BranchInterpolant:
     """The branch series of ``curve``, computed once per parameter set (cached; ``compiled``: its steady states on
@@ -265,7 +271,7 @@ def jump_velocity(params: Parameters, stress: float, curve: str = "aging") -> Ju
             s_low,
             s_max,
         )
-    branch = branch_interpolant(steady_curve_key(params), curve, marches_compiled())
+    branch = curve_branch(params, curve)
 
     def excess(x: float) -> float:
         return float(branch.stress(math.exp(x))) - stress

@@ -27,14 +27,13 @@ from ..reprs import compact_repr
 from .jump import (
     BELOW_VC,
     adaptive_chebyshev,
-    branch_interpolant,
     branch_maximum,
     chebyshev_coefficients,
+    curve_branch,
     require_critical_point,
-    steady_curve_key,
     to_unit,
 )
-from .steady import ACCURATE_QUADRATURE, marches_compiled, steady_state
+from .steady import ACCURATE_QUADRATURE, steady_state
 from .stick import check_velocity
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -280,7 +279,7 @@ def slip_phase(params: Parameters, pulling_velocity: float, start_velocity: floa
     stiffness = params.block.effective_stiffness
     ends, v_end, trajectory = _trajectory(params, v0, vs, vc)
     if trajectory is None:
-        sigma = float(branch_interpolant(steady_curve_key(params), "aging", marches_compiled())(np.array([vs]))[0][0])
+        sigma = float(curve_branch(params, "aging")(np.array([vs]))[0][0])
         return _empty_slip(v0, vs, sigma, stiffness, ends)
     xs, xe = trajectory.log_start, trajectory.log_end
     x = _output_points(trajectory)
@@ -358,7 +357,7 @@ def _trajectory(params: Parameters, v0: float, vs: float, vc: float) -> tuple[st
         if abs(vs - v0) <= SETTLE_TOLERANCE * v0:
             v_end, gap = vs, None
     # spectrally accurate, solved once per curve
-    curve = branch_interpolant(steady_curve_key(params), "aging", marches_compiled())
+    curve = curve_branch(params, "aging")
     if abs(math.log(vs / v_end)) < 1e-14:
         return ends, v_end, None
     trajectory = slip_trajectory(
