@@ -34,8 +34,11 @@ BLOW_UP_FACTOR = 1e10
 RTOL = 1e-10
 #: Most samples a trace with ``every`` may hold (1e7 samples: about 2 GB and 10 s).
 MAX_SAMPLES = 10_000_000
-#: Right-hand-side evaluations allowed per protocol segment before a run is declared stalled.
+#: Right-hand-side evaluations per protocol segment after which its pace is judged: the segment is refused where
+#: that pace projects more than MAX_PROJECTED_CALLS for it (a clock that stops is refused at once, whatever the count).
 MAX_CALLS = 1_000_000
+#: Evaluations a segment may be projected to need, and take at most (~1 minute of CPU on solve_ivp's LSODA).
+MAX_PROJECTED_CALLS = 10_000_000
 #: Evaluations after which a solver whose clock has not moved (relative 1e-12) is declared stalled.
 PROGRESS_CALLS = 20_000
 
@@ -47,11 +50,18 @@ STIFF_PROJECTION = 1e8
 
 
 class _Stalled(Exception):
-    def __init__(self, time: float, projected: bool = False, state: np.ndarray | None = None) -> None:
+    def __init__(
+        self,
+        time: float,
+        projected: bool = False,
+        state: np.ndarray | None = None,
+        cost: tuple[int, float] | None = None,
+    ) -> None:
         super().__init__(time)
         self.time = float(time)
         self.state = None if state is None else np.array(state, dtype=float)  # (a trial state near the stall)
         self.projected = projected  # not stuck: on its pace the piece would need over STIFF_PROJECTION evaluations
+        self.cost = cost  # not stuck: (evaluations taken, projected for the piece) past MAX_PROJECTED_CALLS
 
 
 ATOL = 1e-12
@@ -714,8 +724,6 @@ def _counted(system: System, t0: float, t1: float, limit: bool = True) -> Callab
 
     def rhs(t: float, y: np.ndarray, vlp: float) -> Any:
         calls[0] += 1
-        if limit and calls[0] > MAX_CALLS:
-            raise _Stalled(t, state=y)
         if calls[0] % PROGRESS_CALLS == 0:
             # a clock that has not moved in PROGRESS_CALLS evaluations is stuck for good: say so now
             if limit and t - checkpoint[0] <= 1e-12 * max(abs(t), t1 - t0):
@@ -725,6 +733,11 @@ def _counted(system: System, t0: float, t1: float, limit: bool = True) -> Callab
             # it would run for hours; the caller redoes the piece by implicit steps (_take_implicit_steps)
             if calls[0] * (t1 - t0) > STIFF_PROJECTION * (t - t0):
                 raise _Stalled(t, projected=True, state=y)
+            # past MAX_CALLS a piece that keeps its pace goes on (fast stick-slip: 2.5 million evaluations for 100 s
+            # at 2.4 mm/s, ~40,000 a cycle), one whose pace projects past MAX_PROJECTED_CALLS is refused
+            projected = calls[0] * (t1 - t0) / (t - t0)
+            if limit and calls[0] > MAX_CALLS and projected > MAX_PROJECTED_CALLS:
+                raise _Stalled(t, state=y, cost=(calls[0], projected))
             checkpoint[0] = t
         return system.rhs(t, y, vlp)
 
@@ -744,6 +757,13 @@ def _inertia_error(system: System, t_fail: float, x_fail: float, t0: float, t1: 
 def _stall_error(stalled: _Stalled, t0: float, t1: float, system: System | None = None) -> ModelError:
     """The stall in words; with a slider with mass, its inertial time where it stalled (the stiffness that
     neither LSODA nor Radau's implicit steps could follow)."""
+    if stalled.cost is not None:
+        taken, projected = stalled.cost
+        return ModelError(
+            f"rate-and-state solver: the segment {t0:g} ... {t1:g} s took {taken:,} evaluations to reach "
+            f"t = {stalled.time:.6g} s, on pace for about {projected:,.0f} (more than {MAX_PROJECTED_CALLS:,}, about a "
+            "minute of CPU): each slip or swing needs many steps at these a, b, Dc and stiffness; run a shorter segment"
+        )
     if system is not None and system.inertial and stalled.state is not None:
         return _inertia_error(system, stalled.time, float(stalled.state[system.offset]), t0, t1, "stalled")
     if system is not None and not system.regularized:  # the classical form is already in use: no advice to take it
