@@ -569,8 +569,10 @@ def _odeint(
             sol = _solve(system, y0, grid[0], grid[-1], vlp, rtol, atol, False, t_eval=grid)
     except (_Stalled, ValueError, ArithmeticError):
         return failed
+    if sol.status != 0 or len(sol.t) != len(grid):  # (no time of the grid reached: solve_ivp's y is then a list)
+        return failed
     out = sol.y.T
-    return out, sol.status == 0 and out.shape[0] == len(grid) and bool(np.all(np.isfinite(out)))
+    return out, bool(np.all(np.isfinite(out)))
 
 
 #: A piece starts at rest when the state's distance to the equilibrium, -J^-1 f, is below this fraction of the
