@@ -13,6 +13,7 @@ import math
 
 import pytest
 
+from stickslip.errors import ModelError
 from stickslip.models.rsf import rsf_run
 from stickslip.protocols import Protocol, Segment
 from stickslip.rsf import simulate
@@ -35,3 +36,14 @@ def test_a_run_whose_settled_mean_cannot_be_integrated_ends_steady_with_the_rows
     model_run = rsf_run(run)  # what `run --model rsf` and the sweeps read
     assert model_run.summary["mean_friction"] == pytest.approx(steady, abs=1e-6)  # the rows' over the settled window
     assert model_run.mean == pytest.approx(steady * 1e6, abs=1.0)  # in Pa at 1 MPa
+
+
+def test_the_same_run_sampled_is_refused_for_its_negligible_inertia_not_said_to_have_stopped():
+    """Sampled, a Radau trial step underflowed V (ZeroDivisionError in m dV/dt): it read "the slider stopped", a
+    physical claim the unsampled run above contradicts.  An inertial time of 3e-16 s beside a 100 s segment cannot
+    stop a slider; the refusal now says what is true and what to do (the words a tiny inertia gets elsewhere)."""
+    with pytest.raises(ModelError) as refused:
+        simulate(HEAVY, STEPS, every=0.5)
+    text = str(refused.value)
+    assert "the slider stopped" not in text
+    assert "mV/(σa) = 3.07e-16 s" in text and "too short beside the run (100 s)" in text and "drop the mass" in text
