@@ -343,11 +343,7 @@ def _out_of_range(system: System, t0: float, t1: float, exc: Exception, vlp: flo
     if isinstance(exc, ZeroDivisionError) and tau < NEGLIGIBLE_INERTIA * (t1 - t0):
         # (a stiff slider with m V/(sigma a) = 3e-16 s was "stopped" here while its steps without a grid ran on to
         # a steady slide at the closed-form friction: tests/test_rsf_box_draws.py)
-        return (
-            f"rate-and-state solver failed in the segment {t0:g} ... {t1:g} s: the slider's inertial time "
-            f"mV/(σa) = {tau:.3g} s at {vlp:.3g} m/s is too short beside the run ({t1 - t0:.3g} s); inertia this "
-            "small does not matter, drop the mass (the quasi-static slider is its limit; use eta for fast slip)"
-        )
+        return f"rate-and-state solver failed in the segment {t0:g} ... {t1:g} s: {_negligible_inertia(tau, t0, t1)}"
     if system.inertial and isinstance(exc, ZeroDivisionError) and system.inertia > 1e-200:  # V underflowed
         return (
             f"the slider stopped in the segment {t0:g} ... {t1:g} s: its velocity fell below the floating-point"
@@ -619,7 +615,7 @@ def _at_rest(system: System, y0: np.ndarray, vlp: float, rtol: float, atol: Any)
     f(y0) is rounding alone (1e-12 where k V / a is 1e4 1/s), LSODA kept its first step, sqrt(rtol) x the first
     output time, for the whole piece, 10 million evaluations and ~10 s where 60 do (docs/rsf.md, "A piece that
     starts at rest").  An unstable equilibrium is left to the solver: rounding is the seed of its growth."""
-    with np.errstate(all="ignore"):
+    with np.errstate(all="ignore"):  # (a value beyond the floats only means "not at rest": the solver decides)
         slope = np.asarray(system.rhs(0.0, y0, vlp), dtype=float)
         jac = jacobian_at(system, y0, vlp)
         if not (np.all(np.isfinite(slope)) and np.all(np.isfinite(jac))):
@@ -761,12 +757,14 @@ def _counted(system: System, t0: float, t1: float, limit: bool = True) -> Callab
 
 
 def _inertia_error(system: System, t_fail: float, x_fail: float, t0: float, t1: float, what: str) -> ModelError:
-    v = system.v0 * math.exp(min(x_fail, EXP_CAP))
-    tau = system.inertia * v / system.a
-    return ModelError(
-        f"rate-and-state solver {what} at t = {t_fail:.6g} s: the slider's inertial time mV/(σa) = "
-        f"{tau:.3g} s is too short beside the run ({t1 - t0:.3g} s); inertia this small does not matter, "
-        "drop the mass (the quasi-static slider is its limit; use eta for fast slip)"
+    tau = system.inertia * system.v0 * math.exp(min(x_fail, EXP_CAP)) / system.a
+    return ModelError(f"rate-and-state solver {what} at t = {t_fail:.6g} s: {_negligible_inertia(tau, t0, t1)}")
+
+
+def _negligible_inertia(tau: float, t0: float, t1: float) -> str:
+    return (
+        f"the slider's inertial time mV/(σa) = {tau:.3g} s is too short beside the run ({t1 - t0:.3g} s); inertia "
+        "this small does not matter, drop the mass (the quasi-static slider is its limit; use eta for fast slip)"
     )
 
 
