@@ -7,6 +7,8 @@ an independent Radau integration at rtol 1e-12, or counts odeint's own evaluatio
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 import pytest
 import scipy.integrate
@@ -30,7 +32,7 @@ MOVED = Protocol(
 )
 
 
-def _radau(system: System, y0: np.ndarray, t0: float, t1: float, vlp: float, times: np.ndarray) -> np.ndarray:
+def _radau(system: System, y0: np.ndarray, t0: float, t1: float, vlp: float, times: np.ndarray) -> Any:
     sol = solve_ivp(system.rhs, (t0, t1), y0, method="Radau", args=(vlp,), jac=system.jacobian, rtol=1e-12,
                     atol=1e-14, t_eval=times, dense_output=True)  # fmt: skip
     assert sol.status == 0
