@@ -17,6 +17,7 @@ import time
 
 import pytest
 
+from cost_helpers import least_cpu, plain_cohorts_pace
 from stickslip.parameters import load_parameters
 from stickslip.protocols import constant, segments
 from stickslip.transient import run_transient
@@ -96,8 +97,10 @@ def test_held_pieces_are_one_step_each_and_the_change_is_counted_from_there() ->
     assert 1.5 <= gap <= 2.5, gap
 
 
-@pytest.mark.parametrize(("velocity", "duration"), [(1e-6, 5e-3), (3e-6, 0.02)])
-def test_the_cut_cells_cohorts_are_counted_with_the_reduction_off(velocity: float, duration: float) -> None:
+@pytest.mark.parametrize(("velocity", "duration", "repeats"), [(1e-6, 5e-3, 2), (3e-6, 0.02, 1)])  # (~1.2 and ~4.4 s)
+def test_the_cut_cells_cohorts_are_counted_with_the_reduction_off(
+    velocity: float, duration: float, repeats: int
+) -> None:
     """The reduction off, the start's cohorts integrated from t = 0 through cells cut ahead of the FENE cliff:
     839 steps and ~0.6 s of CPU at 1 um/s for 5 ms (estimated before at 226 and 0.06 s), 2 488 and ~1.6 s at
     3 um/s for 20 ms (1 177 and 0.40 s).  The estimate counts the cohorts the cut adds: those of the population the
@@ -105,10 +108,11 @@ def test_the_cut_cells_cohorts_are_counted_with_the_reduction_off(velocity: floa
     protocol = constant(velocity, duration)
     settings = {**VELOCITY, "reduction": "off"}
     run_transient(GEL, constant(velocity, 1e-4), **settings)  # the kernel and tables loaded, once
-    result, cpu = _taken(protocol, **settings)
+    result, cpu = least_cpu(lambda: _taken(protocol, **settings)[0], repeats)
     estimate = estimate_cost(GEL, protocol, **settings)
     assert 0.3 <= estimate.steps / result.steps <= 3.0, (estimate.steps, result.steps)
-    assert 0.3 <= estimate.seconds / cpu <= 3.0, (estimate.seconds, cpu)
+    pace = plain_cohorts_pace()  # the host's, beside the estimate's constants (tests/cost_helpers.py)
+    assert 0.3 <= estimate.seconds * pace / cpu <= 3.0, (estimate.seconds, pace, cpu)
     added = result.snapshots[0].age.size - steady_cohorts(GEL, velocity, True).age.size
     assert added > 0
     counted = re.search(r"([0-9.e+]+) cohorts of the start cut", estimate.basis)

@@ -18,6 +18,7 @@ import time
 import pytest
 
 from cli_helpers import run_main
+from cost_helpers import least_cpu, plain_cohorts_pace
 from stickslip.parameters import load_parameters
 from stickslip.protocols import constant, segments
 from stickslip.transient import run_transient
@@ -73,15 +74,19 @@ def test_a_slow_steady_start_is_estimated_near_its_cpu() -> None:
     ~21 s before (8.8 x; at 3.5 um/s for 1 s 25 x).  Since the start is held as exact steady sliding while the
     velocity stays (docs/transient.md section 18) the run takes one step, and so does the estimate; the cohorts of
     the slow start are still run, and estimated, with the reduction off (20 ms: ~2 300 steps, ~0.7 s of CPU, through
-    the start's cells cut ahead of the FENE cliff)."""
+    the start's cells cut ahead of the FENE cliff; 1.4-1.8 s on 2026-12-02, when plain cohorts ran 1.5-1.8x their
+    estimate: the seconds are held to the CPU beside that pace, tests/cost_helpers.py)."""
     run_transient(GEL, constant(10e-6, 1e-3), control="velocity", start="steady", reduction="off")  # tables, kernel
     taken, cpu, estimate = _taken_and_estimated(GEL, constant(10e-6, 0.15), control="velocity", start="steady")
     assert taken == 1 and estimate.steps <= 2.0, (estimate.steps, taken)
     assert cpu < 1.0 and estimate.seconds <= 0.05, (estimate.seconds, cpu)
     settings = dict(control="velocity", start="steady", reduction="off")
-    taken, cpu, estimate = _taken_and_estimated(GEL, constant(10e-6, 0.02), **settings)
-    assert 0.3 <= estimate.steps / taken <= 3.0, (estimate.steps, taken)
-    assert 0.3 <= estimate.seconds / cpu <= 5.0, (estimate.seconds, cpu)
+    protocol = constant(10e-6, 0.02)
+    estimate = estimate_cost(GEL, protocol, **settings)
+    result, cpu = least_cpu(lambda: run_transient(GEL, protocol, max_time=60.0, **settings))
+    assert 0.3 <= estimate.steps / result.steps <= 3.0, (estimate.steps, result.steps)
+    pace = plain_cohorts_pace()  # the host's, beside the estimate's constants (tests/cost_helpers.py)
+    assert 0.3 <= estimate.seconds * pace / cpu <= 5.0, (estimate.seconds, pace, cpu)
 
 
 def test_a_hold_too_long_for_the_clock_fails_in_words_that_apply() -> None:
