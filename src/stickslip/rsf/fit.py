@@ -10,6 +10,7 @@ from __future__ import annotations
 import contextlib
 import math
 import os
+import time
 from collections.abc import Callable, Iterator
 from contextvars import ContextVar
 from dataclasses import dataclass, field, replace
@@ -455,7 +456,7 @@ def fit_record(
         return None  # type: ignore[return-value]  # (response_check: the search may go on)
     if check is not None:  # no response to fit: said in seconds, before the search and its restarts
         return _unsearched_fit(setup, start, check, source, window, weight)
-    result, residual = _best_search(setup, start, mismatch, "stiffness" in starts or "stiffness" in held)
+    result, residual, given_up = _best_search(setup, start, mismatch, "stiffness" in starts or "stiffness" in held)
     seen: dict[int, dict[str, float]] = {}
     if protocol_found and not mismatch and len(protocol.segments) > 1:
         # the found change times are estimates: those that matter are fitted, so the intervals carry them
@@ -494,7 +495,7 @@ def fit_record(
     widen = math.sqrt(level.redchi) if given and level.redchi > WARN_CHI2 else None
     table, corr, warns = _report(result, values, setup, start["stiffness"], widen, units)
     change_times, change_warns = _change_report(setup, result, seen) if protocol_found else ((), [])
-    warns += change_warns
+    warns += change_warns + given_up
     if backwards:
         warns.insert(0, "the load-point displacement decreases (the load point moves in the negative direction): "
                         "it was taken by its magnitude, as friction depends on the speed only")  # fmt: skip
@@ -968,12 +969,43 @@ def _step_weights(record: LabRecord, protocol: Protocol, dc: float, weight: floa
     return out
 
 
-def _best_search(setup: _Setup, start: dict[str, float], mismatch: str, stiffness_given: bool) -> Any:
+#: a restart in Dc may take at most the CPU of this many model runs at the first search's pace (METHOD_MAX_NFEV:
+#: what a whole search may take).  The tester's record opening on an unseen step: the first search took 1.0 s for 89
+#: runs, and the restart from Dc = 22 nm ran into a near-critical corner (Dc 5.6 nm, k 3e5 1/m, a slowly ringing
+#: slider) at 0.17 s a run, 107 s for 633 runs, to a chi-square 2.5x the first search's (2026-12-02, AVX2 host;
+#: 0.8 s and back to the first search's minimum on the host before)
+RETRY_RUNS = METHOD_MAX_NFEV
+
+#: the CPU time (time.process_time) past which a model run of the restart under way gives it up (inf: none)
+_DEADLINE: ContextVar[float] = ContextVar("rsf_fit_deadline", default=math.inf)
+
+
+class _OverBudget(Exception):
+    """A restart's model runs passed its deadline (:data:`RETRY_RUNS`)."""
+
+
+def _budgeted_search(setup: _Setup, start: dict[str, float], budget: float) -> Any:
+    """:func:`_search` from ``start``, given up (:class:`_OverBudget`) once it has taken ``budget`` s of CPU; the
+    residual it returns is free of the deadline (the fit goes on with it)."""
+    token = _DEADLINE.set(time.process_time() + budget)
+    try:
+        return _search(setup, start)
+    finally:
+        _DEADLINE.reset(token)
+
+
+def _best_search(
+    setup: _Setup, start: dict[str, float], mismatch: str, stiffness_given: bool
+) -> tuple[Any, Any, list[str]]:
     """The search, restarted from other starts when it never got going (the model cannot be run there, or a, b and
     Dc did not move), and elsewhere in Dc while it is troubled (a local minimum, no covariance); the
-    :func:`restart_notice` callback is told before the first restart in Dc."""
+    :func:`restart_notice` callback is told before the first restart in Dc.  A restart in Dc that runs over
+    :data:`RETRY_RUNS` model runs at the first search's pace is given up; the words saying so are returned."""
     notify = _RESTART_NOTICE.get()
+    began = time.process_time()
     result, residual = _search(setup, start)
+    pace = (time.process_time() - began) / max(int(getattr(result, "nfev", 0) or 0), 1)
+    given_up: list[str] = []
     if not mismatch and _stuck(setup, start, result):
         for other in _rescue_starts(setup, start, stiffness_given):
             retry, retry_residual = _search(setup, other)
@@ -991,8 +1023,17 @@ def _best_search(setup: _Setup, start: dict[str, float], mismatch: str, stiffnes
         other = {**start, "dc": min(max(start["dc"] * factor, 2e-9), 0.5 * start["max_dc"])}
         if not stiffness_given:
             other["stiffness"] = start["stiffness"] * start["dc"] / other["dc"]
-        retry, retry_residual = _search(setup, other)
         sides.add(factor > 1.0)
+        budget = RETRY_RUNS * pace
+        try:
+            retry, retry_residual = _budgeted_search(setup, other, budget)
+        except _OverBudget:
+            given_up.append(
+                f"the restart of the search from Dc = {other['dc']:.3g} m was given up after {budget:.3g} s of CPU"
+                f" (the cost of {RETRY_RUNS} model runs at the first search's pace, {pace:.3g} s a run): its runs"
+                " had slowed, so a minimum that way is not ruled out"
+            )
+            continue
         same = abs(retry.chisqr - result.chisqr) <= 1e-4 * result.chisqr
         if retry.chisqr < result.chisqr * (1 - 1e-9) or (_troubled(result) and not _troubled(retry)):
             result, residual = retry, retry_residual
@@ -1001,7 +1042,7 @@ def _best_search(setup: _Setup, start: dict[str, float], mismatch: str, stiffnes
         # RETRY_DC_FACTORS' docs)
         if same and _troubled(retry) and len(sides) == 2:
             break
-    return result, residual
+    return result, residual, given_up
 
 
 #: halvings (in log k) of the gap between the softest ladder rung within the 95 % region and the next softer one
@@ -2198,6 +2239,8 @@ def _least_squares(setup: _Setup, start: dict[str, float]) -> Any:
     weights = 1.0 if setup.weights is None else np.sqrt(setup.weights)
 
     def residual(p: Any) -> np.ndarray:
+        if time.process_time() > _DEADLINE.get():
+            raise _OverBudget
         values = p.valuesdict()
         model, _ = _model_or_why(record, _history(setup, values), base, values)
         out = (model - record.friction) * weights / noise
